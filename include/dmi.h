@@ -1,0 +1,257 @@
+/*
+ * dmi.h — public API of libdmi, the implicit Euler scheme for differential
+ * inclusions with a delay term of convolution type:
+ *
+ *     u'(t) + A(u(t)) + f(t, u(t)) + int_0^tau H(s) u(t - s) ds  ∋ 0,   t in (0, T),
+ *     u = z on [-tau, 0],
+ *
+ * in R^n, A maximal monotone. With h = tau / N and t_p = p h the scheme
+ * (3.12)-(3.13) of Lamarque, Bastien & Holland is
+ *
+ *     U^p     = z(t_p),                                   p = -N .. 0,
+ *     W^p     = h * sum_{l=0}^{N-1} H(l h) U^{p-l},
+ *     U^{p+1} = (I + h A)^{-1} ( U^p - h f(t_p, U^p) - h W^p ).
+ *
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ *
+ * Conventions that hold for every function below
+ * -----------------------------------------------
+ * - Vectors are arrays of n doubles; matrices are n*n doubles, row-major
+ *   (entry (i, j) at index i*n + j).  Time, tau and h are in the time unit of
+ *   the model (seconds for the oscillator); lambda in the resolvent has that
+ *   same unit.
+ * - Every function returning int returns DMI_OK (0) or one of the negative
+ *   DMI_E* codes.  On failure the solver (if any) is left exactly as it was
+ *   before the call, bitwise, and dmi_last_error(s) describes the reason.
+ * - The solver never keeps a pointer passed in as an array argument: arrays
+ *   are copied.  Callback user pointers are stored and passed back untouched;
+ *   their lifetime is the caller's business.
+ * - The library has no global mutable state, never aborts, exits or prints.
+ *   Distinct solvers may be used concurrently from distinct threads; one
+ *   solver must not be used from two threads at once.
+ */
+#ifndef DMI_H
+#define DMI_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Version of this header; dmi_version() gives the version of the library. */
+#define DMI_VERSION_MAJOR 1
+#define DMI_VERSION_MINOR 0
+#define DMI_VERSION_PATCH 0
+
+/* DMI_API marks the exported functions of the shared library. */
+#if defined(DMI_BUILDING_SHARED) && (defined(__GNUC__) || defined(__clang__))
+#define DMI_API __attribute__((visibility("default")))
+#else
+#define DMI_API
+#endif
+
+/* Opaque solver handle. */
+typedef struct dmi_solver dmi_solver;
+
+/*
+ * Callbacks.  Each returns 0 on success; any other value makes the calling
+ * library function fail with DMI_ECALLBACK and leaves the solver unchanged.
+ * The output array is set to zero before every call, so a callback may write
+ * only the nonzero entries (except the resolvent, which gets no such help:
+ * it must write all n entries).  Non-finite outputs give DMI_ENONFINITE.
+ */
+
+/* out = f(t, u): n values.  t = t_p in time units. */
+typedef int (*dmi_rhs_fn)(double t, const double *u, double *out, void *user);
+
+/* out = (I + lambda A)^{-1} x: n values; lambda = h > 0.  x and out never
+ * alias.  Must be the resolvent of a maximal monotone A for the theory to
+ * hold (the library cannot check that). */
+typedef int (*dmi_resolvent_fn)(double lambda, const double *x, double *out, void *user);
+
+/* out = H(s): n*n values, row-major, for 0 <= s < tau (s = l h, l = 0..N-1). */
+typedef int (*dmi_kernel_fn)(double s, double *out, void *user);
+
+/* out = z(t): n values, for -tau <= t <= 0 (t = p h, p = -N..0). */
+typedef int (*dmi_history_fn)(double t, double *out, void *user);
+
+/* Error codes. */
+enum {
+    DMI_OK = 0,
+    DMI_EINVAL = -1,     /* an argument is invalid (NULL, out of range, NaN) */
+    DMI_ENOMEM = -2,     /* memory could not be allocated (or its size overflows) */
+    DMI_ECALLBACK = -3,  /* a user callback returned nonzero */
+    DMI_ENONFINITE = -4, /* a NaN or infinity appeared (callback output or new state) */
+    DMI_ESTATE = -5      /* the call is not allowed in the solver's current state */
+};
+
+/* Methods of computing the delay sum W^p (see dmi_set_convolution). */
+enum {
+    DMI_CONV_AUTO = 0,   /* the default: the fastest method for this n and N */
+    DMI_CONV_DIRECT = 1, /* the plain sum, N multiply-adds per nonzero kernel entry */
+    DMI_CONV_FFT = 2     /* exact block convolution with FFTs (same sum, other rounding) */
+};
+
+/* ---- version --------------------------------------------------------- */
+
+/* "MAJOR.MINOR.PATCH" of the library actually linked.  Static string. */
+DMI_API const char *dmi_version(void);
+
+/* ---- life cycle ------------------------------------------------------ */
+
+/*
+ * Creates a solver for R^n with delay tau > 0 (time units) and N >= 1 steps
+ * per tau, so h = tau / N.  Allocates the history ring of (N + 1) * n values.
+ * Nothing else is set: f = 0, A = 0 (identity resolvent), H = 0, z = 0.
+ * On success *out owns a new solver (release it with dmi_free).  On error
+ * *out = NULL and the code tells the reason (no handle exists to carry a
+ * message; dmi_strerror(code) gives a generic one):
+ *   DMI_EINVAL  out NULL, n = 0, N = 0, tau <= 0 or not finite, or h = tau/N
+ *               not a positive normal number;
+ *   DMI_ENOMEM  (N + 1) * n doubles overflow size_t or cannot be allocated.
+ */
+DMI_API int dmi_create(dmi_solver **out, size_t n, double tau, size_t N);
+
+/* Frees *s and everything it owns and sets *s = NULL.  s == NULL and
+ * *s == NULL are allowed and do nothing. */
+DMI_API void dmi_free(dmi_solver **s);
+
+/* ---- setup ------------------------------------------------------------
+ * dmi_set_rhs, dmi_set_resolvent, dmi_set_friction, dmi_set_box and
+ * dmi_set_convolution may be called at any time: they take effect from the
+ * next step on and do not alter U^p or the history.  dmi_set_kernel and
+ * dmi_set_history define data sampled by dmi_init, so after dmi_init they
+ * return DMI_ESTATE (create a new solver to change them).
+ * All return DMI_EINVAL if s is NULL.
+ */
+
+/* f: n -> n right-hand side; f = NULL restores f = 0. */
+DMI_API int dmi_set_rhs(dmi_solver *s, dmi_rhs_fn f, void *user);
+
+/* A through its resolvent (I + lambda A)^{-1}; r = NULL restores A = 0.
+ * Replaces any earlier dmi_set_resolvent / dmi_set_friction / dmi_set_box. */
+DMI_API int dmi_set_resolvent(dmi_solver *s, dmi_resolvent_fn r, void *user);
+
+/* Built-in dry friction: A(u) = (alpha_1 sigma(u_1), ..., alpha_n sigma(u_n)),
+ * sigma the sign graph (sigma(0) = [-1, 1]); the resolvent is the soft
+ * threshold out_i = sign(x_i) max(|x_i| - lambda alpha_i, 0).  Copies the n
+ * values of alpha, each finite and >= 0 (alpha_i = 0: no friction on u_i).
+ * DMI_EINVAL if alpha is NULL or a value is negative, NaN or infinite.
+ * Replaces any earlier resolvent setting. */
+DMI_API int dmi_set_friction(dmi_solver *s, const double *alpha);
+
+/* Built-in normal cone of the box K = prod_i [lo_i, hi_i]: the resolvent is
+ * the projection onto K, out_i = min(max(x_i, lo_i), hi_i).  Copies n values
+ * of each; lo_i = -INFINITY and hi_i = +INFINITY are allowed.  DMI_EINVAL if
+ * lo or hi is NULL, a value is NaN, lo_i > hi_i, lo_i = +INFINITY or
+ * hi_i = -INFINITY (K must be nonempty).  Replaces any earlier resolvent. */
+DMI_API int dmi_set_box(dmi_solver *s, const double *lo, const double *hi);
+
+/* Kernel H(s), n*n row-major; H = NULL restores H = 0 (no delay term).
+ * Sampled at s = l h, l = 0..N-1, once by dmi_init.  DMI_ESTATE after init. */
+DMI_API int dmi_set_kernel(dmi_solver *s, dmi_kernel_fn H, void *user);
+
+/* History z(t) on [-tau, 0]; z = NULL restores z = 0.  Sampled at t = p h,
+ * p = -N..0, once by dmi_init.  DMI_ESTATE after init. */
+DMI_API int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user);
+
+/* Method for the delay sum: DMI_CONV_AUTO (default), DMI_CONV_DIRECT or
+ * DMI_CONV_FFT.  All give the same sum up to rounding.  May be changed
+ * between steps.  DMI_EINVAL for another value. */
+DMI_API int dmi_set_convolution(dmi_solver *s, int method);
+
+/* ---- time stepping ----------------------------------------------------- */
+
+/*
+ * Samples the kernel H(l h), l = 0..N-1, and the history U^p = z(p h),
+ * p = -N..0, and sets p = 0.  May be called again to restart from t = 0.
+ * Memory: the nonzero kernel entries take N doubles each (at most N n^2).
+ * Errors: DMI_ECALLBACK / DMI_ENONFINITE (kernel or history callback),
+ * DMI_ENOMEM; the solver is then unchanged (still uninitialised, or still at
+ * its former t_p if it had been initialised).
+ */
+DMI_API int dmi_init(dmi_solver *s);
+
+/*
+ * One step t_p -> t_{p+1}: evaluates f(t_p, U^p), W^p, the resolvent's
+ * argument X^p = U^p - h f(t_p, U^p) - h W^p and U^{p+1} = (I + hA)^{-1} X^p.
+ * Errors: DMI_ESTATE before dmi_init; DMI_ECALLBACK if f or the resolvent
+ * returned nonzero; DMI_ENONFINITE if f, W^p, X^p or U^{p+1} has a NaN or
+ * infinity (X^p is checked before the resolvent sees it).  On any error the
+ * solver is bitwise unchanged, and retrying gives the result of a run that
+ * never failed.
+ */
+DMI_API int dmi_step(dmi_solver *s);
+
+/* steps calls of dmi_step.  Stops at the first failure and returns its code;
+ * the steps done before it are kept (dmi_time tells where the solver is). */
+DMI_API int dmi_advance(dmi_solver *s, size_t steps);
+
+/* ---- queries ------------------------------------------------------------ */
+
+/* t_p = p * h (time units), computed from the integer step counter; 0 before
+ * init and for s == NULL. */
+DMI_API double dmi_time(const dmi_solver *s);
+
+/* *p = the step counter p (number of steps since dmi_init).  DMI_EINVAL for
+ * NULL arguments, DMI_ESTATE before dmi_init. */
+DMI_API int dmi_get_step_index(const dmi_solver *s, uint64_t *p);
+
+/* Step size h = tau / N (time units); 0 for s == NULL. */
+DMI_API double dmi_get_h(const dmi_solver *s);
+
+/* u[0..n-1] = U^p.  DMI_EINVAL for NULL, DMI_ESTATE before dmi_init. */
+DMI_API int dmi_get_state(const dmi_solver *s, double *u);
+
+/* u[0..n-1] = U^{p-lag}, 0 <= lag <= N (history values z(t) for p - lag <= 0).
+ * DMI_EINVAL for NULL or lag > N, DMI_ESTATE before dmi_init. */
+DMI_API int dmi_get_past(const dmi_solver *s, size_t lag, double *u);
+
+/*
+ * Terms of the last step taken, from t_{p-1} to t_p: W[0..n-1] = W^{p-1} and
+ * X[0..n-1] = X^{p-1}, the resolvent's argument, so that (X - U^p) / h is the
+ * element of A(U^p) the step selected (the friction force, for friction).
+ * Either pointer may be NULL if not wanted.  DMI_EINVAL for s NULL,
+ * DMI_ESTATE before dmi_init or before the first step.
+ */
+DMI_API int dmi_get_step_terms(const dmi_solver *s, double *W, double *X);
+
+/* ---- saving and restoring the time-stepping state -----------------------
+ * The state is the step counter, the N + 1 stored states U^{p-N..p} and the
+ * last step's terms; it does not include the callbacks, the resolvent choice
+ * or the kernel (these stay as set on the solver that loads it).  The bytes
+ * are native-endian, begin with a magic and a format version, and are
+ * checked on load: a state saved by a solver with other n, N or tau, or a
+ * truncated or corrupted buffer, is rejected with DMI_EINVAL and the solver
+ * is unchanged.
+ */
+
+/* Number of bytes dmi_state_save writes; 0 for s == NULL. */
+DMI_API size_t dmi_state_size(const dmi_solver *s);
+
+/* Writes the state into buf[0..size-1].  DMI_EINVAL for NULL or size smaller
+ * than dmi_state_size(s); DMI_ESTATE before dmi_init. */
+DMI_API int dmi_state_save(const dmi_solver *s, void *buf, size_t size);
+
+/* Restores a state written by dmi_state_save.  Requires dmi_init to have run
+ * (the kernel samples come from it).  DMI_EINVAL for bad bytes, DMI_ESTATE
+ * before dmi_init, DMI_ENOMEM; the solver is unchanged on error.  Stepping on
+ * from a restored state gives bitwise the same results as the saving solver. */
+DMI_API int dmi_state_load(dmi_solver *s, const void *buf, size_t size);
+
+/* ---- errors -------------------------------------------------------------- */
+
+/* Message of the last failure on s ("" if none, a generic text if s is
+ * NULL).  Owned by s, valid until the next call on s. */
+DMI_API const char *dmi_last_error(const dmi_solver *s);
+
+/* Static description of an error code ("unknown error code" otherwise). */
+DMI_API const char *dmi_strerror(int code);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* DMI_H */

@@ -1,0 +1,130 @@
+/*
+ * The history ring and the delay sum W^p of libdmi.
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include "dmi_internal.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+int dmi_history_alloc(dmi_history *r, size_t n, size_t N)
+{
+    memset(r, 0, sizeof *r);
+    size_t L = N + 1;
+    if (L == 0 || L > SIZE_MAX / 2 / n / sizeof(double))
+        return -1;
+    r->buf = calloc(2 * L * n, sizeof(double));
+    if (!r->buf)
+        return -1;
+    r->n = n;
+    r->N = N;
+    r->L = L;
+    r->head = 0;
+    return 0;
+}
+
+void dmi_history_release(dmi_history *r)
+{
+    free(r->buf);
+    memset(r, 0, sizeof *r);
+}
+
+static void write_slot(dmi_history *r, size_t slot, const double *u)
+{
+    for (size_t j = 0; j < r->n; j++) {
+        double *series = r->buf + j * 2 * r->L;
+        series[slot] = u[j];
+        series[slot + r->L] = u[j];
+    }
+}
+
+void dmi_history_put(dmi_history *r, size_t lag, const double *u)
+{
+    write_slot(r, (r->head + lag) % r->L, u);
+}
+
+void dmi_history_get(const dmi_history *r, size_t lag, double *u)
+{
+    for (size_t j = 0; j < r->n; j++)
+        u[j] = dmi_history_series(r, j)[lag];
+}
+
+void dmi_history_push(dmi_history *r, const double *u)
+{
+    r->head = r->head == 0 ? r->L - 1 : r->head - 1;
+    write_slot(r, r->head, u);
+}
+
+int dmi_kernel_alloc(dmi_kernel *k, size_t n, size_t N, const double *dense)
+{
+    memset(k, 0, sizeof *k);
+    k->n = n;
+    k->N = N;
+    if (!dense)
+        return 0;
+    const size_t nn = n * n;
+    size_t nnz = 0;
+    for (size_t e = 0; e < nn; e++)
+        for (size_t l = 0; l < N; l++)
+            if (dense[l * nn + e] != 0) {
+                nnz++;
+                break;
+            }
+    if (nnz == 0)
+        return 0;
+    k->row = malloc(nnz * sizeof *k->row);
+    k->col = malloc(nnz * sizeof *k->col);
+    k->samples = malloc(nnz * N * sizeof *k->samples); /* nnz * N <= N * n * n: no overflow */
+    if (!k->row || !k->col || !k->samples) {
+        dmi_kernel_release(k);
+        return -1;
+    }
+    size_t q = 0;
+    for (size_t e = 0; e < nn; e++) {
+        int nonzero = 0;
+        for (size_t l = 0; l < N && !nonzero; l++)
+            nonzero = dense[l * nn + e] != 0;
+        if (!nonzero)
+            continue;
+        k->row[q] = e / n;
+        k->col[q] = e % n;
+        for (size_t l = 0; l < N; l++)
+            k->samples[q * N + l] = dense[l * nn + e];
+        q++;
+    }
+    k->nnz = nnz;
+    return 0;
+}
+
+void dmi_kernel_release(dmi_kernel *k)
+{
+    free(k->row);
+    free(k->col);
+    free(k->samples);
+    memset(k, 0, sizeof *k);
+}
+
+/* sum_l a[l] b[l] with four partial sums (vectorisable, fixed order). */
+static double dot(const double *a, const double *b, size_t len)
+{
+    double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+    size_t l = 0;
+    for (; l + 4 <= len; l += 4) {
+        s0 += a[l] * b[l];
+        s1 += a[l + 1] * b[l + 1];
+        s2 += a[l + 2] * b[l + 2];
+        s3 += a[l + 3] * b[l + 3];
+    }
+    for (; l < len; l++)
+        s0 += a[l] * b[l];
+    return (s0 + s1) + (s2 + s3);
+}
+
+void dmi_delay_sum(const dmi_kernel *k, const dmi_history *r, double h, double *W)
+{
+    memset(W, 0, r->n * sizeof *W);
+    for (size_t e = 0; e < k->nnz; e++)
+        W[k->row[e]] += dot(k->samples + e * k->N, dmi_history_series(r, k->col[e]), k->N);
+    for (size_t i = 0; i < r->n; i++)
+        W[i] *= h;
+}

@@ -1,0 +1,53 @@
+/*
+ * Internal pieces of libdmi: the history ring and the delay sum.
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#ifndef DMI_INTERNAL_H
+#define DMI_INTERNAL_H
+
+#include "dmi.h"
+
+/*
+ * History ring of the N + 1 states U^{p-N..p}, stored per component as a
+ * series with a mirror copy, so that U_j^{p-l}, l = 0..N, are contiguous:
+ * buf[j * 2L + head + l], L = N + 1.  A new state moves head one slot back.
+ */
+typedef struct {
+    size_t n, N, L, head;
+    double *buf; /* n * 2L values */
+} dmi_history;
+
+int dmi_history_alloc(dmi_history *r, size_t n, size_t N); /* 0 or -1; zero-filled, head = 0 */
+void dmi_history_release(dmi_history *r);
+/* U^{p-lag} = u (only while filling a fresh ring: head must be 0). */
+void dmi_history_put(dmi_history *r, size_t lag, const double *u);
+/* u = U^{p-lag}, 0 <= lag <= N. */
+void dmi_history_get(const dmi_history *r, size_t lag, double *u);
+/* Makes u the newest state U^{p+1}; U^{p-N} is dropped. */
+void dmi_history_push(dmi_history *r, const double *u);
+/* Pointer to U_j^{p-l}, l = 0..N (contiguous). */
+static inline const double *dmi_history_series(const dmi_history *r, size_t j)
+{
+    return r->buf + j * 2 * r->L + r->head;
+}
+
+/*
+ * Kernel samples H(l h), l = 0..N-1, of the entries (i, j) that are nonzero
+ * at some sample; entries zero at every sample are not stored and cost
+ * nothing.
+ */
+typedef struct {
+    size_t n, N, nnz;
+    size_t *row, *col; /* nnz each */
+    double *samples;   /* nnz * N: samples[e * N + l] = H_{row[e] col[e]}(l h) */
+} dmi_kernel;
+
+/* From dense samples (N * n * n, row-major per l), or none if dense == NULL.
+ * 0 or -1 (out of memory). */
+int dmi_kernel_alloc(dmi_kernel *k, size_t n, size_t N, const double *dense);
+void dmi_kernel_release(dmi_kernel *k);
+
+/* W = h * sum_{l=0}^{N-1} H(l h) U^{p-l} (n values). */
+void dmi_delay_sum(const dmi_kernel *k, const dmi_history *r, double h, double *W);
+
+#endif
