@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# The main job: reproduces the paper's Section 4.  Installs what it lacks
+# (scripts/deps.sh), builds everything in build/, runs the paper's examples and
+# writes into out/: the CSV of each example, Figures 4.1-4.5, the FMU's
+# Example 4.3 run by fmpy over the native run, the evidence for the erratum in
+# (4.4); prints the summary table.  Copies the figures to docs/figures/.
+# Usage: scripts/main.sh
+# Environment: DMI_BUILD_DIR (default build), DMI_OUT_DIR (default out).
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$root"
+build=${DMI_BUILD_DIR:-build}
+out=${DMI_OUT_DIR:-out}
+py="$root/.venv/bin/python"
+ref="$root/../shared/reference"
+
+stage() { printf '\n==== %s ====\n' "$*"; }
+
+stage "dependencies"
+scripts/deps.sh
+
+stage "build ($build)"
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPython3_EXECUTABLE="$py" >/dev/null
+cmake --build "$build" -j "$(nproc)"
+
+mkdir -p "$out"
+ex="$build/examples"
+
+stage "Examples 4.1-4.3 at h = 1/9991: CSV in $out/"
+for e in 41 42 43; do
+  T=10
+  [[ $e == 43 ]] && T=30
+  "$ex/ex$e" 9991 "$T" 1 >"$out/ex$e.csv" 2>"$out/ex$e.log"
+  cat "$out/ex$e.log"
+done
+
+stage "summary table (order study of Figure 4.3 in $out/order.csv)"
+"$ex/paper_summary" "$out/order.csv" | tee "$out/summary.txt"
+
+stage "erratum: scheme (4.4) as printed against (3.12)-(3.13), Example 4.2"
+"$ex/scheme44_as_printed" 10 10 2>&1 >"$out/scheme44.csv" | tee "$out/scheme44.txt"
+
+stage "FMU: Example 4.3 with fmpy"
+rm -f "$out/fmu43.csv"
+if [[ -f scripts/fmu_run.py ]]; then
+  "$py" scripts/fmu_run.py "$out/fmu43.csv"
+else
+  echo "skipped: scripts/fmu_run.py does not exist yet (the FMU is not part of this checkout)"
+fi
+
+stage "figures and comparison with the paper and ../shared/reference"
+refarg=()
+if [[ -d $ref ]]; then
+  refarg=("$ref")
+else
+  echo "note: $ref not found, no comparison with the reference values"
+fi
+MPLBACKEND=Agg "$py" examples/plot_paper.py "$out" "${refarg[@]}" | tee "$out/comparison.txt"
+
+mkdir -p docs/figures
+cp "$out"/*.png docs/figures/
+
+stage "done in ${SECONDS} s: results in $out/, figures also in docs/figures/"
