@@ -1,0 +1,580 @@
+/*
+ * The FMI 2.0 co-simulation interface of the model in model.h: instance
+ * life cycle, the calling sequence (a bitmask of the states in which each
+ * function is allowed), logging through the importer's callback, FMU states.
+ * Nothing here knows about the oscillator.
+ *
+ * Errors: every fmi2Error is logged with its reason (category
+ * logStatusError, sent whatever loggingOn says); category logCalls traces
+ * the calls when debug logging is on.  A rejected call (bad argument, value,
+ * state bytes, or a call not allowed in the current state) leaves the
+ * instance as it was; only a failure of the solver inside fmi2DoStep puts
+ * the instance into the error state (then fmi2SetFMUstate or fmi2Reset).
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "fmi2Functions.h"
+#include "model.h"
+
+/* The instance's states (FMI 2.0 co-simulation state machine). */
+enum {
+    INSTANTIATED = 1 << 0,
+    INIT_MODE = 1 << 1,
+    STEP_COMPLETE = 1 << 2,
+    TERMINATED = 1 << 3,
+    ERROR_STATE = 1 << 4
+};
+#define ANY_STATE (INSTANTIATED | INIT_MODE | STEP_COMPLETE | TERMINATED | ERROR_STATE)
+#define SAVABLE (INSTANTIATED | INIT_MODE | STEP_COMPLETE | TERMINATED)
+#define READABLE (INIT_MODE | STEP_COMPLETE | TERMINATED | ERROR_STATE)
+
+/* Log categories, as declared in modelDescription.xml. */
+static const char *const CATEGORY[] = {"logStatusError", "logCalls"};
+enum { CAT_ERROR = 1 << 0, CAT_CALLS = 1 << 1, CAT_ALL = CAT_ERROR | CAT_CALLS };
+
+typedef struct {
+    char *name;
+    fmi2CallbackLogger logger;
+    fmi2CallbackAllocateMemory allocate;
+    fmi2CallbackFreeMemory release;
+    fmi2ComponentEnvironment environment;
+    int logging_on;
+    unsigned categories; /* CAT_* enabled for debug logging */
+    unsigned state;
+    model m;
+} instance;
+
+/* A saved FMU state: the bytes of model_state_save. */
+typedef struct {
+    size_t size;
+    unsigned char bytes[];
+} saved_state;
+
+static void emit(const instance *in, fmi2Status status, int category, const char *msg)
+{
+    if (!in->logger)
+        return;
+    char text[2 * MODEL_ERRLEN];
+    snprintf(text, sizeof text, "%s", msg);
+    for (char *c = text; *c; c++) /* the message is a format for the importer */
+        if (*c == '%')
+            *c = '?';
+    in->logger(in->environment, in->name, status, CATEGORY[category == CAT_ERROR ? 0 : 1], text);
+}
+
+static fmi2Status error(instance *in, const char *fmt, ...)
+{
+    char msg[2 * MODEL_ERRLEN];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    emit(in, fmi2Error, CAT_ERROR, msg);
+    return fmi2Error;
+}
+
+static const char *state_name(unsigned state)
+{
+    switch (state) {
+    case INSTANTIATED: return "instantiated";
+    case INIT_MODE: return "initialization mode";
+    case STEP_COMPLETE: return "step complete";
+    case TERMINATED: return "terminated";
+    default: return "error";
+    }
+}
+
+/* The instance if fn is allowed in its state; logs and gives NULL if not. */
+static instance *enter(fmi2Component c, const char *fn, unsigned allowed)
+{
+    instance *in = c;
+    if (!in)
+        return NULL;
+    if (!(in->state & allowed)) {
+        error(in, "%s: not allowed in state %s", fn, state_name(in->state));
+        return NULL;
+    }
+    if (in->logging_on && (in->categories & CAT_CALLS))
+        emit(in, fmi2OK, CAT_CALLS, fn);
+    return in;
+}
+
+static int bad_arrays(instance *in, const char *fn, const void *vr, size_t nvr, const void *value)
+{
+    if (nvr > 0 && (!vr || !value)) {
+        error(in, "%s: NULL array", fn);
+        return 1;
+    }
+    return 0;
+}
+
+/* ---- common functions ---- */
+
+const char *fmi2GetTypesPlatform(void)
+{
+    return fmi2TypesPlatform;
+}
+
+const char *fmi2GetVersion(void)
+{
+    return fmi2Version;
+}
+
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
+                               const fmi2String categories[])
+{
+    instance *in = enter(c, "fmi2SetDebugLogging", ANY_STATE);
+    if (!in)
+        return fmi2Error;
+    unsigned set = nCategories == 0 ? CAT_ALL : 0;
+    if (nCategories > 0 && !categories)
+        return error(in, "fmi2SetDebugLogging: NULL categories");
+    for (size_t i = 0; i < nCategories; i++) {
+        unsigned bit = 0;
+        for (unsigned k = 0; k < sizeof CATEGORY / sizeof *CATEGORY; k++)
+            if (categories[i] && strcmp(categories[i], CATEGORY[k]) == 0)
+                bit = 1u << k;
+        if (!bit)
+            return error(in, "fmi2SetDebugLogging: unknown log category \"%s\"",
+                         categories[i] ? categories[i] : "(null)");
+        set |= bit;
+    }
+    in->logging_on = loggingOn != fmi2False;
+    in->categories = set;
+    return fmi2OK;
+}
+
+fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+                              fmi2String fmuResourceLocation,
+                              const fmi2CallbackFunctions *functions, fmi2Boolean visible,
+                              fmi2Boolean loggingOn)
+{
+    (void)fmuResourceLocation;
+    (void)visible;
+    if (!functions || !functions->allocateMemory || !functions->freeMemory)
+        return NULL; /* no way to allocate (nor, maybe, to log) */
+    instance probe = {.name = (char *)(instanceName ? instanceName : "?"),
+                      .logger = functions->logger, .environment = functions->componentEnvironment};
+    if (!instanceName || !*instanceName) {
+        error(&probe, "fmi2Instantiate: the instance name is empty");
+        return NULL;
+    }
+    if (fmuType != fmi2CoSimulation) {
+        error(&probe, "fmi2Instantiate: this FMU supports co-simulation only");
+        return NULL;
+    }
+    if (!fmuGUID || strcmp(fmuGUID, DMI_FMU_GUID) != 0) {
+        error(&probe, "fmi2Instantiate: GUID \"%s\" does not match the FMU's %s",
+              fmuGUID ? fmuGUID : "(null)", DMI_FMU_GUID);
+        return NULL;
+    }
+    instance *in = functions->allocateMemory(1, sizeof *in);
+    size_t len = strlen(instanceName) + 1;
+    char *name = functions->allocateMemory(len, 1);
+    if (!in || !name) {
+        if (in)
+            functions->freeMemory(in);
+        if (name)
+            functions->freeMemory(name);
+        error(&probe, "fmi2Instantiate: out of memory");
+        return NULL;
+    }
+    memcpy(name, instanceName, len);
+    *in = (instance){.name = name, .logger = functions->logger,
+                     .allocate = functions->allocateMemory, .release = functions->freeMemory,
+                     .environment = functions->componentEnvironment,
+                     .logging_on = loggingOn != fmi2False, .categories = CAT_ALL,
+                     .state = INSTANTIATED};
+    model_defaults(&in->m);
+    return in;
+}
+
+void fmi2FreeInstance(fmi2Component c)
+{
+    instance *in = enter(c, "fmi2FreeInstance", ANY_STATE);
+    if (!in)
+        return;
+    model_free(&in->m);
+    in->release(in->name);
+    in->release(in);
+}
+
+fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
+                               fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime)
+{
+    instance *in = enter(c, "fmi2SetupExperiment", INSTANTIATED);
+    (void)toleranceDefined;
+    (void)tolerance;
+    if (!in)
+        return fmi2Error;
+    if (!isfinite(startTime))
+        return error(in, "fmi2SetupExperiment: the start time %g is not finite", startTime);
+    if (stopTimeDefined && !(stopTime >= startTime))
+        return error(in, "fmi2SetupExperiment: stop time %.17g before start time %.17g", stopTime,
+                     startTime);
+    in->m.t_start = startTime;
+    in->m.t_comm = startTime;
+    return fmi2OK;
+}
+
+fmi2Status fmi2EnterInitializationMode(fmi2Component c)
+{
+    instance *in = enter(c, "fmi2EnterInitializationMode", INSTANTIATED);
+    if (!in)
+        return fmi2Error;
+    in->state = INIT_MODE;
+    return fmi2OK;
+}
+
+fmi2Status fmi2ExitInitializationMode(fmi2Component c)
+{
+    instance *in = enter(c, "fmi2ExitInitializationMode", INIT_MODE);
+    char err[MODEL_ERRLEN];
+    if (!in)
+        return fmi2Error;
+    if (model_start(&in->m, in->m.t_start, err) != 0)
+        return error(in, "fmi2ExitInitializationMode: %s", err);
+    in->state = STEP_COMPLETE;
+    return fmi2OK;
+}
+
+fmi2Status fmi2Terminate(fmi2Component c)
+{
+    instance *in = enter(c, "fmi2Terminate", STEP_COMPLETE);
+    if (!in)
+        return fmi2Error;
+    in->state = TERMINATED;
+    return fmi2OK;
+}
+
+fmi2Status fmi2Reset(fmi2Component c)
+{
+    instance *in = enter(c, "fmi2Reset", ANY_STATE);
+    if (!in)
+        return fmi2Error;
+    model_free(&in->m);
+    model_defaults(&in->m);
+    in->state = INSTANTIATED;
+    return fmi2OK;
+}
+
+/* ---- getting and setting variables ---- */
+
+fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                       fmi2Real value[])
+{
+    instance *in = enter(c, "fmi2GetReal", READABLE);
+    char err[MODEL_ERRLEN];
+    if (!in || bad_arrays(in, "fmi2GetReal", vr, nvr, value))
+        return fmi2Error;
+    for (size_t i = 0; i < nvr; i++)
+        if (model_get_real(&in->m, vr[i], &value[i], err) != 0)
+            return error(in, "fmi2GetReal: %s", err);
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          fmi2Integer value[])
+{
+    instance *in = enter(c, "fmi2GetInteger", READABLE);
+    char err[MODEL_ERRLEN];
+    if (!in || bad_arrays(in, "fmi2GetInteger", vr, nvr, value))
+        return fmi2Error;
+    for (size_t i = 0; i < nvr; i++)
+        if (model_get_integer(&in->m, vr[i], &value[i], err) != 0)
+            return error(in, "fmi2GetInteger: %s", err);
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          fmi2Boolean value[])
+{
+    instance *in = enter(c, "fmi2GetBoolean", READABLE);
+    char err[MODEL_ERRLEN];
+    if (!in || bad_arrays(in, "fmi2GetBoolean", vr, nvr, value))
+        return fmi2Error;
+    for (size_t i = 0; i < nvr; i++) {
+        int b = 0;
+        if (model_get_boolean(&in->m, vr[i], &b, err) != 0)
+            return error(in, "fmi2GetBoolean: %s", err);
+        value[i] = b ? fmi2True : fmi2False;
+    }
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                         fmi2String value[])
+{
+    instance *in = enter(c, "fmi2GetString", READABLE);
+    if (!in)
+        return fmi2Error;
+    (void)vr;
+    (void)value;
+    return nvr == 0 ? fmi2OK : error(in, "fmi2GetString: the FMU has no String variables");
+}
+
+/* Whether the variable vr may be set in the instance's state. */
+static int settable(const instance *in, unsigned vr)
+{
+    return model_is_parameter(vr) ? (in->state & (INSTANTIATED | INIT_MODE)) != 0 : 1;
+}
+
+fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                       const fmi2Real value[])
+{
+    instance *in = enter(c, "fmi2SetReal", INSTANTIATED | INIT_MODE | STEP_COMPLETE);
+    char err[MODEL_ERRLEN];
+    if (!in || bad_arrays(in, "fmi2SetReal", vr, nvr, value))
+        return fmi2Error;
+    model next = in->m; /* all values or none */
+    for (size_t i = 0; i < nvr; i++) {
+        if (!settable(in, vr[i]))
+            return error(in, "fmi2SetReal: the parameter with value reference %u cannot be "
+                             "changed after initialization", vr[i]);
+        if (model_set_real(&next, vr[i], value[i], err) != 0)
+            return error(in, "fmi2SetReal: %s", err);
+    }
+    in->m = next;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          const fmi2Integer value[])
+{
+    instance *in = enter(c, "fmi2SetInteger", INSTANTIATED | INIT_MODE | STEP_COMPLETE);
+    char err[MODEL_ERRLEN];
+    if (!in || bad_arrays(in, "fmi2SetInteger", vr, nvr, value))
+        return fmi2Error;
+    model next = in->m;
+    for (size_t i = 0; i < nvr; i++) {
+        if (!settable(in, vr[i]))
+            return error(in, "fmi2SetInteger: the parameter with value reference %u cannot be "
+                             "changed after initialization", vr[i]);
+        if (model_set_integer(&next, vr[i], value[i], err) != 0)
+            return error(in, "fmi2SetInteger: %s", err);
+    }
+    in->m = next;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          const fmi2Boolean value[])
+{
+    instance *in = enter(c, "fmi2SetBoolean", INSTANTIATED | INIT_MODE | STEP_COMPLETE);
+    if (!in)
+        return fmi2Error;
+    (void)vr;
+    (void)value;
+    return nvr == 0 ? fmi2OK : error(in, "fmi2SetBoolean: the FMU has no settable Boolean variable");
+}
+
+fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                         const fmi2String value[])
+{
+    instance *in = enter(c, "fmi2SetString", INSTANTIATED | INIT_MODE | STEP_COMPLETE);
+    if (!in)
+        return fmi2Error;
+    (void)vr;
+    (void)value;
+    return nvr == 0 ? fmi2OK : error(in, "fmi2SetString: the FMU has no String variables");
+}
+
+/* ---- FMU states ---- */
+
+fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
+{
+    instance *in = enter(c, "fmi2GetFMUstate", SAVABLE);
+    if (!in)
+        return fmi2Error;
+    if (!FMUstate)
+        return error(in, "fmi2GetFMUstate: NULL pointer");
+    const size_t size = model_state_size(&in->m);
+    saved_state *s = *FMUstate;
+    if (!s || s->size != size) {
+        saved_state *fresh = in->allocate(1, sizeof *s + size);
+        if (!fresh)
+            return error(in, "fmi2GetFMUstate: out of memory (%zu bytes)", size);
+        if (s)
+            in->release(s);
+        s = fresh;
+    }
+    s->size = size;
+    model_state_save(&in->m, in->state, s->bytes);
+    *FMUstate = s;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
+{
+    instance *in = enter(c, "fmi2SetFMUstate", ANY_STATE);
+    const saved_state *s = FMUstate;
+    uint32_t tag = 0;
+    char err[MODEL_ERRLEN];
+    if (!in)
+        return fmi2Error;
+    if (!s)
+        return error(in, "fmi2SetFMUstate: NULL state");
+    if (model_state_load(&in->m, SAVABLE, &tag, s->bytes, s->size, err) != 0)
+        return error(in, "fmi2SetFMUstate: %s", err);
+    in->state = tag;
+    return fmi2OK;
+}
+
+fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
+{
+    instance *in = enter(c, "fmi2FreeFMUstate", ANY_STATE);
+    if (!in)
+        return fmi2Error;
+    if (FMUstate && *FMUstate) {
+        in->release(*FMUstate);
+        *FMUstate = NULL;
+    }
+    return fmi2OK;
+}
+
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size)
+{
+    instance *in = enter(c, "fmi2SerializedFMUstateSize", ANY_STATE);
+    const saved_state *s = FMUstate;
+    if (!in)
+        return fmi2Error;
+    if (!s || !size)
+        return error(in, "fmi2SerializedFMUstateSize: NULL argument");
+    *size = s->size;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate,
+                                 fmi2Byte serializedState[], size_t size)
+{
+    instance *in = enter(c, "fmi2SerializeFMUstate", ANY_STATE);
+    const saved_state *s = FMUstate;
+    if (!in)
+        return fmi2Error;
+    if (!s || !serializedState)
+        return error(in, "fmi2SerializeFMUstate: NULL argument");
+    if (size < s->size)
+        return error(in, "fmi2SerializeFMUstate: buffer of %zu bytes, %zu needed", size, s->size);
+    memcpy(serializedState, s->bytes, s->size);
+    return fmi2OK;
+}
+
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[],
+                                   size_t size, fmi2FMUstate *FMUstate)
+{
+    instance *in = enter(c, "fmi2DeSerializeFMUstate", ANY_STATE);
+    uint32_t tag = 0;
+    char err[MODEL_ERRLEN];
+    if (!in)
+        return fmi2Error;
+    if (!serializedState || !FMUstate)
+        return error(in, "fmi2DeSerializeFMUstate: NULL argument");
+    if (model_state_load(NULL, SAVABLE, &tag, (const unsigned char *)serializedState, size, err) != 0)
+        return error(in, "fmi2DeSerializeFMUstate: %s", err);
+    saved_state *s = in->allocate(1, sizeof *s + size);
+    if (!s)
+        return error(in, "fmi2DeSerializeFMUstate: out of memory (%zu bytes)", size);
+    s->size = size;
+    memcpy(s->bytes, serializedState, size);
+    *FMUstate = s;
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[],
+                                        size_t nUnknown, const fmi2ValueReference vKnown_ref[],
+                                        size_t nKnown, const fmi2Real dvKnown[],
+                                        fmi2Real dvUnknown[])
+{
+    instance *in = enter(c, "fmi2GetDirectionalDerivative", ANY_STATE);
+    (void)vUnknown_ref, (void)nUnknown, (void)vKnown_ref, (void)nKnown, (void)dvKnown,
+        (void)dvUnknown;
+    return in ? error(in, "fmi2GetDirectionalDerivative: not provided by this FMU") : fmi2Error;
+}
+
+/* ---- co-simulation ---- */
+
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                       const fmi2Integer order[], const fmi2Real value[])
+{
+    instance *in = enter(c, "fmi2SetRealInputDerivatives", ANY_STATE);
+    (void)vr, (void)nvr, (void)order, (void)value;
+    return in ? error(in, "fmi2SetRealInputDerivatives: the FMU does not interpolate inputs")
+              : fmi2Error;
+}
+
+fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
+                                        size_t nvr, const fmi2Integer order[], fmi2Real value[])
+{
+    instance *in = enter(c, "fmi2GetRealOutputDerivatives", ANY_STATE);
+    (void)vr, (void)nvr, (void)order, (void)value;
+    return in ? error(in, "fmi2GetRealOutputDerivatives: the FMU provides no output derivatives")
+              : fmi2Error;
+}
+
+fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
+                      fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint)
+{
+    instance *in = enter(c, "fmi2DoStep", STEP_COMPLETE);
+    char err[MODEL_ERRLEN];
+    (void)noSetFMUStatePriorToCurrentPoint;
+    if (!in)
+        return fmi2Error;
+    int rc = model_do_step(&in->m, currentCommunicationPoint, communicationStepSize, err);
+    if (rc == -2)
+        in->state = ERROR_STATE;
+    return rc == 0 ? fmi2OK : error(in, "fmi2DoStep: %s", err);
+}
+
+fmi2Status fmi2CancelStep(fmi2Component c)
+{
+    instance *in = enter(c, "fmi2CancelStep", ANY_STATE);
+    return in ? error(in, "fmi2CancelStep: steps are never asynchronous") : fmi2Error;
+}
+
+fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value)
+{
+    instance *in = enter(c, "fmi2GetStatus", READABLE);
+    (void)s, (void)value;
+    return in ? error(in, "fmi2GetStatus: steps are never asynchronous") : fmi2Error;
+}
+
+fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value)
+{
+    instance *in = enter(c, "fmi2GetRealStatus", READABLE);
+    if (!in)
+        return fmi2Error;
+    if (s != fmi2LastSuccessfulTime || !value)
+        return error(in, "fmi2GetRealStatus: only fmi2LastSuccessfulTime is available");
+    *value = in->m.t_comm;
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value)
+{
+    instance *in = enter(c, "fmi2GetIntegerStatus", READABLE);
+    (void)s, (void)value;
+    return in ? error(in, "fmi2GetIntegerStatus: no Integer status is defined") : fmi2Error;
+}
+
+fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
+{
+    instance *in = enter(c, "fmi2GetBooleanStatus", READABLE);
+    if (!in)
+        return fmi2Error;
+    if (s != fmi2Terminated || !value)
+        return error(in, "fmi2GetBooleanStatus: only fmi2Terminated is available");
+    *value = fmi2False; /* the FMU never asks to stop */
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value)
+{
+    instance *in = enter(c, "fmi2GetStringStatus", READABLE);
+    (void)s, (void)value;
+    return in ? error(in, "fmi2GetStringStatus: no String status is defined") : fmi2Error;
+}

@@ -1,0 +1,362 @@
+/*
+ * The friction oscillator (4.1) through libdmi's public API: see model.h.
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include "model.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Start values: Example 4.3 (b = alpha = tau = 1, N = 1000,
+ * H(s) = cos 2 pi s + cos 10 pi s + cos 20 pi s, g(t) = 1.3 cos 8t, w0 = v0 = 0).
+ * The same numbers are the start values in modelDescription.xml. */
+static const double REAL_START[MODEL_NREAL] = {
+    [VR_b] = 1.0, [VR_alpha] = 1.0, [VR_tau] = 1.0, [VR_w0] = 0.0, [VR_v0] = 0.0,
+    [VR_H_c0] = 0.0, [VR_H_c1] = 0.0, [VR_H_lambda] = 0.0,
+    [VR_H_a1] = 1.0, [VR_H_omega1] = 6.283185307179586,
+    [VR_H_a2] = 1.0, [VR_H_omega2] = 31.41592653589793,
+    [VR_H_a3] = 1.0, [VR_H_omega3] = 62.83185307179586,
+    [VR_g_offset] = 0.0, [VR_g_amp] = 1.3, [VR_g_omega] = 8.0, [VR_g_phase] = 0.0,
+    [VR_g_in] = 0.0,
+};
+static const int N_START = 1000;
+
+static const char *const REAL_NAME[MODEL_NREAL] = {
+    "b", "alpha", "tau", "w0", "v0", "H_c0", "H_c1", "H_lambda",
+    "H_a1", "H_omega1", "H_a2", "H_omega2", "H_a3", "H_omega3",
+    "g_offset", "g_amp", "g_omega", "g_phase", "g_in",
+};
+
+static int fail(char *err, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err, MODEL_ERRLEN, fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+void model_defaults(model *m)
+{
+    memcpy(m->real, REAL_START, sizeof m->real);
+    m->N = N_START;
+    m->t_start = 0.0;
+    m->t_comm = 0.0;
+    m->solver = NULL;
+}
+
+void model_free(model *m)
+{
+    dmi_free(&m->solver);
+}
+
+int model_is_parameter(unsigned vr)
+{
+    return vr < VR_g_in || vr == VR_N;
+}
+
+int model_set_real(model *m, unsigned vr, double value, char *err)
+{
+    if (vr >= MODEL_NREAL)
+        return fail(err, "value reference %u is not a settable Real variable", vr);
+    const char *name = REAL_NAME[vr];
+    if (!isfinite(value))
+        return fail(err, "%s = %g: the value must be finite", name, value);
+    if (vr == VR_tau && !(value > 0))
+        return fail(err, "%s = %.17g: the delay must be > 0", name, value);
+    if (vr == VR_alpha && !(value >= 0))
+        return fail(err, "%s = %.17g: the friction coefficient must be >= 0", name, value);
+    m->real[vr] = value;
+    return 0;
+}
+
+int model_set_integer(model *m, unsigned vr, int value, char *err)
+{
+    if (vr != VR_N)
+        return fail(err, "value reference %u is not a settable Integer variable", vr);
+    if (value < 1)
+        return fail(err, "N = %d: the number of steps per tau must be >= 1", value);
+    m->N = value;
+    return 0;
+}
+
+/* ---- the model's callbacks ---- */
+
+static double forcing(const model *m, double t)
+{
+    const double *r = m->real;
+    return r[VR_g_offset] + r[VR_g_amp] * cos(r[VR_g_omega] * t + r[VR_g_phase]) + r[VR_g_in];
+}
+
+static int rhs(double t, const double *u, double *out, void *user)
+{
+    const model *m = user;
+    out[0] = -u[1];
+    out[1] = m->real[VR_b] * u[0] + forcing(m, m->t_start + t);
+    return 0;
+}
+
+static int kernel(double s, double *out, void *user)
+{
+    const double *r = ((const model *)user)->real;
+    out[2] = r[VR_H_c0] + r[VR_H_c1] * exp(-r[VR_H_lambda] * s) + r[VR_H_a1] * cos(r[VR_H_omega1] * s) +
+             r[VR_H_a2] * cos(r[VR_H_omega2] * s) + r[VR_H_a3] * cos(r[VR_H_omega3] * s);
+    return 0;
+}
+
+static int history(double t, double *out, void *user)
+{
+    const model *m = user;
+    (void)t;
+    out[0] = m->real[VR_w0];
+    out[1] = m->real[VR_v0];
+    return 0;
+}
+
+static int solver_fail(char *err, const char *what, dmi_solver *s, int rc)
+{
+    snprintf(err, MODEL_ERRLEN, "%s: %s", what, s ? dmi_last_error(s) : dmi_strerror(rc));
+    return -1;
+}
+
+int model_start(model *m, double t_start, char *err)
+{
+    dmi_solver *s = NULL;
+    const double alpha[2] = {0.0, m->real[VR_alpha]};
+    int rc = dmi_create(&s, 2, m->real[VR_tau], (size_t)m->N);
+    if (rc != DMI_OK)
+        return solver_fail(err, "creating the solver (tau, N)", NULL, rc);
+    if ((rc = dmi_set_rhs(s, rhs, m)) != DMI_OK || (rc = dmi_set_kernel(s, kernel, m)) != DMI_OK ||
+        (rc = dmi_set_history(s, history, m)) != DMI_OK ||
+        (rc = dmi_set_friction(s, alpha)) != DMI_OK || (rc = dmi_init(s)) != DMI_OK) {
+        solver_fail(err, "initialising the solver", s, rc);
+        dmi_free(&s);
+        return -1;
+    }
+    dmi_free(&m->solver);
+    m->solver = s;
+    m->t_start = t_start;
+    m->t_comm = t_start;
+    return 0;
+}
+
+int model_do_step(model *m, double t_current, double step, char *err)
+{
+    const double h = dmi_get_h(m->solver);
+    if (!isfinite(t_current) || !isfinite(step) || step < 0)
+        return fail(err, "doStep(%.17g, %.17g): the time and the step must be finite and the step >= 0",
+                    t_current, step);
+    if (fabs(t_current - m->t_comm) > MODEL_TIME_TOL * h)
+        return fail(err, "doStep: the communication point %.17g is not the FMU's time %.17g", t_current,
+                    m->t_comm);
+    const double t_end = t_current + step;
+    const double target = ceil((t_end - m->t_start) / h - MODEL_TIME_TOL);
+    uint64_t p = 0;
+    dmi_get_step_index(m->solver, &p);
+    if (!(target < 9007199254740992.0)) /* 2^53: beyond it p h has no meaning */
+        return fail(err, "doStep: t = %.17g is too far from the start for the step h", t_end);
+    if (target > (double)p) {
+        int rc = dmi_advance(m->solver, (size_t)(target - (double)p));
+        if (rc != DMI_OK) {
+            solver_fail(err, "doStep", m->solver, rc);
+            return -2;
+        }
+    }
+    m->t_comm = t_end;
+    return 0;
+}
+
+/* The outputs at t_comm: u_h(t_comm) interpolated between U^{p-1} and U^p,
+ * and the terms of the last step (from t_{p-1} to t_p). */
+static void outputs(const model *m, double u[2], double W[2], double X[2])
+{
+    uint64_t p = 0;
+    if (!m->solver) {
+        u[0] = m->real[VR_w0];
+        u[1] = m->real[VR_v0];
+        W[1] = 0.0;
+        X[1] = u[1];
+        return;
+    }
+    dmi_get_step_index(m->solver, &p);
+    dmi_get_state(m->solver, u);
+    if (p == 0) {
+        W[1] = 0.0;
+        X[1] = u[1];
+        return;
+    }
+    dmi_get_step_terms(m->solver, W, X);
+    const double h = dmi_get_h(m->solver);
+    const double theta = (m->t_comm - m->t_start) / h - (double)(p - 1);
+    if (theta < 1.0 - MODEL_TIME_TOL) {
+        double prev[2];
+        dmi_get_past(m->solver, 1, prev);
+        const double th = theta > 0.0 ? theta : 0.0;
+        for (int i = 0; i < 2; i++)
+            u[i] = prev[i] + th * (u[i] - prev[i]);
+    }
+}
+
+int model_get_real(const model *m, unsigned vr, double *value, char *err)
+{
+    if (vr < MODEL_NREAL) {
+        *value = m->real[vr];
+        return 0;
+    }
+    double u[2], W[2], X[2], U[2] = {m->real[VR_w0], m->real[VR_v0]};
+    outputs(m, u, W, X);
+    if (m->solver)
+        dmi_get_state(m->solver, U);
+    switch (vr) {
+    case VR_w: *value = u[0]; return 0;
+    case VR_v: *value = u[1]; return 0;
+    case VR_friction: *value = m->solver ? (X[1] - U[1]) / dmi_get_h(m->solver) : 0.0; return 0;
+    case VR_delay_force: *value = W[1]; return 0;
+    default:
+        return fail(err, "value reference %u is not a Real variable", vr);
+    }
+}
+
+int model_get_integer(const model *m, unsigned vr, int *value, char *err)
+{
+    if (vr != VR_N)
+        return fail(err, "value reference %u is not an Integer variable", vr);
+    *value = m->N;
+    return 0;
+}
+
+int model_get_boolean(const model *m, unsigned vr, int *value, char *err)
+{
+    if (vr != VR_sticking)
+        return fail(err, "value reference %u is not a Boolean variable", vr);
+    double U[2] = {m->real[VR_w0], m->real[VR_v0]};
+    if (m->solver)
+        dmi_get_state(m->solver, U);
+    *value = U[1] == 0.0;
+    return 0;
+}
+
+/* ---- saved state ---- */
+
+static const char STATE_MAGIC[8] = {'d', 'm', 'i', 'F', 'M', 'U', 's', 't'};
+enum { STATE_VERSION = 1 };
+/* magic, version, tag, total size, nreal, dmi size, N */
+#define STATE_HEADER (8 + 4 + 4 + 8 + 8 + 8 + 8)
+#define STATE_REALS ((MODEL_NREAL + 2) * 8)
+
+/* FNV-1a, 64 bits */
+static uint64_t checksum(const unsigned char *b, size_t n)
+{
+    uint64_t x = 14695981039346656037u;
+    for (size_t i = 0; i < n; i++)
+        x = (x ^ b[i]) * 1099511628211u;
+    return x;
+}
+
+size_t model_state_size(const model *m)
+{
+    return STATE_HEADER + STATE_REALS + dmi_state_size(m->solver) + 8;
+}
+
+static unsigned char *put(unsigned char *b, const void *v, size_t n)
+{
+    memcpy(b, v, n);
+    return b + n;
+}
+
+void model_state_save(const model *m, uint32_t tag, unsigned char *buf)
+{
+    const uint32_t version = STATE_VERSION;
+    const uint64_t total = model_state_size(m), nreal = MODEL_NREAL;
+    const uint64_t ndmi = dmi_state_size(m->solver);
+    const int64_t N = m->N;
+    unsigned char *b = put(buf, STATE_MAGIC, 8);
+    b = put(b, &version, 4);
+    b = put(b, &tag, 4);
+    b = put(b, &total, 8);
+    b = put(b, &nreal, 8);
+    b = put(b, &ndmi, 8);
+    b = put(b, &N, 8);
+    b = put(b, m->real, sizeof m->real);
+    b = put(b, &m->t_start, 8);
+    b = put(b, &m->t_comm, 8);
+    if (m->solver)
+        dmi_state_save(m->solver, b, (size_t)ndmi);
+    b += ndmi;
+    const uint64_t sum = checksum(buf, (size_t)(b - buf));
+    put(b, &sum, 8);
+}
+
+static const unsigned char *get(const unsigned char *b, void *v, size_t n)
+{
+    memcpy(v, b, n);
+    return b + n;
+}
+
+int model_state_load(model *into, uint32_t tags, uint32_t *tag, const unsigned char *buf,
+                     size_t size, char *err)
+{
+    uint32_t version;
+    uint64_t total, nreal, ndmi, sum;
+    int64_t N;
+    double real[MODEL_NREAL], t_start, t_comm;
+    if (!buf || size < STATE_HEADER + STATE_REALS + 8)
+        return fail(err, "state: %zu bytes is too short for a saved state", size);
+    const unsigned char *b = buf + 8;
+    if (memcmp(buf, STATE_MAGIC, 8) != 0)
+        return fail(err, "state: the bytes are not a saved state of this FMU (bad magic)");
+    b = get(b, &version, 4);
+    b = get(b, tag, 4);
+    b = get(b, &total, 8);
+    b = get(b, &nreal, 8);
+    b = get(b, &ndmi, 8);
+    b = get(b, &N, 8);
+    if (*tag == 0 || (*tag & (*tag - 1)) != 0 || (*tag & tags) == 0)
+        return fail(err, "state: the saved phase tag %lu is not allowed", (unsigned long)*tag);
+    if (version != STATE_VERSION)
+        return fail(err, "state: format version %lu is not supported", (unsigned long)version);
+    if (nreal != MODEL_NREAL || total != size || ndmi != size - (STATE_HEADER + STATE_REALS + 8))
+        return fail(err, "state: the sizes recorded in the state do not match (%zu bytes given)", size);
+    memcpy(&sum, buf + size - 8, 8);
+    if (sum != checksum(buf, size - 8))
+        return fail(err, "state: the checksum does not match (corrupted bytes)");
+    b = get(b, real, sizeof real);
+    b = get(b, &t_start, 8);
+    b = get(b, &t_comm, 8);
+
+    model m;
+    model_defaults(&m);
+    for (unsigned vr = 0; vr < MODEL_NREAL; vr++)
+        if (model_set_real(&m, vr, real[vr], err) != 0)
+            return -1;
+    if (N < 1 || N > INT32_MAX || model_set_integer(&m, VR_N, (int)N, err) != 0)
+        return fail(err, "state: N = %lld is invalid", (long long)N);
+    if (!isfinite(t_start) || !isfinite(t_comm) || t_comm < t_start)
+        return fail(err, "state: invalid times (start %.17g, communication point %.17g)", t_start, t_comm);
+    if (ndmi > 0) {
+        if (model_start(&m, t_start, err) != 0)
+            return -1;
+        int rc = dmi_state_load(m.solver, b, (size_t)ndmi);
+        if (rc != DMI_OK) {
+            solver_fail(err, "state: the solver's history", m.solver, rc);
+            model_free(&m);
+            return -1;
+        }
+    }
+    m.t_start = t_start;
+    m.t_comm = t_comm;
+    if (!into) {
+        model_free(&m);
+        return 0;
+    }
+    model_free(into);
+    *into = m;
+    /* the step's right-hand side reads the variables of *into from now on (the
+     * kernel and history callbacks keep &m, but they are called by dmi_init only) */
+    if (into->solver)
+        dmi_set_rhs(into->solver, rhs, into);
+    return 0;
+}

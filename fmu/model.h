@@ -1,0 +1,101 @@
+/*
+ * The friction oscillator (4.1) of the paper as an FMU model:
+ *
+ *   w'' + b w + int_0^tau H(s) w(t - s) ds + alpha sigma(w') + g(t) ∋ 0,
+ *   (w, w') = (w0, v0) on [-tau, 0],
+ *
+ * in the first-order form (4.3), u = (w, v): f(t, u) = (-v, b w + g(t)),
+ * A = {0} x alpha sigma, kernel [[0, 0], [H, 0]], computed by libdmi.
+ *   H(s) = H_c0 + H_c1 exp(-H_lambda s) + sum_{k=1..3} H_a{k} cos(H_omega{k} s),
+ *   g(t) = g_offset + g_amp cos(g_omega t + g_phase) + g_in(t).
+ *
+ * This file is the model's side of the FMU: its variables (value references,
+ * start values, checks), its time stepping on the grid t_p = t_start + p h
+ * and its saved state.  fmi2Functions.c, the FMI side, checks the calling
+ * sequence and does the logging; it knows nothing about the oscillator.
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#ifndef DMI_FMU_MODEL_H
+#define DMI_FMU_MODEL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "dmi.h"
+
+/* Value references (the numbers in modelDescription.xml). */
+enum {
+    /* Real parameters, then the input and the Real outputs */
+    VR_b, VR_alpha, VR_tau, VR_w0, VR_v0,
+    VR_H_c0, VR_H_c1, VR_H_lambda,
+    VR_H_a1, VR_H_omega1, VR_H_a2, VR_H_omega2, VR_H_a3, VR_H_omega3,
+    VR_g_offset, VR_g_amp, VR_g_omega, VR_g_phase,
+    VR_g_in,
+    VR_w, VR_v, VR_friction, VR_delay_force,
+    /* Integer parameter, Boolean output */
+    VR_N,
+    VR_sticking
+};
+#define MODEL_NREAL (VR_g_in + 1) /* Real variables that are set: parameters and g_in */
+
+/* Interpolation and communication points: times closer than this fraction
+ * of h are the same time. */
+#define MODEL_TIME_TOL 1e-6
+
+typedef struct {
+    double real[MODEL_NREAL]; /* by value reference: parameters, g_in */
+    int N;                    /* steps per tau */
+    double t_start;           /* start time of the experiment: t_p = t_start + p h */
+    double t_comm;            /* the last communication point (t_start before any step) */
+    dmi_solver *solver;       /* NULL until model_start */
+} model;
+
+/* Longest message written into the err buffers below. */
+#define MODEL_ERRLEN 256
+
+/* Start values (Example 4.3), no solver. */
+void model_defaults(model *m);
+/* Frees the solver; m can be reused after model_defaults. */
+void model_free(model *m);
+
+/* Whether vr is a parameter (set only before the experiment starts), the
+ * input g_in, or an output. */
+int model_is_parameter(unsigned vr);
+
+/* Sets one variable after checking it (finite, tau > 0, alpha >= 0, N >= 1);
+ * a rejected value leaves m unchanged and writes the reason to err.
+ * 0 on success. */
+int model_set_real(model *m, unsigned vr, double value, char *err);
+int model_set_integer(model *m, unsigned vr, int value, char *err);
+/* Reads one variable; outputs come from the solver (before model_start:
+ * w0, v0, friction = delay_force = 0, sticking = (v0 == 0)). */
+int model_get_real(const model *m, unsigned vr, double *value, char *err);
+int model_get_integer(const model *m, unsigned vr, int *value, char *err);
+int model_get_boolean(const model *m, unsigned vr, int *value, char *err);
+
+/* Creates and initialises the solver from the parameters, at t_start. */
+int model_start(model *m, double t_start, char *err);
+
+/* The communication step from t_current (which must be t_comm to within
+ * MODEL_TIME_TOL h) to t_end = t_current + step, step >= 0: takes every step
+ * whose start t_p is before t_end (by more than MODEL_TIME_TOL h).
+ * Returns -1 for bad arguments (m unchanged), -2 for a solver failure (the
+ * steps already taken are kept); err tells why. */
+int model_do_step(model *m, double t_current, double step, char *err);
+
+/*
+ * Saved state: the bytes hold a magic, a format version, the sizes, the
+ * variables, t_start, t_comm, an opaque 32-bit tag of the caller (the FMI
+ * phase), libdmi's own checked state bytes (the whole history) and a
+ * checksum.  model_state_size is the byte count model_state_save writes.
+ */
+size_t model_state_size(const model *m);
+void model_state_save(const model *m, uint32_t tag, unsigned char *buf);
+/* Checks the bytes and, when into is not NULL, replaces *into by the saved
+ * model (a fresh solver loaded with the saved history).  *tag gets the saved
+ * tag, which must be a single bit of tags.  Bad bytes: nonzero, the reason
+ * in err, *into unchanged. */
+int model_state_load(model *into, uint32_t tags, uint32_t *tag, const unsigned char *buf,
+                     size_t size, char *err);
+
+#endif
