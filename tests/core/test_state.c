@@ -1,0 +1,184 @@
+/*
+ * dmi_state_save / dmi_state_load (issue 2): a run replayed from a loaded
+ * state is bitwise the run of the saving solver; states of other solvers
+ * (n, N, tau), truncated, corrupted or foreign bytes are refused with
+ * DMI_EINVAL and leave the solver unchanged.
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core_test.h"
+
+enum { N = 16, SAVED_AT = 37, MORE = 25 }; /* SAVED_AT > N: the ring has wrapped */
+
+/* A model solver (n = 2, N = 16, tau = 1) after steps steps. */
+static dmi_solver *model_after(core_model *m, size_t steps)
+{
+    dmi_solver *s = core_model_solver(m, N);
+    if (s && dmi_advance(s, steps) != DMI_OK)
+        dmi_free(&s);
+    return s;
+}
+
+static void test_replay(void)
+{
+    core_model ma = {0}, mb = {0}, mc = {0};
+    dmi_solver *a = model_after(&ma, SAVED_AT), *b = model_after(&mb, 5), *c = model_after(&mc, 0);
+    CU_ASSERT_FATAL(a && b && c);
+    size_t size;
+    unsigned char *saved = core_save(a, &size);
+    CU_ASSERT_PTR_NOT_NULL_FATAL(saved);
+    CU_ASSERT_EQUAL(size, dmi_state_size(b));
+    double Wa[2], Xa[2], Wb[2], Xb[2], ua[2], ub[2];
+    CU_ASSERT_EQUAL(dmi_get_step_terms(a, Wa, Xa), DMI_OK);
+
+    /* into a solver ahead of or behind the saved point, and into one never stepped */
+    CU_ASSERT_EQUAL(dmi_state_load(b, saved, size), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_state_load(c, saved, size), DMI_OK);
+    uint64_t p = 0;
+    CU_ASSERT_EQUAL(dmi_get_step_index(b, &p), DMI_OK);
+    CU_ASSERT_EQUAL(p, SAVED_AT);
+    CU_ASSERT_EQUAL(dmi_time(b), dmi_time(a));
+    CU_ASSERT_EQUAL(dmi_get_step_terms(b, Wb, Xb), DMI_OK);
+    CU_ASSERT(memcmp(Wa, Wb, sizeof Wa) == 0 && memcmp(Xa, Xb, sizeof Xa) == 0);
+    int past_same = 1;
+    for (size_t lag = 0; lag <= N; lag++)
+        past_same &= dmi_get_past(a, lag, ua) == DMI_OK && dmi_get_past(b, lag, ub) == DMI_OK &&
+                     memcmp(ua, ub, sizeof ua) == 0;
+    CU_ASSERT(past_same);
+    CU_ASSERT(core_state_is(b, saved, size));
+
+    CU_ASSERT_EQUAL(dmi_advance(a, MORE), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_advance(b, MORE), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_advance(c, MORE), DMI_OK);
+    CU_ASSERT(core_same_state(a, b));
+    CU_ASSERT(core_same_state(a, c));
+    CU_ASSERT(!core_state_is(a, saved, size)); /* the run did move on */
+
+    /* rewinding the saving solver itself replays the same run */
+    size_t size_end;
+    unsigned char *end = core_save(a, &size_end);
+    CU_ASSERT_EQUAL(dmi_state_load(a, saved, size), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_advance(a, MORE), DMI_OK);
+    CU_ASSERT(core_state_is(a, end, size_end));
+
+    /* buffers need no alignment */
+    unsigned char *odd = malloc(size + 1);
+    CU_ASSERT_PTR_NOT_NULL_FATAL(odd);
+    CU_ASSERT_EQUAL(dmi_state_save(b, odd + 1, size), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_state_load(c, odd + 1, size), DMI_OK);
+    CU_ASSERT(core_same_state(b, c));
+    /* a larger buffer is fine for saving */
+    unsigned char *large = calloc(size + 64, 1);
+    CU_ASSERT_PTR_NOT_NULL_FATAL(large);
+    CU_ASSERT_EQUAL(dmi_state_save(b, large, size + 64), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_state_load(c, large, size), DMI_OK);
+    CU_ASSERT(core_same_state(b, c));
+
+    free(large);
+    free(odd);
+    free(end);
+    free(saved);
+    dmi_free(&a);
+    dmi_free(&b);
+    dmi_free(&c);
+}
+
+/* load must fail with DMI_EINVAL, a message, and leave s bitwise as before. */
+static int refused(dmi_solver *s, const void *buf, size_t size, const unsigned char *before,
+                   size_t before_size)
+{
+    int rc = dmi_state_load(s, buf, size);
+    return rc == DMI_EINVAL && dmi_last_error(s)[0] != '\0' &&
+           core_state_is(s, before, before_size);
+}
+
+static void test_refused(void)
+{
+    core_model ma = {0}, ms = {0};
+    dmi_solver *a = model_after(&ma, SAVED_AT), *s = model_after(&ms, 11);
+    CU_ASSERT_FATAL(a && s);
+    size_t size, size_s;
+    unsigned char *saved = core_save(a, &size), *before = core_save(s, &size_s);
+    unsigned char *buf = malloc(size + 8);
+    CU_ASSERT_FATAL(saved && before && buf);
+
+    /* truncated, too long, empty, NULL */
+    memcpy(buf, saved, size);
+    buf[size] = 0;
+    CU_ASSERT(refused(s, buf, size - 1, before, size_s));
+    CU_ASSERT(refused(s, buf, size + 1, before, size_s));
+    CU_ASSERT(refused(s, buf, 0, before, size_s));
+    CU_ASSERT(refused(s, buf, 8, before, size_s));
+    CU_ASSERT(refused(s, NULL, size, before, size_s));
+
+    /* bad magic */
+    memcpy(buf, saved, size);
+    memset(buf, 'X', 8);
+    CU_ASSERT(refused(s, buf, size, before, size_s));
+
+    /* every single corrupted byte, anywhere (header, history, terms, checksum) */
+    size_t accepted = 0;
+    for (size_t i = 0; i < size; i++) {
+        memcpy(buf, saved, size);
+        buf[i] ^= 0x5A;
+        accepted += !refused(s, buf, size, before, size_s);
+        memcpy(buf, saved, size);
+        buf[i] ^= 0x01; /* the lowest bit: the smallest change of a double */
+        accepted += !refused(s, buf, size, before, size_s);
+    }
+    if (accepted)
+        printf("\n  %zu corrupted states accepted", accepted);
+    CU_ASSERT_EQUAL(accepted, 0);
+
+    /* states of other solvers, of the same size (so the header is what tells) */
+    const struct {
+        size_t n, N;
+        double tau;
+    } other[] = {{1, 2 * N + 3, 1.0}, {2, N, 2.0}, {2, N, 1.0 + 1e-15}, {2, N + 1, 1.0},
+                 {3, N, 1.0}};
+    for (size_t k = 0; k < sizeof other / sizeof *other; k++) {
+        dmi_solver *o = NULL;
+        CU_ASSERT_EQUAL_FATAL(dmi_create(&o, other[k].n, other[k].tau, other[k].N), DMI_OK);
+        CU_ASSERT_EQUAL_FATAL(dmi_init(o), DMI_OK);
+        CU_ASSERT_EQUAL(dmi_advance(o, SAVED_AT), DMI_OK);
+        size_t size_o;
+        unsigned char *so = core_save(o, &size_o), *before_o = core_save(o, &size_o);
+        CU_ASSERT_FATAL(so && before_o);
+        if (k < 3) /* same byte count: the header check must catch it */
+            CU_ASSERT_EQUAL(size_o, size);
+        CU_ASSERT(refused(s, so, size_o, before, size_s));
+        CU_ASSERT(refused(o, saved, size, before_o, size_o));
+        free(so);
+        free(before_o);
+        dmi_free(&o);
+    }
+
+    /* after all that, s still runs like a twin that saw none of it */
+    core_model mt = {0};
+    dmi_solver *t = model_after(&mt, 11);
+    CU_ASSERT_FATAL(t != NULL);
+    CU_ASSERT_EQUAL(dmi_advance(s, MORE), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_advance(t, MORE), DMI_OK);
+    CU_ASSERT(core_same_state(s, t));
+
+    free(buf);
+    free(saved);
+    free(before);
+    dmi_free(&a);
+    dmi_free(&s);
+    dmi_free(&t);
+}
+
+int main(int argc, char **argv)
+{
+    static const core_test tests[] = {
+        {"save, load elsewhere, replay: bitwise the same run", test_replay},
+        {"other n/N/tau, truncated, corrupted, bad magic: refused, solver unchanged",
+         test_refused},
+        {NULL, NULL}};
+    return core_main(argc, argv, "core: state save and load", tests);
+}
