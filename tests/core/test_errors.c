@@ -21,7 +21,7 @@
  * After the call both are stepped on: s must still agree with r bitwise. */
 
 enum { STAGE_CREATED, STAGE_INITIALISED, STAGE_STEPPED };
-enum { TWIN_N = 8 };
+enum { TWIN_N = 64, STEPPED = 3 * TWIN_N / 2 + 5 }; /* steps of STAGE_STEPPED: past N */
 
 typedef struct {
     core_model ms, mr;
@@ -49,18 +49,19 @@ static int set_operator(dmi_solver *s, int op)
                              : DMI_OK;
 }
 
-static int twin_open_op(twin *tw, int stage, int op)
+static int twin_open_op(twin *tw, int stage, int op, int method)
 {
     memset(tw, 0, sizeof *tw);
     int ok = dmi_create(&tw->s, 2, 1.0, TWIN_N) == DMI_OK &&
              dmi_create(&tw->r, 2, 1.0, TWIN_N) == DMI_OK &&
              core_model_setup(tw->s, &tw->ms) == DMI_OK &&
              core_model_setup(tw->r, &tw->mr) == DMI_OK && set_operator(tw->s, op) == DMI_OK &&
-             set_operator(tw->r, op) == DMI_OK;
+             set_operator(tw->r, op) == DMI_OK && dmi_set_convolution(tw->s, method) == DMI_OK &&
+             dmi_set_convolution(tw->r, method) == DMI_OK;
     if (ok && stage >= STAGE_INITIALISED)
         ok = dmi_init(tw->s) == DMI_OK && dmi_init(tw->r) == DMI_OK;
     if (ok && stage >= STAGE_STEPPED)
-        ok = dmi_advance(tw->s, 3) == DMI_OK && dmi_advance(tw->r, 3) == DMI_OK;
+        ok = dmi_advance(tw->s, STEPPED) == DMI_OK && dmi_advance(tw->r, STEPPED) == DMI_OK;
     if (ok && stage >= STAGE_INITIALISED)
         ok = (tw->before = core_save(tw->s, &tw->size)) != NULL;
     if (!ok)
@@ -70,7 +71,7 @@ static int twin_open_op(twin *tw, int stage, int op)
 
 static int twin_open(twin *tw, int stage)
 {
-    return twin_open_op(tw, stage, OP_CALLBACK);
+    return twin_open_op(tw, stage, OP_CALLBACK, DMI_CONV_AUTO);
 }
 
 /* Initialises both if needed, advances both k steps; 1 iff their states agree bitwise. */
@@ -354,7 +355,7 @@ static void test_reinit_callbacks(void)
             tw.ms.fault[kinds[k]] = FAULTS[f];
             tw.ms.fail_after[kinds[k]] = tw.ms.calls[kinds[k]] + 3;
             int rc = dmi_init(tw.s);
-            CU_ASSERT_EQUAL(dmi_time(tw.s), 3.0 / TWIN_N);
+            CU_ASSERT_EQUAL(dmi_time(tw.s), (double)STEPPED * (1.0 / TWIN_N));
             tw.ms.fault[kinds[k]] = FAULT_NONE;
             check_error(&tw, rc, expected_code(FAULTS[f]), "dmi_init again");
             twin_close(&tw);
@@ -362,7 +363,8 @@ static void test_reinit_callbacks(void)
 }
 
 /* f or the resolvent failing in dmi_step, with the model's resolvent callback
- * or (f only) the built-in friction or box: DMI_ECALLBACK / DMI_ENONFINITE,
+ * or (f only) the built-in friction or box, with the direct and the FFT delay
+ * sum: DMI_ECALLBACK / DMI_ENONFINITE,
  * bitwise unchanged, a retry with the fault still there fails the same way,
  * and once fixed the run is that of the twin that never failed.  With the
  * friction this is the trap of the soft threshold, which maps NaN to 0. */
@@ -372,24 +374,26 @@ static void test_step_callbacks(void)
         int kind, op;
     } cases[] = {{CB_RHS, OP_CALLBACK}, {CB_RESOLVENT, OP_CALLBACK}, {CB_RHS, OP_FRICTION},
                  {CB_RHS, OP_BOX}};
-    for (size_t c = 0; c < sizeof cases / sizeof *cases; c++)
-        for (int f = 0; f < NFAULTS; f++) {
-            const int kind = cases[c].kind;
-            twin tw;
-            CU_ASSERT_FATAL(twin_open_op(&tw, STAGE_STEPPED, cases[c].op));
-            tw.ms.fault[kind] = FAULTS[f];
-            tw.ms.fail_after[kind] = tw.ms.calls[kind];
-            int rc = dmi_step(tw.s);
-            CU_ASSERT_EQUAL(dmi_step(tw.s), rc);
-            CU_ASSERT_EQUAL(dmi_advance(tw.s, 2), rc);
-            CU_ASSERT(core_state_is(tw.s, tw.before, tw.size));
-            if (rc != expected_code(FAULTS[f]))
-                printf("\n  %s fault %d with operator %d: %d", KIND_NAME[kind], FAULTS[f],
-                       cases[c].op, rc);
-            tw.ms.fault[kind] = FAULT_NONE;
-            check_error(&tw, rc, expected_code(FAULTS[f]), "dmi_step");
-            twin_close(&tw);
-        }
+    const int methods[] = {DMI_CONV_DIRECT, DMI_CONV_FFT};
+    for (int meth = 0; meth < 2; meth++)
+        for (size_t c = 0; c < sizeof cases / sizeof *cases; c++)
+            for (int f = 0; f < NFAULTS; f++) {
+                const int kind = cases[c].kind;
+                twin tw;
+                CU_ASSERT_FATAL(twin_open_op(&tw, STAGE_STEPPED, cases[c].op, methods[meth]));
+                tw.ms.fault[kind] = FAULTS[f];
+                tw.ms.fail_after[kind] = tw.ms.calls[kind];
+                int rc = dmi_step(tw.s);
+                CU_ASSERT_EQUAL(dmi_step(tw.s), rc);
+                CU_ASSERT_EQUAL(dmi_advance(tw.s, 2), rc);
+                CU_ASSERT(core_state_is(tw.s, tw.before, tw.size));
+                if (rc != expected_code(FAULTS[f]))
+                    printf("\n  %s fault %d with operator %d, method %d: %d", KIND_NAME[kind],
+                           FAULTS[f], cases[c].op, methods[meth], rc);
+                tw.ms.fault[kind] = FAULT_NONE;
+                check_error(&tw, rc, expected_code(FAULTS[f]), "dmi_step");
+                twin_close(&tw);
+            }
 }
 
 /* dmi_advance stops at the first failure and keeps the steps before it. */
@@ -403,7 +407,7 @@ static void test_advance_stops(void)
     CU_ASSERT_EQUAL(dmi_advance(tw.s, 10), DMI_ECALLBACK);
     CU_ASSERT(dmi_last_error(tw.s)[0] != '\0');
     CU_ASSERT_EQUAL(dmi_get_step_index(tw.s, &p), DMI_OK);
-    CU_ASSERT_EQUAL(p, 3 + 4);
+    CU_ASSERT_EQUAL(p, STEPPED + 4);
     CU_ASSERT_EQUAL(dmi_advance(tw.r, 4), DMI_OK);
     CU_ASSERT(core_same_state(tw.s, tw.r));
     tw.ms.fault[CB_RHS] = FAULT_NONE;

@@ -87,6 +87,43 @@ static void test_replay(void)
     dmi_free(&c);
 }
 
+/* The same with each method of the delay sum, at an N where the FFT engine
+ * has blocks of several sizes: its rebuild from a loaded state must give the
+ * engine of the uninterrupted run (bitwise), also when loaded into a solver
+ * at an earlier or a later point. */
+static void test_replay_methods(void)
+{
+    const int methods[] = {DMI_CONV_DIRECT, DMI_CONV_FFT, DMI_CONV_AUTO};
+    const size_t NB = 500, at = 1237, others[] = {0, 90, 1500, 1237}, more = 777;
+    for (int m = 0; m < 3; m++) {
+        core_model ma = {0};
+        dmi_solver *a = core_model_solver(&ma, NB);
+        CU_ASSERT_FATAL(a != NULL);
+        CU_ASSERT_EQUAL(dmi_set_convolution(a, methods[m]), DMI_OK);
+        CU_ASSERT_EQUAL(dmi_advance(a, at), DMI_OK);
+        size_t size;
+        unsigned char *saved = core_save(a, &size);
+        CU_ASSERT_PTR_NOT_NULL_FATAL(saved);
+        CU_ASSERT_EQUAL(dmi_advance(a, more), DMI_OK);
+        for (size_t k = 0; k < sizeof others / sizeof *others; k++) {
+            core_model mb = {0};
+            dmi_solver *b = core_model_solver(&mb, NB);
+            CU_ASSERT_FATAL(b != NULL);
+            CU_ASSERT_EQUAL(dmi_set_convolution(b, methods[m]), DMI_OK);
+            CU_ASSERT_EQUAL(dmi_advance(b, others[k]), DMI_OK);
+            CU_ASSERT_EQUAL(dmi_state_load(b, saved, size), DMI_OK);
+            CU_ASSERT_EQUAL(dmi_advance(b, more), DMI_OK);
+            int same = core_same_state(a, b);
+            if (!same)
+                printf("\n  method %d: replay loaded at step %zu differs", methods[m], others[k]);
+            CU_ASSERT(same);
+            dmi_free(&b);
+        }
+        free(saved);
+        dmi_free(&a);
+    }
+}
+
 /* load must fail with DMI_EINVAL, a message, and leave s bitwise as before. */
 static int refused(dmi_solver *s, const void *buf, size_t size, const unsigned char *before,
                    size_t before_size)
@@ -177,6 +214,7 @@ int main(int argc, char **argv)
 {
     static const core_test tests[] = {
         {"save, load elsewhere, replay: bitwise the same run", test_replay},
+        {"replay with the direct, FFT and automatic delay sum, N = 500", test_replay_methods},
         {"other n/N/tau, truncated, corrupted, bad magic: refused, solver unchanged",
          test_refused},
         {NULL, NULL}};
