@@ -35,9 +35,11 @@ def exact(example, t):
 
 
 def read_csv(path):
-    """Columns of a CSV file with a header line, as a dict of arrays."""
-    data = np.genfromtxt(path, delimiter=",", names=True, dtype=None, encoding="utf-8")
-    return {name: np.atleast_1d(data[name]) for name in data.dtype.names}
+    """Columns of a numeric CSV file with a header line, as a dict of arrays."""
+    with open(path) as f:
+        names = f.readline().strip().split(",")
+        data = np.loadtxt(f, delimiter=",", ndmin=2)
+    return {name: data[:, i] for i, name in enumerate(names)}
 
 
 def save(fig, path):
