@@ -147,21 +147,21 @@ int model_do_step(model *m, double t_current, double step, char *err)
 {
     const double h = dmi_get_h(m->solver);
     if (!isfinite(t_current) || !isfinite(step) || step < 0)
-        return fail(err, "doStep(%.17g, %.17g): the time and the step must be finite and the step >= 0",
+        return fail(err, "the time %.17g and the step %.17g must be finite and the step >= 0",
                     t_current, step);
     if (fabs(t_current - m->t_comm) > MODEL_TIME_TOL * h)
-        return fail(err, "doStep: the communication point %.17g is not the FMU's time %.17g", t_current,
+        return fail(err, "the communication point %.17g is not the FMU's time %.17g", t_current,
                     m->t_comm);
     const double t_end = t_current + step;
     const double target = ceil((t_end - m->t_start) / h - MODEL_TIME_TOL);
     uint64_t p = 0;
     dmi_get_step_index(m->solver, &p);
     if (!(target < 9007199254740992.0)) /* 2^53: beyond it p h has no meaning */
-        return fail(err, "doStep: t = %.17g is too far from the start for the step h", t_end);
+        return fail(err, "t = %.17g is too far from the start for the step h", t_end);
     if (target > (double)p) {
         int rc = dmi_advance(m->solver, (size_t)(target - (double)p));
         if (rc != DMI_OK) {
-            solver_fail(err, "doStep", m->solver, rc);
+            solver_fail(err, "the solver failed", m->solver, rc);
             return -2;
         }
     }

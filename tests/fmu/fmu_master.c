@@ -1,0 +1,217 @@
+/*
+ * fmu_master — a small FMI 2.0 co-simulation master, a second importer beside
+ * fmpy: loads the unpacked FMU binary with dlopen, runs Example 4.3 at
+ * N = 9991 and compares w, v at the reference's points (every 100th step,
+ * values computed by an independent implementation) to 1e-12; checks on the
+ * way that a saved FMU state, serialized and restored, replays bitwise.
+ *
+ * Usage: fmu_master FMU.so GUID ex43_N9991.csv T
+ * Exit status 0 if every check passed.
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include <dlfcn.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi2FunctionTypes.h"
+
+/* Value references of the FMU (its modelDescription.xml). */
+enum { VR_w = 19, VR_v = 20, VR_N = 23 };
+static const int N = 9991;
+static const double TOL = 1e-12;
+
+typedef struct {
+    fmi2InstantiateTYPE *instantiate;
+    fmi2FreeInstanceTYPE *free_instance;
+    fmi2SetupExperimentTYPE *setup;
+    fmi2EnterInitializationModeTYPE *enter_init;
+    fmi2ExitInitializationModeTYPE *exit_init;
+    fmi2SetIntegerTYPE *set_integer;
+    fmi2GetRealTYPE *get_real;
+    fmi2DoStepTYPE *do_step;
+    fmi2GetFMUstateTYPE *get_state;
+    fmi2SetFMUstateTYPE *set_state;
+    fmi2FreeFMUstateTYPE *free_state;
+    fmi2SerializedFMUstateSizeTYPE *state_size;
+    fmi2SerializeFMUstateTYPE *serialize;
+    fmi2DeSerializeFMUstateTYPE *deserialize;
+    fmi2TerminateTYPE *terminate;
+} fmi2;
+
+static int failures = 0;
+
+static void check(int ok, const char *what)
+{
+    if (!ok) {
+        fprintf(stderr, "fmu_master: FAILED: %s\n", what);
+        failures++;
+    }
+}
+
+static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status,
+                   fmi2String category, fmi2String message, ...)
+{
+    va_list ap;
+    (void)env;
+    fprintf(stderr, "[%s %d %s] ", name, (int)status, category);
+    va_start(ap, message);
+    vfprintf(stderr, message, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+}
+
+/* Looks up name in the library; NULL (and a message) if missing. */
+static void *sym(void *lib, const char *name)
+{
+    void *f = dlsym(lib, name);
+    if (!f)
+        fprintf(stderr, "fmu_master: %s not exported\n", name);
+    return f;
+}
+
+static int load(void *lib, fmi2 *f)
+{
+    /* object pointer to function pointer: the POSIX dlsym idiom */
+#define LOAD(field, name) *(void **)(&f->field) = sym(lib, name)
+    LOAD(instantiate, "fmi2Instantiate");
+    LOAD(free_instance, "fmi2FreeInstance");
+    LOAD(setup, "fmi2SetupExperiment");
+    LOAD(enter_init, "fmi2EnterInitializationMode");
+    LOAD(exit_init, "fmi2ExitInitializationMode");
+    LOAD(set_integer, "fmi2SetInteger");
+    LOAD(get_real, "fmi2GetReal");
+    LOAD(do_step, "fmi2DoStep");
+    LOAD(get_state, "fmi2GetFMUstate");
+    LOAD(set_state, "fmi2SetFMUstate");
+    LOAD(free_state, "fmi2FreeFMUstate");
+    LOAD(state_size, "fmi2SerializedFMUstateSize");
+    LOAD(serialize, "fmi2SerializeFMUstate");
+    LOAD(deserialize, "fmi2DeSerializeFMUstate");
+    LOAD(terminate, "fmi2Terminate");
+#undef LOAD
+    void **p = (void **)f;
+    for (size_t i = 0; i < sizeof *f / sizeof(void *); i++)
+        if (!p[i])
+            return -1;
+    return 0;
+}
+
+/* The reference rows: step index p and w, v at t_p. */
+typedef struct {
+    long p;
+    double w, v;
+} row;
+
+static row *read_reference(const char *path, size_t *count)
+{
+    FILE *in = fopen(path, "r");
+    char line[256];
+    size_t n = 0, cap = 4096;
+    row *rows = malloc(cap * sizeof *rows);
+    if (!in || !rows || !fgets(line, sizeof line, in)) {
+        if (in)
+            fclose(in);
+        free(rows);
+        return NULL;
+    }
+    double t;
+    while (n < cap && fscanf(in, "%ld,%lf,%lf,%lf", &rows[n].p, &t, &rows[n].w, &rows[n].v) == 4)
+        n++;
+    fclose(in);
+    *count = n;
+    return rows;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 5) {
+        fprintf(stderr, "usage: fmu_master FMU.so GUID ex43_N9991.csv T\n");
+        return 2;
+    }
+    const double T = atof(argv[4]), h = 1.0 / N;
+    size_t nrows = 0;
+    row *ref = read_reference(argv[3], &nrows);
+    void *lib = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
+    fmi2 f;
+    if (!ref || nrows < 2 || !lib || load(lib, &f) != 0) {
+        fprintf(stderr, "fmu_master: cannot read %s or load %s (%s)\n", argv[3], argv[1],
+                lib ? "missing functions" : dlerror());
+        return 1;
+    }
+    const fmi2CallbackFunctions cb = {logger, calloc, free, NULL, NULL};
+    fmi2Component c = f.instantiate("master", fmi2CoSimulation, argv[2], "", &cb, fmi2False,
+                                    fmi2False);
+    const fmi2ValueReference vr_N = VR_N, vr_wv[2] = {VR_w, VR_v};
+    const fmi2Integer n_value = N;
+    check(c != NULL, "fmi2Instantiate");
+    if (!c)
+        return 1;
+    check(f.setup(c, fmi2False, 0.0, 0.0, fmi2True, T) == fmi2OK, "fmi2SetupExperiment");
+    check(f.enter_init(c) == fmi2OK, "fmi2EnterInitializationMode");
+    check(f.set_integer(c, &vr_N, 1, &n_value) == fmi2OK, "fmi2SetInteger N");
+    check(f.exit_init(c) == fmi2OK, "fmi2ExitInitializationMode");
+
+    double t = 0.0, maxdev = 0.0, wv[2];
+    size_t compared = 0;
+    fmi2FMUstate saved = NULL;
+    double saved_t = 0.0, replay[2] = {0, 0};
+    size_t k;
+    for (k = 0; k < nrows && ref[k].p * h <= T + 1e-9; k++) {
+        const double t_next = (double)ref[k].p / N; /* the reference's t_p */
+        if (k > 0)
+            check(f.do_step(c, t, t_next - t, fmi2False) == fmi2OK, "fmi2DoStep");
+        t = t_next;
+        check(f.get_real(c, vr_wv, 2, wv) == fmi2OK, "fmi2GetReal");
+        const double dev = fmax(fabs(wv[0] - ref[k].w), fabs(wv[1] - ref[k].v));
+        maxdev = fmax(maxdev, dev);
+        compared++;
+        if (k == nrows / 20) { /* save the state here, check it replays below */
+            check(f.get_state(c, &saved) == fmi2OK, "fmi2GetFMUstate");
+            saved_t = t;
+        }
+        if (k == nrows / 20 + 5)
+            memcpy(replay, wv, sizeof wv);
+    }
+    check(maxdev <= TOL, "w, v equal the reference values to 1e-12");
+    check(compared > 5, "enough reference points");
+
+    /* serialize, deserialize, restore: the same five communication steps again */
+    if (saved) {
+        size_t size = 0;
+        check(f.state_size(c, saved, &size) == fmi2OK && size > 0, "fmi2SerializedFMUstateSize");
+        fmi2Byte *bytes = malloc(size);
+        fmi2FMUstate back = NULL;
+        check(bytes && f.serialize(c, saved, bytes, size) == fmi2OK, "fmi2SerializeFMUstate");
+        check(bytes && f.deserialize(c, bytes, size, &back) == fmi2OK, "fmi2DeSerializeFMUstate");
+        if (bytes && size > 100) { /* a corrupted copy is refused */
+            fmi2FMUstate bad = NULL;
+            bytes[size / 2] ^= 1;
+            check(f.deserialize(c, bytes, size, &bad) == fmi2Error && bad == NULL,
+                  "corrupted state rejected");
+        }
+        free(bytes);
+        check(back && f.set_state(c, back) == fmi2OK, "fmi2SetFMUstate");
+        size_t k0 = nrows / 20;
+        t = saved_t;
+        for (size_t j = k0 + 1; j <= k0 + 5 && j < nrows; j++) {
+            const double t_next = (double)ref[j].p / N;
+            check(f.do_step(c, t, t_next - t, fmi2False) == fmi2OK, "fmi2DoStep after restore");
+            t = t_next;
+        }
+        check(f.get_real(c, vr_wv, 2, wv) == fmi2OK, "fmi2GetReal after restore");
+        check(k > k0 + 5 ? wv[0] == replay[0] && wv[1] == replay[1] : 1,
+              "restored state replays bitwise");
+        f.free_state(c, &saved);
+        f.free_state(c, &back);
+    }
+    check(f.terminate(c) == fmi2OK, "fmi2Terminate");
+    f.free_instance(c);
+    dlclose(lib);
+    free(ref);
+    printf("fmu_master: %zu reference points to t = %g, max deviation %.3g; %d failures\n",
+           compared, T, maxdev, failures);
+    return failures == 0 ? 0 : 1;
+}

@@ -1,0 +1,462 @@
+# The FMU DelayFrictionOscillator.fmu against the issue's contract, driven by
+# fmpy: validation, outputs against a native libdmi run, input, FMU states,
+# reset, several instances, errors, logging, binary.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+import math
+import os
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+from fmpy import simulate_fmu
+from fmpy.fmi1 import FMICallException
+from fmpy.validation import validate_fmu
+
+from native import START, Run
+
+OUT = ["w", "v", "friction", "delay_force", "sticking"]
+REALS = ["b", "alpha", "tau", "w0", "v0", "H_c0", "H_c1", "H_lambda", "H_a1", "H_omega1", "H_a2",
+         "H_omega2", "H_a3", "H_omega3", "g_offset", "g_amp", "g_omega", "g_phase"]
+T = 30.0
+
+
+@pytest.fixture(scope="module")
+def native43(libdmi):
+    """Example 4.3 natively to T = 30 (plus a margin for the last interpolant)."""
+    return Run(libdmi, 30001)
+
+
+def outputs(s, vr):
+    f = s.fmu
+    real = f.getReal([vr[n] for n in OUT[:4]])
+    return tuple(real) + (bool(f.getBoolean([vr["sticking"]])[0]),)
+
+
+def start(s, t0=0.0, **params):
+    f = s.fmu
+    f.setupExperiment(startTime=t0)
+    f.enterInitializationMode()
+    for name, value in params.items():
+        if name == "N":
+            f.setInteger([s.vr["N"]], [value])
+        else:
+            f.setReal([s.vr[name]], [value])
+    f.exitInitializationMode()
+
+
+@pytest.fixture
+def sl(slave, vr):
+    def make(**kw):
+        s = slave(**kw)
+        s.vr = vr
+        return s
+    return make
+
+
+def assert_close(got, want, tol=1e-12):
+    got, want = np.asarray(got, dtype=float), np.asarray(want, dtype=float)
+    assert got.shape == want.shape
+    err = np.max(np.abs(got - want))
+    assert err <= tol, f"max deviation {err:.3g} > {tol:g}"
+
+
+# ---- the FMU as a file ----
+
+def test_validate_fmu(fmu_path):
+    assert validate_fmu(fmu_path) == []
+
+
+def test_fmutool_check(fmu_path):
+    fmutool = os.path.join(os.path.dirname(sys.executable), "fmutool")
+    r = subprocess.run([fmutool, "-input", fmu_path, "-check"], capture_output=True, text=True,
+                       env=dict(os.environ, QT_QPA_PLATFORM="offscreen"), timeout=120)
+    text = r.stdout + r.stderr
+    assert r.returncode == 0, text
+    assert "compliant with FMI-2.0" in text, text
+    assert "No semantic error" in text, text
+    assert "ERROR" not in text, text
+
+
+def test_model_description_contract(md):
+    cs = md.coSimulation
+    assert md.fmiVersion == "2.0" and cs.modelIdentifier == "DelayFrictionOscillator"
+    assert cs.canHandleVariableCommunicationStepSize
+    assert cs.canGetAndSetFMUstate and cs.canSerializeFMUstate
+    var = {v.name: v for v in md.modelVariables}
+    for n in REALS + ["N"]:
+        assert var[n].causality == "parameter", n
+        assert float(var[n].start) == START[n], n
+    assert var["N"].type == "Integer"
+    assert var["g_in"].causality == "input" and var["g_in"].type == "Real"
+    for n in OUT:
+        assert var[n].causality == "output", n
+    assert var["sticking"].type == "Boolean"
+    assert {c for c in md.logCategories} >= {"logStatusError", "logCalls"} or \
+        {c.name for c in md.logCategories} >= {"logStatusError", "logCalls"}
+    de = md.defaultExperiment
+    assert float(de.stopTime) == 30.0
+    k = float(de.stepSize) / (START["tau"] / START["N"])
+    assert abs(k - round(k)) < 1e-9 and round(k) >= 1
+
+
+def test_start_values_inside_binary(md, sl):
+    """The binary's own start values equal the modelDescription's."""
+    s = sl()
+    s.fmu.setupExperiment(startTime=0.0)
+    s.fmu.enterInitializationMode()
+    var = {v.name: v for v in md.modelVariables}
+    got = s.fmu.getReal([s.vr[n] for n in REALS])
+    assert got == [float(var[n].start) for n in REALS]
+    assert s.fmu.getInteger([s.vr["N"]]) == [int(var["N"].start)]
+
+
+def test_binary_needs_libc_libm_and_exports_fmi2_only(unzipdir):
+    so = os.path.join(unzipdir, "binaries", "linux64", "DelayFrictionOscillator.so")
+    dyn = subprocess.run(["readelf", "-d", so], capture_output=True, text=True, check=True).stdout
+    needed = {line.split("[")[1].split("]")[0] for line in dyn.splitlines() if "(NEEDED)" in line}
+    assert needed and needed <= {"libc.so.6", "libm.so.6"}, needed
+    syms = subprocess.run(["nm", "-D", "--defined-only", so], capture_output=True, text=True,
+                          check=True).stdout.split("\n")
+    names = [line.split()[-1] for line in syms if line.strip()]
+    assert "fmi2DoStep" in names and "fmi2Instantiate" in names
+    assert [n for n in names if not n.startswith("fmi2")] == []
+
+
+# ---- outputs against a native libdmi run ----
+
+@pytest.mark.parametrize("interval", [0.01, 0.0123])
+def test_simulate_matches_native(fmu_path, native43, interval):
+    r = simulate_fmu(fmu_path, stop_time=T, output_interval=interval, output=OUT)
+    t = r["time"]
+    assert t[0] == 0.0 and abs(t[-1] - T) < 1e-9 and len(t) == math.ceil(T / interval - 1e-9) + 1
+    want = native43.table(t)
+    got = np.column_stack([r[n] for n in OUT]).astype(float)
+    assert_close(got[:, :4], want[:, :4])
+    assert np.array_equal(got[:, 4], want[:, 4])
+    # the run is not trivial: it slides and sticks
+    assert got[:, 4].any() and not got[:, 4].all()
+
+
+def test_varying_steps_match_native(sl, native43):
+    s = sl()
+    start(s)
+    h = START["tau"] / START["N"]
+    pattern = [0.01, 0.0123, h, 0.3 * h, 0.7 * h, 5 * h, 0.0, 0.25, 1e-9, 0.1, 2.5 * h, 0.05]
+    t, rows, times = 0.0, [], []
+    i = 0
+    while t < 12.0:
+        dt = pattern[i % len(pattern)]
+        s.fmu.doStep(t, dt)
+        t += dt
+        i += 1
+        times.append(t)
+        rows.append(outputs(s, s.vr))
+    got = np.array(rows, dtype=float)
+    want = native43.table(times)
+    assert_close(got[:, :4], want[:, :4])
+    assert np.array_equal(got[:, 4], want[:, 4])
+
+
+def test_g_in_from_an_input_signal(fmu_path, libdmi):
+    sig_t = np.array([0.0, 1.0, 2.0, 3.0, 4.5, 6.0])
+    sig_v = np.array([0.0, 0.8, -0.5, 1.5, -1.0, 0.2])
+    signal = np.array(list(zip(sig_t, sig_v)), dtype=[("time", np.float64), ("g_in", np.float64)])
+    r = simulate_fmu(fmu_path, stop_time=6.0, output_interval=0.01, input=signal, output=OUT)
+    cps = r["time"]
+    h = START["tau"] / START["N"]
+
+    def g_in(p):  # the value set at the last communication point at or before t_p
+        k = np.searchsorted(cps, p * h + 1e-6 * h, side="right") - 1
+        return float(np.interp(cps[k], sig_t, sig_v))
+
+    native = Run(libdmi, 6001, g_in=g_in)
+    want = native.table(cps)
+    got = np.column_stack([r[n] for n in OUT]).astype(float)
+    assert_close(got[:, :4], want[:, :4])
+    # and the input mattered
+    plain = Run(libdmi, 6001).table(cps)
+    assert np.max(np.abs(plain[:, 0] - got[:, 0])) > 1e-3
+
+
+def test_parameters_and_start_time_match_native(sl, libdmi):
+    params = dict(b=2.0, alpha=0.3, tau=0.5, N=400, w0=0.2, v0=-0.1, H_c0=0.5, H_c1=-1.0,
+                  H_lambda=2.0, H_a1=0.3, H_omega1=3.0, H_a2=0.0, H_omega2=1.0, H_a3=-0.2,
+                  H_omega3=7.0, g_offset=0.1, g_amp=0.9, g_omega=3.0, g_phase=0.4)
+    t0 = 1.5
+    s = sl()
+    start(s, t0, **params)
+    times, rows, t = [], [], t0
+    for k in range(1, 301):
+        s.fmu.doStep(t, 0.0137)
+        t = t0 + k * 0.0137
+        times.append(t)
+        rows.append(outputs(s, s.vr))
+    native = Run(libdmi, int(300 * 0.0137 / (0.5 / 400)) + 2, t_start=t0, **params)
+    assert_close(np.array(rows, dtype=float)[:, :4], native.table(times)[:, :4])
+
+
+# ---- FMU states ----
+
+def run_steps(s, t, n, dt=0.0123):
+    rows = []
+    for _ in range(n):
+        s.fmu.doStep(t, dt)
+        t += dt
+        rows.append(outputs(s, s.vr))
+    return t, rows
+
+
+def test_state_get_set_replays_bitwise(sl):
+    s = sl()
+    start(s)
+    t, _ = run_steps(s, 0.0, 200)
+    state = s.fmu.getFMUstate()
+    _, first = run_steps(s, t, 150)
+    s.fmu.setFMUstate(state)
+    _, again = run_steps(s, t, 150)
+    assert first == again
+    # serialized and deserialized in the same process
+    data = s.fmu.serializeFMUstate(state)
+    s.fmu.freeFMUstate(state)
+    back = s.fmu.deSerializeFMUstate(data)
+    s.fmu.setFMUstate(back)
+    _, third = run_steps(s, t, 150)
+    assert third == first
+    s.fmu.freeFMUstate(back)
+
+
+def test_state_before_initialization_restores_phase(sl):
+    s = sl()
+    s.fmu.setupExperiment(startTime=0.0)
+    state = s.fmu.getFMUstate()  # instantiated, no history yet
+    s.fmu.enterInitializationMode()
+    s.fmu.exitInitializationMode()
+    run_steps(s, 0.0, 10)
+    s.fmu.setFMUstate(state)
+    with pytest.raises(FMICallException):
+        s.fmu.doStep(0.123, 0.01)  # back in the instantiated state
+    assert any("not allowed" in m for m in s.errors())
+    s.fmu.enterInitializationMode()
+    s.fmu.exitInitializationMode()
+    s.fmu.freeFMUstate(state)
+
+
+CHILD = textwrap.dedent("""
+    import sys, json
+    sys.path.insert(0, {here!r})
+    import conftest, test_fmu
+    from fmpy import read_model_description
+    md = read_model_description({fmu!r})
+    s = conftest.Slave(md, {unzip!r})
+    s.vr = {{v.name: v.valueReference for v in md.modelVariables}}
+    test_fmu.start(s)
+    t, _ = test_fmu.run_steps(s, 0.0, 200)
+    st = s.fmu.getFMUstate()
+    open({path!r}, "wb").write(s.fmu.serializeFMUstate(st))
+    _, rows = test_fmu.run_steps(s, t, 150)
+    print(json.dumps([t, [[float(x) for x in r] for r in rows]]))
+""")
+
+
+def test_state_serialized_in_another_process(sl, fmu_path, unzipdir, tmp_path):
+    path = str(tmp_path / "state.bin")
+    code = CHILD.format(here=os.path.dirname(__file__), fmu=fmu_path, unzip=str(unzipdir), path=path)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         timeout=120).stdout
+    import json
+    t, rows = json.loads(out.strip().splitlines()[-1])
+    s = sl()
+    start(s, N=7)  # another experiment; the state replaces it all
+    st = s.fmu.deSerializeFMUstate(open(path, "rb").read())
+    s.fmu.setFMUstate(st)
+    _, mine = run_steps(s, t, 150)
+    assert [[float(x) for x in r] for r in mine] == rows
+    s.fmu.freeFMUstate(st)
+
+
+def test_bad_state_bytes_are_rejected(sl):
+    s = sl()
+    start(s)
+    t, _ = run_steps(s, 0.0, 50)
+    st = s.fmu.getFMUstate()
+    data = s.fmu.serializeFMUstate(st)
+    s.fmu.freeFMUstate(st)
+    t, _ = run_steps(s, t, 20)
+    before = outputs(s, s.vr)
+    bad = [b"", data[:10], data[:-1], data[: len(data) // 2], data + b"\0",
+           b"X" + data[1:]]
+    for pos in (9, 13, 40, 60, 200, len(data) // 2, len(data) - 3):  # header, variables, history, checksum
+        b = bytearray(data)
+        b[pos] ^= 0x10
+        bad.append(bytes(b))
+    for k, b in enumerate(bad):
+        n = len(s.errors())
+        with pytest.raises(FMICallException):
+            st = s.fmu.deSerializeFMUstate(b)
+        assert len(s.errors()) == n + 1 and "state" in s.errors()[-1], (k, s.errors()[-1:])
+    assert outputs(s, s.vr) == before
+    # the instance goes on as if nothing happened
+    ref = sl(name="ref")
+    start(ref)
+    tr, _ = run_steps(ref, 0.0, 70)
+    assert outputs(ref, ref.vr) == before
+    assert run_steps(s, t, 30)[1] == run_steps(ref, tr, 30)[1]
+
+
+def test_reset_allows_a_new_experiment(sl):
+    s = sl()
+    start(s, alpha=0.5, N=500)
+    _, first = run_steps(s, 0.0, 100)
+    s.fmu.reset()
+    s.fmu.enterInitializationMode()
+    assert s.fmu.getReal([s.vr["alpha"]]) == [START["alpha"]]
+    assert s.fmu.getInteger([s.vr["N"]]) == [START["N"]]
+    s.fmu.exitInitializationMode()
+    _, default = run_steps(s, 0.0, 100)
+    s.fmu.reset()
+    start(s, alpha=0.5, N=500)
+    _, again = run_steps(s, 0.0, 100)
+    assert again == first and default != first
+    fresh = sl(name="fresh")
+    start(fresh)
+    assert run_steps(fresh, 0.0, 100)[1] == default
+
+
+def test_two_instances_are_independent(sl):
+    a, b = sl(name="a"), sl(name="b")
+    start(a)
+    start(b, alpha=0.2, g_amp=2.0)
+    ta = tb = 0.0
+    ra, rb = [], []
+    for _ in range(100):  # interleaved, different steps
+        ta, x = run_steps(a, ta, 1, 0.0123)
+        tb, y = run_steps(b, tb, 2, 0.005)
+        ra += x
+        rb += y
+    a2, b2 = sl(name="a2"), sl(name="b2")
+    start(a2)
+    start(b2, alpha=0.2, g_amp=2.0)
+    assert run_steps(a2, 0.0, 100, 0.0123)[1] == ra
+    assert run_steps(b2, 0.0, 200, 0.005)[1] == rb
+
+
+# ---- errors and logging ----
+
+@pytest.mark.parametrize("name,value", [("tau", 0.0), ("tau", -1.0), ("alpha", -0.1), ("N", 0),
+                                        ("N", -3)] + [(n, math.nan) for n in REALS]
+                         + [("g_in", math.inf), ("tau", math.inf), ("b", -math.inf)])
+def test_invalid_parameter_is_an_error(sl, name, value):
+    s = sl()
+    s.fmu.setupExperiment(startTime=0.0)
+    s.fmu.enterInitializationMode()
+    with pytest.raises(FMICallException) as e:
+        if name == "N":
+            s.fmu.setInteger([s.vr[name]], [value])
+        else:
+            s.fmu.setReal([s.vr[name]], [value])
+    assert e.value.status == 3
+    assert len(s.errors()) == 1 and name in s.errors()[0]
+    # unchanged, and the experiment still runs
+    if name == "N":
+        assert s.fmu.getInteger([s.vr["N"]]) == [START["N"]]
+    else:
+        assert s.fmu.getReal([s.vr[name]]) == [START.get(name, 0.0)]
+    s.fmu.exitInitializationMode()
+    s.fmu.doStep(0.0, 0.01)
+
+
+def test_step_size_h_not_representable_is_an_error(sl):
+    s = sl()
+    s.fmu.setupExperiment(startTime=0.0)
+    s.fmu.enterInitializationMode()
+    s.fmu.setReal([s.vr["tau"]], [1e-310])  # finite and > 0, but h = tau/N is subnormal
+    with pytest.raises(FMICallException):
+        s.fmu.exitInitializationMode()
+    assert "solver" in s.errors()[-1]
+
+
+def test_illegal_call_sequence(sl):
+    s = sl()
+    with pytest.raises(FMICallException):
+        s.fmu.doStep(0.0, 0.01)  # before initialization
+    with pytest.raises(FMICallException):
+        s.fmu.exitInitializationMode()
+    start(s)
+    s.fmu.doStep(0.0, 0.01)
+    with pytest.raises(FMICallException):
+        s.fmu.setReal([s.vr["alpha"]], [2.0])  # a parameter after initialization
+    with pytest.raises(FMICallException):
+        s.fmu.doStep(0.5, 0.01)  # not the FMU's time
+    with pytest.raises(FMICallException):
+        s.fmu.doStep(0.01, -0.01)
+    with pytest.raises(FMICallException):
+        s.fmu.setReal([s.vr["w"]], [1.0])  # an output
+    assert len(s.errors()) == 6
+    # a time equal to the FMU's up to a tiny fraction of h is accepted
+    s.fmu.doStep(0.01 + 1e-12, 0.01)
+    s.fmu.setReal([s.vr["g_in"]], [0.5])  # the input may be set between steps
+    s.fmu.terminate()
+    with pytest.raises(FMICallException):
+        s.fmu.doStep(0.02, 0.01)
+    assert len(s.errors()) == 7 and "terminated" in s.errors()[-1]
+
+
+def test_solver_failure_is_an_error_state(sl):
+    s = sl()
+    start(s)
+    s.fmu.setReal([s.vr["g_in"]], [1e308])  # v overflows after about 1800 steps
+    with pytest.raises(FMICallException):
+        s.fmu.doStep(0.0, 5.0)
+    assert "fmi2DoStep" in s.errors()[-1] and "inf" in s.errors()[-1]
+    with pytest.raises(FMICallException):
+        s.fmu.doStep(5.0, 0.01)  # error state: no more steps
+    assert "not allowed in state error" in s.errors()[-1]
+    s.fmu.reset()
+    start(s)
+    s.fmu.doStep(0.0, 0.01)
+
+
+def test_logging_honours_flags_and_categories(sl):
+    quiet = sl(name="quiet", logging_on=False)
+    start(quiet)
+    quiet.fmu.doStep(0.0, 0.01)
+    assert quiet.log == []
+    loud = sl(name="loud", logging_on=True)
+    start(loud)
+    loud.fmu.doStep(0.0, 0.01)
+    calls = [m for st, c, m in loud.log if c == "logCalls"]
+    assert "fmi2DoStep" in calls and "fmi2ExitInitializationMode" in calls
+    loud.fmu.setDebugLogging(True, ["logStatusError"])  # calls no longer traced
+    n = len(loud.log)
+    loud.fmu.doStep(0.01, 0.01)
+    assert len(loud.log) == n
+    with pytest.raises(FMICallException):
+        loud.fmu.setDebugLogging(True, ["noSuchCategory"])
+    assert "noSuchCategory" in loud.errors()[-1]
+    loud.fmu.setDebugLogging(False, [])
+    with pytest.raises(FMICallException):
+        loud.fmu.doStep(5.0, 0.01)
+    assert loud.log[-1][1] == "logStatusError"  # errors are reported all the same
+
+
+def test_instantiate_rejects_wrong_guid(md, unzipdir):
+    from types import SimpleNamespace
+    from conftest import Slave
+    wrong = SimpleNamespace(guid="{00000000-0000-0000-0000-000000000000}", coSimulation=md.coSimulation)
+    with pytest.raises(Exception, match="instantiate"):
+        Slave(wrong, unzipdir)
+
+
+# ---- the main-job script ----
+
+def test_fmu_run_script_writes_the_csv(source_dir, fmu_path, native43, tmp_path):
+    out = tmp_path / "run.csv"
+    subprocess.run([sys.executable, os.path.join(source_dir, "scripts", "fmu_run.py"), "--fmu",
+                    fmu_path, "--out", str(out)], check=True, timeout=120)
+    lines = out.read_text().splitlines()
+    assert lines[0] == "t,w,v,friction,delay_force,sticking"
+    rows = np.array([[float(x) for x in l.split(",")] for l in lines[1:]])
+    assert rows[0, 0] == 0.0 and abs(rows[-1, 0] - T) < 1e-9
+    assert_close(rows[:, 1:5], native43.table(rows[:, 0])[:, :4])
