@@ -265,46 +265,94 @@ fmi2Status fmi2Reset(fmi2Component c)
 
 /* ---- getting and setting variables ---- */
 
+/* Element i of a value array through the model's getter or setter. */
+typedef int get_fn(const model *m, unsigned vr, void *values, size_t i, char *err);
+typedef int set_fn(model *m, unsigned vr, const void *values, size_t i, char *err);
+
+static int get_real(const model *m, unsigned vr, void *values, size_t i, char *err)
+{
+    return model_get_real(m, vr, (fmi2Real *)values + i, err);
+}
+
+static int get_integer(const model *m, unsigned vr, void *values, size_t i, char *err)
+{
+    return model_get_integer(m, vr, (fmi2Integer *)values + i, err);
+}
+
+static int get_boolean(const model *m, unsigned vr, void *values, size_t i, char *err)
+{
+    int b = 0;
+    if (model_get_boolean(m, vr, &b, err) != 0)
+        return -1;
+    ((fmi2Boolean *)values)[i] = b ? fmi2True : fmi2False;
+    return 0;
+}
+
+static int set_real(model *m, unsigned vr, const void *values, size_t i, char *err)
+{
+    return model_set_real(m, vr, ((const fmi2Real *)values)[i], err);
+}
+
+static int set_integer(model *m, unsigned vr, const void *values, size_t i, char *err)
+{
+    return model_set_integer(m, vr, ((const fmi2Integer *)values)[i], err);
+}
+
+static fmi2Status get_values(fmi2Component c, const char *fn, const fmi2ValueReference vr[],
+                             size_t nvr, void *value, get_fn *get)
+{
+    instance *in = enter(c, fn, READABLE);
+    char err[MODEL_ERRLEN];
+    if (!in || bad_arrays(in, fn, vr, nvr, value))
+        return fmi2Error;
+    for (size_t i = 0; i < nvr; i++)
+        if (get(&in->m, vr[i], value, i, err) != 0)
+            return error(in, "%s: %s", fn, err);
+    return fmi2OK;
+}
+
+/* Whether the variable vr may be set in the instance's state. */
+static int settable(const instance *in, unsigned vr)
+{
+    return model_is_parameter(vr) ? (in->state & (INSTANTIATED | INIT_MODE)) != 0 : 1;
+}
+
+/* All values or none. */
+static fmi2Status set_values(fmi2Component c, const char *fn, const fmi2ValueReference vr[],
+                             size_t nvr, const void *value, set_fn *set)
+{
+    instance *in = enter(c, fn, INSTANTIATED | INIT_MODE | STEP_COMPLETE);
+    char err[MODEL_ERRLEN];
+    if (!in || bad_arrays(in, fn, vr, nvr, value))
+        return fmi2Error;
+    model next = in->m;
+    for (size_t i = 0; i < nvr; i++) {
+        if (!settable(in, vr[i]))
+            return error(in, "%s: the parameter with value reference %u cannot be changed after "
+                             "initialization", fn, vr[i]);
+        if (set(&next, vr[i], value, i, err) != 0)
+            return error(in, "%s: %s", fn, err);
+    }
+    in->m = next;
+    return fmi2OK;
+}
+
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                        fmi2Real value[])
 {
-    instance *in = enter(c, "fmi2GetReal", READABLE);
-    char err[MODEL_ERRLEN];
-    if (!in || bad_arrays(in, "fmi2GetReal", vr, nvr, value))
-        return fmi2Error;
-    for (size_t i = 0; i < nvr; i++)
-        if (model_get_real(&in->m, vr[i], &value[i], err) != 0)
-            return error(in, "fmi2GetReal: %s", err);
-    return fmi2OK;
+    return get_values(c, "fmi2GetReal", vr, nvr, value, get_real);
 }
 
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                           fmi2Integer value[])
 {
-    instance *in = enter(c, "fmi2GetInteger", READABLE);
-    char err[MODEL_ERRLEN];
-    if (!in || bad_arrays(in, "fmi2GetInteger", vr, nvr, value))
-        return fmi2Error;
-    for (size_t i = 0; i < nvr; i++)
-        if (model_get_integer(&in->m, vr[i], &value[i], err) != 0)
-            return error(in, "fmi2GetInteger: %s", err);
-    return fmi2OK;
+    return get_values(c, "fmi2GetInteger", vr, nvr, value, get_integer);
 }
 
 fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                           fmi2Boolean value[])
 {
-    instance *in = enter(c, "fmi2GetBoolean", READABLE);
-    char err[MODEL_ERRLEN];
-    if (!in || bad_arrays(in, "fmi2GetBoolean", vr, nvr, value))
-        return fmi2Error;
-    for (size_t i = 0; i < nvr; i++) {
-        int b = 0;
-        if (model_get_boolean(&in->m, vr[i], &b, err) != 0)
-            return error(in, "fmi2GetBoolean: %s", err);
-        value[i] = b ? fmi2True : fmi2False;
-    }
-    return fmi2OK;
+    return get_values(c, "fmi2GetBoolean", vr, nvr, value, get_boolean);
 }
 
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -318,48 +366,16 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
     return nvr == 0 ? fmi2OK : error(in, "fmi2GetString: the FMU has no String variables");
 }
 
-/* Whether the variable vr may be set in the instance's state. */
-static int settable(const instance *in, unsigned vr)
-{
-    return model_is_parameter(vr) ? (in->state & (INSTANTIATED | INIT_MODE)) != 0 : 1;
-}
-
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                        const fmi2Real value[])
 {
-    instance *in = enter(c, "fmi2SetReal", INSTANTIATED | INIT_MODE | STEP_COMPLETE);
-    char err[MODEL_ERRLEN];
-    if (!in || bad_arrays(in, "fmi2SetReal", vr, nvr, value))
-        return fmi2Error;
-    model next = in->m; /* all values or none */
-    for (size_t i = 0; i < nvr; i++) {
-        if (!settable(in, vr[i]))
-            return error(in, "fmi2SetReal: the parameter with value reference %u cannot be "
-                             "changed after initialization", vr[i]);
-        if (model_set_real(&next, vr[i], value[i], err) != 0)
-            return error(in, "fmi2SetReal: %s", err);
-    }
-    in->m = next;
-    return fmi2OK;
+    return set_values(c, "fmi2SetReal", vr, nvr, value, set_real);
 }
 
 fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                           const fmi2Integer value[])
 {
-    instance *in = enter(c, "fmi2SetInteger", INSTANTIATED | INIT_MODE | STEP_COMPLETE);
-    char err[MODEL_ERRLEN];
-    if (!in || bad_arrays(in, "fmi2SetInteger", vr, nvr, value))
-        return fmi2Error;
-    model next = in->m;
-    for (size_t i = 0; i < nvr; i++) {
-        if (!settable(in, vr[i]))
-            return error(in, "fmi2SetInteger: the parameter with value reference %u cannot be "
-                             "changed after initialization", vr[i]);
-        if (model_set_integer(&next, vr[i], value[i], err) != 0)
-            return error(in, "fmi2SetInteger: %s", err);
-    }
-    in->m = next;
-    return fmi2OK;
+    return set_values(c, "fmi2SetInteger", vr, nvr, value, set_integer);
 }
 
 fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
