@@ -5,16 +5,26 @@
 #       the functions declared DMI_API in HEADER = the global symbols of MAP
 #       = the defined dynamic symbols of LIBSHARED, each with the version of
 #       its MAP node; SONAME libdmi.so.<major>; LIBSTATIC defines only dmi_*
-#       global symbols.
+#       global symbols; the enum constants keep their released values.
 #   check_symbols.py fortran HEADER MODULE_SOURCE
 #       every DMI_API function has an interface bound to it (bind(C, name=...))
-#       or a module procedure of the same name in MODULE_SOURCE.
+#       and a public Fortran procedure of the same name in MODULE_SOURCE, and
+#       every DMI_* constant of HEADER is a parameter of the same value there.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 import re
 import subprocess
 import sys
 
 failures = []
+
+# The enum constants of the released ABI (soname libdmi.so.1): a program compiled
+# with them must keep working, so a value never changes within a soname.
+# New constants may be added (and then listed here when released).
+RELEASED_CONSTANTS = {
+    "DMI_OK": 0, "DMI_EINVAL": -1, "DMI_ENOMEM": -2, "DMI_ECALLBACK": -3,
+    "DMI_ENONFINITE": -4, "DMI_ESTATE": -5,
+    "DMI_CONV_AUTO": 0, "DMI_CONV_DIRECT": 1, "DMI_CONV_FFT": 2,
+}
 
 
 def check(ok, message):
@@ -30,6 +40,15 @@ def header_functions(path):
     check(len(names) == len(set(names)), f"{path}: a function is declared twice: {names}")
     check(names, f"{path}: no DMI_API function found")
     return set(names)
+
+
+def header_constants(path):
+    """{name: value} of the DMI_* enumerators and #defines with integer values."""
+    text = open(path, encoding="utf-8").read()
+    text = re.sub(r"/\*.*?\*/", " ", text, flags=re.S)
+    found = re.findall(r"^\s*(DMI_\w+)\s*=\s*(-?\d+)\s*,?\s*$", text, flags=re.M)
+    found += re.findall(r"^\s*#\s*define\s+(DMI_\w+)\s+(-?\d+)\s*$", text, flags=re.M)
+    return {name: int(value) for name, value in found}
 
 
 def version_nodes(path):
@@ -68,12 +87,17 @@ def dynamic_symbols(lib):
 
 def check_library(header, mapfile, shared, static):
     api = header_functions(header)
+    constants = header_constants(header)
+    for name, value in RELEASED_CONSTANTS.items():
+        check(constants.get(name) == value,
+              f"{header}: {name} is {constants.get(name)}, released as {value}")
+    major = constants.get("DMI_VERSION_MAJOR")
     nodes = version_nodes(mapfile)
-    check(nodes and nodes[0][0] == "DMI_1.0" and nodes[0][1] is None,
-          f"{mapfile}: the first node must be DMI_1.0 (inheriting nothing)")
+    check(nodes and nodes[0][0] == f"DMI_{major}.0" and nodes[0][1] is None,
+          f"{mapfile}: the first node must be DMI_{major}.0 (inheriting nothing)")
     node_of = {}
     for i, (name, parent, globs) in enumerate(nodes):
-        check(re.fullmatch(r"DMI_1\.\d+", name), f"{mapfile}: node {name} is not DMI_1.<minor>")
+        check(re.fullmatch(rf"DMI_{major}\.\d+", name), f"{mapfile}: node {name} is not DMI_{major}.<minor>")
         if i > 0:
             check(parent == nodes[i - 1][0], f"{mapfile}: node {name} must inherit {nodes[i - 1][0]}")
         for g in globs:
@@ -94,9 +118,8 @@ def check_library(header, mapfile, shared, static):
               f"the script says '{node_of.get(name)}'")
 
     dyn = subprocess.run(["readelf", "-d", shared], check=True, capture_output=True, text=True).stdout
-    major = re.search(r"#define\s+DMI_VERSION_MAJOR\s+(\d+)", open(header, encoding="utf-8").read())
     soname = re.search(r"\(SONAME\).*\[(.*)\]", dyn)
-    check(major and soname and soname.group(1) == f"libdmi.so.{major.group(1)}",
+    check(soname and soname.group(1) == f"libdmi.so.{major}",
           f"{shared}: SONAME {soname and soname.group(1)} is not libdmi.so.<DMI_VERSION_MAJOR>")
 
     out = subprocess.run(["nm", "--defined-only", "--extern-only", static], check=True,
@@ -120,6 +143,16 @@ def check_fortran(header, module):
         check(name in bound, f"{module}: no interface bound to the C function {name}")
         check(name in procedures and name in public,
               f"{module}: no public Fortran procedure named {name}")
+    parameters = {}  # name: (value, public)
+    for attrs, name, value in re.findall(r"^\s*integer\b(.*\bparameter\b.*)::\s*(DMI_\w+)\s*=\s*(-?\d+)",
+                                         text, flags=re.I | re.M):
+        parameters[name.upper()] = (int(value), bool(re.search(r"\bpublic\b", attrs, flags=re.I))
+                                    or name.lower() in public)
+    constants = header_constants(header)
+    check(constants, f"{header}: no DMI_* constant found")
+    for name, value in sorted(constants.items()):
+        check(parameters.get(name) == (value, True),
+              f"{module}: public parameter {name} = {value} expected, found {parameters.get(name)}")
 
 
 def main(argv):

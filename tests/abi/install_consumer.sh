@@ -2,11 +2,12 @@
 # Installs a build tree into a temporary prefix and builds and runs the
 # consumer programs (tests/abi/consumer) from a copy outside the source tree,
 # as a user of the installed package would.
-#   install_consumer.sh cmake|pkg-config BUILD_DIR LIBDIR INCLUDEDIR [fortran]
+#   install_consumer.sh cmake|pkg-config BUILD_DIR LIBDIR INCLUDEDIR [fortran] [FILE...]
 # cmake: a CMake project with find_package(dmi) (shared, static and, with
 # "fortran", the Fortran module); pkg-config: the compilers with the flags of
 # dmi.pc (and dmi-fortran.pc).  LIBDIR and INCLUDEDIR are the build's
 # CMAKE_INSTALL_LIBDIR and CMAKE_INSTALL_INCLUDEDIR (relative to the prefix).
+# FILEs (relative to the prefix) must be installed too (e.g. the FMU).
 # CC and FC name the compilers.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 set -euo pipefail
@@ -14,7 +15,9 @@ mode=$1
 build=$(cd "$2" && pwd)
 lib=$3
 inc=$4
-fortran=${5:-}
+shift 4
+fortran=
+if [[ ${1:-} == fortran ]]; then fortran=1; shift; fi
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 work=$(mktemp -d "${TMPDIR:-/tmp}/dmi-install.XXXXXX")
 trap 'rm -rf "$work"' EXIT
@@ -24,7 +27,7 @@ cd "$work" # (gfortran writes module files into the current folder)
 cmake --install "$build" --prefix "$prefix" >/dev/null
 cp -r "$here/consumer" "$work/src"
 for f in "$inc/dmi.h" "$lib/libdmi.so.1" "$lib/libdmi.a" "$lib/cmake/dmi/dmiConfig.cmake" \
-         "$lib/cmake/dmi/dmiConfigVersion.cmake" "$lib/pkgconfig/dmi.pc"; do
+         "$lib/cmake/dmi/dmiConfigVersion.cmake" "$lib/pkgconfig/dmi.pc" "$@"; do
   [[ -e $prefix/$f ]] || { echo "not installed: $f"; exit 1; }
 done
 if [[ $fortran ]]; then
@@ -77,6 +80,7 @@ pkg-config)
   fi
   ;;
 *)
-  echo "usage: install_consumer.sh cmake|pkg-config BUILD_DIR LIBDIR INCLUDEDIR [fortran]"; exit 2 ;;
+  echo "usage: install_consumer.sh cmake|pkg-config BUILD_DIR LIBDIR INCLUDEDIR [fortran] [FILE...]"
+  exit 2 ;;
 esac
 echo "installed package works ($mode)"

@@ -210,6 +210,7 @@ program test_binding
   call expect_ok(dmi_get_step_index(s, index), 'dmi_get_step_index')
   call check(index == 2, 'step index after two steps')
   call dmi_free(s)
+  deallocate(buf, message) ! (main program variables are not freed at its end)
 
   if (failures > 0) then
     print '(i0, a)', failures, ' failure(s)'
