@@ -169,35 +169,38 @@ int model_do_step(model *m, double t_current, double step, char *err)
     return 0;
 }
 
-/* The outputs at t_comm: u_h(t_comm) interpolated between U^{p-1} and U^p,
- * and the terms of the last step (from t_{p-1} to t_p). */
-static void outputs(const model *m, double u[2], double W[2], double X[2])
+/* The outputs at t_comm: w, v = u_h(t_comm), interpolated between U^{p-1}
+ * and U^p; friction, delay force and sticking of the last step (from t_{p-1}
+ * to t_p).  Before the first step: U^0, no forces. */
+typedef struct {
+    double w, v, friction, delay_force;
+    int sticking;
+} output_values;
+
+static output_values outputs(const model *m)
 {
+    output_values o = {m->real[VR_w0], m->real[VR_v0], 0.0, 0.0, m->real[VR_v0] == 0.0};
     uint64_t p = 0;
-    if (!m->solver) {
-        u[0] = m->real[VR_w0];
-        u[1] = m->real[VR_v0];
-        W[1] = 0.0;
-        X[1] = u[1];
-        return;
-    }
-    dmi_get_step_index(m->solver, &p);
-    dmi_get_state(m->solver, u);
-    if (p == 0) {
-        W[1] = 0.0;
-        X[1] = u[1];
-        return;
-    }
-    dmi_get_step_terms(m->solver, W, X);
+    double U[2], prev[2], W[2], X[2];
+    if (!m->solver || dmi_get_step_index(m->solver, &p) != DMI_OK || p == 0)
+        return o;
     const double h = dmi_get_h(m->solver);
+    dmi_get_state(m->solver, U);
+    dmi_get_past(m->solver, 1, prev);
+    dmi_get_step_terms(m->solver, W, X);
     const double theta = (m->t_comm - m->t_start) / h - (double)(p - 1);
-    if (theta < 1.0 - MODEL_TIME_TOL) {
-        double prev[2];
-        dmi_get_past(m->solver, 1, prev);
+    if (theta >= 1.0 - MODEL_TIME_TOL) {
+        o.w = U[0];
+        o.v = U[1];
+    } else {
         const double th = theta > 0.0 ? theta : 0.0;
-        for (int i = 0; i < 2; i++)
-            u[i] = prev[i] + th * (u[i] - prev[i]);
+        o.w = prev[0] + th * (U[0] - prev[0]);
+        o.v = prev[1] + th * (U[1] - prev[1]);
     }
+    o.friction = (X[1] - U[1]) / h;
+    o.delay_force = W[1];
+    o.sticking = U[1] == 0.0;
+    return o;
 }
 
 int model_get_real(const model *m, unsigned vr, double *value, char *err)
@@ -206,15 +209,12 @@ int model_get_real(const model *m, unsigned vr, double *value, char *err)
         *value = m->real[vr];
         return 0;
     }
-    double u[2], W[2], X[2], U[2] = {m->real[VR_w0], m->real[VR_v0]};
-    outputs(m, u, W, X);
-    if (m->solver)
-        dmi_get_state(m->solver, U);
+    const output_values o = outputs(m);
     switch (vr) {
-    case VR_w: *value = u[0]; return 0;
-    case VR_v: *value = u[1]; return 0;
-    case VR_friction: *value = m->solver ? (X[1] - U[1]) / dmi_get_h(m->solver) : 0.0; return 0;
-    case VR_delay_force: *value = W[1]; return 0;
+    case VR_w: *value = o.w; return 0;
+    case VR_v: *value = o.v; return 0;
+    case VR_friction: *value = o.friction; return 0;
+    case VR_delay_force: *value = o.delay_force; return 0;
     default:
         return fail(err, "value reference %u is not a Real variable", vr);
     }
@@ -232,10 +232,7 @@ int model_get_boolean(const model *m, unsigned vr, int *value, char *err)
 {
     if (vr != VR_sticking)
         return fail(err, "value reference %u is not a Boolean variable", vr);
-    double U[2] = {m->real[VR_w0], m->real[VR_v0]};
-    if (m->solver)
-        dmi_get_state(m->solver, U);
-    *value = U[1] == 0.0;
+    *value = outputs(m).sticking;
     return 0;
 }
 
