@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # Simulates DelayFrictionOscillator.fmu with fmpy from its start values
 # (Example 4.3) and writes the CSV t,w,v,friction,delay_force,sticking.
-# Usage: scripts/fmu_run.py [--fmu PATH] [--out CSV] [--stop-time T] [--interval DT]
+# Usage: scripts/fmu_run.py [--fmu PATH] [--out CSV | CSV] [--stop-time T] [--interval DT]
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 import argparse
 import os
@@ -17,9 +17,12 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--fmu", default=os.path.join(root, "build", "fmu", "DelayFrictionOscillator.fmu"))
     ap.add_argument("--out", default="fmu_ex43.csv")
+    ap.add_argument("csv", nargs="?", help="the CSV to write (same as --out)")
     ap.add_argument("--stop-time", type=float, help="default: the FMU's DefaultExperiment")
     ap.add_argument("--interval", type=float, help="output interval; default: its stepSize")
     a = ap.parse_args()
+    if a.csv:
+        a.out = a.csv
     if not os.path.isfile(a.fmu):
         sys.exit(f"fmu_run: {a.fmu} not found (build the project first)")
     de = read_model_description(a.fmu).defaultExperiment
