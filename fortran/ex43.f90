@@ -60,13 +60,20 @@ program ex43_fortran
   real(c_double), parameter :: alpha(2) = [0.0_c_double, 1.0_c_double]
   type(oscillator), target :: model
   type(c_ptr) :: s
+  ! N, T, stride as given (defaults 9991, 30, 1)
+  character(len=64) :: args(3) = [character(len=64) :: '9991', '30', '1']
+  integer :: i, ios(3)
 
-  n_tau = 9991
-  t_end = 30
-  stride = 1
-  if (command_argument_count() >= 1) n_tau = int_argument(1)
-  if (command_argument_count() >= 2) t_end = real_argument(2)
-  if (command_argument_count() >= 3) stride = max(int_argument(3), 1_c_size_t)
+  do i = 1, min(command_argument_count(), size(args))
+    call get_command_argument(i, args(i))
+  end do
+  read (args(1), *, iostat=ios(1)) n_tau
+  read (args(2), *, iostat=ios(2)) t_end
+  read (args(3), *, iostat=ios(3)) stride
+  if (any(ios /= 0) .or. n_tau < 1 .or. stride < 1) then
+    write (error_unit, '(a)') 'usage: ex43_fortran [N [T [stride]]]'
+    stop 2
+  end if
   model = oscillator(1.0_c_double, 1.3_c_double, 8.0_c_double)
 
   s = c_null_ptr
@@ -111,21 +118,4 @@ contains
     write (buf, '(es25.16e3)') x
     str = trim(adjustl(buf))
   end function number
-
-  function int_argument(i) result(v)
-    integer, intent(in) :: i
-    integer(c_size_t) :: v
-    character(len=64) :: arg
-    call get_command_argument(i, arg)
-    read (arg, *) v
-  end function int_argument
-
-  function real_argument(i) result(v)
-    integer, intent(in) :: i
-    real(c_double) :: v
-    character(len=64) :: arg
-    call get_command_argument(i, arg)
-    read (arg, *) v
-  end function real_argument
-
 end program ex43_fortran
