@@ -101,6 +101,16 @@ int core_close_rel(const char *what, double a, double b, double rel)
     return ok;
 }
 
+dmi_solver *core_paper_solver(paper_example *ex, size_t N)
+{
+    dmi_solver *s = NULL;
+    if (dmi_create(&s, 2, 1.0, N) != DMI_OK)
+        return NULL;
+    if (paper_setup(s, ex) != DMI_OK || dmi_init(s) != DMI_OK)
+        dmi_free(&s);
+    return s;
+}
+
 /* ---- saved states ---------------------------------------------------------- */
 
 unsigned char *core_save(const dmi_solver *s, size_t *size)

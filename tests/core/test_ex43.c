@@ -13,7 +13,6 @@
 #include <stdlib.h>
 
 #include "core_test.h"
-#include "paper.h"
 
 static const double T_END = 30;
 
@@ -101,13 +100,9 @@ static int dmi_ex43(size_t N, trajectory *tr)
     if (trajectory_alloc(tr, N) != 0)
         return DMI_ENOMEM;
     paper_example ex = {43};
-    dmi_solver *s = NULL;
+    dmi_solver *s = core_paper_solver(&ex, N);
     double u[2];
-    int rc = dmi_create(&s, 2, 1.0, N);
-    if (rc == DMI_OK)
-        rc = paper_setup(s, &ex);
-    if (rc == DMI_OK)
-        rc = dmi_init(s);
+    int rc = s ? DMI_OK : DMI_ENOMEM;
     for (size_t p = 0; rc == DMI_OK && p <= tr->M; p++) {
         if (p > 0)
             rc = dmi_step(s);

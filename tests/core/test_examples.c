@@ -10,7 +10,6 @@
 #include <stdlib.h>
 
 #include "core_test.h"
-#include "paper.h"
 
 /* The reference errors may differ in the third digit (README). */
 static const double REF_REL = 0.01;
@@ -24,16 +23,12 @@ typedef struct {
 static int exact_errors(int example, size_t N, max_errors *e)
 {
     paper_example ex = {example};
-    dmi_solver *s = NULL;
+    dmi_solver *s = core_paper_solver(&ex, N);
     const double h = 1.0 / (double)N;
     const size_t M = 10 * N; /* T = 10 */
     double u[2];
     *e = (max_errors){0, 0, 0, 1};
-    int rc = dmi_create(&s, 2, 1.0, N);
-    if (rc == DMI_OK)
-        rc = paper_setup(s, &ex);
-    if (rc == DMI_OK)
-        rc = dmi_init(s);
+    int rc = s ? DMI_OK : DMI_ENOMEM;
     for (size_t k = 0; rc == DMI_OK && k <= N + M; k++) { /* p = k - N */
         double t;
         if (k < N) {

@@ -12,18 +12,6 @@
 #include <string.h>
 
 #include "core_test.h"
-#include "paper.h"
-
-/* An initialised solver of a paper example with h = 1/N. */
-static dmi_solver *paper_solver(paper_example *ex, size_t N)
-{
-    dmi_solver *s = NULL;
-    if (dmi_create(&s, 2, 1.0, N) != DMI_OK)
-        return NULL;
-    if (paper_setup(s, ex) != DMI_OK || dmi_init(s) != DMI_OK)
-        dmi_free(&s);
-    return s;
-}
 
 /* Two solvers stepped in turn give what each gives alone. */
 static void test_interleaved(void)
@@ -31,9 +19,9 @@ static void test_interleaved(void)
     enum { K = 700 };
     paper_example ex = {42};
     core_model m1 = {0}, m2 = {0};
-    dmi_solver *a = paper_solver(&ex, 200), *b = core_model_solver(&m1, 16);
-    dmi_solver *a2 = paper_solver(&ex, 200), *b2 = core_model_solver(&m2, 16);
-    dmi_solver *a3 = paper_solver(&ex, 200); /* same model, same user data as a2 */
+    dmi_solver *a = core_paper_solver(&ex, 200), *b = core_model_solver(&m1, 16);
+    dmi_solver *a2 = core_paper_solver(&ex, 200), *b2 = core_model_solver(&m2, 16);
+    dmi_solver *a3 = core_paper_solver(&ex, 200); /* same model, same user data as a2 */
     CU_ASSERT_FATAL(a && b && a2 && b2 && a3);
     CU_ASSERT_EQUAL(dmi_advance(a, K), DMI_OK);
     CU_ASSERT_EQUAL(dmi_advance(b, K), DMI_OK);
@@ -306,15 +294,22 @@ static void test_time(void)
     dmi_free(&s);
 }
 
+/* a: a model solver that ran 45 steps and was then restarted by dmi_init;
+ * b: a new one. */
+static int restarted_pair(core_model *m1, core_model *m2, dmi_solver **a, dmi_solver **b)
+{
+    *a = core_model_solver(m1, 16);
+    *b = core_model_solver(m2, 16);
+    return *a && *b && dmi_advance(*a, 45) == DMI_OK && dmi_init(*a) == DMI_OK;
+}
+
 /* dmi_init on a solver that has run restarts it exactly as a new one: same
  * counter, history and no last step; the same run afterwards, bitwise. */
 static void test_restart(void)
 {
     core_model m1 = {0}, m2 = {0};
-    dmi_solver *a = core_model_solver(&m1, 16), *b = core_model_solver(&m2, 16);
-    CU_ASSERT_FATAL(a && b);
-    CU_ASSERT_EQUAL(dmi_advance(a, 45), DMI_OK);
-    CU_ASSERT_EQUAL(dmi_init(a), DMI_OK);
+    dmi_solver *a, *b;
+    CU_ASSERT_FATAL(restarted_pair(&m1, &m2, &a, &b));
     uint64_t pa = 1, pb = 2;
     CU_ASSERT(dmi_get_step_index(a, &pa) == DMI_OK && dmi_get_step_index(b, &pb) == DMI_OK &&
               pa == pb);
@@ -338,10 +333,8 @@ static void test_restart(void)
 static void test_restart_bytes(void)
 {
     core_model m1 = {0}, m2 = {0};
-    dmi_solver *a = core_model_solver(&m1, 16), *b = core_model_solver(&m2, 16);
-    CU_ASSERT_FATAL(a && b);
-    CU_ASSERT_EQUAL(dmi_advance(a, 45), DMI_OK);
-    CU_ASSERT_EQUAL(dmi_init(a), DMI_OK);
+    dmi_solver *a, *b;
+    CU_ASSERT_FATAL(restarted_pair(&m1, &m2, &a, &b));
     int same = core_same_state(a, b);
     if (!same)
         printf("\n  BUG (src/dmi.c): after dmi_init the saved state still holds the former "
