@@ -94,15 +94,16 @@ static int independent_ex43(size_t N, trajectory *tr)
     return 0;
 }
 
-/* The same with libdmi and the model of examples/paper.c. */
-static int dmi_ex43(size_t N, trajectory *tr)
+/* The same with libdmi, the model of examples/paper.c and the given method
+ * of the delay sum. */
+static int dmi_ex43(size_t N, int method, trajectory *tr)
 {
     if (trajectory_alloc(tr, N) != 0)
         return DMI_ENOMEM;
     paper_example ex = {43};
     dmi_solver *s = core_paper_solver(&ex, N);
     double u[2];
-    int rc = s ? DMI_OK : DMI_ENOMEM;
+    int rc = s ? dmi_set_convolution(s, method) : DMI_ENOMEM;
     for (size_t p = 0; rc == DMI_OK && p <= tr->M; p++) {
         if (p > 0)
             rc = dmi_step(s);
@@ -183,37 +184,43 @@ static size_t check_phases(const trajectory *tr, phase *ph)
     return count;
 }
 
-/* libdmi against the straightforward computation at N = 1000. */
+/* libdmi (each method of the delay sum) against the straightforward
+ * computation at N = 1000. */
 static void test_against_independent(void)
 {
     const size_t N = 1000;
-    trajectory a = {0}, b = {0};
-    CU_ASSERT_EQUAL_FATAL(dmi_ex43(N, &a), DMI_OK);
-    if (independent_ex43(N, &b) != 0) {
-        trajectory_free(&a);
-        CU_FAIL_FATAL("out of memory");
-    }
-    double dw = 0, dv = 0, scale = 0;
-    for (size_t p = 0; p <= a.M; p++) {
-        dw = fmax(dw, fabs(a.w[p] - b.w[p]));
-        dv = fmax(dv, fabs(a.v[p] - b.v[p]));
-        scale = fmax(scale, fmax(fabs(b.w[p]), fabs(b.v[p])));
-    }
-    printf("\n  N = 1000: max |w - w_indep| = %.3e, max |v - v_indep| = %.3e (max |u| = %.3f)", dw,
-           dv, scale);
-    CU_ASSERT(dw <= 1e-12);
-    CU_ASSERT(dv <= 1e-12);
-    CU_ASSERT(scale > 0.01); /* the comparison is not of two zero solutions */
-
+    const int methods[] = {DMI_CONV_AUTO, DMI_CONV_DIRECT, DMI_CONV_FFT};
+    trajectory b = {0};
+    CU_ASSERT_FATAL(independent_ex43(N, &b) == 0);
     static phase pa[MAX_PHASES], pb[MAX_PHASES];
-    size_t na = check_phases(&a, pa), nb = check_phases(&b, pb);
-    CU_ASSERT_EQUAL(na, nb);
-    int same = na == nb;
-    for (size_t k = 0; same && k < na && k < MAX_PHASES; k++)
-        same = pa[k].first == pb[k].first && pa[k].last == pb[k].last;
-    CU_ASSERT(same);
+    size_t nb = check_phases(&b, pb);
+    for (int m = 0; m < 3; m++) {
+        trajectory a = {0};
+        if (dmi_ex43(N, methods[m], &a) != DMI_OK) {
+            trajectory_free(&b);
+            CU_FAIL_FATAL("libdmi run of Example 4.3 failed");
+        }
+        double dw = 0, dv = 0, scale = 0;
+        for (size_t p = 0; p <= a.M; p++) {
+            dw = fmax(dw, fabs(a.w[p] - b.w[p]));
+            dv = fmax(dv, fabs(a.v[p] - b.v[p]));
+            scale = fmax(scale, fmax(fabs(b.w[p]), fabs(b.v[p])));
+        }
+        printf("\n  N = 1000, method %d: max |w - w_indep| = %.3e, max |v - v_indep| = %.3e "
+               "(max |u| = %.3f)",
+               methods[m], dw, dv, scale);
+        CU_ASSERT(dw <= 1e-12);
+        CU_ASSERT(dv <= 1e-12);
+        CU_ASSERT(scale > 0.01); /* the comparison is not of two zero solutions */
+        size_t na = check_phases(&a, pa);
+        CU_ASSERT_EQUAL(na, nb);
+        int same = na == nb;
+        for (size_t k = 0; same && k < na && k < MAX_PHASES; k++)
+            same = pa[k].first == pb[k].first && pa[k].last == pb[k].last;
+        CU_ASSERT(same);
+        trajectory_free(&a);
+    }
     printf("\n");
-    trajectory_free(&a);
     trajectory_free(&b);
 }
 
@@ -226,7 +233,7 @@ static void test_against_reference(void)
     double *ref = core_read_csv("ex43_N9991.csv", 4, &rows);
     CU_ASSERT_PTR_NOT_NULL_FATAL(ref);
     trajectory a = {0};
-    if (dmi_ex43(N, &a) != DMI_OK) {
+    if (dmi_ex43(N, DMI_CONV_AUTO, &a) != DMI_OK) {
         free(ref);
         CU_FAIL_FATAL("libdmi run of Example 4.3 failed");
     }
@@ -263,7 +270,7 @@ static void test_against_reference(void)
 int main(int argc, char **argv)
 {
     static const core_test tests[] = {
-        {"Example 4.3, N = 1000: libdmi = straightforward computation, same phases",
+        {"Example 4.3, N = 1000: libdmi (each method) = straightforward computation, phases",
          test_against_independent},
         {"Example 4.3, h = 1/9991, T = 30: reference values and phases", test_against_reference},
         {NULL, NULL}};
