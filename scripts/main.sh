@@ -20,11 +20,15 @@ stage() { printf '\n==== %s ====\n' "$*"; }
 stage "dependencies"
 scripts/deps.sh
 
-stage "build ($build)"
-cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPython3_EXECUTABLE="$py" >/dev/null
-cmake --build "$build" -j "$(nproc)"
-
+stage "build ($build, log in $out/build.log)"
 mkdir -p "$out"
+if ! { cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPython3_EXECUTABLE="$py" &&
+       cmake --build "$build" -j "$(nproc)"; } >"$out/build.log" 2>&1; then
+  tail -n 40 "$out/build.log"
+  echo "main: the build failed (full log: $out/build.log)"
+  exit 1
+fi
+echo "built"
 ex="$build/examples"
 
 stage "Examples 4.1-4.3 at h = 1/9991: CSV in $out/"
@@ -42,11 +46,16 @@ stage "erratum: scheme (4.4) as printed against (3.12)-(3.13), Example 4.2"
 "$ex/scheme44_as_printed" 10 10 2>&1 >"$out/scheme44.csv" | tee "$out/scheme44.txt"
 
 stage "FMU: Example 4.3 with fmpy"
-rm -f "$out/fmu43.csv"
-if [[ -f scripts/fmu_run.py ]]; then
-  "$py" scripts/fmu_run.py "$out/fmu43.csv"
+rm -f "$out/fmu43.csv" "$out/ex43_fmu_native.csv"
+fmu="$build/fmu/DelayFrictionOscillator.fmu"
+if [[ -f scripts/fmu_run.py && -f $fmu ]]; then
+  "$py" scripts/fmu_run.py --fmu "$fmu" --out "$out/fmu43.csv"
+  # The native run with the FMU's step h = 1/N (its start value of N), for the overlay.
+  fmu_N=$("$py" -c 'import sys; from fmpy import read_model_description as md
+print(next(v.start for v in md(sys.argv[1]).modelVariables if v.name == "N"))' "$fmu")
+  "$ex/ex43" "$fmu_N" 30 1 >"$out/ex43_fmu_native.csv"
 else
-  echo "skipped: scripts/fmu_run.py does not exist yet (the FMU is not part of this checkout)"
+  echo "skipped: scripts/fmu_run.py or $fmu does not exist (no FMU in this checkout)"
 fi
 
 stage "figures and comparison with the paper and ../shared/reference"
