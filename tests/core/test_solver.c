@@ -228,7 +228,8 @@ static void test_defaults(void)
 }
 
 /* A user resolvent that is the soft threshold sign(x) max(|x| - lambda alpha, 0)
- * gives bitwise the run of the built-in friction (Example 4.3, with static phases). */
+ * gives bitwise the run of the built-in friction (Example 4.3, with static
+ * phases); the step terms give the friction force of the step. */
 static int soft_threshold(double lambda, const double *x, double *out, void *user)
 {
     const double *alpha = user;
@@ -251,16 +252,25 @@ static void test_user_friction(void)
     CU_ASSERT_EQUAL(dmi_set_resolvent(b, soft_threshold, alpha), DMI_OK);
     CU_ASSERT_EQUAL(dmi_init(a), DMI_OK);
     CU_ASSERT_EQUAL(dmi_init(b), DMI_OK);
-    int same = 1;
+    int same = 1, force_ok = 1;
     size_t stuck = 0;
+    const double h = 1.0 / 500;
     for (int k = 0; k < 2500; k++) {
         same &= dmi_step(a) == DMI_OK && dmi_step(b) == DMI_OK;
         if (k % 50 == 0)
             same &= core_same_state(a, b);
-        stuck += dmi_get_state(a, u) == DMI_OK && u[1] == 0.0;
+        double X[2];
+        force_ok &= dmi_get_state(a, u) == DMI_OK && dmi_get_step_terms(a, NULL, X) == DMI_OK;
+        stuck += u[1] == 0.0;
+        /* (X - U^{p+1}) / h is the element of A(U^{p+1}) = {0} x sigma(v) selected:
+         * the friction force, sign(v) when sliding, in [-1, 1] when stuck */
+        double force = (X[1] - u[1]) / h;
+        force_ok &= fabs(X[0] - u[0]) == 0.0 && fabs(force) <= 1 + 1e-9 &&
+                    (u[1] == 0.0 || fabs(force - copysign(1.0, u[1])) <= 1e-9);
     }
     CU_ASSERT(same && core_same_state(a, b));
     CU_ASSERT(stuck > 100); /* the dead zone of the threshold was used */
+    CU_ASSERT(force_ok);
     dmi_free(&a);
     dmi_free(&b);
 }
