@@ -3,7 +3,10 @@
  * fmpy: loads the unpacked FMU binary with dlopen, runs Example 4.3 at
  * N = 9991 and compares w, v at the reference's points (every 100th step,
  * values computed by an independent implementation) to 1e-12; checks on the
- * way that a saved FMU state, serialized and restored, replays bitwise.
+ * way that a saved FMU state, serialized and restored, replays bitwise; then
+ * runs the error paths on a second instance (invalid parameters, calls out of
+ * sequence, truncated state bytes, reset), so that they run under the
+ * sanitizers too.
  *
  * Usage: fmu_master FMU.so GUID ex43_N9991.csv T
  * Exit status 0 if every check passed.
@@ -19,7 +22,7 @@
 #include "fmi2FunctionTypes.h"
 
 /* Value references of the FMU (its modelDescription.xml). */
-enum { VR_w = 19, VR_v = 20, VR_N = 23 };
+enum { VR_tau = 2, VR_w = 19, VR_v = 20, VR_N = 23 };
 static const int N = 9991;
 static const double TOL = 1e-12;
 
@@ -30,6 +33,8 @@ typedef struct {
     fmi2EnterInitializationModeTYPE *enter_init;
     fmi2ExitInitializationModeTYPE *exit_init;
     fmi2SetIntegerTYPE *set_integer;
+    fmi2SetRealTYPE *set_real;
+    fmi2ResetTYPE *reset;
     fmi2GetRealTYPE *get_real;
     fmi2DoStepTYPE *do_step;
     fmi2GetFMUstateTYPE *get_state;
@@ -82,6 +87,8 @@ static int load(void *lib, fmi2 *f)
     LOAD(enter_init, "fmi2EnterInitializationMode");
     LOAD(exit_init, "fmi2ExitInitializationMode");
     LOAD(set_integer, "fmi2SetInteger");
+    LOAD(set_real, "fmi2SetReal");
+    LOAD(reset, "fmi2Reset");
     LOAD(get_real, "fmi2GetReal");
     LOAD(do_step, "fmi2DoStep");
     LOAD(get_state, "fmi2GetFMUstate");
@@ -104,6 +111,49 @@ typedef struct {
     long p;
     double w, v;
 } row;
+
+/* A second instance through the error paths: each call must give fmi2Error
+ * and leave the instance usable. */
+static void error_paths(const fmi2 *f, const char *guid, const fmi2CallbackFunctions *cb)
+{
+    fmi2Component c = f->instantiate("errors", fmi2CoSimulation, guid, "", cb, fmi2False,
+                                     fmi2False);
+    const fmi2ValueReference vr_tau = VR_tau, vr_N = VR_N, vr_wv[2] = {VR_w, VR_v};
+    const fmi2Real bad_tau = -1.0;
+    const fmi2Integer bad_N = 0;
+    double wv[2];
+    check(c != NULL, "second fmi2Instantiate");
+    if (!c)
+        return;
+    check(f->instantiate("x", fmi2CoSimulation, "{wrong}", "", cb, fmi2False, fmi2False) == NULL,
+          "wrong GUID refused");
+    check(f->do_step(c, 0.0, 0.1, fmi2False) == fmi2Error, "doStep before initialization");
+    check(f->setup(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) == fmi2OK, "setup");
+    check(f->enter_init(c) == fmi2OK, "enter initialization");
+    check(f->set_real(c, &vr_tau, 1, &bad_tau) == fmi2Error, "tau = -1 refused");
+    check(f->set_integer(c, &vr_N, 1, &bad_N) == fmi2Error, "N = 0 refused");
+    check(f->exit_init(c) == fmi2OK, "exit initialization after refused values");
+    check(f->do_step(c, 0.5, 0.1, fmi2False) == fmi2Error, "doStep from a wrong time");
+    check(f->do_step(c, 0.0, 0.1, fmi2False) == fmi2OK, "doStep");
+    fmi2FMUstate st = NULL;
+    size_t size = 0;
+    check(f->get_state(c, &st) == fmi2OK && f->state_size(c, st, &size) == fmi2OK, "get state");
+    fmi2Byte *bytes = malloc(size);
+    if (bytes && f->serialize(c, st, bytes, size) == fmi2OK) {
+        fmi2FMUstate bad = NULL;
+        check(f->deserialize(c, bytes, size - 1, &bad) == fmi2Error, "truncated state refused");
+        check(f->deserialize(c, bytes, 20, &bad) == fmi2Error, "short state refused");
+    }
+    free(bytes);
+    f->free_state(c, &st);
+    check(f->reset(c) == fmi2OK, "reset");
+    check(f->setup(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) == fmi2OK &&
+              f->enter_init(c) == fmi2OK && f->exit_init(c) == fmi2OK &&
+              f->do_step(c, 0.0, 0.1, fmi2False) == fmi2OK &&
+              f->get_real(c, vr_wv, 2, wv) == fmi2OK,
+          "a new experiment after reset");
+    f->free_instance(c);
+}
 
 static row *read_reference(const char *path, size_t *count)
 {
@@ -207,6 +257,7 @@ int main(int argc, char **argv)
         f.free_state(c, &saved);
         f.free_state(c, &back);
     }
+    error_paths(&f, argv[2], &cb);
     check(f.terminate(c) == fmi2OK, "fmi2Terminate");
     f.free_instance(c);
     dlclose(lib);
