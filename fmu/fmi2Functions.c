@@ -113,6 +113,13 @@ static int bad_arrays(instance *in, const char *fn, const void *vr, size_t nvr, 
     return 0;
 }
 
+/* A function this FMU does not provide: always fmi2Error, with the reason. */
+static fmi2Status unsupported(fmi2Component c, const char *fn, unsigned allowed, const char *why)
+{
+    instance *in = enter(c, fn, allowed);
+    return in ? error(in, "%s: %s", fn, why) : fmi2Error;
+}
+
 /* ---- common functions ---- */
 
 const char *fmi2GetTypesPlatform(void)
@@ -506,10 +513,9 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
                                         size_t nKnown, const fmi2Real dvKnown[],
                                         fmi2Real dvUnknown[])
 {
-    instance *in = enter(c, "fmi2GetDirectionalDerivative", ANY_STATE);
     (void)vUnknown_ref, (void)nUnknown, (void)vKnown_ref, (void)nKnown, (void)dvKnown,
         (void)dvUnknown;
-    return in ? error(in, "fmi2GetDirectionalDerivative: not provided by this FMU") : fmi2Error;
+    return unsupported(c, "fmi2GetDirectionalDerivative", ANY_STATE, "not provided by this FMU");
 }
 
 /* ---- co-simulation ---- */
@@ -517,19 +523,17 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[])
 {
-    instance *in = enter(c, "fmi2SetRealInputDerivatives", ANY_STATE);
     (void)vr, (void)nvr, (void)order, (void)value;
-    return in ? error(in, "fmi2SetRealInputDerivatives: the FMU does not interpolate inputs")
-              : fmi2Error;
+    return unsupported(c, "fmi2SetRealInputDerivatives", ANY_STATE,
+                       "the FMU does not interpolate inputs");
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
                                         size_t nvr, const fmi2Integer order[], fmi2Real value[])
 {
-    instance *in = enter(c, "fmi2GetRealOutputDerivatives", ANY_STATE);
     (void)vr, (void)nvr, (void)order, (void)value;
-    return in ? error(in, "fmi2GetRealOutputDerivatives: the FMU provides no output derivatives")
-              : fmi2Error;
+    return unsupported(c, "fmi2GetRealOutputDerivatives", ANY_STATE,
+                       "the FMU provides no output derivatives");
 }
 
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
@@ -548,15 +552,13 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
 
 fmi2Status fmi2CancelStep(fmi2Component c)
 {
-    instance *in = enter(c, "fmi2CancelStep", ANY_STATE);
-    return in ? error(in, "fmi2CancelStep: steps are never asynchronous") : fmi2Error;
+    return unsupported(c, "fmi2CancelStep", ANY_STATE, "steps are never asynchronous");
 }
 
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value)
 {
-    instance *in = enter(c, "fmi2GetStatus", READABLE);
     (void)s, (void)value;
-    return in ? error(in, "fmi2GetStatus: steps are never asynchronous") : fmi2Error;
+    return unsupported(c, "fmi2GetStatus", READABLE, "steps are never asynchronous");
 }
 
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value)
@@ -572,9 +574,8 @@ fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *
 
 fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value)
 {
-    instance *in = enter(c, "fmi2GetIntegerStatus", READABLE);
     (void)s, (void)value;
-    return in ? error(in, "fmi2GetIntegerStatus: no Integer status is defined") : fmi2Error;
+    return unsupported(c, "fmi2GetIntegerStatus", READABLE, "no Integer status is defined");
 }
 
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
@@ -590,7 +591,6 @@ fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boo
 
 fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value)
 {
-    instance *in = enter(c, "fmi2GetStringStatus", READABLE);
     (void)s, (void)value;
-    return in ? error(in, "fmi2GetStringStatus: no String status is defined") : fmi2Error;
+    return unsupported(c, "fmi2GetStringStatus", READABLE, "no String status is defined");
 }

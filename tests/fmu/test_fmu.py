@@ -494,3 +494,21 @@ def test_fmu_run_script_writes_the_csv(source_dir, fmu_path, native43, tmp_path)
     rows = np.array([[float(x) for x in l.split(",")] for l in lines[1:]])
     assert rows[0, 0] == 0.0 and abs(rows[-1, 0] - T) < 1e-9
     assert_close(rows[:, 1:5], native43.table(rows[:, 0])[:, :4])
+
+
+def test_status_queries_and_unsupported_functions(sl):
+    from fmpy.fmi2 import fmi2LastSuccessfulTime, fmi2Terminated, fmi2DoStepStatus
+    s = sl()
+    start(s)
+    s.fmu.doStep(0.0, 0.0123)
+    s.fmu.doStep(0.0123, 0.0123)
+    assert s.fmu.getRealStatus(fmi2LastSuccessfulTime) == 0.0123 + 0.0123
+    assert not s.fmu.getBooleanStatus(fmi2Terminated)
+    for call in (lambda: s.fmu.getStatus(fmi2DoStepStatus), s.fmu.cancelStep,
+                 lambda: s.fmu.setRealInputDerivatives([s.vr["g_in"]], [1], [0.0]),
+                 lambda: s.fmu.getDirectionalDerivative([s.vr["w"]], [s.vr["g_in"]], [1.0])):
+        n = len(s.errors())
+        with pytest.raises(FMICallException):
+            call()
+        assert len(s.errors()) == n + 1
+    s.fmu.doStep(0.0246, 0.01)  # still usable
