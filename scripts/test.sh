@@ -1,25 +1,59 @@
 #!/usr/bin/env bash
 # Runs every test: installs what is missing, builds, runs ctest (CUnit, pytest,
 # gfortran and packaging tests), then the same suite built with
-# -fsanitize=address,undefined.  Usage: scripts/test.sh
+# -fsanitize=address,undefined, then the suite under valgrind memcheck, then
+# each libFuzzer target for a bounded time.  Usage: scripts/test.sh
+#   DMI_BUILD_PREFIX   build directories <prefix>, <prefix>-asan, <prefix>-fuzz
+#                      (default: build)
+#   DMI_FUZZ_SECONDS   fuzzing time per target (default: 60)
+# Test labels: "nosan" = not run in the sanitizer build nor under valgrind
+# (Python loading a sanitized .so, abidiff, resident-memory bounds),
+# "slow" = not run under valgrind (valgrind makes it take many minutes).
+# SPDX-License-Identifier: GPL-3.0-or-later
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
 scripts/deps.sh
 jobs=$(nproc)
 py="$root/.venv/bin/python"
+build=${DMI_BUILD_PREFIX:-build}
+fuzz_seconds=${DMI_FUZZ_SECONDS:-60}
 
-stage() { printf '\n==== %s ====\n' "$*"; }
+timings=()
+stage_name=""
+stage_start=$SECONDS
+stage() {
+  [[ -n $stage_name ]] && timings+=("$(printf '%5d s  %s' $((SECONDS - stage_start)) "$stage_name")")
+  stage_name="$*"
+  stage_start=$SECONDS
+  printf '\n==== %s ====\n' "$*"
+}
 
 stage "build (RelWithDebInfo) and ctest"
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPython3_EXECUTABLE="$py" >/dev/null
-cmake --build build -j "$jobs"
-ctest --test-dir build --output-on-failure -j "$jobs"
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPython3_EXECUTABLE="$py" \
+  -DMEMORYCHECK_COMMAND_OPTIONS="--error-exitcode=1 --leak-check=full --show-leak-kinds=definite,indirect,possible --errors-for-leak-kinds=definite,indirect,possible" \
+  >/dev/null
+cmake --build "$build" -j "$jobs"
+ctest --test-dir "$build" --output-on-failure -j "$jobs"
 
 stage "build with -fsanitize=address,undefined and ctest"
-cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DDMI_SANITIZE=ON -DPython3_EXECUTABLE="$py" >/dev/null
-cmake --build build-asan -j "$jobs"
+cmake -S . -B "$build-asan" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DDMI_SANITIZE=ON -DPython3_EXECUTABLE="$py" >/dev/null
+cmake --build "$build-asan" -j "$jobs"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir build-asan --output-on-failure -j "$jobs" -LE nosan
+  ctest --test-dir "$build-asan" --output-on-failure -j "$jobs" -LE nosan
+
+stage "valgrind memcheck of the ctest suite (labels nosan and slow excluded)"
+# Each test runs under valgrind; an invalid access or a leak makes valgrind
+# exit with 1, which fails the test.
+if ! ctest --test-dir "$build" -T memcheck --output-on-failure -j "$jobs" -LE 'nosan|slow'; then
+  for log in "$build"/Testing/Temporary/MemoryChecker.*.log; do
+    grep -q "ERROR SUMMARY: [1-9]" "$log" && { echo "---- $log"; head -n 60 "$log"; }
+  done
+  exit 1
+fi
+
+stage "libFuzzer targets, $fuzz_seconds s each"
+DMI_FUZZ_BUILD="$build-fuzz" fuzz/run.sh "$fuzz_seconds"
 
 stage "all tests passed"
+printf '%s\n' "${timings[@]}" "$(printf '%5d s  total' "$SECONDS")"
