@@ -104,8 +104,7 @@ void dmi_kernel_release(dmi_kernel *k)
     memset(k, 0, sizeof *k);
 }
 
-/* sum_l a[l] b[l] with four partial sums (vectorisable, fixed order). */
-static double dot(const double *a, const double *b, size_t len)
+double dmi_dot(const double *a, const double *b, size_t len)
 {
     double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
     size_t l = 0;
@@ -124,7 +123,7 @@ void dmi_delay_sum(const dmi_kernel *k, const dmi_history *r, double h, double *
 {
     memset(W, 0, r->n * sizeof *W);
     for (size_t e = 0; e < k->nnz; e++)
-        W[k->row[e]] += dot(k->samples + e * k->N, dmi_history_series(r, k->col[e]), k->N);
+        W[k->row[e]] += dmi_dot(k->samples + e * k->N, dmi_history_series(r, k->col[e]), k->N);
     for (size_t i = 0; i < r->n; i++)
         W[i] *= h;
 }

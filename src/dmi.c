@@ -36,6 +36,7 @@ struct dmi_solver {
     uint64_t p;         /* step counter: t_p = p h */
     dmi_history ring;   /* U^{p-N..p} */
     dmi_kernel kernel;  /* nonzero entries of H(l h) */
+    dmi_conv *conv;     /* FFT engine, or NULL: the direct sum is in use */
     int have_last;      /* a step was taken since init / load */
     double *last_W;     /* W^{p-1} (n) */
     double *last_X;     /* X^{p-1} (n) */
@@ -150,6 +151,7 @@ void dmi_free(dmi_solver **ps)
     free(s->a_hi);
     dmi_history_release(&s->ring);
     dmi_kernel_release(&s->kernel);
+    dmi_conv_free(s->conv);
     free(s->last_W);
     free(s->last_X);
     free(s->work);
@@ -263,6 +265,15 @@ int dmi_set_convolution(dmi_solver *s, int method)
         return DMI_EINVAL;
     if (method != DMI_CONV_AUTO && method != DMI_CONV_DIRECT && method != DMI_CONV_FFT)
         return fail(s, DMI_EINVAL, "dmi_set_convolution: unknown method %d", method);
+    if (s->initialized) { /* the engine follows the method from the next step on */
+        dmi_conv *c = NULL;
+        if (dmi_conv_create(&c, &s->kernel, s->n, s->N, method) != 0)
+            return fail(s, DMI_ENOMEM, "dmi_set_convolution: out of memory for the FFT engine");
+        if (c)
+            dmi_conv_rebuild(c, &s->kernel, &s->ring, s->p);
+        dmi_conv_free(s->conv);
+        s->conv = c;
+    }
     s->conv_method = method;
     return DMI_OK;
 }
@@ -334,9 +345,12 @@ int dmi_init(dmi_solver *s)
     dmi_history ring = {0};
     if (dmi_history_alloc(&ring, s->n, s->N) != 0)
         return fail(s, DMI_ENOMEM, "dmi_init: out of memory for the history");
+    dmi_conv *c = NULL;
     int rc = sample_kernel(s, &k);
     if (rc == DMI_OK)
         rc = sample_history(s, &ring);
+    if (rc == DMI_OK && dmi_conv_create(&c, &k, s->n, s->N, s->conv_method) != 0)
+        rc = fail(s, DMI_ENOMEM, "dmi_init: out of memory for the FFT engine");
     if (rc != DMI_OK) {
         dmi_kernel_release(&k);
         dmi_history_release(&ring);
@@ -346,8 +360,14 @@ int dmi_init(dmi_solver *s)
     dmi_history_release(&s->ring);
     s->kernel = k;
     s->ring = ring;
+    dmi_conv_free(s->conv);
+    s->conv = c;
+    if (c) /* the history's FFT part, before the first step */
+        dmi_conv_rebuild(c, &s->kernel, &s->ring, 0);
     s->p = 0;
     s->have_last = 0;
+    memset(s->last_W, 0, s->n * sizeof *s->last_W); /* a restart saves the bytes of a new run */
+    memset(s->last_X, 0, s->n * sizeof *s->last_X);
     s->initialized = 1;
     return DMI_OK;
 }
@@ -403,7 +423,10 @@ int dmi_step(dmi_solver *s)
         if (bad < n)
             return fail(s, DMI_ENONFINITE, "dmi_step: f(%.17g, U)[%zu] = %g", t, bad, fv[bad]);
     }
-    dmi_delay_sum(&s->kernel, &s->ring, h, W);
+    if (s->conv)
+        dmi_conv_sum(s->conv, &s->kernel, &s->ring, s->p, h, W);
+    else
+        dmi_delay_sum(&s->kernel, &s->ring, h, W);
     size_t bad = first_nonfinite(W, n);
     if (bad < n)
         return fail(s, DMI_ENONFINITE, "dmi_step: delay term W[%zu] = %g at t = %.17g", bad, W[bad],
@@ -428,6 +451,8 @@ int dmi_step(dmi_solver *s)
     memcpy(s->last_X, X, n * sizeof *X);
     s->have_last = 1;
     s->p++;
+    if (s->conv)
+        dmi_conv_advance(s->conv, &s->kernel, &s->ring, s->p);
     return DMI_OK;
 }
 
@@ -610,6 +635,8 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
     memcpy(s->last_X, d + (s->N + 2) * n, n * sizeof *d);
     s->p = hdr[5];
     s->have_last = (int)hdr[6];
+    if (s->conv)
+        dmi_conv_rebuild(s->conv, &s->kernel, &s->ring, s->p);
     free(d);
     return DMI_OK;
 }

@@ -47,7 +47,33 @@ typedef struct {
 int dmi_kernel_alloc(dmi_kernel *k, size_t n, size_t N, const double *dense);
 void dmi_kernel_release(dmi_kernel *k);
 
-/* W = h * sum_{l=0}^{N-1} H(l h) U^{p-l} (n values). */
+/* sum_{l<len} a[l] b[l] with four partial sums in a fixed order. */
+double dmi_dot(const double *a, const double *b, size_t len);
+
+/* W = h * sum_{l=0}^{N-1} H(l h) U^{p-l} (n values): the direct method. */
 void dmi_delay_sum(const dmi_kernel *k, const dmi_history *r, double h, double *W);
+
+/*
+ * The FFT method (conv.c): an exact block convolution engine whose whole
+ * state is a function of p, the kernel and the history ring, so it can be
+ * rebuilt from them at any p with bitwise the same future results.
+ */
+typedef struct dmi_conv dmi_conv;
+
+/* For method DMI_CONV_FFT, or DMI_CONV_AUTO when its cost model predicts
+ * the engine faster than the direct sum: *out = a new engine for kernel k
+ * (its kernel spectra computed; call dmi_conv_rebuild before use).  Else
+ * *out = NULL (use dmi_delay_sum).  0, or -1 when out of memory. */
+int dmi_conv_create(dmi_conv **out, const dmi_kernel *k, size_t n, size_t N, int method);
+void dmi_conv_free(dmi_conv *c);
+/* Recomputes the engine's state for step p from the ring (U^{p-N..p}). */
+void dmi_conv_rebuild(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p);
+/* After U^p was pushed (p the new step counter): updates the blocks due at p. */
+void dmi_conv_advance(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p);
+/* W^p, as dmi_delay_sum, without changing the engine. */
+void dmi_conv_sum(const dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p,
+                  double h, double *W);
+/* Number of FFT block sizes in use (0: the engine degenerated to direct sums). */
+size_t dmi_conv_levels(const dmi_conv *c);
 
 #endif

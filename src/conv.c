@@ -1,0 +1,404 @@
+/*
+ * The FFT method of the delay sum W^p = h sum_{l=0}^{N-1} H(l h) U^{p-l}:
+ * an exact online block convolution (non-uniformly partitioned overlap-save
+ * with a frequency-domain delay line per block size).
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ *
+ * Layout of the lags.  The lags l = 0..N-1 are cut into
+ *   - a direct head [0, S_1 - 1) and a direct tail [tail, N), summed every step;
+ *   - partitions of block sizes S_1 < S_2 < ... < S_L (powers of two).  A
+ *     partition of size S and index k holds the lags [S-1 + kS, S-1 + (k+1)S).
+ * The sizes grow from the head (S_i's partitions fill [S_i - 1, S_{i+1} - 1)),
+ * S_L fills the middle, and the sizes shrink again towards lag N, so that
+ * every partition ends at least S before N + 1.
+ *
+ * Block convolution.  For size S and block j (the outputs p = jS .. jS+S-1)
+ * the window b holds the 2S states U^m, m = (b-1)S + 1 .. (b+1)S, and the
+ * partition k contributes to block j through the window b = j - 1 - k: its
+ * part of the outputs is the upper half of the cyclic convolution (length
+ * M = 2S) of the window with the partition's kernel samples (overlap-save).
+ * The spectra of the windows b = j-depth .. j-1 are kept per component in a
+ * ring (the frequency-domain delay line), so each block costs one forward FFT
+ * per kernel column, one complex multiply-add per partition and nonzero
+ * kernel entry, and one inverse FFT per kernel row.
+ *
+ * Exactness of restarts.  Everything the engine holds at step p is a function
+ * of (p, the kernel, the stored states U^{p-N..p}): the window spectra and the
+ * block sums are computed by the same code from the same numbers whether they
+ * are updated step by step or rebuilt from the history ring, because every
+ * window of a partition that ends S before N + 1 stays inside the ring until
+ * its block is over.  So dmi_conv_rebuild after a state load or a change of
+ * method gives bitwise the engine of an uninterrupted run.  The history z is
+ * no exception: dmi_init rebuilds the engine at p = 0, so the history's FFT
+ * part is transformed before the first step.
+ */
+#include "dmi_internal.h"
+
+#include <gsl/gsl_fft_halfcomplex.h>
+#include <gsl/gsl_fft_real.h>
+#include <stdlib.h>
+#include <string.h>
+
+/*
+ * Cost model of one step in nanoseconds, measured with bench/ (Example 4.3,
+ * see bench/README text in the report): per lag and nonzero kernel entry of
+ * a direct sum, per partition and nonzero entry (M/2 complex multiply-adds
+ * every S steps), per FFT of a used row or column (two per 2S points every S
+ * steps), and a fixed cost per level.
+ */
+#define COST_LAG 0.35
+#define COST_PART 1.4
+#define COST_FFT 22.0
+#define COST_LEVEL 5.0
+
+/* ---- layout ---------------------------------------------------------------- */
+
+#define MAX_LEVELS 8
+
+typedef struct {
+    size_t L;
+    size_t S[MAX_LEVELS];
+    size_t kfirst[MAX_LEVELS][2], kcount[MAX_LEVELS][2]; /* [0] front run, [1] back run */
+    size_t head, tail;
+} layout;
+
+/* A partition of size S starting at lag a fits if it ends S before N + 1. */
+static int fits(size_t a, size_t S, size_t N)
+{
+    return a + 2 * S <= N + 1;
+}
+
+/* Lays out the sizes S_1 = s1, S_{i+1} = g S_i, i < L; 0 if impossible. */
+static int make_layout(size_t N, size_t s1, size_t g, size_t L, layout *out)
+{
+    layout y;
+    memset(&y, 0, sizeof y);
+    y.L = L;
+    size_t pos = s1 - 1;
+    y.head = pos;
+    for (size_t i = 0; i < L; i++) {
+        size_t S = i == 0 ? s1 : y.S[i - 1] * g;
+        y.S[i] = S;
+        y.kfirst[i][0] = (pos + 1) / S - 1;
+        if (i + 1 < L) {
+            size_t target = S * g - 1;
+            for (; pos < target; pos += S) {
+                if (!fits(pos, S, N))
+                    return 0;
+                y.kcount[i][0]++;
+            }
+        } else {
+            for (; fits(pos, S, N); pos += S)
+                y.kcount[i][0]++;
+            if (y.kcount[i][0] == 0)
+                return 0;
+        }
+    }
+    for (size_t i = L - 1; i-- > 0;) {
+        size_t S = y.S[i];
+        y.kfirst[i][1] = (pos + 1) / S - 1;
+        for (; fits(pos, S, N); pos += S)
+            y.kcount[i][1]++;
+    }
+    y.tail = pos;
+    *out = y;
+    return 1;
+}
+
+static double layout_cost(const layout *y, size_t N, size_t nnz, size_t ffts)
+{
+    double c = COST_LAG * (double)nnz * (double)(y->head + (N - y->tail));
+    for (size_t i = 0; i < y->L; i++)
+        c += COST_LEVEL + COST_FFT * (double)ffts +
+             COST_PART * (double)nnz * (double)(y->kcount[i][0] + y->kcount[i][1]);
+    return c;
+}
+
+/* The cheapest layout with at least one level; 0 if none fits. */
+static int best_layout(size_t N, size_t nnz, size_t ffts, layout *best)
+{
+    double best_cost = 0;
+    int found = 0;
+    for (size_t s1 = 4; s1 <= 4096 && s1 <= N; s1 *= 2)
+        for (size_t g = 2; g <= 256; g *= 2)
+            for (size_t L = g == 2 ? 1 : 2; L <= MAX_LEVELS; L++) { /* (L = 1: any g) */
+                layout y;
+                if (!make_layout(N, s1, g, L, &y))
+                    break;
+                double c = layout_cost(&y, N, nnz, ffts);
+                if (!found || c < best_cost) {
+                    best_cost = c;
+                    *best = y;
+                    found = 1;
+                }
+            }
+    return found;
+}
+
+/* ---- the engine -------------------------------------------------------------- */
+
+typedef struct {
+    size_t S, M;          /* block size and FFT length 2S */
+    size_t nparts, depth; /* partitions; windows kept (largest k + 1) */
+    size_t *k;            /* partition indices */
+    double *kspec;        /* nnz * nparts * M: kernel spectra / M (split layout) */
+    double *xspec;        /* n * depth * M: spectrum of window b in slot b mod depth */
+    double *out;          /* n * S: block sums (before the factor h) of the current block */
+} level;
+
+struct dmi_conv {
+    size_t n, N, nnz;
+    size_t head, tail;
+    size_t nlevels;
+    level lv[MAX_LEVELS];
+    unsigned char *col_used, *row_used; /* n each */
+    double *acc;                        /* M of the largest level */
+};
+
+/*
+ * Spectra are kept in a split layout: the real parts re_0 .. re_{M/2-1} at
+ * [0, M/2), the imaginary parts im_1 .. im_{M/2-1} at [M/2 + 1, M), and the
+ * real re_{M/2} at M/2 (the slot of im_0), so the multiply-add is a plain
+ * loop over the bins.  GSL's radix-2 halfcomplex layout differs only in the
+ * order of the imaginary parts (reversed).
+ */
+static void reverse_im(double *x, size_t M)
+{
+    for (size_t a = M / 2 + 1, b = M - 1; a < b; a++, b--) {
+        double t = x[a];
+        x[a] = x[b];
+        x[b] = t;
+    }
+}
+
+static void forward(double *x, size_t M)
+{
+    gsl_fft_real_radix2_transform(x, 1, M); /* M is a power of two: cannot fail */
+    reverse_im(x, M);
+}
+
+static void backward(double *x, size_t M)
+{
+    reverse_im(x, M);
+    gsl_fft_halfcomplex_radix2_backward(x, 1, M);
+}
+
+/* acc += K * X bin by bin (split layout; M/2 even).  Bin 0 (re_0 and re_{M/2})
+ * goes through the complex loop too and is then corrected; the loop is
+ * unrolled by two bins for the SLP vectoriser. */
+static void multiply_add(double *restrict acc, const double *restrict K,
+                         const double *restrict X, size_t M)
+{
+    const size_t H = M / 2;
+    const double a0 = acc[0] + K[0] * X[0], aH = acc[H] + K[H] * X[H];
+    double *restrict ar = acc, *restrict ai = acc + H;
+    const double *kr = K, *ki = K + H, *xr = X, *xi = X + H;
+    for (size_t q = 0; q < H; q += 2) {
+        double r0 = kr[q] * xr[q] - ki[q] * xi[q], r1 = kr[q + 1] * xr[q + 1] - ki[q + 1] * xi[q + 1];
+        double i0 = kr[q] * xi[q] + ki[q] * xr[q], i1 = kr[q + 1] * xi[q + 1] + ki[q + 1] * xr[q + 1];
+        ar[q] += r0;
+        ar[q + 1] += r1;
+        ai[q] += i0;
+        ai[q + 1] += i1;
+    }
+    acc[0] = a0;
+    acc[H] = aH;
+}
+
+void dmi_conv_free(dmi_conv *c)
+{
+    if (!c)
+        return;
+    for (size_t i = 0; i < c->nlevels; i++) {
+        free(c->lv[i].k);
+        free(c->lv[i].kspec);
+        free(c->lv[i].xspec);
+        free(c->lv[i].out);
+    }
+    free(c->col_used);
+    free(c->row_used);
+    free(c->acc);
+    free(c);
+}
+
+static int level_alloc(level *v, const layout *y, size_t i, size_t n, size_t nnz)
+{
+    v->S = y->S[i];
+    v->M = 2 * v->S;
+    v->nparts = y->kcount[i][0] + y->kcount[i][1];
+    v->k = malloc(v->nparts * sizeof *v->k);
+    if (!v->k)
+        return -1;
+    size_t q = 0;
+    for (int run = 0; run < 2; run++)
+        for (size_t t = 0; t < y->kcount[i][run]; t++)
+            v->k[q++] = y->kfirst[i][run] + t;
+    v->depth = v->k[v->nparts - 1] + 1;
+    /* The sizes are bounded by the N n^2 kernel samples and the ring (no overflow:
+     * nparts M <= 2 (N + S) and depth M <= 2 (N + S)). */
+    v->kspec = malloc(nnz * v->nparts * v->M * sizeof *v->kspec);
+    v->xspec = calloc(n * v->depth * v->M, sizeof *v->xspec);
+    v->out = calloc(n * v->S, sizeof *v->out);
+    return v->kspec && v->xspec && v->out ? 0 : -1;
+}
+
+/* Spectrum / M of the kernel samples of entry e on the partition's lags. */
+static void kernel_spectra(level *v, const dmi_kernel *k)
+{
+    const size_t S = v->S, M = v->M;
+    for (size_t e = 0; e < k->nnz; e++)
+        for (size_t q = 0; q < v->nparts; q++) {
+            double *x = v->kspec + (e * v->nparts + q) * M;
+            const double *h = k->samples + e * k->N + (S - 1 + v->k[q] * S);
+            for (size_t t = 0; t < S; t++)
+                x[t] = h[t] / (double)M;
+            memset(x + S, 0, S * sizeof *x);
+            forward(x, M);
+        }
+}
+
+int dmi_conv_create(dmi_conv **out, const dmi_kernel *k, size_t n, size_t N, int method)
+{
+    *out = NULL;
+    if (method == DMI_CONV_DIRECT)
+        return 0;
+    unsigned char *cu = calloc(n, 1), *ru = calloc(n, 1);
+    if (!cu || !ru) {
+        free(cu);
+        free(ru);
+        return -1;
+    }
+    size_t ffts = 0;
+    for (size_t e = 0; e < k->nnz; e++) {
+        ffts += !cu[k->col[e]] + !ru[k->row[e]];
+        cu[k->col[e]] = ru[k->row[e]] = 1;
+    }
+    layout y;
+    int have = k->nnz > 0 && best_layout(N, k->nnz, ffts, &y);
+    if (method == DMI_CONV_AUTO &&
+        (!have || layout_cost(&y, N, k->nnz, ffts) >= COST_LAG * (double)k->nnz * (double)N)) {
+        free(cu);
+        free(ru);
+        return 0;
+    }
+    if (!have) { /* no kernel, or too short for any block: only direct sums */
+        memset(&y, 0, sizeof y);
+        y.head = y.tail = N;
+    }
+    dmi_conv *c = calloc(1, sizeof *c);
+    if (!c) {
+        free(cu);
+        free(ru);
+        return -1;
+    }
+    c->n = n;
+    c->N = N;
+    c->nnz = k->nnz;
+    c->head = y.head;
+    c->tail = y.tail;
+    c->col_used = cu;
+    c->row_used = ru;
+    int rc = 0;
+    for (size_t i = 0; i < y.L && rc == 0; i++) {
+        c->nlevels = i + 1;
+        rc = level_alloc(&c->lv[i], &y, i, n, k->nnz);
+    }
+    c->acc = malloc((y.L ? 2 * y.S[y.L - 1] : 1) * sizeof *c->acc);
+    if (rc != 0 || !c->acc) {
+        dmi_conv_free(c);
+        return -1;
+    }
+    for (size_t i = 0; i < c->nlevels; i++)
+        kernel_spectra(&c->lv[i], k);
+    *out = c;
+    return 0;
+}
+
+/* Spectrum of window b of component col into its slot; the window's oldest
+ * state U^{(b-1)S+1} is at lag `lag0` of the ring. */
+static void window(level *v, const dmi_history *r, size_t col, size_t lag0, size_t slot)
+{
+    double *x = v->xspec + (col * v->depth + slot) * v->M;
+    const double *u = dmi_history_series(r, col) + lag0; /* u[-t] = U^{(b-1)S+1+t} */
+    for (size_t t = 0; t < v->M; t++)
+        x[t] = *(u - t);
+    forward(x, v->M);
+}
+
+/* The block sums of block j from the windows j-1-k in the delay line. */
+static void block(const dmi_conv *c, level *v, const dmi_kernel *k, uint64_t j, double *acc)
+{
+    const size_t M = v->M, S = v->S;
+    for (size_t i = 0; i < c->n; i++) {
+        if (!c->row_used[i])
+            continue;
+        memset(acc, 0, M * sizeof *acc);
+        for (size_t e = 0; e < k->nnz; e++) {
+            if (k->row[e] != i)
+                continue;
+            const double *xs = v->xspec + k->col[e] * v->depth * M;
+            for (size_t q = 0; q < v->nparts; q++) {
+                size_t slot = (size_t)((j + v->depth - 1 - v->k[q]) % v->depth);
+                multiply_add(acc, v->kspec + (e * v->nparts + q) * M, xs + slot * M, M);
+            }
+        }
+        backward(acc, M);
+        memcpy(v->out + i * S, acc + S, S * sizeof *acc);
+    }
+}
+
+void dmi_conv_rebuild(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p)
+{
+    for (size_t i = 0; i < c->nlevels; i++) {
+        level *v = &c->lv[i];
+        const size_t S = v->S;
+        const uint64_t j = p / S;
+        const size_t rem = (size_t)(p - j * S);
+        for (size_t t = 0; t < v->depth; t++) { /* window b = j - depth + t */
+            size_t lag0 = rem + (v->depth - t + 1) * S - 1;
+            size_t slot = (size_t)((j + t) % v->depth);
+            for (size_t col = 0; col < c->n; col++)
+                if (c->col_used[col])
+                    window(v, r, col, lag0, slot);
+        }
+        block(c, v, k, j, c->acc);
+    }
+}
+
+void dmi_conv_advance(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p)
+{
+    for (size_t i = 0; i < c->nlevels; i++) {
+        level *v = &c->lv[i];
+        if (p % v->S != 0)
+            continue;
+        const uint64_t j = p / v->S; /* new window b = j - 1: oldest state at lag 2S - 1 */
+        size_t slot = (size_t)((j + v->depth - 1) % v->depth);
+        for (size_t col = 0; col < c->n; col++)
+            if (c->col_used[col])
+                window(v, r, col, 2 * v->S - 1, slot);
+        block(c, v, k, j, c->acc);
+    }
+}
+
+void dmi_conv_sum(const dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p,
+                  double h, double *W)
+{
+    memset(W, 0, c->n * sizeof *W);
+    for (size_t e = 0; e < k->nnz; e++) {
+        const double *a = k->samples + e * k->N, *u = dmi_history_series(r, k->col[e]);
+        W[k->row[e]] += dmi_dot(a, u, c->head) + dmi_dot(a + c->tail, u + c->tail, c->N - c->tail);
+    }
+    for (size_t i = 0; i < c->nlevels; i++) {
+        const level *v = &c->lv[i];
+        const size_t rem = (size_t)(p % v->S);
+        for (size_t row = 0; row < c->n; row++)
+            W[row] += v->out[row * v->S + rem];
+    }
+    for (size_t row = 0; row < c->n; row++)
+        W[row] *= h;
+}
+
+size_t dmi_conv_levels(const dmi_conv *c)
+{
+    return c ? c->nlevels : 0;
+}
