@@ -50,7 +50,8 @@ typedef struct {
  * Runs an example with h = 1/N to T (T/h steps, rounded to the nearest
  * integer).  Writes CSV rows "t,w,v[,w_exact,v_exact]" for every stride-th
  * t_p (from t = -tau for examples with exact solutions, else from 0) if csv is
- * not NULL.  Returns a DMI_* code; res is filled on success.
+ * not NULL.  Returns a DMI_* code (DMI_EINVAL also for T < 0, NaN or
+ * T/h > 1e15); res is filled on success.
  */
 int paper_run(int example, size_t N, double T, int method, FILE *csv, size_t stride,
               paper_result *res);
