@@ -28,7 +28,8 @@ int hard_run_tests(int silent);
 
 /* While "quiet" is active, file descriptors 1 and 2 go to a temporary file.
  * hard_quiet_end restores them and returns the number of bytes that were
- * written meanwhile (-1 if the redirection failed). */
+ * written meanwhile, not counting lines of the sanitizers' runtimes (-1 if
+ * the redirection failed). */
 typedef struct {
     int saved_out, saved_err, fd;
 } hard_quiet;
