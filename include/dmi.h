@@ -157,9 +157,29 @@ DMI_API int dmi_set_kernel(dmi_solver *s, dmi_kernel_fn H, void *user);
  * p = -N..0, once by dmi_init.  DMI_ESTATE after init. */
 DMI_API int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user);
 
-/* Method for the delay sum: DMI_CONV_AUTO (default), DMI_CONV_DIRECT or
- * DMI_CONV_FFT.  All give the same sum up to rounding.  May be changed
- * between steps.  DMI_EINVAL for another value. */
+/*
+ * Method for the delay sum W^p: DMI_CONV_AUTO (default), DMI_CONV_DIRECT or
+ * DMI_CONV_FFT.  All compute the same sum (the same rectangle rule) and differ
+ * only by rounding (about 1e-16 relative on the paper's examples).
+ *   DIRECT  the plain sum: N multiply-adds per nonzero kernel entry and step.
+ *   FFT     an exact block convolution: the newest and the oldest lags are
+ *           summed directly, the others in blocks of power-of-two sizes by
+ *           FFT (GSL radix-2), O(log N)-ish work per step; extra memory about
+ *           2 N per nonzero kernel entry and 2 N per kernel column and block
+ *           size (a few block sizes), i.e. still O(N n^2).
+ *   AUTO    FFT when a cost model measured on x86-64 predicts it faster
+ *           than DIRECT for this N and kernel pattern, else DIRECT; for one
+ *           nonzero kernel entry that is N >= 382 (a full 3 x 3 kernel:
+ *           N >= 174).  The choice is made by dmi_init and by this call.
+ * Kernel entries that are zero at every sample cost nothing in either method.
+ * May be called at any time, also between steps: the FFT engine is then
+ * (re)built from the stored states U^{p-N..p}, and stepping on is bitwise the
+ * same as in a solver that used FFT all along from the same state; this is
+ * also how dmi_state_load restores it.  A failed step leaves the engine
+ * untouched, as the rest of the solver.
+ * Errors: DMI_EINVAL for another value (solver unchanged); DMI_ENOMEM if the
+ * FFT engine cannot be allocated after dmi_init (the former method stays).
+ */
 DMI_API int dmi_set_convolution(dmi_solver *s, int method);
 
 /* ---- time stepping ----------------------------------------------------- */

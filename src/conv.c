@@ -40,16 +40,22 @@
 #include <string.h>
 
 /*
- * Cost model of one step in nanoseconds, measured with bench/ (Example 4.3,
- * see bench/README text in the report): per lag and nonzero kernel entry of
- * a direct sum, per partition and nonzero entry (M/2 complex multiply-adds
- * every S steps), per FFT of a used row or column (two per 2S points every S
- * steps), and a fixed cost per level.
+ * Cost model of one step in nanoseconds, fitted (least squares) to the CPU
+ * time per step of Example 4.3 run with 16 layouts at each of N = 1000, 9991,
+ * 100000 (GCC 12 -O2, x86-64): per lag and nonzero kernel entry of the
+ * engine's direct head and tail, per partition and nonzero entry (M/2 complex
+ * multiply-adds every S steps), per radix-2 FFT of a used row or column (two
+ * per block of S steps), and a fixed cost per block size.  COST_DIRECT is
+ * the lag of the plain sum (DMI_CONV_DIRECT).  DMI_CONV_AUTO takes the FFT
+ * method when the model says it is cheaper: for one nonzero kernel entry
+ * (the oscillator) from N = 382 on, for a full 3 x 3 kernel from N = 174 on
+ * (measured crossover of the oscillator: between N = 256 and 384).
  */
-#define COST_LAG 0.35
-#define COST_PART 1.4
-#define COST_FFT 22.0
-#define COST_LEVEL 5.0
+#define COST_LAG 0.58
+#define COST_PART 2.7
+#define COST_FFT 40.0
+#define COST_LEVEL 13.0
+#define COST_DIRECT 0.42
 
 /* ---- layout ---------------------------------------------------------------- */
 
@@ -276,7 +282,7 @@ int dmi_conv_create(dmi_conv **out, const dmi_kernel *k, size_t n, size_t N, int
     layout y;
     int have = k->nnz > 0 && best_layout(N, k->nnz, ffts, &y);
     if (method == DMI_CONV_AUTO &&
-        (!have || layout_cost(&y, N, k->nnz, ffts) >= COST_LAG * (double)k->nnz * (double)N)) {
+        (!have || layout_cost(&y, N, k->nnz, ffts) >= COST_DIRECT * (double)k->nnz * (double)N)) {
         free(cu);
         free(ru);
         return 0;
@@ -337,8 +343,11 @@ static void block(const dmi_conv *c, level *v, const dmi_kernel *k, uint64_t j, 
             if (k->row[e] != i)
                 continue;
             const double *xs = v->xspec + k->col[e] * v->depth * M;
+            const size_t base = (size_t)(j % v->depth) + v->depth - 1;
             for (size_t q = 0; q < v->nparts; q++) {
-                size_t slot = (size_t)((j + v->depth - 1 - v->k[q]) % v->depth);
+                size_t slot = base - v->k[q]; /* (j - 1 - k) mod depth */
+                if (slot >= v->depth)
+                    slot -= v->depth;
                 multiply_add(acc, v->kspec + (e * v->nparts + q) * M, xs + slot * M, M);
             }
         }
@@ -369,7 +378,7 @@ void dmi_conv_advance(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, ui
 {
     for (size_t i = 0; i < c->nlevels; i++) {
         level *v = &c->lv[i];
-        if (p % v->S != 0)
+        if ((p & (v->S - 1)) != 0) /* S is a power of two */
             continue;
         const uint64_t j = p / v->S; /* new window b = j - 1: oldest state at lag 2S - 1 */
         size_t slot = (size_t)((j + v->depth - 1) % v->depth);
@@ -390,7 +399,7 @@ void dmi_conv_sum(const dmi_conv *c, const dmi_kernel *k, const dmi_history *r, 
     }
     for (size_t i = 0; i < c->nlevels; i++) {
         const level *v = &c->lv[i];
-        const size_t rem = (size_t)(p % v->S);
+        const size_t rem = (size_t)(p & (v->S - 1));
         for (size_t row = 0; row < c->n; row++)
             W[row] += v->out[row * v->S + rem];
     }

@@ -304,9 +304,10 @@ static int sample_kernel(dmi_solver *s, dmi_kernel *k)
         }
         size_t bad = first_nonfinite(Hl, nn);
         if (bad < nn) {
+            rc = fail(s, DMI_ENONFINITE, "dmi_init: kernel H(%.17g)[%zu][%zu] = %g", t, bad / n,
+                      bad % n, Hl[bad]);
             free(dense);
-            return fail(s, DMI_ENONFINITE, "dmi_init: kernel H(%.17g)[%zu][%zu] = %g", t, bad / n,
-                        bad % n, Hl[bad]);
+            return rc;
         }
     }
     int rc = dmi_kernel_alloc(k, n, N, dense);

@@ -10,8 +10,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <CUnit/Basic.h>
+#include <CUnit/CUnit.h>
 
+#include "conv_run.h"
 #include "dmi.h"
 #include "paper.h"
 
@@ -291,20 +292,13 @@ static void test_switch_midrun(void)
 
 int main(void)
 {
-    if (CU_initialize_registry() != CUE_SUCCESS)
-        return 2;
-    CU_pSuite s = CU_add_suite("conv", NULL, NULL);
-    if (!s || !CU_add_test(s, "FFT vs DIRECT, Examples 4.1-4.3", test_paper_examples) ||
-        !CU_add_test(s, "FFT vs DIRECT, n = 3 full kernel", test_full_matrix_kernel) ||
-        !CU_add_test(s, "rollback in FFT mode", test_rollback_fft) ||
-        !CU_add_test(s, "state load in FFT mode", test_state_load_fft) ||
-        !CU_add_test(s, "switching method mid-run", test_switch_midrun)) {
-        CU_cleanup_registry();
-        return 2;
-    }
-    CU_basic_set_mode(CU_BRM_VERBOSE);
-    CU_basic_run_tests();
-    unsigned failed = CU_get_number_of_failures() + CU_get_number_of_tests_failed();
-    CU_cleanup_registry();
-    return failed ? 1 : 0;
+    static CU_TestInfo tests[] = {
+        {"FFT vs DIRECT, Examples 4.1-4.3", test_paper_examples},
+        {"FFT vs DIRECT, n = 3 full kernel", test_full_matrix_kernel},
+        {"rollback in FFT mode", test_rollback_fft},
+        {"state load in FFT mode", test_state_load_fft},
+        {"switching method mid-run", test_switch_midrun},
+        CU_TEST_INFO_NULL,
+    };
+    return conv_run("conv", tests);
 }

@@ -10,8 +10,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <CUnit/Basic.h>
+#include <CUnit/CUnit.h>
 
+#include "conv_run.h"
 #include "dmi_internal.h"
 
 /* Deterministic pseudo-random numbers in [-1, 1) (xorshift64*). */
@@ -166,20 +167,13 @@ static void test_planner(void)
 
 int main(void)
 {
-    if (CU_initialize_registry() != CUE_SUCCESS)
-        return 2;
-    CU_pSuite s = CU_add_suite("conv_engine", NULL, NULL);
-    if (!s || !CU_add_test(s, "every N up to 300", test_small_N) ||
-        !CU_add_test(s, "large N, several block sizes", test_large_N) ||
-        !CU_add_test(s, "matrix kernels n = 2, 3", test_matrix_kernels) ||
-        !CU_add_test(s, "zero kernel", test_zero_kernel) ||
-        !CU_add_test(s, "planner", test_planner)) {
-        CU_cleanup_registry();
-        return 2;
-    }
-    CU_basic_set_mode(CU_BRM_VERBOSE);
-    CU_basic_run_tests();
-    unsigned failed = CU_get_number_of_failures() + CU_get_number_of_tests_failed();
-    CU_cleanup_registry();
-    return failed ? 1 : 0;
+    static CU_TestInfo tests[] = {
+        {"every N up to 300", test_small_N},
+        {"large N, several block sizes", test_large_N},
+        {"matrix kernels n = 2, 3", test_matrix_kernels},
+        {"zero kernel", test_zero_kernel},
+        {"planner", test_planner},
+        CU_TEST_INFO_NULL,
+    };
+    return conv_run("conv_engine", tests);
 }

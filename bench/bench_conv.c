@@ -1,0 +1,132 @@
+/*
+ * Benchmark of the delay sum methods on the paper's Example 4.3 (not a test):
+ * N = 1000 and 9991 to T = 30, N = 100000 to a shorter T, the default method
+ * (DMI_CONV_AUTO) and DMI_CONV_DIRECT in one process.  The two solvers are
+ * stepped in alternating chunks so that a changing machine load hits both
+ * alike.  Prints ns per step, the speed-up, the memory each solver added to
+ * the resident set, the peak resident set and the maximum deviation.
+ * Usage: bench_conv [T for N = 100000, default 3]
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "paper.h"
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Current resident set in MiB (Linux /proc; 0 if unavailable). */
+static double rss_mib(void)
+{
+    long pages = 0, resident = 0;
+    FILE *f = fopen("/proc/self/statm", "r");
+    if (f) {
+        if (fscanf(f, "%ld %ld", &pages, &resident) != 2)
+            resident = 0;
+        fclose(f);
+    }
+    return (double)resident * (double)sysconf(_SC_PAGESIZE) / 1048576.0;
+}
+
+typedef struct {
+    dmi_solver *s;
+    paper_example ex;
+    double mem, secs, *w; /* w: the trajectory (w, v) of every step */
+} run;
+
+/* Makes the solver; mem = what its creation and dmi_init added to the
+ * resident set (the trajectory buffer is touched before). */
+static int start(run *r, size_t N, int method, size_t steps)
+{
+    r->ex.example = 43;
+    r->secs = 0;
+    r->w = calloc(2 * steps, sizeof *r->w);
+    if (!r->w)
+        return DMI_ENOMEM;
+    memset(r->w, 1, 2 * steps * sizeof *r->w);
+    double before = rss_mib();
+    int rc = dmi_create(&r->s, 2, 1.0, N);
+    if (rc == DMI_OK)
+        rc = paper_setup(r->s, &r->ex);
+    if (rc == DMI_OK)
+        rc = dmi_set_convolution(r->s, method);
+    if (rc == DMI_OK)
+        rc = dmi_init(r->s);
+    r->mem = rss_mib() - before;
+    return rc;
+}
+
+static int chunk(run *r, size_t from, size_t to)
+{
+    double t0 = now();
+    for (size_t p = from; p < to; p++) {
+        int rc = dmi_step(r->s);
+        if (rc != DMI_OK)
+            return rc;
+        dmi_get_state(r->s, r->w + 2 * p);
+    }
+    r->secs += now() - t0;
+    return DMI_OK;
+}
+
+int main(int argc, char **argv)
+{
+    const double Tlong = argc > 1 ? atof(argv[1]) : 3.0;
+    const size_t Ns[3] = {1000, 9991, 100000};
+    const double Ts[3] = {30.0, 30.0, Tlong};
+    double fast[3] = {0};
+    printf("Example 4.3, tau = 1, h = 1/N; DIRECT vs the default method (AUTO)\n");
+    printf("%7s %5s %8s | %10s %10s %8s | %9s %9s | %9s\n", "N", "T", "steps", "DIRECT",
+           "default", "speed-up", "mem DIR", "mem def", "max dev");
+    printf("%7s %5s %8s | %10s %10s %8s | %9s %9s | %9s\n", "", "", "", "ns/step", "ns/step", "",
+           "MiB", "MiB", "rel.");
+    for (int k = 0; k < 3; k++) {
+        const size_t N = Ns[k], steps = (size_t)llround(Ts[k] * (double)N);
+        run d = {0}, a = {0};
+        int rc = start(&d, N, DMI_CONV_DIRECT, steps);
+        if (rc == DMI_OK)
+            rc = start(&a, N, DMI_CONV_AUTO, steps);
+        const size_t C = 2000;
+        for (size_t p = 0; p < steps && rc == DMI_OK; p += C) {
+            size_t to = p + C < steps ? p + C : steps;
+            rc = chunk(&d, p, to);
+            if (rc == DMI_OK)
+                rc = chunk(&a, p, to);
+        }
+        if (rc != DMI_OK) {
+            fprintf(stderr, "N = %zu: %s\n", N, dmi_strerror(rc));
+            return 1;
+        }
+        double dev = 0, big = 0;
+        for (size_t i = 0; i < 2 * steps; i++) {
+            dev = fmax(dev, fabs(d.w[i] - a.w[i]));
+            big = fmax(big, fabs(d.w[i]));
+        }
+        double nd = 1e9 * d.secs / (double)steps, na = 1e9 * a.secs / (double)steps;
+        fast[k] = na;
+        printf("%7zu %5g %8zu | %10.1f %10.1f %7.1fx | %9.2f %9.2f | %9.2e\n", N, Ts[k], steps, nd,
+               na, nd / na, d.mem, a.mem, dev / big);
+        fflush(stdout);
+        dmi_free(&d.s);
+        dmi_free(&a.s);
+        free(d.w);
+        free(a.w);
+    }
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    printf("default method: cost per step grows %.2fx from N = 1000 to N = 100000\n",
+           fast[2] / fast[0]);
+    printf("peak resident set of the process: %.1f MiB\n", (double)ru.ru_maxrss / 1024.0);
+    return 0;
+}
