@@ -93,11 +93,11 @@ static int make_layout(size_t N, size_t s1, size_t g, size_t L, layout *out)
                     return 0;
                 y.kcount[i][0]++;
             }
-        } else {
-            for (; fits(pos, S, N); pos += S)
-                y.kcount[i][0]++;
-            if (y.kcount[i][0] == 0)
+        } else { /* as many as fit, counted without a loop (N may be huge) */
+            if (!fits(pos, S, N))
                 return 0;
+            y.kcount[i][0] = (N + 1 - 2 * S - pos) / S + 1;
+            pos += y.kcount[i][0] * S;
         }
     }
     for (size_t i = L - 1; i-- > 0;) {
