@@ -148,7 +148,7 @@ typedef struct {
     size_t nparts, depth; /* partitions; windows kept (largest k + 1) */
     size_t *k;            /* partition indices */
     double *kspec;        /* nnz * nparts * M: kernel spectra / M (split layout) */
-    double *xspec;        /* n * depth * M: spectrum of window b in slot b mod depth */
+    double *xspec;        /* ncols * depth * M: spectrum of window b in slot b mod depth */
     double *out;          /* n * S: block sums (before the factor h) of the current block */
 } level;
 
@@ -157,7 +157,9 @@ struct dmi_conv {
     size_t head, tail;
     size_t nlevels;
     level lv[MAX_LEVELS];
-    unsigned char *col_used, *row_used; /* n each */
+    size_t ncols;                       /* kernel columns used */
+    size_t *col_slot;                   /* n: 1 + index of a used column among them, 0 */
+    unsigned char *row_used;            /* n */
     double *acc;                        /* M of the largest level */
 };
 
@@ -221,13 +223,13 @@ void dmi_conv_free(dmi_conv *c)
         free(c->lv[i].xspec);
         free(c->lv[i].out);
     }
-    free(c->col_used);
+    free(c->col_slot);
     free(c->row_used);
     free(c->acc);
     free(c);
 }
 
-static int level_alloc(level *v, const layout *y, size_t i, size_t n, size_t nnz)
+static int level_alloc(level *v, const layout *y, size_t i, size_t n, size_t ncols, size_t nnz)
 {
     v->S = y->S[i];
     v->M = 2 * v->S;
@@ -243,7 +245,7 @@ static int level_alloc(level *v, const layout *y, size_t i, size_t n, size_t nnz
     /* The sizes are bounded by the N n^2 kernel samples and the ring (no overflow:
      * nparts M <= 2 (N + S) and depth M <= 2 (N + S)). */
     v->kspec = malloc(nnz * v->nparts * v->M * sizeof *v->kspec);
-    v->xspec = calloc(n * v->depth * v->M, sizeof *v->xspec);
+    v->xspec = calloc(ncols * v->depth * v->M, sizeof *v->xspec);
     v->out = calloc(n * v->S, sizeof *v->out);
     return v->kspec && v->xspec && v->out ? 0 : -1;
 }
@@ -268,17 +270,21 @@ int dmi_conv_create(dmi_conv **out, const dmi_kernel *k, size_t n, size_t N, int
     *out = NULL;
     if (method == DMI_CONV_DIRECT)
         return 0;
-    unsigned char *cu = calloc(n, 1), *ru = calloc(n, 1);
+    size_t *cu = calloc(n, sizeof *cu);
+    unsigned char *ru = calloc(n, 1);
     if (!cu || !ru) {
         free(cu);
         free(ru);
         return -1;
     }
-    size_t ffts = 0;
+    size_t ffts = 0, ncols = 0;
     for (size_t e = 0; e < k->nnz; e++) {
-        ffts += !cu[k->col[e]] + !ru[k->row[e]];
-        cu[k->col[e]] = ru[k->row[e]] = 1;
+        if (!cu[k->col[e]])
+            cu[k->col[e]] = ++ncols;
+        ffts += !ru[k->row[e]];
+        ru[k->row[e]] = 1;
     }
+    ffts += ncols;
     layout y;
     int have = k->nnz > 0 && best_layout(N, k->nnz, ffts, &y);
     if (method == DMI_CONV_AUTO &&
@@ -302,12 +308,13 @@ int dmi_conv_create(dmi_conv **out, const dmi_kernel *k, size_t n, size_t N, int
     c->nnz = k->nnz;
     c->head = y.head;
     c->tail = y.tail;
-    c->col_used = cu;
+    c->ncols = ncols;
+    c->col_slot = cu;
     c->row_used = ru;
     int rc = 0;
     for (size_t i = 0; i < y.L && rc == 0; i++) {
         c->nlevels = i + 1;
-        rc = level_alloc(&c->lv[i], &y, i, n, k->nnz);
+        rc = level_alloc(&c->lv[i], &y, i, n, ncols, k->nnz);
     }
     c->acc = malloc((y.L ? 2 * y.S[y.L - 1] : 1) * sizeof *c->acc);
     if (rc != 0 || !c->acc) {
@@ -320,15 +327,19 @@ int dmi_conv_create(dmi_conv **out, const dmi_kernel *k, size_t n, size_t N, int
     return 0;
 }
 
-/* Spectrum of window b of component col into its slot; the window's oldest
+/* Spectra of window b of the used columns into its slot; the window's oldest
  * state U^{(b-1)S+1} is at lag `lag0` of the ring. */
-static void window(level *v, const dmi_history *r, size_t col, size_t lag0, size_t slot)
+static void window(const dmi_conv *c, level *v, const dmi_history *r, size_t lag0, size_t slot)
 {
-    double *x = v->xspec + (col * v->depth + slot) * v->M;
-    const double *u = dmi_history_series(r, col) + lag0; /* u[-t] = U^{(b-1)S+1+t} */
-    for (size_t t = 0; t < v->M; t++)
-        x[t] = *(u - t);
-    forward(x, v->M);
+    for (size_t col = 0; col < c->n; col++) {
+        if (!c->col_slot[col])
+            continue;
+        double *x = v->xspec + ((c->col_slot[col] - 1) * v->depth + slot) * v->M;
+        const double *u = dmi_history_series(r, col) + lag0; /* u[-t] = U^{(b-1)S+1+t} */
+        for (size_t t = 0; t < v->M; t++)
+            x[t] = *(u - t);
+        forward(x, v->M);
+    }
 }
 
 /* The block sums of block j from the windows j-1-k in the delay line. */
@@ -342,7 +353,7 @@ static void block(const dmi_conv *c, level *v, const dmi_kernel *k, uint64_t j, 
         for (size_t e = 0; e < k->nnz; e++) {
             if (k->row[e] != i)
                 continue;
-            const double *xs = v->xspec + k->col[e] * v->depth * M;
+            const double *xs = v->xspec + (c->col_slot[k->col[e]] - 1) * v->depth * M;
             const size_t base = (size_t)(j % v->depth) + v->depth - 1;
             for (size_t q = 0; q < v->nparts; q++) {
                 size_t slot = base - v->k[q]; /* (j - 1 - k) mod depth */
@@ -366,9 +377,7 @@ void dmi_conv_rebuild(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, ui
         for (size_t t = 0; t < v->depth; t++) { /* window b = j - depth + t */
             size_t lag0 = rem + (v->depth - t + 1) * S - 1;
             size_t slot = (size_t)((j + t) % v->depth);
-            for (size_t col = 0; col < c->n; col++)
-                if (c->col_used[col])
-                    window(v, r, col, lag0, slot);
+            window(c, v, r, lag0, slot);
         }
         block(c, v, k, j, c->acc);
     }
@@ -382,9 +391,7 @@ void dmi_conv_advance(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, ui
             continue;
         const uint64_t j = p / v->S; /* new window b = j - 1: oldest state at lag 2S - 1 */
         size_t slot = (size_t)((j + v->depth - 1) % v->depth);
-        for (size_t col = 0; col < c->n; col++)
-            if (c->col_used[col])
-                window(v, r, col, 2 * v->S - 1, slot);
+        window(c, v, r, 2 * v->S - 1, slot);
         block(c, v, k, j, c->acc);
     }
 }

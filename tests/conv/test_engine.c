@@ -118,12 +118,13 @@ static void test_large_N(void)
 }
 
 /* n = 2 with the oscillator's pattern (one nonzero entry of four) and n = 3 with
- * a full kernel and with a sparse one. */
+ * a full kernel and with sparse ones (all columns used; a single column). */
 static void test_matrix_kernels(void)
 {
     check_case(2, 700, 1u << 2, 300, 11);
     check_case(3, 333, 0x1ffu, 200, 12);
     check_case(3, 1000, (1u << 1) | (1u << 5) | (1u << 6), 300, 13);
+    check_case(3, 600, (1u << 1) | (1u << 4), 300, 14); /* one column, two rows */
 }
 
 /* A kernel that is zero everywhere: the engine holds no FFT level at all. */
