@@ -32,6 +32,9 @@ enum {
 #define ANY_STATE (INSTANTIATED | INIT_MODE | STEP_COMPLETE | TERMINATED | ERROR_STATE)
 #define SAVABLE (INSTANTIATED | INIT_MODE | STEP_COMPLETE | TERMINATED)
 #define READABLE (INIT_MODE | STEP_COMPLETE | TERMINATED | ERROR_STATE)
+/* The states with a solver (after fmi2ExitInitializationMode): their saved
+ * states hold the history. */
+#define HAS_SOLVER (STEP_COMPLETE | TERMINATED)
 
 /* Log categories, as declared in modelDescription.xml. */
 static const char *const CATEGORY[] = {"logStatusError", "logCalls"};
@@ -442,7 +445,7 @@ fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
         return fmi2Error;
     if (!s)
         return error(in, "fmi2SetFMUstate: NULL state");
-    if (model_state_load(&in->m, SAVABLE, &tag, s->bytes, s->size, err) != 0)
+    if (model_state_load(&in->m, SAVABLE, HAS_SOLVER, &tag, s->bytes, s->size, err) != 0)
         return error(in, "fmi2SetFMUstate: %s", err);
     in->state = tag;
     return fmi2OK;
@@ -497,7 +500,8 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedSta
         return fmi2Error;
     if (!serializedState || !FMUstate)
         return error(in, "fmi2DeSerializeFMUstate: NULL argument");
-    if (model_state_load(NULL, SAVABLE, &tag, (const unsigned char *)serializedState, size, err) != 0)
+    if (model_state_load(NULL, SAVABLE, HAS_SOLVER, &tag, (const unsigned char *)serializedState,
+                         size, err) != 0)
         return error(in, "fmi2DeSerializeFMUstate: %s", err);
     saved_state *s = in->allocate(1, sizeof *s + size);
     if (!s)

@@ -122,17 +122,33 @@ static int solver_fail(char *err, const char *what, dmi_solver *s, int rc)
     return -1;
 }
 
+/* A new solver for the parameters of m: only the history ring of (N + 1) * 2
+ * values is allocated, nothing is sampled yet. */
+static int solver_create(const model *m, dmi_solver **out, char *err)
+{
+    int rc = dmi_create(out, 2, m->real[VR_tau], (size_t)m->N);
+    return rc == DMI_OK ? 0 : solver_fail(err, "creating the solver (tau, N)", NULL, rc);
+}
+
+/* Sets the model's callbacks and friction on s and samples the kernel and
+ * the history (dmi_init). */
+static int solver_init(model *m, dmi_solver *s, char *err)
+{
+    const double alpha[2] = {0.0, m->real[VR_alpha]};
+    int rc;
+    if ((rc = dmi_set_rhs(s, rhs, m)) != DMI_OK || (rc = dmi_set_kernel(s, kernel, m)) != DMI_OK ||
+        (rc = dmi_set_history(s, history, m)) != DMI_OK ||
+        (rc = dmi_set_friction(s, alpha)) != DMI_OK || (rc = dmi_init(s)) != DMI_OK)
+        return solver_fail(err, "initialising the solver", s, rc);
+    return 0;
+}
+
 int model_start(model *m, double t_start, char *err)
 {
     dmi_solver *s = NULL;
-    const double alpha[2] = {0.0, m->real[VR_alpha]};
-    int rc = dmi_create(&s, 2, m->real[VR_tau], (size_t)m->N);
-    if (rc != DMI_OK)
-        return solver_fail(err, "creating the solver (tau, N)", NULL, rc);
-    if ((rc = dmi_set_rhs(s, rhs, m)) != DMI_OK || (rc = dmi_set_kernel(s, kernel, m)) != DMI_OK ||
-        (rc = dmi_set_history(s, history, m)) != DMI_OK ||
-        (rc = dmi_set_friction(s, alpha)) != DMI_OK || (rc = dmi_init(s)) != DMI_OK) {
-        solver_fail(err, "initialising the solver", s, rc);
+    if (solver_create(m, &s, err) != 0)
+        return -1;
+    if (solver_init(m, s, err) != 0) {
         dmi_free(&s);
         return -1;
     }
@@ -146,8 +162,8 @@ int model_start(model *m, double t_start, char *err)
 int model_do_step(model *m, double t_current, double step, char *err)
 {
     const double h = dmi_get_h(m->solver);
-    if (!isfinite(t_current) || !isfinite(step) || step < 0)
-        return fail(err, "the time %.17g and the step %.17g must be finite and the step >= 0",
+    if (!isfinite(t_current) || !isfinite(step) || !(step > 0))
+        return fail(err, "the time %.17g and the step %.17g must be finite and the step > 0",
                     t_current, step);
     if (fabs(t_current - m->t_comm) > MODEL_TIME_TOL * h)
         return fail(err, "the communication point %.17g is not the FMU's time %.17g", t_current,
@@ -293,8 +309,8 @@ static const unsigned char *get(const unsigned char *b, void *v, size_t n)
     return b + n;
 }
 
-int model_state_load(model *into, uint32_t tags, uint32_t *tag, const unsigned char *buf,
-                     size_t size, char *err)
+int model_state_load(model *into, uint32_t tags, uint32_t solver_tags, uint32_t *tag,
+                     const unsigned char *buf, size_t size, char *err)
 {
     uint32_t version;
     uint64_t total, nreal, ndmi, sum;
@@ -333,15 +349,35 @@ int model_state_load(model *into, uint32_t tags, uint32_t *tag, const unsigned c
         return fail(err, "state: N = %lld is invalid", (long long)N);
     if (!isfinite(t_start) || !isfinite(t_comm) || t_comm < t_start)
         return fail(err, "state: invalid times (start %.17g, communication point %.17g)", t_start, t_comm);
-    if (ndmi > 0) {
-        if (model_start(&m, t_start, err) != 0)
+    const int has_solver = (*tag & solver_tags) != 0;
+    if (has_solver != (ndmi > 0))
+        return fail(err, "state: the saved phase tag %lu %s the solver's history, the state has "
+                         "%llu bytes of it", (unsigned long)*tag, has_solver ? "needs" : "has no",
+                    (unsigned long long)ndmi);
+    if (has_solver) {
+        /* libdmi's state holds the N + 1 stored states U^{p-N..p} of 2 doubles:
+         * fewer bytes cannot be a history for this N (checked before the
+         * solver for N is allocated); then the exact size from libdmi. */
+        if (ndmi / (2 * sizeof(double)) < (uint64_t)N + 1)
+            return fail(err, "state: the solver's history of %llu bytes is too short for N = %lld",
+                        (unsigned long long)ndmi, (long long)N);
+        dmi_solver *s = NULL;
+        if (solver_create(&m, &s, err) != 0)
             return -1;
-        int rc = dmi_state_load(m.solver, b, (size_t)ndmi);
-        if (rc != DMI_OK) {
-            solver_fail(err, "state: the solver's history", m.solver, rc);
-            model_free(&m);
+        const size_t need = dmi_state_size(s);
+        if (need != ndmi) {
+            dmi_free(&s);
+            return fail(err, "state: the solver's history has %llu bytes, N = %lld needs %zu",
+                        (unsigned long long)ndmi, (long long)N, need);
+        }
+        int rc = solver_init(&m, s, err);
+        if (rc == 0 && (rc = dmi_state_load(s, b, (size_t)ndmi)) != DMI_OK)
+            solver_fail(err, "state: the solver's history", s, rc);
+        if (rc != 0) {
+            dmi_free(&s);
             return -1;
         }
+        m.solver = s;
     }
     m.t_start = t_start;
     m.t_comm = t_comm;

@@ -77,7 +77,7 @@ int model_get_boolean(const model *m, unsigned vr, int *value, char *err);
 int model_start(model *m, double t_start, char *err);
 
 /* The communication step from t_current (which must be t_comm to within
- * MODEL_TIME_TOL h) to t_end = t_current + step, step >= 0: takes every step
+ * MODEL_TIME_TOL h) to t_end = t_current + step, step > 0: takes every step
  * whose start t_p is before t_end (by more than MODEL_TIME_TOL h).
  * Returns -1 for bad arguments (m unchanged), -2 for a solver failure (the
  * steps already taken are kept); err tells why. */
@@ -93,9 +93,12 @@ size_t model_state_size(const model *m);
 void model_state_save(const model *m, uint32_t tag, unsigned char *buf);
 /* Checks the bytes and, when into is not NULL, replaces *into by the saved
  * model (a fresh solver loaded with the saved history).  *tag gets the saved
- * tag, which must be a single bit of tags.  Bad bytes: nonzero, the reason
- * in err, *into unchanged. */
-int model_state_load(model *into, uint32_t tags, uint32_t *tag, const unsigned char *buf,
-                     size_t size, char *err);
+ * tag, which must be a single bit of tags; the state holds libdmi's bytes if
+ * and only if that bit is in solver_tags (the phases that have a solver).
+ * The memory allocated is bounded by a multiple of size: the history's size
+ * is checked against N before the solver is created.  Bad bytes: nonzero,
+ * the reason in err, *into unchanged. */
+int model_state_load(model *into, uint32_t tags, uint32_t solver_tags, uint32_t *tag,
+                     const unsigned char *buf, size_t size, char *err);
 
 #endif

@@ -5,7 +5,7 @@
  * values computed by an independent implementation) to 1e-12; checks on the
  * way that a saved FMU state, serialized and restored, replays bitwise; then
  * runs the error paths on a second instance (invalid parameters, calls out of
- * sequence, truncated state bytes, reset), so that they run under the
+ * sequence, a zero step, truncated state bytes, reset), so that they run under the
  * sanitizers too.
  *
  * Usage: fmu_master FMU.so GUID ex43_N9991.csv T
@@ -134,6 +134,7 @@ static void error_paths(const fmi2 *f, const char *guid, const fmi2CallbackFunct
     check(f->set_integer(c, &vr_N, 1, &bad_N) == fmi2Error, "N = 0 refused");
     check(f->exit_init(c) == fmi2OK, "exit initialization after refused values");
     check(f->do_step(c, 0.5, 0.1, fmi2False) == fmi2Error, "doStep from a wrong time");
+    check(f->do_step(c, 0.0, 0.0, fmi2False) == fmi2Error, "zero step refused");
     check(f->do_step(c, 0.0, 0.1, fmi2False) == fmi2OK, "doStep");
     fmi2FMUstate st = NULL;
     size_t size = 0;

@@ -4,6 +4,7 @@
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 import math
 import os
+import struct
 import subprocess
 import sys
 import textwrap
@@ -139,19 +140,30 @@ def test_simulate_matches_native(fmu_path, native43, interval):
 
 
 def test_varying_steps_match_native(sl, native43):
+    """Uneven FMU2Slave steps; a zero step among them is a bad input (issue 6):
+    fmi2Error with a logged reason, and the instance goes on unchanged."""
     s = sl()
     start(s)
     h = START["tau"] / START["N"]
     pattern = [0.01, 0.0123, h, 0.3 * h, 0.7 * h, 5 * h, 0.0, 0.25, 1e-9, 0.1, 2.5 * h, 0.05]
     t, rows, times = 0.0, [], []
-    i = 0
+    i = zero_steps = 0
     while t < 12.0:
         dt = pattern[i % len(pattern)]
-        s.fmu.doStep(t, dt)
-        t += dt
         i += 1
-        times.append(t)
+        if dt == 0.0:
+            n = len(s.errors())
+            with pytest.raises(FMICallException) as e:
+                s.fmu.doStep(t, dt)
+            assert e.value.status == 3
+            assert len(s.errors()) == n + 1 and "step" in s.errors()[-1], s.errors()[-1:]
+            zero_steps += 1
+        else:
+            s.fmu.doStep(t, dt)
+            t += dt
+        times.append(t)  # after a refused step: the outputs at t are still those of t
         rows.append(outputs(s, s.vr))
+    assert zero_steps > 10
     got = np.array(rows, dtype=float)
     want = native43.table(times)
     assert_close(got[:, :4], want[:, :4])
@@ -331,6 +343,140 @@ def test_bad_state_bytes_are_rejected(sl):
     assert run_steps(s, t, 30)[1] == run_steps(ref, tr, 30)[1]
 
 
+# The saved state's layout (fmu/model.h), written here from that description:
+# magic[8], format version u32, phase tag u32, total size u64, number of Reals
+# u64, size of libdmi's part u64, N i64, the Reals, t_start, t_comm (doubles),
+# libdmi's state bytes, FNV-1a 64 checksum of all bytes before it.  The phase
+# tags are the FMU's state bits: instantiated 1, initialization mode 2, step
+# complete 4, terminated 8.
+HEAD = struct.Struct("=8sIIQQQq")
+PHASE = dict(instantiated=1, init=2, step_complete=4, terminated=8)
+
+
+def fnv1a64(data):
+    x = 14695981039346656037
+    for byte in data:
+        x = ((x ^ byte) * 1099511628211) & 0xFFFFFFFFFFFFFFFF
+    return x
+
+
+def edit_state(data, tag=None, N=None, dmi=None):
+    """The state bytes with the phase tag, N or libdmi's part replaced, the
+    sizes and the checksum made consistent again."""
+    magic, version, old_tag, total, nreal, ndmi, old_N = HEAD.unpack_from(data)
+    reals = data[HEAD.size:HEAD.size + (nreal + 2) * 8]
+    part = data[HEAD.size + len(reals):len(data) - 8]
+    assert len(part) == ndmi and total == len(data)
+    part = part if dmi is None else dmi
+    body = reals + part
+    head = HEAD.pack(magic, version, old_tag if tag is None else tag, HEAD.size + len(body) + 8,
+                     nreal, len(part), old_N if N is None else N)
+    return head + body + struct.pack("=Q", fnv1a64(head + body))
+
+
+def saved_bytes(s):
+    st = s.fmu.getFMUstate()
+    data = s.fmu.serializeFMUstate(st)
+    s.fmu.freeFMUstate(st)
+    return data
+
+
+def assert_refused(s, data, *words):
+    """fmi2DeSerializeFMUstate refuses data with one logged error holding words."""
+    n = len(s.errors())
+    with pytest.raises(FMICallException) as e:
+        s.fmu.deSerializeFMUstate(data)
+    assert e.value.status == 3
+    assert len(s.errors()) == n + 1, s.errors()[n:]
+    assert all(w in s.errors()[-1] for w in words), s.errors()[-1]
+
+
+def test_state_phase_and_history_must_agree(sl):
+    """A phase with a solver (step complete, terminated) needs libdmi's history
+    in the state; a phase before initialization must not have one."""
+    s = sl()
+    s.fmu.setupExperiment(startTime=0.0)
+    before_init = saved_bytes(s)  # instantiated: no history
+    s.fmu.enterInitializationMode()
+    s.fmu.exitInitializationMode()
+    t, _ = run_steps(s, 0.0, 20)
+    stepping = saved_bytes(s)
+    assert HEAD.unpack_from(before_init)[2] == PHASE["instantiated"]
+    assert HEAD.unpack_from(before_init)[5] == 0
+    assert HEAD.unpack_from(stepping)[2] == PHASE["step_complete"]
+    assert HEAD.unpack_from(stepping)[5] > 0
+    # the helper re-encodes a state bitwise, and what it writes is read back
+    assert edit_state(before_init) == before_init and edit_state(stepping) == stepping
+    s.fmu.freeFMUstate(s.fmu.deSerializeFMUstate(edit_state(stepping, tag=PHASE["terminated"])))
+    s.fmu.freeFMUstate(s.fmu.deSerializeFMUstate(edit_state(before_init, tag=PHASE["init"])))
+    now = outputs(s, s.vr)
+    for data, phase in [(before_init, "step_complete"), (before_init, "terminated"),
+                        (stepping, "instantiated"), (stepping, "init")]:
+        assert_refused(s, edit_state(data, tag=PHASE[phase]), "state", "history")
+    # the instance is unchanged and steps on
+    assert outputs(s, s.vr) == now
+    ref = sl(name="ref")
+    start(ref)
+    tr, _ = run_steps(ref, 0.0, 20)
+    assert run_steps(s, t, 10)[1] == run_steps(ref, tr, 10)[1]
+
+
+def test_state_history_size_must_match_N(sl):
+    """libdmi's part of the state must be the history of exactly the saved N."""
+    s = sl()
+    start(s, N=100)
+    t, _ = run_steps(s, 0.0, 30)
+    data = saved_bytes(s)
+    now = outputs(s, s.vr)
+    for N in (99, 101, 50, 200, 2 ** 31 - 1):
+        assert_refused(s, edit_state(data, N=N), "state", "history", f"N = {N}")
+    part = data[HEAD.size + (HEAD.unpack_from(data)[4] + 2) * 8:-8]
+    for other in (part[:-16], part + bytes(16), part[:16]):  # libdmi's part of another size
+        assert_refused(s, edit_state(data, dmi=other), "state", "history")
+    assert outputs(s, s.vr) == now
+    ref = sl(name="ref")
+    start(ref, N=100)
+    tr, _ = run_steps(ref, 0.0, 30)
+    assert run_steps(s, t, 5)[1] == run_steps(ref, tr, 5)[1]
+
+
+CHILD_HUGE_N = textwrap.dedent("""
+    import sys, json, resource
+    sys.path.insert(0, {here!r})
+    import conftest, test_fmu
+    from fmpy import read_model_description
+    from fmpy.fmi1 import FMICallException
+    md = read_model_description({fmu!r})
+    s = conftest.Slave(md, {unzip!r})
+    s.vr = {{v.name: v.valueReference for v in md.modelVariables}}
+    test_fmu.start(s, N=100)
+    test_fmu.run_steps(s, 0.0, 10)
+    bad = test_fmu.edit_state(test_fmu.saved_bytes(s), N={N})
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    try:
+        s.fmu.freeFMUstate(s.fmu.deSerializeFMUstate(bad))
+        status = 0
+    except FMICallException as e:
+        status = e.status
+    grown = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - peak
+    print(json.dumps([status, grown, len(bad), s.errors()]))
+""")
+
+
+def test_state_claiming_a_huge_N_costs_no_memory(fmu_path, unzipdir):
+    """A state of a few KB claiming N = 2^22 is refused before anything of the
+    size of N is allocated (in a fresh process, so that its peak memory tells)."""
+    code = CHILD_HUGE_N.format(here=os.path.dirname(__file__), fmu=fmu_path, unzip=str(unzipdir),
+                               N=2 ** 22)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         timeout=120).stdout
+    import json
+    status, grown_kib, size, errors = json.loads(out.strip().splitlines()[-1])
+    assert size < 4096
+    assert grown_kib < 16 * 1024, f"peak resident memory grew by {grown_kib} KiB"
+    assert status == 3 and len(errors) == 1 and "N = 4194304" in errors[0], errors
+
+
 def test_reset_allows_a_new_experiment(sl):
     s = sl()
     start(s, alpha=0.5, N=500)
@@ -494,6 +640,27 @@ def test_fmu_run_script_writes_the_csv(source_dir, fmu_path, native43, tmp_path)
     rows = np.array([[float(x) for x in l.split(",")] for l in lines[1:]])
     assert rows[0, 0] == 0.0 and abs(rows[-1, 0] - T) < 1e-9
     assert_close(rows[:, 1:5], native43.table(rows[:, 0])[:, :4])
+
+
+def test_fmu_run_script_start_values(source_dir, fmu_path, libdmi, tmp_path):
+    """--start NAME=VALUE (repeatable) sets start values: the run equals a
+    native run with those parameters; an unknown name is refused."""
+    script = os.path.join(source_dir, "scripts", "fmu_run.py")
+    out = tmp_path / "run.csv"
+    subprocess.run([sys.executable, script, "--fmu", fmu_path, "--out", str(out), "--stop-time",
+                    "2", "--interval", "0.0123", "--start", "N=997", "--start", "alpha=0.5",
+                    "--start", "g_amp=2"], check=True, timeout=120)
+    rows = np.array([[float(x) for x in l.split(",")] for l in out.read_text().splitlines()[1:]])
+    assert abs(rows[-1, 0] - 2.0) < 1e-9 and len(rows) == math.ceil(2 / 0.0123) + 1
+    native = Run(libdmi, 2 * 997 + 2, N=997, alpha=0.5, g_amp=2.0)
+    assert_close(rows[:, 1:5], native.table(rows[:, 0])[:, :4])
+    assert np.array_equal(rows[:, 5], native.table(rows[:, 0])[:, 4])
+    for bad in ("nosuch=1", "N=1.5", "alpha"):
+        r = subprocess.run([sys.executable, script, "--fmu", fmu_path, "--out",
+                            str(tmp_path / "bad.csv"), "--start", bad],
+                           capture_output=True, text=True, timeout=120)
+        assert r.returncode != 0 and "--start" in r.stderr, (bad, r.stderr)
+    assert not (tmp_path / "bad.csv").exists()
 
 
 def test_status_queries_and_unsupported_functions(sl):
