@@ -660,6 +660,9 @@ def test_fmu_run_script_start_values(source_dir, fmu_path, libdmi, tmp_path):
                             str(tmp_path / "bad.csv"), "--start", bad],
                            capture_output=True, text=True, timeout=120)
         assert r.returncode != 0 and "--start" in r.stderr, (bad, r.stderr)
+    r = subprocess.run([sys.executable, script, "--fmu", fmu_path, "--out", str(tmp_path / "bad.csv"),
+                        "--start", "tau=-1"], capture_output=True, text=True, timeout=120)
+    assert r.returncode != 0 and "the delay must be > 0" in r.stdout + r.stderr, r.stdout + r.stderr
     assert not (tmp_path / "bad.csv").exists()
 
 
