@@ -42,37 +42,13 @@ static void must(int ok)
         abort();
 }
 
-static uint64_t fnv1a(const uint8_t *b, size_t n, size_t skip_at)
-{
-    uint64_t h = UINT64_C(0xcbf29ce484222325);
-    for (size_t i = 0; i < n; i++)
-        h = (h ^ ((i >= skip_at && i < skip_at + 8) ? 0 : b[i])) * UINT64_C(0x100000001b3);
-    return h;
-}
-
-#define FMU_HDR 48
-#define FMU_DMI (FMU_HDR + (FMU_g_in + 3) * 8)
-static void fix_checksums(uint8_t *b, size_t size)
-{
-    if (size < FMU_DMI + 8)
-        return;
-    uint64_t ndmi;
-    memcpy(&ndmi, b + 32, 8);
-    if (ndmi >= 64 && ndmi <= size - FMU_DMI - 8) {
-        uint64_t inner = fnv1a(b + FMU_DMI, (size_t)ndmi, 56);
-        memcpy(b + FMU_DMI + 56, &inner, 8);
-    }
-    uint64_t outer = fnv1a(b, size - 8, SIZE_MAX);
-    memcpy(b + size - 8, &outer, 8);
-}
-
 /* An instance in phase 0 (instantiated), 1 (initialization mode) or 2
  * (stepping, t = 0.03 with N = 10). */
 static fmi2Component instance(int phase, const fmi2CallbackFunctions *cb)
 {
     fmi2Component c = fmu_new(&F, DMI_FMU_GUID, cb);
     must(c != NULL);
-    const fmi2ValueReference vrN = FMU_N;
+    const fmi2ValueReference vrN = VR_N;
     const fmi2Integer N = 10;
     if (phase >= 1)
         must(F.setup(c, fmi2False, 0, 0.0, fmi2False, 0) == fmi2OK && F.enter_init(c) == fmi2OK &&
@@ -103,7 +79,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     must(bytes != NULL);
     memcpy(bytes, data + 1, n);
     if (flags & 1)
-        fix_checksums(bytes, n);
+        fmu_state_fix_checksums(bytes, n, 1);
 
     fmu_log log = {0};
     const fmi2CallbackFunctions cb = fmu_callbacks(&log);
@@ -139,7 +115,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 if (s != fmi2OK)
                     break;
                 t += 0.01;
-                const fmi2ValueReference vr[4] = {FMU_w, FMU_v, FMU_friction, FMU_delay_force};
+                const fmi2ValueReference vr[4] = {VR_w, VR_v, VR_friction, VR_delay_force};
                 fmi2Real out[4];
                 must(F.get_real(c, vr, 4, out) == fmi2OK);
             }

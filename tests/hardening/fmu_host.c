@@ -7,6 +7,7 @@
 
 #include <dlfcn.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -112,4 +113,26 @@ unsigned char *fmu_snapshot(const fmu_api *f, fmi2Component c, size_t *size)
     if (st)
         f->free_state(c, &st);
     return b;
+}
+
+static uint64_t fnv1a(const unsigned char *b, size_t n, size_t skip_at)
+{
+    uint64_t h = UINT64_C(0xcbf29ce484222325);
+    for (size_t i = 0; i < n; i++)
+        h = (h ^ ((i >= skip_at && i - skip_at < 8) ? 0 : b[i])) * UINT64_C(0x100000001b3);
+    return h;
+}
+
+void fmu_state_fix_checksums(unsigned char *b, size_t size, int inner)
+{
+    if (size < FMU_STATE_DMI + 8)
+        return;
+    uint64_t ndmi;
+    memcpy(&ndmi, b + 32, 8);
+    if (inner && ndmi >= 64 && ndmi <= size - FMU_STATE_DMI - 8) {
+        uint64_t sum = fnv1a(b + FMU_STATE_DMI, (size_t)ndmi, 56);
+        memcpy(b + FMU_STATE_DMI + 56, &sum, 8);
+    }
+    uint64_t sum = fnv1a(b, size - 8, SIZE_MAX);
+    memcpy(b + size - 8, &sum, 8);
 }

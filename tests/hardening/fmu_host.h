@@ -10,17 +10,8 @@
 
 #include "fmi2FunctionTypes.h"
 
-/* Value references of the FMU's variables (modelDescription.xml). */
-enum {
-    FMU_b, FMU_alpha, FMU_tau, FMU_w0, FMU_v0,
-    FMU_H_c0, FMU_H_c1, FMU_H_lambda,
-    FMU_H_a1, FMU_H_omega1, FMU_H_a2, FMU_H_omega2, FMU_H_a3, FMU_H_omega3,
-    FMU_g_offset, FMU_g_amp, FMU_g_omega, FMU_g_phase,
-    FMU_g_in,
-    FMU_w, FMU_v, FMU_friction, FMU_delay_force,
-    FMU_N,
-    FMU_sticking
-};
+/* The value references VR_* of the FMU's variables, as in modelDescription.xml. */
+#include "model.h"
 
 typedef struct {
     void *lib;
@@ -72,5 +63,15 @@ fmi2Component fmu_new(const fmu_api *f, const char *guid, const fmi2CallbackFunc
 /* The serialized state of c (malloc'd, *size bytes) or NULL if it cannot be
  * taken (e.g. in the error state). */
 unsigned char *fmu_snapshot(const fmu_api *f, fmi2Component c, size_t *size);
+
+/* Serialized states (layout of fmu/model.c): a 48-byte header (magic,
+ * version, phase tag, total size, number of Reals, size ndmi of libdmi's part
+ * at byte 32, N at byte 40), the Real variables, t_start, t_comm, libdmi's
+ * state (src/dmi.c: FNV-1a checksum in its 8th word), the FNV-1a checksum of
+ * everything before.  Recomputes the outer checksum, and libdmi's if inner
+ * and the recorded ndmi fits, so that an edit reaches the checks behind. */
+#define FMU_STATE_HEADER 48
+#define FMU_STATE_DMI (FMU_STATE_HEADER + (VR_g_in + 3) * 8)
+void fmu_state_fix_checksums(unsigned char *b, size_t size, int inner);
 
 #endif

@@ -33,11 +33,17 @@ const char *__asan_default_options(void)
 
 static int print_table; /* --table: print the rows instead of only testing */
 
+static const char *code_name(int code)
+{
+    static const char *const names[] = {"DMI_OK", "DMI_EINVAL", "DMI_ENOMEM", "DMI_ECALLBACK",
+                                        "DMI_ENONFINITE", "DMI_ESTATE"};
+    return code <= 0 && code >= DMI_ESTATE ? names[-code] : "?";
+}
+
 static void row(const char *id, const char *fn, const char *input, int code, const char *msg)
 {
     if (print_table)
-        printf("| %s | `%s` | %s | `%d` %s | %s |\n", id, fn, input, code,
-               code == DMI_OK ? "DMI_OK" : "", msg);
+        printf("| %s | `%s` | %s | `%s` | %s |\n", id, fn, input, code_name(code), msg);
 }
 
 /* ---- snapshots: everything observable of a solver's time-stepping state ---- */

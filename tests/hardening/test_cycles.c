@@ -112,7 +112,7 @@ static int fmu_cycle(int k, double u[2])
     fmi2Component c = fmu_new(&F, GUID, &cb);
     if (!c)
         return -1;
-    const fmi2ValueReference vrN = FMU_N, vrwv[2] = {FMU_w, FMU_v};
+    const fmi2ValueReference vrN = VR_N, vrwv[2] = {VR_w, VR_v};
     const fmi2Integer N = 100;
     const double dt = k ? 0.025 : 0.01;
     int ok = F.setup(c, fmi2False, 0, 0.0, fmi2False, 0) == fmi2OK &&

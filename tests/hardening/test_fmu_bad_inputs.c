@@ -68,7 +68,7 @@ static int build(ctx *x, int setup)
     x->c = fmu_new(&F, GUID, x->cb);
     if (!x->c)
         return -1;
-    const fmi2ValueReference vrN = FMU_N, vrg[2] = {FMU_g_offset, FMU_g_amp};
+    const fmi2ValueReference vrN = VR_N, vrg[2] = {VR_g_offset, VR_g_amp};
     const fmi2Integer N = N_TEST;
     const fmi2Real huge[2] = {1e308, 1e308};
     int ok = 1;
@@ -104,34 +104,9 @@ static int usable(ctx *x, int setup)
 
 /* ---- state bytes (layout of fmu/model.c) ----------------------------------------- */
 
-static uint64_t fnv1a(const unsigned char *b, size_t n, size_t skip_at)
-{
-    uint64_t h = UINT64_C(0xcbf29ce484222325);
-    for (size_t i = 0; i < n; i++) {
-        unsigned char c = (i >= skip_at && i < skip_at + 8) ? 0 : b[i];
-        h = (h ^ c) * UINT64_C(0x100000001b3);
-    }
-    return h;
-}
-#define FMU_HDR 48                    /* magic, version, tag, total, nreal, ndmi, N */
-#define FMU_REALS ((FMU_g_in + 3) * 8) /* the Real variables, t_start, t_comm */
-#define FMU_DMI (FMU_HDR + FMU_REALS)  /* offset of libdmi's state bytes */
-
-/* Recomputes libdmi's inner checksum (if a dmi part of ndmi bytes is there
- * and which != FIX_OUTER) and the outer one, so that edits reach the checks
- * behind them. */
+#define FMU_HDR FMU_STATE_HEADER
+#define FMU_DMI FMU_STATE_DMI
 enum { FIX_NONE, FIX_BOTH, FIX_OUTER };
-static void fix_checksums(unsigned char *b, size_t size, int which)
-{
-    uint64_t ndmi;
-    memcpy(&ndmi, b + 32, 8);
-    if (which != FIX_OUTER && ndmi >= 64 && FMU_DMI + ndmi + 8 <= size) {
-        uint64_t inner = fnv1a(b + FMU_DMI, (size_t)ndmi, 56);
-        memcpy(b + FMU_DMI + 56, &inner, 8);
-    }
-    uint64_t outer = fnv1a(b, size - 8, SIZE_MAX);
-    memcpy(b + size - 8, &outer, 8);
-}
 
 /* Deserializes bytes into a state and sets it; the first failure's status. */
 static fmi2Status restore(ctx *x, const unsigned char *b, size_t size)
@@ -171,7 +146,7 @@ static fmi2Status restore_edited(ctx *x, int edit, size_t at, double value, long
     case E_F64: memcpy(b + at, &value, 8); break;
     }
     if (fix != FIX_NONE)
-        fix_checksums(b, size, fix);
+        fmu_state_fix_checksums(b, size, fix == FIX_BOTH);
     fmi2Status rc = restore(x, b, len);
     free(b);
     return rc;
@@ -198,55 +173,55 @@ static fmi2Real rbuf[4];
 static fmi2Integer ibuf[4];
 static fmi2Boolean bbuf[4];
 
-CALL(p_tau0, return set_r(c, FMU_tau, 0.0);)
-CALL(p_tau_neg, return set_r(c, FMU_tau, -1.0);)
-CALL(p_tau_nan, return set_r(c, FMU_tau, NAN);)
-CALL(p_tau_inf, return set_r(c, FMU_tau, INFINITY);)
-CALL(p_alpha_neg, return set_r(c, FMU_alpha, -1.0);)
-CALL(p_alpha_nan, return set_r(c, FMU_alpha, NAN);)
-CALL(p_alpha_ninf, return set_r(c, FMU_alpha, -INFINITY);)
-CALL(p_b_nan, return set_r(c, FMU_b, NAN);)
-CALL(p_b_inf, return set_r(c, FMU_b, INFINITY);)
-CALL(p_w0_ninf, return set_r(c, FMU_w0, -INFINITY);)
-CALL(p_v0_nan, return set_r(c, FMU_v0, NAN);)
-CALL(p_hl_inf, return set_r(c, FMU_H_lambda, INFINITY);)
-CALL(p_ho_nan, return set_r(c, FMU_H_omega3, NAN);)
-CALL(p_gamp_nan, return set_r(c, FMU_g_amp, NAN);)
-CALL(p_gph_inf, return set_r(c, FMU_g_phase, INFINITY);)
-CALL(p_N0, return set_i(c, FMU_N, 0);)
-CALL(p_Nneg, return set_i(c, FMU_N, -1);)
-CALL(p_Nmin, return set_i(c, FMU_N, INT_MIN);)
-CALL(p_two, const fmi2ValueReference vr[2] = {FMU_b, FMU_tau}; const fmi2Real v[2] = {2.0, -1.0};
+CALL(p_tau0, return set_r(c, VR_tau, 0.0);)
+CALL(p_tau_neg, return set_r(c, VR_tau, -1.0);)
+CALL(p_tau_nan, return set_r(c, VR_tau, NAN);)
+CALL(p_tau_inf, return set_r(c, VR_tau, INFINITY);)
+CALL(p_alpha_neg, return set_r(c, VR_alpha, -1.0);)
+CALL(p_alpha_nan, return set_r(c, VR_alpha, NAN);)
+CALL(p_alpha_ninf, return set_r(c, VR_alpha, -INFINITY);)
+CALL(p_b_nan, return set_r(c, VR_b, NAN);)
+CALL(p_b_inf, return set_r(c, VR_b, INFINITY);)
+CALL(p_w0_ninf, return set_r(c, VR_w0, -INFINITY);)
+CALL(p_v0_nan, return set_r(c, VR_v0, NAN);)
+CALL(p_hl_inf, return set_r(c, VR_H_lambda, INFINITY);)
+CALL(p_ho_nan, return set_r(c, VR_H_omega3, NAN);)
+CALL(p_gamp_nan, return set_r(c, VR_g_amp, NAN);)
+CALL(p_gph_inf, return set_r(c, VR_g_phase, INFINITY);)
+CALL(p_N0, return set_i(c, VR_N, 0);)
+CALL(p_Nneg, return set_i(c, VR_N, -1);)
+CALL(p_Nmin, return set_i(c, VR_N, INT_MIN);)
+CALL(p_two, const fmi2ValueReference vr[2] = {VR_b, VR_tau}; const fmi2Real v[2] = {2.0, -1.0};
      return F.set_real(c, vr, 2, v);)
-CALL(p_gin_nan, return set_r(c, FMU_g_in, NAN);)
-CALL(p_gin_inf, return set_r(c, FMU_g_in, -INFINITY);)
-CALL(p_late, return set_r(c, FMU_tau, 2.0);)
-CALL(p_late_N, return set_i(c, FMU_N, 50);)
+CALL(p_gin_nan, return set_r(c, VR_g_in, NAN);)
+CALL(p_gin_inf, return set_r(c, VR_g_in, -INFINITY);)
+CALL(p_late, return set_r(c, VR_tau, 2.0);)
+CALL(p_late_N, return set_i(c, VR_N, 50);)
 CALL(v_unknown, return set_r(c, 999, 1.0);)
-CALL(v_output, return set_r(c, FMU_w, 1.0);)
-CALL(v_int_on_real, return set_i(c, FMU_tau, 2);)
+CALL(v_output, return set_r(c, VR_w, 1.0);)
+CALL(v_int_on_real, return set_i(c, VR_tau, 2);)
 CALL(v_get_unknown, const fmi2ValueReference vr = 999; return F.get_real(c, &vr, 1, rbuf);)
-CALL(v_get_int_wrong, const fmi2ValueReference vr = FMU_w; return F.get_integer(c, &vr, 1, ibuf);)
-CALL(v_get_bool_wrong, const fmi2ValueReference vr = FMU_tau; return F.get_boolean(c, &vr, 1, bbuf);)
+CALL(v_get_int_wrong, const fmi2ValueReference vr = VR_w; return F.get_integer(c, &vr, 1, ibuf);)
+CALL(v_get_bool_wrong, const fmi2ValueReference vr = VR_tau; return F.get_boolean(c, &vr, 1, bbuf);)
 CALL(v_vr_null, const fmi2Real v = 1; return F.set_real(c, NULL, 1, &v);)
-CALL(v_val_null, const fmi2ValueReference vr = FMU_b; return F.set_real(c, &vr, 1, NULL);)
-CALL(v_get_null, const fmi2ValueReference vr = FMU_w; return F.get_real(c, &vr, 1, NULL);)
-CALL(v_set_bool, const fmi2ValueReference vr = FMU_sticking; const fmi2Boolean v = fmi2True;
+CALL(v_val_null, const fmi2ValueReference vr = VR_b; return F.set_real(c, &vr, 1, NULL);)
+CALL(v_get_null, const fmi2ValueReference vr = VR_w; return F.get_real(c, &vr, 1, NULL);)
+CALL(v_set_bool, const fmi2ValueReference vr = VR_sticking; const fmi2Boolean v = fmi2True;
      return F.set_boolean(c, &vr, 1, &v);)
 CALL(v_set_string, const fmi2ValueReference vr = 0; const fmi2String v = "x";
      return F.set_string(c, &vr, 1, &v);)
 CALL(x_start_nan, return F.setup(c, fmi2False, 0, NAN, fmi2False, 0);)
 CALL(x_stop_before, return F.setup(c, fmi2False, 0, 1.0, fmi2True, 0.5);)
 /* tau is set back to 1 after the failure so that only the failed call is judged */
-CALL(x_h_subnormal, fmi2Status r = set_r(c, FMU_tau, 1e-310);
-     if (r == fmi2OK) r = F.exit_init(c); set_r(c, FMU_tau, 1.0); return r;)
+CALL(x_h_subnormal, fmi2Status r = set_r(c, VR_tau, 1e-310);
+     if (r == fmi2OK) r = F.exit_init(c); set_r(c, VR_tau, 1.0); return r;)
 CALL(s_step_inst, return F.do_step(c, 0.0, H_TEST, fmi2True);)
 CALL(s_exit_inst, return F.exit_init(c);)
 CALL(s_enter_twice, return F.enter_init(c);)
 CALL(s_setup_late, return F.setup(c, fmi2False, 0, 0.0, fmi2False, 0);)
 CALL(s_term_inst, return F.terminate(c);)
-CALL(s_get_inst, const fmi2ValueReference vr = FMU_w; return F.get_real(c, &vr, 1, rbuf);)
-CALL(s_set_term, return set_r(c, FMU_g_in, 1.0);)
+CALL(s_get_inst, const fmi2ValueReference vr = VR_w; return F.get_real(c, &vr, 1, rbuf);)
+CALL(s_set_term, return set_r(c, VR_g_in, 1.0);)
 CALL(s_getstate_err, fmi2FMUstate st = NULL; fmi2Status r = F.get_state(c, &st);
      if (st) F.free_state(c, &st); return r;)
 CALL(s_cancel, return F.cancel_step(c);)
@@ -284,10 +259,10 @@ CALL(t_total, return restore_edited(x, E_U64, 16, 1e6, 0, 1);)
 CALL(t_checksum, size_t n; unsigned char *b = fmu_snapshot(&F, c, &n); free(b);
      return restore_edited(x, E_XOR, n - 3, 0, 0, 0);)
 CALL(t_data, return restore_edited(x, E_XOR, FMU_DMI + 100, 0, 0, 0);)
-CALL(t_real_nan, return restore_edited(x, E_F64, FMU_HDR + 8 * FMU_b, NAN, 0, 1);)
-CALL(t_tau_neg, return restore_edited(x, E_F64, FMU_HDR + 8 * FMU_tau, -1.0, 0, 1);)
+CALL(t_real_nan, return restore_edited(x, E_F64, FMU_HDR + 8 * VR_b, NAN, 0, 1);)
+CALL(t_tau_neg, return restore_edited(x, E_F64, FMU_HDR + 8 * VR_tau, -1.0, 0, 1);)
 CALL(t_N0, return restore_edited(x, E_U64, 40, 0, 0, 1);)
-CALL(t_times, return restore_edited(x, E_F64, FMU_HDR + 8 * (FMU_g_in + 2), -1.0, 0, 1);)
+CALL(t_times, return restore_edited(x, E_F64, FMU_HDR + 8 * (VR_g_in + 2), -1.0, 0, 1);)
 CALL(t_inner, return restore_edited(x, E_XOR, FMU_DMI + 64 + 8, 0, 0, FIX_OUTER);)
 CALL(t_inner_fixed, return restore_edited(x, E_F64, FMU_DMI + 64, NAN, 0, 1);)
 CALL(t_inner_N, return restore_edited(x, E_U64, 40, 50, 0, 1);)
@@ -311,7 +286,7 @@ CALL(t_no_history, size_t n; unsigned char *own = fmu_snapshot(&F, c, &n); fmi2S
          size_t m = FMU_DMI + 8; uint64_t total = m, zero = 0;
          unsigned char *b = malloc(m);
          if (b) { memcpy(b, own, FMU_DMI); memcpy(b + 16, &total, 8); memcpy(b + 32, &zero, 8);
-                  fix_checksums(b, m, FIX_BOTH); r = restore(x, b, m); free(b); } }
+                  fmu_state_fix_checksums(b, m, 1); r = restore(x, b, m); free(b); } }
      free(own); return r;)
 
 typedef struct {
