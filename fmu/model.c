@@ -159,6 +159,13 @@ int model_start(model *m, double t_start, char *err)
     return 0;
 }
 
+/* The number of steps taken when the FMU is at time t: every step whose start
+ * t_p = t_start + p h is before t by more than MODEL_TIME_TOL h. */
+static double steps_before(const model *m, double t, double h)
+{
+    return ceil((t - m->t_start) / h - MODEL_TIME_TOL);
+}
+
 int model_do_step(model *m, double t_current, double step, char *err)
 {
     const double h = dmi_get_h(m->solver);
@@ -169,7 +176,7 @@ int model_do_step(model *m, double t_current, double step, char *err)
         return fail(err, "the communication point %.17g is not the FMU's time %.17g", t_current,
                     m->t_comm);
     const double t_end = t_current + step;
-    const double target = ceil((t_end - m->t_start) / h - MODEL_TIME_TOL);
+    const double target = steps_before(m, t_end, h);
     uint64_t p = 0;
     dmi_get_step_index(m->solver, &p);
     if (!(target < 9007199254740992.0)) /* 2^53: beyond it p h has no meaning */
@@ -373,11 +380,23 @@ int model_state_load(model *into, uint32_t tags, uint32_t solver_tags, uint32_t 
         int rc = solver_init(&m, s, err);
         if (rc == 0 && (rc = dmi_state_load(s, b, (size_t)ndmi)) != DMI_OK)
             solver_fail(err, "state: the solver's history", s, rc);
+        /* The FMU's time is never beyond the solver's t_p (a doStep takes the
+         * steps up to it): a communication point far ahead would make the
+         * next doStep take all the steps to it. */
+        uint64_t p = 0;
+        m.t_start = t_start;
+        if (rc == 0 && (dmi_get_step_index(s, &p) != DMI_OK ||
+                        steps_before(&m, t_comm, dmi_get_h(s)) > (double)p))
+            rc = fail(err, "state: the communication point %.17g is beyond the solver's step "
+                           "%llu", t_comm, (unsigned long long)p);
         if (rc != 0) {
             dmi_free(&s);
             return -1;
         }
         m.solver = s;
+    } else if (t_comm != t_start) { /* before initialization: no step taken */
+        return fail(err, "state: invalid times (start %.17g, communication point %.17g)",
+                    t_start, t_comm);
     }
     m.t_start = t_start;
     m.t_comm = t_comm;

@@ -96,8 +96,10 @@ void model_state_save(const model *m, uint32_t tag, unsigned char *buf);
  * tag, which must be a single bit of tags; the state holds libdmi's bytes if
  * and only if that bit is in solver_tags (the phases that have a solver).
  * The memory allocated is bounded by a multiple of size: the history's size
- * is checked against N before the solver is created.  Bad bytes: nonzero,
- * the reason in err, *into unchanged. */
+ * is checked against N before the solver is created.  The saved t_comm must
+ * not be beyond the saved solver's t_p (t_start if there is no solver), so
+ * that the next step's work is bounded by its own length.  Bad bytes:
+ * nonzero, the reason in err, *into unchanged. */
 int model_state_load(model *into, uint32_t tags, uint32_t solver_tags, uint32_t *tag,
                      const unsigned char *buf, size_t size, char *err);
 

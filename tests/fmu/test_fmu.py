@@ -360,11 +360,14 @@ def fnv1a64(data):
     return x
 
 
-def edit_state(data, tag=None, N=None, dmi=None):
-    """The state bytes with the phase tag, N or libdmi's part replaced, the
-    sizes and the checksum made consistent again."""
+def edit_state(data, tag=None, N=None, dmi=None, t_comm=None):
+    """The state bytes with the phase tag, N, libdmi's part or the
+    communication point replaced, the sizes and the checksum made consistent
+    again."""
     magic, version, old_tag, total, nreal, ndmi, old_N = HEAD.unpack_from(data)
     reals = data[HEAD.size:HEAD.size + (nreal + 2) * 8]
+    if t_comm is not None:
+        reals = reals[:-8] + struct.pack("=d", t_comm)
     part = data[HEAD.size + len(reals):len(data) - 8]
     assert len(part) == ndmi and total == len(data)
     part = part if dmi is None else dmi
@@ -438,6 +441,29 @@ def test_state_history_size_must_match_N(sl):
     start(ref, N=100)
     tr, _ = run_steps(ref, 0.0, 30)
     assert run_steps(s, t, 5)[1] == run_steps(ref, tr, 5)[1]
+
+
+def test_state_time_must_agree_with_history(sl):
+    """The communication point of a state is never beyond the step its
+    history has reached (else the next doStep would take every step up to it),
+    and it is the start time before initialization."""
+    s = sl()
+    s.fmu.setupExperiment(startTime=0.5)
+    before_init = saved_bytes(s)
+    s.fmu.enterInitializationMode()
+    s.fmu.exitInitializationMode()
+    t, _ = run_steps(s, 0.5, 10)  # t = 0.623: p = 123
+    data = saved_bytes(s)
+    now = outputs(s, s.vr)
+    h = START["tau"] / START["N"]
+    # the state's own time, and a time inside the last step, are accepted
+    for ok in (t, 0.5 + 122.5 * h):
+        s.fmu.freeFMUstate(s.fmu.deSerializeFMUstate(edit_state(data, t_comm=ok)))
+    for far in (0.5 + 123.01 * h, 0.5 + 124 * h, 1e9, 1.5e10):
+        assert_refused(s, edit_state(data, t_comm=far), "state", "communication point")
+    assert_refused(s, edit_state(before_init, t_comm=0.6), "state", "times")
+    assert outputs(s, s.vr) == now
+    s.fmu.doStep(t, 0.01)
 
 
 CHILD_HUGE_N = textwrap.dedent("""
