@@ -263,6 +263,8 @@ CALL(t_real_nan, return restore_edited(x, E_F64, FMU_HDR + 8 * VR_b, NAN, 0, 1);
 CALL(t_tau_neg, return restore_edited(x, E_F64, FMU_HDR + 8 * VR_tau, -1.0, 0, 1);)
 CALL(t_N0, return restore_edited(x, E_U64, 40, 0, 0, 1);)
 CALL(t_times, return restore_edited(x, E_F64, FMU_HDR + 8 * (VR_g_in + 2), -1.0, 0, 1);)
+CALL(t_comm_far, return restore_edited(x, E_F64, FMU_HDR + 8 * (VR_g_in + 2), 1.5e10, 0, 1);)
+CALL(t_comm_init, return restore_edited(x, E_F64, FMU_HDR + 8 * (VR_g_in + 2), 0.5, 0, 1);)
 CALL(t_inner, return restore_edited(x, E_XOR, FMU_DMI + 64 + 8, 0, 0, FIX_OUTER);)
 CALL(t_inner_fixed, return restore_edited(x, E_F64, FMU_DMI + 64, NAN, 0, 1);)
 CALL(t_inner_N, return restore_edited(x, E_U64, 40, 50, 0, 1);)
@@ -382,6 +384,8 @@ static const bad_case cases[] = {
     {"F99", "fmi2DeSerializeFMUstate", "tau = -1 (checksums valid)", F_INIT, t_tau_neg, "tau"},
     {"F100", "fmi2DeSerializeFMUstate", "N = 0 (checksums valid)", F_STEP, t_N0, "N"},
     {"F101", "fmi2DeSerializeFMUstate", "start time after the communication point (checksums valid)", F_STEP, t_times, "times"},
+    {"F111", "fmi2DeSerializeFMUstate", "communication point 1.5e10 with a history at t = 0.05 (checksums valid)", F_STEP, t_comm_far, "communication point"},
+    {"F112", "fmi2DeSerializeFMUstate", "initialization-mode state with communication point 0.5 != start time 0 (checksums valid)", F_INIT, t_comm_init, "times"},
     {"F102", "fmi2DeSerializeFMUstate", "a byte of libdmi's part altered, outer checksum valid", F_STEP, t_inner, "history"},
     {"F103", "fmi2DeSerializeFMUstate", "U^p = NaN in libdmi's part (all checksums valid)", F_STEP, t_inner_fixed, "history"},
     {"F104", "fmi2DeSerializeFMUstate", "N = 50 while the history is for N = 100 (checksums valid)", F_STEP, t_inner_N, "history"},
