@@ -95,7 +95,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     input in = {data, size};
     uint8_t k = byte(&in);
     size_t n = k % 4 == 3 ? 1 + byte(&in) % 3 : MODEL_n; /* the model callbacks need n = 2 */
-    size_t N = 1 + (byte(&in) | (size_t)byte(&in) << 8) % 300;
+    size_t N = 1 + (byte(&in) | (size_t)byte(&in) << 8) % (k & 4 ? 1200 : 300); /* FFT from ~400 */
     double tau = byte(&in) < 224 ? 0.25 + byte(&in) / 64.0 : raw_double(&in);
     model m;
     model_default(&m);
