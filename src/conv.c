@@ -44,16 +44,20 @@
  * time per step of Example 4.3 run with 16 layouts at each of N = 1000, 9991,
  * 100000 (GCC 12 -O2, x86-64): per lag and nonzero kernel entry of the
  * engine's direct head and tail, per partition and nonzero entry (M/2 complex
- * multiply-adds every S steps), per radix-2 FFT of a used row or column (two
- * per block of S steps), and a fixed cost per block size.  COST_DIRECT is
- * the lag of the plain sum (DMI_CONV_DIRECT).  DMI_CONV_AUTO takes the FFT
- * method when the model says it is cheaper: for one nonzero kernel entry
- * (the oscillator) from N = 382 on, for a full 3 x 3 kernel from N = 174 on
- * (measured crossover of the oscillator: between N = 256 and 384).
+ * multiply-adds every S steps), per FFT of a used row or column (two per
+ * block of S steps), and a fixed cost per block size.  The fit was made with
+ * GSL's radix-2 FFT and one product per multiply-add pass; COST_FFT and
+ * COST_PART are that fit scaled by the instruction counts (callgrind) of the
+ * mixed-radix FFT (0.57) and of the paired multiply-add (0.9) now in use.
+ * COST_DIRECT is the lag of the plain sum (DMI_CONV_DIRECT).  DMI_CONV_AUTO
+ * takes the FFT method when the model says it is cheaper: for one nonzero
+ * kernel entry (the oscillator) from N = 270 on, for a full 3 x 3 kernel
+ * from N = 126 on (crossover of the oscillator in instructions per step,
+ * callgrind: between N = 192 and 256).
  */
 #define COST_LAG 0.58
-#define COST_PART 2.7
-#define COST_FFT 40.0
+#define COST_PART 2.45
+#define COST_FFT 23.0
 #define COST_LEVEL 13.0
 #define COST_DIRECT 0.42
 
@@ -123,6 +127,7 @@ static double layout_cost(const layout *y, size_t N, size_t nnz, size_t ffts)
 /* The cheapest layout with at least one level; 0 if none fits. */
 static int best_layout(size_t N, size_t nnz, size_t ffts, layout *best)
 {
+
     double best_cost = 0;
     int found = 0;
     for (size_t s1 = 4; s1 <= 4096 && s1 <= N; s1 *= 2)
@@ -150,6 +155,10 @@ typedef struct {
     double *kspec;        /* nnz * nparts * M: kernel spectra / M (split layout) */
     double *xspec;        /* ncols * depth * M: spectrum of window b in slot b mod depth */
     double *out;          /* n * S: block sums (before the factor h) of the current block */
+    gsl_fft_real_wavetable *rtab;
+    gsl_fft_halfcomplex_wavetable *htab;
+    gsl_fft_real_workspace *work;
+    double *tmp; /* M: scratch of the transforms */
 } level;
 
 struct dmi_conv {
@@ -161,49 +170,71 @@ struct dmi_conv {
     size_t *col_slot;                   /* n: 1 + index of a used column among them, 0 */
     unsigned char *row_used;            /* n */
     double *acc;                        /* M of the largest level */
+    double *zero;                       /* M of the largest level: zeros, the partner of an
+                                           unpaired product in multiply_add2 */
 };
 
 /*
  * Spectra are kept in a split layout: the real parts re_0 .. re_{M/2-1} at
- * [0, M/2), the imaginary parts im_1 .. im_{M/2-1} at [M/2 + 1, M), and the
- * real re_{M/2} at M/2 (the slot of im_0), so the multiply-add is a plain
- * loop over the bins.  GSL's radix-2 halfcomplex layout differs only in the
- * order of the imaginary parts (reversed).
+ * [0, M/2), the real re_{M/2} at M/2 (the slot of im_0), the imaginary parts
+ * im_1 .. im_{M/2-1} at [M/2 + 1, M), so the multiply-add is a plain loop
+ * over the bins.  The transforms are GSL's mixed-radix real FFTs, whose
+ * halfcomplex layout re_0, (re_1, im_1), ..., re_{M/2} is converted through
+ * the level's scratch array.  The wavetables and the workspace are made once
+ * by dmi_conv_create; with them and a power-of-two M the transforms have no
+ * error path (GSL checks only n against the tables), so stepping never
+ * reaches GSL's error handler.
  */
-static void reverse_im(double *x, size_t M)
+static void forward(level *v, double *x)
 {
-    for (size_t a = M / 2 + 1, b = M - 1; a < b; a++, b--) {
-        double t = x[a];
-        x[a] = x[b];
-        x[b] = t;
+    const size_t M = v->M, H = M / 2;
+    double *y = v->tmp;
+    memcpy(y, x, M * sizeof *y);
+    gsl_fft_real_transform(y, 1, M, v->rtab, v->work);
+    x[0] = y[0];
+    x[H] = y[M - 1];
+    for (size_t q = 1; q < H; q++) {
+        x[q] = y[2 * q - 1];
+        x[H + q] = y[2 * q];
     }
 }
 
-static void forward(double *x, size_t M)
+/* x (split layout) -> the unscaled inverse transform in the scratch array. */
+static const double *backward(level *v, const double *x)
 {
-    gsl_fft_real_radix2_transform(x, 1, M); /* M is a power of two: cannot fail */
-    reverse_im(x, M);
+    const size_t M = v->M, H = M / 2;
+    double *y = v->tmp;
+    y[0] = x[0];
+    y[M - 1] = x[H];
+    for (size_t q = 1; q < H; q++) {
+        y[2 * q - 1] = x[q];
+        y[2 * q] = x[H + q];
+    }
+    gsl_fft_halfcomplex_transform(y, 1, M, v->htab, v->work);
+    return y;
 }
 
-static void backward(double *x, size_t M)
-{
-    reverse_im(x, M);
-    gsl_fft_halfcomplex_radix2_backward(x, 1, M);
-}
-
-/* acc += K * X bin by bin (split layout; M/2 even).  Bin 0 (re_0 and re_{M/2})
- * goes through the complex loop too and is then corrected; the loop is
- * unrolled by two bins for the SLP vectoriser. */
-static void multiply_add(double *restrict acc, const double *restrict K,
-                         const double *restrict X, size_t M)
+/* acc += K1 * X1 + K2 * X2 bin by bin (split layout; M/2 even).  Two
+ * products per pass halve the loads and stores of acc.  Bin 0 (re_0 and
+ * re_{M/2}) goes through the complex loop too and is then corrected; the
+ * loop is unrolled by two bins for the SLP vectoriser. */
+static void multiply_add2(double *restrict acc, const double *restrict K1,
+                          const double *restrict X1, const double *restrict K2,
+                          const double *restrict X2, size_t M)
 {
     const size_t H = M / 2;
-    const double a0 = acc[0] + K[0] * X[0], aH = acc[H] + K[H] * X[H];
+    const double a0 = acc[0] + (K1[0] * X1[0] + K2[0] * X2[0]);
+    const double aH = acc[H] + (K1[H] * X1[H] + K2[H] * X2[H]);
     double *restrict ar = acc, *restrict ai = acc + H;
-    const double *kr = K, *ki = K + H, *xr = X, *xi = X + H;
+    const double *kr = K1, *ki = K1 + H, *xr = X1, *xi = X1 + H;
+    const double *lr = K2, *li = K2 + H, *yr = X2, *yi = X2 + H;
     for (size_t q = 0; q < H; q += 2) {
-        double r0 = kr[q] * xr[q] - ki[q] * xi[q], r1 = kr[q + 1] * xr[q + 1] - ki[q + 1] * xi[q + 1];
-        double i0 = kr[q] * xi[q] + ki[q] * xr[q], i1 = kr[q + 1] * xi[q + 1] + ki[q + 1] * xr[q + 1];
+        double r0 = (kr[q] * xr[q] - ki[q] * xi[q]) + (lr[q] * yr[q] - li[q] * yi[q]);
+        double r1 = (kr[q + 1] * xr[q + 1] - ki[q + 1] * xi[q + 1]) +
+                    (lr[q + 1] * yr[q + 1] - li[q + 1] * yi[q + 1]);
+        double i0 = (kr[q] * xi[q] + ki[q] * xr[q]) + (lr[q] * yi[q] + li[q] * yr[q]);
+        double i1 = (kr[q + 1] * xi[q + 1] + ki[q + 1] * xr[q + 1]) +
+                    (lr[q + 1] * yi[q + 1] + li[q + 1] * yr[q + 1]);
         ar[q] += r0;
         ar[q + 1] += r1;
         ai[q] += i0;
@@ -222,10 +253,18 @@ void dmi_conv_free(dmi_conv *c)
         free(c->lv[i].kspec);
         free(c->lv[i].xspec);
         free(c->lv[i].out);
+        free(c->lv[i].tmp);
+        if (c->lv[i].rtab)
+            gsl_fft_real_wavetable_free(c->lv[i].rtab);
+        if (c->lv[i].htab)
+            gsl_fft_halfcomplex_wavetable_free(c->lv[i].htab);
+        if (c->lv[i].work)
+            gsl_fft_real_workspace_free(c->lv[i].work);
     }
     free(c->col_slot);
     free(c->row_used);
     free(c->acc);
+    free(c->zero);
     free(c);
 }
 
@@ -247,7 +286,16 @@ static int level_alloc(level *v, const layout *y, size_t i, size_t n, size_t nco
     v->kspec = malloc(nnz * v->nparts * v->M * sizeof *v->kspec);
     v->xspec = calloc(ncols * v->depth * v->M, sizeof *v->xspec);
     v->out = calloc(n * v->S, sizeof *v->out);
-    return v->kspec && v->xspec && v->out ? 0 : -1;
+    v->tmp = malloc(v->M * sizeof *v->tmp);
+    if (!v->kspec || !v->xspec || !v->out || !v->tmp)
+        return -1;
+    /* GSL's allocators call its error handler (which aborts by default) when
+     * malloc fails: a residual risk of engine creation (dmi_init,
+     * dmi_set_convolution) only; stepping and loading allocate nothing. */
+    v->rtab = gsl_fft_real_wavetable_alloc(v->M);
+    v->htab = gsl_fft_halfcomplex_wavetable_alloc(v->M);
+    v->work = gsl_fft_real_workspace_alloc(v->M);
+    return v->rtab && v->htab && v->work ? 0 : -1;
 }
 
 /* Spectrum / M of the kernel samples of entry e on the partition's lags. */
@@ -261,7 +309,7 @@ static void kernel_spectra(level *v, const dmi_kernel *k)
             for (size_t t = 0; t < S; t++)
                 x[t] = h[t] / (double)M;
             memset(x + S, 0, S * sizeof *x);
-            forward(x, M);
+            forward(v, x);
         }
 }
 
@@ -317,7 +365,8 @@ int dmi_conv_create(dmi_conv **out, const dmi_kernel *k, size_t n, size_t N, int
         rc = level_alloc(&c->lv[i], &y, i, n, ncols, k->nnz);
     }
     c->acc = malloc((y.L ? 2 * y.S[y.L - 1] : 1) * sizeof *c->acc);
-    if (rc != 0 || !c->acc) {
+    c->zero = calloc(y.L ? 2 * y.S[y.L - 1] : 1, sizeof *c->zero);
+    if (rc != 0 || !c->acc || !c->zero) {
         dmi_conv_free(c);
         return -1;
     }
@@ -338,7 +387,7 @@ static void window(const dmi_conv *c, level *v, const dmi_history *r, size_t lag
         const double *u = dmi_history_series(r, col) + lag0; /* u[-t] = U^{(b-1)S+1+t} */
         for (size_t t = 0; t < v->M; t++)
             x[t] = *(u - t);
-        forward(x, v->M);
+        forward(v, x);
     }
 }
 
@@ -346,24 +395,33 @@ static void window(const dmi_conv *c, level *v, const dmi_history *r, size_t lag
 static void block(const dmi_conv *c, level *v, const dmi_kernel *k, uint64_t j, double *acc)
 {
     const size_t M = v->M, S = v->S;
+    const size_t base = (size_t)(j % v->depth) + v->depth - 1;
     for (size_t i = 0; i < c->n; i++) {
         if (!c->row_used[i])
             continue;
         memset(acc, 0, M * sizeof *acc);
+        const double *K1 = NULL, *X1 = NULL; /* a product waiting for its partner */
         for (size_t e = 0; e < k->nnz; e++) {
             if (k->row[e] != i)
                 continue;
             const double *xs = v->xspec + (c->col_slot[k->col[e]] - 1) * v->depth * M;
-            const size_t base = (size_t)(j % v->depth) + v->depth - 1;
             for (size_t q = 0; q < v->nparts; q++) {
                 size_t slot = base - v->k[q]; /* (j - 1 - k) mod depth */
                 if (slot >= v->depth)
                     slot -= v->depth;
-                multiply_add(acc, v->kspec + (e * v->nparts + q) * M, xs + slot * M, M);
+                const double *K = v->kspec + (e * v->nparts + q) * M, *X = xs + slot * M;
+                if (!K1) {
+                    K1 = K;
+                    X1 = X;
+                } else {
+                    multiply_add2(acc, K1, X1, K, X, M);
+                    K1 = NULL;
+                }
             }
         }
-        backward(acc, M);
-        memcpy(v->out + i * S, acc + S, S * sizeof *acc);
+        if (K1)
+            multiply_add2(acc, K1, X1, c->zero, c->zero, M);
+        memcpy(v->out + i * S, backward(v, acc) + S, S * sizeof *acc);
     }
 }
 
@@ -399,7 +457,8 @@ void dmi_conv_advance(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, ui
 void dmi_conv_sum(const dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p,
                   double h, double *W)
 {
-    memset(W, 0, c->n * sizeof *W);
+    for (size_t row = 0; row < c->n; row++)
+        W[row] = 0;
     for (size_t e = 0; e < k->nnz; e++) {
         const double *a = k->samples + e * k->N, *u = dmi_history_series(r, k->col[e]);
         W[k->row[e]] += dmi_dot(a, u, c->head) + dmi_dot(a + c->tail, u + c->tail, c->N - c->tail);

@@ -43,12 +43,6 @@ void dmi_history_put(dmi_history *r, size_t lag, const double *u)
     write_slot(r, (r->head + lag) % r->L, u);
 }
 
-void dmi_history_get(const dmi_history *r, size_t lag, double *u)
-{
-    for (size_t j = 0; j < r->n; j++)
-        u[j] = dmi_history_series(r, j)[lag];
-}
-
 void dmi_history_push(dmi_history *r, const double *u)
 {
     r->head = r->head == 0 ? r->L - 1 : r->head - 1;

@@ -411,11 +411,12 @@ int dmi_step(dmi_solver *s)
     if (!s->initialized)
         return fail(s, DMI_ESTATE, "dmi_step: call dmi_init first");
     const size_t n = s->n;
-    const double h = s->h, t = dmi_time(s);
+    const double h = s->h, t = (double)s->p * h; /* dmi_time */
     double *U = s->work, *fv = U + n, *W = fv + n, *X = W + n, *U1 = X + n;
     dmi_history_get(&s->ring, 0, U);
 
-    memset(fv, 0, n * sizeof *fv);
+    for (size_t i = 0; i < n; i++) /* (loops, not memset/memcpy: n is small) */
+        fv[i] = 0;
     if (s->f) {
         int rc = s->f(t, U, fv, s->f_user);
         if (rc != 0)
@@ -448,8 +449,10 @@ int dmi_step(dmi_solver *s)
 
     /* commit */
     dmi_history_push(&s->ring, U1);
-    memcpy(s->last_W, W, n * sizeof *W);
-    memcpy(s->last_X, X, n * sizeof *X);
+    for (size_t i = 0; i < n; i++) {
+        s->last_W[i] = W[i];
+        s->last_X[i] = X[i];
+    }
     s->have_last = 1;
     s->p++;
     if (s->conv)

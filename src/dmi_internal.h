@@ -21,14 +21,18 @@ int dmi_history_alloc(dmi_history *r, size_t n, size_t N); /* 0 or -1; zero-fill
 void dmi_history_release(dmi_history *r);
 /* U^{p-lag} = u (only while filling a fresh ring: head must be 0). */
 void dmi_history_put(dmi_history *r, size_t lag, const double *u);
-/* u = U^{p-lag}, 0 <= lag <= N. */
-void dmi_history_get(const dmi_history *r, size_t lag, double *u);
 /* Makes u the newest state U^{p+1}; U^{p-N} is dropped. */
 void dmi_history_push(dmi_history *r, const double *u);
 /* Pointer to U_j^{p-l}, l = 0..N (contiguous). */
 static inline const double *dmi_history_series(const dmi_history *r, size_t j)
 {
     return r->buf + j * 2 * r->L + r->head;
+}
+/* u = U^{p-lag}, 0 <= lag <= N. */
+static inline void dmi_history_get(const dmi_history *r, size_t lag, double *u)
+{
+    for (size_t j = 0; j < r->n; j++)
+        u[j] = dmi_history_series(r, j)[lag];
 }
 
 /*
