@@ -454,23 +454,26 @@ void dmi_conv_advance(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, ui
     }
 }
 
+/* Each row is summed in a local and W written once (a vector load of values
+ * just stored one by one stalls).  The kernel entries of a row are
+ * contiguous (dmi_kernel_alloc stores them row by row). */
 void dmi_conv_sum(const dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p,
                   double h, double *W)
 {
-    for (size_t row = 0; row < c->n; row++)
-        W[row] = 0;
-    for (size_t e = 0; e < k->nnz; e++) {
-        const double *a = k->samples + e * k->N, *u = dmi_history_series(r, k->col[e]);
-        W[k->row[e]] += dmi_dot(a, u, c->head) + dmi_dot(a + c->tail, u + c->tail, c->N - c->tail);
+    size_t e = 0;
+    for (size_t row = 0; row < c->n; row++) {
+        double w = 0;
+        for (; e < k->nnz && k->row[e] == row; e++) {
+            const double *a = k->samples + e * k->N, *u = dmi_history_series(r, k->col[e]);
+            w += dmi_dot(a, u, c->head) + dmi_dot(a + c->tail, u + c->tail, c->N - c->tail);
+        }
+        if (c->row_used[row])
+            for (size_t i = 0; i < c->nlevels; i++) {
+                const level *v = &c->lv[i];
+                w += v->out[row * v->S + (size_t)(p & (v->S - 1))];
+            }
+        W[row] = w * h;
     }
-    for (size_t i = 0; i < c->nlevels; i++) {
-        const level *v = &c->lv[i];
-        const size_t rem = (size_t)(p & (v->S - 1));
-        for (size_t row = 0; row < c->n; row++)
-            W[row] += v->out[row * v->S + rem];
-    }
-    for (size_t row = 0; row < c->n; row++)
-        W[row] *= h;
 }
 
 size_t dmi_conv_levels(const dmi_conv *c)

@@ -115,9 +115,11 @@ double dmi_dot(const double *a, const double *b, size_t len)
 
 void dmi_delay_sum(const dmi_kernel *k, const dmi_history *r, double h, double *W)
 {
-    memset(W, 0, r->n * sizeof *W);
-    for (size_t e = 0; e < k->nnz; e++)
-        W[k->row[e]] += dmi_dot(k->samples + e * k->N, dmi_history_series(r, k->col[e]), k->N);
-    for (size_t i = 0; i < r->n; i++)
-        W[i] *= h;
+    size_t e = 0; /* the entries of a row are contiguous (dmi_kernel_alloc) */
+    for (size_t row = 0; row < r->n; row++) {
+        double w = 0;
+        for (; e < k->nnz && k->row[e] == row; e++)
+            w += dmi_dot(k->samples + e * k->N, dmi_history_series(r, k->col[e]), k->N);
+        W[row] = w * h;
+    }
 }

@@ -38,7 +38,8 @@ static inline void dmi_history_get(const dmi_history *r, size_t lag, double *u)
 /*
  * Kernel samples H(l h), l = 0..N-1, of the entries (i, j) that are nonzero
  * at some sample; entries zero at every sample are not stored and cost
- * nothing.
+ * nothing.  They are stored row by row (e = row n + col ascending), so the
+ * entries of a row are contiguous.
  */
 typedef struct {
     size_t n, N, nnz;
