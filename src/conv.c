@@ -443,6 +443,8 @@ void dmi_conv_rebuild(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, ui
 
 void dmi_conv_advance(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p)
 {
+    if (c->nlevels == 0 || (p & (c->lv[0].S - 1)) != 0) /* the sizes are multiples of S_1 */
+        return;
     for (size_t i = 0; i < c->nlevels; i++) {
         level *v = &c->lv[i];
         if ((p & (v->S - 1)) != 0) /* S is a power of two */
