@@ -46,18 +46,17 @@
  * engine's direct head and tail, per partition and nonzero entry (M/2 complex
  * multiply-adds every S steps), per FFT of a used row or column (two per
  * block of S steps), and a fixed cost per block size.  The fit was made with
- * GSL's radix-2 FFT and one product per multiply-add pass; COST_FFT and
- * COST_PART are that fit scaled by the instruction counts (callgrind) of the
- * mixed-radix FFT (0.57) and of the paired multiply-add (0.9) now in use.
+ * GSL's radix-2 FFT (in use) and one product per multiply-add pass;
+ * COST_PART is that fit scaled by the instruction count (callgrind) of the
+ * paired multiply-add now in use (0.9).
  * COST_DIRECT is the lag of the plain sum (DMI_CONV_DIRECT).  DMI_CONV_AUTO
  * takes the FFT method when the model says it is cheaper: for one nonzero
- * kernel entry (the oscillator) from N = 270 on, for a full 3 x 3 kernel
- * from N = 126 on (crossover of the oscillator in instructions per step,
- * callgrind: between N = 192 and 256).
+ * kernel entry (the oscillator) from N = 382 on, for a full 3 x 3 kernel
+ * from N = 174 on.
  */
 #define COST_LAG 0.58
 #define COST_PART 2.45
-#define COST_FFT 23.0
+#define COST_FFT 40.4
 #define COST_LEVEL 13.0
 #define COST_DIRECT 0.42
 
@@ -155,9 +154,6 @@ typedef struct {
     double *kspec;        /* nnz * nparts * M: kernel spectra / M (split layout) */
     double *xspec;        /* ncols * depth * M: spectrum of window b in slot b mod depth */
     double *out;          /* n * S: block sums (before the factor h) of the current block */
-    gsl_fft_real_wavetable *rtab;
-    gsl_fft_halfcomplex_wavetable *htab;
-    gsl_fft_real_workspace *work;
     double *tmp; /* M: scratch of the transforms */
 } level;
 
@@ -178,25 +174,24 @@ struct dmi_conv {
  * Spectra are kept in a split layout: the real parts re_0 .. re_{M/2-1} at
  * [0, M/2), the real re_{M/2} at M/2 (the slot of im_0), the imaginary parts
  * im_1 .. im_{M/2-1} at [M/2 + 1, M), so the multiply-add is a plain loop
- * over the bins.  The transforms are GSL's mixed-radix real FFTs, whose
- * halfcomplex layout re_0, (re_1, im_1), ..., re_{M/2} is converted through
- * the level's scratch array.  The wavetables and the workspace are made once
- * by dmi_conv_create; with them and a power-of-two M the transforms have no
- * error path (GSL checks only n against the tables), so stepping never
- * reaches GSL's error handler.
+ * over the bins.  The transforms are GSL's radix-2 real FFTs, whose
+ * halfcomplex layout re_0 .. re_{M/2}, im_{M/2-1} .. im_1 is converted
+ * through the level's scratch array.  They allocate nothing and, M being a
+ * power of two, have no error path: GSL's error handler (which aborts by
+ * default) is never reached.  GSL's mixed-radix FFT is faster (about 12 % at
+ * N = 9991) but its wavetables are allocated by functions that call that
+ * handler when malloc fails, and the library must never abort.
  */
 static void forward(level *v, double *x)
 {
     const size_t M = v->M, H = M / 2;
     double *y = v->tmp;
     memcpy(y, x, M * sizeof *y);
-    gsl_fft_real_transform(y, 1, M, v->rtab, v->work);
-    x[0] = y[0];
-    x[H] = y[M - 1];
-    for (size_t q = 1; q < H; q++) {
-        x[q] = y[2 * q - 1];
-        x[H + q] = y[2 * q];
-    }
+    gsl_fft_real_radix2_transform(y, 1, M);
+    for (size_t q = 0; q <= H; q++)
+        x[q] = y[q];
+    for (size_t q = 1; q < H; q++)
+        x[H + q] = y[M - q];
 }
 
 /* x (split layout) -> the unscaled inverse transform in the scratch array. */
@@ -204,13 +199,11 @@ static const double *backward(level *v, const double *x)
 {
     const size_t M = v->M, H = M / 2;
     double *y = v->tmp;
-    y[0] = x[0];
-    y[M - 1] = x[H];
-    for (size_t q = 1; q < H; q++) {
-        y[2 * q - 1] = x[q];
-        y[2 * q] = x[H + q];
-    }
-    gsl_fft_halfcomplex_transform(y, 1, M, v->htab, v->work);
+    for (size_t q = 0; q <= H; q++)
+        y[q] = x[q];
+    for (size_t q = 1; q < H; q++)
+        y[M - q] = x[H + q];
+    gsl_fft_halfcomplex_radix2_backward(y, 1, M);
     return y;
 }
 
@@ -254,12 +247,6 @@ void dmi_conv_free(dmi_conv *c)
         free(c->lv[i].xspec);
         free(c->lv[i].out);
         free(c->lv[i].tmp);
-        if (c->lv[i].rtab)
-            gsl_fft_real_wavetable_free(c->lv[i].rtab);
-        if (c->lv[i].htab)
-            gsl_fft_halfcomplex_wavetable_free(c->lv[i].htab);
-        if (c->lv[i].work)
-            gsl_fft_real_workspace_free(c->lv[i].work);
     }
     free(c->col_slot);
     free(c->row_used);
@@ -287,15 +274,7 @@ static int level_alloc(level *v, const layout *y, size_t i, size_t n, size_t nco
     v->xspec = calloc(ncols * v->depth * v->M, sizeof *v->xspec);
     v->out = calloc(n * v->S, sizeof *v->out);
     v->tmp = malloc(v->M * sizeof *v->tmp);
-    if (!v->kspec || !v->xspec || !v->out || !v->tmp)
-        return -1;
-    /* GSL's allocators call its error handler (which aborts by default) when
-     * malloc fails: a residual risk of engine creation (dmi_init,
-     * dmi_set_convolution) only; stepping and loading allocate nothing. */
-    v->rtab = gsl_fft_real_wavetable_alloc(v->M);
-    v->htab = gsl_fft_halfcomplex_wavetable_alloc(v->M);
-    v->work = gsl_fft_real_workspace_alloc(v->M);
-    return v->rtab && v->htab && v->work ? 0 : -1;
+    return v->kspec && v->xspec && v->out && v->tmp ? 0 : -1;
 }
 
 /* Spectrum / M of the kernel samples of entry e on the partition's lags. */
