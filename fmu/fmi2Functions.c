@@ -81,6 +81,18 @@ static fmi2Status error(instance *in, const char *fmt, ...)
     return fmi2Error;
 }
 
+/* A status the FMU cannot give: fmi2Discard (FMI 2.0, 4.2.3), the reason
+ * logged only when debug logging of calls is on. */
+static fmi2Status discard(instance *in, const char *fn, const char *why)
+{
+    if (in->logging_on && (in->categories & CAT_CALLS)) {
+        char msg[2 * MODEL_ERRLEN];
+        snprintf(msg, sizeof msg, "%s: %s", fn, why);
+        emit(in, fmi2Discard, CAT_CALLS, msg);
+    }
+    return fmi2Discard;
+}
+
 static const char *state_name(unsigned state)
 {
     switch (state) {
@@ -561,8 +573,13 @@ fmi2Status fmi2CancelStep(fmi2Component c)
 
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value)
 {
-    (void)s, (void)value;
-    return unsupported(c, "fmi2GetStatus", READABLE, "steps are never asynchronous");
+    instance *in = enter(c, "fmi2GetStatus", READABLE);
+    (void)s;
+    if (!in)
+        return fmi2Error;
+    if (!value)
+        return error(in, "fmi2GetStatus: value is NULL");
+    return discard(in, "fmi2GetStatus", "steps are never asynchronous");
 }
 
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value)
@@ -570,16 +587,23 @@ fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *
     instance *in = enter(c, "fmi2GetRealStatus", READABLE);
     if (!in)
         return fmi2Error;
-    if (s != fmi2LastSuccessfulTime || !value)
-        return error(in, "fmi2GetRealStatus: only fmi2LastSuccessfulTime is available");
+    if (!value)
+        return error(in, "fmi2GetRealStatus: value is NULL");
+    if (s != fmi2LastSuccessfulTime)
+        return discard(in, "fmi2GetRealStatus", "only fmi2LastSuccessfulTime is available");
     *value = in->m.t_comm;
     return fmi2OK;
 }
 
 fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value)
 {
-    (void)s, (void)value;
-    return unsupported(c, "fmi2GetIntegerStatus", READABLE, "no Integer status is defined");
+    instance *in = enter(c, "fmi2GetIntegerStatus", READABLE);
+    (void)s;
+    if (!in)
+        return fmi2Error;
+    if (!value)
+        return error(in, "fmi2GetIntegerStatus: value is NULL");
+    return discard(in, "fmi2GetIntegerStatus", "no Integer status is defined");
 }
 
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
@@ -587,14 +611,21 @@ fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boo
     instance *in = enter(c, "fmi2GetBooleanStatus", READABLE);
     if (!in)
         return fmi2Error;
-    if (s != fmi2Terminated || !value)
-        return error(in, "fmi2GetBooleanStatus: only fmi2Terminated is available");
+    if (!value)
+        return error(in, "fmi2GetBooleanStatus: value is NULL");
+    if (s != fmi2Terminated)
+        return discard(in, "fmi2GetBooleanStatus", "only fmi2Terminated is available");
     *value = fmi2False; /* the FMU never asks to stop */
     return fmi2OK;
 }
 
 fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value)
 {
-    (void)s, (void)value;
-    return unsupported(c, "fmi2GetStringStatus", READABLE, "no String status is defined");
+    instance *in = enter(c, "fmi2GetStringStatus", READABLE);
+    (void)s;
+    if (!in)
+        return fmi2Error;
+    if (!value)
+        return error(in, "fmi2GetStringStatus: value is NULL");
+    return discard(in, "fmi2GetStringStatus", "no String status is defined");
 }

@@ -94,6 +94,9 @@ def test_model_description_contract(md):
     for n in OUT:
         assert var[n].causality == "output", n
     assert var["sticking"].type == "Boolean"
+    # Outputs at a communication point come from the steps before it: no direct feedthrough of g_in.
+    assert sorted(o.variable.name for o in md.outputs) == sorted(OUT)
+    assert all(o.dependencies == [] for o in md.outputs)
     assert [c.name for c in md.logCategories] == ["logStatusError", "logCalls"]
     de = md.defaultExperiment
     assert float(de.stopTime) == 30.0
@@ -693,14 +696,26 @@ def test_fmu_run_script_start_values(source_dir, fmu_path, libdmi, tmp_path):
 
 
 def test_status_queries_and_unsupported_functions(sl):
-    from fmpy.fmi2 import fmi2LastSuccessfulTime, fmi2Terminated, fmi2DoStepStatus
+    from fmpy.fmi2 import (fmi2LastSuccessfulTime, fmi2Terminated, fmi2DoStepStatus,
+                           fmi2PendingStatus, fmi2Discard)
     s = sl()
     start(s)
     s.fmu.doStep(0.0, 0.0123)
     s.fmu.doStep(0.0123, 0.0123)
     assert s.fmu.getRealStatus(fmi2LastSuccessfulTime) == 0.0123 + 0.0123
     assert not s.fmu.getBooleanStatus(fmi2Terminated)
-    for call in (lambda: s.fmu.getStatus(fmi2DoStepStatus), s.fmu.cancelStep,
+    # Status the FMU cannot give: fmi2Discard (FMI 2.0, 4.2.3), not an error.
+    for call in (lambda: s.fmu.getStatus(fmi2DoStepStatus),
+                 lambda: s.fmu.getRealStatus(fmi2DoStepStatus),
+                 lambda: s.fmu.getIntegerStatus(fmi2DoStepStatus),
+                 lambda: s.fmu.getBooleanStatus(fmi2DoStepStatus),
+                 lambda: s.fmu.getStringStatus(fmi2PendingStatus)):
+        n = len(s.errors())
+        with pytest.raises(FMICallException) as e:
+            call()
+        assert e.value.status == fmi2Discard
+        assert len(s.errors()) == n
+    for call in (s.fmu.cancelStep,
                  lambda: s.fmu.setRealInputDerivatives([s.vr["g_in"]], [1], [0.0]),
                  lambda: s.fmu.getDirectionalDerivative([s.vr["w"]], [s.vr["g_in"]], [1.0])):
         n = len(s.errors())
