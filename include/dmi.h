@@ -22,7 +22,9 @@
  *   same unit.
  * - Every function returning int returns DMI_OK (0) or one of the negative
  *   DMI_E* codes.  On failure the solver (if any) is left exactly as it was
- *   before the call, bitwise, and dmi_last_error(s) describes the reason.
+ *   before the call, bitwise (all but the message buffer), and
+ *   dmi_last_error(s) describes the reason.  (dmi_advance keeps the steps it
+ *   took before the failing one.)
  * - The solver never keeps a pointer passed in as an array argument: arrays
  *   are copied.  Callback user pointers are stored and passed back untouched;
  *   their lifetime is the caller's business.
@@ -59,8 +61,7 @@ typedef struct dmi_solver dmi_solver;
  * Callbacks.  Each returns 0 on success; any other value makes the calling
  * library function fail with DMI_ECALLBACK and leaves the solver unchanged.
  * The output array is set to zero before every call, so a callback may write
- * only the nonzero entries (except the resolvent, which gets no such help:
- * it must write all n entries).  Non-finite outputs give DMI_ENONFINITE.
+ * only the nonzero entries.  Non-finite outputs give DMI_ENONFINITE.
  */
 
 /* out = f(t, u): n values.  t = t_p in time units. */
@@ -170,7 +171,8 @@ DMI_API int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user);
  *   AUTO    FFT when a cost model measured on x86-64 predicts it faster
  *           than DIRECT for this N and kernel pattern, else DIRECT; for one
  *           nonzero kernel entry that is N >= 382 (a full 3 x 3 kernel:
- *           N >= 174).  The choice is made by dmi_init and by this call.
+ *           N >= 174; the model also picks FFT for 158 <= N <= 164).
+ *           The choice is made by dmi_init and by this call.
  * Kernel entries that are zero at every sample cost nothing in either method.
  * May be called at any time, also between steps: the FFT engine is then
  * (re)built from the stored states U^{p-N..p}, and stepping on is bitwise the
@@ -240,8 +242,9 @@ DMI_API int dmi_get_step_terms(const dmi_solver *s, double *W, double *X);
 
 /* ---- saving and restoring the time-stepping state -----------------------
  * The state is the step counter, the N + 1 stored states U^{p-N..p} and the
- * last step's terms; it does not include the callbacks, the resolvent choice
- * or the kernel (these stay as set on the solver that loads it).  The bytes
+ * last step's terms; it does not include the callbacks, the resolvent choice,
+ * the convolution method or the kernel (these stay as set on the solver that
+ * loads it).  The bytes
  * are native-endian, begin with a magic and a format version, and are
  * checked on load: a state saved by a solver with other n, N or tau, or a
  * truncated or corrupted buffer, is rejected with DMI_EINVAL and the solver
@@ -255,10 +258,13 @@ DMI_API size_t dmi_state_size(const dmi_solver *s);
  * than dmi_state_size(s); DMI_ESTATE before dmi_init. */
 DMI_API int dmi_state_save(const dmi_solver *s, void *buf, size_t size);
 
-/* Restores a state written by dmi_state_save.  Requires dmi_init to have run
- * (the kernel samples come from it).  DMI_EINVAL for bad bytes, DMI_ESTATE
- * before dmi_init, DMI_ENOMEM; the solver is unchanged on error.  Stepping on
- * from a restored state gives bitwise the same results as the saving solver. */
+/* Restores a state written by dmi_state_save; size must equal
+ * dmi_state_size(s).  Requires dmi_init to have run (the kernel samples come
+ * from it).  DMI_EINVAL for bad bytes or another size, DMI_ESTATE before
+ * dmi_init, DMI_ENOMEM; the solver is unchanged on error.  Stepping on from a
+ * restored state gives bitwise the same results as the saving solver if both
+ * use the same callbacks and convolution method (another method differs by
+ * rounding only). */
 DMI_API int dmi_state_load(dmi_solver *s, const void *buf, size_t size);
 
 /* ---- errors -------------------------------------------------------------- */

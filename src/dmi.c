@@ -37,7 +37,6 @@ struct dmi_solver {
     dmi_history ring;   /* U^{p-N..p} */
     dmi_kernel kernel;  /* nonzero entries of H(l h) */
     dmi_conv *conv;     /* FFT engine, or NULL: the direct sum is in use */
-    int have_last;      /* a step was taken since init / load */
     double *last_W;     /* W^{p-1} (n) */
     double *last_X;     /* X^{p-1} (n) */
     double *work;       /* 5 n scratch values: U^p, f, W, X, U^{p+1} */
@@ -321,7 +320,8 @@ static int sample_history(dmi_solver *s, dmi_history *ring)
     const size_t n = s->n, N = s->N;
     double *u = s->work;
     for (size_t k = 0; k <= N; k++) { /* U^{-k} = z(-k h) */
-        double t = -(double)k * s->h;
+        /* t_{-k} = -k h, exactly -tau at k = N (-N h may round below it) */
+        double t = k == s->N ? -s->tau : k == 0 ? 0.0 : -(double)k * s->h;
         memset(u, 0, n * sizeof *u);
         if (s->z) {
             int rc = s->z(t, u, s->z_user);
@@ -366,7 +366,6 @@ int dmi_init(dmi_solver *s)
     if (c) /* the history's FFT part, before the first step */
         dmi_conv_rebuild(c, &s->kernel, &s->ring, 0);
     s->p = 0;
-    s->have_last = 0;
     memset(s->last_W, 0, s->n * sizeof *s->last_W); /* a restart saves the bytes of a new run */
     memset(s->last_X, 0, s->n * sizeof *s->last_X);
     s->initialized = 1;
@@ -453,7 +452,6 @@ int dmi_step(dmi_solver *s)
         s->last_W[i] = W[i];
         s->last_X[i] = X[i];
     }
-    s->have_last = 1;
     s->p++;
     if (s->conv)
         dmi_conv_advance(s->conv, &s->kernel, &s->ring, s->p);
@@ -505,7 +503,10 @@ int dmi_get_step_index(const dmi_solver *s, uint64_t *p)
 
 int dmi_get_state(const dmi_solver *s, double *u)
 {
-    return dmi_get_past(s, 0, u);
+    int rc = check_query(s, u, "dmi_get_state");
+    if (rc == DMI_OK)
+        dmi_history_get(&s->ring, 0, u);
+    return rc;
 }
 
 int dmi_get_past(const dmi_solver *s, size_t lag, double *u)
@@ -523,7 +524,7 @@ int dmi_get_step_terms(const dmi_solver *s, double *W, double *X)
 {
     if (!s)
         return DMI_EINVAL;
-    if (!s->initialized || !s->have_last)
+    if (!s->initialized || s->p == 0)
         return fail(s, DMI_ESTATE, "dmi_get_step_terms: no step taken since dmi_init");
     if (W)
         memcpy(W, s->last_W, s->n * sizeof *W);
@@ -534,7 +535,7 @@ int dmi_get_step_terms(const dmi_solver *s, double *W, double *X)
 
 /* ---- state save / load ---------------------------------------------------------
  * Layout (native endian): header of 8 uint64 words
- *   magic, version, n, N, bits of tau, p, have_last, checksum
+ *   magic, version, n, N, bits of tau, p, p != 0 (a step was taken), checksum
  * then (N + 1) n doubles U^{p-lag} for lag = 0..N, n doubles W, n doubles X.
  * checksum = FNV-1a 64 of every other byte (header with checksum word 0).
  */
@@ -576,7 +577,7 @@ int dmi_state_save(const dmi_solver *s, void *buf, size_t size)
     if (size < need)
         return fail(s, DMI_EINVAL, "dmi_state_save: buffer of %zu bytes, %zu needed", size, need);
     uint64_t hdr[STATE_WORDS] = {STATE_MAGIC, STATE_VERSION, (uint64_t)n, (uint64_t)s->N, 0,
-                                 s->p, (uint64_t)s->have_last, 0};
+                                 s->p, (uint64_t)(s->p != 0), 0};
     memcpy(&hdr[4], &s->tau, sizeof(double));
     unsigned char *b = buf;
     memcpy(b, hdr, sizeof hdr);
@@ -615,8 +616,11 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
                     "dmi_state_load: state of a solver with n = %llu, N = %llu, tau = %g; this "
                     "one has n = %zu, N = %zu, tau = %g",
                     (unsigned long long)hdr[2], (unsigned long long)hdr[3], tau, n, s->N, s->tau);
-    if (hdr[6] > 1 || hdr[7] != state_checksum(b, need))
+    if (hdr[7] != state_checksum(b, need))
         return fail(s, DMI_EINVAL, "dmi_state_load: corrupted state (checksum mismatch)");
+    if (hdr[6] != (uint64_t)(hdr[5] != 0))
+        return fail(s, DMI_EINVAL, "dmi_state_load: corrupted state (step flag %llu at p = %llu)",
+                    (unsigned long long)hdr[6], (unsigned long long)hdr[5]);
     const size_t nd = (s->N + 3) * n;
     double *d = malloc(nd * sizeof *d);
     if (!d)
@@ -638,7 +642,6 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
     memcpy(s->last_W, d + (s->N + 1) * n, n * sizeof *d);
     memcpy(s->last_X, d + (s->N + 2) * n, n * sizeof *d);
     s->p = hdr[5];
-    s->have_last = (int)hdr[6];
     if (s->conv)
         dmi_conv_rebuild(s->conv, &s->kernel, &s->ring, s->p);
     free(d);

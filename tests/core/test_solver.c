@@ -304,6 +304,42 @@ static void test_time(void)
     dmi_free(&s);
 }
 
+/* The history is asked for z(t) with -tau <= t <= 0 only, as dmi.h promises,
+ * even where -N * (tau / N) rounds below -tau (tau = 0.7999999999999999,
+ * N = 3), and its samples are z(0), z(-h), ..., z(-tau). */
+typedef struct {
+    double tau;
+    double t[4];
+    int calls;
+} domain_check;
+
+static int history_in_domain(double t, double *out, void *user)
+{
+    domain_check *d = user;
+    if (t < -d->tau || t > 0 || d->calls >= 4)
+        return 1;
+    d->t[d->calls++] = t;
+    out[0] = t;
+    return 0;
+}
+
+static void test_history_domain(void)
+{
+    const double tau = 0.7999999999999999;
+    const size_t N = 3;
+    CU_ASSERT(-(double)N * (tau / (double)N) < -tau); /* the case that needs care */
+    domain_check d = {tau, {0}, 0};
+    dmi_solver *s = NULL;
+    CU_ASSERT_EQUAL_FATAL(dmi_create(&s, 1, tau, N), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_history(s, history_in_domain, &d), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_init(s), DMI_OK);
+    CU_ASSERT_EQUAL(d.calls, 4);
+    double u = 1;
+    CU_ASSERT(dmi_get_past(s, N, &u) == DMI_OK && u == -tau);
+    CU_ASSERT(dmi_get_past(s, 0, &u) == DMI_OK && u == 0.0 && !signbit(u));
+    dmi_free(&s);
+}
+
 /* a: a model solver that ran 45 steps and was then restarted by dmi_init;
  * b: a new one. */
 static int restarted_pair(core_model *m1, core_model *m2, dmi_solver **a, dmi_solver **b)
@@ -365,6 +401,7 @@ int main(int argc, char **argv)
         {"defaults: nothing set gives U = z(0) exactly", test_defaults},
         {"user soft-threshold resolvent = built-in friction, bitwise", test_user_friction},
         {"dmi_time = p * (tau / N) from the counter", test_time},
+        {"history sampled on [-tau, 0] only, z(-tau) at lag N", test_history_domain},
         {"dmi_init restarts a solver exactly", test_restart},
         {"after dmi_init a restarted solver saves the bytes of a new one", test_restart_bytes},
         {NULL, NULL}};

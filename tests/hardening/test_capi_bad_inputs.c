@@ -315,6 +315,7 @@ CALL(c_load_foreign_n_hdr, return LOAD(s, E_WORD_FIXED, 16, 3, 0, 0);)
 CALL(c_load_checksum, return LOAD(s, E_BYTE, 60, 0, 0, 0);)
 CALL(c_load_data, return LOAD(s, E_BYTE, STATE_HEADER + 3, 0, 0, 0);)
 CALL(c_load_have_last, return LOAD(s, E_WORD_FIXED, 48, 2, 0, 0);)
+CALL(c_load_flag0, return LOAD(s, E_WORD_FIXED, 48, 0, 0, 0);)
 CALL(c_load_step_huge, return LOAD(s, E_WORD, 40, 1e19, 0, 0);)
 CALL(c_load_nan, return LOAD(s, E_DOUBLE_FIXED, STATE_HEADER, NAN, 0, 0);)
 CALL(c_load_inf, return LOAD(s, E_DOUBLE_FIXED, STATE_HEADER + (MODEL_N + 2) * MODEL_n * 8,
@@ -412,6 +413,7 @@ static const bad_case cases[] = {
     {"C99", "dmi_state_load", "checksum byte altered", S_INIT, c_load_checksum, DMI_EINVAL, "checksum"},
     {"C100", "dmi_state_load", "a data byte altered", S_INIT, c_load_data, DMI_EINVAL, "checksum"},
     {"C101", "dmi_state_load", "last-step flag = 2 (checksum valid)", S_INIT, c_load_have_last, DMI_EINVAL, "corrupted"},
+    {"C114", "dmi_state_load", "last-step flag = 0 at p > 0 (checksum valid)", S_INIT, c_load_flag0, DMI_EINVAL, "corrupted"},
     {"C102", "dmi_state_load", "step counter 1e19 (checksum not fixed)", S_INIT, c_load_step_huge, DMI_EINVAL, "checksum"},
     {"C103", "dmi_state_load", "U^p[0] = NaN (checksum valid)", S_INIT, c_load_nan, DMI_EINVAL, "non-finite"},
     {"C104", "dmi_state_load", "last W[0] = -Inf (checksum valid)", S_INIT, c_load_inf, DMI_EINVAL, "non-finite"},
