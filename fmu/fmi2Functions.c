@@ -81,18 +81,6 @@ static fmi2Status error(instance *in, const char *fmt, ...)
     return fmi2Error;
 }
 
-/* A status the FMU cannot give: fmi2Discard (FMI 2.0, 4.2.3), the reason
- * logged only when debug logging of calls is on. */
-static fmi2Status discard(instance *in, const char *fn, const char *why)
-{
-    if (in->logging_on && (in->categories & CAT_CALLS)) {
-        char msg[2 * MODEL_ERRLEN];
-        snprintf(msg, sizeof msg, "%s: %s", fn, why);
-        emit(in, fmi2Discard, CAT_CALLS, msg);
-    }
-    return fmi2Discard;
-}
-
 static const char *state_name(unsigned state)
 {
     switch (state) {
@@ -571,61 +559,64 @@ fmi2Status fmi2CancelStep(fmi2Component c)
     return unsupported(c, "fmi2CancelStep", ANY_STATE, "steps are never asynchronous");
 }
 
-fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value)
+/* A status query the FMU cannot answer (this kind of status is not
+ * available): fmi2Discard (FMI 2.0, 4.2.3), the reason logged only when debug
+ * logging of calls is on. */
+static fmi2Status no_status(fmi2Component c, const char *fn, const void *value, const char *why)
 {
-    instance *in = enter(c, "fmi2GetStatus", READABLE);
-    (void)s;
+    instance *in = enter(c, fn, READABLE);
     if (!in)
         return fmi2Error;
     if (!value)
-        return error(in, "fmi2GetStatus: value is NULL");
-    return discard(in, "fmi2GetStatus", "steps are never asynchronous");
+        return error(in, "%s: value is NULL", fn);
+    if (in->logging_on && (in->categories & CAT_CALLS)) {
+        char msg[2 * MODEL_ERRLEN];
+        snprintf(msg, sizeof msg, "%s: %s", fn, why);
+        emit(in, fmi2Discard, CAT_CALLS, msg);
+    }
+    return fmi2Discard;
+}
+
+fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value)
+{
+    (void)s;
+    return no_status(c, "fmi2GetStatus", value, "steps are never asynchronous");
 }
 
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value)
 {
+    if (s != fmi2LastSuccessfulTime)
+        return no_status(c, "fmi2GetRealStatus", value, "only fmi2LastSuccessfulTime is available");
     instance *in = enter(c, "fmi2GetRealStatus", READABLE);
     if (!in)
         return fmi2Error;
     if (!value)
         return error(in, "fmi2GetRealStatus: value is NULL");
-    if (s != fmi2LastSuccessfulTime)
-        return discard(in, "fmi2GetRealStatus", "only fmi2LastSuccessfulTime is available");
     *value = in->m.t_comm;
     return fmi2OK;
 }
 
 fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value)
 {
-    instance *in = enter(c, "fmi2GetIntegerStatus", READABLE);
     (void)s;
-    if (!in)
-        return fmi2Error;
-    if (!value)
-        return error(in, "fmi2GetIntegerStatus: value is NULL");
-    return discard(in, "fmi2GetIntegerStatus", "no Integer status is defined");
+    return no_status(c, "fmi2GetIntegerStatus", value, "no Integer status is defined");
 }
 
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
 {
+    if (s != fmi2Terminated)
+        return no_status(c, "fmi2GetBooleanStatus", value, "only fmi2Terminated is available");
     instance *in = enter(c, "fmi2GetBooleanStatus", READABLE);
     if (!in)
         return fmi2Error;
     if (!value)
         return error(in, "fmi2GetBooleanStatus: value is NULL");
-    if (s != fmi2Terminated)
-        return discard(in, "fmi2GetBooleanStatus", "only fmi2Terminated is available");
     *value = fmi2False; /* the FMU never asks to stop */
     return fmi2OK;
 }
 
 fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value)
 {
-    instance *in = enter(c, "fmi2GetStringStatus", READABLE);
     (void)s;
-    if (!in)
-        return fmi2Error;
-    if (!value)
-        return error(in, "fmi2GetStringStatus: value is NULL");
-    return discard(in, "fmi2GetStringStatus", "no String status is defined");
+    return no_status(c, "fmi2GetStringStatus", value, "no String status is defined");
 }
