@@ -56,14 +56,6 @@ static int fail(const dmi_solver *cs, int code, const char *fmt, ...)
     return code;
 }
 
-static int all_finite(const double *x, size_t n)
-{
-    for (size_t i = 0; i < n; i++)
-        if (!isfinite(x[i]))
-            return 0;
-    return 1;
-}
-
 static size_t first_nonfinite(const double *x, size_t n)
 {
     size_t i = 0;
@@ -626,7 +618,7 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
     if (!d)
         return fail(s, DMI_ENOMEM, "dmi_state_load: out of memory");
     memcpy(d, b + sizeof hdr, nd * sizeof *d);
-    if (!all_finite(d, nd)) {
+    if (first_nonfinite(d, nd) < nd) {
         free(d);
         return fail(s, DMI_EINVAL, "dmi_state_load: state holds a non-finite value");
     }

@@ -12,39 +12,19 @@
  * Exit status 0 if every check passed.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include <dlfcn.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "fmi2FunctionTypes.h"
+#include "fmu_loader.h"
 
 /* Value references of the FMU (its modelDescription.xml). */
 enum { VR_tau = 2, VR_w = 19, VR_v = 20, VR_N = 23 };
 static const int N = 9991;
 static const double TOL = 1e-12;
 
-typedef struct {
-    fmi2InstantiateTYPE *instantiate;
-    fmi2FreeInstanceTYPE *free_instance;
-    fmi2SetupExperimentTYPE *setup;
-    fmi2EnterInitializationModeTYPE *enter_init;
-    fmi2ExitInitializationModeTYPE *exit_init;
-    fmi2SetIntegerTYPE *set_integer;
-    fmi2SetRealTYPE *set_real;
-    fmi2ResetTYPE *reset;
-    fmi2GetRealTYPE *get_real;
-    fmi2DoStepTYPE *do_step;
-    fmi2GetFMUstateTYPE *get_state;
-    fmi2SetFMUstateTYPE *set_state;
-    fmi2FreeFMUstateTYPE *free_state;
-    fmi2SerializedFMUstateSizeTYPE *state_size;
-    fmi2SerializeFMUstateTYPE *serialize;
-    fmi2DeSerializeFMUstateTYPE *deserialize;
-    fmi2TerminateTYPE *terminate;
-} fmi2;
 
 static int failures = 0;
 
@@ -68,44 +48,6 @@ static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status sta
     fputc('\n', stderr);
 }
 
-/* Looks up name in the library; NULL (and a message) if missing. */
-static void *sym(void *lib, const char *name)
-{
-    void *f = dlsym(lib, name);
-    if (!f)
-        fprintf(stderr, "fmu_master: %s not exported\n", name);
-    return f;
-}
-
-static int load(void *lib, fmi2 *f)
-{
-    /* object pointer to function pointer: the POSIX dlsym idiom */
-#define LOAD(field, name) *(void **)(&f->field) = sym(lib, name)
-    LOAD(instantiate, "fmi2Instantiate");
-    LOAD(free_instance, "fmi2FreeInstance");
-    LOAD(setup, "fmi2SetupExperiment");
-    LOAD(enter_init, "fmi2EnterInitializationMode");
-    LOAD(exit_init, "fmi2ExitInitializationMode");
-    LOAD(set_integer, "fmi2SetInteger");
-    LOAD(set_real, "fmi2SetReal");
-    LOAD(reset, "fmi2Reset");
-    LOAD(get_real, "fmi2GetReal");
-    LOAD(do_step, "fmi2DoStep");
-    LOAD(get_state, "fmi2GetFMUstate");
-    LOAD(set_state, "fmi2SetFMUstate");
-    LOAD(free_state, "fmi2FreeFMUstate");
-    LOAD(state_size, "fmi2SerializedFMUstateSize");
-    LOAD(serialize, "fmi2SerializeFMUstate");
-    LOAD(deserialize, "fmi2DeSerializeFMUstate");
-    LOAD(terminate, "fmi2Terminate");
-#undef LOAD
-    void **p = (void **)f;
-    for (size_t i = 0; i < sizeof *f / sizeof(void *); i++)
-        if (!p[i])
-            return -1;
-    return 0;
-}
-
 /* The reference rows: step index p and w, v at t_p. */
 typedef struct {
     long p;
@@ -114,7 +56,7 @@ typedef struct {
 
 /* A second instance through the error paths: each call must give fmi2Error
  * and leave the instance usable. */
-static void error_paths(const fmi2 *f, const char *guid, const fmi2CallbackFunctions *cb)
+static void error_paths(const fmu_api *f, const char *guid, const fmi2CallbackFunctions *cb)
 {
     fmi2Component c = f->instantiate("errors", fmi2CoSimulation, guid, "", cb, fmi2False,
                                      fmi2False);
@@ -185,11 +127,9 @@ int main(int argc, char **argv)
     const double T = atof(argv[4]), h = 1.0 / N;
     size_t nrows = 0;
     row *ref = read_reference(argv[3], &nrows);
-    void *lib = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
-    fmi2 f;
-    if (!ref || nrows < 2 || !lib || load(lib, &f) != 0) {
-        fprintf(stderr, "fmu_master: cannot read %s or load %s (%s)\n", argv[3], argv[1],
-                lib ? "missing functions" : dlerror());
+    fmu_api f;
+    if (!ref || nrows < 2 || fmu_load(&f, argv[1]) != 0) {
+        fprintf(stderr, "fmu_master: cannot read %s or load %s\n", argv[3], argv[1]);
         return 1;
     }
     const fmi2CallbackFunctions cb = {logger, calloc, free, NULL, NULL};
@@ -261,7 +201,7 @@ int main(int argc, char **argv)
     error_paths(&f, argv[2], &cb);
     check(f.terminate(c) == fmi2OK, "fmi2Terminate");
     f.free_instance(c);
-    dlclose(lib);
+    fmu_unload(&f);
     free(ref);
     printf("fmu_master: %zu reference points to t = %g, max deviation %.3g; %d failures\n",
            compared, T, maxdev, failures);
