@@ -64,16 +64,6 @@ static size_t first_nonfinite(const double *x, size_t n)
     return i;
 }
 
-/* a * b elements of size sz, or 0 on overflow. */
-static size_t mul_size(size_t a, size_t b, size_t sz)
-{
-    if (a != 0 && b > SIZE_MAX / a)
-        return 0;
-    if (a * b != 0 && sz > SIZE_MAX / (a * b))
-        return 0;
-    return a * b * sz;
-}
-
 const char *dmi_version(void)
 {
     return STR(DMI_VERSION_MAJOR) "." STR(DMI_VERSION_MINOR) "." STR(DMI_VERSION_PATCH);
@@ -109,8 +99,8 @@ int dmi_create(dmi_solver **out, size_t n, double tau, size_t N)
     double h = tau / (double)N;
     if (!isnormal(h))
         return DMI_EINVAL;
-    if (N == SIZE_MAX || mul_size(2 * (N + 1) > N ? 2 * (N + 1) : 0, n, sizeof(double)) == 0 ||
-        mul_size(5, n, sizeof(double)) == 0)
+    if (N == SIZE_MAX || dmi_mul_size(2 * (N + 1) > N ? 2 * (N + 1) : 0, n, sizeof(double)) == 0 ||
+        dmi_mul_size(5, n, sizeof(double)) == 0)
         return DMI_ENOMEM;
 
     dmi_solver *s = calloc(1, sizeof *s);
@@ -278,7 +268,7 @@ static int sample_kernel(dmi_solver *s, dmi_kernel *k)
     if (!s->H)
         return dmi_kernel_alloc(k, n, N, NULL) == 0 ? DMI_OK
                                                    : fail(s, DMI_ENOMEM, "dmi_init: out of memory");
-    size_t bytes = mul_size(n, n, 1) ? mul_size(N, nn, sizeof(double)) : 0; /* n * n overflows */
+    size_t bytes = dmi_mul_size(n, n, 1) ? dmi_mul_size(N, nn, sizeof(double)) : 0; /* n * n overflows */
     double *dense = bytes ? malloc(bytes) : NULL;
     if (!dense)
         return fail(s, DMI_ENOMEM, "dmi_init: cannot allocate %zu x %zu x %zu kernel samples", N,
@@ -412,24 +402,26 @@ int dmi_step(dmi_solver *s)
         int rc = s->f(t, U, fv, s->f_user);
         if (rc != 0)
             return fail(s, DMI_ECALLBACK, "dmi_step: rhs callback returned %d at t = %.17g", rc, t);
-        size_t bad = first_nonfinite(fv, n);
-        if (bad < n)
-            return fail(s, DMI_ENONFINITE, "dmi_step: f(%.17g, U)[%zu] = %g", t, bad, fv[bad]);
     }
     if (s->conv)
         dmi_conv_sum(s->conv, &s->kernel, &s->ring, s->p, h, W);
     else
         dmi_delay_sum(&s->kernel, &s->ring, h, W);
-    size_t bad = first_nonfinite(W, n);
-    if (bad < n)
-        return fail(s, DMI_ENONFINITE, "dmi_step: delay term W[%zu] = %g at t = %.17g", bad, W[bad],
-                    t);
     for (size_t i = 0; i < n; i++)
         X[i] = U[i] - h * fv[i] - h * W[i];
-    bad = first_nonfinite(X, n);
-    if (bad < n)
+    /* A non-finite f or W makes X non-finite (U^p and h are finite), so one
+     * check of X guards all three; the culprit is named on the error path. */
+    size_t bad = first_nonfinite(X, n);
+    if (bad < n) {
+        size_t bf = first_nonfinite(fv, n), bw = first_nonfinite(W, n);
+        if (bf < n)
+            return fail(s, DMI_ENONFINITE, "dmi_step: f(%.17g, U)[%zu] = %g", t, bf, fv[bf]);
+        if (bw < n)
+            return fail(s, DMI_ENONFINITE, "dmi_step: delay term W[%zu] = %g at t = %.17g", bw,
+                        W[bw], t);
         return fail(s, DMI_ENONFINITE, "dmi_step: resolvent argument X[%zu] = %g at t = %.17g",
                     bad, X[bad], t);
+    }
     int rc = apply_resolvent(s, X, U1);
     if (rc != DMI_OK)
         return rc;
