@@ -255,6 +255,16 @@ void dmi_conv_free(dmi_conv *c)
     free(c);
 }
 
+/* a * b doubles (a, b >= 1; a itself checked by the caller's bounds), zeroed
+ * if zero; NULL if out of memory or the size overflows. */
+static double *doubles(size_t a, size_t b, int zero)
+{
+    size_t bytes = dmi_mul_size(a, b, sizeof(double));
+    if (bytes == 0)
+        return NULL;
+    return zero ? calloc(1, bytes) : malloc(bytes);
+}
+
 static int level_alloc(level *v, const layout *y, size_t i, size_t n, size_t ncols, size_t nnz)
 {
     v->S = y->S[i];
@@ -268,12 +278,13 @@ static int level_alloc(level *v, const layout *y, size_t i, size_t n, size_t nco
         for (size_t t = 0; t < y->kcount[i][run]; t++)
             v->k[q++] = y->kfirst[i][run] + t;
     v->depth = v->k[v->nparts - 1] + 1;
-    /* The sizes are bounded by the N n^2 kernel samples and the ring (no overflow:
-     * nparts M <= 2 (N + S) and depth M <= 2 (N + S)). */
-    v->kspec = malloc(nnz * v->nparts * v->M * sizeof *v->kspec);
-    v->xspec = calloc(ncols * v->depth * v->M, sizeof *v->xspec);
-    v->out = calloc(n * v->S, sizeof *v->out);
-    v->tmp = malloc(v->M * sizeof *v->tmp);
+    /* nparts M <= 2 (N + 1) and depth M <= 2 (N + 1 + S): a few times the
+     * kernel samples and the ring, which may still overflow size_t on a
+     * 32-bit target. */
+    v->kspec = doubles(nnz, v->nparts * v->M, 0);
+    v->xspec = doubles(ncols * v->depth, v->M, 1);
+    v->out = doubles(n, v->S, 1);
+    v->tmp = doubles(1, v->M, 0);
     return v->kspec && v->xspec && v->out && v->tmp ? 0 : -1;
 }
 

@@ -7,6 +7,16 @@
 
 #include "dmi.h"
 
+/* a * b elements of size sz, or 0 on overflow. */
+static inline size_t dmi_mul_size(size_t a, size_t b, size_t sz)
+{
+    if (a != 0 && b > SIZE_MAX / a)
+        return 0;
+    if (a * b != 0 && sz > SIZE_MAX / (a * b))
+        return 0;
+    return a * b * sz;
+}
+
 /*
  * History ring of the N + 1 states U^{p-N..p}, stored per component as a
  * series with a mirror copy, so that U_j^{p-l}, l = 0..N, are contiguous:
