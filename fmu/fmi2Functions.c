@@ -10,12 +10,19 @@
  * state bytes, or a call not allowed in the current state) leaves the
  * instance as it was; only a failure of the solver inside fmi2DoStep puts
  * the instance into the error state (then fmi2SetFMUstate or fmi2Reset).
+ *
+ * Memory: libdmi allocates the solver with the C library, so all the FMU's
+ * memory comes from there (calloc, malloc, free) and the model description
+ * says canNotUseMemoryManagementFunctions="true": the importer's
+ * allocateMemory and freeMemory are not called and may be NULL (FMI 2.0:
+ * with the default "false", an FMU must not call malloc itself).
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "fmi2Functions.h"
@@ -43,9 +50,8 @@ enum { CAT_ERROR = 1 << 0, CAT_CALLS = 1 << 1, CAT_ALL = CAT_ERROR | CAT_CALLS }
 typedef struct {
     char *name;
     fmi2CallbackLogger logger;
-    fmi2CallbackAllocateMemory allocate;
-    fmi2CallbackFreeMemory release;
     fmi2ComponentEnvironment environment;
+    int logging_instantiate; /* loggingOn of fmi2Instantiate, restored by fmi2Reset */
     int logging_on;
     unsigned categories; /* CAT_* enabled for debug logging */
     unsigned state;
@@ -166,8 +172,8 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
 {
     (void)fmuResourceLocation;
     (void)visible;
-    if (!functions || !functions->allocateMemory || !functions->freeMemory)
-        return NULL; /* no way to allocate (nor, maybe, to log) */
+    if (!functions)
+        return NULL; /* no way to log why */
     instance probe = {.name = (char *)(instanceName ? instanceName : "?"),
                       .logger = functions->logger, .environment = functions->componentEnvironment};
     if (!instanceName || !*instanceName) {
@@ -183,21 +189,19 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
               fmuGUID ? fmuGUID : "(null)", DMI_FMU_GUID);
         return NULL;
     }
-    instance *in = functions->allocateMemory(1, sizeof *in);
+    instance *in = calloc(1, sizeof *in);
     size_t len = strlen(instanceName) + 1;
-    char *name = functions->allocateMemory(len, 1);
+    char *name = malloc(len);
     if (!in || !name) {
-        if (in)
-            functions->freeMemory(in);
-        if (name)
-            functions->freeMemory(name);
+        free(in);
+        free(name);
         error(&probe, "fmi2Instantiate: out of memory");
         return NULL;
     }
     memcpy(name, instanceName, len);
     *in = (instance){.name = name, .logger = functions->logger,
-                     .allocate = functions->allocateMemory, .release = functions->freeMemory,
                      .environment = functions->componentEnvironment,
+                     .logging_instantiate = loggingOn != fmi2False,
                      .logging_on = loggingOn != fmi2False, .categories = CAT_ALL,
                      .state = INSTANTIATED};
     model_defaults(&in->m);
@@ -210,8 +214,8 @@ void fmi2FreeInstance(fmi2Component c)
     if (!in)
         return;
     model_free(&in->m);
-    in->release(in->name);
-    in->release(in);
+    free(in->name);
+    free(in);
 }
 
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
@@ -269,6 +273,8 @@ fmi2Status fmi2Reset(fmi2Component c)
         return fmi2Error;
     model_free(&in->m);
     model_defaults(&in->m);
+    in->logging_on = in->logging_instantiate; /* as if just instantiated (FMI 2.0) */
+    in->categories = CAT_ALL;
     in->state = INSTANTIATED;
     return fmi2OK;
 }
@@ -422,11 +428,10 @@ fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
     const size_t size = model_state_size(&in->m);
     saved_state *s = *FMUstate;
     if (!s || s->size != size) {
-        saved_state *fresh = in->allocate(1, sizeof *s + size);
+        saved_state *fresh = malloc(sizeof *s + size);
         if (!fresh)
             return error(in, "fmi2GetFMUstate: out of memory (%zu bytes)", size);
-        if (s)
-            in->release(s);
+        free(s);
         s = fresh;
     }
     s->size = size;
@@ -457,7 +462,7 @@ fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
     if (!in)
         return fmi2Error;
     if (FMUstate && *FMUstate) {
-        in->release(*FMUstate);
+        free(*FMUstate);
         *FMUstate = NULL;
     }
     return fmi2OK;
@@ -503,7 +508,7 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedSta
     if (model_state_load(NULL, SAVABLE, HAS_SOLVER, &tag, (const unsigned char *)serializedState,
                          size, err) != 0)
         return error(in, "fmi2DeSerializeFMUstate: %s", err);
-    saved_state *s = in->allocate(1, sizeof *s + size);
+    saved_state *s = malloc(sizeof *s + size);
     if (!s)
         return error(in, "fmi2DeSerializeFMUstate: out of memory (%zu bytes)", size);
     s->size = size;

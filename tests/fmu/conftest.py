@@ -55,7 +55,7 @@ def vr(md):
 class Slave:
     """An FMU2Slave whose log messages land in self.log as (status, category, message)."""
 
-    def __init__(self, md, unzipdir, name="dfo", logging_on=False):
+    def __init__(self, md, unzipdir, name="dfo", logging_on=False, memory_callbacks=True):
         self.log = []
 
         def logger(env, instance, status, category, message):
@@ -63,8 +63,9 @@ class Slave:
 
         self.callbacks = fmi2CallbackFunctions()
         self.callbacks.logger = fmi2CallbackLoggerTYPE(logger)
-        self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-        self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        if memory_callbacks:  # else NULL, as canNotUseMemoryManagementFunctions allows
+            self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+            self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
         addLoggerProxy(byref(self.callbacks))
         self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
                              modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)

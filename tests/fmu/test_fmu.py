@@ -98,6 +98,8 @@ def test_model_description_contract(md):
     assert sorted(o.variable.name for o in md.outputs) == sorted(OUT)
     assert all(o.dependencies == [] for o in md.outputs)
     assert [c.name for c in md.logCategories] == ["logStatusError", "logCalls"]
+    # libdmi allocates with the C library: the FMU must not be given allocateMemory to honour.
+    assert md.coSimulation.canNotUseMemoryManagementFunctions is True
     de = md.defaultExperiment
     assert float(de.stopTime) == 30.0
     k = float(de.stepSize) / (START["tau"] / START["N"])
@@ -648,6 +650,40 @@ def test_logging_honours_flags_and_categories(sl):
     with pytest.raises(FMICallException):
         loud.fmu.doStep(5.0, 0.01)
     assert loud.log[-1][1] == "logStatusError"  # errors are reported all the same
+
+
+def test_runs_without_memory_callbacks(sl):
+    """allocateMemory = freeMemory = NULL (canNotUseMemoryManagementFunctions): a whole run, an FMU
+    state and its serialization work as with the callbacks."""
+    bare, full = sl(name="bare", memory_callbacks=False), sl(name="full")
+    for s in (bare, full):
+        start(s)
+        s.fmu.doStep(0.0, 0.5)
+    state = bare.fmu.getFMUstate()
+    data = bare.fmu.serializeFMUstate(state)
+    bare.fmu.doStep(0.5, 0.5)
+    full.fmu.doStep(0.5, 0.5)
+    assert outputs(bare, bare.vr) == outputs(full, full.vr)
+    restored = bare.fmu.deSerializeFMUstate(data)
+    bare.fmu.setFMUstate(restored)
+    bare.fmu.doStep(0.5, 0.5)
+    assert outputs(bare, bare.vr) == outputs(full, full.vr)
+    bare.fmu.freeFMUstate(state)
+    bare.fmu.freeFMUstate(restored)
+    assert bare.errors() == []
+
+
+def test_reset_restores_the_logging_of_instantiate(sl):
+    """fmi2Reset puts the FMU into the state fmi2Instantiate left it in, logging settings included."""
+    s = sl(name="quiet", logging_on=False)
+    s.fmu.setDebugLogging(True, ["logCalls"])
+    start(s)
+    assert any(c == "logCalls" for st, c, m in s.log)
+    s.fmu.reset()
+    n = len(s.log)
+    start(s)
+    s.fmu.doStep(0.0, 0.01)
+    assert s.log[n:] == []
 
 
 def test_instantiate_rejects_wrong_guid(md, unzipdir):

@@ -454,13 +454,11 @@ static void test_instantiate(void)
 {
     fmu_log log;
     const fmi2CallbackFunctions cb = fmu_callbacks(&log);
-    const fmi2CallbackFunctions no_alloc = {cb.logger, NULL, cb.freeMemory, NULL, &log};
     static const struct {
         const char *id, *input, *name, *guid, *msg;
-        int type, callbacks; /* 0: NULL, 1: cb, 2: no allocateMemory */
+        int type, callbacks; /* 0: NULL, 1: cb */
     } t[] = {
         {"F01", "functions = NULL", "x", NULL, NULL, fmi2CoSimulation, 0},
-        {"F02", "functions->allocateMemory = NULL", "x", NULL, NULL, fmi2CoSimulation, 2},
         {"F03", "instanceName = NULL", NULL, NULL, "name", fmi2CoSimulation, 1},
         {"F04", "instanceName = \"\"", "", NULL, "name", fmi2CoSimulation, 1},
         {"F05", "fmuType = fmi2ModelExchange", "x", NULL, "co-simulation", fmi2ModelExchange, 1},
@@ -471,8 +469,7 @@ static void test_instantiate(void)
     for (size_t i = 0; i < sizeof t / sizeof t[0]; i++) {
         memset(&log, 0, sizeof log);
         const char *guid = t[i].guid ? (t[i].guid[0] ? t[i].guid : NULL) : GUID;
-        const fmi2CallbackFunctions *fns = t[i].callbacks == 0 ? NULL
-                                           : t[i].callbacks == 1 ? &cb : &no_alloc;
+        const fmi2CallbackFunctions *fns = t[i].callbacks == 0 ? NULL : &cb;
         fmi2Component c = F.instantiate(t[i].name, (fmi2Type)t[i].type, guid, "", fns, fmi2False,
                                         fmi2False);
         CHECK(c == NULL, "%s fmi2Instantiate(%s) returned an instance", t[i].id, t[i].input);
