@@ -268,7 +268,8 @@ static int sample_kernel(dmi_solver *s, dmi_kernel *k)
     if (!s->H)
         return dmi_kernel_alloc(k, n, N, NULL) == 0 ? DMI_OK
                                                    : fail(s, DMI_ENOMEM, "dmi_init: out of memory");
-    size_t bytes = dmi_mul_size(n, n, 1) ? dmi_mul_size(N, nn, sizeof(double)) : 0; /* n * n overflows */
+    /* (0 also when n * n overflows) */
+    size_t bytes = dmi_mul_size(n, n, 1) ? dmi_mul_size(N, nn, sizeof(double)) : 0;
     double *dense = bytes ? malloc(bytes) : NULL;
     if (!dense)
         return fail(s, DMI_ENOMEM, "dmi_init: cannot allocate %zu x %zu x %zu kernel samples", N,
