@@ -73,6 +73,13 @@ static int start(run *r, size_t N, int method, size_t steps, int delay)
     return rc;
 }
 
+static void finish(run *r)
+{
+    dmi_free(&r->s);
+    free(r->w);
+    r->w = NULL;
+}
+
 static int chunk(run *r, size_t from, size_t to)
 {
     double t0 = now();
@@ -105,12 +112,9 @@ int main(int argc, char **argv)
         int rc = DMI_OK;
         for (size_t r = 0; r < reps && rc == DMI_OK; r++) {
             if (r > 0) {
-                dmi_free(&d.s);
-                dmi_free(&a.s);
-                dmi_free(&b.s);
-                free(d.w);
-                free(a.w);
-                free(b.w);
+                finish(&d);
+                finish(&a);
+                finish(&b);
             }
             rc = start(&d, N, DMI_CONV_DIRECT, steps, 1);
             if (rc == DMI_OK)
@@ -143,12 +147,9 @@ int main(int argc, char **argv)
         printf("%7zu %5g %8zu | %10.1f %10.1f %7.1fx | %9.1f %7.1fx | %9.2f %9.2f | %9.2e\n", N,
                Ts[k], steps, nd, na, nd / na, nb, nd / nb, d.mem, a.mem, dev / big);
         fflush(stdout);
-        dmi_free(&d.s);
-        dmi_free(&a.s);
-        dmi_free(&b.s);
-        free(d.w);
-        free(a.w);
-        free(b.w);
+        finish(&d);
+        finish(&a);
+        finish(&b);
     }
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
