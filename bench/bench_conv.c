@@ -111,11 +111,9 @@ int main(int argc, char **argv)
         run d = {0}, a = {0}, b = {0};
         int rc = DMI_OK;
         for (size_t r = 0; r < reps && rc == DMI_OK; r++) {
-            if (r > 0) {
-                finish(&d);
-                finish(&a);
-                finish(&b);
-            }
+            finish(&d); /* (nothing to free in the first repetition) */
+            finish(&a);
+            finish(&b);
             rc = start(&d, N, DMI_CONV_DIRECT, steps, 1);
             if (rc == DMI_OK)
                 rc = start(&a, N, DMI_CONV_AUTO, steps, 1);

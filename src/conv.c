@@ -255,8 +255,9 @@ void dmi_conv_free(dmi_conv *c)
     free(c);
 }
 
-/* a * b doubles (a, b >= 1; a itself checked by the caller's bounds), zeroed
- * if zero; NULL if out of memory or the size overflows. */
+/* a * b doubles, zeroed if zero; NULL if out of memory or the size
+ * overflows.  a, b >= 1; a product passed as a or b (nparts M, ncols depth)
+ * is bounded by the ring's size, which dmi_create checked. */
 static double *doubles(size_t a, size_t b, int zero)
 {
     size_t bytes = dmi_mul_size(a, b, sizeof(double));
