@@ -49,6 +49,12 @@
  * GSL's radix-2 FFT (in use) and one product per multiply-add pass;
  * COST_PART is that fit scaled by the instruction count (callgrind) of the
  * paired multiply-add now in use (0.9).
+ * Past length M = 4096 (32 KiB of data) a radix-2 FFT leaves the L1 cache
+ * and its cost per step of the block, flat below, grows: measured on two
+ * x86-64 machines (GSL 2.7), M = 8192 costs 1.6 to 2.8 times as much per
+ * step as M = 4096 and every further doubling about one such cost more, so
+ * the model charges an FFT of block size S > 2048 as 1 + log2(S / 2048)
+ * FFTs (fft_weight).
  * COST_DIRECT is the lag of the plain sum (DMI_CONV_DIRECT).  DMI_CONV_AUTO
  * takes the FFT method when the model says it is cheaper: for one nonzero
  * kernel entry (the oscillator) from N = 382 on, for a full 3 x 3 kernel
@@ -114,11 +120,20 @@ static int make_layout(size_t N, size_t s1, size_t g, size_t L, layout *out)
     return 1;
 }
 
+/* Cost of an FFT of block size S in units of COST_FFT (see above). */
+static double fft_weight(size_t S)
+{
+    double w = 1.0;
+    for (; S > 2048; S /= 2)
+        w += 1.0;
+    return w;
+}
+
 static double layout_cost(const layout *y, size_t N, size_t nnz, size_t ffts)
 {
     double c = COST_LAG * (double)nnz * (double)(y->head + (N - y->tail));
     for (size_t i = 0; i < y->L; i++)
-        c += COST_LEVEL + COST_FFT * (double)ffts +
+        c += COST_LEVEL + COST_FFT * fft_weight(y->S[i]) * (double)ffts +
              COST_PART * (double)nnz * (double)(y->kcount[i][0] + y->kcount[i][1]);
     return c;
 }
@@ -154,7 +169,6 @@ typedef struct {
     double *kspec;        /* nnz * nparts * M: kernel spectra / M (split layout) */
     double *xspec;        /* ncols * depth * M: spectrum of window b in slot b mod depth */
     double *out;          /* n * S: block sums (before the factor h) of the current block */
-    double *tmp; /* M: scratch of the transforms */
 } level;
 
 struct dmi_conv {
@@ -174,37 +188,36 @@ struct dmi_conv {
  * Spectra are kept in a split layout: the real parts re_0 .. re_{M/2-1} at
  * [0, M/2), the real re_{M/2} at M/2 (the slot of im_0), the imaginary parts
  * im_1 .. im_{M/2-1} at [M/2 + 1, M), so the multiply-add is a plain loop
- * over the bins.  The transforms are GSL's radix-2 real FFTs, whose
- * halfcomplex layout re_0 .. re_{M/2}, im_{M/2-1} .. im_1 is converted
- * through the level's scratch array.  They allocate nothing and, M being a
- * power of two, have no error path: GSL's error handler (which aborts by
- * default) is never reached.  GSL's mixed-radix FFT is faster (about 12 % at
- * N = 9991) but its wavetables are allocated by functions that call that
- * handler when malloc fails, and the library must never abort.
+ * over the bins.  The transforms are GSL's radix-2 real FFTs, in place; their
+ * halfcomplex layout re_0 .. re_{M/2}, im_{M/2-1} .. im_1 differs from the
+ * split layout only by the order of the imaginary parts, which is reversed in
+ * place.  They allocate nothing and, M being a power of two, have no error
+ * path: GSL's error handler (which aborts by default) is never reached.
+ * GSL's mixed-radix FFT is faster (about 12 % at N = 9991) but its
+ * wavetables are allocated by functions that call that handler when malloc
+ * fails, and the library must never abort.
  */
-static void forward(level *v, double *x)
+static void reverse_imaginary(double *x, size_t M)
 {
-    const size_t M = v->M, H = M / 2;
-    double *y = v->tmp;
-    memcpy(y, x, M * sizeof *y);
-    gsl_fft_real_radix2_transform(y, 1, M);
-    for (size_t q = 0; q <= H; q++)
-        x[q] = y[q];
-    for (size_t q = 1; q < H; q++)
-        x[H + q] = y[M - q];
+    for (size_t a = M / 2 + 1, b = M - 1; a < b; a++, b--) {
+        double t = x[a];
+        x[a] = x[b];
+        x[b] = t;
+    }
 }
 
-/* x (split layout) -> the unscaled inverse transform in the scratch array. */
-static const double *backward(level *v, const double *x)
+/* x (M values) -> its spectrum, split layout. */
+static void forward(double *x, size_t M)
 {
-    const size_t M = v->M, H = M / 2;
-    double *y = v->tmp;
-    for (size_t q = 0; q <= H; q++)
-        y[q] = x[q];
-    for (size_t q = 1; q < H; q++)
-        y[M - q] = x[H + q];
-    gsl_fft_halfcomplex_radix2_backward(y, 1, M);
-    return y;
+    gsl_fft_real_radix2_transform(x, 1, M);
+    reverse_imaginary(x, M);
+}
+
+/* x (split layout) -> its unscaled inverse transform (M values). */
+static void backward(double *x, size_t M)
+{
+    reverse_imaginary(x, M);
+    gsl_fft_halfcomplex_radix2_backward(x, 1, M);
 }
 
 /* acc += K1 * X1 + K2 * X2 bin by bin (split layout; M/2 even).  Two
@@ -246,7 +259,6 @@ void dmi_conv_free(dmi_conv *c)
         free(c->lv[i].kspec);
         free(c->lv[i].xspec);
         free(c->lv[i].out);
-        free(c->lv[i].tmp);
     }
     free(c->col_slot);
     free(c->row_used);
@@ -285,8 +297,7 @@ static int level_alloc(level *v, const layout *y, size_t i, size_t n, size_t nco
     v->kspec = doubles(nnz, v->nparts * v->M, 0);
     v->xspec = doubles(ncols * v->depth, v->M, 1);
     v->out = doubles(n, v->S, 1);
-    v->tmp = doubles(1, v->M, 0);
-    return v->kspec && v->xspec && v->out && v->tmp ? 0 : -1;
+    return v->kspec && v->xspec && v->out ? 0 : -1;
 }
 
 /* Spectrum / M of the kernel samples of entry e on the partition's lags. */
@@ -300,7 +311,7 @@ static void kernel_spectra(level *v, const dmi_kernel *k)
             for (size_t t = 0; t < S; t++)
                 x[t] = h[t] / (double)M;
             memset(x + S, 0, S * sizeof *x);
-            forward(v, x);
+            forward(x, M);
         }
 }
 
@@ -378,7 +389,7 @@ static void window(const dmi_conv *c, level *v, const dmi_history *r, size_t lag
         const double *u = dmi_history_series(r, col) + lag0; /* u[-t] = U^{(b-1)S+1+t} */
         for (size_t t = 0; t < v->M; t++)
             x[t] = *(u - t);
-        forward(v, x);
+        forward(x, v->M);
     }
 }
 
@@ -412,7 +423,8 @@ static void block(const dmi_conv *c, level *v, const dmi_kernel *k, uint64_t j, 
         }
         if (K1)
             multiply_add2(acc, K1, X1, c->zero, c->zero, M);
-        memcpy(v->out + i * S, backward(v, acc) + S, S * sizeof *acc);
+        backward(acc, M);
+        memcpy(v->out + i * S, acc + S, S * sizeof *acc);
     }
 }
 
