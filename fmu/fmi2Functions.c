@@ -402,7 +402,8 @@ fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
         return fmi2Error;
     (void)vr;
     (void)value;
-    return nvr == 0 ? fmi2OK : error(in, "fmi2SetBoolean: the FMU has no settable Boolean variable");
+    return nvr == 0 ? fmi2OK
+                    : error(in, "fmi2SetBoolean: the FMU has no settable Boolean variable");
 }
 
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,

@@ -102,7 +102,8 @@ static int rhs(double t, const double *u, double *out, void *user)
 static int kernel(double s, double *out, void *user)
 {
     const double *r = ((const model *)user)->real;
-    out[2] = r[VR_H_c0] + r[VR_H_c1] * exp(-r[VR_H_lambda] * s) + r[VR_H_a1] * cos(r[VR_H_omega1] * s) +
+    out[2] = r[VR_H_c0] + r[VR_H_c1] * exp(-r[VR_H_lambda] * s) +
+             r[VR_H_a1] * cos(r[VR_H_omega1] * s) +
              r[VR_H_a2] * cos(r[VR_H_omega2] * s) + r[VR_H_a3] * cos(r[VR_H_omega3] * s);
     return 0;
 }
@@ -339,7 +340,8 @@ int model_state_load(model *into, uint32_t tags, uint32_t solver_tags, uint32_t 
     if (version != STATE_VERSION)
         return fail(err, "state: format version %lu is not supported", (unsigned long)version);
     if (nreal != MODEL_NREAL || total != size || ndmi != size - (STATE_HEADER + STATE_REALS + 8))
-        return fail(err, "state: the sizes recorded in the state do not match (%zu bytes given)", size);
+        return fail(err, "state: the sizes recorded in the state do not match (%zu bytes given)",
+                    size);
     memcpy(&sum, buf + size - 8, 8);
     if (sum != checksum(buf, size - 8))
         return fail(err, "state: the checksum does not match (corrupted bytes)");
@@ -355,7 +357,8 @@ int model_state_load(model *into, uint32_t tags, uint32_t solver_tags, uint32_t 
     if (N < 1 || N > INT32_MAX || model_set_integer(&m, VR_N, (int)N, err) != 0)
         return fail(err, "state: N = %lld is invalid", (long long)N);
     if (!isfinite(t_start) || !isfinite(t_comm) || t_comm < t_start)
-        return fail(err, "state: invalid times (start %.17g, communication point %.17g)", t_start, t_comm);
+        return fail(err, "state: invalid times (start %.17g, communication point %.17g)", t_start,
+                    t_comm);
     const int has_solver = (*tag & solver_tags) != 0;
     if (has_solver != (ndmi > 0))
         return fail(err, "state: the saved phase tag %lu %s the solver's history, the state has "

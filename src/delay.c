@@ -11,7 +11,7 @@ int dmi_history_alloc(dmi_history *r, size_t n, size_t N)
 {
     memset(r, 0, sizeof *r);
     size_t L = N + 1;
-    if (L == 0 || L > SIZE_MAX / 2 / n / sizeof(double))
+    if (L == 0 || dmi_mul_size(n, L, 2 * sizeof(double)) == 0) /* the series and its mirror */
         return -1;
     r->buf = calloc(2 * L * n, sizeof(double));
     if (!r->buf)
