@@ -1,12 +1,12 @@
 /*
  * Benchmark of the delay sum methods on the paper's Example 4.3 (not a test):
  * N = 1000 and 9991 to T = 30, N = 100000 to a shorter T, the default method
- * (DMI_CONV_AUTO) and DMI_CONV_DIRECT in one process.  The two solvers are
+ * (DMI_CONV_AUTO) and DMI_CONV_DIRECT in one process.  The solvers are
  * stepped in alternating chunks of CHUNK steps so that a changing machine
- * load hits both alike; short runs are repeated and the fastest repetition counts.  Prints
- * ns per step, the speed-up, the heap memory each solver holds after
- * dmi_init (glibc's mallinfo2), the peak resident set and the maximum
- * relative deviation of the default method's states from DIRECT's.
+ * load hits them alike; short runs are repeated and the fastest repetition
+ * counts.  Prints ns per step, the speed-up, the heap memory each solver
+ * holds after dmi_init (glibc's mallinfo2), the peak resident set and the
+ * maximum relative deviation of the default method's states from DIRECT's.
  * A third solver steps the same model without the delay term, in the same
  * chunks: its cost is what every step pays besides the delay sum (the
  * forcing's cos 8t, the callbacks, the checks, the history), so DIRECT's

@@ -52,9 +52,9 @@
  * Past length M = 4096 (32 KiB of data) a radix-2 FFT leaves the L1 cache
  * and its cost per step of the block, flat below, grows: measured on two
  * x86-64 machines (GSL 2.7), M = 8192 costs 1.6 to 2.8 times as much per
- * step as M = 4096 and every further doubling about one such cost more, so
- * the model charges an FFT of block size S > 2048 as 1 + log2(S / 2048)
- * FFTs (fft_weight).
+ * step as M = 4096, and every further doubling adds 0.5 to 1.2 times the
+ * cost at 4096, so the model charges an FFT of block size S > 2048 as
+ * 1 + log2(S / 2048) FFTs (fft_weight).
  * COST_DIRECT is the lag of the plain sum (DMI_CONV_DIRECT).  DMI_CONV_AUTO
  * takes the FFT method when the model says it is cheaper: for one nonzero
  * kernel entry (the oscillator) from N = 382 on, for a full 3 x 3 kernel
