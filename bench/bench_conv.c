@@ -15,12 +15,12 @@
  * Usage: bench_conv [T for N = 100000, default 3]
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
-#define _POSIX_C_SOURCE 200809L
+#include "clock.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <sys/resource.h>
-#include <time.h>
 #ifdef __GLIBC__
 #include <malloc.h>
 #endif
@@ -33,13 +33,6 @@
  * 20 % slower at N = 100000 than alone (its largest block, 2048 steps, then
  * starts cold in almost every chunk), with 30000 steps as fast as alone. */
 #define CHUNK 30000
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 /* Heap bytes in use, in MiB (glibc; 0 elsewhere). */
 static double heap_mib(void)
