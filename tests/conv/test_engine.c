@@ -92,12 +92,13 @@ static void check_steps(size_t n, size_t N, unsigned mask, size_t steps, size_t 
             dmi_conv_sum(c2, &k, &r, p, h, Wr);
             diff = memcmp(W, Wr, n * sizeof *W) != 0;
         }
-        if (bad) /* the first component, which may not be the one that differs */
-            fprintf(stderr, "\n  n = %zu, N = %zu, mask %x, p = %llu: W %.17g naive %.17g",
-                    n, N, mask, (unsigned long long)p, W[0], Wn[0]);
+        if (bad || diff) /* the first component, which may not be the one that differs */
+            fprintf(stderr, "\n  n = %zu, N = %zu, mask %x, p = %llu: W %.17g", n, N, mask,
+                    (unsigned long long)p, W[0]);
+        if (bad)
+            fprintf(stderr, " naive %.17g", Wn[0]);
         if (diff) /* set only at a step with a rebuild, so Wr is this step's */
-            fprintf(stderr, "\n  n = %zu, N = %zu, mask %x, p = %llu: W %.17g rebuilt %.17g",
-                    n, N, mask, (unsigned long long)p, W[0], Wr[0]);
+            fprintf(stderr, " rebuilt %.17g", Wr[0]);
     }
     CU_ASSERT(!bad);
     CU_ASSERT(!diff);
