@@ -212,6 +212,14 @@ static int column_used(const dmi_expk *k, size_t t, size_t j)
     return 0;
 }
 
+int dmi_expk_term_used(const dmi_expk *k, size_t t)
+{
+    for (size_t j = 0; j < k->n; j++)
+        if (column_used(k, t, j))
+            return 1;
+    return 0;
+}
+
 size_t dmi_expk_sums(const dmi_expk *k)
 {
     size_t count = 0;
