@@ -53,6 +53,12 @@ def test_help(prog, flag):
         assert re.search(rf"^  {re.escape(name)} +\S", r.stdout, re.M), f"{name} not explained"
 
 
+def test_ex43_help_warns_of_its_output():
+    """With no arguments ex43 writes about 300,000 CSV lines (T*N + 2 = 299,732)."""
+    text = " ".join(run(NAMES["ex43"], "--help").stdout.split())
+    assert "with no arguments about 300,000 lines" in text
+
+
 @pytest.mark.parametrize("prog", PROGRAMS, ids=lambda p: p.name)
 def test_empty_argument_rejected(prog):
     """'' is a bad value for every kind of argument, and surplus where none is taken."""
