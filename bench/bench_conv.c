@@ -98,7 +98,7 @@ int main(int argc, char **argv)
 {
     double Tlong = 3.0;
     const cli_arg args[] = {{"T", CLI_TIME, &Tlong, 100,
-                             "end time of the run at N = 100000, at least 1e-5 (one step); default 3"}};
+                             "end time of the run at N = 100000, at least 1e-5 for one step"}};
     const cli_program prog = {
         "bench_conv",
         "Benchmark (not a test) of the delay sum on the paper's Example 4.3, tau = 1, h = 1/N:\n"

@@ -28,8 +28,21 @@ static void help(const cli_program *prog)
     printf("\n%s\n", prog->purpose);
     if (prog->n_args > 0)
         printf("\narguments (optional, in this order):\n");
-    for (size_t i = 0; i < prog->n_args; i++)
-        printf("  %-10s %s\n", prog->args[i].name, prog->args[i].help);
+    for (size_t i = 0; i < prog->n_args; i++) {
+        const cli_arg *a = &prog->args[i];
+        printf("  %-10s %s", a->name, a->help);
+        if (a->kind == CLI_COUNT)
+            printf(" (default %zu", *(const size_t *)a->value);
+        else if (a->kind == CLI_TIME)
+            printf(" (default %g", *(const double *)a->value);
+        else if (*(const char *const *)a->value)
+            printf(" (default %s", *(const char *const *)a->value);
+        else
+            printf(" (default: none");
+        if (a->max > 0)
+            printf(", at most %.15g", a->max);
+        puts(")");
+    }
     printf("\n%s\n", prog->output);
 }
 
@@ -49,8 +62,10 @@ static const char *parse(const cli_arg *a, const char *text, char *why, size_t n
     errno = 0;
     switch (a->kind) {
     case CLI_COUNT: {
-        unsigned long long v = isdigit((unsigned char)text[0]) ? strtoull(text, &end, 10) : 0;
-        if (!isdigit((unsigned char)text[0]) || *end != '\0')
+        if (!isdigit((unsigned char)text[0]))
+            return "must be a whole number >= 1 (decimal digits)";
+        unsigned long long v = strtoull(text, &end, 10);
+        if (*end != '\0')
             return "must be a whole number >= 1 (decimal digits)";
         if (v == 0)
             return "must be >= 1";

@@ -5,7 +5,7 @@
  *
  *   static size_t N = 9991;
  *   static const cli_arg args[] = {
- *       {"N", CLI_COUNT, &N, 0, "steps per delay: h = tau/N (default 9991)"}};
+ *       {"N", CLI_COUNT, &N, 0, "steps per delay: h = tau/N"}};
  *   static const cli_program prog = {"ex43", "Runs Example 4.3.", "CSV rows t,w,v.",
  *                                    args, 1};
  *   cli_parse(&prog, argc, argv);
@@ -28,7 +28,7 @@ typedef struct {
     cli_kind kind;
     void *value;      /* size_t *, double * or const char **: holds the default, gets the value */
     double max;       /* the largest value accepted (CLI_COUNT, CLI_TIME); 0: no bound */
-    const char *help; /* what it means, its unit and its default */
+    const char *help; /* what it means and its unit (--help adds the default and max) */
 } cli_arg;
 
 typedef struct {

@@ -42,9 +42,9 @@ int main(int argc, char **argv)
     size_t N = 9991, stride = 1;
     double T = T_DEFAULT;
     const cli_arg args[] = {
-        {"N", CLI_COUNT, &N, 1e9, "steps per delay: h = tau/N with tau = 1 (default 9991)"},
-        {"T", CLI_TIME, &T, 1e6, "end time (default " STR(T_DEFAULT) ")"},
-        {"stride", CLI_COUNT, &stride, 0, "write every stride-th step only (default 1: all)"}};
+        {"N", CLI_COUNT, &N, 1e9, "steps per delay: h = tau/N with tau = 1"},
+        {"T", CLI_TIME, &T, 1e6, "end time"},
+        {"stride", CLI_COUNT, &stride, 0, "write only every stride-th step"}};
     const cli_program prog = {
         "ex" STR(EXAMPLE),
         "Integrates " WHAT ",\nb = alpha = tau = 1, with libdmi's implicit Euler scheme (3.12)-(3.13).",

@@ -165,8 +165,8 @@ int main(int argc, char **argv)
     size_t stride = 1;
     int failed = 0;
     const cli_arg args[] = {
-        {"T", CLI_TIME, &T, 1e4, "end time of Example 4.2 (default 10)"},
-        {"stride", CLI_COUNT, &stride, 0, "write every stride-th step of the CSV only (default 1: all)"}};
+        {"T", CLI_TIME, &T, 1e4, "end time of Example 4.2"},
+        {"stride", CLI_COUNT, &stride, 0, "write only every stride-th step of the CSV"}};
     const cli_program prog = {
         "scheme44_as_printed",
         "Evidence for the erratum in the paper's scheme (4.4): integrates Example 4.2 on [-1, T]\n"

@@ -49,8 +49,8 @@ def test_help(prog, flag):
     assert r.stdout.startswith(f"usage: {prog.name} [--help]")
     assert "stdout:" in r.stdout, "the usage must say what the program prints"
     assert "exit status:" in r.stdout
-    for name in usage_arguments(r.stdout):  # each argument is explained on a line of its own
-        assert re.search(rf"^  {re.escape(name)} +\S", r.stdout, re.M), f"{name} not explained"
+    for name in usage_arguments(r.stdout):  # each argument: a line with its meaning and default
+        assert re.search(rf"^  {re.escape(name)} +\S.*\(default", r.stdout, re.M), f"{name} not explained"
 
 
 def test_ex43_help_warns_of_its_output():
