@@ -57,7 +57,7 @@ def main() -> int:
                     "and per solver step h = 1/N, and the ratio of the two N per solver step.",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     ap.add_argument("--fmu", default=DEFAULT_FMU, help="the FMU file")
-    ap.add_argument("--time", type=positive, default=3.0,
+    ap.add_argument("--time", type=positive, default=10.0,
                     help="simulated time per round (seconds of model time)")
     ap.add_argument("--rounds", type=count, default=3, help="rounds of both runs; the fastest counts")
     args = ap.parse_args()
