@@ -89,8 +89,8 @@ int main(int argc, char **argv)
         "Times Example 4.3 with its kernel as three exponential terms (default method: the\n"
         "recursion) at N = 1e3 .. 1e6, beside the model without the delay term, the kernel\n"
         "as a callback (default method: FFT) and DIRECT.",
-        "stdout: a table of ns per step and ratios (a few seconds to a minute); exit 1 if a\n"
-        "solver fails.",
+        "stdout: a table of ns per step and ratios (a few seconds to a minute).\n"
+        "exit status: 0, 1 if a solver fails, 2 for a bad argument.",
         args, 2};
     cli_parse(&prog, argc, argv);
 
