@@ -26,7 +26,7 @@
 #endif
 
 #include "cli.h"
-#include "paper.h"
+#include "run.h"
 
 /* Steps per chunk.  A chunk must be long against the refill of the caches
  * after the other solvers' chunks, which is a cost of the alternation, not
@@ -45,12 +45,6 @@ static double heap_mib(void)
     return 0;
 #endif
 }
-
-typedef struct {
-    dmi_solver *s;
-    paper_example ex;
-    double mem, secs, *w; /* w: the trajectory (w, v) of every step */
-} run;
 
 /* Makes the solver; mem = the heap its creation and dmi_init took. */
 static int start(run *r, size_t N, int method, size_t steps, int delay)
@@ -72,26 +66,6 @@ static int start(run *r, size_t N, int method, size_t steps, int delay)
         rc = dmi_init(r->s);
     r->mem = heap_mib() - before;
     return rc;
-}
-
-static void finish(run *r)
-{
-    dmi_free(&r->s);
-    free(r->w);
-    r->w = NULL;
-}
-
-static int chunk(run *r, size_t from, size_t to)
-{
-    double t0 = now();
-    for (size_t p = from; p < to; p++) {
-        int rc = dmi_step(r->s);
-        if (rc != DMI_OK)
-            return rc;
-        dmi_get_state(r->s, r->w + 2 * p);
-    }
-    r->secs += now() - t0;
-    return DMI_OK;
 }
 
 int main(int argc, char **argv)
@@ -138,11 +112,11 @@ int main(int argc, char **argv)
                 rc = start(&b, N, DMI_CONV_AUTO, steps, 0);
             for (size_t p = 0; p < steps && rc == DMI_OK; p += CHUNK) {
                 size_t to = p + CHUNK < steps ? p + CHUNK : steps;
-                rc = chunk(&d, p, to);
+                rc = chunk(&d, p, to, now);
                 if (rc == DMI_OK)
-                    rc = chunk(&a, p, to);
+                    rc = chunk(&a, p, to, now);
                 if (rc == DMI_OK)
-                    rc = chunk(&b, p, to);
+                    rc = chunk(&b, p, to, now);
             }
             nd = fmin(nd, 1e9 * d.secs / (double)steps);
             na = fmin(na, 1e9 * a.secs / (double)steps);

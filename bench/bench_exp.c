@@ -21,17 +21,11 @@
 #include <stdlib.h>
 
 #include "cli.h"
-#include "paper.h"
+#include "run.h"
 
 #define CHUNK 30000
 
 enum { REC, NODELAY, FFT, DIRECT, KINDS };
-
-typedef struct {
-    dmi_solver *s;
-    paper_example ex;
-    double secs, *u; /* u: the states (w, v) of every step */
-} run;
 
 static int start(run *r, size_t N, int kind, size_t steps)
 {
@@ -40,8 +34,8 @@ static int start(run *r, size_t N, int kind, size_t steps)
     const double C[12] = {0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0}; /* entry (1, 0) of each */
     r->ex.example = 43;
     r->secs = 0;
-    r->u = malloc(2 * steps * sizeof *r->u);
-    if (!r->u)
+    r->w = malloc(2 * steps * sizeof *r->w);
+    if (!r->w)
         return DMI_ENOMEM;
     int rc = dmi_create(&r->s, 2, 1.0, N);
     if (rc == DMI_OK)
@@ -55,26 +49,6 @@ static int start(run *r, size_t N, int kind, size_t steps)
     if (rc == DMI_OK)
         rc = dmi_init(r->s);
     return rc;
-}
-
-static void finish(run *r)
-{
-    dmi_free(&r->s);
-    free(r->u);
-    r->u = NULL;
-}
-
-static int chunk(run *r, size_t from, size_t to)
-{
-    double t0 = cpu_now();
-    for (size_t p = from; p < to; p++) {
-        int rc = dmi_step(r->s);
-        if (rc != DMI_OK)
-            return rc;
-        dmi_get_state(r->s, r->u + 2 * p);
-    }
-    r->secs += cpu_now() - t0;
-    return DMI_OK;
 }
 
 int main(int argc, char **argv)
@@ -111,12 +85,12 @@ int main(int argc, char **argv)
                 rc = start(&r[i], N, i, steps);
             for (size_t p = 0; p < steps && rc == DMI_OK; p += CHUNK)
                 for (int i = 0; i < NODELAY + 1 && rc == DMI_OK; i++)
-                    rc = chunk(&r[i], p, p + CHUNK < steps ? p + CHUNK : steps);
+                    rc = chunk(&r[i], p, p + CHUNK < steps ? p + CHUNK : steps, cpu_now);
             if (rc == DMI_OK)
-                rc = chunk(&r[FFT], 0, steps);
+                rc = chunk(&r[FFT], 0, steps, cpu_now);
             for (size_t q = 0; rc == DMI_OK && q < 2 * steps; q++) {
-                dev = fmax(dev, fabs(r[REC].u[q] - r[FFT].u[q]));
-                big = fmax(big, fabs(r[FFT].u[q]));
+                dev = fmax(dev, fabs(r[REC].w[q] - r[FFT].w[q]));
+                big = fmax(big, fabs(r[FFT].w[q]));
             }
             for (int i = 0; i < FFT + 1; i++) {
                 ns[i] = fmin(ns[i], 1e9 * r[i].secs / (double)steps);
@@ -125,7 +99,7 @@ int main(int argc, char **argv)
             if (rc == DMI_OK)
                 rc = start(&r[DIRECT], N, DIRECT, dsteps);
             if (rc == DMI_OK)
-                rc = chunk(&r[DIRECT], 0, dsteps);
+                rc = chunk(&r[DIRECT], 0, dsteps, cpu_now);
             ns[DIRECT] = fmin(ns[DIRECT], 1e9 * r[DIRECT].secs / (double)dsteps);
             finish(&r[DIRECT]);
         }
