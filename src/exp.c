@@ -158,7 +158,7 @@ int dmi_expk_copy(dmi_expk *k, size_t n, size_t K, const double *a, const double
                   const double *C, const double *D)
 {
     memset(k, 0, sizeof *k);
-    size_t mat = dmi_mul_size(K, n * n, sizeof(double)); /* n * n: dmi_create checked it */
+    size_t mat = dmi_mul_size(K, n * n, sizeof(double)); /* n * n: the caller checked it */
     if (mat == 0)
         return -1;
     k->a = malloc(K * sizeof *k->a);
