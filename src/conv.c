@@ -32,7 +32,9 @@
  * no exception: dmi_init rebuilds the engine at p = 0, so the history's FFT
  * part is transformed before the first step.
  */
-#include "dmi_internal.h"
+#include "conv.h"
+
+#include "bytes.h"
 
 #include <gsl/gsl_fft_halfcomplex.h>
 #include <gsl/gsl_fft_real.h>

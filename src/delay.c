@@ -2,7 +2,9 @@
  * The history ring and the delay sum W^p of libdmi.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include "dmi_internal.h"
+#include "delay.h"
+
+#include "bytes.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -1,9 +1,11 @@
 /*
- * libdmi — the implicit Euler scheme (3.12)-(3.13) with a Volterra delay term.
+ * libdmi — the implicit Euler scheme (3.12)-(3.13) with a Volterra delay term:
+ * the solver's life cycle and its step.  Its saved state is in state.c.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include "dmi_internal.h"
-#include "exp.h"
+#include "solver.h"
+
+#include "bytes.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -14,42 +16,11 @@
 #define STR_(x) #x
 #define STR(x) STR_(x)
 
-enum { A_NONE, A_CALLBACK, A_FRICTION, A_BOX };
-
-struct dmi_solver {
-    size_t n, N;
-    double tau, h;
-
-    dmi_rhs_fn f;
-    void *f_user;
-    int a_kind;
-    dmi_resolvent_fn r;
-    void *r_user;
-    double *a_lo;  /* friction: alpha (n); box: lo (n) */
-    double *a_hi;  /* box: hi (n) */
-    dmi_kernel_fn H;    /* dmi_expk_eval for a kernel set by dmi_set_kernel_exp */
-    void *H_user;
-    dmi_expk expk;      /* that kernel's parameters (K = 0: none) */
-    dmi_history_fn z;
-    void *z_user;
-    int conv_method;
-
-    int initialized;
-    uint64_t p;         /* step counter: t_p = p h */
-    dmi_history ring;   /* U^{p-N..p} */
-    dmi_kernel kernel;  /* nonzero entries of H(l h) */
-    dmi_conv *conv;     /* FFT engine, or NULL */
-    dmi_exp *rec;       /* recursion engine, or NULL (both NULL: the direct sum) */
-    double *last_W;     /* W^{p-1} (n) */
-    double *last_X;     /* X^{p-1} (n) */
-    double *work;       /* 5 n scratch values: U^p, f, W, X, U^{p+1} */
-
-    char err[256];
-};
+enum { A_NONE, A_CALLBACK, A_FRICTION, A_BOX }; /* s->a_kind */
 
 /* The message buffer is not part of the numerical state: const functions may
  * write it (every solver is allocated by dmi_create, never const-defined). */
-static int fail(const dmi_solver *cs, int code, const char *fmt, ...)
+int dmi_fail(const dmi_solver *cs, int code, const char *fmt, ...)
 {
     dmi_solver *s = (dmi_solver *)cs;
     va_list ap;
@@ -59,7 +30,7 @@ static int fail(const dmi_solver *cs, int code, const char *fmt, ...)
     return code;
 }
 
-static size_t first_nonfinite(const double *x, size_t n)
+size_t dmi_first_nonfinite(const double *x, size_t n)
 {
     size_t i = 0;
     while (i < n && isfinite(x[i]))
@@ -71,11 +42,6 @@ static size_t first_nonfinite(const double *x, size_t n)
  * s->conv is the FFT engine, s->rec the recursion's; both NULL when the
  * direct sum is in use.  Built with DMI_NO_FFT (no conv.c, no GSL: the
  * FMU's sources) there is no FFT engine. */
-
-static int has_expk(const dmi_solver *s)
-{
-    return s->H == dmi_expk_eval;
-}
 
 /* Index of the first growing term (a_k > 0, C_k or D_k not zero) of the
  * exponential kernel, or K. */
@@ -92,23 +58,23 @@ static int check_method(const dmi_solver *s, int method, const char *fn)
 {
     if (method != DMI_CONV_AUTO && method != DMI_CONV_DIRECT && method != DMI_CONV_FFT &&
         method != DMI_CONV_RECURSIVE)
-        return fail(s, DMI_EINVAL, "%s: unknown method %d", fn, method);
+        return dmi_fail(s, DMI_EINVAL, "%s: unknown method %d", fn, method);
 #ifdef DMI_NO_FFT
     if (method == DMI_CONV_FFT)
-        return fail(s, DMI_EINVAL, "%s: DMI_CONV_FFT is not available, this libdmi was built "
-                                   "without the FFT (DMI_NO_FFT)", fn);
+        return dmi_fail(s, DMI_EINVAL, "%s: DMI_CONV_FFT is not available, this libdmi was built "
+                                       "without the FFT (DMI_NO_FFT)", fn);
 #endif
     if (method != DMI_CONV_RECURSIVE)
         return DMI_OK;
-    if (s->H && !has_expk(s))
-        return fail(s, DMI_EINVAL, "%s: method %d (DMI_CONV_RECURSIVE) needs a kernel given by "
-                                   "dmi_set_kernel_exp, not a callback", fn, method);
+    if (s->H && !dmi_has_expk(s))
+        return dmi_fail(s, DMI_EINVAL, "%s: method %d (DMI_CONV_RECURSIVE) needs a kernel given by "
+                                       "dmi_set_kernel_exp, not a callback", fn, method);
     size_t k = first_growing(s);
     if (k < s->expk.K)
-        return fail(s, DMI_EINVAL, "%s: method %d (DMI_CONV_RECURSIVE) refuses the growing term "
-                                   "a[%zu] = %g > 0: the recursion would multiply its rounding "
-                                   "errors by exp(a h) > 1 every step (use DIRECT or FFT)", fn,
-                    method, k, s->expk.a[k]);
+        return dmi_fail(s, DMI_EINVAL, "%s: method %d (DMI_CONV_RECURSIVE) refuses the growing "
+                                       "term a[%zu] = %g > 0: the recursion would multiply its "
+                                       "rounding errors by exp(a h) > 1 every step (use DIRECT or "
+                                       "FFT)", fn, method, k, s->expk.a[k]);
     return DMI_OK;
 }
 
@@ -119,16 +85,16 @@ static int engine_make(const dmi_solver *s, const dmi_kernel *k, int method, dmi
 {
     *conv = NULL;
     *rec = NULL;
-    if (method == DMI_CONV_AUTO && has_expk(s) && first_growing(s) == s->expk.K)
+    if (method == DMI_CONV_AUTO && dmi_has_expk(s) && first_growing(s) == s->expk.K)
         method = DMI_CONV_RECURSIVE;
     if (method == DMI_CONV_RECURSIVE) {
-        if (has_expk(s) && dmi_exp_create(rec, &s->expk, s->N, s->h) != 0)
-            return fail(s, DMI_ENOMEM, "%s: out of memory for the recursion's sums", fn);
+        if (dmi_has_expk(s) && dmi_exp_create(rec, &s->expk, s->N, s->h) != 0)
+            return dmi_fail(s, DMI_ENOMEM, "%s: out of memory for the recursion's sums", fn);
         return DMI_OK;
     }
 #ifndef DMI_NO_FFT
     if (dmi_conv_create(conv, k, s->n, s->N, method) != 0)
-        return fail(s, DMI_ENOMEM, "%s: out of memory for the FFT engine", fn);
+        return dmi_fail(s, DMI_ENOMEM, "%s: out of memory for the FFT engine", fn);
 #else
     (void)k;
 #endif
@@ -146,7 +112,7 @@ static void engine_free(dmi_conv *conv, dmi_exp *rec)
 }
 
 /* Recomputes the engines for s's step p from the ring. */
-static void engine_rebuild(const dmi_solver *s, dmi_conv *conv, dmi_exp *rec)
+void dmi_engine_rebuild(const dmi_solver *s, dmi_conv *conv, dmi_exp *rec)
 {
 #ifndef DMI_NO_FFT
     if (conv)
@@ -298,14 +264,15 @@ int dmi_set_friction(dmi_solver *s, const double *alpha)
     if (!s)
         return DMI_EINVAL;
     if (!alpha)
-        return fail(s, DMI_EINVAL, "dmi_set_friction: alpha is NULL");
+        return dmi_fail(s, DMI_EINVAL, "dmi_set_friction: alpha is NULL");
     for (size_t i = 0; i < s->n; i++)
         if (!isfinite(alpha[i]) || alpha[i] < 0)
-            return fail(s, DMI_EINVAL,
-                        "dmi_set_friction: alpha[%zu] = %g must be finite and >= 0", i, alpha[i]);
+            return dmi_fail(s, DMI_EINVAL,
+                            "dmi_set_friction: alpha[%zu] = %g must be finite and >= 0", i,
+                            alpha[i]);
     double *a = malloc(s->n * sizeof *a);
     if (!a)
-        return fail(s, DMI_ENOMEM, "dmi_set_friction: out of memory");
+        return dmi_fail(s, DMI_ENOMEM, "dmi_set_friction: out of memory");
     memcpy(a, alpha, s->n * sizeof *a);
     set_operator(s, A_FRICTION, a, NULL, NULL, NULL);
     return DMI_OK;
@@ -316,21 +283,21 @@ int dmi_set_box(dmi_solver *s, const double *lo, const double *hi)
     if (!s)
         return DMI_EINVAL;
     if (!lo || !hi)
-        return fail(s, DMI_EINVAL, "dmi_set_box: %s is NULL", lo ? "hi" : "lo");
+        return dmi_fail(s, DMI_EINVAL, "dmi_set_box: %s is NULL", lo ? "hi" : "lo");
     for (size_t i = 0; i < s->n; i++) {
         if (isnan(lo[i]) || isnan(hi[i]))
-            return fail(s, DMI_EINVAL, "dmi_set_box: lo[%zu] or hi[%zu] is NaN", i, i);
+            return dmi_fail(s, DMI_EINVAL, "dmi_set_box: lo[%zu] or hi[%zu] is NaN", i, i);
         if (lo[i] > hi[i])
-            return fail(s, DMI_EINVAL, "dmi_set_box: lo[%zu] = %g > hi[%zu] = %g", i, lo[i], i,
-                        hi[i]);
+            return dmi_fail(s, DMI_EINVAL, "dmi_set_box: lo[%zu] = %g > hi[%zu] = %g", i, lo[i], i,
+                            hi[i]);
         if (lo[i] == INFINITY || hi[i] == -INFINITY)
-            return fail(s, DMI_EINVAL, "dmi_set_box: the box is empty in component %zu", i);
+            return dmi_fail(s, DMI_EINVAL, "dmi_set_box: the box is empty in component %zu", i);
     }
     double *l = malloc(s->n * sizeof *l), *u = malloc(s->n * sizeof *u);
     if (!l || !u) {
         free(l);
         free(u);
-        return fail(s, DMI_ENOMEM, "dmi_set_box: out of memory");
+        return dmi_fail(s, DMI_ENOMEM, "dmi_set_box: out of memory");
     }
     memcpy(l, lo, s->n * sizeof *l);
     memcpy(u, hi, s->n * sizeof *u);
@@ -343,8 +310,8 @@ int dmi_set_kernel(dmi_solver *s, dmi_kernel_fn H, void *user)
     if (!s)
         return DMI_EINVAL;
     if (s->initialized)
-        return fail(s, DMI_ESTATE, "dmi_set_kernel: the kernel is sampled by dmi_init and "
-                                   "cannot change afterwards");
+        return dmi_fail(s, DMI_ESTATE, "dmi_set_kernel: the kernel is sampled by dmi_init and "
+                                       "cannot change afterwards");
     dmi_expk_release(&s->expk);
     s->H = H;
     s->H_user = user;
@@ -358,33 +325,33 @@ int dmi_set_kernel_exp(dmi_solver *s, size_t K, const double *a, const double *b
     if (!s)
         return DMI_EINVAL;
     if (s->initialized)
-        return fail(s, DMI_ESTATE, "%s: the kernel is sampled by dmi_init and cannot change "
-                                   "afterwards", fn);
+        return dmi_fail(s, DMI_ESTATE, "%s: the kernel is sampled by dmi_init and cannot change "
+                                       "afterwards", fn);
     if (K == 0)
-        return fail(s, DMI_EINVAL, "%s: K = 0 terms (dmi_set_kernel(s, NULL, NULL) removes the "
-                                   "kernel)", fn);
+        return dmi_fail(s, DMI_EINVAL, "%s: K = 0 terms (dmi_set_kernel(s, NULL, NULL) removes the "
+                                       "kernel)", fn);
     if (!a || !b || !C)
-        return fail(s, DMI_EINVAL, "%s: %s is NULL", fn, !a ? "a" : !b ? "b" : "C");
+        return dmi_fail(s, DMI_EINVAL, "%s: %s is NULL", fn, !a ? "a" : !b ? "b" : "C");
     for (size_t k = 0; k < K; k++) {
         if (!isfinite(a[k]))
-            return fail(s, DMI_EINVAL, "%s: a[%zu] = %g is not finite", fn, k, a[k]);
+            return dmi_fail(s, DMI_EINVAL, "%s: a[%zu] = %g is not finite", fn, k, a[k]);
         if (!isfinite(b[k]))
-            return fail(s, DMI_EINVAL, "%s: b[%zu] = %g is not finite", fn, k, b[k]);
+            return dmi_fail(s, DMI_EINVAL, "%s: b[%zu] = %g is not finite", fn, k, b[k]);
     }
     const size_t n = s->n, nn = n * n; /* (used only if n n K doubles fit in size_t) */
     if (dmi_mul_size(n, n, 1) == 0 || dmi_mul_size(K, nn, sizeof(double)) == 0)
-        return fail(s, DMI_ENOMEM, "%s: %zu terms of %zu x %zu matrices overflow", fn, K, n, n);
+        return dmi_fail(s, DMI_ENOMEM, "%s: %zu terms of %zu x %zu matrices overflow", fn, K, n, n);
     for (size_t q = 0; q < K * nn; q++) {
         if (!isfinite(C[q]))
-            return fail(s, DMI_EINVAL, "%s: C[%zu] (term %zu, entry (%zu, %zu)) = %g is not "
-                                       "finite", fn, q, q / nn, q % nn / n, q % n, C[q]);
+            return dmi_fail(s, DMI_EINVAL, "%s: C[%zu] (term %zu, entry (%zu, %zu)) = %g is not "
+                                           "finite", fn, q, q / nn, q % nn / n, q % n, C[q]);
         if (D && !isfinite(D[q]))
-            return fail(s, DMI_EINVAL, "%s: D[%zu] (term %zu, entry (%zu, %zu)) = %g is not "
-                                       "finite", fn, q, q / nn, q % nn / n, q % n, D[q]);
+            return dmi_fail(s, DMI_EINVAL, "%s: D[%zu] (term %zu, entry (%zu, %zu)) = %g is not "
+                                           "finite", fn, q, q / nn, q % nn / n, q % n, D[q]);
     }
     dmi_expk k;
     if (dmi_expk_copy(&k, n, K, a, b, C, D) != 0)
-        return fail(s, DMI_ENOMEM, "%s: out of memory", fn);
+        return dmi_fail(s, DMI_ENOMEM, "%s: out of memory", fn);
     dmi_expk_release(&s->expk);
     s->expk = k;
     s->H = dmi_expk_eval;
@@ -397,8 +364,8 @@ int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user)
     if (!s)
         return DMI_EINVAL;
     if (s->initialized)
-        return fail(s, DMI_ESTATE, "dmi_set_history: the history is sampled by dmi_init and "
-                                   "cannot change afterwards");
+        return dmi_fail(s, DMI_ESTATE, "dmi_set_history: the history is sampled by dmi_init and "
+                                       "cannot change afterwards");
     s->z = z;
     s->z_user = user;
     return DMI_OK;
@@ -417,7 +384,7 @@ int dmi_set_convolution(dmi_solver *s, int method)
         rc = engine_make(s, &s->kernel, method, &c, &e, "dmi_set_convolution");
         if (rc != DMI_OK)
             return rc;
-        engine_rebuild(s, c, e);
+        dmi_engine_rebuild(s, c, e);
         engine_free(s->conv, s->rec);
         s->conv = c;
         s->rec = e;
@@ -433,14 +400,15 @@ static int sample_kernel(dmi_solver *s, dmi_kernel *k)
 {
     const size_t n = s->n, N = s->N, nn = n * n;
     if (!s->H)
-        return dmi_kernel_alloc(k, n, N, NULL) == 0 ? DMI_OK
-                                                   : fail(s, DMI_ENOMEM, "dmi_init: out of memory");
+        return dmi_kernel_alloc(k, n, N, NULL) == 0
+                   ? DMI_OK
+                   : dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory");
     /* (0 also when n * n overflows) */
     size_t bytes = dmi_mul_size(n, n, 1) ? dmi_mul_size(N, nn, sizeof(double)) : 0;
     double *dense = bytes ? malloc(bytes) : NULL;
     if (!dense)
-        return fail(s, DMI_ENOMEM, "dmi_init: cannot allocate %zu x %zu x %zu kernel samples", N,
-                    n, n);
+        return dmi_fail(s, DMI_ENOMEM, "dmi_init: cannot allocate %zu x %zu x %zu kernel samples",
+                        N, n, n);
     for (size_t l = 0; l < N; l++) {
         double t = (double)l * s->h;
         double *Hl = dense + l * nn;
@@ -448,20 +416,20 @@ static int sample_kernel(dmi_solver *s, dmi_kernel *k)
         int rc = s->H(t, Hl, s->H_user);
         if (rc != 0) {
             free(dense);
-            return fail(s, DMI_ECALLBACK, "dmi_init: kernel callback returned %d at s = %.17g", rc,
-                        t);
+            return dmi_fail(s, DMI_ECALLBACK, "dmi_init: kernel callback returned %d at s = %.17g",
+                            rc, t);
         }
-        size_t bad = first_nonfinite(Hl, nn);
+        size_t bad = dmi_first_nonfinite(Hl, nn);
         if (bad < nn) {
-            rc = fail(s, DMI_ENONFINITE, "dmi_init: kernel H(%.17g)[%zu][%zu] = %g", t, bad / n,
-                      bad % n, Hl[bad]);
+            rc = dmi_fail(s, DMI_ENONFINITE, "dmi_init: kernel H(%.17g)[%zu][%zu] = %g", t, bad / n,
+                          bad % n, Hl[bad]);
             free(dense);
             return rc;
         }
     }
     int rc = dmi_kernel_alloc(k, n, N, dense);
     free(dense);
-    return rc == 0 ? DMI_OK : fail(s, DMI_ENOMEM, "dmi_init: out of memory for kernel samples");
+    return rc == 0 ? DMI_OK : dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for kernel samples");
 }
 
 /* Samples z(p h), p = -N..0, into ring. */
@@ -476,12 +444,12 @@ static int sample_history(dmi_solver *s, dmi_history *ring)
         if (s->z) {
             int rc = s->z(t, u, s->z_user);
             if (rc != 0)
-                return fail(s, DMI_ECALLBACK, "dmi_init: history callback returned %d at t = %.17g",
-                            rc, t);
-            size_t bad = first_nonfinite(u, n);
+                return dmi_fail(s, DMI_ECALLBACK,
+                                "dmi_init: history callback returned %d at t = %.17g", rc, t);
+            size_t bad = dmi_first_nonfinite(u, n);
             if (bad < n)
-                return fail(s, DMI_ENONFINITE, "dmi_init: history z(%.17g)[%zu] = %g", t, bad,
-                            u[bad]);
+                return dmi_fail(s, DMI_ENONFINITE, "dmi_init: history z(%.17g)[%zu] = %g", t, bad,
+                                u[bad]);
         }
         dmi_history_put(ring, k, u);
     }
@@ -498,7 +466,7 @@ int dmi_init(dmi_solver *s)
     dmi_kernel k = {0};
     dmi_history ring = {0};
     if (dmi_history_alloc(&ring, s->n, s->N) != 0)
-        return fail(s, DMI_ENOMEM, "dmi_init: out of memory for the history");
+        return dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for the history");
     dmi_conv *c = NULL;
     dmi_exp *e = NULL;
     rc = sample_kernel(s, &k);
@@ -519,7 +487,7 @@ int dmi_init(dmi_solver *s)
     s->conv = c;
     s->rec = e;
     s->p = 0;
-    engine_rebuild(s, c, e); /* the history's part, before the first step */
+    dmi_engine_rebuild(s, c, e); /* the history's part, before the first step */
     memset(s->last_W, 0, s->n * sizeof *s->last_W); /* a restart saves the bytes of a new run */
     memset(s->last_X, 0, s->n * sizeof *s->last_X);
     s->initialized = 1;
@@ -537,8 +505,8 @@ static int apply_resolvent(dmi_solver *s, const double *x, double *out)
         memset(out, 0, n * sizeof *out);
         int rc = s->r(h, x, out, s->r_user);
         if (rc != 0)
-            return fail(s, DMI_ECALLBACK, "dmi_step: resolvent callback returned %d at t = %.17g",
-                        rc, dmi_time(s));
+            return dmi_fail(s, DMI_ECALLBACK, "dmi_step: resolvent callback returned %d at "
+                                              "t = %.17g", rc, dmi_time(s));
         break;
     }
     case A_FRICTION:
@@ -562,7 +530,7 @@ int dmi_step(dmi_solver *s)
     if (!s)
         return DMI_EINVAL;
     if (!s->initialized)
-        return fail(s, DMI_ESTATE, "dmi_step: call dmi_init first");
+        return dmi_fail(s, DMI_ESTATE, "dmi_step: call dmi_init first");
     const size_t n = s->n;
     const double h = s->h, t = (double)s->p * h; /* dmi_time */
     double *U = s->work, *fv = U + n, *W = fv + n, *X = W + n, *U1 = X + n;
@@ -573,31 +541,32 @@ int dmi_step(dmi_solver *s)
     if (s->f) {
         int rc = s->f(t, U, fv, s->f_user);
         if (rc != 0)
-            return fail(s, DMI_ECALLBACK, "dmi_step: rhs callback returned %d at t = %.17g", rc, t);
+            return dmi_fail(s, DMI_ECALLBACK, "dmi_step: rhs callback returned %d at t = %.17g", rc,
+                            t);
     }
     delay_sum(s, W);
     for (size_t i = 0; i < n; i++)
         X[i] = U[i] - h * fv[i] - h * W[i];
     /* A non-finite f or W makes X non-finite (U^p and h are finite), so one
      * check of X guards all three; the culprit is named on the error path. */
-    size_t bad = first_nonfinite(X, n);
+    size_t bad = dmi_first_nonfinite(X, n);
     if (bad < n) {
-        size_t bf = first_nonfinite(fv, n), bw = first_nonfinite(W, n);
+        size_t bf = dmi_first_nonfinite(fv, n), bw = dmi_first_nonfinite(W, n);
         if (bf < n)
-            return fail(s, DMI_ENONFINITE, "dmi_step: f(%.17g, U)[%zu] = %g", t, bf, fv[bf]);
+            return dmi_fail(s, DMI_ENONFINITE, "dmi_step: f(%.17g, U)[%zu] = %g", t, bf, fv[bf]);
         if (bw < n)
-            return fail(s, DMI_ENONFINITE, "dmi_step: delay term W[%zu] = %g at t = %.17g", bw,
-                        W[bw], t);
-        return fail(s, DMI_ENONFINITE, "dmi_step: resolvent argument X[%zu] = %g at t = %.17g",
-                    bad, X[bad], t);
+            return dmi_fail(s, DMI_ENONFINITE, "dmi_step: delay term W[%zu] = %g at t = %.17g", bw,
+                            W[bw], t);
+        return dmi_fail(s, DMI_ENONFINITE, "dmi_step: resolvent argument X[%zu] = %g at t = %.17g",
+                        bad, X[bad], t);
     }
     int rc = apply_resolvent(s, X, U1);
     if (rc != DMI_OK)
         return rc;
-    bad = first_nonfinite(U1, n);
+    bad = dmi_first_nonfinite(U1, n);
     if (bad < n)
-        return fail(s, DMI_ENONFINITE, "dmi_step: new state U[%zu] = %g at t = %.17g", bad,
-                    U1[bad], t + h);
+        return dmi_fail(s, DMI_ENONFINITE, "dmi_step: new state U[%zu] = %g at t = %.17g", bad,
+                        U1[bad], t + h);
 
     /* commit */
     dmi_history_push(&s->ring, U1);
@@ -634,20 +603,20 @@ double dmi_get_h(const dmi_solver *s)
     return s ? s->h : 0.0;
 }
 
-static int check_query(const dmi_solver *s, const void *out, const char *fn)
+int dmi_check_query(const dmi_solver *s, const void *out, const char *fn)
 {
     if (!s)
         return DMI_EINVAL;
     if (!out)
-        return fail(s, DMI_EINVAL, "%s: output pointer is NULL", fn);
+        return dmi_fail(s, DMI_EINVAL, "%s: output pointer is NULL", fn);
     if (!s->initialized)
-        return fail(s, DMI_ESTATE, "%s: call dmi_init first", fn);
+        return dmi_fail(s, DMI_ESTATE, "%s: call dmi_init first", fn);
     return DMI_OK;
 }
 
 int dmi_get_step_index(const dmi_solver *s, uint64_t *p)
 {
-    int rc = check_query(s, p, "dmi_get_step_index");
+    int rc = dmi_check_query(s, p, "dmi_get_step_index");
     if (rc == DMI_OK)
         *p = s->p;
     return rc;
@@ -655,7 +624,7 @@ int dmi_get_step_index(const dmi_solver *s, uint64_t *p)
 
 int dmi_get_state(const dmi_solver *s, double *u)
 {
-    int rc = check_query(s, u, "dmi_get_state");
+    int rc = dmi_check_query(s, u, "dmi_get_state");
     if (rc == DMI_OK)
         dmi_history_get(&s->ring, 0, u);
     return rc;
@@ -663,11 +632,11 @@ int dmi_get_state(const dmi_solver *s, double *u)
 
 int dmi_get_past(const dmi_solver *s, size_t lag, double *u)
 {
-    int rc = check_query(s, u, "dmi_get_past");
+    int rc = dmi_check_query(s, u, "dmi_get_past");
     if (rc != DMI_OK)
         return rc;
     if (lag > s->N)
-        return fail(s, DMI_EINVAL, "dmi_get_past: lag %zu > N = %zu", lag, s->N);
+        return dmi_fail(s, DMI_EINVAL, "dmi_get_past: lag %zu > N = %zu", lag, s->N);
     dmi_history_get(&s->ring, lag, u);
     return DMI_OK;
 }
@@ -677,153 +646,10 @@ int dmi_get_step_terms(const dmi_solver *s, double *W, double *X)
     if (!s)
         return DMI_EINVAL;
     if (!s->initialized || s->p == 0)
-        return fail(s, DMI_ESTATE, "dmi_get_step_terms: no step taken since dmi_init");
+        return dmi_fail(s, DMI_ESTATE, "dmi_get_step_terms: no step taken since dmi_init");
     if (W)
         memcpy(W, s->last_W, s->n * sizeof *W);
     if (X)
         memcpy(X, s->last_X, s->n * sizeof *X);
-    return DMI_OK;
-}
-
-/* ---- state save / load ---------------------------------------------------------
- * Layout (native endian): header of 8 uint64 words
- *   magic, version, n, N, bits of tau, p, p != 0 (a step was taken), checksum
- * then (N + 1) n doubles U^{p-lag} for lag = 0..N, n doubles W, n doubles X,
- * then (version 2, libdmi 1.1) the recursion's part: 3 uint64 words
- *   E = 2 dmi_expk_sums (0 without an exponential kernel),
- *   1 if the sums are those of a running recursion (else 0 and zeros),
- *   dmi_expk_signature (0 without an exponential kernel)
- * and E doubles, the sums (re, im).
- * checksum = FNV-1a 64 of every other byte (header with checksum word 0).
- */
-#define STATE_MAGIC UINT64_C(0x444d495354415445) /* "DMISTATE" */
-#define STATE_VERSION UINT64_C(2)
-#define STATE_WORDS 8
-#define STATE_REC_WORDS 3
-
-/* The number of doubles of the recursion's sums in s's state. */
-static size_t state_sums(const dmi_solver *s)
-{
-    return has_expk(s) ? 2 * dmi_expk_sums(&s->expk) : 0;
-}
-
-static uint64_t state_checksum(const unsigned char *buf, size_t size)
-{
-    const size_t cks = 7 * sizeof(uint64_t);
-    static const unsigned char zero[sizeof(uint64_t)];
-    uint64_t hsh = dmi_fnv1a(DMI_FNV1A_INIT, buf, cks);
-    hsh = dmi_fnv1a(hsh, zero, sizeof zero);
-    return dmi_fnv1a(hsh, buf + cks + sizeof(uint64_t), size - cks - sizeof(uint64_t));
-}
-
-size_t dmi_state_size(const dmi_solver *s)
-{
-    if (!s)
-        return 0;
-    return (STATE_WORDS + STATE_REC_WORDS) * sizeof(uint64_t) +
-           ((s->N + 1) * s->n + 2 * s->n + state_sums(s)) * sizeof(double);
-}
-
-int dmi_state_save(const dmi_solver *s, void *buf, size_t size)
-{
-    int rc = check_query(s, buf, "dmi_state_save");
-    if (rc != DMI_OK)
-        return rc;
-    const size_t need = dmi_state_size(s), n = s->n;
-    if (size < need)
-        return fail(s, DMI_EINVAL, "dmi_state_save: buffer of %zu bytes, %zu needed", size, need);
-    uint64_t hdr[STATE_WORDS] = {STATE_MAGIC, STATE_VERSION, (uint64_t)n, (uint64_t)s->N, 0,
-                                 s->p, (uint64_t)(s->p != 0), 0};
-    memcpy(&hdr[4], &s->tau, sizeof(double));
-    unsigned char *b = buf;
-    memcpy(b, hdr, sizeof hdr);
-    unsigned char *d = b + sizeof hdr; /* buf may be unaligned: copy bytes */
-    for (size_t lag = 0; lag <= s->N; lag++)
-        for (size_t j = 0; j < n; j++, d += sizeof(double))
-            memcpy(d, &dmi_history_series(&s->ring, j)[lag], sizeof(double));
-    memcpy(d, s->last_W, n * sizeof(double));
-    d += n * sizeof(double);
-    memcpy(d, s->last_X, n * sizeof(double));
-    d += n * sizeof(double);
-    const size_t E = state_sums(s);
-    uint64_t rec[STATE_REC_WORDS] = {E, s->rec != NULL,
-                                     E ? dmi_expk_signature(&s->expk, s->N, s->h) : 0};
-    memcpy(d, rec, sizeof rec);
-    d += sizeof rec;
-    if (s->rec)
-        dmi_exp_get(s->rec, d);
-    else
-        memset(d, 0, E * sizeof(double));
-    hdr[7] = state_checksum(b, need);
-    memcpy(b + 7 * sizeof(uint64_t), &hdr[7], sizeof(uint64_t));
-    return DMI_OK;
-}
-
-int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
-{
-    int rc = check_query(s, buf, "dmi_state_load");
-    if (rc != DMI_OK)
-        return rc;
-    const size_t need = dmi_state_size(s), n = s->n;
-    if (size != need)
-        return fail(s, DMI_EINVAL, "dmi_state_load: %zu bytes, this solver's state has %zu", size,
-                    need);
-    const unsigned char *b = buf;
-    uint64_t hdr[STATE_WORDS];
-    memcpy(hdr, b, sizeof hdr);
-    double tau;
-    memcpy(&tau, &hdr[4], sizeof tau);
-    if (hdr[0] != STATE_MAGIC)
-        return fail(s, DMI_EINVAL, "dmi_state_load: not a dmi state (bad magic)");
-    if (hdr[1] != STATE_VERSION)
-        return fail(s, DMI_EINVAL, "dmi_state_load: state format version %llu (libdmi 1.0 wrote "
-                                   "version 1); this libdmi reads version %llu only",
-                    (unsigned long long)hdr[1], (unsigned long long)STATE_VERSION);
-    if (hdr[2] != (uint64_t)n || hdr[3] != (uint64_t)s->N || memcmp(&tau, &s->tau, sizeof tau))
-        return fail(s, DMI_EINVAL,
-                    "dmi_state_load: state of a solver with n = %llu, N = %llu, tau = %g; this "
-                    "one has n = %zu, N = %zu, tau = %g",
-                    (unsigned long long)hdr[2], (unsigned long long)hdr[3], tau, n, s->N, s->tau);
-    if (hdr[7] != state_checksum(b, need))
-        return fail(s, DMI_EINVAL, "dmi_state_load: corrupted state (checksum mismatch)");
-    if (hdr[6] != (uint64_t)(hdr[5] != 0))
-        return fail(s, DMI_EINVAL, "dmi_state_load: corrupted state (step flag %llu at p = %llu)",
-                    (unsigned long long)hdr[6], (unsigned long long)hdr[5]);
-    const size_t E = state_sums(s), nd = (s->N + 3) * n + E;
-    uint64_t rec[STATE_REC_WORDS];
-    memcpy(rec, b + sizeof hdr + (s->N + 3) * n * sizeof(double), sizeof rec);
-    if (rec[0] != E || rec[1] > 1)
-        return fail(s, DMI_EINVAL, "dmi_state_load: corrupted state (recursion words %llu, %llu; "
-                                   "this solver has %zu sums)", (unsigned long long)rec[0],
-                    (unsigned long long)rec[1], E);
-    double *d = malloc((nd ? nd : 1) * sizeof *d);
-    if (!d)
-        return fail(s, DMI_ENOMEM, "dmi_state_load: out of memory");
-    memcpy(d, b + sizeof hdr, (nd - E) * sizeof *d);
-    memcpy(d + nd - E, b + sizeof hdr + (nd - E) * sizeof *d + sizeof rec, E * sizeof *d);
-    if (first_nonfinite(d, nd) < nd) {
-        free(d);
-        return fail(s, DMI_EINVAL, "dmi_state_load: state holds a non-finite value");
-    }
-    dmi_history ring = {0};
-    if (dmi_history_alloc(&ring, n, s->N) != 0) {
-        free(d);
-        return fail(s, DMI_ENOMEM, "dmi_state_load: out of memory");
-    }
-    for (size_t lag = 0; lag <= s->N; lag++)
-        dmi_history_put(&ring, lag, d + lag * n);
-    dmi_history_release(&s->ring);
-    s->ring = ring;
-    memcpy(s->last_W, d + (s->N + 1) * n, n * sizeof *d);
-    memcpy(s->last_X, d + (s->N + 2) * n, n * sizeof *d);
-    s->p = hdr[5];
-    /* The sums of the same recursion continue bitwise; any others (a state
-     * of another method or kernel) are anchored afresh from the states. */
-    if (s->rec && rec[1] == 1 && rec[2] == dmi_expk_signature(&s->expk, s->N, s->h))
-        dmi_exp_set(s->rec, d + nd - E);
-    else
-        engine_rebuild(s, NULL, s->rec);
-    engine_rebuild(s, s->conv, NULL);
-    free(d);
     return DMI_OK;
 }

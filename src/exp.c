@@ -26,6 +26,8 @@
  */
 #include "exp.h"
 
+#include "bytes.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

@@ -13,7 +13,7 @@
 
 #include <stdint.h>
 
-#include "dmi_internal.h"
+#include "delay.h"
 
 /* The kernel's parameters (copies of the caller's arrays). */
 typedef struct {

@@ -13,7 +13,7 @@
 #include <CUnit/CUnit.h>
 
 #include "conv_run.h"
-#include "dmi_internal.h"
+#include "conv.h"
 
 /* Deterministic pseudo-random numbers in [-1, 1) (xorshift64*). */
 static double rnd(uint64_t *x)

@@ -1,32 +1,11 @@
 /*
- * Internal pieces of libdmi: the history ring and the delay sum.
+ * The history ring, the kernel samples and the direct delay sum (delay.c).
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
-#ifndef DMI_INTERNAL_H
-#define DMI_INTERNAL_H
+#ifndef DMI_DELAY_H
+#define DMI_DELAY_H
 
-#include "dmi.h"
-
-/* a * b elements of size sz, or 0 on overflow. */
-static inline size_t dmi_mul_size(size_t a, size_t b, size_t sz)
-{
-    if (a != 0 && b > SIZE_MAX / a)
-        return 0;
-    if (a * b != 0 && sz > SIZE_MAX / (a * b))
-        return 0;
-    return a * b * sz;
-}
-
-/* FNV-1a 64 of len bytes, continuing from hsh (DMI_FNV1A_INIT to start). */
-#define DMI_FNV1A_INIT UINT64_C(0xcbf29ce484222325)
-static inline uint64_t dmi_fnv1a(uint64_t hsh, const unsigned char *b, size_t len)
-{
-    for (size_t i = 0; i < len; i++) {
-        hsh ^= b[i];
-        hsh *= UINT64_C(0x100000001b3);
-    }
-    return hsh;
-}
+#include <stddef.h>
 
 /*
  * History ring of the N + 1 states U^{p-N..p}, stored per component as a
@@ -78,29 +57,5 @@ double dmi_dot(const double *a, const double *b, size_t len);
 
 /* W = h * sum_{l=0}^{N-1} H(l h) U^{p-l} (n values): the direct method. */
 void dmi_delay_sum(const dmi_kernel *k, const dmi_history *r, double h, double *W);
-
-/*
- * The FFT method (conv.c, absent when built with DMI_NO_FFT): an exact block
- * convolution engine whose whole state is a function of p, the kernel and
- * the history ring, so it can be rebuilt from them at any p with bitwise the
- * same future results.
- */
-typedef struct dmi_conv dmi_conv;
-
-/* For method DMI_CONV_FFT, or DMI_CONV_AUTO when its cost model predicts
- * the engine faster than the direct sum: *out = a new engine for kernel k
- * (its kernel spectra computed; call dmi_conv_rebuild before use).  Else
- * *out = NULL (use dmi_delay_sum).  0, or -1 when out of memory. */
-int dmi_conv_create(dmi_conv **out, const dmi_kernel *k, size_t n, size_t N, int method);
-void dmi_conv_free(dmi_conv *c);
-/* Recomputes the engine's state for step p from the ring (U^{p-N..p}). */
-void dmi_conv_rebuild(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p);
-/* After U^p was pushed (p the new step counter): updates the blocks due at p. */
-void dmi_conv_advance(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p);
-/* W^p, as dmi_delay_sum, without changing the engine. */
-void dmi_conv_sum(const dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p,
-                  double h, double *W);
-/* Number of FFT block sizes in use (0: the engine degenerated to direct sums). */
-size_t dmi_conv_levels(const dmi_conv *c);
 
 #endif

@@ -1,0 +1,66 @@
+/*
+ * The solver of libdmi (dmi.c), for the files that handle its innards: the
+ * saved state (state.c).
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#ifndef DMI_SOLVER_H
+#define DMI_SOLVER_H
+
+#include <stdint.h>
+
+#include "conv.h"
+#include "delay.h"
+#include "dmi.h"
+#include "exp.h"
+
+struct dmi_solver {
+    size_t n, N;
+    double tau, h;
+
+    dmi_rhs_fn f;
+    void *f_user;
+    int a_kind;         /* A_NONE, A_CALLBACK, A_FRICTION, A_BOX (dmi.c) */
+    dmi_resolvent_fn r;
+    void *r_user;
+    double *a_lo;  /* friction: alpha (n); box: lo (n) */
+    double *a_hi;  /* box: hi (n) */
+    dmi_kernel_fn H;    /* dmi_expk_eval for a kernel set by dmi_set_kernel_exp */
+    void *H_user;
+    dmi_expk expk;      /* that kernel's parameters (K = 0: none) */
+    dmi_history_fn z;
+    void *z_user;
+    int conv_method;
+
+    int initialized;
+    uint64_t p;         /* step counter: t_p = p h */
+    dmi_history ring;   /* U^{p-N..p} */
+    dmi_kernel kernel;  /* nonzero entries of H(l h) */
+    dmi_conv *conv;     /* FFT engine, or NULL */
+    dmi_exp *rec;       /* recursion engine, or NULL (both NULL: the direct sum) */
+    double *last_W;     /* W^{p-1} (n) */
+    double *last_X;     /* X^{p-1} (n) */
+    double *work;       /* 5 n scratch values: U^p, f, W, X, U^{p+1} */
+
+    char err[256];
+};
+
+/* Writes the message (printf format) for dmi_last_error; returns code. */
+int dmi_fail(const dmi_solver *s, int code, const char *fmt, ...);
+
+/* The index of the first non-finite x[i], or n. */
+size_t dmi_first_nonfinite(const double *x, size_t n);
+
+/* The checks of a query fn writing to out: s not NULL (else DMI_EINVAL),
+ * out not NULL, s initialized.  DMI_OK or the error. */
+int dmi_check_query(const dmi_solver *s, const void *out, const char *fn);
+
+/* Whether s's kernel is the exponential one of dmi_set_kernel_exp. */
+static inline int dmi_has_expk(const dmi_solver *s)
+{
+    return s->H == dmi_expk_eval;
+}
+
+/* Recomputes the engines (either may be NULL) for s's step p from the ring. */
+void dmi_engine_rebuild(const dmi_solver *s, dmi_conv *conv, dmi_exp *rec);
+
+#endif
