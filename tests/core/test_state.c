@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bytes.h" /* the state's layout (src/) */
 #include "core_test.h"
 
 enum { N = 16, SAVED_AT = 37, MORE = 25 }; /* SAVED_AT > N: the ring has wrapped */
@@ -210,6 +211,80 @@ static void test_refused(void)
     dmi_free(&t);
 }
 
+/* bytes.h, the one description of the state's bytes (libdmi, the FMU and the
+ * tests use it): its FNV-1a against the published test vectors, and a saved
+ * state read at its offsets against what the solver's queries return. */
+static void test_layout(void)
+{
+    static const struct {
+        const char *text;
+        uint64_t fnv1a;
+    } fnv[] = {{"", UINT64_C(0xcbf29ce484222325)}, {"a", UINT64_C(0xaf63dc4c8601ec8c)},
+               {"foobar", UINT64_C(0x85944171f73967e8)}}; /* FNV reference test vectors */
+    for (size_t k = 0; k < sizeof fnv / sizeof *fnv; k++)
+        CU_ASSERT_EQUAL(dmi_fnv1a(DMI_FNV1A_INIT, (const unsigned char *)fnv[k].text,
+                                  strlen(fnv[k].text)), fnv[k].fnv1a);
+    const unsigned char ab[10] = "0123456789"; /* skip: the 8 bytes at 1 read as zero */
+    const unsigned char az[10] = {'0', 0, 0, 0, 0, 0, 0, 0, 0, '9'};
+    CU_ASSERT_EQUAL(dmi_fnv1a_skip(ab, 10, 1), dmi_fnv1a(DMI_FNV1A_INIT, az, 10));
+
+    core_model m = {0};
+    dmi_solver *s = model_after(&m, SAVED_AT);
+    CU_ASSERT_FATAL(s != NULL);
+    size_t size;
+    unsigned char *b = core_save(s, &size);
+    CU_ASSERT_FATAL(b != NULL);
+    const size_t n = 2;
+    CU_ASSERT_EQUAL(size, dmi_state_bytes(n, N, 0));
+    CU_ASSERT_EQUAL(size, 8 * 8 + (N + 3) * n * 8 + 3 * 8); /* no sums: 8 + 3 words */
+    CU_ASSERT_EQUAL(dmi_get_u64(b, DMI_STATE_AT_MAGIC), DMI_STATE_MAGIC);
+    CU_ASSERT(memcmp(b, "ETATSIMD", 8) == 0 || memcmp(b, "DMISTATE", 8) == 0); /* by endianness */
+    CU_ASSERT_EQUAL(dmi_get_u64(b, DMI_STATE_AT_VERSION), 2);
+    CU_ASSERT_EQUAL(dmi_get_u64(b, DMI_STATE_AT_n), n);
+    CU_ASSERT_EQUAL(dmi_get_u64(b, DMI_STATE_AT_N), N);
+    CU_ASSERT_EQUAL(dmi_get_double(b, DMI_STATE_AT_TAU), 1.0);
+    CU_ASSERT_EQUAL(dmi_get_u64(b, DMI_STATE_AT_P), SAVED_AT);
+    CU_ASSERT_EQUAL(dmi_get_u64(b, DMI_STATE_AT_STEPPED), 1);
+    int same = 1;
+    double u[2], W[2], X[2];
+    for (size_t lag = 0; lag <= N; lag++) {
+        same &= dmi_get_past(s, lag, u) == DMI_OK;
+        for (size_t j = 0; j < n; j++)
+            same &= dmi_get_double(b, dmi_state_at_double(n, lag, j)) == u[j];
+    }
+    same &= dmi_get_step_terms(s, W, X) == DMI_OK;
+    for (size_t j = 0; j < n; j++)
+        same &= dmi_get_double(b, dmi_state_at_double(n, N + 1, j)) == W[j] &&
+                dmi_get_double(b, dmi_state_at_double(n, N + 2, j)) == X[j];
+    CU_ASSERT(same);
+    const size_t rec = dmi_state_at_rec(n, N);
+    CU_ASSERT_EQUAL(rec + DMI_STATE_REC_BYTES, size);
+    CU_ASSERT_EQUAL(dmi_get_u64(b, rec + DMI_STATE_REC_E), 0);
+    CU_ASSERT_EQUAL(dmi_get_u64(b, rec + DMI_STATE_REC_RUNNING), 0);
+    CU_ASSERT_EQUAL(dmi_get_u64(b, rec + DMI_STATE_REC_SIGNATURE), 0);
+    CU_ASSERT_EQUAL(dmi_get_u64(b, DMI_STATE_AT_CHECKSUM),
+                    dmi_fnv1a_skip(b, size, DMI_STATE_AT_CHECKSUM));
+    free(b);
+    dmi_free(&s);
+
+    /* with the recursion: two terms, each used in one column: 2 sums of 2 doubles */
+    const double a[2] = {-1, 0}, bk[2] = {0, 3}, C[8] = {0, 1, 0, 0, 0, 0, 1, 0};
+    CU_ASSERT_EQUAL_FATAL(dmi_create(&s, n, 1.0, N), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_kernel_exp(s, 2, a, bk, C, NULL), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_convolution(s, DMI_CONV_RECURSIVE), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_init(s), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_advance(s, 3), DMI_OK);
+    b = core_save(s, &size);
+    CU_ASSERT_FATAL(b != NULL);
+    CU_ASSERT_EQUAL(size, dmi_state_bytes(n, N, 4));
+    CU_ASSERT_EQUAL(dmi_get_u64(b, rec + DMI_STATE_REC_E), 4);
+    CU_ASSERT_EQUAL(dmi_get_u64(b, rec + DMI_STATE_REC_RUNNING), 1);
+    CU_ASSERT_EQUAL(dmi_get_u64(b, DMI_STATE_AT_CHECKSUM),
+                    dmi_fnv1a_skip(b, size, DMI_STATE_AT_CHECKSUM));
+    free(b);
+    dmi_free(&s);
+}
+
 int main(int argc, char **argv)
 {
     static const core_test tests[] = {
@@ -217,6 +292,7 @@ int main(int argc, char **argv)
         {"replay with the direct, FFT and automatic delay sum, N = 500", test_replay_methods},
         {"other n/N/tau, truncated, corrupted, bad magic: refused, solver unchanged",
          test_refused},
+        {"the layout of bytes.h: FNV-1a vectors, the saved bytes at its offsets", test_layout},
         {NULL, NULL}};
     return core_main(argc, argv, "core: state save and load", tests);
 }

@@ -19,6 +19,7 @@
 
 #include <CUnit/CUnit.h>
 
+#include "bytes.h" /* the state's layout (src/) */
 #include "capi_model.h"
 #include "dmi.h"
 #include "hard_util.h"
@@ -155,19 +156,14 @@ static unsigned char *saved_state(size_t n, double tau, size_t N, size_t *size)
     return b;
 }
 
-/* The state's checksum, recomputed independently from the layout documented
- * in src/dmi.c: FNV-1a 64 over all bytes with the 8th header word as zero. */
+/* The state's checksum, recomputed after an edit (layout: src/bytes.h) so
+ * that the edit reaches the checks behind it. */
 static void fix_checksum(unsigned char *b, size_t size)
 {
-    uint64_t h = UINT64_C(0xcbf29ce484222325);
-    for (size_t i = 0; i < size; i++) {
-        unsigned char c = (i >= 56 && i < 64) ? 0 : b[i];
-        h ^= c;
-        h *= UINT64_C(0x100000001b3);
-    }
-    memcpy(b + 56, &h, sizeof h);
+    dmi_put_u64(b, DMI_STATE_AT_CHECKSUM, dmi_fnv1a_skip(b, size, DMI_STATE_AT_CHECKSUM));
 }
-#define STATE_HEADER 64 /* 8 uint64 words before the doubles */
+/* Byte offset of U_j^{p-lag} (lag N + 2: X^{p-1}) in the model's state. */
+#define AT_DOUBLE(lag, j) dmi_state_at_double(MODEL_n, (lag), (j))
 
 /* ---- the cases ------------------------------------------------------------------ */
 
@@ -308,18 +304,17 @@ CALL(c_load_long, return LOAD(s, E_NONE, 0, 0, 1, 0);)
 CALL(c_load_empty, return load_edited(s, MODEL_n, MODEL_TAU, MODEL_N, E_NONE, 0, 0,
                                       -(long)dmi_state_size(s), 0);)
 CALL(c_load_magic, return LOAD(s, E_BYTE, 0, 0, 0, 0);)
-CALL(c_load_version, return LOAD(s, E_WORD_FIXED, 8, 1, 0, 0);)
+CALL(c_load_version, return LOAD(s, E_WORD_FIXED, DMI_STATE_AT_VERSION, 1, 0, 0);)
 CALL(c_load_foreign_nN, return load_edited(s, 1, MODEL_TAU, 11, E_NONE, 0, 0, 0, 0);)
 CALL(c_load_foreign_tau, return load_edited(s, MODEL_n, 2.0, MODEL_N, E_NONE, 0, 0, 0, 0);)
-CALL(c_load_foreign_n_hdr, return LOAD(s, E_WORD_FIXED, 16, 3, 0, 0);)
-CALL(c_load_checksum, return LOAD(s, E_BYTE, 60, 0, 0, 0);)
-CALL(c_load_data, return LOAD(s, E_BYTE, STATE_HEADER + 3, 0, 0, 0);)
-CALL(c_load_have_last, return LOAD(s, E_WORD_FIXED, 48, 2, 0, 0);)
-CALL(c_load_flag0, return LOAD(s, E_WORD_FIXED, 48, 0, 0, 0);)
-CALL(c_load_step_huge, return LOAD(s, E_WORD, 40, 1e19, 0, 0);)
-CALL(c_load_nan, return LOAD(s, E_DOUBLE_FIXED, STATE_HEADER, NAN, 0, 0);)
-CALL(c_load_inf, return LOAD(s, E_DOUBLE_FIXED, STATE_HEADER + (MODEL_N + 2) * MODEL_n * 8,
-                             -INFINITY, 0, 0);)
+CALL(c_load_foreign_n_hdr, return LOAD(s, E_WORD_FIXED, DMI_STATE_AT_n, 3, 0, 0);)
+CALL(c_load_checksum, return LOAD(s, E_BYTE, DMI_STATE_AT_CHECKSUM + 4, 0, 0, 0);)
+CALL(c_load_data, return LOAD(s, E_BYTE, AT_DOUBLE(0, 0) + 3, 0, 0, 0);)
+CALL(c_load_have_last, return LOAD(s, E_WORD_FIXED, DMI_STATE_AT_STEPPED, 2, 0, 0);)
+CALL(c_load_flag0, return LOAD(s, E_WORD_FIXED, DMI_STATE_AT_STEPPED, 0, 0, 0);)
+CALL(c_load_step_huge, return LOAD(s, E_WORD, DMI_STATE_AT_P, 1e19, 0, 0);)
+CALL(c_load_nan, return LOAD(s, E_DOUBLE_FIXED, AT_DOUBLE(0, 0), NAN, 0, 0);)
+CALL(c_load_inf, return LOAD(s, E_DOUBLE_FIXED, AT_DOUBLE(MODEL_N + 2, 0), -INFINITY, 0, 0);)
 
 typedef struct {
     const char *id, *fn, *input;
