@@ -25,7 +25,7 @@
 #define MODEL_BOOL_OUTPUT 4    /* Boolean, output, discrete */
 #define MODEL_TIME 5           /* Float64, independent: FMI 3.0 only (FMI 2.0 has none) */
 
-/* The coarse-step criterion of the N description: see model.h (model_growth). */
+/* The coarse-step criterion of the N description: model_coarse_step (model.h). */
 #define MODEL_VARIABLES(X, Y)                                                                        \
     X(b, MODEL_REAL_PARAMETER, 1.0, "stiffness coefficient b in b w")                             \
     X(alpha, MODEL_REAL_PARAMETER, 1.0, "dry friction coefficient alpha (>= 0)")                  \
@@ -53,10 +53,11 @@
       "the element r of alpha sigma(v) selected by the step containing t, in [-alpha, alpha]")    \
     Y(delay_force, MODEL_REAL_OUTPUT, "the delay term W of the step containing t")              \
     X(N, MODEL_INT_PARAMETER, 1000,                                                               \
-      "steps per tau (h = tau / N); N = 10^8 needs about 1.6 GB.  Warning at initialization "     \
-      "when the step is coarse: the explicit part of the scheme amplifies an undamped "           \
-      "oscillation by about (1 + h^2 |b|) per step, and (1 + h^2 |b|)^(T/h) > 2 over the "        \
-      "default experiment's T = 30 (|b| h T > 0.69)")                                             \
+      "steps per tau (h = tau / N); the solver takes about 104 N bytes (N = 10^8: 10 GB).  "      \
+      "ExitInitializationMode warns (status Warning) when the step is coarse: the explicit part " \
+      "of the scheme amplifies an undamped oscillation by about (1 + h^2 b) per step (b > 0), "   \
+      "so warning when (1 + h^2 b)^(T/h) > 2, T the experiment's length (stop - start time, 30 " \
+      "if not given), about N < tau b T / ln 2 (N < 44 for the default experiment)")             \
     Y(sticking, MODEL_BOOL_OUTPUT, "v = 0 at the end of the step containing t")               \
     Y(time, MODEL_TIME, "the simulation time, the last communication point")
 

@@ -104,7 +104,7 @@ fmu_status fmu_setup_experiment(fmu_instance *in, const char *fn, double start_t
  * (start_time not NULL: checked and set as by fmu_setup_experiment). */
 fmu_status fmu_enter_init(fmu_instance *in, const char *fn, const double *start_time,
                           int stop_time_defined, double stop_time);
-/* Starts the solver; FMU_WARNING (logged) when the step is coarse (model_growth). */
+/* Starts the solver; FMU_WARNING (logged) when the step is coarse (model_coarse_step). */
 fmu_status fmu_exit_init(fmu_instance *in, const char *fn);
 fmu_status fmu_terminate(fmu_instance *in, const char *fn);
 fmu_status fmu_reset(fmu_instance *in, const char *fn);

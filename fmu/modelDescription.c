@@ -38,6 +38,19 @@ static int is_output(const variable *x)
 static const char *const CATEGORIES[][2] = {MODEL_LOG_CATEGORIES(CAT)};
 #undef CAT
 
+/* Writes text as an XML attribute value (without the quotes). */
+static void attr(FILE *f, const char *text)
+{
+    for (const char *c = text; *c; c++)
+        switch (*c) {
+        case '<': fputs("&lt;", f); break;
+        case '>': fputs("&gt;", f); break;
+        case '&': fputs("&amp;", f); break;
+        case '"': fputs("&quot;", f); break;
+        default: fputc(*c, f);
+        }
+}
+
 static void header(FILE *f, int v, const char *guid, const char *version)
 {
     fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
@@ -81,8 +94,11 @@ static void header(FILE *f, int v, const char *guid, const char *version)
                 MODEL_NAME);
     fprintf(f, "  <LogCategories>\n");
     for (size_t k = 0; k < sizeof CATEGORIES / sizeof CATEGORIES[0]; k++)
-        fprintf(f, "    <Category name=\"%s\" description=\"%s\"/>\n", CATEGORIES[k][0],
-                CATEGORIES[k][1]);
+    {
+        fprintf(f, "    <Category name=\"%s\" description=\"", CATEGORIES[k][0]);
+        attr(f, CATEGORIES[k][1]);
+        fprintf(f, "\"/>\n");
+    }
     fprintf(f, "  </LogCategories>\n"
                "  <DefaultExperiment startTime=\"0.0\" stopTime=\"%.1f\" stepSize=\"0.01\"/>\n",
             MODEL_DEFAULT_T);
@@ -98,12 +114,13 @@ static void variables2(FILE *f)
         fprintf(f, "    <!-- index %zu -->\n"
                    "    <ScalarVariable name=\"%s\" valueReference=\"%zu\" causality=\"%s\" "
                    "variability=\"%s\"%s\n"
-                   "                    description=\"%s\">\n",
+                   "                    description=\"",
                 i + 1, x->name, i, CAUSALITY[x->kind], VARIABILITY[x->kind],
                 x->kind == MODEL_REAL_INPUT ? ""
                 : x->start                  ? " initial=\"exact\""
-                                            : " initial=\"calculated\"",
-                x->description);
+                                            : " initial=\"calculated\"");
+        attr(f, x->description);
+        fprintf(f, "\">\n");
         if (x->start)
             fprintf(f, "      <%s start=\"%s\"/>\n", TYPE2[x->kind], x->start);
         else
@@ -134,7 +151,9 @@ static void variables3(FILE *f)
                                                                     : "");
         if (x->start)
             fprintf(f, " start=\"%s\"", x->start);
-        fprintf(f, "\n      description=\"%s\"/>\n", x->description);
+        fprintf(f, "\n      description=\"");
+        attr(f, x->description);
+        fprintf(f, "\"/>\n");
     }
     fprintf(f, "  </ModelVariables>\n  <ModelStructure>\n");
     for (size_t i = 0; i < NVARS; i++)
