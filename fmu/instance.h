@@ -118,7 +118,8 @@ fmu_status fmu_get(fmu_instance *in, const char *fn, const unsigned vr[], size_t
 /* All values or none. */
 fmu_status fmu_set(fmu_instance *in, const char *fn, const unsigned vr[], size_t nvr,
                    const void *values, fmu_set_fn *set);
-/* A type of which the FMU has no variable (nothing to get or set): nvr = 0 is OK. */
+/* A type of which the FMU has no variable (nothing to get or set): nvr = 0 is
+ * OK; what: "String variables", ... */
 fmu_status fmu_no_variables(fmu_instance *in, const char *fn, size_t nvr, const char *type);
 
 /* FMU states: *state is an opaque pointer owned by the importer until freed. */
