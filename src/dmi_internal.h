@@ -17,6 +17,17 @@ static inline size_t dmi_mul_size(size_t a, size_t b, size_t sz)
     return a * b * sz;
 }
 
+/* FNV-1a 64 of len bytes, continuing from hsh (DMI_FNV1A_INIT to start). */
+#define DMI_FNV1A_INIT UINT64_C(0xcbf29ce484222325)
+static inline uint64_t dmi_fnv1a(uint64_t hsh, const unsigned char *b, size_t len)
+{
+    for (size_t i = 0; i < len; i++) {
+        hsh ^= b[i];
+        hsh *= UINT64_C(0x100000001b3);
+    }
+    return hsh;
+}
+
 /*
  * History ring of the N + 1 states U^{p-N..p}, stored per component as a
  * series with a mirror copy, so that U_j^{p-l}, l = 0..N, are contiguous:
@@ -69,9 +80,10 @@ double dmi_dot(const double *a, const double *b, size_t len);
 void dmi_delay_sum(const dmi_kernel *k, const dmi_history *r, double h, double *W);
 
 /*
- * The FFT method (conv.c): an exact block convolution engine whose whole
- * state is a function of p, the kernel and the history ring, so it can be
- * rebuilt from them at any p with bitwise the same future results.
+ * The FFT method (conv.c, absent when built with DMI_NO_FFT): an exact block
+ * convolution engine whose whole state is a function of p, the kernel and
+ * the history ring, so it can be rebuilt from them at any p with bitwise the
+ * same future results.
  */
 typedef struct dmi_conv dmi_conv;
 

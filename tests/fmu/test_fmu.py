@@ -933,7 +933,7 @@ def test_out_of_memory_names_N_and_the_bytes(sl):
     assert len(s.errors()) == 1
     msg = s.errors()[0]
     assert "N = 2000000000" in msg and "out of memory" in msg and "bytes" in msg, msg
-    assert str(104 * 2_000_000_000) in msg, msg
+    assert str(40 * 2_000_000_000) in msg, msg
 
 
 CHILD_BIG_N = textwrap.dedent("""
@@ -956,7 +956,7 @@ def test_large_N_logs_what_initialization_allocates(fmu_path, unzipdir, sl):
     """Above 100 MB, ExitInitializationMode logs N and the bytes (category
     logMemory, although logging is off); the logged size is the peak resident
     memory it takes to within 30 % (measured in a fresh process)."""
-    N = 1_500_000
+    N = 3_000_000
     code = CHILD_BIG_N.format(here=os.path.dirname(__file__), fmu=fmu_path, unzip=str(unzipdir), N=N)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                          timeout=120).stdout
