@@ -862,6 +862,19 @@ def test_fmi3_do_step_flags_and_unsupported_functions(fmu_paths, tmp_path):
     s.fmu.freeInstance()
 
 
+def test_time_is_a_variable_of_fmi3_only(sl, md, fmi_version):
+    s = sl()
+    start(s)
+    s.fmu.doStep(0.0, 0.25)
+    time_vr = len(md.modelVariables) - (1 if fmi_version == "3" else 0)  # the next free one for FMI 2.0
+    if fmi_version == "3":
+        assert s.fmu.getReal([time_vr]) == [0.25]
+    else:
+        with pytest.raises(FMICallException):
+            s.fmu.getReal([time_vr])
+        assert f"value reference {time_vr}" in s.errors()[-1]
+
+
 def test_fmi3_refuses_event_mode_and_intermediate_update(fmu_paths, tmp_path):
     from fmpy import extract, read_model_description
     from fmpy.fmi3 import FMU3Slave
