@@ -17,9 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <CUnit/Basic.h>
-
-#include "dmi.h"
+#include "core_test.h"
 
 enum { CHECKPOINTS = 30 };
 
@@ -166,21 +164,12 @@ static void test_n3_box(void)
     CU_ASSERT(run(&m, 100000, 1000000, 1) <= 1e-11);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    if (CU_initialize_registry() != CUE_SUCCESS)
-        return 2;
-    CU_pSuite suite = CU_add_suite("conv: RECURSIVE accuracy over 10^6 steps", NULL, NULL);
-    if (!suite || !CU_add_test(suite, "n = 1, N = 10^6, 10^6 steps, every kind of term", test_n1_N1e6) ||
-        !CU_add_test(suite, "n = 1, N = 1000, 1.2 10^6 steps (300 anchors)", test_n1_N1000) ||
-        !CU_add_test(suite, "n = 3, box, full C_k, D_k, N = 10^5, 10^6 steps", test_n3_box)) {
-        CU_cleanup_registry();
-        return 2;
-    }
-    CU_basic_set_mode(CU_BRM_VERBOSE);
-    CU_basic_run_tests();
-    unsigned failed = CU_get_number_of_failures() + CU_get_number_of_tests_failed();
-    unsigned ran = CU_get_number_of_tests_run();
-    CU_cleanup_registry();
-    return failed == 0 && ran > 0 ? 0 : 1;
+    static const core_test tests[] = {
+        {"n = 1, N = 10^6, 10^6 steps, every kind of term", test_n1_N1e6},
+        {"n = 1, N = 1000, 1.2 10^6 steps (300 anchors)", test_n1_N1000},
+        {"n = 3, box, full C_k, D_k, N = 10^5, 10^6 steps", test_n3_box},
+        {NULL, NULL}};
+    return core_main(argc, argv, "conv: RECURSIVE accuracy over 10^6 steps", tests);
 }
