@@ -4,10 +4,19 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "fmu_loader.h"
+#include "fmu_fmi3.h"
 
 #include <dlfcn.h>
 #include <stdio.h>
 #include <string.h>
+
+static void *lookup(void *lib, const char *name)
+{
+    void *p = dlsym(lib, name);
+    if (!p)
+        fprintf(stderr, "fmu_load: %s not exported\n", name);
+    return p;
+}
 
 int fmu_load(fmu_api *f, const char *so_path)
 {
@@ -16,6 +25,15 @@ int fmu_load(fmu_api *f, const char *so_path)
     if (!f->lib) {
         fprintf(stderr, "fmu_load: %s\n", dlerror());
         return -1;
+    }
+    f->version = 2;
+    if (dlsym(f->lib, "fmi3InstantiateCoSimulation")) {
+        f->version = 3;
+        if (fmu_fmi3_attach(f, lookup) != 0) {
+            fmu_unload(f);
+            return -1;
+        }
+        return 0;
     }
     int missing = 0;
     /* object pointer to function pointer: the POSIX dlsym idiom */

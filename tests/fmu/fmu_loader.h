@@ -1,7 +1,8 @@
 /*
  * The FMI 2.0 functions of an unpacked FMU binary, loaded with dlopen: the
  * one loader of the C importers in tests/ (fmu_master, the hardening tests,
- * the FMU fuzzer).
+ * the FMU fuzzer).  An FMI 3.0 binary is loaded behind the same FMI 2.0
+ * function types (fmu_fmi3.h); version tells which one it is.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #ifndef FMU_LOADER_H
@@ -11,6 +12,7 @@
 
 typedef struct {
     void *lib;
+    int version; /* 2 or 3 */
     fmi2InstantiateTYPE *instantiate;
     fmi2FreeInstanceTYPE *free_instance;
     fmi2SetDebugLoggingTYPE *set_debug_logging;
