@@ -1,28 +1,78 @@
 /*
- * The loader of fmu_loader.h.
+ * The loader of fmu_loader.h: dlopen/dlsym on POSIX, LoadLibrary/GetProcAddress
+ * under _WIN32 (the C master built for Windows runs under Wine).
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
+#ifdef _WIN32
+#define WIN32_LEAN_AND_MEAN
+#include <windows.h>
+#else
 #define _POSIX_C_SOURCE 200809L
+#include <dlfcn.h>
+#endif
 #include "fmu_loader.h"
 
-#include <dlfcn.h>
 #include <stdio.h>
 #include <string.h>
+
+/* The platform's library calls.  lib_open prints the reason of a failure. */
+#ifdef _WIN32
+static void *lib_open(const char *path)
+{
+    HMODULE lib = LoadLibraryA(path);
+    if (!lib)
+        fprintf(stderr, "fmu_load: LoadLibrary(%s) failed, error %lu\n", path,
+                (unsigned long)GetLastError());
+    return (void *)lib;
+}
+
+/* Copies the address of the function `name` into the function pointer at
+ * `fn`; 0 if found, -1 if not. */
+static int lib_sym(void *lib, const char *name, void *fn)
+{
+    FARPROC p = GetProcAddress((HMODULE)lib, name);
+    memcpy(fn, &p, sizeof p);
+    return p ? 0 : -1;
+}
+
+static void lib_close(void *lib)
+{
+    FreeLibrary((HMODULE)lib);
+}
+#else
+static void *lib_open(const char *path)
+{
+    void *lib = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!lib)
+        fprintf(stderr, "fmu_load: %s\n", dlerror());
+    return lib;
+}
+
+/* As above; object pointer to function pointer through memcpy (POSIX
+ * guarantees the two have the same representation). */
+static int lib_sym(void *lib, const char *name, void *fn)
+{
+    void *p = dlsym(lib, name);
+    memcpy(fn, &p, sizeof p);
+    return p ? 0 : -1;
+}
+
+static void lib_close(void *lib)
+{
+    dlclose(lib);
+}
+#endif
 
 int fmu_load(fmu_api *f, const char *so_path)
 {
     memset(f, 0, sizeof *f);
-    f->lib = dlopen(so_path, RTLD_NOW | RTLD_LOCAL);
-    if (!f->lib) {
-        fprintf(stderr, "fmu_load: %s\n", dlerror());
+    f->lib = lib_open(so_path);
+    if (!f->lib)
         return -1;
-    }
     int missing = 0;
-    /* object pointer to function pointer: the POSIX dlsym idiom */
 #define SYM(field, name)                                                                          \
     do {                                                                                          \
-        *(void **)(&f->field) = dlsym(f->lib, name);                                              \
-        if (!f->field) {                                                                          \
+        if (lib_sym(f->lib, name, &f->field) != 0) {                                              \
             fprintf(stderr, "fmu_load: %s not exported\n", name);                                 \
             missing = 1;                                                                          \
         }                                                                                         \
@@ -63,6 +113,6 @@ int fmu_load(fmu_api *f, const char *so_path)
 void fmu_unload(fmu_api *f)
 {
     if (f->lib)
-        dlclose(f->lib);
+        lib_close(f->lib);
     memset(f, 0, sizeof *f);
 }

@@ -1,7 +1,7 @@
 /*
- * The FMI 2.0 functions of an unpacked FMU binary, loaded with dlopen: the
- * one loader of the C importers in tests/ (fmu_master, the hardening tests,
- * the FMU fuzzer).
+ * The FMI 2.0 functions of an unpacked FMU binary, loaded with dlopen (or
+ * LoadLibrary under _WIN32): the one loader of the C importers in tests/
+ * (fmu_master, also built for Windows; the hardening tests, the FMU fuzzer).
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #ifndef FMU_LOADER_H
@@ -10,7 +10,7 @@
 #include "fmi2FunctionTypes.h"
 
 typedef struct {
-    void *lib;
+    void *lib; /* the dlopen handle or the HMODULE */
     fmi2InstantiateTYPE *instantiate;
     fmi2FreeInstanceTYPE *free_instance;
     fmi2SetDebugLoggingTYPE *set_debug_logging;
@@ -39,7 +39,7 @@ typedef struct {
 } fmu_api;
 
 /* 0 on success; -1 (message on stderr) if the library or a function is missing. */
-int fmu_load(fmu_api *f, const char *so_path);
+int fmu_load(fmu_api *f, const char *so_path); /* .so or .dll */
 void fmu_unload(fmu_api *f);
 
 #endif
