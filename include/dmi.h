@@ -179,7 +179,9 @@ DMI_API int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user);
  * same as in a solver that used FFT all along from the same state; this is
  * also how dmi_state_load restores it.  A failed step leaves the engine
  * untouched, as the rest of the solver.
- * Errors: DMI_EINVAL for another value (solver unchanged); DMI_ENOMEM if the
+ * Errors: DMI_EINVAL for another value (solver unchanged), and for
+ * DMI_CONV_FFT in a libdmi built without the FFT and GSL (compile definition
+ * DMI_NO_FFT, as inside the FMU; AUTO then never picks it); DMI_ENOMEM if the
  * FFT engine cannot be allocated after dmi_init (the former method stays).
  */
 DMI_API int dmi_set_convolution(dmi_solver *s, int method);

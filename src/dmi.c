@@ -64,6 +64,67 @@ static size_t first_nonfinite(const double *x, size_t n)
     return i;
 }
 
+/* ---- the delay sum's engine ------------------------------------------------
+ * s->conv is the FFT engine, or NULL when the direct sum is in use.  Built
+ * with DMI_NO_FFT (no conv.c, no GSL: the FMU's sources) there is none. */
+
+/* *out = the engine that method asks for with kernel k (NULL: direct). */
+static int conv_make(const dmi_solver *s, const dmi_kernel *k, int method, dmi_conv **out,
+                     const char *fn)
+{
+    *out = NULL;
+#ifndef DMI_NO_FFT
+    if (dmi_conv_create(out, k, s->n, s->N, method) != 0)
+        return fail(s, DMI_ENOMEM, "%s: out of memory for the FFT engine", fn);
+#else
+    (void)s, (void)k, (void)method, (void)fn;
+#endif
+    return DMI_OK;
+}
+
+static void conv_free(dmi_conv *c)
+{
+#ifndef DMI_NO_FFT
+    dmi_conv_free(c);
+#else
+    (void)c;
+#endif
+}
+
+/* Recomputes engine c for s's step p from the ring. */
+static void conv_rebuild(const dmi_solver *s, dmi_conv *c)
+{
+#ifndef DMI_NO_FFT
+    if (c)
+        dmi_conv_rebuild(c, &s->kernel, &s->ring, s->p);
+#else
+    (void)s, (void)c;
+#endif
+}
+
+/* W = W^p. */
+static void delay_sum(const dmi_solver *s, double *W)
+{
+#ifndef DMI_NO_FFT
+    if (s->conv) {
+        dmi_conv_sum(s->conv, &s->kernel, &s->ring, s->p, s->h, W);
+        return;
+    }
+#endif
+    dmi_delay_sum(&s->kernel, &s->ring, s->h, W);
+}
+
+/* After a step was committed (U^p pushed, p counted). */
+static void conv_advance(dmi_solver *s)
+{
+#ifndef DMI_NO_FFT
+    if (s->conv)
+        dmi_conv_advance(s->conv, &s->kernel, &s->ring, s->p);
+#else
+    (void)s;
+#endif
+}
+
 const char *dmi_version(void)
 {
     return STR(DMI_VERSION_MAJOR) "." STR(DMI_VERSION_MINOR) "." STR(DMI_VERSION_PATCH);
@@ -132,7 +193,7 @@ void dmi_free(dmi_solver **ps)
     free(s->a_hi);
     dmi_history_release(&s->ring);
     dmi_kernel_release(&s->kernel);
-    dmi_conv_free(s->conv);
+    conv_free(s->conv);
     free(s->last_W);
     free(s->last_X);
     free(s->work);
@@ -246,13 +307,18 @@ int dmi_set_convolution(dmi_solver *s, int method)
         return DMI_EINVAL;
     if (method != DMI_CONV_AUTO && method != DMI_CONV_DIRECT && method != DMI_CONV_FFT)
         return fail(s, DMI_EINVAL, "dmi_set_convolution: unknown method %d", method);
+#ifdef DMI_NO_FFT
+    if (method == DMI_CONV_FFT)
+        return fail(s, DMI_EINVAL, "dmi_set_convolution: DMI_CONV_FFT is not available, this "
+                                   "libdmi was built without the FFT (DMI_NO_FFT)");
+#endif
     if (s->initialized) { /* the engine follows the method from the next step on */
         dmi_conv *c = NULL;
-        if (dmi_conv_create(&c, &s->kernel, s->n, s->N, method) != 0)
-            return fail(s, DMI_ENOMEM, "dmi_set_convolution: out of memory for the FFT engine");
-        if (c)
-            dmi_conv_rebuild(c, &s->kernel, &s->ring, s->p);
-        dmi_conv_free(s->conv);
+        int rc = conv_make(s, &s->kernel, method, &c, "dmi_set_convolution");
+        if (rc != DMI_OK)
+            return rc;
+        conv_rebuild(s, c);
+        conv_free(s->conv);
         s->conv = c;
     }
     s->conv_method = method;
@@ -333,8 +399,8 @@ int dmi_init(dmi_solver *s)
     int rc = sample_kernel(s, &k);
     if (rc == DMI_OK)
         rc = sample_history(s, &ring);
-    if (rc == DMI_OK && dmi_conv_create(&c, &k, s->n, s->N, s->conv_method) != 0)
-        rc = fail(s, DMI_ENOMEM, "dmi_init: out of memory for the FFT engine");
+    if (rc == DMI_OK)
+        rc = conv_make(s, &k, s->conv_method, &c, "dmi_init");
     if (rc != DMI_OK) {
         dmi_kernel_release(&k);
         dmi_history_release(&ring);
@@ -344,11 +410,10 @@ int dmi_init(dmi_solver *s)
     dmi_history_release(&s->ring);
     s->kernel = k;
     s->ring = ring;
-    dmi_conv_free(s->conv);
+    conv_free(s->conv);
     s->conv = c;
-    if (c) /* the history's FFT part, before the first step */
-        dmi_conv_rebuild(c, &s->kernel, &s->ring, 0);
     s->p = 0;
+    conv_rebuild(s, c); /* the history's part, before the first step */
     memset(s->last_W, 0, s->n * sizeof *s->last_W); /* a restart saves the bytes of a new run */
     memset(s->last_X, 0, s->n * sizeof *s->last_X);
     s->initialized = 1;
@@ -404,10 +469,7 @@ int dmi_step(dmi_solver *s)
         if (rc != 0)
             return fail(s, DMI_ECALLBACK, "dmi_step: rhs callback returned %d at t = %.17g", rc, t);
     }
-    if (s->conv)
-        dmi_conv_sum(s->conv, &s->kernel, &s->ring, s->p, h, W);
-    else
-        dmi_delay_sum(&s->kernel, &s->ring, h, W);
+    delay_sum(s, W);
     for (size_t i = 0; i < n; i++)
         X[i] = U[i] - h * fv[i] - h * W[i];
     /* A non-finite f or W makes X non-finite (U^p and h are finite), so one
@@ -438,8 +500,7 @@ int dmi_step(dmi_solver *s)
         s->last_X[i] = X[i];
     }
     s->p++;
-    if (s->conv)
-        dmi_conv_advance(s->conv, &s->kernel, &s->ring, s->p);
+    conv_advance(s);
     return DMI_OK;
 }
 
@@ -627,8 +688,7 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
     memcpy(s->last_W, d + (s->N + 1) * n, n * sizeof *d);
     memcpy(s->last_X, d + (s->N + 2) * n, n * sizeof *d);
     s->p = hdr[5];
-    if (s->conv)
-        dmi_conv_rebuild(s->conv, &s->kernel, &s->ring, s->p);
+    conv_rebuild(s, s->conv);
     free(d);
     return DMI_OK;
 }
