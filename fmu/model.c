@@ -10,25 +10,17 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Start values: Example 4.3 (b = alpha = tau = 1, N = 1000,
- * H(s) = cos 2 pi s + cos 10 pi s + cos 20 pi s, g(t) = 1.3 cos 8t, w0 = v0 = 0).
- * The same numbers are the start values in modelDescription.xml. */
-static const double REAL_START[MODEL_NREAL] = {
-    [VR_b] = 1.0, [VR_alpha] = 1.0, [VR_tau] = 1.0, [VR_w0] = 0.0, [VR_v0] = 0.0,
-    [VR_H_c0] = 0.0, [VR_H_c1] = 0.0, [VR_H_lambda] = 0.0,
-    [VR_H_a1] = 1.0, [VR_H_omega1] = 6.283185307179586,
-    [VR_H_a2] = 1.0, [VR_H_omega2] = 31.41592653589793,
-    [VR_H_a3] = 1.0, [VR_H_omega3] = 62.83185307179586,
-    [VR_g_offset] = 0.0, [VR_g_amp] = 1.3, [VR_g_omega] = 8.0, [VR_g_phase] = 0.0,
-    [VR_g_in] = 0.0,
-};
-static const int N_START = 1000;
-
-static const char *const REAL_NAME[MODEL_NREAL] = {
-    "b", "alpha", "tau", "w0", "v0", "H_c0", "H_c1", "H_lambda",
-    "H_a1", "H_omega1", "H_a2", "H_omega2", "H_a3", "H_omega3",
-    "g_offset", "g_amp", "g_omega", "g_phase", "g_in",
-};
+/* Start values (Example 4.3: b = alpha = tau = 1, N = 1000,
+ * H(s) = cos 2 pi s + cos 10 pi s + cos 20 pi s, g(t) = 1.3 cos 8t,
+ * w0 = v0 = 0) and names, from config.h as the model descriptions. */
+#define START_X(name, kind, start, description) [VR_##name] = start,
+#define START_Y(name, kind, description)
+static const double START[MODEL_NVARS] = {MODEL_VARIABLES(START_X, START_Y)};
+#undef START_X
+#undef START_Y
+#define NAME_X(name, kind, ...) [VR_##name] = #name,
+static const char *const NAME[MODEL_NVARS] = {MODEL_VARIABLES(NAME_X, NAME_X)};
+#undef NAME_X
 
 static int fail(char *err, const char *fmt, ...)
 {
@@ -41,8 +33,8 @@ static int fail(char *err, const char *fmt, ...)
 
 void model_defaults(model *m)
 {
-    memcpy(m->real, REAL_START, sizeof m->real);
-    m->N = N_START;
+    memcpy(m->real, START, sizeof m->real);
+    m->N = (int)START[VR_N];
     m->t_start = 0.0;
     m->t_comm = 0.0;
     m->solver = NULL;
@@ -62,7 +54,7 @@ int model_set_real(model *m, unsigned vr, double value, char *err)
 {
     if (vr >= MODEL_NREAL)
         return fail(err, "value reference %u is not a settable Real variable", vr);
-    const char *name = REAL_NAME[vr];
+    const char *name = NAME[vr];
     if (!isfinite(value))
         return fail(err, "%s = %g: the value must be finite", name, value);
     if (vr == VR_tau && !(value > 0))
@@ -144,8 +136,9 @@ static int solver_init(model *m, dmi_solver *s, char *err)
     return 0;
 }
 
-int model_start(model *m, double t_start, char *err)
+int model_start(model *m, double t_start, char *err, char *note)
 {
+    note[0] = '\0';
     dmi_solver *s = NULL;
     if (solver_create(m, &s, err) != 0)
         return -1;
@@ -157,6 +150,12 @@ int model_start(model *m, double t_start, char *err)
     m->solver = s;
     m->t_start = t_start;
     m->t_comm = t_start;
+    return 0;
+}
+
+int model_coarse_step(const model *m, double T, char *msg)
+{
+    (void)m, (void)T, (void)msg;
     return 0;
 }
 

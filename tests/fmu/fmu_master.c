@@ -24,8 +24,8 @@
 
 #include "fmu_loader.h"
 
-/* Value references of the FMU (its modelDescription.xml). */
-enum { VR_tau = 2, VR_w = 19, VR_v = 20, VR_N = 23 };
+/* Value references VR_* of the FMU (fmu/config.h, as its modelDescription.xml). */
+#include "model.h"
 static const int N = 9991;
 static const double TOL = 1e-12;
 

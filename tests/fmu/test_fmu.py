@@ -86,6 +86,9 @@ def test_model_description_contract(md):
     assert cs.canHandleVariableCommunicationStepSize
     assert cs.canGetAndSetFMUstate and cs.canSerializeFMUstate
     var = {v.name: v for v in md.modelVariables}
+    # the variables (written from config.h's table) are exactly the contract's, value references 0, 1, ...
+    assert sorted(var) == sorted(REALS + ["N", "g_in"] + OUT)
+    assert sorted(v.valueReference for v in md.modelVariables) == list(range(len(var)))
     for n in REALS + ["N"]:
         assert var[n].causality == "parameter", n
         assert float(var[n].start) == START[n], n
@@ -97,7 +100,8 @@ def test_model_description_contract(md):
     # Outputs at a communication point come from the steps before it: no direct feedthrough of g_in.
     assert sorted(o.variable.name for o in md.outputs) == sorted(OUT)
     assert all(o.dependencies == [] for o in md.outputs)
-    assert [c.name for c in md.logCategories] == ["logStatusError", "logCalls"]
+    assert [c.name for c in md.logCategories] == ["logStatusError", "logStatusWarning", "logCalls",
+                                                  "logMemory"]
     # libdmi allocates with the C library: the FMU must not be given allocateMemory to honour.
     assert md.coSimulation.canNotUseMemoryManagementFunctions is True
     de = md.defaultExperiment
