@@ -44,7 +44,7 @@ extern "C" {
 
 /* Version of this header; dmi_version() gives the version of the library. */
 #define DMI_VERSION_MAJOR 1
-#define DMI_VERSION_MINOR 0
+#define DMI_VERSION_MINOR 1
 #define DMI_VERSION_PATCH 0
 
 /* DMI_API marks the exported functions of the shared library. */
@@ -92,7 +92,8 @@ enum {
 enum {
     DMI_CONV_AUTO = 0,   /* the default: the fastest method for this n and N */
     DMI_CONV_DIRECT = 1, /* the plain sum, N multiply-adds per nonzero kernel entry */
-    DMI_CONV_FFT = 2     /* exact block convolution with FFTs (same sum, other rounding) */
+    DMI_CONV_FFT = 2,    /* exact block convolution with FFTs (same sum, other rounding) */
+    DMI_CONV_RECURSIVE = 3 /* (since 1.1) O(1) recursion of an exponential-sum kernel */
 };
 
 /* ---- version --------------------------------------------------------- */
@@ -154,21 +155,58 @@ DMI_API int dmi_set_box(dmi_solver *s, const double *lo, const double *hi);
  * Sampled at s = l h, l = 0..N-1, once by dmi_init.  DMI_ESTATE after init. */
 DMI_API int dmi_set_kernel(dmi_solver *s, dmi_kernel_fn H, void *user);
 
+/*
+ * (Since 1.1.)  Kernel as a sum of K exponential terms,
+ *
+ *     H(s) = sum_{k<K} exp(a[k] s) * (C_k cos(b[k] s) + D_k sin(b[k] s)),
+ *
+ * C_k = C + k*n*n and D_k = D + k*n*n, row-major n x n; D == NULL means
+ * every D_k = 0.  a (decay rate if negative) and b (angular frequency) are
+ * in 1 / time unit, C and D in the kernel's unit (that of H).  The arrays
+ * (K, K, K n n and K n n doubles) are copied.  Replaces a kernel set by
+ * dmi_set_kernel, and dmi_set_kernel replaces this one.
+ * With it every method computes the same rectangle-rule sum of the samples
+ * H(l h), which dmi_init takes from this formula; DMI_CONV_RECURSIVE (and
+ * AUTO, see dmi_set_convolution) computes it in O(K n^2) per step, whatever
+ * N is, by the recursion S^{p+1} = r S^p + U^{p+1} - r^N U^{p+1-N},
+ * r = exp((a + i b) h), per term.
+ * Errors: DMI_EINVAL if s is NULL; K = 0; a, b or C is NULL; or a value of
+ * a, b, C or D is NaN or infinite (the message names the argument and index);
+ * DMI_ENOMEM; DMI_ESTATE after dmi_init.
+ */
+DMI_API int dmi_set_kernel_exp(dmi_solver *s, size_t K, const double *a, const double *b,
+                               const double *C, const double *D);
+
 /* History z(t) on [-tau, 0]; z = NULL restores z = 0.  Sampled at t = p h,
  * p = -N..0, once by dmi_init.  DMI_ESTATE after init. */
 DMI_API int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user);
 
 /*
- * Method for the delay sum W^p: DMI_CONV_AUTO (default), DMI_CONV_DIRECT or
- * DMI_CONV_FFT.  All compute the same sum (the same rectangle rule) and differ
- * only by rounding (about 1e-16 relative on the paper's examples).
+ * Method for the delay sum W^p: DMI_CONV_AUTO (default), DMI_CONV_DIRECT,
+ * DMI_CONV_FFT or DMI_CONV_RECURSIVE.  All compute the same sum (the same
+ * rectangle rule) and differ only by rounding (about 1e-16 relative on the
+ * paper's examples; RECURSIVE: see there).
  *   DIRECT  the plain sum: N multiply-adds per nonzero kernel entry and step.
  *   FFT     an exact block convolution: the newest and the oldest lags are
  *           summed directly, the others in blocks of power-of-two sizes by
  *           FFT (GSL radix-2), O(log N)-ish work per step; extra memory about
  *           2 N per nonzero kernel entry and 2 N per kernel column and block
  *           size (a few block sizes), i.e. still O(N n^2).
- *   AUTO    FFT when a cost model measured on x86-64 predicts it faster
+ *   RECURSIVE  (since 1.1) only for a kernel set by dmi_set_kernel_exp
+ *           whose terms all have a[k] <= 0: per term k and used column j the
+ *           sum S = sum_{l<N} r^l U_j^{p-l}, r = exp((a + i b) h), follows
+ *           S <- r S + U_j^{p+1} - r^N U_j^{p+1-N}: O(K n^2) work per step
+ *           and O(K n) memory besides the samples, whatever N is.  r and r^N
+ *           are computed in double-double, and every 4 N steps (at the steps
+ *           p that are multiples of 4 N) the sums are recomputed from the
+ *           stored states with compensated sums, so rounding never piles up
+ *           for longer; the result stays within about 1e-11 of
+ *           h sum_l |H(l h)| max|U| of the direct sum (tested over 10^6 steps,
+ *           N up to 10^6).  A growing term (a[k] > 0, |r| > 1) would multiply
+ *           each step's rounding by |r| every step: RECURSIVE refuses it.
+ *           DMI_EINVAL also for a kernel given as a callback.
+ *   AUTO    RECURSIVE for an exponential kernel without growing terms, else
+ *           FFT when a cost model measured on x86-64 predicts it faster
  *           than DIRECT for this N and kernel pattern, else DIRECT; for one
  *           nonzero kernel entry that is N >= 382 (a full 3 x 3 kernel:
  *           N >= 174; the model also picks FFT for 158 <= N <= 164).
@@ -177,9 +215,13 @@ DMI_API int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user);
  * May be called at any time, also between steps: the FFT engine is then
  * (re)built from the stored states U^{p-N..p}, and stepping on is bitwise the
  * same as in a solver that used FFT all along from the same state; this is
- * also how dmi_state_load restores it.  A failed step leaves the engine
+ * also how dmi_state_load restores it.  The recursion's sums are computed
+ * afresh from the stored states (as at its periodic anchors), so switching
+ * to RECURSIVE agrees with a run that used it all along up to rounding; its
+ * sums are part of the saved state, so a state load continues bitwise.  A failed step leaves the engine
  * untouched, as the rest of the solver.
- * Errors: DMI_EINVAL for another value (solver unchanged), and for
+ * Errors: DMI_EINVAL for another value (solver unchanged), for RECURSIVE as
+ * said there (checked again by dmi_init, since the kernel may change), and for
  * DMI_CONV_FFT in a libdmi built without the FFT and GSL (compile definition
  * DMI_NO_FFT, as inside the FMU; AUTO then never picks it); DMI_ENOMEM if the
  * FFT engine cannot be allocated after dmi_init (the former method stays).
@@ -243,8 +285,11 @@ DMI_API int dmi_get_past(const dmi_solver *s, size_t lag, double *u);
 DMI_API int dmi_get_step_terms(const dmi_solver *s, double *W, double *X);
 
 /* ---- saving and restoring the time-stepping state -----------------------
- * The state is the step counter, the N + 1 stored states U^{p-N..p} and the
- * last step's terms; it does not include the callbacks, the resolvent choice,
+ * The state is the step counter, the N + 1 stored states U^{p-N..p}, the
+ * last step's terms and, for a kernel set by dmi_set_kernel_exp, the
+ * recursion's sums (so its size depends on that kernel; format version 2
+ * since libdmi 1.1: states of libdmi 1.0, version 1, are refused with
+ * DMI_EINVAL and a message saying so); it does not include the callbacks, the resolvent choice,
  * the convolution method or the kernel (these stay as set on the solver that
  * loads it).  The bytes
  * are native-endian, begin with a magic and a format version, and are

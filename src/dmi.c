@@ -3,6 +3,7 @@
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include "dmi_internal.h"
+#include "exp.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -26,8 +27,9 @@ struct dmi_solver {
     void *r_user;
     double *a_lo;  /* friction: alpha (n); box: lo (n) */
     double *a_hi;  /* box: hi (n) */
-    dmi_kernel_fn H;
+    dmi_kernel_fn H;    /* dmi_expk_eval for a kernel set by dmi_set_kernel_exp */
     void *H_user;
+    dmi_expk expk;      /* that kernel's parameters (K = 0: none) */
     dmi_history_fn z;
     void *z_user;
     int conv_method;
@@ -36,7 +38,8 @@ struct dmi_solver {
     uint64_t p;         /* step counter: t_p = p h */
     dmi_history ring;   /* U^{p-N..p} */
     dmi_kernel kernel;  /* nonzero entries of H(l h) */
-    dmi_conv *conv;     /* FFT engine, or NULL: the direct sum is in use */
+    dmi_conv *conv;     /* FFT engine, or NULL */
+    dmi_exp *rec;       /* recursion engine, or NULL (both NULL: the direct sum) */
     double *last_W;     /* W^{p-1} (n) */
     double *last_X;     /* X^{p-1} (n) */
     double *work;       /* 5 n scratch values: U^p, f, W, X, U^{p+1} */
@@ -65,46 +68,102 @@ static size_t first_nonfinite(const double *x, size_t n)
 }
 
 /* ---- the delay sum's engine ------------------------------------------------
- * s->conv is the FFT engine, or NULL when the direct sum is in use.  Built
- * with DMI_NO_FFT (no conv.c, no GSL: the FMU's sources) there is none. */
+ * s->conv is the FFT engine, s->rec the recursion's; both NULL when the
+ * direct sum is in use.  Built with DMI_NO_FFT (no conv.c, no GSL: the
+ * FMU's sources) there is no FFT engine. */
 
-/* *out = the engine that method asks for with kernel k (NULL: direct). */
-static int conv_make(const dmi_solver *s, const dmi_kernel *k, int method, dmi_conv **out,
-                     const char *fn)
+static int has_expk(const dmi_solver *s)
 {
-    *out = NULL;
+    return s->H == dmi_expk_eval;
+}
+
+/* Index of the first growing term (a_k > 0) of the exponential kernel, or K. */
+static size_t first_growing(const dmi_solver *s)
+{
+    size_t k = 0;
+    while (k < s->expk.K && !(s->expk.a[k] > 0))
+        k++;
+    return k;
+}
+
+/* Whether method is allowed with s's kernel (DMI_EINVAL and a message if not). */
+static int check_method(const dmi_solver *s, int method, const char *fn)
+{
+    if (method != DMI_CONV_AUTO && method != DMI_CONV_DIRECT && method != DMI_CONV_FFT &&
+        method != DMI_CONV_RECURSIVE)
+        return fail(s, DMI_EINVAL, "%s: unknown method %d", fn, method);
+#ifdef DMI_NO_FFT
+    if (method == DMI_CONV_FFT)
+        return fail(s, DMI_EINVAL, "%s: DMI_CONV_FFT is not available, this libdmi was built "
+                                   "without the FFT (DMI_NO_FFT)", fn);
+#endif
+    if (method != DMI_CONV_RECURSIVE)
+        return DMI_OK;
+    if (s->H && !has_expk(s))
+        return fail(s, DMI_EINVAL, "%s: method %d (DMI_CONV_RECURSIVE) needs a kernel given by "
+                                   "dmi_set_kernel_exp, not a callback", fn, method);
+    size_t k = first_growing(s);
+    if (k < s->expk.K)
+        return fail(s, DMI_EINVAL, "%s: method %d (DMI_CONV_RECURSIVE) refuses the growing term "
+                                   "a[%zu] = %g > 0: the recursion would multiply its rounding "
+                                   "errors by exp(a h) > 1 every step (use DIRECT or FFT)", fn,
+                    method, k, s->expk.a[k]);
+    return DMI_OK;
+}
+
+/* The engines that method asks for with kernel samples k (AUTO: the
+ * recursion for an exponential kernel without growing terms). */
+static int engine_make(const dmi_solver *s, const dmi_kernel *k, int method, dmi_conv **conv,
+                       dmi_exp **rec, const char *fn)
+{
+    *conv = NULL;
+    *rec = NULL;
+    if (method == DMI_CONV_AUTO && has_expk(s) && first_growing(s) == s->expk.K)
+        method = DMI_CONV_RECURSIVE;
+    if (method == DMI_CONV_RECURSIVE) {
+        if (has_expk(s) && dmi_exp_create(rec, &s->expk, s->N, s->h) != 0)
+            return fail(s, DMI_ENOMEM, "%s: out of memory for the recursion's sums", fn);
+        return DMI_OK;
+    }
 #ifndef DMI_NO_FFT
-    if (dmi_conv_create(out, k, s->n, s->N, method) != 0)
+    if (dmi_conv_create(conv, k, s->n, s->N, method) != 0)
         return fail(s, DMI_ENOMEM, "%s: out of memory for the FFT engine", fn);
 #else
-    (void)s, (void)k, (void)method, (void)fn;
+    (void)k;
 #endif
     return DMI_OK;
 }
 
-static void conv_free(dmi_conv *c)
+static void engine_free(dmi_conv *conv, dmi_exp *rec)
 {
 #ifndef DMI_NO_FFT
-    dmi_conv_free(c);
+    dmi_conv_free(conv);
 #else
-    (void)c;
+    (void)conv;
 #endif
+    dmi_exp_free(rec);
 }
 
-/* Recomputes engine c for s's step p from the ring. */
-static void conv_rebuild(const dmi_solver *s, dmi_conv *c)
+/* Recomputes the engines for s's step p from the ring. */
+static void engine_rebuild(const dmi_solver *s, dmi_conv *conv, dmi_exp *rec)
 {
 #ifndef DMI_NO_FFT
-    if (c)
-        dmi_conv_rebuild(c, &s->kernel, &s->ring, s->p);
+    if (conv)
+        dmi_conv_rebuild(conv, &s->kernel, &s->ring, s->p);
 #else
-    (void)s, (void)c;
+    (void)conv;
 #endif
+    if (rec)
+        dmi_exp_anchor(rec, &s->ring);
 }
 
 /* W = W^p. */
 static void delay_sum(const dmi_solver *s, double *W)
 {
+    if (s->rec) {
+        dmi_exp_sum(s->rec, s->h, W);
+        return;
+    }
 #ifndef DMI_NO_FFT
     if (s->conv) {
         dmi_conv_sum(s->conv, &s->kernel, &s->ring, s->p, s->h, W);
@@ -115,14 +174,14 @@ static void delay_sum(const dmi_solver *s, double *W)
 }
 
 /* After a step was committed (U^p pushed, p counted). */
-static void conv_advance(dmi_solver *s)
+static void engine_advance(dmi_solver *s)
 {
 #ifndef DMI_NO_FFT
     if (s->conv)
         dmi_conv_advance(s->conv, &s->kernel, &s->ring, s->p);
-#else
-    (void)s;
 #endif
+    if (s->rec)
+        dmi_exp_advance(s->rec, &s->ring, s->p);
 }
 
 const char *dmi_version(void)
@@ -193,7 +252,8 @@ void dmi_free(dmi_solver **ps)
     free(s->a_hi);
     dmi_history_release(&s->ring);
     dmi_kernel_release(&s->kernel);
-    conv_free(s->conv);
+    dmi_expk_release(&s->expk);
+    engine_free(s->conv, s->rec);
     free(s->last_W);
     free(s->last_X);
     free(s->work);
@@ -284,8 +344,50 @@ int dmi_set_kernel(dmi_solver *s, dmi_kernel_fn H, void *user)
     if (s->initialized)
         return fail(s, DMI_ESTATE, "dmi_set_kernel: the kernel is sampled by dmi_init and "
                                    "cannot change afterwards");
+    dmi_expk_release(&s->expk);
     s->H = H;
     s->H_user = user;
+    return DMI_OK;
+}
+
+int dmi_set_kernel_exp(dmi_solver *s, size_t K, const double *a, const double *b,
+                       const double *C, const double *D)
+{
+    static const char fn[] = "dmi_set_kernel_exp";
+    if (!s)
+        return DMI_EINVAL;
+    if (s->initialized)
+        return fail(s, DMI_ESTATE, "%s: the kernel is sampled by dmi_init and cannot change "
+                                   "afterwards", fn);
+    if (K == 0)
+        return fail(s, DMI_EINVAL, "%s: K = 0 terms (dmi_set_kernel(s, NULL, NULL) removes the "
+                                   "kernel)", fn);
+    if (!a || !b || !C)
+        return fail(s, DMI_EINVAL, "%s: %s is NULL", fn, !a ? "a" : !b ? "b" : "C");
+    for (size_t k = 0; k < K; k++) {
+        if (!isfinite(a[k]))
+            return fail(s, DMI_EINVAL, "%s: a[%zu] = %g is not finite", fn, k, a[k]);
+        if (!isfinite(b[k]))
+            return fail(s, DMI_EINVAL, "%s: b[%zu] = %g is not finite", fn, k, b[k]);
+    }
+    const size_t n = s->n, nn = n * n; /* n * n * K doubles: checked by dmi_expk_copy */
+    if (dmi_mul_size(K, nn, sizeof(double)) == 0)
+        return fail(s, DMI_ENOMEM, "%s: %zu terms of %zu x %zu matrices overflow", fn, K, n, n);
+    for (size_t q = 0; q < K * nn; q++) {
+        if (!isfinite(C[q]))
+            return fail(s, DMI_EINVAL, "%s: C[%zu] (term %zu, entry (%zu, %zu)) = %g is not "
+                                       "finite", fn, q, q / nn, q % nn / n, q % n, C[q]);
+        if (D && !isfinite(D[q]))
+            return fail(s, DMI_EINVAL, "%s: D[%zu] (term %zu, entry (%zu, %zu)) = %g is not "
+                                       "finite", fn, q, q / nn, q % nn / n, q % n, D[q]);
+    }
+    dmi_expk k;
+    if (dmi_expk_copy(&k, n, K, a, b, C, D) != 0)
+        return fail(s, DMI_ENOMEM, "%s: out of memory", fn);
+    dmi_expk_release(&s->expk);
+    s->expk = k;
+    s->H = dmi_expk_eval;
+    s->H_user = &s->expk;
     return DMI_OK;
 }
 
@@ -305,21 +407,19 @@ int dmi_set_convolution(dmi_solver *s, int method)
 {
     if (!s)
         return DMI_EINVAL;
-    if (method != DMI_CONV_AUTO && method != DMI_CONV_DIRECT && method != DMI_CONV_FFT)
-        return fail(s, DMI_EINVAL, "dmi_set_convolution: unknown method %d", method);
-#ifdef DMI_NO_FFT
-    if (method == DMI_CONV_FFT)
-        return fail(s, DMI_EINVAL, "dmi_set_convolution: DMI_CONV_FFT is not available, this "
-                                   "libdmi was built without the FFT (DMI_NO_FFT)");
-#endif
+    int rc = check_method(s, method, "dmi_set_convolution");
+    if (rc != DMI_OK)
+        return rc;
     if (s->initialized) { /* the engine follows the method from the next step on */
         dmi_conv *c = NULL;
-        int rc = conv_make(s, &s->kernel, method, &c, "dmi_set_convolution");
+        dmi_exp *e = NULL;
+        rc = engine_make(s, &s->kernel, method, &c, &e, "dmi_set_convolution");
         if (rc != DMI_OK)
             return rc;
-        conv_rebuild(s, c);
-        conv_free(s->conv);
+        engine_rebuild(s, c, e);
+        engine_free(s->conv, s->rec);
         s->conv = c;
+        s->rec = e;
     }
     s->conv_method = method;
     return DMI_OK;
@@ -391,16 +491,20 @@ int dmi_init(dmi_solver *s)
 {
     if (!s)
         return DMI_EINVAL;
+    int rc = check_method(s, s->conv_method, "dmi_init"); /* the kernel may have changed */
+    if (rc != DMI_OK)
+        return rc;
     dmi_kernel k = {0};
     dmi_history ring = {0};
     if (dmi_history_alloc(&ring, s->n, s->N) != 0)
         return fail(s, DMI_ENOMEM, "dmi_init: out of memory for the history");
     dmi_conv *c = NULL;
-    int rc = sample_kernel(s, &k);
+    dmi_exp *e = NULL;
+    rc = sample_kernel(s, &k);
     if (rc == DMI_OK)
         rc = sample_history(s, &ring);
     if (rc == DMI_OK)
-        rc = conv_make(s, &k, s->conv_method, &c, "dmi_init");
+        rc = engine_make(s, &k, s->conv_method, &c, &e, "dmi_init");
     if (rc != DMI_OK) {
         dmi_kernel_release(&k);
         dmi_history_release(&ring);
@@ -410,10 +514,11 @@ int dmi_init(dmi_solver *s)
     dmi_history_release(&s->ring);
     s->kernel = k;
     s->ring = ring;
-    conv_free(s->conv);
+    engine_free(s->conv, s->rec);
     s->conv = c;
+    s->rec = e;
     s->p = 0;
-    conv_rebuild(s, c); /* the history's part, before the first step */
+    engine_rebuild(s, c, e); /* the history's part, before the first step */
     memset(s->last_W, 0, s->n * sizeof *s->last_W); /* a restart saves the bytes of a new run */
     memset(s->last_X, 0, s->n * sizeof *s->last_X);
     s->initialized = 1;
@@ -500,7 +605,7 @@ int dmi_step(dmi_solver *s)
         s->last_X[i] = X[i];
     }
     s->p++;
-    conv_advance(s);
+    engine_advance(s);
     return DMI_OK;
 }
 
@@ -582,36 +687,40 @@ int dmi_get_step_terms(const dmi_solver *s, double *W, double *X)
 /* ---- state save / load ---------------------------------------------------------
  * Layout (native endian): header of 8 uint64 words
  *   magic, version, n, N, bits of tau, p, p != 0 (a step was taken), checksum
- * then (N + 1) n doubles U^{p-lag} for lag = 0..N, n doubles W, n doubles X.
+ * then (N + 1) n doubles U^{p-lag} for lag = 0..N, n doubles W, n doubles X,
+ * then (version 2, libdmi 1.1) the recursion's part: 3 uint64 words
+ *   E = 2 dmi_expk_sums (0 without an exponential kernel),
+ *   1 if the sums are those of a running recursion (else 0 and zeros),
+ *   dmi_expk_signature (0 without an exponential kernel)
+ * and E doubles, the sums (re, im).
  * checksum = FNV-1a 64 of every other byte (header with checksum word 0).
  */
 #define STATE_MAGIC UINT64_C(0x444d495354415445) /* "DMISTATE" */
-#define STATE_VERSION UINT64_C(1)
+#define STATE_VERSION UINT64_C(2)
 #define STATE_WORDS 8
+#define STATE_REC_WORDS 3
 
-static uint64_t fnv1a(uint64_t hsh, const unsigned char *b, size_t len)
+/* The number of doubles of the recursion's sums in s's state. */
+static size_t state_sums(const dmi_solver *s)
 {
-    for (size_t i = 0; i < len; i++) {
-        hsh ^= b[i];
-        hsh *= UINT64_C(0x100000001b3);
-    }
-    return hsh;
+    return has_expk(s) ? 2 * dmi_expk_sums(&s->expk) : 0;
 }
 
 static uint64_t state_checksum(const unsigned char *buf, size_t size)
 {
     const size_t cks = 7 * sizeof(uint64_t);
     static const unsigned char zero[sizeof(uint64_t)];
-    uint64_t hsh = fnv1a(UINT64_C(0xcbf29ce484222325), buf, cks);
-    hsh = fnv1a(hsh, zero, sizeof zero);
-    return fnv1a(hsh, buf + cks + sizeof(uint64_t), size - cks - sizeof(uint64_t));
+    uint64_t hsh = dmi_fnv1a(DMI_FNV1A_INIT, buf, cks);
+    hsh = dmi_fnv1a(hsh, zero, sizeof zero);
+    return dmi_fnv1a(hsh, buf + cks + sizeof(uint64_t), size - cks - sizeof(uint64_t));
 }
 
 size_t dmi_state_size(const dmi_solver *s)
 {
     if (!s)
         return 0;
-    return STATE_WORDS * sizeof(uint64_t) + ((s->N + 1) * s->n + 2 * s->n) * sizeof(double);
+    return (STATE_WORDS + STATE_REC_WORDS) * sizeof(uint64_t) +
+           ((s->N + 1) * s->n + 2 * s->n + state_sums(s)) * sizeof(double);
 }
 
 int dmi_state_save(const dmi_solver *s, void *buf, size_t size)
@@ -632,7 +741,18 @@ int dmi_state_save(const dmi_solver *s, void *buf, size_t size)
         for (size_t j = 0; j < n; j++, d += sizeof(double))
             memcpy(d, &dmi_history_series(&s->ring, j)[lag], sizeof(double));
     memcpy(d, s->last_W, n * sizeof(double));
-    memcpy(d + n * sizeof(double), s->last_X, n * sizeof(double));
+    d += n * sizeof(double);
+    memcpy(d, s->last_X, n * sizeof(double));
+    d += n * sizeof(double);
+    const size_t E = state_sums(s);
+    uint64_t rec[STATE_REC_WORDS] = {E, s->rec != NULL,
+                                     E ? dmi_expk_signature(&s->expk, s->N, s->h) : 0};
+    memcpy(d, rec, sizeof rec);
+    d += sizeof rec;
+    if (s->rec)
+        dmi_exp_get(s->rec, d);
+    else
+        memset(d, 0, E * sizeof(double));
     hdr[7] = state_checksum(b, need);
     memcpy(b + 7 * sizeof(uint64_t), &hdr[7], sizeof(uint64_t));
     return DMI_OK;
@@ -655,7 +775,8 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
     if (hdr[0] != STATE_MAGIC)
         return fail(s, DMI_EINVAL, "dmi_state_load: not a dmi state (bad magic)");
     if (hdr[1] != STATE_VERSION)
-        return fail(s, DMI_EINVAL, "dmi_state_load: state format version %llu, expected %llu",
+        return fail(s, DMI_EINVAL, "dmi_state_load: state format version %llu (libdmi 1.0 wrote "
+                                   "version 1); this libdmi reads version %llu only",
                     (unsigned long long)hdr[1], (unsigned long long)STATE_VERSION);
     if (hdr[2] != (uint64_t)n || hdr[3] != (uint64_t)s->N || memcmp(&tau, &s->tau, sizeof tau))
         return fail(s, DMI_EINVAL,
@@ -667,11 +788,18 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
     if (hdr[6] != (uint64_t)(hdr[5] != 0))
         return fail(s, DMI_EINVAL, "dmi_state_load: corrupted state (step flag %llu at p = %llu)",
                     (unsigned long long)hdr[6], (unsigned long long)hdr[5]);
-    const size_t nd = (s->N + 3) * n;
-    double *d = malloc(nd * sizeof *d);
+    const size_t E = state_sums(s), nd = (s->N + 3) * n + E;
+    uint64_t rec[STATE_REC_WORDS];
+    memcpy(rec, b + sizeof hdr + (s->N + 3) * n * sizeof(double), sizeof rec);
+    if (rec[0] != E || rec[1] > 1)
+        return fail(s, DMI_EINVAL, "dmi_state_load: corrupted state (recursion words %llu, %llu; "
+                                   "this solver has %zu sums)", (unsigned long long)rec[0],
+                    (unsigned long long)rec[1], E);
+    double *d = malloc((nd ? nd : 1) * sizeof *d);
     if (!d)
         return fail(s, DMI_ENOMEM, "dmi_state_load: out of memory");
-    memcpy(d, b + sizeof hdr, nd * sizeof *d);
+    memcpy(d, b + sizeof hdr, (nd - E) * sizeof *d);
+    memcpy(d + nd - E, b + sizeof hdr + (nd - E) * sizeof *d + sizeof rec, E * sizeof *d);
     if (first_nonfinite(d, nd) < nd) {
         free(d);
         return fail(s, DMI_EINVAL, "dmi_state_load: state holds a non-finite value");
@@ -688,7 +816,13 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
     memcpy(s->last_W, d + (s->N + 1) * n, n * sizeof *d);
     memcpy(s->last_X, d + (s->N + 2) * n, n * sizeof *d);
     s->p = hdr[5];
-    conv_rebuild(s, s->conv);
+    /* The sums of the same recursion continue bitwise; any others (a state
+     * of another method or kernel) are anchored afresh from the states. */
+    if (s->rec && rec[1] == 1 && rec[2] == dmi_expk_signature(&s->expk, s->N, s->h))
+        dmi_exp_set(s->rec, d + nd - E);
+    else
+        engine_rebuild(s, NULL, s->rec);
+    engine_rebuild(s, s->conv, NULL);
     free(d);
     return DMI_OK;
 }

@@ -17,6 +17,17 @@ static inline size_t dmi_mul_size(size_t a, size_t b, size_t sz)
     return a * b * sz;
 }
 
+/* FNV-1a 64 of len bytes, continuing from hsh (DMI_FNV1A_INIT to start). */
+#define DMI_FNV1A_INIT UINT64_C(0xcbf29ce484222325)
+static inline uint64_t dmi_fnv1a(uint64_t hsh, const unsigned char *b, size_t len)
+{
+    for (size_t i = 0; i < len; i++) {
+        hsh ^= b[i];
+        hsh *= UINT64_C(0x100000001b3);
+    }
+    return hsh;
+}
+
 /*
  * History ring of the N + 1 states U^{p-N..p}, stored per component as a
  * series with a mirror copy, so that U_j^{p-l}, l = 0..N, are contiguous:

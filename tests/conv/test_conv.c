@@ -275,8 +275,8 @@ static void test_switch_midrun(void)
     /* invalid method: error, state and method unchanged */
     size_t size;
     unsigned char *before = save(c, &size);
-    CU_ASSERT(dmi_set_convolution(c, 3) == DMI_EINVAL);
-    CU_ASSERT(strstr(dmi_last_error(c), "3") != NULL);
+    CU_ASSERT(dmi_set_convolution(c, 4) == DMI_EINVAL);
+    CU_ASSERT(strstr(dmi_last_error(c), "4") != NULL);
     unsigned char *after = save(c, &size);
     CU_ASSERT(memcmp(before, after, size) == 0);
     free(after);

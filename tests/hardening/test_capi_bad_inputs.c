@@ -308,7 +308,7 @@ CALL(c_load_long, return LOAD(s, E_NONE, 0, 0, 1, 0);)
 CALL(c_load_empty, return load_edited(s, MODEL_n, MODEL_TAU, MODEL_N, E_NONE, 0, 0,
                                       -(long)dmi_state_size(s), 0);)
 CALL(c_load_magic, return LOAD(s, E_BYTE, 0, 0, 0, 0);)
-CALL(c_load_version, return LOAD(s, E_WORD_FIXED, 8, 2, 0, 0);)
+CALL(c_load_version, return LOAD(s, E_WORD_FIXED, 8, 1, 0, 0);)
 CALL(c_load_foreign_nN, return load_edited(s, 1, MODEL_TAU, 11, E_NONE, 0, 0, 0, 0);)
 CALL(c_load_foreign_tau, return load_edited(s, MODEL_n, 2.0, MODEL_N, E_NONE, 0, 0, 0, 0);)
 CALL(c_load_foreign_n_hdr, return LOAD(s, E_WORD_FIXED, 16, 3, 0, 0);)
@@ -406,7 +406,7 @@ static const bad_case cases[] = {
     {"C92", "dmi_state_load", "one byte too many", S_INIT, c_load_long, DMI_EINVAL, "bytes"},
     {"C93", "dmi_state_load", "size = 0", S_INIT, c_load_empty, DMI_EINVAL, "bytes"},
     {"C94", "dmi_state_load", "magic altered", S_INIT, c_load_magic, DMI_EINVAL, "magic"},
-    {"C95", "dmi_state_load", "format version 2 (checksum valid)", S_INIT, c_load_version, DMI_EINVAL, "version"},
+    {"C95", "dmi_state_load", "format version 1 of libdmi 1.0 (checksum valid)", S_INIT, c_load_version, DMI_EINVAL, "version"},
     {"C96", "dmi_state_load", "foreign: saved with n = 1, N = 11 (same byte count)", S_INIT, c_load_foreign_nN, DMI_EINVAL, "n = 1"},
     {"C97", "dmi_state_load", "foreign: saved with tau = 2 (same n, N)", S_INIT0, c_load_foreign_tau, DMI_EINVAL, "tau = 2"},
     {"C98", "dmi_state_load", "header says n = 3 (checksum valid)", S_INIT, c_load_foreign_n_hdr, DMI_EINVAL, "n = 3"},

@@ -1,0 +1,446 @@
+/*
+ * Exponential-sum kernels and the recursive method of the delay sum W^p.
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ *
+ * Accuracy.  A sum S = sum_{l<N} r^l U^{p-l} run by the recursion
+ * S <- r S + U_new - r^N U_old weighs the state that entered l steps ago by
+ * the product of the l multipliers used since.  With r rounded to double
+ * (relative error up to 1.1e-16) that weight is off by l * 1.1e-16, 1e-10 at
+ * l = 10^6, and the state leaves with a residue that never decays when
+ * |r| = 1.  So r is computed in double-double (hi + lo, about 1e-32) from
+ * (a + i b) h, itself the exact double-double product, and each step
+ * multiplies by both parts; r^N is the double-double power of that r, so
+ * the removal matches the weight the state carries.  What remains is the
+ * rounding of each step's arithmetic (about 1e-16 of |S| per step, in
+ * random directions); it decays with |r| < 1 but not with |r| = 1, so every
+ * PERIOD N steps (at the steps p that are multiples of it) the sums are
+ * anchored afresh from the stored states U^{p-N..p}: weights r^l accurate to
+ * a few units of rounding (a double-double power every BLOCK lags times a
+ * table of r^i, i < BLOCK), products summed with error-free transformations.
+ * That costs N multiply-adds per sum every PERIOD N steps, O(1) per step.
+ * Growing terms (a_k > 0, |r| > 1) would multiply each step's rounding by
+ * |r| every step: dmi.c refuses them for this method.
+ * Double-double needs only C99 (fma); no long double, whose precision
+ * differs between compilers.
+ */
+#include "exp.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define BLOCK 64  /* lags per double-double weight in an anchor */
+#define PERIOD 4  /* anchoring period in units of N */
+
+/* ---- double-double arithmetic (setup and anchors only) -------------------- */
+
+typedef struct {
+    double hi, lo;
+} dd;
+
+typedef struct {
+    dd re, im;
+} cdd;
+
+static dd two_sum(double a, double b)
+{
+    double s = a + b, bb = s - a;
+    dd r = {s, (a - (s - bb)) + (b - bb)};
+    return r;
+}
+
+static dd fast_two_sum(double a, double b) /* |a| >= |b| */
+{
+    double s = a + b;
+    dd r = {s, b - (s - a)};
+    return r;
+}
+
+static dd dd_add(dd a, dd b)
+{
+    dd s = two_sum(a.hi, b.hi);
+    return fast_two_sum(s.hi, s.lo + (a.lo + b.lo));
+}
+
+static dd dd_neg(dd a)
+{
+    dd r = {-a.hi, -a.lo};
+    return r;
+}
+
+static dd dd_mul(dd a, dd b)
+{
+    double p = a.hi * b.hi;
+    double e = fma(a.hi, b.hi, -p);
+    return fast_two_sum(p, e + (a.hi * b.lo + a.lo * b.hi));
+}
+
+static dd dd_div_int(dd a, double k) /* k a small positive integer */
+{
+    double q = a.hi / k;
+    double rem = fma(-q, k, a.hi) + a.lo; /* a - q k, exactly up to a.lo's rounding */
+    return fast_two_sum(q, rem / k);
+}
+
+static dd dd_scale(dd a, int e)
+{
+    dd r = {ldexp(a.hi, e), ldexp(a.lo, e)};
+    return r;
+}
+
+static cdd cdd_add(cdd a, cdd b)
+{
+    cdd r = {dd_add(a.re, b.re), dd_add(a.im, b.im)};
+    return r;
+}
+
+static cdd cdd_mul(cdd a, cdd b)
+{
+    cdd r = {dd_add(dd_mul(a.re, b.re), dd_neg(dd_mul(a.im, b.im))),
+             dd_add(dd_mul(a.re, b.im), dd_mul(a.im, b.re))};
+    return r;
+}
+
+static cdd cdd_one(void)
+{
+    cdd r = {{1.0, 0.0}, {0.0, 0.0}};
+    return r;
+}
+
+/* exp(z), z = (x, y) in double-double: scaled to |z| <= 2^-10, Taylor
+ * series (Horner, 14 terms), squared back. */
+static cdd cdd_exp(dd x, dd y)
+{
+    cdd zero = {{0, 0}, {0, 0}};
+    if (x.hi < -746.0) /* underflows whatever y is */
+        return zero;
+    int m = 0;
+    for (double mag = fabs(x.hi) + fabs(y.hi); mag > 0x1p-10 && m < 2100; mag /= 2)
+        m++;
+    cdd w = {dd_scale(x, -m), dd_scale(y, -m)};
+    cdd t = cdd_one();
+    for (int k = 14; k >= 1; k--) {
+        cdd wt = cdd_mul(w, t);
+        wt.re = dd_div_int(wt.re, k);
+        wt.im = dd_div_int(wt.im, k);
+        t = cdd_add(cdd_one(), wt);
+    }
+    for (int i = 0; i < m; i++)
+        t = cdd_mul(t, t);
+    return t;
+}
+
+static cdd cdd_pow(cdd r, uint64_t e)
+{
+    cdd out = cdd_one();
+    for (; e; e >>= 1) {
+        if (e & 1)
+            out = cdd_mul(out, r);
+        r = cdd_mul(r, r);
+    }
+    return out;
+}
+
+/* Values below this are flushed to zero: their products would be subnormal
+ * (slow on many processors) and their weight is nothing against the lag-0
+ * weight 1. */
+#define TINY 1e-290
+
+static double flush(double x)
+{
+    return fabs(x) < TINY ? 0.0 : x;
+}
+
+/* ---- the kernel's parameters ----------------------------------------------- */
+
+int dmi_expk_copy(dmi_expk *k, size_t n, size_t K, const double *a, const double *b,
+                  const double *C, const double *D)
+{
+    memset(k, 0, sizeof *k);
+    size_t mat = dmi_mul_size(K, n * n, sizeof(double)); /* n * n: dmi_create checked it */
+    if (mat == 0)
+        return -1;
+    k->a = malloc(K * sizeof *k->a);
+    k->b = malloc(K * sizeof *k->b);
+    k->C = malloc(mat);
+    k->D = D ? malloc(mat) : NULL;
+    if (!k->a || !k->b || !k->C || (D && !k->D)) {
+        dmi_expk_release(k);
+        return -1;
+    }
+    memcpy(k->a, a, K * sizeof *k->a);
+    memcpy(k->b, b, K * sizeof *k->b);
+    memcpy(k->C, C, mat);
+    if (D)
+        memcpy(k->D, D, mat);
+    k->n = n;
+    k->K = K;
+    return 0;
+}
+
+void dmi_expk_release(dmi_expk *k)
+{
+    free(k->a);
+    free(k->b);
+    free(k->C);
+    free(k->D);
+    memset(k, 0, sizeof *k);
+}
+
+int dmi_expk_eval(double s, double *out, void *user)
+{
+    const dmi_expk *k = user;
+    const size_t nn = k->n * k->n;
+    for (size_t t = 0; t < k->K; t++) {
+        double e = exp(k->a[t] * s), c = e * cos(k->b[t] * s), sn = e * sin(k->b[t] * s);
+        const double *C = k->C + t * nn, *D = k->D ? k->D + t * nn : NULL;
+        for (size_t q = 0; q < nn; q++)
+            out[q] += D ? C[q] * c + D[q] * sn : C[q] * c;
+    }
+    return 0;
+}
+
+/* Whether column j of term t has a nonzero entry in C_t or D_t. */
+static int column_used(const dmi_expk *k, size_t t, size_t j)
+{
+    const size_t n = k->n, nn = n * n;
+    for (size_t i = 0; i < n; i++) {
+        size_t q = t * nn + i * n + j;
+        if (k->C[q] != 0 || (k->D && k->D[q] != 0))
+            return 1;
+    }
+    return 0;
+}
+
+size_t dmi_expk_sums(const dmi_expk *k)
+{
+    size_t count = 0;
+    for (size_t t = 0; t < k->K; t++)
+        for (size_t j = 0; j < k->n; j++)
+            count += (size_t)column_used(k, t, j);
+    return count;
+}
+
+static uint64_t hash_word(uint64_t hsh, uint64_t w)
+{
+    unsigned char b[sizeof w];
+    memcpy(b, &w, sizeof w);
+    return dmi_fnv1a(hsh, b, sizeof b);
+}
+
+static uint64_t bits(double x)
+{
+    uint64_t w;
+    memcpy(&w, &x, sizeof w);
+    return w;
+}
+
+uint64_t dmi_expk_signature(const dmi_expk *k, size_t N, double h)
+{
+    uint64_t hsh = hash_word(hash_word(DMI_FNV1A_INIT, (uint64_t)N), bits(h));
+    for (size_t t = 0; t < k->K; t++)
+        for (size_t j = 0; j < k->n; j++)
+            if (column_used(k, t, j))
+                hsh = hash_word(hash_word(hash_word(hsh, bits(k->a[t])), bits(k->b[t])), j);
+    return hsh;
+}
+
+/* ---- the engine -------------------------------------------------------------- */
+
+typedef struct {
+    int real;                    /* b = 0: r is real and the sums stay real */
+    double rh_re, rh_im;         /* r = rh + rl */
+    double rl_re, rl_im;
+    double rN_re, rN_im;         /* r^N */
+    cdd rB;                      /* r^BLOCK, for the anchors */
+    double tab[2 * BLOCK];       /* r^i, i < BLOCK: re, im */
+} term;
+
+typedef struct {
+    size_t term, col;
+    double re, im; /* the sum S */
+} sum;
+
+typedef struct {
+    size_t sum, row;
+    double C, D; /* W_row += C Re S + D Im S */
+} part;
+
+struct dmi_exp {
+    size_t n, N, nterms, nsums, nparts;
+    uint64_t period;
+    term *terms;
+    sum *sums;
+    part *parts;
+};
+
+void dmi_exp_free(dmi_exp *e)
+{
+    if (!e)
+        return;
+    free(e->terms);
+    free(e->sums);
+    free(e->parts);
+    free(e);
+}
+
+static void term_init(term *t, double a, double b, double h, size_t N)
+{
+    dd x = {a * h, fma(a, h, -(a * h))}, y = {b * h, fma(b, h, -(b * h))};
+    cdd r = cdd_exp(x, y);
+    if (b == 0) /* exp of a real number is real: no rounding in im */
+        r.im.hi = r.im.lo = 0;
+    t->real = b == 0;
+    t->rh_re = r.re.hi;
+    t->rh_im = r.im.hi;
+    t->rl_re = fabs(r.re.hi) < 1e-270 ? 0.0 : r.re.lo;
+    t->rl_im = fabs(r.im.hi) < 1e-270 ? 0.0 : r.im.lo;
+    cdd rN = cdd_pow(r, (uint64_t)N);
+    t->rN_re = flush(rN.re.hi);
+    t->rN_im = flush(rN.im.hi);
+    cdd w = cdd_one();
+    for (size_t i = 0; i < BLOCK; i++) {
+        t->tab[2 * i] = flush(w.re.hi);
+        t->tab[2 * i + 1] = flush(w.im.hi);
+        w = cdd_mul(w, r);
+    }
+    t->rB = w;
+}
+
+int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
+{
+    *out = NULL;
+    const size_t n = k->n, nn = n * n;
+    dmi_exp *e = calloc(1, sizeof *e);
+    if (!e)
+        return -1;
+    e->n = n;
+    e->N = N;
+    e->period = (uint64_t)PERIOD * (uint64_t)N;
+    e->nsums = dmi_expk_sums(k);
+    for (size_t q = 0; q < k->K * nn; q++) /* k->K n n was checked by dmi_expk_copy */
+        e->nparts += k->C[q] != 0 || (k->D && k->D[q] != 0);
+    e->nterms = k->K;
+    e->terms = malloc((k->K ? k->K : 1) * sizeof *e->terms);
+    e->sums = calloc(e->nsums ? e->nsums : 1, sizeof *e->sums);
+    e->parts = malloc((e->nparts ? e->nparts : 1) * sizeof *e->parts);
+    if (!e->terms || !e->sums || !e->parts) {
+        dmi_exp_free(e);
+        return -1;
+    }
+    size_t q = 0, np = 0;
+    for (size_t t = 0; t < k->K; t++) {
+        term_init(&e->terms[t], k->a[t], k->b[t], h, N);
+        for (size_t j = 0; j < n; j++) {
+            if (!column_used(k, t, j))
+                continue;
+            e->sums[q].term = t;
+            e->sums[q].col = j;
+            for (size_t i = 0; i < n; i++) {
+                size_t x = t * nn + i * n + j;
+                double C = k->C[x], D = k->D ? k->D[x] : 0.0;
+                if (C == 0 && D == 0)
+                    continue;
+                part pt = {q, i, C, D};
+                e->parts[np++] = pt;
+            }
+            q++;
+        }
+    }
+    *out = e;
+    return 0;
+}
+
+/* acc += x, error-free: acc.hi + acc.lo carries the sum's rounding. */
+static void accumulate(dd *acc, double x)
+{
+    dd s = two_sum(acc->hi, x);
+    acc->hi = s.hi;
+    acc->lo += s.lo;
+}
+
+void dmi_exp_anchor(dmi_exp *e, const dmi_history *r)
+{
+    for (size_t q = 0; q < e->nsums; q++) {
+        sum *S = &e->sums[q];
+        const term *t = &e->terms[S->term];
+        const double *u = dmi_history_series(r, S->col); /* u[l] = U^{p-l} */
+        dd re = {0, 0}, im = {0, 0};
+        cdd base = cdd_one(); /* r^l0 */
+        for (size_t l0 = 0; l0 < e->N; l0 += BLOCK) {
+            const double br = base.re.hi, bi = base.im.hi;
+            if (fabs(br) + fabs(bi) < TINY)
+                break;
+            const size_t len = e->N - l0 < BLOCK ? e->N - l0 : BLOCK;
+            for (size_t i = 0; i < len; i++) {
+                double wr = br * t->tab[2 * i] - bi * t->tab[2 * i + 1];
+                accumulate(&re, wr * u[l0 + i]);
+                if (!t->real) {
+                    double wi = br * t->tab[2 * i + 1] + bi * t->tab[2 * i];
+                    accumulate(&im, wi * u[l0 + i]);
+                }
+            }
+            base = cdd_mul(base, t->rB);
+        }
+        S->re = re.hi + re.lo;
+        S->im = im.hi + im.lo;
+    }
+}
+
+void dmi_exp_advance(dmi_exp *e, const dmi_history *r, uint64_t p)
+{
+    if (p % e->period == 0) {
+        dmi_exp_anchor(e, r);
+        return;
+    }
+    const size_t N = e->N;
+    for (size_t q = 0; q < e->nsums; q++) {
+        sum *S = &e->sums[q];
+        const term *t = &e->terms[S->term];
+        const double *u = dmi_history_series(r, S->col);
+        const double unew = u[0], uold = u[N];
+        const double x = S->re, y = S->im;
+        if (t->real) {
+            S->re = x * t->rh_re + (x * t->rl_re + (unew - t->rN_re * uold));
+        } else {
+            S->re = (x * t->rh_re - y * t->rh_im) +
+                    ((x * t->rl_re - y * t->rl_im) + (unew - t->rN_re * uold));
+            S->im = (x * t->rh_im + y * t->rh_re) +
+                    ((x * t->rl_im + y * t->rl_re) - t->rN_im * uold);
+        }
+    }
+}
+
+void dmi_exp_sum(const dmi_exp *e, double h, double *W)
+{
+    for (size_t i = 0; i < e->n; i++)
+        W[i] = 0;
+    for (size_t q = 0; q < e->nparts; q++) {
+        const part *pt = &e->parts[q];
+        const sum *S = &e->sums[pt->sum];
+        W[pt->row] += pt->C * S->re + pt->D * S->im;
+    }
+    for (size_t i = 0; i < e->n; i++)
+        W[i] *= h;
+}
+
+uint64_t dmi_exp_period(const dmi_exp *e)
+{
+    return e->period;
+}
+
+void dmi_exp_get(const dmi_exp *e, unsigned char *bytes)
+{
+    for (size_t q = 0; q < e->nsums; q++) {
+        memcpy(bytes + 2 * q * sizeof(double), &e->sums[q].re, sizeof(double));
+        memcpy(bytes + (2 * q + 1) * sizeof(double), &e->sums[q].im, sizeof(double));
+    }
+}
+
+void dmi_exp_set(dmi_exp *e, const double *sums)
+{
+    for (size_t q = 0; q < e->nsums; q++) {
+        e->sums[q].re = sums[2 * q];
+        e->sums[q].im = sums[2 * q + 1];
+    }
+}
