@@ -26,6 +26,7 @@
 #define MODEL_REAL_OUTPUT 2    /* Real (Float64), output, continuous */
 #define MODEL_INT_PARAMETER 3  /* Integer (Int32), parameter, fixed */
 #define MODEL_BOOL_OUTPUT 4    /* Boolean, output, discrete */
+#define MODEL_TIME 5           /* Float64, independent: FMI 3.0 only (FMI 2.0 has none) */
 
 /* The coarse-step criterion of the N description: see model.h (model_growth). */
 #define MODEL_VARIABLES(X, Y)                                                                        \
@@ -59,7 +60,8 @@
       "when the step is coarse: the explicit part of the scheme amplifies an undamped "           \
       "oscillation by about (1 + h^2 |b|) per step, and (1 + h^2 |b|)^(T/h) > 2 over the "        \
       "default experiment's T = 30 (|b| h T > 0.69)")                                             \
-    Y(sticking, MODEL_BOOL_OUTPUT, "v = 0 at the end of the step containing t")
+    Y(sticking, MODEL_BOOL_OUTPUT, "v = 0 at the end of the step containing t")               \
+    Y(time, MODEL_TIME, "the simulation time, the last communication point")
 
 /* The log categories of both model descriptions: C(name, description), in
  * the order of instance.c's CAT_* numbers. */

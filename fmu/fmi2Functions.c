@@ -90,7 +90,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fm
 fmi2Status fmi2EnterInitializationMode(fmi2Component c)
 {
     ENTER(c, FN_ENTER_INIT, "fmi2EnterInitializationMode");
-    return (fmi2Status)fmu_enter_init(in, "fmi2EnterInitializationMode");
+    return (fmi2Status)fmu_enter_init(in, "fmi2EnterInitializationMode", NULL, 0, 0.0);
 }
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component c)

@@ -227,8 +227,9 @@ fmu_status fmu_set_debug_logging(fmu_instance *in, const char *fn, int on, size_
     return fmu_leave(in, fn, FMU_OK);
 }
 
-fmu_status fmu_setup_experiment(fmu_instance *in, const char *fn, double start_time,
-                                int stop_time_defined, double stop_time)
+/* The start and stop time, not logged. */
+static fmu_status setup(fmu_instance *in, const char *fn, double start_time,
+                        int stop_time_defined, double stop_time)
 {
     if (!isfinite(start_time))
         return fmu_error(in, fn, "the start time %g is not finite", start_time);
@@ -239,11 +240,20 @@ fmu_status fmu_setup_experiment(fmu_instance *in, const char *fn, double start_t
     in->m.t_comm = start_time;
     in->stop_defined = stop_time_defined != 0;
     in->stop_time = stop_time;
-    return fmu_leave(in, fn, FMU_OK);
+    return FMU_OK;
 }
 
-fmu_status fmu_enter_init(fmu_instance *in, const char *fn)
+fmu_status fmu_setup_experiment(fmu_instance *in, const char *fn, double start_time,
+                                int stop_time_defined, double stop_time)
 {
+    return fmu_leave(in, fn, setup(in, fn, start_time, stop_time_defined, stop_time));
+}
+
+fmu_status fmu_enter_init(fmu_instance *in, const char *fn, const double *start_time,
+                          int stop_time_defined, double stop_time)
+{
+    if (start_time && setup(in, fn, *start_time, stop_time_defined, stop_time) != FMU_OK)
+        return FMU_ERROR;
     in->state = FMU_INIT_MODE;
     return fmu_leave(in, fn, FMU_OK);
 }

@@ -97,10 +97,13 @@ model *fmu_model(fmu_instance *in);
 fmu_status fmu_set_debug_logging(fmu_instance *in, const char *fn, int on, size_t n,
                                  const char *const categories[]);
 void fmu_free_instance(fmu_instance *in, const char *fn);
-/* fmi2SetupExperiment; FMI 3.0's fmi3EnterInitializationMode calls it and then fmu_enter_init. */
+/* fmi2SetupExperiment: the start time, and the stop time if defined. */
 fmu_status fmu_setup_experiment(fmu_instance *in, const char *fn, double start_time,
                                 int stop_time_defined, double stop_time);
-fmu_status fmu_enter_init(fmu_instance *in, const char *fn);
+/* Enters initialization mode; FMI 3.0 gives the experiment's times here
+ * (start_time not NULL: checked and set as by fmu_setup_experiment). */
+fmu_status fmu_enter_init(fmu_instance *in, const char *fn, const double *start_time,
+                          int stop_time_defined, double stop_time);
 /* Starts the solver; FMU_WARNING (logged) when the step is coarse (model_growth). */
 fmu_status fmu_exit_init(fmu_instance *in, const char *fn);
 fmu_status fmu_terminate(fmu_instance *in, const char *fn);

@@ -238,6 +238,7 @@ int model_get_real(const model *m, unsigned vr, double *value, char *err)
     case VR_v: *value = o.v; return 0;
     case VR_friction: *value = o.friction; return 0;
     case VR_delay_force: *value = o.delay_force; return 0;
+    case VR_time: *value = m->t_comm; return 0;
     default:
         return fail(err, "value reference %u is not a Real variable", vr);
     }

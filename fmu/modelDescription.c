@@ -23,11 +23,18 @@ typedef struct {
 static const variable VARS[] = {MODEL_VARIABLES(VAR_X, VAR_Y)};
 #define NVARS (sizeof VARS / sizeof VARS[0])
 
-static const char *const CAUSALITY[] = {"parameter", "input", "output", "parameter", "output"};
-static const char *const VARIABILITY[] = {"fixed", "continuous", "continuous", "fixed",
-                                          "discrete"};
-static const char *const TYPE2[] = {"Real", "Real", "Real", "Integer", "Boolean"};
-static const char *const TYPE3[] = {"Float64", "Float64", "Float64", "Int32", "Boolean"};
+static const char *const CAUSALITY[] = {"parameter", "input",  "output",
+                                        "parameter", "output", "independent"};
+static const char *const VARIABILITY[] = {"fixed", "continuous", "continuous",
+                                          "fixed", "discrete",   "continuous"};
+static const char *const TYPE2[] = {"Real", "Real", "Real", "Integer", "Boolean", NULL};
+static const char *const TYPE3[] = {"Float64", "Float64", "Float64", "Int32", "Boolean", "Float64"};
+
+/* Outputs: no start value, not the time. */
+static int is_output(const variable *x)
+{
+    return !x->start && x->kind != MODEL_TIME;
+}
 
 #define CAT(name, description) {#name, description},
 static const char *const CATEGORIES[][2] = {MODEL_LOG_CATEGORIES(CAT)};
@@ -97,6 +104,8 @@ static void variables2(FILE *f)
     fprintf(f, "  <ModelVariables>\n");
     for (size_t i = 0; i < NVARS; i++) {
         const variable *x = &VARS[i];
+        if (!TYPE2[x->kind])
+            continue; /* FMI 2.0 has no independent variable (ModelVariables index = i + 1) */
         fprintf(f, "    <!-- index %zu -->\n"
                    "    <ScalarVariable name=\"%s\" valueReference=\"%zu\" causality=\"%s\" "
                    "variability=\"%s\"%s\n"
@@ -114,11 +123,11 @@ static void variables2(FILE *f)
     }
     fprintf(f, "  </ModelVariables>\n  <ModelStructure>\n    <Outputs>\n");
     for (size_t i = 0; i < NVARS; i++)
-        if (!VARS[i].start)
+        if (is_output(&VARS[i]))
             fprintf(f, "      <Unknown index=\"%zu\" dependencies=\"\"/>\n", i + 1);
     fprintf(f, "    </Outputs>\n    <InitialUnknowns>\n");
     for (size_t i = 0; i < NVARS; i++)
-        if (!VARS[i].start)
+        if (is_output(&VARS[i]))
             fprintf(f, "      <Unknown index=\"%zu\"/>\n", i + 1);
     fprintf(f, "    </InitialUnknowns>\n  </ModelStructure>\n");
 }
@@ -131,17 +140,19 @@ static void variables3(FILE *f)
         fprintf(f, "    <%s name=\"%s\" valueReference=\"%zu\" causality=\"%s\" "
                    "variability=\"%s\"%s",
                 TYPE3[x->kind], x->name, i, CAUSALITY[x->kind], VARIABILITY[x->kind],
-                x->kind == MODEL_REAL_INPUT ? "" : x->start ? " initial=\"exact\"" : "");
+                x->kind == MODEL_REAL_INPUT || x->kind == MODEL_TIME ? ""
+                : x->start                                          ? " initial=\"exact\""
+                                                                    : "");
         if (x->start)
             fprintf(f, " start=\"%s\"", x->start);
         fprintf(f, "\n      description=\"%s\"/>\n", x->description);
     }
     fprintf(f, "  </ModelVariables>\n  <ModelStructure>\n");
     for (size_t i = 0; i < NVARS; i++)
-        if (!VARS[i].start)
+        if (is_output(&VARS[i]))
             fprintf(f, "    <Output valueReference=\"%zu\" dependencies=\"\"/>\n", i);
     for (size_t i = 0; i < NVARS; i++)
-        if (!VARS[i].start)
+        if (is_output(&VARS[i]))
             fprintf(f, "    <InitialUnknown valueReference=\"%zu\" dependencies=\"\"/>\n", i);
     fprintf(f, "  </ModelStructure>\n");
 }

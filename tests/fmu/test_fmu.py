@@ -1,7 +1,10 @@
-# The FMU DelayFrictionOscillator.fmu against the issue's contract, driven by
-# fmpy: validation, outputs against a native libdmi run, input, FMU states,
-# reset, several instances, errors, logging, binary.
+# The FMUs DelayFrictionOscillator.fmu (FMI 2.0) and fmi3/DelayFrictionOscillator.fmu
+# (FMI 3.0) against the issue's contract, driven by fmpy: validation, outputs
+# against a native libdmi run and against each other, input, FMU states, reset,
+# several instances, errors, logging, binary.  Tests taking fmu_path (or a
+# fixture built on it) run on both FMUs.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+import ctypes
 import math
 import os
 import struct
@@ -69,7 +72,9 @@ def test_validate_fmu(fmu_path):
     assert validate_fmu(fmu_path) == []
 
 
-def test_fmutool_check(fmu_path):
+def test_fmutool_check(fmu_path, fmi_version):
+    if fmi_version == "3":
+        pytest.skip("fmutool checks FMI 2.0 FMUs")
     fmutool = os.path.join(os.path.dirname(sys.executable), "fmutool")
     r = subprocess.run([fmutool, "-input", fmu_path, "-check"], capture_output=True, text=True,
                        env=dict(os.environ, QT_QPA_PLATFORM="offscreen"), timeout=120)
@@ -80,20 +85,23 @@ def test_fmutool_check(fmu_path):
     assert "ERROR" not in text, text
 
 
-def test_model_description_contract(md):
+def test_model_description_contract(md, fmi_version):
     cs = md.coSimulation
-    assert md.fmiVersion == "2.0" and cs.modelIdentifier == "DelayFrictionOscillator"
+    assert md.fmiVersion == fmi_version + ".0" and cs.modelIdentifier == "DelayFrictionOscillator"
     assert cs.canHandleVariableCommunicationStepSize
     assert cs.canGetAndSetFMUstate and cs.canSerializeFMUstate
     var = {v.name: v for v in md.modelVariables}
     # the variables (written from config.h's table) are exactly the contract's, value references 0, 1, ...
-    assert sorted(var) == sorted(REALS + ["N", "g_in"] + OUT)
+    # FMI 3.0 asks for the independent variable, time
+    assert sorted(var) == sorted(REALS + ["N", "g_in"] + OUT + (["time"] if fmi_version == "3" else []))
     assert sorted(v.valueReference for v in md.modelVariables) == list(range(len(var)))
     for n in REALS + ["N"]:
         assert var[n].causality == "parameter", n
         assert float(var[n].start) == START[n], n
-    assert var["N"].type == "Integer"
-    assert var["g_in"].causality == "input" and var["g_in"].type == "Real"
+    real, integer = ("Real", "Integer") if fmi_version == "2" else ("Float64", "Int32")
+    assert var["N"].type == integer
+    assert var["g_in"].causality == "input" and var["g_in"].type == real
+    assert all(var[n].type == real for n in REALS + OUT[:4])
     for n in OUT:
         assert var[n].causality == "output", n
     assert var["sticking"].type == "Boolean"
@@ -102,8 +110,14 @@ def test_model_description_contract(md):
     assert all(o.dependencies == [] for o in md.outputs)
     assert [c.name for c in md.logCategories] == ["logStatusError", "logStatusWarning", "logCalls",
                                                   "logMemory"]
-    # libdmi allocates with the C library: the FMU must not be given allocateMemory to honour.
-    assert md.coSimulation.canNotUseMemoryManagementFunctions is True
+    if fmi_version == "2":
+        # libdmi allocates with the C library: the FMU must not be given allocateMemory to honour.
+        assert md.coSimulation.canNotUseMemoryManagementFunctions is True
+    else:
+        # no events, no early return, no intermediate update
+        assert cs.hasEventMode is not True and cs.canReturnEarlyAfterIntermediateUpdate is not True
+        assert cs.providesIntermediateUpdate is not True
+        assert var["time"].causality == "independent"
     de = md.defaultExperiment
     assert float(de.stopTime) == 30.0
     k = float(de.stepSize) / (START["tau"] / START["N"])
@@ -121,16 +135,19 @@ def test_start_values_inside_binary(md, sl):
     assert s.fmu.getInteger([s.vr["N"]]) == [int(var["N"].start)]
 
 
-def test_binary_needs_libc_libm_and_exports_fmi2_only(unzipdir):
-    so = os.path.join(unzipdir, "binaries", "linux64", "DelayFrictionOscillator.so")
+def test_binary_needs_libc_libm_and_exports_fmi_only(unzipdir, fmi_version):
+    folder = "linux64" if fmi_version == "2" else "x86_64-linux"
+    so = os.path.join(unzipdir, "binaries", folder, "DelayFrictionOscillator.so")
     dyn = subprocess.run(["readelf", "-d", so], capture_output=True, text=True, check=True).stdout
     needed = {line.split("[")[1].split("]")[0] for line in dyn.splitlines() if "(NEEDED)" in line}
     assert needed and needed <= {"libc.so.6", "libm.so.6"}, needed
     syms = subprocess.run(["nm", "-D", "--defined-only", so], capture_output=True, text=True,
                           check=True).stdout.split("\n")
     names = [line.split()[-1] for line in syms if line.strip()]
-    assert "fmi2DoStep" in names and "fmi2Instantiate" in names
-    assert [n for n in names if not n.startswith("fmi2")] == []
+    prefix = "fmi" + fmi_version
+    assert prefix + "DoStep" in names
+    assert prefix + ("Instantiate" if fmi_version == "2" else "InstantiateCoSimulation") in names
+    assert [n for n in names if not n.startswith(prefix)] == []
 
 
 # ---- outputs against a native libdmi run ----
@@ -617,7 +634,7 @@ def test_solver_failure_is_an_error_state(sl):
     s.fmu.setReal([s.vr["g_in"]], [1e308])  # v overflows after about 1800 steps
     with pytest.raises(FMICallException):
         s.fmu.doStep(0.0, 5.0)
-    assert "fmi2DoStep" in s.errors()[-1] and "inf" in s.errors()[-1]
+    assert s.prefix + "DoStep" in s.errors()[-1] and "inf" in s.errors()[-1]
     with pytest.raises(FMICallException):
         s.fmu.doStep(5.0, 0.01)  # error state: no more steps
     assert "not allowed in state error" in s.errors()[-1]
@@ -642,7 +659,7 @@ def test_logging_honours_flags_and_categories(sl):
     start(loud)
     loud.fmu.doStep(0.0, 0.01)
     calls = [m for st, c, m in loud.log if c == "logCalls"]
-    assert "fmi2DoStep" in calls and "fmi2ExitInitializationMode" in calls
+    assert loud.prefix + "DoStep" in calls and loud.prefix + "ExitInitializationMode" in calls
     loud.fmu.setDebugLogging(True, ["logStatusError"])  # calls no longer traced
     n = len(loud.log)
     loud.fmu.doStep(0.01, 0.01)
@@ -656,9 +673,11 @@ def test_logging_honours_flags_and_categories(sl):
     assert loud.log[-1][1] == "logStatusError"  # errors are reported all the same
 
 
-def test_runs_without_memory_callbacks(sl):
+def test_runs_without_memory_callbacks(sl, fmi_version):
     """allocateMemory = freeMemory = NULL (canNotUseMemoryManagementFunctions): a whole run, an FMU
     state and its serialization work as with the callbacks."""
+    if fmi_version == "3":
+        pytest.skip("FMI 3.0 has no memory callbacks")
     bare, full = sl(name="bare", memory_callbacks=False), sl(name="full")
     for s in (bare, full):
         start(s)
@@ -693,14 +712,16 @@ def test_reset_restores_the_logging_of_instantiate(sl):
 def test_instantiate_rejects_wrong_guid(md, unzipdir):
     from types import SimpleNamespace
     from conftest import Slave
-    wrong = SimpleNamespace(guid="{00000000-0000-0000-0000-000000000000}", coSimulation=md.coSimulation)
+    wrong = SimpleNamespace(guid="{00000000-0000-0000-0000-000000000000}", coSimulation=md.coSimulation,
+                            fmiVersion=md.fmiVersion)
     with pytest.raises(Exception, match="instantiate"):
         Slave(wrong, unzipdir)
 
 
 # ---- the main-job script ----
 
-def test_fmu_run_script_writes_the_csv(source_dir, fmu_path, native43, tmp_path):
+def test_fmu_run_script_writes_the_csv(source_dir, fmu_paths, native43, tmp_path):
+    fmu_path = fmu_paths["2"]  # the script's FMU (it reads "Integer" start values: FMI 2.0)
     out = tmp_path / "run.csv"
     subprocess.run([sys.executable, os.path.join(source_dir, "scripts", "fmu_run.py"), "--fmu",
                     fmu_path, "--out", str(out)], check=True, timeout=120)
@@ -711,9 +732,10 @@ def test_fmu_run_script_writes_the_csv(source_dir, fmu_path, native43, tmp_path)
     assert_close(rows[:, 1:5], native43.table(rows[:, 0])[:, :4])
 
 
-def test_fmu_run_script_start_values(source_dir, fmu_path, libdmi, tmp_path):
+def test_fmu_run_script_start_values(source_dir, fmu_paths, libdmi, tmp_path):
     """--start NAME=VALUE (repeatable) sets start values: the run equals a
     native run with those parameters; an unknown name is refused."""
+    fmu_path = fmu_paths["2"]
     script = os.path.join(source_dir, "scripts", "fmu_run.py")
     out = tmp_path / "run.csv"
     subprocess.run([sys.executable, script, "--fmu", fmu_path, "--out", str(out), "--stop-time",
@@ -735,7 +757,9 @@ def test_fmu_run_script_start_values(source_dir, fmu_path, libdmi, tmp_path):
     assert not (tmp_path / "bad.csv").exists()
 
 
-def test_status_queries_and_unsupported_functions(sl):
+def test_status_queries_and_unsupported_functions(sl, fmi_version):
+    if fmi_version == "3":
+        pytest.skip("FMI 2.0's status functions: see test_fmi3_do_step_flags_and_unsupported_functions")
     from fmpy.fmi2 import (fmi2LastSuccessfulTime, fmi2Terminated, fmi2DoStepStatus,
                            fmi2PendingStatus, fmi2Discard)
     s = sl()
@@ -763,3 +787,91 @@ def test_status_queries_and_unsupported_functions(sl):
             call()
         assert len(s.errors()) == n + 1
     s.fmu.doStep(0.0246, 0.01)  # still usable
+
+
+# ---- FMI 3.0 beside FMI 2.0 ----
+
+def slave_of(path, tmp_path, name):
+    from fmpy import extract, read_model_description
+    from conftest import Slave
+    md = read_model_description(path)
+    s = Slave(md, extract(path, str(tmp_path / name)), name=name)
+    s.vr = {v.name: v.valueReference for v in md.modelVariables}
+    return s
+
+
+def test_fmi3_outputs_equal_fmi2_bitwise(fmu_paths):
+    """The same settings (parameters, an input signal, an uneven output
+    interval) give bitwise the same outputs in both FMUs (plain fmpy runs)."""
+    sig = np.array([(0.0, 0.0), (1.0, 0.8), (2.0, -0.5), (3.0, 1.5)],
+                   dtype=[("time", np.float64), ("g_in", np.float64)])
+    kw = dict(stop_time=3.0, output_interval=0.0123, input=sig, output=OUT,
+              start_values={"N": 997, "alpha": 0.5, "g_amp": 2.0, "tau": 0.8, "H_c1": 0.3,
+                            "H_lambda": 2.0})
+    r2 = simulate_fmu(fmu_paths["2"], **kw)
+    r3 = simulate_fmu(fmu_paths["3"], **kw)
+    assert len(r2) == len(r3) == math.ceil(3.0 / 0.0123) + 1
+    for n in ["time"] + OUT:
+        assert np.array_equal(r2[n], r3[n]), n
+    assert np.ptp(r3["w"]) > 0.1 and r3["sticking"].any() and not r3["sticking"].all()
+
+
+def test_state_bytes_cross_versions(fmu_paths, tmp_path):
+    """Both FMUs write the same checked bytes: a state saved by one restores
+    into the other, which then steps on bitwise like the first."""
+    s2, s3 = slave_of(fmu_paths["2"], tmp_path, "two"), slave_of(fmu_paths["3"], tmp_path, "three")
+    for a, b in ((s2, s3), (s3, s2)):
+        start(a, N=500)
+        start(b)
+        t, _ = run_steps(a, 0.0, 40)
+        data = saved_bytes(a)
+        st = b.fmu.deSerializeFMUstate(data)
+        b.fmu.setFMUstate(st)
+        b.fmu.freeFMUstate(st)
+        assert saved_bytes(b) == data
+        assert run_steps(b, t, 30)[1] == run_steps(a, t, 30)[1]
+        a.fmu.reset()
+        b.fmu.reset()
+    for s in (s2, s3):
+        s.fmu.freeInstance()
+
+
+def test_fmi3_do_step_flags_and_unsupported_functions(fmu_paths, tmp_path):
+    """fmi3DoStep reports no event, no termination, no early return and the
+    time reached; the functions of event mode, clocks and derivatives refuse
+    with fmi3Error and a logged reason; the instance steps on."""
+    s = slave_of(fmu_paths["3"], tmp_path, "flags")
+    start(s)
+    f3 = s.fmu.fmu3
+    assert f3.doStep(0.0, 0.0123) == (False, False, False, 0.0123)
+    assert f3.doStep(0.0123, 0.5) == (False, False, False, 0.0123 + 0.5)
+    assert f3.getFloat64([s.vr["time"]]) == [0.0123 + 0.5]
+    for call in (f3.enterEventMode, f3.enterStepMode,
+                 lambda: f3.getOutputDerivatives([s.vr["w"]], [1]),
+                 lambda: f3.getDirectionalDerivative([s.vr["w"]], [s.vr["g_in"]], [1.0]),
+                 lambda: f3.getFloat32([s.vr["w"]]), lambda: f3.setInt8([0], [1])):
+        n = len(s.errors())
+        with pytest.raises(FMICallException) as e:
+            call()
+        assert e.value.status == 3 and len(s.errors()) == n + 1, s.errors()[n:]
+    # a Float64 array whose length is not the number of scalar variables
+    with pytest.raises(FMICallException):
+        f3.fmi3GetFloat64(f3.component, (ctypes.c_uint32 * 2)(19, 20), 2, (ctypes.c_double * 3)(), 3)
+    assert "3 values for 2 value references" in s.errors()[-1]
+    f3.doStep(0.5123, 0.01)
+    s.fmu.freeInstance()
+
+
+def test_fmi3_refuses_event_mode_and_intermediate_update(fmu_paths, tmp_path):
+    from fmpy import extract, read_model_description
+    from fmpy.fmi3 import FMU3Slave
+    md = read_model_description(fmu_paths["3"])
+    unzip = extract(fmu_paths["3"], str(tmp_path / "u"))
+    for kw, word in ((dict(eventModeUsed=True), "event mode"),
+                     (dict(requiredIntermediateVariables=[19]), "intermediate")):
+        log = []
+        f = FMU3Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier="DelayFrictionOscillator",
+                      instanceName="x")
+        with pytest.raises(Exception, match="instantiate"):
+            f.instantiate(logMessage=lambda env, st, cat, msg: log.append((st, msg.decode())), **kw)
+        assert len(log) == 1 and log[0][0] == 3 and word in log[0][1], log

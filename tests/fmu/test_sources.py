@@ -1,5 +1,5 @@
-# The FMU's sources/: every C file it needs, listed in its model description
-# (FMI 2.0 <SourceFiles>) or sources/buildDescription.xml (FMI 3.0).  Without
+# The FMU's sources/ (both FMUs): every C file it needs, listed in its model
+# description (FMI 2.0 <SourceFiles>) or sources/buildDescription.xml (FMI 3.0).  Without
 # its binaries/, the unpacked FMU is built by fmpy (build_platform_binary:
 # CMake and the system's C compiler) and by a plain `cc -std=c99` with libc
 # and libm alone; the rebuilt FMU's outputs equal the shipped binary's to 1e-12.
@@ -40,7 +40,8 @@ def test_sources_rebuild_the_fmu(fmu_path, tmp_path):
 
     (tmp_path / "build").mkdir()
     build_platform_binary(unzipdir, build_dir=str(tmp_path / "build"))
-    assert os.path.isfile(os.path.join(unzipdir, "binaries", fmpy.platform,
+    platform = fmpy.platform if md.fmiVersion == "2.0" else fmpy.platform_tuple
+    assert os.path.isfile(os.path.join(unzipdir, "binaries", platform,
                                        md.coSimulation.modelIdentifier + fmpy.sharedLibraryExtension))
     run = dict(stop_time=30.0, output_interval=0.01, output=OUT)  # Example 4.3, N = 1000
     shipped_run = simulate_fmu(fmu_path, **run)

@@ -1,5 +1,7 @@
-# The FMU's Windows binaries: imports (system DLLs only) and exports (the FMI
-# functions only), read with mingw-w64's objdump; and the C master, built for
+# The FMUs' Windows binaries (FMI 2.0: binaries/win64, FMI 3.0:
+# binaries/x86_64-windows): imports (system DLLs only) and exports (the
+# functions of fmu/fmi2/ or fmu/fmi3/, nothing else), read with mingw-w64's
+# objdump; and the C master, built for
 # Windows from tests/fmu/fmu_master.c, running under Wine with the DLL of the
 # unpacked FMU: Example 4.3 at N = 9991 to T = 30 and rows of the bad-input
 # table, its outputs equal to the Linux binary's (the same master on Linux) to
@@ -27,18 +29,15 @@ def _env(name):
     return value
 
 
-@pytest.fixture(scope="module")
-def unpacked(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("fmu")
-    with zipfile.ZipFile(_env("DMI_FMU")) as z:
+# FMI version: the FMU's variable, its Windows platform folder.
+FMUS = {"2": ("DMI_FMU", "win64"), "3": ("DMI_FMU3", "x86_64-windows")}
+
+
+def unpack(version, folder):
+    with zipfile.ZipFile(_env(FMUS[version][0])) as z:
         z.extractall(folder)
-    return folder
-
-
-@pytest.fixture(scope="module")
-def dll(unpacked):
-    path = unpacked / "binaries" / "win64" / f"{NAME}.dll"
-    assert path.is_file(), "the FMU has no binaries/win64"
+    path = folder / "binaries" / FMUS[version][1] / f"{NAME}.dll"
+    assert path.is_file(), f"the FMU has no binaries/{FMUS[version][1]}"
     return path
 
 
@@ -60,23 +59,26 @@ def exported_names(dump):
     return names
 
 
-def test_imports_are_system_dlls(dll):
-    imports = re.findall(r"DLL Name: (\S+)", objdump(dll))
+@pytest.mark.parametrize("version", ["2", "3"])
+def test_imports_are_system_dlls(version, tmp_path):
+    imports = re.findall(r"DLL Name: (\S+)", objdump(unpack(version, tmp_path)))
     assert imports, "no import table found"
     assert [d for d in imports if not SYSTEM_DLL.fullmatch(d)] == []
 
 
-def test_exports_are_the_fmi2_functions(dll):
-    header = open(os.path.join(_env("DMI_SOURCE_DIR"), "fmu", "fmi2", "fmi2Functions.h")).read()
-    declared = set(re.findall(r"^FMI2_Export fmi2\w+TYPE (fmi2\w+);", header, re.M))
+@pytest.mark.parametrize("version", ["2", "3"])
+def test_exports_are_the_fmi_functions(version, tmp_path):
+    v = version
+    header = os.path.join(_env("DMI_SOURCE_DIR"), "fmu", f"fmi{v}", f"fmi{v}Functions.h")
+    declared = re.findall(rf"^FMI{v}_Export fmi{v}\w+TYPE (fmi{v}\w+);", open(header).read(), re.M)
     assert len(declared) > 30
-    assert sorted(exported_names(objdump(dll))) == sorted(declared)
+    assert sorted(exported_names(objdump(unpack(version, tmp_path)))) == sorted(declared)
 
 
 @pytest.fixture(scope="module")
 def wine():
-    """(wine, environment) with the prefix in the build tree; stops the
-    wineserver of that prefix afterwards."""
+    """(wine, environment) with the prefix in the build tree; afterwards stops
+    the wineserver of that prefix and waits until it has exited."""
     wine, server = _env("DMI_WINE"), _env("DMI_WINESERVER")
     for program in (wine, server):
         if not os.access(program, os.X_OK):
@@ -87,8 +89,8 @@ def wine():
     try:
         yield wine, env
     finally:
-        subprocess.run([server, "-k"], env=env, timeout=60, check=False)
-        subprocess.run([server, "-w"], env=env, timeout=60, check=False)
+        subprocess.run([server, "--kill"], env=env, timeout=60, check=False)
+        subprocess.run([server, "--wait"], env=env, timeout=60, check=False)
 
 
 def run_master(command, out, **kw):
@@ -114,9 +116,10 @@ def table_messages():
     return rows
 
 
-def test_master_under_wine(unpacked, dll, wine, tmp_path):
+def test_master_under_wine(wine, tmp_path):
     program, env = wine
-    so = unpacked / "binaries" / "linux64" / f"{NAME}.so"
+    dll = unpack("2", tmp_path)
+    so = tmp_path / "binaries" / "linux64" / f"{NAME}.so"
     linux = run_master([_env("DMI_MASTER"), str(so)], tmp_path / "linux.csv")
     windows = run_master([program, _env("DMI_MASTER_EXE"), str(dll)], tmp_path / "windows.csv",
                          env=env)
