@@ -167,7 +167,7 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 {
     (void)vr, (void)value;
     ENTER(c, FN_GET, "fmi2GetString");
-    return (fmi2Status)fmu_no_variables(in, "fmi2GetString", nvr, "String");
+    return (fmi2Status)fmu_no_variables(in, "fmi2GetString", nvr, "String variables");
 }
 
 fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -175,7 +175,7 @@ fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
 {
     (void)vr, (void)value;
     ENTER(c, FN_SET, "fmi2SetBoolean");
-    return (fmi2Status)fmu_no_variables(in, "fmi2SetBoolean", nvr, "settable Boolean");
+    return (fmi2Status)fmu_no_variables(in, "fmi2SetBoolean", nvr, "settable Boolean variable");
 }
 
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -183,7 +183,7 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 {
     (void)vr, (void)value;
     ENTER(c, FN_SET, "fmi2SetString");
-    return (fmi2Status)fmu_no_variables(in, "fmi2SetString", nvr, "String");
+    return (fmi2Status)fmu_no_variables(in, "fmi2SetString", nvr, "String variables");
 }
 
 /* ---- FMU states ---- */

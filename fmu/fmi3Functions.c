@@ -61,7 +61,7 @@ fmi3Instance fmi3InstantiateCoSimulation(
     if (instanceName && *instanceName) { /* (an empty name: refused by fmu_instantiate) */
         if (!instantiationToken || strcmp(instantiationToken, DMI_FMU_GUID) != 0) {
             fmu_log_error(fn, name, sink, logger, instanceEnvironment,
-                          "instantiation token \"%s\" does not match the FMU's %s",
+                          "instantiation token \"%s\" is not the FMU's GUID %s",
                           instantiationToken ? instantiationToken : "(null)", DMI_FMU_GUID);
             return NULL;
         }
@@ -220,25 +220,25 @@ SET(Int32, set_int32)
         ENTER(instance, which, "fmi3" #Name);                                                     \
         return (fmi3Status)fmu_no_variables(in, "fmi3" #Name, nValueReferences, what);            \
     }
-NONE(GetFloat32, FN_GET, fmi3Float32, "Float32")
-NONE(GetInt8, FN_GET, fmi3Int8, "Int8")
-NONE(GetUInt8, FN_GET, fmi3UInt8, "UInt8")
-NONE(GetInt16, FN_GET, fmi3Int16, "Int16")
-NONE(GetUInt16, FN_GET, fmi3UInt16, "UInt16")
-NONE(GetUInt32, FN_GET, fmi3UInt32, "UInt32")
-NONE(GetInt64, FN_GET, fmi3Int64, "Int64")
-NONE(GetUInt64, FN_GET, fmi3UInt64, "UInt64")
-NONE(GetString, FN_GET, fmi3String, "String")
-NONE(SetFloat32, FN_SET, const fmi3Float32, "Float32")
-NONE(SetInt8, FN_SET, const fmi3Int8, "Int8")
-NONE(SetUInt8, FN_SET, const fmi3UInt8, "UInt8")
-NONE(SetInt16, FN_SET, const fmi3Int16, "Int16")
-NONE(SetUInt16, FN_SET, const fmi3UInt16, "UInt16")
-NONE(SetUInt32, FN_SET, const fmi3UInt32, "UInt32")
-NONE(SetInt64, FN_SET, const fmi3Int64, "Int64")
-NONE(SetUInt64, FN_SET, const fmi3UInt64, "UInt64")
-NONE(SetBoolean, FN_SET, const fmi3Boolean, "settable Boolean")
-NONE(SetString, FN_SET, const fmi3String, "String")
+NONE(GetFloat32, FN_GET, fmi3Float32, "Float32 variables")
+NONE(GetInt8, FN_GET, fmi3Int8, "Int8 variables")
+NONE(GetUInt8, FN_GET, fmi3UInt8, "UInt8 variables")
+NONE(GetInt16, FN_GET, fmi3Int16, "Int16 variables")
+NONE(GetUInt16, FN_GET, fmi3UInt16, "UInt16 variables")
+NONE(GetUInt32, FN_GET, fmi3UInt32, "UInt32 variables")
+NONE(GetInt64, FN_GET, fmi3Int64, "Int64 variables")
+NONE(GetUInt64, FN_GET, fmi3UInt64, "UInt64 variables")
+NONE(GetString, FN_GET, fmi3String, "String variables")
+NONE(SetFloat32, FN_SET, const fmi3Float32, "Float32 variables")
+NONE(SetInt8, FN_SET, const fmi3Int8, "Int8 variables")
+NONE(SetUInt8, FN_SET, const fmi3UInt8, "UInt8 variables")
+NONE(SetInt16, FN_SET, const fmi3Int16, "Int16 variables")
+NONE(SetUInt16, FN_SET, const fmi3UInt16, "UInt16 variables")
+NONE(SetUInt32, FN_SET, const fmi3UInt32, "UInt32 variables")
+NONE(SetInt64, FN_SET, const fmi3Int64, "Int64 variables")
+NONE(SetUInt64, FN_SET, const fmi3UInt64, "UInt64 variables")
+NONE(SetBoolean, FN_SET, const fmi3Boolean, "settable Boolean variable")
+NONE(SetString, FN_SET, const fmi3String, "String variables")
 
 fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference valueReferences[],
                          size_t nValueReferences, size_t valueSizes[], fmi3Binary values[],
@@ -246,7 +246,7 @@ fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference valueRe
 {
     (void)valueReferences, (void)valueSizes, (void)values, (void)nValues;
     ENTER(instance, FN_GET, "fmi3GetBinary");
-    return (fmi3Status)fmu_no_variables(in, "fmi3GetBinary", nValueReferences, "Binary");
+    return (fmi3Status)fmu_no_variables(in, "fmi3GetBinary", nValueReferences, "Binary variables");
 }
 
 fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -255,7 +255,7 @@ fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference valueRe
 {
     (void)valueReferences, (void)valueSizes, (void)values, (void)nValues;
     ENTER(instance, FN_SET, "fmi3SetBinary");
-    return (fmi3Status)fmu_no_variables(in, "fmi3SetBinary", nValueReferences, "Binary");
+    return (fmi3Status)fmu_no_variables(in, "fmi3SetBinary", nValueReferences, "Binary variables");
 }
 
 fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -263,7 +263,7 @@ fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference valueRef
 {
     (void)valueReferences, (void)values;
     ENTER(instance, FN_GET, "fmi3GetClock");
-    return (fmi3Status)fmu_no_variables(in, "fmi3GetClock", nValueReferences, "Clock");
+    return (fmi3Status)fmu_no_variables(in, "fmi3GetClock", nValueReferences, "Clock variables");
 }
 
 fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -271,7 +271,7 @@ fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference valueRef
 {
     (void)valueReferences, (void)values;
     ENTER(instance, FN_SET, "fmi3SetClock");
-    return (fmi3Status)fmu_no_variables(in, "fmi3SetClock", nValueReferences, "Clock");
+    return (fmi3Status)fmu_no_variables(in, "fmi3SetClock", nValueReferences, "Clock variables");
 }
 
 /* ---- FMU states: the same checked bytes as the FMI 2.0 FMU's ---- */

@@ -342,7 +342,7 @@ fmu_status fmu_set(fmu_instance *in, const char *fn, const unsigned vr[], size_t
 fmu_status fmu_no_variables(fmu_instance *in, const char *fn, size_t nvr, const char *type)
 {
     return nvr == 0 ? fmu_leave(in, fn, FMU_OK)
-                    : fmu_error(in, fn, "the FMU has no %s variables", type);
+                    : fmu_error(in, fn, "the FMU has no %s", type);
 }
 
 /* ---- FMU states ---- */

@@ -104,7 +104,7 @@ fmu_status fmu_setup_experiment(fmu_instance *in, const char *fn, double start_t
  * (start_time not NULL: checked and set as by fmu_setup_experiment). */
 fmu_status fmu_enter_init(fmu_instance *in, const char *fn, const double *start_time,
                           int stop_time_defined, double stop_time);
-/* Starts the solver; FMU_WARNING (logged) when the step is coarse (model_growth). */
+/* Starts the solver; FMU_WARNING (logged) when the step is coarse (model_coarse_step). */
 fmu_status fmu_exit_init(fmu_instance *in, const char *fn);
 fmu_status fmu_terminate(fmu_instance *in, const char *fn);
 fmu_status fmu_reset(fmu_instance *in, const char *fn);
@@ -118,7 +118,8 @@ fmu_status fmu_get(fmu_instance *in, const char *fn, const unsigned vr[], size_t
 /* All values or none. */
 fmu_status fmu_set(fmu_instance *in, const char *fn, const unsigned vr[], size_t nvr,
                    const void *values, fmu_set_fn *set);
-/* A type of which the FMU has no variable (nothing to get or set): nvr = 0 is OK. */
+/* A type of which the FMU has no variable (nothing to get or set): nvr = 0 is
+ * OK; what: "String variables", ... */
 fmu_status fmu_no_variables(fmu_instance *in, const char *fn, size_t nvr, const char *type);
 
 /* FMU states: *state is an opaque pointer owned by the importer until freed. */

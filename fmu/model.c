@@ -115,11 +115,27 @@ static int solver_fail(char *err, const char *what, dmi_solver *s, int rc)
     return -1;
 }
 
+double model_solver_bytes(int N)
+{
+    return MODEL_BYTES_PER_STEP * (double)N;
+}
+
+/* Out of memory for N: the error names N and the bytes needed. */
+static int memory_fail(char *err, const char *what, int N)
+{
+    snprintf(err, MODEL_ERRLEN, "%s: out of memory: N = %d steps per tau need about %.0f bytes "
+                                "(%.3g GB, %d bytes per step)",
+             what, N, model_solver_bytes(N), model_solver_bytes(N) / 1e9, MODEL_BYTES_PER_STEP);
+    return -1;
+}
+
 /* A new solver for the parameters of m: only the history ring of (N + 1) * 2
  * values is allocated, nothing is sampled yet. */
 static int solver_create(const model *m, dmi_solver **out, char *err)
 {
     int rc = dmi_create(out, 2, m->real[VR_tau], (size_t)m->N);
+    if (rc == DMI_ENOMEM)
+        return memory_fail(err, "creating the solver", m->N);
     return rc == DMI_OK ? 0 : solver_fail(err, "creating the solver (tau, N)", NULL, rc);
 }
 
@@ -132,13 +148,19 @@ static int solver_init(model *m, dmi_solver *s, char *err)
     if ((rc = dmi_set_rhs(s, rhs, m)) != DMI_OK || (rc = dmi_set_kernel(s, kernel, m)) != DMI_OK ||
         (rc = dmi_set_history(s, history, m)) != DMI_OK ||
         (rc = dmi_set_friction(s, alpha)) != DMI_OK || (rc = dmi_init(s)) != DMI_OK)
-        return solver_fail(err, "initialising the solver", s, rc);
+        return rc == DMI_ENOMEM ? memory_fail(err, "initialising the solver", m->N)
+                                : solver_fail(err, "initialising the solver", s, rc);
     return 0;
 }
 
 int model_start(model *m, double t_start, char *err, char *note)
 {
     note[0] = '\0';
+    if (model_solver_bytes(m->N) > MODEL_NOTE_BYTES)
+        snprintf(note, MODEL_ERRLEN, "N = %d steps per tau: the solver allocates about %.0f bytes "
+                                     "(%.3g MB, %d bytes per step)",
+                 m->N, model_solver_bytes(m->N), model_solver_bytes(m->N) / 1e6,
+                 MODEL_BYTES_PER_STEP);
     dmi_solver *s = NULL;
     if (solver_create(m, &s, err) != 0)
         return -1;
@@ -155,8 +177,21 @@ int model_start(model *m, double t_start, char *err, char *note)
 
 int model_coarse_step(const model *m, double T, char *msg)
 {
-    (void)m, (void)T, (void)msg;
-    return 0;
+    const double b = m->real[VR_b], tau = m->real[VR_tau], h = tau / m->N;
+    if (!(b > 0) || !(T > 0))
+        return 0;
+    /* log of the growth (1 + h^2 b)^(T/h) over the experiment */
+    const double ln_growth = T / h * log1p(h * h * b);
+    if (!(ln_growth > log(MODEL_COARSE_GROWTH)))
+        return 0;
+    /* h b T <= ln 2 keeps the growth below 2: N >= tau b T / ln 2 */
+    const double n_min = ceil(tau * b * T / log(MODEL_COARSE_GROWTH));
+    snprintf(msg, MODEL_ERRLEN, "N = %d (h = %.3g) is a coarse step for b = %.3g: the scheme's "
+                                "explicit part amplifies an undamped oscillation by about "
+                                "(1 + h^2 b) = %.6g per step, 10^%.3g over T = %.3g; N >= %.3g "
+                                "keeps it below %g",
+             m->N, h, b, 1.0 + h * h * b, ln_growth / log(10.0), T, n_min, MODEL_COARSE_GROWTH);
+    return 1;
 }
 
 /* The number of steps taken when the FMU is at time t: every step whose start
@@ -220,7 +255,10 @@ static output_values outputs(const model *m)
         o.w = prev[0] + th * (U[0] - prev[0]);
         o.v = prev[1] + th * (U[1] - prev[1]);
     }
-    o.friction = (X[1] - U[1]) / h;
+    /* the element of alpha sigma(v) the step selected: in [-alpha, alpha],
+     * up to the rounding of (X - U)/h, which the clamp removes */
+    const double alpha = m->real[VR_alpha];
+    o.friction = fmin(fmax((X[1] - U[1]) / h, -alpha), alpha);
     o.delay_force = W[1];
     o.sticking = U[1] == 0.0;
     return o;

@@ -76,6 +76,11 @@ int model_get_boolean(const model *m, unsigned vr, int *value, char *err);
  * failure, err tells why (for memory: N and the bytes needed).  note gets a
  * message when the solver takes more than MODEL_NOTE_BYTES, else "". */
 #define MODEL_NOTE_BYTES 100e6
+/* The memory the solver takes per step of the history, about: the peak
+ * resident memory of initialization and the first step, measured for
+ * N = 2e6 and 8e6 (history, kernel samples, delay-sum engine). */
+#define MODEL_BYTES_PER_STEP 104
+double model_solver_bytes(int N);
 int model_start(model *m, double t_start, char *err, char *note);
 
 /* Whether the step h = tau/N is coarse for an experiment of length T: the

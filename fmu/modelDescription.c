@@ -40,6 +40,19 @@ static int is_output(const variable *x)
 static const char *const CATEGORIES[][2] = {MODEL_LOG_CATEGORIES(CAT)};
 #undef CAT
 
+/* Writes text as an XML attribute value (without the quotes). */
+static void attr(FILE *f, const char *text)
+{
+    for (const char *c = text; *c; c++)
+        switch (*c) {
+        case '<': fputs("&lt;", f); break;
+        case '>': fputs("&gt;", f); break;
+        case '&': fputs("&amp;", f); break;
+        case '"': fputs("&quot;", f); break;
+        default: fputc(*c, f);
+        }
+}
+
 static void header(FILE *f, int v, const char *guid, const char *version, int nsources,
                    char **sources)
 {
@@ -75,8 +88,11 @@ static void header(FILE *f, int v, const char *guid, const char *version, int ns
         fprintf(f, "/>\n");
     if (v == 2 && nsources > 0) {
         fprintf(f, ">\n    <SourceFiles>\n");
-        for (int k = 0; k < nsources; k++)
-            fprintf(f, "      <File name=\"%s\"/>\n", sources[k]);
+        for (int k = 0; k < nsources; k++) {
+            fprintf(f, "      <File name=\"");
+            attr(f, sources[k]);
+            fprintf(f, "\"/>\n");
+        }
         fprintf(f, "    </SourceFiles>\n  </CoSimulation>\n");
     }
     if (v == 3) /* no event mode, no early return, no intermediate update */
@@ -92,8 +108,11 @@ static void header(FILE *f, int v, const char *guid, const char *version, int ns
                 MODEL_NAME);
     fprintf(f, "  <LogCategories>\n");
     for (size_t k = 0; k < sizeof CATEGORIES / sizeof CATEGORIES[0]; k++)
-        fprintf(f, "    <Category name=\"%s\" description=\"%s\"/>\n", CATEGORIES[k][0],
-                CATEGORIES[k][1]);
+    {
+        fprintf(f, "    <Category name=\"%s\" description=\"", CATEGORIES[k][0]);
+        attr(f, CATEGORIES[k][1]);
+        fprintf(f, "\"/>\n");
+    }
     fprintf(f, "  </LogCategories>\n"
                "  <DefaultExperiment startTime=\"0.0\" stopTime=\"%.1f\" stepSize=\"0.01\"/>\n",
             MODEL_DEFAULT_T);
@@ -109,12 +128,13 @@ static void variables2(FILE *f)
         fprintf(f, "    <!-- index %zu -->\n"
                    "    <ScalarVariable name=\"%s\" valueReference=\"%zu\" causality=\"%s\" "
                    "variability=\"%s\"%s\n"
-                   "                    description=\"%s\">\n",
+                   "                    description=\"",
                 i + 1, x->name, i, CAUSALITY[x->kind], VARIABILITY[x->kind],
                 x->kind == MODEL_REAL_INPUT ? ""
                 : x->start                  ? " initial=\"exact\""
-                                            : " initial=\"calculated\"",
-                x->description);
+                                            : " initial=\"calculated\"");
+        attr(f, x->description);
+        fprintf(f, "\">\n");
         if (x->start)
             fprintf(f, "      <%s start=\"%s\"/>\n", TYPE2[x->kind], x->start);
         else
@@ -145,7 +165,9 @@ static void variables3(FILE *f)
                                                                     : "");
         if (x->start)
             fprintf(f, " start=\"%s\"", x->start);
-        fprintf(f, "\n      description=\"%s\"/>\n", x->description);
+        fprintf(f, "\n      description=\"");
+        attr(f, x->description);
+        fprintf(f, "\"/>\n");
     }
     fprintf(f, "  </ModelVariables>\n  <ModelStructure>\n");
     for (size_t i = 0; i < NVARS; i++)

@@ -81,6 +81,9 @@ class FMI3AsFMI2:
     def enterInitializationMode(self):
         return self.fmu3.enterInitializationMode(startTime=self.times[0], stopTime=self.times[1])
 
+    def exitInitializationMode(self):  # with its status (fmpy's returns None)
+        return self.fmu3.fmi3ExitInitializationMode(self.fmu3.component)
+
     def reset(self):
         self.times = (0.0, None)
         return self.fmu3.reset()

@@ -11,11 +11,13 @@
 #include <dlfcn.h>
 #endif
 #include "fmu_loader.h"
+#include "fmu_fmi3.h"
 
 #include <stdio.h>
 #include <string.h>
 
-/* The platform's library calls.  lib_open prints the reason of a failure. */
+/* The platform's library calls.  lib_open prints the reason of a failure;
+ * lib_sym gives the address of a function as an object pointer, or NULL. */
 #ifdef _WIN32
 static void *lib_open(const char *path)
 {
@@ -26,13 +28,12 @@ static void *lib_open(const char *path)
     return (void *)lib;
 }
 
-/* Copies the address of the function `name` into the function pointer at
- * `fn`; 0 if found, -1 if not. */
-static int lib_sym(void *lib, const char *name, void *fn)
+static void *lib_sym(void *lib, const char *name)
 {
-    FARPROC p = GetProcAddress((HMODULE)lib, name);
-    memcpy(fn, &p, sizeof p);
-    return p ? 0 : -1;
+    FARPROC fn = GetProcAddress((HMODULE)lib, name);
+    void *p;
+    memcpy(&p, &fn, sizeof p); /* the same size on Windows, as on POSIX */
+    return p;
 }
 
 static void lib_close(void *lib)
@@ -48,13 +49,9 @@ static void *lib_open(const char *path)
     return lib;
 }
 
-/* As above; object pointer to function pointer through memcpy (POSIX
- * guarantees the two have the same representation). */
-static int lib_sym(void *lib, const char *name, void *fn)
+static void *lib_sym(void *lib, const char *name)
 {
-    void *p = dlsym(lib, name);
-    memcpy(fn, &p, sizeof p);
-    return p ? 0 : -1;
+    return dlsym(lib, name);
 }
 
 static void lib_close(void *lib)
@@ -63,19 +60,36 @@ static void lib_close(void *lib)
 }
 #endif
 
+static void *lookup(void *lib, const char *name)
+{
+    void *p = lib_sym(lib, name);
+    if (!p)
+        fprintf(stderr, "fmu_load: %s not exported\n", name);
+    return p;
+}
+
 int fmu_load(fmu_api *f, const char *so_path)
 {
     memset(f, 0, sizeof *f);
     f->lib = lib_open(so_path);
     if (!f->lib)
         return -1;
+    f->version = 2;
+    if (lib_sym(f->lib, "fmi3InstantiateCoSimulation")) {
+        f->version = 3;
+        if (fmu_fmi3_attach(f, lookup) != 0) {
+            fmu_unload(f);
+            return -1;
+        }
+        return 0;
+    }
     int missing = 0;
+    /* object pointer to function pointer: the POSIX dlsym idiom */
 #define SYM(field, name)                                                                          \
     do {                                                                                          \
-        if (lib_sym(f->lib, name, &f->field) != 0) {                                              \
-            fprintf(stderr, "fmu_load: %s not exported\n", name);                                 \
+        *(void **)(&f->field) = lookup(f->lib, name);                                             \
+        if (!f->field)                                                                            \
             missing = 1;                                                                          \
-        }                                                                                         \
     } while (0)
     SYM(instantiate, "fmi2Instantiate");
     SYM(free_instance, "fmi2FreeInstance");

@@ -2,6 +2,8 @@
  * The FMI 2.0 functions of an unpacked FMU binary, loaded with dlopen (or
  * LoadLibrary under _WIN32): the one loader of the C importers in tests/
  * (fmu_master, also built for Windows; the hardening tests, the FMU fuzzer).
+ * An FMI 3.0 binary is loaded behind the same FMI 2.0 function types
+ * (fmu_fmi3.h); version tells which one it is.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #ifndef FMU_LOADER_H
@@ -10,7 +12,8 @@
 #include "fmi2FunctionTypes.h"
 
 typedef struct {
-    void *lib; /* the dlopen handle or the HMODULE */
+    void *lib;   /* the dlopen handle or the HMODULE */
+    int version; /* 2 or 3 */
     fmi2InstantiateTYPE *instantiate;
     fmi2FreeInstanceTYPE *free_instance;
     fmi2SetDebugLoggingTYPE *set_debug_logging;

@@ -875,3 +875,116 @@ def test_fmi3_refuses_event_mode_and_intermediate_update(fmu_paths, tmp_path):
         with pytest.raises(Exception, match="instantiate"):
             f.instantiate(logMessage=lambda env, st, cat, msg: log.append((st, msg.decode())), **kw)
         assert len(log) == 1 and log[0][0] == 3 and word in log[0][1], log
+
+
+# ---- what a new user hit (issue 16, items 3-6) ----
+
+def coarse(N, T, b=1.0, tau=1.0):
+    """The criterion, computed here: (1 + h^2 b)^(T/h) > 2."""
+    h = tau / N
+    return (1 + h * h * b) ** (T / h) > 2
+
+
+def test_coarse_step_warns_at_initialization(sl, fmu_path):
+    """ExitInitializationMode returns Warning, with a logged reason, when the
+    explicit part's growth (1 + h^2 b)^(T/h) exceeds 2; not for N = 1000."""
+    assert coarse(43, 30.0) and not coarse(44, 30.0) and coarse(10, 30.0) and not coarse(10, 3.0)
+    for N, stop, b in [(1000, None, 1.0), (1, None, 1.0), (43, None, 1.0), (44, None, 1.0),
+                       (10, 30.0, 1.0), (10, 3.0, 1.0), (10, None, -1.0), (44, None, 1.1)]:
+        s = sl()
+        s.fmu.setupExperiment(startTime=0.0, **({} if stop is None else dict(stopTime=stop)))
+        s.fmu.enterInitializationMode()
+        s.fmu.setInteger([s.vr["N"]], [N])
+        s.fmu.setReal([s.vr["b"]], [b])
+        status = s.fmu.exitInitializationMode()
+        warned = [m for st, c, m in s.log if st == 1 and c == "logStatusWarning"]
+        want = b > 0 and coarse(N, 30.0 if stop is None else stop, b)
+        assert status == (1 if want else 0), (N, stop, b, status, s.log)
+        assert len(warned) == (1 if want else 0), (N, stop, b, s.log)
+        if want:
+            assert f"N = {N}" in warned[0] and "coarse" in warned[0] and "1 + h^2 b" in warned[0]
+        s.fmu.doStep(0.0, 0.5)  # and it runs on
+    # what the warning is about: the coarse run explodes
+    r = simulate_fmu(fmu_path, stop_time=30.0, output_interval=1.0, start_values={"N": 1},
+                     output=["w"])
+    assert np.max(np.abs(r["w"])) > 1e6
+
+
+def test_friction_lies_in_minus_alpha_alpha(fmu_path, native43):
+    """friction is an element of alpha sigma(v): in [-alpha, alpha] at every
+    step, although (X - U)/h rounds beyond alpha at thousands of them."""
+    unclamped = (native43.X[1:, 1] - native43.U[1:, 1]) / native43.h
+    assert np.sum(np.abs(unclamped) > 1.0) > 100
+    r = simulate_fmu(fmu_path, stop_time=T, output_interval=0.001, output=["friction"])
+    assert np.max(np.abs(r["friction"])) <= 1.0
+    assert np.sum(np.abs(r["friction"]) == 1.0) > 1000  # sliding: the bound itself
+    r = simulate_fmu(fmu_path, stop_time=5.0, output_interval=0.001, output=["friction"],
+                     start_values={"alpha": 0.3})
+    assert np.max(np.abs(r["friction"])) <= 0.3 and np.max(np.abs(r["friction"])) == 0.3
+
+
+def test_out_of_memory_names_N_and_the_bytes(sl):
+    s = sl()
+    s.fmu.setupExperiment(startTime=0.0)
+    s.fmu.enterInitializationMode()
+    s.fmu.setInteger([s.vr["N"]], [2_000_000_000])  # 64 GB of history alone
+    with pytest.raises(FMICallException):
+        s.fmu.exitInitializationMode()
+    assert len(s.errors()) == 1
+    msg = s.errors()[0]
+    assert "N = 2000000000" in msg and "out of memory" in msg and "bytes" in msg, msg
+    assert str(104 * 2_000_000_000) in msg, msg
+
+
+CHILD_BIG_N = textwrap.dedent("""
+    import sys, json, resource
+    sys.path.insert(0, {here!r})
+    import conftest, test_fmu
+    from fmpy import read_model_description
+    md = read_model_description({fmu!r})
+    s = conftest.Slave(md, {unzip!r})
+    s.vr = {{v.name: v.valueReference for v in md.modelVariables}}
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    test_fmu.start(s, N={N})
+    s.fmu.doStep(0.0, 0.001)
+    grown = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before
+    print(json.dumps([grown * 1024, s.log]))
+""")
+
+
+def test_large_N_logs_what_initialization_allocates(fmu_path, unzipdir, sl):
+    """Above 100 MB, ExitInitializationMode logs N and the bytes (category
+    logMemory, although logging is off); the logged size is the peak resident
+    memory it takes to within 30 % (measured in a fresh process)."""
+    N = 1_500_000
+    code = CHILD_BIG_N.format(here=os.path.dirname(__file__), fmu=fmu_path, unzip=str(unzipdir), N=N)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         timeout=120).stdout
+    import json
+    grown, log = json.loads(out.strip().splitlines()[-1])
+    notes = [m for st, c, m in log if c == "logMemory"]
+    assert len(notes) == 1 and f"N = {N}" in notes[0], log
+    logged = float(notes[0].split("about ")[1].split(" bytes")[0])
+    assert logged > 100e6 and abs(grown - logged) < 0.3 * logged, (grown, logged)
+    s = sl()
+    start(s)  # N = 1000: nothing to say
+    assert s.log == []
+
+
+def test_each_call_logged_once_with_its_outcome(sl):
+    s = sl(logging_on=True)
+    start(s)
+    p = s.prefix
+    real = "Real" if p == "fmi2" else "Float64"
+    n = len(s.log)
+    with pytest.raises(FMICallException):
+        s.fmu.setReal([s.vr["tau"]], [-1.0])  # in step mode, a parameter: refused
+    assert [(st, m.split(":")[0]) for st, c, m in s.log[n:]] == [(3, f"{p}Set{real}")], s.log[n:]
+    n = len(s.log)
+    s.fmu.setReal([s.vr["g_in"]], [0.5])
+    s.fmu.doStep(0.0, 0.01)
+    assert s.log[n:] == [(0, "logCalls", f"{p}Set{real}"), (0, "logCalls", f"{p}DoStep")]
+    n = len(s.log)
+    with pytest.raises(FMICallException):
+        s.fmu.doStep(0.5, 0.01)
+    assert len(s.log[n:]) == 1 and s.log[n][0] == 3 and s.log[n][2].startswith(f"{p}DoStep: ")

@@ -1,11 +1,11 @@
 # The FMUs' Windows binaries (FMI 2.0: binaries/win64, FMI 3.0:
 # binaries/x86_64-windows): imports (system DLLs only) and exports (the
 # functions of fmu/fmi2/ or fmu/fmi3/, nothing else), read with mingw-w64's
-# objdump; and the C master, built for
-# Windows from tests/fmu/fmu_master.c, running under Wine with the DLL of the
-# unpacked FMU: Example 4.3 at N = 9991 to T = 30 and rows of the bad-input
-# table, its outputs equal to the Linux binary's (the same master on Linux) to
-# 1e-12.  Without a working Wine the test fails.
+# objdump; and the C master, built for Windows from tests/fmu/fmu_master.c,
+# running under Wine with the DLL of each unpacked FMU: Example 4.3 at
+# N = 9991 to T = 30 and rows of the bad-input table, its outputs equal to the
+# Linux binary's (the same master on Linux) to 1e-12.  Without a working Wine
+# the test fails.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 import os
 import re
@@ -16,8 +16,9 @@ import numpy as np
 import pytest
 
 NAME = "DelayFrictionOscillator"
-# Rows of docs/bad-inputs.md that fmu_master's error paths go through.
-ROWS = ["F06", "F11", "F12", "F13", "F25", "F27", "F33", "F50", "F64", "F65", "F87"]
+# Rows of docs/bad-inputs.md that fmu_master's error paths go through (F: FMI 2.0, G: FMI 3.0).
+ROWS = {"2": ["F06", "F11", "F12", "F13", "F25", "F27", "F33", "F50", "F64", "F65", "F87"],
+        "3": ["G06", "G11", "G12", "G13", "G25", "G27", "G33", "G50", "G65", "G87"]}
 # DLLs every Windows has: the kernel and the C runtime (msvcrt, or the UCRT's API sets).
 SYSTEM_DLL = re.compile(r"(kernel32|msvcrt|api-ms-win-crt-[a-z0-9-]+)\.dll", re.I)
 
@@ -29,8 +30,8 @@ def _env(name):
     return value
 
 
-# FMI version: the FMU's variable, its Windows platform folder.
-FMUS = {"2": ("DMI_FMU", "win64"), "3": ("DMI_FMU3", "x86_64-windows")}
+# FMI version: the FMU's variable, its Windows and Linux platform folders.
+FMUS = {"2": ("DMI_FMU", "win64", "linux64"), "3": ("DMI_FMU3", "x86_64-windows", "x86_64-linux")}
 
 
 def unpack(version, folder):
@@ -111,15 +112,16 @@ def table_messages():
     rows = {}
     for line in open(path):
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if re.fullmatch(r"F\d+", cells[0]):
+        if re.fullmatch(r"[FG]\d+", cells[0]):
             rows[cells[0]] = cells[-1]
     return rows
 
 
-def test_master_under_wine(wine, tmp_path):
+@pytest.mark.parametrize("version", ["2", "3"])
+def test_master_under_wine(version, wine, tmp_path):
     program, env = wine
-    dll = unpack("2", tmp_path)
-    so = tmp_path / "binaries" / "linux64" / f"{NAME}.so"
+    dll = unpack(version, tmp_path)
+    so = tmp_path / "binaries" / FMUS[version][2] / f"{NAME}.so"
     linux = run_master([_env("DMI_MASTER"), str(so)], tmp_path / "linux.csv")
     windows = run_master([program, _env("DMI_MASTER_EXE"), str(dll)], tmp_path / "windows.csv",
                          env=env)
@@ -131,5 +133,5 @@ def test_master_under_wine(wine, tmp_path):
     # The same logged reasons, and those of the table's rows among them.
     assert logged(windows.stderr) == logged(linux.stderr)
     table = table_messages()
-    for row in ROWS:
+    for row in ROWS[version]:
         assert any(line.endswith("] " + table[row]) for line in logged(windows.stderr)), row
