@@ -4,10 +4,7 @@
  */
 #include "paper.h"
 
-#include <ctype.h>
-#include <errno.h>
 #include <math.h>
-#include <stdint.h>
 #include <stdlib.h>
 
 static const double PI = 3.14159265358979323846;
@@ -191,29 +188,4 @@ int paper_run(int example, size_t N, double T, int method, FILE *csv, size_t str
     if (rc == DMI_OK && res)
         *res = r;
     return rc;
-}
-
-int paper_parse_count(const char *arg, size_t *out)
-{
-    char *end;
-    if (!arg || !isdigit((unsigned char)arg[0]))
-        return -1;
-    errno = 0;
-    unsigned long long v = strtoull(arg, &end, 10);
-    if (errno != 0 || *end != '\0' || v == 0 || v > SIZE_MAX)
-        return -1;
-    *out = (size_t)v;
-    return 0;
-}
-
-int paper_parse_time(const char *arg, double *out)
-{
-    char *end;
-    if (!arg || arg[0] == '\0')
-        return -1;
-    double v = strtod(arg, &end);
-    if (*end != '\0' || !isfinite(v) || !(v > 0))
-        return -1;
-    *out = v;
-    return 0;
 }

@@ -56,12 +56,4 @@ typedef struct {
 int paper_run(int example, size_t N, double T, int method, FILE *csv, size_t stride,
               paper_result *res);
 
-/*
- * Command-line arguments of the example programs: a count >= 1 (decimal
- * digits only) and a time > 0 (finite).  Return 0 and set *out, or -1 and
- * leave *out unchanged.
- */
-int paper_parse_count(const char *arg, size_t *out);
-int paper_parse_time(const char *arg, double *out);
-
 #endif

@@ -6,7 +6,7 @@
  * ("example,k,N,h,max_err_state,max_err_w,max_err_v", the columns of
  * ../shared/reference/errors_ex41_ex42.csv).
  *
- * Usage: paper_summary [order.csv]
+ * Usage: paper_summary [order.csv]; paper_summary --help
  *
  * The errors are maxima over t_p in [-tau, T] against the exact solutions
  * (4.8) and (4.10); the observed order is the least-squares slope of
@@ -14,10 +14,13 @@
  * solver run alone (no output), measured with clock().
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 #include <time.h>
 
+#include "cli.h"
 #include "paper.h"
 
 enum { N_PAPER = 9991, ORDER_RUNS = 18 };
@@ -99,12 +102,23 @@ int main(int argc, char **argv)
     FILE *csv = NULL;
     double study_seconds = 0;
     int failed = 0;
-    if (argc > 1) {
-        csv = fopen(argv[1], "w");
-        if (!csv) {
-            perror(argv[1]);
-            return 1;
-        }
+    const char *csv_path = NULL;
+    const cli_arg args[] = {{"order.csv", CLI_PATH, &csv_path, 0,
+                             "also write the errors of the order study to this CSV file"}};
+    const cli_program prog = {
+        "paper_summary",
+        "The summary table of the paper's Section 4: Examples 4.1-4.3 at h = 1/9991 and the\n"
+        "order study of Figure 4.3 (h = 1/(1001 + 50k), k = 1..18) for Examples 4.1 and 4.2.",
+        "stdout: the table (errors, observed orders, static and dynamic phases, CPU time).\n"
+        "order.csv: \"example,k,N,h,max_err_state,max_err_w,max_err_v\", one row per run.\n"
+        "exit status: 0, 1 if a run fails or the CSV cannot be written, 2 for a bad\n"
+        "  argument (also an order.csv that cannot be opened).",
+        args, 1};
+    cli_parse(&prog, argc, argv);
+    if (csv_path) {
+        csv = fopen(csv_path, "w");
+        if (!csv)
+            cli_reject(&prog, "order.csv", csv_path, strerror(errno));
         fputs("example,k,N,h,max_err_state,max_err_w,max_err_v\n", csv);
     }
     puts("Paper, Section 4 (b = alpha = tau = 1, h = 1/9991).  error: max over t_p in [-1, T] of");
@@ -138,7 +152,7 @@ int main(int argc, char **argv)
            study_seconds);
     puts("a finite number of static and dynamic phases for Example 4.3 (Figures 4.4, 4.5).");
     if (csv && fclose(csv) != 0) {
-        perror(argv[1]);
+        perror(csv_path);
         failed = 1;
     }
     return failed;

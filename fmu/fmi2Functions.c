@@ -9,6 +9,7 @@
  * (FMI 2.0: with the default "false", an FMU must not call malloc itself).
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
+#include <stdio.h>
 #include <string.h>
 
 #include "fmi2Functions.h"
@@ -115,6 +116,10 @@ fmi2Status fmi2Reset(fmi2Component c)
 
 static int get_real(const model *m, unsigned vr, void *values, size_t i, char *err)
 {
+    if (vr == VR_time) { /* FMI 3.0's independent variable: not a variable of FMI 2.0 */
+        snprintf(err, MODEL_ERRLEN, "value reference %u is not a Real variable", vr);
+        return -1;
+    }
     return model_get_real(m, vr, (fmi2Real *)values + i, err);
 }
 

@@ -91,13 +91,27 @@ static int rhs(double t, const double *u, double *out, void *user)
     return 0;
 }
 
-static int kernel(double s, double *out, void *user)
+/* H(s) = H_c0 + H_c1 exp(-H_lambda s) + sum_k H_a{k} cos(H_omega{k} s) as a
+ * sum of exponentials (entry (1, 0) of the kernel), the terms with a zero
+ * coefficient left out, so that the default method is the O(1) recursion.
+ * A growing term (H_lambda < 0, H_c1 != 0) is refused by the recursion; the
+ * default method is then the direct sum (the FMU is built without the FFT). */
+static int set_kernel(const model *m, dmi_solver *s)
 {
-    const double *r = ((const model *)user)->real;
-    out[2] = r[VR_H_c0] + r[VR_H_c1] * exp(-r[VR_H_lambda] * s) +
-             r[VR_H_a1] * cos(r[VR_H_omega1] * s) +
-             r[VR_H_a2] * cos(r[VR_H_omega2] * s) + r[VR_H_a3] * cos(r[VR_H_omega3] * s);
-    return 0;
+    const double *r = m->real;
+    const double coef[5] = {r[VR_H_c0], r[VR_H_c1], r[VR_H_a1], r[VR_H_a2], r[VR_H_a3]};
+    const double rate[5] = {0.0, -r[VR_H_lambda], 0.0, 0.0, 0.0};
+    const double freq[5] = {0.0, 0.0, r[VR_H_omega1], r[VR_H_omega2], r[VR_H_omega3]};
+    double a[5], b[5], C[5 * 4] = {0};
+    size_t K = 0;
+    for (size_t k = 0; k < 5; k++)
+        if (coef[k] != 0) {
+            a[K] = rate[k];
+            b[K] = freq[k];
+            C[4 * K + 2] = coef[k];
+            K++;
+        }
+    return K ? dmi_set_kernel_exp(s, K, a, b, C, NULL) : dmi_set_kernel(s, NULL, NULL);
 }
 
 static int history(double t, double *out, void *user)
@@ -130,13 +144,24 @@ static int memory_fail(char *err, const char *what, int N)
 }
 
 /* A new solver for the parameters of m: only the history ring of (N + 1) * 2
- * values is allocated, nothing is sampled yet. */
+ * values is allocated and the kernel's terms are set (they make part of the
+ * state's size), nothing is sampled yet. */
 static int solver_create(const model *m, dmi_solver **out, char *err)
 {
     int rc = dmi_create(out, 2, m->real[VR_tau], (size_t)m->N);
     if (rc == DMI_ENOMEM)
         return memory_fail(err, "creating the solver", m->N);
-    return rc == DMI_OK ? 0 : solver_fail(err, "creating the solver (tau, N)", NULL, rc);
+    if (rc != DMI_OK)
+        return solver_fail(err, "creating the solver (tau, N)", NULL, rc);
+    if ((rc = set_kernel(m, *out)) != DMI_OK) {
+        if (rc == DMI_ENOMEM)
+            memory_fail(err, "setting the kernel", m->N);
+        else
+            solver_fail(err, "setting the kernel", *out, rc);
+        dmi_free(out);
+        return -1;
+    }
+    return 0;
 }
 
 /* Sets the model's callbacks and friction on s and samples the kernel and
@@ -145,7 +170,7 @@ static int solver_init(model *m, dmi_solver *s, char *err)
 {
     const double alpha[2] = {0.0, m->real[VR_alpha]};
     int rc;
-    if ((rc = dmi_set_rhs(s, rhs, m)) != DMI_OK || (rc = dmi_set_kernel(s, kernel, m)) != DMI_OK ||
+    if ((rc = dmi_set_rhs(s, rhs, m)) != DMI_OK ||
         (rc = dmi_set_history(s, history, m)) != DMI_OK ||
         (rc = dmi_set_friction(s, alpha)) != DMI_OK || (rc = dmi_init(s)) != DMI_OK)
         return rc == DMI_ENOMEM ? memory_fail(err, "initialising the solver", m->N)

@@ -78,8 +78,9 @@ int model_get_boolean(const model *m, unsigned vr, int *value, char *err);
 #define MODEL_NOTE_BYTES 100e6
 /* The memory the solver takes per step of the history, about: the peak
  * resident memory of initialization and the first step, measured for
- * N = 2e6 and 8e6 (history, kernel samples, delay-sum engine). */
-#define MODEL_BYTES_PER_STEP 104
+ * N = 2e6 and 8e6 (history and its copy at initialization; the kernel as
+ * exponential terms, or its samples for the direct sum). */
+#define MODEL_BYTES_PER_STEP 40
 double model_solver_bytes(int N);
 int model_start(model *m, double t_start, char *err, char *note);
 

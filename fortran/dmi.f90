@@ -12,6 +12,9 @@
 !   as in C: entry (i, j) (1-based) is out((i - 1) * n + j).
 ! - dmi_version, dmi_last_error and dmi_strerror return a Fortran string
 !   (a copy), not a C pointer.
+! - dmi_set_kernel_exp (since 1.1) needs the array d (C accepts NULL for all
+!   D_k = 0: pass zeros).  c and d hold K n x n matrices, each row-major as
+!   above: entry (i, j) of term k (1-based) is c((k - 1) * n * n + (i - 1) * n + j).
 ! - dmi_get_step_terms needs both arrays (C accepts NULL for either).
 ! - The state buffer of dmi_state_save / dmi_state_load is an array of
 !   integer(c_int8_t) of dmi_state_size(s) elements.
@@ -26,7 +29,7 @@ module dmi
 
   ! Version of this binding (the same as the C header it mirrors).
   integer(c_int), parameter, public :: DMI_VERSION_MAJOR = 1
-  integer(c_int), parameter, public :: DMI_VERSION_MINOR = 0
+  integer(c_int), parameter, public :: DMI_VERSION_MINOR = 1
   integer(c_int), parameter, public :: DMI_VERSION_PATCH = 0
 
   ! Error codes.
@@ -41,11 +44,12 @@ module dmi
   integer(c_int), parameter, public :: DMI_CONV_AUTO = 0
   integer(c_int), parameter, public :: DMI_CONV_DIRECT = 1
   integer(c_int), parameter, public :: DMI_CONV_FFT = 2
+  integer(c_int), parameter, public :: DMI_CONV_RECURSIVE = 3 ! (since 1.1)
 
   public :: dmi_rhs_fn, dmi_resolvent_fn, dmi_kernel_fn, dmi_history_fn
   public :: dmi_version, dmi_create, dmi_free
   public :: dmi_set_rhs, dmi_set_resolvent, dmi_set_friction, dmi_set_box
-  public :: dmi_set_kernel, dmi_set_history, dmi_set_convolution
+  public :: dmi_set_kernel, dmi_set_kernel_exp, dmi_set_history, dmi_set_convolution
   public :: dmi_init, dmi_step, dmi_advance
   public :: dmi_time, dmi_get_step_index, dmi_get_h, dmi_get_state, dmi_get_past
   public :: dmi_get_step_terms
@@ -150,6 +154,14 @@ module dmi
       type(c_ptr), value :: user
       integer(c_int) :: rc
     end function dmi_set_kernel
+
+    function dmi_set_kernel_exp(s, k, a, b, c, d) result(rc) bind(C, name='dmi_set_kernel_exp')
+      import :: c_int, c_ptr, c_size_t, c_double
+      type(c_ptr), value :: s
+      integer(c_size_t), value :: k
+      real(c_double), intent(in) :: a(*), b(*), c(*), d(*)
+      integer(c_int) :: rc
+    end function dmi_set_kernel_exp
 
     function dmi_set_history(s, z, user) result(rc) bind(C, name='dmi_set_history')
       import :: c_int, c_ptr, c_funptr

@@ -1,6 +1,7 @@
 /*
  * libFuzzer target: the C API's create / set / init / step / save / load
- * sequence driven by the fuzzer's bytes.  The sizes, tau, every setter's
+ * sequence driven by the fuzzer's bytes (kernels as callbacks or as
+ * exponential terms, dmi_set_kernel_exp, every method).  The sizes, tau, every setter's
  * arguments (raw doubles included: NaN, Inf, subnormals), the callbacks'
  * misbehaviour (fail, NaN, +-Inf, huge values) and the order of calls come
  * from the input.  Besides the sanitizers, it aborts on a broken contract:
@@ -136,9 +137,30 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             rc = dmi_set_box(s, lo, hi);
             break;
         }
-        case 4:
-            rc = dmi_set_kernel(s, n == MODEL_n && byte(&in) % 4 ? model_kernel : NULL, &m);
+        case 4: {
+            uint8_t how = byte(&in);
+            if (how % 4 != 1) {
+                rc = dmi_set_kernel(s, n == MODEL_n && how % 4 ? model_kernel : NULL, &m);
+                break;
+            }
+            /* exponential terms (libdmi 1.1): K = 0..4, values from the
+             * input, any of a, b, C, D missing */
+            double a[4], b[4], C[4 * 9], D[4 * 9];
+            size_t K = byte(&in) % 5;
+            for (size_t t = 0; t < K; t++) {
+                a[t] = -fabs(value(&in)) * (byte(&in) < 240 ? 1 : -1); /* mostly not growing */
+                b[t] = value(&in);
+                for (size_t q = 0; q < n * n; q++) {
+                    C[t * n * n + q] = value(&in);
+                    D[t * n * n + q] = value(&in);
+                }
+            }
+            uint8_t miss = byte(&in);
+            rc = dmi_set_kernel_exp(s, K, miss == 1 ? NULL : a, miss == 2 ? NULL : b,
+                                    miss == 3 ? NULL : C, miss % 2 ? NULL : D);
+            stateful = 1;
             break;
+        }
         case 5:
             rc = dmi_set_history(s, n == MODEL_n && byte(&in) % 4 ? model_history : NULL, &m);
             break;

@@ -218,8 +218,8 @@ DMI_API int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user);
  * also how dmi_state_load restores it.  The recursion's sums are computed
  * afresh from the stored states (as at its periodic anchors), so switching
  * to RECURSIVE agrees with a run that used it all along up to rounding; its
- * sums are part of the saved state, so a state load continues bitwise.  A failed step leaves the engine
- * untouched, as the rest of the solver.
+ * sums are part of the saved state, so a state load continues bitwise.  A
+ * failed step leaves the engines untouched, as the rest of the solver.
  * Errors: DMI_EINVAL for another value (solver unchanged), for RECURSIVE as
  * said there (checked again by dmi_init, since the kernel may change), and for
  * DMI_CONV_FFT in a libdmi built without the FFT and GSL (compile definition

@@ -3,7 +3,8 @@
 # (scripts/deps.sh), builds everything in build/, runs the paper's examples and
 # writes into out/: the CSV of each example, Figures 4.1-4.5, the FMU's
 # Example 4.3 run by fmpy over the native run, the evidence for the erratum in
-# (4.4); prints the summary table.  Copies the figures to docs/figures/.
+# (4.4), the oscillator with a Prony-series memory (exponential kernel terms,
+# the recursion against the FFT); prints the summary table.  Copies the figures to docs/figures/.
 # Usage: scripts/main.sh
 # Environment: DMI_BUILD_DIR (default build), DMI_OUT_DIR (default out).
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -44,6 +45,9 @@ stage "summary table (order study of Figure 4.3 in $out/order.csv)"
 
 stage "erratum: scheme (4.4) as printed against (3.12)-(3.13), Example 4.2"
 "$ex/scheme44_as_printed" 10 10 2>&1 >"$out/scheme44.csv" | tee "$out/scheme44.txt"
+
+stage "Prony-series (viscoelastic) memory at N = 1e5: the recursion beside the FFT"
+"$ex/prony" 100000 20 | tee "$out/prony.txt"
 
 stage "FMU: Example 4.3 with fmpy"
 rm -f "$out/fmu43.csv" "$out/ex43_fmu_native.csv"

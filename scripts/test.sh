@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Runs every test: installs what is missing, builds, runs ctest (CUnit, pytest,
 # gfortran and packaging tests), then the same suite built with
-# -fsanitize=address,undefined, then the suite under valgrind memcheck, then
+# -fsanitize=address,undefined, then the threads test (label "threads")
+# built with -fsanitize=thread, then the suite under valgrind memcheck, then
 # each libFuzzer target for a bounded time.  Usage: scripts/test.sh
-#   DMI_BUILD_PREFIX   build directories <prefix>, <prefix>-asan, <prefix>-fuzz
-#                      (default: build)
+#   DMI_BUILD_PREFIX   build directories <prefix>, <prefix>-asan, <prefix>-tsan,
+#                      <prefix>-fuzz (default: build)
 #   DMI_FUZZ_SECONDS   fuzzing time per target (default: 60)
 # Test labels: "nosan" = not run in the sanitizer build nor under valgrind
 # (Python loading a sanitized .so, abidiff, resident-memory bounds),
@@ -43,6 +44,14 @@ cmake -S . -B "$build-asan" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DDMI_SANITIZE=ON 
 cmake --build "$build-asan" -j "$jobs"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir "$build-asan" --output-on-failure -j "$jobs" -LE nosan
+
+stage "build with -fsanitize=thread and the threads test"
+# Only what tests/threads needs (libdmi, the FMU, the test): solvers and FMU
+# instances on 8 threads.  A data race stops the test with exit code 66.
+cmake -S . -B "$build-tsan" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDMI_SANITIZE_THREAD=ON \
+  -DPython3_EXECUTABLE="$py" >/dev/null
+cmake --build "$build-tsan" -j "$jobs" --target test_threads
+TSAN_OPTIONS=halt_on_error=1:exitcode=66 ctest --test-dir "$build-tsan" --output-on-failure -L threads
 
 stage "valgrind memcheck of the ctest suite"
 # Each test runs under valgrind; an invalid access or a leak makes valgrind

@@ -77,11 +77,12 @@ static int has_expk(const dmi_solver *s)
     return s->H == dmi_expk_eval;
 }
 
-/* Index of the first growing term (a_k > 0) of the exponential kernel, or K. */
+/* Index of the first growing term (a_k > 0, C_k or D_k not zero) of the
+ * exponential kernel, or K. */
 static size_t first_growing(const dmi_solver *s)
 {
     size_t k = 0;
-    while (k < s->expk.K && !(s->expk.a[k] > 0))
+    while (k < s->expk.K && !(s->expk.a[k] > 0 && dmi_expk_term_used(&s->expk, k)))
         k++;
     return k;
 }

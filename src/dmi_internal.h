@@ -80,9 +80,10 @@ double dmi_dot(const double *a, const double *b, size_t len);
 void dmi_delay_sum(const dmi_kernel *k, const dmi_history *r, double h, double *W);
 
 /*
- * The FFT method (conv.c, absent when built with DMI_NO_FFT): an exact block convolution engine whose whole
- * state is a function of p, the kernel and the history ring, so it can be
- * rebuilt from them at any p with bitwise the same future results.
+ * The FFT method (conv.c, absent when built with DMI_NO_FFT): an exact block
+ * convolution engine whose whole state is a function of p, the kernel and
+ * the history ring, so it can be rebuilt from them at any p with bitwise the
+ * same future results.
  */
 typedef struct dmi_conv dmi_conv;
 

@@ -212,6 +212,14 @@ static int column_used(const dmi_expk *k, size_t t, size_t j)
     return 0;
 }
 
+int dmi_expk_term_used(const dmi_expk *k, size_t t)
+{
+    for (size_t j = 0; j < k->n; j++)
+        if (column_used(k, t, j))
+            return 1;
+    return 0;
+}
+
 size_t dmi_expk_sums(const dmi_expk *k)
 {
     size_t count = 0;
@@ -305,6 +313,14 @@ static void term_init(term *t, double a, double b, double h, size_t N)
         w = cdd_mul(w, r);
     }
     t->rB = w;
+    /* Only N = 1 can have finite samples H(0) but an r that overflows (a h
+     * or b h beyond the range): then r^l, l >= 1, weighs nothing. */
+    if (!(isfinite(t->rh_re) && isfinite(t->rh_im) && isfinite(t->rl_re) &&
+          isfinite(t->rl_im) && isfinite(t->rN_re) && isfinite(t->rN_im))) {
+        memset(t, 0, sizeof *t);
+        t->real = b == 0;
+        t->tab[0] = 1.0;
+    }
 }
 
 int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)

@@ -31,6 +31,9 @@ void dmi_expk_release(dmi_expk *k);
 /* H(s) of the kernel: a dmi_kernel_fn, user = the dmi_expk. */
 int dmi_expk_eval(double s, double *out, void *user);
 
+/* Whether term t has a nonzero entry in C_t or D_t. */
+int dmi_expk_term_used(const dmi_expk *k, size_t t);
+
 /* Number of sums S_kj of the recursion (terms times their used columns). */
 size_t dmi_expk_sums(const dmi_expk *k);
 

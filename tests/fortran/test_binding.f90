@@ -210,6 +210,34 @@ program test_binding
   call expect_ok(dmi_get_step_index(s, index), 'dmi_get_step_index')
   call check(index == 2, 'step index after two steps')
   call dmi_free(s)
+
+  ! ---- an exponential kernel (libdmi 1.1), summed by the recursion ------------
+  ! H(s) = [[0.5 exp(-s), 0], [0.2 cos 3s, 0.1 sin 3s]], z = (1, -1), f = 0:
+  ! W^0 = h sum_{l<4} H(l h) (1, -1), written out here.
+  call expect_ok(dmi_create(s, int(n, c_size_t), tau, int(n_tau, c_size_t)), 'dmi_create')
+  call expect_ok(dmi_set_history(s, c_funloc(constant_history), c_null_ptr), 'dmi_set_history')
+  call expect_ok(dmi_set_kernel(s, c_funloc(kernel), c_null_ptr), 'dmi_set_kernel')
+  call check(dmi_set_convolution(s, DMI_CONV_RECURSIVE) == DMI_EINVAL, &
+             'RECURSIVE accepted a callback kernel')
+  call check(dmi_set_kernel_exp(s, 0_c_size_t, [0.0_c_double], [0.0_c_double], [0.0_c_double], &
+             [0.0_c_double]) == DMI_EINVAL, 'dmi_set_kernel_exp with K = 0')
+  call expect_ok(dmi_set_kernel_exp(s, 2_c_size_t, [-1.0_c_double, 0.0_c_double], &
+                 [0.0_c_double, 3.0_c_double], &
+                 [0.5_c_double, 0.0_c_double, 0.0_c_double, 0.0_c_double, &
+                  0.0_c_double, 0.0_c_double, 0.2_c_double, 0.0_c_double], &
+                 [0.0_c_double, 0.0_c_double, 0.0_c_double, 0.0_c_double, &
+                  0.0_c_double, 0.0_c_double, 0.0_c_double, 0.1_c_double]), 'dmi_set_kernel_exp')
+  call expect_ok(dmi_set_convolution(s, DMI_CONV_RECURSIVE), 'dmi_set_convolution(RECURSIVE)')
+  call expect_ok(dmi_init(s), 'dmi_init')
+  call expect_ok(dmi_step(s), 'dmi_step')
+  call expect_ok(dmi_get_step_terms(s, w, x), 'dmi_get_step_terms')
+  we(:, 0) = 0
+  do lag = 0, n_tau - 1
+    we(1, 0) = we(1, 0) + h * 0.5_c_double * exp(-lag * h)
+    we(2, 0) = we(2, 0) + h * (0.2_c_double * cos(3 * lag * h) - 0.1_c_double * sin(3 * lag * h))
+  end do
+  call check(all(abs(w - we(:, 0)) <= 1e-15_c_double), 'W^0 of the exponential kernel')
+  call dmi_free(s)
   deallocate(buf, message) ! (main program variables are not freed at its end)
 
   if (failures > 0) then

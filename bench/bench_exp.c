@@ -1,0 +1,124 @@
+/*
+ * Benchmark of exponential-sum kernels (issue 13; not a test): Example 4.3
+ * (tau = 1, h = 1/N) with its kernel cos 2 pi s + cos 10 pi s + cos 20 pi s
+ * given as three exponential terms (dmi_set_kernel_exp) under the default
+ * method (AUTO, which takes the recursion), at N = 10^3, 10^4, 10^5, 10^6,
+ * beside the same model without the delay term, the kernel as a callback
+ * under the default method (the FFT) and under DIRECT.  The first two are
+ * stepped in alternating chunks of CHUNK steps, so machine load hits them
+ * alike; the FFT runs after them (alternating with it, its megabytes of
+ * spectra evict their data) and DIRECT last, with at most 10^9 / N steps.  All of it is
+ * repeated (reps times) and the fastest repetition counts; the times are CPU
+ * times of the process (the machine may be shared).  Prints ns per
+ * step and the ratios, and the largest deviation of the recursion's states
+ * from the FFT's, relative to max |U|.
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include "clock.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "cli.h"
+#include "run.h"
+
+#define CHUNK 30000
+
+enum { REC, NODELAY, FFT, DIRECT, KINDS };
+
+static int start(run *r, size_t N, int kind, size_t steps)
+{
+    static const double PI = 3.14159265358979323846;
+    const double a[3] = {0, 0, 0}, b[3] = {2 * PI, 10 * PI, 20 * PI};
+    const double C[12] = {0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0}; /* entry (1, 0) of each */
+    r->ex.example = 43;
+    r->secs = 0;
+    r->w = malloc(2 * steps * sizeof *r->w);
+    if (!r->w)
+        return DMI_ENOMEM;
+    int rc = dmi_create(&r->s, 2, 1.0, N);
+    if (rc == DMI_OK)
+        rc = paper_setup(r->s, &r->ex);
+    if (rc == DMI_OK && kind == REC)
+        rc = dmi_set_kernel_exp(r->s, 3, a, b, C, NULL);
+    if (rc == DMI_OK && kind == NODELAY)
+        rc = dmi_set_kernel(r->s, NULL, NULL);
+    if (rc == DMI_OK)
+        rc = dmi_set_convolution(r->s, kind == DIRECT ? DMI_CONV_DIRECT : DMI_CONV_AUTO);
+    if (rc == DMI_OK)
+        rc = dmi_init(r->s);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    size_t steps = 300000, reps = 5;
+    const cli_arg args[] = {{"steps", CLI_COUNT, &steps, 1e8,
+                             "steps of each method at each N (DIRECT: at most 10^9 / N)"},
+                            {"reps", CLI_COUNT, &reps, 100,
+                             "repetitions; the fastest counts for each method"}};
+    const cli_program prog = {
+        "bench_exp",
+        "Times Example 4.3 with its kernel as three exponential terms (default method: the\n"
+        "recursion) at N = 1e3 .. 1e6, beside the model without the delay term, the kernel\n"
+        "as a callback (default method: FFT) and DIRECT.",
+        "stdout: a table of ns per step and ratios (a few seconds to a minute).\n"
+        "exit status: 0, 1 if a solver fails, 2 for a bad argument.",
+        args, 2};
+    cli_parse(&prog, argc, argv);
+
+    static const char *names[KINDS] = {"exp (rec)", "no delay", "callback (FFT)", "DIRECT"};
+    printf("Example 4.3, tau = 1, h = 1/N, %zu steps per method (DIRECT: at most 1e9/N), "
+           "best of %zu\n", steps, reps);
+    printf("%8s | %10s %10s %8s | %14s %10s | %11s\n", "N", names[REC], names[NODELAY],
+           "rec/nodel", names[FFT], names[DIRECT], "dev rec-FFT");
+    const size_t Ns[4] = {1000, 10000, 100000, 1000000};
+    double rec[4], worst_over = 0;
+    for (int k = 0; k < 4; k++) {
+        const size_t N = Ns[k], dsteps = steps < 1000000000 / N ? steps : 1000000000 / N;
+        double ns[KINDS] = {INFINITY, INFINITY, INFINITY, INFINITY}, dev = 0, big = 0;
+        int rc = DMI_OK;
+        for (size_t rep = 0; rep < reps && rc == DMI_OK; rep++) {
+            run r[KINDS] = {{0}};
+            for (int i = 0; i < FFT + 1 && rc == DMI_OK; i++)
+                rc = start(&r[i], N, i, steps);
+            for (size_t p = 0; p < steps && rc == DMI_OK; p += CHUNK)
+                for (int i = 0; i < NODELAY + 1 && rc == DMI_OK; i++)
+                    rc = chunk(&r[i], p, p + CHUNK < steps ? p + CHUNK : steps, cpu_now);
+            if (rc == DMI_OK)
+                rc = chunk(&r[FFT], 0, steps, cpu_now);
+            for (size_t q = 0; rc == DMI_OK && q < 2 * steps; q++) {
+                dev = fmax(dev, fabs(r[REC].w[q] - r[FFT].w[q]));
+                big = fmax(big, fabs(r[FFT].w[q]));
+            }
+            for (int i = 0; i < FFT + 1; i++) {
+                ns[i] = fmin(ns[i], 1e9 * r[i].secs / (double)steps);
+                finish(&r[i]);
+            }
+            if (rc == DMI_OK)
+                rc = start(&r[DIRECT], N, DIRECT, dsteps);
+            if (rc == DMI_OK)
+                rc = chunk(&r[DIRECT], 0, dsteps, cpu_now);
+            ns[DIRECT] = fmin(ns[DIRECT], 1e9 * r[DIRECT].secs / (double)dsteps);
+            finish(&r[DIRECT]);
+        }
+        if (rc != DMI_OK) {
+            fprintf(stderr, "bench_exp: N = %zu: %s\n", N, dmi_strerror(rc));
+            return 1;
+        }
+        rec[k] = ns[REC];
+        worst_over = fmax(worst_over, ns[REC] / ns[NODELAY]);
+        printf("%8zu | %10.1f %10.1f %8.2fx | %14.1f %10.1f | %11.2e\n", N, ns[REC], ns[NODELAY],
+               ns[REC] / ns[NODELAY], ns[FFT], ns[DIRECT], dev / big);
+        fflush(stdout);
+    }
+    double lo = rec[0], hi = rec[0];
+    for (int k = 1; k < 4; k++) {
+        lo = fmin(lo, rec[k]);
+        hi = fmax(hi, rec[k]);
+    }
+    printf("recursion: slowest / fastest N = %.2fx; at most %.2fx the model without delay\n",
+           hi / lo, worst_over);
+    return 0;
+}
