@@ -371,8 +371,8 @@ int dmi_set_kernel_exp(dmi_solver *s, size_t K, const double *a, const double *b
         if (!isfinite(b[k]))
             return fail(s, DMI_EINVAL, "%s: b[%zu] = %g is not finite", fn, k, b[k]);
     }
-    const size_t n = s->n, nn = n * n; /* n * n * K doubles: checked by dmi_expk_copy */
-    if (dmi_mul_size(K, nn, sizeof(double)) == 0)
+    const size_t n = s->n, nn = n * n; /* (used only if n n K doubles fit in size_t) */
+    if (dmi_mul_size(n, n, 1) == 0 || dmi_mul_size(K, nn, sizeof(double)) == 0)
         return fail(s, DMI_ENOMEM, "%s: %zu terms of %zu x %zu matrices overflow", fn, K, n, n);
     for (size_t q = 0; q < K * nn; q++) {
         if (!isfinite(C[q]))

@@ -20,8 +20,9 @@
  * That costs N multiply-adds per sum every PERIOD N steps, O(1) per step.
  * Growing terms (a_k > 0, |r| > 1) would multiply each step's rounding by
  * |r| every step: dmi.c refuses them for this method.
- * Double-double needs only C99 (fma); no long double, whose precision
- * differs between compilers.
+ * Double-double needs only C99 (fma) and arithmetic evaluated in double
+ * (FLT_EVAL_METHOD 0: SSE2, every 64-bit target; not the x87 of 32-bit x86);
+ * no long double, whose precision differs between compilers.
  */
 #include "exp.h"
 
@@ -107,7 +108,7 @@ static cdd cdd_one(void)
     return r;
 }
 
-/* exp(z), z = (x, y) in double-double: scaled to |z| <= 2^-10, Taylor
+/* exp(z), z = (x, y) in double-double: scaled to |z| <= 2^-10 (0.0009765625), Taylor
  * series (Horner, 14 terms), squared back. */
 static cdd cdd_exp(dd x, dd y)
 {
@@ -115,7 +116,7 @@ static cdd cdd_exp(dd x, dd y)
     if (x.hi < -746.0) /* underflows whatever y is */
         return zero;
     int m = 0;
-    for (double mag = fabs(x.hi) + fabs(y.hi); mag > 0x1p-10 && m < 2100; mag /= 2)
+    for (double mag = fabs(x.hi) + fabs(y.hi); mag > 0.0009765625 && m < 2100; mag /= 2)
         m++;
     cdd w = {dd_scale(x, -m), dd_scale(y, -m)};
     cdd t = cdd_one();
@@ -157,7 +158,7 @@ int dmi_expk_copy(dmi_expk *k, size_t n, size_t K, const double *a, const double
                   const double *C, const double *D)
 {
     memset(k, 0, sizeof *k);
-    size_t mat = dmi_mul_size(K, n * n, sizeof(double)); /* n * n: dmi_create checked it */
+    size_t mat = dmi_mul_size(K, n * n, sizeof(double)); /* n * n: the caller checked it */
     if (mat == 0)
         return -1;
     k->a = malloc(K * sizeof *k->a);

@@ -3,6 +3,9 @@
 # the outputs of a native libdmi run with the kernel as a callback (sampled,
 # default method) to 1e-12.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+import glob
+import subprocess
+
 import numpy as np
 import pytest
 from fmpy import simulate_fmu
@@ -27,3 +30,14 @@ def test_kernel_terms_match_native(fmu_path, libdmi, params):
     assert err <= 1e-12, f"max deviation {err:.3g}"
     assert np.array_equal(got[:, 4], want[:, 4])
     assert np.max(np.abs(got[:, 3])) > 1e-3  # the delay term is not trivial
+
+
+def test_binary_has_no_fft_and_no_gsl(unzipdir):
+    """The FMU is built from libdmi's GSL-free core: no gsl_ symbol at all (nm),
+    defined or undefined, and no FFT engine."""
+    so = glob.glob(f"{unzipdir}/binaries/linux64/*.so")
+    assert len(so) == 1
+    names = subprocess.run(["nm", so[0]], capture_output=True, text=True, check=True).stdout
+    assert "dmi_set_kernel_exp" in names  # (nm sees the symbol table: the check is not blind)
+    assert "gsl_" not in names
+    assert "dmi_conv_" not in names
