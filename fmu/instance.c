@@ -156,16 +156,6 @@ fmu_instance *fmu_enter(void *c, fmu_fn which, const char *fn)
     return in;
 }
 
-unsigned fmu_state(const fmu_instance *in)
-{
-    return in->state;
-}
-
-model *fmu_model(fmu_instance *in)
-{
-    return &in->m;
-}
-
 double fmu_time(const fmu_instance *in)
 {
     return in->m.t_comm;

@@ -91,9 +91,6 @@ fmu_status fmu_error(fmu_instance *in, const char *fn, const char *fmt, ...);
  * already (an error or warning), returns st. */
 fmu_status fmu_leave(fmu_instance *in, const char *fn, fmu_status st);
 
-unsigned fmu_state(const fmu_instance *in);
-model *fmu_model(fmu_instance *in);
-
 fmu_status fmu_set_debug_logging(fmu_instance *in, const char *fn, int on, size_t n,
                                  const char *const categories[]);
 void fmu_free_instance(fmu_instance *in, const char *fn);

@@ -45,7 +45,7 @@ static const char *fmi3_words(const char *text, char *buf, size_t size)
     static const char *const WORDS[][2] = {
         {"fmi2SetupExperiment", "fmi3EnterInitializationMode"},
         {"fmi2Instantiate", "fmi3InstantiateCoSimulation"},
-        {"fmi2ModelExchange", "model exchange (fmi3InstantiateModelExchange)"},
+        {"fmuType = fmi2ModelExchange", "a model-exchange instance"},
         {"DeSerialize", "Deserialize"}, {"FMUstate", "FMUState"}, {"Real", "Float64"},
         {"Integer", "Int32"}, {"fmi2", "fmi3"}};
     size_t n = 0;
@@ -79,6 +79,8 @@ static void row(const char *id, const char *fn, const char *input, const char *r
         return;
     }
     char fn3[128], input3[256], result3[64];
+    if (strstr(input, "fmi2ModelExchange")) /* F05: the function of that interface type */
+        fn = "fmi3InstantiateModelExchange";
     printf("| G%s | `%s` | %s | %s | %s |\n", id + 1, fmi3_words(fn, fn3, sizeof fn3),
            fmi3_words(input, input3, sizeof input3), fmi3_words(result, result3, sizeof result3),
            msg);
