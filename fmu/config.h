@@ -16,6 +16,9 @@
 #define DMI_FMU_CONFIG_H
 
 #define MODEL_NAME "DelayFrictionOscillator"
+/* The GUID (FMI 2.0) and instantiationToken (FMI 3.0); fmu/CMakeLists.txt
+ * reads it from here for the model descriptions and the tests. */
+#define DMI_FMU_GUID "{5f0c3a8e-6d2b-4c71-9e15-a3d4b7c80e42}"
 
 /* Kinds: type, causality and variability. */
 #define MODEL_REAL_PARAMETER 0 /* Real (Float64), parameter, fixed */

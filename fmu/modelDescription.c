@@ -2,7 +2,9 @@
  * Writes the FMU's modelDescription.xml for FMI 2.0 or 3.0 from the one
  * variable table of config.h; run at build time.
  *
- * Usage: modelDescription 2|3 GUID VERSION OUTPUT
+ * Usage: modelDescription 2|3 GUID VERSION OUTPUT [SOURCE...]
+ * The SOURCEs (FMI 2.0: the C files of sources/) go into <SourceFiles>; FMI
+ * 3.0 lists them in sources/buildDescription.xml instead.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include <stdio.h>
@@ -51,7 +53,8 @@ static void attr(FILE *f, const char *text)
         }
 }
 
-static void header(FILE *f, int v, const char *guid, const char *version)
+static void header(FILE *f, int v, const char *guid, const char *version, int nsources,
+                   char **sources)
 {
     fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
                "<!-- The friction oscillator (4.1) with a delay term of convolution, by libdmi.\n"
@@ -79,9 +82,20 @@ static void header(FILE *f, int v, const char *guid, const char *version)
                    "    maxOutputDerivativeOrder=\"0\"\n"
                    "    canNotUseMemoryManagementFunctions=\"true\"\n"
                    "    canGetAndSetFMUstate=\"true\"\n"
-                   "    canSerializeFMUstate=\"true\"/>\n",
+                   "    canSerializeFMUstate=\"true\"",
                 MODEL_NAME);
-    else /* no event mode, no early return, no intermediate update */
+    if (v == 2 && nsources == 0)
+        fprintf(f, "/>\n");
+    if (v == 2 && nsources > 0) {
+        fprintf(f, ">\n    <SourceFiles>\n");
+        for (int k = 0; k < nsources; k++) {
+            fprintf(f, "      <File name=\"");
+            attr(f, sources[k]);
+            fprintf(f, "\"/>\n");
+        }
+        fprintf(f, "    </SourceFiles>\n  </CoSimulation>\n");
+    }
+    if (v == 3) /* no event mode, no early return, no intermediate update */
         fprintf(f, "  <CoSimulation\n"
                    "    modelIdentifier=\"%s\"\n"
                    "    canHandleVariableCommunicationStepSize=\"true\"\n"
@@ -167,8 +181,8 @@ static void variables3(FILE *f)
 
 int main(int argc, char **argv)
 {
-    if (argc != 5 || (strcmp(argv[1], "2") != 0 && strcmp(argv[1], "3") != 0)) {
-        fprintf(stderr, "usage: modelDescription 2|3 GUID VERSION OUTPUT\n");
+    if (argc < 5 || (strcmp(argv[1], "2") != 0 && strcmp(argv[1], "3") != 0)) {
+        fprintf(stderr, "usage: modelDescription 2|3 GUID VERSION OUTPUT [SOURCE...]\n");
         return 2;
     }
     const int v = argv[1][0] - '0';
@@ -177,7 +191,7 @@ int main(int argc, char **argv)
         perror(argv[4]);
         return 1;
     }
-    header(f, v, argv[2], argv[3]);
+    header(f, v, argv[2], argv[3], argc - 5, argv + 5);
     if (v == 2)
         variables2(f);
     else
