@@ -10,25 +10,17 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Start values: Example 4.3 (b = alpha = tau = 1, N = 1000,
- * H(s) = cos 2 pi s + cos 10 pi s + cos 20 pi s, g(t) = 1.3 cos 8t, w0 = v0 = 0).
- * The same numbers are the start values in modelDescription.xml. */
-static const double REAL_START[MODEL_NREAL] = {
-    [VR_b] = 1.0, [VR_alpha] = 1.0, [VR_tau] = 1.0, [VR_w0] = 0.0, [VR_v0] = 0.0,
-    [VR_H_c0] = 0.0, [VR_H_c1] = 0.0, [VR_H_lambda] = 0.0,
-    [VR_H_a1] = 1.0, [VR_H_omega1] = 6.283185307179586,
-    [VR_H_a2] = 1.0, [VR_H_omega2] = 31.41592653589793,
-    [VR_H_a3] = 1.0, [VR_H_omega3] = 62.83185307179586,
-    [VR_g_offset] = 0.0, [VR_g_amp] = 1.3, [VR_g_omega] = 8.0, [VR_g_phase] = 0.0,
-    [VR_g_in] = 0.0,
-};
-static const int N_START = 1000;
-
-static const char *const REAL_NAME[MODEL_NREAL] = {
-    "b", "alpha", "tau", "w0", "v0", "H_c0", "H_c1", "H_lambda",
-    "H_a1", "H_omega1", "H_a2", "H_omega2", "H_a3", "H_omega3",
-    "g_offset", "g_amp", "g_omega", "g_phase", "g_in",
-};
+/* Start values (Example 4.3: b = alpha = tau = 1, N = 1000,
+ * H(s) = cos 2 pi s + cos 10 pi s + cos 20 pi s, g(t) = 1.3 cos 8t,
+ * w0 = v0 = 0) and names, from config.h as the model descriptions. */
+#define START_X(name, kind, start, description) [VR_##name] = start,
+#define START_Y(name, kind, description)
+static const double START[MODEL_NVARS] = {MODEL_VARIABLES(START_X, START_Y)};
+#undef START_X
+#undef START_Y
+#define NAME_X(name, kind, ...) [VR_##name] = #name,
+static const char *const NAME[MODEL_NVARS] = {MODEL_VARIABLES(NAME_X, NAME_X)};
+#undef NAME_X
 
 static int fail(char *err, const char *fmt, ...)
 {
@@ -41,8 +33,8 @@ static int fail(char *err, const char *fmt, ...)
 
 void model_defaults(model *m)
 {
-    memcpy(m->real, REAL_START, sizeof m->real);
-    m->N = N_START;
+    memcpy(m->real, START, sizeof m->real);
+    m->N = (int)START[VR_N];
     m->t_start = 0.0;
     m->t_comm = 0.0;
     m->solver = NULL;
@@ -62,7 +54,7 @@ int model_set_real(model *m, unsigned vr, double value, char *err)
 {
     if (vr >= MODEL_NREAL)
         return fail(err, "value reference %u is not a settable Real variable", vr);
-    const char *name = REAL_NAME[vr];
+    const char *name = NAME[vr];
     if (!isfinite(value))
         return fail(err, "%s = %g: the value must be finite", name, value);
     if (vr == VR_tau && !(value > 0))
@@ -137,16 +129,35 @@ static int solver_fail(char *err, const char *what, dmi_solver *s, int rc)
     return -1;
 }
 
+double model_solver_bytes(int N)
+{
+    return MODEL_BYTES_PER_STEP * (double)N;
+}
+
+/* Out of memory for N: the error names N and the bytes needed. */
+static int memory_fail(char *err, const char *what, int N)
+{
+    snprintf(err, MODEL_ERRLEN, "%s: out of memory: N = %d steps per tau need about %.0f bytes "
+                                "(%.3g GB, %d bytes per step)",
+             what, N, model_solver_bytes(N), model_solver_bytes(N) / 1e9, MODEL_BYTES_PER_STEP);
+    return -1;
+}
+
 /* A new solver for the parameters of m: only the history ring of (N + 1) * 2
  * values is allocated and the kernel's terms are set (they make part of the
  * state's size), nothing is sampled yet. */
 static int solver_create(const model *m, dmi_solver **out, char *err)
 {
     int rc = dmi_create(out, 2, m->real[VR_tau], (size_t)m->N);
+    if (rc == DMI_ENOMEM)
+        return memory_fail(err, "creating the solver", m->N);
     if (rc != DMI_OK)
         return solver_fail(err, "creating the solver (tau, N)", NULL, rc);
     if ((rc = set_kernel(m, *out)) != DMI_OK) {
-        solver_fail(err, "setting the kernel", *out, rc);
+        if (rc == DMI_ENOMEM)
+            memory_fail(err, "setting the kernel", m->N);
+        else
+            solver_fail(err, "setting the kernel", *out, rc);
         dmi_free(out);
         return -1;
     }
@@ -162,12 +173,19 @@ static int solver_init(model *m, dmi_solver *s, char *err)
     if ((rc = dmi_set_rhs(s, rhs, m)) != DMI_OK ||
         (rc = dmi_set_history(s, history, m)) != DMI_OK ||
         (rc = dmi_set_friction(s, alpha)) != DMI_OK || (rc = dmi_init(s)) != DMI_OK)
-        return solver_fail(err, "initialising the solver", s, rc);
+        return rc == DMI_ENOMEM ? memory_fail(err, "initialising the solver", m->N)
+                                : solver_fail(err, "initialising the solver", s, rc);
     return 0;
 }
 
-int model_start(model *m, double t_start, char *err)
+int model_start(model *m, double t_start, char *err, char *note)
 {
+    note[0] = '\0';
+    if (model_solver_bytes(m->N) > MODEL_NOTE_BYTES)
+        snprintf(note, MODEL_ERRLEN, "N = %d steps per tau: the solver allocates about %.0f bytes "
+                                     "(%.3g MB, %d bytes per step)",
+                 m->N, model_solver_bytes(m->N), model_solver_bytes(m->N) / 1e6,
+                 MODEL_BYTES_PER_STEP);
     dmi_solver *s = NULL;
     if (solver_create(m, &s, err) != 0)
         return -1;
@@ -180,6 +198,25 @@ int model_start(model *m, double t_start, char *err)
     m->t_start = t_start;
     m->t_comm = t_start;
     return 0;
+}
+
+int model_coarse_step(const model *m, double T, char *msg)
+{
+    const double b = m->real[VR_b], tau = m->real[VR_tau], h = tau / m->N;
+    if (!(b > 0) || !(T > 0))
+        return 0;
+    /* log of the growth (1 + h^2 b)^(T/h) over the experiment */
+    const double ln_growth = T / h * log1p(h * h * b);
+    if (!(ln_growth > log(MODEL_COARSE_GROWTH)))
+        return 0;
+    /* h b T <= ln 2 keeps the growth below 2: N >= tau b T / ln 2 */
+    const double n_min = ceil(tau * b * T / log(MODEL_COARSE_GROWTH));
+    snprintf(msg, MODEL_ERRLEN, "N = %d (h = %.3g) is a coarse step for b = %.3g: the scheme's "
+                                "explicit part amplifies an undamped oscillation by about "
+                                "(1 + h^2 b) = %.6g per step, 10^%.3g over T = %.3g; N >= %.3g "
+                                "keeps it below %g",
+             m->N, h, b, 1.0 + h * h * b, ln_growth / log(10.0), T, n_min, MODEL_COARSE_GROWTH);
+    return 1;
 }
 
 /* The number of steps taken when the FMU is at time t: every step whose start
@@ -243,7 +280,10 @@ static output_values outputs(const model *m)
         o.w = prev[0] + th * (U[0] - prev[0]);
         o.v = prev[1] + th * (U[1] - prev[1]);
     }
-    o.friction = (X[1] - U[1]) / h;
+    /* the element of alpha sigma(v) the step selected: in [-alpha, alpha],
+     * up to the rounding of (X - U)/h, which the clamp removes */
+    const double alpha = m->real[VR_alpha];
+    o.friction = fmin(fmax((X[1] - U[1]) / h, -alpha), alpha);
     o.delay_force = W[1];
     o.sticking = U[1] == 0.0;
     return o;
@@ -261,6 +301,7 @@ int model_get_real(const model *m, unsigned vr, double *value, char *err)
     case VR_v: *value = o.v; return 0;
     case VR_friction: *value = o.friction; return 0;
     case VR_delay_force: *value = o.delay_force; return 0;
+    case VR_time: *value = m->t_comm; return 0;
     default:
         return fail(err, "value reference %u is not a Real variable", vr);
     }

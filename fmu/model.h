@@ -11,8 +11,10 @@
  *
  * This file is the model's side of the FMU: its variables (value references,
  * start values, checks), its time stepping on the grid t_p = t_start + p h
- * and its saved state.  fmi2Functions.c, the FMI side, checks the calling
- * sequence and does the logging; it knows nothing about the oscillator.
+ * and its saved state.  instance.c, the FMI side common to FMI 2.0 and 3.0,
+ * checks the calling sequence and does the logging; fmi2Functions.c and
+ * fmi3Functions.c adapt it to each standard.  Neither knows about the
+ * oscillator.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #ifndef DMI_FMU_MODEL_H
@@ -21,21 +23,15 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "config.h"
 #include "dmi.h"
 
-/* Value references (the numbers in modelDescription.xml). */
-enum {
-    /* Real parameters, then the input and the Real outputs */
-    VR_b, VR_alpha, VR_tau, VR_w0, VR_v0,
-    VR_H_c0, VR_H_c1, VR_H_lambda,
-    VR_H_a1, VR_H_omega1, VR_H_a2, VR_H_omega2, VR_H_a3, VR_H_omega3,
-    VR_g_offset, VR_g_amp, VR_g_omega, VR_g_phase,
-    VR_g_in,
-    VR_w, VR_v, VR_friction, VR_delay_force,
-    /* Integer parameter, Boolean output */
-    VR_N,
-    VR_sticking
-};
+/* Value references (the numbers in both model descriptions): VR_<name>, in
+ * the order of config.h.  The Real variables that are set (parameters and
+ * g_in) come first, then the outputs, N, sticking. */
+#define MODEL_VR(name, kind, ...) VR_##name,
+enum { MODEL_VARIABLES(MODEL_VR, MODEL_VR) MODEL_NVARS };
+#undef MODEL_VR
 #define MODEL_NREAL (VR_g_in + 1) /* Real variables that are set: parameters and g_in */
 
 /* Interpolation and communication points: times closer than this fraction
@@ -73,8 +69,28 @@ int model_get_real(const model *m, unsigned vr, double *value, char *err);
 int model_get_integer(const model *m, unsigned vr, int *value, char *err);
 int model_get_boolean(const model *m, unsigned vr, int *value, char *err);
 
-/* Creates and initialises the solver from the parameters, at t_start. */
-int model_start(model *m, double t_start, char *err);
+/* The length of the default experiment (both model descriptions' stopTime). */
+#define MODEL_DEFAULT_T 30.0
+
+/* Creates and initialises the solver from the parameters, at t_start.  On
+ * failure, err tells why (for memory: N and the bytes needed).  note gets a
+ * message when the solver takes more than MODEL_NOTE_BYTES, else "". */
+#define MODEL_NOTE_BYTES 100e6
+/* The memory the solver takes per step of the history, about: the peak
+ * resident memory of initialization and the first step, measured for
+ * N = 2e6 and 8e6 (history and its copy at initialization; the kernel as
+ * exponential terms, or its samples for the direct sum). */
+#define MODEL_BYTES_PER_STEP 40
+double model_solver_bytes(int N);
+int model_start(model *m, double t_start, char *err, char *note);
+
+/* Whether the step h = tau/N is coarse for an experiment of length T: the
+ * explicit part of the scheme amplifies an undamped oscillation by about
+ * (1 + h^2 b) per step (b > 0), so by (1 + h^2 b)^(T/h) ~ exp(b h T) over the
+ * run; coarse when that exceeds MODEL_COARSE_GROWTH.  1 with the reason in
+ * msg, 0 if not. */
+#define MODEL_COARSE_GROWTH 2.0
+int model_coarse_step(const model *m, double T, char *msg);
 
 /* The communication step from t_current (which must be t_comm to within
  * MODEL_TIME_TOL h) to t_end = t_current + step, step > 0: takes every step

@@ -1,7 +1,10 @@
 /*
  * libFuzzer target: fmi2DeSerializeFMUstate of the fuzzer's bytes into an
  * instance of the FMU (loaded with dlopen, instrumented like this program),
- * then fmi2SetFMUstate and a few steps from the restored time.
+ * then fmi2SetFMUstate and a few steps from the restored time.  Built for
+ * each FMU: fuzz_fmu_state (FMI 2.0) and fuzz_fmu3_state (FMI 3.0, through
+ * tests/fmu/fmu_fmi3.c: fmi3DeserializeFMUState, ...; the same corpus, as
+ * both write the same bytes).
  *
  * Input: one flags byte, then the serialized state.  Flags bit 0: recompute
  * the state's checksums (the FMU's outer one and libdmi's inner one, layout of
@@ -51,7 +54,8 @@ static fmi2Component instance(int phase, const fmi2CallbackFunctions *cb)
     const fmi2ValueReference vrN = VR_N;
     const fmi2Integer N = 10;
     if (phase >= 1)
-        must(F.setup(c, fmi2False, 0, 0.0, fmi2False, 0) == fmi2OK && F.enter_init(c) == fmi2OK &&
+        /* stop time 1: N = 10 is no coarse step for so short an experiment (no warning) */
+        must(F.setup(c, fmi2False, 0, 0.0, fmi2True, 1.0) == fmi2OK && F.enter_init(c) == fmi2OK &&
              F.set_integer(c, &vrN, 1, &N) == fmi2OK);
     if (phase >= 2) {
         must(F.exit_init(c) == fmi2OK);
@@ -107,7 +111,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         must(again != NULL);
         free(again);
         fmi2Real t = 0;
-        if (F.get_real_status(c, fmi2LastSuccessfulTime, &t) == fmi2OK)
+        const fmi2ValueReference vr_time = VR_time; /* FMI 3.0: the variable time */
+        if (F.get_real_status ? F.get_real_status(c, fmi2LastSuccessfulTime, &t) == fmi2OK
+                              : F.get_real(c, &vr_time, 1, &t) == fmi2OK)
             for (int k = 0; k < 3; k++) {
                 errors = log.errors;
                 fmi2Status s = F.do_step(c, t, 0.01, fmi2True);

@@ -16,41 +16,52 @@ extern "C" {
 
 #define fmi2Version "2.0"
 
-fmi2GetTypesPlatformTYPE fmi2GetTypesPlatform;
-fmi2GetVersionTYPE fmi2GetVersion;
-fmi2SetDebugLoggingTYPE fmi2SetDebugLogging;
-fmi2InstantiateTYPE fmi2Instantiate;
-fmi2FreeInstanceTYPE fmi2FreeInstance;
-fmi2SetupExperimentTYPE fmi2SetupExperiment;
-fmi2EnterInitializationModeTYPE fmi2EnterInitializationMode;
-fmi2ExitInitializationModeTYPE fmi2ExitInitializationMode;
-fmi2TerminateTYPE fmi2Terminate;
-fmi2ResetTYPE fmi2Reset;
-fmi2GetRealTYPE fmi2GetReal;
-fmi2GetIntegerTYPE fmi2GetInteger;
-fmi2GetBooleanTYPE fmi2GetBoolean;
-fmi2GetStringTYPE fmi2GetString;
-fmi2SetRealTYPE fmi2SetReal;
-fmi2SetIntegerTYPE fmi2SetInteger;
-fmi2SetBooleanTYPE fmi2SetBoolean;
-fmi2SetStringTYPE fmi2SetString;
-fmi2GetFMUstateTYPE fmi2GetFMUstate;
-fmi2SetFMUstateTYPE fmi2SetFMUstate;
-fmi2FreeFMUstateTYPE fmi2FreeFMUstate;
-fmi2SerializedFMUstateSizeTYPE fmi2SerializedFMUstateSize;
-fmi2SerializeFMUstateTYPE fmi2SerializeFMUstate;
-fmi2DeSerializeFMUstateTYPE fmi2DeSerializeFMUstate;
-fmi2GetDirectionalDerivativeTYPE fmi2GetDirectionalDerivative;
+/* FMI2_Export marks the functions the binary exports.  A Windows DLL exports
+ * these and nothing else once one function is __declspec(dllexport); on ELF
+ * the version script fmu.map selects them. */
+#ifndef FMI2_Export
+#ifdef _WIN32
+#define FMI2_Export __declspec(dllexport)
+#else
+#define FMI2_Export
+#endif
+#endif
 
-fmi2SetRealInputDerivativesTYPE fmi2SetRealInputDerivatives;
-fmi2GetRealOutputDerivativesTYPE fmi2GetRealOutputDerivatives;
-fmi2DoStepTYPE fmi2DoStep;
-fmi2CancelStepTYPE fmi2CancelStep;
-fmi2GetStatusTYPE fmi2GetStatus;
-fmi2GetRealStatusTYPE fmi2GetRealStatus;
-fmi2GetIntegerStatusTYPE fmi2GetIntegerStatus;
-fmi2GetBooleanStatusTYPE fmi2GetBooleanStatus;
-fmi2GetStringStatusTYPE fmi2GetStringStatus;
+FMI2_Export fmi2GetTypesPlatformTYPE fmi2GetTypesPlatform;
+FMI2_Export fmi2GetVersionTYPE fmi2GetVersion;
+FMI2_Export fmi2SetDebugLoggingTYPE fmi2SetDebugLogging;
+FMI2_Export fmi2InstantiateTYPE fmi2Instantiate;
+FMI2_Export fmi2FreeInstanceTYPE fmi2FreeInstance;
+FMI2_Export fmi2SetupExperimentTYPE fmi2SetupExperiment;
+FMI2_Export fmi2EnterInitializationModeTYPE fmi2EnterInitializationMode;
+FMI2_Export fmi2ExitInitializationModeTYPE fmi2ExitInitializationMode;
+FMI2_Export fmi2TerminateTYPE fmi2Terminate;
+FMI2_Export fmi2ResetTYPE fmi2Reset;
+FMI2_Export fmi2GetRealTYPE fmi2GetReal;
+FMI2_Export fmi2GetIntegerTYPE fmi2GetInteger;
+FMI2_Export fmi2GetBooleanTYPE fmi2GetBoolean;
+FMI2_Export fmi2GetStringTYPE fmi2GetString;
+FMI2_Export fmi2SetRealTYPE fmi2SetReal;
+FMI2_Export fmi2SetIntegerTYPE fmi2SetInteger;
+FMI2_Export fmi2SetBooleanTYPE fmi2SetBoolean;
+FMI2_Export fmi2SetStringTYPE fmi2SetString;
+FMI2_Export fmi2GetFMUstateTYPE fmi2GetFMUstate;
+FMI2_Export fmi2SetFMUstateTYPE fmi2SetFMUstate;
+FMI2_Export fmi2FreeFMUstateTYPE fmi2FreeFMUstate;
+FMI2_Export fmi2SerializedFMUstateSizeTYPE fmi2SerializedFMUstateSize;
+FMI2_Export fmi2SerializeFMUstateTYPE fmi2SerializeFMUstate;
+FMI2_Export fmi2DeSerializeFMUstateTYPE fmi2DeSerializeFMUstate;
+FMI2_Export fmi2GetDirectionalDerivativeTYPE fmi2GetDirectionalDerivative;
+
+FMI2_Export fmi2SetRealInputDerivativesTYPE fmi2SetRealInputDerivatives;
+FMI2_Export fmi2GetRealOutputDerivativesTYPE fmi2GetRealOutputDerivatives;
+FMI2_Export fmi2DoStepTYPE fmi2DoStep;
+FMI2_Export fmi2CancelStepTYPE fmi2CancelStep;
+FMI2_Export fmi2GetStatusTYPE fmi2GetStatus;
+FMI2_Export fmi2GetRealStatusTYPE fmi2GetRealStatus;
+FMI2_Export fmi2GetIntegerStatusTYPE fmi2GetIntegerStatus;
+FMI2_Export fmi2GetBooleanStatusTYPE fmi2GetBooleanStatus;
+FMI2_Export fmi2GetStringStatusTYPE fmi2GetStringStatus;
 
 #ifdef __cplusplus
 }

@@ -1,7 +1,9 @@
 /*
- * The FMI 2.0 functions of an unpacked FMU binary, loaded with dlopen: the
- * one loader of the C importers in tests/ (fmu_master, the hardening tests,
- * the FMU fuzzer).
+ * The FMI 2.0 functions of an unpacked FMU binary, loaded with dlopen (or
+ * LoadLibrary under _WIN32): the one loader of the C importers in tests/
+ * (fmu_master, also built for Windows; the hardening tests, the FMU fuzzer).
+ * An FMI 3.0 binary is loaded behind the same FMI 2.0 function types
+ * (fmu_fmi3.h); version tells which one it is.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #ifndef FMU_LOADER_H
@@ -10,7 +12,8 @@
 #include "fmi2FunctionTypes.h"
 
 typedef struct {
-    void *lib;
+    void *lib;   /* the dlopen handle or the HMODULE */
+    int version; /* 2 or 3 */
     fmi2InstantiateTYPE *instantiate;
     fmi2FreeInstanceTYPE *free_instance;
     fmi2SetDebugLoggingTYPE *set_debug_logging;
@@ -39,7 +42,7 @@ typedef struct {
 } fmu_api;
 
 /* 0 on success; -1 (message on stderr) if the library or a function is missing. */
-int fmu_load(fmu_api *f, const char *so_path);
+int fmu_load(fmu_api *f, const char *so_path); /* .so or .dll */
 void fmu_unload(fmu_api *f);
 
 #endif

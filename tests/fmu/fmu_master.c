@@ -8,10 +8,14 @@
  * sequence, a zero step, truncated state bytes, reset), so that they run under the
  * sanitizers too.
  *
- * Usage: fmu_master FMU.so GUID ex43_N9991.csv T
+ * Usage: fmu_master FMU.so GUID ex43_N9991.csv T [outputs.csv]
+ * With outputs.csv: writes p, w, v at each compared point (%.17g), for the
+ * comparison of two builds (the Windows DLL under Wine against the Linux .so).
+ * Built for Linux and, unchanged, for Windows (mingw-w64; fmu_loader.c).
  * Exit status 0 if every check passed.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -20,8 +24,8 @@
 
 #include "fmu_loader.h"
 
-/* Value references of the FMU (its modelDescription.xml). */
-enum { VR_tau = 2, VR_w = 19, VR_v = 20, VR_N = 23 };
+/* Value references VR_* of the FMU (fmu/config.h, as its modelDescription.xml). */
+#include "model.h"
 static const int N = 9991;
 static const double TOL = 1e-12;
 
@@ -54,26 +58,37 @@ typedef struct {
     double w, v;
 } row;
 
-/* A second instance through the error paths: each call must give fmi2Error
- * and leave the instance usable. */
+/* A second instance through the error paths, rows of docs/bad-inputs.md
+ * among them (their logged reasons, printed by the logger, are compared with
+ * the table by tests/wine): each call must give fmi2Error and leave the
+ * instance usable. */
 static void error_paths(const fmu_api *f, const char *guid, const fmi2CallbackFunctions *cb)
 {
     fmi2Component c = f->instantiate("errors", fmi2CoSimulation, guid, "", cb, fmi2False,
                                      fmi2False);
-    const fmi2ValueReference vr_tau = VR_tau, vr_N = VR_N, vr_wv[2] = {VR_w, VR_v};
-    const fmi2Real bad_tau = -1.0;
-    const fmi2Integer bad_N = 0;
+    const fmi2ValueReference vr_tau = VR_tau, vr_N = VR_N, vr_wv[2] = {VR_w, VR_v}, vr_999 = 999;
+    const fmi2Real bad_tau[3] = {-1.0, NAN, INFINITY}, one = 1.0;
+    const fmi2Integer bad_N[2] = {0, INT_MIN};
+    const fmi2String nonsense = "nonsense";
     double wv[2];
     check(c != NULL, "second fmi2Instantiate");
     if (!c)
         return;
-    check(f->instantiate("x", fmi2CoSimulation, "{wrong}", "", cb, fmi2False, fmi2False) == NULL,
-          "wrong GUID refused");
-    check(f->do_step(c, 0.0, 0.1, fmi2False) == fmi2Error, "doStep before initialization");
+    check(f->instantiate("x", fmi2CoSimulation, "{00000000-0000-0000-0000-000000000000}", "", cb,
+                         fmi2False, fmi2False) == NULL,
+          "wrong GUID refused"); /* F06 */
+    check(f->do_step(c, 0.0, 0.1, fmi2False) == fmi2Error, "doStep before initialization"); /* F50 */
     check(f->setup(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) == fmi2OK, "setup");
     check(f->enter_init(c) == fmi2OK, "enter initialization");
-    check(f->set_real(c, &vr_tau, 1, &bad_tau) == fmi2Error, "tau = -1 refused");
-    check(f->set_integer(c, &vr_N, 1, &bad_N) == fmi2Error, "N = 0 refused");
+    for (int i = 0; i < 3; i++) /* F11, F12, F13 */
+        check(f->set_real(c, &vr_tau, 1, &bad_tau[i]) == fmi2Error, "tau = -1, NaN, Inf refused");
+    for (int i = 0; i < 2; i++) /* F25, F27 */
+        check(f->set_integer(c, &vr_N, 1, &bad_N[i]) == fmi2Error, "N = 0, INT_MIN refused");
+    check(f->set_real(c, &vr_999, 1, &one) == fmi2Error, "unknown value reference"); /* F33 */
+    check(f->set_debug_logging(c, fmi2True, 1, &nonsense) == fmi2Error,
+          "unknown log category"); /* F65 */
+    if (f->version == 2) /* F64; FMI 3.0 has no fmi3CancelStep */
+        check(f->cancel_step(c) == fmi2Error, "fmi2CancelStep");
     check(f->exit_init(c) == fmi2OK, "exit initialization after refused values");
     check(f->do_step(c, 0.5, 0.1, fmi2False) == fmi2Error, "doStep from a wrong time");
     check(f->do_step(c, 0.0, 0.0, fmi2False) == fmi2Error, "zero step refused");
@@ -85,7 +100,7 @@ static void error_paths(const fmu_api *f, const char *guid, const fmi2CallbackFu
     if (bytes && f->serialize(c, st, bytes, size) == fmi2OK) {
         fmi2FMUstate bad = NULL;
         check(f->deserialize(c, bytes, size - 1, &bad) == fmi2Error, "truncated state refused");
-        check(f->deserialize(c, bytes, 20, &bad) == fmi2Error, "short state refused");
+        check(f->deserialize(c, bytes, 20, &bad) == fmi2Error, "short state refused"); /* F87 */
     }
     free(bytes);
     f->free_state(c, &st);
@@ -120,9 +135,14 @@ static row *read_reference(const char *path, size_t *count)
 
 int main(int argc, char **argv)
 {
-    if (argc != 5) {
-        fprintf(stderr, "usage: fmu_master FMU.so GUID ex43_N9991.csv T\n");
+    if (argc != 5 && argc != 6) {
+        fprintf(stderr, "usage: fmu_master FMU.so GUID ex43_N9991.csv T [outputs.csv]\n");
         return 2;
+    }
+    FILE *out = argc == 6 ? fopen(argv[5], "w") : NULL;
+    if (argc == 6 && !out) {
+        fprintf(stderr, "fmu_master: cannot write %s\n", argv[5]);
+        return 1;
     }
     const double T = atof(argv[4]), h = 1.0 / N;
     size_t nrows = 0;
@@ -159,6 +179,8 @@ int main(int argc, char **argv)
         const double dev = fmax(fabs(wv[0] - ref[k].w), fabs(wv[1] - ref[k].v));
         maxdev = fmax(maxdev, dev);
         compared++;
+        if (out)
+            fprintf(out, "%ld,%.17g,%.17g\n", ref[k].p, wv[0], wv[1]);
         if (k == nrows / 20) { /* save the state here, check it replays below */
             check(f.get_state(c, &saved) == fmi2OK, "fmi2GetFMUstate");
             saved_t = t;
@@ -203,6 +225,7 @@ int main(int argc, char **argv)
     f.free_instance(c);
     fmu_unload(&f);
     free(ref);
+    check(!out || fclose(out) == 0, "outputs written");
     printf("fmu_master: %zu reference points to t = %g, max deviation %.3g; %d failures\n",
            compared, T, maxdev, failures);
     return failures == 0 ? 0 : 1;

@@ -1,7 +1,10 @@
-# The FMU DelayFrictionOscillator.fmu against the issue's contract, driven by
-# fmpy: validation, outputs against a native libdmi run, input, FMU states,
-# reset, several instances, errors, logging, binary.
+# The FMUs DelayFrictionOscillator.fmu (FMI 2.0) and fmi3/DelayFrictionOscillator.fmu
+# (FMI 3.0) against the issue's contract, driven by fmpy: validation, outputs
+# against a native libdmi run and against each other, input, FMU states, reset,
+# several instances, errors, logging, binary.  Tests taking fmu_path (or a
+# fixture built on it) run on both FMUs.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+import ctypes
 import math
 import os
 import struct
@@ -69,7 +72,9 @@ def test_validate_fmu(fmu_path):
     assert validate_fmu(fmu_path) == []
 
 
-def test_fmutool_check(fmu_path):
+def test_fmutool_check(fmu_path, fmi_version):
+    if fmi_version == "3":
+        pytest.skip("fmutool checks FMI 2.0 FMUs")
     fmutool = os.path.join(os.path.dirname(sys.executable), "fmutool")
     r = subprocess.run([fmutool, "-input", fmu_path, "-check"], capture_output=True, text=True,
                        env=dict(os.environ, QT_QPA_PLATFORM="offscreen"), timeout=120)
@@ -80,26 +85,39 @@ def test_fmutool_check(fmu_path):
     assert "ERROR" not in text, text
 
 
-def test_model_description_contract(md):
+def test_model_description_contract(md, fmi_version):
     cs = md.coSimulation
-    assert md.fmiVersion == "2.0" and cs.modelIdentifier == "DelayFrictionOscillator"
+    assert md.fmiVersion == fmi_version + ".0" and cs.modelIdentifier == "DelayFrictionOscillator"
     assert cs.canHandleVariableCommunicationStepSize
     assert cs.canGetAndSetFMUstate and cs.canSerializeFMUstate
     var = {v.name: v for v in md.modelVariables}
+    # the variables (written from config.h's table) are exactly the contract's, value references 0, 1, ...
+    # FMI 3.0 asks for the independent variable, time
+    assert sorted(var) == sorted(REALS + ["N", "g_in"] + OUT + (["time"] if fmi_version == "3" else []))
+    assert sorted(v.valueReference for v in md.modelVariables) == list(range(len(var)))
     for n in REALS + ["N"]:
         assert var[n].causality == "parameter", n
         assert float(var[n].start) == START[n], n
-    assert var["N"].type == "Integer"
-    assert var["g_in"].causality == "input" and var["g_in"].type == "Real"
+    real, integer = ("Real", "Integer") if fmi_version == "2" else ("Float64", "Int32")
+    assert var["N"].type == integer
+    assert var["g_in"].causality == "input" and var["g_in"].type == real
+    assert all(var[n].type == real for n in REALS + OUT[:4])
     for n in OUT:
         assert var[n].causality == "output", n
     assert var["sticking"].type == "Boolean"
     # Outputs at a communication point come from the steps before it: no direct feedthrough of g_in.
     assert sorted(o.variable.name for o in md.outputs) == sorted(OUT)
     assert all(o.dependencies == [] for o in md.outputs)
-    assert [c.name for c in md.logCategories] == ["logStatusError", "logCalls"]
-    # libdmi allocates with the C library: the FMU must not be given allocateMemory to honour.
-    assert md.coSimulation.canNotUseMemoryManagementFunctions is True
+    assert [c.name for c in md.logCategories] == ["logStatusError", "logStatusWarning", "logCalls",
+                                                  "logMemory"]
+    if fmi_version == "2":
+        # libdmi allocates with the C library: the FMU must not be given allocateMemory to honour.
+        assert md.coSimulation.canNotUseMemoryManagementFunctions is True
+    else:
+        # no events, no early return, no intermediate update
+        assert cs.hasEventMode is not True and cs.canReturnEarlyAfterIntermediateUpdate is not True
+        assert cs.providesIntermediateUpdate is not True
+        assert var["time"].causality == "independent"
     de = md.defaultExperiment
     assert float(de.stopTime) == 30.0
     k = float(de.stepSize) / (START["tau"] / START["N"])
@@ -117,16 +135,19 @@ def test_start_values_inside_binary(md, sl):
     assert s.fmu.getInteger([s.vr["N"]]) == [int(var["N"].start)]
 
 
-def test_binary_needs_libc_libm_and_exports_fmi2_only(unzipdir):
-    so = os.path.join(unzipdir, "binaries", "linux64", "DelayFrictionOscillator.so")
+def test_binary_needs_libc_libm_and_exports_fmi_only(unzipdir, fmi_version):
+    folder = "linux64" if fmi_version == "2" else "x86_64-linux"
+    so = os.path.join(unzipdir, "binaries", folder, "DelayFrictionOscillator.so")
     dyn = subprocess.run(["readelf", "-d", so], capture_output=True, text=True, check=True).stdout
     needed = {line.split("[")[1].split("]")[0] for line in dyn.splitlines() if "(NEEDED)" in line}
     assert needed and needed <= {"libc.so.6", "libm.so.6"}, needed
     syms = subprocess.run(["nm", "-D", "--defined-only", so], capture_output=True, text=True,
                           check=True).stdout.split("\n")
     names = [line.split()[-1] for line in syms if line.strip()]
-    assert "fmi2DoStep" in names and "fmi2Instantiate" in names
-    assert [n for n in names if not n.startswith("fmi2")] == []
+    prefix = "fmi" + fmi_version
+    assert prefix + "DoStep" in names
+    assert prefix + ("Instantiate" if fmi_version == "2" else "InstantiateCoSimulation") in names
+    assert [n for n in names if not n.startswith(prefix)] == []
 
 
 # ---- outputs against a native libdmi run ----
@@ -613,7 +634,7 @@ def test_solver_failure_is_an_error_state(sl):
     s.fmu.setReal([s.vr["g_in"]], [1e308])  # v overflows after about 1800 steps
     with pytest.raises(FMICallException):
         s.fmu.doStep(0.0, 5.0)
-    assert "fmi2DoStep" in s.errors()[-1] and "inf" in s.errors()[-1]
+    assert s.prefix + "DoStep" in s.errors()[-1] and "inf" in s.errors()[-1]
     with pytest.raises(FMICallException):
         s.fmu.doStep(5.0, 0.01)  # error state: no more steps
     assert "not allowed in state error" in s.errors()[-1]
@@ -638,7 +659,7 @@ def test_logging_honours_flags_and_categories(sl):
     start(loud)
     loud.fmu.doStep(0.0, 0.01)
     calls = [m for st, c, m in loud.log if c == "logCalls"]
-    assert "fmi2DoStep" in calls and "fmi2ExitInitializationMode" in calls
+    assert loud.prefix + "DoStep" in calls and loud.prefix + "ExitInitializationMode" in calls
     loud.fmu.setDebugLogging(True, ["logStatusError"])  # calls no longer traced
     n = len(loud.log)
     loud.fmu.doStep(0.01, 0.01)
@@ -652,9 +673,11 @@ def test_logging_honours_flags_and_categories(sl):
     assert loud.log[-1][1] == "logStatusError"  # errors are reported all the same
 
 
-def test_runs_without_memory_callbacks(sl):
+def test_runs_without_memory_callbacks(sl, fmi_version):
     """allocateMemory = freeMemory = NULL (canNotUseMemoryManagementFunctions): a whole run, an FMU
     state and its serialization work as with the callbacks."""
+    if fmi_version == "3":
+        pytest.skip("FMI 3.0 has no memory callbacks")
     bare, full = sl(name="bare", memory_callbacks=False), sl(name="full")
     for s in (bare, full):
         start(s)
@@ -689,14 +712,16 @@ def test_reset_restores_the_logging_of_instantiate(sl):
 def test_instantiate_rejects_wrong_guid(md, unzipdir):
     from types import SimpleNamespace
     from conftest import Slave
-    wrong = SimpleNamespace(guid="{00000000-0000-0000-0000-000000000000}", coSimulation=md.coSimulation)
+    wrong = SimpleNamespace(guid="{00000000-0000-0000-0000-000000000000}", coSimulation=md.coSimulation,
+                            fmiVersion=md.fmiVersion)
     with pytest.raises(Exception, match="instantiate"):
         Slave(wrong, unzipdir)
 
 
 # ---- the main-job script ----
 
-def test_fmu_run_script_writes_the_csv(source_dir, fmu_path, native43, tmp_path):
+def test_fmu_run_script_writes_the_csv(source_dir, fmu_paths, native43, tmp_path):
+    fmu_path = fmu_paths["2"]  # the script's FMU (it reads "Integer" start values: FMI 2.0)
     out = tmp_path / "run.csv"
     subprocess.run([sys.executable, os.path.join(source_dir, "scripts", "fmu_run.py"), "--fmu",
                     fmu_path, "--out", str(out)], check=True, timeout=120)
@@ -707,9 +732,10 @@ def test_fmu_run_script_writes_the_csv(source_dir, fmu_path, native43, tmp_path)
     assert_close(rows[:, 1:5], native43.table(rows[:, 0])[:, :4])
 
 
-def test_fmu_run_script_start_values(source_dir, fmu_path, libdmi, tmp_path):
+def test_fmu_run_script_start_values(source_dir, fmu_paths, libdmi, tmp_path):
     """--start NAME=VALUE (repeatable) sets start values: the run equals a
     native run with those parameters; an unknown name is refused."""
+    fmu_path = fmu_paths["2"]
     script = os.path.join(source_dir, "scripts", "fmu_run.py")
     out = tmp_path / "run.csv"
     subprocess.run([sys.executable, script, "--fmu", fmu_path, "--out", str(out), "--stop-time",
@@ -731,7 +757,9 @@ def test_fmu_run_script_start_values(source_dir, fmu_path, libdmi, tmp_path):
     assert not (tmp_path / "bad.csv").exists()
 
 
-def test_status_queries_and_unsupported_functions(sl):
+def test_status_queries_and_unsupported_functions(sl, fmi_version):
+    if fmi_version == "3":
+        pytest.skip("FMI 2.0's status functions: see test_fmi3_do_step_flags_and_unsupported_functions")
     from fmpy.fmi2 import (fmi2LastSuccessfulTime, fmi2Terminated, fmi2DoStepStatus,
                            fmi2PendingStatus, fmi2Discard)
     s = sl()
@@ -759,3 +787,217 @@ def test_status_queries_and_unsupported_functions(sl):
             call()
         assert len(s.errors()) == n + 1
     s.fmu.doStep(0.0246, 0.01)  # still usable
+
+
+# ---- FMI 3.0 beside FMI 2.0 ----
+
+def slave_of(path, tmp_path, name):
+    from fmpy import extract, read_model_description
+    from conftest import Slave
+    md = read_model_description(path)
+    s = Slave(md, extract(path, str(tmp_path / name)), name=name)
+    s.vr = {v.name: v.valueReference for v in md.modelVariables}
+    return s
+
+
+def test_fmi3_outputs_equal_fmi2_bitwise(fmu_paths):
+    """The same settings (parameters, an input signal, an uneven output
+    interval) give bitwise the same outputs in both FMUs (plain fmpy runs)."""
+    sig = np.array([(0.0, 0.0), (1.0, 0.8), (2.0, -0.5), (3.0, 1.5)],
+                   dtype=[("time", np.float64), ("g_in", np.float64)])
+    kw = dict(stop_time=3.0, output_interval=0.0123, input=sig, output=OUT,
+              start_values={"N": 997, "alpha": 0.5, "g_amp": 2.0, "tau": 0.8, "H_c1": 0.3,
+                            "H_lambda": 2.0})
+    r2 = simulate_fmu(fmu_paths["2"], **kw)
+    r3 = simulate_fmu(fmu_paths["3"], **kw)
+    assert len(r2) == len(r3) == math.ceil(3.0 / 0.0123) + 1
+    for n in ["time"] + OUT:
+        assert np.array_equal(r2[n], r3[n]), n
+    assert np.ptp(r3["w"]) > 0.1 and r3["sticking"].any() and not r3["sticking"].all()
+
+
+def test_state_bytes_cross_versions(fmu_paths, tmp_path):
+    """Both FMUs write the same checked bytes: a state saved by one restores
+    into the other, which then steps on bitwise like the first."""
+    s2, s3 = slave_of(fmu_paths["2"], tmp_path, "two"), slave_of(fmu_paths["3"], tmp_path, "three")
+    for a, b in ((s2, s3), (s3, s2)):
+        start(a, N=500)
+        start(b)
+        t, _ = run_steps(a, 0.0, 40)
+        data = saved_bytes(a)
+        st = b.fmu.deSerializeFMUstate(data)
+        b.fmu.setFMUstate(st)
+        b.fmu.freeFMUstate(st)
+        assert saved_bytes(b) == data
+        assert run_steps(b, t, 30)[1] == run_steps(a, t, 30)[1]
+        a.fmu.reset()
+        b.fmu.reset()
+    for s in (s2, s3):
+        s.fmu.freeInstance()
+
+
+def test_fmi3_do_step_flags_and_unsupported_functions(fmu_paths, tmp_path):
+    """fmi3DoStep reports no event, no termination, no early return and the
+    time reached; the functions of event mode, clocks and derivatives refuse
+    with fmi3Error and a logged reason; the instance steps on."""
+    s = slave_of(fmu_paths["3"], tmp_path, "flags")
+    start(s)
+    f3 = s.fmu.fmu3
+    assert f3.doStep(0.0, 0.0123) == (False, False, False, 0.0123)
+    assert f3.doStep(0.0123, 0.5) == (False, False, False, 0.0123 + 0.5)
+    assert f3.getFloat64([s.vr["time"]]) == [0.0123 + 0.5]
+    for call in (f3.enterEventMode, f3.enterStepMode,
+                 lambda: f3.getOutputDerivatives([s.vr["w"]], [1]),
+                 lambda: f3.getDirectionalDerivative([s.vr["w"]], [s.vr["g_in"]], [1.0]),
+                 lambda: f3.getFloat32([s.vr["w"]]), lambda: f3.setInt8([0], [1])):
+        n = len(s.errors())
+        with pytest.raises(FMICallException) as e:
+            call()
+        assert e.value.status == 3 and len(s.errors()) == n + 1, s.errors()[n:]
+    # a Float64 array whose length is not the number of scalar variables
+    with pytest.raises(FMICallException):
+        f3.fmi3GetFloat64(f3.component, (ctypes.c_uint32 * 2)(19, 20), 2, (ctypes.c_double * 3)(), 3)
+    assert "3 values for 2 value references" in s.errors()[-1]
+    f3.doStep(0.5123, 0.01)
+    s.fmu.freeInstance()
+
+
+def test_time_is_a_variable_of_fmi3_only(sl, md, fmi_version):
+    s = sl()
+    start(s)
+    s.fmu.doStep(0.0, 0.25)
+    time_vr = len(md.modelVariables) - (1 if fmi_version == "3" else 0)  # the next free one for FMI 2.0
+    if fmi_version == "3":
+        assert s.fmu.getReal([time_vr]) == [0.25]
+    else:
+        with pytest.raises(FMICallException):
+            s.fmu.getReal([time_vr])
+        assert f"value reference {time_vr}" in s.errors()[-1]
+
+
+def test_fmi3_refuses_event_mode_and_intermediate_update(fmu_paths, tmp_path):
+    from fmpy import extract, read_model_description
+    from fmpy.fmi3 import FMU3Slave
+    md = read_model_description(fmu_paths["3"])
+    unzip = extract(fmu_paths["3"], str(tmp_path / "u"))
+    for kw, word in ((dict(eventModeUsed=True), "event mode"),
+                     (dict(requiredIntermediateVariables=[19]), "intermediate")):
+        log = []
+        f = FMU3Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier="DelayFrictionOscillator",
+                      instanceName="x")
+        with pytest.raises(Exception, match="instantiate"):
+            f.instantiate(logMessage=lambda env, st, cat, msg: log.append((st, msg.decode())), **kw)
+        assert len(log) == 1 and log[0][0] == 3 and word in log[0][1], log
+
+
+# ---- what a new user hit (issue 16, items 3-6) ----
+
+def coarse(N, T, b=1.0, tau=1.0):
+    """The criterion, computed here: (1 + h^2 b)^(T/h) > 2."""
+    h = tau / N
+    return (1 + h * h * b) ** (T / h) > 2
+
+
+def test_coarse_step_warns_at_initialization(sl, fmu_path):
+    """ExitInitializationMode returns Warning, with a logged reason, when the
+    explicit part's growth (1 + h^2 b)^(T/h) exceeds 2; not for N = 1000."""
+    assert coarse(43, 30.0) and not coarse(44, 30.0) and coarse(10, 30.0) and not coarse(10, 3.0)
+    for N, stop, b in [(1000, None, 1.0), (1, None, 1.0), (43, None, 1.0), (44, None, 1.0),
+                       (10, 30.0, 1.0), (10, 3.0, 1.0), (10, None, -1.0), (44, None, 1.1)]:
+        s = sl()
+        s.fmu.setupExperiment(startTime=0.0, **({} if stop is None else dict(stopTime=stop)))
+        s.fmu.enterInitializationMode()
+        s.fmu.setInteger([s.vr["N"]], [N])
+        s.fmu.setReal([s.vr["b"]], [b])
+        status = s.fmu.exitInitializationMode()
+        warned = [m for st, c, m in s.log if st == 1 and c == "logStatusWarning"]
+        want = b > 0 and coarse(N, 30.0 if stop is None else stop, b)
+        assert status == (1 if want else 0), (N, stop, b, status, s.log)
+        assert len(warned) == (1 if want else 0), (N, stop, b, s.log)
+        if want:
+            assert f"N = {N}" in warned[0] and "coarse" in warned[0] and "1 + h^2 b" in warned[0]
+        s.fmu.doStep(0.0, 0.5)  # and it runs on
+    # what the warning is about: the coarse run explodes
+    r = simulate_fmu(fmu_path, stop_time=30.0, output_interval=1.0, start_values={"N": 1},
+                     output=["w"])
+    assert np.max(np.abs(r["w"])) > 1e6
+
+
+def test_friction_lies_in_minus_alpha_alpha(fmu_path, native43):
+    """friction is an element of alpha sigma(v): in [-alpha, alpha] at every
+    step, although (X - U)/h rounds beyond alpha at thousands of them."""
+    unclamped = (native43.X[1:, 1] - native43.U[1:, 1]) / native43.h
+    assert np.sum(np.abs(unclamped) > 1.0) > 100
+    r = simulate_fmu(fmu_path, stop_time=T, output_interval=0.001, output=["friction"])
+    assert np.max(np.abs(r["friction"])) <= 1.0
+    assert np.sum(np.abs(r["friction"]) == 1.0) > 1000  # sliding: the bound itself
+    r = simulate_fmu(fmu_path, stop_time=5.0, output_interval=0.001, output=["friction"],
+                     start_values={"alpha": 0.3})
+    assert np.max(np.abs(r["friction"])) <= 0.3 and np.max(np.abs(r["friction"])) == 0.3
+
+
+def test_out_of_memory_names_N_and_the_bytes(sl):
+    s = sl()
+    s.fmu.setupExperiment(startTime=0.0)
+    s.fmu.enterInitializationMode()
+    s.fmu.setInteger([s.vr["N"]], [2_000_000_000])  # 64 GB of history alone
+    with pytest.raises(FMICallException):
+        s.fmu.exitInitializationMode()
+    assert len(s.errors()) == 1
+    msg = s.errors()[0]
+    assert "N = 2000000000" in msg and "out of memory" in msg and "bytes" in msg, msg
+    assert str(40 * 2_000_000_000) in msg, msg
+
+
+CHILD_BIG_N = textwrap.dedent("""
+    import sys, json, resource
+    sys.path.insert(0, {here!r})
+    import conftest, test_fmu
+    from fmpy import read_model_description
+    md = read_model_description({fmu!r})
+    s = conftest.Slave(md, {unzip!r})
+    s.vr = {{v.name: v.valueReference for v in md.modelVariables}}
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    test_fmu.start(s, N={N})
+    s.fmu.doStep(0.0, 0.001)
+    grown = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before
+    print(json.dumps([grown * 1024, s.log]))
+""")
+
+
+def test_large_N_logs_what_initialization_allocates(fmu_path, unzipdir, sl):
+    """Above 100 MB, ExitInitializationMode logs N and the bytes (category
+    logMemory, although logging is off); the logged size is the peak resident
+    memory it takes to within 30 % (measured in a fresh process)."""
+    N = 3_000_000
+    code = CHILD_BIG_N.format(here=os.path.dirname(__file__), fmu=fmu_path, unzip=str(unzipdir), N=N)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         timeout=120).stdout
+    import json
+    grown, log = json.loads(out.strip().splitlines()[-1])
+    notes = [m for st, c, m in log if c == "logMemory"]
+    assert len(notes) == 1 and f"N = {N}" in notes[0], log
+    logged = float(notes[0].split("about ")[1].split(" bytes")[0])
+    assert logged > 100e6 and abs(grown - logged) < 0.3 * logged, (grown, logged)
+    s = sl()
+    start(s)  # N = 1000: nothing to say
+    assert s.log == []
+
+
+def test_each_call_logged_once_with_its_outcome(sl):
+    s = sl(logging_on=True)
+    start(s)
+    p = s.prefix
+    real = "Real" if p == "fmi2" else "Float64"
+    n = len(s.log)
+    with pytest.raises(FMICallException):
+        s.fmu.setReal([s.vr["tau"]], [-1.0])  # in step mode, a parameter: refused
+    assert [(st, m.split(":")[0]) for st, c, m in s.log[n:]] == [(3, f"{p}Set{real}")], s.log[n:]
+    n = len(s.log)
+    s.fmu.setReal([s.vr["g_in"]], [0.5])
+    s.fmu.doStep(0.0, 0.01)
+    assert s.log[n:] == [(0, "logCalls", f"{p}Set{real}"), (0, "logCalls", f"{p}DoStep")]
+    n = len(s.log)
+    with pytest.raises(FMICallException):
+        s.fmu.doStep(0.5, 0.01)
+    assert len(s.log[n:]) == 1 and s.log[n][0] == 3 and s.log[n][2].startswith(f"{p}DoStep: ")
