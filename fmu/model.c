@@ -4,6 +4,8 @@
  */
 #include "model.h"
 
+#include "bytes.h" /* libdmi's: FNV-1a, values at a byte offset */
+
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -325,92 +327,58 @@ int model_get_boolean(const model *m, unsigned vr, int *value, char *err)
 
 /* ---- saved state ---- */
 
-static const char STATE_MAGIC[8] = {'d', 'm', 'i', 'F', 'M', 'U', 's', 't'};
-enum { STATE_VERSION = 1 };
-/* magic, version, tag, total size, nreal, dmi size, N */
-#define STATE_HEADER (8 + 4 + 4 + 8 + 8 + 8 + 8)
-#define STATE_REALS ((MODEL_NREAL + 2) * 8)
-
-/* FNV-1a, 64 bits */
-static uint64_t checksum(const unsigned char *b, size_t n)
-{
-    uint64_t x = 14695981039346656037u;
-    for (size_t i = 0; i < n; i++)
-        x = (x ^ b[i]) * 1099511628211u;
-    return x;
-}
-
 size_t model_state_size(const model *m)
 {
-    return STATE_HEADER + STATE_REALS + dmi_state_size(m->solver) + 8;
-}
-
-static unsigned char *put(unsigned char *b, const void *v, size_t n)
-{
-    memcpy(b, v, n);
-    return b + n;
+    return MODEL_STATE_AT_DMI + dmi_state_size(m->solver) + 8;
 }
 
 void model_state_save(const model *m, uint32_t tag, unsigned char *buf)
 {
-    const uint32_t version = STATE_VERSION;
-    const uint64_t total = model_state_size(m), nreal = MODEL_NREAL;
-    const uint64_t ndmi = dmi_state_size(m->solver);
-    const int64_t N = m->N;
-    unsigned char *b = put(buf, STATE_MAGIC, 8);
-    b = put(b, &version, 4);
-    b = put(b, &tag, 4);
-    b = put(b, &total, 8);
-    b = put(b, &nreal, 8);
-    b = put(b, &ndmi, 8);
-    b = put(b, &N, 8);
-    b = put(b, m->real, sizeof m->real);
-    b = put(b, &m->t_start, 8);
-    b = put(b, &m->t_comm, 8);
+    const size_t total = model_state_size(m), ndmi = dmi_state_size(m->solver);
+    memcpy(buf, MODEL_STATE_MAGIC, 8);
+    dmi_put_u32(buf, MODEL_STATE_AT_VERSION, MODEL_STATE_VERSION);
+    dmi_put_u32(buf, MODEL_STATE_AT_TAG, tag);
+    dmi_put_u64(buf, MODEL_STATE_AT_TOTAL, total);
+    dmi_put_u64(buf, MODEL_STATE_AT_NREAL, MODEL_NREAL);
+    dmi_put_u64(buf, MODEL_STATE_AT_NDMI, ndmi);
+    dmi_put_u64(buf, MODEL_STATE_AT_N, (uint64_t)(int64_t)m->N);
+    for (unsigned vr = 0; vr < MODEL_NREAL; vr++)
+        dmi_put_double(buf, MODEL_STATE_AT_REAL + 8 * vr, m->real[vr]);
+    dmi_put_double(buf, MODEL_STATE_AT_REAL + 8 * MODEL_NREAL, m->t_start);
+    dmi_put_double(buf, MODEL_STATE_AT_REAL + 8 * (MODEL_NREAL + 1), m->t_comm);
     if (m->solver)
-        dmi_state_save(m->solver, b, (size_t)ndmi);
-    b += ndmi;
-    const uint64_t sum = checksum(buf, (size_t)(b - buf));
-    put(b, &sum, 8);
-}
-
-static const unsigned char *get(const unsigned char *b, void *v, size_t n)
-{
-    memcpy(v, b, n);
-    return b + n;
+        dmi_state_save(m->solver, buf + MODEL_STATE_AT_DMI, ndmi);
+    dmi_put_u64(buf, total - 8, dmi_fnv1a(DMI_FNV1A_INIT, buf, total - 8));
 }
 
 int model_state_load(model *into, uint32_t tags, uint32_t solver_tags, uint32_t *tag,
                      const unsigned char *buf, size_t size, char *err)
 {
-    uint32_t version;
-    uint64_t total, nreal, ndmi, sum;
-    int64_t N;
-    double real[MODEL_NREAL], t_start, t_comm;
-    if (!buf || size < STATE_HEADER + STATE_REALS + 8)
+    if (!buf || size < MODEL_STATE_AT_DMI + 8)
         return fail(err, "state: %zu bytes is too short for a saved state", size);
-    const unsigned char *b = buf + 8;
-    if (memcmp(buf, STATE_MAGIC, 8) != 0)
+    if (memcmp(buf, MODEL_STATE_MAGIC, 8) != 0)
         return fail(err, "state: the bytes are not a saved state of this FMU (bad magic)");
-    b = get(b, &version, 4);
-    b = get(b, tag, 4);
-    b = get(b, &total, 8);
-    b = get(b, &nreal, 8);
-    b = get(b, &ndmi, 8);
-    b = get(b, &N, 8);
+    const uint32_t version = dmi_get_u32(buf, MODEL_STATE_AT_VERSION);
+    const uint64_t total = dmi_get_u64(buf, MODEL_STATE_AT_TOTAL);
+    const uint64_t nreal = dmi_get_u64(buf, MODEL_STATE_AT_NREAL);
+    const uint64_t ndmi = dmi_get_u64(buf, MODEL_STATE_AT_NDMI);
+    const int64_t N = (int64_t)dmi_get_u64(buf, MODEL_STATE_AT_N);
+    *tag = dmi_get_u32(buf, MODEL_STATE_AT_TAG);
     if (*tag == 0 || (*tag & (*tag - 1)) != 0 || (*tag & tags) == 0)
         return fail(err, "state: the saved phase tag %lu is not allowed", (unsigned long)*tag);
-    if (version != STATE_VERSION)
+    if (version != MODEL_STATE_VERSION)
         return fail(err, "state: format version %lu is not supported", (unsigned long)version);
-    if (nreal != MODEL_NREAL || total != size || ndmi != size - (STATE_HEADER + STATE_REALS + 8))
+    if (nreal != MODEL_NREAL || total != size || ndmi != size - (MODEL_STATE_AT_DMI + 8))
         return fail(err, "state: the sizes recorded in the state do not match (%zu bytes given)",
                     size);
-    memcpy(&sum, buf + size - 8, 8);
-    if (sum != checksum(buf, size - 8))
+    if (dmi_get_u64(buf, size - 8) != dmi_fnv1a(DMI_FNV1A_INIT, buf, size - 8))
         return fail(err, "state: the checksum does not match (corrupted bytes)");
-    b = get(b, real, sizeof real);
-    b = get(b, &t_start, 8);
-    b = get(b, &t_comm, 8);
+    double real[MODEL_NREAL];
+    for (unsigned vr = 0; vr < MODEL_NREAL; vr++)
+        real[vr] = dmi_get_double(buf, MODEL_STATE_AT_REAL + 8 * vr);
+    const double t_start = dmi_get_double(buf, MODEL_STATE_AT_REAL + 8 * MODEL_NREAL);
+    const double t_comm = dmi_get_double(buf, MODEL_STATE_AT_REAL + 8 * (MODEL_NREAL + 1));
+    const unsigned char *b = buf + MODEL_STATE_AT_DMI;
 
     model m;
     model_defaults(&m);

@@ -104,7 +104,21 @@ int model_do_step(model *m, double t_current, double step, char *err);
  * variables, t_start, t_comm, an opaque 32-bit tag of the caller (the FMI
  * phase), libdmi's own checked state bytes (the whole history) and a
  * checksum.  model_state_size is the byte count model_state_save writes.
+ * Native endian, at these byte offsets (the tests read them from here too);
+ * the last 8 bytes are the FNV-1a 64 (src/bytes.h) of all bytes before them.
  */
+#define MODEL_STATE_MAGIC "dmiFMUst" /* its 8 bytes, without the NUL */
+enum {
+    MODEL_STATE_VERSION = 1,
+    MODEL_STATE_AT_VERSION = 8, /* uint32 */
+    MODEL_STATE_AT_TAG = 12,    /* uint32: the caller's tag */
+    MODEL_STATE_AT_TOTAL = 16,  /* uint64: bytes of the whole state */
+    MODEL_STATE_AT_NREAL = 24,  /* uint64: MODEL_NREAL */
+    MODEL_STATE_AT_NDMI = 32,   /* uint64: bytes of libdmi's state (0: no solver) */
+    MODEL_STATE_AT_N = 40,      /* int64 */
+    MODEL_STATE_AT_REAL = 48,   /* MODEL_NREAL doubles, by value reference; t_start, t_comm */
+    MODEL_STATE_AT_DMI = MODEL_STATE_AT_REAL + 8 * (MODEL_NREAL + 2) /* libdmi's state */
+};
 size_t model_state_size(const model *m);
 void model_state_save(const model *m, uint32_t tag, unsigned char *buf);
 /* Checks the bytes and, when into is not NULL, replaces *into by the saved

@@ -7,8 +7,8 @@
  * both write the same bytes).
  *
  * Input: one flags byte, then the serialized state.  Flags bit 0: recompute
- * the state's checksums (the FMU's outer one and libdmi's inner one, layout of
- * fmu/model.c and src/dmi.c) so that the fuzzer gets past them to the checks
+ * the state's checksums (the FMU's outer one and libdmi's inner one, layouts
+ * in fmu/model.h and src/bytes.h) so that the fuzzer gets past them to the checks
  * behind; bits 1-2: the phase of the instance that receives the state
  * (instantiated, initialization mode, stepping).
  *

@@ -47,31 +47,24 @@ static inline uint64_t dmi_fnv1a_skip(const unsigned char *b, size_t len, size_t
     return dmi_fnv1a(hsh, b + at + sizeof zero, len - at - sizeof zero);
 }
 
-/* ---- words at a byte offset (native endian, any alignment) ------------------ */
-
-static inline void dmi_put_u64(unsigned char *b, size_t at, uint64_t w)
-{
-    memcpy(b + at, &w, sizeof w);
-}
-
-static inline uint64_t dmi_get_u64(const unsigned char *b, size_t at)
-{
-    uint64_t w;
-    memcpy(&w, b + at, sizeof w);
-    return w;
-}
-
-static inline void dmi_put_double(unsigned char *b, size_t at, double x)
-{
-    memcpy(b + at, &x, sizeof x);
-}
-
-static inline double dmi_get_double(const unsigned char *b, size_t at)
-{
-    double x;
-    memcpy(&x, b + at, sizeof x);
-    return x;
-}
+/* ---- values at a byte offset (native endian, any alignment) ----------------------
+ * dmi_put_u32(b, at, x), dmi_get_u32(b, at), and the same for u64 (uint64_t)
+ * and double: x copied to or from the bytes b[at .. at + sizeof x). */
+#define DMI_BYTES_AT(name, type)                                                                  \
+    static inline void dmi_put_##name(unsigned char *b, size_t at, type x)                        \
+    {                                                                                             \
+        memcpy(b + at, &x, sizeof x);                                                             \
+    }                                                                                             \
+    static inline type dmi_get_##name(const unsigned char *b, size_t at)                          \
+    {                                                                                             \
+        type x;                                                                                   \
+        memcpy(&x, b + at, sizeof x);                                                             \
+        return x;                                                                                 \
+    }
+DMI_BYTES_AT(u32, uint32_t)
+DMI_BYTES_AT(u64, uint64_t)
+DMI_BYTES_AT(double, double)
+#undef DMI_BYTES_AT
 
 /* ---- libdmi's saved state ------------------------------------------------------
  * Native endian.  A header of 8 uint64 words at the byte offsets below:

@@ -7,6 +7,7 @@
 import ctypes
 import math
 import os
+import re
 import struct
 import subprocess
 import sys
@@ -351,7 +352,9 @@ def test_bad_state_bytes_are_rejected(sl):
     before = outputs(s, s.vr)
     bad = [b"", data[:10], data[:-1], data[: len(data) // 2], data + b"\0",
            b"X" + data[1:]]
-    for pos in (9, 13, 40, 60, 200, len(data) // 2, len(data) - 3):  # header, variables, history, checksum
+    at_dmi = state_at_real(state_field(data, "nreal") + 2)
+    for pos in (STATE_AT["VERSION"] + 1, STATE_AT["TAG"] + 1, STATE_AT["N"], STATE_AT["REAL"] + 12,
+                at_dmi + 24, len(data) // 2, len(data) - 3):  # header, variables, history, checksum
         b = bytearray(data)
         b[pos] ^= 0x10
         bad.append(bytes(b))
@@ -369,14 +372,36 @@ def test_bad_state_bytes_are_rejected(sl):
     assert run_steps(s, t, 30)[1] == run_steps(ref, tr, 30)[1]
 
 
-# The saved state's layout (fmu/model.h), written here from that description:
-# magic[8], format version u32, phase tag u32, total size u64, number of Reals
-# u64, size of libdmi's part u64, N i64, the Reals, t_start, t_comm (doubles),
-# libdmi's state bytes, FNV-1a 64 checksum of all bytes before it.  The phase
-# tags are the FMU's state bits: instantiated 1, initialization mode 2, step
-# complete 4, terminated 8.
-HEAD = struct.Struct("=8sIIQQQq")
+# The saved state's layout: the byte offsets MODEL_STATE_AT_* are read from
+# fmu/model.h, the one place that states them (the FMU and the C tests compile
+# them); the types are those its comments give: format version u32, phase tag
+# u32, total size u64, number of Reals u64, size of libdmi's part u64, N i64,
+# then the Reals, t_start, t_comm (doubles), libdmi's state bytes, and the
+# FNV-1a 64 checksum of all bytes before it (src/bytes.h; fnv1a64 below is
+# checked against the published test vectors).  The phase tags are the FMU's
+# state bits: instantiated 1, initialization mode 2, step complete 4,
+# terminated 8.
+def _model_state_layout():
+    path = os.path.join(os.path.dirname(__file__), "..", "..", "fmu", "model.h")
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    at = {k: int(v) for k, v in re.findall(r"\bMODEL_STATE_AT_(\w+) = (\d+)", text)}
+    magic = re.search(r'#define MODEL_STATE_MAGIC "(\w{8})"', text).group(1).encode()
+    return at, magic
+
+
+STATE_AT, STATE_MAGIC = _model_state_layout()
+STATE_FIELD = dict(version="I", tag="I", total="Q", nreal="Q", ndmi="Q", N="q")
 PHASE = dict(instantiated=1, init=2, step_complete=4, terminated=8)
+
+
+def state_field(data, name):
+    return struct.unpack_from("=" + STATE_FIELD[name], data, STATE_AT[name.upper()])[0]
+
+
+def state_at_real(k):
+    """Offset of Real k (k = nreal: t_start, nreal + 1: t_comm, nreal + 2: libdmi's part)."""
+    return STATE_AT["REAL"] + 8 * k
 
 
 def fnv1a64(data):
@@ -386,21 +411,32 @@ def fnv1a64(data):
     return x
 
 
+def test_state_layout_helpers():
+    """fnv1a64 gives the FNV reference vectors, and every offset read from
+    fmu/model.h has its type here (edit_state re-encoding the FMU's own states
+    bitwise is checked in test_state_phase_and_history_must_agree)."""
+    assert [fnv1a64(t) for t in (b"", b"a", b"foobar")] == [
+        0xCBF29CE484222325, 0xAF63DC4C8601EC8C, 0x85944171F73967E8]
+    assert sorted(STATE_AT) == sorted(["REAL"] + [k.upper() for k in STATE_FIELD])
+
+
 def edit_state(data, tag=None, N=None, dmi=None, t_comm=None):
     """The state bytes with the phase tag, N, libdmi's part or the
     communication point replaced, the sizes and the checksum made consistent
     again."""
-    magic, version, old_tag, total, nreal, ndmi, old_N = HEAD.unpack_from(data)
-    reals = data[HEAD.size:HEAD.size + (nreal + 2) * 8]
+    assert data[:8] == STATE_MAGIC and state_field(data, "total") == len(data)
+    nreal = state_field(data, "nreal")
+    at_dmi = state_at_real(nreal + 2)
+    part = data[at_dmi:len(data) - 8]
+    assert len(part) == state_field(data, "ndmi")
+    b = bytearray(data[:at_dmi]) + (part if dmi is None else dmi)
+    edits = dict(tag=tag, N=N, ndmi=len(b) - at_dmi, total=len(b) + 8)
+    for name, value in edits.items():
+        if value is not None:
+            struct.pack_into("=" + STATE_FIELD[name], b, STATE_AT[name.upper()], value)
     if t_comm is not None:
-        reals = reals[:-8] + struct.pack("=d", t_comm)
-    part = data[HEAD.size + len(reals):len(data) - 8]
-    assert len(part) == ndmi and total == len(data)
-    part = part if dmi is None else dmi
-    body = reals + part
-    head = HEAD.pack(magic, version, old_tag if tag is None else tag, HEAD.size + len(body) + 8,
-                     nreal, len(part), old_N if N is None else N)
-    return head + body + struct.pack("=Q", fnv1a64(head + body))
+        struct.pack_into("=d", b, state_at_real(nreal + 1), t_comm)
+    return bytes(b) + struct.pack("=Q", fnv1a64(b))
 
 
 def saved_bytes(s):
@@ -430,10 +466,10 @@ def test_state_phase_and_history_must_agree(sl):
     s.fmu.exitInitializationMode()
     t, _ = run_steps(s, 0.0, 20)
     stepping = saved_bytes(s)
-    assert HEAD.unpack_from(before_init)[2] == PHASE["instantiated"]
-    assert HEAD.unpack_from(before_init)[5] == 0
-    assert HEAD.unpack_from(stepping)[2] == PHASE["step_complete"]
-    assert HEAD.unpack_from(stepping)[5] > 0
+    assert state_field(before_init, "tag") == PHASE["instantiated"]
+    assert state_field(before_init, "ndmi") == 0
+    assert state_field(stepping, "tag") == PHASE["step_complete"]
+    assert state_field(stepping, "ndmi") > 0
     # the helper re-encodes a state bitwise, and what it writes is read back
     assert edit_state(before_init) == before_init and edit_state(stepping) == stepping
     s.fmu.freeFMUstate(s.fmu.deSerializeFMUstate(edit_state(stepping, tag=PHASE["terminated"])))
@@ -459,7 +495,7 @@ def test_state_history_size_must_match_N(sl):
     now = outputs(s, s.vr)
     for N in (99, 101, 50, 200, 2 ** 31 - 1):
         assert_refused(s, edit_state(data, N=N), "state", "history", f"N = {N}")
-    part = data[HEAD.size + (HEAD.unpack_from(data)[4] + 2) * 8:-8]
+    part = data[state_at_real(state_field(data, "nreal") + 2):-8]
     for other in (part[:-16], part + bytes(16), part[:16]):  # libdmi's part of another size
         assert_refused(s, edit_state(data, dmi=other), "state", "history")
     assert outputs(s, s.vr) == now

@@ -5,6 +5,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "fmu_host.h"
 
+#include "bytes.h" /* the checksums and libdmi's state layout (src/) */
+
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -56,24 +58,15 @@ unsigned char *fmu_snapshot(const fmu_api *f, fmi2Component c, size_t *size)
     return b;
 }
 
-static uint64_t fnv1a(const unsigned char *b, size_t n, size_t skip_at)
-{
-    uint64_t h = UINT64_C(0xcbf29ce484222325);
-    for (size_t i = 0; i < n; i++)
-        h = (h ^ ((i >= skip_at && i - skip_at < 8) ? 0 : b[i])) * UINT64_C(0x100000001b3);
-    return h;
-}
-
 void fmu_state_fix_checksums(unsigned char *b, size_t size, int inner)
 {
-    if (size < FMU_STATE_DMI + 8)
+    if (size < MODEL_STATE_AT_DMI + 8)
         return;
-    uint64_t ndmi;
-    memcpy(&ndmi, b + 32, 8);
-    if (inner && ndmi >= 64 && ndmi <= size - FMU_STATE_DMI - 8) {
-        uint64_t sum = fnv1a(b + FMU_STATE_DMI, (size_t)ndmi, 56);
-        memcpy(b + FMU_STATE_DMI + 56, &sum, 8);
+    const uint64_t ndmi = dmi_get_u64(b, MODEL_STATE_AT_NDMI);
+    if (inner && ndmi >= DMI_STATE_HEADER && ndmi <= size - MODEL_STATE_AT_DMI - 8) {
+        unsigned char *d = b + MODEL_STATE_AT_DMI;
+        dmi_put_u64(d, DMI_STATE_AT_CHECKSUM,
+                    dmi_fnv1a_skip(d, (size_t)ndmi, DMI_STATE_AT_CHECKSUM));
     }
-    uint64_t sum = fnv1a(b, size - 8, SIZE_MAX);
-    memcpy(b + size - 8, &sum, 8);
+    dmi_put_u64(b, size - 8, dmi_fnv1a(DMI_FNV1A_INIT, b, size - 8));
 }

@@ -32,14 +32,10 @@ fmi2Component fmu_new(const fmu_api *f, const char *guid, const fmi2CallbackFunc
  * taken (e.g. in the error state). */
 unsigned char *fmu_snapshot(const fmu_api *f, fmi2Component c, size_t *size);
 
-/* Serialized states (layout of fmu/model.c): a 48-byte header (magic,
- * version, phase tag, total size, number of Reals, size ndmi of libdmi's part
- * at byte 32, N at byte 40), the Real variables, t_start, t_comm, libdmi's
- * state (src/dmi.c: FNV-1a checksum in its 8th word), the FNV-1a checksum of
- * everything before.  Recomputes the outer checksum, and libdmi's if inner
- * and the recorded ndmi fits, so that an edit reaches the checks behind. */
-#define FMU_STATE_HEADER 48
-#define FMU_STATE_DMI (FMU_STATE_HEADER + (VR_g_in + 3) * 8)
+/* Serialized states (layout: MODEL_STATE_AT_* of fmu/model.h, libdmi's part
+ * at MODEL_STATE_AT_DMI laid out as src/bytes.h says).  Recomputes the outer
+ * checksum, and libdmi's if inner and the recorded ndmi fits, so that an
+ * edit reaches the checks behind. */
 void fmu_state_fix_checksums(unsigned char *b, size_t size, int inner);
 
 #endif

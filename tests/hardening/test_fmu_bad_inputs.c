@@ -22,6 +22,7 @@
 
 #include <CUnit/CUnit.h>
 
+#include "bytes.h" /* libdmi's state layout and value accessors (src/) */
 #include "dmi.h"
 #include "fmu_host.h"
 #include "hard_util.h"
@@ -147,10 +148,10 @@ static int usable(ctx *x, int setup)
     return 1;
 }
 
-/* ---- state bytes (layout of fmu/model.c) ----------------------------------------- */
+/* ---- state bytes (layout: fmu/model.h, libdmi's part src/bytes.h) --------------- */
 
-#define FMU_HDR FMU_STATE_HEADER
-#define FMU_DMI FMU_STATE_DMI
+#define AT_REAL(vr) (MODEL_STATE_AT_REAL + 8 * (vr))     /* t_start: MODEL_NREAL, t_comm: + 1 */
+#define AT_DMI(at) (MODEL_STATE_AT_DMI + (size_t)(at)) /* offset at in libdmi's part */
 enum { FIX_NONE, FIX_BOTH, FIX_OUTER };
 
 /* Deserializes bytes into a state and sets it; the first failure's status. */
@@ -182,13 +183,11 @@ static fmi2Status restore_edited(ctx *x, int edit, size_t at, double value, long
     }
     memcpy(b, own, size);
     free(own);
-    uint32_t u32 = (uint32_t)value;
-    uint64_t u64 = (uint64_t)value;
     switch (edit) {
     case E_XOR: b[at] ^= 0x24; break;
-    case E_U32: memcpy(b + at, &u32, 4); break;
-    case E_U64: memcpy(b + at, &u64, 8); break;
-    case E_F64: memcpy(b + at, &value, 8); break;
+    case E_U32: dmi_put_u32(b, at, (uint32_t)value); break;
+    case E_U64: dmi_put_u64(b, at, (uint64_t)value); break;
+    case E_F64: dmi_put_double(b, at, value); break;
     }
     if (fix != FIX_NONE)
         fmu_state_fix_checksums(b, size, fix == FIX_BOTH);
@@ -302,24 +301,24 @@ CALL(t_short20, fmi2Status r = fmi2Fatal; size_t n; unsigned char *b = fmu_snaps
 CALL(t_empty, fmi2Status r = fmi2Fatal; size_t n; unsigned char *b = fmu_snapshot(&F, c, &n);
      if (b) r = restore(x, b, 0); free(b); return r;)
 CALL(t_long1, return restore_edited(x, E_NONE, 0, 0, 1, 0);)
-CALL(t_magic, return restore_edited(x, E_XOR, 2, 0, 0, 0);)
-CALL(t_version, return restore_edited(x, E_U32, 8, 2, 0, 1);)
-CALL(t_tag0, return restore_edited(x, E_U32, 12, 0, 0, 1);)
-CALL(t_tag_error, return restore_edited(x, E_U32, 12, 16, 0, 1);)
-CALL(t_tag_two, return restore_edited(x, E_U32, 12, 6, 0, 1);)
-CALL(t_total, return restore_edited(x, E_U64, 16, 1e6, 0, 1);)
+CALL(t_magic, return restore_edited(x, E_XOR, 2, 0, 0, 0);) /* a byte of the magic (0-7) */
+CALL(t_version, return restore_edited(x, E_U32, MODEL_STATE_AT_VERSION, 2, 0, 1);)
+CALL(t_tag0, return restore_edited(x, E_U32, MODEL_STATE_AT_TAG, 0, 0, 1);)
+CALL(t_tag_error, return restore_edited(x, E_U32, MODEL_STATE_AT_TAG, 16, 0, 1);)
+CALL(t_tag_two, return restore_edited(x, E_U32, MODEL_STATE_AT_TAG, 6, 0, 1);)
+CALL(t_total, return restore_edited(x, E_U64, MODEL_STATE_AT_TOTAL, 1e6, 0, 1);)
 CALL(t_checksum, size_t n; unsigned char *b = fmu_snapshot(&F, c, &n); free(b);
      return restore_edited(x, E_XOR, n - 3, 0, 0, 0);)
-CALL(t_data, return restore_edited(x, E_XOR, FMU_DMI + 100, 0, 0, 0);)
-CALL(t_real_nan, return restore_edited(x, E_F64, FMU_HDR + 8 * VR_b, NAN, 0, 1);)
-CALL(t_tau_neg, return restore_edited(x, E_F64, FMU_HDR + 8 * VR_tau, -1.0, 0, 1);)
-CALL(t_N0, return restore_edited(x, E_U64, 40, 0, 0, 1);)
-CALL(t_times, return restore_edited(x, E_F64, FMU_HDR + 8 * (VR_g_in + 2), -1.0, 0, 1);)
-CALL(t_comm_far, return restore_edited(x, E_F64, FMU_HDR + 8 * (VR_g_in + 2), 1.5e10, 0, 1);)
-CALL(t_comm_init, return restore_edited(x, E_F64, FMU_HDR + 8 * (VR_g_in + 2), 0.5, 0, 1);)
-CALL(t_inner, return restore_edited(x, E_XOR, FMU_DMI + 64 + 8, 0, 0, FIX_OUTER);)
-CALL(t_inner_fixed, return restore_edited(x, E_F64, FMU_DMI + 64, NAN, 0, 1);)
-CALL(t_inner_N, return restore_edited(x, E_U64, 40, 50, 0, 1);)
+CALL(t_data, return restore_edited(x, E_XOR, AT_DMI(100), 0, 0, 0);)
+CALL(t_real_nan, return restore_edited(x, E_F64, AT_REAL(VR_b), NAN, 0, 1);)
+CALL(t_tau_neg, return restore_edited(x, E_F64, AT_REAL(VR_tau), -1.0, 0, 1);)
+CALL(t_N0, return restore_edited(x, E_U64, MODEL_STATE_AT_N, 0, 0, 1);)
+CALL(t_times, return restore_edited(x, E_F64, AT_REAL(MODEL_NREAL + 1), -1.0, 0, 1);)
+CALL(t_comm_far, return restore_edited(x, E_F64, AT_REAL(MODEL_NREAL + 1), 1.5e10, 0, 1);)
+CALL(t_comm_init, return restore_edited(x, E_F64, AT_REAL(MODEL_NREAL + 1), 0.5, 0, 1);)
+CALL(t_inner, return restore_edited(x, E_XOR, AT_DMI(DMI_STATE_HEADER + 8), 0, 0, FIX_OUTER);)
+CALL(t_inner_fixed, return restore_edited(x, E_F64, AT_DMI(dmi_state_at_double(2, 0, 0)), NAN, 0, 1);)
+CALL(t_inner_N, return restore_edited(x, E_U64, MODEL_STATE_AT_N, 50, 0, 1);)
 
 /* Foreign bytes: libdmi's own state format, of the right length. */
 CALL(t_foreign_dmi, size_t n; unsigned char *own = fmu_snapshot(&F, c, &n); free(own);
@@ -336,10 +335,11 @@ CALL(t_random, size_t n; unsigned char *b = fmu_snapshot(&F, c, &n); fmi2Status 
      free(b); return r;)
 /* A state claiming the step-complete phase without any history (ndmi = 0). */
 CALL(t_no_history, size_t n; unsigned char *own = fmu_snapshot(&F, c, &n); fmi2Status r = fmi2Fatal;
-     if (own && n > FMU_DMI + 8) {
-         size_t m = FMU_DMI + 8; uint64_t total = m, zero = 0;
+     if (own && n > MODEL_STATE_AT_DMI + 8) {
+         size_t m = MODEL_STATE_AT_DMI + 8;
          unsigned char *b = malloc(m);
-         if (b) { memcpy(b, own, FMU_DMI); memcpy(b + 16, &total, 8); memcpy(b + 32, &zero, 8);
+         if (b) { memcpy(b, own, MODEL_STATE_AT_DMI); dmi_put_u64(b, MODEL_STATE_AT_TOTAL, m);
+                  dmi_put_u64(b, MODEL_STATE_AT_NDMI, 0);
                   fmu_state_fix_checksums(b, m, 1); r = restore(x, b, m); free(b); } }
      free(own); return r;)
 
@@ -626,7 +626,7 @@ static void test_state_claiming_huge_N(void)
     CU_ASSERT_EQUAL_FATAL(build(&x, F_STEP), 0);
     struct rusage ru0, ru1;
     getrusage(RUSAGE_SELF, &ru0);
-    fmi2Status st = restore_edited(&x, E_U64, 40, (double)(1 << 22), 0, 1);
+    fmi2Status st = restore_edited(&x, E_U64, MODEL_STATE_AT_N, (double)(1 << 22), 0, 1);
     getrusage(RUSAGE_SELF, &ru1);
     long grown = ru1.ru_maxrss - ru0.ru_maxrss; /* KiB */
     CHECK(st == fmi2Error, "F110: state with N = 2^22 and a history for N = 100: status %d",
