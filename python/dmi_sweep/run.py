@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import logging
 import os
+import pickle
 import sys
 import time
 from dataclasses import dataclass
@@ -21,8 +22,25 @@ from .simulate import FMUPlugin, run_chunk
 from .spec import Spec
 from .store import LOG, Store
 
-# Workers need not have dmi_sweep installed: the worker code travels by value.
+# Neither the scheduler nor the workers need dmi_sweep installed: the worker code
+# travels by value (cloudpickle), inside the plugin and inside each task.
 cloudpickle.register_pickle_by_value(simulate)
+
+
+class _Call:
+    """Unpickling this calls fn(*args). A task is pickle.loads(cloudpickle.dumps(_Call(...))): the
+    scheduler, which unpickles task graphs, sees only bytes; the worker runs fn, sent by value."""
+
+    def __init__(self, fn, *args):
+        self.fn, self.args = fn, args
+
+    def __reduce__(self):
+        return self.fn, self.args
+
+
+def task(fn, *args) -> bytes:
+    """The bytes of a task for pickle.loads (see _Call)."""
+    return cloudpickle.dumps(_Call(fn, *args))
 
 
 @dataclass
@@ -110,11 +128,16 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
         client.register_plugin(plugin)
         job = spec.job()
         bar = Progress(spec.n_points, len(done), progress)
-        futures = [client.submit(run_chunk, plugin.name, job, [(i, spec.point(i)) for i in c],
-                                 pure=False) for c in chunks(todo, n_workers, chunk_size)]
+        futures = [client.submit(pickle.loads, task(run_chunk, plugin.name, job,
+                                                    [(i, spec.point(i)) for i in c]), pure=False)
+                   for c in chunks(todo, n_workers, chunk_size)]
         computed = failed = 0
+        written: set[int] = set()
         for fut in as_completed(futures):
-            results = fut.result()
+            results = [r for r in fut.result() if r["point"] not in written]
+            if not results:
+                continue
+            written.update(r["point"] for r in results)
             store.write(results)
             computed += len(results)
             failed += sum(1 for r in results if r.get("error"))
