@@ -196,3 +196,20 @@ def test_bad_spec_exit_status_of_the_command(tmp_path, fmu_path):
     spec = write_spec(tmp_path, GOOD.format(fmu=fmu_path).replace("g_amp = [1.0]", "gamp = [1.0]"))
     r = run_sweep("run", spec, "--out", tmp_path / "out")
     assert r.returncode == 2 and "'gamp' is not a variable" in r.stderr, r.stderr
+
+
+def test_reset_instance_equals_fresh_instance(fmu_path, tmp_path):
+    """A worker's instance, reset between points, gives what a fresh instance gives, bit for bit,
+    also after a point the FMU rejected."""
+    from dmi_sweep.simulate import Runner, unpack
+    job = {"start_time": 0.0, "stop_time": 2.0, "output_interval": 0.01, "transient": 1.0,
+           "start": {"N": 300}, "outputs": OUTPUTS, "poincare": 0.3}
+    a, b, bad = {"g_amp": 2.0, "alpha": 0.4}, {"g_amp": 1.2, "alpha": 1.0}, {"alpha": -1.0}
+    unzipdir = unpack(open(fmu_path, "rb").read(), str(tmp_path))
+    fresh = [Runner(unzipdir).run(job, p) for p in (a, b)]
+    reused = Runner(unzipdir)
+    runs = [reused.run(job, p) for p in (a, b, a, bad, b, a)]
+    assert runs[3]["error"] and "friction coefficient" in runs[3]["error"]
+    for got, want in zip([runs[0], runs[1], runs[2], runs[4], runs[5]], [fresh[0], fresh[1], fresh[0], fresh[1], fresh[0]]):
+        assert got == want
+    assert fresh[0] != fresh[1]
