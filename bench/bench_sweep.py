@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # The sweep's throughput with 1 and 2 local workers in one run, and its time per
 # point against a bare fmpy FMU2Slave loop over the same point.
-# Usage: bench/bench_sweep.py [--fmu FMU] [--points P] [--stop-time T] [--N N]
+# Usage: bench/bench_sweep.py [--fmu FMU] [--points P] [--stop-time T] [--N N] [--repeat R]
 #   (needs dmi_sweep importable: .venv after scripts/deps.sh, or PYTHONPATH=python)
 # Each LocalCluster is started and warmed up (FMU shipped, unpacked and
 # instantiated on every worker) before the clock starts: the figures are the
@@ -129,6 +129,7 @@ def main():
     ap.add_argument("--points", type=int, default=48)
     ap.add_argument("--stop-time", type=float, default=60.0)
     ap.add_argument("--N", type=int, default=9991)
+    ap.add_argument("--repeat", type=int, default=1, help="pairs of 1- and 2-worker sweeps, alternating")
     a = ap.parse_args()
     T, transient = a.stop_time, a.stop_time / 2
     with tempfile.TemporaryDirectory() as tmp:
@@ -139,21 +140,27 @@ def main():
         print(f"sweep: {a.points} points of g_amp, N = {a.N}, T = {T:g}, output interval 0.01, "
               f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f} at start")
         bare1, runner1 = interleaved(spec_path, g_amps[::4])
-        start1, t1, (wb1, wb2) = timed_sweep(spec_path, 1, work, g_amps[1::6])
-        start2, t2, _ = timed_sweep(spec_path, 2, work, g_amps[1::6])
+        pairs = []
+        for r in range(a.repeat):
+            start1, t1, (wb1, wb2) = timed_sweep(spec_path, 1, work / f"r{r}", g_amps[1::6])
+            start2, t2, _ = timed_sweep(spec_path, 2, work / f"r{r}", g_amps[1::6])
+            p1, p2 = a.points / t1, a.points / t2
+            pairs.append((p1, p2, t1, wb1, wb2))
+            print(f"1 worker : {p1:7.3f} points/s ({t1:.2f} s; cluster start and warm-up {start1:.1f} s)")
+            print(f"2 workers: {p2:7.3f} points/s ({t2:.2f} s; cluster start and warm-up {start2:.1f} s)")
+            print(f"ratio 2/1 workers: {p2 / p1:.2f}")
+            wb = (wb1 + wb2) / 2
+            print(f"per point, in the worker: bare loop {wb * 1e3:.1f} ms (just before the sweep "
+                  f"{wb1 * 1e3:.1f}, just after {wb2 * 1e3:.1f}); the whole sweep on 1 worker (Dask, "
+                  f"Parquet, progress) {t1 / a.points * 1e3:.1f} ms: overhead {100 * (t1 / a.points / wb - 1):+.1f} %")
         bare2, runner2 = interleaved(spec_path, g_amps[2::4])
         bare, runner = (bare1 + bare2) / 2, (runner1 + runner2) / 2
-        p1, p2 = a.points / t1, a.points / t2
-        print(f"1 worker : {p1:7.3f} points/s ({t1:.2f} s; cluster start and warm-up {start1:.1f} s)")
-        print(f"2 workers: {p2:7.3f} points/s ({t2:.2f} s; cluster start and warm-up {start2:.1f} s)")
-        print(f"ratio 2/1 workers: {p2 / p1:.2f}")
         print(f"per point, in this process, alternating: bare FMU2Slave loop {bare * 1e3:.1f} ms, the "
               f"sweep's worker code {runner * 1e3:.1f} ms: overhead {100 * (runner / bare - 1):+.1f} % "
-              f"(before the Dask runs {100 * (runner1 / bare1 - 1):+.1f} %, after {100 * (runner2 / bare2 - 1):+.1f} %)")
-        wb = (wb1 + wb2) / 2
-        print(f"per point, in the worker: bare loop {wb * 1e3:.1f} ms (just before the sweep "
-              f"{wb1 * 1e3:.1f}, just after {wb2 * 1e3:.1f}); the whole sweep on 1 worker (Dask, "
-              f"Parquet, progress) {t1 / a.points * 1e3:.1f} ms: overhead {100 * (t1 / a.points / wb - 1):+.1f} %")
+              f"(first half {100 * (runner1 / bare1 - 1):+.1f} %, second half {100 * (runner2 / bare2 - 1):+.1f} %)")
+        if a.repeat > 1:
+            ratios = sorted(p2 / p1 for p1, p2, *_ in pairs)
+            print(f"ratios 2/1 workers over {a.repeat} pairs: " + ", ".join(f"{x:.2f}" for x in ratios))
         print(f"load average {os.getloadavg()[0]:.2f} at the end")
 
 

@@ -36,6 +36,18 @@ def plain(fmu, values, stop, interval, **kw):
                         output=OUTPUTS, **kw)
 
 
+def assert_stats_equal(row, res, transient):
+    """The row's statistics against those of the simulate_fmu result `res`, computed here (math.fsum
+    for the mean) over its rows with time >= transient."""
+    window = res[res["time"] >= transient - 1e-9]
+    for y in OUTPUTS:
+        col = [float(x) for x in window[y]]
+        want = [float(res[y][-1]), min(col), max(col), math.fsum(col) / len(col)]
+        got = [row[f"{y}_{s}"] for s in ("final", "min", "max", "mean")]
+        assert np.max(np.abs(np.subtract(got, want))) <= 1e-12, (y, got, want)
+    return window
+
+
 @pytest.fixture(scope="module")
 def two_workers(tmp_path_factory, fmu_path):
     d = tmp_path_factory.mktemp("two")
@@ -60,13 +72,7 @@ def test_values_equal_plain_fmpy_runs(two_workers, fmu_path):
         values = {"N": 400, "tau": 0.5, "g_amp": row["g_amp"], "alpha": row["alpha"]}
         res = plain(fmu_path, values, 3.0, 0.01)
         assert len(res) == 301 and res["time"][-1] == 3.0
-        window = res[res["time"] >= 1.5 - 1e-9]
-        assert len(window) == 151
-        for y in OUTPUTS:
-            col = [float(x) for x in window[y]]
-            want = [float(res[y][-1]), min(col), max(col), math.fsum(col) / len(col)]
-            got = [row[f"{y}_{s}"] for s in ("final", "min", "max", "mean")]
-            assert np.max(np.abs(np.subtract(got, want))) <= 1e-12, (y, got, want)
+        assert len(assert_stats_equal(row, res, 1.5)) == 151
         times = [1.5 + k * period for k in range(int((3.0 - 1.5) / period) + 1)]
         t_in = [0.0] + [t for t in times for _ in (0, 1)] + [3.0]
         signal = np.array([(t, 0.0) for t in t_in], dtype=[("time", float), ("g_in", float)])
@@ -77,6 +83,25 @@ def test_values_equal_plain_fmpy_runs(two_workers, fmu_path):
             assert np.max(np.abs(np.subtract(row[f"{y}_poincare"], want))) <= 1e-12, y
     # the stick fraction is the mean of the Boolean output: some points stick part of the time
     assert ((ok["sticking_mean"] > 0) & (ok["sticking_mean"] < 1)).any()
+
+
+def test_fmi3_fmu_equals_plain_fmpy(tmp_path):
+    """The same sweep on an FMI 3.0 build of the oscillator (DMI_FMU3, set by ctest when the build
+    has one): FMU3Slave chosen from fmiVersion, values as simulate_fmu gives them."""
+    import os
+    fmu3 = os.environ.get("DMI_FMU3")
+    if not fmu3:
+        pytest.skip("DMI_FMU3 is not set: no FMI 3.0 FMU in this build")
+    from fmpy import read_model_description
+    assert read_model_description(fmu3).fmiVersion.startswith("3")
+    spec = write_spec(tmp_path, SPEC.format(fmu=fmu3).replace("[-0.5, 0.3, 1.0]", "[1.0]"))
+    r = run_sweep("run", spec, "--out", tmp_path / "out", "--workers", "2", "--chunk-size", "1")
+    assert r.returncode == 0, r.stderr
+    df = pd.read_parquet(tmp_path / "out").sort_values("point")
+    assert len(df) == 3 and df["error"].isna().all()
+    for _, row in df.iterrows():
+        res = plain(fmu3, {"N": 400, "tau": 0.5, "g_amp": row["g_amp"], "alpha": 1.0}, 3.0, 0.01)
+        assert_stats_equal(row, res, 1.5)
 
 
 def test_failing_point_recorded(two_workers):
