@@ -15,7 +15,8 @@ from dataclasses import dataclass
 from typing import TextIO
 
 import cloudpickle
-from distributed import Client, LocalCluster, as_completed
+import dask
+from distributed import Client, KilledWorker, LocalCluster, as_completed
 
 from . import simulate
 from .simulate import FMUPlugin, run_chunk
@@ -98,8 +99,10 @@ def make_client(workers: int | None, scheduler: str | None) -> Client:
     if scheduler:
         return Client(scheduler, timeout="30s")
     n = workers or os.cpu_count() or 1
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                           dashboard_address=None, silence_logs=logging.ERROR)
+    # No task waits on a busy worker: one that dies takes only its running chunk with it.
+    with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}):
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                               dashboard_address=None, silence_logs=logging.ERROR)
     return Client(cluster)
 
 
@@ -128,13 +131,33 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
         client.register_plugin(plugin)
         job = spec.job()
         bar = Progress(spec.n_points, len(done), progress)
-        futures = [client.submit(pickle.loads, task(run_chunk, plugin.name, job,
-                                                    [(i, spec.point(i)) for i in c]), pure=False)
-                   for c in chunks(todo, n_workers, chunk_size)]
+
+        def submit(points: list[int]):
+            payload = task(run_chunk, plugin.name, job, [(i, spec.point(i)) for i in points])
+            fut = client.submit(pickle.loads, payload, pure=False)
+            pending[fut.key] = points
+            return fut
+
+        pending: dict[str, list[int]] = {}
+        lost: dict[int, int] = {}    # point -> times its single-point task was lost with a worker
+        stream = as_completed([submit(c) for c in chunks(todo, n_workers, chunk_size)])
         computed = failed = 0
         written: set[int] = set()
-        for fut in as_completed(futures):
-            results = [r for r in fut.result() if r["point"] not in written]
+        for fut in stream:
+            points = pending.pop(fut.key)
+            try:
+                results = fut.result()
+            except KilledWorker as e:
+                # The chunk's workers died (the FMU crashed them?), or it was on a worker that
+                # another chunk killed. Each point alone, twice, finds the culprit.
+                if len(points) > 1 or lost.get(points[0], 0) < 1:
+                    for i in points:
+                        lost[i] = lost.get(i, -1) + 1
+                        stream.add(submit([i]))
+                    continue
+                results = [{"point": points[0], "error": f"{type(e).__name__}: {e}"}]
+            results = [r for r in results if r["point"] not in written]
+            fut.release()
             if not results:
                 continue
             written.update(r["point"] for r in results)
@@ -142,7 +165,6 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
             computed += len(results)
             failed += sum(1 for r in results if r.get("error"))
             bar.update(len(results))
-            fut.release()
         bar.close()
     finally:
         client.close()

@@ -238,3 +238,34 @@ def test_reset_instance_equals_fresh_instance(fmu_path, tmp_path):
     for got, want in zip([runs[0], runs[1], runs[2], runs[4], runs[5]], [fresh[0], fresh[1], fresh[0], fresh[1], fresh[0]]):
         assert got == want
     assert fresh[0] != fresh[1]
+
+
+def test_point_that_kills_its_worker(tmp_path, fmu_path, monkeypatch):
+    """A chunk whose task kills its worker (an FMU crashing the process) is split into single points;
+    the culprit is recorded with the error, the other points are computed."""
+    import os
+
+    import dask
+    from distributed import LocalCluster
+
+    import dmi_sweep.run as sweep
+    from dmi_sweep.spec import load
+    real = sweep.run_chunk
+
+    def crashing(plugin_name, job, points):
+        if any(i == 5 for i, _ in points):
+            os._exit(3)
+        return real(plugin_name, job, points)
+
+    monkeypatch.setattr(sweep, "run_chunk", crashing)
+    spec = load(write_spec(tmp_path, SPEC.format(fmu=fmu_path).replace("[-0.5, 0.3, 1.0]", "[0.3, 1.0]")
+                           .replace("num = 3", "num = 4")))
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0,
+                          "distributed.scheduler.worker-saturation": 1.0}), \
+            LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as c:
+        s = sweep.run(spec, tmp_path / "out", scheduler=c.scheduler_address, chunk_size=4, progress=None)
+    df = pd.read_parquet(tmp_path / "out").sort_values("point")
+    assert (s.computed, s.failed) == (8, 1), df[["point", "error"]].to_string()
+    assert list(df["point"]) == list(range(8))
+    assert "KilledWorker" in df["error"][df["point"] == 5].iloc[0]
+    assert df[df["point"] != 5]["error"].isna().all()
