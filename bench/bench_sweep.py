@@ -92,18 +92,20 @@ def interleaved(spec_path: Path, g_amps: list[float]) -> tuple[float, float]:
 
 
 def bare_points(fmu_path: str, N: int, T: float, transient: float, g_amps: list[float]) -> float:
-    """Seconds per point of the bare loop over g_amps (run in a Dask worker by timed_sweep)."""
+    """Wall-clock and CPU seconds per point of the bare loop over g_amps (run in a Dask worker by
+    timed_sweep)."""
     bare = Bare(fmu_path, N, T, transient)
     bare.point(g_amps[0])
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     for g in g_amps:
         bare.point(g)
-    return (time.perf_counter() - t0) / len(g_amps)
+    return (time.perf_counter() - t0) / len(g_amps), (time.process_time() - c0) / len(g_amps)
 
 
 def timed_sweep(spec_path: Path, workers: int, work: Path, bare_g: list[float]):
-    """Start-up seconds, sweep seconds of the sweep on a warmed-up LocalCluster of `workers`, and the
-    bare loop's seconds per point in one of its workers just before and just after the sweep."""
+    """Start-up seconds, sweep seconds of the sweep on a warmed-up LocalCluster of `workers`, the
+    CPU seconds it took (workers, and this process: client and scheduler), and the bare loop's
+    (wall, CPU) seconds per point in one of its workers just before and just after the sweep."""
     t0 = time.perf_counter()
     with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
                       silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
@@ -115,12 +117,14 @@ def timed_sweep(spec_path: Path, workers: int, work: Path, bare_g: list[float]):
         spec = load(spec_path)
         args = (str(spec.fmu), spec.start["N"], spec.stop_time, spec.transient, bare_g)
         before = client.submit(bare_points, *args, pure=False).result()
+        cpu0 = sum(client.run(time.process_time).values()) + time.process_time()
         t1 = time.perf_counter()
         s = sweep_run.run(spec, work / f"w{workers}", scheduler=cluster.scheduler_address, progress=None)
         seconds = time.perf_counter() - t1
+        cpu = time.process_time() + sum(client.run(time.process_time).values()) - cpu0
         after = client.submit(bare_points, *args, pure=False).result()
         assert s.computed == spec.n_points and s.failed == 0
-        return startup, seconds, (before, after)
+        return startup, seconds, cpu, (before, after)
 
 
 def main():
@@ -142,8 +146,8 @@ def main():
         bare1, runner1 = interleaved(spec_path, g_amps[::4])
         pairs = []
         for r in range(a.repeat):
-            start1, t1, (wb1, wb2) = timed_sweep(spec_path, 1, work / f"r{r}", g_amps[1::6])
-            start2, t2, _ = timed_sweep(spec_path, 2, work / f"r{r}", g_amps[1::6])
+            start1, t1, cpu1, ((wb1, cb1), (wb2, cb2)) = timed_sweep(spec_path, 1, work / f"r{r}", g_amps[1::6])
+            start2, t2, cpu2, _ = timed_sweep(spec_path, 2, work / f"r{r}", g_amps[1::6])
             p1, p2 = a.points / t1, a.points / t2
             pairs.append((p1, p2, t1, wb1, wb2))
             print(f"1 worker : {p1:7.3f} points/s ({t1:.2f} s; cluster start and warm-up {start1:.1f} s)")
@@ -153,6 +157,10 @@ def main():
             print(f"per point, in the worker: bare loop {wb * 1e3:.1f} ms (just before the sweep "
                   f"{wb1 * 1e3:.1f}, just after {wb2 * 1e3:.1f}); the whole sweep on 1 worker (Dask, "
                   f"Parquet, progress) {t1 / a.points * 1e3:.1f} ms: overhead {100 * (t1 / a.points / wb - 1):+.1f} %")
+            cb = (cb1 + cb2) / 2
+            print(f"CPU time per point: bare loop {cb * 1e3:.1f} ms; the sweep (worker, client, scheduler) "
+                  f"{cpu1 / a.points * 1e3:.1f} ms with 1 worker ({100 * (cpu1 / a.points / cb - 1):+.1f} %), "
+                  f"{cpu2 / a.points * 1e3:.1f} ms with 2 ({100 * (cpu2 / a.points / cb - 1):+.1f} %)")
         bare2, runner2 = interleaved(spec_path, g_amps[2::4])
         bare, runner = (bare1 + bare2) / 2, (runner1 + runner2) / 2
         print(f"per point, in this process, alternating: bare FMU2Slave loop {bare * 1e3:.1f} ms, the "
