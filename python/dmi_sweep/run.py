@@ -63,7 +63,7 @@ class Progress:
         self.last = 0.0
         self.tty = bool(stream) and stream.isatty()
 
-    def update(self, n: int, force: bool = False):
+    def update(self, n: int, force: bool = False) -> None:
         self.done += n
         now = time.monotonic()
         if self.stream is None or (not force and now - self.last < (0.2 if self.tty else 5.0)):
@@ -79,7 +79,7 @@ class Progress:
         self.stream.write(("\r" + line) if self.tty else line + "\n")
         self.stream.flush()
 
-    def close(self):
+    def close(self) -> None:
         self.update(0, force=True)
         if self.stream is not None and self.tty:
             self.stream.write("\n")

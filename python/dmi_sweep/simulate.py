@@ -93,7 +93,7 @@ class Runner:
         self.fmu = instantiate_fmu(self.unzipdir, self.md, fmi_type="CoSimulation", logger=logger)
         self.used = False
 
-    def discard(self):
+    def discard(self) -> None:
         """Frees the instance (after a failure; the next point gets a new one)."""
         if self.fmu is not None:
             try:
@@ -185,7 +185,7 @@ class Runner:
         last = sample() if not plan else None
         if in_window(t0, transient):
             rows.append(sample())
-        if period is not None and isclose(t0, transient) and events and isclose(events[0], t0):
+        if period is not None and isclose(t0, transient):   # the section's first time is t0
             poincare.append(sample())
         time = t0
         step = fmu.doStep
@@ -223,7 +223,7 @@ class Runner:
             raise ValueError(f"{name} has no value")
         return v.start
 
-    def close(self):
+    def close(self) -> None:
         self.discard()
 
 
@@ -245,7 +245,7 @@ class FMUPlugin(WorkerPlugin):
         self.fmu_bytes = fmu_bytes
         self.name = "dmi-sweep-" + sha256[:16]
 
-    def setup(self, worker=None):
+    def setup(self, worker: Any = None) -> None:
         base = getattr(worker, "local_directory", None) or tempfile.gettempdir()
         self.unzipdir = unpack(self.fmu_bytes, base)
         self.local = threading.local()
@@ -261,7 +261,7 @@ class FMUPlugin(WorkerPlugin):
                 self.runners.append(r)
         return r
 
-    def teardown(self, worker=None):
+    def teardown(self, worker: Any = None) -> None:
         for r in self.runners:
             r.close()
         shutil.rmtree(self.unzipdir, ignore_errors=True)
