@@ -76,6 +76,7 @@ class Runner:
         self.used = False
         self.messages: list[str] = []
         self.plans: dict[tuple, list] = {}
+        self.instantiations = 0
 
     def _logger2(self, env, instance, status, category, message):
         self._log(status, message)
@@ -92,6 +93,7 @@ class Runner:
         logger = self._logger3 if self.fmi3 else self._logger2
         self.fmu = instantiate_fmu(self.unzipdir, self.md, fmi_type="CoSimulation", logger=logger)
         self.used = False
+        self.instantiations += 1
 
     def discard(self) -> None:
         """Frees the instance (after a failure; the next point gets a new one)."""
@@ -269,12 +271,14 @@ class FMUPlugin(WorkerPlugin):
 
 def run_chunk(plugin_name: str, job: dict, points: list[tuple[int, dict]]) -> list[dict]:
     """A Dask task: simulates the points [(index, {name: value})] with this worker's FMU instance;
-    each result carries `point`, the worker's host and pid."""
+    each result carries `point`, the worker's pid, and how many times this worker has instantiated
+    the FMU so far."""
     runner = get_worker().plugins[plugin_name].runner()
     out = []
     for index, values in points:
         r = runner.run(job, values)
         r["point"] = index
         r["pid"] = os.getpid()
+        r["instantiations"] = runner.instantiations
         out.append(r)
     return out

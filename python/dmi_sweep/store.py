@@ -1,6 +1,7 @@
 # The result folder: a Parquet dataset of chunk files part-<first point>.parquet
 # (each written to a hidden temporary file, then renamed), the spec (_spec.toml),
-# the metadata (_meta.json) and a log of the chunks written (_log.jsonl).
+# the metadata (_meta.json) and a log of the runs and chunks written (_log.jsonl:
+# points, worker pids, FMU instantiations so far on the worker).
 # Readers (pandas.read_parquet, pyarrow) skip names starting with "_" or ".".
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
@@ -142,6 +143,7 @@ class Store:
         with open(self.dir / LOG, "a") as f:   # which points this run computed (pid of the worker)
             f.write(json.dumps({"time": time.time(), "client": os.getpid(), "file": name,
                                 "points": [r["point"] for r in results],
-                                "workers": sorted({r.get("pid") for r in results if r.get("pid")})})
+                                "workers": sorted({r.get("pid") for r in results if r.get("pid")}),
+                                "instantiations": max(r.get("instantiations", 0) for r in results)})
                     + "\n")
         return self.dir / name

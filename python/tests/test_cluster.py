@@ -57,10 +57,12 @@ def test_scheduler_and_workers_elsewhere(cluster, tmp_path, fmu_path):
     remote = pd.read_parquet(tmp_path / "remote").sort_values("point").reset_index(drop=True)
     local = pd.read_parquet(tmp_path / "local").sort_values("point").reset_index(drop=True)
     pd.testing.assert_frame_equal(remote, local, check_exact=True)
-    pids = {p for e in log_entries(tmp_path / "remote") for p in e.get("workers", [])}
-    assert pids == {w.pid for w in cluster.workers}             # both workers computed points
-    assert any(cluster.worker_dir.glob("*/dmi-sweep-fmu-*/modelDescription.xml")) or \
-        any(cluster.worker_dir.rglob("dmi-sweep-fmu-*"))      # unpacked in the workers' own folder
+    chunks = [e for e in log_entries(tmp_path / "remote") if "points" in e]
+    assert len(chunks) == 6
+    assert {p for e in chunks for p in e["workers"]} == {w.pid for w in cluster.workers}  # both worked
+    assert {e["instantiations"] for e in chunks} == {1}        # one FMU instance per worker
+    unpacked = list(cluster.worker_dir.rglob("dmi-sweep-fmu-*/modelDescription.xml"))
+    assert len(unpacked) == 2                                   # unpacked once per worker, in its folder
 
 
 def test_worker_killed_mid_sweep(cluster, tmp_path, fmu_path, processes):
