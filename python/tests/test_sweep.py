@@ -151,16 +151,16 @@ def test_changed_spec_refused_unless_restart(tmp_path, fmu_path):
     assert len(df) == 1 and abs(df["w_final"][0] - res["w"][-1]) <= 1e-12
 
 
-def test_plots(two_workers, tmp_path):
+def test_plots(two_workers, tmp_path, capsys):
+    from dmi_sweep.cli import main
     d, _ = two_workers
     for args in (["--x", "g_amp"], ["--x", "g_amp", "--y", "alpha", "--metric", "sticking_mean"]):
         png = tmp_path / "p.png"
-        r = run_sweep("plot", d / "out", *args, "-o", png)
-        assert r.returncode == 0, r.stderr
+        assert main(["plot", str(d / "out"), *args, "-o", str(png)]) == 0
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
         png.unlink()
-    r = run_sweep("plot", d / "out", "--x", "nope", "-o", tmp_path / "p.png")
-    assert r.returncode == 2 and "'nope' is not a column" in r.stderr
+    assert main(["plot", str(d / "out"), "--x", "nope", "-o", str(tmp_path / "p.png")]) == 2
+    assert "'nope' is not a column" in capsys.readouterr().err
 
 
 GOOD = """
