@@ -269,3 +269,21 @@ def test_point_that_kills_its_worker(tmp_path, fmu_path, monkeypatch):
     assert list(df["point"]) == list(range(8))
     assert "KilledWorker" in df["error"][df["point"] == 5].iloc[0]
     assert df[df["point"] != 5]["error"].isna().all()
+
+
+def test_latin_hypercube_sweep(tmp_path, fmu_path):
+    """[random]: n points with the sampled values as columns, each equal to a plain fmpy run."""
+    text = SPEC.format(fmu=fmu_path).replace(
+        "[grid]\ng_amp = { start = 0.8, stop = 2.4, num = 3 }\nalpha = [-0.5, 0.3, 1.0]",
+        "[random]\nn = 3\nseed = 7\ng_amp = { low = 0.8, high = 2.4 }\nalpha = { low = 0.2, high = 1.0 }")
+    assert "[random]" in text
+    spec = write_spec(tmp_path, text)
+    r = run_sweep("run", spec, "--out", tmp_path / "out", "--workers", "1")
+    assert r.returncode == 0, r.stderr
+    df = pd.read_parquet(tmp_path / "out").sort_values("point")
+    assert list(df["point"]) == [0, 1, 2] and df["error"].isna().all()
+    assert df["g_amp"].between(0.8, 2.4).all() and df["alpha"].between(0.2, 1.0).all()
+    assert df["g_amp"].nunique() == 3
+    for _, row in df.iterrows():
+        res = plain(fmu_path, {"N": 400, "tau": 0.5, "g_amp": row["g_amp"], "alpha": row["alpha"]}, 3.0, 0.01)
+        assert_stats_equal(row, res, 1.5)
