@@ -117,11 +117,14 @@ def timed_sweep(spec_path: Path, workers: int, work: Path, bare_g: list[float]):
         spec = load(spec_path)
         args = (str(spec.fmu), spec.start["N"], spec.stop_time, spec.transient, bare_g)
         before = client.submit(bare_points, *args, pure=False).result()
-        cpu0 = sum(client.run(time.process_time).values()) + time.process_time()
+        cpu_w0, cpu_c0 = sum(client.run(time.process_time).values()), time.process_time()
         t1 = time.perf_counter()
         s = sweep_run.run(spec, work / f"w{workers}", scheduler=cluster.scheduler_address, progress=None)
         seconds = time.perf_counter() - t1
-        cpu = time.process_time() + sum(client.run(time.process_time).values()) - cpu0
+        cpu_c = time.process_time() - cpu_c0
+        cpu_w = sum(client.run(time.process_time).values()) - cpu_w0
+        print(f"  {workers} worker(s): CPU seconds in the workers {cpu_w:.2f}, in the client and scheduler {cpu_c:.2f}")
+        cpu = cpu_w + cpu_c
         after = client.submit(bare_points, *args, pure=False).result()
         assert s.computed == spec.n_points and s.failed == 0
         return startup, seconds, cpu, (before, after)
