@@ -35,3 +35,13 @@ if [[ ! -f $stamp ]] || ! cmp -s "$req" "$stamp"; then
   "$venv/bin/python" -m pip install -q -r "$req"
   cp "$req" "$stamp"
 fi
+
+# dmi-sweep (python/), editable, its dependencies pinned above: reinstalled when
+# python/pyproject.toml changes or the checkout moves.
+sweep_stamp="$venv/.dmi-sweep.stamp"
+sweep_want="$root $(sha256sum "$root/python/pyproject.toml" | cut -d' ' -f1)"
+if [[ ! -x $venv/bin/dmi-sweep ]] || [[ $(cat "$sweep_stamp" 2>/dev/null) != "$sweep_want" ]]; then
+  echo "deps: installing dmi-sweep (python/) into .venv"
+  "$venv/bin/python" -m pip install -q --no-deps -e "$root/python"
+  echo "$sweep_want" >"$sweep_stamp"
+fi

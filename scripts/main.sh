@@ -4,7 +4,9 @@
 # writes into out/: the CSV of each example, Figures 4.1-4.5, the FMU's
 # Example 4.3 run by fmpy over the native run, the evidence for the erratum in
 # (4.4), the oscillator with a Prony-series memory (exponential kernel terms,
-# the recursion against the FFT); prints the summary table.  Copies the figures to docs/figures/.
+# the recursion against the FFT), a bifurcation diagram of Example 4.3 over the
+# forcing amplitude (dmi-sweep); prints the summary table.  Copies the figures
+# to docs/figures/.
 # Usage: scripts/main.sh
 # Environment: DMI_BUILD_DIR (default build), DMI_OUT_DIR (default out).
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -59,6 +61,19 @@ if [[ -f scripts/fmu_run.py && -f $fmu ]]; then
   "$ex/ex43" "$fmu_N" 30 1 >"$out/ex43_fmu_native.csv"
 else
   echo "skipped: scripts/fmu_run.py or $fmu does not exist (no FMU in this checkout)"
+fi
+
+stage "dmi-sweep: bifurcation diagram of Example 4.3 over g_amp (Poincare section of w)"
+sweep="$root/.venv/bin/dmi-sweep"
+if [[ -f $fmu && -x $sweep ]]; then
+  rm -rf "$out/sweep_ex43"
+  sweep_start=$SECONDS
+  DMI_FMU="$fmu" "$sweep" run python/examples/ex43_g_amp.toml --out "$out/sweep_ex43" --quiet
+  "$sweep" plot "$out/sweep_ex43" --x g_amp -o "$out/bifurcation_ex43.png"
+  "$sweep" plot "$out/sweep_ex43" --x g_amp --metric sticking_mean -o "$out/stick_fraction_ex43.png"
+  echo "bifurcation diagram: 60 points (N = 9991, T = 160) in $((SECONDS - sweep_start)) s on $(nproc) cores"
+else
+  echo "skipped: $fmu or $sweep does not exist"
 fi
 
 stage "figures and comparison with the paper and ../shared/reference"

@@ -1,0 +1,284 @@
+# The worker side of dmi-sweep: runs one point of a sweep on a co-simulation
+# FMU (FMI 2.0 or 3.0) with the communication points of fmpy.simulate_fmu, and
+# reduces the outputs to statistics and Poincare samples.  This module is
+# shipped to the workers by value (cloudpickle), so it imports nothing from
+# dmi_sweep: workers need fmpy, numpy and distributed, not this package.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+from __future__ import annotations
+
+import io
+import math
+import os
+import shutil
+import tempfile
+import threading
+import zipfile
+from math import isclose
+from typing import Any
+
+import numpy as np
+from distributed import WorkerPlugin, get_worker
+from fmpy import read_model_description
+from fmpy.simulation import (apply_start_values, instantiate_fmu, settable_in_initialization_mode,
+                             settable_in_instantiated)
+
+STATUS = ["OK", "Warning", "Discard", "Error", "Fatal", "Pending"]
+
+
+def communication_plan(start_time: float, stop_time: float, interval: float, variable_step: bool,
+                       events: list[float]) -> list[tuple[float, bool, bool]]:
+    """The communication points after start_time, in order, as (time, recorded, event): the loop of
+    fmpy.simulate_fmu (co-simulation) with `events` (sorted) playing the part of its input events.
+    `recorded` is False only for an event point that is not one of simulate_fmu's own points
+    (start_time + k interval, and stop_time)."""
+    plan = []
+    time = start_time
+    n_steps = 0
+    events = [e for e in events if e > start_time and not isclose(e, start_time)]
+    k = 0
+    while not (time > stop_time or isclose(time, stop_time)):
+        next_regular = start_time + (n_steps + 1) * interval
+        nxt = next_regular
+        cut = False
+        while k < len(events) and (events[k] < time or isclose(events[k], time)):
+            k += 1
+        if k < len(events) and variable_step and nxt > events[k] and not isclose(nxt, events[k]):
+            nxt = events[k]
+            cut = True
+        if nxt > stop_time and not isclose(nxt, stop_time):
+            if not variable_step:
+                break
+            nxt = stop_time
+            cut = False
+        event = k < len(events) and isclose(nxt, events[k])
+        plan.append((nxt, not cut, event))
+        time = nxt
+        if isclose(time, next_regular):
+            n_steps += 1
+    return plan
+
+
+def in_window(time: float, transient: float) -> bool:
+    """Whether a communication point belongs to the statistics window [transient, stop_time]."""
+    return time >= transient or isclose(time, transient)
+
+
+class Runner:
+    """One instance of an unpacked co-simulation FMU, instantiated on first use and reset between
+    points."""
+
+    def __init__(self, unzipdir: str):
+        self.unzipdir = unzipdir
+        self.md = read_model_description(unzipdir)
+        self.fmi3 = self.md.fmiVersion.startswith("3")
+        self.variables = {v.name: v for v in self.md.modelVariables}
+        self.fmu: Any = None
+        self.used = False
+        self.messages: list[str] = []
+        self.plans: dict[tuple, list] = {}
+        self.instantiations = 0
+
+    def _logger2(self, env, instance, status, category, message):
+        self._log(status, message)
+
+    def _logger3(self, env, status, category, message):
+        self._log(status, message)
+
+    def _log(self, status, message):
+        if status >= 1:  # warnings and worse explain a failing point
+            text = message.decode(errors="replace") if isinstance(message, bytes) else str(message)
+            self.messages.append(f"[{STATUS[status] if status < len(STATUS) else status}] {text}")
+
+    def _fresh(self):
+        logger = self._logger3 if self.fmi3 else self._logger2
+        self.fmu = instantiate_fmu(self.unzipdir, self.md, fmi_type="CoSimulation", logger=logger)
+        self.used = False
+        self.instantiations += 1
+
+    def discard(self) -> None:
+        """Frees the instance (after a failure; the next point gets a new one)."""
+        if self.fmu is not None:
+            try:
+                self.fmu.freeInstance()
+            except Exception:
+                pass
+        self.fmu = None
+
+    def _getters(self, names):
+        groups: dict[str, tuple[list[str], list[int]]] = {}
+        for name in names:
+            v = self.variables[name]
+            t = v.type
+            if t == "Enumeration":
+                t = "Int64" if self.fmi3 else "Integer"
+            groups.setdefault(t, ([], []))
+            groups[t][0].append(name)
+            groups[t][1].append(v.valueReference)
+        order = [n for ns, _ in groups.values() for n in ns]
+        getters = [(getattr(self.fmu, "get" + t), vrs) for t, (_, vrs) in groups.items()]
+        return order, getters
+
+    def run(self, job: dict, values: dict) -> dict:
+        """Simulates one point: the job's start values updated by `values`. Returns the statistics
+        (and Poincare samples), or {"error": message} if the FMU failed."""
+        self.messages.clear()
+        try:
+            if self.fmu is None:
+                self._fresh()
+            elif self.used:
+                self.fmu.reset()
+            self.used = True
+            return self._simulate(job, values)
+        except Exception as e:  # the FMU rejected something: record it, start afresh next time
+            self.discard()
+            reason = "; ".join(self.messages)
+            return {"error": f"{type(e).__name__}: {e}" + (f" (FMU log: {reason})" if reason else "")}
+
+    def _simulate(self, job, values):
+        fmu = self.fmu
+        t0, stop, interval = job["start_time"], job["stop_time"], job["output_interval"]
+        transient = job["transient"]
+        start = dict(job["start"])
+        start.update(values)
+        if self.fmi3:
+            rest = apply_start_values(fmu, self.md, start, settable=settable_in_instantiated)
+            fmu.enterInitializationMode(startTime=t0, stopTime=stop)
+        else:
+            fmu.setupExperiment(startTime=t0, stopTime=stop)
+            rest = apply_start_values(fmu, self.md, start, settable=settable_in_instantiated)
+            fmu.enterInitializationMode()
+        rest = apply_start_values(fmu, self.md, rest, settable=settable_in_initialization_mode)
+        fmu.exitInitializationMode()
+        if rest:
+            raise ValueError("could not set the start values of " + ", ".join(rest))
+
+        events: list[float] = []
+        period = job["poincare"]
+        if isinstance(period, str):
+            period = 2 * math.pi / float(self._value(period, start))
+        if period is not None:
+            if not (period > 0 and math.isfinite(period)):
+                raise ValueError(f"the Poincare period {period!r} is not a positive number")
+            k = 0
+            while True:
+                t = transient + k * period
+                if t > stop and not isclose(t, stop):
+                    break
+                events.append(t)
+                k += 1
+        variable_step = bool(self.md.coSimulation.canHandleVariableCommunicationStepSize)
+        key = (t0, stop, interval, variable_step, period, transient)
+        plan = self.plans.get(key)
+        if plan is None:
+            plan = communication_plan(t0, stop, interval, variable_step, events)
+            if len(self.plans) > 64:
+                self.plans.clear()
+            self.plans[key] = plan
+        names, getters = self._getters(job["outputs"])
+
+        def sample():
+            row = []
+            for get, vrs in getters:
+                row.extend(get(vrs))
+            return row
+
+        rows = []
+        poincare = []
+        last = sample() if not plan else None
+        if in_window(t0, transient):
+            rows.append(sample())
+        if period is not None and isclose(t0, transient):   # the section's first time is t0
+            poincare.append(sample())
+        time = t0
+        step = fmu.doStep
+        n = len(plan)
+        for i, (t, recorded, event) in enumerate(plan):
+            step(time, t - time)
+            time = t
+            if recorded and (in_window(t, transient) or i == n - 1):
+                row = sample()
+                if in_window(t, transient):
+                    rows.append(row)
+                last = row
+            if event:
+                poincare.append(sample())
+        fmu.terminate()
+
+        data = np.asarray(rows, dtype=float).reshape(len(rows), len(names))
+        result: dict[str, Any] = {"error": None}
+        final = np.asarray(last, dtype=float)
+        for j, name in enumerate(names):
+            col = data[:, j]
+            result[name + "_final"] = float(final[j])
+            result[name + "_min"] = float(col.min()) if len(col) else math.nan
+            result[name + "_max"] = float(col.max()) if len(col) else math.nan
+            result[name + "_mean"] = float(col.mean()) if len(col) else math.nan
+            if period is not None:
+                result[name + "_poincare"] = [float(r[j]) for r in poincare]
+        return result
+
+    def _value(self, name, start):
+        if name in start:
+            return start[name]
+        v = self.variables[name]
+        if v.start is None:
+            raise ValueError(f"{name} has no value")
+        return v.start
+
+    def close(self) -> None:
+        self.discard()
+
+
+def unpack(fmu_bytes: bytes, directory: str) -> str:
+    """Extracts the FMU (zip bytes) into a new folder under `directory`; returns the folder."""
+    unzipdir = tempfile.mkdtemp(prefix="dmi-sweep-fmu-", dir=directory)
+    with zipfile.ZipFile(io.BytesIO(fmu_bytes)) as z:
+        z.extractall(unzipdir)
+    return unzipdir
+
+
+class FMUPlugin(WorkerPlugin):
+    """Carries the FMU's bytes to each worker once (Dask sends registered plugins to every worker,
+    also to workers that join later), unpacks them there once, and keeps one Runner per thread."""
+
+    idempotent = True
+
+    def __init__(self, fmu_bytes: bytes, sha256: str):
+        self.fmu_bytes = fmu_bytes
+        self.name = "dmi-sweep-" + sha256[:16]
+
+    def setup(self, worker: Any = None) -> None:
+        base = getattr(worker, "local_directory", None) or tempfile.gettempdir()
+        self.unzipdir = unpack(self.fmu_bytes, base)
+        self.local = threading.local()
+        self.runners: list[Runner] = []
+        self.lock = threading.Lock()
+
+    def runner(self) -> Runner:
+        r = getattr(self.local, "runner", None)
+        if r is None:
+            r = Runner(self.unzipdir)
+            self.local.runner = r
+            with self.lock:
+                self.runners.append(r)
+        return r
+
+    def teardown(self, worker: Any = None) -> None:
+        for r in self.runners:
+            r.close()
+        shutil.rmtree(self.unzipdir, ignore_errors=True)
+
+
+def run_chunk(plugin_name: str, job: dict, points: list[tuple[int, dict]]) -> list[dict]:
+    """A Dask task: simulates the points [(index, {name: value})] with this worker's FMU instance;
+    each result carries `point`, the worker's pid, and how many times this worker has instantiated
+    the FMU so far."""
+    runner = get_worker().plugins[plugin_name].runner()
+    out = []
+    for index, values in points:
+        r = runner.run(job, values)
+        r["point"] = index
+        r["pid"] = os.getpid()
+        r["instantiations"] = runner.instantiations
+        out.append(r)
+    return out

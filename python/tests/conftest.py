@@ -1,0 +1,132 @@
+# Fixtures of the dmi-sweep tests: the FMU (DMI_FMU, set by ctest), specs
+# written to temporary folders, the command run as a subprocess, and a real Dask
+# cluster (a `dask scheduler` and `dask worker` processes on 127.0.0.1, the
+# workers in another temporary folder), every process stopped by its pid.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+from __future__ import annotations
+
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+PYTHON_DIR = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="session")
+def fmu_path() -> str:
+    path = os.environ.get("DMI_FMU")
+    if not path:
+        pytest.fail("environment variable DMI_FMU is not set (run the tests through ctest)")
+    return path
+
+
+def write_spec(directory: Path, text: str, name: str = "spec.toml") -> Path:
+    p = directory / name
+    p.write_text(text)
+    return p
+
+
+def env_with_package() -> dict[str, str]:
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(PYTHON_DIR), env.get("PYTHONPATH")]))
+    return env
+
+
+def sweep_cmd(*args: str) -> list[str]:
+    return [sys.executable, "-m", "dmi_sweep", *map(str, args)]
+
+
+def run_sweep(*args: str, timeout: float = 240) -> subprocess.CompletedProcess:
+    return subprocess.run(sweep_cmd(*args), capture_output=True, text=True, env=env_with_package(),
+                          timeout=timeout)
+
+
+def log_entries(out: Path) -> list[dict]:
+    """The lines of the result folder's _log.jsonl (a line cut by a kill is skipped)."""
+    entries = []
+    for line in (out / "_log.jsonl").read_text().splitlines():
+        try:
+            entries.append(json.loads(line))
+        except json.JSONDecodeError:
+            pass
+    return entries
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Processes:
+    """Processes started by a test; stop() ends each by its pid."""
+
+    def __init__(self):
+        self.procs: list[subprocess.Popen] = []
+
+    def start(self, args, **kw) -> subprocess.Popen:
+        p = subprocess.Popen(args, **kw)
+        self.procs.append(p)
+        return p
+
+    def stop(self):
+        for p in reversed(self.procs):
+            if p.poll() is None:
+                os.kill(p.pid, signal.SIGTERM)
+                try:
+                    p.wait(timeout=15)
+                except subprocess.TimeoutExpired:
+                    os.kill(p.pid, signal.SIGKILL)
+                    p.wait(timeout=15)
+
+
+@pytest.fixture
+def processes():
+    procs = Processes()
+    yield procs
+    procs.stop()
+
+
+class Cluster:
+    def __init__(self, address: str, scheduler: subprocess.Popen, workers: list[subprocess.Popen],
+                 worker_dir: Path):
+        self.address, self.scheduler, self.workers, self.worker_dir = address, scheduler, workers, worker_dir
+
+
+@pytest.fixture
+def cluster(processes, tmp_path_factory) -> Cluster:
+    """`dask scheduler` on a free port of 127.0.0.1 and two `dask worker` processes (no nanny, one
+    thread each) started in their own temporary folder, without this package on their path."""
+    from distributed import Client
+
+    dask = str(Path(sys.executable).parent / "dask")
+    sdir = tmp_path_factory.mktemp("scheduler")
+    wdir = tmp_path_factory.mktemp("workers")
+    address = f"tcp://127.0.0.1:{free_port()}"
+    quiet = dict(stdout=subprocess.DEVNULL, stderr=open(sdir / "cluster.log", "w"))
+    sched = processes.start([dask, "scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
+                             "--no-dashboard"], cwd=sdir, **quiet)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    workers = [processes.start([dask, "worker", address, "--nthreads", "1", "--nworkers", "1",
+                                "--no-nanny", "--no-dashboard", "--host", "127.0.0.1",
+                                "--local-directory", str(wdir)], cwd=wdir, env=env, **quiet)
+               for _ in range(2)]
+    deadline = time.monotonic() + 60
+    while True:
+        assert sched.poll() is None, "the dask scheduler exited"
+        try:
+            with Client(address, timeout=5) as c:
+                c.wait_for_workers(2, timeout=max(1, deadline - time.monotonic()))
+            break
+        except OSError:
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(0.5)
+    return Cluster(address, sched, workers, wdir)

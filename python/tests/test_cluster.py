@@ -1,0 +1,109 @@
+# dmi-sweep on a real Dask cluster on the loopback: a `dask scheduler` and two
+# `dask worker` processes started by the test in another folder (no shared
+# files, no dmi_sweep on their path); a worker killed with SIGKILL mid-sweep;
+# the client killed mid-sweep and the command rerun.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pandas as pd
+
+from conftest import env_with_package, log_entries, run_sweep, sweep_cmd, write_spec
+
+# about 0.1 s per point on this machine: long enough to kill something mid-sweep
+SLOW = """
+fmu = "{fmu}"
+stop_time = 30.0
+output_interval = 0.01
+transient = 20.0
+outputs = ["w", "sticking"]
+[start]
+N = 9991
+[grid]
+g_amp = {{ start = 0.5, stop = 2.5, num = {num} }}
+"""
+
+
+def wait_for_parts(out: Path, n: int, proc: subprocess.Popen, timeout: float = 120):
+    deadline = time.monotonic() + timeout
+    while len(list(out.glob("part-*.parquet"))) < n:
+        assert proc.poll() is None, "the sweep ended before it could be interrupted"
+        assert time.monotonic() < deadline, "no progress"
+        time.sleep(0.05)
+
+
+def check_complete(out: Path, total: int) -> pd.DataFrame:
+    df = pd.read_parquet(out)
+    assert sorted(df["point"]) == list(range(total))      # every point, each once
+    assert df["error"].isna().all()
+    return df
+
+
+def test_scheduler_and_workers_elsewhere(cluster, tmp_path, fmu_path):
+    """The sweep through --scheduler equals the LocalCluster's; the FMU reached the workers through
+    Dask only (their folder is another one, they have no path to the FMU)."""
+    spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=6).replace("30.0", "3.0")
+                      .replace("20.0", "2.0"))
+    r = run_sweep("run", spec, "--out", tmp_path / "remote", "--scheduler", cluster.address,
+                  "--chunk-size", "1")
+    assert r.returncode == 0, r.stderr
+    r = run_sweep("run", spec, "--out", tmp_path / "local", "--workers", "1")
+    assert r.returncode == 0, r.stderr
+    remote = pd.read_parquet(tmp_path / "remote").sort_values("point").reset_index(drop=True)
+    local = pd.read_parquet(tmp_path / "local").sort_values("point").reset_index(drop=True)
+    pd.testing.assert_frame_equal(remote, local, check_exact=True)
+    chunks = [e for e in log_entries(tmp_path / "remote") if "points" in e]
+    assert len(chunks) == 6
+    assert {p for e in chunks for p in e["workers"]} == {w.pid for w in cluster.workers}  # both worked
+    assert {e["instantiations"] for e in chunks} == {1}        # one FMU instance per worker
+    unpacked = list(cluster.worker_dir.rglob("dmi-sweep-fmu-*/modelDescription.xml"))
+    assert len(unpacked) == 2                                   # unpacked once per worker, in its folder
+
+
+def test_worker_killed_mid_sweep(cluster, tmp_path, fmu_path, processes):
+    total = 40
+    spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=total))
+    out = tmp_path / "out"
+    client = processes.start(sweep_cmd("run", spec, "--out", out, "--scheduler", cluster.address,
+                                       "--chunk-size", "1", "--quiet"),
+                             env=env_with_package(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True)
+    wait_for_parts(out, 4, client)
+    victim = cluster.workers[0]
+    os.kill(victim.pid, signal.SIGKILL)
+    victim.wait(timeout=10)
+    assert len(list(out.glob("part-*.parquet"))) < total       # killed mid-sweep
+    stdout, stderr = client.communicate(timeout=180)
+    assert client.returncode == 0, stderr
+    check_complete(out, total)
+    survivor = cluster.workers[1].pid
+    after = [e for e in log_entries(out) if "points" in e and e["workers"] == [survivor]]
+    assert after, "the surviving worker computed nothing"
+
+
+def test_client_killed_then_rerun(cluster, tmp_path, fmu_path, processes):
+    """Only the points missing after the kill are computed by the rerun, each once."""
+    total = 40
+    spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=total))
+    out = tmp_path / "out"
+    args = ("run", spec, "--out", out, "--scheduler", cluster.address, "--chunk-size", "1", "--quiet")
+    client = processes.start(sweep_cmd(*args), env=env_with_package(), stdout=subprocess.DEVNULL,
+                             stderr=subprocess.DEVNULL)
+    wait_for_parts(out, 5, client)
+    os.kill(client.pid, signal.SIGKILL)
+    client.wait(timeout=10)
+    done = set(pd.read_parquet(out)["point"])
+    assert 5 <= len(done) < total
+    n_before = len(log_entries(out))
+    r = run_sweep(*args)
+    assert r.returncode == 0, r.stderr
+    new = log_entries(out)[n_before:]
+    assert new[0]["run"] and new[0]["done"] == len(done) and new[0]["todo"] == total - len(done)
+    computed = [p for e in new[1:] for p in e["points"]]
+    assert sorted(computed) == sorted(set(range(total)) - done)   # the missing ones, each once
+    check_complete(out, total)
