@@ -367,7 +367,9 @@ int model_state_load(model *into, uint32_t tags, uint32_t solver_tags, uint32_t 
     if (*tag == 0 || (*tag & (*tag - 1)) != 0 || (*tag & tags) == 0)
         return fail(err, "state: the saved phase tag %lu is not allowed", (unsigned long)*tag);
     if (version != MODEL_STATE_VERSION)
-        return fail(err, "state: format version %lu is not supported", (unsigned long)version);
+        return fail(err, "state: format version %lu is not supported (this FMU reads version %d%s)",
+                    (unsigned long)version, MODEL_STATE_VERSION,
+                    version == 1 ? "; version 1 was written by the FMU of libdmi 1.0" : "");
     if (nreal != MODEL_NREAL || total != size || ndmi != size - (MODEL_STATE_AT_DMI + 8))
         return fail(err, "state: the sizes recorded in the state do not match (%zu bytes given)",
                     size);

@@ -109,7 +109,7 @@ int model_do_step(model *m, double t_current, double step, char *err);
  */
 #define MODEL_STATE_MAGIC "dmiFMUst" /* its 8 bytes, without the NUL */
 enum {
-    MODEL_STATE_VERSION = 1,
+    MODEL_STATE_VERSION = 2, /* 1: FMUs of libdmi 1.0 (their libdmi state has format 1) */
     MODEL_STATE_AT_VERSION = 8, /* uint32 */
     MODEL_STATE_AT_TAG = 12,    /* uint32: the caller's tag */
     MODEL_STATE_AT_TOTAL = 16,  /* uint64: bytes of the whole state */

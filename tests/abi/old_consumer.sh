@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # A program built against libdmi 1.0 runs against this libdmi.so.1: builds
-# the last 1.0 version of the sources (from the git history) with its example
+# the 1.0.0 release's sources (from the git history) with its example
 # program ex43, runs ex43 against its own libdmi.so.1 and against LIBDMI (this
 # build's), and requires the same output, byte for byte, and that the second
 # run loaded LIBDMI.  Exits 77 (skipped) when the history is not available.
@@ -10,14 +10,11 @@ set -euo pipefail
 src=$1
 new=$(readlink -f "$2")
 git -C "$src" rev-parse --git-dir >/dev/null 2>&1 || { echo "no git history: skipped"; exit 77; }
-old=
-for c in $(git -C "$src" rev-list HEAD); do
-  if git -C "$src" show "$c:CMakeLists.txt" | grep -q '^project(dmi VERSION 1\.0\.0'; then
-    old=$c
-    break
-  fi
-done
-[[ $old ]] || { echo "no 1.0 version in the history: skipped"; exit 77; }
+# The last commit of the 1.0 release line on main (libdmi 1.0.0).
+old=5cd99dec437480a016750d3e30c966da19d925ca
+git -C "$src" cat-file -e "$old^{commit}" 2>/dev/null || { echo "no commit $old (1.0) in the history: skipped"; exit 77; }
+git -C "$src" show "$old:CMakeLists.txt" | grep -q '^project(dmi VERSION 1\.0\.0' ||
+  { echo "commit $old is not libdmi 1.0.0"; exit 1; }
 work=$(mktemp -d "${TMPDIR:-/tmp}/dmi-old.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 mkdir "$work/tree"
