@@ -222,8 +222,9 @@ DMI_API int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user);
  * failed step leaves the engines untouched, as the rest of the solver.
  * Errors: DMI_EINVAL for another value (solver unchanged), for RECURSIVE as
  * said there (checked again by dmi_init, since the kernel may change), and for
- * DMI_CONV_FFT in a libdmi built without the FFT and GSL (compile definition
- * DMI_NO_FFT, as inside the FMU; AUTO then never picks it); DMI_ENOMEM if the
+ * DMI_CONV_FFT in a libdmi built without the FFT and GSL (its core sources
+ * without the definition DMI_HAVE_FFT, as inside the FMU; AUTO then never
+ * picks it); DMI_ENOMEM if the
  * FFT engine cannot be allocated after dmi_init (the former method stays).
  */
 DMI_API int dmi_set_convolution(dmi_solver *s, int method);

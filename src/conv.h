@@ -1,6 +1,6 @@
 /*
- * The FFT method of the delay sum (conv.c; absent when libdmi is built with
- * DMI_NO_FFT): an exact block convolution engine whose whole state is a
+ * The FFT method of the delay sum (conv.c; present only when libdmi is built
+ * with DMI_HAVE_FFT): an exact block convolution engine whose whole state is a
  * function of p, the kernel and the history ring, so it can be rebuilt from
  * them at any p with bitwise the same future results.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later

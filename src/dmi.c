@@ -40,8 +40,9 @@ size_t dmi_first_nonfinite(const double *x, size_t n)
 
 /* ---- the delay sum's engine ------------------------------------------------
  * s->conv is the FFT engine, s->rec the recursion's; both NULL when the
- * direct sum is in use.  Built with DMI_NO_FFT (no conv.c, no GSL: the
- * FMU's sources) there is no FFT engine. */
+ * direct sum is in use.  The FFT engine exists only when built with
+ * DMI_HAVE_FFT (conv.c and GSL, as libdmi is); without it (the core alone:
+ * the FMU's sources) the FFT method is refused. */
 
 /* Index of the first growing term (a_k > 0, C_k or D_k not zero) of the
  * exponential kernel, or K. */
@@ -59,10 +60,10 @@ static int check_method(const dmi_solver *s, int method, const char *fn)
     if (method != DMI_CONV_AUTO && method != DMI_CONV_DIRECT && method != DMI_CONV_FFT &&
         method != DMI_CONV_RECURSIVE)
         return dmi_fail(s, DMI_EINVAL, "%s: unknown method %d", fn, method);
-#ifdef DMI_NO_FFT
+#ifndef DMI_HAVE_FFT
     if (method == DMI_CONV_FFT)
         return dmi_fail(s, DMI_EINVAL, "%s: DMI_CONV_FFT is not available, this libdmi was built "
-                                       "without the FFT (DMI_NO_FFT)", fn);
+                                       "without the FFT (no DMI_HAVE_FFT)", fn);
 #endif
     if (method != DMI_CONV_RECURSIVE)
         return DMI_OK;
@@ -92,7 +93,7 @@ static int engine_make(const dmi_solver *s, const dmi_kernel *k, int method, dmi
             return dmi_fail(s, DMI_ENOMEM, "%s: out of memory for the recursion's sums", fn);
         return DMI_OK;
     }
-#ifndef DMI_NO_FFT
+#ifdef DMI_HAVE_FFT
     if (dmi_conv_create(conv, k, s->n, s->N, method) != 0)
         return dmi_fail(s, DMI_ENOMEM, "%s: out of memory for the FFT engine", fn);
 #else
@@ -103,7 +104,7 @@ static int engine_make(const dmi_solver *s, const dmi_kernel *k, int method, dmi
 
 static void engine_free(dmi_conv *conv, dmi_exp *rec)
 {
-#ifndef DMI_NO_FFT
+#ifdef DMI_HAVE_FFT
     dmi_conv_free(conv);
 #else
     (void)conv;
@@ -114,7 +115,7 @@ static void engine_free(dmi_conv *conv, dmi_exp *rec)
 /* Recomputes the engines for s's step p from the ring. */
 void dmi_engine_rebuild(const dmi_solver *s, dmi_conv *conv, dmi_exp *rec)
 {
-#ifndef DMI_NO_FFT
+#ifdef DMI_HAVE_FFT
     if (conv)
         dmi_conv_rebuild(conv, &s->kernel, &s->ring, s->p);
 #else
@@ -131,7 +132,7 @@ static void delay_sum(const dmi_solver *s, double *W)
         dmi_exp_sum(s->rec, s->h, W);
         return;
     }
-#ifndef DMI_NO_FFT
+#ifdef DMI_HAVE_FFT
     if (s->conv) {
         dmi_conv_sum(s->conv, &s->kernel, &s->ring, s->p, s->h, W);
         return;
@@ -143,7 +144,7 @@ static void delay_sum(const dmi_solver *s, double *W)
 /* After a step was committed (U^p pushed, p counted). */
 static void engine_advance(dmi_solver *s)
 {
-#ifndef DMI_NO_FFT
+#ifdef DMI_HAVE_FFT
     if (s->conv)
         dmi_conv_advance(s->conv, &s->kernel, &s->ring, s->p);
 #endif

@@ -1,6 +1,6 @@
 /*
- * libdmi built from its GSL-free core (DMI_CORE_SOURCES, compiled with
- * DMI_NO_FFT, as inside the FMU): DMI_CONV_FFT is refused with a message,
+ * libdmi built from its GSL-free core (DMI_CORE_SOURCES, compiled without
+ * DMI_HAVE_FFT, as inside the FMU): DMI_CONV_FFT is refused with a message,
  * AUTO falls back to the direct sum, and Example 4.3 at h = 1/9991 still
  * matches ../shared/reference/ex43_N9991.csv.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
