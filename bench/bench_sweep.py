@@ -132,7 +132,8 @@ def timed_sweep(spec_path: Path, workers: int, work: Path, bare_g: list[float]):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--fmu", default=str(ROOT / "build" / "fmu" / "DelayFrictionOscillator.fmu"))
+    ap.add_argument("--fmu", type=lambda f: str(Path(f).resolve()),  # the spec is written elsewhere
+                    default=str(ROOT / "build" / "fmu" / "DelayFrictionOscillator.fmu"))
     ap.add_argument("--points", type=int, default=48)
     ap.add_argument("--stop-time", type=float, default=60.0)
     ap.add_argument("--N", type=int, default=9991)
