@@ -192,8 +192,10 @@ DMI_API int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user);
  *           FFT (GSL radix-2), O(log N)-ish work per step; extra memory about
  *           2 N per nonzero kernel entry and 2 N per kernel column and block
  *           size (a few block sizes), i.e. still O(N n^2).
- *   RECURSIVE  (since 1.1) only for a kernel set by dmi_set_kernel_exp
- *           whose terms all have a[k] <= 0: per term k and used column j the
+ *   RECURSIVE  (since 1.1) for a kernel set by dmi_set_kernel_exp whose
+ *           terms all have a[k] <= 0 and |b[k]| h <= pi (or for no kernel at
+ *           all: H = 0 is the empty sum, K = 0, and W^p = 0 exactly): per
+ *           term k and used column j the
  *           sum S = sum_{l<N} r^l U_j^{p-l}, r = exp((a + i b) h), follows
  *           S <- r S + U_j^{p+1} - r^N U_j^{p+1-N}: O(K n^2) work per step
  *           and O(K n) memory besides the samples, whatever N is.  r and r^N
@@ -204,8 +206,14 @@ DMI_API int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user);
  *           h sum_l |H(l h)| max|U| of the direct sum (tested over 10^6 steps,
  *           N up to 10^6).  A growing term (a[k] > 0, |r| > 1) would multiply
  *           each step's rounding by |r| every step: RECURSIVE refuses it.
- *           DMI_EINVAL also for a kernel given as a callback.
- *   AUTO    RECURSIVE for an exponential kernel without growing terms, else
+ *           Beyond |b[k]| h = pi the samples cos(b l h) alias a frequency
+ *           below pi / h (the kernel is not resolved by the step h) and
+ *           r = exp(i b h) and the samples lose accuracy as |b| h grows (the
+ *           methods differ by 1.8e-7 at b h = 1e9): RECURSIVE refuses such a
+ *           term too (the message names it; use a smaller h).  Terms whose
+ *           C_k and D_k are zero are never refused.  DMI_EINVAL also for a
+ *           kernel given as a callback.
+ *   AUTO    RECURSIVE for an exponential kernel that RECURSIVE takes, else
  *           FFT when a cost model measured on x86-64 predicts it faster
  *           than DIRECT for this N and kernel pattern, else DIRECT; for one
  *           nonzero kernel entry that is N >= 382 (a full 3 x 3 kernel:
@@ -290,7 +298,8 @@ DMI_API int dmi_get_step_terms(const dmi_solver *s, double *W, double *X);
  * last step's terms and, for a kernel set by dmi_set_kernel_exp, the
  * recursion's sums (so its size depends on that kernel; format version 2
  * since libdmi 1.1: states of libdmi 1.0, version 1, are refused with
- * DMI_EINVAL and a message saying so); it does not include the callbacks, the resolvent choice,
+ * DMI_EINVAL and a message naming that version and libdmi 1.0, whatever
+ * their size); it does not include the callbacks, the resolvent choice,
  * the convolution method or the kernel (these stay as set on the solver that
  * loads it).  The bytes
  * are native-endian, begin with a magic and a format version, and are

@@ -280,6 +280,7 @@ typedef struct {
 struct dmi_exp {
     size_t n, N, nterms, nsums, nparts;
     uint64_t period;
+    uint64_t next; /* the next anchoring step: the multiple of period after the last anchor */
     term *terms;
     sum *sums;
     part *parts;
@@ -378,8 +379,15 @@ static void accumulate(dd *acc, double x)
     acc->lo += s.lo;
 }
 
-void dmi_exp_anchor(dmi_exp *e, const dmi_history *r)
+/* The step after p at which the sums are anchored next. */
+static void set_next(dmi_exp *e, uint64_t p)
 {
+    e->next = p - p % e->period + e->period;
+}
+
+void dmi_exp_anchor(dmi_exp *e, const dmi_history *r, uint64_t p)
+{
+    set_next(e, p);
     for (size_t q = 0; q < e->nsums; q++) {
         sum *S = &e->sums[q];
         const term *t = &e->terms[S->term];
@@ -408,8 +416,8 @@ void dmi_exp_anchor(dmi_exp *e, const dmi_history *r)
 
 void dmi_exp_advance(dmi_exp *e, const dmi_history *r, uint64_t p)
 {
-    if (p % e->period == 0) {
-        dmi_exp_anchor(e, r);
+    if (p == e->next) {
+        dmi_exp_anchor(e, r, p);
         return;
     }
     const size_t N = e->N;
@@ -456,8 +464,9 @@ void dmi_exp_get(const dmi_exp *e, unsigned char *bytes)
     }
 }
 
-void dmi_exp_set(dmi_exp *e, const double *sums)
+void dmi_exp_set(dmi_exp *e, const double *sums, uint64_t p)
 {
+    set_next(e, p);
     for (size_t q = 0; q < e->nsums; q++) {
         e->sums[q].re = sums[2 * q];
         e->sums[q].im = sums[2 * q + 1];

@@ -55,17 +55,20 @@ typedef struct dmi_exp dmi_exp;
  * dmi_exp_anchor before use).  0, or -1 when out of memory. */
 int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h);
 void dmi_exp_free(dmi_exp *e);
-/* Computes the sums S^p from the ring (U^{p-N..p}). */
-void dmi_exp_anchor(dmi_exp *e, const dmi_history *r);
-/* After U^p was pushed (p the new step counter): S^{p-1} -> S^p. */
+/* Computes the sums S^p from the ring (U^{p-N..p}) at step p. */
+void dmi_exp_anchor(dmi_exp *e, const dmi_history *r, uint64_t p);
+/* After U^p was pushed (p the new step counter): S^{p-1} -> S^p (anchored
+ * afresh when p is the next multiple of the period; the engine keeps that
+ * step, set by dmi_exp_anchor and dmi_exp_set from their p, so that its
+ * sums stay a function of p and the states). */
 void dmi_exp_advance(dmi_exp *e, const dmi_history *r, uint64_t p);
 /* W^p (n values). */
 void dmi_exp_sum(const dmi_exp *e, double h, double *W);
 /* The anchoring period in steps. */
 uint64_t dmi_exp_period(const dmi_exp *e);
 /* The sums as 2 dmi_expk_sums doubles (re, im): written to bytes (any
- * alignment), or set from the doubles. */
+ * alignment), or set from the doubles as those of step p. */
 void dmi_exp_get(const dmi_exp *e, unsigned char *bytes);
-void dmi_exp_set(dmi_exp *e, const double *sums);
+void dmi_exp_set(dmi_exp *e, const double *sums, uint64_t p);
 
 #endif

@@ -62,21 +62,30 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
     if (rc != DMI_OK)
         return rc;
     const size_t need = dmi_state_size(s), n = s->n, N = s->N;
+    const unsigned char *b = buf;
+    /* magic and version before the size: a state of another format has
+     * another size, and the version is what tells the caller why */
+    if (size < DMI_STATE_HEADER)
+        return dmi_fail(s, DMI_EINVAL, "dmi_state_load: %zu bytes, this solver's state has %zu",
+                        size, need);
+    if (dmi_get_u64(b, DMI_STATE_AT_MAGIC) != DMI_STATE_MAGIC)
+        return dmi_fail(s, DMI_EINVAL, "dmi_state_load: not a dmi state (bad magic)");
+    const uint64_t version = dmi_get_u64(b, DMI_STATE_AT_VERSION);
+    if (version == 1)
+        return dmi_fail(s, DMI_EINVAL, "dmi_state_load: state format version 1, written by libdmi "
+                                       "1.0; this libdmi reads version %llu only (save the state "
+                                       "again with it)", (unsigned long long)DMI_STATE_VERSION);
+    if (version != DMI_STATE_VERSION)
+        return dmi_fail(s, DMI_EINVAL, "dmi_state_load: state format version %llu; this libdmi "
+                                       "reads version %llu only", (unsigned long long)version,
+                        (unsigned long long)DMI_STATE_VERSION);
     if (size != need)
         return dmi_fail(s, DMI_EINVAL, "dmi_state_load: %zu bytes, this solver's state has %zu",
                         size, need);
-    const unsigned char *b = buf;
-    const uint64_t version = dmi_get_u64(b, DMI_STATE_AT_VERSION);
     const uint64_t hn = dmi_get_u64(b, DMI_STATE_AT_n), hN = dmi_get_u64(b, DMI_STATE_AT_N);
     const uint64_t p = dmi_get_u64(b, DMI_STATE_AT_P);
     const uint64_t stepped = dmi_get_u64(b, DMI_STATE_AT_STEPPED);
     const double tau = dmi_get_double(b, DMI_STATE_AT_TAU);
-    if (dmi_get_u64(b, DMI_STATE_AT_MAGIC) != DMI_STATE_MAGIC)
-        return dmi_fail(s, DMI_EINVAL, "dmi_state_load: not a dmi state (bad magic)");
-    if (version != DMI_STATE_VERSION)
-        return dmi_fail(s, DMI_EINVAL, "dmi_state_load: state format version %llu (libdmi 1.0 "
-                                       "wrote version 1); this libdmi reads version %llu only",
-                        (unsigned long long)version, (unsigned long long)DMI_STATE_VERSION);
     if (hn != (uint64_t)n || hN != (uint64_t)N || memcmp(&tau, &s->tau, sizeof tau))
         return dmi_fail(s, DMI_EINVAL,
                         "dmi_state_load: state of a solver with n = %llu, N = %llu, tau = %g; "
@@ -122,7 +131,7 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
      * of another method or kernel) are anchored afresh from the states. */
     if (s->rec && running == 1 &&
         dmi_get_u64(rec, DMI_STATE_REC_SIGNATURE) == dmi_expk_signature(&s->expk, N, s->h))
-        dmi_exp_set(s->rec, d + nd - E);
+        dmi_exp_set(s->rec, d + nd - E, p);
     else
         dmi_engine_rebuild(s, NULL, s->rec);
     dmi_engine_rebuild(s, s->conv, NULL);

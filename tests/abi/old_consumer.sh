@@ -3,16 +3,23 @@
 # the 1.0.0 release's sources (from the git history) with its example
 # program ex43, runs ex43 against its own libdmi.so.1 and against LIBDMI (this
 # build's), and requires the same output, byte for byte, and that the second
-# run loaded LIBDMI.  Exits 77 (skipped) when the history is not available.
+# run loaded LIBDMI.  Exits 77 (skipped) only for a shallow clone, whose
+# history may lack the release commit; a full clone without that commit, or
+# sources outside a git clone, are an error.
 #   old_consumer.sh SOURCE_DIR LIBDMI
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 set -euo pipefail
 src=$1
 new=$(readlink -f "$2")
-git -C "$src" rev-parse --git-dir >/dev/null 2>&1 || { echo "no git history: skipped"; exit 77; }
-# The last commit of the 1.0 release line on main (libdmi 1.0.0).
+git -C "$src" rev-parse --git-dir >/dev/null 2>&1 || { echo "$src is not a git clone: no 1.0.0 sources"; exit 1; }
+# The libdmi 1.0.0 release commit.
 old=5cd99dec437480a016750d3e30c966da19d925ca
-git -C "$src" cat-file -e "$old^{commit}" 2>/dev/null || { echo "no commit $old (1.0) in the history: skipped"; exit 77; }
+if ! git -C "$src" cat-file -e "$old^{commit}" 2>/dev/null; then
+  if [[ $(git -C "$src" rev-parse --is-shallow-repository) == true ]]; then
+    echo "shallow clone without commit $old (1.0.0): skipped"; exit 77
+  fi
+  echo "commit $old (libdmi 1.0.0) is missing from a full clone"; exit 1
+fi
 git -C "$src" show "$old:CMakeLists.txt" | grep -q '^project(dmi VERSION 1\.0\.0' ||
   { echo "commit $old is not libdmi 1.0.0"; exit 1; }
 work=$(mktemp -d "${TMPDIR:-/tmp}/dmi-old.XXXXXX")

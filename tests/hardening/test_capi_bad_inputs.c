@@ -162,6 +162,50 @@ static void fix_checksum(unsigned char *b, size_t size)
 {
     dmi_put_u64(b, DMI_STATE_AT_CHECKSUM, dmi_fnv1a_skip(b, size, DMI_STATE_AT_CHECKSUM));
 }
+/* The state of s (initialised and stepped) in format version 1, built as
+ * libdmi 1.0 wrote it (src/dmi.c of the 1.0.0 release, independent of
+ * bytes.h): 8 uint64 words magic "DMISTATE", 1, n, N, bits of tau, p,
+ * p != 0, FNV-1a 64 of all bytes with this word zero; then (N + 1) n doubles
+ * U_j^{p-lag} (lag-major), n doubles W, n doubles X.  Caller frees. */
+static unsigned char *state_v1(const dmi_solver *s, size_t *size)
+{
+    enum { n = MODEL_n, N = MODEL_N };
+    const double tau = MODEL_TAU;
+    uint64_t w[8] = {UINT64_C(0x444d495354415445), 1, n, N, 0, 0, 0, 0};
+    double d[(N + 3) * n];
+    memcpy(&w[4], &tau, sizeof tau);
+    if (dmi_get_step_index(s, &w[5]) != DMI_OK)
+        return NULL;
+    w[6] = w[5] != 0;
+    for (size_t lag = 0; lag <= N; lag++)
+        if (dmi_get_past(s, lag, d + lag * n) != DMI_OK)
+            return NULL;
+    if (dmi_get_step_terms(s, d + (N + 1) * n, d + (N + 2) * n) != DMI_OK)
+        return NULL;
+    *size = sizeof w + sizeof d; /* 176 bytes */
+    unsigned char *b = malloc(*size);
+    if (!b)
+        return NULL;
+    memcpy(b, w, sizeof w);
+    memcpy(b + sizeof w, d, sizeof d);
+    uint64_t hsh = UINT64_C(0xcbf29ce484222325);
+    for (size_t i = 0; i < *size; i++) {
+        hsh ^= b[i];
+        hsh *= UINT64_C(0x100000001b3);
+    }
+    memcpy(b + 7 * sizeof(uint64_t), &hsh, sizeof hsh);
+    return b;
+}
+
+static int load_v1(dmi_solver *s)
+{
+    size_t size;
+    unsigned char *b = state_v1(s, &size);
+    int rc = b ? dmi_state_load(s, b, size) : -100;
+    free(b);
+    return rc;
+}
+
 /* Byte offset of U_j^{p-lag} (lag N + 2: X^{p-1}) in the model's state. */
 #define AT_DOUBLE(lag, j) dmi_state_at_double(MODEL_n, (lag), (j))
 
@@ -204,6 +248,32 @@ CALL(c_box_hi_ninf, const double l[2] = {-1, -INFINITY}, u[2] = {1, -INFINITY};
      return dmi_set_box(s, l, u);)
 CALL(c_kern_null, return dmi_set_kernel(NULL, model_kernel, m);)
 CALL(c_kern_late, return dmi_set_kernel(s, model_kernel, m);)
+/* dmi_set_kernel_exp: a 2-term kernel of the n = 2 model (C and D 2 x 2 x 2) */
+static const double xa[2] = {0, -1}, xb[2] = {2, 0};
+static const double xC[8] = {0.1, 0, 0, 0.1, 0.2, 0, 0, 0.2}, xD[8] = {0.3, 0, 0, 0, 0, 0, 0, 0};
+/* x with x[at] = v: the arrays of a bad call */
+static const double *with(const double *x, size_t len, size_t at, double v)
+{
+    static double out[8];
+    memcpy(out, x, len * sizeof *x);
+    out[at] = v;
+    return out;
+}
+CALL(c_kexp_null, return dmi_set_kernel_exp(NULL, 2, xa, xb, xC, xD);)
+CALL(c_kexp_k0, return dmi_set_kernel_exp(s, 0, xa, xb, xC, xD);)
+CALL(c_kexp_a_null, return dmi_set_kernel_exp(s, 2, NULL, xb, xC, xD);)
+CALL(c_kexp_b_null, return dmi_set_kernel_exp(s, 2, xa, NULL, xC, xD);)
+CALL(c_kexp_C_null, return dmi_set_kernel_exp(s, 2, xa, xb, NULL, xD);)
+CALL(c_kexp_a_nan, return dmi_set_kernel_exp(s, 2, with(xa, 2, 1, NAN), xb, xC, xD);)
+CALL(c_kexp_a_inf, return dmi_set_kernel_exp(s, 2, with(xa, 2, 0, -INFINITY), xb, xC, xD);)
+CALL(c_kexp_b_nan, return dmi_set_kernel_exp(s, 2, xa, with(xb, 2, 0, NAN), xC, xD);)
+CALL(c_kexp_b_inf, return dmi_set_kernel_exp(s, 2, xa, with(xb, 2, 1, INFINITY), xC, xD);)
+CALL(c_kexp_C_nan, return dmi_set_kernel_exp(s, 2, xa, xb, with(xC, 8, 6, NAN), xD);)
+CALL(c_kexp_C_inf, return dmi_set_kernel_exp(s, 2, xa, xb, with(xC, 8, 1, INFINITY), xD);)
+CALL(c_kexp_D_nan, return dmi_set_kernel_exp(s, 2, xa, xb, xC, with(xD, 8, 3, NAN));)
+CALL(c_kexp_D_inf, return dmi_set_kernel_exp(s, 2, xa, xb, xC, with(xD, 8, 5, -INFINITY));)
+CALL(c_kexp_late, return dmi_set_kernel_exp(s, 2, xa, xb, xC, xD);)
+CALL(c_conv_rec_callback, return dmi_set_convolution(s, DMI_CONV_RECURSIVE);)
 CALL(c_hist_null, return dmi_set_history(NULL, model_history, m);)
 CALL(c_hist_late, return dmi_set_history(s, model_history, m);)
 CALL(c_conv_null, return dmi_set_convolution(NULL, DMI_CONV_DIRECT);)
@@ -304,7 +374,7 @@ CALL(c_load_long, return LOAD(s, E_NONE, 0, 0, 1, 0);)
 CALL(c_load_empty, return load_edited(s, MODEL_n, MODEL_TAU, MODEL_N, E_NONE, 0, 0,
                                       -(long)dmi_state_size(s), 0);)
 CALL(c_load_magic, return LOAD(s, E_BYTE, 0, 0, 0, 0);)
-CALL(c_load_version, return LOAD(s, E_WORD_FIXED, DMI_STATE_AT_VERSION, 1, 0, 0);)
+CALL(c_load_version, return load_v1(s);)
 CALL(c_load_foreign_nN, return load_edited(s, 1, MODEL_TAU, 11, E_NONE, 0, 0, 0, 0);)
 CALL(c_load_foreign_tau, return load_edited(s, MODEL_n, 2.0, MODEL_N, E_NONE, 0, 0, 0, 0);)
 CALL(c_load_foreign_n_hdr, return LOAD(s, E_WORD_FIXED, DMI_STATE_AT_n, 3, 0, 0);)
@@ -344,6 +414,21 @@ static const bad_case cases[] = {
     {"C35", "dmi_set_box", "lo[1] = hi[1] = -Inf (empty box)", S_INIT, c_box_hi_ninf, DMI_EINVAL, "empty"},
     {"C36", "dmi_set_kernel", "s = NULL", S_NULL, c_kern_null, DMI_EINVAL, NULL},
     {"C37", "dmi_set_kernel", "after dmi_init", S_INIT, c_kern_late, DMI_ESTATE, "dmi_set_kernel"},
+    {"C115", "dmi_set_kernel_exp", "s = NULL", S_NULL, c_kexp_null, DMI_EINVAL, NULL},
+    {"C116", "dmi_set_kernel_exp", "K = 0", S_FRESH, c_kexp_k0, DMI_EINVAL, "K = 0"},
+    {"C117", "dmi_set_kernel_exp", "a = NULL", S_FRESH, c_kexp_a_null, DMI_EINVAL, "a is NULL"},
+    {"C118", "dmi_set_kernel_exp", "b = NULL", S_FRESH, c_kexp_b_null, DMI_EINVAL, "b is NULL"},
+    {"C119", "dmi_set_kernel_exp", "C = NULL", S_FRESH, c_kexp_C_null, DMI_EINVAL, "C is NULL"},
+    {"C120", "dmi_set_kernel_exp", "a[1] = NaN", S_FRESH, c_kexp_a_nan, DMI_EINVAL, "a[1] = nan"},
+    {"C121", "dmi_set_kernel_exp", "a[0] = -Inf", S_FRESH, c_kexp_a_inf, DMI_EINVAL, "a[0] = -inf"},
+    {"C122", "dmi_set_kernel_exp", "b[0] = NaN", S_FRESH, c_kexp_b_nan, DMI_EINVAL, "b[0] = nan"},
+    {"C123", "dmi_set_kernel_exp", "b[1] = +Inf", S_FRESH, c_kexp_b_inf, DMI_EINVAL, "b[1] = inf"},
+    {"C124", "dmi_set_kernel_exp", "C[6] = NaN", S_FRESH, c_kexp_C_nan, DMI_EINVAL, "C[6] (term 1, entry (1, 0))"},
+    {"C125", "dmi_set_kernel_exp", "C[1] = +Inf", S_FRESH, c_kexp_C_inf, DMI_EINVAL, "C[1] (term 0, entry (0, 1))"},
+    {"C126", "dmi_set_kernel_exp", "D[3] = NaN", S_FRESH, c_kexp_D_nan, DMI_EINVAL, "D[3] (term 0, entry (1, 1))"},
+    {"C127", "dmi_set_kernel_exp", "D[5] = -Inf", S_FRESH, c_kexp_D_inf, DMI_EINVAL, "D[5] (term 1, entry (0, 1))"},
+    {"C128", "dmi_set_kernel_exp", "after dmi_init", S_INIT, c_kexp_late, DMI_ESTATE, "dmi_init"},
+    {"C129", "dmi_set_convolution", "DMI_CONV_RECURSIVE with a callback kernel, after dmi_init", S_INIT, c_conv_rec_callback, DMI_EINVAL, "callback"},
     {"C38", "dmi_set_history", "s = NULL", S_NULL, c_hist_null, DMI_EINVAL, NULL},
     {"C39", "dmi_set_history", "after dmi_init", S_INIT0, c_hist_late, DMI_ESTATE, "dmi_set_history"},
     {"C40", "dmi_set_convolution", "s = NULL", S_NULL, c_conv_null, DMI_EINVAL, NULL},
@@ -401,7 +486,7 @@ static const bad_case cases[] = {
     {"C92", "dmi_state_load", "one byte too many", S_INIT, c_load_long, DMI_EINVAL, "bytes"},
     {"C93", "dmi_state_load", "size = 0", S_INIT, c_load_empty, DMI_EINVAL, "bytes"},
     {"C94", "dmi_state_load", "magic altered", S_INIT, c_load_magic, DMI_EINVAL, "magic"},
-    {"C95", "dmi_state_load", "format version 1 of libdmi 1.0 (checksum valid)", S_INIT, c_load_version, DMI_EINVAL, "version"},
+    {"C95", "dmi_state_load", "a genuine state of libdmi 1.0 (format version 1, 24 bytes shorter)", S_INIT, c_load_version, DMI_EINVAL, "version 1, written by libdmi 1.0"},
     {"C96", "dmi_state_load", "foreign: saved with n = 1, N = 11 (same byte count)", S_INIT, c_load_foreign_nN, DMI_EINVAL, "n = 1"},
     {"C97", "dmi_state_load", "foreign: saved with tau = 2 (same n, N)", S_INIT0, c_load_foreign_tau, DMI_EINVAL, "tau = 2"},
     {"C98", "dmi_state_load", "header says n = 3 (checksum valid)", S_INIT, c_load_foreign_n_hdr, DMI_EINVAL, "n = 3"},
@@ -548,6 +633,61 @@ static void test_init_kernel_too_large(void)
     CHECK(dmi_get_step_index(s, &p) == DMI_ESTATE, "C16: solver initialised after a failed init");
     CHECK(dmi_step(s) == DMI_ESTATE, "C16: step after failed init not refused");
     dmi_free(&s);
+}
+
+/* DMI_CONV_RECURSIVE refuses an exponential kernel with a growing term or
+ * with |b| h > pi, by dmi_set_convolution (the method stays AUTO, which
+ * picks another method) and by dmi_init (when the kernel came after the
+ * method); the solver is then still uninitialised. */
+static void test_recursive_refusals(void)
+{
+    static const struct {
+        const char *id, *fn, *input;
+        double a0, b0;
+        int init;
+        const char *msg;
+    } t[] = {
+        {"C130", "dmi_set_convolution", "DMI_CONV_RECURSIVE, growing term a[0] = 0.5", 0.5, 2, 0,
+         "a[0] = 0.5 > 0"},
+        {"C131", "dmi_init", "DMI_CONV_RECURSIVE chosen before a kernel with a growing term", 0.5,
+         2, 1, "a[0] = 0.5 > 0"},
+        {"C132", "dmi_set_convolution", "DMI_CONV_RECURSIVE, b[0] = 13 with h = 0.25: b h = 3.25 > pi",
+         0, 13, 0, "b h = 3.25 is beyond [-pi, pi]"},
+        {"C133", "dmi_init", "DMI_CONV_RECURSIVE chosen before a kernel with b h = -3.25 < -pi", 0,
+         -13, 1, "b h = -3.25 is beyond [-pi, pi]"},
+    };
+    for (size_t i = 0; i < sizeof t / sizeof t[0]; i++) {
+        model m;
+        model_default(&m);
+        dmi_solver *s = NULL;
+        CU_ASSERT_EQUAL_FATAL(model_solver(&s, &m), DMI_OK);
+        const double a[2] = {t[i].a0, -1}, b[2] = {t[i].b0, 0};
+        int rc = DMI_OK;
+        if (t[i].init)
+            rc = dmi_set_kernel(s, NULL, NULL) == DMI_OK && /* no kernel: RECURSIVE taken */
+                         dmi_set_convolution(s, DMI_CONV_RECURSIVE) == DMI_OK &&
+                         dmi_set_kernel_exp(s, 2, a, b, xC, xD) == DMI_OK
+                     ? dmi_init(s)
+                     : -100;
+        else
+            rc = dmi_set_kernel_exp(s, 2, a, b, xC, xD) == DMI_OK
+                     ? dmi_set_convolution(s, DMI_CONV_RECURSIVE)
+                     : -100;
+        CHECK(rc == DMI_EINVAL, "%s %s(%s): %d, expected DMI_EINVAL", t[i].id, t[i].fn,
+              t[i].input, rc);
+        CHECK(strstr(dmi_last_error(s), t[i].msg) != NULL, "%s: message \"%s\" lacks \"%s\"",
+              t[i].id, dmi_last_error(s), t[i].msg);
+        row(t[i].id, t[i].fn, t[i].input, rc, dmi_last_error(s));
+        uint64_t p;
+        CHECK(dmi_get_step_index(s, &p) == DMI_ESTATE, "%s: solver initialised", t[i].id);
+        /* the same kernel under AUTO (the default, kept by the refused call):
+         * accepted, another method than the recursion */
+        if (t[i].init)
+            CU_ASSERT_EQUAL(dmi_set_convolution(s, DMI_CONV_AUTO), DMI_OK);
+        CHECK(dmi_init(s) == DMI_OK && dmi_step(s) == DMI_OK, "%s: AUTO refused the kernel: %s",
+              t[i].id, dmi_last_error(s));
+        dmi_free(&s);
+    }
 }
 
 /* W^p overflows although every callback output is finite. */
@@ -724,6 +864,7 @@ int main(int argc, char **argv)
         !CU_add_test(suite, "step: resolvent argument overflow", test_resolvent_argument_overflow) ||
         !CU_add_test(suite, "advance: partial", test_advance_partial) ||
         !CU_add_test(suite, "table of bad calls", test_table) ||
+        !CU_add_test(suite, "recursion refusals", test_recursive_refusals) ||
         !CU_add_test(suite, "queries without code", test_queries_without_code) ||
         !CU_add_test(suite, "every corruption", test_every_corruption)) {
         CU_cleanup_registry();
