@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 import pandas as pd
+import pytest
 
 from conftest import env_with_package, log_entries, run_sweep, sweep_cmd, write_spec
 
@@ -97,8 +98,15 @@ def test_client_killed_then_rerun(cluster, tmp_path, fmu_path, processes):
     wait_for_parts(out, 5, client)
     os.kill(client.pid, signal.SIGKILL)
     client.wait(timeout=10)
-    done = set(pd.read_parquet(out)["point"])
+    # a reader never sees a partial chunk: every chunk in the folder is whole (the log names its
+    # points), a temporary file the kill may have left is not read
+    df = pd.read_parquet(out)
+    done = set(df["point"])
     assert 5 <= len(done) < total
+    assert len(df) == len(done) and df["error"].isna().all() and df["w_final"].notna().all()
+    logged = {p for e in log_entries(out) if "points" in e for p in e["points"]}
+    assert done <= logged
+    assert all(p.name.startswith(f".tmp-{client.pid}-") for p in out.glob(".*"))
     n_before = len(log_entries(out))
     r = run_sweep(*args)
     assert r.returncode == 0, r.stderr
@@ -107,3 +115,26 @@ def test_client_killed_then_rerun(cluster, tmp_path, fmu_path, processes):
     computed = [p for e in new[1:] for p in e["points"]]
     assert sorted(computed) == sorted(set(range(total)) - done)   # the missing ones, each once
     check_complete(out, total)
+    assert not list(out.glob(".*")), "temporary files left"
+
+
+def test_timed_out_sweep_leaves_no_process(tmp_path, fmu_path):
+    """A sweep that exceeds its timeout in the tests is killed with its LocalCluster: its process
+    group (client, nannies, workers) is empty afterwards."""
+    from conftest import finish_sweep, group_members, kill_group, start_sweep
+    spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=40))
+    out = tmp_path / "out"
+    p = start_sweep("run", spec, "--out", out, "--workers", "2", "--chunk-size", "1", "--quiet")
+    try:
+        wait_for_parts(out, 1, p)
+        assert len(group_members(p.pid)) >= 3         # the client and its workers are running
+    except BaseException:
+        kill_group(p.pid)
+        p.communicate()
+        raise
+    with pytest.raises(subprocess.TimeoutExpired):
+        finish_sweep(p, timeout=0.1)
+    deadline = time.monotonic() + 10
+    while group_members(p.pid) and time.monotonic() < deadline:   # SIGKILL is delivered at once,
+        time.sleep(0.05)                                           # the exit takes a moment
+    assert group_members(p.pid) == []
