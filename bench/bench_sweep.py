@@ -23,6 +23,7 @@ from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
 from dmi_sweep import run as sweep_run
+from dmi_sweep.cli import positive_int
 from dmi_sweep.simulate import Runner, communication_plan, in_window
 from dmi_sweep.spec import SpecError, load
 
@@ -129,17 +130,6 @@ def timed_sweep(spec_path: Path, workers: int, work: Path, bare_g: list[float]):
         after = client.submit(bare_points, *args, pure=False).result()
         assert s.computed == spec.n_points and s.failed == 0
         return startup, seconds, cpu, (before, after)
-
-
-def positive_int(text: str) -> int:
-    """argparse type: a whole number >= 1."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number >= 1")
-    return value
 
 
 def positive_float(text: str) -> float:

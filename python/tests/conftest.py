@@ -1,7 +1,8 @@
 # Fixtures of the dmi-sweep tests: the FMU (DMI_FMU, set by ctest), specs
-# written to temporary folders, the command run as a subprocess, and a real Dask
-# cluster (a `dask scheduler` and `dask worker` processes on 127.0.0.1, the
-# workers in another temporary folder), every process stopped by its pid.
+# written to temporary folders, the command run as a subprocess in its own
+# process group (the group killed when it ends), and a real Dask cluster (a
+# `dask scheduler` and `dask worker` processes on 127.0.0.1, the workers in
+# another temporary folder), every process stopped by its pid, then its group.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 

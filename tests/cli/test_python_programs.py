@@ -97,12 +97,12 @@ def test_empty_value_rejected(prog, option, tmp_path):
 
 
 @pytest.mark.parametrize("args, message", [
-    (["--points", "0"], "argument --points: '0' is not a whole number >= 1"),
-    (["--points", "2.5"], "argument --points: '2.5' is not a whole number >= 1"),
+    (["--points", "0"], "argument --points: '0' is not an integer >= 1"),
+    (["--points", "2.5"], "argument --points: '2.5' is not an integer >= 1"),
     (["--stop-time", "-1"], "argument --stop-time: '-1' is not a finite number > 0"),
     (["--stop-time", "nan"], "argument --stop-time: 'nan' is not a finite number > 0"),
-    (["--N", "abc"], "argument --N: 'abc' is not a whole number >= 1"),
-    (["--repeat", "0"], "argument --repeat: '0' is not a whole number >= 1"),
+    (["--N", "abc"], "argument --N: 'abc' is not an integer >= 1"),
+    (["--repeat", "0"], "argument --repeat: '0' is not an integer >= 1"),
     (["--fmu", "/nonexistent-dmi/x.fmu"], "--fmu '/nonexistent-dmi/x.fmu': no such file"),
 ])
 def test_bench_sweep_bad_arguments(args, message):
