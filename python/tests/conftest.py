@@ -53,16 +53,15 @@ def kill_group(pgid: int) -> None:
         pass
 
 
-def start_sweep(*args: str) -> subprocess.Popen:
-    """dmi-sweep started in its own process group (its LocalCluster's processes join it); see
-    finish_sweep."""
-    return subprocess.Popen(sweep_cmd(*args), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            env=env_with_package(), start_new_session=True)
+def start_group(args: list, env: dict[str, str]) -> subprocess.Popen:
+    """A command started in its own process group (what it starts joins it); see finish_group."""
+    return subprocess.Popen(list(map(str, args)), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, env=env, start_new_session=True)
 
 
-def finish_sweep(p: subprocess.Popen, timeout: float = 240) -> subprocess.CompletedProcess:
-    """Waits for the dmi-sweep p; when it is done, times out (TimeoutExpired) or this fails, its
-    process group is killed: no worker of its LocalCluster outlives it."""
+def finish_group(p: subprocess.Popen, timeout: float = 240) -> subprocess.CompletedProcess:
+    """Waits for p (started by start_group); when it is done, times out (TimeoutExpired) or this
+    fails, its process group is killed: no worker of a LocalCluster it started outlives it."""
     try:
         stdout, stderr = p.communicate(timeout=timeout)
     finally:
@@ -71,8 +70,12 @@ def finish_sweep(p: subprocess.Popen, timeout: float = 240) -> subprocess.Comple
     return subprocess.CompletedProcess(p.args, p.returncode, stdout, stderr)
 
 
+def start_sweep(*args: str) -> subprocess.Popen:
+    return start_group(sweep_cmd(*args), env_with_package())
+
+
 def run_sweep(*args: str, timeout: float = 240) -> subprocess.CompletedProcess:
-    return finish_sweep(start_sweep(*args), timeout)
+    return finish_group(start_sweep(*args), timeout)
 
 
 def group_members(pgid: int) -> list[int]:

@@ -15,7 +15,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from conftest import (env_with_package, finish_sweep, group_members, kill_group, log_entries, run_sweep,
+from conftest import (env_with_package, finish_group, group_members, kill_group, log_entries, run_sweep,
                       start_sweep, sweep_cmd, write_spec)
 
 # about 0.1 s per point on this machine: long enough to kill something mid-sweep
@@ -132,7 +132,7 @@ def test_timed_out_sweep_leaves_no_process(tmp_path, fmu_path):
         p.communicate()
         raise
     with pytest.raises(subprocess.TimeoutExpired):
-        finish_sweep(p, timeout=0.1)
+        finish_group(p, timeout=0.1)
     deadline = time.monotonic() + 10
     while group_members(p.pid) and time.monotonic() < deadline:   # SIGKILL is delivered at once,
         time.sleep(0.05)                                           # the exit takes a moment
