@@ -38,6 +38,8 @@ def start_values(md, items: list, error) -> dict:
 
 def check_output(path: str, error) -> None:
     """error(message) unless path can be created or overwritten as a file."""
+    if not path:
+        error("--out '': no file name")
     folder = os.path.dirname(os.path.abspath(path))
     if os.path.isdir(path):
         error(f"--out {path}: is a folder, not a file name")
@@ -74,7 +76,7 @@ def main() -> None:
                     help="start value of a parameter or input, e.g. N=9991 (repeatable; "
                          "default: the FMU's start values)")
     a = ap.parse_args()
-    if a.csv:
+    if a.csv is not None:
         a.out = a.csv
     check_output(a.out, ap.error)
     if not os.path.isfile(a.fmu):

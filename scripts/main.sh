@@ -64,17 +64,7 @@ else
 fi
 
 stage "dmi-sweep: bifurcation diagram of Example 4.3 over g_amp (Poincare section of w)"
-sweep="$root/.venv/bin/dmi-sweep"
-if [[ -f $fmu && -x $sweep ]]; then
-  rm -rf "$out/sweep_ex43"
-  sweep_start=$SECONDS
-  DMI_FMU="$fmu" "$sweep" run python/examples/ex43_g_amp.toml --out "$out/sweep_ex43" --quiet
-  "$sweep" plot "$out/sweep_ex43" --x g_amp -o "$out/bifurcation_ex43.png"
-  "$sweep" plot "$out/sweep_ex43" --x g_amp --metric sticking_mean -o "$out/stick_fraction_ex43.png"
-  echo "bifurcation diagram: 60 points (N = 9991, T = 160) in $((SECONDS - sweep_start)) s on $(nproc) cores"
-else
-  echo "skipped: $fmu or $sweep does not exist"
-fi
+DMI_BUILD_DIR="$build" scripts/sweep_ex43.sh "$out"
 
 stage "figures and comparison with the paper and ../shared/reference"
 refarg=()

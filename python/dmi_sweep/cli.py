@@ -11,7 +11,8 @@ import sys
 from . import __version__
 
 
-def _positive(text: str) -> int:
+def positive_int(text: str) -> int:
+    """argparse type: an integer >= 1 (the message names the bad text)."""
     try:
         n = int(text)
     except ValueError:
@@ -29,11 +30,11 @@ def parser() -> argparse.ArgumentParser:
     r = sub.add_parser("run", help="run (or resume) a sweep")
     r.add_argument("spec", help="the sweep specification (TOML)")
     r.add_argument("--out", required=True, help="the result folder (a Parquet dataset)")
-    r.add_argument("--workers", type=_positive, help="worker processes of the local cluster "
+    r.add_argument("--workers", type=positive_int, help="worker processes of the local cluster "
                    "(default: one per core)")
     r.add_argument("--scheduler", help="address of an existing Dask scheduler, tcp://host:port")
     r.add_argument("--restart", action="store_true", help="delete the results of another sweep in --out")
-    r.add_argument("--chunk-size", type=_positive, help="points per task (default: about 8 tasks per "
+    r.add_argument("--chunk-size", type=positive_int, help="points per task (default: about 8 tasks per "
                    "worker, at most 64 points each)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     p = sub.add_parser("plot", help="plot a sweep: bifurcation diagram (one parameter) or heatmap (two)")

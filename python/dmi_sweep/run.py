@@ -7,12 +7,13 @@ from __future__ import annotations
 
 import json
 import logging
+import math
 import os
 import pickle
 import sys
 import time
 from dataclasses import dataclass
-from typing import TextIO
+from typing import Callable, TextIO
 
 import cloudpickle
 import dask
@@ -56,16 +57,20 @@ class Summary:
 class Progress:
     """A one-line progress bar on stderr: points done of total, rate, time left."""
 
-    def __init__(self, total: int, done: int, stream: TextIO | None = sys.stderr, width: int = 30):
+    def __init__(self, total: int, done: int, stream: TextIO | None = sys.stderr, width: int = 30,
+                 clock: Callable[[], float] = time.monotonic):
+        """total points, of which `done` were done before; a line at most every 0.2 s on a terminal,
+        every 5 s elsewhere (a log file), and at close()."""
         self.total, self.start_done, self.done = total, done, done
-        self.stream, self.width = stream, width
-        self.t0 = time.monotonic()
-        self.last = 0.0
-        self.tty = bool(stream) and stream.isatty()
+        self.stream, self.width, self.clock = stream, width, clock
+        self.t0 = clock()
+        self.last = -math.inf       # the first update shows at once
+        self.tty = stream is not None and stream.isatty()
 
     def update(self, n: int, force: bool = False) -> None:
+        """n more points done."""
         self.done += n
-        now = time.monotonic()
+        now = self.clock()
         if self.stream is None or (not force and now - self.last < (0.2 if self.tty else 5.0)):
             return
         self.last = now
@@ -74,7 +79,11 @@ class Progress:
         left = (self.total - self.done) / rate if rate > 0 else float("nan")
         filled = int(self.width * self.done / max(self.total, 1))
         bar = "#" * filled + "-" * (self.width - filled)
-        eta = time.strftime("%H:%M:%S", time.gmtime(left)) if left == left else "--:--:--"
+        if math.isfinite(left):
+            s = round(left)
+            eta = f"{s // 3600:02d}:{s // 60 % 60:02d}:{s % 60:02d}"   # hours beyond 99 as they are
+        else:
+            eta = "--:--:--"
         line = f"[{bar}] {self.done}/{self.total} points, {rate:.2f}/s, {eta} left"
         self.stream.write(("\r" + line) if self.tty else line + "\n")
         self.stream.flush()

@@ -13,7 +13,7 @@ import platform
 import time
 from importlib import metadata
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO, Callable
 
 import pyarrow as pa
 import pyarrow.parquet as pq
@@ -23,10 +23,22 @@ from .spec import Spec
 META = "_meta.json"
 SPEC = "_spec.toml"
 LOG = "_log.jsonl"
+TMP = ".tmp-"            # temporary files: .tmp-<pid of the writer>-<name>
 
 
 class StoreError(RuntimeError):
     """The folder holds something else than this sweep (message says what to do)."""
+
+
+def _running(pid: int) -> bool:
+    """Whether the process `pid` exists (on this machine)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
 
 
 def _versions() -> dict[str, str]:
@@ -86,28 +98,44 @@ class Store:
                              "give an empty or new folder")
         d.mkdir(parents=True, exist_ok=True)
         if not meta_path.exists():
-            store._write_atomic(SPEC, spec.text)
+            store._write_atomic(SPEC, lambda f: f.write(spec.text))
             meta = {"identity": spec.identity(), "fmu": str(spec.fmu), "fmu_sha256": spec.sha256,
                     "fmi_version": spec.model.fmiVersion, "model_name": spec.model.modelName,
                     "points": spec.n_points, "params": spec.params, "outputs": spec.outputs,
                     "mode": spec.mode, "versions": _versions(),
                     "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
-            store._write_atomic(META, json.dumps(meta, indent=1).encode())
+            store._write_atomic(META, lambda f: f.write(json.dumps(meta, indent=1).encode()))
+        store._remove_stale_temporaries()
         return store
 
     def _clear(self):
         for p in self.dir.iterdir():
             if (p.name.startswith("part-") and p.suffix == ".parquet") or p.name in (META, SPEC, LOG) \
-                    or p.name.startswith(".tmp-"):
+                    or p.name.startswith(TMP):
                 p.unlink()
 
-    def _write_atomic(self, name: str, data: bytes):
-        tmp = self.dir / f".tmp-{os.getpid()}-{name}"
-        with open(tmp, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, self.dir / name)
+    def _write_atomic(self, name: str, write: Callable[[BinaryIO], object]) -> Path:
+        """Writes the file `name` of the folder through write(file): into a hidden temporary file
+        (.tmp-<pid>-<name>, skipped by readers), synced, then renamed, so a reader sees either no file
+        or the whole file. A temporary file left by a killed process is removed by open()."""
+        tmp = self.dir / f"{TMP}{os.getpid()}-{name}"
+        try:
+            with open(tmp, "wb") as f:
+                write(f)
+                f.flush()
+                os.fsync(f.fileno())
+            os.replace(tmp, self.dir / name)
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise
+        return self.dir / name
+
+    def _remove_stale_temporaries(self):
+        """Removes the temporary files of processes that no longer run (a killed client)."""
+        for p in self.dir.glob(TMP + "*"):
+            pid = p.name[len(TMP):].split("-", 1)[0]
+            if not pid.isdigit() or not _running(int(pid)):
+                p.unlink(missing_ok=True)
 
     def parts(self) -> list[Path]:
         return sorted(self.dir.glob("part-*.parquet"))
@@ -137,9 +165,7 @@ class Store:
                     cols[f.name].append(r.get(f.name, math.nan))
         table = pa.Table.from_pydict(cols, schema=self.schema)
         name = f"part-{results[0]['point']:09d}.parquet"
-        tmp = self.dir / f".tmp-{os.getpid()}-{name}"
-        pq.write_table(table, tmp)
-        os.replace(tmp, self.dir / name)
+        self._write_atomic(name, lambda f: pq.write_table(table, f))
         with open(self.dir / LOG, "a") as f:   # which points this run computed (pid of the worker)
             f.write(json.dumps({"time": time.time(), "client": os.getpid(), "file": name,
                                 "points": [r["point"] for r in results],

@@ -1,7 +1,8 @@
 # Fixtures of the dmi-sweep tests: the FMU (DMI_FMU, set by ctest), specs
-# written to temporary folders, the command run as a subprocess, and a real Dask
-# cluster (a `dask scheduler` and `dask worker` processes on 127.0.0.1, the
-# workers in another temporary folder), every process stopped by its pid.
+# written to temporary folders, the command run as a subprocess in its own
+# process group (the group killed when it ends), and a real Dask cluster (a
+# `dask scheduler` and `dask worker` processes on 127.0.0.1, the workers in
+# another temporary folder), every process stopped by its pid, then its group.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -43,9 +44,51 @@ def sweep_cmd(*args: str) -> list[str]:
     return [sys.executable, "-m", "dmi_sweep", *map(str, args)]
 
 
+def kill_group(pgid: int) -> None:
+    """SIGKILL to the process group pgid (a process started with start_new_session=True and its
+    children, the workers of its LocalCluster); nothing if the group has no process left."""
+    try:
+        os.killpg(pgid, signal.SIGKILL)
+    except ProcessLookupError:
+        pass
+
+
+def start_group(args: list, env: dict[str, str]) -> subprocess.Popen:
+    """A command started in its own process group (what it starts joins it); see finish_group."""
+    return subprocess.Popen(list(map(str, args)), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, env=env, start_new_session=True)
+
+
+def finish_group(p: subprocess.Popen, timeout: float = 240) -> subprocess.CompletedProcess:
+    """Waits for p (started by start_group); when it is done, times out (TimeoutExpired) or this
+    fails, its process group is killed: no worker of a LocalCluster it started outlives it."""
+    try:
+        stdout, stderr = p.communicate(timeout=timeout)
+    finally:
+        kill_group(p.pid)
+        p.communicate()
+    return subprocess.CompletedProcess(p.args, p.returncode, stdout, stderr)
+
+
+def start_sweep(*args: str) -> subprocess.Popen:
+    return start_group(sweep_cmd(*args), env_with_package())
+
+
 def run_sweep(*args: str, timeout: float = 240) -> subprocess.CompletedProcess:
-    return subprocess.run(sweep_cmd(*args), capture_output=True, text=True, env=env_with_package(),
-                          timeout=timeout)
+    return finish_group(start_sweep(*args), timeout)
+
+
+def group_members(pgid: int) -> list[int]:
+    """The live (not zombie) processes of the process group pgid, from /proc."""
+    members = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):
+            continue
+        if fields[0] != "Z" and int(fields[2]) == pgid:
+            members.append(int(stat.parent.name))
+    return members
 
 
 def log_entries(out: Path) -> list[dict]:
@@ -66,15 +109,24 @@ def free_port() -> int:
 
 
 class Processes:
-    """Processes started by a test; stop() ends each by its pid."""
+    """Processes started by a test, each in its own process group, and the log files they write;
+    stop() ends each process by its pid (SIGTERM, then SIGKILL), then its group (what it started),
+    and closes the files."""
 
     def __init__(self):
         self.procs: list[subprocess.Popen] = []
+        self.files: list = []
 
     def start(self, args, **kw) -> subprocess.Popen:
-        p = subprocess.Popen(args, **kw)
+        p = subprocess.Popen(args, start_new_session=True, **kw)
         self.procs.append(p)
         return p
+
+    def log(self, path: Path):
+        """path opened for writing, closed by stop()."""
+        f = open(path, "w")
+        self.files.append(f)
+        return f
 
     def stop(self):
         for p in reversed(self.procs):
@@ -85,6 +137,9 @@ class Processes:
                 except subprocess.TimeoutExpired:
                     os.kill(p.pid, signal.SIGKILL)
                     p.wait(timeout=15)
+            kill_group(p.pid)
+        for f in self.files:
+            f.close()
 
 
 @pytest.fixture
@@ -110,7 +165,7 @@ def cluster(processes, tmp_path_factory) -> Cluster:
     sdir = tmp_path_factory.mktemp("scheduler")
     wdir = tmp_path_factory.mktemp("workers")
     address = f"tcp://127.0.0.1:{free_port()}"
-    quiet = dict(stdout=subprocess.DEVNULL, stderr=open(sdir / "cluster.log", "w"))
+    quiet = dict(stdout=subprocess.DEVNULL, stderr=processes.log(sdir / "cluster.log"))
     sched = processes.start([dask, "scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
                              "--no-dashboard"], cwd=sdir, **quiet)
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}

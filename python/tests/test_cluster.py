@@ -1,7 +1,8 @@
 # dmi-sweep on a real Dask cluster on the loopback: a `dask scheduler` and two
 # `dask worker` processes started by the test in another folder (no shared
 # files, no dmi_sweep on their path); a worker killed with SIGKILL mid-sweep;
-# the client killed mid-sweep and the command rerun.
+# the client killed mid-sweep and the command rerun; a timed-out sweep killed
+# with its LocalCluster.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -12,8 +13,10 @@ import time
 from pathlib import Path
 
 import pandas as pd
+import pytest
 
-from conftest import env_with_package, log_entries, run_sweep, sweep_cmd, write_spec
+from conftest import (env_with_package, finish_group, group_members, kill_group, log_entries, run_sweep,
+                      start_sweep, sweep_cmd, write_spec)
 
 # about 0.1 s per point on this machine: long enough to kill something mid-sweep
 SLOW = """
@@ -97,8 +100,13 @@ def test_client_killed_then_rerun(cluster, tmp_path, fmu_path, processes):
     wait_for_parts(out, 5, client)
     os.kill(client.pid, signal.SIGKILL)
     client.wait(timeout=10)
-    done = set(pd.read_parquet(out)["point"])
+    # a reader never sees a partial chunk: every chunk file in the folder reads whole, a temporary
+    # file the kill may have left is not read
+    df = pd.read_parquet(out)
+    done = set(df["point"])
     assert 5 <= len(done) < total
+    assert len(df) == len(done) and df["error"].isna().all() and df["w_final"].notna().all()
+    assert all(p.name.startswith(f".tmp-{client.pid}-") for p in out.glob(".*"))
     n_before = len(log_entries(out))
     r = run_sweep(*args)
     assert r.returncode == 0, r.stderr
@@ -107,3 +115,25 @@ def test_client_killed_then_rerun(cluster, tmp_path, fmu_path, processes):
     computed = [p for e in new[1:] for p in e["points"]]
     assert sorted(computed) == sorted(set(range(total)) - done)   # the missing ones, each once
     check_complete(out, total)
+    assert not list(out.glob(".*")), "temporary files left"
+
+
+def test_timed_out_sweep_leaves_no_process(tmp_path, fmu_path):
+    """A sweep that exceeds its timeout in the tests is killed with its LocalCluster: its process
+    group (client, nannies, workers) is empty afterwards."""
+    spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=40))
+    out = tmp_path / "out"
+    p = start_sweep("run", spec, "--out", out, "--workers", "2", "--chunk-size", "1", "--quiet")
+    try:
+        wait_for_parts(out, 1, p)
+        assert len(group_members(p.pid)) >= 3         # the client and its workers are running
+    except BaseException:
+        kill_group(p.pid)
+        p.communicate()
+        raise
+    with pytest.raises(subprocess.TimeoutExpired):
+        finish_group(p, timeout=0.1)
+    deadline = time.monotonic() + 10
+    while group_members(p.pid) and time.monotonic() < deadline:   # SIGKILL is delivered at once,
+        time.sleep(0.05)                                           # the exit takes a moment
+    assert group_members(p.pid) == []

@@ -54,6 +54,7 @@ def two_workers(tmp_path_factory, fmu_path):
     spec = write_spec(d, SPEC.format(fmu=fmu_path))
     r = run_sweep("run", spec, "--out", d / "out", "--workers", "2", "--chunk-size", "1")
     assert r.returncode == 0, r.stderr
+    assert not list((d / "out").glob(".*")), "temporary files left"
     return d, pd.read_parquet(d / "out").sort_values("point").reset_index(drop=True)
 
 
@@ -91,7 +92,8 @@ def test_fmi3_fmu_equals_plain_fmpy(tmp_path):
     import os
     fmu3 = os.environ.get("DMI_FMU3")
     if not fmu3:
-        pytest.skip("DMI_FMU3 is not set: no FMI 3.0 FMU in this build")
+        pytest.fail("environment variable DMI_FMU3 is not set (run the tests through ctest, which "
+                    "sets it to the FMI 3.0 FMU of the build)")
     from fmpy import read_model_description
     assert read_model_description(fmu3).fmiVersion.startswith("3")
     spec = write_spec(tmp_path, SPEC.format(fmu=fmu3).replace("[-0.5, 0.3, 1.0]", "[1.0]"))
