@@ -131,17 +131,45 @@ static int solver_fail(char *err, const char *what, dmi_solver *s, int rc)
     return -1;
 }
 
-double model_solver_bytes(int N)
+/* The bytes libdmi allocates for the model's solver, from its layout
+ * (src/delay.h, src/exp.h, dmi_create and dmi_init in src/dmi.c): n = 2
+ * components, N steps per tau, nnz nonzero kernel entries (H(s) acts on w
+ * in the v equation: 1, or 0 without a kernel), K exponential terms.
+ * After initialisation (kept): the history ring, 2 (N + 1) n doubles (the
+ * series and its mirror), the kernel samples, nnz N doubles, and the
+ * recursion's sums, one complex sum per term and column used: 2 K doubles.
+ * While dmi_init samples the kernel (peak): dmi_create's ring, dmi_init's
+ * new ring, the dense samples, N n^2 doubles, and the kept samples. */
+static void solver_bytes(const model *m, double *kept, double *peak)
 {
-    return MODEL_BYTES_PER_STEP * (double)N;
+    const double n = 2, N = m->N, d = sizeof(double);
+    const unsigned coef[5] = {VR_H_c0, VR_H_c1, VR_H_a1, VR_H_a2, VR_H_a3};
+    double K = 0;
+    for (size_t k = 0; k < 5; k++)
+        K += m->real[coef[k]] != 0;
+    const double nnz = K > 0, ring = 2 * (N + 1) * n * d, samples = nnz * N * d;
+    *kept = ring + samples + 2 * K * d;
+    *peak = 2 * ring + N * n * n * d + samples;
+}
+
+/* "N = .. steps per tau: <bytes> while initialising, <bytes> after", the
+ * sizes of solver_bytes, into out (MODEL_ERRLEN). */
+static void describe_bytes(const model *m, const char *prefix, char *out)
+{
+    double kept, peak;
+    solver_bytes(m, &kept, &peak);
+    snprintf(out, MODEL_ERRLEN, "%sN = %d steps per tau: the solver allocates %.0f bytes (%.3g GB) "
+                                "while initialising and keeps %.0f bytes (%.3g GB): a history of "
+                                "2(N+1) states and N kernel samples",
+             prefix, m->N, peak, peak / 1e9, kept, kept / 1e9);
 }
 
 /* Out of memory for N: the error names N and the bytes needed. */
-static int memory_fail(char *err, const char *what, int N)
+static int memory_fail(char *err, const char *what, const model *m)
 {
-    snprintf(err, MODEL_ERRLEN, "%s: out of memory: N = %d steps per tau need about %.0f bytes "
-                                "(%.3g GB, %d bytes per step)",
-             what, N, model_solver_bytes(N), model_solver_bytes(N) / 1e9, MODEL_BYTES_PER_STEP);
+    char prefix[MODEL_ERRLEN];
+    snprintf(prefix, sizeof prefix, "%s: out of memory: ", what);
+    describe_bytes(m, prefix, err);
     return -1;
 }
 
@@ -152,12 +180,12 @@ static int solver_create(const model *m, dmi_solver **out, char *err)
 {
     int rc = dmi_create(out, 2, m->real[VR_tau], (size_t)m->N);
     if (rc == DMI_ENOMEM)
-        return memory_fail(err, "creating the solver", m->N);
+        return memory_fail(err, "creating the solver", m);
     if (rc != DMI_OK)
         return solver_fail(err, "creating the solver (tau, N)", NULL, rc);
     if ((rc = set_kernel(m, *out)) != DMI_OK) {
         if (rc == DMI_ENOMEM)
-            memory_fail(err, "setting the kernel", m->N);
+            memory_fail(err, "setting the kernel", m);
         else
             solver_fail(err, "setting the kernel", *out, rc);
         dmi_free(out);
@@ -175,19 +203,18 @@ static int solver_init(model *m, dmi_solver *s, char *err)
     if ((rc = dmi_set_rhs(s, rhs, m)) != DMI_OK ||
         (rc = dmi_set_history(s, history, m)) != DMI_OK ||
         (rc = dmi_set_friction(s, alpha)) != DMI_OK || (rc = dmi_init(s)) != DMI_OK)
-        return rc == DMI_ENOMEM ? memory_fail(err, "initialising the solver", m->N)
+        return rc == DMI_ENOMEM ? memory_fail(err, "initialising the solver", m)
                                 : solver_fail(err, "initialising the solver", s, rc);
     return 0;
 }
 
 int model_start(model *m, double t_start, char *err, char *note)
 {
+    double kept, peak;
+    solver_bytes(m, &kept, &peak);
     note[0] = '\0';
-    if (model_solver_bytes(m->N) > MODEL_NOTE_BYTES)
-        snprintf(note, MODEL_ERRLEN, "N = %d steps per tau: the solver allocates about %.0f bytes "
-                                     "(%.3g MB, %d bytes per step)",
-                 m->N, model_solver_bytes(m->N), model_solver_bytes(m->N) / 1e6,
-                 MODEL_BYTES_PER_STEP);
+    if (peak > MODEL_NOTE_BYTES)
+        describe_bytes(m, "", note);
     dmi_solver *s = NULL;
     if (solver_create(m, &s, err) != 0)
         return -1;

@@ -74,14 +74,10 @@ int model_get_boolean(const model *m, unsigned vr, int *value, char *err);
 
 /* Creates and initialises the solver from the parameters, at t_start.  On
  * failure, err tells why (for memory: N and the bytes needed).  note gets a
- * message when the solver takes more than MODEL_NOTE_BYTES, else "". */
+ * message with N and the bytes (allocated while initialising, kept after:
+ * from libdmi's layout, in model.c) when the solver allocates more than
+ * MODEL_NOTE_BYTES, else "". */
 #define MODEL_NOTE_BYTES 100e6
-/* The memory the solver takes per step of the history, about: the peak
- * resident memory of initialization and the first step, measured for
- * N = 2e6 and 8e6 (history and its copy at initialization; the kernel as
- * exponential terms, or its samples for the direct sum). */
-#define MODEL_BYTES_PER_STEP 40
-double model_solver_bytes(int N);
 int model_start(model *m, double t_start, char *err, char *note);
 
 /* Whether the step h = tau/N is coarse for an experiment of length T: the

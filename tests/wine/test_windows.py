@@ -9,7 +9,9 @@
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 import os
 import re
+import signal
 import subprocess
+import time
 import zipfile
 
 import numpy as np
@@ -76,22 +78,87 @@ def test_exports_are_the_fmi_functions(version, tmp_path):
     assert sorted(exported_names(objdump(unpack(version, tmp_path)))) == sorted(declared)
 
 
+def prefix_processes(prefix):
+    """The pids of the running processes (not zombies) whose environment has
+    WINEPREFIX=prefix (those of this user that /proc lets us read)."""
+    mark = b"WINEPREFIX=" + os.fsencode(prefix) + b"\0"
+    pids = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit() and int(entry) != os.getpid():
+            try:
+                if open(f"/proc/{entry}/stat").read().rsplit(")", 1)[1].split()[0] == "Z":
+                    continue  # ended already, not yet reaped by its parent
+                with open(f"/proc/{entry}/environ", "rb") as f:
+                    if mark in f.read() + b"\0":
+                        pids.append(int(entry))
+            except OSError:  # another user's, or gone
+                pass
+    return pids
+
+
+def stop(pids, sig):
+    for pid in pids:
+        try:
+            os.kill(pid, sig)
+        except ProcessLookupError:  # ended meanwhile
+            pass
+
+
+def program_name(pid):
+    try:
+        return os.path.basename(os.readlink(f"/proc/{pid}/exe"))
+    except OSError:
+        return ""
+
+
 @pytest.fixture(scope="module")
 def wine():
-    """(wine, environment) with the prefix in the build tree; afterwards stops
-    the wineserver of that prefix and waits until it has exited."""
+    """(wine, environment) with the prefix in the build tree.  Wine starts its
+    wineserver and its own processes (services.exe, ...) on the first call;
+    afterwards each process of the prefix (found by its environment) is
+    stopped by its pid, the wineserver first (SIGTERM: it saves the prefix's
+    registry), and the fixture fails if one is still there after SIGKILL."""
     wine, server = _env("DMI_WINE"), _env("DMI_WINESERVER")
     for program in (wine, server):
         if not os.access(program, os.X_OK):
             pytest.fail(f"{program}: Wine cannot run (scripts/deps.sh installs Debian's wine64)")
-    env = dict(os.environ, WINEPREFIX=_env("DMI_WINEPREFIX"), WINEDEBUG="-all",
+    prefix = os.path.abspath(_env("DMI_WINEPREFIX"))
+    env = dict(os.environ, WINEPREFIX=prefix, WINEDEBUG="-all",
                WINEDLLOVERRIDES="mscoree,mshtml=;winemenubuilder.exe=d")
     env.pop("DISPLAY", None)
+    left = prefix_processes(prefix)
+    if left:
+        pytest.fail(f"processes of {prefix} from an earlier run still run: {left}")
     try:
         yield wine, env
     finally:
-        subprocess.run([server, "--kill"], env=env, timeout=60, check=False)
-        subprocess.run([server, "--wait"], env=env, timeout=60, check=False)
+        started = prefix_processes(prefix)
+        servers = [p for p in started if program_name(p) == os.path.basename(server)]
+        stop(servers + [p for p in started if p not in servers], signal.SIGTERM)
+        deadline = time.monotonic() + 30
+        while prefix_processes(prefix) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        stop(prefix_processes(prefix), signal.SIGKILL)
+        time.sleep(0.5)
+        left = prefix_processes(prefix)
+    assert not left, f"Wine processes still running after SIGKILL: {left}"
+
+
+def test_prefix_processes_are_found_and_stopped(tmp_path):
+    """The search of the wine fixture's teardown: a process with the prefix in
+    its environment is found (and one without it is not), and stop() ends it."""
+    prefix = str(tmp_path / "prefix")
+    child = subprocess.Popen(["sleep", "60"], env=dict(os.environ, WINEPREFIX=prefix))
+    other = subprocess.Popen(["sleep", "60"], env=dict(os.environ, WINEPREFIX=prefix + "x"))
+    try:
+        assert prefix_processes(prefix) == [child.pid]
+        stop([child.pid], signal.SIGTERM)
+        assert child.wait(timeout=10) == -signal.SIGTERM
+        assert prefix_processes(prefix) == []
+    finally:
+        for p in (child, other):
+            p.kill()
+            p.wait()
 
 
 def run_master(command, out, **kw):
