@@ -111,7 +111,11 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
         return dmi_fail(s, DMI_ENOMEM, "dmi_state_load: out of memory");
     memcpy(d, b + dmi_state_at_double(n, 0, 0), (nd - E) * sizeof *d);
     memcpy(d + nd - E, rec + DMI_STATE_REC_BYTES, E * sizeof *d);
-    if (dmi_first_nonfinite(d, nd) < nd) {
+    /* The states, W and X of a committed step are finite.  The recursion's
+     * sums need not be: a finite but huge history can overflow them, and the
+     * next step then fails with DMI_ENONFINITE; they are restored as saved,
+     * so that a loaded solver fails the same way. */
+    if (dmi_first_nonfinite(d, nd - E) < nd - E) {
         free(d);
         return dmi_fail(s, DMI_EINVAL, "dmi_state_load: state holds a non-finite value");
     }
