@@ -75,7 +75,7 @@ class Runner:
         self.fmu: Any = None
         self.used = False
         self.messages: list[str] = []
-        self.plans: dict[tuple, list] = {}
+        self.plans: dict[tuple, tuple] = {}  # key: (plan, in window, read) per point
         self.instantiations = 0
 
     def _logger2(self, env, instance, status, category, message):
@@ -168,12 +168,18 @@ class Runner:
                 k += 1
         variable_step = bool(self.md.coSimulation.canHandleVariableCommunicationStepSize)
         key = (t0, stop, interval, variable_step, period, transient)
-        plan = self.plans.get(key)
-        if plan is None:
+        cached = self.plans.get(key)
+        if cached is None:
             plan = communication_plan(t0, stop, interval, variable_step, events)
+            # per communication point: in the statistics window; read (in the window, or the last)
+            window = [in_window(t, transient) for t, _, _ in plan]
+            read = [recorded and (w or i == len(plan) - 1)
+                    for i, ((_, recorded, _), w) in enumerate(zip(plan, window))]
+            cached = plan, window, read
             if len(self.plans) > 64:
                 self.plans.clear()
-            self.plans[key] = plan
+            self.plans[key] = cached
+        plan, window, read = cached
         names, getters = self._getters(job["outputs"])
 
         def sample():
@@ -191,15 +197,13 @@ class Runner:
             poincare.append(sample())
         time = t0
         step = fmu.doStep
-        n = len(plan)
-        for i, (t, recorded, event) in enumerate(plan):
+        for (t, _, event), w, r in zip(plan, window, read):
             step(time, t - time)
             time = t
-            if recorded and (in_window(t, transient) or i == n - 1):
-                row = sample()
-                if in_window(t, transient):
-                    rows.append(row)
-                last = row
+            if r:
+                last = sample()
+                if w:
+                    rows.append(last)
             if event:
                 poincare.append(sample())
         fmu.terminate()
