@@ -29,9 +29,6 @@ enum { REC, NODELAY, FFT, DIRECT, KINDS };
 
 static int start(run *r, size_t N, int kind, size_t steps)
 {
-    static const double PI = 3.14159265358979323846;
-    const double a[3] = {0, 0, 0}, b[3] = {2 * PI, 10 * PI, 20 * PI};
-    const double C[12] = {0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0}; /* entry (1, 0) of each */
     r->ex.example = 43;
     r->secs = 0;
     r->w = malloc(2 * steps * sizeof *r->w);
@@ -41,7 +38,7 @@ static int start(run *r, size_t N, int kind, size_t steps)
     if (rc == DMI_OK)
         rc = paper_setup(r->s, &r->ex);
     if (rc == DMI_OK && kind == REC)
-        rc = dmi_set_kernel_exp(r->s, 3, a, b, C, NULL);
+        rc = paper_set_kernel_exp43(r->s);
     if (rc == DMI_OK && kind == NODELAY)
         rc = dmi_set_kernel(r->s, NULL, NULL);
     if (rc == DMI_OK)

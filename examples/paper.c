@@ -99,6 +99,13 @@ int paper_setup(dmi_solver *s, paper_example *ex)
     return rc;
 }
 
+int paper_set_kernel_exp43(dmi_solver *s)
+{
+    const double a[3] = {0, 0, 0}, b[3] = {2 * PI, 10 * PI, 20 * PI};
+    const double C[12] = {0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0}; /* entry (1, 0) of each */
+    return dmi_set_kernel_exp(s, 3, a, b, C, NULL);
+}
+
 static void track(int example, double t, const double *u, paper_result *res)
 {
     if (!paper_has_exact(example))

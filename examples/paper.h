@@ -38,6 +38,12 @@ int paper_history(double t, double *out, void *user);
 /* Sets rhs, kernel, history and the built-in friction alpha = (0, 1) on s. */
 int paper_setup(dmi_solver *s, paper_example *ex);
 
+/* Replaces the kernel of s by Example 4.3's (paper_H) given as the exponential
+ * sum of dmi_set_kernel_exp: K = 3 terms cos(b_k s), a_k = 0,
+ * b = 2 pi, 10 pi, 20 pi, each in the entry (1, 0) (so that
+ * DMI_CONV_RECURSIVE can take it).  The error of dmi_set_kernel_exp. */
+int paper_set_kernel_exp43(dmi_solver *s);
+
 typedef struct {
     double max_err_state; /* max over t_p in [-tau, T] of |U^p - (w, w')(t_p)| (Euclidean) */
     double max_err_w, max_err_v;

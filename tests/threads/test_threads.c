@@ -61,16 +61,6 @@ typedef struct {
     trajectory solver[N_METHODS], fmu_run;
 } job;
 
-/* Example 4.3's kernel as an exponential sum: H(s) = cos 2 pi s + cos 10 pi s
- * + cos 20 pi s in the entry (1, 0) (paper_H). */
-static int set_kernel_exp(dmi_solver *s)
-{
-    const double pi = 3.14159265358979323846, a[3] = {0, 0, 0};
-    const double b[3] = {2 * pi, 10 * pi, 20 * pi};
-    const double C[3][4] = {{0, 0, 1, 0}, {0, 0, 1, 0}, {0, 0, 1, 0}};
-    return dmi_set_kernel_exp(s, 3, a, b, &C[0][0], NULL);
-}
-
 /* Example 4.3 with h = 1/N to T under one method. */
 static trajectory run_solver(size_t N, int method, int exp)
 {
@@ -82,7 +72,7 @@ static trajectory run_solver(size_t N, int method, int exp)
     if (rc == DMI_OK)
         rc = paper_setup(s, &ex);
     if (rc == DMI_OK && exp)
-        rc = set_kernel_exp(s);
+        rc = paper_set_kernel_exp43(s);
     if (rc == DMI_OK)
         rc = dmi_set_convolution(s, method);
     if (rc == DMI_OK)
