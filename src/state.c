@@ -132,13 +132,14 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
     memcpy(s->last_X, d + (N + 2) * n, n * sizeof *d);
     s->p = p;
     /* The sums of the same recursion continue bitwise; any others (a state
-     * of another method or kernel) are anchored afresh from the states. */
+     * of another method or kernel) are anchored afresh from the states, and
+     * the FFT engine is rebuilt from them (s->rec and s->conv are never both
+     * set). */
     if (s->rec && running == 1 &&
         dmi_get_u64(rec, DMI_STATE_REC_SIGNATURE) == dmi_expk_signature(&s->expk, N, s->h))
         dmi_exp_set(s->rec, d + nd - E, p);
     else
-        dmi_engine_rebuild(s, NULL, s->rec);
-    dmi_engine_rebuild(s, s->conv, NULL);
+        dmi_engine_rebuild(s, s->conv, s->rec);
     free(d);
     return DMI_OK;
 }
