@@ -46,12 +46,19 @@ static void help(const cli_program *prog)
     printf("\n%s\n", prog->output);
 }
 
-void cli_reject(const cli_program *prog, const char *name, const char *text, const char *why)
+/* After the message of a bad command line: the usage line and a pointer to
+ * --help on stderr, exit status 2. */
+static void refuse(const cli_program *prog)
 {
-    fprintf(stderr, "%s: %s = '%s': %s\n", prog->name, name, text, why);
     usage_line(prog, stderr);
     fprintf(stderr, "(%s --help explains the arguments)\n", prog->name);
     exit(2);
+}
+
+void cli_reject(const cli_program *prog, const char *name, const char *text, const char *why)
+{
+    fprintf(stderr, "%s: %s = '%s': %s\n", prog->name, name, text, why);
+    refuse(prog);
 }
 
 /* Sets *a's value from text and returns NULL, or returns why text is not a value of a
@@ -113,9 +120,7 @@ void cli_parse(const cli_program *prog, int argc, char **argv)
         if ((size_t)(i - 1) >= prog->n_args) {
             fprintf(stderr, "%s: too many arguments: '%s' (at most %zu)\n", prog->name, argv[i],
                     prog->n_args);
-            usage_line(prog, stderr);
-            fprintf(stderr, "(%s --help explains the arguments)\n", prog->name);
-            exit(2);
+            refuse(prog);
         }
         const cli_arg *a = &prog->args[i - 1];
         char buf[64];
