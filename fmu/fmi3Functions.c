@@ -31,6 +31,9 @@ static void sink(fmu_callback logger, void *environment, const char *name, fmu_s
     ((fmi3LogMessageCallback)logger)(environment, (fmi3Status)status, category, message);
 }
 
+/* The reason every function of model exchange or scheduled execution gives. */
+#define NO_ME "the FMU supports co-simulation only"
+
 /* ---- version, logging, instances ---- */
 
 const char *fmi3GetVersion(void)
@@ -75,6 +78,17 @@ fmi3Instance fmi3InstantiateCoSimulation(
     return fmu_instantiate(fn, instanceName, sink, logger, instanceEnvironment, loggingOn);
 }
 
+/* The instantiation of an interface type the FMU does not provide: NULL,
+ * the reason logged. */
+static fmi3Instance refuse_instantiate(const char *fn, fmi3String instanceName,
+                                       fmi3InstanceEnvironment instanceEnvironment,
+                                       fmi3LogMessageCallback logMessage)
+{
+    fmu_log_error(fn, instanceName ? instanceName : "?", sink, (fmu_callback)logMessage,
+                  instanceEnvironment, "%s", NO_ME);
+    return NULL;
+}
+
 fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
                                           fmi3String resourcePath, fmi3Boolean visible,
                                           fmi3Boolean loggingOn,
@@ -82,10 +96,8 @@ fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String in
                                           fmi3LogMessageCallback logMessage)
 {
     (void)instantiationToken, (void)resourcePath, (void)visible, (void)loggingOn;
-    fmu_log_error("fmi3InstantiateModelExchange", instanceName ? instanceName : "?", sink,
-                  (fmu_callback)logMessage, instanceEnvironment,
-                  "this FMU supports co-simulation only");
-    return NULL;
+    return refuse_instantiate("fmi3InstantiateModelExchange", instanceName, instanceEnvironment,
+                              logMessage);
 }
 
 fmi3Instance fmi3InstantiateScheduledExecution(
@@ -96,10 +108,8 @@ fmi3Instance fmi3InstantiateScheduledExecution(
 {
     (void)instantiationToken, (void)resourcePath, (void)visible, (void)loggingOn;
     (void)clockUpdate, (void)lockPreemption, (void)unlockPreemption;
-    fmu_log_error("fmi3InstantiateScheduledExecution", instanceName ? instanceName : "?", sink,
-                  (fmu_callback)logMessage, instanceEnvironment,
-                  "this FMU supports co-simulation only");
-    return NULL;
+    return refuse_instantiate("fmi3InstantiateScheduledExecution", instanceName,
+                              instanceEnvironment, logMessage);
 }
 
 void fmi3FreeInstance(fmi3Instance instance)
@@ -341,7 +351,6 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
 
 #define UNSUPPORTED(call, why) return (fmi3Status)fmu_unsupported(instance, call, why)
 #define NO_EVENTS "the FMU has no event mode and no clocks"
-#define NO_ME "the FMU supports co-simulation only"
 
 fmi3Status fmi3EnterEventMode(fmi3Instance instance)
 {
@@ -539,5 +548,5 @@ fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference 
                                       fmi3Float64 activationTime)
 {
     (void)clockReference, (void)activationTime;
-    UNSUPPORTED("fmi3ActivateModelPartition", "the FMU supports co-simulation only");
+    UNSUPPORTED("fmi3ActivateModelPartition", NO_ME);
 }
