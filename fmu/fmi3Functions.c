@@ -58,18 +58,17 @@ fmi3Instance fmi3InstantiateCoSimulation(
 {
     static const char fn[] = "fmi3InstantiateCoSimulation";
     const fmu_callback logger = (fmu_callback)logMessage;
-    const char *name = instanceName ? instanceName : "?";
     (void)resourcePath, (void)visible, (void)earlyReturnAllowed;
     (void)requiredIntermediateVariables, (void)intermediateUpdate;
     if (instanceName && *instanceName) { /* (an empty name: refused by fmu_instantiate) */
         if (!instantiationToken || strcmp(instantiationToken, DMI_FMU_GUID) != 0) {
-            fmu_log_error(fn, name, sink, logger, instanceEnvironment,
+            fmu_log_error(fn, instanceName, sink, logger, instanceEnvironment,
                           "instantiation token \"%s\" is not the FMU's GUID %s",
                           instantiationToken ? instantiationToken : "(null)", DMI_FMU_GUID);
             return NULL;
         }
         if (eventModeUsed || nRequiredIntermediateVariables > 0) {
-            fmu_log_error(fn, name, sink, logger, instanceEnvironment, "%s",
+            fmu_log_error(fn, instanceName, sink, logger, instanceEnvironment, "%s",
                           eventModeUsed ? "the FMU has no event mode (hasEventMode=\"false\")"
                                         : "the FMU provides no intermediate update");
             return NULL;
