@@ -58,15 +58,16 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         return NULL; /* no way to log why */
     const fmu_callback logger = (fmu_callback)functions->logger;
     void *env = functions->componentEnvironment;
-    const char *name = instanceName ? instanceName : "?";
-    if (instanceName && *instanceName && fmuType != fmi2CoSimulation) {
-        fmu_log_error(fn, name, sink, logger, env, "this FMU supports co-simulation only");
-        return NULL;
-    }
-    if (instanceName && *instanceName && (!fmuGUID || strcmp(fmuGUID, DMI_FMU_GUID) != 0)) {
-        fmu_log_error(fn, name, sink, logger, env, "GUID \"%s\" does not match the FMU's %s",
-                      fmuGUID ? fmuGUID : "(null)", DMI_FMU_GUID);
-        return NULL;
+    if (instanceName && *instanceName) { /* (an empty name: refused by fmu_instantiate) */
+        if (fmuType != fmi2CoSimulation) {
+            fmu_log_error(fn, instanceName, sink, logger, env, "this FMU supports co-simulation only");
+            return NULL;
+        }
+        if (!fmuGUID || strcmp(fmuGUID, DMI_FMU_GUID) != 0) {
+            fmu_log_error(fn, instanceName, sink, logger, env, "GUID \"%s\" does not match the FMU's %s",
+                          fmuGUID ? fmuGUID : "(null)", DMI_FMU_GUID);
+            return NULL;
+        }
     }
     return fmu_instantiate(fn, instanceName, sink, logger, env, loggingOn != fmi2False);
 }

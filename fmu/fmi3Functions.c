@@ -31,6 +31,9 @@ static void sink(fmu_callback logger, void *environment, const char *name, fmu_s
     ((fmi3LogMessageCallback)logger)(environment, (fmi3Status)status, category, message);
 }
 
+/* The reason every function of model exchange or scheduled execution gives. */
+#define NO_ME "the FMU supports co-simulation only"
+
 /* ---- version, logging, instances ---- */
 
 const char *fmi3GetVersion(void)
@@ -55,24 +58,34 @@ fmi3Instance fmi3InstantiateCoSimulation(
 {
     static const char fn[] = "fmi3InstantiateCoSimulation";
     const fmu_callback logger = (fmu_callback)logMessage;
-    const char *name = instanceName ? instanceName : "?";
     (void)resourcePath, (void)visible, (void)earlyReturnAllowed;
     (void)requiredIntermediateVariables, (void)intermediateUpdate;
     if (instanceName && *instanceName) { /* (an empty name: refused by fmu_instantiate) */
         if (!instantiationToken || strcmp(instantiationToken, DMI_FMU_GUID) != 0) {
-            fmu_log_error(fn, name, sink, logger, instanceEnvironment,
+            fmu_log_error(fn, instanceName, sink, logger, instanceEnvironment,
                           "instantiation token \"%s\" is not the FMU's GUID %s",
                           instantiationToken ? instantiationToken : "(null)", DMI_FMU_GUID);
             return NULL;
         }
         if (eventModeUsed || nRequiredIntermediateVariables > 0) {
-            fmu_log_error(fn, name, sink, logger, instanceEnvironment, "%s",
+            fmu_log_error(fn, instanceName, sink, logger, instanceEnvironment, "%s",
                           eventModeUsed ? "the FMU has no event mode (hasEventMode=\"false\")"
                                         : "the FMU provides no intermediate update");
             return NULL;
         }
     }
     return fmu_instantiate(fn, instanceName, sink, logger, instanceEnvironment, loggingOn);
+}
+
+/* The instantiation of an interface type the FMU does not provide: NULL,
+ * the reason logged. */
+static fmi3Instance refuse_instantiate(const char *fn, fmi3String instanceName,
+                                       fmi3InstanceEnvironment instanceEnvironment,
+                                       fmi3LogMessageCallback logMessage)
+{
+    fmu_log_error(fn, instanceName ? instanceName : "?", sink, (fmu_callback)logMessage,
+                  instanceEnvironment, "%s", NO_ME);
+    return NULL;
 }
 
 fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
@@ -82,10 +95,8 @@ fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String in
                                           fmi3LogMessageCallback logMessage)
 {
     (void)instantiationToken, (void)resourcePath, (void)visible, (void)loggingOn;
-    fmu_log_error("fmi3InstantiateModelExchange", instanceName ? instanceName : "?", sink,
-                  (fmu_callback)logMessage, instanceEnvironment,
-                  "this FMU supports co-simulation only");
-    return NULL;
+    return refuse_instantiate("fmi3InstantiateModelExchange", instanceName, instanceEnvironment,
+                              logMessage);
 }
 
 fmi3Instance fmi3InstantiateScheduledExecution(
@@ -96,10 +107,8 @@ fmi3Instance fmi3InstantiateScheduledExecution(
 {
     (void)instantiationToken, (void)resourcePath, (void)visible, (void)loggingOn;
     (void)clockUpdate, (void)lockPreemption, (void)unlockPreemption;
-    fmu_log_error("fmi3InstantiateScheduledExecution", instanceName ? instanceName : "?", sink,
-                  (fmu_callback)logMessage, instanceEnvironment,
-                  "this FMU supports co-simulation only");
-    return NULL;
+    return refuse_instantiate("fmi3InstantiateScheduledExecution", instanceName,
+                              instanceEnvironment, logMessage);
 }
 
 void fmi3FreeInstance(fmi3Instance instance)
@@ -341,7 +350,6 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
 
 #define UNSUPPORTED(call, why) return (fmi3Status)fmu_unsupported(instance, call, why)
 #define NO_EVENTS "the FMU has no event mode and no clocks"
-#define NO_ME "the FMU supports co-simulation only"
 
 fmi3Status fmi3EnterEventMode(fmi3Instance instance)
 {
@@ -539,5 +547,5 @@ fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference 
                                       fmi3Float64 activationTime)
 {
     (void)clockReference, (void)activationTime;
-    UNSUPPORTED("fmi3ActivateModelPartition", "the FMU supports co-simulation only");
+    UNSUPPORTED("fmi3ActivateModelPartition", NO_ME);
 }

@@ -93,6 +93,10 @@ static int rhs(double t, const double *u, double *out, void *user)
     return 0;
 }
 
+/* The coefficients of H's terms, by value reference: H_c0, H_c1 exp(..),
+ * H_a{k} cos(..); a term with a zero coefficient is left out of the kernel. */
+static const unsigned KERNEL_COEF[5] = {VR_H_c0, VR_H_c1, VR_H_a1, VR_H_a2, VR_H_a3};
+
 /* H(s) = H_c0 + H_c1 exp(-H_lambda s) + sum_k H_a{k} cos(H_omega{k} s) as a
  * sum of exponentials (entry (1, 0) of the kernel), the terms with a zero
  * coefficient left out, so that the default method is the O(1) recursion.
@@ -101,16 +105,15 @@ static int rhs(double t, const double *u, double *out, void *user)
 static int set_kernel(const model *m, dmi_solver *s)
 {
     const double *r = m->real;
-    const double coef[5] = {r[VR_H_c0], r[VR_H_c1], r[VR_H_a1], r[VR_H_a2], r[VR_H_a3]};
     const double rate[5] = {0.0, -r[VR_H_lambda], 0.0, 0.0, 0.0};
     const double freq[5] = {0.0, 0.0, r[VR_H_omega1], r[VR_H_omega2], r[VR_H_omega3]};
     double a[5], b[5], C[5 * 4] = {0};
     size_t K = 0;
     for (size_t k = 0; k < 5; k++)
-        if (coef[k] != 0) {
+        if (r[KERNEL_COEF[k]] != 0) {
             a[K] = rate[k];
             b[K] = freq[k];
-            C[4 * K + 2] = coef[k];
+            C[4 * K + 2] = r[KERNEL_COEF[k]];
             K++;
         }
     return K ? dmi_set_kernel_exp(s, K, a, b, C, NULL) : dmi_set_kernel(s, NULL, NULL);
@@ -143,10 +146,9 @@ static int solver_fail(char *err, const char *what, dmi_solver *s, int rc)
 static void solver_bytes(const model *m, double *kept, double *peak)
 {
     const double n = 2, N = m->N, d = sizeof(double);
-    const unsigned coef[5] = {VR_H_c0, VR_H_c1, VR_H_a1, VR_H_a2, VR_H_a3};
     double K = 0;
     for (size_t k = 0; k < 5; k++)
-        K += m->real[coef[k]] != 0;
+        K += m->real[KERNEL_COEF[k]] != 0;
     const double nnz = K > 0, ring = 2 * (N + 1) * n * d, samples = nnz * N * d;
     *kept = ring + samples + 2 * K * d;
     *peak = 2 * ring + N * n * n * d + samples;

@@ -2,7 +2,8 @@
  * Writes the FMU's modelDescription.xml for FMI 2.0 or 3.0 from the one
  * variable table of config.h; run at build time.
  *
- * Usage: modelDescription 2|3 GUID VERSION OUTPUT [SOURCE...]
+ * Usage: modelDescription 2|3 VERSION OUTPUT [SOURCE...]
+ * (the GUID / instantiationToken is config.h's DMI_FMU_GUID)
  * The SOURCEs (FMI 2.0: the C files of sources/) go into <SourceFiles>; FMI
  * 3.0 lists them in sources/buildDescription.xml instead.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -53,7 +54,7 @@ static void attr(FILE *f, const char *text)
         }
 }
 
-static void header(FILE *f, int v, const char *guid, const char *version, int nsources,
+static void header(FILE *f, int v, const char *version, int nsources,
                    char **sources)
 {
     fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
@@ -72,7 +73,7 @@ static void header(FILE *f, int v, const char *guid, const char *version, int ns
                "  license=\"GPL-3.0-or-later\"\n"
                "  generationTool=\"dmi\"\n"
                "  variableNamingConvention=\"flat\"%s>\n",
-            v == 2 ? "2.0" : "3.0", MODEL_NAME, v == 2 ? "guid" : "instantiationToken", guid,
+            v == 2 ? "2.0" : "3.0", MODEL_NAME, v == 2 ? "guid" : "instantiationToken", DMI_FMU_GUID,
             version, version, v == 2 ? "\n  numberOfEventIndicators=\"0\"" : "");
     if (v == 2)
         fprintf(f, "  <CoSimulation\n"
@@ -181,17 +182,17 @@ static void variables3(FILE *f)
 
 int main(int argc, char **argv)
 {
-    if (argc < 5 || (strcmp(argv[1], "2") != 0 && strcmp(argv[1], "3") != 0)) {
-        fprintf(stderr, "usage: modelDescription 2|3 GUID VERSION OUTPUT [SOURCE...]\n");
+    if (argc < 4 || (strcmp(argv[1], "2") != 0 && strcmp(argv[1], "3") != 0)) {
+        fprintf(stderr, "usage: modelDescription 2|3 VERSION OUTPUT [SOURCE...]\n");
         return 2;
     }
     const int v = argv[1][0] - '0';
-    FILE *f = fopen(argv[4], "w");
+    FILE *f = fopen(argv[3], "w");
     if (!f) {
-        perror(argv[4]);
+        perror(argv[3]);
         return 1;
     }
-    header(f, v, argv[2], argv[3], argc - 5, argv + 5);
+    header(f, v, argv[2], argc - 4, argv + 4);
     if (v == 2)
         variables2(f);
     else
