@@ -12,13 +12,12 @@ import os
 import shutil
 import tempfile
 import threading
-import zipfile
 from math import isclose
 from typing import Any
 
 import numpy as np
 from distributed import WorkerPlugin, get_worker
-from fmpy import read_model_description
+from fmpy import extract, read_model_description
 from fmpy.simulation import (apply_start_values, instantiate_fmu, settable_in_initialization_mode,
                              settable_in_instantiated)
 
@@ -234,11 +233,9 @@ class Runner:
 
 
 def unpack(fmu_bytes: bytes, directory: str) -> str:
-    """Extracts the FMU (zip bytes) into a new folder under `directory`; returns the folder."""
-    unzipdir = tempfile.mkdtemp(prefix="dmi-sweep-fmu-", dir=directory)
-    with zipfile.ZipFile(io.BytesIO(fmu_bytes)) as z:
-        z.extractall(unzipdir)
-    return unzipdir
+    """Extracts the FMU (zip bytes) into a new folder under `directory` with fmpy.extract (which
+    refuses absolute and backslash paths); returns the folder."""
+    return str(extract(io.BytesIO(fmu_bytes), tempfile.mkdtemp(prefix="dmi-sweep-fmu-", dir=directory)))
 
 
 class FMUPlugin(WorkerPlugin):
