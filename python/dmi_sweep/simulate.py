@@ -12,13 +12,12 @@ import os
 import shutil
 import tempfile
 import threading
-import zipfile
 from math import isclose
 from typing import Any
 
 import numpy as np
 from distributed import WorkerPlugin, get_worker
-from fmpy import read_model_description
+from fmpy import extract, read_model_description
 from fmpy.simulation import (apply_start_values, instantiate_fmu, settable_in_initialization_mode,
                              settable_in_instantiated)
 
@@ -71,6 +70,7 @@ class Runner:
         self.unzipdir = unzipdir
         self.md = read_model_description(unzipdir)
         self.fmi3 = self.md.fmiVersion.startswith("3")
+        self.variable_step = bool(self.md.coSimulation.canHandleVariableCommunicationStepSize)
         self.variables = {v.name: v for v in self.md.modelVariables}
         self.fmu: Any = None
         self.used = False
@@ -152,25 +152,24 @@ class Runner:
         if rest:
             raise ValueError("could not set the start values of " + ", ".join(rest))
 
-        events: list[float] = []
         period = job["poincare"]
         if isinstance(period, str):
             period = 2 * math.pi / float(self._value(period, start))
-        if period is not None:
-            if not (period > 0 and math.isfinite(period)):
-                raise ValueError(f"the Poincare period {period!r} is not a positive number")
-            k = 0
-            while True:
-                t = transient + k * period
-                if t > stop and not isclose(t, stop):
-                    break
-                events.append(t)
-                k += 1
-        variable_step = bool(self.md.coSimulation.canHandleVariableCommunicationStepSize)
-        key = (t0, stop, interval, variable_step, period, transient)
+        if period is not None and not (period > 0 and math.isfinite(period)):
+            raise ValueError(f"the Poincare period {period!r} is not a positive number")
+        key = (t0, stop, interval, period, transient)
         cached = self.plans.get(key)
         if cached is None:
-            plan = communication_plan(t0, stop, interval, variable_step, events)
+            events: list[float] = []    # the Poincare section's times
+            if period is not None:
+                k = 0
+                while True:
+                    t = transient + k * period
+                    if t > stop and not isclose(t, stop):
+                        break
+                    events.append(t)
+                    k += 1
+            plan = communication_plan(t0, stop, interval, self.variable_step, events)
             # per communication point: in the statistics window; read (in the window, or the last)
             window = [in_window(t, transient) for t, _, _ in plan]
             read = [recorded and (w or i == len(plan) - 1)
@@ -234,11 +233,9 @@ class Runner:
 
 
 def unpack(fmu_bytes: bytes, directory: str) -> str:
-    """Extracts the FMU (zip bytes) into a new folder under `directory`; returns the folder."""
-    unzipdir = tempfile.mkdtemp(prefix="dmi-sweep-fmu-", dir=directory)
-    with zipfile.ZipFile(io.BytesIO(fmu_bytes)) as z:
-        z.extractall(unzipdir)
-    return unzipdir
+    """Extracts the FMU (zip bytes) into a new folder under `directory` with fmpy.extract (which
+    refuses absolute and backslash paths); returns the folder."""
+    return str(extract(io.BytesIO(fmu_bytes), tempfile.mkdtemp(prefix="dmi-sweep-fmu-", dir=directory)))
 
 
 class FMUPlugin(WorkerPlugin):

@@ -82,12 +82,13 @@ class Store:
         meta_path = d / META
         if d.exists() and not d.is_dir():
             raise StoreError(f"{d} exists and is not a folder")
+        identity = spec.identity()
         if meta_path.exists():
             meta = json.loads(meta_path.read_text())
-            if meta.get("identity") != spec.identity() and not restart:
+            if meta.get("identity") != identity and not restart:
                 what = ("the FMU changed (sha256 " + meta.get("identity", {}).get("fmu_sha256", "?")[:12]
                         + " -> " + spec.sha256[:12] + ")"
-                        if meta.get("identity", {}).get("spec") == spec.identity()["spec"]
+                        if meta.get("identity", {}).get("spec") == identity["spec"]
                         else f"the spec differs from {d / SPEC}")
                 raise StoreError(f"{d} holds another sweep: {what}. Use another --out, or --restart "
                                  "to delete its results and start again")
@@ -99,7 +100,7 @@ class Store:
         d.mkdir(parents=True, exist_ok=True)
         if not meta_path.exists():
             store._write_atomic(SPEC, lambda f: f.write(spec.text))
-            meta = {"identity": spec.identity(), "fmu": str(spec.fmu), "fmu_sha256": spec.sha256,
+            meta = {"identity": identity, "fmu": str(spec.fmu), "fmu_sha256": spec.sha256,
                     "fmi_version": spec.model.fmiVersion, "model_name": spec.model.modelName,
                     "points": spec.n_points, "params": spec.params, "outputs": spec.outputs,
                     "mode": spec.mode, "versions": _versions(),
@@ -157,9 +158,7 @@ class Store:
             for f in self.schema:
                 if f.name in values:
                     cols[f.name].append(values[f.name])
-                elif f.name.endswith("_poincare"):
-                    cols[f.name].append(r.get(f.name))
-                elif f.name in ("point", "error"):
+                elif f.name in ("point", "error") or f.name.endswith("_poincare"):   # null if absent
                     cols[f.name].append(r.get(f.name))
                 else:
                     cols[f.name].append(r.get(f.name, math.nan))

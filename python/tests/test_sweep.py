@@ -78,9 +78,9 @@ def test_values_equal_plain_fmpy_runs(two_workers, fmu_path):
         t_in = [0.0] + [t for t in times for _ in (0, 1)] + [3.0]
         signal = np.array([(t, 0.0) for t in t_in], dtype=[("time", float), ("g_in", float)])
         ev = plain(fmu_path, values, 3.0, 0.01, input=signal)
+        assert all(min(abs(ev["time"] - t)) < 1e-12 for t in times)
         for y in OUTPUTS:
             want = [float(ev[y][np.argmin(np.abs(ev["time"] - t))]) for t in times]
-            assert all(min(abs(ev["time"] - t)) < 1e-12 for t in times)
             assert np.max(np.abs(np.subtract(row[f"{y}_poincare"], want))) <= 1e-12, y
     # the stick fraction is the mean of the Boolean output: some points stick part of the time
     assert ((ok["sticking_mean"] > 0) & (ok["sticking_mean"] < 1)).any()
