@@ -155,23 +155,23 @@ static void solver_bytes(const model *m, double *kept, double *peak)
 }
 
 /* "N = .. steps per tau: <bytes> while initialising, <bytes> after", the
- * sizes of solver_bytes, into out (MODEL_ERRLEN). */
-static void describe_bytes(const model *m, const char *prefix, char *out)
+ * sizes of solver_bytes, into out (size bytes; cut to fit). */
+static void describe_bytes(const model *m, char *out, size_t size)
 {
     double kept, peak;
     solver_bytes(m, &kept, &peak);
-    snprintf(out, MODEL_ERRLEN, "%sN = %d steps per tau: the solver allocates %.0f bytes (%.3g GB) "
-                                "while initialising and keeps %.0f bytes (%.3g GB): a history of "
-                                "2(N+1) states and N kernel samples",
-             prefix, m->N, peak, peak / 1e9, kept, kept / 1e9);
+    snprintf(out, size, "N = %d steps per tau: the solver allocates %.0f bytes (%.3g GB) "
+                        "while initialising and keeps %.0f bytes (%.3g GB): a history of "
+                        "2(N+1) states and N kernel samples",
+             m->N, peak, peak / 1e9, kept, kept / 1e9);
 }
 
 /* Out of memory for N: the error names N and the bytes needed. */
 static int memory_fail(char *err, const char *what, const model *m)
 {
-    char prefix[MODEL_ERRLEN];
-    snprintf(prefix, sizeof prefix, "%s: out of memory: ", what);
-    describe_bytes(m, prefix, err);
+    int len = snprintf(err, MODEL_ERRLEN, "%s: out of memory: ", what);
+    if (len >= 0 && len < MODEL_ERRLEN)
+        describe_bytes(m, err + len, (size_t)(MODEL_ERRLEN - len));
     return -1;
 }
 
@@ -216,7 +216,7 @@ int model_start(model *m, double t_start, char *err, char *note)
     solver_bytes(m, &kept, &peak);
     note[0] = '\0';
     if (peak > MODEL_NOTE_BYTES)
-        describe_bytes(m, "", note);
+        describe_bytes(m, note, MODEL_ERRLEN);
     dmi_solver *s = NULL;
     if (solver_create(m, &s, err) != 0)
         return -1;
@@ -244,9 +244,9 @@ int model_coarse_step(const model *m, double T, char *msg)
     const double n_min = ceil(tau * b * T / log(MODEL_COARSE_GROWTH));
     snprintf(msg, MODEL_ERRLEN, "N = %d (h = %.3g) is a coarse step for b = %.3g: the scheme's "
                                 "explicit part amplifies an undamped oscillation by about "
-                                "(1 + h^2 b) = %.6g per step, 10^%.3g over T = %.3g; N >= %.3g "
+                                "(1 + h^2 b) = %.6g per step, \xc3\x97%.3g over T = %.3g; N >= %.3g "
                                 "keeps it below %g",
-             m->N, h, b, 1.0 + h * h * b, ln_growth / log(10.0), T, n_min, MODEL_COARSE_GROWTH);
+             m->N, h, b, 1.0 + h * h * b, exp(ln_growth), T, n_min, MODEL_COARSE_GROWTH);
     return 1;
 }
 

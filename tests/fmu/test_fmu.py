@@ -952,6 +952,12 @@ def test_coarse_step_warns_at_initialization(sl, fmu_path):
         assert len(warned) == (1 if want else 0), (N, stop, b, s.log)
         if want:
             assert f"N = {N}" in warned[0] and "coarse" in warned[0] and "1 + h^2 b" in warned[0]
+            # the growth as a factor, "\u00d754 over T = 40", computed here
+            T = 30.0 if stop is None else stop
+            h = 1.0 / N
+            factor = re.search("\u00d7(\\S+) over T = ", warned[0])
+            assert factor, warned[0]
+            assert float(factor.group(1)) == pytest.approx((1 + h * h * b) ** (T / h), rel=5e-3)
         s.fmu.doStep(0.0, 0.5)  # and it runs on
     # what the warning is about: the coarse run explodes
     r = simulate_fmu(fmu_path, stop_time=30.0, output_interval=1.0, start_values={"N": 1},
