@@ -8,6 +8,7 @@
 from __future__ import annotations
 
 import ctypes
+import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -57,6 +58,15 @@ def _arg_kind(t: Any) -> str:
     return "?"
 
 
+def _c_kinds(signature: str) -> str:
+    """The argument kinds of a C signature "int (double, double *, ...)" ("?" if not int-valued)."""
+    m = re.fullmatch(r"\s*int\s*\((.*)\)\s*", signature)
+    if not m:
+        return "?"
+    args = [a.strip() for a in m.group(1).split(",")]
+    return "".join("p" if a.endswith("*") else "d" if a == "double" else "?" for a in args)
+
+
 def _check_ctypes(kind: Kind, fn: Any, what: str) -> None:
     argtypes, restype = getattr(fn, "argtypes", None), getattr(fn, "restype", ctypes.c_int)
     if argtypes is None:  # a foreign function declared without a prototype: taken as it is
@@ -97,7 +107,7 @@ def _pointer_value(p: Any) -> int | None:
 def _c_function(kind: Kind, f: Any, user: Any) -> Bound | None:
     """The address of a C-callable f, checked against kind's signature; None if f is not one."""
     if type(f).__name__ == "LowLevelCallable" and hasattr(f, "signature"):  # scipy
-        if f.signature.replace(" ", "") != kind.c.replace(" ", ""):
+        if _c_kinds(f.signature) != kind.args:
             raise InvalidArgument(_lib.EINVAL, f"set_{kind.name}: the LowLevelCallable has the "
                                   f"signature {f.signature!r}, libdmi calls {kind.c!r}")
         fn = f.function
