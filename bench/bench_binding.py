@@ -6,7 +6,8 @@
 # scheme as a user would write it (direct delay sum).  Rounds interleave the
 # four; the fastest round of each counts; CPU times of the process (the
 # machine may be shared).  Needs dmi importable (.venv after scripts/deps.sh,
-# or PYTHONPATH=<build>/python) and numba.
+# or PYTHONPATH=<build>/python) and numba.  The C program runs with the
+# binding's libdmi.so.1 (LD_LIBRARY_PATH), so both time the same library.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -55,7 +56,11 @@ def parse() -> argparse.Namespace:
 
 
 def c_run(program: str, N: int, steps: int) -> tuple[float, list[float]]:
-    out = subprocess.run([program, str(N), str(steps)], capture_output=True, text=True, check=True)
+    """ns per step and the final state of the C program, run with the binding's own libdmi."""
+    import dmi
+    env = dict(os.environ, LD_LIBRARY_PATH=str(Path(dmi.__file__).parent))  # before its RUNPATH
+    out = subprocess.run([program, str(N), str(steps)], capture_output=True, text=True, check=True,
+                         env=env)
     lines = out.stdout.split("\n")
     return float(lines[0].split()[1]), [float(x) for x in lines[1].split()]
 
@@ -124,7 +129,8 @@ def main() -> None:
         best["NumPy"] = min(best["NumPy"], ns)
     print(f"Example 4.3, N = {N}, kernel as 3 exponential terms (recursion), friction; "
           f"best of {args.rounds} interleaved rounds, CPU time")
-    print(f"dmi {dmi.version()}, numba {numba.__version__}, numpy {np.__version__}")
+    print(f"dmi {dmi.version()} ({Path(dmi.__file__).parent / 'libdmi.so.1'}, also for the C "
+          f"program), numba {numba.__version__}, numpy {np.__version__}")
     print(f"{'rhs':<28} {'steps':>9} {'ns/step':>10} {'x C':>8}")
     rows = [("C (bench_binding)", "C", big), ("numba cfunc (dmi.Solver)", "numba", big),
             ("Python function (dmi.Solver)", "Python", small), ("plain NumPy scheme", "NumPy", small)]
