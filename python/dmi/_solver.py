@@ -7,7 +7,7 @@ import ctypes
 import math
 import operator
 import threading
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
@@ -20,7 +20,8 @@ from ._errors import Error, InvalidArgument, from_code
 _L = _lib.lib
 _DP = ctypes.POINTER(ctypes.c_double)
 
-Callback = Callable[..., Any] | Any  # a Python function or a C function (see Solver.set_rhs)
+# A Python function, or a C function: numba cfunc, ctypes function pointer, scipy.LowLevelCallable.
+Callback = Any
 
 
 def _count(value: Any, name: str, minimum: int) -> int:
@@ -328,10 +329,9 @@ class Solver:
         """Frees the C solver (``dmi_free``); the object is unusable afterwards.  Also done when
         the object is collected."""
         if self._handle is not None:
-            with self._using():
-                pass
-            _L.dmi_free(ctypes.byref(self._handle))
-            self._handle = None
+            with self._using() as s:
+                _L.dmi_free(ctypes.byref(s))
+                self._handle = None
             self._keep.clear()
 
     def __enter__(self) -> Solver:

@@ -6,6 +6,7 @@
 from __future__ import annotations
 
 import ctypes
+import functools
 import os
 import subprocess
 from pathlib import Path
@@ -85,6 +86,7 @@ def python_callbacks(example: int):
     return rhs, kernel, history
 
 
+@functools.cache
 def numba_callbacks(example: int):
     """The same as numba cfuncs with libdmi's C signatures."""
     numba = pytest.importorskip("numba")
