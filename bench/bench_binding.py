@@ -49,7 +49,7 @@ def parse() -> argparse.Namespace:
                     help="steps of the C and numba runs (default: 1000000)")
     ap.add_argument("--python-steps", type=positive, default=30000,
                     help="steps of the Python-rhs and NumPy runs (default: 30000)")
-    ap.add_argument("--rounds", type=positive, default=5, help="interleaved rounds (default: 5)")
+    ap.add_argument("--rounds", type=positive, default=7, help="interleaved rounds (default: 7)")
     ap.add_argument("--c-program", type=program, default=str(ROOT / "build" / "bench" / "bench_binding"),
                     help="the C program (default: build/bench/bench_binding)")
     return ap.parse_args()
