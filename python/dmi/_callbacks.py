@@ -42,12 +42,10 @@ HISTORY = Kind("history", "int (double, double *, void *)", _lib.HistoryFn, "dpp
 @dataclass
 class Bound:
     """What a setter hands to libdmi: the function's address and the user pointer (None: NULL),
-    the objects that must stay alive as long as the solver uses them, and whether the function
-    is Python (called back with the GIL)."""
+    and the objects that must stay alive as long as the solver uses them."""
     address: int | None
     user: int | None
     keep: tuple
-    python: bool
 
 
 def _arg_kind(t: Any) -> str:
@@ -87,11 +85,16 @@ def _capsule_pointer(capsule: Any) -> int:
 
 
 def _pointer_value(p: Any) -> int | None:
-    """A user pointer: None, an int address, a ctypes pointer or object (its address), a capsule."""
+    """A user pointer: None, an int address, a NumPy array or ctypes object (its data's address),
+    a ctypes pointer, a capsule."""
     if p is None:
         return None
     if isinstance(p, int):
         return p
+    if isinstance(p, np.ndarray):
+        if not p.flags.c_contiguous:
+            raise InvalidArgument(_lib.EINVAL, "user: a NumPy array must be C-contiguous")
+        return p.ctypes.data
     if isinstance(p, ctypes.c_void_p):
         return p.value
     if isinstance(p, ctypes._Pointer):
@@ -100,8 +103,8 @@ def _pointer_value(p: Any) -> int | None:
         return ctypes.addressof(p)
     if type(p).__name__ == "PyCapsule":
         return _capsule_pointer(p)
-    raise InvalidArgument(_lib.EINVAL, f"user = {p!r}: expected None, an address (int), a ctypes "
-                          "object or pointer, or a capsule")
+    raise InvalidArgument(_lib.EINVAL, f"user = {p!r}: expected None, an address (int), a NumPy "
+                          "array, a ctypes object or pointer, or a capsule")
 
 
 def _c_function(kind: Kind, f: Any, user: Any) -> Bound | None:
@@ -114,13 +117,13 @@ def _c_function(kind: Kind, f: Any, user: Any) -> Bound | None:
         address = (ctypes.cast(fn, ctypes.c_void_p).value if isinstance(fn, ctypes._CFuncPtr)
                    else _capsule_pointer(fn))
         user_ptr = _pointer_value(user if user is not None else f.user_data)
-        return Bound(address, user_ptr, (f, user), False)
+        return Bound(address, user_ptr, (f, user))
     if isinstance(getattr(f, "ctypes", None), ctypes._CFuncPtr) and hasattr(f, "address"):  # numba
         _check_ctypes(kind, f.ctypes, "the numba cfunc")
-        return Bound(int(f.address), _pointer_value(user), (f, user), False)
+        return Bound(int(f.address), _pointer_value(user), (f, user))
     if isinstance(f, ctypes._CFuncPtr):
         _check_ctypes(kind, f, "the ctypes function")
-        return Bound(ctypes.cast(f, ctypes.c_void_p).value, _pointer_value(user), (f, user), False)
+        return Bound(ctypes.cast(f, ctypes.c_void_p).value, _pointer_value(user), (f, user))
     return None
 
 
@@ -173,7 +176,7 @@ def _python_function(kind: Kind, f: Callable, n: int, failure: list) -> Bound:
                 return 1
 
     c = kind.proto(trampoline)
-    return Bound(ctypes.cast(c, ctypes.c_void_p).value, None, (c, f), True)
+    return Bound(ctypes.cast(c, ctypes.c_void_p).value, None, (c, f))
 
 
 def bind(kind: Kind, f: Any, user: Any, n: int, failure: list) -> Bound:
@@ -181,7 +184,7 @@ def bind(kind: Kind, f: Any, user: Any, n: int, failure: list) -> Bound:
     if f is None:
         if user is not None:
             raise InvalidArgument(_lib.EINVAL, f"set_{kind.name}: a user pointer without a function")
-        return Bound(None, None, (), False)
+        return Bound(None, None, ())
     c = _c_function(kind, f, user)
     if c is not None:
         return c

@@ -148,9 +148,10 @@ class Solver:
     def set_rhs(self, f: Callback | None, user: Any = None) -> None:
         """Right-hand side f: ``f(t, u) -> array (n)``, or a C function
         ``int f(double t, const double *u, double *out, void *user)`` (``dmi.RHS_SIGNATURE``).
-        None restores f = 0.  ``user``: the C function's user pointer (an int address, a ctypes
-        object or pointer; a LowLevelCallable's own user_data otherwise).  Takes effect from the
-        next step; may be called at any time."""
+        None restores f = 0.  ``user``: the C function's user pointer: a NumPy array or ctypes
+        object (its data; the solver keeps the object alive), a ctypes pointer or an int address
+        (the memory is yours to keep alive); a LowLevelCallable's own user_data otherwise.  Takes
+        effect from the next step; may be called at any time."""
         self._set_callback("rhs", cb.RHS, _L.dmi_set_rhs, f, user)
 
     def set_resolvent(self, r: Callback | None, user: Any = None) -> None:
@@ -166,7 +167,7 @@ class Solver:
         a = _array(alpha, (self._n,), "alpha")
         with self._using() as s:
             self._check(_L.dmi_set_friction(s, _ptr(a)))
-        self._keep["resolvent"] = cb.Bound(None, None, (), False)
+        self._keep["resolvent"] = cb.Bound(None, None, ())
 
     def set_box(self, lo: Any, hi: Any) -> None:
         """Built-in normal cone of the box prod_i [lo_i, hi_i] (the resolvent is the projection):
@@ -175,7 +176,7 @@ class Solver:
         lo_a, hi_a = _array(lo, (self._n,), "lo"), _array(hi, (self._n,), "hi")
         with self._using() as s:
             self._check(_L.dmi_set_box(s, _ptr(lo_a), _ptr(hi_a)))
-        self._keep["resolvent"] = cb.Bound(None, None, (), False)
+        self._keep["resolvent"] = cb.Bound(None, None, ())
 
     def set_kernel(self, H: Callback | None, user: Any = None) -> None:
         """Kernel: ``H(s) -> array (n, n)`` for 0 <= s < tau, or a C function
@@ -198,7 +199,7 @@ class Solver:
         D_a = None if D is None else _array(D, (K, n, n), "D")
         with self._using() as s:
             self._check(_L.dmi_set_kernel_exp(s, K, _ptr(a_a), _ptr(b_a), _ptr(C_a), _ptr(D_a)))
-        self._keep["kernel"] = cb.Bound(None, None, (), False)
+        self._keep["kernel"] = cb.Bound(None, None, ())
 
     def set_history(self, z: Callback | None, user: Any = None) -> None:
         """History: ``z(t) -> array (n)`` for -tau <= t <= 0, or a C function

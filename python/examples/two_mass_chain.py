@@ -56,7 +56,7 @@ def params() -> np.ndarray:
 
 
 def numba_rhs():
-    """f(t, u) as a numba cfunc; the user pointer is a double * to params()."""
+    """f(t, u) as a numba cfunc; its user pointer is a double * to the values of params()."""
     import numba
     from numba import types
 
@@ -80,7 +80,7 @@ def simulate(T: float, N: int) -> tuple[np.ndarray, np.ndarray, float]:
 
     p = params()
     s = dmi.Solver(4, TAU, N)
-    s.set_rhs(numba_rhs(), p.ctypes.data)  # p outlives the run below
+    s.set_rhs(numba_rhs(), p)  # the cfunc's user pointer: p's data (the solver keeps p alive)
     s.set_friction([0.0, 0.0, MU[0] / M1, MU[1] / M2])
     s.set_kernel_exp(*kernel_terms())
     s.init()

@@ -259,3 +259,28 @@ def test_c_function_with_another_signature_refused():
     with pytest.raises(dmi.InvalidArgument, match="LowLevelCallable"):
         s.set_rhs(scipy.LowLevelCallable(kernel.ctypes))
     assert same(s, twin)
+
+
+def test_user_array_kept_alive_and_checked():
+    """A NumPy array as the user pointer: its data reaches the C function, the solver keeps it
+    alive (no other reference here), and a non-contiguous one is refused."""
+    numba = pytest.importorskip("numba")
+    import gc
+
+    sig = numba.types.intc(numba.types.float64, numba.types.CPointer(numba.types.float64),
+                           numba.types.CPointer(numba.types.float64),
+                           numba.types.CPointer(numba.types.float64))
+
+    @numba.cfunc(sig)
+    def growth(t, u, out, user):  # f = -c u: U^{p+1} = (1 + c h) U^p
+        out[0] = -user[0] * u[0]
+        return 0
+    s = dmi.Solver(1, 1.0, 4)
+    s.set_history(lambda t: np.ones(1))
+    with pytest.raises(dmi.InvalidArgument, match="C-contiguous"):
+        s.set_rhs(growth, np.array([[3.0, 9.0], [9.0, 9.0]])[:, 0])
+    s.set_rhs(growth, np.array([2.0]))
+    gc.collect()
+    s.init()
+    _, U = s.run(3)
+    assert U[:, 0].tolist() == [1.0, 1.5, 2.25, 3.375]  # h = 1/4, c = 2: factor 1.5, exact

@@ -48,7 +48,6 @@ def solver(testlib, rhs: str, exp_kernel: bool) -> dmi.Solver:
     if exp_kernel:
         s.set_kernel_exp(**EXP43)
         s.set_convolution("recursive")
-    s._test_keep = ex  # the user pointer's object lives as long as the solver
     return s
 
 
