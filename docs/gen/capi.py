@@ -138,12 +138,14 @@ def header(path: Path, root: Path) -> str:
         pieces.append((pending, text[last:]))
     rel = path.relative_to(root) if path.is_relative_to(root) else path
     out = [f"## {path.name}\n", f"`{rel}`: `#include <{path.name}>`\n"]
+    in_section = False      # entries before the first section are one heading level higher
     for i, (c, code) in enumerate(pieces):
         decl = [(k, n) for k, n in names(code) if not (guard and n == guard.group(1))]
         body = comment_text(c)
         first = body.split("\n", 1)[0].strip()
         sec = SECTION.match(first)
         if sec:
+            in_section = True
             out.append(f"### {sec.group(1).capitalize()}\n")
             rest = body.split("\n", 1)[1] if "\n" in body else ""
             if rest.strip():
@@ -158,7 +160,7 @@ def header(path: Path, root: Path) -> str:
         title = ", ".join(listed) if listed else first.rstrip(".")
         for _, n in decl:
             out.append(f"({n})=")
-        out.append(f"#### {escape(title)}\n")
+        out.append(f"{'####' if in_section else '###'} {escape(title)}\n")
         out.append(declarations(code))
         if body and (listed or body != first):      # a one-line group title is not repeated
             out.append(render(body))
