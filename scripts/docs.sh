@@ -45,16 +45,16 @@ rm -rf "$src" "$html"
 mkdir -p "$src"
 cp -r docs/. "$src/"
 # Pages written with other parts of the project: a stub until they are there.
-while read -r page by; do
+while IFS='|' read -r page title by; do
   if [[ ! -f docs/$page ]]; then
     echo "docs: docs/$page is not there yet: a stub stands in for it"
-    printf '# %s\n\n(written by %s; not there yet)\n' "${page%.md}" "$by" >"$src/$page"
+    printf '# %s\n\n(written by %s; not there yet)\n' "$title" "$by" >"$src/$page"
   fi
 done <<'PAGES'
-sweep.md the dmi-sweep work of issue 19
-fmu-export.md the FMU-export work of issue 20
-python.md the Python binding of issue 21
-benchmarks-scale.md the engine-at-scale work of issue 23
+sweep.md|dmi-sweep|the dmi-sweep work of issue 19
+fmu-export.md|Exporting your own model as an FMU|the FMU-export work of issue 20
+python.md|Python|the Python binding of issue 21
+benchmarks-scale.md|Benchmarks at scale|the engine-at-scale work of issue 23
 PAGES
 "$py" docs/gen/capi.py include/*.h >"$src/c-api.md"
 mapfile -t fmus < <(find "$build" -name '*.fmu' -not -path "$build/docs/*" -not -path '*/Testing/*' | sort)

@@ -92,9 +92,9 @@ def test_sweep_example(tmp_path):
         cmd = re.sub(r"^\.venv/bin/python", sys.executable, cmd)
         r = run_group(cmd, tmp_path, env)
         assert r.returncode == 0, r.stdout + r.stderr
-    assert "g_omega" in r.stdout and "sticking_mean" in r.stdout
+    assert "tau" in r.stdout and "sticking_mean" in r.stdout
     import pandas
     table = pandas.read_parquet(tmp_path / "results")
-    assert len(table) == 9 and table["error"].isna().all()
-    assert sorted(table["g_omega"]) == list(np.linspace(0.6, 1.4, 9))
+    assert len(table) == 6 and table["error"].isna().all()
+    assert sorted(table["tau"]) == list(np.linspace(2.0, 3.0, 6))
     assert (tmp_path / "bifurcation.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
