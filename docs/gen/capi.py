@@ -116,8 +116,10 @@ def constants_table(code: str) -> str:
 
 
 def declarations(code: str) -> str:
-    """The declarations as written (preprocessor conditionals kept, blank lines dropped)."""
+    """The declarations as written (blank lines dropped; #if/#else kept around macros only)."""
     keep = [m.group(0) for m in TOKEN.finditer(code) if not m.group(0).startswith("/*")]
+    if not any(re.match(r"#\s*define", k) for k in keep):    # conditionals only around macros
+        keep = [k for k in keep if not k.startswith("#")]
     keep = [re.sub(r"/\*.*?\*/", "", k, flags=re.S) if k.startswith("enum") else k for k in keep]
     keep = [re.sub(r"\n\s*\n", "\n", k) for k in keep]
     keep = ["\n".join(ln.rstrip() for ln in k.split("\n")) for k in keep]
