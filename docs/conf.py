@@ -15,3 +15,5 @@ html_theme = "alabaster"
 html_title = "dmi documentation"
 html_theme_options = {"page_width": "1100px", "body_max_width": "none"}
 html_show_sourcelink = False
+html_static_path = ["_static"]
+html_css_files = ["custom.css"]
