@@ -23,7 +23,7 @@
 #include <string.h>
 
 enum { BRANCHES = 3 };
-static const double M1 = 1.0, M2 = 0.5, K1 = 4.0, K2 = 2.0, MU1 = 0.3, MU2 = 0.2;
+static const double M1 = 1.0, M2 = 0.5, K1 = 4.0, K2 = 2.0, MU1 = 1.2, MU2 = 0.5;
 static const double F = 1.5, OMEGA = 1.7, TAU = 5.0;
 static const double G[BRANCHES] = {3.0, 1.0, 0.5}, THETA[BRANCHES] = {0.05, 0.5, 2.0};
 
