@@ -68,3 +68,15 @@ def test_two_mass_chain(tmp_path):
     assert dev <= 1e-10 and np.abs(want).max() > 0.1
     assert (want[1:, 2:] == 0).any(axis=0).all()  # both masses stick at some time (the friction acts)
     assert np.array_equal(got[:, 3:] == 0, want[:, 2:] == 0)
+
+
+def test_docs_first_snippet():
+    """The first Python block of docs/python.md runs and gives the shapes its comment says."""
+    import re
+    page = (EXAMPLE.parents[2] / "docs" / "python.md").read_text()
+    code = re.findall(r"```python\n(.*?)```", page, re.S)[0]
+    scope: dict = {}
+    exec(code, scope)
+    assert "t: (3001,), U: (3001, 2)" in code
+    assert scope["t"].shape == (3001,) and scope["U"].shape == (3001, 2) and scope["t"][-1] == 30.0
+    assert (scope["U"][1:, 1] == 0).any() and abs(scope["U"][:, 1]).max() > 0.01  # stick and slip
