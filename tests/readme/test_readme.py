@@ -2,7 +2,7 @@
 # relative link and image resolves; the fmpy example runs and gives what it says (4001 rows 0.01
 # apart, w(40) equal to the native Example 4.3 run of build/examples/ex43); the sweep example (its
 # spec and its three commands) runs and writes one row per grid point and the plot.
-# The C program is built and run by readme_snippet.sh.  Environment (set by ctest): DMI_FMU,
+# The Python example (import dmi) gives ex43's w(30).  The C program is built and run by readme_snippet.sh.  Environment (set by ctest): DMI_FMU,
 # DMI_EXAMPLES_DIR.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 import io
@@ -79,6 +79,20 @@ def test_fmpy_example():
                             check=True).stdout.strip().splitlines()[-1].split(",")
     assert abs(float(native[0]) - 40) < 1e-9
     assert abs(float(w40) - float(native[1])) <= 1e-10, (w40, native)
+
+
+def test_python_example():
+    """The README's dmi block gives Example 4.3's w(30), as the C program ex43 does."""
+    code = blocks("python")[1]
+    assert "import dmi" in code
+    out = io.StringIO()
+    with redirect_stdout(out):
+        exec(compile(code, "README.md", "exec"), {})
+    t30, w30 = map(float, out.getvalue().split())
+    native = subprocess.run([EXAMPLES / "ex43", "1000", "30", "30000"], capture_output=True, text=True,
+                            check=True).stdout.strip().splitlines()[-1].split(",")
+    assert t30 == 30.0 and abs(float(native[0]) - 30) < 1e-12
+    assert abs(w30 - float(native[1])) <= 1e-11 * max(1.0, abs(float(native[1]))), (w30, native)
 
 
 def test_sweep_example(tmp_path):
