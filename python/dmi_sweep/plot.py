@@ -58,10 +58,10 @@ class Labels:
 
 
 def plot(directory: str | os.PathLike, x: str, y: str | None, metric: str | None,
-         output: str | os.PathLike, hue: str | None = None) -> None:
+         output: str | os.PathLike, hue: str | None = None):
     """Writes the plot of the sweep in `directory` to `output` (PNG): against the parameter x, one
     set per value of `hue`, or a heatmap over x and y. Every swept parameter must be x, y or hue, or
-    hold a single value among the successful points."""
+    hold a single value among the successful points. Returns the (closed) matplotlib Figure."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -146,3 +146,4 @@ def plot(directory: str | os.PathLike, x: str, y: str | None, metric: str | None
     fig.tight_layout()
     fig.savefig(output)
     plt.close(fig)
+    return fig

@@ -97,6 +97,8 @@ class Progress:
         stream.write(("\r\033[K" if clear else "") + text + "\n")
         stream.flush()
         self.last = -math.inf
+        if clear:
+            self.shown = -1          # the bar's line is gone: close() shows it again
 
     def close(self) -> None:
         """The last line, unless the line last shown has the same count."""
@@ -254,8 +256,11 @@ def make_client(workers: int | None, scheduler: str | None, sec: Security | None
     n = workers or os.cpu_count() or 1
     # No task waits on a busy worker: one that dies takes only its running chunk with it.
     with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}), _sigint_ignored():
+        # The scheduler's HTTP server (the dashboard, if asked) on a free port of 127.0.0.1, not on
+        # 8787, which another cluster of the machine may hold.
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
                                dashboard_address="127.0.0.1:0" if dashboard else None,
+                               scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
                                silence_logs=logging.CRITICAL)
     return Client(cluster)
 
