@@ -28,7 +28,7 @@ from distributed.comm.core import CommClosedError
 from distributed.security import Security
 
 from . import simulate
-from .simulate import FMUPlugin, check_start, run_chunk
+from .simulate import FMUPlugin, check_start, has_worker_plugin, run_chunk
 from .spec import Spec, SpecError
 from .store import Store
 
@@ -360,8 +360,9 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
     try:
         try:
             n_workers = len(client.scheduler_info(n_workers=-1).get("workers", {})) or (workers or 1)
+            # removed at the end unless it was there before (registered by the caller, say)
+            registered = not client.run_on_scheduler(has_worker_plugin, name=plugin.name)
             client.register_plugin(plugin)
-            registered = True
             removals: list[dict[str, Any]] = []     # remove-worker events, from the client's thread
 
             def on_event(event):   # in the client's thread, when the scheduler sends the event
@@ -431,10 +432,10 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
         e.saved, e.total = len(done) + computed, spec.n_points
         raise
     finally:
-        if registered and client.status == "running":
+        if client.status == "running":
             with contextlib.suppress(Exception):
                 client.unsubscribe_topic("all")
-            if scheduler:
+            if scheduler and registered:
                 with contextlib.suppress(Exception):
                     client.unregister_worker_plugin(plugin.name)
         with contextlib.suppress(Exception):

@@ -312,6 +312,12 @@ class FMUPlugin(WorkerPlugin):
         shutil.rmtree(self.unzipdir, ignore_errors=True)
 
 
+def has_worker_plugin(dask_scheduler: Any, name: str) -> bool:
+    """On the scheduler (Client.run_on_scheduler): whether a worker plugin of that name is
+    registered."""
+    return name in dask_scheduler.worker_plugins
+
+
 def check_start(fmu_bytes: bytes, job: dict) -> str | None:
     """Runner.check_start on the FMU unpacked into a temporary folder (removed after)."""
     with tempfile.TemporaryDirectory(prefix="dmi-sweep-check-") as d:
