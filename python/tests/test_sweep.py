@@ -517,3 +517,29 @@ def test_repair_interrupted_loses_no_point(tmp_path, fmu_path, monkeypatch):
     store.close()
     after = pd.read_parquet(out).sort_values("point").reset_index(drop=True)
     pd.testing.assert_frame_equal(after, table, check_exact=True)
+
+
+def test_plugin_removed_while_a_point_runs(fmu_path, tmp_path):
+    """Runner.close() (the worker plugin's teardown, when the plugin is removed or the worker stops)
+    while a point runs in another thread: the point ends with its values (the instance is not freed
+    under it: that crashed the worker), the instance is freed right after, a later point is refused."""
+    import threading
+    import time
+    from dmi_sweep.simulate import Runner, unpack
+    job = {"start_time": 0.0, "stop_time": 10.0, "output_interval": 0.01, "transient": 5.0,
+           "start": {"N": 4000}, "outputs": OUTPUTS, "poincare": None}
+    runner = Runner(unpack(open(fmu_path, "rb").read(), str(tmp_path)))
+    want = Runner(runner.unzipdir).run(job, {"g_amp": 1.5})
+    out = {}
+    t = threading.Thread(target=lambda: out.update(runner.run(job, {"g_amp": 1.5})))
+    t.start()
+    deadline = time.monotonic() + 30
+    while not runner.lock.locked() or runner.fmu is None:
+        assert time.monotonic() < deadline
+        time.sleep(0.001)
+    runner.close()
+    assert runner.fmu is not None            # still in use
+    t.join(timeout=60)
+    assert out == want
+    assert runner.fmu is None                # freed when the point ended
+    assert "plugin was removed" in runner.run(job, {"g_amp": 1.0})["error"]
