@@ -247,7 +247,7 @@ def make_client(workers: int | None, scheduler: str | None, sec: Security | None
             return Client(scheduler, timeout="30s", security=sec)
         except (OSError, CommClosedError, ssl.SSLError) as e:
             text = _reasons(e)
-            if sec is not None and any(w in text for w in ("SSL", "certificate", "TLS", "handshake")):
+            if any(isinstance(c, ssl.SSLError) for c in _chain(e)):   # the handshake failed
                 raise ConnectionSetupError(
                     f"the TLS connection to {scheduler} failed: {text}. Check that --tls-ca-file is "
                     "the CA that signed the scheduler's certificate and that the scheduler trusts "
@@ -265,15 +265,23 @@ def make_client(workers: int | None, scheduler: str | None, sec: Security | None
     return Client(cluster)
 
 
+def _chain(e: BaseException | None) -> Iterator[BaseException]:
+    """An exception and its causes (at most 8)."""
+    for _ in range(8):
+        if e is None:
+            return
+        yield e
+        e = e.__cause__ or e.__context__
+
+
 def _reasons(e: BaseException) -> str:
     """The messages of an exception and its causes, in one line."""
-    out = []
-    while e is not None and len(out) < 4:
-        text = f"{type(e).__name__}: {e}" if str(e) else type(e).__name__
+    out: list[str] = []
+    for c in _chain(e):
+        text = f"{type(c).__name__}: {c}" if str(c) else type(c).__name__
         if text not in out:
             out.append(text)
-        e = e.__cause__ or e.__context__
-    return "; ".join(out)
+    return "; ".join(out[:4])
 
 
 @dataclass
