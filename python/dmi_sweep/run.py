@@ -12,6 +12,7 @@ import logging
 import math
 import os
 import pickle
+import re
 import signal
 import ssl
 import sys
@@ -247,7 +248,9 @@ def make_client(workers: int | None, scheduler: str | None, sec: Security | None
             return Client(scheduler, timeout="30s", security=sec)
         except (OSError, CommClosedError, ssl.SSLError) as e:
             text = _reasons(e)
-            if any(isinstance(c, ssl.SSLError) for c in _chain(e)):   # the handshake failed
+            # the handshake failed: an SSLError among the causes, or in the message of Dask's
+            # CommClosedError (which keeps only the text of tornado's SSLError)
+            if any(isinstance(c, ssl.SSLError) for c in _chain(e)) or re.search(r"SSL\w*Error|\[SSL", text):
                 raise ConnectionSetupError(
                     f"the TLS connection to {scheduler} failed: {text}. Check that --tls-ca-file is "
                     "the CA that signed the scheduler's certificate and that the scheduler trusts "
@@ -284,6 +287,9 @@ def _reasons(e: BaseException) -> str:
     return "; ".join(out[:4])
 
 
+STDERR: Any = object()   # run()'s default stream: sys.stderr when called (pytest, say, replaces it)
+
+
 @dataclass
 class Summary:
     total: int          # points of the sweep
@@ -296,11 +302,12 @@ class Summary:
 
 def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, scheduler: str | None = None,
         restart: bool = False, chunk_size: int | None = None,
-        progress: TextIO | None = sys.stderr, tls_ca_file: str | None = None,
+        progress: TextIO | None = STDERR, tls_ca_file: str | None = None,
         tls_cert: str | None = None, tls_key: str | None = None, dashboard: bool = False,
-        messages: TextIO | None = sys.stderr) -> Summary:
+        messages: TextIO | None = STDERR) -> Summary:
     """Runs the sweep `spec` into the folder `out`, resuming what is there. The progress bar goes
-    to `progress`, the lines about repairs, lost workers and the dashboard to `messages`.
+    to `progress`, the lines about repairs, lost workers and the dashboard to `messages` (default:
+    sys.stderr at the time of the call; None: nowhere).
 
     Before anything is written: the TLS options are checked (ConnectionSetupError) and the FMU is
     instantiated here with the [start] values (SpecError with the FMU's message if it refuses them).
@@ -308,6 +315,8 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
     are repaired. Raises ClusterLost if the scheduler cannot be reached or is lost; the chunks
     written stay, and the same call resumes."""
     t0 = time.monotonic()
+    progress = sys.stderr if progress is STDERR else progress
+    messages = sys.stderr if messages is STDERR else messages
     sec = security(scheduler, tls_ca_file, tls_cert, tls_key)
     refusal = check_start(spec.fmu.read_bytes(), spec.job())
     if refusal:
