@@ -195,6 +195,8 @@ def test_scheduler_killed_mid_sweep(cluster, tmp_path, fmu_path, processes):
     assert len(messages) == 2, stderr                      # the reason, and what is saved
     entries = log_entries(out)
     assert [e for e in entries if "lost" in e], "no log entry of the loss"
+    # Dask's ERROR lines (the client failing to reconnect) are in the log, not on the terminal
+    assert [e for e in entries if e.get("level") == "ERROR" and e["log"].startswith("distributed.")], entries
     n_before = len(entries)
     r = run_sweep("run", spec, "--out", out, "--workers", "2", "--quiet")
     assert r.returncode == 0, r.stderr
