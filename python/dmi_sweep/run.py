@@ -8,6 +8,7 @@
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import logging
 import math
 import os
@@ -365,10 +366,11 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
         client = make_client(workers, None, None, dashboard)
     cluster = client.cluster
     if dashboard:
-        services = client.scheduler_info().get("services", {})
-        say(f"dmi-sweep: the Dask dashboard is at {client.dashboard_link}\n" if "dashboard" in services
-            else "dmi-sweep: the scheduler runs no dashboard (Dask's dashboard needs bokeh: "
-            "pip install bokeh)\n")
+        # the local scheduler serves the dashboard's pages only if bokeh is installed here
+        if scheduler or importlib.util.find_spec("bokeh") is not None:
+            say(f"dmi-sweep: the Dask dashboard is at {client.dashboard_link}\n")
+        else:
+            say("dmi-sweep: no dashboard: Dask's dashboard needs bokeh (pip install bokeh)\n")
     plugin = FMUPlugin(spec.fmu.read_bytes(), spec.sha256)
     bar = Progress(spec.n_points, len(done), progress)
     registered = False
