@@ -250,8 +250,10 @@ def make_client(workers: int | None, scheduler: str | None, sec: Security | None
         except (OSError, CommClosedError, ssl.SSLError) as e:
             text = _reasons(e)
             # the handshake failed: an SSLError among the causes, or in the message of Dask's
-            # CommClosedError (which keeps only the text of tornado's SSLError)
-            if any(isinstance(c, ssl.SSLError) for c in _chain(e)) or re.search(r"SSL\w*Error|\[SSL", text):
+            # CommClosedError (which keeps only the text of tornado's SSLError), or a TLS connection
+            # that the scheduler closed at once (under TLS 1.3 the client may see only that)
+            if any(isinstance(c, ssl.SSLError) for c in _chain(e)) \
+                    or re.search(r"SSL\w*Error|\[SSL|<TLS \(closed\)", text):
                 raise ConnectionSetupError(
                     f"the TLS connection to {scheduler} failed: {text}. Check that --tls-ca-file is "
                     "the CA that signed the scheduler's certificate and that the scheduler trusts "
