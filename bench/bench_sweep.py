@@ -24,7 +24,7 @@ from fmpy.fmi2 import FMU2Slave
 
 from dmi_sweep import run as sweep_run
 from dmi_sweep.cli import positive_int
-from dmi_sweep.simulate import Runner, communication_plan, in_window
+from dmi_sweep.simulate import FMUPlugin, Runner, communication_plan, in_window
 from dmi_sweep.spec import SpecError, load
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -110,9 +110,12 @@ def timed_sweep(spec_path: Path, workers: int, work: Path, bare_g: list[float]):
     (wall, CPU) seconds per point in one of its workers just before and just after the sweep."""
     t0 = time.perf_counter()
     with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                      scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}, host="127.0.0.1",
                       silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
         warm = load(spec_path)
         warm.values = warm.values[: 2 * workers]      # two points per worker: ship, unpack, instantiate
+        # registered here, the plugin stays for the timed sweep (run() removes only its own)
+        client.register_plugin(FMUPlugin(warm.fmu.read_bytes(), warm.sha256))
         sweep_run.run(warm, work / f"warm{workers}", scheduler=cluster.scheduler_address,
                       chunk_size=1, progress=None)
         startup = time.perf_counter() - t0

@@ -1,7 +1,5 @@
-# The command line: dmi-sweep run SPEC.toml --out DIR [--workers K] [--scheduler ADDRESS]
-#                   dmi-sweep plot DIR --x PARAM [--y PARAM] [--metric COLUMN] -o FILE.png
-# Exit status: 0 done, 1 a failure while running, 2 a bad spec or command line
-# (nothing was run), 130 interrupted (what was written stays; rerun to resume).
+# The command line: dmi-sweep run SPEC.toml --out DIR [options], dmi-sweep plot DIR --x PARAM [options]
+# (`dmi-sweep run --help` and docs/sweep.md list them).  Exit statuses: see EXIT below.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -9,6 +7,15 @@ import argparse
 import sys
 
 from . import __version__
+
+EXIT = """exit status:
+  0    every point of the sweep succeeded (the folder holds all of them)
+  1    every point was computed, but some failed: their rows hold the error (the count is printed)
+  2    nothing was run: a bad spec or command line, [start] values the FMU refuses, a folder
+       that holds another sweep or that another client is using, missing or bad TLS certificates
+  3    the cluster was lost or could not be reached: the finished points are saved, and the same
+       command resumes
+  130  interrupted (Ctrl-C): the finished points are saved, and the same command resumes"""
 
 
 def positive_int(text: str) -> int:
@@ -23,26 +30,48 @@ def positive_int(text: str) -> int:
 
 
 def parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="dmi-sweep", description="Parameter sweeps of a co-simulation "
-                                 "FMU on Dask, and their plots.")
+    fmt = argparse.RawDescriptionHelpFormatter
+    ap = argparse.ArgumentParser(prog="dmi-sweep", formatter_class=fmt, epilog=EXIT,
+                                 description="Parameter sweeps of a co-simulation FMU on Dask, and "
+                                 "their plots.")
     ap.add_argument("--version", action="version", version=f"dmi-sweep {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
-    r = sub.add_parser("run", help="run (or resume) a sweep")
+    r = sub.add_parser("run", help="run (or resume) a sweep", formatter_class=fmt, epilog=EXIT,
+                       description="Runs the sweep of SPEC into the folder --out, or resumes it: an "
+                       "unchanged spec computes only the points missing from the folder. One client "
+                       "per folder: a second one is refused (exit 2).")
     r.add_argument("spec", help="the sweep specification (TOML)")
     r.add_argument("--out", required=True, help="the result folder (a Parquet dataset)")
     r.add_argument("--workers", type=positive_int, help="worker processes of the local cluster "
-                   "(default: one per core)")
-    r.add_argument("--scheduler", help="address of an existing Dask scheduler, tcp://host:port")
-    r.add_argument("--restart", action="store_true", help="delete the results of another sweep in --out")
-    r.add_argument("--chunk-size", type=positive_int, help="points per task (default: about 8 tasks per "
-                   "worker, at most 64 points each)")
+                   "(default: one per core); the local cluster listens on 127.0.0.1 only")
+    r.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler: "
+                   "tls://host:port (with certificates), or tcp://host:port on a private network only")
+    r.add_argument("--tls-ca-file", metavar="PEM", help="the CA certificate(s) that signed the "
+                   "scheduler's certificate (default: Dask's distributed.comm.tls.ca-file)")
+    r.add_argument("--tls-cert", metavar="PEM", help="this client's certificate (default: Dask's "
+                   "distributed.comm.tls.client.cert)")
+    r.add_argument("--tls-key", metavar="PEM", help="this client's private key, unless --tls-cert "
+                   "holds it (default: Dask's distributed.comm.tls.client.key)")
+    r.add_argument("--restart", action="store_true", help="delete the folder's results, whatever "
+                   "spec they came from, and start again (without it, an unchanged spec resumes and "
+                   "a changed one is refused)")
+    r.add_argument("--chunk-size", type=positive_int, help="points per task (default: about 8 tasks "
+                   "per worker, at most 64 points each)")
+    r.add_argument("--dashboard", action="store_true", help="start the local cluster's Dask dashboard "
+                   "on a free port of 127.0.0.1 and print its address (with --scheduler: print the "
+                   "scheduler's)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
-    p = sub.add_parser("plot", help="plot a sweep: bifurcation diagram (one parameter) or heatmap (two)")
+    p = sub.add_parser("plot", help="plot a sweep: bifurcation diagram (one parameter) or heatmap (two)",
+                       description="Plots the sweep in DIR against the parameter --x: its Poincare "
+                       "samples or a metric (a sweep of one parameter), one line per value of --hue, or "
+                       "a heatmap over --x and --y. A sweep of two or more parameters needs --y or "
+                       "--hue (and the others held at one value).")
     p.add_argument("dir", help="the result folder")
     p.add_argument("--x", required=True, help="the parameter on the x axis")
-    p.add_argument("--y", help="a second parameter: a heatmap of the metric")
-    p.add_argument("--metric", help="the column to show (default: the first *_poincare column with one "
-                   "parameter, else the first *_mean column)")
+    p.add_argument("--y", help="a second parameter: a heatmap of the metric over --x and --y")
+    p.add_argument("--hue", help="a second parameter: one line (or set of points) per value of it")
+    p.add_argument("--metric", help="the column to show (default: the first *_poincare column, or "
+                   "with --y the first *_mean column)")
     p.add_argument("-o", "--output", required=True, help="the PNG to write")
     return ap
 
@@ -51,36 +80,53 @@ def main(argv: list[str] | None = None) -> int:
     """Runs the command line; returns the exit status."""
     a = parser().parse_args(argv)
     if a.command == "run":
-        from .run import run
-        from .spec import SpecError, load
-        from .store import StoreError
-        if a.workers and a.scheduler:
-            print("dmi-sweep: --workers is for the local cluster; with --scheduler the cluster's "
-                  "workers are used", file=sys.stderr)
-            return 2
-        try:
-            spec = load(a.spec)
-        except SpecError as e:
-            print(f"dmi-sweep: bad spec {a.spec}: {e}", file=sys.stderr)
-            return 2
-        try:
-            s = run(spec, a.out, workers=a.workers, scheduler=a.scheduler, restart=a.restart,
-                    chunk_size=a.chunk_size, progress=None if a.quiet else sys.stderr)
-        except StoreError as e:
-            print(f"dmi-sweep: {e}", file=sys.stderr)
-            return 2
-        except KeyboardInterrupt:
-            print(f"\ndmi-sweep: interrupted; the finished chunks are in {a.out}: run the same "
-                  "command to resume", file=sys.stderr)
-            return 130
-        print(f"dmi-sweep: {s.total} points in {a.out} ({s.skipped} already there, {s.computed} "
-              f"computed in {s.seconds:.1f} s, {s.failed} failed)")
-        return 0
+        return _run(a)
     from .plot import PlotError, plot
     try:
-        plot(a.dir, a.x, a.y, a.metric, a.output)
+        plot(a.dir, a.x, a.y, a.metric, a.output, hue=a.hue)
     except PlotError as e:
         print(f"dmi-sweep plot: {e}", file=sys.stderr)
         return 2
     print(f"dmi-sweep: wrote {a.output}")
+    return 0
+
+
+def _run(a: argparse.Namespace) -> int:
+    from .run import ClusterLost, ConnectionSetupError, run
+    from .spec import SpecError, load
+    from .store import StoreError
+    if a.workers and a.scheduler:
+        print("dmi-sweep: --workers is for the local cluster; with --scheduler the cluster's "
+              "workers are used", file=sys.stderr)
+        return 2
+    try:
+        spec = load(a.spec)
+        s = run(spec, a.out, workers=a.workers, scheduler=a.scheduler, restart=a.restart,
+                chunk_size=a.chunk_size, progress=None if a.quiet else sys.stderr,
+                tls_ca_file=a.tls_ca_file, tls_cert=a.tls_cert, tls_key=a.tls_key,
+                dashboard=a.dashboard)
+    except SpecError as e:
+        print(f"dmi-sweep: bad spec {a.spec}: {e}", file=sys.stderr)
+        return 2
+    except (StoreError, ConnectionSetupError) as e:
+        print(f"dmi-sweep: {e}", file=sys.stderr)
+        return 2
+    except ClusterLost as e:
+        if e.saved is None:
+            print(f"dmi-sweep: {e.reason}.\nNothing was run; the same command starts the sweep once "
+                  "the scheduler is up.", file=sys.stderr)
+        else:
+            print(f"dmi-sweep: {e.reason}.\n{e.saved} of {e.total} points are saved in {a.out}; the "
+                  "same command resumes the sweep (once the scheduler is back).", file=sys.stderr)
+        return 3
+    except KeyboardInterrupt:
+        print(f"dmi-sweep: interrupted; the finished chunks are in {a.out}: run the same "
+              "command to resume", file=sys.stderr)
+        return 130
+    print(f"dmi-sweep: {s.total} points in {a.out} ({s.skipped} already there, {s.computed} "
+          f"computed in {s.seconds:.1f} s, {s.failed} failed)")
+    if s.failed:
+        print(f"dmi-sweep: {s.failed} of {s.total} points failed: their rows hold the reason in the "
+              "column error", file=sys.stderr)
+        return 1
     return 0

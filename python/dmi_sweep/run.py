@@ -1,28 +1,38 @@
-# Runs a sweep on Dask: a LocalCluster of K single-threaded worker processes by
-# default, or an existing cluster (--scheduler).  The FMU travels to each worker
-# once, inside a worker plugin; chunks of points are tasks; each finished chunk
-# is written to the result folder at once.
+# Runs a sweep on Dask: a LocalCluster of K single-threaded worker processes on
+# 127.0.0.1 by default, or an existing cluster (--scheduler, plain TCP or TLS).
+# The FMU travels to each worker once, inside a worker plugin (removed at the
+# end); chunks of points are tasks; each finished chunk is written to the result
+# folder at once.  Dask's warnings and errors go to the folder's _log.jsonl, not
+# to the terminal; a lost cluster ends the run with ClusterLost.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
-import json
+import contextlib
+import importlib.util
 import logging
 import math
 import os
 import pickle
+import re
+import signal
+import ssl
 import sys
+import threading
 import time
+from concurrent.futures import CancelledError
 from dataclasses import dataclass
-from typing import Callable, TextIO
+from typing import Any, Callable, Iterator, TextIO
 
 import cloudpickle
 import dask
 from distributed import Client, KilledWorker, LocalCluster, as_completed
+from distributed.comm.core import CommClosedError
+from distributed.security import Security
 
 from . import simulate
-from .simulate import FMUPlugin, run_chunk
-from .spec import Spec
-from .store import LOG, Store
+from .simulate import FMUPlugin, check_start, has_worker_plugin, run_chunk
+from .spec import Spec, SpecError
+from .store import Store
 
 # Neither the scheduler nor the workers need dmi_sweep installed: the worker code
 # travels by value (cloudpickle), inside the plugin and inside each task.
@@ -45,15 +55,6 @@ def task(fn, *args) -> bytes:
     return cloudpickle.dumps(_Call(fn, *args))
 
 
-@dataclass
-class Summary:
-    total: int          # points of the sweep
-    skipped: int        # already in the folder when this run started
-    computed: int       # computed and written by this run
-    failed: int         # of those, points whose row has an error
-    seconds: float
-
-
 class Progress:
     """A one-line progress bar on stderr: points done of total, rate, time left."""
 
@@ -65,6 +66,7 @@ class Progress:
         self.stream, self.width, self.clock = stream, width, clock
         self.t0 = clock()
         self.last = -math.inf       # the first update shows at once
+        self.shown = -1             # points done at the line last shown
         self.tty = stream is not None and stream.isatty()
 
     def update(self, n: int, force: bool = False) -> None:
@@ -73,7 +75,7 @@ class Progress:
         now = self.clock()
         if self.stream is None or (not force and now - self.last < (0.2 if self.tty else 5.0)):
             return
-        self.last = now
+        self.last, self.shown = now, self.done
         elapsed = now - self.t0
         rate = (self.done - self.start_done) / elapsed if elapsed > 0 else 0.0
         left = (self.total - self.done) / rate if rate > 0 else float("nan")
@@ -88,10 +90,25 @@ class Progress:
         self.stream.write(("\r" + line) if self.tty else line + "\n")
         self.stream.flush()
 
+    def note(self, stream: TextIO | None, text: str) -> None:
+        """A line of its own (a lost worker, say) on `stream`; on the bar's terminal, the bar is
+        cleared first and shown again below at the next update."""
+        if stream is None:
+            return
+        clear = stream is self.stream and self.tty and self.shown >= 0
+        stream.write(("\r\033[K" if clear else "") + text + "\n")
+        stream.flush()
+        self.last = -math.inf
+        if clear:
+            self.shown = -1          # the bar's line is gone: close() shows it again
+
     def close(self) -> None:
-        self.update(0, force=True)
-        if self.stream is not None and self.tty:
+        """The last line, unless the line last shown has the same count."""
+        if self.done != self.shown:
+            self.update(0, force=True)
+        if self.stream is not None and self.tty and self.shown >= 0:
             self.stream.write("\n")
+            self.stream.flush()
 
 
 def chunks(todo: list[int], n_workers: int, chunk_size: int | None) -> list[list[int]]:
@@ -102,44 +119,284 @@ def chunks(todo: list[int], n_workers: int, chunk_size: int | None) -> list[list
     return [todo[i:i + chunk_size] for i in range(0, len(todo), chunk_size)]
 
 
-def make_client(workers: int | None, scheduler: str | None) -> Client:
-    """A client of the cluster at `scheduler`, or of a new LocalCluster of `workers` processes
-    (default: one per core) with one thread each."""
+class ClusterLost(RuntimeError):
+    """The scheduler (or the connection to it) is gone, or could not be reached; the chunks written
+    so far stay in the folder."""
+
+    def __init__(self, reason: str, saved: int | None = None, total: int = 0):
+        """saved: the points in the folder (None: the folder was not opened)."""
+        super().__init__(reason)
+        self.reason, self.saved, self.total = reason, saved, total
+
+
+class ConnectionSetupError(RuntimeError):
+    """TLS options or configuration that cannot work (missing certificates, unreadable files, options
+    without a tls:// address, a certificate the scheduler rejects): nothing was run."""
+
+
+TLS_KEYS = ("distributed.comm.tls.ca-file", "distributed.comm.tls.client.cert",
+            "distributed.comm.tls.client.key")
+
+
+def security(scheduler: str | None, tls_ca_file: str | None = None, tls_cert: str | None = None,
+             tls_key: str | None = None) -> Security | None:
+    """The Security of the connection to `scheduler`: the --tls-* options over Dask's configuration
+    (distributed.comm.tls.*), checked before connecting: a tls:// address needs a CA file and a
+    client certificate, from either source; every file must be readable and make an SSL context.
+    None for a plain address without TLS options (Dask's own defaults)."""
+    options = {"tls_ca_file": tls_ca_file, "tls_client_cert": tls_cert, "tls_client_key": tls_key}
+    given = [f"--{k.replace('tls_client_', 'tls-').replace('_', '-')}" for k, v in options.items() if v]
+    tls = bool(scheduler) and scheduler.startswith("tls://")
+    if given and not tls:
+        raise ConnectionSetupError(
+            f"{', '.join(given)} given, but {'--scheduler ' + scheduler if scheduler else 'no --scheduler'}"
+            " is not a tls:// address: the TLS options are for a scheduler started with "
+            "--protocol tls (the local cluster listens on 127.0.0.1 only and needs none)")
+    if not tls:
+        return None
+    sec = Security(require_encryption=True, **{k: v for k, v in options.items() if v})
+    if not sec.tls_ca_file or not sec.tls_client_cert:
+        raise ConnectionSetupError(
+            f"{scheduler} is a TLS address, but no certificates were given: pass --tls-ca-file (the CA "
+            "that signed the scheduler's certificate), --tls-cert (this client's certificate) and "
+            "--tls-key (its private key, unless the certificate file holds it), or set them in Dask's "
+            f"configuration ({', '.join(TLS_KEYS)}; in the environment "
+            "DASK_DISTRIBUTED__COMM__TLS__CA_FILE, DASK_DISTRIBUTED__COMM__TLS__CLIENT__CERT, "
+            "DASK_DISTRIBUTED__COMM__TLS__CLIENT__KEY). Nothing was run")
+    files = {"CA file": sec.tls_ca_file, "certificate": sec.tls_client_cert, "key": sec.tls_client_key}
+    for what, path in files.items():
+        if path and "\n" not in path:
+            try:
+                with open(path, "rb"):
+                    pass
+            except OSError as e:
+                raise ConnectionSetupError(f"cannot read the TLS {what} {path}: {e.strerror}. "
+                                           "Nothing was run") from None
+    try:
+        sec.get_connection_args("client")
+    except (ssl.SSLError, ValueError, OSError) as e:
+        raise ConnectionSetupError(
+            f"the TLS files do not make a client context ({e}): --tls-cert must be a PEM "
+            "certificate, --tls-key its PEM private key, --tls-ca-file PEM CA certificates "
+            f"(given or configured: {', '.join(f'{w} {p}' for w, p in files.items() if p)}). "
+            "Nothing was run") from None
+    return sec
+
+
+class _LogFileHandler(logging.Handler):
+    """Log records as lines of the folder's _log.jsonl."""
+
+    def __init__(self, store: Store):
+        super().__init__(logging.WARNING)
+        self.store = store
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            entry = {"log": record.name, "level": record.levelname, "message": record.getMessage()}
+            if record.exc_info:
+                entry["traceback"] = logging.Formatter().formatException(record.exc_info)
+            self.store.log(entry)
+        except Exception:
+            self.handleError(record)
+
+
+@contextlib.contextmanager
+def logs_to(store: Store) -> Iterator[None]:
+    """While inside: the warnings and errors of Dask, Tornado and asyncio in this process, and
+    Python warnings, go to the folder's _log.jsonl instead of the terminal."""
+    handler = _LogFileHandler(store)
+    names = {"distributed", "tornado", "asyncio", "bokeh", "py.warnings"}
+    names |= {n for n, lg in logging.root.manager.loggerDict.items()
+              if isinstance(lg, logging.Logger) and lg.handlers and n.split(".")[0] in names}
+    saved = {}
+    for n in names:
+        lg = logging.getLogger(n)
+        saved[n] = (lg.handlers[:], lg.propagate)
+        lg.handlers, lg.propagate = [handler], False
+    logging.captureWarnings(True)
+    try:
+        yield
+    finally:
+        logging.captureWarnings(False)
+        for n, (handlers, propagate) in saved.items():
+            lg = logging.getLogger(n)
+            lg.handlers, lg.propagate = handlers, propagate
+
+
+@contextlib.contextmanager
+def _sigint_ignored() -> Iterator[None]:
+    """SIGINT ignored while the local cluster starts its processes: they inherit it, so a Ctrl-C
+    reaches only this client, which closes them in order (no half-dead worker, no leaked
+    semaphore)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+
+
+def make_client(workers: int | None, scheduler: str | None, sec: Security | None = None,
+                dashboard: bool = False) -> Client:
+    """A client of the cluster at `scheduler`, or of a new LocalCluster on 127.0.0.1 of `workers`
+    processes (default: one per core) with one thread each, its dashboard on a free port of
+    127.0.0.1 if asked. Raises ClusterLost if the scheduler cannot be reached, ConnectionSetupError
+    if it refuses this client's certificate."""
     if scheduler:
-        return Client(scheduler, timeout="30s")
+        try:
+            return Client(scheduler, timeout="30s", security=sec)
+        except (OSError, CommClosedError, ssl.SSLError) as e:
+            text = _reasons(e)
+            # the handshake failed: an SSLError among the causes, or in the message of Dask's
+            # CommClosedError (which keeps only the text of tornado's SSLError), or a TLS connection
+            # that the scheduler closed at once (under TLS 1.3 the client may see only that)
+            if any(isinstance(c, ssl.SSLError) for c in _chain(e)) \
+                    or re.search(r"SSL\w*Error|\[SSL|<TLS \(closed\)", text):
+                raise ConnectionSetupError(
+                    f"the TLS connection to {scheduler} failed: {text}. Check that --tls-ca-file is "
+                    "the CA that signed the scheduler's certificate and that the scheduler trusts "
+                    "the CA of --tls-cert. Nothing was run") from None
+            raise ClusterLost(f"cannot reach the scheduler at {scheduler}: {text}") from None
     n = workers or os.cpu_count() or 1
     # No task waits on a busy worker: one that dies takes only its running chunk with it.
-    with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}):
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.ERROR)
+    with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}), _sigint_ignored():
+        # The scheduler's HTTP server (the dashboard, if asked) on a free port of 127.0.0.1, not on
+        # 8787, which another cluster of the machine may hold.
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
+                               dashboard_address="127.0.0.1:0" if dashboard else None,
+                               scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+                               silence_logs=logging.CRITICAL)
     return Client(cluster)
+
+
+def _chain(e: BaseException | None) -> Iterator[BaseException]:
+    """An exception and its causes (at most 8)."""
+    for _ in range(8):
+        if e is None:
+            return
+        yield e
+        e = e.__cause__ or e.__context__
+
+
+def _reasons(e: BaseException) -> str:
+    """The messages of an exception and its causes, in one line."""
+    out: list[str] = []
+    for c in _chain(e):
+        text = f"{type(c).__name__}: {c}" if str(c) else type(c).__name__
+        if text not in out:
+            out.append(text)
+    return "; ".join(out[:4])
+
+
+STDERR: Any = object()   # run()'s default stream: sys.stderr when called (pytest, say, replaces it)
+
+
+@dataclass
+class Summary:
+    total: int          # points of the sweep
+    skipped: int        # already in the folder when this run started
+    computed: int       # computed and written by this run
+    failed: int         # points of the folder whose row has an error (this run's and earlier)
+    seconds: float
+    repaired: int = 0   # duplicate rows of older runs dropped before computing
 
 
 def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, scheduler: str | None = None,
         restart: bool = False, chunk_size: int | None = None,
-        progress: TextIO | None = sys.stderr) -> Summary:
-    """Runs the sweep `spec` into the folder `out`, resuming what is there."""
+        progress: TextIO | None = STDERR, tls_ca_file: str | None = None,
+        tls_cert: str | None = None, tls_key: str | None = None, dashboard: bool = False,
+        messages: TextIO | None = STDERR) -> Summary:
+    """Runs the sweep `spec` into the folder `out`, resuming what is there. The progress bar goes
+    to `progress`, the lines about repairs, lost workers and the dashboard to `messages` (default:
+    sys.stderr at the time of the call; None: nowhere).
+
+    Before anything is written: the TLS options are checked (ConnectionSetupError) and the FMU is
+    instantiated here with the [start] values (SpecError with the FMU's message if it refuses them).
+    Then the folder is locked (StoreError if another client holds it) and duplicates of older runs
+    are repaired. Raises ClusterLost if the scheduler cannot be reached or is lost; the chunks
+    written stay, and the same call resumes."""
     t0 = time.monotonic()
-    store = Store.open(out, spec, restart=restart)
+    progress = sys.stderr if progress is STDERR else progress
+    messages = sys.stderr if messages is STDERR else messages
+    sec = security(scheduler, tls_ca_file, tls_cert, tls_key)
+    refusal = check_start(spec.fmu.read_bytes(), spec.job())
+    if refusal:
+        raise SpecError(f"the FMU refuses the [start] values: {refusal}")
+    # An external scheduler is reached (and its certificate checks passed) before the folder is made.
+    client = make_client(None, scheduler, sec) if scheduler else None
+    try:
+        store = Store.open(out, spec, restart=restart)
+    except BaseException:
+        if client is not None:
+            client.close()
+        raise
+    try:
+        with logs_to(store):
+            return _run_locked(spec, store, t0, client, workers, chunk_size, progress, messages,
+                               dashboard)
+    finally:
+        store.close()
+
+
+def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, workers: int | None,
+                chunk_size: int | None, progress: TextIO | None, messages: TextIO | None,
+                dashboard: bool) -> Summary:
+    """The run once the folder is locked: with the client of the external cluster, or None for a
+    LocalCluster of `workers` processes (started only when points are missing)."""
+    scheduler = client.scheduler.address if client is not None else None
+    say = messages.write if messages is not None else (lambda text: None)
+    repaired, rewritten, removed = store.repair()
+    if repaired:
+        say(f"dmi-sweep: {store.dir} held {repaired} extra copies of points from overlapping older runs: "
+            f"dropped them, one row per point kept ({rewritten} chunk files rewritten, {removed} "
+            "removed)\n")
     done = store.done()
     todo = [i for i in range(spec.n_points) if i not in done]
-    with open(store.dir / LOG, "a") as f:
-        f.write(json.dumps({"time": time.time(), "client": os.getpid(), "run": True,
-                            "done": len(done), "todo": len(todo)}) + "\n")
-    if progress is not None and done:
-        progress.write(f"dmi-sweep: {len(done)} of {spec.n_points} points already in {store.dir}, "
-                       f"computing the {len(todo)} missing\n")
+    failed_before = store.failed()
+    store.log({"run": True, "done": len(done), "todo": len(todo), "repaired": repaired})
+    if done:
+        say(f"dmi-sweep: {len(done)} of {spec.n_points} points already in {store.dir}, "
+            f"computing the {len(todo)} missing\n")
     if not todo:
-        return Summary(spec.n_points, len(done), 0, 0, time.monotonic() - t0)
+        if client is not None:
+            client.close()
+        return Summary(spec.n_points, len(done), 0, failed_before, time.monotonic() - t0, repaired)
 
-    client = make_client(workers, scheduler)
+    if client is None:
+        client = make_client(workers, None, None, dashboard)
     cluster = client.cluster
+    if dashboard:
+        # the local scheduler serves the dashboard's pages only if bokeh is installed here
+        if scheduler or importlib.util.find_spec("bokeh") is not None:
+            say(f"dmi-sweep: the Dask dashboard is at {client.dashboard_link}\n")
+        else:
+            say("dmi-sweep: no dashboard: Dask's dashboard needs bokeh (pip install bokeh)\n")
+    plugin = FMUPlugin(spec.fmu.read_bytes(), spec.sha256)
+    bar = Progress(spec.n_points, len(done), progress)
+    registered = False
+    computed = failed = 0
+    pending: dict[str, list[int]] = {}           # key of a task -> its points
     try:
-        n_workers = len(client.scheduler_info().get("workers", {})) or (workers or 1)
-        plugin = FMUPlugin(spec.fmu.read_bytes(), spec.sha256)
-        client.register_plugin(plugin)
+        try:
+            n_workers = len(client.scheduler_info(n_workers=-1).get("workers", {})) or (workers or 1)
+            # removed at the end unless it was there before (registered by the caller, say)
+            registered = not client.run_on_scheduler(has_worker_plugin, name=plugin.name)
+            client.register_plugin(plugin)
+            removals: list[dict[str, Any]] = []     # remove-worker events, from the client's thread
+
+            def on_event(event):   # in the client's thread, when the scheduler sends the event
+                msg = event[1]
+                if isinstance(msg, dict) and msg.get("action") == "remove-worker":
+                    keys = set(msg.get("processing-tasks", ())) | set(msg.get("lost-computed-tasks", ()))
+                    again = [pending.get(k) for k in keys]
+                    removals.append({**msg, "again": sorted(c for c in again if c)})
+
+            client.subscribe_topic("all", on_event)
+        except (OSError, CommClosedError, CancelledError) as e:
+            raise ClusterLost(f"the connection to the scheduler broke: {_reasons(e)}") from None
         job = spec.job()
-        bar = Progress(spec.n_points, len(done), progress)
 
         def submit(points: list[int]):
             payload = task(run_chunk, plugin.name, job, [(i, spec.point(i)) for i in points])
@@ -147,36 +404,64 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
             pending[fut.key] = points
             return fut
 
-        pending: dict[str, list[int]] = {}
+        def report_removals():
+            while removals:
+                ev = removals.pop(0)
+                store.log({"worker_lost": ev.get("worker"), "expected": ev.get("expected"),
+                           "chunks_again": ev["again"]})
+                if not ev.get("expected"):
+                    firsts = ", ".join(str(c[0]) for c in ev["again"])
+                    bar.note(messages, f"dmi-sweep: lost worker {ev.get('worker')}; "
+                             + (f"{len(ev['again'])} chunks (first points {firsts}) run again on the "
+                                "other workers" if ev["again"] else "no chunk of this sweep was on it"))
+
         lost: dict[int, int] = {}    # point -> times its single-point task was lost with a worker
-        stream = as_completed([submit(c) for c in chunks(todo, n_workers, chunk_size)])
-        computed = failed = 0
         written: set[int] = set()
-        for fut in stream:
-            points = pending.pop(fut.key)
-            try:
-                results = fut.result()
-            except KilledWorker as e:
-                # The chunk's workers died (the FMU crashed them?), or it was on a worker that
-                # another chunk killed. Each point alone, twice, finds the culprit.
-                if len(points) > 1 or lost.get(points[0], 0) < 1:
-                    for i in points:
-                        lost[i] = lost.get(i, -1) + 1
-                        stream.add(submit([i]))
+        try:
+            stream = as_completed([submit(c) for c in chunks(todo, n_workers, chunk_size)])
+            for fut in stream:
+                report_removals()
+                points = pending.pop(fut.key)
+                try:
+                    results = fut.result()
+                except KilledWorker as e:
+                    # The chunk's workers died (the FMU crashed them?), or it was on a worker that
+                    # another chunk killed. Each point alone, twice, finds the culprit.
+                    if len(points) > 1 or lost.get(points[0], 0) < 1:
+                        for i in points:
+                            lost[i] = lost.get(i, -1) + 1
+                            stream.add(submit([i]))
+                        continue
+                    results = [{"point": points[0], "error": f"{type(e).__name__}: {e}"}]
+                except (OSError, CommClosedError, CancelledError) as e:   # the scheduler is gone
+                    store.log({"lost": _reasons(e)})
+                    raise ClusterLost("lost the connection to the scheduler"
+                                      + (f" at {scheduler}" if scheduler else "")) from None
+                results = [r for r in results if r["point"] not in written]
+                fut.release()
+                if not results:
                     continue
-                results = [{"point": points[0], "error": f"{type(e).__name__}: {e}"}]
-            results = [r for r in results if r["point"] not in written]
-            fut.release()
-            if not results:
-                continue
-            written.update(r["point"] for r in results)
-            store.write(results)
-            computed += len(results)
-            failed += sum(1 for r in results if r.get("error"))
-            bar.update(len(results))
-        bar.close()
+                written.update(r["point"] for r in results)
+                store.write(results)
+                computed += len(results)
+                failed += sum(1 for r in results if r.get("error"))
+                bar.update(len(results))
+            report_removals()
+        finally:
+            bar.close()
+    except ClusterLost as e:
+        e.saved, e.total = len(done) + computed, spec.n_points
+        raise
     finally:
-        client.close()
+        if client.status == "running":
+            with contextlib.suppress(Exception):
+                client.unsubscribe_topic("all")
+            if scheduler and registered:
+                with contextlib.suppress(Exception):
+                    client.unregister_worker_plugin(plugin.name)
+        with contextlib.suppress(Exception):
+            client.close(timeout=5 if client.status == "running" else 1)
         if not scheduler and cluster is not None:
             cluster.close()
-    return Summary(spec.n_points, len(done), computed, failed, time.monotonic() - t0)
+    return Summary(spec.n_points, len(done), computed, failed_before + failed,
+                   time.monotonic() - t0, repaired)

@@ -77,6 +77,8 @@ class Runner:
         self.messages: list[str] = []
         self.plans: dict[tuple, tuple] = {}  # key: (plan, in window, read) per point
         self.instantiations = 0
+        self.lock = threading.Lock()         # held while a point runs
+        self.closing = False                 # the plugin is being removed: free after this point
 
     def _logger2(self, env, instance, status, category, message):
         self._log(status, message)
@@ -121,6 +123,16 @@ class Runner:
     def run(self, job: dict, values: dict) -> dict:
         """Simulates one point: the job's start values updated by `values`. Returns the statistics
         (and Poincare samples), or {"error": message} if the FMU failed."""
+        with self.lock:
+            if self.closing:
+                return {"error": "the worker plugin was removed while the point waited"}
+            try:
+                return self._run(job, values)
+            finally:
+                if self.closing:      # close() came while this point ran: free the instance now
+                    self.discard()
+
+    def _run(self, job: dict, values: dict) -> dict:
         self.messages.clear()
         try:
             if self.fmu is None:
@@ -228,8 +240,38 @@ class Runner:
             raise ValueError(f"{name} has no value")
         return v.start
 
+    def check_start(self, job: dict) -> str | None:
+        """Instantiates the FMU and sets the job's [start] values (in the modes fmpy sets them),
+        without running: None if the FMU takes them, else its reason with its logged messages."""
+        self.messages.clear()
+        try:
+            self._fresh()
+            fmu, t0, stop = self.fmu, job["start_time"], job["stop_time"]
+            if self.fmi3:
+                rest = apply_start_values(fmu, self.md, job["start"], settable=settable_in_instantiated)
+                fmu.enterInitializationMode(startTime=t0, stopTime=stop)
+            else:
+                fmu.setupExperiment(startTime=t0, stopTime=stop)
+                rest = apply_start_values(fmu, self.md, job["start"], settable=settable_in_instantiated)
+                fmu.enterInitializationMode()
+            rest = apply_start_values(fmu, self.md, rest, settable=settable_in_initialization_mode)
+            if rest:
+                return "cannot set " + ", ".join(rest)
+            return None
+        except Exception as e:
+            reason = "; ".join(self.messages)
+            return f"{type(e).__name__}: {e}" + (f" (FMU log: {reason})" if reason else "")
+        finally:
+            self.discard()
+
     def close(self) -> None:
-        self.discard()
+        """Frees the instance now, or, if a point is running in another thread, when it ends."""
+        self.closing = True
+        if self.lock.acquire(blocking=False):
+            try:
+                self.discard()
+            finally:
+                self.lock.release()
 
 
 def unpack(fmu_bytes: bytes, directory: str) -> str:
@@ -268,6 +310,19 @@ class FMUPlugin(WorkerPlugin):
         for r in self.runners:
             r.close()
         shutil.rmtree(self.unzipdir, ignore_errors=True)
+
+
+def has_worker_plugin(dask_scheduler: Any, name: str) -> bool:
+    """On the scheduler (Client.run_on_scheduler): whether a worker plugin of that name is
+    registered."""
+    return name in dask_scheduler.worker_plugins
+
+
+def check_start(fmu_bytes: bytes, job: dict) -> str | None:
+    """Runner.check_start on the FMU unpacked into a temporary folder (removed after)."""
+    with tempfile.TemporaryDirectory(prefix="dmi-sweep-check-") as d:
+        runner = Runner(unpack(fmu_bytes, d))
+        return runner.check_start(job)
 
 
 def run_chunk(plugin_name: str, job: dict, points: list[tuple[int, dict]]) -> list[dict]:

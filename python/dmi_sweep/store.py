@@ -1,15 +1,19 @@
 # The result folder: a Parquet dataset of chunk files part-<first point>.parquet
 # (each written to a hidden temporary file, then renamed), the spec (_spec.toml),
-# the metadata (_meta.json) and a log of the runs and chunks written (_log.jsonl:
-# points, worker pids, FMU instantiations so far on the worker).
-# Readers (pandas.read_parquet, pyarrow) skip names starting with "_" or ".".
+# the metadata (_meta.json), a log of the runs and chunks written (_log.jsonl:
+# points, worker pids, FMU instantiations so far on the worker; lost workers,
+# repairs, Dask's warnings and errors) and the lock file (_lock: the client that
+# holds the folder).  Readers (pandas.read_parquet, pyarrow) skip names starting
+# with "_" or ".".
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
+import fcntl
 import json
 import math
 import os
 import platform
+import socket
 import time
 from importlib import metadata
 from pathlib import Path
@@ -23,11 +27,50 @@ from .spec import Spec
 META = "_meta.json"
 SPEC = "_spec.toml"
 LOG = "_log.jsonl"
+LOCK = "_lock"
 TMP = ".tmp-"            # temporary files: .tmp-<pid of the writer>-<name>
 
 
 class StoreError(RuntimeError):
-    """The folder holds something else than this sweep (message says what to do)."""
+    """The folder holds something else than this sweep, or another client uses it (the message says
+    what to do)."""
+
+
+class FolderLock:
+    """The operating system's lock (flock) on the folder's _lock file, held by one client while it
+    runs: it dies with its holder, also with a SIGKILLed one. The file says who holds the lock (host,
+    pid, start time); the file itself stays, empty of meaning once unlocked."""
+
+    def __init__(self, directory: Path):
+        self.path = directory / LOCK
+        fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)   # not inherited by workers (PEP 446)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.read(fd, 4096).decode(errors="replace")
+            os.close(fd)
+            try:
+                h = json.loads(holder)
+                who = f"pid {h['pid']} on {h['host']}, started {h['started']}"
+            except (ValueError, KeyError, TypeError):
+                who = "a client that has not yet said who it is"
+            raise StoreError(f"{directory} is in use by another dmi-sweep client ({who}). One client "
+                             "per folder: wait for it to end, or stop it (its finished points stay) "
+                             "and run the same command again") from None
+        except OSError as e:
+            os.close(fd)
+            raise StoreError(f"cannot lock {self.path}: {e.strerror} (the filesystem must support "
+                             "flock; see the lock in the dmi-sweep documentation)") from None
+        self.fd = fd
+        me = {"host": socket.gethostname(), "pid": os.getpid(),
+              "started": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, json.dumps(me).encode(), 0)
+
+    def release(self) -> None:
+        if self.fd is not None:
+            os.close(self.fd)      # closing the only descriptor releases the lock
+            self.fd = None
 
 
 def _running(pid: int) -> bool:
@@ -72,16 +115,32 @@ class Store:
         self.dir = directory
         self.spec = spec
         self.schema = schema(spec)
+        self.lock: FolderLock | None = None
 
     @classmethod
     def open(cls, directory: str | os.PathLike, spec: Spec, restart: bool = False) -> "Store":
-        """Creates the folder, or reopens it to resume the same sweep. A folder of another sweep
-        (spec or FMU changed) is an error unless restart, which deletes its results."""
+        """Creates the folder, or reopens it to resume the same sweep, and locks it (close() unlocks).
+        A folder of another sweep (spec or FMU changed) is an error unless restart, which deletes its
+        results; so is a folder another client holds."""
         d = Path(directory)
         store = cls(d, spec)
         meta_path = d / META
         if d.exists() and not d.is_dir():
             raise StoreError(f"{d} exists and is not a folder")
+        if d.exists() and not meta_path.exists() and not (d / LOCK).exists() and any(d.iterdir()):
+            raise StoreError(f"{d} is not empty and holds no dmi-sweep results ({META} missing); "
+                             "give an empty or new folder")
+        d.mkdir(parents=True, exist_ok=True)
+        store.lock = FolderLock(d)
+        try:
+            store._open_locked(restart)
+        except BaseException:
+            store.close()
+            raise
+        return store
+
+    def _open_locked(self, restart: bool) -> None:
+        d, spec, meta_path = self.dir, self.spec, self.dir / META
         identity = spec.identity()
         if meta_path.exists():
             meta = json.loads(meta_path.read_text())
@@ -93,21 +152,67 @@ class Store:
                 raise StoreError(f"{d} holds another sweep: {what}. Use another --out, or --restart "
                                  "to delete its results and start again")
             if restart:
-                store._clear()
-        elif d.exists() and any(p for p in d.iterdir()):
-            raise StoreError(f"{d} is not empty and holds no dmi-sweep results ({META} missing); "
-                             "give an empty or new folder")
-        d.mkdir(parents=True, exist_ok=True)
+                self._clear()
         if not meta_path.exists():
-            store._write_atomic(SPEC, lambda f: f.write(spec.text))
+            self._write_atomic(SPEC, lambda f: f.write(spec.text))
+            variables = {v.name: v for v in spec.model.modelVariables}
             meta = {"identity": identity, "fmu": str(spec.fmu), "fmu_sha256": spec.sha256,
                     "fmi_version": spec.model.fmiVersion, "model_name": spec.model.modelName,
                     "points": spec.n_points, "params": spec.params, "outputs": spec.outputs,
+                    "output_types": {y: variables[y].type for y in spec.outputs},
                     "mode": spec.mode, "versions": _versions(),
                     "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
-            store._write_atomic(META, lambda f: f.write(json.dumps(meta, indent=1).encode()))
-        store._remove_stale_temporaries()
-        return store
+            self._write_atomic(META, lambda f: f.write(json.dumps(meta, indent=1).encode()))
+        self._remove_stale_temporaries()
+
+    def close(self) -> None:
+        """Unlocks the folder."""
+        if self.lock is not None:
+            self.lock.release()
+            self.lock = None
+
+    def log(self, entry: dict[str, Any]) -> None:
+        """Appends one line to _log.jsonl: the entry with the time and the client's pid."""
+        with open(self.dir / LOG, "a") as f:
+            f.write(json.dumps({"time": time.time(), "client": os.getpid(), **entry}, default=str) + "\n")
+
+    def repair(self) -> tuple[int, int, int]:
+        """Drops the extra copies of points that several chunk files hold (overlapping chunks of
+        older runs, before the lock existed): keeps one row per point, a successful one if there is
+        one, else the one in the first file. A file that loses rows is rewritten under its own name
+        (write then rename: it holds either all its old rows or the kept ones), a file that keeps
+        none is removed; the kept copy of a point is never touched, so a crash at any moment loses
+        no point. Returns (rows dropped, files rewritten, files removed)."""
+        parts = self.parts()
+        keep: dict[int, tuple[int, int, bool]] = {}   # point -> (file, row, succeeded)
+        tables = []
+        for f, p in enumerate(parts):
+            t = pq.read_table(p, columns=["point", "error"])
+            tables.append(t)
+            for row, (point, error) in enumerate(zip(t.column("point").to_pylist(),
+                                                     t.column("error").to_pylist())):
+                old = keep.get(point)
+                if old is None or (error is None and not old[2]):
+                    keep[point] = (f, row, error is None)
+        kept_rows: dict[int, list[int]] = {}
+        for f, row, _ in keep.values():
+            kept_rows.setdefault(f, []).append(row)
+        dropped = rewritten = removed = 0
+        for f, (p, t) in enumerate(zip(parts, tables)):
+            rows = sorted(kept_rows.get(f, []))
+            if len(rows) == t.num_rows:
+                continue
+            dropped += t.num_rows - len(rows)
+            if rows:
+                table = pq.read_table(p).take(rows)
+                self._write_atomic(p.name, lambda out: pq.write_table(table, out))
+                rewritten += 1
+            else:
+                p.unlink()
+                removed += 1
+        if dropped:
+            self.log({"repair": {"dropped": dropped, "rewritten": rewritten, "removed": removed}})
+        return dropped, rewritten, removed
 
     def _clear(self):
         for p in self.dir.iterdir():
@@ -148,6 +253,14 @@ class Store:
             done.update(pq.read_table(p, columns=["point"]).column("point").to_pylist())
         return done
 
+    def failed(self) -> int:
+        """The rows of the dataset whose point failed (error not null)."""
+        n = 0
+        for p in self.parts():
+            error = pq.read_table(p, columns=["error"]).column("error")
+            n += len(error) - error.null_count
+        return n
+
     def write(self, results: list[dict[str, Any]]) -> Path:
         """Writes one chunk of results (each with its "point") as part-<first point>.parquet:
         to a temporary file, then renamed, so a reader never sees half a chunk."""
@@ -164,11 +277,12 @@ class Store:
                     cols[f.name].append(r.get(f.name, math.nan))
         table = pa.Table.from_pydict(cols, schema=self.schema)
         name = f"part-{results[0]['point']:09d}.parquet"
+        k = 1
+        while (self.dir / name).exists():      # never replace a chunk (a repaired file keeps its name)
+            name = f"part-{results[0]['point']:09d}-{k}.parquet"
+            k += 1
         self._write_atomic(name, lambda f: pq.write_table(table, f))
-        with open(self.dir / LOG, "a") as f:   # which points this run computed (pid of the worker)
-            f.write(json.dumps({"time": time.time(), "client": os.getpid(), "file": name,
-                                "points": [r["point"] for r in results],
-                                "workers": sorted({r.get("pid") for r in results if r.get("pid")}),
-                                "instantiations": max(r.get("instantiations", 0) for r in results)})
-                    + "\n")
+        self.log({"file": name, "points": [r["point"] for r in results],   # the worker's pid
+                  "workers": sorted({r.get("pid") for r in results if r.get("pid")}),
+                  "instantiations": max(r.get("instantiations", 0) for r in results)})
         return self.dir / name

@@ -159,29 +159,41 @@ class Cluster:
 def cluster(processes, tmp_path_factory) -> Cluster:
     """`dask scheduler` on a free port of 127.0.0.1 and two `dask worker` processes (no nanny, one
     thread each) started in their own temporary folder, without this package on their path."""
-    from distributed import Client
-
     dask = str(Path(sys.executable).parent / "dask")
     sdir = tmp_path_factory.mktemp("scheduler")
     wdir = tmp_path_factory.mktemp("workers")
     address = f"tcp://127.0.0.1:{free_port()}"
     quiet = dict(stdout=subprocess.DEVNULL, stderr=processes.log(sdir / "cluster.log"))
+    # --dashboard-address on 127.0.0.1: with --no-dashboard, Dask's HTTP server listens on 0.0.0.0
     sched = processes.start([dask, "scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
-                             "--no-dashboard"], cwd=sdir, **quiet)
+                             "--dashboard-address", "127.0.0.1:0"], cwd=sdir, **quiet)
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
     workers = [processes.start([dask, "worker", address, "--nthreads", "1", "--nworkers", "1",
-                                "--no-nanny", "--no-dashboard", "--host", "127.0.0.1",
+                                "--no-nanny", "--dashboard-address", "127.0.0.1:0", "--host", "127.0.0.1",
                                 "--local-directory", str(wdir)], cwd=wdir, env=env, **quiet)
                for _ in range(2)]
+    wait_for_cluster(address, sched, 2)
+    return Cluster(address, sched, workers, wdir)
+
+
+def wait_for_cluster(address: str, scheduler: subprocess.Popen, n_workers: int, security=None) -> None:
+    """Until the scheduler at `address` has n_workers workers (60 s at most)."""
+    from distributed import Client
     deadline = time.monotonic() + 60
     while True:
-        assert sched.poll() is None, "the dask scheduler exited"
+        assert scheduler.poll() is None, "the dask scheduler exited"
         try:
-            with Client(address, timeout=5) as c:
-                c.wait_for_workers(2, timeout=max(1, deadline - time.monotonic()))
-            break
+            with Client(address, timeout=5, security=security) as c:
+                c.wait_for_workers(n_workers, timeout=max(1, deadline - time.monotonic()))
+            return
         except OSError:
             if time.monotonic() > deadline:
                 raise
             time.sleep(0.5)
-    return Cluster(address, sched, workers, wdir)
+
+
+def listening(pid: int) -> list[tuple[str, int]]:
+    """The (address, port) pairs the process pid listens on (TCP)."""
+    import psutil
+    return sorted((c.laddr.ip, c.laddr.port) for c in psutil.Process(pid).net_connections(kind="inet")
+                  if c.status == psutil.CONN_LISTEN)

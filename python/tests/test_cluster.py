@@ -32,6 +32,13 @@ g_amp = {{ start = 0.5, stop = 2.5, num = {num} }}
 """
 
 
+def worker_address(cluster, pid: int) -> str:
+    from distributed import Client
+    with Client(cluster.address, timeout=10) as c:
+        pids = c.run(os.getpid)
+    return next(a for a, p in pids.items() if p == pid)
+
+
 def wait_for_parts(out: Path, n: int, proc: subprocess.Popen, timeout: float = 120):
     deadline = time.monotonic() + timeout
     while len(list(out.glob("part-*.parquet"))) < n:
@@ -64,8 +71,16 @@ def test_scheduler_and_workers_elsewhere(cluster, tmp_path, fmu_path):
     assert len(chunks) == 6
     assert {p for e in chunks for p in e["workers"]} == {w.pid for w in cluster.workers}  # both worked
     assert {e["instantiations"] for e in chunks} == {1}        # one FMU instance per worker
-    unpacked = list(cluster.worker_dir.rglob("dmi-sweep-fmu-*/modelDescription.xml"))
-    assert len(unpacked) == 2                                   # unpacked once per worker, in its folder
+    # the worker plugin is removed at the end: gone from the scheduler and the workers, and its
+    # teardown removed the FMU unpacked in each worker's folder
+    from distributed import Client
+    with Client(cluster.address, timeout=10) as c:
+        on_workers = c.run(lambda dask_worker: sorted(dask_worker.plugins))
+        on_scheduler = c.run_on_scheduler(lambda dask_scheduler: sorted(dask_scheduler.worker_plugins))
+    assert len(on_workers) == 2
+    assert not [n for names in on_workers.values() for n in names if n.startswith("dmi-sweep")], on_workers
+    assert not [n for n in on_scheduler if n.startswith("dmi-sweep")], on_scheduler
+    assert not list(cluster.worker_dir.rglob("dmi-sweep-fmu-*")), "the unpacked FMU is left"
 
 
 def test_worker_killed_mid_sweep(cluster, tmp_path, fmu_path, processes):
@@ -78,6 +93,7 @@ def test_worker_killed_mid_sweep(cluster, tmp_path, fmu_path, processes):
                              text=True)
     wait_for_parts(out, 4, client)
     victim = cluster.workers[0]
+    address = worker_address(cluster, victim.pid)
     os.kill(victim.pid, signal.SIGKILL)
     victim.wait(timeout=10)
     assert len(list(out.glob("part-*.parquet"))) < total       # killed mid-sweep
@@ -85,8 +101,22 @@ def test_worker_killed_mid_sweep(cluster, tmp_path, fmu_path, processes):
     assert client.returncode == 0, stderr
     check_complete(out, total)
     survivor = cluster.workers[1].pid
-    after = [e for e in log_entries(out) if "points" in e and e["workers"] == [survivor]]
+    entries = log_entries(out)
+    after = [e for e in entries if "points" in e and e["workers"] == [survivor]]
     assert after, "the surviving worker computed nothing"
+    # one line on stderr and one log entry name the lost worker and the chunks it was running,
+    # which the survivor then computed
+    lines = [x for x in stderr.splitlines() if "lost worker" in x]
+    assert len(lines) == 1 and lines[0].startswith(f"dmi-sweep: lost worker {address}; "), stderr
+    lost = [e for e in entries if "worker_lost" in e]
+    assert [e["worker_lost"] for e in lost] == [address]
+    again = lost[0]["chunks_again"]
+    assert again, "the killed worker was running no chunk"
+    assert f"{len(again)} chunks (first points {', '.join(str(c[0]) for c in again)}) run again" in lines[0]
+    i = entries.index(lost[0])
+    rerun = {p for e in entries[i:] if "points" in e and e["workers"] == [survivor] for p in e["points"]}
+    assert {p for c in again for p in c} <= rerun
+    assert "Traceback" not in stderr
 
 
 def test_client_killed_then_rerun(cluster, tmp_path, fmu_path, processes):
@@ -137,3 +167,64 @@ def test_timed_out_sweep_leaves_no_process(tmp_path, fmu_path):
     while group_members(p.pid) and time.monotonic() < deadline:   # SIGKILL is delivered at once,
         time.sleep(0.05)                                           # the exit takes a moment
     assert group_members(p.pid) == []
+
+
+def test_scheduler_killed_mid_sweep(cluster, tmp_path, fmu_path, processes):
+    """The scheduler SIGKILLed by its pid mid-sweep: exit 3, a short message (points saved, the
+    same command resumes), no traceback, Dask's log lines in _log.jsonl and not on the terminal; a
+    rerun on a local cluster computes exactly the missing points."""
+    total = 40
+    spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=total))
+    out = tmp_path / "out"
+    client = processes.start(sweep_cmd("run", spec, "--out", out, "--scheduler", cluster.address,
+                                       "--chunk-size", "1"),
+                             env=env_with_package(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True)
+    wait_for_parts(out, 3, client)
+    os.kill(cluster.scheduler.pid, signal.SIGKILL)
+    cluster.scheduler.wait(timeout=10)
+    stdout, stderr = client.communicate(timeout=120)
+    assert client.returncode == 3, stdout + stderr
+    done = set(pd.read_parquet(out)["point"])
+    assert 3 <= len(done) < total
+    text = stdout + stderr
+    assert "Traceback" not in text and " - ERROR - " not in text and "distributed." not in text, text
+    assert f"lost the connection to the scheduler at {cluster.address}" in stderr
+    assert f"{len(done)} of {total} points are saved in {out}; the same command resumes" in stderr
+    messages = [x for x in stderr.splitlines() if not x.startswith("[")]
+    assert len(messages) == 2, stderr                      # the reason, and what is saved
+    entries = log_entries(out)
+    assert [e for e in entries if "lost" in e], "no log entry of the loss"
+    # Dask's ERROR lines (the client failing to reconnect) are in the log, not on the terminal
+    assert [e for e in entries if e.get("level") == "ERROR" and e["log"].startswith("distributed.")], entries
+    n_before = len(entries)
+    r = run_sweep("run", spec, "--out", out, "--workers", "2", "--quiet")
+    assert r.returncode == 0, r.stderr
+    computed = [p for e in log_entries(out)[n_before:] if "points" in e for p in e["points"]]
+    assert sorted(computed) == sorted(set(range(total)) - done)
+    check_complete(out, total)
+
+
+def test_ctrl_c(tmp_path, fmu_path):
+    """SIGINT to the whole process group, as Ctrl-C in a terminal sends it: exit 130, one message,
+    no traceback and no leaked-semaphore warning; the rerun completes the sweep."""
+    total = 40
+    spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=total))
+    out = tmp_path / "out"
+    p = start_sweep("run", spec, "--out", out, "--workers", "2", "--chunk-size", "1")
+    try:
+        wait_for_parts(out, 2, p)
+        os.killpg(p.pid, signal.SIGINT)
+        stdout, stderr = p.communicate(timeout=60)
+        # what the workers print while they stop comes after the client's exit: wait for them
+        deadline = time.monotonic() + 20
+        while group_members(p.pid) and time.monotonic() < deadline:
+            time.sleep(0.1)
+    finally:
+        kill_group(p.pid)
+    assert p.returncode == 130, stdout + stderr
+    assert "interrupted; the finished chunks are in" in stderr
+    assert "Traceback" not in stderr and "leaked semaphore" not in stderr and "KeyboardInterrupt" not in stderr, stderr
+    r = run_sweep("run", spec, "--out", out, "--workers", "2", "--quiet")
+    assert r.returncode == 0, r.stderr
+    check_complete(out, total)

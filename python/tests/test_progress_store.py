@@ -67,6 +67,26 @@ def test_progress_on_a_terminal_and_long_times():
                               "\n")
 
 
+def test_progress_last_line_once():
+    """close() after an update that showed the final count prints no second line."""
+    clock, out = Clock(), io.StringIO()
+    bar = Progress(10, 0, out, width=10, clock=clock)
+    clock.now += 1.0
+    bar.update(10)
+    clock.now += 1.0
+    bar.close()
+    assert out.getvalue() == "[##########] 10/10 points, 10.00/s, 00:00:00 left\n"
+    tty = Terminal()
+    bar = Progress(10, 0, tty, width=10, clock=clock)
+    clock.now += 1.0
+    bar.update(10)
+    bar.note(tty, "dmi-sweep: lost worker tcp://x")
+    bar.close()
+    assert tty.getvalue() == ("\r[##########] 10/10 points, 10.00/s, 00:00:00 left"
+                              "\r\033[Kdmi-sweep: lost worker tcp://x\n"
+                              "\r[##########] 10/10 points, 10.00/s, 00:00:00 left\n")
+
+
 def test_progress_quiet():
     bar = Progress(10, 0, None, clock=Clock())
     bar.update(10)
@@ -91,7 +111,8 @@ def test_write_then_rename(tmp_path, fmu_path):
     out = tmp_path / "out"
     store = Store.open(out, spec)
     part = store.write([{"point": 1, "w_final": 0.5, "w_min": 0.0, "w_max": 1.0, "w_mean": 0.25}])
-    assert sorted(p.name for p in out.iterdir()) == ["_log.jsonl", "_meta.json", "_spec.toml", part.name]
+    assert sorted(p.name for p in out.iterdir()) == ["_lock", "_log.jsonl", "_meta.json", "_spec.toml",
+                                                     part.name]
     half = part.read_bytes()[: part.stat().st_size // 2]
     dead = out / f".tmp-{_dead_pid()}-part-000000000.parquet"
     alive = out / f".tmp-{os.getpid()}-part-000000007.parquet"
@@ -99,6 +120,7 @@ def test_write_then_rename(tmp_path, fmu_path):
         p.write_bytes(half)
     df = pd.read_parquet(out)                       # the reader skips the temporary files
     assert list(df["point"]) == [1] and list(df["w_final"]) == [0.5] and list(df["g_amp"]) == [2.0]
+    store.close()
     assert Store.open(out, spec).done() == {1}
     assert not dead.exists() and alive.exists()
 
@@ -120,3 +142,29 @@ def test_failed_write_leaves_no_temporary_file(tmp_path, fmu_path):
     with pytest.raises(OSError, match="No space left"):
         store._write_atomic("_meta.json", half_then_full)
     assert sorted((p.name, p.read_bytes()) for p in (tmp_path / "out").iterdir()) == before
+
+
+def test_lock_held_until_close(tmp_path, fmu_path):
+    """While a Store is open, opening the folder again (another open file, as another client's) is
+    refused naming the holder; after close() it opens; an unrelated non-empty folder is refused
+    without a lock file being left in it."""
+    import json
+    import socket
+    from dmi_sweep.spec import load
+    from dmi_sweep.store import Store, StoreError
+    spec = load(write_spec(tmp_path, f'fmu = "{fmu_path}"\nstop_time = 1.0\noutput_interval = 0.1\n'
+                                     'transient = 0.5\noutputs = ["w"]\n[grid]\ng_amp = [1.0]\n'))
+    first = Store.open(tmp_path / "out", spec)
+    holder = json.loads((tmp_path / "out" / "_lock").read_text())
+    assert holder["pid"] == os.getpid() and holder["host"] == socket.gethostname()
+    with pytest.raises(StoreError, match=f"in use by another dmi-sweep client \\(pid {os.getpid()} on "
+                       f"{socket.gethostname()}, started {holder['started']}\\)"):
+        Store.open(tmp_path / "out", spec)
+    first.close()
+    Store.open(tmp_path / "out", spec).close()
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "notes.txt").write_text("mine")
+    with pytest.raises(StoreError, match="holds no dmi-sweep results"):
+        Store.open(other, spec)
+    assert [p.name for p in other.iterdir()] == ["notes.txt"]

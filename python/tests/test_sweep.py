@@ -53,7 +53,9 @@ def two_workers(tmp_path_factory, fmu_path):
     d = tmp_path_factory.mktemp("two")
     spec = write_spec(d, SPEC.format(fmu=fmu_path))
     r = run_sweep("run", spec, "--out", d / "out", "--workers", "2", "--chunk-size", "1")
-    assert r.returncode == 0, r.stderr
+    # alpha = -0.5 fails at 3 of the 9 points: exit status 1, the count printed
+    assert r.returncode == 1 and "3 of 9 points failed" in r.stderr, r.stderr
+    assert "9 points in" in r.stdout and "3 failed" in r.stdout, r.stdout
     assert not list((d / "out").glob(".*")), "temporary files left"
     return d, pd.read_parquet(d / "out").sort_values("point").reset_index(drop=True)
 
@@ -121,7 +123,7 @@ def test_independent_of_workers(two_workers, tmp_path):
     """One worker and default chunks give the same table, bit for bit."""
     d, df2 = two_workers
     r = run_sweep("run", d / "spec.toml", "--out", tmp_path / "one", "--workers", "1")
-    assert r.returncode == 0, r.stderr
+    assert r.returncode == 1, r.stderr
     df1 = pd.read_parquet(tmp_path / "one").sort_values("point").reset_index(drop=True)
     pd.testing.assert_frame_equal(df1, df2, check_exact=True)
 
@@ -135,7 +137,9 @@ def test_metadata_and_resume_nothing_to_do(two_workers, fmu_path):
     assert meta["versions"]["fmpy"] and meta["versions"]["distributed"]
     assert (d / "out" / "_spec.toml").read_text() == (d / "spec.toml").read_text()
     r = run_sweep("run", d / "spec.toml", "--out", d / "out")
-    assert r.returncode == 0 and "9 already there, 0 computed" in r.stdout, r.stdout + r.stderr
+    # the failed points of the first run still count: exit 1 until the folder holds 9 good points
+    assert r.returncode == 1 and "9 already there, 0 computed" in r.stdout, r.stdout + r.stderr
+    assert "3 of 9 points failed" in r.stderr, r.stderr
     assert log_entries(d / "out")[-1] == {**log_entries(d / "out")[-1], "run": True, "todo": 0}
 
 
@@ -154,15 +158,68 @@ def test_changed_spec_refused_unless_restart(tmp_path, fmu_path):
 
 
 def test_plots(two_workers, tmp_path, capsys):
+    """A sweep of g_amp and alpha: --x g_amp alone is refused naming alpha; --hue alpha draws one
+    set per value of alpha, with the Poincare samples of the table; the labels are words with the
+    symbol; the heatmap's colour bar is the stick fraction."""
     from dmi_sweep.cli import main
-    d, _ = two_workers
-    for args in (["--x", "g_amp"], ["--x", "g_amp", "--y", "alpha", "--metric", "sticking_mean"]):
-        png = tmp_path / "p.png"
-        assert main(["plot", str(d / "out"), *args, "-o", str(png)]) == 0
-        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-        png.unlink()
-    assert main(["plot", str(d / "out"), "--x", "nope", "-o", str(tmp_path / "p.png")]) == 2
+    from dmi_sweep.plot import plot
+    d, df = two_workers
+    png = tmp_path / "p.png"
+    assert main(["plot", str(d / "out"), "--x", "g_amp", "-o", str(png)]) == 2
+    err = capsys.readouterr().err
+    assert "the sweep varies alpha besides g_amp" in err and "--hue" in err, err
+    assert not png.exists()
+
+    fig = plot(d / "out", "g_amp", None, None, png, hue="alpha")
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "forcing amplitude g_amp"
+    assert ax.get_ylabel() == "displacement w on the Poincaré section"
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["alpha = 0.3", "alpha = 1"]
+    assert ax.get_legend().get_title().get_text() == "friction coefficient alpha"
+    ok = df[df["error"].isna()]
+    for line, alpha in zip(ax.get_lines(), (0.3, 1.0)):
+        rows = ok[ok["alpha"] == alpha]
+        want = sorted((g, y) for g, ys in zip(rows["g_amp"], rows["w_poincare"]) for y in ys)
+        assert sorted(zip(line.get_xdata(), line.get_ydata())) == want
+
+    fig = plot(d / "out", "g_amp", "alpha", "sticking_mean", png)
+    assert (fig.axes[0].get_xlabel(), fig.axes[0].get_ylabel()) == ("forcing amplitude g_amp",
+                                                                     "friction coefficient alpha")
+    assert fig.axes[1].get_ylabel() == "stick fraction"          # the colour bar
+    fig = plot(d / "out", "alpha", None, "w_max", png, hue="g_amp")
+    assert fig.axes[0].get_ylabel() == "maximum of displacement w"
+    assert len(fig.axes[0].get_lines()) == 3
+
+    assert main(["plot", str(d / "out"), "--x", "nope", "-o", str(png)]) == 2
     assert "'nope' is not a column" in capsys.readouterr().err
+
+
+def test_plot_refuses_naming_the_other_parameters(tmp_path, capsys):
+    """Three swept parameters (a folder made here): --x a is refused, naming b and c; --x a --hue b
+    too, naming c; a parameter that holds one value is not in the way."""
+    import json
+    from dmi_sweep.cli import main
+    rows = [(a, b, c) for a in (1.0, 2.0) for b in (0.1, 0.2) for c in (5.0, 6.0)]
+    table = pd.DataFrame({"a": [r[0] for r in rows], "b": [r[1] for r in rows], "c": [r[2] for r in rows],
+                          "k": 3.0, "point": range(8), "w_mean": np.arange(8.0), "error": None})
+    out = tmp_path / "out"
+    out.mkdir()
+    table.to_parquet(out / "part-000000000.parquet")
+    (out / "_meta.json").write_text(json.dumps({"params": ["a", "b", "c", "k"], "model_name": "X"}))
+    png = str(tmp_path / "p.png")
+    assert main(["plot", str(out), "--x", "a", "--metric", "w_mean", "-o", png]) == 2
+    assert "the sweep varies b, c besides a" in capsys.readouterr().err
+    assert main(["plot", str(out), "--x", "a", "--hue", "b", "--metric", "w_mean", "-o", png]) == 2
+    assert "the sweep varies c besides a" in capsys.readouterr().err
+    assert main(["plot", str(out), "--x", "a", "--y", "b", "--hue", "c",
+                 "-o", png]) == 2
+    assert "not both" in capsys.readouterr().err
+    table[table["c"] == 5.0].to_parquet(out / "part-000000000.parquet")
+    assert main(["plot", str(out), "--x", "a", "--hue", "b", "--metric", "w_mean", "-o", png]) == 0
+    from dmi_sweep.plot import plot
+    ax = plot(out, "a", None, "w_mean", png, hue="b").axes[0]
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("a", "mean of w")   # another FMU: names only
 
 
 GOOD = """
@@ -289,3 +346,200 @@ def test_latin_hypercube_sweep(tmp_path, fmu_path):
     for _, row in df.iterrows():
         res = plain(fmu_path, {"N": 400, "tau": 0.5, "g_amp": row["g_amp"], "alpha": row["alpha"]}, 3.0, 0.01)
         assert_stats_equal(row, res, 1.5)
+
+
+def test_start_value_refused_before_anything_runs(tmp_path, fmu_path):
+    """N = 0 in [start]: the FMU refuses it when set; exit 2 with the FMU's message, no cluster
+    started, no folder made."""
+    spec = write_spec(tmp_path, SPEC.format(fmu=fmu_path).replace("N = 400", "N = 0"))
+    r = run_sweep("run", spec, "--out", tmp_path / "out", "--workers", "1")
+    assert r.returncode == 2, r.stderr
+    assert "the FMU refuses the [start] values" in r.stderr
+    assert "N = 0: the number of steps per tau must be >= 1" in r.stderr, r.stderr
+    assert "Traceback" not in r.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_help_texts():
+    """run --help gives every exit status and says what --restart deletes; the TLS options."""
+    import subprocess
+    import sys
+    from conftest import env_with_package
+    r = subprocess.run([sys.executable, "-m", "dmi_sweep", "run", "--help"], capture_output=True,
+                       text=True, env=env_with_package(), timeout=60)
+    assert r.returncode == 0
+    text = " ".join(r.stdout.split())
+    for status in ("0 every point of the sweep succeeded", "1 every point was computed, but some failed",
+                   "2 nothing was run", "3 the cluster was lost", "130 interrupted"):
+        assert status in text, status
+    assert "delete the folder's results, whatever spec they came from" in text
+    assert "an unchanged spec resumes" in text
+    for option in ("--tls-ca-file", "--tls-cert", "--tls-key", "--dashboard"):
+        assert option in text
+
+
+def test_quiet_by_default(two_workers):
+    """The fixture's run printed its progress and summary, nothing else (no Dask warning, no port
+    message): checked on a fresh run's output."""
+    d, _ = two_workers
+    import shutil
+    shutil.rmtree(d / "again", ignore_errors=True)
+    r = run_sweep("run", d / "spec.toml", "--out", d / "again", "--workers", "2")
+    lines = r.stderr.splitlines()
+    assert lines and all(x.startswith("[") or x.startswith("dmi-sweep: 3 of 9 points failed")
+                         for x in lines), r.stderr
+    assert lines[-2].startswith("[##############################] 9/9 points")
+    assert sum(1 for x in lines if " 9/9 points" in x) == 1            # the last line once
+
+
+def test_two_clients_one_folder(tmp_path, fmu_path):
+    """A second client on a folder in use is refused at once (exit 2) naming the first (host, pid,
+    start time); after the first, a rerun with another chunk size computes nothing: every point
+    once."""
+    import socket
+    import time
+    from conftest import finish_group, start_sweep
+    spec = write_spec(tmp_path, SPEC.format(fmu=fmu_path).replace("num = 3", "num = 6")
+                      .replace("[-0.5, 0.3, 1.0]", "[0.3, 1.0, 2.0]"))
+    out = tmp_path / "out"
+    first = start_sweep("run", spec, "--out", out, "--workers", "1", "--chunk-size", "7")
+    try:
+        deadline = time.monotonic() + 60
+        while str(first.pid) not in ((out / "_lock").read_text() if (out / "_lock").exists() else ""):
+            assert first.poll() is None and time.monotonic() < deadline, "the first client never locked"
+            time.sleep(0.02)
+        t = time.monotonic()
+        second = run_sweep("run", spec, "--out", out, "--workers", "1", "--chunk-size", "10")
+        assert first.poll() is None, "the first client ended before the second was refused"
+        assert second.returncode == 2, second.stderr
+        assert f"pid {first.pid} on {socket.gethostname()}, started 20" in second.stderr, second.stderr
+        assert "in use by another dmi-sweep client" in second.stderr
+        assert time.monotonic() - t < 30
+    finally:
+        r = finish_group(first)
+    assert r.returncode == 0, r.stderr
+    r = run_sweep("run", spec, "--out", out, "--workers", "1", "--chunk-size", "10")
+    assert r.returncode == 0 and "18 already there, 0 computed" in r.stdout, r.stdout + r.stderr
+    assert sorted(pd.read_parquet(out)["point"]) == list(range(18))
+
+
+def test_sigkilled_client_leaves_the_folder_unlocked(tmp_path, fmu_path):
+    """The lock dies with its holder: the client alone is SIGKILLed (its LocalCluster's workers
+    still run), and the next client takes the folder and completes exactly the missing points."""
+    import os
+    import signal
+    import time
+    from conftest import finish_group, kill_group, start_sweep
+    spec = write_spec(tmp_path, SPEC.format(fmu=fmu_path).replace("num = 3", "num = 10")
+                      .replace("[-0.5, 0.3, 1.0]", "[0.3, 1.0]").replace("N = 400", "N = 2000"))
+    out = tmp_path / "out"
+    first = start_sweep("run", spec, "--out", out, "--workers", "1", "--chunk-size", "1")
+    try:
+        deadline = time.monotonic() + 120
+        while len(list(out.glob("part-*.parquet"))) < 2:
+            assert first.poll() is None and time.monotonic() < deadline, "no progress"
+            time.sleep(0.05)
+        os.kill(first.pid, signal.SIGKILL)
+        first.wait(timeout=10)
+        done = set(pd.read_parquet(out)["point"])
+        assert len(done) < 20
+        r = run_sweep("run", spec, "--out", out, "--workers", "1", "--quiet")
+    finally:
+        kill_group(first.pid)          # the workers the killed client left
+        finish_group(first)
+    assert r.returncode == 0, r.stderr
+    assert f"{len(done)} already there, {20 - len(done)} computed" in r.stdout, r.stdout
+    assert sorted(pd.read_parquet(out)["point"]) == list(range(20))
+
+
+def _small_folder(tmp_path, fmu_path):
+    """A finished sweep of 4 points, one chunk file each, and its table."""
+    spec = write_spec(tmp_path, SPEC.format(fmu=fmu_path).replace("num = 3", "num = 2")
+                      .replace("[-0.5, 0.3, 1.0]", "[0.3, 1.0]"))
+    out = tmp_path / "out"
+    r = run_sweep("run", spec, "--out", out, "--workers", "1", "--chunk-size", "1")
+    assert r.returncode == 0, r.stderr
+    return spec, out, pd.read_parquet(out).sort_values("point").reset_index(drop=True)
+
+
+def _craft_overlaps(out, table):
+    """Chunk files as two older clients (without the lock) would have left them: points 1-2 again,
+    point 0 twice in one file, and a failed copy of point 3 in a file read before its good one."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+    schema = pq.read_schema(out / "part-000000000.parquet")
+    pq.write_table(pa.Table.from_pandas(table.iloc[[1, 2]], schema=schema, preserve_index=False),
+                   out / "part-000000001-old.parquet")
+    pq.write_table(pa.Table.from_pandas(table.iloc[[0, 0]], schema=schema, preserve_index=False),
+                   out / "part-000000000-twice.parquet")
+    bad = table.iloc[[3]].copy()
+    bad["error"] = "KilledWorker: crafted"
+    bad["w_final"] = float("nan")
+    pq.write_table(pa.Table.from_pandas(bad, schema=schema, preserve_index=False),
+                   out / "part-000000000-error.parquet")
+    assert len(pd.read_parquet(out)) == 9
+
+
+def test_overlapping_chunks_repaired(tmp_path, fmu_path):
+    """The next run drops the 5 extra rows (saying so), keeps one row per point, the successful
+    one of point 3, and computes nothing: the table equals the one before the crafting."""
+    spec, out, table = _small_folder(tmp_path, fmu_path)
+    _craft_overlaps(out, table)
+    r = run_sweep("run", spec, "--out", out, "--workers", "1")
+    assert r.returncode == 0, r.stderr
+    assert "held 5 extra copies of points" in r.stderr, r.stderr
+    assert "4 already there, 0 computed" in r.stdout
+    after = pd.read_parquet(out).sort_values("point").reset_index(drop=True)
+    pd.testing.assert_frame_equal(after, table, check_exact=True)
+    assert [e["repair"] for e in log_entries(out) if "repair" in e] == [
+        {"dropped": 5, "rewritten": 1, "removed": 4}]
+
+
+def test_repair_interrupted_loses_no_point(tmp_path, fmu_path, monkeypatch):
+    """A repair that fails at its first rewrite (disk full) leaves every point in the folder; the
+    next repair completes it."""
+    from dmi_sweep.spec import load
+    from dmi_sweep.store import Store
+    spec, out, table = _small_folder(tmp_path, fmu_path)
+    _craft_overlaps(out, table)
+    store = Store.open(out, load(spec))
+    real = store._write_atomic
+
+    def full(name, write):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(store, "_write_atomic", full)
+    with pytest.raises(OSError):
+        store.repair()
+    assert set(pd.read_parquet(out)["point"]) == {0, 1, 2, 3}
+    monkeypatch.setattr(store, "_write_atomic", real)
+    assert store.repair()[0] > 0
+    store.close()
+    after = pd.read_parquet(out).sort_values("point").reset_index(drop=True)
+    pd.testing.assert_frame_equal(after, table, check_exact=True)
+
+
+def test_plugin_removed_while_a_point_runs(fmu_path, tmp_path):
+    """Runner.close() (the worker plugin's teardown, when the plugin is removed or the worker stops)
+    while a point runs in another thread: the point ends with its values (the instance is not freed
+    under it: that crashed the worker), the instance is freed right after, a later point is refused."""
+    import threading
+    import time
+    from dmi_sweep.simulate import Runner, unpack
+    job = {"start_time": 0.0, "stop_time": 10.0, "output_interval": 0.01, "transient": 5.0,
+           "start": {"N": 4000}, "outputs": OUTPUTS, "poincare": None}
+    runner = Runner(unpack(open(fmu_path, "rb").read(), str(tmp_path)))
+    want = Runner(runner.unzipdir).run(job, {"g_amp": 1.5})
+    out = {}
+    t = threading.Thread(target=lambda: out.update(runner.run(job, {"g_amp": 1.5})))
+    t.start()
+    deadline = time.monotonic() + 30
+    while not runner.lock.locked() or runner.fmu is None:
+        assert time.monotonic() < deadline
+        time.sleep(0.001)
+    runner.close()
+    assert runner.fmu is not None            # still in use
+    t.join(timeout=60)
+    assert out == want
+    assert runner.fmu is None                # freed when the point ended
+    assert "plugin was removed" in runner.run(job, {"g_amp": 1.0})["error"]
