@@ -7,9 +7,10 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
 # Debian packages (dpkg name) that the build and tests use.
 # libtsan2: gcc's ThreadSanitizer runtime (the threads stage of test.sh).
+# openssl: the certificates of the TLS sweep test (python/tests/test_tls.py).
 debs=(build-essential cmake ninja-build pkg-config libgsl-dev libcunit1-dev gfortran
       abigail-tools clang libclang-rt-14-dev valgrind python3 python3-venv python3-pip libtsan2
-      gcc-mingw-w64-x86-64 wine64)
+      gcc-mingw-w64-x86-64 wine64 openssl)
 missing=()
 for d in "${debs[@]}"; do
   dpkg-query -W -f='${Status}' "$d" 2>/dev/null | grep -q "install ok installed" || missing+=("$d")
