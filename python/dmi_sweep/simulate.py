@@ -174,9 +174,13 @@ class Runner:
         if cached is None:
             events: list[float] = []    # the Poincare section's times
             if period is not None:
-                k = 0
+                # t = k period for the integers k with t in [transient, stop]: the same phase of a
+                # forcing of that period at every sample and for every period swept
+                k = math.ceil(transient / period)
+                if isclose((k - 1) * period, transient):
+                    k -= 1
                 while True:
-                    t = transient + k * period
+                    t = k * period
                     if t > stop and not isclose(t, stop):
                         break
                     events.append(t)
@@ -186,11 +190,12 @@ class Runner:
             window = [in_window(t, transient) for t, _, _ in plan]
             read = [recorded and (w or i == len(plan) - 1)
                     for i, ((_, recorded, _), w) in enumerate(zip(plan, window))]
-            cached = plan, window, read
+            at_start = bool(events) and isclose(events[0], t0)   # a sample before the first step
+            cached = plan, window, read, at_start
             if len(self.plans) > 64:
                 self.plans.clear()
             self.plans[key] = cached
-        plan, window, read = cached
+        plan, window, read, at_start = cached
         names, getters = self._getters(job["outputs"])
 
         def sample():
@@ -204,7 +209,7 @@ class Runner:
         last = sample() if not plan else None
         if in_window(t0, transient):
             rows.append(sample())
-        if period is not None and isclose(t0, transient):   # the section's first time is t0
+        if at_start:
             poincare.append(sample())
         time = t0
         step = fmu.doStep
