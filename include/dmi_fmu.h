@@ -1,0 +1,181 @@
+/*
+ * dmi_fmu.h: a dmi model as an FMI 2.0 and 3.0 co-simulation FMU.
+ *
+ * A model provides only what is its own: its variables (one table), a
+ * function that configures a dmi_solver from the parameter values, a
+ * function that computes the outputs at a communication point, and
+ * optionally checks.  It defines them in one object, DMI_FMU_MODEL, in its
+ * C file(s); the CMake function dmi_add_fmu() of find_package(dmi) compiles
+ * them with the FMU framework and libdmi's GSL-free core into <name>.fmu
+ * (FMI 2.0) and fmi3/<name>.fmu (FMI 3.0), both model descriptions written
+ * from the table (docs/fmu-export.md).
+ *
+ * The framework owns everything else, for every model: the FMI 2.0 and 3.0
+ * functions and their calling sequence; the time grid t_p = t_start + p h
+ * (h = tau / N) from an integer step counter; a doStep takes every step whose
+ * start t_p is before the end of the communication step; the outputs are
+ * computed at any communication point from the piecewise-linear interpolant
+ * of the scheme; inputs are held per step (step p uses the values set at or
+ * before t_p); FMU states are checked bytes holding the variables and the
+ * whole history; errors and warnings go to the importer's logger (never
+ * printed, never aborting), with the memory the solver needs.
+ *
+ * Units: the model's own (the table's unit column); time in the units of the
+ * FMU's time, tau in the same units.  Memory: the framework allocates
+ * everything (through the C library); a model's functions allocate nothing
+ * that outlives their call, and never keep the pointers they are given
+ * beyond the lifetime the comments below state.
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#ifndef DMI_FMU_H
+#define DMI_FMU_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "dmi.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The size of the message buffers (err, msg) the framework passes to a
+ * model's functions, with the NUL: longer messages are cut (use snprintf). */
+#define DMI_FMU_ERRLEN 256
+
+/*
+ * One variable of the table, in the order of the value references 0, 1, ...
+ * Write the table as an X-macro list and expand it with DMI_FMU_VARIABLE:
+ *
+ *   #define MY_VARIABLES(X)                                                 \
+ *       X(tau, Float64, parameter, 10.0, "s", "delay of the convolution")    \
+ *       X(N, Int32, parameter, 1000, "", "steps per tau")                   \
+ *       X(x, Float64, output, , "m", "position")
+ *   enum { MY_VARIABLES(DMI_FMU_VR) MY_NVARS };          (VR_tau, VR_N, VR_x)
+ *   static const dmi_fmu_variable VARIABLES[] = {MY_VARIABLES(DMI_FMU_VARIABLE)};
+ *
+ * Columns: name (a C identifier, unique), type (Float64, Int32, Boolean),
+ * causality (parameter: set before ExitInitializationMode, fixed after;
+ * input: set at any time, held per step; output: computed, no start value;
+ * independent: the time, Float64, no start value, at most one; when the
+ * table has none, the framework adds "time" after the last variable),
+ * start value (a C constant; empty for outputs and the independent
+ * variable; Boolean: 0 or 1), unit ("" for none) and description.
+ * The model descriptions' generator (run by dmi_add_fmu at build time) checks
+ * the table: a duplicate name, an output with a start value, a parameter or
+ * input without one, an unknown type or causality fail the build with a
+ * message naming the variable.
+ */
+typedef struct {
+    const char *name;
+    const char *type;        /* "Float64", "Int32" or "Boolean" */
+    const char *causality;   /* "parameter", "input", "output" or "independent" */
+    const char *start_text;  /* the start value as written, "" for none */
+    double start;            /* its value (Int32 and Boolean: exact) */
+    const char *unit;        /* "" for none */
+    const char *description;
+} dmi_fmu_variable;
+
+/* One table entry from an X-macro row (see dmi_fmu_variable).  An empty
+ * start gives start_text "" (the value is then unused). */
+#define DMI_FMU_VARIABLE(name, type, causality, start, unit, description)                        \
+    {#name, #type, #causality, #start, (start - 0.0), unit, description},
+
+/* The value reference VR_<name> of an X-macro row, for an enum. */
+#define DMI_FMU_VR(name, ...) VR_##name,
+
+/*
+ * The values of an instance's variables that are set (parameters, inputs),
+ * owned by the framework.  value[vr] holds variable vr (Int32 and Boolean as
+ * exact doubles; outputs: unspecified).  A model's functions get a const
+ * pointer that stays valid, with the same address, as long as the solver
+ * they configure (so the solver's callbacks may keep it as their user data
+ * and read the inputs at each step); they never write through it.
+ */
+typedef struct {
+    double t_start; /* the experiment's start time: the solver's time t is t_start + t */
+    double value[]; /* by value reference */
+} dmi_fmu_values;
+
+/*
+ * The outputs' arguments at a communication point t (the FMU's time), in
+ * step p (from t_{p-1} to t_p, t_{p-1} < t <= t_p; p = 0 before the first
+ * step).  Arrays of n values (the model's n), owned by the framework, valid
+ * during the call.
+ */
+typedef struct {
+    double t;          /* the communication point */
+    double h;          /* the step tau / N */
+    uint64_t p;        /* the step containing t */
+    size_t n;          /* the solver's dimension */
+    const double *u;   /* u_h(t), the scheme's piecewise-linear interpolant; NULL before
+                          ExitInitializationMode (no solver: outputs from the parameters) */
+    const double *U;   /* U^p */
+    const double *W;   /* W of step p, the delay term (zeros when p = 0) */
+    const double *X;   /* X of step p, the resolvent's argument: U^p = J(X) (U^0 when p = 0) */
+} dmi_fmu_point;
+
+/*
+ * Configures the new solver s, created by the framework with dmi_create(s,
+ * model n, tau, N) from the parameters: sets rhs, the maximal monotone part
+ * (dmi_set_friction, dmi_set_box or dmi_set_resolvent), the kernel
+ * (dmi_set_kernel_exp or dmi_set_kernel) and the history, with v as user
+ * data if the callbacks need the variables.  The framework calls dmi_init
+ * after it.  Returns 0, or nonzero with the reason in err (DMI_FMU_ERRLEN
+ * bytes; when err is left empty, dmi_last_error(s) is used; DMI_ENOMEM gives
+ * the framework's out-of-memory message with N and the bytes).  The FMU then
+ * logs "configuring the solver: <err>" and returns Error.
+ */
+typedef int dmi_fmu_configure_fn(const dmi_fmu_values *v, dmi_solver *s, char *err);
+
+/* Writes the outputs at pt into out[vr] for every output vr (Int32 and
+ * Boolean outputs as exact doubles); the other entries are not read. */
+typedef void dmi_fmu_outputs_fn(const dmi_fmu_values *v, const dmi_fmu_point *pt, double *out);
+
+/* Optional: accepts the value of parameter or input vr (before it is
+ * stored; v holds the values before the call): 0, or nonzero with the reason
+ * in err (the set call is refused, nothing changes).  The framework already
+ * refuses non-finite values, tau <= 0 and N < 1. */
+typedef int dmi_fmu_accept_fn(const dmi_fmu_values *v, unsigned vr, double value, char *err);
+
+/* Optional: run at ExitInitializationMode, before the solver is created,
+ * for an experiment of length T (stop - start time, or the default
+ * experiment's stop time).  0: fine; 1: a warning (msg, status Warning);
+ * -1: refused (msg, status Error). */
+typedef int dmi_fmu_check_fn(const dmi_fmu_values *v, double T, char *msg);
+
+/* Optional: the bytes the solver allocates while initialising (peak) and
+ * keeps (kept), for the memory messages.  Without it the framework uses an
+ * upper bound for a dense kernel. */
+typedef void dmi_fmu_bytes_fn(const dmi_fmu_values *v, double *peak, double *kept);
+
+/* A model: what dmi_add_fmu builds an FMU of. */
+typedef struct {
+    const char *description;              /* the model descriptions' description */
+    const dmi_fmu_variable *variables;    /* the table (value reference = index) */
+    size_t nvariables;
+    size_t n;                             /* components of u */
+    unsigned tau;                         /* value reference of the delay (Float64 parameter) */
+    unsigned N;                           /* value reference of the steps per tau (Int32 parameter) */
+    double stop_time;                     /* the default experiment (start 0) */
+    double step_size;                     /* its communication step */
+    dmi_fmu_configure_fn *configure;
+    dmi_fmu_outputs_fn *outputs;
+    dmi_fmu_accept_fn *accept;            /* NULL: none */
+    dmi_fmu_check_fn *check;              /* NULL: none */
+    dmi_fmu_bytes_fn *bytes;              /* NULL: the upper bound */
+} dmi_fmu_model;
+
+/* The model of the FMU: define it once, in one of its C files:
+ *   const dmi_fmu_model DMI_FMU_MODEL = {...}; */
+#define DMI_FMU_MODEL dmi_fmu_model_definition
+extern const dmi_fmu_model DMI_FMU_MODEL;
+
+/* The number of entries of a table array. */
+#define DMI_FMU_COUNT(table) (sizeof(table) / sizeof((table)[0]))
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
