@@ -8,8 +8,8 @@
  * The FMU has no event mode, never returns early and provides no
  * intermediate update (its model description says so): fmi3DoStep always
  * reports eventHandlingNeeded = terminateSimulation = earlyReturn = false.
- * Its variables are Float64 (parameters, the input g_in, outputs), Int32 (N)
- * and Boolean (sticking), all scalars; the functions of the other types, of
+ * Its variables are Float64, Int32 and Boolean scalars (the model's table,
+ * dmi_fmu.h); the functions of the other types, of
  * clocks, of model exchange and scheduled execution are exported as the
  * standard asks and refuse with fmi3Error and a logged reason.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -19,9 +19,9 @@
 #include "fmi3Functions.h"
 #include "instance.h"
 
-#define ENTER(c, which, fn)                                                                       \
-    fmu_instance *in = fmu_enter(c, which, fn);                                                   \
-    if (!in)                                                                                      \
+#define ENTER(c, which, fn)                                                                        \
+    fmu_instance *in = fmu_enter(c, which, fn);                                                    \
+    if (!in)                                                                                       \
     return fmi3Error
 
 static void sink(fmu_callback logger, void *environment, const char *name, fmu_status status,
@@ -61,10 +61,10 @@ fmi3Instance fmi3InstantiateCoSimulation(
     (void)resourcePath, (void)visible, (void)earlyReturnAllowed;
     (void)requiredIntermediateVariables, (void)intermediateUpdate;
     if (instanceName && *instanceName) { /* (an empty name: refused by fmu_instantiate) */
-        if (!instantiationToken || strcmp(instantiationToken, DMI_FMU_GUID) != 0) {
+        if (!instantiationToken || strcmp(instantiationToken, dmi_fmu_guid) != 0) {
             fmu_log_error(fn, instanceName, sink, logger, instanceEnvironment,
                           "instantiation token \"%s\" is not the FMU's GUID %s",
-                          instantiationToken ? instantiationToken : "(null)", DMI_FMU_GUID);
+                          instantiationToken ? instantiationToken : "(null)", dmi_fmu_guid);
             return NULL;
         }
         if (eventModeUsed || nRequiredIntermediateVariables > 0) {
@@ -150,37 +150,34 @@ fmi3Status fmi3Reset(fmi3Instance instance)
 
 /* ---- getting and setting values ---- */
 
-static int get_float64(const model *m, unsigned vr, void *values, size_t i, char *err)
+static void put_float64(void *values, size_t i, double x)
 {
-    return model_get_real(m, vr, (fmi3Float64 *)values + i, err);
+    ((fmi3Float64 *)values)[i] = x;
 }
 
-static int get_int32(const model *m, unsigned vr, void *values, size_t i, char *err)
+static void put_int32(void *values, size_t i, double x)
 {
-    int v = 0;
-    if (model_get_integer(m, vr, &v, err) != 0)
-        return -1;
-    ((fmi3Int32 *)values)[i] = v;
-    return 0;
+    ((fmi3Int32 *)values)[i] = (fmi3Int32)x;
 }
 
-static int get_boolean(const model *m, unsigned vr, void *values, size_t i, char *err)
+static void put_boolean(void *values, size_t i, double x)
 {
-    int b = 0;
-    if (model_get_boolean(m, vr, &b, err) != 0)
-        return -1;
-    ((fmi3Boolean *)values)[i] = b != 0;
-    return 0;
+    ((fmi3Boolean *)values)[i] = x != 0;
 }
 
-static int set_float64(model *m, unsigned vr, const void *values, size_t i, char *err)
+static double take_float64(const void *values, size_t i)
 {
-    return model_set_real(m, vr, ((const fmi3Float64 *)values)[i], err);
+    return ((const fmi3Float64 *)values)[i];
 }
 
-static int set_int32(model *m, unsigned vr, const void *values, size_t i, char *err)
+static double take_int32(const void *values, size_t i)
 {
-    return model_set_integer(m, vr, ((const fmi3Int32 *)values)[i], err);
+    return ((const fmi3Int32 *)values)[i];
+}
+
+static double take_boolean(const void *values, size_t i)
+{
+    return ((const fmi3Boolean *)values)[i] != 0;
 }
 
 /* All variables are scalars: one value per value reference. */
@@ -194,40 +191,41 @@ static int bad_count(fmu_instance *in, const char *fn, size_t nvr, size_t nValue
     return 0;
 }
 
-#define GET(Type, getter)                                                                         \
-    fmi3Status fmi3Get##Type(fmi3Instance instance, const fmi3ValueReference valueReferences[],   \
-                             size_t nValueReferences, fmi3##Type values[], size_t nValues)        \
-    {                                                                                             \
-        ENTER(instance, FN_GET, "fmi3Get" #Type);                                                 \
-        if (bad_count(in, "fmi3Get" #Type, nValueReferences, nValues))                            \
-            return fmi3Error;                                                                     \
-        return (fmi3Status)fmu_get(in, "fmi3Get" #Type, valueReferences, nValueReferences,        \
-                                   values, getter);                                               \
+#define GET(Type, kind, put)                                                                       \
+    fmi3Status fmi3Get##Type(fmi3Instance instance, const fmi3ValueReference valueReferences[],    \
+                             size_t nValueReferences, fmi3##Type values[], size_t nValues)         \
+    {                                                                                              \
+        ENTER(instance, FN_GET, "fmi3Get" #Type);                                                  \
+        if (bad_count(in, "fmi3Get" #Type, nValueReferences, nValues))                             \
+            return fmi3Error;                                                                      \
+        return (fmi3Status)fmu_get(in, "fmi3Get" #Type, valueReferences, nValueReferences,         \
+                                   values, kind, put);                                             \
     }
-#define SET(Type, setter)                                                                         \
-    fmi3Status fmi3Set##Type(fmi3Instance instance, const fmi3ValueReference valueReferences[],   \
-                             size_t nValueReferences, const fmi3##Type values[], size_t nValues)  \
-    {                                                                                             \
-        ENTER(instance, FN_SET, "fmi3Set" #Type);                                                 \
-        if (bad_count(in, "fmi3Set" #Type, nValueReferences, nValues))                            \
-            return fmi3Error;                                                                     \
-        return (fmi3Status)fmu_set(in, "fmi3Set" #Type, valueReferences, nValueReferences,        \
-                                   values, setter);                                               \
+#define SET(Type, kind, take)                                                                      \
+    fmi3Status fmi3Set##Type(fmi3Instance instance, const fmi3ValueReference valueReferences[],    \
+                             size_t nValueReferences, const fmi3##Type values[], size_t nValues)   \
+    {                                                                                              \
+        ENTER(instance, FN_SET, "fmi3Set" #Type);                                                  \
+        if (bad_count(in, "fmi3Set" #Type, nValueReferences, nValues))                             \
+            return fmi3Error;                                                                      \
+        return (fmi3Status)fmu_set(in, "fmi3Set" #Type, valueReferences, nValueReferences,         \
+                                   values, kind, take);                                            \
     }
-GET(Float64, get_float64)
-GET(Int32, get_int32)
-GET(Boolean, get_boolean)
-SET(Float64, set_float64)
-SET(Int32, set_int32)
+GET(Float64, FMU_FLOAT64, put_float64)
+GET(Int32, FMU_INT32, put_int32)
+GET(Boolean, FMU_BOOLEAN, put_boolean)
+SET(Float64, FMU_FLOAT64, take_float64)
+SET(Int32, FMU_INT32, take_int32)
+SET(Boolean, FMU_BOOLEAN, take_boolean)
 
-/* The types of which the FMU has no variable (Boolean: none settable). */
-#define NONE(Name, which, Type, what)                                                             \
-    fmi3Status fmi3##Name(fmi3Instance instance, const fmi3ValueReference valueReferences[],      \
-                          size_t nValueReferences, Type values[], size_t nValues)                 \
-    {                                                                                             \
-        (void)valueReferences, (void)values, (void)nValues;                                       \
-        ENTER(instance, which, "fmi3" #Name);                                                     \
-        return (fmi3Status)fmu_no_variables(in, "fmi3" #Name, nValueReferences, what);            \
+/* The types of which the FMU has no variable. */
+#define NONE(Name, which, Type, what)                                                              \
+    fmi3Status fmi3##Name(fmi3Instance instance, const fmi3ValueReference valueReferences[],       \
+                          size_t nValueReferences, Type values[], size_t nValues)                  \
+    {                                                                                              \
+        (void)valueReferences, (void)values, (void)nValues;                                        \
+        ENTER(instance, which, "fmi3" #Name);                                                      \
+        return (fmi3Status)fmu_no_variables(in, "fmi3" #Name, nValueReferences, what);             \
     }
 NONE(GetFloat32, FN_GET, fmi3Float32, "Float32 variables")
 NONE(GetInt8, FN_GET, fmi3Int8, "Int8 variables")
@@ -246,7 +244,6 @@ NONE(SetUInt16, FN_SET, const fmi3UInt16, "UInt16 variables")
 NONE(SetUInt32, FN_SET, const fmi3UInt32, "UInt32 variables")
 NONE(SetInt64, FN_SET, const fmi3Int64, "Int64 variables")
 NONE(SetUInt64, FN_SET, const fmi3UInt64, "UInt64 variables")
-NONE(SetBoolean, FN_SET, const fmi3Boolean, "settable Boolean variable")
 NONE(SetString, FN_SET, const fmi3String, "String variables")
 
 fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -383,15 +380,15 @@ fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference
     UNSUPPORTED("fmi3GetVariableDependencies", "dependencies are in the model description only");
 }
 
-#define DERIVATIVE(Name)                                                                          \
-    fmi3Status fmi3##Name(fmi3Instance instance, const fmi3ValueReference unknowns[],             \
-                          size_t nUnknowns, const fmi3ValueReference knowns[], size_t nKnowns,    \
-                          const fmi3Float64 seed[], size_t nSeed, fmi3Float64 sensitivity[],      \
-                          size_t nSensitivity)                                                    \
-    {                                                                                             \
-        (void)unknowns, (void)nUnknowns, (void)knowns, (void)nKnowns, (void)seed, (void)nSeed;    \
-        (void)sensitivity, (void)nSensitivity;                                                    \
-        UNSUPPORTED("fmi3" #Name, "not provided by this FMU");                                    \
+#define DERIVATIVE(Name)                                                                           \
+    fmi3Status fmi3##Name(fmi3Instance instance, const fmi3ValueReference unknowns[],              \
+                          size_t nUnknowns, const fmi3ValueReference knowns[], size_t nKnowns,     \
+                          const fmi3Float64 seed[], size_t nSeed, fmi3Float64 sensitivity[],       \
+                          size_t nSensitivity)                                                     \
+    {                                                                                              \
+        (void)unknowns, (void)nUnknowns, (void)knowns, (void)nKnowns, (void)seed, (void)nSeed;     \
+        (void)sensitivity, (void)nSensitivity;                                                     \
+        UNSUPPORTED("fmi3" #Name, "not provided by this FMU");                                     \
     }
 DERIVATIVE(GetDirectionalDerivative)
 DERIVATIVE(GetAdjointDerivative)
@@ -519,11 +516,11 @@ fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time)
 }
 
 /* The model-exchange functions on arrays of continuous states or event indicators. */
-#define ME_ARRAY(Name, Type)                                                                      \
-    fmi3Status fmi3##Name(fmi3Instance instance, Type values[], size_t n)                         \
-    {                                                                                             \
-        (void)values, (void)n;                                                                    \
-        UNSUPPORTED("fmi3" #Name, NO_ME);                                                         \
+#define ME_ARRAY(Name, Type)                                                                       \
+    fmi3Status fmi3##Name(fmi3Instance instance, Type values[], size_t n)                          \
+    {                                                                                              \
+        (void)values, (void)n;                                                                     \
+        UNSUPPORTED("fmi3" #Name, NO_ME);                                                          \
     }
 ME_ARRAY(SetContinuousStates, const fmi3Float64)
 ME_ARRAY(GetContinuousStateDerivatives, fmi3Float64)

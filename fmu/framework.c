@@ -199,9 +199,13 @@ static int solver_create(const dmi_fmu_values *v, dmi_solver **out, char *err)
     if ((rc = MODEL->configure(v, *out, msg)) != 0) {
         if (rc == DMI_ENOMEM)
             memory_fail(err, "configuring the solver", v);
-        else
-            snprintf(err, FMU_ERRLEN, "configuring the solver: %s",
-                     msg[0] ? msg : dmi_last_error(*out));
+        else { /* the model's message after the prefix, cut to fit */
+            const char *why = msg[0] ? msg : dmi_last_error(*out);
+            size_t len = strlen(strcpy(err, "configuring the solver: "));
+            for (size_t i = 0; why[i] && len + 1 < FMU_ERRLEN; i++)
+                err[len++] = why[i];
+            err[len] = '\0';
+        }
         dmi_free(out);
         return -1;
     }

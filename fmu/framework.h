@@ -20,6 +20,14 @@
  * dmi_add_fmu into the generated fmu_identity.c. */
 extern const char dmi_fmu_guid[];
 
+/* The log categories of both model descriptions: C(name, description), in
+ * the order of instance.c's CAT_* numbers. */
+#define FMU_LOG_CATEGORIES(C)                                                                      \
+    C(logStatusError, "the reason of every error (always sent)")                                   \
+    C(logStatusWarning, "every warning, e.g. a coarse step (always sent)")                         \
+    C(logCalls, "each FMI call with its outcome, when debug logging is on")                        \
+    C(logMemory, "what initialization allocates when it is more than 100 MB (always sent)")
+
 /* Longest message written into the err buffers below. */
 #define FMU_ERRLEN DMI_FMU_ERRLEN
 
