@@ -106,6 +106,11 @@ function(_dmi_fmu_version name v target guid all_sources)
                         LIBRARY_OUTPUT_DIRECTORY ${linux} LINK_DEPENDS ${fw}/fmu.map)
   target_include_directories(${target} PRIVATE ${dir} ${fw}/fmi${v})
   target_compile_options(${target} PRIVATE ${DMI_FMU_COMPILE_OPTIONS})
+  if(CMAKE_C_COMPILER_ID MATCHES "GNU|Clang")
+    # Calls inside the library need not go through the PLT (only fmi2*/fmi3*
+    # are exported, fmu.map): libdmi's core is inlined as in libdmi.so.
+    target_compile_options(${target} PRIVATE -fno-semantic-interposition)
+  endif()
   target_link_libraries(${target} PRIVATE m)
   target_link_options(${target} PRIVATE -Wl,--version-script=${fw}/fmu.map)
   if(NOT DMI_SANITIZE AND NOT DMI_SANITIZE_THREAD)

@@ -76,24 +76,33 @@ static const char *type_name(unsigned type)
 
 int fmu_model_new(fmu_model *m)
 {
-    const size_t nvr = count_vr(), n = MODEL->n;
-    m->v = malloc(sizeof *m->v + (2 * nvr + 5 * n) * sizeof(double));
+    const unsigned nvr = count_vr();
+    const size_t n = MODEL->n;
+    m->v = malloc(sizeof *m->v + (2 * nvr + 5 * n) * sizeof(double) + nvr);
     if (!m->v)
         return -1;
     m->out = m->v->value + nvr;
     m->work = m->out + nvr;
+    m->kind = (unsigned char *)(m->work + 5 * n);
+    m->nvr = nvr;
+    for (unsigned vr = 0; vr < nvr; vr++)
+        m->kind[vr] = (unsigned char)fmu_kind(vr);
     m->solver = NULL;
     fmu_model_defaults(m);
     return 0;
 }
 
+unsigned fmu_model_kind(const fmu_model *m, unsigned vr)
+{
+    return vr < m->nvr ? m->kind[vr] : 0;
+}
+
 void fmu_model_defaults(fmu_model *m)
 {
-    const unsigned nvr = count_vr();
     dmi_free(&m->solver);
     m->v->t_start = 0.0;
-    for (unsigned vr = 0; vr < nvr; vr++)
-        m->v->value[vr] = fmu_is_set(fmu_kind(vr)) ? MODEL->variables[vr].start : 0.0;
+    for (unsigned vr = 0; vr < m->nvr; vr++)
+        m->v->value[vr] = fmu_is_set(m->kind[vr]) ? MODEL->variables[vr].start : 0.0;
     m->t_comm = 0.0;
     m->out_valid = 0;
 }
@@ -107,7 +116,7 @@ void fmu_model_free(fmu_model *m)
 
 int fmu_model_check(const fmu_model *m, unsigned vr, unsigned type, double value, char *err)
 {
-    const unsigned kind = fmu_kind(vr);
+    const unsigned kind = fmu_model_kind(m, vr);
     if (!(kind & type) || !fmu_is_set(kind))
         return fail(err, "value reference %u is not a settable %s variable", vr, type_name(type));
     const char *name = name_of(vr);
@@ -319,7 +328,7 @@ static void outputs(fmu_model *m)
 
 int fmu_model_get(fmu_model *m, unsigned vr, unsigned type, double *value, char *err)
 {
-    const unsigned kind = fmu_kind(vr);
+    const unsigned kind = fmu_model_kind(m, vr);
     if (!(kind & type & (FMU_FLOAT64 | FMU_INT32 | FMU_BOOLEAN)) ||
         ((type & FMU_NO_INDEPENDENT) && (kind & FMU_INDEPENDENT)))
         return fail(err, "value reference %u is not %s %s variable", vr,
@@ -389,7 +398,7 @@ void fmu_model_state_save(const fmu_model *m, uint32_t tag, unsigned char *buf)
     dmi_put_u64(buf, FMU_STATE_AT_NREAL, nreal);
     dmi_put_u64(buf, FMU_STATE_AT_NDMI, ndmi);
     for (unsigned vr = 0; vr < MODEL->nvariables; vr++) {
-        const unsigned kind = fmu_kind(vr);
+        const unsigned kind = m->kind[vr];
         if (!fmu_is_set(kind))
             continue;
         if (kind & FMU_FLOAT64) {
@@ -413,7 +422,7 @@ static int load_values(fmu_model *m, const unsigned char *buf, char *err)
     size_t at_i = FMU_STATE_AT_INT, at_r = at_real();
     for (int pass = 0; pass < 2; pass++) /* the Float64 values first, then the others */
         for (unsigned vr = 0; vr < MODEL->nvariables; vr++) {
-            const unsigned kind = fmu_kind(vr);
+            const unsigned kind = m->kind[vr];
             if (!fmu_is_set(kind) || ((kind & FMU_FLOAT64) != 0) != (pass == 0))
                 continue;
             double value;

@@ -56,8 +56,13 @@ typedef struct {
     dmi_solver *solver; /* NULL until fmu_model_start */
     double *out;        /* the outputs by value reference (with v's block) */
     double *work;       /* 5 n values: u, U, U^{p-1}, W, X (with v's block) */
+    unsigned char *kind; /* fmu_kind of every value reference (with v's block) */
+    unsigned nvr;       /* the number of value references */
     int out_valid;      /* out holds the outputs at t_comm */
 } fmu_model;
+
+/* fmu_kind(vr) from m's copy (no string compared). */
+unsigned fmu_model_kind(const fmu_model *m, unsigned vr);
 
 /* Allocates the values with their start values (no solver): 0, or -1 when
  * out of memory. */
