@@ -106,6 +106,9 @@ function(_dmi_fmu_version name v target guid all_sources)
                         LIBRARY_OUTPUT_DIRECTORY ${linux} LINK_DEPENDS ${fw}/fmu.map)
   target_include_directories(${target} PRIVATE ${dir} ${fw}/fmi${v})
   target_compile_options(${target} PRIVATE ${DMI_FMU_COMPILE_OPTIONS})
+  if(NOT CMAKE_BUILD_TYPE AND NOT CMAKE_CONFIGURATION_TYPES) # no build type: optimised anyway
+    target_compile_options(${target} PRIVATE -O2)
+  endif()
   if(CMAKE_C_COMPILER_ID MATCHES "GNU|Clang")
     # Calls inside the library need not go through the PLT (only fmi2*/fmi3*
     # are exported, fmu.map): libdmi's core is inlined as in libdmi.so.

@@ -46,7 +46,7 @@ static int check_table(unsigned nvr)
     int bad = 0, independent = 0;
     if (!MODEL->variables || MODEL->nvariables == 0 || !MODEL->configure || !MODEL->outputs ||
         MODEL->n == 0)
-        return refuse("the model has %s%sno variables, configure, outputs or n", "", "");
+        return refuse("the model needs variables, configure, outputs and n >= 1%s%s", "", "");
     for (unsigned vr = 0; vr < MODEL->nvariables; vr++) {
         const dmi_fmu_variable *x = var(vr);
         const unsigned kind = fmu_kind(vr);

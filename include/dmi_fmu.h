@@ -24,7 +24,12 @@
  * FMU's time, tau in the same units.  Memory: the framework allocates
  * everything (through the C library); a model's functions allocate nothing
  * that outlives their call, and never keep the pointers they are given
- * beyond the lifetime the comments below state.
+ * beyond the lifetime the comments below state.  Threads: the framework
+ * calls a model's functions for one instance at a time, but instances may
+ * run in different threads at once: a model keeps no global mutable state
+ * (everything it needs is in dmi_fmu_values).  Errors: a model's function
+ * reports with its return value and a message in the buffer it is given;
+ * it never prints, aborts or exits.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #ifndef DMI_FMU_H
@@ -129,7 +134,10 @@ typedef struct {
 typedef int dmi_fmu_configure_fn(const dmi_fmu_values *v, dmi_solver *s, char *err);
 
 /* Writes the outputs at pt into out[vr] for every output vr (Int32 and
- * Boolean outputs as exact doubles); the other entries are not read. */
+ * Boolean outputs as exact doubles); the other entries are not read.  Called
+ * at the first get of an output after a step, a set or a restored state
+ * (the values are kept until the next change); out has one entry per value
+ * reference and is owned by the framework. */
 typedef void dmi_fmu_outputs_fn(const dmi_fmu_values *v, const dmi_fmu_point *pt, double *out);
 
 /* Optional: accepts the value of parameter or input vr (before it is
@@ -145,11 +153,15 @@ typedef int dmi_fmu_accept_fn(const dmi_fmu_values *v, unsigned vr, double value
 typedef int dmi_fmu_check_fn(const dmi_fmu_values *v, double T, char *msg);
 
 /* Optional: the bytes the solver allocates while initialising (peak) and
- * keeps (kept), for the memory messages.  Without it the framework uses an
- * upper bound for a dense kernel. */
+ * keeps (kept), for the memory messages (logMemory when peak > 100 MB, and
+ * the out-of-memory error).  Without it the framework uses the figures of a
+ * dense kernel (every entry of H sampled): 2 (N + 1) n doubles of history
+ * and n^2 N samples kept, twice that while initialising. */
 typedef void dmi_fmu_bytes_fn(const dmi_fmu_values *v, double *peak, double *kept);
 
-/* A model: what dmi_add_fmu builds an FMU of. */
+/* A model: what dmi_add_fmu builds an FMU of.  The model descriptions'
+ * generator checks it at build time (a table as described above, tau a
+ * Float64 and N an Int32 parameter, n >= 1, configure and outputs given). */
 typedef struct {
     const char *description;              /* the model descriptions' description */
     const dmi_fmu_variable *variables;    /* the table (value reference = index) */
