@@ -201,6 +201,20 @@ const char dmi_fmu_guid[] = \"@arg_GUID@\";
   set(framework ${fw}/framework.c ${fw}/framework.h ${fw}/instance.c ${fw}/instance.h
       ${fw}/fmi2Functions.c ${fw}/fmi3Functions.c ${DMI_FMU_INCLUDE_DIR}/dmi_fmu.h)
   set(all ${model} ${framework} ${gen}/fmu_identity.c ${DMI_FMU_CORE_SOURCES})
+  # sources/ is one folder: a model file may not take a framework file's name.
+  set(taken "")
+  foreach(f IN LISTS framework DMI_FMU_CORE_SOURCES)
+    get_filename_component(file ${f} NAME)
+    list(APPEND taken ${file})
+  endforeach()
+  list(APPEND taken fmu_identity.c)
+  foreach(f IN LISTS model)
+    get_filename_component(file ${f} NAME)
+    if(file IN_LIST taken)
+      message(FATAL_ERROR "dmi_add_fmu(${name}): the model's file ${f} has the name of a file of "
+                          "the framework or libdmi (${taken}): rename it")
+    endif()
+  endforeach()
 
   # The model descriptions' writer, run at build time: the model with the
   # framework's model layer and the core (every .c but the FMI side).
