@@ -3,7 +3,8 @@
 # type or causality fail the build with a message naming the variable; a
 # configure function that fails makes ExitInitializationMode log its message
 # and return Error (the FMU goes on: Reset and a good run).  The control: the
-# same model without the bad row builds and runs.
+# same model without the bad row builds and runs.  A model file named like a
+# framework file is refused when configuring.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 import pytest
 from fmpy.fmi1 import FMICallException
@@ -117,3 +118,13 @@ def test_failing_configure_is_an_error(good, version, k, message):
     inst.fmu.doStep(0.0, 1.0)
     assert inst.get(["w"])[0] == pytest.approx(0.9 ** 10, rel=1e-14)
     inst.free()
+
+
+def test_model_file_named_like_the_framework(prefix, tmp_path):
+    """sources/ is one folder: a model file called instance.c is refused at
+    configure time, naming the file."""
+    src = project(tmp_path, "")
+    (src / "bad.c").rename(src / "instance.c")
+    (src / "CMakeLists.txt").write_text(CMAKE.replace("SOURCES bad.c", "SOURCES instance.c"))
+    rc, out = build(src, tmp_path / "build", prefix, check=False)
+    assert rc != 0 and "dmi_add_fmu(Bad): the model's file" in out and "instance.c" in out, out
