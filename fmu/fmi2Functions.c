@@ -114,11 +114,6 @@ fmi2Status fmi2Reset(fmi2Component c)
 
 /* ---- getting and setting variables ---- */
 
-static void put_real(void *values, size_t i, double x)
-{
-    ((fmi2Real *)values)[i] = x;
-}
-
 static void put_integer(void *values, size_t i, double x)
 {
     ((fmi2Integer *)values)[i] = (fmi2Integer)x;
@@ -160,7 +155,7 @@ static double take_boolean(const void *values, size_t i)
         ENTER(c, FN_SET, "fmi2Set" #Type);                                                        \
         return (fmi2Status)fmu_set(in, "fmi2Set" #Type, vr, nvr, value, kind, take);              \
     }
-GET(Real, fmi2Real, FMU_FLOAT64, put_real)
+GET(Real, fmi2Real, FMU_FLOAT64, NULL) /* the values are doubles */
 GET(Integer, fmi2Integer, FMU_INT32, put_integer)
 GET(Boolean, fmi2Boolean, FMU_BOOLEAN, put_boolean)
 SET(Real, fmi2Real, FMU_FLOAT64, take_real)

@@ -150,11 +150,6 @@ fmi3Status fmi3Reset(fmi3Instance instance)
 
 /* ---- getting and setting values ---- */
 
-static void put_float64(void *values, size_t i, double x)
-{
-    ((fmi3Float64 *)values)[i] = x;
-}
-
 static void put_int32(void *values, size_t i, double x)
 {
     ((fmi3Int32 *)values)[i] = (fmi3Int32)x;
@@ -211,7 +206,7 @@ static int bad_count(fmu_instance *in, const char *fn, size_t nvr, size_t nValue
         return (fmi3Status)fmu_set(in, "fmi3Set" #Type, valueReferences, nValueReferences,         \
                                    values, kind, take);                                            \
     }
-GET(Float64, FMU_FLOAT64, put_float64)
+GET(Float64, FMU_FLOAT64, NULL) /* the values are doubles */
 GET(Int32, FMU_INT32, put_int32)
 GET(Boolean, FMU_BOOLEAN, put_boolean)
 SET(Float64, FMU_FLOAT64, take_float64)

@@ -345,6 +345,15 @@ int fmu_model_get(fmu_model *m, unsigned vr, unsigned type, double *value, char 
     return 0;
 }
 
+int fmu_model_get_reals(fmu_model *m, const unsigned vr[], size_t nvr, unsigned type,
+                        double *values, char *err)
+{
+    for (size_t i = 0; i < nvr; i++)
+        if (fmu_model_get(m, vr[i], type, &values[i], err) != 0)
+            return -1;
+    return 0;
+}
+
 void fmu_model_set_start(fmu_model *m, double t_start)
 {
     m->v->t_start = t_start;

@@ -86,6 +86,11 @@ int fmu_model_get(fmu_model *m, unsigned vr, unsigned type, double *value, char 
 /* The experiment's start time t_start, the FMU's time (no solver yet). */
 void fmu_model_set_start(fmu_model *m, double t_start);
 
+/* fmu_model_get of nvr Float64 variables vr[i] into values[i] (type has
+ * FMU_FLOAT64): one call for an FMI get of Float64 values. */
+int fmu_model_get_reals(fmu_model *m, const unsigned vr[], size_t nvr, unsigned type,
+                        double *values, char *err);
+
 /* The model's check at ExitInitializationMode for an experiment of length T
  * (DMI_FMU_MODEL.check, 0 without one). */
 int fmu_model_check_start(const fmu_model *m, double T, char *msg);

@@ -112,7 +112,8 @@ fmu_status fmu_reset(fmu_instance *in, const char *fn);
 typedef void fmu_put_fn(void *values, size_t i, double value);
 typedef double fmu_take_fn(const void *values, size_t i);
 /* The variables vr of type (FMU_FLOAT64, ..., with FMU_NO_INDEPENDENT for
- * FMI 2.0's Real). */
+ * FMI 2.0's Real); put converts each value (NULL for FMU_FLOAT64: values is
+ * an array of doubles). */
 fmu_status fmu_get(fmu_instance *in, const char *fn, const unsigned vr[], size_t nvr,
                    void *values, unsigned type, fmu_put_fn *put);
 /* All values or none. */
