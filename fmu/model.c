@@ -177,4 +177,5 @@ const dmi_fmu_model DMI_FMU_MODEL = {
     .accept = accept,
     .check = check_coarse_step,
     .bytes = solver_bytes,
+    .author = "the dmi authors",
 };

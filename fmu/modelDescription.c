@@ -181,11 +181,18 @@ static void header(FILE *f, int v, const char *guid, int nsources, char **source
             dmi_version(), v == 2 ? "2.0" : "3.0", name, v == 2 ? "guid" : "instantiationToken",
             guid);
     attr(f, MODEL->description ? MODEL->description : "");
-    fprintf(f, " (libdmi %s)\"\n"
-               "  version=\"%s\"\n"
+    fprintf(f, " (libdmi %s)\"\n", dmi_version());
+    if (MODEL->author) {
+        fprintf(f, "  author=\"");
+        attr(f, MODEL->author);
+        fprintf(f, "\"\n");
+    }
+    /* libdmi's licence: the FMU holds its code */
+    fprintf(f, "  version=\"%s\"\n"
+               "  license=\"GPL-3.0-or-later\"\n"
                "  generationTool=\"dmi\"\n"
                "  variableNamingConvention=\"flat\"%s>\n",
-            dmi_version(), dmi_version(), v == 2 ? "\n  numberOfEventIndicators=\"0\"" : "");
+            dmi_version(), v == 2 ? "\n  numberOfEventIndicators=\"0\"" : "");
     if (v == 2)
         fprintf(f, "  <CoSimulation\n"
                    "    modelIdentifier=\"%s\"\n"

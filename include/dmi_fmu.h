@@ -163,7 +163,8 @@ typedef void dmi_fmu_bytes_fn(const dmi_fmu_values *v, double *peak, double *kep
  * generator checks it at build time (a table as described above, tau a
  * Float64 and N an Int32 parameter, n >= 1, configure and outputs given). */
 typedef struct {
-    const char *description;              /* the model descriptions' description */
+    const char *description;              /* the model descriptions' description (with
+                                             " (libdmi <version>)" appended) */
     const dmi_fmu_variable *variables;    /* the table (value reference = index) */
     size_t nvariables;
     size_t n;                             /* components of u */
@@ -175,7 +176,8 @@ typedef struct {
     dmi_fmu_outputs_fn *outputs;
     dmi_fmu_accept_fn *accept;            /* NULL: none */
     dmi_fmu_check_fn *check;              /* NULL: none */
-    dmi_fmu_bytes_fn *bytes;              /* NULL: the upper bound */
+    dmi_fmu_bytes_fn *bytes;              /* NULL: the figures of a dense kernel */
+    const char *author;                   /* the model descriptions' author; NULL: none */
 } dmi_fmu_model;
 
 /* The model of the FMU: define it once, in one of its C files:
