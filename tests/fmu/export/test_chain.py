@@ -2,12 +2,16 @@
 # valid (fmpy, fmutool), FMI 2.0 and 3.0 bitwise equal, within 1e-12 of the
 # plain libdmi program of the same model (native.c, the independent
 # computation: no FMU code), FMU states replaying bitwise, bad parameters
-# refused with a logged message naming the value.
+# refused with a logged message naming the value; the Windows DLLs (mingw-w64)
+# export the FMI functions only and import only system DLLs.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 import math
 import os
+import re
+import shutil
 import subprocess
 import sys
+import zipfile
 
 import numpy as np
 import pytest
@@ -141,3 +145,19 @@ def test_bad_parameter_refused(chain, version, name, value):
     inst.start()
     inst.fmu.doStep(0.0, 0.5)
     inst.free()
+
+
+@pytest.mark.parametrize("version,platform", [("2", "win64"), ("3", "x86_64-windows")])
+def test_windows_dll(chain, version, platform, tmp_path):
+    objdump = shutil.which("x86_64-w64-mingw32-objdump")
+    assert objdump, "mingw-w64's objdump not found (scripts/deps.sh installs it)"
+    with zipfile.ZipFile(chain[version]) as z:
+        z.extractall(tmp_path)
+    dump = subprocess.run([objdump, "-p", str(tmp_path / "binaries" / platform / f"{NAME}.dll")],
+                          capture_output=True, text=True, check=True).stdout
+    imports = set(re.findall(r"DLL Name: (\S+)", dump))
+    assert imports and all(re.match(r"(kernel32|msvcrt|api-ms-win-crt-[a-z0-9-]+)\.dll", d, re.I)
+                           for d in imports), imports
+    exports = re.findall(r"^\s+\[\s*\d+\] (\S+)$", dump.split("[Ordinal/Name Pointer] Table")[1],
+                         re.M)
+    assert f"fmi{version}DoStep" in exports and all(e.startswith(f"fmi{version}") for e in exports)
