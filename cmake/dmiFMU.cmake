@@ -27,8 +27,8 @@
 # Inputs, set by dmiConfig.cmake (find_package(dmi)) or by the dmi source
 # tree: DMI_FMU_FRAMEWORK_DIR (the framework's sources, fmi2/ and fmi3/
 # headers, fmu.map), DMI_FMU_CORE_SOURCES (libdmi's core with dmi.h),
-# DMI_FMU_INCLUDE_DIR (dmi.h, dmi_fmu.h) and DMI_FMU_COMPILE_OPTIONS (default -Wall -Wextra -Wpedantic; never
-# -Werror in a user's build).
+# DMI_FMU_INCLUDE_DIR (dmi.h, dmi_fmu.h) and DMI_FMU_COMPILE_OPTIONS (default
+# -Wall -Wextra -Wpedantic; never -Werror in a user's build).
 include_guard(GLOBAL)
 
 if(NOT DEFINED DMI_FMU_COMPILE_OPTIONS)

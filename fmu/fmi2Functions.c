@@ -59,11 +59,13 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     void *env = functions->componentEnvironment;
     if (instanceName && *instanceName) { /* (an empty name: refused by fmu_instantiate) */
         if (fmuType != fmi2CoSimulation) {
-            fmu_log_error(fn, instanceName, sink, logger, env, "this FMU supports co-simulation only");
+            fmu_log_error(fn, instanceName, sink, logger, env,
+                          "this FMU supports co-simulation only");
             return NULL;
         }
         if (!fmuGUID || strcmp(fmuGUID, dmi_fmu_guid) != 0) {
-            fmu_log_error(fn, instanceName, sink, logger, env, "GUID \"%s\" does not match the FMU's %s",
+            fmu_log_error(fn, instanceName, sink, logger, env,
+                          "GUID \"%s\" does not match the FMU's %s",
                           fmuGUID ? fmuGUID : "(null)", dmi_fmu_guid);
             return NULL;
         }

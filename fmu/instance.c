@@ -319,8 +319,9 @@ fmu_status fmu_get(fmu_instance *in, const char *fn, const unsigned vr[], size_t
 /* Whether the variable vr may be set in the instance's state. */
 static int settable(const fmu_instance *in, unsigned vr)
 {
-    return fmu_model_kind(&in->m, vr) & FMU_PARAMETER ? (in->state & (FMU_INSTANTIATED | FMU_INIT_MODE)) != 0
-                                        : 1;
+    if (fmu_model_kind(&in->m, vr) & FMU_PARAMETER)
+        return (in->state & (FMU_INSTANTIATED | FMU_INIT_MODE)) != 0;
+    return 1;
 }
 
 fmu_status fmu_set(fmu_instance *in, const char *fn, const unsigned vr[], size_t nvr,

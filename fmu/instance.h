@@ -1,7 +1,8 @@
 /*
  * The FMI side of the FMU common to FMI 2.0 and 3.0: an instance of the
- * model (framework.h over the model's dmi_fmu.h definition), the calling sequence (one table of the states in which
- * each function is allowed), logging through the importer's callback,
+ * model (framework.h over the model's dmi_fmu.h definition), the calling
+ * sequence (one table of the states in which each function is allowed),
+ * logging through the importer's callback,
  * all-or-nothing get/set, FMU states as checked bytes.  fmi2Functions.c and
  * fmi3Functions.c are thin adapters over it: they convert types and names
  * and call these functions.  Nothing here knows about a particular model, or

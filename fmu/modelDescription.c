@@ -30,9 +30,7 @@ static const dmi_fmu_variable *var(unsigned vr)
     return vr < MODEL->nvariables ? &MODEL->variables[vr] : &TIME;
 }
 
-static const char *name = "?"; /* the model's, for the messages */
-
-static int refuse(const char *fmt, const char *a, const char *b)
+static int refuse(const char *name, const char *fmt, const char *a, const char *b)
 {
     fprintf(stderr, "dmi_add_fmu(%s): error: ", name);
     fprintf(stderr, fmt, a, b);
@@ -41,42 +39,43 @@ static int refuse(const char *fmt, const char *a, const char *b)
 }
 
 /* The table's errors, each with the variable's name: 0 if none. */
-static int check_table(unsigned nvr)
+static int check_table(const char *name, unsigned nvr)
 {
     int bad = 0, independent = 0;
     if (!MODEL->variables || MODEL->nvariables == 0 || !MODEL->configure || !MODEL->outputs ||
         MODEL->n == 0)
-        return refuse("the model needs variables, configure, outputs and n >= 1%s%s", "", "");
+        return refuse(name, "the model needs variables, configure, outputs and n >= 1%s%s", "",
+                      "");
     for (unsigned vr = 0; vr < MODEL->nvariables; vr++) {
         const dmi_fmu_variable *x = var(vr);
         const unsigned kind = fmu_kind(vr);
         const int has_start = x->start_text[0] != '\0';
         for (unsigned k = 0; k < vr; k++)
             if (strcmp(var(k)->name, x->name) == 0)
-                bad |= refuse("variable \"%s\" is defined twice%s", x->name, "");
+                bad |= refuse(name, "variable \"%s\" is defined twice%s", x->name, "");
         if (strcmp(x->type, "Float64") && strcmp(x->type, "Int32") && strcmp(x->type, "Boolean"))
-            bad |= refuse("variable \"%s\": unknown type \"%s\" (Float64, Int32 or Boolean)",
+            bad |= refuse(name, "variable \"%s\": unknown type \"%s\" (Float64, Int32 or Boolean)",
                           x->name, x->type);
         else if (!kind)
-            bad |= refuse("variable \"%s\": unknown causality \"%s\" (parameter, input, output "
-                          "or independent)", x->name, x->causality);
+            bad |= refuse(name, "variable \"%s\": unknown causality \"%s\" (parameter, input, "
+                                "output or independent)", x->name, x->causality);
         else if ((kind & (FMU_OUTPUT | FMU_INDEPENDENT)) && has_start)
-            bad |= refuse("variable \"%s\": an output or the independent variable has no start "
-                          "value (start %s given)", x->name, x->start_text);
+            bad |= refuse(name, "variable \"%s\": an output or the independent variable has no "
+                                "start value (start %s given)", x->name, x->start_text);
         else if (fmu_is_set(kind) && !has_start)
-            bad |= refuse("variable \"%s\": a %s needs a start value", x->name, x->causality);
+            bad |= refuse(name, "variable \"%s\": a %s needs a start value", x->name, x->causality);
         else if ((kind & FMU_INDEPENDENT) && (!(kind & FMU_FLOAT64) || independent++))
-            bad |= refuse("variable \"%s\": the independent variable is Float64, and only "
+            bad |= refuse(name, "variable \"%s\": the independent variable is Float64, and only "
                           "one%s", x->name, "");
         else if ((kind & FMU_BOOLEAN) && has_start && x->start != 0 && x->start != 1)
-            bad |= refuse("variable \"%s\": a Boolean starts at 0 or 1 (start %s)", x->name,
+            bad |= refuse(name, "variable \"%s\": a Boolean starts at 0 or 1 (start %s)", x->name,
                           x->start_text);
     }
     if (MODEL->tau >= nvr || fmu_kind(MODEL->tau) != (FMU_FLOAT64 | FMU_PARAMETER))
-        bad |= refuse("the model's tau (value reference %s) is not a Float64 parameter%s",
+        bad |= refuse(name, "the model's tau (value reference %s) is not a Float64 parameter%s",
                       MODEL->tau < nvr ? var(MODEL->tau)->name : "out of range", "");
     if (MODEL->N >= nvr || fmu_kind(MODEL->N) != (FMU_INT32 | FMU_PARAMETER))
-        bad |= refuse("the model's N (value reference %s) is not an Int32 parameter%s",
+        bad |= refuse(name, "the model's N (value reference %s) is not an Int32 parameter%s",
                       MODEL->N < nvr ? var(MODEL->N)->name : "out of range", "");
     return bad;
 }
@@ -142,7 +141,8 @@ static void start(FILE *f, unsigned vr)
 static void unit(FILE *f, unsigned vr, int v)
 {
     const dmi_fmu_variable *x = var(vr);
-    if (x->unit[0] && (fmu_kind(vr) & FMU_FLOAT64) && (v == 3 || !(fmu_kind(vr) & FMU_INDEPENDENT))) {
+    const unsigned kind = fmu_kind(vr);
+    if (x->unit[0] && (kind & FMU_FLOAT64) && (v == 3 || !(kind & FMU_INDEPENDENT))) {
         fprintf(f, " unit=\"");
         attr(f, x->unit);
         fprintf(f, "\"");
@@ -169,7 +169,8 @@ static void unit_definitions(FILE *f, unsigned nvr)
         fprintf(f, "  </UnitDefinitions>\n");
 }
 
-static void header(FILE *f, int v, const char *guid, int nsources, char **sources, unsigned nvr)
+static void header(FILE *f, int v, const char *name, const char *guid, int nsources,
+                   char **sources, unsigned nvr)
 {
     fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
                "<!-- Written by dmi_add_fmu (libdmi %s) from the model's variable table. -->\n"
@@ -279,7 +280,8 @@ static void variables3(FILE *f, unsigned nvr)
     fprintf(f, "  <ModelVariables>\n");
     for (unsigned vr = 0; vr < nvr; vr++) {
         const unsigned kind = fmu_kind(vr);
-        fprintf(f, "    <%s name=\"%s\" valueReference=\"%u\" causality=\"%s\" variability=\"%s\"%s",
+        fprintf(f, "    <%s name=\"%s\" valueReference=\"%u\" causality=\"%s\" "
+                   "variability=\"%s\"%s",
                 var(vr)->type, var(vr)->name, vr, causality(vr), variability(vr),
                 kind & (FMU_INPUT | FMU_INDEPENDENT | FMU_OUTPUT) ? "" : " initial=\"exact\"");
         unit(f, vr, 3);
@@ -304,11 +306,11 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: modelDescription 2|3 NAME GUID OUTPUT [SOURCE...]\n");
         return 2;
     }
-    name = argv[2];
+    const char *name = argv[2];
     unsigned nvr = (unsigned)MODEL->nvariables;
     while (fmu_kind(nvr)) /* the time the framework adds */
         nvr++;
-    if (check_table(nvr) != 0)
+    if (check_table(name, nvr) != 0)
         return 1;
     const int v = argv[1][0] - '0';
     FILE *f = fopen(argv[4], "w");
@@ -316,7 +318,7 @@ int main(int argc, char **argv)
         perror(argv[4]);
         return 1;
     }
-    header(f, v, argv[3], argc - 5, argv + 5, nvr);
+    header(f, v, name, argv[3], argc - 5, argv + 5, nvr);
     if (v == 2)
         variables2(f, nvr);
     else

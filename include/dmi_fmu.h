@@ -169,7 +169,8 @@ typedef struct {
     size_t nvariables;
     size_t n;                             /* components of u */
     unsigned tau;                         /* value reference of the delay (Float64 parameter) */
-    unsigned N;                           /* value reference of the steps per tau (Int32 parameter) */
+    unsigned N;                           /* value reference of the steps per tau (Int32
+                                             parameter) */
     double stop_time;                     /* the default experiment (start 0) */
     double step_size;                     /* its communication step */
     dmi_fmu_configure_fn *configure;

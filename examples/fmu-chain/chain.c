@@ -22,31 +22,31 @@
 #include "dmi_fmu.h"
 
 #define VARIABLES(X)                                                                               \
-    X(k_p, Float64, parameter, 1.0, "N/m", "stiffness of the plate springs")                      \
-    X(k_c, Float64, parameter, 2.0, "N/m", "stiffness of the coupling springs")                   \
-    X(V, Float64, parameter, 0.1, "m/s", "speed of the plate")                                    \
-    X(alpha1, Float64, parameter, 1.0, "N", "dry friction of block 1 (>= 0)")                     \
-    X(alpha2, Float64, parameter, 1.2, "N", "dry friction of block 2 (>= 0)")                     \
-    X(alpha3, Float64, parameter, 0.9, "N", "dry friction of block 3 (>= 0)")                     \
-    X(g1, Float64, parameter, 0.3, "N/(m.s)", "memory: amplitude of exp(-s/theta1)")              \
-    X(theta1, Float64, parameter, 0.5, "s", "memory: relaxation time 1 (> 0)")                    \
-    X(g2, Float64, parameter, 0.1, "N/(m.s)", "memory: amplitude of exp(-s/theta2)")              \
-    X(theta2, Float64, parameter, 3.0, "s", "memory: relaxation time 2 (> 0)")                    \
-    X(tau, Float64, parameter, 10.0, "s", "length of the memory (> 0)")                           \
-    X(N, Int32, parameter, 1000, "", "steps per tau (h = tau / N)")                               \
-    X(x0_1, Float64, parameter, 0.0, "m", "history of x1 on [-tau, 0]")                           \
-    X(x0_2, Float64, parameter, 0.0, "m", "history of x2 on [-tau, 0]")                           \
-    X(x0_3, Float64, parameter, 0.0, "m", "history of x3 on [-tau, 0]")                           \
-    X(F_in, Float64, input, 0.0, "N", "force on block 1; step p uses the value set at or before t_p") \
-    X(x1, Float64, output, , "m", "position of block 1 (piecewise-linear interpolant)")           \
-    X(x2, Float64, output, , "m", "position of block 2")                                          \
-    X(x3, Float64, output, , "m", "position of block 3")                                          \
-    X(v1, Float64, output, , "m/s", "velocity of block 1 (piecewise-linear interpolant)")         \
-    X(v2, Float64, output, , "m/s", "velocity of block 2")                                        \
-    X(v3, Float64, output, , "m/s", "velocity of block 3")                                        \
-    X(friction1, Float64, output, , "N", "the element of alpha1 sigma(v1) of the step containing t") \
-    X(friction2, Float64, output, , "N", "the element of alpha2 sigma(v2) of the step containing t") \
-    X(friction3, Float64, output, , "N", "the element of alpha3 sigma(v3) of the step containing t")
+    X(k_p, Float64, parameter, 1.0, "N/m", "stiffness of the plate springs")                       \
+    X(k_c, Float64, parameter, 2.0, "N/m", "stiffness of the coupling springs")                    \
+    X(V, Float64, parameter, 0.1, "m/s", "speed of the plate")                                     \
+    X(alpha1, Float64, parameter, 1.0, "N", "dry friction of block 1 (>= 0)")                      \
+    X(alpha2, Float64, parameter, 1.2, "N", "dry friction of block 2 (>= 0)")                      \
+    X(alpha3, Float64, parameter, 0.9, "N", "dry friction of block 3 (>= 0)")                      \
+    X(g1, Float64, parameter, 0.3, "N/(m.s)", "memory: amplitude of exp(-s/theta1)")               \
+    X(theta1, Float64, parameter, 0.5, "s", "memory: relaxation time 1 (> 0)")                     \
+    X(g2, Float64, parameter, 0.1, "N/(m.s)", "memory: amplitude of exp(-s/theta2)")               \
+    X(theta2, Float64, parameter, 3.0, "s", "memory: relaxation time 2 (> 0)")                     \
+    X(tau, Float64, parameter, 10.0, "s", "length of the memory (> 0)")                            \
+    X(N, Int32, parameter, 1000, "", "steps per tau (h = tau / N)")                                \
+    X(x0_1, Float64, parameter, 0.0, "m", "history of x1 on [-tau, 0]")                            \
+    X(x0_2, Float64, parameter, 0.0, "m", "history of x2 on [-tau, 0]")                            \
+    X(x0_3, Float64, parameter, 0.0, "m", "history of x3 on [-tau, 0]")                            \
+    X(F_in, Float64, input, 0.0, "N", "force on block 1 (step p: the value set by t_p)")           \
+    X(x1, Float64, output, , "m", "position of block 1 (piecewise-linear interpolant)")            \
+    X(x2, Float64, output, , "m", "position of block 2")                                           \
+    X(x3, Float64, output, , "m", "position of block 3")                                           \
+    X(v1, Float64, output, , "m/s", "velocity of block 1 (piecewise-linear interpolant)")          \
+    X(v2, Float64, output, , "m/s", "velocity of block 2")                                         \
+    X(v3, Float64, output, , "m/s", "velocity of block 3")                                         \
+    X(friction1, Float64, output, , "N", "element of alpha1 sigma(v1) of the step")                \
+    X(friction2, Float64, output, , "N", "element of alpha2 sigma(v2) of the step")                \
+    X(friction3, Float64, output, , "N", "element of alpha3 sigma(v3) of the step")
 
 enum { VARIABLES(DMI_FMU_VR) NVARS };
 static const dmi_fmu_variable TABLE[] = {VARIABLES(DMI_FMU_VARIABLE)};
@@ -81,7 +81,8 @@ static int configure(const dmi_fmu_values *m, dmi_solver *s, char *err)
 {
     const double *p = m->value;
     const double alpha[6] = {0, 0, 0, p[VR_alpha1], p[VR_alpha2], p[VR_alpha3]};
-    const double a[2] = {-1 / p[VR_theta1], -1 / p[VR_theta2]}, b[2] = {0, 0}, g[2] = {p[VR_g1], p[VR_g2]};
+    const double a[2] = {-1 / p[VR_theta1], -1 / p[VR_theta2]}, b[2] = {0, 0};
+    const double g[2] = {p[VR_g1], p[VR_g2]};
     double C[2 * 36] = {0}; /* C_k = g_k [[0, 0], [L, 0]] */
     for (int k = 0; k < 2; k++)
         for (int i = 0; i < 3; i++)
