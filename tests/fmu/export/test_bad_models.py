@@ -2,7 +2,8 @@
 # installed dmi: a duplicate name, an output with a start value, an unknown
 # type or causality fail the build with a message naming the variable; a
 # configure function that fails makes ExitInitializationMode log its message
-# and return Error (the FMU goes on: Reset and a good run).  The control: the
+# and return Error (the FMU goes on: Reset and a good run); the model's check
+# there warns (Warning, the run goes on) or refuses (Error, no solver).  The control: the
 # same model without the bad row builds and runs.  A model file named like a
 # framework file is refused when configuring.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -52,13 +53,23 @@ static int configure(const dmi_fmu_values *m, dmi_solver *s, char *err)
     dmi_set_rhs(s, rhs, (void *)m);
     return dmi_set_history(s, history, NULL);
 }
+/* explicit in f: h k > 1 overshoots (a warning), h k > 2 grows (refused) */
+static int check(const dmi_fmu_values *m, double T, char *msg)
+{
+    const double hk = m->value[0] / m->value[1] * m->value[2];
+    if (hk <= 1)
+        return 0;
+    snprintf(msg, DMI_FMU_ERRLEN, "h k = %g over T = %g: %s", hk, T,
+             hk > 2 ? "the scheme grows" : "the scheme overshoots");
+    return hk > 2 ? -1 : 1;
+}
 static void outputs(const dmi_fmu_values *m, const dmi_fmu_point *pt, double *out)
 {
     (void)m;
     out[DMI_FMU_COUNT(TABLE) - 1] = pt->u ? pt->u[0] : 1.0;
 }
 const dmi_fmu_model DMI_FMU_MODEL = {"w' + k w = 0", TABLE, DMI_FMU_COUNT(TABLE), 1, 0, 1, 1.0,
-                                     0.1, configure, outputs, NULL, NULL, NULL};
+                                     0.1, configure, outputs, NULL, check, NULL, NULL};
 """
 
 
@@ -128,3 +139,22 @@ def test_model_file_named_like_the_framework(prefix, tmp_path):
     (src / "CMakeLists.txt").write_text(CMAKE.replace("SOURCES bad.c", "SOURCES instance.c"))
     rc, out = build(src, tmp_path / "build", prefix, check=False)
     assert rc != 0 and "dmi_add_fmu(Bad): the model's file" in out and "instance.c" in out, out
+
+
+@pytest.mark.parametrize("version", ["2", "3"])
+def test_check_warns_or_refuses(good, version):
+    path = str(good / ("Bad.fmu" if version == "2" else "fmi3/Bad.fmu"))
+    inst = Instance(path)
+    inst.set("k", 15.0)  # h k = 1.5
+    inst.start(stop=4.0)  # Warning: fmpy logs it and goes on
+    assert [(st, c) for st, c, m in inst.log] == [(1, "logStatusWarning")], inst.log
+    assert "h k = 1.5 over T = 4: the scheme overshoots" in inst.log[0][2]
+    inst.fmu.doStep(0.0, 0.1)
+    assert inst.get(["w"])[0] == pytest.approx(1 - 1.5, rel=1e-14)
+    inst.free()
+    inst = Instance(path)
+    inst.set("k", 25.0)  # h k = 2.5
+    with pytest.raises(FMICallException):
+        inst.start()
+    assert inst.log[-1][0] == 3 and "h k = 2.5 over T = 1: the scheme grows" in inst.log[-1][2]
+    inst.free()
