@@ -54,7 +54,8 @@ def build(src, build_dir, prefix, check=True):
 
 class Instance:
     """An FMU2Slave or FMU3Slave of the FMU at path with the calls the tests
-    use under one name; self.log holds (status, category, message)."""
+    use under one name; self.log holds (status, category, message) (FMI 2.0:
+    of the newest instance, fmpy's logger proxy being shared)."""
 
     def __init__(self, path, name="inst"):
         self.md = read_model_description(path)

@@ -161,3 +161,25 @@ def test_windows_dll(chain, version, platform, tmp_path):
     exports = re.findall(r"^\s+\[\s*\d+\] (\S+)$", dump.split("[Ordinal/Name Pointer] Table")[1],
                          re.M)
     assert f"fmi{version}DoStep" in exports and all(e.startswith(f"fmi{version}") for e in exports)
+
+
+def test_state_of_another_model_refused(chain):
+    """The chain's state bytes given to the oscillator FMU (and back): refused
+    by the recorded sizes, with the reason logged.  (One instance at a time:
+    fmpy's FMI 2.0 logger proxy is shared.)"""
+    paths = {"chain": chain["2"],
+             "osc": os.path.join(os.environ["DMI_BUILD_DIR"], "fmu", "DelayFrictionOscillator.fmu")}
+    states = {}
+    for name, path in paths.items():
+        inst = Instance(path, name)
+        inst.start()
+        states[name] = inst.save()
+        inst.free()
+    for name, other in (("chain", "osc"), ("osc", "chain")):
+        inst = Instance(paths[name], name)
+        inst.start()
+        with pytest.raises(FMICallException):
+            inst.restore(states[other])
+        assert "the sizes recorded in the state do not match" in inst.log[-1][2], inst.log
+        inst.restore(states[name])  # its own state still restores
+        inst.free()
