@@ -19,9 +19,9 @@
 #include "fmi3Functions.h"
 #include "instance.h"
 
-#define ENTER(c, which, fn)                                                                        \
-    fmu_instance *in = fmu_enter(c, which, fn);                                                    \
-    if (!in)                                                                                       \
+#define ENTER(c, which, fn)                                                                       \
+    fmu_instance *in = fmu_enter(c, which, fn);                                                   \
+    if (!in)                                                                                      \
     return fmi3Error
 
 static void sink(fmu_callback logger, void *environment, const char *name, fmu_status status,
@@ -186,25 +186,25 @@ static int bad_count(fmu_instance *in, const char *fn, size_t nvr, size_t nValue
     return 0;
 }
 
-#define GET(Type, kind, put)                                                                       \
-    fmi3Status fmi3Get##Type(fmi3Instance instance, const fmi3ValueReference valueReferences[],    \
-                             size_t nValueReferences, fmi3##Type values[], size_t nValues)         \
-    {                                                                                              \
-        ENTER(instance, FN_GET, "fmi3Get" #Type);                                                  \
-        if (bad_count(in, "fmi3Get" #Type, nValueReferences, nValues))                             \
-            return fmi3Error;                                                                      \
-        return (fmi3Status)fmu_get(in, "fmi3Get" #Type, valueReferences, nValueReferences,         \
-                                   values, kind, put);                                             \
+#define GET(Type, kind, put)                                                                      \
+    fmi3Status fmi3Get##Type(fmi3Instance instance, const fmi3ValueReference valueReferences[],   \
+                             size_t nValueReferences, fmi3##Type values[], size_t nValues)        \
+    {                                                                                             \
+        ENTER(instance, FN_GET, "fmi3Get" #Type);                                                 \
+        if (bad_count(in, "fmi3Get" #Type, nValueReferences, nValues))                            \
+            return fmi3Error;                                                                     \
+        return (fmi3Status)fmu_get(in, "fmi3Get" #Type, valueReferences, nValueReferences,        \
+                                   values, kind, put);                                            \
     }
-#define SET(Type, kind, take)                                                                      \
-    fmi3Status fmi3Set##Type(fmi3Instance instance, const fmi3ValueReference valueReferences[],    \
-                             size_t nValueReferences, const fmi3##Type values[], size_t nValues)   \
-    {                                                                                              \
-        ENTER(instance, FN_SET, "fmi3Set" #Type);                                                  \
-        if (bad_count(in, "fmi3Set" #Type, nValueReferences, nValues))                             \
-            return fmi3Error;                                                                      \
-        return (fmi3Status)fmu_set(in, "fmi3Set" #Type, valueReferences, nValueReferences,         \
-                                   values, kind, take);                                            \
+#define SET(Type, kind, take)                                                                     \
+    fmi3Status fmi3Set##Type(fmi3Instance instance, const fmi3ValueReference valueReferences[],   \
+                             size_t nValueReferences, const fmi3##Type values[], size_t nValues)  \
+    {                                                                                             \
+        ENTER(instance, FN_SET, "fmi3Set" #Type);                                                 \
+        if (bad_count(in, "fmi3Set" #Type, nValueReferences, nValues))                            \
+            return fmi3Error;                                                                     \
+        return (fmi3Status)fmu_set(in, "fmi3Set" #Type, valueReferences, nValueReferences,        \
+                                   values, kind, take);                                           \
     }
 GET(Float64, FMU_FLOAT64, NULL) /* the values are doubles */
 GET(Int32, FMU_INT32, put_int32)
@@ -214,13 +214,13 @@ SET(Int32, FMU_INT32, take_int32)
 SET(Boolean, FMU_BOOLEAN, take_boolean)
 
 /* The types of which the FMU has no variable. */
-#define NONE(Name, which, Type, what)                                                              \
-    fmi3Status fmi3##Name(fmi3Instance instance, const fmi3ValueReference valueReferences[],       \
-                          size_t nValueReferences, Type values[], size_t nValues)                  \
-    {                                                                                              \
-        (void)valueReferences, (void)values, (void)nValues;                                        \
-        ENTER(instance, which, "fmi3" #Name);                                                      \
-        return (fmi3Status)fmu_no_variables(in, "fmi3" #Name, nValueReferences, what);             \
+#define NONE(Name, which, Type, what)                                                             \
+    fmi3Status fmi3##Name(fmi3Instance instance, const fmi3ValueReference valueReferences[],      \
+                          size_t nValueReferences, Type values[], size_t nValues)                 \
+    {                                                                                             \
+        (void)valueReferences, (void)values, (void)nValues;                                       \
+        ENTER(instance, which, "fmi3" #Name);                                                     \
+        return (fmi3Status)fmu_no_variables(in, "fmi3" #Name, nValueReferences, what);            \
     }
 NONE(GetFloat32, FN_GET, fmi3Float32, "Float32 variables")
 NONE(GetInt8, FN_GET, fmi3Int8, "Int8 variables")
@@ -375,15 +375,15 @@ fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference
     UNSUPPORTED("fmi3GetVariableDependencies", "dependencies are in the model description only");
 }
 
-#define DERIVATIVE(Name)                                                                           \
-    fmi3Status fmi3##Name(fmi3Instance instance, const fmi3ValueReference unknowns[],              \
-                          size_t nUnknowns, const fmi3ValueReference knowns[], size_t nKnowns,     \
-                          const fmi3Float64 seed[], size_t nSeed, fmi3Float64 sensitivity[],       \
-                          size_t nSensitivity)                                                     \
-    {                                                                                              \
-        (void)unknowns, (void)nUnknowns, (void)knowns, (void)nKnowns, (void)seed, (void)nSeed;     \
-        (void)sensitivity, (void)nSensitivity;                                                     \
-        UNSUPPORTED("fmi3" #Name, "not provided by this FMU");                                     \
+#define DERIVATIVE(Name)                                                                          \
+    fmi3Status fmi3##Name(fmi3Instance instance, const fmi3ValueReference unknowns[],             \
+                          size_t nUnknowns, const fmi3ValueReference knowns[], size_t nKnowns,    \
+                          const fmi3Float64 seed[], size_t nSeed, fmi3Float64 sensitivity[],      \
+                          size_t nSensitivity)                                                    \
+    {                                                                                             \
+        (void)unknowns, (void)nUnknowns, (void)knowns, (void)nKnowns, (void)seed, (void)nSeed;    \
+        (void)sensitivity, (void)nSensitivity;                                                    \
+        UNSUPPORTED("fmi3" #Name, "not provided by this FMU");                                    \
     }
 DERIVATIVE(GetDirectionalDerivative)
 DERIVATIVE(GetAdjointDerivative)
@@ -511,11 +511,11 @@ fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time)
 }
 
 /* The model-exchange functions on arrays of continuous states or event indicators. */
-#define ME_ARRAY(Name, Type)                                                                       \
-    fmi3Status fmi3##Name(fmi3Instance instance, Type values[], size_t n)                          \
-    {                                                                                              \
-        (void)values, (void)n;                                                                     \
-        UNSUPPORTED("fmi3" #Name, NO_ME);                                                          \
+#define ME_ARRAY(Name, Type)                                                                      \
+    fmi3Status fmi3##Name(fmi3Instance instance, Type values[], size_t n)                         \
+    {                                                                                             \
+        (void)values, (void)n;                                                                    \
+        UNSUPPORTED("fmi3" #Name, NO_ME);                                                         \
     }
 ME_ARRAY(SetContinuousStates, const fmi3Float64)
 ME_ARRAY(GetContinuousStateDerivatives, fmi3Float64)
