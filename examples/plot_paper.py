@@ -45,7 +45,6 @@ def read_csv(path):
 
 
 def save(fig, path):
-    fig.tight_layout()
     fig.savefig(path, **PNG)
     plt.close(fig)
     print(f"wrote {path}")
@@ -53,21 +52,21 @@ def save(fig, path):
 
 def displacement_speed(title, curves, path, xlim=None):
     """Two panels, (a) displacement and (b) speed; curves: (label, t, w, v, style)."""
-    fig, axes = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True)
+    fig, axes = plt.subplots(2, 1, figsize=(8, 7), sharex=True, layout="constrained")
     for label, t, w, v, style in curves:
         axes[0].plot(t, w, label=label, **style)
         axes[1].plot(t, v, label=label, **style)
     axes[0].set_ylabel("displacement w")
-    axes[1].set_ylabel("speed w'")
-    axes[1].set_xlabel("t")
+    axes[1].set_ylabel("speed w′ = dw/dt")
+    axes[1].set_xlabel("time t")
     axes[0].set_title(f"{title} (a) displacement")
     axes[1].set_title("(b) speed")
     for ax in axes:
         ax.grid(True, alpha=0.3)
-        if len(curves) > 1:
-            ax.legend(loc="best")
         if xlim:
             ax.set_xlim(*xlim)
+    if len(curves) > 1:   # below the panels, never over the curves
+        fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncols=len(curves))
     save(fig, path)
 
 
@@ -97,23 +96,23 @@ def order_figure(out, order):
     sel = order["example"] == 4.2
     h, e = order["h"][sel], order["max_err_state"][sel]
     p = np.polyfit(np.log(h), np.log(e), 1)
-    fig, ax = plt.subplots(figsize=(7, 5))
+    fig, ax = plt.subplots(figsize=(7, 5.5), layout="constrained")
     ax.loglog(h, e, "o", color="tab:blue", label="max error, Example 4.2")
     hh = np.array([h.min(), h.max()])
     ax.loglog(hh, np.exp(np.polyval(p, np.log(hh))), "-", color="tab:red",
               label=f"least-squares line, slope {p[0]:.3f} (paper {PAPER_SLOPE})")
-    ax.set_xlabel("h = 1/(1001 + 50k), k = 1..18")
-    ax.set_ylabel("max over t_p in [-1, 10] of |U^p - (w, w')(t_p)|")
+    ax.set_xlabel("step size h = 1/(1001 + 50k), k = 1..18")
+    ax.set_ylabel("max error over t_p in [−1, 10], |U^p − (w, w′)(t_p)|")
     ax.set_title("Figure 4.3: order of the scheme (3.12)-(3.13)")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
+    fig.legend(loc="outside lower center", ncols=2)
     save(fig, out / "fig4_3.png")
     return float(p[0])
 
 
 def scheme44_figure(out):
     d = read_csv(out / "scheme44.csv")
-    fig, ax = plt.subplots(figsize=(8, 5))
+    fig, ax = plt.subplots(figsize=(8, 6), layout="constrained")
     styles = [("err_printed", "(4.4) as printed: +h·Σ", "tab:red", "-"),
               ("err_no_h", "only the factor h missing: -h·Σ", "tab:purple", "-"),
               ("err_sign", "only the sign flipped: +h·h·Σ", "tab:green", "-"),
@@ -126,11 +125,11 @@ def scheme44_figure(out):
     top = math.ceil(math.log10(np.nanmax(np.where(np.isfinite(d["err_printed"]), d["err_printed"],
                                                    np.nan))))
     ax.set_yticks([10.0 ** k for k in range(-4, top + 1, 10)])
-    ax.set_xlabel("t")
-    ax.set_ylabel("|U^p - (w, w')(t_p)|")
+    ax.set_xlabel("time t")
+    ax.set_ylabel("error |U^p − (w, w′)(t_p)|")
     ax.set_title(f"Example 4.2, h = 1/{N_PAPER}: scheme (4.4) as printed diverges")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(loc="upper left", fontsize=9)
+    fig.legend(loc="outside lower center", ncols=2, fontsize=9)
     save(fig, out / "scheme44.png")
 
 

@@ -20,7 +20,7 @@ if ((${#targets[@]} == 0)); then
   for c in fuzz/corpus/*/; do targets+=("$(basename "$c")"); done
 fi
 
-CC=clang cmake -S fuzz -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+CC=clang cmake -S fuzz -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDMI_WERROR=ON \
   -DPython3_EXECUTABLE="$py" >/dev/null
 cmake --build "$build" -j 2 --target fuzzers
 

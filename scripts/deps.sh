@@ -36,12 +36,19 @@ if [[ ! -f $stamp ]] || ! cmp -s "$req" "$stamp"; then
   cp "$req" "$stamp"
 fi
 
-# dmi-sweep (python/), editable, its dependencies pinned above: reinstalled when
-# python/pyproject.toml changes or the checkout moves.
-sweep_stamp="$venv/.dmi-sweep.stamp"
-sweep_want="$root $(sha256sum "$root/python/pyproject.toml" | cut -d' ' -f1)"
-if [[ ! -x $venv/bin/dmi-sweep ]] || [[ $(cat "$sweep_stamp" 2>/dev/null) != "$sweep_want" ]]; then
-  echo "deps: installing dmi-sweep (python/) into .venv"
-  "$venv/bin/python" -m pip install -q --no-deps -e "$root/python"
-  echo "$sweep_want" >"$sweep_stamp"
+# The Python package dmi (pyproject.toml: the binding, libdmi built from src/,
+# and dmi-sweep), its dependencies pinned above; built without isolation with
+# the pinned scikit-build-core.  Reinstalled when a file it is built from
+# changes or the checkout moves.  Replaces the former distribution dmi-sweep.
+pkg_stamp="$venv/.dmi.stamp"
+pkg_want="$root $(cd "$root" && find pyproject.toml CMakeLists.txt cmake src include python/CMakeLists.txt \
+  python/run.c python/README.md python/dmi python/dmi_sweep -type f ! -name '*.pyc' -print0 |
+  sort -z | xargs -0 sha256sum | sha256sum | cut -d' ' -f1)"
+if [[ ! -x $venv/bin/dmi-sweep ]] || [[ $(cat "$pkg_stamp" 2>/dev/null) != "$pkg_want" ]]; then
+  echo "deps: installing the Python package dmi (binding and dmi-sweep) into .venv"
+  if "$venv/bin/python" -m pip show -q dmi-sweep >/dev/null 2>&1; then
+    "$venv/bin/python" -m pip uninstall -q -y dmi-sweep
+  fi
+  "$venv/bin/python" -m pip install -q --no-deps --no-build-isolation "$root"
+  echo "$pkg_want" >"$pkg_stamp"
 fi

@@ -4,8 +4,8 @@
 # writes into out/: the CSV of each example, Figures 4.1-4.5, the FMU's
 # Example 4.3 run by fmpy over the native run, the evidence for the erratum in
 # (4.4), the oscillator with a Prony-series memory (exponential kernel terms,
-# the recursion against the FFT), a bifurcation diagram of Example 4.3 over the
-# forcing amplitude (dmi-sweep); prints the summary table.  Copies the figures
+# the recursion against the FFT), a bifurcation diagram of the oscillator over the
+# delay tau (dmi-sweep); prints the summary table.  Copies the figures
 # to docs/figures/.
 # Usage: scripts/main.sh
 # Environment: DMI_BUILD_DIR (default build), DMI_OUT_DIR (default out).
@@ -63,7 +63,7 @@ else
   echo "skipped: scripts/fmu_run.py or $fmu does not exist (no FMU in this checkout)"
 fi
 
-stage "dmi-sweep: bifurcation diagram of Example 4.3 over g_amp (Poincare section of w)"
+stage "dmi-sweep: bifurcation diagram of the oscillator over the delay tau (Poincare section of w)"
 DMI_BUILD_DIR="$build" scripts/sweep_ex43.sh "$out"
 
 stage "figures and comparison with the paper and ../shared/reference"

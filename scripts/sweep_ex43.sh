@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The main job's bifurcation diagram (scripts/main.sh runs it): dmi-sweep runs
-# the spec (default python/examples/ex43_g_amp.toml: Example 4.3 over g_amp,
-# Poincare section of w) into OUT/sweep_ex43 and plots OUT/bifurcation_ex43.png
-# and OUT/stick_fraction_ex43.png; prints the points, N and T of the spec and the
+# the spec (default python/examples/oscillator_tau.toml: the oscillator over the delay
+# tau, Poincare section of w) into OUT/sweep_ex43 and plots, over the
+# spec's first swept parameter, OUT/bifurcation_ex43.png and
+# OUT/stick_fraction_ex43.png; prints the points, N and T of the spec and the
 # time it took on this machine's cores.  Exit status 1, with a message, when the
 # FMU or dmi-sweep is missing or the sweep fails.
 # Usage: scripts/sweep_ex43.sh OUT [SPEC]
@@ -16,7 +17,7 @@ if [[ $# -lt 1 || $# -gt 2 ]]; then
   exit 2
 fi
 out=$1
-spec=${2:-$root/python/examples/ex43_g_amp.toml}
+spec=${2:-$root/python/examples/oscillator_tau.toml}
 build=${DMI_BUILD_DIR:-$root/build}
 fmu="$build/fmu/DelayFrictionOscillator.fmu"
 sweep=${DMI_SWEEP:-$root/.venv/bin/dmi-sweep}
@@ -30,8 +31,9 @@ rm -rf "$out/sweep_ex43"
 mkdir -p "$out"
 start=$SECONDS
 DMI_FMU="$fmu" "$sweep" run "$spec" --out "$out/sweep_ex43" --quiet || fail "the sweep failed"
-"$sweep" plot "$out/sweep_ex43" --x g_amp -o "$out/bifurcation_ex43.png" || fail "the plot failed"
-"$sweep" plot "$out/sweep_ex43" --x g_amp --metric sticking_mean -o "$out/stick_fraction_ex43.png" ||
+x=$("$py" -c 'import json, sys; print(json.load(open(sys.argv[1]))["params"][0])' "$out/sweep_ex43/_meta.json")
+"$sweep" plot "$out/sweep_ex43" --x "$x" -o "$out/bifurcation_ex43.png" || fail "the plot failed"
+"$sweep" plot "$out/sweep_ex43" --x "$x" --metric sticking_mean -o "$out/stick_fraction_ex43.png" ||
   fail "the plot failed"
 seconds=$((SECONDS - start))
 # the points as the sweep counted them (its metadata), N and T as the spec gives them

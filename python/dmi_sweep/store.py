@@ -43,7 +43,7 @@ def _running(pid: int) -> bool:
 
 def _versions() -> dict[str, str]:
     out = {"python": platform.python_version()}
-    for dist in ("dmi-sweep", "fmpy", "dask", "distributed", "pyarrow", "numpy", "pandas"):
+    for dist in ("dmi", "fmpy", "dask", "distributed", "pyarrow", "numpy", "pandas"):
         try:
             out[dist] = metadata.version(dist)
         except metadata.PackageNotFoundError:

@@ -1,6 +1,7 @@
 # The main job's sweep stage, scripts/sweep_ex43.sh: it fails with a message
-# when the FMU or dmi-sweep is missing (it skipped the diagram silently), and
-# prints the number of points of the spec it ran (it printed a fixed 60).
+# when the FMU or dmi-sweep is missing (it skipped the diagram silently),
+# prints the number of points of the spec it ran (it printed a fixed 60), and
+# plots over the spec's swept parameter (the main job's spec sweeps g_omega).
 # dmi-sweep is this checkout's (python -m dmi_sweep through a wrapper); the
 # script runs in its own process group, killed when it ends.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -51,6 +52,23 @@ def test_prints_the_points_of_the_spec(tmp_path, build, sweep_command):
     assert "bifurcation diagram: 3 points of g_amp (N = 200, T = 2) in " in r.stdout, r.stdout
     for png in ("bifurcation_ex43.png", "stick_fraction_ex43.png"):
         assert (tmp_path / "out" / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_plots_over_the_swept_parameter(tmp_path, build, sweep_command):
+    spec = tmp_path / "small.toml"
+    spec.write_text(SMALL.replace("g_amp = { start = 0.5, stop = 4.0, num = 3 }",
+                                  "g_omega = { start = 6.0, stop = 8.0, num = 2 }"))
+    r = run(tmp_path / "out", spec, DMI_BUILD_DIR=str(build), DMI_SWEEP=str(sweep_command))
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "bifurcation diagram: 2 points of g_omega (N = 200, T = 2) in " in r.stdout, r.stdout
+    assert (tmp_path / "out" / "bifurcation_ex43.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_main_spec_is_valid():
+    """The main job's default spec loads (every key and parameter known to dmi-sweep)."""
+    from dmi_sweep.spec import load
+    spec = load(PYTHON_DIR / "examples" / "oscillator_tau.toml")
+    assert spec.n_points >= 50
 
 
 def test_missing_fmu_fails(tmp_path, sweep_command):

@@ -5,7 +5,10 @@
 #   install_consumer.sh cmake|pkg-config BUILD_DIR LIBDIR INCLUDEDIR [fortran] [FILE...]
 # cmake: a CMake project with find_package(dmi) (shared, static and, with
 # "fortran", the Fortran module); pkg-config: the compilers with the flags of
-# dmi.pc (and dmi-fortran.pc).  LIBDIR and INCLUDEDIR are the build's
+# dmi.pc (and dmi-fortran.pc), whose libdir and includedir must be exactly
+# <prefix>/LIBDIR and <prefix>/INCLUDEDIR, the prefix given to cmake --install
+# (given with a trailing slash, which the .pc files drop), and follow the tree
+# when it is moved (pkg-config --define-prefix).  LIBDIR and INCLUDEDIR are the build's
 # CMAKE_INSTALL_LIBDIR and CMAKE_INSTALL_INCLUDEDIR (relative to the prefix).
 # FILEs (relative to the prefix) must be installed too (e.g. the FMU).
 # CC and FC name the compilers.
@@ -24,7 +27,9 @@ trap 'rm -rf "$work"' EXIT
 prefix=$work/prefix
 cd "$work" # (gfortran writes module files into the current folder)
 
-cmake --install "$build" --prefix "$prefix" >/dev/null
+given=$prefix
+[[ $mode != pkg-config ]] || given=$prefix/ # the .pc files must still say <prefix>/lib
+cmake --install "$build" --prefix "$given" >/dev/null
 cp -r "$here/consumer" "$work/src"
 for f in "$inc/dmi.h" "$lib/libdmi.so.1" "$lib/libdmi.a" "$lib/cmake/dmi/dmiConfig.cmake" \
          "$lib/cmake/dmi/dmiConfigVersion.cmake" "$lib/pkgconfig/dmi.pc" "$@"; do
@@ -60,8 +65,17 @@ cmake)
   ;;
 pkg-config)
   export PKG_CONFIG_PATH=$prefix/$lib/pkgconfig
+  # Exact strings: "$prefix/lib", not "$prefix/lib/pkgconfig/../..//lib".
+  expect() { # expect PACKAGE VARIABLE VALUE [pkg-config option]
+    local got
+    got=$(pkg-config ${4:-} --variable="$2" "$1")
+    [[ $got == "$3" ]] || { echo "$1.pc${4:+ ($4)}: $2 is '$got', expected '$3'"; exit 1; }
+  }
+  for pc in dmi ${fortran:+dmi-fortran}; do
+    expect $pc libdir "$prefix/$lib"
+    expect $pc includedir "$prefix/$inc"
+  done
   libdir=$(pkg-config --variable=libdir dmi)
-  [[ $(realpath -m "$libdir") == $(realpath "$prefix/$lib") ]] || { echo "dmi.pc: libdir $libdir is not in $prefix"; exit 1; }
   # shellcheck disable=SC2046  # the flags are lists of words
   "${CC:-cc}" "$work/src/consumer.c" -o "$work/consumer" $(pkg-config --cflags --libs dmi) -lm \
       -Wl,-rpath,"$libdir"
@@ -78,6 +92,13 @@ pkg-config)
         $(pkg-config --cflags --libs dmi-fortran) -Wl,-rpath,"$libdir"
     run "$work/consumer_fortran" shared
   fi
+  # A tree moved after installing: pkg-config --define-prefix finds it.
+  mv "$prefix" "$work/moved"
+  export PKG_CONFIG_PATH=$work/moved/$lib/pkgconfig
+  for pc in dmi ${fortran:+dmi-fortran}; do
+    expect $pc libdir "$work/moved/$lib" --define-prefix
+    expect $pc includedir "$work/moved/$inc" --define-prefix
+  done
   ;;
 *)
   echo "usage: install_consumer.sh cmake|pkg-config BUILD_DIR LIBDIR INCLUDEDIR [fortran] [FILE...]"

@@ -1,0 +1,350 @@
+# dmi.Solver: one libdmi solver (include/dmi.h), method for function.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""The class dmi.Solver."""
+from __future__ import annotations
+
+import ctypes
+import math
+import operator
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any
+
+import numpy as np
+
+from . import _callbacks as cb
+from . import _lib
+from ._errors import Error, InvalidArgument, from_code
+
+_L = _lib.lib
+_DP = ctypes.POINTER(ctypes.c_double)
+
+# A Python function, or a C function: numba cfunc, ctypes function pointer, scipy.LowLevelCallable.
+Callback = Any
+
+
+def _count(value: Any, name: str, minimum: int) -> int:
+    try:
+        v = operator.index(value)
+    except TypeError:
+        raise InvalidArgument(_lib.EINVAL, f"{name} = {value!r} is not an integer") from None
+    if v < minimum:
+        raise InvalidArgument(_lib.EINVAL, f"{name} = {v}: must be >= {minimum}")
+    return v
+
+
+def _array(value: Any, shape: tuple[int, ...], name: str) -> np.ndarray:
+    """value as a C-contiguous float64 array of the given shape, or InvalidArgument."""
+    try:
+        a = np.ascontiguousarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise InvalidArgument(_lib.EINVAL, f"{name}: not an array of floats ({e})") from None
+    if a.shape != shape:
+        raise InvalidArgument(_lib.EINVAL, f"{name} has shape {a.shape}; expected {shape}")
+    return a
+
+
+def _ptr(a: np.ndarray | None) -> Any:
+    return None if a is None else a.ctypes.data_as(_DP)
+
+
+class Solver:
+    """The implicit Euler scheme (3.12)-(3.13) for u' + A(u) + f(t, u) + int_0^tau H(s) u(t-s) ds ∋ 0,
+    u = z on [-tau, 0], in R^n, with h = tau / N (``dmi_create``).
+
+    Nothing is set at first: f = 0, A = 0, H = 0, z = 0.  Set the model with the ``set_*``
+    methods, then :meth:`init`, then :meth:`step`, :meth:`advance` or :meth:`run`.
+    Every failure raises :class:`dmi.Error` (:class:`dmi.InvalidArgument` for a bad argument or
+    call, also a ``ValueError``) and leaves the solver as it was.
+
+    Callbacks may be Python functions (``f(t, u) -> (n,)``, ``r(lam, x) -> (n,)``,
+    ``H(s) -> (n, n)``, ``z(t) -> (n,)``, float64 NumPy arrays in and out) or C functions with
+    libdmi's signature, called by the library with no Python in between: a numba ``cfunc``
+    (signatures ``dmi.RHS_SIGNATURE`` etc.), a ctypes function pointer or a
+    ``scipy.LowLevelCallable``.  A solver may be used by one thread at a time; distinct solvers
+    run in parallel in distinct threads (the GIL is released in every call into libdmi and taken
+    only by Python callbacks).
+    """
+
+    def __init__(self, n: int, tau: float, N: int):
+        """A solver for R^n with delay tau > 0 (finite) and N >= 1 steps per tau (h = tau / N)."""
+        self._handle = None
+        n = _count(n, "n", 1)
+        N = _count(N, "N", 1)
+        try:
+            tau = float(tau)
+        except (TypeError, ValueError):
+            raise InvalidArgument(_lib.EINVAL, f"tau = {tau!r} is not a number") from None
+        if not (math.isfinite(tau) and tau > 0):
+            raise InvalidArgument(_lib.EINVAL, f"tau = {tau}: must be finite and > 0")
+        handle = ctypes.c_void_p()
+        rc = _L.dmi_create(ctypes.byref(handle), n, tau, N)
+        if rc != _lib.OK:
+            raise from_code(rc, f"dmi_create(n = {n}, tau = {tau!r}, N = {N}): "
+                                f"{_L.dmi_strerror(rc).decode()}")
+        self._handle = handle
+        self._n, self._tau, self._N = n, tau, N
+        self._keep: dict[str, cb.Bound] = {}   # callbacks and data libdmi points to
+        self._failure: list = [None]           # an exception raised in a Python callback
+        self._busy = threading.Lock()
+
+    # ---- helpers -----------------------------------------------------------------------------
+
+    @contextmanager
+    def _using(self) -> Iterator[ctypes.c_void_p]:
+        """The handle, for one call at a time (libdmi: one solver, one thread)."""
+        if self._handle is None:
+            raise InvalidArgument(_lib.ESTATE, "the solver is closed")
+        if not self._busy.acquire(blocking=False):
+            raise InvalidArgument(_lib.ESTATE, "the solver is in use (by another thread, or by a "
+                                  "callback of this solver calling it)")
+        try:
+            yield self._handle
+        finally:
+            self._busy.release()
+
+    def _check(self, rc: int) -> None:
+        """Raises the exception for libdmi's return code rc: a Python callback's own exception
+        first (the library then returned DMI_ECALLBACK)."""
+        failure, self._failure[0] = self._failure[0], None
+        if rc == _lib.OK:
+            return
+        if failure is not None:
+            raise failure
+        raise from_code(rc, _L.dmi_last_error(self._handle).decode())
+
+    def _set_callback(self, slot: str, kind: cb.Kind, setter: Any, f: Any, user: Any) -> None:
+        bound = cb.bind(kind, f, user, self._n, self._failure)
+        with self._using() as s:
+            self._check(setter(s, bound.address, bound.user))
+        self._keep[slot] = bound  # only now: a refused call keeps the former callback alive
+
+    # ---- sizes ---------------------------------------------------------------------------------
+
+    @property
+    def n(self) -> int:
+        """Dimension n of the state."""
+        return self._n
+
+    @property
+    def tau(self) -> float:
+        """Delay tau (time units)."""
+        return self._tau
+
+    @property
+    def N(self) -> int:
+        """Steps per delay: h = tau / N."""
+        return self._N
+
+    @property
+    def h(self) -> float:
+        """Step size h = tau / N (time units), ``dmi_get_h``."""
+        with self._using() as s:
+            return _L.dmi_get_h(s)
+
+    # ---- setup -------------------------------------------------------------------------------
+
+    def set_rhs(self, f: Callback | None, user: Any = None) -> None:
+        """Right-hand side f: ``f(t, u) -> array (n)``, or a C function
+        ``int f(double t, const double *u, double *out, void *user)`` (``dmi.RHS_SIGNATURE``).
+        None restores f = 0.  ``user``: the C function's user pointer: a NumPy array or ctypes
+        object (its data; the solver keeps the object alive), a ctypes pointer or an int address
+        (the memory is yours to keep alive); a LowLevelCallable's own user_data otherwise.  Takes
+        effect from the next step; may be called at any time."""
+        self._set_callback("rhs", cb.RHS, _L.dmi_set_rhs, f, user)
+
+    def set_resolvent(self, r: Callback | None, user: Any = None) -> None:
+        """A through its resolvent: ``r(lam, x) -> (I + lam A)^{-1} x``, array (n), lam = h; or a
+        C function ``int r(double lam, const double *x, double *out, void *user)``
+        (``dmi.RESOLVENT_SIGNATURE``).  None restores A = 0.  Replaces an earlier resolvent,
+        friction or box."""
+        self._set_callback("resolvent", cb.RESOLVENT, _L.dmi_set_resolvent, r, user)
+
+    def set_friction(self, alpha: Any) -> None:
+        """Built-in dry friction A(u)_i = alpha_i sigma(u_i): alpha has n finite values >= 0
+        (``dmi_set_friction``).  Replaces an earlier resolvent, friction or box."""
+        a = _array(alpha, (self._n,), "alpha")
+        with self._using() as s:
+            self._check(_L.dmi_set_friction(s, _ptr(a)))
+        self._keep["resolvent"] = cb.Bound(None, None, ())
+
+    def set_box(self, lo: Any, hi: Any) -> None:
+        """Built-in normal cone of the box prod_i [lo_i, hi_i] (the resolvent is the projection):
+        n values each, no NaN, lo_i <= hi_i, infinite bounds allowed (``dmi_set_box``).  Replaces
+        an earlier resolvent, friction or box."""
+        lo_a, hi_a = _array(lo, (self._n,), "lo"), _array(hi, (self._n,), "hi")
+        with self._using() as s:
+            self._check(_L.dmi_set_box(s, _ptr(lo_a), _ptr(hi_a)))
+        self._keep["resolvent"] = cb.Bound(None, None, ())
+
+    def set_kernel(self, H: Callback | None, user: Any = None) -> None:
+        """Kernel: ``H(s) -> array (n, n)`` for 0 <= s < tau, or a C function
+        ``int H(double s, double *out, void *user)`` writing n*n values row-major
+        (``dmi.KERNEL_SIGNATURE``).  None: H = 0.  Sampled by :meth:`init`, so refused after it."""
+        self._set_callback("kernel", cb.KERNEL, _L.dmi_set_kernel, H, user)
+
+    def set_kernel_exp(self, a: Any, b: Any, C: Any, D: Any = None) -> None:
+        """Kernel as K exponential terms H(s) = sum_k exp(a_k s) (C_k cos(b_k s) + D_k sin(b_k s)):
+        a and b of shape (K,) (1 / time unit), C and D of shape (K, n, n) (D None: zero)
+        (``dmi_set_kernel_exp``).  Refused after :meth:`init`."""
+        if np.ndim(a) != 1 or len(a) == 0:
+            raise InvalidArgument(_lib.EINVAL, f"set_kernel_exp: a has shape {np.shape(a)}; expected "
+                                  "(K,), K >= 1 terms (set_kernel(None) removes the kernel)")
+        K = len(a)
+        a_a = _array(a, (K,), "a")
+        n = self._n
+        b_a = _array(b, (K,), "b")
+        C_a = _array(C, (K, n, n), "C")
+        D_a = None if D is None else _array(D, (K, n, n), "D")
+        with self._using() as s:
+            self._check(_L.dmi_set_kernel_exp(s, K, _ptr(a_a), _ptr(b_a), _ptr(C_a), _ptr(D_a)))
+        self._keep["kernel"] = cb.Bound(None, None, ())
+
+    def set_history(self, z: Callback | None, user: Any = None) -> None:
+        """History: ``z(t) -> array (n)`` for -tau <= t <= 0, or a C function
+        ``int z(double t, double *out, void *user)`` (``dmi.HISTORY_SIGNATURE``).  None: z = 0.
+        Sampled by :meth:`init`, so refused after it."""
+        self._set_callback("history", cb.HISTORY, _L.dmi_set_history, z, user)
+
+    def set_convolution(self, method: str) -> None:
+        """Method of the delay sum: ``"auto"`` (default), ``"direct"``, ``"fft"`` or
+        ``"recursive"`` (exponential kernels, see ``dmi_set_convolution``).  Any time, also
+        between steps; the methods differ by rounding only."""
+        code = _lib.CONV.get(method) if isinstance(method, str) else None
+        if code is None:
+            raise InvalidArgument(_lib.EINVAL, f"set_convolution: method {method!r}: expected one of "
+                                  f"{', '.join(map(repr, _lib.CONV))}")
+        with self._using() as s:
+            self._check(_L.dmi_set_convolution(s, code))
+
+    # ---- time stepping -------------------------------------------------------------------------
+
+    def init(self) -> None:
+        """Samples the kernel and the history and sets t = 0 (p = 0); again: restarts from t = 0."""
+        with self._using() as s:
+            self._check(_L.dmi_init(s))
+
+    def step(self) -> None:
+        """One step t_p -> t_{p+1}.  On failure the solver is bitwise where it was, and a retry
+        gives a clean run's result; an exception raised by a Python callback comes out as it is."""
+        with self._using() as s:
+            self._check(_L.dmi_step(s))
+
+    def advance(self, steps: int) -> None:
+        """``steps`` steps in C.  Stops at the first failing step (the steps before it are kept,
+        :attr:`step_index` tells how many) and raises its error."""
+        steps = _count(steps, "steps", 0)
+        with self._using() as s:
+            self._check(_L.dmi_advance(s, steps))
+
+    def run(self, steps: int, stride: int = 1) -> tuple[np.ndarray, np.ndarray]:
+        """``steps`` steps in C, recording the states there: returns ``t`` (rows,) and ``U``
+        (rows, n) at p0, p0 + stride, ..., p0 + k stride <= p0 + steps, and at p0 + steps (the
+        last row), p0 the step index at the call.  On a failing step the steps before it are
+        kept, and the exception has the rows recorded until then as ``partial = (t, U)``."""
+        steps = _count(steps, "steps", 0)
+        stride = _count(stride, "stride", 1)
+        cap = steps // stride + 2
+        t = np.empty(cap)
+        U = np.empty((cap, self._n))
+        rows = ctypes.c_size_t(0)
+        with self._using() as s:
+            rc = _lib.pylib.dmi_py_run(s, self._n, steps, stride, _ptr(t), _ptr(U), ctypes.byref(rows))
+            try:
+                self._check(rc)
+            except BaseException as e:
+                e.partial = (t[:rows.value].copy(), U[:rows.value].copy())
+                raise
+        return t[:rows.value].copy(), U[:rows.value].copy()
+
+    # ---- queries ---------------------------------------------------------------------------------
+
+    @property
+    def time(self) -> float:
+        """t_p = p h (time units); 0 before :meth:`init`."""
+        with self._using() as s:
+            return _L.dmi_time(s)
+
+    @property
+    def step_index(self) -> int:
+        """The step counter p (steps since :meth:`init`); InvalidArgument before it."""
+        p = ctypes.c_uint64()
+        with self._using() as s:
+            self._check(_L.dmi_get_step_index(s, ctypes.byref(p)))
+        return p.value
+
+    @property
+    def state(self) -> np.ndarray:
+        """U^p, a new array (n,)."""
+        u = np.empty(self._n)
+        with self._using() as s:
+            self._check(_L.dmi_get_state(s, _ptr(u)))
+        return u
+
+    def past(self, lag: int) -> np.ndarray:
+        """U^{p - lag}, 0 <= lag <= N (history values for p - lag <= 0), a new array (n,)."""
+        lag = _count(lag, "lag", 0)
+        if lag > self._N:
+            raise InvalidArgument(_lib.EINVAL, f"past: lag = {lag} > N = {self._N}")
+        u = np.empty(self._n)
+        with self._using() as s:
+            self._check(_L.dmi_get_past(s, lag, _ptr(u)))
+        return u
+
+    def step_terms(self) -> tuple[np.ndarray, np.ndarray]:
+        """Terms of the last step (t_{p-1} -> t_p): ``W`` = W^{p-1} (the delay sum) and ``X`` =
+        X^{p-1} (the resolvent's argument; (X - U^p) / h is the element of A(U^p) selected, the
+        friction force for friction).  InvalidArgument before the first step."""
+        W, X = np.empty(self._n), np.empty(self._n)
+        with self._using() as s:
+            self._check(_L.dmi_get_step_terms(s, _ptr(W), _ptr(X)))
+        return W, X
+
+    # ---- saving and restoring ------------------------------------------------------------------
+
+    def save_state(self) -> bytes:
+        """The time-stepping state (step counter, the N + 1 stored states, the last terms, an
+        exponential kernel's sums) as bytes (``dmi_state_save``); not the callbacks, resolvent,
+        method or kernel."""
+        with self._using() as s:
+            size = _L.dmi_state_size(s)
+            buf = ctypes.create_string_buffer(size)
+            self._check(_L.dmi_state_save(s, buf, size))
+        return buf.raw
+
+    def load_state(self, data: bytes) -> None:
+        """Restores bytes of :meth:`save_state` from a solver with the same n, N, tau (and
+        exponential kernel); needs :meth:`init` first.  Bad bytes: InvalidArgument, solver
+        unchanged.  Stepping on is bitwise the saving solver's."""
+        try:
+            raw = bytes(data)
+        except TypeError:
+            raise InvalidArgument(_lib.EINVAL, "load_state: data is not bytes-like") from None
+        with self._using() as s:
+            self._check(_L.dmi_state_load(s, raw, len(raw)))
+
+    # ---- life cycle ------------------------------------------------------------------------------
+
+    def close(self) -> None:
+        """Frees the C solver (``dmi_free``); the object is unusable afterwards.  Also done when
+        the object is collected."""
+        if self._handle is not None:
+            with self._using() as s:
+                _L.dmi_free(ctypes.byref(s))
+                self._handle = None
+            self._keep.clear()
+
+    def __enter__(self) -> Solver:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        if getattr(self, "_handle", None) is not None:
+            _L.dmi_free(ctypes.byref(self._handle))
+            self._handle = None
+
+    def __repr__(self) -> str:
+        return f"dmi.Solver(n={self._n}, tau={self._tau!r}, N={self._N})"

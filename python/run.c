@@ -1,0 +1,47 @@
+/*
+ * dmi_py_run: the loop behind dmi.Solver.run (python/dmi/_solver.py): steps a
+ * solver and records the states in C, with no Python between the steps.
+ * Part of the Python package dmi only (libdmipy.so beside libdmi.so.1 in the
+ * package): libdmi's own API has no such call.
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include <stddef.h>
+
+#include "dmi.h"
+
+#if defined(__GNUC__) || defined(__clang__)
+#define DMI_PY_API __attribute__((visibility("default")))
+#else
+#define DMI_PY_API
+#endif
+
+/*
+ * From the solver's step p0 (dmi_init done), takes `steps` steps and records
+ * t_p and U^p (n values, rows of U) at p = p0, p0 + stride, ..., every
+ * stride-th step, and at p0 + steps if that is not among them: at most
+ * steps / stride + 2 rows, the caller's arrays t and U hold that many.
+ * *rows = the number of rows written, also on failure.  Returns DMI_OK or
+ * the code of the first failing step (the steps before it are kept, as in
+ * dmi_advance).  stride >= 1.
+ */
+DMI_PY_API int dmi_py_run(dmi_solver *s, size_t n, size_t steps, size_t stride, double *t,
+                          double *U, size_t *rows)
+{
+    size_t r = 0;
+    int rc = dmi_get_state(s, U);
+    if (rc == DMI_OK) {
+        t[r++] = dmi_time(s);
+        for (size_t done = 0; done < steps;) {
+            size_t chunk = steps - done < stride ? steps - done : stride;
+            rc = dmi_advance(s, chunk);
+            if (rc != DMI_OK)
+                break;
+            done += chunk;
+            t[r] = dmi_time(s);
+            dmi_get_state(s, U + r * n);
+            r++;
+        }
+    }
+    *rows = r;
+    return rc;
+}

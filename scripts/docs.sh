@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# Builds the documentation site into <build>/docs/html (open index.html there).  Installs what it
+# lacks (scripts/deps.sh; the pinned docs/requirements.txt into .venv), builds the project when
+# the build folder has no FMU yet, copies docs/ into <build>/docs/src, generates there the C API
+# reference from the comments of include/*.h (docs/gen/capi.py) and the FMU variable tables
+# from the model description of every FMU the build produced (docs/gen/fmu_variables.py), and
+# runs Sphinx with warnings as errors.  A page that another part of the project writes and that
+# is not there yet gets a stub saying so (named below), and the script says which.
+# With --check it then installs Debian's chromium when missing and checks the site
+# (tests/docs/check_site.py: the references against the header, the FMUs, dmi-sweep's parser
+# and the Python packages; links and images; headless Chromium).
+# Usage: scripts/docs.sh [--check]
+# Environment: DMI_BUILD_DIR (default build).
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$root"
+check=0
+case "${1:-}" in
+  "") ;;
+  --check) check=1 ;;
+  *) echo "usage: scripts/docs.sh [--check]" >&2; exit 2 ;;
+esac
+build=${DMI_BUILD_DIR:-build}
+py="$root/.venv/bin/python"
+
+scripts/deps.sh
+req=docs/requirements.txt
+stamp="$root/.venv/.docs-requirements.stamp"
+if [[ ! -f $stamp ]] || ! cmp -s "$req" "$stamp"; then
+  echo "docs: installing the documentation's Python packages into .venv"
+  "$py" -m pip install -q -r "$req"
+  cp "$req" "$stamp"
+fi
+
+if [[ -z $(find "$build/fmu" -name '*.fmu' 2>/dev/null | head -n 1) ]]; then
+  echo "docs: building the project in $build (the FMU reference is read from the built FMUs)"
+  cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPython3_EXECUTABLE="$py" >/dev/null
+  cmake --build "$build" -j "$(nproc)" >/dev/null
+fi
+
+src="$build/docs/src"
+html="$build/docs/html"
+rm -rf "$src" "$html"
+mkdir -p "$src"
+cp -r docs/. "$src/"
+# Pages written with other parts of the project: a stub until they are there.
+while IFS='|' read -r page title by; do
+  if [[ ! -f docs/$page ]]; then
+    echo "docs: docs/$page is not there yet: a stub stands in for it"
+    printf '# %s\n\n(written by %s; not there yet)\n' "$title" "$by" >"$src/$page"
+  fi
+done <<'PAGES'
+sweep.md|dmi-sweep|the dmi-sweep work of issue 19
+fmu-export.md|Exporting your own model as an FMU|the FMU-export work of issue 20
+python.md|Python|the Python binding of issue 21
+benchmarks-scale.md|Benchmarks at scale|the engine-at-scale work of issue 23
+PAGES
+"$py" docs/gen/capi.py include/*.h >"$src/c-api.md"
+mapfile -t fmus < <(find "$build" -name '*.fmu' -not -path "$build/docs/*" -not -path '*/Testing/*' | sort)
+((${#fmus[@]})) || { echo "docs: no FMU in $build" >&2; exit 1; }
+"$py" docs/gen/fmu_variables.py "$build" "${fmus[@]}" >"$src/fmu-variables.md"
+
+"$py" -m sphinx -W --keep-going -q -b html "$src" "$html"
+echo "docs: the site is in $html/index.html"
+
+if ((check)); then
+  if ! command -v chromium >/dev/null; then
+    echo "docs: installing chromium (Debian) for the rendering check"
+    sudo=""
+    [[ $(id -u) -eq 0 ]] || sudo="sudo"
+    $sudo apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends chromium >/dev/null
+  fi
+  "$py" tests/docs/check_site.py "$root" "$build"
+fi
