@@ -70,16 +70,18 @@ extern "C" {
  * the table: a duplicate name, an output with a start value, a parameter or
  * input without one, an unknown type or causality fail the build with a
  * message naming the variable.
+ * Fields (all strings static, from the macro): name; type ("Float64",
+ * "Int32" or "Boolean"); causality ("parameter", "input", "output" or
+ * "independent"); start_text (the start value as written, "" for none);
+ * start (its value; Int32 and Boolean exact); unit ("" for none);
+ * description.
  */
-typedef struct {
-    const char *name;
-    const char *type;        /* "Float64", "Int32" or "Boolean" */
-    const char *causality;   /* "parameter", "input", "output" or "independent" */
-    const char *start_text;  /* the start value as written, "" for none */
-    double start;            /* its value (Int32 and Boolean: exact) */
-    const char *unit;        /* "" for none */
-    const char *description;
-} dmi_fmu_variable;
+typedef struct dmi_fmu_variable dmi_fmu_variable;
+struct dmi_fmu_variable {
+    const char *name, *type, *causality, *start_text;
+    double start;
+    const char *unit, *description;
+};
 
 /* One table entry from an X-macro row (see dmi_fmu_variable).  An empty
  * start gives start_text "" (the value is then unused). */
@@ -91,34 +93,37 @@ typedef struct {
 
 /*
  * The values of an instance's variables that are set (parameters, inputs),
- * owned by the framework.  value[vr] holds variable vr (Int32 and Boolean as
- * exact doubles; outputs: unspecified).  A model's functions get a const
- * pointer that stays valid, with the same address, as long as the solver
- * they configure (so the solver's callbacks may keep it as their user data
- * and read the inputs at each step); they never write through it.
+ * owned by the framework.  value[vr] holds variable vr, by value reference
+ * (Int32 and Boolean as exact doubles; outputs: unspecified); t_start is the
+ * experiment's start time (the solver's time t is the FMU's t_start + t).
+ * A model's functions get a const pointer that stays valid, with the same
+ * address, as long as the solver they configure (so the solver's callbacks
+ * may keep it as their user data and read the inputs at each step); they
+ * never write through it.
  */
-typedef struct {
-    double t_start; /* the experiment's start time: the solver's time t is t_start + t */
-    double value[]; /* by value reference */
-} dmi_fmu_values;
+typedef struct dmi_fmu_values dmi_fmu_values;
+struct dmi_fmu_values {
+    double t_start;
+    double value[];
+};
 
 /*
  * The outputs' arguments at a communication point t (the FMU's time), in
  * step p (from t_{p-1} to t_p, t_{p-1} < t <= t_p; p = 0 before the first
- * step).  Arrays of n values (the model's n), owned by the framework, valid
- * during the call.
+ * step): t; h = tau / N; p; n, the solver's dimension; u = u_h(t), the
+ * scheme's piecewise-linear interpolant, NULL before ExitInitializationMode
+ * (no solver yet: give the outputs from the parameters); U = U^p; W, the
+ * delay term of step p (zeros when p = 0); X, the resolvent's argument of
+ * step p, U^p = J(X) (U^0 when p = 0).  Arrays of n values, owned by the
+ * framework, valid during the call; U, W, X are NULL when u is.
  */
-typedef struct {
-    double t;          /* the communication point */
-    double h;          /* the step tau / N */
-    uint64_t p;        /* the step containing t */
-    size_t n;          /* the solver's dimension */
-    const double *u;   /* u_h(t), the scheme's piecewise-linear interpolant; NULL before
-                          ExitInitializationMode (no solver: outputs from the parameters) */
-    const double *U;   /* U^p */
-    const double *W;   /* W of step p, the delay term (zeros when p = 0) */
-    const double *X;   /* X of step p, the resolvent's argument: U^p = J(X) (U^0 when p = 0) */
-} dmi_fmu_point;
+typedef struct dmi_fmu_point dmi_fmu_point;
+struct dmi_fmu_point {
+    double t, h;
+    uint64_t p;
+    size_t n;
+    const double *u, *U, *W, *X;
+};
 
 /*
  * Configures the new solver s, created by the framework with dmi_create(s,
@@ -131,55 +136,63 @@ typedef struct {
  * the framework's out-of-memory message with N and the bytes).  The FMU then
  * logs "configuring the solver: <err>" and returns Error.
  */
-typedef int dmi_fmu_configure_fn(const dmi_fmu_values *v, dmi_solver *s, char *err);
+typedef int (*dmi_fmu_configure_fn)(const dmi_fmu_values *v, dmi_solver *s, char *err);
 
 /* Writes the outputs at pt into out[vr] for every output vr (Int32 and
  * Boolean outputs as exact doubles); the other entries are not read.  Called
  * at the first get of an output after a step, a set or a restored state
  * (the values are kept until the next change); out has one entry per value
  * reference and is owned by the framework. */
-typedef void dmi_fmu_outputs_fn(const dmi_fmu_values *v, const dmi_fmu_point *pt, double *out);
+typedef void (*dmi_fmu_outputs_fn)(const dmi_fmu_values *v, const dmi_fmu_point *pt,
+                                   double *out);
 
 /* Optional: accepts the value of parameter or input vr (before it is
  * stored; v holds the values before the call): 0, or nonzero with the reason
  * in err (the set call is refused, nothing changes).  The framework already
  * refuses non-finite values, tau <= 0 and N < 1. */
-typedef int dmi_fmu_accept_fn(const dmi_fmu_values *v, unsigned vr, double value, char *err);
+typedef int (*dmi_fmu_accept_fn)(const dmi_fmu_values *v, unsigned vr, double value, char *err);
 
 /* Optional: run at ExitInitializationMode, before the solver is created,
  * for an experiment of length T (stop - start time, or the default
  * experiment's stop time).  0: fine; 1: a warning (msg, status Warning);
  * -1: refused (msg, status Error). */
-typedef int dmi_fmu_check_fn(const dmi_fmu_values *v, double T, char *msg);
+typedef int (*dmi_fmu_check_fn)(const dmi_fmu_values *v, double T, char *msg);
 
 /* Optional: the bytes the solver allocates while initialising (peak) and
  * keeps (kept), for the memory messages (logMemory when peak > 100 MB, and
  * the out-of-memory error).  Without it the framework uses the figures of a
  * dense kernel (every entry of H sampled): 2 (N + 1) n doubles of history
  * and n^2 N samples kept, twice that while initialising. */
-typedef void dmi_fmu_bytes_fn(const dmi_fmu_values *v, double *peak, double *kept);
+typedef void (*dmi_fmu_bytes_fn)(const dmi_fmu_values *v, double *peak, double *kept);
 
-/* A model: what dmi_add_fmu builds an FMU of.  The model descriptions'
- * generator checks it at build time (a table as described above, tau a
- * Float64 and N an Int32 parameter, n >= 1, configure and outputs given). */
-typedef struct {
-    const char *description;              /* the model descriptions' description (with
-                                             " (libdmi <version>)" appended) */
-    const dmi_fmu_variable *variables;    /* the table (value reference = index) */
+/*
+ * A model: what dmi_add_fmu builds an FMU of.  Fields: description (the
+ * model descriptions', with " (libdmi <version>)" appended); variables and
+ * nvariables (the table, value reference = index); n (the components of u);
+ * tau and N (the value references of the delay, a Float64 parameter, and of
+ * the steps per tau, an Int32 parameter); stop_time and step_size (the
+ * default experiment, which starts at 0); configure and outputs (required);
+ * accept, check and bytes (optional: NULL for none; without bytes, the
+ * figures of a dense kernel); author (the model descriptions' author, NULL
+ * for none).  The model descriptions' generator checks it at build time (a
+ * table as described above, tau and N as said, n >= 1, configure and
+ * outputs given).
+ */
+typedef struct dmi_fmu_model dmi_fmu_model;
+struct dmi_fmu_model {
+    const char *description;
+    const dmi_fmu_variable *variables;
     size_t nvariables;
-    size_t n;                             /* components of u */
-    unsigned tau;                         /* value reference of the delay (Float64 parameter) */
-    unsigned N;                           /* value reference of the steps per tau (Int32
-                                             parameter) */
-    double stop_time;                     /* the default experiment (start 0) */
-    double step_size;                     /* its communication step */
-    dmi_fmu_configure_fn *configure;
-    dmi_fmu_outputs_fn *outputs;
-    dmi_fmu_accept_fn *accept;            /* NULL: none */
-    dmi_fmu_check_fn *check;              /* NULL: none */
-    dmi_fmu_bytes_fn *bytes;              /* NULL: the figures of a dense kernel */
-    const char *author;                   /* the model descriptions' author; NULL: none */
-} dmi_fmu_model;
+    size_t n;
+    unsigned tau, N;
+    double stop_time, step_size;
+    dmi_fmu_configure_fn configure;
+    dmi_fmu_outputs_fn outputs;
+    dmi_fmu_accept_fn accept;
+    dmi_fmu_check_fn check;
+    dmi_fmu_bytes_fn bytes;
+    const char *author;
+};
 
 /* The model of the FMU: define it once, in one of its C files:
  *   const dmi_fmu_model DMI_FMU_MODEL = {...}; */
