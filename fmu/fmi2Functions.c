@@ -9,7 +9,6 @@
  * (FMI 2.0: with the default "false", an FMU must not call malloc itself).
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include <stdio.h>
 #include <string.h>
 
 #include "fmi2Functions.h"
@@ -60,12 +59,14 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     void *env = functions->componentEnvironment;
     if (instanceName && *instanceName) { /* (an empty name: refused by fmu_instantiate) */
         if (fmuType != fmi2CoSimulation) {
-            fmu_log_error(fn, instanceName, sink, logger, env, "this FMU supports co-simulation only");
+            fmu_log_error(fn, instanceName, sink, logger, env,
+                          "this FMU supports co-simulation only");
             return NULL;
         }
-        if (!fmuGUID || strcmp(fmuGUID, DMI_FMU_GUID) != 0) {
-            fmu_log_error(fn, instanceName, sink, logger, env, "GUID \"%s\" does not match the FMU's %s",
-                          fmuGUID ? fmuGUID : "(null)", DMI_FMU_GUID);
+        if (!fmuGUID || strcmp(fmuGUID, dmi_fmu_guid) != 0) {
+            fmu_log_error(fn, instanceName, sink, logger, env,
+                          "GUID \"%s\" does not match the FMU's %s",
+                          fmuGUID ? fmuGUID : "(null)", dmi_fmu_guid);
             return NULL;
         }
     }
@@ -115,58 +116,53 @@ fmi2Status fmi2Reset(fmi2Component c)
 
 /* ---- getting and setting variables ---- */
 
-static int get_real(const model *m, unsigned vr, void *values, size_t i, char *err)
+static void put_integer(void *values, size_t i, double x)
 {
-    if (vr == VR_time) { /* FMI 3.0's independent variable: not a variable of FMI 2.0 */
-        snprintf(err, MODEL_ERRLEN, "value reference %u is not a Real variable", vr);
-        return -1;
-    }
-    return model_get_real(m, vr, (fmi2Real *)values + i, err);
+    ((fmi2Integer *)values)[i] = (fmi2Integer)x;
 }
 
-static int get_integer(const model *m, unsigned vr, void *values, size_t i, char *err)
+static void put_boolean(void *values, size_t i, double x)
 {
-    return model_get_integer(m, vr, (fmi2Integer *)values + i, err);
+    ((fmi2Boolean *)values)[i] = x != 0 ? fmi2True : fmi2False;
 }
 
-static int get_boolean(const model *m, unsigned vr, void *values, size_t i, char *err)
+static double take_real(const void *values, size_t i)
 {
-    int b = 0;
-    if (model_get_boolean(m, vr, &b, err) != 0)
-        return -1;
-    ((fmi2Boolean *)values)[i] = b ? fmi2True : fmi2False;
-    return 0;
+    return ((const fmi2Real *)values)[i];
 }
 
-static int set_real(model *m, unsigned vr, const void *values, size_t i, char *err)
+static double take_integer(const void *values, size_t i)
 {
-    return model_set_real(m, vr, ((const fmi2Real *)values)[i], err);
+    return ((const fmi2Integer *)values)[i];
 }
 
-static int set_integer(model *m, unsigned vr, const void *values, size_t i, char *err)
+static double take_boolean(const void *values, size_t i)
 {
-    return model_set_integer(m, vr, ((const fmi2Integer *)values)[i], err);
+    return ((const fmi2Boolean *)values)[i] != fmi2False;
 }
 
-#define GET(Type, type, getter)                                                                   \
+/* FMI 2.0 has no independent variable: FMI 3.0's time is not a Real here. */
+#define GET(Type, type, kind, put)                                                                \
     fmi2Status fmi2Get##Type(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,          \
                              type value[])                                                        \
     {                                                                                             \
         ENTER(c, FN_GET, "fmi2Get" #Type);                                                        \
-        return (fmi2Status)fmu_get(in, "fmi2Get" #Type, vr, nvr, value, getter);                  \
+        return (fmi2Status)fmu_get(in, "fmi2Get" #Type, vr, nvr, value,                           \
+                                   (kind) | FMU_NO_INDEPENDENT, put);                             \
     }
-#define SET(Type, type, setter)                                                                   \
+#define SET(Type, type, kind, take)                                                               \
     fmi2Status fmi2Set##Type(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,          \
                              const type value[])                                                  \
     {                                                                                             \
         ENTER(c, FN_SET, "fmi2Set" #Type);                                                        \
-        return (fmi2Status)fmu_set(in, "fmi2Set" #Type, vr, nvr, value, setter);                  \
+        return (fmi2Status)fmu_set(in, "fmi2Set" #Type, vr, nvr, value, kind, take);              \
     }
-GET(Real, fmi2Real, get_real)
-GET(Integer, fmi2Integer, get_integer)
-GET(Boolean, fmi2Boolean, get_boolean)
-SET(Real, fmi2Real, set_real)
-SET(Integer, fmi2Integer, set_integer)
+GET(Real, fmi2Real, FMU_FLOAT64, NULL) /* the values are doubles */
+GET(Integer, fmi2Integer, FMU_INT32, put_integer)
+GET(Boolean, fmi2Boolean, FMU_BOOLEAN, put_boolean)
+SET(Real, fmi2Real, FMU_FLOAT64, take_real)
+SET(Integer, fmi2Integer, FMU_INT32, take_integer)
+SET(Boolean, fmi2Boolean, FMU_BOOLEAN, take_boolean)
 
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                          fmi2String value[])
@@ -174,14 +170,6 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
     (void)vr, (void)value;
     ENTER(c, FN_GET, "fmi2GetString");
     return (fmi2Status)fmu_no_variables(in, "fmi2GetString", nvr, "String variables");
-}
-
-fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
-                          const fmi2Boolean value[])
-{
-    (void)vr, (void)value;
-    ENTER(c, FN_SET, "fmi2SetBoolean");
-    return (fmi2Status)fmu_no_variables(in, "fmi2SetBoolean", nvr, "settable Boolean variable");
 }
 
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,

@@ -8,8 +8,8 @@
  * The FMU has no event mode, never returns early and provides no
  * intermediate update (its model description says so): fmi3DoStep always
  * reports eventHandlingNeeded = terminateSimulation = earlyReturn = false.
- * Its variables are Float64 (parameters, the input g_in, outputs), Int32 (N)
- * and Boolean (sticking), all scalars; the functions of the other types, of
+ * Its variables are Float64, Int32 and Boolean scalars (the model's table,
+ * dmi_fmu.h); the functions of the other types, of
  * clocks, of model exchange and scheduled execution are exported as the
  * standard asks and refuse with fmi3Error and a logged reason.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -61,10 +61,10 @@ fmi3Instance fmi3InstantiateCoSimulation(
     (void)resourcePath, (void)visible, (void)earlyReturnAllowed;
     (void)requiredIntermediateVariables, (void)intermediateUpdate;
     if (instanceName && *instanceName) { /* (an empty name: refused by fmu_instantiate) */
-        if (!instantiationToken || strcmp(instantiationToken, DMI_FMU_GUID) != 0) {
+        if (!instantiationToken || strcmp(instantiationToken, dmi_fmu_guid) != 0) {
             fmu_log_error(fn, instanceName, sink, logger, instanceEnvironment,
                           "instantiation token \"%s\" is not the FMU's GUID %s",
-                          instantiationToken ? instantiationToken : "(null)", DMI_FMU_GUID);
+                          instantiationToken ? instantiationToken : "(null)", dmi_fmu_guid);
             return NULL;
         }
         if (eventModeUsed || nRequiredIntermediateVariables > 0) {
@@ -150,37 +150,29 @@ fmi3Status fmi3Reset(fmi3Instance instance)
 
 /* ---- getting and setting values ---- */
 
-static int get_float64(const model *m, unsigned vr, void *values, size_t i, char *err)
+static void put_int32(void *values, size_t i, double x)
 {
-    return model_get_real(m, vr, (fmi3Float64 *)values + i, err);
+    ((fmi3Int32 *)values)[i] = (fmi3Int32)x;
 }
 
-static int get_int32(const model *m, unsigned vr, void *values, size_t i, char *err)
+static void put_boolean(void *values, size_t i, double x)
 {
-    int v = 0;
-    if (model_get_integer(m, vr, &v, err) != 0)
-        return -1;
-    ((fmi3Int32 *)values)[i] = v;
-    return 0;
+    ((fmi3Boolean *)values)[i] = x != 0;
 }
 
-static int get_boolean(const model *m, unsigned vr, void *values, size_t i, char *err)
+static double take_float64(const void *values, size_t i)
 {
-    int b = 0;
-    if (model_get_boolean(m, vr, &b, err) != 0)
-        return -1;
-    ((fmi3Boolean *)values)[i] = b != 0;
-    return 0;
+    return ((const fmi3Float64 *)values)[i];
 }
 
-static int set_float64(model *m, unsigned vr, const void *values, size_t i, char *err)
+static double take_int32(const void *values, size_t i)
 {
-    return model_set_real(m, vr, ((const fmi3Float64 *)values)[i], err);
+    return ((const fmi3Int32 *)values)[i];
 }
 
-static int set_int32(model *m, unsigned vr, const void *values, size_t i, char *err)
+static double take_boolean(const void *values, size_t i)
 {
-    return model_set_integer(m, vr, ((const fmi3Int32 *)values)[i], err);
+    return ((const fmi3Boolean *)values)[i] != 0;
 }
 
 /* All variables are scalars: one value per value reference. */
@@ -194,7 +186,7 @@ static int bad_count(fmu_instance *in, const char *fn, size_t nvr, size_t nValue
     return 0;
 }
 
-#define GET(Type, getter)                                                                         \
+#define GET(Type, kind, put)                                                                      \
     fmi3Status fmi3Get##Type(fmi3Instance instance, const fmi3ValueReference valueReferences[],   \
                              size_t nValueReferences, fmi3##Type values[], size_t nValues)        \
     {                                                                                             \
@@ -202,9 +194,9 @@ static int bad_count(fmu_instance *in, const char *fn, size_t nvr, size_t nValue
         if (bad_count(in, "fmi3Get" #Type, nValueReferences, nValues))                            \
             return fmi3Error;                                                                     \
         return (fmi3Status)fmu_get(in, "fmi3Get" #Type, valueReferences, nValueReferences,        \
-                                   values, getter);                                               \
+                                   values, kind, put);                                            \
     }
-#define SET(Type, setter)                                                                         \
+#define SET(Type, kind, take)                                                                     \
     fmi3Status fmi3Set##Type(fmi3Instance instance, const fmi3ValueReference valueReferences[],   \
                              size_t nValueReferences, const fmi3##Type values[], size_t nValues)  \
     {                                                                                             \
@@ -212,15 +204,16 @@ static int bad_count(fmu_instance *in, const char *fn, size_t nvr, size_t nValue
         if (bad_count(in, "fmi3Set" #Type, nValueReferences, nValues))                            \
             return fmi3Error;                                                                     \
         return (fmi3Status)fmu_set(in, "fmi3Set" #Type, valueReferences, nValueReferences,        \
-                                   values, setter);                                               \
+                                   values, kind, take);                                           \
     }
-GET(Float64, get_float64)
-GET(Int32, get_int32)
-GET(Boolean, get_boolean)
-SET(Float64, set_float64)
-SET(Int32, set_int32)
+GET(Float64, FMU_FLOAT64, NULL) /* the values are doubles */
+GET(Int32, FMU_INT32, put_int32)
+GET(Boolean, FMU_BOOLEAN, put_boolean)
+SET(Float64, FMU_FLOAT64, take_float64)
+SET(Int32, FMU_INT32, take_int32)
+SET(Boolean, FMU_BOOLEAN, take_boolean)
 
-/* The types of which the FMU has no variable (Boolean: none settable). */
+/* The types of which the FMU has no variable. */
 #define NONE(Name, which, Type, what)                                                             \
     fmi3Status fmi3##Name(fmi3Instance instance, const fmi3ValueReference valueReferences[],      \
                           size_t nValueReferences, Type values[], size_t nValues)                 \
@@ -246,7 +239,6 @@ NONE(SetUInt16, FN_SET, const fmi3UInt16, "UInt16 variables")
 NONE(SetUInt32, FN_SET, const fmi3UInt32, "UInt32 variables")
 NONE(SetInt64, FN_SET, const fmi3Int64, "Int64 variables")
 NONE(SetUInt64, FN_SET, const fmi3UInt64, "UInt64 variables")
-NONE(SetBoolean, FN_SET, const fmi3Boolean, "settable Boolean variable")
 NONE(SetString, FN_SET, const fmi3String, "String variables")
 
 fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference valueReferences[],

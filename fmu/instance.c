@@ -43,7 +43,7 @@ static const unsigned ALLOWED[FN_COUNT] = {
 
 /* Log categories, as declared in both model descriptions. */
 #define CAT_NAME(name, description) #name,
-static const char *const CATEGORY[] = {MODEL_LOG_CATEGORIES(CAT_NAME)};
+static const char *const CATEGORY[] = {FMU_LOG_CATEGORIES(CAT_NAME)};
 #undef CAT_NAME
 enum { CAT_ERROR, CAT_WARNING, CAT_CALLS, CAT_MEMORY, NCAT };
 #define CAT_ALL ((1u << NCAT) - 1)
@@ -60,10 +60,10 @@ struct fmu_instance {
     unsigned state;
     int stop_defined;
     double stop_time;
-    model m;
+    fmu_model m;
 };
 
-/* A saved FMU state: the bytes of model_state_save. */
+/* A saved FMU state: the bytes of fmu_model_state_save. */
 typedef struct {
     size_t size;
     unsigned char bytes[];
@@ -74,7 +74,7 @@ static void send(fmu_sink *sink, fmu_callback logger, void *environment, const c
 {
     if (!sink || !logger)
         return;
-    char text[2 * MODEL_ERRLEN + 64];
+    char text[2 * FMU_ERRLEN + 64];
     if (msg)
         snprintf(text, sizeof text, "%s: %s", fn, msg);
     else /* a call that succeeded: its name, the outcome in the status */
@@ -95,7 +95,7 @@ static void emit(fmu_instance *in, fmu_status status, int category, const char *
 static void emitv(fmu_instance *in, fmu_status status, int category, const char *fn,
                   const char *fmt, va_list ap)
 {
-    char msg[2 * MODEL_ERRLEN];
+    char msg[2 * FMU_ERRLEN];
     vsnprintf(msg, sizeof msg, fmt, ap);
     emit(in, status, category, fn, msg);
 }
@@ -103,7 +103,7 @@ static void emitv(fmu_instance *in, fmu_status status, int category, const char 
 void fmu_log_error(const char *fn, const char *name, fmu_sink *sink, fmu_callback logger,
                    void *environment, const char *fmt, ...)
 {
-    char msg[2 * MODEL_ERRLEN];
+    char msg[2 * FMU_ERRLEN];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
@@ -172,9 +172,11 @@ fmu_instance *fmu_instantiate(const char *fn, const char *name, fmu_sink *sink,
     fmu_instance *in = calloc(1, sizeof *in);
     size_t len = strlen(name) + 1;
     char *copy = malloc(len);
-    if (!in || !copy) {
+    fmu_model m = {0};
+    if (!in || !copy || fmu_model_new(&m) != 0) {
         free(in);
         free(copy);
+        fmu_model_free(&m);
         fmu_log_error(fn, shown, sink, logger, environment, "out of memory");
         return NULL;
     }
@@ -182,8 +184,7 @@ fmu_instance *fmu_instantiate(const char *fn, const char *name, fmu_sink *sink,
     *in = (fmu_instance){.name = copy, .sink = sink, .logger = logger,
                          .environment = environment, .logging_instantiate = logging_on != 0,
                          .logging_on = logging_on != 0, .categories = CAT_ALL,
-                         .state = FMU_INSTANTIATED};
-    model_defaults(&in->m);
+                         .state = FMU_INSTANTIATED, .m = m};
     fmu_leave(in, fn, FMU_OK);
     return in;
 }
@@ -191,7 +192,7 @@ fmu_instance *fmu_instantiate(const char *fn, const char *name, fmu_sink *sink,
 void fmu_free_instance(fmu_instance *in, const char *fn)
 {
     fmu_leave(in, fn, FMU_OK);
-    model_free(&in->m);
+    fmu_model_free(&in->m);
     free(in->name);
     free(in);
 }
@@ -226,8 +227,7 @@ static fmu_status setup(fmu_instance *in, const char *fn, double start_time,
     if (stop_time_defined && !(stop_time >= start_time))
         return fmu_error(in, fn, "stop time %.17g before start time %.17g", stop_time,
                          start_time);
-    in->m.t_start = start_time;
-    in->m.t_comm = start_time;
+    fmu_model_set_start(&in->m, start_time);
     in->stop_defined = stop_time_defined != 0;
     in->stop_time = stop_time;
     return FMU_OK;
@@ -250,15 +250,19 @@ fmu_status fmu_enter_init(fmu_instance *in, const char *fn, const double *start_
 
 fmu_status fmu_exit_init(fmu_instance *in, const char *fn)
 {
-    char err[MODEL_ERRLEN], note[MODEL_ERRLEN];
-    if (model_start(&in->m, in->m.t_start, err, note) != 0)
+    char err[FMU_ERRLEN], note[FMU_ERRLEN], msg[FMU_ERRLEN];
+    const double T = in->stop_defined ? in->stop_time - in->m.v->t_start
+                                      : DMI_FMU_MODEL.stop_time;
+    const int check = fmu_model_check_start(&in->m, T, msg);
+    if (check < 0)
+        return fmu_error(in, fn, "%s", msg);
+    if (fmu_model_start(&in->m, in->m.v->t_start, err, note) != 0)
         return fmu_error(in, fn, "%s", err);
     in->state = FMU_STEP_MODE;
     if (note[0])
         send(in->sink, in->logger, in->environment, in->name, FMU_OK, CAT_MEMORY, fn, note);
-    const double T = in->stop_defined ? in->stop_time - in->m.t_start : MODEL_DEFAULT_T;
-    if (model_coarse_step(&in->m, T, err)) {
-        emit(in, FMU_WARNING, CAT_WARNING, fn, err);
+    if (check > 0) {
+        emit(in, FMU_WARNING, CAT_WARNING, fn, msg);
         return FMU_WARNING;
     }
     return fmu_leave(in, fn, FMU_OK);
@@ -272,8 +276,7 @@ fmu_status fmu_terminate(fmu_instance *in, const char *fn)
 
 fmu_status fmu_reset(fmu_instance *in, const char *fn)
 {
-    model_free(&in->m);
-    model_defaults(&in->m);
+    fmu_model_defaults(&in->m);
     in->logging_on = in->logging_instantiate; /* as if just instantiated */
     in->categories = CAT_ALL;
     in->state = FMU_INSTANTIATED;
@@ -294,38 +297,48 @@ static int bad_arrays(fmu_instance *in, const char *fn, const void *vr, size_t n
 }
 
 fmu_status fmu_get(fmu_instance *in, const char *fn, const unsigned vr[], size_t nvr,
-                   void *values, fmu_get_fn *get)
+                   void *values, unsigned type, fmu_put_fn *put)
 {
-    char err[MODEL_ERRLEN];
+    char err[FMU_ERRLEN];
     if (bad_arrays(in, fn, vr, nvr, values))
         return FMU_ERROR;
-    for (size_t i = 0; i < nvr; i++)
-        if (get(&in->m, vr[i], values, i, err) != 0)
+    if (type & FMU_FLOAT64) { /* the values are doubles already */
+        if (fmu_model_get_reals(&in->m, vr, nvr, type, values, err) != 0)
             return fmu_error(in, fn, "%s", err);
+        return fmu_leave(in, fn, FMU_OK);
+    }
+    for (size_t i = 0; i < nvr; i++) {
+        double x;
+        if (fmu_model_get(&in->m, vr[i], type, &x, err) != 0)
+            return fmu_error(in, fn, "%s", err);
+        put(values, i, x);
+    }
     return fmu_leave(in, fn, FMU_OK);
 }
 
 /* Whether the variable vr may be set in the instance's state. */
 static int settable(const fmu_instance *in, unsigned vr)
 {
-    return model_is_parameter(vr) ? (in->state & (FMU_INSTANTIATED | FMU_INIT_MODE)) != 0 : 1;
+    if (fmu_model_kind(&in->m, vr) & FMU_PARAMETER)
+        return (in->state & (FMU_INSTANTIATED | FMU_INIT_MODE)) != 0;
+    return 1;
 }
 
 fmu_status fmu_set(fmu_instance *in, const char *fn, const unsigned vr[], size_t nvr,
-                   const void *values, fmu_set_fn *set)
+                   const void *values, unsigned type, fmu_take_fn *take)
 {
-    char err[MODEL_ERRLEN];
+    char err[FMU_ERRLEN];
     if (bad_arrays(in, fn, vr, nvr, values))
         return FMU_ERROR;
-    model next = in->m;
-    for (size_t i = 0; i < nvr; i++) {
+    for (size_t i = 0; i < nvr; i++) { /* every value checked before any is stored */
         if (!settable(in, vr[i]))
             return fmu_error(in, fn, "the parameter with value reference %u cannot be changed "
                                      "after initialization", vr[i]);
-        if (set(&next, vr[i], values, i, err) != 0)
+        if (fmu_model_check(&in->m, vr[i], type, take(values, i), err) != 0)
             return fmu_error(in, fn, "%s", err);
     }
-    in->m = next;
+    for (size_t i = 0; i < nvr; i++)
+        fmu_model_store(&in->m, vr[i], take(values, i));
     return fmu_leave(in, fn, FMU_OK);
 }
 
@@ -341,7 +354,7 @@ fmu_status fmu_get_state(fmu_instance *in, const char *fn, void **state)
 {
     if (!state)
         return fmu_error(in, fn, "NULL pointer");
-    const size_t size = model_state_size(&in->m);
+    const size_t size = fmu_model_state_size(&in->m);
     saved_state *s = *state;
     if (!s || s->size != size) {
         saved_state *fresh = malloc(sizeof *s + size);
@@ -351,7 +364,7 @@ fmu_status fmu_get_state(fmu_instance *in, const char *fn, void **state)
         s = fresh;
     }
     s->size = size;
-    model_state_save(&in->m, in->state, s->bytes);
+    fmu_model_state_save(&in->m, in->state, s->bytes);
     *state = s;
     return fmu_leave(in, fn, FMU_OK);
 }
@@ -360,10 +373,10 @@ fmu_status fmu_set_state(fmu_instance *in, const char *fn, const void *state)
 {
     const saved_state *s = state;
     uint32_t tag = 0;
-    char err[MODEL_ERRLEN];
+    char err[FMU_ERRLEN];
     if (!s)
         return fmu_error(in, fn, "NULL state");
-    if (model_state_load(&in->m, SAVABLE, HAS_SOLVER, &tag, s->bytes, s->size, err) != 0)
+    if (fmu_model_state_load(&in->m, SAVABLE, HAS_SOLVER, &tag, s->bytes, s->size, err) != 0)
         return fmu_error(in, fn, "%s", err);
     in->state = tag;
     return fmu_leave(in, fn, FMU_OK);
@@ -403,10 +416,10 @@ fmu_status fmu_deserialize(fmu_instance *in, const char *fn, const unsigned char
                            size_t size, void **state)
 {
     uint32_t tag = 0;
-    char err[MODEL_ERRLEN];
+    char err[FMU_ERRLEN];
     if (!bytes || !state)
         return fmu_error(in, fn, "NULL argument");
-    if (model_state_load(NULL, SAVABLE, HAS_SOLVER, &tag, bytes, size, err) != 0)
+    if (fmu_model_state_load(NULL, SAVABLE, HAS_SOLVER, &tag, bytes, size, err) != 0)
         return fmu_error(in, fn, "%s", err);
     saved_state *s = malloc(sizeof *s + size);
     if (!s)
@@ -421,8 +434,8 @@ fmu_status fmu_deserialize(fmu_instance *in, const char *fn, const unsigned char
 
 fmu_status fmu_do_step(fmu_instance *in, const char *fn, double t, double h)
 {
-    char err[MODEL_ERRLEN];
-    int rc = model_do_step(&in->m, t, h, err);
+    char err[FMU_ERRLEN];
+    int rc = fmu_model_do_step(&in->m, t, h, err);
     if (rc == -2)
         in->state = FMU_ERROR_STATE;
     return rc == 0 ? fmu_leave(in, fn, FMU_OK) : fmu_error(in, fn, "%s", err);

@@ -1,10 +1,11 @@
 /*
  * The FMI side of the FMU common to FMI 2.0 and 3.0: an instance of the
- * model in model.h, the calling sequence (one table of the states in which
- * each function is allowed), logging through the importer's callback,
+ * model (framework.h over the model's dmi_fmu.h definition), the calling
+ * sequence (one table of the states in which each function is allowed),
+ * logging through the importer's callback,
  * all-or-nothing get/set, FMU states as checked bytes.  fmi2Functions.c and
  * fmi3Functions.c are thin adapters over it: they convert types and names
- * and call these functions.  Nothing here knows about the oscillator, or
+ * and call these functions.  Nothing here knows about a particular model, or
  * about a version of the standard beyond the states both share.
  *
  * Every function takes the FMI function's name (fn, "fmi2SetReal", ...) for
@@ -27,7 +28,7 @@
 
 #include <stddef.h>
 
-#include "model.h"
+#include "framework.h"
 
 /* Status codes: the same numbers as fmi2Status and fmi3Status. */
 typedef enum { FMU_OK, FMU_WARNING, FMU_DISCARD, FMU_ERROR, FMU_FATAL } fmu_status;
@@ -101,20 +102,24 @@ fmu_status fmu_setup_experiment(fmu_instance *in, const char *fn, double start_t
  * (start_time not NULL: checked and set as by fmu_setup_experiment). */
 fmu_status fmu_enter_init(fmu_instance *in, const char *fn, const double *start_time,
                           int stop_time_defined, double stop_time);
-/* Starts the solver; FMU_WARNING (logged) when the step is coarse (model_coarse_step). */
+/* Runs the model's check (a refusal: FMU_ERROR, nothing started) and starts
+ * the solver; FMU_WARNING (logged) when the check warns. */
 fmu_status fmu_exit_init(fmu_instance *in, const char *fn);
 fmu_status fmu_terminate(fmu_instance *in, const char *fn);
 fmu_status fmu_reset(fmu_instance *in, const char *fn);
 
-/* Element i of a value array through the model's getter or setter (the
- * adapter converts the FMI type). */
-typedef int fmu_get_fn(const model *m, unsigned vr, void *values, size_t i, char *err);
-typedef int fmu_set_fn(model *m, unsigned vr, const void *values, size_t i, char *err);
+/* Element i of an FMI value array from or to a double (the adapter converts
+ * its type; Int32 and Boolean values are exact doubles, Boolean 0 or 1). */
+typedef void fmu_put_fn(void *values, size_t i, double value);
+typedef double fmu_take_fn(const void *values, size_t i);
+/* The variables vr of type (FMU_FLOAT64, ..., with FMU_NO_INDEPENDENT for
+ * FMI 2.0's Real); put converts each value (NULL for FMU_FLOAT64: values is
+ * an array of doubles). */
 fmu_status fmu_get(fmu_instance *in, const char *fn, const unsigned vr[], size_t nvr,
-                   void *values, fmu_get_fn *get);
+                   void *values, unsigned type, fmu_put_fn *put);
 /* All values or none. */
 fmu_status fmu_set(fmu_instance *in, const char *fn, const unsigned vr[], size_t nvr,
-                   const void *values, fmu_set_fn *set);
+                   const void *values, unsigned type, fmu_take_fn *take);
 /* A type of which the FMU has no variable (nothing to get or set): nvr = 0 is
  * OK; what: "String variables", ... */
 fmu_status fmu_no_variables(fmu_instance *in, const char *fn, size_t nvr, const char *type);
@@ -129,7 +134,7 @@ fmu_status fmu_serialize(fmu_instance *in, const char *fn, const void *state,
 fmu_status fmu_deserialize(fmu_instance *in, const char *fn, const unsigned char *bytes,
                            size_t size, void **state);
 
-/* The communication step from t to t + h (model_do_step). */
+/* The communication step from t to t + h (fmu_model_do_step). */
 fmu_status fmu_do_step(fmu_instance *in, const char *fn, double t, double h);
 /* The FMU's time (the last communication point). */
 double fmu_time(const fmu_instance *in);

@@ -1,0 +1,157 @@
+/*
+ * Benchmark of FMU export (issue 20; not a test): the Burridge-Knopoff chain
+ * of examples/fmu-chain as its FMU (built in-tree with dmi_add_fmu, loaded
+ * with tests/fmu's loader) against the native libdmi loop of the same model
+ * (examples/fmu-chain/native.c, the same parameters, libdmi.so).  Each case
+ * runs the default experiment (T = 100, tau = 10) at N steps per tau with
+ * communication step dt (0.1, or h: one solver step per doStep), without or
+ * with the outputs at every communication point:
+ *   FMU     fmi2DoStep(t, dt) [then fmi2GetReal of the 9 outputs];
+ *   native  dmi_advance to the same grid step [then the same outputs from
+ *           dmi_get_state, dmi_get_past, dmi_get_step_terms, interpolated].
+ * Rounds are interleaved (each round runs every case, FMU and native one after
+ * the other, the order alternating), the fastest of the rounds counts; times
+ * are CPU times of the process, initialization not timed.  Prints the time
+ * per solver step and the ratio FMU / native (target <= 1.1).
+ * Usage: bench_fmu_chain [rounds]   (default 7)
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include "clock.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "dmi.h"
+#include "fmu_loader.h"
+
+#define CHAIN_NATIVE_NO_MAIN
+#include "native.c"
+
+/* The chain's value references (examples/fmu-chain/chain.c's table). */
+enum { VR_N = 11, VR_x1 = 16, NOUT = 9 };
+
+static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status,
+                   fmi2String category, fmi2String message, ...)
+{
+    (void)env;
+    (void)category;
+    fprintf(stderr, "bench_fmu_chain: %s: status %d: %s\n", name, (int)status, message);
+}
+
+/* CPU seconds of the FMU's loop to T; negative if a call failed. */
+static double fmu_run(const fmu_api *f, int N, double T, double dt, int get, double *sink)
+{
+    const fmi2CallbackFunctions cb = {logger, calloc, free, NULL, NULL};
+    fmi2Component c = f->instantiate("bench", fmi2CoSimulation, DMI_CHAIN_GUID, "", &cb,
+                                     fmi2False, fmi2False);
+    if (!c)
+        return -1;
+    const fmi2ValueReference vr_N = VR_N;
+    fmi2ValueReference out[NOUT];
+    for (int i = 0; i < NOUT; i++)
+        out[i] = VR_x1 + (fmi2ValueReference)i;
+    const fmi2Integer n = N;
+    double secs = -1, y[NOUT];
+    if (f->setup(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) == fmi2OK &&
+        f->set_integer(c, &vr_N, 1, &n) == fmi2OK && f->enter_init(c) == fmi2OK &&
+        f->exit_init(c) == fmi2OK) {
+        const long steps = lround(T / dt);
+        long k = 0;
+        const double t0 = cpu_now();
+        y[0] = 0;
+        while (k < steps && f->do_step(c, (double)k * dt, dt, fmi2True) == fmi2OK &&
+               (!get || f->get_real(c, out, NOUT, y) == fmi2OK)) {
+            *sink += y[0];
+            k++;
+        }
+        secs = k == steps ? cpu_now() - t0 : -1;
+    }
+    f->terminate(c);
+    f->free_instance(c);
+    return secs;
+}
+
+/* CPU seconds of the native loop to T; negative on failure. */
+static double native_run(int N, double T, double dt, int get, double *sink)
+{
+    chain c = CHAIN_DEFAULT;
+    c.N = (size_t)N;
+    dmi_solver *s = NULL;
+    if (chain_solver(&s, &c, 1) != DMI_OK)
+        return -1;
+    const double h = dmi_get_h(s);
+    const long steps = lround(T / dt);
+    double U[6], prev[6], W[6], X[6], y[NOUT];
+    long k = 0;
+    const double t0 = cpu_now();
+    for (; k < steps; k++) {
+        const double t = (double)(k + 1) * dt;
+        uint64_t p = 0;
+        dmi_get_step_index(s, &p);
+        const double target = ceil(t / h - 1e-6);
+        if (target > (double)p && dmi_advance(s, (size_t)(target - (double)p)) != DMI_OK)
+            break;
+        if (!get)
+            continue;
+        dmi_get_step_index(s, &p);
+        dmi_get_state(s, U);
+        dmi_get_past(s, 1, prev);
+        dmi_get_step_terms(s, W, X);
+        const double theta = t / h - (double)(p - 1);
+        for (int i = 0; i < 6; i++)
+            y[i] = theta >= 1 - 1e-6 ? U[i] : prev[i] + theta * (U[i] - prev[i]);
+        for (int i = 0; i < 3; i++)
+            y[6 + i] = fmin(fmax((X[3 + i] - U[3 + i]) / h, -c.alpha[i]), c.alpha[i]);
+        *sink += y[0];
+    }
+    const double secs = k == steps ? cpu_now() - t0 : -1;
+    dmi_free(&s);
+    return secs;
+}
+
+int main(int argc, char **argv)
+{
+    const int rounds = argc > 1 ? atoi(argv[1]) : 7;
+    const double T = 100.0, tau = 10.0;
+    static const int Ns[] = {1000, 100000};
+    enum { NCASE = 8 }; /* N x (dt = 0.1, h) x (no outputs, outputs) */
+    double best[NCASE][2];
+    fmu_api f;
+    if (fmu_load(&f, DMI_CHAIN_BINARY) != 0)
+        return 1;
+    for (int i = 0; i < NCASE; i++)
+        best[i][0] = best[i][1] = INFINITY;
+    double sink = 0;
+    for (int r = 0; r < rounds; r++)
+        for (int i = 0; i < NCASE; i++) {
+            const int N = Ns[i / 4], get = i % 2;
+            const double dt = (i / 2) % 2 ? tau / N : 0.1;
+            for (int j = 0; j < 2; j++) {
+                const int fmu = (j + r + i) % 2; /* the order alternates */
+                const double secs = fmu ? fmu_run(&f, N, T, dt, get, &sink)
+                                        : native_run(N, T, dt, get, &sink);
+                if (secs < 0) {
+                    fprintf(stderr, "bench_fmu_chain: a run failed (N = %d)\n", N);
+                    return 1;
+                }
+                if (secs < best[i][fmu])
+                    best[i][fmu] = secs;
+            }
+        }
+    printf("Burridge-Knopoff chain, T = %g, tau = %g, fastest of %d interleaved rounds "
+           "(CPU time)\n", T, tau, rounds);
+    printf("| N | communication step | outputs read | solver steps | native ns/step | "
+           "FMU ns/step | FMU / native |\n|---|---|---|---|---|---|---|\n");
+    for (int i = 0; i < NCASE; i++) {
+        const int N = Ns[i / 4];
+        const double steps = T / tau * N;
+        printf("| %d | %s | %s | %.0f | %.1f | %.1f | %.3f |\n", N, (i / 2) % 2 ? "h" : "0.1",
+               i % 2 ? "9" : "none", steps, 1e9 * best[i][0] / steps, 1e9 * best[i][1] / steps,
+               best[i][1] / best[i][0]);
+    }
+    fflush(stdout);
+    fprintf(stderr, "(checksum %g)\n", sink);
+    fmu_unload(&f);
+    return 0;
+}

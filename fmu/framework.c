@@ -1,0 +1,560 @@
+/*
+ * The FMU framework's model layer: see framework.h.
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include "framework.h"
+
+#include "bytes.h" /* libdmi's: FNV-1a, values at a byte offset */
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MODEL (&DMI_FMU_MODEL)
+
+static int fail(char *err, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err, FMU_ERRLEN, fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+/* ---- the table ---- */
+
+static unsigned kind_of(const dmi_fmu_variable *x)
+{
+    static const char *const TYPES[] = {"Float64", "Int32", "Boolean"};
+    static const char *const CAUSALITIES[] = {"parameter", "input", "output", "independent"};
+    unsigned type = 0, causality = 0;
+    for (unsigned k = 0; k < 3; k++)
+        if (strcmp(x->type, TYPES[k]) == 0)
+            type = FMU_FLOAT64 << k;
+    for (unsigned k = 0; k < 4; k++)
+        if (strcmp(x->causality, CAUSALITIES[k]) == 0)
+            causality = FMU_PARAMETER << k;
+    return type && causality ? type | causality : 0;
+}
+
+/* The number of value references: the table's, and the time if it has no
+ * independent variable. */
+static unsigned count_vr(void)
+{
+    for (size_t i = 0; i < MODEL->nvariables; i++)
+        if (kind_of(&MODEL->variables[i]) & FMU_INDEPENDENT)
+            return (unsigned)MODEL->nvariables;
+    return (unsigned)MODEL->nvariables + 1;
+}
+
+unsigned fmu_kind(unsigned vr)
+{
+    if (vr < MODEL->nvariables)
+        return kind_of(&MODEL->variables[vr]);
+    return vr < count_vr() ? FMU_FLOAT64 | FMU_INDEPENDENT : 0;
+}
+
+int fmu_is_set(unsigned kind)
+{
+    return (kind & (FMU_PARAMETER | FMU_INPUT)) != 0;
+}
+
+static const char *name_of(unsigned vr)
+{
+    return vr < MODEL->nvariables ? MODEL->variables[vr].name : "time";
+}
+
+/* "Real", "Integer", "Boolean": the FMI 2.0 names, as in the messages. */
+static const char *type_name(unsigned type)
+{
+    return type & FMU_FLOAT64 ? "Real" : type & FMU_INT32 ? "Integer" : "Boolean";
+}
+
+/* ---- values ---- */
+
+int fmu_model_new(fmu_model *m)
+{
+    const unsigned nvr = count_vr();
+    const size_t n = MODEL->n;
+    m->v = malloc(sizeof *m->v + (2 * nvr + 5 * n) * sizeof(double) + nvr);
+    if (!m->v)
+        return -1;
+    m->out = m->v->value + nvr;
+    m->work = m->out + nvr;
+    m->kind = (unsigned char *)(m->work + 5 * n);
+    m->nvr = nvr;
+    for (unsigned vr = 0; vr < nvr; vr++)
+        m->kind[vr] = (unsigned char)fmu_kind(vr);
+    m->solver = NULL;
+    fmu_model_defaults(m);
+    return 0;
+}
+
+unsigned fmu_model_kind(const fmu_model *m, unsigned vr)
+{
+    return vr < m->nvr ? m->kind[vr] : 0;
+}
+
+void fmu_model_defaults(fmu_model *m)
+{
+    dmi_free(&m->solver);
+    m->v->t_start = 0.0;
+    for (unsigned vr = 0; vr < m->nvr; vr++)
+        m->v->value[vr] = fmu_is_set(m->kind[vr]) ? MODEL->variables[vr].start : 0.0;
+    m->t_comm = 0.0;
+    m->out_valid = 0;
+}
+
+void fmu_model_free(fmu_model *m)
+{
+    dmi_free(&m->solver); /* before the values its callbacks read */
+    free(m->v);
+    m->v = NULL;
+}
+
+int fmu_model_check(const fmu_model *m, unsigned vr, unsigned type, double value, char *err)
+{
+    const unsigned kind = fmu_model_kind(m, vr);
+    if (!(kind & type) || !fmu_is_set(kind))
+        return fail(err, "value reference %u is not a settable %s variable", vr, type_name(type));
+    const char *name = name_of(vr);
+    if (!isfinite(value))
+        return fail(err, "%s = %g: the value must be finite", name, value);
+    if ((type & FMU_BOOLEAN) && value != 0 && value != 1)
+        return fail(err, "%s = %g: a Boolean is 0 or 1", name, value);
+    if (vr == MODEL->tau && !(value > 0))
+        return fail(err, "%s = %.17g: the delay must be > 0", name, value);
+    if (vr == MODEL->N && !(value >= 1))
+        return fail(err, "%s = %.0f: the number of steps per tau must be >= 1", name, value);
+    err[0] = '\0';
+    if (MODEL->accept && MODEL->accept(m->v, vr, value, err) != 0) {
+        if (!err[0])
+            return fail(err, "%s = %.17g: refused by the model", name, value);
+        return -1;
+    }
+    return 0;
+}
+
+void fmu_model_store(fmu_model *m, unsigned vr, double value)
+{
+    m->v->value[vr] = value;
+    m->out_valid = 0;
+}
+
+/* ---- memory ---- */
+
+static size_t steps_per_tau(const dmi_fmu_values *v)
+{
+    return (size_t)v->value[MODEL->N];
+}
+
+/* The bytes the solver allocates: the model's figures, or the bound of a
+ * dense kernel (the history ring, 2 (N + 1) n doubles; n^2 N kernel samples
+ * kept, the same again while sampling). */
+static void solver_bytes(const dmi_fmu_values *v, double *peak, double *kept)
+{
+    if (MODEL->bytes) {
+        MODEL->bytes(v, peak, kept);
+        return;
+    }
+    const double n = (double)MODEL->n, N = (double)steps_per_tau(v), d = sizeof(double);
+    const double ring = 2 * (N + 1) * n * d, samples = n * n * N * d;
+    *kept = ring + samples;
+    *peak = 2 * ring + 2 * samples;
+}
+
+/* "N = .. steps per tau: <bytes> while initialising, <bytes> after" into out
+ * (size bytes; cut to fit). */
+static void describe_bytes(const dmi_fmu_values *v, char *out, size_t size)
+{
+    double kept, peak;
+    solver_bytes(v, &peak, &kept);
+    snprintf(out, size, "%s = %zu steps per tau: the solver allocates %.0f bytes (%.3g GB) "
+                        "while initialising and keeps %.0f bytes (%.3g GB): a history of "
+                        "2(N+1) states and N kernel samples",
+             name_of(MODEL->N), steps_per_tau(v), peak, peak / 1e9, kept, kept / 1e9);
+}
+
+/* Out of memory: the error names N and the bytes needed. */
+static int memory_fail(char *err, const char *what, const dmi_fmu_values *v)
+{
+    int len = snprintf(err, FMU_ERRLEN, "%s: out of memory: ", what);
+    if (len >= 0 && len < FMU_ERRLEN)
+        describe_bytes(v, err + len, (size_t)(FMU_ERRLEN - len));
+    return -1;
+}
+
+static int solver_fail(char *err, const char *what, dmi_solver *s, int rc)
+{
+    snprintf(err, FMU_ERRLEN, "%s: %s", what, s ? dmi_last_error(s) : dmi_strerror(rc));
+    return -1;
+}
+
+/* ---- the solver ---- */
+
+/* A new solver for the values v, configured by the model, not initialised:
+ * only the history ring is allocated (with what the model's configure
+ * allocates: the kernel's terms), nothing is sampled yet. */
+static int solver_create(const dmi_fmu_values *v, dmi_solver **out, char *err)
+{
+    int rc = dmi_create(out, MODEL->n, v->value[MODEL->tau], steps_per_tau(v));
+    if (rc == DMI_ENOMEM)
+        return memory_fail(err, "creating the solver", v);
+    if (rc != DMI_OK)
+        return solver_fail(err, "creating the solver (tau, N)", NULL, rc);
+    char msg[FMU_ERRLEN] = "";
+    if ((rc = MODEL->configure(v, *out, msg)) != 0) {
+        if (rc == DMI_ENOMEM)
+            memory_fail(err, "configuring the solver", v);
+        else { /* the model's message after the prefix, cut to fit */
+            const char *why = msg[0] ? msg : dmi_last_error(*out);
+            size_t len = strlen(strcpy(err, "configuring the solver: "));
+            for (size_t i = 0; why[i] && len + 1 < FMU_ERRLEN; i++)
+                err[len++] = why[i];
+            err[len] = '\0';
+        }
+        dmi_free(out);
+        return -1;
+    }
+    return 0;
+}
+
+/* Samples the kernel and the history (dmi_init). */
+static int solver_init(const dmi_fmu_values *v, dmi_solver *s, char *err)
+{
+    int rc = dmi_init(s);
+    if (rc == DMI_ENOMEM)
+        return memory_fail(err, "initialising the solver", v);
+    return rc == DMI_OK ? 0 : solver_fail(err, "initialising the solver", s, rc);
+}
+
+int fmu_model_check_start(const fmu_model *m, double T, char *msg)
+{
+    msg[0] = '\0';
+    return MODEL->check ? MODEL->check(m->v, T, msg) : 0;
+}
+
+int fmu_model_start(fmu_model *m, double t_start, char *err, char *note)
+{
+    double kept, peak;
+    solver_bytes(m->v, &peak, &kept);
+    note[0] = '\0';
+    if (peak > FMU_NOTE_BYTES)
+        describe_bytes(m->v, note, FMU_ERRLEN);
+    dmi_solver *s = NULL;
+    if (solver_create(m->v, &s, err) != 0)
+        return -1;
+    if (solver_init(m->v, s, err) != 0) {
+        dmi_free(&s);
+        return -1;
+    }
+    dmi_free(&m->solver);
+    m->solver = s;
+    m->v->t_start = t_start;
+    m->t_comm = t_start;
+    m->out_valid = 0;
+    return 0;
+}
+
+/* The number of steps taken when the FMU is at time t: every step whose start
+ * t_p = t_start + p h is before t by more than FMU_TIME_TOL h. */
+static double steps_before(double t_start, double t, double h)
+{
+    return ceil((t - t_start) / h - FMU_TIME_TOL);
+}
+
+int fmu_model_do_step(fmu_model *m, double t_current, double step, char *err)
+{
+    const double h = dmi_get_h(m->solver);
+    if (!isfinite(t_current) || !isfinite(step) || !(step > 0))
+        return fail(err, "the time %.17g and the step %.17g must be finite and the step > 0",
+                    t_current, step);
+    if (fabs(t_current - m->t_comm) > FMU_TIME_TOL * h)
+        return fail(err, "the communication point %.17g is not the FMU's time %.17g", t_current,
+                    m->t_comm);
+    const double t_end = t_current + step;
+    const double target = steps_before(m->v->t_start, t_end, h);
+    uint64_t p = 0;
+    dmi_get_step_index(m->solver, &p);
+    if (!(target < 9007199254740992.0)) /* 2^53: beyond it p h has no meaning */
+        return fail(err, "t = %.17g is too far from the start for the step h", t_end);
+    m->out_valid = 0;
+    if (target > (double)p) {
+        int rc = dmi_advance(m->solver, (size_t)(target - (double)p));
+        if (rc != DMI_OK) {
+            solver_fail(err, "the solver failed", m->solver, rc);
+            return -2;
+        }
+    }
+    m->t_comm = t_end;
+    return 0;
+}
+
+/* ---- outputs ---- */
+
+/* The model's outputs at t_comm into m->out: u = u_h(t_comm) interpolated
+ * between U^{p-1} and U^p, W and X of that step.  Before the first step: U^0
+ * (u = X = U^0, W = 0); before the solver: no state. */
+static void outputs(fmu_model *m)
+{
+    const size_t n = MODEL->n;
+    double *u = m->work, *U = u + n, *prev = U + n, *W = prev + n, *X = W + n;
+    dmi_fmu_point pt = {m->t_comm, 0.0, 0, n, NULL, NULL, NULL, NULL};
+    if (m->solver) {
+        uint64_t p = 0;
+        dmi_get_step_index(m->solver, &p);
+        const double h = dmi_get_h(m->solver);
+        dmi_get_state(m->solver, U);
+        if (p == 0) {
+            for (size_t i = 0; i < n; i++) {
+                u[i] = X[i] = U[i];
+                W[i] = 0.0;
+            }
+        } else {
+            dmi_get_past(m->solver, 1, prev);
+            dmi_get_step_terms(m->solver, W, X);
+            const double theta = (m->t_comm - m->v->t_start) / h - (double)(p - 1);
+            const double th = theta > 0.0 ? theta : 0.0;
+            for (size_t i = 0; i < n; i++)
+                u[i] = theta >= 1.0 - FMU_TIME_TOL ? U[i] : prev[i] + th * (U[i] - prev[i]);
+        }
+        pt = (dmi_fmu_point){m->t_comm, h, p, n, u, U, W, X};
+    }
+    MODEL->outputs(m->v, &pt, m->out);
+    m->out_valid = 1;
+}
+
+int fmu_model_get(fmu_model *m, unsigned vr, unsigned type, double *value, char *err)
+{
+    const unsigned kind = fmu_model_kind(m, vr);
+    if (!(kind & type & (FMU_FLOAT64 | FMU_INT32 | FMU_BOOLEAN)) ||
+        ((type & FMU_NO_INDEPENDENT) && (kind & FMU_INDEPENDENT)))
+        return fail(err, "value reference %u is not %s %s variable", vr,
+                    type & FMU_INT32 ? "an" : "a", type_name(type));
+    if (fmu_is_set(kind)) {
+        *value = m->v->value[vr];
+    } else if (kind & FMU_INDEPENDENT) {
+        *value = m->t_comm;
+    } else {
+        if (!m->out_valid)
+            outputs(m);
+        *value = m->out[vr];
+    }
+    return 0;
+}
+
+int fmu_model_get_reals(fmu_model *m, const unsigned vr[], size_t nvr, unsigned type,
+                        double *values, char *err)
+{
+    for (size_t i = 0; i < nvr; i++)
+        if (fmu_model_get(m, vr[i], type, &values[i], err) != 0)
+            return -1;
+    return 0;
+}
+
+void fmu_model_set_start(fmu_model *m, double t_start)
+{
+    m->v->t_start = t_start;
+    m->t_comm = t_start;
+    m->out_valid = 0;
+}
+
+/* ---- saved state ---- */
+
+/* The numbers of Float64 and of other values set (the state's layout). */
+static void count_set(size_t *nreal, size_t *nint)
+{
+    *nreal = *nint = 0;
+    for (unsigned vr = 0; vr < MODEL->nvariables; vr++) {
+        const unsigned kind = fmu_kind(vr);
+        if (fmu_is_set(kind))
+            ++*(kind & FMU_FLOAT64 ? nreal : nint);
+    }
+}
+
+/* The offset of the Float64 values (after the integers) and of libdmi's part
+ * (after them, t_start and t_comm). */
+static size_t at_real(void)
+{
+    size_t nreal, nint;
+    count_set(&nreal, &nint);
+    return FMU_STATE_AT_INT + 8 * nint;
+}
+
+static size_t at_dmi(void)
+{
+    size_t nreal, nint;
+    count_set(&nreal, &nint);
+    return FMU_STATE_AT_INT + 8 * (nint + nreal + 2);
+}
+
+size_t fmu_model_state_size(const fmu_model *m)
+{
+    return at_dmi() + dmi_state_size(m->solver) + 8;
+}
+
+void fmu_model_state_save(const fmu_model *m, uint32_t tag, unsigned char *buf)
+{
+    const size_t total = fmu_model_state_size(m), ndmi = dmi_state_size(m->solver);
+    size_t nreal, nint, at_i = FMU_STATE_AT_INT, at_r = at_real();
+    count_set(&nreal, &nint);
+    memcpy(buf, FMU_STATE_MAGIC, 8);
+    dmi_put_u32(buf, FMU_STATE_AT_VERSION, FMU_STATE_VERSION);
+    dmi_put_u32(buf, FMU_STATE_AT_TAG, tag);
+    dmi_put_u64(buf, FMU_STATE_AT_TOTAL, total);
+    dmi_put_u64(buf, FMU_STATE_AT_NREAL, nreal);
+    dmi_put_u64(buf, FMU_STATE_AT_NDMI, ndmi);
+    for (unsigned vr = 0; vr < MODEL->nvariables; vr++) {
+        const unsigned kind = m->kind[vr];
+        if (!fmu_is_set(kind))
+            continue;
+        if (kind & FMU_FLOAT64) {
+            dmi_put_double(buf, at_r, m->v->value[vr]);
+            at_r += 8;
+        } else {
+            dmi_put_u64(buf, at_i, (uint64_t)(int64_t)m->v->value[vr]);
+            at_i += 8;
+        }
+    }
+    dmi_put_double(buf, at_r, m->v->t_start);
+    dmi_put_double(buf, at_r + 8, m->t_comm);
+    if (m->solver)
+        dmi_state_save(m->solver, buf + at_r + 16, ndmi);
+    dmi_put_u64(buf, total - 8, dmi_fnv1a(DMI_FNV1A_INIT, buf, total - 8));
+}
+
+/* The values of the state bytes into m (checked as if set); 0 or -1 (err). */
+static int load_values(fmu_model *m, const unsigned char *buf, char *err)
+{
+    size_t at_i = FMU_STATE_AT_INT, at_r = at_real();
+    for (int pass = 0; pass < 2; pass++) /* the Float64 values first, then the others */
+        for (unsigned vr = 0; vr < MODEL->nvariables; vr++) {
+            const unsigned kind = m->kind[vr];
+            if (!fmu_is_set(kind) || ((kind & FMU_FLOAT64) != 0) != (pass == 0))
+                continue;
+            double value;
+            if (pass == 0) {
+                value = dmi_get_double(buf, at_r);
+                at_r += 8;
+                if (fmu_model_check(m, vr, kind, value, err) != 0)
+                    return -1;
+            } else {
+                const int64_t x = (int64_t)dmi_get_u64(buf, at_i);
+                at_i += 8;
+                value = (double)x;
+                if (x < INT32_MIN || x > INT32_MAX || fmu_model_check(m, vr, kind, value, err))
+                    return fail(err, "state: %s = %lld is invalid", name_of(vr), (long long)x);
+            }
+            fmu_model_store(m, vr, value);
+        }
+    return 0;
+}
+
+/* The solver of the saved history b (ndmi bytes) for the values of m. */
+static int load_solver(fmu_model *m, const unsigned char *b, uint64_t ndmi, char *err)
+{
+    const size_t N = steps_per_tau(m->v);
+    /* libdmi's state holds the N + 1 stored states U^{p-N..p} of n doubles:
+     * fewer bytes cannot be a history for this N (checked before the solver
+     * for N is allocated); then the exact size from libdmi. */
+    if (ndmi / (MODEL->n * sizeof(double)) < (uint64_t)N + 1)
+        return fail(err, "state: the solver's history of %llu bytes is too short for %s = %zu",
+                    (unsigned long long)ndmi, name_of(MODEL->N), N);
+    dmi_solver *s = NULL;
+    if (solver_create(m->v, &s, err) != 0)
+        return -1;
+    const size_t need = dmi_state_size(s);
+    if (need != ndmi) {
+        dmi_free(&s);
+        return fail(err, "state: the solver's history has %llu bytes, %s = %zu needs %zu",
+                    (unsigned long long)ndmi, name_of(MODEL->N), N, need);
+    }
+    int rc = solver_init(m->v, s, err);
+    if (rc == 0 && (rc = dmi_state_load(s, b, (size_t)ndmi)) != DMI_OK)
+        solver_fail(err, "state: the solver's history", s, rc);
+    /* The FMU's time is never beyond the solver's t_p (a doStep takes the
+     * steps up to it): a communication point far ahead would make the next
+     * doStep take all the steps to it. */
+    uint64_t p = 0;
+    if (rc == 0 && (dmi_get_step_index(s, &p) != DMI_OK ||
+                    steps_before(m->v->t_start, m->t_comm, dmi_get_h(s)) > (double)p))
+        rc = fail(err, "state: the communication point %.17g is beyond the solver's step %llu",
+                  m->t_comm, (unsigned long long)p);
+    if (rc != 0) {
+        dmi_free(&s);
+        return -1;
+    }
+    m->solver = s;
+    return 0;
+}
+
+int fmu_model_state_load(fmu_model *into, uint32_t tags, uint32_t solver_tags, uint32_t *tag,
+                         const unsigned char *buf, size_t size, char *err)
+{
+    const size_t AT_DMI = at_dmi(), AT_REAL = at_real();
+    size_t nreal_model, nint;
+    count_set(&nreal_model, &nint);
+    if (!buf || size < AT_DMI + 8)
+        return fail(err, "state: %zu bytes is too short for a saved state", size);
+    if (memcmp(buf, FMU_STATE_MAGIC, 8) != 0)
+        return fail(err, "state: the bytes are not a saved state of this FMU (bad magic)");
+    const uint32_t version = dmi_get_u32(buf, FMU_STATE_AT_VERSION);
+    const uint64_t total = dmi_get_u64(buf, FMU_STATE_AT_TOTAL);
+    const uint64_t nreal = dmi_get_u64(buf, FMU_STATE_AT_NREAL);
+    const uint64_t ndmi = dmi_get_u64(buf, FMU_STATE_AT_NDMI);
+    *tag = dmi_get_u32(buf, FMU_STATE_AT_TAG);
+    if (*tag == 0 || (*tag & (*tag - 1)) != 0 || (*tag & tags) == 0)
+        return fail(err, "state: the saved phase tag %lu is not allowed", (unsigned long)*tag);
+    if (version != FMU_STATE_VERSION)
+        return fail(err, "state: format version %lu is not supported (this FMU reads version %d%s)",
+                    (unsigned long)version, FMU_STATE_VERSION,
+                    version == 1 ? "; version 1 was written by the FMU of libdmi 1.0" : "");
+    if (nreal != nreal_model || total != size || ndmi != size - (AT_DMI + 8))
+        return fail(err, "state: the sizes recorded in the state do not match (%zu bytes given)",
+                    size);
+    if (dmi_get_u64(buf, size - 8) != dmi_fnv1a(DMI_FNV1A_INIT, buf, size - 8))
+        return fail(err, "state: the checksum does not match (corrupted bytes)");
+    const double t_start = dmi_get_double(buf, AT_REAL + 8 * nreal);
+    const double t_comm = dmi_get_double(buf, AT_REAL + 8 * (nreal + 1));
+
+    fmu_model m;
+    if (fmu_model_new(&m) != 0)
+        return fail(err, "state: out of memory");
+    if (load_values(&m, buf, err) != 0)
+        goto refused;
+    if (!isfinite(t_start) || !isfinite(t_comm) || t_comm < t_start) {
+        fail(err, "state: invalid times (start %.17g, communication point %.17g)", t_start,
+             t_comm);
+        goto refused;
+    }
+    m.v->t_start = t_start;
+    m.t_comm = t_comm;
+    const int has_solver = (*tag & solver_tags) != 0;
+    if (has_solver != (ndmi > 0)) {
+        fail(err, "state: the saved phase tag %lu %s the solver's history, the state has %llu "
+                  "bytes of it", (unsigned long)*tag, has_solver ? "needs" : "has no",
+             (unsigned long long)ndmi);
+        goto refused;
+    }
+    if (has_solver) {
+        if (load_solver(&m, buf + AT_DMI, ndmi, err) != 0)
+            goto refused;
+    } else if (t_comm != t_start) { /* before initialization: no step taken */
+        fail(err, "state: invalid times (start %.17g, communication point %.17g)", t_start,
+             t_comm);
+        goto refused;
+    }
+    m.out_valid = 0;
+    if (into) {
+        fmu_model_free(into);
+        *into = m; /* the solver's callbacks keep m.v, which moves with it */
+    } else {
+        fmu_model_free(&m);
+    }
+    return 0;
+refused:
+    fmu_model_free(&m);
+    return -1;
+}
