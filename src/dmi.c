@@ -146,7 +146,7 @@ void dmi_engine_rebuild(const dmi_solver *s, dmi_conv *conv, dmi_exp *rec)
 static void delay_sum(const dmi_solver *s, double *W)
 {
     if (s->rec) {
-        dmi_exp_sum(s->rec, s->h, W);
+        dmi_exp_sum(s->rec, W);
         return;
     }
 #ifdef DMI_HAVE_FFT

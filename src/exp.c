@@ -267,23 +267,35 @@ typedef struct {
     double tab[2 * BLOCK];       /* r^i, i < BLOCK: re, im */
 } term;
 
+/* The multipliers of one sum for its step, copied from its term so that the
+ * step reads one contiguous record per sum. */
 typedef struct {
-    size_t term, col;
-    double re, im; /* the sum S */
-} sum;
+    double rh_re, rh_im, rl_re, rl_im, rN_re, rN_im;
+} mult;
 
-typedef struct {
-    size_t sum, row;
-    double C, D; /* W_row += C Re S + D Im S */
-} part;
-
+/*
+ * The sums are kept in the order real ones first (nreal of them), then the
+ * complex ones, so that the step runs two branch-free loops; slot[q] is the
+ * place of sum q in the saved order (term by term, used columns ascending).
+ * The parts C, D of row i are parts [row_start[i], row_start[i + 1]), in the
+ * saved order of their sums, so each W_i is summed in the order of the
+ * original engine.  W (h times the sum, n values) is recomputed whenever the
+ * sums change, so dmi_exp_sum only copies it.
+ */
 struct dmi_exp {
-    size_t n, N, nterms, nsums, nparts;
+    size_t n, N, nterms, nsums, nreal, nparts;
+    double h;
     uint64_t period;
     uint64_t next; /* the next anchoring step: the multiple of period after the last anchor */
     term *terms;
-    sum *sums;
-    part *parts;
+    size_t *term_of, *col, *slot; /* per sum */
+    size_t *series;               /* per sum: offset of its column's series in the ring */
+    mult *m;                      /* per sum */
+    double *re, *im;              /* per sum: the sum S */
+    size_t *row_start;            /* n + 1 */
+    size_t *psum;                 /* per part: its sum (internal index) */
+    double *pC, *pD;              /* per part: W_row += C Re S + D Im S */
+    double *W;                    /* n: h sum of the parts, W^p */
 };
 
 void dmi_exp_free(dmi_exp *e)
@@ -291,8 +303,18 @@ void dmi_exp_free(dmi_exp *e)
     if (!e)
         return;
     free(e->terms);
-    free(e->sums);
-    free(e->parts);
+    free(e->term_of);
+    free(e->col);
+    free(e->slot);
+    free(e->series);
+    free(e->m);
+    free(e->re);
+    free(e->im);
+    free(e->row_start);
+    free(e->psum);
+    free(e->pC);
+    free(e->pD);
+    free(e->W);
     free(e);
 }
 
@@ -327,6 +349,11 @@ static void term_init(term *t, double a, double b, double h, size_t N)
     }
 }
 
+static void *array(size_t count, size_t size)
+{
+    return calloc(count ? count : 1, size);
+}
+
 int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
 {
     *out = NULL;
@@ -336,39 +363,89 @@ int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
         return -1;
     e->n = n;
     e->N = N;
+    e->h = h;
     e->period = (uint64_t)PERIOD * (uint64_t)N;
     e->nsums = dmi_expk_sums(k);
     for (size_t q = 0; q < k->K * nn; q++) /* k->K n n was checked by dmi_expk_copy */
         e->nparts += k->C[q] != 0 || (k->D && k->D[q] != 0);
     e->nterms = k->K;
-    e->terms = malloc((k->K ? k->K : 1) * sizeof *e->terms);
-    e->sums = calloc(e->nsums ? e->nsums : 1, sizeof *e->sums);
-    e->parts = malloc((e->nparts ? e->nparts : 1) * sizeof *e->parts);
-    if (!e->terms || !e->sums || !e->parts) {
+    const size_t ns = e->nsums, np = e->nparts;
+    e->terms = array(k->K, sizeof *e->terms);
+    e->term_of = array(ns, sizeof *e->term_of);
+    e->col = array(ns, sizeof *e->col);
+    e->slot = array(ns, sizeof *e->slot);
+    e->series = array(ns, sizeof *e->series);
+    e->m = array(ns, sizeof *e->m);
+    e->re = array(ns, sizeof *e->re);
+    e->im = array(ns, sizeof *e->im);
+    e->row_start = array(n + 1, sizeof *e->row_start);
+    e->psum = array(np, sizeof *e->psum);
+    e->pC = array(np, sizeof *e->pC);
+    e->pD = array(np, sizeof *e->pD);
+    e->W = array(n, sizeof *e->W);
+    size_t *index = array(k->K * n, sizeof *index); /* (t, j) -> internal sum index */
+    if (!e->terms || !e->term_of || !e->col || !e->slot || !e->series || !e->m || !e->re ||
+        !e->im || !e->row_start || !e->psum || !e->pC || !e->pD || !e->W || !index) {
+        free(index);
         dmi_exp_free(e);
         return -1;
     }
-    size_t q = 0, np = 0;
-    for (size_t t = 0; t < k->K; t++) {
+    for (size_t t = 0; t < k->K; t++)
         term_init(&e->terms[t], k->a[t], k->b[t], h, N);
-        for (size_t j = 0; j < n; j++) {
-            if (!column_used(k, t, j))
-                continue;
-            e->sums[q].term = t;
-            e->sums[q].col = j;
-            for (size_t i = 0; i < n; i++) {
+    /* internal order: the real sums, then the complex ones, each in saved order */
+    size_t q = 0;
+    for (int pass = 0; pass < 2; pass++)
+        for (size_t t = 0, sv = 0; t < k->K; t++)
+            for (size_t j = 0; j < n; j++) {
+                if (!column_used(k, t, j))
+                    continue;
+                if (e->terms[t].real == (pass == 0)) {
+                    const term *tm = &e->terms[t];
+                    mult mu = {tm->rh_re, tm->rh_im, tm->rl_re, tm->rl_im, tm->rN_re, tm->rN_im};
+                    e->term_of[q] = t;
+                    e->col[q] = j;
+                    e->slot[q] = sv;
+                    e->series[q] = j * 2 * (N + 1); /* the ring's layout, L = N + 1 */
+                    e->m[q] = mu;
+                    index[t * n + j] = q++;
+                }
+                sv++;
+            }
+    for (size_t x = 0; x < ns; x++)
+        e->nreal += (size_t)e->terms[e->term_of[x]].real;
+    /* parts row by row; within a row in the saved order (term, column) */
+    size_t pp = 0;
+    for (size_t i = 0; i < n; i++) {
+        e->row_start[i] = pp;
+        for (size_t t = 0; t < k->K; t++)
+            for (size_t j = 0; j < n; j++) {
                 size_t x = t * nn + i * n + j;
                 double C = k->C[x], D = k->D ? k->D[x] : 0.0;
                 if (C == 0 && D == 0)
                     continue;
-                part pt = {q, i, C, D};
-                e->parts[np++] = pt;
+                e->psum[pp] = index[t * n + j];
+                e->pC[pp] = C;
+                e->pD[pp] = D;
+                pp++;
             }
-            q++;
-        }
     }
+    e->row_start[n] = pp;
+    free(index);
     *out = e;
     return 0;
+}
+
+/* W = h sum of the parts, row by row (each row in a local, written once). */
+static void update_W(dmi_exp *e)
+{
+    const double *re = e->re, *im = e->im, *C = e->pC, *D = e->pD;
+    const size_t *ps = e->psum;
+    for (size_t i = 0; i < e->n; i++) {
+        double w = 0;
+        for (size_t q = e->row_start[i]; q < e->row_start[i + 1]; q++)
+            w += C[q] * re[ps[q]] + D[q] * im[ps[q]];
+        e->W[i] = w * e->h;
+    }
 }
 
 /* acc += x, error-free: acc.hi + acc.lo carries the sum's rounding. */
@@ -389,9 +466,8 @@ void dmi_exp_anchor(dmi_exp *e, const dmi_history *r, uint64_t p)
 {
     set_next(e, p);
     for (size_t q = 0; q < e->nsums; q++) {
-        sum *S = &e->sums[q];
-        const term *t = &e->terms[S->term];
-        const double *u = dmi_history_series(r, S->col); /* u[l] = U^{p-l} */
+        const term *t = &e->terms[e->term_of[q]];
+        const double *u = dmi_history_series(r, e->col[q]); /* u[l] = U^{p-l} */
         dd re = {0, 0}, im = {0, 0};
         cdd base = cdd_one(); /* r^l0 */
         for (size_t l0 = 0; l0 < e->N; l0 += BLOCK) {
@@ -409,9 +485,10 @@ void dmi_exp_anchor(dmi_exp *e, const dmi_history *r, uint64_t p)
             }
             base = cdd_mul(base, t->rB);
         }
-        S->re = re.hi + re.lo;
-        S->im = im.hi + im.lo;
+        e->re[q] = re.hi + re.lo;
+        e->im[q] = im.hi + im.lo;
     }
+    update_W(e);
 }
 
 void dmi_exp_advance(dmi_exp *e, const dmi_history *r, uint64_t p)
@@ -420,35 +497,29 @@ void dmi_exp_advance(dmi_exp *e, const dmi_history *r, uint64_t p)
         dmi_exp_anchor(e, r, p);
         return;
     }
-    const size_t N = e->N;
-    for (size_t q = 0; q < e->nsums; q++) {
-        sum *S = &e->sums[q];
-        const term *t = &e->terms[S->term];
-        const double *u = dmi_history_series(r, S->col);
-        const double unew = u[0], uold = u[N];
-        const double x = S->re, y = S->im;
-        if (t->real) {
-            S->re = x * t->rh_re + (x * t->rl_re + (unew - t->rN_re * uold));
-        } else {
-            S->re = (x * t->rh_re - y * t->rh_im) +
-                    ((x * t->rl_re - y * t->rl_im) + (unew - t->rN_re * uold));
-            S->im = (x * t->rh_im + y * t->rh_re) +
-                    ((x * t->rl_im + y * t->rl_re) - t->rN_im * uold);
-        }
+    const double *buf = r->buf + r->head;
+    const size_t N = e->N, nr = e->nreal, ns = e->nsums;
+    const size_t *off = e->series;
+    const mult *m = e->m;
+    double *re = e->re, *im = e->im;
+    for (size_t q = 0; q < nr; q++) {
+        const double unew = buf[off[q]], uold = buf[off[q] + N], x = re[q];
+        re[q] = x * m[q].rh_re + (x * m[q].rl_re + (unew - m[q].rN_re * uold));
     }
+    for (size_t q = nr; q < ns; q++) {
+        const double unew = buf[off[q]], uold = buf[off[q] + N], x = re[q], y = im[q];
+        re[q] = (x * m[q].rh_re - y * m[q].rh_im) +
+                ((x * m[q].rl_re - y * m[q].rl_im) + (unew - m[q].rN_re * uold));
+        im[q] = (x * m[q].rh_im + y * m[q].rh_re) +
+                ((x * m[q].rl_im + y * m[q].rl_re) - m[q].rN_im * uold);
+    }
+    update_W(e);
 }
 
-void dmi_exp_sum(const dmi_exp *e, double h, double *W)
+void dmi_exp_sum(const dmi_exp *e, double *W)
 {
     for (size_t i = 0; i < e->n; i++)
-        W[i] = 0;
-    for (size_t q = 0; q < e->nparts; q++) {
-        const part *pt = &e->parts[q];
-        const sum *S = &e->sums[pt->sum];
-        W[pt->row] += pt->C * S->re + pt->D * S->im;
-    }
-    for (size_t i = 0; i < e->n; i++)
-        W[i] *= h;
+        W[i] = e->W[i];
 }
 
 uint64_t dmi_exp_period(const dmi_exp *e)
@@ -459,8 +530,9 @@ uint64_t dmi_exp_period(const dmi_exp *e)
 void dmi_exp_get(const dmi_exp *e, unsigned char *bytes)
 {
     for (size_t q = 0; q < e->nsums; q++) {
-        memcpy(bytes + 2 * q * sizeof(double), &e->sums[q].re, sizeof(double));
-        memcpy(bytes + (2 * q + 1) * sizeof(double), &e->sums[q].im, sizeof(double));
+        const size_t s = e->slot[q];
+        memcpy(bytes + 2 * s * sizeof(double), &e->re[q], sizeof(double));
+        memcpy(bytes + (2 * s + 1) * sizeof(double), &e->im[q], sizeof(double));
     }
 }
 
@@ -468,7 +540,8 @@ void dmi_exp_set(dmi_exp *e, const double *sums, uint64_t p)
 {
     set_next(e, p);
     for (size_t q = 0; q < e->nsums; q++) {
-        e->sums[q].re = sums[2 * q];
-        e->sums[q].im = sums[2 * q + 1];
+        e->re[q] = sums[2 * e->slot[q]];
+        e->im[q] = sums[2 * e->slot[q] + 1];
     }
+    update_W(e);
 }
