@@ -203,6 +203,71 @@ int dmi_expk_eval(double s, double *out, void *user)
     return 0;
 }
 
+int dmi_expk_sample(const dmi_expk *k, size_t N, double h, dmi_kernel *out)
+{
+    const size_t n = k->n, nn = n * n, K = k->K;
+    dmi_kernel_alloc(out, n, N, NULL);
+    /* per term and sample: e^{a s} cos(b s) and e^{a s} sin(b s), as dmi_expk_eval */
+    size_t bytes = dmi_mul_size(2 * K, N, sizeof(double));
+    double *cs = bytes ? malloc(bytes) : NULL;
+    if (!cs)
+        return -1;
+    int finite = 1;
+    for (size_t t = 0; t < K; t++)
+        for (size_t l = 0; l < N; l++) {
+            double x = (double)l * h, e = exp(k->a[t] * x);
+            double c = e * cos(k->b[t] * x), sn = e * sin(k->b[t] * x);
+            cs[(2 * t) * N + l] = c;
+            cs[(2 * t + 1) * N + l] = sn;
+            finite &= isfinite(c) && isfinite(sn);
+        }
+    size_t cand = 0;
+    for (size_t q = 0; q < nn; q++)
+        for (size_t t = 0; t < K; t++)
+            if (k->C[t * nn + q] != 0 || (k->D && k->D[t * nn + q] != 0)) {
+                cand++;
+                break;
+            }
+    int rc = finite ? 0 : 1;
+    if (rc == 0 && cand > 0) {
+        out->row = malloc(cand * sizeof *out->row);
+        out->col = malloc(cand * sizeof *out->col);
+        out->samples = malloc(cand * N * sizeof *out->samples); /* <= N n n doubles */
+        rc = out->row && out->col && out->samples ? 0 : -1;
+    }
+    size_t e = 0;
+    for (size_t q = 0; q < nn && rc == 0; q++) {
+        int used = 0;
+        for (size_t t = 0; t < K && !used; t++)
+            used = k->C[t * nn + q] != 0 || (k->D && k->D[t * nn + q] != 0);
+        if (!used)
+            continue;
+        double *x = out->samples + e * N;
+        int nonzero = 0;
+        for (size_t l = 0; l < N; l++) {
+            double v = 0;
+            for (size_t t = 0; t < K; t++) {
+                const double C = k->C[t * nn + q], c = cs[(2 * t) * N + l];
+                v += k->D ? C * c + k->D[t * nn + q] * cs[(2 * t + 1) * N + l] : C * c;
+            }
+            x[l] = v;
+            nonzero |= v != 0;
+            if (!isfinite(v))
+                rc = 1;
+        }
+        if (nonzero) {
+            out->row[e] = q / n;
+            out->col[e] = q % n;
+            e++;
+        }
+    }
+    free(cs);
+    out->nnz = e;
+    if (rc != 0)
+        dmi_kernel_release(out);
+    return rc;
+}
+
 /* Whether column j of term t has a nonzero entry in C_t or D_t. */
 static int column_used(const dmi_expk *k, size_t t, size_t j)
 {

@@ -31,6 +31,13 @@ void dmi_expk_release(dmi_expk *k);
 /* H(s) of the kernel: a dmi_kernel_fn, user = the dmi_expk. */
 int dmi_expk_eval(double s, double *out, void *user);
 
+/* The samples H(l h), l < N, of the entries that some C_k or D_k has, as
+ * dmi_kernel_alloc would store them from dense samples of dmi_expk_eval
+ * (bitwise the same values; entries zero at every sample left out), without
+ * the N n n dense array.  0; -1 when out of memory; 1 when a sample is not
+ * finite (the dense path then tells which).  out is empty unless 0. */
+int dmi_expk_sample(const dmi_expk *k, size_t N, double h, dmi_kernel *out);
+
 /* Whether term t has a nonzero entry in C_t or D_t. */
 int dmi_expk_term_used(const dmi_expk *k, size_t t);
 
