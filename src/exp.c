@@ -343,9 +343,9 @@ typedef struct {
  * complex ones, so that the step runs two branch-free loops; slot[q] is the
  * place of sum q in the saved order (term by term, used columns ascending).
  * The parts C, D of row i are parts [row_start[i], row_start[i + 1]), in the
- * saved order of their sums, so each W_i is summed in the order of the
- * original engine.  W (h times the sum, n values) is recomputed whenever the
- * sums change, so dmi_exp_sum only copies it.
+ * saved order of their sums (summed in two partial sums, see update_W).  W
+ * (h times the sum, n values) is recomputed whenever the sums change, so
+ * dmi_exp_sum only copies it.
  */
 struct dmi_exp {
     size_t n, N, nterms, nsums, nreal, nparts;
@@ -360,6 +360,7 @@ struct dmi_exp {
     size_t *row_start;            /* n + 1 */
     size_t *psum;                 /* per part: its sum (internal index) */
     double *pC, *pD;              /* per part: W_row += C Re S + D Im S */
+    int has_D;                    /* some part has D != 0 */
     double *W;                    /* n: h sum of the parts, W^p */
 };
 
@@ -491,6 +492,7 @@ int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
                 e->psum[pp] = index[t * n + j];
                 e->pC[pp] = C;
                 e->pD[pp] = D;
+                e->has_D |= D != 0;
                 pp++;
             }
     }
@@ -500,16 +502,34 @@ int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
     return 0;
 }
 
-/* W = h sum of the parts, row by row (each row in a local, written once). */
+/* W = h sum of the parts, row by row (each row in locals, written once).
+ * Two partial sums in a fixed order, so a long row (a dense block) is not
+ * one chain of dependent additions; without D (no sine part in any term)
+ * the imaginary parts are not read. */
 static void update_W(dmi_exp *e)
 {
     const double *re = e->re, *im = e->im, *C = e->pC, *D = e->pD;
     const size_t *ps = e->psum;
     for (size_t i = 0; i < e->n; i++) {
-        double w = 0;
-        for (size_t q = e->row_start[i]; q < e->row_start[i + 1]; q++)
-            w += C[q] * re[ps[q]] + D[q] * im[ps[q]];
-        e->W[i] = w * e->h;
+        const size_t end = e->row_start[i + 1];
+        size_t q = e->row_start[i];
+        double w0 = 0, w1 = 0;
+        if (e->has_D) {
+            for (; q + 1 < end; q += 2) {
+                w0 += C[q] * re[ps[q]] + D[q] * im[ps[q]];
+                w1 += C[q + 1] * re[ps[q + 1]] + D[q + 1] * im[ps[q + 1]];
+            }
+            if (q < end)
+                w0 += C[q] * re[ps[q]] + D[q] * im[ps[q]];
+        } else {
+            for (; q + 1 < end; q += 2) {
+                w0 += C[q] * re[ps[q]];
+                w1 += C[q + 1] * re[ps[q + 1]];
+            }
+            if (q < end)
+                w0 += C[q] * re[ps[q]];
+        }
+        e->W[i] = (w0 + w1) * e->h;
     }
 }
 
