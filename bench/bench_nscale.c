@@ -15,8 +15,9 @@
  * time, one after the other (interleaved, so the machine's drift hits them
  * alike); the fastest round counts.  AUTO's pick is identified by its first
  * steps' delay terms, which equal bitwise those of the method it runs.
- * Configurations whose sampled kernel (N n^2 doubles, which dmi_init
- * allocates) would exceed `mem` MiB are skipped for the sampled methods.
+ * Configurations whose kernel samples (N nnz doubles, which DIRECT and FFT
+ * hold, and the plain loop as much) would exceed `mem` MiB are skipped for
+ * those methods.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include "clock.h"
@@ -228,13 +229,13 @@ static int auto_pick(chain *c, int shape, size_t N, int *pick)
 
 int main(int argc, char **argv)
 {
-    size_t rounds = 7, mem = 2048, mmax = 128;
+    size_t rounds = 7, mem = 1024, mmax = 128;
     double ms = 30;
     const cli_arg args[] = {
         {"rounds", CLI_COUNT, &rounds, 1000, "interleaved rounds; the fastest counts"},
         {"ms", CLI_TIME, &ms, 1e5, "wall time of one method in one round, milliseconds"},
         {"mem", CLI_COUNT, &mem, 1e6,
-         "MiB: skip the sampled methods where N n^2 doubles (dmi_init's samples) exceed it"},
+         "MiB: skip DIRECT, FFT and the plain loop where N nnz doubles of samples exceed it"},
         {"mmax", CLI_COUNT, &mmax, 128, "the largest chain (m = 1, 4, 16, 64, 128 up to it)"}};
     const cli_program prog = {
         "bench_nscale",
@@ -262,11 +263,15 @@ int main(int argc, char **argv)
                 chain c = {m, 10.0};
                 if (shape != DIAG && m == 1)
                     continue; /* the same as diagonal */
-                const int sampled = (double)N * (double)n * (double)n * 8.0 <=
-                                    (double)mem * 1048576.0;
+                size_t nnz = 0;
+                for (size_t i = 0; i < m; i++)
+                    for (size_t j = 0; j < m; j++)
+                        nnz += b_entry(shape, i, j) != 0;
+                const int sampled = (double)N * (double)nnz * 8.0 <= (double)mem * 1048576.0;
                 dmi_solver *s[KINDS] = {NULL};
                 plain p;
-                int rc = plain_make(&p, m, shape, N);
+                memset(&p, 0, sizeof p);
+                int rc = sampled ? plain_make(&p, m, shape, N) : DMI_OK;
                 for (int k = 0; k < PLAIN && rc == DMI_OK; k++)
                     if (sampled || k == NODELAY || k == REC || k == AUTO)
                         rc = make(&s[k], &c, shape, N, k);
@@ -306,20 +311,24 @@ int main(int argc, char **argv)
                         fastest = k;
                 const double auto_ratio = best[AUTO] / best[fastest];
                 worst_auto = fmax(worst_auto, auto_ratio);
-                char cell[KINDS][24];
+                char cell[KINDS][24], ratio[3][24];
                 for (int k = 0; k < KINDS; k++) {
                     if (isinf(best[k]))
                         snprintf(cell[k], sizeof cell[k], "skipped");
                     else
                         snprintf(cell[k], sizeof cell[k], "%.4g", best[k]);
                 }
+                const double q[3] = {best[REC] / best[NODELAY], best[FFT] / best[REC],
+                                     best[DIRECT] / best[PLAIN]};
+                for (int k = 0; k < 3; k++)
+                    snprintf(ratio[k], sizeof ratio[k], isnan(q[k]) || isinf(q[k]) ? "-" : "%.2f",
+                             q[k]);
                 snprintf(table[rows], sizeof table[rows],
                          "| %zu | %zu | %s | %zu | %s | %s | %s | %s | %s | %s | %s | %.2f | "
-                         "%.2f | %.2f | %.2f |",
+                         "%s | %s | %s |",
                          m, n, shape_name[shape], N, cell[NODELAY], cell[AUTO],
                          pick < 0 ? "?" : kind_name[pick], cell[DIRECT], cell[FFT], cell[REC],
-                         kind_name[fastest], auto_ratio, best[REC] / best[NODELAY],
-                         best[FFT] / best[REC], best[DIRECT] / best[PLAIN]);
+                         kind_name[fastest], auto_ratio, ratio[0], ratio[1], ratio[2]);
                 printf("%s\n", table[rows]);
                 fflush(stdout);
                 rows++;
