@@ -14,7 +14,11 @@
  * flags).  Each round steps every method for about `ms` milliseconds of wall
  * time, one after the other (interleaved, so the machine's drift hits them
  * alike); the fastest round counts.  AUTO's pick is identified by its first
- * steps' delay terms, which equal bitwise those of the method it runs.
+ * steps' delay terms, which equal bitwise those of the method it runs; the
+ * same for the kernel given as a callback (dmi_set_kernel), where AUTO
+ * chooses between DIRECT and FFT by its cost model, and whose pick is
+ * compared with the faster of the two as timed with the exponential kernel
+ * (the same engines on the same sparsity).
  * Configurations whose kernel samples (N nnz doubles, which DIRECT and FFT
  * hold, and the plain loop as much) would exceed `mem` MiB are skipped for
  * those methods.
@@ -41,7 +45,8 @@ static const int kind_method[KINDS] = {DMI_CONV_AUTO, DMI_CONV_AUTO, DMI_CONV_DI
 
 typedef struct {
     size_t m;
-    double k; /* stiffness */
+    double k;  /* stiffness */
+    int shape; /* of B */
 } chain;
 
 static int chain_rhs(double t, const double *u, double *out, void *user)
@@ -81,8 +86,21 @@ static double b_entry(int shape, size_t i, size_t j)
     return pow(0.9, (double)d);
 }
 
-/* A solver of the chain for kind (not PLAIN); 0 or the error. */
-static int make(dmi_solver **s, chain *c, int shape, size_t N, int kind)
+/* The kernel as a callback: G(s) B in the lower left block. */
+static int chain_kernel(double s, double *out, void *user)
+{
+    const chain *c = user;
+    const size_t m = c->m, n = 2 * m;
+    const double g = 0.5 * exp(-s) + 0.3 * exp(-3 * s);
+    for (size_t i = 0; i < m; i++)
+        for (size_t j = 0; j < m; j++)
+            out[(m + i) * n + j] = g * b_entry(c->shape, i, j);
+    return 0;
+}
+
+/* A solver of the chain for kind (not PLAIN), the kernel as exponential
+ * terms, or as a callback if callback; 0 or the error. */
+static int make(dmi_solver **s, chain *c, int shape, size_t N, int kind, int callback)
 {
     const size_t m = c->m, n = 2 * m;
     int rc = dmi_create(s, n, 1.0, N);
@@ -103,7 +121,7 @@ static int make(dmi_solver **s, chain *c, int shape, size_t N, int kind)
             for (size_t i = 0; i < m; i++)
                 for (size_t j = 0; j < m; j++)
                     C[t * n * n + (m + i) * n + j] = coef[t] * b_entry(shape, i, j);
-        rc = dmi_set_kernel_exp(*s, 2, a, b, C, NULL);
+        rc = callback ? dmi_set_kernel(*s, chain_kernel, c) : dmi_set_kernel_exp(*s, 2, a, b, C, NULL);
         if (rc == DMI_OK)
             rc = dmi_set_convolution(*s, kind_method[kind]);
     }
@@ -196,10 +214,10 @@ static int timed(dmi_solver *s, plain *p, double ms, size_t *steps, double *ns)
 }
 
 /* W of the first two steps of a fresh solver of kind (2 n values). */
-static int first_terms(chain *c, int shape, size_t N, int kind, double *W)
+static int first_terms(chain *c, int shape, size_t N, int kind, int callback, double *W)
 {
     dmi_solver *s = NULL;
-    int rc = make(&s, c, shape, N, kind);
+    int rc = make(&s, c, shape, N, kind, callback);
     for (int k = 0; k < 2 && rc == DMI_OK; k++) {
         rc = dmi_step(s);
         if (rc == DMI_OK)
@@ -209,17 +227,18 @@ static int first_terms(chain *c, int shape, size_t N, int kind, double *W)
     return rc;
 }
 
-/* Which method AUTO runs: the one whose first delay terms equal AUTO's. */
-static int auto_pick(chain *c, int shape, size_t N, int *pick)
+/* Which method AUTO runs: the one whose first delay terms equal AUTO's
+ * (with the kernel as a callback: DIRECT or FFT). */
+static int auto_pick(chain *c, int shape, size_t N, int callback, int *pick)
 {
     const size_t len = 4 * c->m;
     double *w = malloc(2 * len * sizeof *w);
     if (!w)
         return DMI_ENOMEM;
-    int rc = first_terms(c, shape, N, AUTO, w);
+    int rc = first_terms(c, shape, N, AUTO, callback, w);
     *pick = -1;
-    for (int k = DIRECT; k <= REC && rc == DMI_OK; k++) {
-        rc = first_terms(c, shape, N, k, w + len);
+    for (int k = DIRECT; k <= (callback ? FFT : REC) && rc == DMI_OK; k++) {
+        rc = first_terms(c, shape, N, k, callback, w + len);
         if (rc == DMI_OK && memcmp(w, w + len, len * sizeof *w) == 0)
             *pick = k;
     }
@@ -243,7 +262,9 @@ int main(int argc, char **argv)
         "stiffness) with the memory kernel [[0, 0], [G(s) B, 0]], G two exponential terms,\n"
         "B diagonal, tridiagonal or dense, at m = 1, 4, 16, 64, 128 and N = 1e3, 1e4: the\n"
         "methods AUTO, DIRECT, FFT and RECURSIVE beside the model without the kernel and\n"
-        "a plain loop of N nnz multiply-adds, in interleaved rounds (a few minutes).",
+        "a plain loop of N nnz multiply-adds, in interleaved rounds, and AUTO's pick for
+"
+        "the kernel given as a callback (a few minutes).",
         "stdout: one line per configuration as it is measured, then the table in Markdown\n"
         "(ns per step, AUTO's pick, ratios).\n"
         "exit status: 0, 1 if a solver fails, 2 for a bad argument.",
@@ -251,35 +272,38 @@ int main(int argc, char **argv)
     cli_parse(&prog, argc, argv);
 
     static const size_t ms_list[5] = {1, 4, 16, 64, 128}, Ns[2] = {1000, 10000};
-    char table[128][256];
+    char table[128][320];
     size_t rows = 0;
-    double worst_auto = 0;
+    double worst_auto = 0, worst_cb = 0;
     printf("chain of m masses, tau = 1, h = 1/N; %zu interleaved rounds of %g ms per method\n",
            rounds, ms);
     for (int mi = 0; mi < 5 && ms_list[mi] <= mmax; mi++)
         for (int shape = 0; shape < SHAPES; shape++)
             for (int ni = 0; ni < 2; ni++) {
                 const size_t m = ms_list[mi], n = 2 * m, N = Ns[ni];
-                chain c = {m, 10.0};
+                chain c = {m, 10.0, shape};
                 if (shape != DIAG && m == 1)
                     continue; /* the same as diagonal */
                 size_t nnz = 0;
                 for (size_t i = 0; i < m; i++)
                     for (size_t j = 0; j < m; j++)
                         nnz += b_entry(shape, i, j) != 0;
-                const int sampled = (double)N * (double)nnz * 8.0 <= (double)mem * 1048576.0;
+                const double MiB = (double)mem * 1048576.0;
+                const int sampled = (double)N * (double)nnz * 8.0 <= MiB;
+                /* a callback kernel is sampled through an N n n array */
+                const int cb = (double)N * (double)n * (double)n * 8.0 <= MiB;
                 dmi_solver *s[KINDS] = {NULL};
                 plain p;
                 memset(&p, 0, sizeof p);
                 int rc = sampled ? plain_make(&p, m, shape, N) : DMI_OK;
                 for (int k = 0; k < PLAIN && rc == DMI_OK; k++)
                     if (sampled || k == NODELAY || k == REC || k == AUTO)
-                        rc = make(&s[k], &c, shape, N, k);
-                int pick = -1;
+                        rc = make(&s[k], &c, shape, N, k, 0);
+                int pick = -1, cb_pick = -1;
                 if (rc == DMI_OK && sampled)
-                    rc = auto_pick(&c, shape, N, &pick);
-                else if (rc == DMI_OK)
-                    pick = REC; /* (not identified: AUTO takes the recursion for this kernel) */
+                    rc = auto_pick(&c, shape, N, 0, &pick);
+                if (rc == DMI_OK && sampled && cb)
+                    rc = auto_pick(&c, shape, N, 1, &cb_pick);
                 double best[KINDS];
                 size_t steps[KINDS];
                 for (int k = 0; k < KINDS; k++) {
@@ -288,9 +312,7 @@ int main(int argc, char **argv)
                 }
                 for (size_t r = 0; r <= rounds && rc == DMI_OK; r++) /* round 0: warm-up */
                     for (int k = 0; k < KINDS && rc == DMI_OK; k++) {
-                        if (k != PLAIN && !s[k])
-                            continue;
-                        if (k == PLAIN && !sampled)
+                        if ((k != PLAIN && !s[k]) || (k == PLAIN && !sampled))
                             continue;
                         double ns = INFINITY;
                         rc = timed(k == PLAIN ? NULL : s[k], &p, ms, &steps[k], &ns);
@@ -305,39 +327,47 @@ int main(int argc, char **argv)
                             shape_name[shape], N, dmi_strerror(rc));
                     return 1;
                 }
-                int fastest = AUTO;
-                for (int k = DIRECT; k <= REC; k++)
+                int fastest = REC; /* of the methods AUTO chooses from */
+                for (int k = DIRECT; k <= FFT; k++)
                     if (best[k] < best[fastest])
                         fastest = k;
                 const double auto_ratio = best[AUTO] / best[fastest];
                 worst_auto = fmax(worst_auto, auto_ratio);
-                char cell[KINDS][24], ratio[3][24];
+                /* the callback: AUTO's pick among DIRECT and FFT, timed as they ran above */
+                const int cb_fast = best[DIRECT] < best[FFT] ? DIRECT : FFT;
+                const double cb_ratio = cb_pick < 0 ? NAN : best[cb_pick] / best[cb_fast];
+                if (cb_pick >= 0)
+                    worst_cb = fmax(worst_cb, cb_ratio);
+                char cell[KINDS][24], ratio[5][24];
                 for (int k = 0; k < KINDS; k++) {
                     if (isinf(best[k]))
                         snprintf(cell[k], sizeof cell[k], "skipped");
                     else
                         snprintf(cell[k], sizeof cell[k], "%.4g", best[k]);
                 }
-                const double q[3] = {best[REC] / best[NODELAY], best[FFT] / best[REC],
-                                     best[DIRECT] / best[PLAIN]};
-                for (int k = 0; k < 3; k++)
+                const double q[5] = {auto_ratio, best[REC] / best[NODELAY], best[FFT] / best[REC],
+                                     best[DIRECT] / best[PLAIN], cb_ratio};
+                for (int k = 0; k < 5; k++)
                     snprintf(ratio[k], sizeof ratio[k], isnan(q[k]) || isinf(q[k]) ? "-" : "%.2f",
                              q[k]);
                 snprintf(table[rows], sizeof table[rows],
-                         "| %zu | %zu | %s | %zu | %s | %s | %s | %s | %s | %s | %s | %.2f | "
-                         "%s | %s | %s |",
-                         m, n, shape_name[shape], N, cell[NODELAY], cell[AUTO],
-                         pick < 0 ? "?" : kind_name[pick], cell[DIRECT], cell[FFT], cell[REC],
-                         kind_name[fastest], auto_ratio, ratio[0], ratio[1], ratio[2]);
+                         "| %zu | %zu | %s | %zu | %s | %s | %s | %s | %s | %s | %s | %s | %s | "
+                         "%s | %s | %s | %s |",
+                         m, n, shape_name[shape], N, cell[NODELAY], cell[DIRECT], cell[FFT],
+                         cell[REC], cell[AUTO], pick < 0 ? "-" : kind_name[pick],
+                         kind_name[fastest], ratio[0], ratio[1], ratio[2], ratio[3],
+                         cb_pick < 0 ? "-" : kind_name[cb_pick], ratio[4]);
                 printf("%s\n", table[rows]);
                 fflush(stdout);
                 rows++;
             }
-    printf("\nns per step (fastest of %zu interleaved rounds); AUTO / fastest at most %.2f\n\n",
-           rounds, worst_auto);
-    printf("| m | n | B | N | no delay | AUTO | AUTO's pick | DIRECT | FFT | RECURSIVE | fastest "
-           "| AUTO / fastest | REC / no delay | FFT / REC | DIRECT / plain loop |\n");
-    printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    printf("\nns per step, fastest of %zu interleaved rounds of %g ms (wall time); AUTO / fastest "
+           "at most %.2f;\ncallback kernel: AUTO's pick / the faster of DIRECT and FFT at most "
+           "%.2f\n\n", rounds, ms, worst_auto, worst_cb);
+    printf("| m | n | B | N | no delay | DIRECT | FFT | RECURSIVE | AUTO | AUTO's pick | fastest "
+           "| AUTO / fastest | REC / no delay | FFT / REC | DIRECT / plain loop "
+           "| callback: AUTO's pick | callback: pick / faster |\n");
+    printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (size_t r = 0; r < rows; r++)
         printf("%s\n", table[r]);
     return 0;
