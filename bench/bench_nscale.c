@@ -262,8 +262,7 @@ int main(int argc, char **argv)
         "stiffness) with the memory kernel [[0, 0], [G(s) B, 0]], G two exponential terms,\n"
         "B diagonal, tridiagonal or dense, at m = 1, 4, 16, 64, 128 and N = 1e3, 1e4: the\n"
         "methods AUTO, DIRECT, FFT and RECURSIVE beside the model without the kernel and\n"
-        "a plain loop of N nnz multiply-adds, in interleaved rounds, and AUTO's pick for
-"
+        "a plain loop of N nnz multiply-adds, in interleaved rounds, and AUTO's pick for\n"
         "the kernel given as a callback (a few minutes).",
         "stdout: one line per configuration as it is measured, then the table in Markdown\n"
         "(ns per step, AUTO's pick, ratios).\n"
