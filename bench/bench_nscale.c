@@ -121,7 +121,8 @@ static int make(dmi_solver **s, chain *c, int shape, size_t N, int kind, int cal
             for (size_t i = 0; i < m; i++)
                 for (size_t j = 0; j < m; j++)
                     C[t * n * n + (m + i) * n + j] = coef[t] * b_entry(shape, i, j);
-        rc = callback ? dmi_set_kernel(*s, chain_kernel, c) : dmi_set_kernel_exp(*s, 2, a, b, C, NULL);
+        rc = callback ? dmi_set_kernel(*s, chain_kernel, c)
+                      : dmi_set_kernel_exp(*s, 2, a, b, C, NULL);
         if (rc == DMI_OK)
             rc = dmi_set_convolution(*s, kind_method[kind]);
     }

@@ -156,20 +156,20 @@ void dmi_engine_rebuild(const dmi_solver *s, dmi_conv *conv, dmi_exp *rec)
         dmi_exp_anchor(rec, &s->ring, s->p);
 }
 
-/* W = W^p. */
-static void delay_sum(const dmi_solver *s, double *W)
+/* W^p: the recursion's own array (valid until the engine moves on), or W
+ * filled. */
+static const double *delay_sum(const dmi_solver *s, double *W)
 {
-    if (s->rec) {
-        dmi_exp_sum(s->rec, W);
-        return;
-    }
+    if (s->rec)
+        return dmi_exp_sum(s->rec);
 #ifdef DMI_HAVE_FFT
     if (s->conv) {
         dmi_conv_sum(s->conv, &s->kernel, &s->ring, s->p, s->h, W);
-        return;
+        return W;
     }
 #endif
     dmi_delay_sum(&s->kernel, &s->ring, s->h, W);
+    return W;
 }
 
 /* After a step was committed (U^p pushed, p counted). */
@@ -592,7 +592,7 @@ int dmi_step(dmi_solver *s)
         return dmi_fail(s, DMI_ESTATE, "dmi_step: call dmi_init first");
     const size_t n = s->n;
     const double h = s->h, t = (double)s->p * h; /* dmi_time */
-    double *U = s->work, *fv = U + n, *W = fv + n, *X = W + n, *U1 = X + n;
+    double *U = s->work, *fv = U + n, *Wbuf = fv + n, *X = Wbuf + n, *U1 = X + n;
     dmi_history_get(&s->ring, 0, U);
 
     for (size_t i = 0; i < n; i++) /* (loops, not memset/memcpy: n is small) */
@@ -603,7 +603,7 @@ int dmi_step(dmi_solver *s)
             return dmi_fail(s, DMI_ECALLBACK, "dmi_step: rhs callback returned %d at t = %.17g", rc,
                             t);
     }
-    delay_sum(s, W);
+    const double *W = delay_sum(s, Wbuf);
     for (size_t i = 0; i < n; i++)
         X[i] = U[i] - h * fv[i] - h * W[i];
     /* A non-finite f or W makes X non-finite (U^p and h are finite), so one

@@ -333,9 +333,15 @@ typedef struct {
 } term;
 
 /* The multipliers of one sum for its step, copied from its term so that the
- * step reads one contiguous record per sum. */
+ * step reads one contiguous record per sum, as pairs (re, im) so that the
+ * step of a complex sum is the same arithmetic on both halves (which the
+ * compiler may pair into vector operations):
+ *     S' = (x hi + y hi_rot) + ((x lo + y lo_rot) + ((unew, 0) - uold rN))
+ * with S = (x, y), hi = (rh_re, rh_im), hi_rot = (-rh_im, rh_re), the same
+ * for lo = rl, and rN = (rN_re, rN_im): term by term the operations of
+ * x rh - y rh_im etc., so the same results bitwise. */
 typedef struct {
-    double rh_re, rh_im, rl_re, rl_im, rN_re, rN_im;
+    double hi[2], hi_rot[2], lo[2], lo_rot[2], rN[2];
 } mult;
 
 /*
@@ -356,7 +362,7 @@ struct dmi_exp {
     size_t *term_of, *col, *slot; /* per sum */
     size_t *series;               /* per sum: offset of its column's series in the ring */
     mult *m;                      /* per sum */
-    double *re, *im;              /* per sum: the sum S */
+    double *S;                    /* per sum: the sum S (re, im) */
     size_t *row_start;            /* n + 1 */
     size_t *psum;                 /* per part: its sum (internal index) */
     double *pC, *pD;              /* per part: W_row += C Re S + D Im S */
@@ -374,8 +380,7 @@ void dmi_exp_free(dmi_exp *e)
     free(e->slot);
     free(e->series);
     free(e->m);
-    free(e->re);
-    free(e->im);
+    free(e->S);
     free(e->row_start);
     free(e->psum);
     free(e->pC);
@@ -442,16 +447,15 @@ int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
     e->slot = array(ns, sizeof *e->slot);
     e->series = array(ns, sizeof *e->series);
     e->m = array(ns, sizeof *e->m);
-    e->re = array(ns, sizeof *e->re);
-    e->im = array(ns, sizeof *e->im);
+    e->S = array(2 * ns, sizeof *e->S);
     e->row_start = array(n + 1, sizeof *e->row_start);
     e->psum = array(np, sizeof *e->psum);
     e->pC = array(np, sizeof *e->pC);
     e->pD = array(np, sizeof *e->pD);
     e->W = array(n, sizeof *e->W);
     size_t *index = array(k->K * n, sizeof *index); /* (t, j) -> internal sum index */
-    if (!e->terms || !e->term_of || !e->col || !e->slot || !e->series || !e->m || !e->re ||
-        !e->im || !e->row_start || !e->psum || !e->pC || !e->pD || !e->W || !index) {
+    if (!e->terms || !e->term_of || !e->col || !e->slot || !e->series || !e->m || !e->S ||
+        !e->row_start || !e->psum || !e->pC || !e->pD || !e->W || !index) {
         free(index);
         dmi_exp_free(e);
         return -1;
@@ -467,7 +471,9 @@ int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
                     continue;
                 if (e->terms[t].real == (pass == 0)) {
                     const term *tm = &e->terms[t];
-                    mult mu = {tm->rh_re, tm->rh_im, tm->rl_re, tm->rl_im, tm->rN_re, tm->rN_im};
+                    mult mu = {{tm->rh_re, tm->rh_im}, {-tm->rh_im, tm->rh_re},
+                               {tm->rl_re, tm->rl_im}, {-tm->rl_im, tm->rl_re},
+                               {tm->rN_re, tm->rN_im}};
                     e->term_of[q] = t;
                     e->col[q] = j;
                     e->slot[q] = sv;
@@ -508,7 +514,7 @@ int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
  * the imaginary parts are not read. */
 static void update_W(dmi_exp *e)
 {
-    const double *re = e->re, *im = e->im, *C = e->pC, *D = e->pD;
+    const double *S = e->S, *C = e->pC, *D = e->pD;
     const size_t *ps = e->psum;
     for (size_t i = 0; i < e->n; i++) {
         const size_t end = e->row_start[i + 1];
@@ -516,18 +522,18 @@ static void update_W(dmi_exp *e)
         double w0 = 0, w1 = 0;
         if (e->has_D) {
             for (; q + 1 < end; q += 2) {
-                w0 += C[q] * re[ps[q]] + D[q] * im[ps[q]];
-                w1 += C[q + 1] * re[ps[q + 1]] + D[q + 1] * im[ps[q + 1]];
+                w0 += C[q] * S[2 * ps[q]] + D[q] * S[2 * ps[q] + 1];
+                w1 += C[q + 1] * S[2 * ps[q + 1]] + D[q + 1] * S[2 * ps[q + 1] + 1];
             }
             if (q < end)
-                w0 += C[q] * re[ps[q]] + D[q] * im[ps[q]];
+                w0 += C[q] * S[2 * ps[q]] + D[q] * S[2 * ps[q] + 1];
         } else {
             for (; q + 1 < end; q += 2) {
-                w0 += C[q] * re[ps[q]];
-                w1 += C[q + 1] * re[ps[q + 1]];
+                w0 += C[q] * S[2 * ps[q]];
+                w1 += C[q + 1] * S[2 * ps[q + 1]];
             }
             if (q < end)
-                w0 += C[q] * re[ps[q]];
+                w0 += C[q] * S[2 * ps[q]];
         }
         e->W[i] = (w0 + w1) * e->h;
     }
@@ -570,8 +576,8 @@ void dmi_exp_anchor(dmi_exp *e, const dmi_history *r, uint64_t p)
             }
             base = cdd_mul(base, t->rB);
         }
-        e->re[q] = re.hi + re.lo;
-        e->im[q] = im.hi + im.lo;
+        e->S[2 * q] = re.hi + re.lo;
+        e->S[2 * q + 1] = im.hi + im.lo;
     }
     update_W(e);
 }
@@ -586,25 +592,28 @@ void dmi_exp_advance(dmi_exp *e, const dmi_history *r, uint64_t p)
     const size_t N = e->N, nr = e->nreal, ns = e->nsums;
     const size_t *off = e->series;
     const mult *m = e->m;
-    double *re = e->re, *im = e->im;
+    double *S = e->S;
     for (size_t q = 0; q < nr; q++) {
-        const double unew = buf[off[q]], uold = buf[off[q] + N], x = re[q];
-        re[q] = x * m[q].rh_re + (x * m[q].rl_re + (unew - m[q].rN_re * uold));
+        const double unew = buf[off[q]], uold = buf[off[q] + N], x = S[2 * q];
+        S[2 * q] = x * m[q].hi[0] + (x * m[q].lo[0] + (unew - m[q].rN[0] * uold));
     }
     for (size_t q = nr; q < ns; q++) {
-        const double unew = buf[off[q]], uold = buf[off[q] + N], x = re[q], y = im[q];
-        re[q] = (x * m[q].rh_re - y * m[q].rh_im) +
-                ((x * m[q].rl_re - y * m[q].rl_im) + (unew - m[q].rN_re * uold));
-        im[q] = (x * m[q].rh_im + y * m[q].rh_re) +
-                ((x * m[q].rl_im + y * m[q].rl_re) - m[q].rN_im * uold);
+        const double unew = buf[off[q]], uold = buf[off[q] + N];
+        const double x = S[2 * q], y = S[2 * q + 1];
+        double v[2];
+        for (int c = 0; c < 2; c++)
+            v[c] = (x * m[q].hi[c] + y * m[q].hi_rot[c]) +
+                   ((x * m[q].lo[c] + y * m[q].lo_rot[c]) +
+                    ((c == 0 ? unew : 0.0) - m[q].rN[c] * uold));
+        S[2 * q] = v[0];
+        S[2 * q + 1] = v[1];
     }
     update_W(e);
 }
 
-void dmi_exp_sum(const dmi_exp *e, double *W)
+const double *dmi_exp_sum(const dmi_exp *e)
 {
-    for (size_t i = 0; i < e->n; i++)
-        W[i] = e->W[i];
+    return e->W;
 }
 
 uint64_t dmi_exp_period(const dmi_exp *e)
@@ -616,8 +625,7 @@ void dmi_exp_get(const dmi_exp *e, unsigned char *bytes)
 {
     for (size_t q = 0; q < e->nsums; q++) {
         const size_t s = e->slot[q];
-        memcpy(bytes + 2 * s * sizeof(double), &e->re[q], sizeof(double));
-        memcpy(bytes + (2 * s + 1) * sizeof(double), &e->im[q], sizeof(double));
+        memcpy(bytes + 2 * s * sizeof(double), &e->S[2 * q], 2 * sizeof(double));
     }
 }
 
@@ -625,8 +633,8 @@ void dmi_exp_set(dmi_exp *e, const double *sums, uint64_t p)
 {
     set_next(e, p);
     for (size_t q = 0; q < e->nsums; q++) {
-        e->re[q] = sums[2 * e->slot[q]];
-        e->im[q] = sums[2 * e->slot[q] + 1];
+        e->S[2 * q] = sums[2 * e->slot[q]];
+        e->S[2 * q + 1] = sums[2 * e->slot[q] + 1];
     }
     update_W(e);
 }

@@ -69,8 +69,9 @@ void dmi_exp_anchor(dmi_exp *e, const dmi_history *r, uint64_t p);
  * step, set by dmi_exp_anchor and dmi_exp_set from their p, so that its
  * sums stay a function of p and the states). */
 void dmi_exp_advance(dmi_exp *e, const dmi_history *r, uint64_t p);
-/* W^p (n values; computed, times h, whenever the sums change). */
-void dmi_exp_sum(const dmi_exp *e, double *W);
+/* W^p (n values, the engine's own: computed, times h, whenever the sums
+ * change; valid until the next call that changes them). */
+const double *dmi_exp_sum(const dmi_exp *e);
 /* The anchoring period in steps. */
 uint64_t dmi_exp_period(const dmi_exp *e);
 /* The sums as 2 dmi_expk_sums doubles (re, im): written to bytes (any
