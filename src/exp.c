@@ -367,6 +367,11 @@ struct dmi_exp {
     size_t *psum;                 /* per part: its sum (internal index) */
     double *pC, *pD;              /* per part: W_row += C Re S + D Im S */
     int has_D;                    /* some part has D != 0 */
+    /* the parts as a matrix when it is small or full enough: the rows with a
+     * part (nrows of them, listed in rows), each a row of nsums C (and D)
+     * values, zero where no part is */
+    size_t nrows, *rows;
+    double *Cm, *Dm;
     double *W;                    /* n: h sum of the parts, W^p */
 };
 
@@ -386,6 +391,9 @@ void dmi_exp_free(dmi_exp *e)
     free(e->pC);
     free(e->pD);
     free(e->W);
+    free(e->rows);
+    free(e->Cm);
+    free(e->Dm);
     free(e);
 }
 
@@ -504,6 +512,28 @@ int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
     }
     e->row_start[n] = pp;
     free(index);
+    for (size_t i = 0; i < n; i++)
+        e->nrows += e->row_start[i + 1] > e->row_start[i];
+    if (e->nrows * ns <= 2 * np + 8) { /* (nrows ns <= n n K: no overflow) */
+        e->rows = array(e->nrows, sizeof *e->rows);
+        e->Cm = array(e->nrows * ns, sizeof *e->Cm);
+        e->Dm = e->has_D ? array(e->nrows * ns, sizeof *e->Dm) : NULL;
+        if (!e->rows || !e->Cm || (e->has_D && !e->Dm)) {
+            dmi_exp_free(e);
+            return -1;
+        }
+        for (size_t i = 0, r = 0; i < n; i++) {
+            if (e->row_start[i + 1] == e->row_start[i])
+                continue;
+            e->rows[r] = i;
+            for (size_t x = e->row_start[i]; x < e->row_start[i + 1]; x++) {
+                e->Cm[r * ns + e->psum[x]] = e->pC[x];
+                if (e->Dm)
+                    e->Dm[r * ns + e->psum[x]] = e->pD[x];
+            }
+            r++;
+        }
+    }
     *out = e;
     return 0;
 }
@@ -515,7 +545,25 @@ int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
 static void update_W(dmi_exp *e)
 {
     const double *S = e->S, *C = e->pC, *D = e->pD;
-    const size_t *ps = e->psum;
+    const size_t *ps = e->psum, ns = e->nsums;
+    if (e->Cm) { /* the matrix form: no indices (the other rows stay 0) */
+        for (size_t r = 0; r < e->nrows; r++) {
+            const double *Cr = e->Cm + r * ns, *Dr = e->Dm ? e->Dm + r * ns : NULL;
+            double w0 = 0, w1 = 0;
+            size_t q = 0;
+            for (; q + 1 < ns; q += 2) {
+                w0 += Cr[q] * S[2 * q];
+                w1 += Cr[q + 1] * S[2 * q + 2];
+            }
+            if (q < ns)
+                w0 += Cr[q] * S[2 * q];
+            if (Dr)
+                for (q = 0; q < ns; q++)
+                    w1 += Dr[q] * S[2 * q + 1];
+            e->W[e->rows[r]] = (w0 + w1) * e->h;
+        }
+        return;
+    }
     for (size_t i = 0; i < e->n; i++) {
         const size_t end = e->row_start[i + 1];
         size_t q = e->row_start[i];
