@@ -393,13 +393,17 @@ static int lowrank_make(lowrank *z, const dmi_kernel *k, size_t n, size_t ncols)
                     res[l] -= d * qb[l];
                 c[e * rmax + b] += d;
             }
-        if (norm1(res, N) <= LOWRANK_TOL * norm1(x, N))
+        const double len = sqrt(dmi_dot(res, res, N)), size = norm1(x, N);
+        if (!isfinite(size) || !isfinite(len)) { /* (samples near DBL_MAX) */
+            ok = 0;
+            break;
+        }
+        if (norm1(res, N) <= LOWRANK_TOL * size)
             continue;
         if (r == rmax) {
             ok = 0;
             break;
         }
-        double len = sqrt(dmi_dot(res, res, N));
         for (size_t l = 0; l < N; l++)
             q[r * N + l] = res[l] / len;
         c[e * rmax + r] = len;
@@ -415,7 +419,7 @@ static int lowrank_make(lowrank *z, const dmi_kernel *k, size_t n, size_t ncols)
                     used[b * n + k->col[e]] = 1;
                     nv++;
                 }
-    if (!ok || !used || 2 * nv > nnz) {
+    if (!ok || !used || r == 0 || 2 * nv > nnz) {
         free(q);
         free(c);
         free(used);
