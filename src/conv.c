@@ -169,7 +169,7 @@ typedef struct {
     size_t S, M;          /* block size and FFT length 2S */
     size_t nparts, depth; /* partitions; windows kept (largest k + 1) */
     size_t *k;            /* partition indices */
-    double *kspec;        /* nnz * nparts * M: kernel spectra / M (split layout) */
+    double *kspec;        /* nspec * nparts * M: kernel spectra / M (split layout) */
     double *xspec;        /* ncols * depth * M: spectrum of window b in slot b mod depth */
     double *out;          /* n * S: block sums (before the factor h) of the current block */
 } level;
@@ -183,8 +183,9 @@ typedef struct {
  * The engine then convolves the virtual kernel whose entry (row k n + j,
  * column j) is q_k, for the columns j that some entry with c_ek != 0 uses:
  * at most r n entries instead of nnz, so one forward transform per state
- * column, one inverse per virtual row and r ncols products per partition;
- * W costs nnz r multiply-adds more.  The series are found by Gram-Schmidt
+ * column, one inverse per virtual row and r ncols products per partition,
+ * with the spectra of the r series only (shared by the columns, so they
+ * stay in cache); W costs nnz r multiply-adds more.  The series are found by Gram-Schmidt
  * (each projection done twice) in the entries' order; an entry is
  * represented when its residual's sum of |.| is at most LOWRANK_TOL of its
  * samples' (so W moves by at most LOWRANK_TOL of h sum_l ||H(l h)|| max |U|);
@@ -316,7 +317,7 @@ static double *doubles(size_t a, size_t b, int zero)
     return zero ? calloc(1, bytes) : malloc(bytes);
 }
 
-static int level_alloc(level *v, const layout *y, size_t i, size_t n, size_t ncols, size_t nnz)
+static int level_alloc(level *v, const layout *y, size_t i, size_t n, size_t ncols, size_t nspec)
 {
     v->S = y->S[i];
     v->M = 2 * v->S;
@@ -332,25 +333,31 @@ static int level_alloc(level *v, const layout *y, size_t i, size_t n, size_t nco
     /* nparts M <= 2 (N + 1) and depth M <= 2 (N + 1 + S): a few times the
      * kernel samples and the ring, which may still overflow size_t on a
      * 32-bit target. */
-    v->kspec = doubles(nnz, v->nparts * v->M, 0);
+    v->kspec = doubles(nspec, v->nparts * v->M, 0);
     v->xspec = doubles(ncols * v->depth, v->M, 1);
     v->out = doubles(n, v->S, 1);
     return v->kspec && v->xspec && v->out ? 0 : -1;
 }
 
-/* Spectrum / M of the kernel samples of entry e on the partition's lags. */
-static void kernel_spectra(level *v, const dmi_kernel *k)
+/* Spectrum / M of the kernel samples of each distinct series on the
+ * partition's lags: those of the entries of k, or of a low-rank form's r
+ * basis series (its virtual entry e has series kv.row[e] / n, see spec). */
+static void kernel_spectra(level *v, const dmi_kernel *k, const lowrank *z)
 {
     const size_t S = v->S, M = v->M;
-    for (size_t e = 0; e < k->nnz; e++)
+    for (size_t e = 0; e < k->nnz; e++) {
+        if (z->r && e > 0 && k->row[e] / z->n == k->row[e - 1] / z->n)
+            continue; /* (the entries of a basis series are contiguous) */
+        const size_t sp = z->r ? k->row[e] / z->n : e;
         for (size_t q = 0; q < v->nparts; q++) {
-            double *x = v->kspec + (e * v->nparts + q) * M;
+            double *x = v->kspec + (sp * v->nparts + q) * M;
             const double *h = k->samples + e * k->N + (S - 1 + v->k[q] * S);
             for (size_t t = 0; t < S; t++)
                 x[t] = h[t] / (double)M;
             memset(x + S, 0, S * sizeof *x);
             forward(x, M);
         }
+    }
 }
 
 /* sum |x_l|, l < N. */
@@ -557,7 +564,7 @@ int dmi_conv_create(dmi_conv **out, const dmi_kernel *k, size_t n, size_t N, int
     int rc = 0;
     for (size_t i = 0; i < y.L && rc == 0; i++) {
         c->nlevels = i + 1;
-        rc = level_alloc(&c->lv[i], &y, i, nn, ncols, kk->nnz);
+        rc = level_alloc(&c->lv[i], &y, i, nn, ncols, lr == 1 ? z.r : kk->nnz);
     }
     c->acc = malloc((y.L ? 2 * y.S[y.L - 1] : 1) * sizeof *c->acc);
     c->zero = calloc(y.L ? 2 * y.S[y.L - 1] : 1, sizeof *c->zero);
@@ -566,7 +573,7 @@ int dmi_conv_create(dmi_conv **out, const dmi_kernel *k, size_t n, size_t N, int
         return -1;
     }
     for (size_t i = 0; i < c->nlevels; i++)
-        kernel_spectra(&c->lv[i], kk);
+        kernel_spectra(&c->lv[i], kk, &c->z);
     *out = c;
     return 0;
 }
@@ -606,11 +613,12 @@ static void block(const dmi_conv *c, level *v, const dmi_kernel *k, uint64_t j, 
             if (k->row[e] != i)
                 continue;
             const double *xs = v->xspec + (c->col_slot[k->col[e]] - 1) * v->depth * M;
+            const size_t sp = c->z.r ? k->row[e] / c->z.n : e; /* its spectra */
             for (size_t q = 0; q < v->nparts; q++) {
                 size_t slot = base - v->k[q]; /* (j - 1 - k) mod depth */
                 if (slot >= v->depth)
                     slot -= v->depth;
-                const double *K = v->kspec + (e * v->nparts + q) * M, *X = xs + slot * M;
+                const double *K = v->kspec + (sp * v->nparts + q) * M, *X = xs + slot * M;
                 if (!K1) {
                     K1 = K;
                     X1 = X;
