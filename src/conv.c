@@ -185,11 +185,13 @@ typedef struct {
  * at most r n entries instead of nnz, so one forward transform per state
  * column, one inverse per virtual row and r ncols products per partition,
  * with the spectra of the r series only (shared by the columns, so they
- * stay in cache); W costs nnz r multiply-adds more.  The series are found by Gram-Schmidt
- * (each projection done twice) in the entries' order; an entry is
- * represented when its residual's sum of |.| is at most LOWRANK_TOL of its
- * samples' (so W moves by at most LOWRANK_TOL of h sum_l ||H(l h)|| max |U|);
- * the virtual kernel is used only when it has at most half the entries.
+ * stay in cache); W costs nnz r multiply-adds more.  The series are found
+ * by Gram-Schmidt (each projection done twice) in the entries' order; an
+ * entry is represented when its residual's sum of |.| is at most LOWRANK_TOL
+ * of its samples' (so W moves by at most LOWRANK_TOL of
+ * h sum_l ||H(l h)|| max |U|); the virtual kernel is used only when it has
+ * at most half the entries.  The engine's state stays a function of (p, the
+ * kernel, the ring): rebuilds are exact as before.
  */
 #define LOWRANK_TOL 1e-14
 #define LOWRANK_MAX 8 /* basis series at most */
@@ -341,7 +343,7 @@ static int level_alloc(level *v, const layout *y, size_t i, size_t n, size_t nco
 
 /* Spectrum / M of the kernel samples of each distinct series on the
  * partition's lags: those of the entries of k, or of a low-rank form's r
- * basis series (its virtual entry e has series kv.row[e] / n, see spec). */
+ * basis series (virtual entry e has series kv.row[e] / n). */
 static void kernel_spectra(level *v, const dmi_kernel *k, const lowrank *z)
 {
     const size_t S = v->S, M = v->M;
@@ -668,30 +670,10 @@ void dmi_conv_advance(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, ui
     }
 }
 
-static void engine_sum(const dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p,
-                       double h, double *W);
-
-/* Each row is summed in a local and W written once (a vector load of values
- * just stored one by one stalls).  The kernel entries of a row are
- * contiguous (dmi_kernel_alloc stores them row by row). */
-void dmi_conv_sum(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p, double h,
-                  double *W)
-{
-    const lowrank *z = &c->z;
-    if (z->r) { /* the virtual rows' sums, then W_i = h sum c_ek Y_(k n + col) */
-        engine_sum(c, &z->kv, r, p, 1.0, z->Y);
-        for (size_t i = 0; i < z->n; i++) {
-            double w = 0;
-            for (size_t t = z->tstart[i]; t < z->tstart[i + 1]; t++)
-                w += z->tc[t] * z->Y[z->tv[t]];
-            W[i] = w * h;
-        }
-        return;
-    }
-    engine_sum(c, k, r, p, h, W);
-}
-
-/* The engine's sums of kernel k (W: c->n values). */
+/* The engine's sums of kernel k (W: c->n values).  Each row is summed in a
+ * local and W written once (a vector load of values just stored one by one
+ * stalls).  The kernel entries of a row are contiguous (dmi_kernel_alloc
+ * stores them row by row). */
 static void engine_sum(const dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p,
                        double h, double *W)
 {
@@ -709,6 +691,23 @@ static void engine_sum(const dmi_conv *c, const dmi_kernel *k, const dmi_history
             }
         W[row] = w * h;
     }
+}
+
+void dmi_conv_sum(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p, double h,
+                  double *W)
+{
+    const lowrank *z = &c->z;
+    if (z->r) { /* the virtual rows' sums, then W_i = h sum c_ek Y_(k n + col) */
+        engine_sum(c, &z->kv, r, p, 1.0, z->Y);
+        for (size_t i = 0; i < z->n; i++) {
+            double w = 0;
+            for (size_t t = z->tstart[i]; t < z->tstart[i + 1]; t++)
+                w += z->tc[t] * z->Y[z->tv[t]];
+            W[i] = w * h;
+        }
+        return;
+    }
+    engine_sum(c, k, r, p, h, W);
 }
 
 size_t dmi_conv_levels(const dmi_conv *c)
