@@ -19,9 +19,10 @@
  * chooses between DIRECT and FFT by its cost model, and whose pick is
  * compared with the faster of the two as timed with the exponential kernel
  * (the same engines on the same sparsity).
- * Configurations whose kernel samples (N nnz doubles, which DIRECT and FFT
- * hold, and the plain loop as much) would exceed `mem` MiB are skipped for
- * those methods.
+ * Configurations whose kernel samples (N nnz doubles, which every solver
+ * with the kernel holds, and the plain loop as much) would exceed `mem` MiB
+ * are skipped for DIRECT, FFT and the plain loop (the recursion and AUTO
+ * still run, to show the recursion at that size).
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include "clock.h"

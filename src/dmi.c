@@ -95,30 +95,16 @@ static int check_method(const dmi_solver *s, int method, const char *fn)
                                    "FFT)", fn, method, k, s->expk.a[k]);
 }
 
-/* The method that runs for method: AUTO is the recursion for an exponential
- * kernel it takes (see first_unfit). */
-static int resolved(const dmi_solver *s, int method)
-{
-    int aliased;
-    if (method == DMI_CONV_AUTO && dmi_has_expk(s) && first_unfit(s, &aliased) == s->expk.K)
-        return DMI_CONV_RECURSIVE;
-    return method;
-}
-
-/* Whether method needs the kernel samples: every method but the recursion
- * of an exponential kernel (a callback kernel is always sampled). */
-static int needs_samples(const dmi_solver *s, int method)
-{
-    return !(dmi_has_expk(s) && resolved(s, method) == DMI_CONV_RECURSIVE);
-}
-
-/* The engines that method asks for with kernel samples k. */
+/* The engines that method asks for with kernel samples k (AUTO: the
+ * recursion for an exponential kernel it takes, see first_unfit). */
 static int engine_make(const dmi_solver *s, const dmi_kernel *k, int method, dmi_conv **conv,
                        dmi_exp **rec, const char *fn)
 {
     *conv = NULL;
     *rec = NULL;
-    method = resolved(s, method);
+    int aliased;
+    if (method == DMI_CONV_AUTO && dmi_has_expk(s) && first_unfit(s, &aliased) == s->expk.K)
+        method = DMI_CONV_RECURSIVE;
     if (method == DMI_CONV_RECURSIVE) {
         if (dmi_has_expk(s) && dmi_exp_create(rec, &s->expk, s->N, s->h) != 0)
             return dmi_fail(s, DMI_ENOMEM, "%s: out of memory for the recursion's sums", fn);
@@ -403,8 +389,6 @@ int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user)
     return DMI_OK;
 }
 
-static int sample_kernel(dmi_solver *s, dmi_kernel *k, const char *fn);
-
 int dmi_set_convolution(dmi_solver *s, int method)
 {
     if (!s)
@@ -415,21 +399,9 @@ int dmi_set_convolution(dmi_solver *s, int method)
     if (s->initialized) { /* the engine follows the method from the next step on */
         dmi_conv *c = NULL;
         dmi_exp *e = NULL;
-        dmi_kernel k = {0};
-        const int sample = !s->kernel_sampled && needs_samples(s, method);
-        if (sample)
-            rc = sample_kernel(s, &k, "dmi_set_convolution");
-        if (rc == DMI_OK)
-            rc = engine_make(s, sample ? &k : &s->kernel, method, &c, &e, "dmi_set_convolution");
-        if (rc != DMI_OK) {
-            dmi_kernel_release(&k);
+        rc = engine_make(s, &s->kernel, method, &c, &e, "dmi_set_convolution");
+        if (rc != DMI_OK)
             return rc;
-        }
-        if (sample) {
-            dmi_kernel_release(&s->kernel);
-            s->kernel = k;
-            s->kernel_sampled = 1;
-        }
         dmi_engine_rebuild(s, c, e);
         engine_free(s->conv, s->rec);
         s->conv = c;
@@ -441,21 +413,20 @@ int dmi_set_convolution(dmi_solver *s, int method)
 
 /* ---- init ------------------------------------------------------------------ */
 
-/* Samples H(l h), l = 0..N-1, into k (nonzero entries only); fn names the
- * caller in the messages.  An exponential kernel is sampled entry by entry
- * (dmi_expk_sample: no N n n array); where a sample is not finite, the
- * general path below names it. */
-static int sample_kernel(dmi_solver *s, dmi_kernel *k, const char *fn)
+/* Samples H(l h), l = 0..N-1, into k (nonzero entries only).  An
+ * exponential kernel is sampled entry by entry (dmi_expk_sample: no N n n
+ * array); where a sample is not finite, the general path below names it. */
+static int sample_kernel(dmi_solver *s, dmi_kernel *k)
 {
     const size_t n = s->n, N = s->N, nn = n * n;
     if (!s->H)
         return dmi_kernel_alloc(k, n, N, NULL) == 0
                    ? DMI_OK
-                   : dmi_fail(s, DMI_ENOMEM, "%s: out of memory", fn);
+                   : dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory");
     if (dmi_has_expk(s)) {
         int rc = dmi_expk_sample(&s->expk, N, s->h, k);
         if (rc < 0)
-            return dmi_fail(s, DMI_ENOMEM, "%s: out of memory for kernel samples", fn);
+            return dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for kernel samples");
         if (rc == 0)
             return DMI_OK;
     }
@@ -463,7 +434,7 @@ static int sample_kernel(dmi_solver *s, dmi_kernel *k, const char *fn)
     size_t bytes = dmi_mul_size(n, n, 1) ? dmi_mul_size(N, nn, sizeof(double)) : 0;
     double *dense = bytes ? malloc(bytes) : NULL;
     if (!dense)
-        return dmi_fail(s, DMI_ENOMEM, "%s: cannot allocate %zu x %zu x %zu kernel samples", fn,
+        return dmi_fail(s, DMI_ENOMEM, "dmi_init: cannot allocate %zu x %zu x %zu kernel samples",
                         N, n, n);
     for (size_t l = 0; l < N; l++) {
         double t = (double)l * s->h;
@@ -472,20 +443,20 @@ static int sample_kernel(dmi_solver *s, dmi_kernel *k, const char *fn)
         int rc = s->H(t, Hl, s->H_user);
         if (rc != 0) {
             free(dense);
-            return dmi_fail(s, DMI_ECALLBACK, "%s: kernel callback returned %d at s = %.17g", fn,
+            return dmi_fail(s, DMI_ECALLBACK, "dmi_init: kernel callback returned %d at s = %.17g",
                             rc, t);
         }
         size_t bad = dmi_first_nonfinite(Hl, nn);
         if (bad < nn) {
-            rc = dmi_fail(s, DMI_ENONFINITE, "%s: kernel H(%.17g)[%zu][%zu] = %g", fn, t,
-                          bad / n, bad % n, Hl[bad]);
+            rc = dmi_fail(s, DMI_ENONFINITE, "dmi_init: kernel H(%.17g)[%zu][%zu] = %g", t, bad / n,
+                          bad % n, Hl[bad]);
             free(dense);
             return rc;
         }
     }
     int rc = dmi_kernel_alloc(k, n, N, dense);
     free(dense);
-    return rc == 0 ? DMI_OK : dmi_fail(s, DMI_ENOMEM, "%s: out of memory for kernel samples", fn);
+    return rc == 0 ? DMI_OK : dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for kernel samples");
 }
 
 /* Samples z(p h), p = -N..0, into ring. */
@@ -525,9 +496,7 @@ int dmi_init(dmi_solver *s)
         return dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for the history");
     dmi_conv *c = NULL;
     dmi_exp *e = NULL;
-    /* The recursion needs no samples: they are taken when a method needs them. */
-    const int sampled = needs_samples(s, s->conv_method);
-    rc = sampled ? sample_kernel(s, &k, "dmi_init") : DMI_OK;
+    rc = sample_kernel(s, &k);
     if (rc == DMI_OK)
         rc = sample_history(s, &ring);
     if (rc == DMI_OK)
@@ -540,7 +509,6 @@ int dmi_init(dmi_solver *s)
     dmi_kernel_release(&s->kernel);
     dmi_history_release(&s->ring);
     s->kernel = k;
-    s->kernel_sampled = sampled;
     s->ring = ring;
     engine_free(s->conv, s->rec);
     s->conv = c;

@@ -34,8 +34,7 @@ struct dmi_solver {
     int initialized;
     uint64_t p;         /* step counter: t_p = p h */
     dmi_history ring;   /* U^{p-N..p} */
-    dmi_kernel kernel;  /* nonzero entries of H(l h), when kernel_sampled */
-    int kernel_sampled; /* 0: not yet (the recursion needs no samples; taken on a switch) */
+    dmi_kernel kernel;  /* nonzero entries of H(l h) */
     dmi_conv *conv;     /* FFT engine, or NULL */
     dmi_exp *rec;       /* recursion engine, or NULL (both NULL: the direct sum) */
     double *last_W;     /* W^{p-1} (n) */
