@@ -38,6 +38,7 @@
 
 #include <gsl/gsl_fft_halfcomplex.h>
 #include <gsl/gsl_fft_real.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -168,12 +169,45 @@ typedef struct {
     size_t S, M;          /* block size and FFT length 2S */
     size_t nparts, depth; /* partitions; windows kept (largest k + 1) */
     size_t *k;            /* partition indices */
-    double *kspec;        /* nnz * nparts * M: kernel spectra / M (split layout) */
+    double *kspec;        /* nspec * nparts * M: kernel spectra / M (split layout) */
     double *xspec;        /* ncols * depth * M: spectrum of window b in slot b mod depth */
     double *out;          /* n * S: block sums (before the factor h) of the current block */
 } level;
 
+/*
+ * Low-rank kernels.  When the N-sample series of the kernel's nnz entries
+ * span only r dimensions (H(s) = G(s) B, or a few relaxation functions times
+ * constant matrices: a modal model with viscoelastic parts), each entry is
+ * s_e = sum_k c_ek q_k with q_k orthonormal series, and
+ *     W_i = h sum_{e in row i} sum_k c_ek (q_k * U_col(e))(p).
+ * The engine then convolves the virtual kernel whose entry (row k n + j,
+ * column j) is q_k, for the columns j that some entry with c_ek != 0 uses:
+ * at most r n entries instead of nnz, so one forward transform per state
+ * column, one inverse per virtual row and r ncols products per partition,
+ * with the spectra of the r series only (shared by the columns, so they
+ * stay in cache); W costs nnz r multiply-adds more.  The series are found
+ * by Gram-Schmidt (each projection done twice) in the entries' order; an
+ * entry is represented when its residual's sum of |.| is at most LOWRANK_TOL
+ * of its samples' (so W moves by at most LOWRANK_TOL of
+ * h sum_l ||H(l h)|| max |U|); the virtual kernel is used only when it has
+ * at most half the entries.  The engine's state stays a function of (p, the
+ * kernel, the ring): rebuilds are exact as before.
+ */
+#define LOWRANK_TOL 1e-14
+#define LOWRANK_MAX 8 /* basis series at most */
+
+typedef struct {
+    size_t r;          /* basis series (0: not in use) */
+    size_t n;          /* the real n */
+    dmi_kernel kv;     /* the virtual kernel, kv.n = r n */
+    size_t *tstart;    /* n + 1: the terms of row i are [tstart[i], tstart[i + 1]) */
+    size_t *tv;        /* per term: its virtual row */
+    double *tc;        /* per term: its coefficient c_ek */
+    double *Y;         /* r n: the virtual rows' sums (scratch of dmi_conv_sum) */
+} lowrank;
+
 struct dmi_conv {
+    lowrank z;
     size_t n, N, nnz;
     size_t head, tail;
     size_t nlevels;
@@ -264,6 +298,11 @@ void dmi_conv_free(dmi_conv *c)
     }
     free(c->col_slot);
     free(c->row_used);
+    dmi_kernel_release(&c->z.kv);
+    free(c->z.tstart);
+    free(c->z.tv);
+    free(c->z.tc);
+    free(c->z.Y);
     free(c->acc);
     free(c->zero);
     free(c);
@@ -280,7 +319,7 @@ static double *doubles(size_t a, size_t b, int zero)
     return zero ? calloc(1, bytes) : malloc(bytes);
 }
 
-static int level_alloc(level *v, const layout *y, size_t i, size_t n, size_t ncols, size_t nnz)
+static int level_alloc(level *v, const layout *y, size_t i, size_t n, size_t ncols, size_t nspec)
 {
     v->S = y->S[i];
     v->M = 2 * v->S;
@@ -296,25 +335,171 @@ static int level_alloc(level *v, const layout *y, size_t i, size_t n, size_t nco
     /* nparts M <= 2 (N + 1) and depth M <= 2 (N + 1 + S): a few times the
      * kernel samples and the ring, which may still overflow size_t on a
      * 32-bit target. */
-    v->kspec = doubles(nnz, v->nparts * v->M, 0);
+    v->kspec = doubles(nspec, v->nparts * v->M, 0);
     v->xspec = doubles(ncols * v->depth, v->M, 1);
     v->out = doubles(n, v->S, 1);
     return v->kspec && v->xspec && v->out ? 0 : -1;
 }
 
-/* Spectrum / M of the kernel samples of entry e on the partition's lags. */
-static void kernel_spectra(level *v, const dmi_kernel *k)
+/* Spectrum / M of the kernel samples of each distinct series on the
+ * partition's lags: those of the entries of k, or of a low-rank form's r
+ * basis series (virtual entry e has series kv.row[e] / n). */
+static void kernel_spectra(level *v, const dmi_kernel *k, const lowrank *z)
 {
     const size_t S = v->S, M = v->M;
-    for (size_t e = 0; e < k->nnz; e++)
+    for (size_t e = 0; e < k->nnz; e++) {
+        if (z->r && e > 0 && k->row[e] / z->n == k->row[e - 1] / z->n)
+            continue; /* (the entries of a basis series are contiguous) */
+        const size_t sp = z->r ? k->row[e] / z->n : e;
         for (size_t q = 0; q < v->nparts; q++) {
-            double *x = v->kspec + (e * v->nparts + q) * M;
+            double *x = v->kspec + (sp * v->nparts + q) * M;
             const double *h = k->samples + e * k->N + (S - 1 + v->k[q] * S);
             for (size_t t = 0; t < S; t++)
                 x[t] = h[t] / (double)M;
             memset(x + S, 0, S * sizeof *x);
             forward(x, M);
         }
+    }
+}
+
+/* sum |x_l|, l < N. */
+static double norm1(const double *x, size_t N)
+{
+    double a = 0;
+    for (size_t l = 0; l < N; l++)
+        a += fabs(x[l]);
+    return a;
+}
+
+/* The low-rank form of k in z (see above): 1 made, 0 not low rank enough
+ * (z empty), -1 out of memory. */
+static int lowrank_make(lowrank *z, const dmi_kernel *k, size_t n, size_t ncols)
+{
+    memset(z, 0, sizeof *z);
+    const size_t N = k->N, nnz = k->nnz;
+    size_t rmax = ncols ? nnz / (2 * ncols) : 0;
+    if (rmax > LOWRANK_MAX)
+        rmax = LOWRANK_MAX;
+    if (rmax == 0)
+        return 0;
+    double *q = doubles(rmax + 1, N, 0), *c = doubles(nnz, rmax, 1);
+    if (!q || !c) {
+        free(q);
+        free(c);
+        return -1;
+    }
+    size_t r = 0;
+    int ok = 1;
+    double *res = q + rmax * N; /* the residual of the entry at hand */
+    for (size_t e = 0; e < nnz && ok; e++) {
+        const double *x = k->samples + e * N;
+        memcpy(res, x, N * sizeof *res);
+        for (int pass = 0; pass < 2; pass++)
+            for (size_t b = 0; b < r; b++) {
+                const double *qb = q + b * N;
+                double d = dmi_dot(qb, res, N);
+                for (size_t l = 0; l < N; l++)
+                    res[l] -= d * qb[l];
+                c[e * rmax + b] += d;
+            }
+        const double len = sqrt(dmi_dot(res, res, N)), size = norm1(x, N);
+        if (!isfinite(size) || !isfinite(len)) { /* (samples near DBL_MAX) */
+            ok = 0;
+            break;
+        }
+        if (norm1(res, N) <= LOWRANK_TOL * size)
+            continue;
+        if (r == rmax) {
+            ok = 0;
+            break;
+        }
+        for (size_t l = 0; l < N; l++)
+            q[r * N + l] = res[l] / len;
+        c[e * rmax + r] = len;
+        r++;
+    }
+    /* the virtual entries (b, j) that some c_ej != 0 uses */
+    size_t nv = 0;
+    unsigned char *used = ok ? calloc(rmax * n, 1) : NULL;
+    if (ok && used)
+        for (size_t e = 0; e < nnz; e++)
+            for (size_t b = 0; b < r; b++)
+                if (c[e * rmax + b] != 0 && !used[b * n + k->col[e]]) {
+                    used[b * n + k->col[e]] = 1;
+                    nv++;
+                }
+    if (!ok || !used || r == 0 || 2 * nv > nnz) {
+        free(q);
+        free(c);
+        free(used);
+        return ok && !used ? -1 : 0;
+    }
+    size_t terms = 0;
+    for (size_t e = 0; e < nnz * rmax; e++)
+        terms += c[e] != 0;
+    z->r = r;
+    z->n = n;
+    z->kv.n = r * n;
+    z->kv.N = N;
+    z->kv.row = malloc(nv * sizeof *z->kv.row);
+    z->kv.col = malloc(nv * sizeof *z->kv.col);
+    z->kv.samples = doubles(nv, N, 0);
+    z->tstart = malloc((n + 1) * sizeof *z->tstart);
+    z->tv = malloc((terms ? terms : 1) * sizeof *z->tv);
+    z->tc = malloc((terms ? terms : 1) * sizeof *z->tc);
+    z->Y = doubles(r, n, 1);
+    int rc = z->kv.row && z->kv.col && z->kv.samples && z->tstart && z->tv && z->tc && z->Y;
+    if (rc) {
+        size_t v = 0; /* rows b n + j ascending: the entries of a row contiguous */
+        for (size_t b = 0; b < r; b++)
+            for (size_t j = 0; j < n; j++)
+                if (used[b * n + j]) {
+                    z->kv.row[v] = b * n + j;
+                    z->kv.col[v] = j;
+                    memcpy(z->kv.samples + v * N, q + b * N, N * sizeof *q);
+                    v++;
+                }
+        z->kv.nnz = nv;
+        size_t t = 0, e = 0; /* the entries of a row are contiguous in k */
+        for (size_t i = 0; i < n; i++) {
+            z->tstart[i] = t;
+            for (; e < nnz && k->row[e] == i; e++)
+                for (size_t b = 0; b < r; b++)
+                    if (c[e * rmax + b] != 0) {
+                        z->tv[t] = b * n + k->col[e];
+                        z->tc[t] = c[e * rmax + b];
+                        t++;
+                    }
+        }
+        z->tstart[n] = t;
+    }
+    free(q);
+    free(c);
+    free(used);
+    if (!rc) {
+        dmi_kernel_release(&z->kv);
+        free(z->tstart);
+        free(z->tv);
+        free(z->tc);
+        free(z->Y);
+        memset(z, 0, sizeof *z);
+        return -1;
+    }
+    return 1;
+}
+
+/* The used columns (cu[j] = 1 + their index, 0 if unused) and rows of k;
+ * *ncols columns used, *ffts transforms per block (columns and rows). */
+static void usage(const dmi_kernel *k, size_t *cu, unsigned char *ru, size_t *ncols, size_t *ffts)
+{
+    *ffts = *ncols = 0;
+    for (size_t e = 0; e < k->nnz; e++) {
+        if (!cu[k->col[e]])
+            cu[k->col[e]] = ++*ncols;
+        *ffts += !ru[k->row[e]];
+        ru[k->row[e]] = 1;
+    }
+    *ffts += *ncols;
 }
 
 int dmi_conv_create(dmi_conv **out, const dmi_kernel *k, size_t n, size_t N, int method)
@@ -322,51 +507,66 @@ int dmi_conv_create(dmi_conv **out, const dmi_kernel *k, size_t n, size_t N, int
     *out = NULL;
     if (method == DMI_CONV_DIRECT)
         return 0;
-    size_t *cu = calloc(n, sizeof *cu);
+    lowrank z;
+    size_t *cu = calloc(n, sizeof *cu), ncols, ffts;
     unsigned char *ru = calloc(n, 1);
-    if (!cu || !ru) {
+    int lr = cu && ru ? 0 : -1;
+    if (lr == 0) {
+        usage(k, cu, ru, &ncols, &ffts);
+        lr = lowrank_make(&z, k, n, ncols);
+    }
+    const dmi_kernel *kk = k; /* the kernel the engine convolves */
+    size_t nn = n;
+    if (lr == 1) { /* the virtual kernel's rows and columns */
+        kk = &z.kv;
+        nn = z.kv.n;
         free(cu);
         free(ru);
+        cu = calloc(nn, sizeof *cu);
+        ru = calloc(nn, 1);
+        if (cu && ru)
+            usage(kk, cu, ru, &ncols, &ffts);
+    }
+    dmi_conv *c = lr >= 0 && cu && ru ? calloc(1, sizeof *c) : NULL;
+    if (!c) {
+        free(cu);
+        free(ru);
+        if (lr == 1) {
+            c = calloc(1, sizeof *c); /* (only to free z through dmi_conv_free) */
+            if (c)
+                c->z = z;
+            dmi_conv_free(c);
+        }
         return -1;
     }
-    size_t ffts = 0, ncols = 0;
-    for (size_t e = 0; e < k->nnz; e++) {
-        if (!cu[k->col[e]])
-            cu[k->col[e]] = ++ncols;
-        ffts += !ru[k->row[e]];
-        ru[k->row[e]] = 1;
-    }
-    ffts += ncols;
+    if (lr == 1)
+        c->z = z;
+    c->n = nn;
+    c->N = N;
+    c->nnz = kk->nnz;
+    c->ncols = ncols;
+    c->col_slot = cu;
+    c->row_used = ru;
     layout y;
-    int have = k->nnz > 0 && best_layout(N, k->nnz, ffts, &y);
+    int have = kk->nnz > 0 && best_layout(N, kk->nnz, ffts, &y);
+    /* the low-rank form adds nnz r multiply-adds per step, priced as lags */
+    double extra = lr == 1 ? COST_LAG * (double)z.tstart[n] : 0;
     if (method == DMI_CONV_AUTO &&
-        (!have || layout_cost(&y, N, k->nnz, ffts) >= COST_DIRECT * (double)k->nnz * (double)N)) {
-        free(cu);
-        free(ru);
+        (!have || layout_cost(&y, N, kk->nnz, ffts) + extra >=
+                      COST_DIRECT * (double)k->nnz * (double)N)) {
+        dmi_conv_free(c);
         return 0;
     }
     if (!have) { /* no kernel, or too short for any block: only direct sums */
         memset(&y, 0, sizeof y);
         y.head = y.tail = N;
     }
-    dmi_conv *c = calloc(1, sizeof *c);
-    if (!c) {
-        free(cu);
-        free(ru);
-        return -1;
-    }
-    c->n = n;
-    c->N = N;
-    c->nnz = k->nnz;
     c->head = y.head;
     c->tail = y.tail;
-    c->ncols = ncols;
-    c->col_slot = cu;
-    c->row_used = ru;
     int rc = 0;
     for (size_t i = 0; i < y.L && rc == 0; i++) {
         c->nlevels = i + 1;
-        rc = level_alloc(&c->lv[i], &y, i, n, ncols, k->nnz);
+        rc = level_alloc(&c->lv[i], &y, i, nn, ncols, lr == 1 ? z.r : kk->nnz);
     }
     c->acc = malloc((y.L ? 2 * y.S[y.L - 1] : 1) * sizeof *c->acc);
     c->zero = calloc(y.L ? 2 * y.S[y.L - 1] : 1, sizeof *c->zero);
@@ -375,9 +575,15 @@ int dmi_conv_create(dmi_conv **out, const dmi_kernel *k, size_t n, size_t N, int
         return -1;
     }
     for (size_t i = 0; i < c->nlevels; i++)
-        kernel_spectra(&c->lv[i], k);
+        kernel_spectra(&c->lv[i], kk, &c->z);
     *out = c;
     return 0;
+}
+
+/* The kernel c convolves: the virtual one of a low-rank form, or k. */
+static const dmi_kernel *convolved(const dmi_conv *c, const dmi_kernel *k)
+{
+    return c->z.r ? &c->z.kv : k;
 }
 
 /* Spectra of window b of the used columns into its slot; the window's oldest
@@ -409,11 +615,12 @@ static void block(const dmi_conv *c, level *v, const dmi_kernel *k, uint64_t j, 
             if (k->row[e] != i)
                 continue;
             const double *xs = v->xspec + (c->col_slot[k->col[e]] - 1) * v->depth * M;
+            const size_t sp = c->z.r ? k->row[e] / c->z.n : e; /* its spectra */
             for (size_t q = 0; q < v->nparts; q++) {
                 size_t slot = base - v->k[q]; /* (j - 1 - k) mod depth */
                 if (slot >= v->depth)
                     slot -= v->depth;
-                const double *K = v->kspec + (e * v->nparts + q) * M, *X = xs + slot * M;
+                const double *K = v->kspec + (sp * v->nparts + q) * M, *X = xs + slot * M;
                 if (!K1) {
                     K1 = K;
                     X1 = X;
@@ -432,6 +639,7 @@ static void block(const dmi_conv *c, level *v, const dmi_kernel *k, uint64_t j, 
 
 void dmi_conv_rebuild(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p)
 {
+    k = convolved(c, k);
     for (size_t i = 0; i < c->nlevels; i++) {
         level *v = &c->lv[i];
         const size_t S = v->S;
@@ -450,6 +658,7 @@ void dmi_conv_advance(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, ui
 {
     if (c->nlevels == 0 || (p & (c->lv[0].S - 1)) != 0) /* the sizes are multiples of S_1 */
         return;
+    k = convolved(c, k);
     for (size_t i = 0; i < c->nlevels; i++) {
         level *v = &c->lv[i];
         if ((p & (v->S - 1)) != 0) /* S is a power of two */
@@ -461,11 +670,12 @@ void dmi_conv_advance(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, ui
     }
 }
 
-/* Each row is summed in a local and W written once (a vector load of values
- * just stored one by one stalls).  The kernel entries of a row are
- * contiguous (dmi_kernel_alloc stores them row by row). */
-void dmi_conv_sum(const dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p,
-                  double h, double *W)
+/* The engine's sums of kernel k (W: c->n values).  Each row is summed in a
+ * local and W written once (a vector load of values just stored one by one
+ * stalls).  The kernel entries of a row are contiguous (dmi_kernel_alloc
+ * stores them row by row). */
+static void engine_sum(const dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p,
+                       double h, double *W)
 {
     size_t e = 0;
     for (size_t row = 0; row < c->n; row++) {
@@ -483,7 +693,29 @@ void dmi_conv_sum(const dmi_conv *c, const dmi_kernel *k, const dmi_history *r, 
     }
 }
 
+void dmi_conv_sum(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p, double h,
+                  double *W)
+{
+    const lowrank *z = &c->z;
+    if (z->r) { /* the virtual rows' sums, then W_i = h sum c_ek Y_(k n + col) */
+        engine_sum(c, &z->kv, r, p, 1.0, z->Y);
+        for (size_t i = 0; i < z->n; i++) {
+            double w = 0;
+            for (size_t t = z->tstart[i]; t < z->tstart[i + 1]; t++)
+                w += z->tc[t] * z->Y[z->tv[t]];
+            W[i] = w * h;
+        }
+        return;
+    }
+    engine_sum(c, k, r, p, h, W);
+}
+
 size_t dmi_conv_levels(const dmi_conv *c)
 {
     return c ? c->nlevels : 0;
+}
+
+size_t dmi_conv_rank(const dmi_conv *c)
+{
+    return c ? c->z.r : 0;
 }

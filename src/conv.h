@@ -25,10 +25,14 @@ void dmi_conv_free(dmi_conv *c);
 void dmi_conv_rebuild(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p);
 /* After U^p was pushed (p the new step counter): updates the blocks due at p. */
 void dmi_conv_advance(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p);
-/* W^p, as dmi_delay_sum, without changing the engine. */
-void dmi_conv_sum(const dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p,
-                  double h, double *W);
+/* W^p, as dmi_delay_sum, without changing the engine's state (c holds the
+ * scratch of a low-rank kernel). */
+void dmi_conv_sum(dmi_conv *c, const dmi_kernel *k, const dmi_history *r, uint64_t p, double h,
+                  double *W);
 /* Number of FFT block sizes in use (0: the engine degenerated to direct sums). */
 size_t dmi_conv_levels(const dmi_conv *c);
+/* The number of basis series of a low-rank kernel (conv.c), 0 when every
+ * nonzero entry is convolved on its own. */
+size_t dmi_conv_rank(const dmi_conv *c);
 
 #endif

@@ -142,20 +142,20 @@ void dmi_engine_rebuild(const dmi_solver *s, dmi_conv *conv, dmi_exp *rec)
         dmi_exp_anchor(rec, &s->ring, s->p);
 }
 
-/* W = W^p. */
-static void delay_sum(const dmi_solver *s, double *W)
+/* W^p: the recursion's own array (valid until the engine moves on), or W
+ * filled. */
+static const double *delay_sum(const dmi_solver *s, double *W)
 {
-    if (s->rec) {
-        dmi_exp_sum(s->rec, s->h, W);
-        return;
-    }
+    if (s->rec)
+        return dmi_exp_sum(s->rec);
 #ifdef DMI_HAVE_FFT
     if (s->conv) {
         dmi_conv_sum(s->conv, &s->kernel, &s->ring, s->p, s->h, W);
-        return;
+        return W;
     }
 #endif
     dmi_delay_sum(&s->kernel, &s->ring, s->h, W);
+    return W;
 }
 
 /* After a step was committed (U^p pushed, p counted). */
@@ -413,7 +413,9 @@ int dmi_set_convolution(dmi_solver *s, int method)
 
 /* ---- init ------------------------------------------------------------------ */
 
-/* Samples H(l h), l = 0..N-1, into k (nonzero entries only). */
+/* Samples H(l h), l = 0..N-1, into k (nonzero entries only).  An
+ * exponential kernel is sampled entry by entry (dmi_expk_sample: no N n n
+ * array); where a sample is not finite, the general path below names it. */
 static int sample_kernel(dmi_solver *s, dmi_kernel *k)
 {
     const size_t n = s->n, N = s->N, nn = n * n;
@@ -421,6 +423,13 @@ static int sample_kernel(dmi_solver *s, dmi_kernel *k)
         return dmi_kernel_alloc(k, n, N, NULL) == 0
                    ? DMI_OK
                    : dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory");
+    if (dmi_has_expk(s)) {
+        int rc = dmi_expk_sample(&s->expk, N, s->h, k);
+        if (rc < 0)
+            return dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for kernel samples");
+        if (rc == 0)
+            return DMI_OK;
+    }
     /* (0 also when n * n overflows) */
     size_t bytes = dmi_mul_size(n, n, 1) ? dmi_mul_size(N, nn, sizeof(double)) : 0;
     double *dense = bytes ? malloc(bytes) : NULL;
@@ -551,7 +560,7 @@ int dmi_step(dmi_solver *s)
         return dmi_fail(s, DMI_ESTATE, "dmi_step: call dmi_init first");
     const size_t n = s->n;
     const double h = s->h, t = (double)s->p * h; /* dmi_time */
-    double *U = s->work, *fv = U + n, *W = fv + n, *X = W + n, *U1 = X + n;
+    double *U = s->work, *fv = U + n, *Wbuf = fv + n, *X = Wbuf + n, *U1 = X + n;
     dmi_history_get(&s->ring, 0, U);
 
     for (size_t i = 0; i < n; i++) /* (loops, not memset/memcpy: n is small) */
@@ -562,7 +571,7 @@ int dmi_step(dmi_solver *s)
             return dmi_fail(s, DMI_ECALLBACK, "dmi_step: rhs callback returned %d at t = %.17g", rc,
                             t);
     }
-    delay_sum(s, W);
+    const double *W = delay_sum(s, Wbuf);
     for (size_t i = 0; i < n; i++)
         X[i] = U[i] - h * fv[i] - h * W[i];
     /* A non-finite f or W makes X non-finite (U^p and h are finite), so one

@@ -203,6 +203,71 @@ int dmi_expk_eval(double s, double *out, void *user)
     return 0;
 }
 
+int dmi_expk_sample(const dmi_expk *k, size_t N, double h, dmi_kernel *out)
+{
+    const size_t n = k->n, nn = n * n, K = k->K;
+    dmi_kernel_alloc(out, n, N, NULL);
+    /* per term and sample: e^{a s} cos(b s) and e^{a s} sin(b s), as dmi_expk_eval */
+    size_t bytes = dmi_mul_size(2 * K, N, sizeof(double));
+    double *cs = bytes ? malloc(bytes) : NULL;
+    if (!cs)
+        return -1;
+    int finite = 1;
+    for (size_t t = 0; t < K; t++)
+        for (size_t l = 0; l < N; l++) {
+            double x = (double)l * h, e = exp(k->a[t] * x);
+            double c = e * cos(k->b[t] * x), sn = e * sin(k->b[t] * x);
+            cs[(2 * t) * N + l] = c;
+            cs[(2 * t + 1) * N + l] = sn;
+            finite &= isfinite(c) && isfinite(sn);
+        }
+    size_t cand = 0;
+    for (size_t q = 0; q < nn; q++)
+        for (size_t t = 0; t < K; t++)
+            if (k->C[t * nn + q] != 0 || (k->D && k->D[t * nn + q] != 0)) {
+                cand++;
+                break;
+            }
+    int rc = finite ? 0 : 1;
+    if (rc == 0 && cand > 0) {
+        out->row = malloc(cand * sizeof *out->row);
+        out->col = malloc(cand * sizeof *out->col);
+        out->samples = malloc(cand * N * sizeof *out->samples); /* <= N n n doubles */
+        rc = out->row && out->col && out->samples ? 0 : -1;
+    }
+    size_t e = 0;
+    for (size_t q = 0; q < nn && rc == 0; q++) {
+        int used = 0;
+        for (size_t t = 0; t < K && !used; t++)
+            used = k->C[t * nn + q] != 0 || (k->D && k->D[t * nn + q] != 0);
+        if (!used)
+            continue;
+        double *x = out->samples + e * N;
+        int nonzero = 0;
+        for (size_t l = 0; l < N; l++) {
+            double v = 0;
+            for (size_t t = 0; t < K; t++) {
+                const double C = k->C[t * nn + q], c = cs[(2 * t) * N + l];
+                v += k->D ? C * c + k->D[t * nn + q] * cs[(2 * t + 1) * N + l] : C * c;
+            }
+            x[l] = v;
+            nonzero |= v != 0;
+            if (!isfinite(v))
+                rc = 1;
+        }
+        if (nonzero) {
+            out->row[e] = q / n;
+            out->col[e] = q % n;
+            e++;
+        }
+    }
+    free(cs);
+    out->nnz = e;
+    if (rc != 0)
+        dmi_kernel_release(out);
+    return rc;
+}
+
 /* Whether column j of term t has a nonzero entry in C_t or D_t. */
 static int column_used(const dmi_expk *k, size_t t, size_t j)
 {
@@ -267,23 +332,47 @@ typedef struct {
     double tab[2 * BLOCK];       /* r^i, i < BLOCK: re, im */
 } term;
 
+/* The multipliers of one sum for its step, copied from its term so that the
+ * step reads one contiguous record per sum, as pairs (re, im) so that the
+ * step of a complex sum is the same arithmetic on both halves (which the
+ * compiler may pair into vector operations):
+ *     S' = (x hi + y hi_rot) + ((x lo + y lo_rot) + ((unew, 0) - uold rN))
+ * with S = (x, y), hi = (rh_re, rh_im), hi_rot = (-rh_im, rh_re), the same
+ * for lo = rl, and rN = (rN_re, rN_im): term by term the operations of
+ * x rh - y rh_im etc., so the same results bitwise. */
 typedef struct {
-    size_t term, col;
-    double re, im; /* the sum S */
-} sum;
+    double hi[2], hi_rot[2], lo[2], lo_rot[2], rN[2];
+} mult;
 
-typedef struct {
-    size_t sum, row;
-    double C, D; /* W_row += C Re S + D Im S */
-} part;
-
+/*
+ * The sums are kept in the order real ones first (nreal of them), then the
+ * complex ones, so that the step runs two branch-free loops; slot[q] is the
+ * place of sum q in the saved order (term by term, used columns ascending).
+ * The parts C, D of row i are parts [row_start[i], row_start[i + 1]), in the
+ * saved order of their sums (summed in two partial sums, see update_W).  W
+ * (h times the sum, n values) is recomputed whenever the sums change, so
+ * dmi_exp_sum only copies it.
+ */
 struct dmi_exp {
-    size_t n, N, nterms, nsums, nparts;
+    size_t n, N, nterms, nsums, nreal, nparts;
+    double h;
     uint64_t period;
     uint64_t next; /* the next anchoring step: the multiple of period after the last anchor */
     term *terms;
-    sum *sums;
-    part *parts;
+    size_t *term_of, *col, *slot; /* per sum */
+    size_t *series;               /* per sum: offset of its column's series in the ring */
+    mult *m;                      /* per sum */
+    double *S;                    /* per sum: the sum S (re, im) */
+    size_t *row_start;            /* n + 1 */
+    size_t *psum;                 /* per part: its sum (internal index) */
+    double *pC, *pD;              /* per part: W_row += C Re S + D Im S */
+    int has_D;                    /* some part has D != 0 */
+    /* the parts as a matrix when it is small or full enough: the rows with a
+     * part (nrows of them, listed in rows), each a row of nsums C (and D)
+     * values, zero where no part is */
+    size_t nrows, *rows;
+    double *Cm, *Dm;
+    double *W;                    /* n: h sum of the parts, W^p */
 };
 
 void dmi_exp_free(dmi_exp *e)
@@ -291,8 +380,20 @@ void dmi_exp_free(dmi_exp *e)
     if (!e)
         return;
     free(e->terms);
-    free(e->sums);
-    free(e->parts);
+    free(e->term_of);
+    free(e->col);
+    free(e->slot);
+    free(e->series);
+    free(e->m);
+    free(e->S);
+    free(e->row_start);
+    free(e->psum);
+    free(e->pC);
+    free(e->pD);
+    free(e->W);
+    free(e->rows);
+    free(e->Cm);
+    free(e->Dm);
     free(e);
 }
 
@@ -327,6 +428,11 @@ static void term_init(term *t, double a, double b, double h, size_t N)
     }
 }
 
+static void *array(size_t count, size_t size)
+{
+    return calloc(count ? count : 1, size);
+}
+
 int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
 {
     *out = NULL;
@@ -336,39 +442,149 @@ int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
         return -1;
     e->n = n;
     e->N = N;
+    e->h = h;
     e->period = (uint64_t)PERIOD * (uint64_t)N;
     e->nsums = dmi_expk_sums(k);
     for (size_t q = 0; q < k->K * nn; q++) /* k->K n n was checked by dmi_expk_copy */
         e->nparts += k->C[q] != 0 || (k->D && k->D[q] != 0);
     e->nterms = k->K;
-    e->terms = malloc((k->K ? k->K : 1) * sizeof *e->terms);
-    e->sums = calloc(e->nsums ? e->nsums : 1, sizeof *e->sums);
-    e->parts = malloc((e->nparts ? e->nparts : 1) * sizeof *e->parts);
-    if (!e->terms || !e->sums || !e->parts) {
+    const size_t ns = e->nsums, np = e->nparts;
+    e->terms = array(k->K, sizeof *e->terms);
+    e->term_of = array(ns, sizeof *e->term_of);
+    e->col = array(ns, sizeof *e->col);
+    e->slot = array(ns, sizeof *e->slot);
+    e->series = array(ns, sizeof *e->series);
+    e->m = array(ns, sizeof *e->m);
+    e->S = array(2 * ns, sizeof *e->S);
+    e->row_start = array(n + 1, sizeof *e->row_start);
+    e->psum = array(np, sizeof *e->psum);
+    e->pC = array(np, sizeof *e->pC);
+    e->pD = array(np, sizeof *e->pD);
+    e->W = array(n, sizeof *e->W);
+    size_t *index = array(k->K * n, sizeof *index); /* (t, j) -> internal sum index */
+    if (!e->terms || !e->term_of || !e->col || !e->slot || !e->series || !e->m || !e->S ||
+        !e->row_start || !e->psum || !e->pC || !e->pD || !e->W || !index) {
+        free(index);
         dmi_exp_free(e);
         return -1;
     }
-    size_t q = 0, np = 0;
-    for (size_t t = 0; t < k->K; t++) {
+    for (size_t t = 0; t < k->K; t++)
         term_init(&e->terms[t], k->a[t], k->b[t], h, N);
-        for (size_t j = 0; j < n; j++) {
-            if (!column_used(k, t, j))
-                continue;
-            e->sums[q].term = t;
-            e->sums[q].col = j;
-            for (size_t i = 0; i < n; i++) {
+    /* internal order: the real sums, then the complex ones, each in saved order */
+    size_t q = 0;
+    for (int pass = 0; pass < 2; pass++)
+        for (size_t t = 0, sv = 0; t < k->K; t++)
+            for (size_t j = 0; j < n; j++) {
+                if (!column_used(k, t, j))
+                    continue;
+                if (e->terms[t].real == (pass == 0)) {
+                    const term *tm = &e->terms[t];
+                    mult mu = {{tm->rh_re, tm->rh_im}, {-tm->rh_im, tm->rh_re},
+                               {tm->rl_re, tm->rl_im}, {-tm->rl_im, tm->rl_re},
+                               {tm->rN_re, tm->rN_im}};
+                    e->term_of[q] = t;
+                    e->col[q] = j;
+                    e->slot[q] = sv;
+                    e->series[q] = j * 2 * (N + 1); /* the ring's layout, L = N + 1 */
+                    e->m[q] = mu;
+                    index[t * n + j] = q++;
+                }
+                sv++;
+            }
+    for (size_t x = 0; x < ns; x++)
+        e->nreal += (size_t)e->terms[e->term_of[x]].real;
+    /* parts row by row; within a row in the saved order (term, column) */
+    size_t pp = 0;
+    for (size_t i = 0; i < n; i++) {
+        e->row_start[i] = pp;
+        for (size_t t = 0; t < k->K; t++)
+            for (size_t j = 0; j < n; j++) {
                 size_t x = t * nn + i * n + j;
                 double C = k->C[x], D = k->D ? k->D[x] : 0.0;
                 if (C == 0 && D == 0)
                     continue;
-                part pt = {q, i, C, D};
-                e->parts[np++] = pt;
+                e->psum[pp] = index[t * n + j];
+                e->pC[pp] = C;
+                e->pD[pp] = D;
+                e->has_D |= D != 0;
+                pp++;
             }
-            q++;
+    }
+    e->row_start[n] = pp;
+    free(index);
+    for (size_t i = 0; i < n; i++)
+        e->nrows += e->row_start[i + 1] > e->row_start[i];
+    if (e->nrows * ns <= 2 * np + 8) { /* (nrows ns <= n n K: no overflow) */
+        e->rows = array(e->nrows, sizeof *e->rows);
+        e->Cm = array(e->nrows * ns, sizeof *e->Cm);
+        e->Dm = e->has_D ? array(e->nrows * ns, sizeof *e->Dm) : NULL;
+        if (!e->rows || !e->Cm || (e->has_D && !e->Dm)) {
+            dmi_exp_free(e);
+            return -1;
+        }
+        for (size_t i = 0, r = 0; i < n; i++) {
+            if (e->row_start[i + 1] == e->row_start[i])
+                continue;
+            e->rows[r] = i;
+            for (size_t x = e->row_start[i]; x < e->row_start[i + 1]; x++) {
+                e->Cm[r * ns + e->psum[x]] = e->pC[x];
+                if (e->Dm)
+                    e->Dm[r * ns + e->psum[x]] = e->pD[x];
+            }
+            r++;
         }
     }
     *out = e;
     return 0;
+}
+
+/* W = h sum of the parts, row by row (each row in locals, written once).
+ * Two partial sums in a fixed order, so a long row (a dense block) is not
+ * one chain of dependent additions; without D (no sine part in any term)
+ * the imaginary parts are not read. */
+static void update_W(dmi_exp *e)
+{
+    const double *S = e->S, *C = e->pC, *D = e->pD;
+    const size_t *ps = e->psum, ns = e->nsums;
+    if (e->Cm) { /* the matrix form: no indices (the other rows stay 0) */
+        for (size_t r = 0; r < e->nrows; r++) {
+            const double *Cr = e->Cm + r * ns, *Dr = e->Dm ? e->Dm + r * ns : NULL;
+            double w0 = 0, w1 = 0;
+            size_t q = 0;
+            for (; q + 1 < ns; q += 2) {
+                w0 += Cr[q] * S[2 * q];
+                w1 += Cr[q + 1] * S[2 * q + 2];
+            }
+            if (q < ns)
+                w0 += Cr[q] * S[2 * q];
+            if (Dr)
+                for (q = 0; q < ns; q++)
+                    w1 += Dr[q] * S[2 * q + 1];
+            e->W[e->rows[r]] = (w0 + w1) * e->h;
+        }
+        return;
+    }
+    for (size_t i = 0; i < e->n; i++) {
+        const size_t end = e->row_start[i + 1];
+        size_t q = e->row_start[i];
+        double w0 = 0, w1 = 0;
+        if (e->has_D) {
+            for (; q + 1 < end; q += 2) {
+                w0 += C[q] * S[2 * ps[q]] + D[q] * S[2 * ps[q] + 1];
+                w1 += C[q + 1] * S[2 * ps[q + 1]] + D[q + 1] * S[2 * ps[q + 1] + 1];
+            }
+            if (q < end)
+                w0 += C[q] * S[2 * ps[q]] + D[q] * S[2 * ps[q] + 1];
+        } else {
+            for (; q + 1 < end; q += 2) {
+                w0 += C[q] * S[2 * ps[q]];
+                w1 += C[q + 1] * S[2 * ps[q + 1]];
+            }
+            if (q < end)
+                w0 += C[q] * S[2 * ps[q]];
+        }
+        e->W[i] = (w0 + w1) * e->h;
+    }
 }
 
 /* acc += x, error-free: acc.hi + acc.lo carries the sum's rounding. */
@@ -389,9 +605,8 @@ void dmi_exp_anchor(dmi_exp *e, const dmi_history *r, uint64_t p)
 {
     set_next(e, p);
     for (size_t q = 0; q < e->nsums; q++) {
-        sum *S = &e->sums[q];
-        const term *t = &e->terms[S->term];
-        const double *u = dmi_history_series(r, S->col); /* u[l] = U^{p-l} */
+        const term *t = &e->terms[e->term_of[q]];
+        const double *u = dmi_history_series(r, e->col[q]); /* u[l] = U^{p-l} */
         dd re = {0, 0}, im = {0, 0};
         cdd base = cdd_one(); /* r^l0 */
         for (size_t l0 = 0; l0 < e->N; l0 += BLOCK) {
@@ -409,9 +624,10 @@ void dmi_exp_anchor(dmi_exp *e, const dmi_history *r, uint64_t p)
             }
             base = cdd_mul(base, t->rB);
         }
-        S->re = re.hi + re.lo;
-        S->im = im.hi + im.lo;
+        e->S[2 * q] = re.hi + re.lo;
+        e->S[2 * q + 1] = im.hi + im.lo;
     }
+    update_W(e);
 }
 
 void dmi_exp_advance(dmi_exp *e, const dmi_history *r, uint64_t p)
@@ -420,35 +636,32 @@ void dmi_exp_advance(dmi_exp *e, const dmi_history *r, uint64_t p)
         dmi_exp_anchor(e, r, p);
         return;
     }
-    const size_t N = e->N;
-    for (size_t q = 0; q < e->nsums; q++) {
-        sum *S = &e->sums[q];
-        const term *t = &e->terms[S->term];
-        const double *u = dmi_history_series(r, S->col);
-        const double unew = u[0], uold = u[N];
-        const double x = S->re, y = S->im;
-        if (t->real) {
-            S->re = x * t->rh_re + (x * t->rl_re + (unew - t->rN_re * uold));
-        } else {
-            S->re = (x * t->rh_re - y * t->rh_im) +
-                    ((x * t->rl_re - y * t->rl_im) + (unew - t->rN_re * uold));
-            S->im = (x * t->rh_im + y * t->rh_re) +
-                    ((x * t->rl_im + y * t->rl_re) - t->rN_im * uold);
-        }
+    const double *buf = r->buf + r->head;
+    const size_t N = e->N, nr = e->nreal, ns = e->nsums;
+    const size_t *off = e->series;
+    const mult *m = e->m;
+    double *S = e->S;
+    for (size_t q = 0; q < nr; q++) {
+        const double unew = buf[off[q]], uold = buf[off[q] + N], x = S[2 * q];
+        S[2 * q] = x * m[q].hi[0] + (x * m[q].lo[0] + (unew - m[q].rN[0] * uold));
     }
+    for (size_t q = nr; q < ns; q++) {
+        const double unew = buf[off[q]], uold = buf[off[q] + N];
+        const double x = S[2 * q], y = S[2 * q + 1];
+        double v[2];
+        for (int c = 0; c < 2; c++)
+            v[c] = (x * m[q].hi[c] + y * m[q].hi_rot[c]) +
+                   ((x * m[q].lo[c] + y * m[q].lo_rot[c]) +
+                    ((c == 0 ? unew : 0.0) - m[q].rN[c] * uold));
+        S[2 * q] = v[0];
+        S[2 * q + 1] = v[1];
+    }
+    update_W(e);
 }
 
-void dmi_exp_sum(const dmi_exp *e, double h, double *W)
+const double *dmi_exp_sum(const dmi_exp *e)
 {
-    for (size_t i = 0; i < e->n; i++)
-        W[i] = 0;
-    for (size_t q = 0; q < e->nparts; q++) {
-        const part *pt = &e->parts[q];
-        const sum *S = &e->sums[pt->sum];
-        W[pt->row] += pt->C * S->re + pt->D * S->im;
-    }
-    for (size_t i = 0; i < e->n; i++)
-        W[i] *= h;
+    return e->W;
 }
 
 uint64_t dmi_exp_period(const dmi_exp *e)
@@ -459,8 +672,8 @@ uint64_t dmi_exp_period(const dmi_exp *e)
 void dmi_exp_get(const dmi_exp *e, unsigned char *bytes)
 {
     for (size_t q = 0; q < e->nsums; q++) {
-        memcpy(bytes + 2 * q * sizeof(double), &e->sums[q].re, sizeof(double));
-        memcpy(bytes + (2 * q + 1) * sizeof(double), &e->sums[q].im, sizeof(double));
+        const size_t s = e->slot[q];
+        memcpy(bytes + 2 * s * sizeof(double), &e->S[2 * q], 2 * sizeof(double));
     }
 }
 
@@ -468,7 +681,8 @@ void dmi_exp_set(dmi_exp *e, const double *sums, uint64_t p)
 {
     set_next(e, p);
     for (size_t q = 0; q < e->nsums; q++) {
-        e->sums[q].re = sums[2 * q];
-        e->sums[q].im = sums[2 * q + 1];
+        e->S[2 * q] = sums[2 * e->slot[q]];
+        e->S[2 * q + 1] = sums[2 * e->slot[q] + 1];
     }
+    update_W(e);
 }

@@ -31,6 +31,13 @@ void dmi_expk_release(dmi_expk *k);
 /* H(s) of the kernel: a dmi_kernel_fn, user = the dmi_expk. */
 int dmi_expk_eval(double s, double *out, void *user);
 
+/* The samples H(l h), l < N, of the entries that some C_k or D_k has, as
+ * dmi_kernel_alloc would store them from dense samples of dmi_expk_eval
+ * (bitwise the same values; entries zero at every sample left out), without
+ * the N n n dense array.  0; -1 when out of memory; 1 when a sample is not
+ * finite (the dense path then tells which).  out is empty unless 0. */
+int dmi_expk_sample(const dmi_expk *k, size_t N, double h, dmi_kernel *out);
+
 /* Whether term t has a nonzero entry in C_t or D_t. */
 int dmi_expk_term_used(const dmi_expk *k, size_t t);
 
@@ -62,8 +69,9 @@ void dmi_exp_anchor(dmi_exp *e, const dmi_history *r, uint64_t p);
  * step, set by dmi_exp_anchor and dmi_exp_set from their p, so that its
  * sums stay a function of p and the states). */
 void dmi_exp_advance(dmi_exp *e, const dmi_history *r, uint64_t p);
-/* W^p (n values). */
-void dmi_exp_sum(const dmi_exp *e, double h, double *W);
+/* W^p (n values, the engine's own: computed, times h, whenever the sums
+ * change; valid until the next call that changes them). */
+const double *dmi_exp_sum(const dmi_exp *e);
 /* The anchoring period in steps. */
 uint64_t dmi_exp_period(const dmi_exp *e);
 /* The sums as 2 dmi_expk_sums doubles (re, im): written to bytes (any

@@ -73,6 +73,7 @@ static void check_steps(size_t n, size_t N, unsigned mask, size_t steps, size_t 
     dmi_conv *c = NULL, *c2 = NULL;
     CU_ASSERT_FATAL(dmi_conv_create(&c, &k, n, N, DMI_CONV_FFT) == 0 && c);
     CU_ASSERT_FATAL(dmi_conv_create(&c2, &k, n, N, DMI_CONV_FFT) == 0 && c2);
+    CU_ASSERT(dmi_conv_rank(c) == 0); /* random samples: no low-rank form */
     dmi_conv_rebuild(c, &k, &r, 0);
     int bad = 0, diff = 0;
     for (uint64_t p = 0; p <= steps && !bad && !diff; p++) {
