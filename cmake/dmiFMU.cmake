@@ -230,8 +230,9 @@ const char dmi_fmu_guid[] = \"@arg_GUID@\";
   endforeach()
   list(REMOVE_DUPLICATES tool_dirs)
   add_executable(${name}_model_description ${tool_units})
+  # a build tool: in the FMU's own folder of the build tree, not beside the project's programs
   set_target_properties(${name}_model_description PROPERTIES C_STANDARD 99 C_STANDARD_REQUIRED ON
-                        C_EXTENSIONS OFF)
+                        C_EXTENSIONS OFF RUNTIME_OUTPUT_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}/${name}.tools)
   target_include_directories(${name}_model_description PRIVATE ${tool_dirs})
   target_compile_options(${name}_model_description PRIVATE ${DMI_FMU_COMPILE_OPTIONS})
   target_link_libraries(${name}_model_description PRIVATE m)

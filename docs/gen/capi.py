@@ -126,7 +126,17 @@ def declarations(code: str) -> str:
     return "```c\n" + "\n".join(keep) + "\n```\n"
 
 
-def header(path: Path, root: Path) -> str:
+def target(name: str, taken: set[str]) -> str:
+    """The anchor of a name: the name itself, or NAME-macro when another name differs from it only in
+    case (HTML ids are lower case: the macro DMI_FMU_VARIABLE beside the type dmi_fmu_variable)."""
+    key = name.lower()
+    if key in taken:
+        name, key = name + "-macro", key + "-macro"
+    taken.add(key)
+    return name
+
+
+def header(path: Path, root: Path, taken: set[str]) -> str:
     text = path.read_text()
     guard = re.search(r"#ifndef\s+(\w+)\s*\n\s*#define\s+\1\b", text)
     # pieces: (comment, the code after it up to the next comment); enum blocks stay whole
@@ -161,7 +171,7 @@ def header(path: Path, root: Path) -> str:
         listed = [n for k, n in decl if k != "constant"]
         title = ", ".join(listed) if listed else first.rstrip(".")
         for _, n in decl:
-            out.append(f"({n})=")
+            out.append(f"({target(n, taken)})=")
         out.append(f"{'####' if in_section else '###'} {escape(title)}\n")
         out.append(declarations(code))
         if body and (listed or body != first):      # a one-line group title is not repeated
@@ -183,8 +193,9 @@ def main(argv: list[str]) -> int:
           + ", ".join(f"`include/{p.name}`" for p in paths)
           + ": every exported function (`DMI_API`), type, macro and constant, with the text its header gives "
           "(units, ownership, error codes).\n")
+    taken: set[str] = set()
     for p in paths:
-        print(header(p, root))
+        print(header(p, root, taken))
     return 0
 
 
