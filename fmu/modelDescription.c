@@ -67,6 +67,10 @@ static int check_table(const char *name, unsigned nvr)
         else if ((kind & FMU_INDEPENDENT) && (!(kind & FMU_FLOAT64) || independent++))
             bad |= refuse(name, "variable \"%s\": the independent variable is Float64, and only "
                           "one%s", x->name, "");
+        else if ((kind & FMU_INDEPENDENT) && vr + 1 != MODEL->nvariables)
+            /* FMI 2.0 leaves it out and numbers the others 1, 2, ...: it must be last */
+            bad |= refuse(name, "variable \"%s\": the independent variable must be the table's "
+                          "last%s", x->name, "");
         else if ((kind & FMU_BOOLEAN) && has_start && x->start != 0 && x->start != 1)
             bad |= refuse(name, "variable \"%s\": a Boolean starts at 0 or 1 (start %s)", x->name,
                           x->start_text);

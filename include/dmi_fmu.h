@@ -62,8 +62,9 @@ extern "C" {
  * Columns: name (a C identifier, unique), type (Float64, Int32, Boolean),
  * causality (parameter: set before ExitInitializationMode, fixed after;
  * input: set at any time, held per step; output: computed, no start value;
- * independent: the time, Float64, no start value, at most one; when the
- * table has none, the framework adds "time" after the last variable),
+ * independent: the time, Float64, no start value, at most one, the last
+ * row; when the table has none, the framework adds "time" after the last
+ * variable),
  * start value (a C constant; empty for outputs and the independent
  * variable; Boolean: 0 or 1), unit ("" for none) and description.
  * The model descriptions' generator (run by dmi_add_fmu at build time) checks

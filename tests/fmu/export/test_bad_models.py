@@ -95,6 +95,9 @@ def good(prefix, tmp_path_factory):
     ('X(z, Float32, parameter, 1.0, "", "")', 'variable "z": unknown type "Float32"'),
     ('X(q, Float64, local, 1.0, "", "")', 'variable "q": unknown causality "local"'),
     ('X(p, Float64, parameter, , "", "")', 'variable "p": a parameter needs a start value'),
+    # FMI 2.0 numbers the variables without it: anywhere but last its outputs' indices would be off
+    ('X(time, Float64, independent, , "s", "time")',
+     'variable "time": the independent variable must be the table\'s last'),
 ])
 def test_bad_table_fails_the_build(prefix, tmp_path, row, message):
     rc, out = build(project(tmp_path, row), tmp_path / "build", prefix, check=False)

@@ -1,11 +1,17 @@
 # The oscillator FMU built with the framework (dmi_add_fmu) against the FMU
 # of libdmi 1.1 before it (the fixtures of make_old_state.py): a state that
-# FMU saved restores, and the run from it gives the same outputs bitwise;
-# the default experiment's first 5 s too.  Both FMI 2.0 and 3.0.
+# FMU saved restores, and the run from it gives the same outputs; the
+# default experiment's first 5 s too.  Both FMI 2.0 and 3.0.  The framework
+# itself changed no bit (checked when it landed); issue 23 then summed the
+# recursion's parts in another order (two partial sums), which moves the last
+# bits: delay_force (W) by 2e-19 in the fresh run, and from the old state,
+# whose sums were made the old way, v by 7e-18 and friction ((X - U)/h) by
+# 1.4e-15.  So: sticking bitwise, the others to 1e-14 of their largest value.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 import json
 import os
 
+import numpy as np
 import pytest
 
 from old_state_run import fresh_run, open_fmu, run_from_state
@@ -18,24 +24,33 @@ def expected(kind, version):
         return [[float.fromhex(x) for x in r] for r in json.load(f)["rows"]]
 
 
+def assert_same(rows, want):
+    """sticking (column 4) bitwise, w, v, friction, delay_force to 1e-14 of their largest magnitude."""
+    got, want = np.array(rows), np.array(want)
+    assert got.shape == want.shape
+    assert np.array_equal(got[:, 4], want[:, 4])
+    scale = np.max(np.abs(want[:, :4]), axis=0)
+    assert np.all(np.max(np.abs(got[:, :4] - want[:, :4]), axis=0) <= 1e-14 * scale)
+
+
 def path(version):
     return os.environ["DMI_FMU" if version == "2" else "DMI_FMU3"]
 
 
 @pytest.mark.parametrize("version", ["2", "3"])
-def test_old_state_restores_bitwise(version):
+def test_old_state_restores(version):
     with open(os.path.join(HERE, f"state_fmi{version}.bin"), "rb") as f:
         state = f.read()
     fmu, md = open_fmu(path(version), version)
     rows = run_from_state(fmu, md, version, state)
-    assert rows == expected("outputs", version)
+    assert_same(rows, expected("outputs", version))
     fmu.terminate()
     fmu.freeInstance()
 
 
 @pytest.mark.parametrize("version", ["2", "3"])
-def test_default_run_bitwise(version):
+def test_default_run(version):
     fmu, md = open_fmu(path(version), version)
-    assert fresh_run(fmu, md, version) == expected("fresh", version)
+    assert_same(fresh_run(fmu, md, version), expected("fresh", version))
     fmu.terminate()
     fmu.freeInstance()
