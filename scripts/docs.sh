@@ -4,22 +4,25 @@
 # the build folder has no FMU yet, copies docs/ into <build>/docs/src, generates there the C API
 # reference from the comments of include/*.h (docs/gen/capi.py) and the FMU variable tables
 # from the model description of every FMU the build produced (docs/gen/fmu_variables.py), and
-# runs Sphinx with warnings as errors.  A page that another part of the project writes and that
-# is not there yet gets a stub saying so (named below), and the script says which.
+# runs Sphinx with warnings as errors.
 # With --check it then installs Debian's chromium when missing and checks the site
 # (tests/docs/check_site.py: the references against the header, the FMUs, dmi-sweep's parser
 # and the Python packages; links and images; headless Chromium).
-# Usage: scripts/docs.sh [--check]
+# With --install it only installs what the site and its check need, and exits
+# (scripts/test.sh runs it before ctest, so the test docs_site installs nothing).
+# Usage: scripts/docs.sh [--check | --install]
 # Environment: DMI_BUILD_DIR (default build).
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
 check=0
+install_only=0
 case "${1:-}" in
   "") ;;
   --check) check=1 ;;
-  *) echo "usage: scripts/docs.sh [--check]" >&2; exit 2 ;;
+  --install) install_only=1 ;;
+  *) echo "usage: scripts/docs.sh [--check | --install]" >&2; exit 2 ;;
 esac
 build=${DMI_BUILD_DIR:-build}
 py="$root/.venv/bin/python"
@@ -32,6 +35,14 @@ if [[ ! -f $stamp ]] || ! cmp -s "$req" "$stamp"; then
   "$py" -m pip install -q -r "$req"
   cp "$req" "$stamp"
 fi
+if ((check || install_only)) && ! command -v chromium >/dev/null; then
+  echo "docs: installing chromium (Debian) for the rendering check"
+  sudo=""
+  [[ $(id -u) -eq 0 ]] || sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends chromium >/dev/null
+fi
+((install_only)) && exit 0
 
 if [[ -z $(find "$build/fmu" -name '*.fmu' 2>/dev/null | head -n 1) ]]; then
   echo "docs: building the project in $build (the FMU reference is read from the built FMUs)"
@@ -44,18 +55,6 @@ html="$build/docs/html"
 rm -rf "$src" "$html"
 mkdir -p "$src"
 cp -r docs/. "$src/"
-# Pages written with other parts of the project: a stub until they are there.
-while IFS='|' read -r page title by; do
-  if [[ ! -f docs/$page ]]; then
-    echo "docs: docs/$page is not there yet: a stub stands in for it"
-    printf '# %s\n\n(written by %s; not there yet)\n' "$title" "$by" >"$src/$page"
-  fi
-done <<'PAGES'
-sweep.md|dmi-sweep|the dmi-sweep work of issue 19
-fmu-export.md|Exporting your own model as an FMU|the FMU-export work of issue 20
-python.md|Python|the Python binding of issue 21
-benchmarks-scale.md|Benchmarks at scale|the engine-at-scale work of issue 23
-PAGES
 "$py" docs/gen/capi.py include/*.h >"$src/c-api.md"
 mapfile -t fmus < <(find "$build" -name '*.fmu' -not -path "$build/docs/*" -not -path '*/Testing/*' | sort)
 ((${#fmus[@]})) || { echo "docs: no FMU in $build" >&2; exit 1; }
@@ -65,12 +64,5 @@ mapfile -t fmus < <(find "$build" -name '*.fmu' -not -path "$build/docs/*" -not 
 echo "docs: the site is in $html/index.html"
 
 if ((check)); then
-  if ! command -v chromium >/dev/null; then
-    echo "docs: installing chromium (Debian) for the rendering check"
-    sudo=""
-    [[ $(id -u) -eq 0 ]] || sudo="sudo"
-    $sudo apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends chromium >/dev/null
-  fi
   "$py" tests/docs/check_site.py "$root" "$build"
 fi

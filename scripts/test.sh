@@ -21,6 +21,7 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
 scripts/deps.sh
+scripts/docs.sh --install   # the site's packages and chromium, before ctest runs docs_site
 jobs=$(nproc)
 py="$root/.venv/bin/python"
 build=${DMI_BUILD_PREFIX:-build}
