@@ -3,7 +3,8 @@
 # The FMU travels to each worker once, inside a worker plugin (removed at the
 # end); chunks of points are tasks; each finished chunk is written to the result
 # folder at once.  Dask's warnings and errors go to the folder's _log.jsonl, not
-# to the terminal; a lost cluster ends the run with ClusterLost.
+# to the terminal; a lost cluster (the scheduler gone, or no worker for a while)
+# ends the run with ClusterLost.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -30,6 +31,7 @@ from distributed.comm.core import CommClosedError
 from distributed.security import Security
 
 from . import simulate
+from .cli import NO_WORKER_TIMEOUT
 from .simulate import FMUPlugin, check_start, has_worker_plugin, run_chunk
 from .spec import Spec, SpecError
 from .store import Store
@@ -120,13 +122,53 @@ def chunks(todo: list[int], n_workers: int, chunk_size: int | None) -> list[list
 
 
 class ClusterLost(RuntimeError):
-    """The scheduler (or the connection to it) is gone, or could not be reached; the chunks written
-    so far stay in the folder."""
+    """The scheduler (or the connection to it) is gone, or could not be reached, or it has had no
+    worker for too long; the chunks written so far stay in the folder."""
 
-    def __init__(self, reason: str, saved: int | None = None, total: int = 0):
-        """saved: the points in the folder (None: the folder was not opened)."""
+    def __init__(self, reason: str, saved: int | None = None, total: int = 0,
+                 resume: str = "once the scheduler is back"):
+        """saved: the points in the folder (None: the folder was not opened); resume: when the same
+        command can resume the sweep."""
         super().__init__(reason)
-        self.reason, self.saved, self.total = reason, saved, total
+        self.reason, self.saved, self.total, self.resume = reason, saved, total, resume
+
+
+class WorkerWatch:
+    """Asks the scheduler how many workers it has, at most every `interval` seconds (1 s, or a
+    quarter of the timeout if shorter); raises ClusterLost once every answer for `timeout` seconds
+    was none. Errors of the connection to the scheduler (OSError, CommClosedError) propagate."""
+
+    def __init__(self, client: Client, timeout: float, where: str = "",
+                 clock: Callable[[], float] = time.monotonic):
+        """where: " at <address>" for the messages."""
+        self.client, self.timeout, self.where, self.clock = client, timeout, where, clock
+        self.interval = min(1.0, timeout / 4)
+        self.asked = -math.inf       # when the scheduler was last asked
+        self.none_since: float | None = None    # the first answer "no worker" of the current run of them
+
+    def check(self) -> None:
+        now = self.clock()
+        if now - self.asked < self.interval or self.client.status != "running":
+            return
+        self.asked = now
+        if self.client.nthreads():
+            self.none_since = None
+        elif self.none_since is None:
+            self.none_since = now
+        elif now - self.none_since >= self.timeout:
+            raise ClusterLost(f"the scheduler{self.where} has had no worker for {self.timeout:g} s",
+                              resume="once the cluster has workers again")
+
+    def next(self, stream: as_completed) -> Any:
+        """The next finished future of `stream`, or None when it has none left; check() while it
+        waits and between futures."""
+        while not stream.has_ready():
+            if stream.is_empty():
+                return None
+            self.check()
+            time.sleep(0.02)
+        self.check()
+        return next(stream)
 
 
 class ConnectionSetupError(RuntimeError):
@@ -307,7 +349,7 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
         restart: bool = False, chunk_size: int | None = None,
         progress: TextIO | None = STDERR, tls_ca_file: str | None = None,
         tls_cert: str | None = None, tls_key: str | None = None, dashboard: bool = False,
-        messages: TextIO | None = STDERR) -> Summary:
+        messages: TextIO | None = STDERR, no_worker_timeout: float = NO_WORKER_TIMEOUT) -> Summary:
     """Runs the sweep `spec` into the folder `out`, resuming what is there. The progress bar goes
     to `progress`, the lines about repairs, lost workers and the dashboard to `messages` (default:
     sys.stderr at the time of the call; None: nowhere).
@@ -315,8 +357,11 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
     Before anything is written: the TLS options are checked (ConnectionSetupError) and the FMU is
     instantiated here with the [start] values (SpecError with the FMU's message if it refuses them).
     Then the folder is locked (StoreError if another client holds it) and duplicates of older runs
-    are repaired. Raises ClusterLost if the scheduler cannot be reached or is lost; the chunks
-    written stay, and the same call resumes."""
+    are repaired. Raises ClusterLost if the scheduler cannot be reached or is lost, or if the cluster
+    has had no worker for no_worker_timeout seconds; the chunks written stay, and the same call
+    resumes."""
+    if not no_worker_timeout > 0:
+        raise ValueError(f"no_worker_timeout must be > 0 seconds, not {no_worker_timeout!r}")
     t0 = time.monotonic()
     progress = sys.stderr if progress is STDERR else progress
     messages = sys.stderr if messages is STDERR else messages
@@ -335,14 +380,14 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
     try:
         with logs_to(store):
             return _run_locked(spec, store, t0, client, workers, chunk_size, progress, messages,
-                               dashboard)
+                               dashboard, no_worker_timeout)
     finally:
         store.close()
 
 
 def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, workers: int | None,
                 chunk_size: int | None, progress: TextIO | None, messages: TextIO | None,
-                dashboard: bool) -> Summary:
+                dashboard: bool, no_worker_timeout: float) -> Summary:
     """The run once the folder is locked: with the client of the external cluster, or None for a
     LocalCluster of `workers` processes (started only when points are missing)."""
     scheduler = client.scheduler.address if client is not None else None
@@ -415,11 +460,28 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
                              + (f"{len(ev['again'])} chunks (first points {firsts}) run again on the "
                                 "other workers" if ev["again"] else "no chunk of this sweep was on it"))
 
+        where = f" at {scheduler}" if scheduler else ""
+
+        def connection_lost(e: BaseException) -> ClusterLost:
+            store.log({"lost": _reasons(e)})
+            return ClusterLost("lost the connection to the scheduler" + where)
+
+        watch = WorkerWatch(client, no_worker_timeout, where)
         lost: dict[int, int] = {}    # point -> times its single-point task was lost with a worker
         written: set[int] = set()
         try:
             stream = as_completed([submit(c) for c in chunks(todo, n_workers, chunk_size)])
-            for fut in stream:
+            while True:
+                try:
+                    fut = watch.next(stream)
+                except (OSError, CommClosedError, CancelledError) as e:   # the scheduler is gone
+                    raise connection_lost(e) from None
+                except ClusterLost as e:                                    # no worker left
+                    report_removals()
+                    store.log({"lost": e.reason, "no_worker_timeout": no_worker_timeout})
+                    raise
+                if fut is None:
+                    break
                 report_removals()
                 points = pending.pop(fut.key)
                 try:
@@ -434,9 +496,7 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
                         continue
                     results = [{"point": points[0], "error": f"{type(e).__name__}: {e}"}]
                 except (OSError, CommClosedError, CancelledError) as e:   # the scheduler is gone
-                    store.log({"lost": _reasons(e)})
-                    raise ClusterLost("lost the connection to the scheduler"
-                                      + (f" at {scheduler}" if scheduler else "")) from None
+                    raise connection_lost(e) from None
                 results = [r for r in results if r["point"] not in written]
                 fut.release()
                 if not results:
