@@ -135,8 +135,9 @@ class ClusterLost(RuntimeError):
 
 class WorkerWatch:
     """Asks the scheduler how many workers it has, at most every `interval` seconds (1 s, or a
-    quarter of the timeout if shorter); raises ClusterLost once every answer for `timeout` seconds
-    was none. Errors of the connection to the scheduler (OSError, CommClosedError) propagate."""
+    quarter of the timeout if shorter); check() raises ClusterLost once every answer for `timeout`
+    seconds was none. start() does this in a thread of its own: the client's waits (a result whose
+    worker died before it was fetched is computed again, and waits for a worker) end there."""
 
     def __init__(self, client: Client, timeout: float, where: str = "",
                  clock: Callable[[], float] = time.monotonic):
@@ -145,6 +146,8 @@ class WorkerWatch:
         self.interval = min(1.0, timeout / 4)
         self.asked = -math.inf       # when the scheduler was last asked
         self.none_since: float | None = None    # the first answer "no worker" of the current run of them
+        self.lost: ClusterLost | None = None    # set by the thread before it calls on_lost
+        self.stopped = threading.Event()
 
     def check(self) -> None:
         now = self.clock()
@@ -159,16 +162,23 @@ class WorkerWatch:
             raise ClusterLost(f"the scheduler{self.where} has had no worker for {self.timeout:g} s",
                               resume="once the cluster has workers again")
 
-    def next(self, stream: as_completed) -> Any:
-        """The next finished future of `stream`, or None when it has none left; check() while it
-        waits and between futures."""
-        while not stream.has_ready():
-            if stream.is_empty():
-                return None
-            self.check()
-            time.sleep(0.02)
-        self.check()
-        return next(stream)
+    def start(self, on_lost: Callable[[], object]) -> None:
+        """check() every interval in a daemon thread until stop(); when it raises, the ClusterLost
+        goes to self.lost and on_lost() is called (it cancels the run's futures)."""
+        def watch():
+            while not self.stopped.wait(self.interval):
+                try:
+                    self.check()
+                except ClusterLost as e:
+                    self.lost = e
+                    on_lost()
+                    return
+                except Exception:     # the connection to the scheduler: the futures report it
+                    pass
+        threading.Thread(target=watch, name="dmi-sweep-worker-watch", daemon=True).start()
+
+    def stop(self) -> None:
+        self.stopped.set()
 
 
 class ConnectionSetupError(RuntimeError):
@@ -443,11 +453,21 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
             raise ClusterLost(f"the connection to the scheduler broke: {_reasons(e)}") from None
         job = spec.job()
 
+        where = f" at {scheduler}" if scheduler else ""
+        watch = WorkerWatch(client, no_worker_timeout, where)
+        futures: dict[str, Any] = {}             # key of a task -> its future, while pending
+
         def submit(points: list[int]):
             payload = task(run_chunk, plugin.name, job, [(i, spec.point(i)) for i in points])
             fut = client.submit(pickle.loads, payload, pure=False)
-            pending[fut.key] = points
+            pending[fut.key], futures[fut.key] = points, fut
+            if watch.lost:         # after the watch cancelled the others (it sets lost first)
+                fut.cancel()
             return fut
+
+        def cancel_all():          # in the watch's thread
+            with contextlib.suppress(Exception):
+                client.cancel(list(futures.values()))
 
         def report_removals():
             while removals:
@@ -460,28 +480,12 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
                              + (f"{len(ev['again'])} chunks (first points {firsts}) run again on the "
                                 "other workers" if ev["again"] else "no chunk of this sweep was on it"))
 
-        where = f" at {scheduler}" if scheduler else ""
-
-        def connection_lost(e: BaseException) -> ClusterLost:
-            store.log({"lost": _reasons(e)})
-            return ClusterLost("lost the connection to the scheduler" + where)
-
-        watch = WorkerWatch(client, no_worker_timeout, where)
         lost: dict[int, int] = {}    # point -> times its single-point task was lost with a worker
         written: set[int] = set()
         try:
             stream = as_completed([submit(c) for c in chunks(todo, n_workers, chunk_size)])
-            while True:
-                try:
-                    fut = watch.next(stream)
-                except (OSError, CommClosedError, CancelledError) as e:   # the scheduler is gone
-                    raise connection_lost(e) from None
-                except ClusterLost as e:                                    # no worker left
-                    report_removals()
-                    store.log({"lost": e.reason, "no_worker_timeout": no_worker_timeout})
-                    raise
-                if fut is None:
-                    break
+            watch.start(cancel_all)
+            for fut in stream:
                 report_removals()
                 points = pending.pop(fut.key)
                 try:
@@ -495,8 +499,15 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
                             stream.add(submit([i]))
                         continue
                     results = [{"point": points[0], "error": f"{type(e).__name__}: {e}"}]
-                except (OSError, CommClosedError, CancelledError) as e:   # the scheduler is gone
-                    raise connection_lost(e) from None
+                except (OSError, CommClosedError, CancelledError) as e:
+                    if watch.lost:                 # no worker left: the watch cancelled the futures
+                        report_removals()
+                        store.log({"lost": watch.lost.reason, "no_worker_timeout": no_worker_timeout})
+                        raise watch.lost from None
+                    store.log({"lost": _reasons(e)})          # the scheduler is gone
+                    raise ClusterLost("lost the connection to the scheduler" + where) from None
+                finally:
+                    futures.pop(fut.key)       # after result(): the watch may cancel its wait
                 results = [r for r in results if r["point"] not in written]
                 fut.release()
                 if not results:
@@ -508,6 +519,7 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
                 bar.update(len(results))
             report_removals()
         finally:
+            watch.stop()
             bar.close()
     except ClusterLost as e:
         e.saved, e.total = len(done) + computed, spec.n_points

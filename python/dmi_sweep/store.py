@@ -8,6 +8,7 @@
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
+import contextlib
 import errno
 import json
 import math
@@ -117,11 +118,10 @@ class FolderLock:
 
     def release(self) -> None:
         if self.fd is not None:
-            try:
+            with contextlib.suppress(OSError):
                 _unlock(self.fd)
-            finally:
-                os.close(self.fd)      # would release the lock anyway
-                self.fd = None
+            os.close(self.fd)          # would release the lock anyway
+            self.fd = None
 
 
 def _running(pid: int) -> bool:
