@@ -8,13 +8,17 @@ import sys
 
 from . import __version__
 
+# seconds without any worker after which a run stops (exit 3): --no-worker-timeout, and run()'s
+# no_worker_timeout
+NO_WORKER_TIMEOUT = 60.0
+
 EXIT = """exit status:
   0    every point of the sweep succeeded (the folder holds all of them)
   1    every point was computed, but some failed: their rows hold the error (the count is printed)
   2    nothing was run: a bad spec or command line, [start] values the FMU refuses, a folder
        that holds another sweep or that another client is using, missing or bad TLS certificates
-  3    the cluster was lost or could not be reached: the finished points are saved, and the same
-       command resumes
+  3    the cluster was lost or could not be reached, or had no worker for --no-worker-timeout
+       seconds: the finished points are saved, and the same command resumes
   130  interrupted (Ctrl-C): the finished points are saved, and the same command resumes"""
 
 
@@ -27,6 +31,17 @@ def positive_int(text: str) -> int:
     if n < 1:
         raise argparse.ArgumentTypeError(f"{text!r} is not an integer >= 1")
     return n
+
+
+def positive_seconds(text: str) -> float:
+    """argparse type: a finite number of seconds > 0 (the message names the bad text)."""
+    try:
+        x = float(text)
+    except ValueError:
+        x = 0.0
+    if not 0 < x < float("inf"):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds > 0")
+    return x
 
 
 def parser() -> argparse.ArgumentParser:
@@ -46,6 +61,10 @@ def parser() -> argparse.ArgumentParser:
                    "(default: one per core); the local cluster listens on 127.0.0.1 only")
     r.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler: "
                    "tls://host:port (with certificates), or tcp://host:port on a private network only")
+    r.add_argument("--no-worker-timeout", metavar="SECONDS", type=positive_seconds,
+                   default=NO_WORKER_TIMEOUT, help="stop the run (exit 3, the finished points saved) "
+                   "when the cluster has had no worker for this long, as when every worker of a "
+                   f"--scheduler died (default: {NO_WORKER_TIMEOUT:g})")
     r.add_argument("--tls-ca-file", metavar="PEM", help="the CA certificate(s) that signed the "
                    "scheduler's certificate (default: Dask's distributed.comm.tls.ca-file)")
     r.add_argument("--tls-cert", metavar="PEM", help="this client's certificate (default: Dask's "
@@ -104,7 +123,7 @@ def _run(a: argparse.Namespace) -> int:
         s = run(spec, a.out, workers=a.workers, scheduler=a.scheduler, restart=a.restart,
                 chunk_size=a.chunk_size, progress=None if a.quiet else sys.stderr,
                 tls_ca_file=a.tls_ca_file, tls_cert=a.tls_cert, tls_key=a.tls_key,
-                dashboard=a.dashboard)
+                dashboard=a.dashboard, no_worker_timeout=a.no_worker_timeout)
     except SpecError as e:
         print(f"dmi-sweep: bad spec {a.spec}: {e}", file=sys.stderr)
         return 2
@@ -117,7 +136,7 @@ def _run(a: argparse.Namespace) -> int:
                   "the scheduler is up.", file=sys.stderr)
         else:
             print(f"dmi-sweep: {e.reason}.\n{e.saved} of {e.total} points are saved in {a.out}; the "
-                  "same command resumes the sweep (once the scheduler is back).", file=sys.stderr)
+                  f"same command resumes the sweep ({e.resume}).", file=sys.stderr)
         return 3
     except KeyboardInterrupt:
         print(f"dmi-sweep: interrupted; the finished chunks are in {a.out}: run the same "

@@ -3,7 +3,8 @@
 # The FMU travels to each worker once, inside a worker plugin (removed at the
 # end); chunks of points are tasks; each finished chunk is written to the result
 # folder at once.  Dask's warnings and errors go to the folder's _log.jsonl, not
-# to the terminal; a lost cluster ends the run with ClusterLost.
+# to the terminal; a lost cluster (the scheduler gone, or no worker for a while)
+# ends the run with ClusterLost.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -30,6 +31,7 @@ from distributed.comm.core import CommClosedError
 from distributed.security import Security
 
 from . import simulate
+from .cli import NO_WORKER_TIMEOUT
 from .simulate import FMUPlugin, check_start, has_worker_plugin, run_chunk
 from .spec import Spec, SpecError
 from .store import Store
@@ -120,13 +122,63 @@ def chunks(todo: list[int], n_workers: int, chunk_size: int | None) -> list[list
 
 
 class ClusterLost(RuntimeError):
-    """The scheduler (or the connection to it) is gone, or could not be reached; the chunks written
-    so far stay in the folder."""
+    """The scheduler (or the connection to it) is gone, or could not be reached, or it has had no
+    worker for too long; the chunks written so far stay in the folder."""
 
-    def __init__(self, reason: str, saved: int | None = None, total: int = 0):
-        """saved: the points in the folder (None: the folder was not opened)."""
+    def __init__(self, reason: str, saved: int | None = None, total: int = 0,
+                 resume: str = "once the scheduler is back"):
+        """saved: the points in the folder (None: the folder was not opened); resume: when the same
+        command can resume the sweep."""
         super().__init__(reason)
-        self.reason, self.saved, self.total = reason, saved, total
+        self.reason, self.saved, self.total, self.resume = reason, saved, total, resume
+
+
+class WorkerWatch:
+    """Asks the scheduler how many workers it has, at most every `interval` seconds (1 s, or a
+    quarter of the timeout if shorter); check() raises ClusterLost once every answer for `timeout`
+    seconds was none. start() does this in a thread of its own: the client's waits (a result whose
+    worker died before it was fetched is computed again, and waits for a worker) end there."""
+
+    def __init__(self, client: Client, timeout: float, where: str = "",
+                 clock: Callable[[], float] = time.monotonic):
+        """where: " at <address>" for the messages."""
+        self.client, self.timeout, self.where, self.clock = client, timeout, where, clock
+        self.interval = min(1.0, timeout / 4)
+        self.asked = -math.inf       # when the scheduler was last asked
+        self.none_since: float | None = None    # the first answer "no worker" of the current run of them
+        self.lost: ClusterLost | None = None    # set by the thread before it calls on_lost
+        self.stopped = threading.Event()
+
+    def check(self) -> None:
+        now = self.clock()
+        if now - self.asked < self.interval or self.client.status != "running":
+            return
+        self.asked = now
+        if self.client.nthreads():
+            self.none_since = None
+        elif self.none_since is None:
+            self.none_since = now
+        elif now - self.none_since >= self.timeout:
+            raise ClusterLost(f"the scheduler{self.where} has had no worker for {self.timeout:g} s",
+                              resume="once the cluster has workers again")
+
+    def start(self, on_lost: Callable[[], object]) -> None:
+        """check() every interval in a daemon thread until stop(); when it raises, the ClusterLost
+        goes to self.lost and on_lost() is called (it cancels the run's futures)."""
+        def watch():
+            while not self.stopped.wait(self.interval):
+                try:
+                    self.check()
+                except ClusterLost as e:
+                    self.lost = e
+                    on_lost()
+                    return
+                except Exception:     # the connection to the scheduler: the futures report it
+                    pass
+        threading.Thread(target=watch, name="dmi-sweep-worker-watch", daemon=True).start()
+
+    def stop(self) -> None:
+        self.stopped.set()
 
 
 class ConnectionSetupError(RuntimeError):
@@ -307,7 +359,7 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
         restart: bool = False, chunk_size: int | None = None,
         progress: TextIO | None = STDERR, tls_ca_file: str | None = None,
         tls_cert: str | None = None, tls_key: str | None = None, dashboard: bool = False,
-        messages: TextIO | None = STDERR) -> Summary:
+        messages: TextIO | None = STDERR, no_worker_timeout: float = NO_WORKER_TIMEOUT) -> Summary:
     """Runs the sweep `spec` into the folder `out`, resuming what is there. The progress bar goes
     to `progress`, the lines about repairs, lost workers and the dashboard to `messages` (default:
     sys.stderr at the time of the call; None: nowhere).
@@ -315,8 +367,11 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
     Before anything is written: the TLS options are checked (ConnectionSetupError) and the FMU is
     instantiated here with the [start] values (SpecError with the FMU's message if it refuses them).
     Then the folder is locked (StoreError if another client holds it) and duplicates of older runs
-    are repaired. Raises ClusterLost if the scheduler cannot be reached or is lost; the chunks
-    written stay, and the same call resumes."""
+    are repaired. Raises ClusterLost if the scheduler cannot be reached or is lost, or if the cluster
+    has had no worker for no_worker_timeout seconds; the chunks written stay, and the same call
+    resumes."""
+    if not no_worker_timeout > 0:
+        raise ValueError(f"no_worker_timeout must be > 0 seconds, not {no_worker_timeout!r}")
     t0 = time.monotonic()
     progress = sys.stderr if progress is STDERR else progress
     messages = sys.stderr if messages is STDERR else messages
@@ -335,14 +390,14 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
     try:
         with logs_to(store):
             return _run_locked(spec, store, t0, client, workers, chunk_size, progress, messages,
-                               dashboard)
+                               dashboard, no_worker_timeout)
     finally:
         store.close()
 
 
 def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, workers: int | None,
                 chunk_size: int | None, progress: TextIO | None, messages: TextIO | None,
-                dashboard: bool) -> Summary:
+                dashboard: bool, no_worker_timeout: float) -> Summary:
     """The run once the folder is locked: with the client of the external cluster, or None for a
     LocalCluster of `workers` processes (started only when points are missing)."""
     scheduler = client.scheduler.address if client is not None else None
@@ -398,11 +453,21 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
             raise ClusterLost(f"the connection to the scheduler broke: {_reasons(e)}") from None
         job = spec.job()
 
+        where = f" at {scheduler}" if scheduler else ""
+        watch = WorkerWatch(client, no_worker_timeout, where)
+        futures: dict[str, Any] = {}             # key of a task -> its future, while pending
+
         def submit(points: list[int]):
             payload = task(run_chunk, plugin.name, job, [(i, spec.point(i)) for i in points])
             fut = client.submit(pickle.loads, payload, pure=False)
-            pending[fut.key] = points
+            pending[fut.key], futures[fut.key] = points, fut
+            if watch.lost:         # after the watch cancelled the others (it sets lost first)
+                fut.cancel()
             return fut
+
+        def cancel_all():          # in the watch's thread
+            with contextlib.suppress(Exception):
+                client.cancel(list(futures.values()))
 
         def report_removals():
             while removals:
@@ -419,6 +484,7 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
         written: set[int] = set()
         try:
             stream = as_completed([submit(c) for c in chunks(todo, n_workers, chunk_size)])
+            watch.start(cancel_all)
             for fut in stream:
                 report_removals()
                 points = pending.pop(fut.key)
@@ -433,10 +499,15 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
                             stream.add(submit([i]))
                         continue
                     results = [{"point": points[0], "error": f"{type(e).__name__}: {e}"}]
-                except (OSError, CommClosedError, CancelledError) as e:   # the scheduler is gone
-                    store.log({"lost": _reasons(e)})
-                    raise ClusterLost("lost the connection to the scheduler"
-                                      + (f" at {scheduler}" if scheduler else "")) from None
+                except (OSError, CommClosedError, CancelledError) as e:
+                    if watch.lost:                 # no worker left: the watch cancelled the futures
+                        report_removals()
+                        store.log({"lost": watch.lost.reason, "no_worker_timeout": no_worker_timeout})
+                        raise watch.lost from None
+                    store.log({"lost": _reasons(e)})          # the scheduler is gone
+                    raise ClusterLost("lost the connection to the scheduler" + where) from None
+                finally:
+                    futures.pop(fut.key)       # after result(): the watch may cancel its wait
                 results = [r for r in results if r["point"] not in written]
                 fut.release()
                 if not results:
@@ -448,6 +519,7 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
                 bar.update(len(results))
             report_removals()
         finally:
+            watch.stop()
             bar.close()
     except ClusterLost as e:
         e.saved, e.total = len(done) + computed, spec.n_points

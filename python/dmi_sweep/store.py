@@ -8,7 +8,8 @@
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
-import fcntl
+import contextlib
+import errno
 import json
 import math
 import os
@@ -19,6 +20,7 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any, BinaryIO, Callable
 
+import psutil
 import pyarrow as pa
 import pyarrow.parquet as pq
 
@@ -36,17 +38,67 @@ class StoreError(RuntimeError):
     what to do)."""
 
 
-class FolderLock:
-    """The operating system's lock (flock) on the folder's _lock file, held by one client while it
-    runs: it dies with its holder, also with a SIGKILLed one. The file says who holds the lock (host,
-    pid, start time); the file itself stays, empty of meaning once unlocked."""
+# The operating system's lock, the one place that depends on the platform. Both locks belong to the
+# open file: closing it, or the end of the process however it ends, releases them.
+try:
+    import fcntl
+except ImportError:          # Windows
+    import msvcrt
 
-    def __init__(self, directory: Path):
-        self.path = directory / LOCK
-        fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)   # not inherited by workers (PEP 446)
+    LOCK_KIND = "msvcrt.locking"
+    # Windows locks byte ranges, and nobody else may read a locked byte: the lock is on one byte far
+    # beyond the holder's description at the start of the file (a range past the end is allowed), so
+    # that a refused client can still read who holds the folder.
+    _LOCKED_BYTE = 1 << 30
+
+    def _try_lock(fd: int) -> bool:
+        """Locks the file fd without waiting: False if another open file holds the lock."""
+        os.lseek(fd, _LOCKED_BYTE, os.SEEK_SET)
+        try:
+            msvcrt.locking(fd, msvcrt.LK_NBLCK, 1)
+        except OSError as e:
+            if e.errno in (errno.EACCES, errno.EDEADLOCK):
+                return False
+            raise
+        finally:
+            os.lseek(fd, 0, os.SEEK_SET)
+        return True
+
+    def _unlock(fd: int) -> None:
+        os.lseek(fd, _LOCKED_BYTE, os.SEEK_SET)
+        msvcrt.locking(fd, msvcrt.LK_UNLCK, 1)
+else:                        # POSIX
+    LOCK_KIND = "flock"
+
+    def _try_lock(fd: int) -> bool:
+        """Locks the file fd without waiting: False if another open file holds the lock."""
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
+            return False
+        return True
+
+    def _unlock(fd: int) -> None:
+        fcntl.flock(fd, fcntl.LOCK_UN)
+
+
+class FolderLock:
+    """The operating system's lock (flock on POSIX, msvcrt.locking on Windows) on the folder's _lock
+    file, held by one client while it runs: it dies with its holder, also with a killed one. The
+    file says who holds the lock (host, pid, start time); the file itself stays, empty of meaning
+    once unlocked."""
+
+    def __init__(self, directory: Path):
+        self.path = directory / LOCK
+        # not inherited by workers (PEP 446); binary: no newline translation on Windows
+        fd = os.open(self.path, os.O_RDWR | os.O_CREAT | getattr(os, "O_BINARY", 0), 0o644)
+        try:
+            locked = _try_lock(fd)
+        except OSError as e:
+            os.close(fd)
+            raise StoreError(f"cannot lock {self.path}: {e.strerror} (the filesystem must support "
+                             f"{LOCK_KIND}; see the lock in the dmi-sweep documentation)") from None
+        if not locked:
             holder = os.read(fd, 4096).decode(errors="replace")
             os.close(fd)
             try:
@@ -56,32 +108,26 @@ class FolderLock:
                 who = "a client that has not yet said who it is"
             raise StoreError(f"{directory} is in use by another dmi-sweep client ({who}). One client "
                              "per folder: wait for it to end, or stop it (its finished points stay) "
-                             "and run the same command again") from None
-        except OSError as e:
-            os.close(fd)
-            raise StoreError(f"cannot lock {self.path}: {e.strerror} (the filesystem must support "
-                             "flock; see the lock in the dmi-sweep documentation)") from None
-        self.fd = fd
+                             "and run the same command again")
+        self.fd: int | None = fd
         me = {"host": socket.gethostname(), "pid": os.getpid(),
               "started": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
         os.ftruncate(fd, 0)
-        os.pwrite(fd, json.dumps(me).encode(), 0)
+        os.lseek(fd, 0, os.SEEK_SET)
+        os.write(fd, json.dumps(me).encode())
 
     def release(self) -> None:
         if self.fd is not None:
-            os.close(self.fd)      # closing the only descriptor releases the lock
+            with contextlib.suppress(OSError):
+                _unlock(self.fd)
+            os.close(self.fd)          # would release the lock anyway
             self.fd = None
 
 
 def _running(pid: int) -> bool:
-    """Whether the process `pid` exists (on this machine)."""
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
+    """Whether the process `pid` exists (on this machine). Not os.kill(pid, 0), which on Windows
+    ends the process."""
+    return psutil.pid_exists(pid)
 
 
 def _versions() -> dict[str, str]:

@@ -157,8 +157,13 @@ class Cluster:
 
 @pytest.fixture
 def cluster(processes, tmp_path_factory) -> Cluster:
-    """`dask scheduler` on a free port of 127.0.0.1 and two `dask worker` processes (no nanny, one
-    thread each) started in their own temporary folder, without this package on their path."""
+    """A cluster of two workers (see start_cluster)."""
+    return start_cluster(processes, tmp_path_factory, 2)
+
+
+def start_cluster(processes: Processes, tmp_path_factory, n_workers: int) -> Cluster:
+    """`dask scheduler` on a free port of 127.0.0.1 and n_workers `dask worker` processes (no nanny,
+    one thread each) started in their own temporary folder, without this package on their path."""
     dask = str(Path(sys.executable).parent / "dask")
     sdir = tmp_path_factory.mktemp("scheduler")
     wdir = tmp_path_factory.mktemp("workers")
@@ -171,8 +176,8 @@ def cluster(processes, tmp_path_factory) -> Cluster:
     workers = [processes.start([dask, "worker", address, "--nthreads", "1", "--nworkers", "1",
                                 "--no-nanny", "--dashboard-address", "127.0.0.1:0", "--host", "127.0.0.1",
                                 "--local-directory", str(wdir)], cwd=wdir, env=env, **quiet)
-               for _ in range(2)]
-    wait_for_cluster(address, sched, 2)
+               for _ in range(n_workers)]
+    wait_for_cluster(address, sched, n_workers)
     return Cluster(address, sched, workers, wdir)
 
 

@@ -1,8 +1,9 @@
 # dmi-sweep on a real Dask cluster on the loopback: a `dask scheduler` and two
 # `dask worker` processes started by the test in another folder (no shared
 # files, no dmi_sweep on their path); a worker killed with SIGKILL mid-sweep;
-# the client killed mid-sweep and the command rerun; a timed-out sweep killed
-# with its LocalCluster.
+# the client killed mid-sweep and the command rerun; the only worker killed (the
+# run stops after --no-worker-timeout); a timed-out sweep killed with its
+# LocalCluster.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ import pandas as pd
 import pytest
 
 from conftest import (env_with_package, finish_group, group_members, kill_group, log_entries, run_sweep,
-                      start_sweep, sweep_cmd, write_spec)
+                      start_cluster, start_sweep, sweep_cmd, write_spec)
 
 # about 0.1 s per point on this machine: long enough to kill something mid-sweep
 SLOW = """
@@ -197,6 +198,52 @@ def test_scheduler_killed_mid_sweep(cluster, tmp_path, fmu_path, processes):
     assert [e for e in entries if "lost" in e], "no log entry of the loss"
     # Dask's ERROR lines (the client failing to reconnect) are in the log, not on the terminal
     assert [e for e in entries if e.get("level") == "ERROR" and e["log"].startswith("distributed.")], entries
+    n_before = len(entries)
+    r = run_sweep("run", spec, "--out", out, "--workers", "2", "--quiet")
+    assert r.returncode == 0, r.stderr
+    computed = [p for e in log_entries(out)[n_before:] if "points" in e for p in e["points"]]
+    assert sorted(computed) == sorted(set(range(total)) - done)
+    check_complete(out, total)
+
+
+def test_every_worker_lost(processes, tmp_path_factory, tmp_path, fmu_path):
+    """The only worker SIGKILLed by its pid mid-sweep, the scheduler still up: once the cluster has
+    had no worker for --no-worker-timeout seconds (3 here), exit 3 with the short message, no
+    traceback, the loss in _log.jsonl; a rerun on a local cluster computes exactly the missing
+    points. (Before this timeout existed, the client waited forever: communicate() times out.)"""
+    cluster = start_cluster(processes, tmp_path_factory, 1)
+    total = 40
+    spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=total))
+    out = tmp_path / "out"
+    client = processes.start(sweep_cmd("run", spec, "--out", out, "--scheduler", cluster.address,
+                                       "--chunk-size", "1", "--no-worker-timeout", "3"),
+                             env=env_with_package(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True)
+    wait_for_parts(out, 3, client)
+    victim = cluster.workers[0]
+    address = worker_address(cluster, victim.pid)
+    os.kill(victim.pid, signal.SIGKILL)
+    victim.wait(timeout=10)
+    t = time.monotonic()
+    stdout, stderr = client.communicate(timeout=60)
+    waited = time.monotonic() - t
+    assert client.returncode == 3, stdout + stderr
+    assert cluster.scheduler.poll() is None, "the scheduler died: not the case under test"
+    assert waited > 2.5, f"exit {waited:.1f} s after the last worker died, before the timeout of 3 s"
+    done = set(pd.read_parquet(out)["point"])
+    assert 3 <= len(done) < total
+    text = stdout + stderr
+    assert "Traceback" not in text and " - ERROR - " not in text and "distributed." not in text, text
+    assert f"dmi-sweep: the scheduler at {cluster.address} has had no worker for 3 s.\n" in stderr, stderr
+    assert (f"{len(done)} of {total} points are saved in {out}; the same command resumes the sweep "
+            "(once the cluster has workers again)." in stderr), stderr
+    messages = [x for x in stderr.splitlines() if not x.startswith("[")]
+    assert len(messages) == 3 and messages[0].startswith(f"dmi-sweep: lost worker {address}; "), stderr
+    entries = log_entries(out)
+    assert [e["worker_lost"] for e in entries if "worker_lost" in e] == [address]
+    lost = [e for e in entries if "lost" in e]
+    assert [(e["lost"], e["no_worker_timeout"]) for e in lost] == \
+        [(f"the scheduler at {cluster.address} has had no worker for 3 s", 3.0)], lost
     n_before = len(entries)
     r = run_sweep("run", spec, "--out", out, "--workers", "2", "--quiet")
     assert r.returncode == 0, r.stderr

@@ -1,6 +1,8 @@
-# The progress bar (points done of total, rate, time left) on a fake clock, and
-# the result folder's write-then-rename: no temporary file left, a temporary
-# file of a killed writer never read and removed when the folder is reopened.
+# The progress bar (points done of total, rate, time left) on a fake clock; the
+# watch of a cluster without workers, on a fake clock and client; the result
+# folder's write-then-rename: no temporary file left, a temporary file of a
+# killed writer never read and removed when the folder is reopened; the folder
+# lock, with flock and with the Windows branch (msvcrt.locking, emulated here).
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -12,8 +14,8 @@ import sys
 import pandas as pd
 import pytest
 
-from conftest import write_spec
-from dmi_sweep.run import Progress
+from conftest import env_with_package, write_spec
+from dmi_sweep.run import ClusterLost, Progress, WorkerWatch
 
 
 class Clock:
@@ -168,3 +170,169 @@ def test_lock_held_until_close(tmp_path, fmu_path):
     with pytest.raises(StoreError, match="holds no dmi-sweep results"):
         Store.open(other, spec)
     assert [p.name for p in other.iterdir()] == ["notes.txt"]
+
+
+class Workers:
+    """A client whose scheduler answers nthreads() with the given numbers of workers, in turn."""
+
+    def __init__(self, answers: list[int]):
+        self.answers, self.status, self.asked = list(answers), "running", 0
+
+    def nthreads(self) -> dict[str, int]:
+        self.asked += 1
+        return {f"tcp://127.0.0.1:{40000 + i}": 1 for i in range(self.answers.pop(0))}
+
+
+def test_worker_watch_times_out_after_a_run_of_answers_without_workers():
+    """Timeout 4 s: the scheduler is asked at most every second; a worker seen resets the count;
+    the 4th second of "no worker" in a row (asked at 3, 4, 5, 6, 7) raises ClusterLost."""
+    clock, client = Clock(), Workers([0, 0, 1, 0, 0, 0, 0, 0])
+    watch = WorkerWatch(client, 4.0, " at tcp://head:8786", clock=clock)
+    start = clock.now
+    for t in (0.0, 0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 6.9):
+        clock.now = start + t
+        watch.check()                     # 0.5 and 6.9: less than a second after the last question
+    assert client.asked == 7
+    client.status = "connecting"          # reconnecting to the scheduler: not asked
+    clock.now = start + 8.0
+    watch.check()
+    assert client.asked == 7
+    client.status = "running"
+    with pytest.raises(ClusterLost) as e:
+        watch.check()                     # 8 - 3 >= 4
+    assert client.asked == 8
+    assert e.value.reason == "the scheduler at tcp://head:8786 has had no worker for 4 s"
+    assert e.value.resume == "once the cluster has workers again"
+
+
+def test_worker_watch_short_timeout_and_workers_back():
+    """A timeout under 4 s asks every quarter of it (0.125 s for 0.5 s); workers back before it
+    ends: no error; then 0.5 s of "no worker" from the next answer on raises."""
+    clock, client = Clock(), Workers([0, 0, 0, 2, 0, 0, 0, 0, 0])
+    watch = WorkerWatch(client, 0.5, clock=clock)
+    start = clock.now
+    for k in range(8):                    # asked at 0, ..., 0.875 s: no worker since 0.5 s
+        clock.now = start + 0.125 * k
+        watch.check()
+    assert client.asked == 8
+    clock.now = start + 1.0
+    with pytest.raises(ClusterLost, match="^the scheduler has had no worker for 0.5 s$"):
+        watch.check()
+
+
+# The Windows branch of the folder lock run on this machine: fcntl made unavailable and msvcrt
+# replaced by an emulation with POSIX record locks (lockf on the byte range msvcrt.locking would
+# lock: nbytes from the file's position; a refusal raises PermissionError(EACCES) as the C runtime's
+# _locking does). What Windows alone would show (its locked bytes cannot be read by others) is not
+# tested here.
+WINDOWS = r"""
+import errno, os, sys, time, types
+from pathlib import Path
+import fcntl as posix
+
+msvcrt = types.ModuleType("msvcrt")
+msvcrt.LK_UNLCK, msvcrt.LK_LOCK, msvcrt.LK_NBLCK, msvcrt.LK_RLCK, msvcrt.LK_NBRLCK = 0, 1, 2, 3, 4
+calls = []
+
+def locking(fd, mode, nbytes):
+    pos = os.lseek(fd, 0, os.SEEK_CUR)
+    calls.append((mode, pos, nbytes))
+    if mode == msvcrt.LK_UNLCK:
+        posix.lockf(fd, posix.LOCK_UN, nbytes, pos)
+        return
+    assert mode == msvcrt.LK_NBLCK, mode
+    try:
+        posix.lockf(fd, posix.LOCK_EX | posix.LOCK_NB, nbytes, pos)
+    except OSError as e:
+        if e.errno in (errno.EACCES, errno.EAGAIN):
+            raise PermissionError(errno.EACCES, "Permission denied") from None
+        raise
+
+msvcrt.locking = locking
+# the third-party packages first: their own choice of platform is not under test
+import cloudpickle, dask, distributed, fmpy, pandas, psutil, pyarrow.parquet
+sys.modules["fcntl"] = None                  # import fcntl raises ImportError
+if sys.argv[1] != "no-msvcrt":
+    sys.modules["msvcrt"] = msvcrt
+import dmi_sweep, dmi_sweep.cli, dmi_sweep.plot, dmi_sweep.run, dmi_sweep.simulate, dmi_sweep.spec
+from dmi_sweep import store
+print("branch", store.LOCK_KIND, flush=True)
+folder = Path(sys.argv[2])
+if sys.argv[1] == "hold":
+    store.FolderLock(folder)
+    print("locked", flush=True)
+    time.sleep(600)
+elif sys.argv[1] == "try":
+    try:
+        lock = store.FolderLock(folder)
+    except store.StoreError as e:
+        print("refused", e, flush=True)
+    else:
+        print("locked", (folder / "_lock").read_text(), flush=True)
+        lock.release()
+        print("calls", calls, flush=True)
+"""
+
+
+def test_folder_lock_windows_branch(tmp_path, processes):
+    """Without fcntl, dmi_sweep imports and takes the msvcrt branch (and without msvcrt either, the
+    import names msvcrt); with msvcrt emulated, a second process is refused naming the holder, and
+    after the holder is SIGKILLed the folder locks again, on one byte past the holder's description,
+    and unlocks on release."""
+    import json
+    import signal
+    import socket
+    script = tmp_path / "windows.py"
+    script.write_text(WINDOWS)
+    folder = tmp_path / "out"
+    folder.mkdir()
+
+    def attempt(mode: str) -> subprocess.CompletedProcess:
+        return subprocess.run([sys.executable, script, mode, folder], capture_output=True, text=True,
+                              env=env_with_package(), timeout=120)
+
+    r = attempt("no-msvcrt")
+    assert r.returncode != 0 and "No module named 'msvcrt'" in r.stderr, r.stdout + r.stderr
+    holder = processes.start([sys.executable, script, "hold", folder], stdout=subprocess.PIPE,
+                             text=True, env=env_with_package())
+    assert holder.stdout.readline() == "branch msvcrt.locking\n"
+    assert holder.stdout.readline() == "locked\n"
+    r = attempt("try")
+    assert r.returncode == 0, r.stderr
+    started = json.loads((folder / "_lock").read_text())["started"]
+    assert r.stdout == ("branch msvcrt.locking\nrefused " f"{folder} is in use by another dmi-sweep "
+                        f"client (pid {holder.pid} on {socket.gethostname()}, started {started}). One "
+                        "client per folder: wait for it to end, or stop it (its finished points stay) "
+                        "and run the same command again\n"), r.stdout
+    os.kill(holder.pid, signal.SIGKILL)
+    holder.wait(timeout=10)
+    r = attempt("try")
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert lines[0] == "branch msvcrt.locking" and lines[1].startswith("locked "), r.stdout
+    me = json.loads(lines[1][len("locked "):])
+    assert me["pid"] != holder.pid and me["host"] == socket.gethostname()
+    calls = eval(lines[2][len("calls "):])
+    assert [mode for mode, _, _ in calls] == [2, 0]             # LK_NBLCK, then LK_UNLCK
+    (_, at, n), (_, at_unlock, n_unlock) = calls
+    assert (at, n) == (at_unlock, n_unlock) and n >= 1
+    assert at >= 4096                    # beyond what a refused client reads of the description
+
+
+def test_folder_lock_posix_is_flock(tmp_path, fmu_path):
+    """On this machine (POSIX) the lock is flock: a flock taken on the _lock file by another open
+    file refuses the folder; released, the folder opens."""
+    import fcntl
+    from dmi_sweep.spec import load
+    from dmi_sweep.store import LOCK_KIND, Store, StoreError
+    assert LOCK_KIND == "flock"
+    spec = load(write_spec(tmp_path, f'fmu = "{fmu_path}"\nstop_time = 1.0\noutput_interval = 0.1\n'
+                                     'transient = 0.5\noutputs = ["w"]\n[grid]\ng_amp = [1.0]\n'))
+    out = tmp_path / "out"
+    Store.open(out, spec).close()
+    with open(out / "_lock", "r+") as f:
+        fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        with pytest.raises(StoreError, match="in use by another dmi-sweep client"):
+            Store.open(out, spec)
+        fcntl.flock(f, fcntl.LOCK_UN)
+    Store.open(out, spec).close()

@@ -376,6 +376,14 @@ def test_help_texts():
     assert "an unchanged spec resumes" in text
     for option in ("--tls-ca-file", "--tls-cert", "--tls-key", "--dashboard"):
         assert option in text
+    assert ("3 the cluster was lost or could not be reached, or had no worker for --no-worker-timeout "
+            "seconds") in text
+    assert "when the cluster has had no worker for this long" in text and "(default: 60)" in text
+    for bad in ("0", "-5", "nan", "inf", "soon"):
+        r = subprocess.run([sys.executable, "-m", "dmi_sweep", "run", "spec.toml", "--out", "x",
+                            "--no-worker-timeout", bad], capture_output=True, text=True,
+                           env=env_with_package(), timeout=60)
+        assert r.returncode == 2 and f"{bad!r} is not a number of seconds > 0" in r.stderr, r.stderr
 
 
 def test_quiet_by_default(two_workers):
