@@ -20,6 +20,7 @@ import ssl
 import sys
 import threading
 import time
+import uuid
 from concurrent.futures import CancelledError
 from dataclasses import dataclass
 from typing import Any, Callable, Iterator, TextIO
@@ -32,7 +33,7 @@ from distributed.security import Security
 
 from . import simulate
 from .cli import NO_WORKER_TIMEOUT
-from .simulate import FMUPlugin, check_start, has_worker_plugin, run_chunk
+from .simulate import FMUPlugin, PluginClosed, check_start, has_worker_plugin, run_chunk
 from .spec import Spec, SpecError
 from .store import Store
 
@@ -428,7 +429,7 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
             say(f"dmi-sweep: the Dask dashboard is at {client.dashboard_link}\n")
         else:
             say("dmi-sweep: no dashboard: Dask's dashboard needs bokeh (pip install bokeh)\n")
-    plugin = FMUPlugin(spec.fmu.read_bytes(), spec.sha256)
+    plugin = FMUPlugin(spec.fmu.read_bytes(), spec.sha256)      # a caller's, kept across runs
     bar = Progress(spec.n_points, len(done), progress)
     registered = False
     computed = failed = 0
@@ -436,9 +437,13 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
     try:
         try:
             n_workers = len(client.scheduler_info(n_workers=-1).get("workers", {})) or (workers or 1)
-            # removed at the end unless it was there before (registered by the caller, say)
-            registered = not client.run_on_scheduler(has_worker_plugin, name=plugin.name)
-            client.register_plugin(plugin)
+            # A plugin of this FMU registered by the caller is used and kept; else this run registers
+            # its own (a name no other client uses) and removes it at the end, so one client's end
+            # never takes the FMU from another client's chunks.
+            if not client.run_on_scheduler(has_worker_plugin, name=plugin.name):
+                plugin = FMUPlugin(plugin.fmu_bytes, spec.sha256, uuid.uuid4().hex[:12])
+                client.register_plugin(plugin)
+                registered = True
             removals: list[dict[str, Any]] = []     # remove-worker events, from the client's thread
 
             def on_event(event):   # in the client's thread, when the scheduler sends the event
@@ -481,6 +486,7 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
                                 "other workers" if ev["again"] else "no chunk of this sweep was on it"))
 
         lost: dict[int, int] = {}    # point -> times its single-point task was lost with a worker
+        closed: dict[int, int] = {}  # first point of a chunk -> times it found the plugin gone
         written: set[int] = set()
         try:
             stream = as_completed([submit(c) for c in chunks(todo, n_workers, chunk_size)])
@@ -499,6 +505,14 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
                             stream.add(submit([i]))
                         continue
                     results = [{"point": points[0], "error": f"{type(e).__name__}: {e}"}]
+                except PluginClosed:
+                    # the chunk reached a worker that was dropping the plugin: nothing computed
+                    closed[points[0]] = closed.get(points[0], 0) + 1
+                    if closed[points[0]] <= 3:
+                        stream.add(submit(points))
+                        continue
+                    results = [{"point": i, "error": "the chunk found no worker with the FMU three "
+                                "times (its plugin was removed)"} for i in points]
                 except (OSError, CommClosedError, CancelledError) as e:
                     if watch.lost:                 # no worker left: the watch cancelled the futures
                         report_removals()
@@ -506,6 +520,8 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
                         raise watch.lost from None
                     store.log({"lost": _reasons(e)})          # the scheduler is gone
                     raise ClusterLost("lost the connection to the scheduler" + where) from None
+                except Exception as e:     # the task itself failed (not the FMU: that is a row)
+                    results = [{"point": i, "error": f"{type(e).__name__}: {e}"} for i in points]
                 finally:
                     futures.pop(fut.key)       # after result(): the watch may cancel its wait
                 results = [r for r in results if r["point"] not in written]

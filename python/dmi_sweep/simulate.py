@@ -124,8 +124,8 @@ class Runner:
         """Simulates one point: the job's start values updated by `values`. Returns the statistics
         (and Poincare samples), or {"error": message} if the FMU failed."""
         with self.lock:
-            if self.closing:
-                return {"error": "the worker plugin was removed while the point waited"}
+            if self.closing:   # not a result: the client runs the chunk again elsewhere
+                raise PluginClosed("the worker plugin was removed while the point waited")
             try:
                 return self._run(job, values)
             finally:
@@ -246,8 +246,10 @@ class Runner:
         return v.start
 
     def check_start(self, job: dict) -> str | None:
-        """Instantiates the FMU and sets the job's [start] values (in the modes fmpy sets them),
-        without running: None if the FMU takes them, else its reason with its logged messages."""
+        """Instantiates the FMU, sets the job's [start] values (in the modes fmpy sets them) and
+        leaves initialization mode (where a model may check its parameters together), the swept
+        parameters at their start values, without stepping: None if the FMU takes them, else its
+        reason with its logged messages."""
         self.messages.clear()
         try:
             self._fresh()
@@ -262,6 +264,7 @@ class Runner:
             rest = apply_start_values(fmu, self.md, rest, settable=settable_in_initialization_mode)
             if rest:
                 return "cannot set " + ", ".join(rest)
+            fmu.exitInitializationMode()
             return None
         except Exception as e:
             reason = "; ".join(self.messages)
@@ -285,15 +288,22 @@ def unpack(fmu_bytes: bytes, directory: str) -> str:
     return str(extract(io.BytesIO(fmu_bytes), tempfile.mkdtemp(prefix="dmi-sweep-fmu-", dir=directory)))
 
 
+class PluginClosed(RuntimeError):
+    """A chunk reached a worker whose FMU plugin is gone (removed, or the worker closing): no point of
+    it was computed, and the client runs it again."""
+
+
 class FMUPlugin(WorkerPlugin):
     """Carries the FMU's bytes to each worker once (Dask sends registered plugins to every worker,
     also to workers that join later), unpacks them there once, and keeps one Runner per thread."""
 
     idempotent = True
 
-    def __init__(self, fmu_bytes: bytes, sha256: str):
+    def __init__(self, fmu_bytes: bytes, sha256: str, run_id: str = ""):
+        """The name is dmi-sweep-<sha256[:16]>, a plugin a caller may register to keep the FMU on the
+        workers across runs, or with run_id that of one run, which removes it at its end."""
         self.fmu_bytes = fmu_bytes
-        self.name = "dmi-sweep-" + sha256[:16]
+        self.name = "dmi-sweep-" + sha256[:16] + (f"-{run_id}" if run_id else "")
 
     def setup(self, worker: Any = None) -> None:
         base = getattr(worker, "local_directory", None) or tempfile.gettempdir()
@@ -334,7 +344,10 @@ def run_chunk(plugin_name: str, job: dict, points: list[tuple[int, dict]]) -> li
     """A Dask task: simulates the points [(index, {name: value})] with this worker's FMU instance;
     each result carries `point`, the worker's pid, and how many times this worker has instantiated
     the FMU so far."""
-    runner = get_worker().plugins[plugin_name].runner()
+    plugin = get_worker().plugins.get(plugin_name)
+    if plugin is None:
+        raise PluginClosed(f"the worker has no plugin {plugin_name}")
+    runner = plugin.runner()
     out = []
     for index, values in points:
         r = runner.run(job, values)

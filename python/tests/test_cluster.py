@@ -55,6 +55,34 @@ def check_complete(out: Path, total: int) -> pd.DataFrame:
     return df
 
 
+def test_two_clients_one_cluster(cluster, tmp_path, fmu_path):
+    """Two clients sweep the same FMU on one external cluster at once: the first one ends (and
+    removes its worker plugin) while the second one runs; the second still computes every point
+    (each run has its own plugin: with one shared, the first end took the FMU from the other)."""
+    first_spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=200), "first.toml")   # ~10 s
+    second_spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=100), "second.toml")
+    first = start_sweep("run", first_spec, "--out", tmp_path / "first", "--scheduler", cluster.address,
+                        "--chunk-size", "1")
+    second = None
+    try:
+        wait_for_parts(tmp_path / "first", 2, first)
+        # the scheduler runs the first client's tasks first: the first run ends during the second
+        second = start_sweep("run", second_spec, "--out", tmp_path / "second", "--scheduler",
+                             cluster.address, "--chunk-size", "1")
+        r = finish_group(first, 240)
+        assert r.returncode == 0, r.stderr
+        assert second.poll() is None, "the second sweep ended before the first one: no overlap"
+        r = finish_group(second, 240)
+        assert r.returncode == 0, r.stderr
+    finally:
+        for p in (first, second):
+            if p is not None and p.poll() is None:      # an assertion failed: stop it by its group
+                kill_group(p.pid)
+                p.communicate()
+    check_complete(tmp_path / "first", 200)
+    check_complete(tmp_path / "second", 100)
+
+
 def test_scheduler_and_workers_elsewhere(cluster, tmp_path, fmu_path):
     """The sweep through --scheduler equals the LocalCluster's; the FMU reached the workers through
     Dask only (their folder is another one, they have no path to the FMU)."""

@@ -530,7 +530,8 @@ def test_repair_interrupted_loses_no_point(tmp_path, fmu_path, monkeypatch):
 def test_plugin_removed_while_a_point_runs(fmu_path, tmp_path):
     """Runner.close() (the worker plugin's teardown, when the plugin is removed or the worker stops)
     while a point runs in another thread: the point ends with its values (the instance is not freed
-    under it: that crashed the worker), the instance is freed right after, a later point is refused."""
+    under it: that crashed the worker), the instance is freed right after, a later point is refused
+    (an exception, so that the client runs its chunk again, not a failed row)."""
     import threading
     import time
     from dmi_sweep.simulate import Runner, unpack
@@ -550,4 +551,6 @@ def test_plugin_removed_while_a_point_runs(fmu_path, tmp_path):
     t.join(timeout=60)
     assert out == want
     assert runner.fmu is None                # freed when the point ended
-    assert "plugin was removed" in runner.run(job, {"g_amp": 1.0})["error"]
+    from dmi_sweep.simulate import PluginClosed
+    with pytest.raises(PluginClosed, match="plugin was removed"):   # not a row: run again elsewhere
+        runner.run(job, {"g_amp": 1.0})
