@@ -14,7 +14,7 @@ import traceback
 
 import numpy as np
 import pytest
-from conftest import numba_callbacks, python_callbacks
+from conftest import numba_callbacks, paper_solver, python_callbacks
 
 import dmi
 
@@ -23,13 +23,7 @@ N = 50
 
 def model(example=43):
     """Example 4.3 at h = 1/50 with Python callbacks, initialised, and 20 steps taken."""
-    rhs, kernel, history = python_callbacks(example)
-    s = dmi.Solver(2, 1.0, N)
-    s.set_rhs(rhs)
-    s.set_kernel(kernel)
-    s.set_history(history)
-    s.set_friction([0.0, 1.0])
-    s.init()
+    s = paper_solver(example, N, "python")
     s.advance(20)
     return s
 
