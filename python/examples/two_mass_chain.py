@@ -94,18 +94,19 @@ def plot(t: np.ndarray, U: np.ndarray, path: str) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, (ax_x, ax_v) = plt.subplots(2, 1, sharex=True, figsize=(8, 5.5))
+    fig, (ax_x, ax_v) = plt.subplots(2, 1, sharex=True, figsize=(9.5, 5.5))
     for i, c in enumerate(("tab:blue", "tab:red")):
         ax_x.plot(t, U[:, i], color=c, label=f"$x_{i + 1}$")
         ax_v.plot(t, U[:, 2 + i], color=c, label=f"$v_{i + 1}$")
         stuck = U[:, 2 + i] == 0
         ax_v.plot(t[stuck], np.zeros(stuck.sum()) - 0.02 * (i + 1), "|", color=c, ms=4,
                   label=f"mass {i + 1} sticks")
-    ax_x.set_ylabel("displacement")
-    ax_v.set_ylabel("velocity")
-    ax_v.set_xlabel("t")
-    ax_x.legend(loc="upper right")
-    ax_v.legend(loc="upper right", ncol=2, fontsize=8)
+    ax_x.set_ylabel("displacement $x_i$")
+    ax_v.set_ylabel("velocity $v_i = x_i'$")
+    ax_v.set_xlabel("time $t$")
+    # the legends beside the axes, not over the curves
+    ax_x.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=9)
+    ax_v.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     ax_x.set_title("Two-mass chain, dry friction, Prony-series memory (libdmi from Python, numba)")
     fig.tight_layout()
     fig.savefig(path, dpi=120)
