@@ -190,12 +190,33 @@ void dmi_expk_release(dmi_expk *k)
     memset(k, 0, sizeof *k);
 }
 
+/* e^{a_t s} cos(b_t s) and e^{a_t s} sin(b_t s): the one place both the
+ * evaluation and the sampling compute them (the samples are bitwise the
+ * values dmi_expk_eval gives). */
+static void term_weights(const dmi_expk *k, size_t t, double s, double *c, double *sn)
+{
+    const double e = exp(k->a[t] * s);
+    *c = e * cos(k->b[t] * s);
+    *sn = e * sin(k->b[t] * s);
+}
+
+/* Whether entry q (row-major) of some C_t or D_t is nonzero. */
+static int entry_used(const dmi_expk *k, size_t q)
+{
+    const size_t nn = k->n * k->n;
+    for (size_t t = 0; t < k->K; t++)
+        if (k->C[t * nn + q] != 0 || (k->D && k->D[t * nn + q] != 0))
+            return 1;
+    return 0;
+}
+
 int dmi_expk_eval(double s, double *out, void *user)
 {
     const dmi_expk *k = user;
     const size_t nn = k->n * k->n;
     for (size_t t = 0; t < k->K; t++) {
-        double e = exp(k->a[t] * s), c = e * cos(k->b[t] * s), sn = e * sin(k->b[t] * s);
+        double c, sn;
+        term_weights(k, t, s, &c, &sn);
         const double *C = k->C + t * nn, *D = k->D ? k->D + t * nn : NULL;
         for (size_t q = 0; q < nn; q++)
             out[q] += D ? C[q] * c + D[q] * sn : C[q] * c;
@@ -215,19 +236,15 @@ int dmi_expk_sample(const dmi_expk *k, size_t N, double h, dmi_kernel *out)
     int finite = 1;
     for (size_t t = 0; t < K; t++)
         for (size_t l = 0; l < N; l++) {
-            double x = (double)l * h, e = exp(k->a[t] * x);
-            double c = e * cos(k->b[t] * x), sn = e * sin(k->b[t] * x);
+            double c, sn;
+            term_weights(k, t, (double)l * h, &c, &sn);
             cs[(2 * t) * N + l] = c;
             cs[(2 * t + 1) * N + l] = sn;
             finite &= isfinite(c) && isfinite(sn);
         }
     size_t cand = 0;
     for (size_t q = 0; q < nn; q++)
-        for (size_t t = 0; t < K; t++)
-            if (k->C[t * nn + q] != 0 || (k->D && k->D[t * nn + q] != 0)) {
-                cand++;
-                break;
-            }
+        cand += (size_t)entry_used(k, q);
     int rc = finite ? 0 : 1;
     if (rc == 0 && cand > 0) {
         out->row = malloc(cand * sizeof *out->row);
@@ -237,10 +254,7 @@ int dmi_expk_sample(const dmi_expk *k, size_t N, double h, dmi_kernel *out)
     }
     size_t e = 0;
     for (size_t q = 0; q < nn && rc == 0; q++) {
-        int used = 0;
-        for (size_t t = 0; t < K && !used; t++)
-            used = k->C[t * nn + q] != 0 || (k->D && k->D[t * nn + q] != 0);
-        if (!used)
+        if (!entry_used(k, q))
             continue;
         double *x = out->samples + e * N;
         int nonzero = 0;

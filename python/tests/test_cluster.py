@@ -48,6 +48,22 @@ def wait_for_parts(out: Path, n: int, proc: subprocess.Popen, timeout: float = 1
         time.sleep(0.05)
 
 
+def kill_worker_mid_sweep(processes, cluster, spec: Path, out: Path, parts: int, *args: str):
+    """Starts a sweep of spec on the cluster (chunks of one point, args added), SIGKILLs the
+    cluster's first worker by its pid once `parts` chunks are written, and returns the client
+    process and the killed worker's address."""
+    client = processes.start(sweep_cmd("run", spec, "--out", out, "--scheduler", cluster.address,
+                                       "--chunk-size", "1", *args),
+                             env=env_with_package(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True)
+    wait_for_parts(out, parts, client)
+    victim = cluster.workers[0]
+    address = worker_address(cluster, victim.pid)
+    os.kill(victim.pid, signal.SIGKILL)
+    victim.wait(timeout=10)
+    return client, address
+
+
 def check_complete(out: Path, total: int) -> pd.DataFrame:
     df = pd.read_parquet(out)
     assert sorted(df["point"]) == list(range(total))      # every point, each once
@@ -116,15 +132,7 @@ def test_worker_killed_mid_sweep(cluster, tmp_path, fmu_path, processes):
     total = 40
     spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=total))
     out = tmp_path / "out"
-    client = processes.start(sweep_cmd("run", spec, "--out", out, "--scheduler", cluster.address,
-                                       "--chunk-size", "1", "--quiet"),
-                             env=env_with_package(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                             text=True)
-    wait_for_parts(out, 4, client)
-    victim = cluster.workers[0]
-    address = worker_address(cluster, victim.pid)
-    os.kill(victim.pid, signal.SIGKILL)
-    victim.wait(timeout=10)
+    client, address = kill_worker_mid_sweep(processes, cluster, spec, out, 4, "--quiet")
     assert len(list(out.glob("part-*.parquet"))) < total       # killed mid-sweep
     stdout, stderr = client.communicate(timeout=180)
     assert client.returncode == 0, stderr
@@ -243,15 +251,7 @@ def test_every_worker_lost(processes, tmp_path_factory, tmp_path, fmu_path):
     total = 40
     spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=total))
     out = tmp_path / "out"
-    client = processes.start(sweep_cmd("run", spec, "--out", out, "--scheduler", cluster.address,
-                                       "--chunk-size", "1", "--no-worker-timeout", "3"),
-                             env=env_with_package(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                             text=True)
-    wait_for_parts(out, 3, client)
-    victim = cluster.workers[0]
-    address = worker_address(cluster, victim.pid)
-    os.kill(victim.pid, signal.SIGKILL)
-    victim.wait(timeout=10)
+    client, address = kill_worker_mid_sweep(processes, cluster, spec, out, 3, "--no-worker-timeout", "3")
     t = time.monotonic()
     stdout, stderr = client.communicate(timeout=60)
     waited = time.monotonic() - t
