@@ -346,22 +346,21 @@ typedef struct {
     double tab[2 * BLOCK];       /* r^i, i < BLOCK: re, im */
 } term;
 
-/* The multipliers of one sum for its step, copied from its term so that the
- * step reads one contiguous record per sum, as pairs (re, im) so that the
- * step of a complex sum is the same arithmetic on both halves (which the
- * compiler may pair into vector operations):
- *     S' = (x hi + y hi_rot) + ((x lo + y lo_rot) + ((unew, 0) - uold rN))
- * with S = (x, y), hi = (rh_re, rh_im), hi_rot = (-rh_im, rh_re), the same
- * for lo = rl, and rN = (rN_re, rN_im): term by term the operations of
- * x rh - y rh_im etc., so the same results bitwise. */
-typedef struct {
-    double hi[2], hi_rot[2], lo[2], lo_rot[2], rN[2];
-} mult;
-
 /*
  * The sums are kept in the order real ones first (nreal of them), then the
- * complex ones, so that the step runs two branch-free loops; slot[q] is the
- * place of sum q in the saved order (term by term, used columns ascending).
+ * complex ones, each group padded to an even count with a sum that no part
+ * uses (its multipliers 0, its series column 0's: it only holds the newest
+ * state), so that the step runs two branch-free loops over pairs of sums,
+ * which the compiler turns into vector operations: the k-th sum is at
+ * internal index k below nreal, nreal2 + k - nreal above, of cap in all.
+ * The step's data are kept pair by pair, each pair's in one block of PAIR
+ * doubles (field F of sum q at pair[PAIR (q / 2) + F + q % 2]):
+ *     re' = x hr - y hi + ((x lr - y li) + (unew - rNr uold))
+ *     im' = x hi + y hr + ((x li + y lr) + (0 - rNi uold))
+ * with S = x + i y, r = (hr + i hi) + (lr + i li), r^N = rNr + i rNi; a
+ * real sum has y = hi = li = rNi = 0 and only the first line.  slot[q] is
+ * the place of sum q in the saved order (term by term, used columns
+ * ascending).
  * The parts C, D of row i are parts [row_start[i], row_start[i + 1]), in the
  * saved order of their sums (summed in two partial sums, see update_W).  W
  * (h times the sum, n values) is recomputed whenever the sums change, so
@@ -369,25 +368,35 @@ typedef struct {
  */
 struct dmi_exp {
     size_t n, N, nterms, nsums, nreal, nparts;
+    size_t nreal2, cap;           /* nreal rounded up to even; the internal count */
     double h;
     uint64_t period;
     uint64_t next; /* the next anchoring step: the multiple of period after the last anchor */
     term *terms;
-    size_t *term_of, *col, *slot; /* per sum */
-    size_t *series;               /* per sum: offset of its column's series in the ring */
-    mult *m;                      /* per sum */
-    double *S;                    /* per sum: the sum S (re, im) */
+    size_t *term_of, *col, *slot; /* per internal index */
+    size_t *series;               /* per internal index: offset of its column's series in the ring */
+    double *pair;                 /* cap / 2 blocks: the sums and their multipliers */
     size_t *row_start;            /* n + 1 */
-    size_t *psum;                 /* per part: its sum (internal index) */
+    size_t *psum;                 /* per part: its sum's place in pair (F_SRE's) */
     double *pC, *pD;              /* per part: W_row += C Re S + D Im S */
     int has_D;                    /* some part has D != 0 */
     /* the parts as a matrix when it is small or full enough: the rows with a
-     * part (nrows of them, listed in rows), each a row of nsums C (and D)
-     * values, zero where no part is */
+     * part (nrows of them, listed in rows), each a row of cap C (and D)
+     * values over the internal index, zero where no part is */
     size_t nrows, *rows;
     double *Cm, *Dm;
     double *W;                    /* n: h sum of the parts, W^p */
 };
+
+/* The fields of a pair's block (two doubles each). */
+enum { F_SRE = 0, F_SIM = 2, F_HR = 4, F_HI = 6, F_LR = 8, F_LI = 10, F_RNR = 12, F_RNI = 14,
+       PAIR = 16 };
+
+/* Field f of the sum at internal index q. */
+static double *field(const dmi_exp *e, size_t q, int f)
+{
+    return e->pair + PAIR * (q / 2) + (size_t)f + q % 2;
+}
 
 void dmi_exp_free(dmi_exp *e)
 {
@@ -398,8 +407,7 @@ void dmi_exp_free(dmi_exp *e)
     free(e->col);
     free(e->slot);
     free(e->series);
-    free(e->m);
-    free(e->S);
+    free(e->pair);
     free(e->row_start);
     free(e->psum);
     free(e->pC);
@@ -462,21 +470,25 @@ int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
     for (size_t q = 0; q < k->K * nn; q++) /* k->K n n was checked by dmi_expk_copy */
         e->nparts += k->C[q] != 0 || (k->D && k->D[q] != 0);
     e->nterms = k->K;
-    const size_t ns = e->nsums, np = e->nparts;
+    for (size_t t = 0; t < k->K; t++)
+        for (size_t j = 0; j < n; j++)
+            e->nreal += k->b[t] == 0 && column_used(k, t, j);
+    e->nreal2 = e->nreal + (e->nreal & 1);
+    e->cap = e->nreal2 + (e->nsums - e->nreal) + ((e->nsums - e->nreal) & 1);
+    const size_t ns = e->cap, np = e->nparts;
     e->terms = array(k->K, sizeof *e->terms);
     e->term_of = array(ns, sizeof *e->term_of);
     e->col = array(ns, sizeof *e->col);
     e->slot = array(ns, sizeof *e->slot);
     e->series = array(ns, sizeof *e->series);
-    e->m = array(ns, sizeof *e->m);
-    e->S = array(2 * ns, sizeof *e->S);
+    e->pair = array(ns / 2 * PAIR, sizeof *e->pair);
     e->row_start = array(n + 1, sizeof *e->row_start);
     e->psum = array(np, sizeof *e->psum);
     e->pC = array(np, sizeof *e->pC);
     e->pD = array(np, sizeof *e->pD);
     e->W = array(n, sizeof *e->W);
     size_t *index = array(k->K * n, sizeof *index); /* (t, j) -> internal sum index */
-    if (!e->terms || !e->term_of || !e->col || !e->slot || !e->series || !e->m || !e->S ||
+    if (!e->pair || !e->terms || !e->term_of || !e->col || !e->slot || !e->series ||
         !e->row_start || !e->psum || !e->pC || !e->pD || !e->W || !index) {
         free(index);
         dmi_exp_free(e);
@@ -484,29 +496,29 @@ int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
     }
     for (size_t t = 0; t < k->K; t++)
         term_init(&e->terms[t], k->a[t], k->b[t], h, N);
-    /* internal order: the real sums, then the complex ones, each in saved order */
-    size_t q = 0;
+    /* internal order: the real sums, then the complex ones, each in saved
+     * order (the pads: zero multipliers, column 0, from calloc) */
     for (int pass = 0; pass < 2; pass++)
-        for (size_t t = 0, sv = 0; t < k->K; t++)
+        for (size_t t = 0, sv = 0, q = pass == 0 ? 0 : e->nreal2; t < k->K; t++)
             for (size_t j = 0; j < n; j++) {
                 if (!column_used(k, t, j))
                     continue;
                 if (e->terms[t].real == (pass == 0)) {
                     const term *tm = &e->terms[t];
-                    mult mu = {{tm->rh_re, tm->rh_im}, {-tm->rh_im, tm->rh_re},
-                               {tm->rl_re, tm->rl_im}, {-tm->rl_im, tm->rl_re},
-                               {tm->rN_re, tm->rN_im}};
+                    *field(e, q, F_HR) = tm->rh_re;
+                    *field(e, q, F_HI) = tm->rh_im;
+                    *field(e, q, F_LR) = tm->rl_re;
+                    *field(e, q, F_LI) = tm->rl_im;
+                    *field(e, q, F_RNR) = tm->rN_re;
+                    *field(e, q, F_RNI) = tm->rN_im;
                     e->term_of[q] = t;
                     e->col[q] = j;
                     e->slot[q] = sv;
                     e->series[q] = j * 2 * (N + 1); /* the ring's layout, L = N + 1 */
-                    e->m[q] = mu;
                     index[t * n + j] = q++;
                 }
                 sv++;
             }
-    for (size_t x = 0; x < ns; x++)
-        e->nreal += (size_t)e->terms[e->term_of[x]].real;
     /* parts row by row; within a row in the saved order (term, column) */
     size_t pp = 0;
     for (size_t i = 0; i < n; i++) {
@@ -517,7 +529,7 @@ int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
                 double C = k->C[x], D = k->D ? k->D[x] : 0.0;
                 if (C == 0 && D == 0)
                     continue;
-                e->psum[pp] = index[t * n + j];
+                e->psum[pp] = field(e, index[t * n + j], F_SRE) - e->pair;
                 e->pC[pp] = C;
                 e->pD[pp] = D;
                 e->has_D |= D != 0;
@@ -528,7 +540,7 @@ int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
     free(index);
     for (size_t i = 0; i < n; i++)
         e->nrows += e->row_start[i + 1] > e->row_start[i];
-    if (e->nrows * ns <= 2 * np + 8) { /* (nrows ns <= n n K: no overflow) */
+    if (e->nrows * ns <= 2 * np + 8) { /* (nrows ns <= n (n K + 2): no overflow) */
         e->rows = array(e->nrows, sizeof *e->rows);
         e->Cm = array(e->nrows * ns, sizeof *e->Cm);
         e->Dm = e->has_D ? array(e->nrows * ns, sizeof *e->Dm) : NULL;
@@ -541,9 +553,10 @@ int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
                 continue;
             e->rows[r] = i;
             for (size_t x = e->row_start[i]; x < e->row_start[i + 1]; x++) {
-                e->Cm[r * ns + e->psum[x]] = e->pC[x];
+                const size_t q = e->psum[x] / PAIR * 2 + e->psum[x] % 2; /* internal index */
+                e->Cm[r * ns + q] = e->pC[x];
                 if (e->Dm)
-                    e->Dm[r * ns + e->psum[x]] = e->pD[x];
+                    e->Dm[r * ns + q] = e->pD[x];
             }
             r++;
         }
@@ -552,29 +565,39 @@ int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
     return 0;
 }
 
+/* A row of W in the matrix form from its partial sums: lanes w of the C
+ * parts, d of the D parts (NULL: none). */
+static double row_total(const double w[2], const double d[2], double h)
+{
+    return d ? ((w[0] + d[0]) + (w[1] + d[1])) * h : (w[0] + w[1]) * h;
+}
+
 /* W = h sum of the parts, row by row (each row in locals, written once).
- * Two partial sums in a fixed order, so a long row (a dense block) is not
- * one chain of dependent additions; without D (no sine part in any term)
- * the imaginary parts are not read. */
+ * Two partial sums in a fixed order (even and odd internal indices in the
+ * matrix form, each with its C and D parts apart), so a long row (a dense
+ * block) is not one chain of dependent additions; without D (no sine part
+ * in any term) the imaginary parts are not read.  A pad's entries are 0 and
+ * its sums finite, so it adds +-0, which leaves any sum that starts at +0
+ * unchanged; so does a real sum's D part (its imaginary part is 0).  With
+ * one row, dmi_exp_advance sums it in the same order as the sums are made. */
 static void update_W(dmi_exp *e)
 {
-    const double *S = e->S, *C = e->pC, *D = e->pD;
-    const size_t *ps = e->psum, ns = e->nsums;
+    const double *S = e->pair, *C = e->pC, *D = e->pD;
+    const size_t *ps = e->psum, ns = e->cap;
     if (e->Cm) { /* the matrix form: no indices (the other rows stay 0) */
         for (size_t r = 0; r < e->nrows; r++) {
-            const double *Cr = e->Cm + r * ns, *Dr = e->Dm ? e->Dm + r * ns : NULL;
-            double w0 = 0, w1 = 0;
-            size_t q = 0;
-            for (; q + 1 < ns; q += 2) {
-                w0 += Cr[q] * S[2 * q];
-                w1 += Cr[q + 1] * S[2 * q + 2];
+            const double *restrict Cr = e->Cm + r * ns;
+            double w[2] = {0, 0}, d[2] = {0, 0};
+            for (size_t q = 0; q < ns; q += 2)
+                for (int c = 0; c < 2; c++)
+                    w[c] += Cr[q + c] * S[PAIR * (q / 2) + F_SRE + c];
+            if (e->Dm) {
+                const double *restrict Dr = e->Dm + r * ns;
+                for (size_t q = 0; q < ns; q += 2)
+                    for (int c = 0; c < 2; c++)
+                        d[c] += Dr[q + c] * S[PAIR * (q / 2) + F_SIM + c];
             }
-            if (q < ns)
-                w0 += Cr[q] * S[2 * q];
-            if (Dr)
-                for (q = 0; q < ns; q++)
-                    w1 += Dr[q] * S[2 * q + 1];
-            e->W[e->rows[r]] = (w0 + w1) * e->h;
+            e->W[e->rows[r]] = row_total(w, e->Dm ? d : NULL, e->h);
         }
         return;
     }
@@ -584,21 +607,27 @@ static void update_W(dmi_exp *e)
         double w0 = 0, w1 = 0;
         if (e->has_D) {
             for (; q + 1 < end; q += 2) {
-                w0 += C[q] * S[2 * ps[q]] + D[q] * S[2 * ps[q] + 1];
-                w1 += C[q + 1] * S[2 * ps[q + 1]] + D[q + 1] * S[2 * ps[q + 1] + 1];
+                w0 += C[q] * S[ps[q]] + D[q] * S[ps[q] + (F_SIM - F_SRE)];
+                w1 += C[q + 1] * S[ps[q + 1]] + D[q + 1] * S[ps[q + 1] + (F_SIM - F_SRE)];
             }
             if (q < end)
-                w0 += C[q] * S[2 * ps[q]] + D[q] * S[2 * ps[q] + 1];
+                w0 += C[q] * S[ps[q]] + D[q] * S[ps[q] + (F_SIM - F_SRE)];
         } else {
             for (; q + 1 < end; q += 2) {
-                w0 += C[q] * S[2 * ps[q]];
-                w1 += C[q + 1] * S[2 * ps[q + 1]];
+                w0 += C[q] * S[ps[q]];
+                w1 += C[q + 1] * S[ps[q + 1]];
             }
             if (q < end)
-                w0 += C[q] * S[2 * ps[q]];
+                w0 += C[q] * S[ps[q]];
         }
         e->W[i] = (w0 + w1) * e->h;
     }
+}
+
+/* The internal index of the k-th sum (k < nsums). */
+static size_t internal(const dmi_exp *e, size_t k)
+{
+    return k < e->nreal ? k : e->nreal2 + (k - e->nreal);
 }
 
 /* acc += x, error-free: acc.hi + acc.lo carries the sum's rounding. */
@@ -618,7 +647,8 @@ static void set_next(dmi_exp *e, uint64_t p)
 void dmi_exp_anchor(dmi_exp *e, const dmi_history *r, uint64_t p)
 {
     set_next(e, p);
-    for (size_t q = 0; q < e->nsums; q++) {
+    for (size_t k = 0; k < e->nsums; k++) {
+        const size_t q = internal(e, k);
         const term *t = &e->terms[e->term_of[q]];
         const double *u = dmi_history_series(r, e->col[q]); /* u[l] = U^{p-l} */
         dd re = {0, 0}, im = {0, 0};
@@ -638,8 +668,8 @@ void dmi_exp_anchor(dmi_exp *e, const dmi_history *r, uint64_t p)
             }
             base = cdd_mul(base, t->rB);
         }
-        e->S[2 * q] = re.hi + re.lo;
-        e->S[2 * q + 1] = im.hi + im.lo;
+        *field(e, q, F_SRE) = re.hi + re.lo;
+        *field(e, q, F_SIM) = im.hi + im.lo;
     }
     update_W(e);
 }
@@ -651,26 +681,50 @@ void dmi_exp_advance(dmi_exp *e, const dmi_history *r, uint64_t p)
         return;
     }
     const double *buf = r->buf + r->head;
-    const size_t N = e->N, nr = e->nreal, ns = e->nsums;
-    const size_t *off = e->series;
-    const mult *m = e->m;
-    double *S = e->S;
-    for (size_t q = 0; q < nr; q++) {
-        const double unew = buf[off[q]], uold = buf[off[q] + N], x = S[2 * q];
-        S[2 * q] = x * m[q].hi[0] + (x * m[q].lo[0] + (unew - m[q].rN[0] * uold));
-    }
-    for (size_t q = nr; q < ns; q++) {
-        const double unew = buf[off[q]], uold = buf[off[q] + N];
-        const double x = S[2 * q], y = S[2 * q + 1];
-        double v[2];
+    const size_t N = e->N, nr = e->nreal2, ns = e->cap, *off = e->series;
+    /* W's one row of the matrix form, if so, is summed here as the sums are
+     * made, in update_W's order (its lanes c, C parts and D parts apart) */
+    const double *Cr = e->nrows == 1 ? e->Cm : NULL, *Dr = Cr ? e->Dm : NULL;
+    double w[2] = {0, 0}, d[2] = {0, 0};
+    double *restrict v = e->pair;
+    for (size_t q = 0; q < nr; q += 2, v += PAIR) { /* two sums at a time: vector operations */
+        double a[2];
+        for (int c = 0; c < 2; c++) {
+            const double unew = buf[off[q + c]], uold = buf[off[q + c] + N], x = v[F_SRE + c];
+            a[c] = x * v[F_HR + c] + (x * v[F_LR + c] + (unew - v[F_RNR + c] * uold));
+        }
         for (int c = 0; c < 2; c++)
-            v[c] = (x * m[q].hi[c] + y * m[q].hi_rot[c]) +
-                   ((x * m[q].lo[c] + y * m[q].lo_rot[c]) +
-                    ((c == 0 ? unew : 0.0) - m[q].rN[c] * uold));
-        S[2 * q] = v[0];
-        S[2 * q + 1] = v[1];
+            v[F_SRE + c] = a[c];
+        if (Cr) /* (a real sum's D part adds nothing: see update_W) */
+            for (int c = 0; c < 2; c++)
+                w[c] += Cr[q + c] * a[c];
     }
-    update_W(e);
+    for (size_t q = nr; q < ns; q += 2, v += PAIR) {
+        double a[2], b[2];
+        for (int c = 0; c < 2; c++) {
+            const double unew = buf[off[q + c]], uold = buf[off[q + c] + N], x = v[F_SRE + c],
+                         y = v[F_SIM + c];
+            a[c] = (x * v[F_HR + c] - y * v[F_HI + c]) +
+                   ((x * v[F_LR + c] - y * v[F_LI + c]) + (unew - v[F_RNR + c] * uold));
+            b[c] = (x * v[F_HI + c] + y * v[F_HR + c]) +
+                   ((x * v[F_LI + c] + y * v[F_LR + c]) + (0.0 - v[F_RNI + c] * uold));
+        }
+        for (int c = 0; c < 2; c++) {
+            v[F_SRE + c] = a[c];
+            v[F_SIM + c] = b[c];
+        }
+        if (Cr)
+            for (int c = 0; c < 2; c++)
+                w[c] += Cr[q + c] * a[c];
+        if (Dr)
+            for (int c = 0; c < 2; c++)
+                d[c] += Dr[q + c] * b[c];
+    }
+    if (!Cr) {
+        update_W(e);
+        return;
+    }
+    e->W[e->rows[0]] = row_total(w, Dr ? d : NULL, e->h);
 }
 
 const double *dmi_exp_sum(const dmi_exp *e)
@@ -685,18 +739,21 @@ uint64_t dmi_exp_period(const dmi_exp *e)
 
 void dmi_exp_get(const dmi_exp *e, unsigned char *bytes)
 {
-    for (size_t q = 0; q < e->nsums; q++) {
-        const size_t s = e->slot[q];
-        memcpy(bytes + 2 * s * sizeof(double), &e->S[2 * q], 2 * sizeof(double));
+    for (size_t k = 0; k < e->nsums; k++) {
+        const size_t q = internal(e, k), s = e->slot[q];
+        memcpy(bytes + 2 * s * sizeof(double), field(e, q, F_SRE), sizeof(double));
+        memcpy(bytes + (2 * s + 1) * sizeof(double), field(e, q, F_SIM), sizeof(double));
     }
 }
 
 void dmi_exp_set(dmi_exp *e, const double *sums, uint64_t p)
 {
     set_next(e, p);
-    for (size_t q = 0; q < e->nsums; q++) {
-        e->S[2 * q] = sums[2 * e->slot[q]];
-        e->S[2 * q + 1] = sums[2 * e->slot[q] + 1];
+    for (size_t k = 0; k < e->nsums; k++) {
+        const size_t q = internal(e, k);
+        *field(e, q, F_SRE) = sums[2 * e->slot[q]];
+        /* (a real sum's imaginary part is 0, whatever the bytes say) */
+        *field(e, q, F_SIM) = k < e->nreal ? 0.0 : sums[2 * e->slot[q] + 1];
     }
     update_W(e);
 }

@@ -31,16 +31,33 @@ static const double MD[MK * 4] = {0.1, 0.0, 0.0, 0.05, 0, 0, 0, 0, 0, 0, 0, 0,
 
 enum { EN = 50 }; /* the recursion anchors every 4 N = 200 steps */
 
-/* The model solver with the exponential kernel and method, initialised. */
-static dmi_solver *exp_solver(core_model *m, size_t N, int method)
+/* A kernel whose parts are all in row 1 (W_0 = 0), so that the recursion
+ * sums W in its step: a real term on column 0 only (an odd number of real
+ * sums) and two complex ones on columns 0, 1 and 1 (an odd number of
+ * complex sums), with D_k (a real term's D multiplies sin 0 = 0). */
+enum { OK_ = 3 };
+static const double OA[OK_] = {-1.0, 0.0, -0.5};
+static const double OB[OK_] = {0.0, 2.0, 7.0};
+static const double OC[OK_ * 4] = {0, 0, 0.3, 0, 0, 0, 0.2, -0.1, 0, 0, 0, 0.25};
+static const double OD[OK_ * 4] = {0, 0, 0.1, 0, 0, 0, 0.05, 0.1, 0, 0, 0, -0.2};
+
+/* The model solver with an exponential kernel and method, initialised. */
+static dmi_solver *kernel_solver(core_model *m, size_t N, int method, size_t K, const double *a,
+                                 const double *b, const double *C, const double *D)
 {
     dmi_solver *s = NULL;
     if (dmi_create(&s, 2, 1.0, N) != DMI_OK)
         return NULL;
-    if (core_model_setup(s, m) != DMI_OK || dmi_set_kernel_exp(s, MK, MA, MB, MC, MD) != DMI_OK ||
+    if (core_model_setup(s, m) != DMI_OK || dmi_set_kernel_exp(s, K, a, b, C, D) != DMI_OK ||
         dmi_set_convolution(s, method) != DMI_OK || dmi_init(s) != DMI_OK)
         dmi_free(&s);
     return s;
+}
+
+/* The model solver with the kernel M*. */
+static dmi_solver *exp_solver(core_model *m, size_t N, int method)
+{
+    return kernel_solver(m, N, method, MK, MA, MB, MC, MD);
 }
 
 /* Whether dmi_last_error(s) contains each of the (NULL-ended) words. */
@@ -272,6 +289,49 @@ static double bound_scale(const dmi_solver *s, size_t N)
  * right after each switch agrees to 1e-13 of the bound's scale (a switch
  * to the recursion whose sums were not computed afresh gives a W off by the
  * whole sum), and the states after 500 more steps agree to rounding. */
+/* The one-row kernel O*: W summed in the recursion's step, and by the
+ * function that sums it after an anchor or a load.  At every step p from
+ * 150 to 450 (across the anchors at 200 and 400), a's state is loaded into
+ * b and both take a step: the W^p each used (a's summed in the step, b's
+ * after the load) are bitwise equal, and so are the states after it (this
+ * fails if the two summations differ in any bit, at any step).  DIRECT from
+ * the state of p = 150 stays within 1e-13. */
+static void test_one_row(void)
+{
+    core_model m[3];
+    memset(m, 0, sizeof m);
+    dmi_solver *a = kernel_solver(&m[0], EN, DMI_CONV_RECURSIVE, OK_, OA, OB, OC, OD);
+    dmi_solver *b = kernel_solver(&m[1], EN, DMI_CONV_RECURSIVE, OK_, OA, OB, OC, OD);
+    dmi_solver *d = kernel_solver(&m[2], EN, DMI_CONV_DIRECT, OK_, OA, OB, OC, OD);
+    CU_ASSERT_FATAL(a && b && d);
+    CU_ASSERT_FATAL(dmi_advance(a, 150) == DMI_OK);
+    size_t size, differ = 0;
+    unsigned char *saved = core_save(a, &size);
+    CU_ASSERT_FATAL(saved != NULL);
+    CU_ASSERT_EQUAL(dmi_state_load(d, saved, size), DMI_OK);
+    for (int p = 150; p < 450; p++) {
+        unsigned char *now = core_save(a, &size);
+        CU_ASSERT_FATAL(now != NULL);
+        CU_ASSERT_FATAL(dmi_state_load(b, now, size) == DMI_OK);
+        free(now);
+        CU_ASSERT_FATAL(dmi_step(a) == DMI_OK && dmi_step(b) == DMI_OK);
+        double wa[2], wb[2];
+        CU_ASSERT_FATAL(dmi_get_step_terms(a, wa, NULL) == DMI_OK &&
+                        dmi_get_step_terms(b, wb, NULL) == DMI_OK);
+        differ += memcmp(wa, wb, sizeof wa) != 0 || !core_same_state(a, b);
+        CU_ASSERT(wa[0] == 0 && wa[1] != 0); /* the parts are in row 1 */
+    }
+    CU_ASSERT_EQUAL(differ, 0);
+    CU_ASSERT(dmi_advance(d, 300) == DMI_OK);
+    double dev = state_deviation(d, a, EN);
+    printf("\n  DIRECT from the RECURSIVE state: %.2e\n", dev);
+    CU_ASSERT(dev <= 1e-13);
+    free(saved);
+    dmi_free(&a);
+    dmi_free(&b);
+    dmi_free(&d);
+}
+
 static void test_switch(void)
 {
     core_model m1 = {0}, m2 = {0};
@@ -449,6 +509,8 @@ int main(int argc, char **argv)
         {"RECURSIVE: failed steps around an anchor leave the solver bitwise unchanged",
          test_failed_step},
         {"RECURSIVE: state save/load continues bitwise across anchors", test_state},
+        {"RECURSIVE, parts in one row: W summed in the step = after a load, bitwise; = DIRECT",
+         test_one_row},
         {"RECURSIVE: switching methods between steps", test_switch},
         {"dmi_set_kernel_exp copies its arrays", test_copies},
         {"RECURSIVE without a kernel: W = 0, bitwise DIRECT", test_no_kernel},
