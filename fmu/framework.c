@@ -428,6 +428,9 @@ void fmu_model_state_save(const fmu_model *m, uint32_t tag, unsigned char *buf)
 /* The values of the state bytes into m (checked as if set); 0 or -1 (err). */
 static int load_values(fmu_model *m, const unsigned char *buf, char *err)
 {
+    /* every value first, then each checked against all of them: a model's
+     * accept may compare two variables, and the state's values were
+     * accepted together, not beside the start values */
     size_t at_i = FMU_STATE_AT_INT, at_r = at_real();
     for (int pass = 0; pass < 2; pass++) /* the Float64 values first, then the others */
         for (unsigned vr = 0; vr < MODEL->nvariables; vr++) {
@@ -438,16 +441,25 @@ static int load_values(fmu_model *m, const unsigned char *buf, char *err)
             if (pass == 0) {
                 value = dmi_get_double(buf, at_r);
                 at_r += 8;
-                if (fmu_model_check(m, vr, kind, value, err) != 0)
-                    return -1;
             } else {
                 const int64_t x = (int64_t)dmi_get_u64(buf, at_i);
                 at_i += 8;
-                value = (double)x;
-                if (x < INT32_MIN || x > INT32_MAX || fmu_model_check(m, vr, kind, value, err))
+                if (x < INT32_MIN || x > INT32_MAX)
                     return fail(err, "state: %s = %lld is invalid", name_of(vr), (long long)x);
+                value = (double)x;
             }
             fmu_model_store(m, vr, value);
+        }
+    for (int pass = 0; pass < 2; pass++) /* in the same order */
+        for (unsigned vr = 0; vr < MODEL->nvariables; vr++) {
+            const unsigned kind = m->kind[vr];
+            const double value = m->v->value[vr];
+            if (!fmu_is_set(kind) || ((kind & FMU_FLOAT64) != 0) != (pass == 0) ||
+                fmu_model_check(m, vr, kind, value, err) == 0)
+                continue;
+            if (pass == 0)
+                return -1;
+            return fail(err, "state: %s = %lld is invalid", name_of(vr), (long long)value);
         }
     return 0;
 }

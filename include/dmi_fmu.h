@@ -149,7 +149,9 @@ typedef void (*dmi_fmu_outputs_fn)(const dmi_fmu_values *v, const dmi_fmu_point 
 
 /* Optional: accepts the value of parameter or input vr (before it is
  * stored; v holds the values before the call): 0, or nonzero with the reason
- * in err (the set call is refused, nothing changes).  The framework already
+ * in err (the set call is refused, nothing changes).  When an FMU state is
+ * restored, v holds all of the state's values (vr's too) and each is checked
+ * against them; one refused value refuses the state.  The framework already
  * refuses non-finite values, tau <= 0 and N < 1. */
 typedef int (*dmi_fmu_accept_fn)(const dmi_fmu_values *v, unsigned vr, double value, char *err);
 
