@@ -149,7 +149,8 @@ def test_worker_killed_mid_sweep(cluster, tmp_path, fmu_path, processes):
     assert [e["worker_lost"] for e in lost] == [address]
     again = lost[0]["chunks_again"]
     assert again, "the killed worker was running no chunk"
-    assert f"{len(again)} chunks (first points {', '.join(str(c[0]) for c in again)}) run again" in lines[0]
+    assert lines[0].endswith(f"{len(again)} chunks (first points {', '.join(str(c[0]) for c in again)}) "
+                             "run again on the other workers"), lines[0]
     i = entries.index(lost[0])
     rerun = {p for e in entries[i:] if "points" in e and e["workers"] == [survivor] for p in e["points"]}
     assert {p for c in again for p in c} <= rerun
@@ -267,6 +268,7 @@ def test_every_worker_lost(processes, tmp_path_factory, tmp_path, fmu_path):
             "(once the cluster has workers again)." in stderr), stderr
     messages = [x for x in stderr.splitlines() if not x.startswith("[")]
     assert len(messages) == 3 and messages[0].startswith(f"dmi-sweep: lost worker {address}; "), stderr
+    assert messages[0].endswith(" wait for a worker (none is left)"), stderr
     entries = log_entries(out)
     assert [e["worker_lost"] for e in entries if "worker_lost" in e] == [address]
     lost = [e for e in entries if "lost" in e]
