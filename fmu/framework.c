@@ -81,7 +81,9 @@ int fmu_model_new(fmu_model *m)
     m->v = malloc(sizeof *m->v + (2 * nvr + 5 * n) * sizeof(double) + nvr);
     if (!m->v)
         return -1;
-    m->out = m->v->value + nvr;
+    m->value = (double *)(m->v + 1); /* (sizeof *m->v is a multiple of a double's alignment) */
+    m->v->value = m->value;
+    m->out = m->value + nvr;
     m->work = m->out + nvr;
     m->kind = (unsigned char *)(m->work + 5 * n);
     m->nvr = nvr;
@@ -102,7 +104,7 @@ void fmu_model_defaults(fmu_model *m)
     dmi_free(&m->solver);
     m->v->t_start = 0.0;
     for (unsigned vr = 0; vr < m->nvr; vr++)
-        m->v->value[vr] = fmu_is_set(m->kind[vr]) ? MODEL->variables[vr].start : 0.0;
+        m->value[vr] = fmu_is_set(m->kind[vr]) ? MODEL->variables[vr].start : 0.0;
     m->t_comm = 0.0;
     m->out_valid = 0;
 }
@@ -139,7 +141,7 @@ int fmu_model_check(const fmu_model *m, unsigned vr, unsigned type, double value
 
 void fmu_model_store(fmu_model *m, unsigned vr, double value)
 {
-    m->v->value[vr] = value;
+    m->value[vr] = value;
     m->out_valid = 0;
 }
 

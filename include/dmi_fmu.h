@@ -95,8 +95,10 @@ struct dmi_fmu_variable {
 /*
  * The values of an instance's variables that are set (parameters, inputs),
  * owned by the framework.  value[vr] holds variable vr, by value reference
- * (Int32 and Boolean as exact doubles; outputs: unspecified); t_start is the
- * experiment's start time (the solver's time t is the FMU's t_start + t).
+ * (Int32 and Boolean as exact doubles; outputs: unspecified); value points
+ * into the framework's memory (a pointer, not an array member, so that the
+ * header is valid C++ too); t_start is the experiment's start time (the
+ * solver's time t is the FMU's t_start + t).
  * A model's functions get a const pointer that stays valid, with the same
  * address, as long as the solver they configure (so the solver's callbacks
  * may keep it as their user data and read the inputs at each step); they
@@ -105,7 +107,7 @@ struct dmi_fmu_variable {
 typedef struct dmi_fmu_values dmi_fmu_values;
 struct dmi_fmu_values {
     double t_start;
-    double value[];
+    const double *value;
 };
 
 /*
