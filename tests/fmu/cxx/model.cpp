@@ -32,5 +32,5 @@ static void outputs(const dmi_fmu_values *m, const dmi_fmu_point *pt, double *ou
     out[VR_w] = pt->u ? pt->u[0] : 1.0;
 }
 
-extern "C" const dmi_fmu_model DMI_FMU_MODEL = {"u' + k u = 0", TABLE, NVARS, 1, VR_tau, VR_N,
-                                                1.0, 0.1, configure, outputs, NULL, NULL, NULL, NULL};
+const dmi_fmu_model DMI_FMU_MODEL = {"u' + k u = 0", TABLE, NVARS, 1, VR_tau, VR_N,
+                                     1.0, 0.1, configure, outputs, NULL, NULL, NULL, NULL};
