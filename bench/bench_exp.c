@@ -133,7 +133,7 @@ int main(int argc, char **argv)
             return 1;
         }
         qsort(pair, npair, sizeof *pair, by_value);
-        const double paired = pair[npair / 2];
+        const double paired = npair ? pair[npair / 2] : NAN;
         rec[k] = ns[REC];
         worst_over = fmax(worst_over, ns[REC] / ns[NODELAY]);
         worst_paired = fmax(worst_paired, paired);

@@ -116,7 +116,8 @@ void fmu_model_free(fmu_model *m)
     m->v = NULL;
 }
 
-int fmu_model_check(const fmu_model *m, unsigned vr, unsigned type, double value, char *err)
+/* The framework's own checks of a value for vr (before the model's). */
+static int framework_check(const fmu_model *m, unsigned vr, unsigned type, double value, char *err)
 {
     const unsigned kind = fmu_model_kind(m, vr);
     if (!(kind & type) || !fmu_is_set(kind))
@@ -130,13 +131,24 @@ int fmu_model_check(const fmu_model *m, unsigned vr, unsigned type, double value
         return fail(err, "%s = %.17g: the delay must be > 0", name, value);
     if (vr == MODEL->N && !(value >= 1))
         return fail(err, "%s = %.0f: the number of steps per tau must be >= 1", name, value);
+    return 0;
+}
+
+/* The model's accept of a value for vr (after the framework's checks). */
+static int model_accept(const fmu_model *m, unsigned vr, double value, char *err)
+{
     err[0] = '\0';
     if (MODEL->accept && MODEL->accept(m->v, vr, value, err) != 0) {
         if (!err[0])
-            return fail(err, "%s = %.17g: refused by the model", name, value);
+            return fail(err, "%s = %.17g: refused by the model", name_of(vr), value);
         return -1;
     }
     return 0;
+}
+
+int fmu_model_check(const fmu_model *m, unsigned vr, unsigned type, double value, char *err)
+{
+    return framework_check(m, vr, type, value, err) != 0 ? -1 : model_accept(m, vr, value, err);
 }
 
 void fmu_model_store(fmu_model *m, unsigned vr, double value)
@@ -430,39 +442,34 @@ void fmu_model_state_save(const fmu_model *m, uint32_t tag, unsigned char *buf)
 /* The values of the state bytes into m (checked as if set); 0 or -1 (err). */
 static int load_values(fmu_model *m, const unsigned char *buf, char *err)
 {
-    /* every value first, then each checked against all of them: a model's
-     * accept may compare two variables, and the state's values were
-     * accepted together, not beside the start values */
-    size_t at_i = FMU_STATE_AT_INT, at_r = at_real();
-    for (int pass = 0; pass < 2; pass++) /* the Float64 values first, then the others */
-        for (unsigned vr = 0; vr < MODEL->nvariables; vr++) {
-            const unsigned kind = m->kind[vr];
-            if (!fmu_is_set(kind) || ((kind & FMU_FLOAT64) != 0) != (pass == 0))
-                continue;
-            double value;
-            if (pass == 0) {
-                value = dmi_get_double(buf, at_r);
-                at_r += 8;
-            } else {
-                const int64_t x = (int64_t)dmi_get_u64(buf, at_i);
-                at_i += 8;
-                if (x < INT32_MIN || x > INT32_MAX)
-                    return fail(err, "state: %s = %lld is invalid", name_of(vr), (long long)x);
-                value = (double)x;
+    /* Three rounds over the values: the framework's checks of each, then all
+     * stored, then the model's accept of each, so that an accept that
+     * compares two variables sees the state's values (all of them checked
+     * already), not the start values beside them. */
+    for (int round = 0; round < 3; round++) {
+        size_t at_i = FMU_STATE_AT_INT, at_r = at_real();
+        for (int pass = 0; pass < 2; pass++) /* the Float64 values first, then the others */
+            for (unsigned vr = 0; vr < MODEL->nvariables; vr++) {
+                const unsigned kind = m->kind[vr];
+                if (!fmu_is_set(kind) || ((kind & FMU_FLOAT64) != 0) != (pass == 0))
+                    continue;
+                const int64_t x = pass == 0 ? 0 : (int64_t)dmi_get_u64(buf, at_i);
+                const double value = pass == 0 ? dmi_get_double(buf, at_r) : (double)x;
+                *(pass == 0 ? &at_r : &at_i) += 8;
+                int bad = 0;
+                if (round == 0)
+                    bad = (pass == 1 && (x < INT32_MIN || x > INT32_MAX)) ||
+                          framework_check(m, vr, kind, value, err) != 0;
+                else if (round == 1)
+                    fmu_model_store(m, vr, value);
+                else
+                    bad = model_accept(m, vr, value, err) != 0;
+                if (bad)
+                    return pass == 0 ? -1
+                                     : fail(err, "state: %s = %lld is invalid", name_of(vr),
+                                            (long long)x);
             }
-            fmu_model_store(m, vr, value);
-        }
-    for (int pass = 0; pass < 2; pass++) /* in the same order */
-        for (unsigned vr = 0; vr < MODEL->nvariables; vr++) {
-            const unsigned kind = m->kind[vr];
-            const double value = m->v->value[vr];
-            if (!fmu_is_set(kind) || ((kind & FMU_FLOAT64) != 0) != (pass == 0) ||
-                fmu_model_check(m, vr, kind, value, err) == 0)
-                continue;
-            if (pass == 0)
-                return -1;
-            return fail(err, "state: %s = %lld is invalid", name_of(vr), (long long)value);
-        }
+    }
     return 0;
 }
 

@@ -199,9 +199,7 @@ DMI_API int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user);
  *           sum S = sum_{l<N} r^l U_j^{p-l}, r = exp((a + i b) h), follows
  *           S <- r S + U_j^{p+1} - r^N U_j^{p+1-N}: O(K n^2) work per step
  *           and O(K n) memory besides the samples, whatever N is.  r and r^N
- *           are computed in double-double (a step multiplies by r rounded to
- *           double, every 1024th step by a multiplier that puts back the
- *           rounding of the 1023 before), and every 4 N steps (at the steps
+ *           are computed in double-double, and every 4 N steps (at the steps
  *           p that are multiples of 4 N) the sums are recomputed from the
  *           stored states with compensated sums, so rounding never piles up
  *           for longer; the result stays within about 1e-11 of

@@ -5,20 +5,14 @@
  * Accuracy.  A sum S = sum_{l<N} r^l U^{p-l} run by the recursion
  * S <- r S + U_new - r^N U_old weighs the state that entered l steps ago by
  * the product of the l multipliers used since.  With r rounded to double
- * (r~, relative error d up to 1.1e-16) that weight is off by l d, 1e-10 at
+ * (relative error up to 1.1e-16) that weight is off by l * 1.1e-16, 1e-10 at
  * l = 10^6, and the state leaves with a residue that never decays when
- * |r| = 1.  So r is computed in double-double (r = r~ + r_lo, about 1e-32)
- * from (a + i b) h, itself the exact double-double product, and every
- * KSTEP-th step (the steps p that are multiples of KSTEP) multiplies by
- * r^ = r~ + KSTEP r_lo (rounded once) instead of r~: then KSTEP consecutive
- * multipliers make r^KSTEP within one rounding (r~^(KSTEP-1) r^ =
- * r^KSTEP (1 + O(KSTEP^2 d^2))), so a weight is off by at most about
- * (KSTEP + l / KSTEP) d, 2e-13 at l = 10^6 with KSTEP = 1024, for one
- * multiplication per step; r^N is the double-double power of r, so the
- * removal matches the weight the state carries to that much.  What remains
- * is the rounding of each step's arithmetic (about 1e-16 of |S| per step,
- * in random directions, and the removal's mismatch); it decays with
- * |r| < 1 but not with |r| = 1, so every
+ * |r| = 1.  So r is computed in double-double (hi + lo, about 1e-32) from
+ * (a + i b) h, itself the exact double-double product, and each step
+ * multiplies by both parts; r^N is the double-double power of that r, so
+ * the removal matches the weight the state carries.  What remains is the
+ * rounding of each step's arithmetic (about 1e-16 of |S| per step, in
+ * random directions); it decays with |r| < 1 but not with |r| = 1, so every
  * PERIOD N steps (at the steps p that are multiples of it) the sums are
  * anchored afresh from the stored states U^{p-N..p}: weights r^l accurate to
  * a few units of rounding (a double-double power every BLOCK lags times a
@@ -40,7 +34,6 @@
 
 #define BLOCK 64  /* lags per double-double weight in an anchor */
 #define PERIOD 4  /* anchoring period in units of N */
-#define KSTEP 1024 /* every KSTEP-th step multiplies by r^ (see Accuracy) */
 
 /* ---- double-double arithmetic (setup and anchors only) -------------------- */
 
@@ -362,11 +355,10 @@ typedef struct {
  * internal index k below nreal, nreal2 + k - nreal above, of cap in all.
  * The step's data are kept pair by pair, each pair's in one block of PAIR
  * doubles (field F of sum q at pair[PAIR (q / 2) + F + q % 2]):
- *     re' = (x hr - y hi) + (unew - rNr uold)
- *     im' = (x hi + y hr) + (0 - rNi uold)
- * with S = x + i y, hr + i hi = r~ (fields F_HR, F_HI) or, every KSTEP-th
- * step, r^ (F_HRK, F_HIK), and r^N = rNr + i rNi; a real sum has
- * y = hi = rNi = 0 and only the first line.  slot[q] is
+ *     re' = x hr - y hi + ((x lr - y li) + (unew - rNr uold))
+ *     im' = x hi + y hr + ((x li + y lr) + (0 - rNi uold))
+ * with S = x + i y, r = (hr + i hi) + (lr + i li), r^N = rNr + i rNi; a
+ * real sum has y = hi = li = rNi = 0 and only the first line.  slot[q] is
  * the place of sum q in the saved order (term by term, used columns
  * ascending).
  * The parts C, D of row i are parts [row_start[i], row_start[i + 1]), in the
@@ -397,7 +389,7 @@ struct dmi_exp {
 };
 
 /* The fields of a pair's block (two doubles each). */
-enum { F_SRE = 0, F_SIM = 2, F_HR = 4, F_HI = 6, F_HRK = 8, F_HIK = 10, F_RNR = 12, F_RNI = 14,
+enum { F_SRE = 0, F_SIM = 2, F_HR = 4, F_HI = 6, F_LR = 8, F_LI = 10, F_RNR = 12, F_RNI = 14,
        PAIR = 16 };
 
 /* Field f of the sum at internal index q. */
@@ -515,8 +507,8 @@ int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
                     const term *tm = &e->terms[t];
                     *field(e, q, F_HR) = tm->rh_re;
                     *field(e, q, F_HI) = tm->rh_im;
-                    *field(e, q, F_HRK) = tm->rh_re + KSTEP * tm->rl_re;
-                    *field(e, q, F_HIK) = tm->rh_im + KSTEP * tm->rl_im;
+                    *field(e, q, F_LR) = tm->rl_re;
+                    *field(e, q, F_LI) = tm->rl_im;
                     *field(e, q, F_RNR) = tm->rN_re;
                     *field(e, q, F_RNI) = tm->rN_im;
                     e->term_of[q] = t;
@@ -694,38 +686,42 @@ void dmi_exp_advance(dmi_exp *e, const dmi_history *r, uint64_t p)
      * made, in update_W's order (its lanes c, C parts and D parts apart) */
     const double *Cr = e->nrows == 1 ? e->Cm : NULL, *Dr = Cr ? e->Dm : NULL;
     double w[2] = {0, 0}, d[2] = {0, 0};
-    const size_t mo = p % KSTEP == 0 ? F_HRK : F_HR; /* the step's multiplier: r~ or r^ */
-    double *restrict v = e->pair;
-    for (size_t q = 0; q < nr; q += 2, v += PAIR) { /* two sums at a time: vector operations */
-        double a[2];
-        for (int c = 0; c < 2; c++) {
-            const double unew = buf[off[q + c]], uold = buf[off[q + c] + N], x = v[F_SRE + c];
-            a[c] = x * v[mo + c] + (unew - v[F_RNR + c] * uold);
-        }
-        for (int c = 0; c < 2; c++)
-            v[F_SRE + c] = a[c];
-        if (Cr) /* (a real sum's D part adds nothing: see update_W) */
+    { /* (v, restrict, is the only access to the pairs in this block) */
+        double *restrict v = e->pair;
+        /* two sums at a time: vector operations */
+        for (size_t q = 0; q < nr; q += 2, v += PAIR) {
+            double a[2];
+            for (int c = 0; c < 2; c++) {
+                const double unew = buf[off[q + c]], uold = buf[off[q + c] + N], x = v[F_SRE + c];
+                a[c] = x * v[F_HR + c] + (x * v[F_LR + c] + (unew - v[F_RNR + c] * uold));
+            }
             for (int c = 0; c < 2; c++)
-                w[c] += Cr[q + c] * a[c];
-    }
-    for (size_t q = nr; q < ns; q += 2, v += PAIR) {
-        double a[2], b[2];
-        for (int c = 0; c < 2; c++) {
-            const double unew = buf[off[q + c]], uold = buf[off[q + c] + N], x = v[F_SRE + c],
-                         y = v[F_SIM + c], hr = v[mo + c], hi = v[mo + 2 + c];
-            a[c] = (x * hr - y * hi) + (unew - v[F_RNR + c] * uold);
-            b[c] = (x * hi + y * hr) + (0.0 - v[F_RNI + c] * uold);
+                v[F_SRE + c] = a[c];
+            if (Cr) /* (a real sum's D part adds nothing: see update_W) */
+                for (int c = 0; c < 2; c++)
+                    w[c] += Cr[q + c] * a[c];
         }
-        for (int c = 0; c < 2; c++) {
-            v[F_SRE + c] = a[c];
-            v[F_SIM + c] = b[c];
+        for (size_t q = nr; q < ns; q += 2, v += PAIR) {
+            double a[2], b[2];
+            for (int c = 0; c < 2; c++) {
+                const double unew = buf[off[q + c]], uold = buf[off[q + c] + N], x = v[F_SRE + c],
+                             y = v[F_SIM + c];
+                a[c] = (x * v[F_HR + c] - y * v[F_HI + c]) +
+                       ((x * v[F_LR + c] - y * v[F_LI + c]) + (unew - v[F_RNR + c] * uold));
+                b[c] = (x * v[F_HI + c] + y * v[F_HR + c]) +
+                       ((x * v[F_LI + c] + y * v[F_LR + c]) + (0.0 - v[F_RNI + c] * uold));
+            }
+            for (int c = 0; c < 2; c++) {
+                v[F_SRE + c] = a[c];
+                v[F_SIM + c] = b[c];
+            }
+            if (Cr)
+                for (int c = 0; c < 2; c++)
+                    w[c] += Cr[q + c] * a[c];
+            if (Dr)
+                for (int c = 0; c < 2; c++)
+                    d[c] += Dr[q + c] * b[c];
         }
-        if (Cr)
-            for (int c = 0; c < 2; c++)
-                w[c] += Cr[q + c] * a[c];
-        if (Dr)
-            for (int c = 0; c < 2; c++)
-                d[c] += Dr[q + c] * b[c];
     }
     if (!Cr) {
         update_W(e);

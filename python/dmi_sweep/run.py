@@ -481,12 +481,12 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
                            "chunks_again": ev["again"]})
                 if not ev.get("expected"):
                     firsts = ", ".join(str(c[0]) for c in ev["again"])
-                    try:
+                    try:       # (asked now, when the line is written, not when the worker left)
                         others = bool(client.nthreads())
                     except Exception:   # (the connection to the scheduler: the futures report it)
                         others = True
                     where_again = ("run again on the other workers" if others
-                                   else "wait for a worker (none is left)")
+                                   else "wait for a worker (none is left now)")
                     bar.note(messages, f"dmi-sweep: lost worker {ev.get('worker')}; "
                              + (f"{len(ev['again'])} chunks (first points {firsts}) {where_again}"
                                 if ev["again"] else "no chunk of this sweep was on it"))

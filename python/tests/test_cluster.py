@@ -268,7 +268,7 @@ def test_every_worker_lost(processes, tmp_path_factory, tmp_path, fmu_path):
             "(once the cluster has workers again)." in stderr), stderr
     messages = [x for x in stderr.splitlines() if not x.startswith("[")]
     assert len(messages) == 3 and messages[0].startswith(f"dmi-sweep: lost worker {address}; "), stderr
-    assert messages[0].endswith(" wait for a worker (none is left)"), stderr
+    assert messages[0].endswith(" wait for a worker (none is left now)"), stderr
     entries = log_entries(out)
     assert [e["worker_lost"] for e in entries if "worker_lost" in e] == [address]
     lost = [e for e in entries if "lost" in e]

@@ -284,11 +284,6 @@ static double bound_scale(const dmi_solver *s, size_t N)
     return h * hsum * umax;
 }
 
-/* The method changed between steps (RECURSIVE, DIRECT, FFT, AUTO, back to
- * RECURSIVE) against RECURSIVE all along: the delay term W of the step
- * right after each switch agrees to 1e-13 of the bound's scale (a switch
- * to the recursion whose sums were not computed afresh gives a W off by the
- * whole sum), and the states after 500 more steps agree to rounding. */
 /* The one-row kernel O*: W summed in the recursion's step, and by the
  * function that sums it after an anchor or a load.  At every step p from
  * 150 to 450 (across the anchors at 200 and 400), a's state is loaded into
@@ -332,6 +327,11 @@ static void test_one_row(void)
     dmi_free(&d);
 }
 
+/* The method changed between steps (RECURSIVE, DIRECT, FFT, AUTO, back to
+ * RECURSIVE) against RECURSIVE all along: the delay term W of the step
+ * right after each switch agrees to 1e-13 of the bound's scale (a switch
+ * to the recursion whose sums were not computed afresh gives a W off by the
+ * whole sum), and the states after 500 more steps agree to rounding. */
 static void test_switch(void)
 {
     core_model m1 = {0}, m2 = {0};
