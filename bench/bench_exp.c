@@ -29,11 +29,8 @@
 #include <string.h>
 
 #include "cli.h"
+#include "layout.h"
 #include "run.h"
-
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
 
 #define CHUNK 10000
 
@@ -83,13 +80,7 @@ int main(int argc, char **argv)
         "exit status: 0, 1 if a solver fails, 2 for a bad argument.",
         args, 2};
     cli_parse(&prog, argc, argv);
-#ifdef __GLIBC__
-    /* Every N allocates as a fresh process does: glibc raises its mmap
-     * threshold when a block it mapped is freed (the rings of N = 10^4), and
-     * the later N then place their arrays otherwise, which moved the model
-     * without delay by 25 % (docs/benchmarks-scale.md, section 1b). */
-    mallopt(M_MMAP_THRESHOLD, 128 * 1024);
-#endif
+    fresh_allocator(); /* every N allocates as a fresh process does */
 
     static const char *names[KINDS] = {"exp (rec)", "no delay", "callback (FFT)", "DIRECT"};
     printf("Example 4.3, tau = 1, h = 1/N, %zu steps per method (DIRECT: at most 1e9/N), "

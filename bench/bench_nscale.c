@@ -34,6 +34,7 @@
 
 #include "cli.h"
 #include "dmi.h"
+#include "layout.h"
 
 enum { NODELAY, AUTO, DIRECT, FFT, REC, PLAIN, KINDS };
 enum { DIAG, TRI, DENSE, SHAPES };
@@ -271,6 +272,7 @@ int main(int argc, char **argv)
         "exit status: 0, 1 if a solver fails, 2 for a bad argument.",
         args, 4};
     cli_parse(&prog, argc, argv);
+    fresh_allocator(); /* every configuration allocates as a fresh process does */
 
     static const size_t ms_list[5] = {1, 4, 16, 64, 128}, Ns[2] = {1000, 10000};
     char table[128][320];
