@@ -74,6 +74,14 @@ static const char *type_name(unsigned type)
 
 /* ---- values ---- */
 
+/* The values, writable: the block right after *m->v, which v->value (read
+ * only for the model) points to (sizeof *m->v is a multiple of a double's
+ * alignment). */
+static double *values_of(const fmu_model *m)
+{
+    return (double *)(m->v + 1);
+}
+
 int fmu_model_new(fmu_model *m)
 {
     const unsigned nvr = count_vr();
@@ -81,9 +89,8 @@ int fmu_model_new(fmu_model *m)
     m->v = malloc(sizeof *m->v + (2 * nvr + 5 * n) * sizeof(double) + nvr);
     if (!m->v)
         return -1;
-    m->value = (double *)(m->v + 1); /* (sizeof *m->v is a multiple of a double's alignment) */
-    m->v->value = m->value;
-    m->out = m->value + nvr;
+    m->v->value = values_of(m);
+    m->out = values_of(m) + nvr;
     m->work = m->out + nvr;
     m->kind = (unsigned char *)(m->work + 5 * n);
     m->nvr = nvr;
@@ -104,7 +111,7 @@ void fmu_model_defaults(fmu_model *m)
     dmi_free(&m->solver);
     m->v->t_start = 0.0;
     for (unsigned vr = 0; vr < m->nvr; vr++)
-        m->value[vr] = fmu_is_set(m->kind[vr]) ? MODEL->variables[vr].start : 0.0;
+        values_of(m)[vr] = fmu_is_set(m->kind[vr]) ? MODEL->variables[vr].start : 0.0;
     m->t_comm = 0.0;
     m->out_valid = 0;
 }
@@ -117,7 +124,8 @@ void fmu_model_free(fmu_model *m)
 }
 
 /* The framework's own checks of a value for vr (before the model's). */
-static int framework_check(const fmu_model *m, unsigned vr, unsigned type, double value, char *err)
+static int framework_check(const fmu_model *m, unsigned vr, unsigned type, double value,
+                           char *err)
 {
     const unsigned kind = fmu_model_kind(m, vr);
     if (!(kind & type) || !fmu_is_set(kind))
@@ -153,7 +161,7 @@ int fmu_model_check(const fmu_model *m, unsigned vr, unsigned type, double value
 
 void fmu_model_store(fmu_model *m, unsigned vr, double value)
 {
-    m->value[vr] = value;
+    values_of(m)[vr] = value;
     m->out_valid = 0;
 }
 
@@ -442,11 +450,11 @@ void fmu_model_state_save(const fmu_model *m, uint32_t tag, unsigned char *buf)
 /* The values of the state bytes into m (checked as if set); 0 or -1 (err). */
 static int load_values(fmu_model *m, const unsigned char *buf, char *err)
 {
-    /* Three rounds over the values: the framework's checks of each, then all
-     * stored, then the model's accept of each, so that an accept that
-     * compares two variables sees the state's values (all of them checked
-     * already), not the start values beside them. */
-    for (int round = 0; round < 3; round++) {
+    /* Two rounds: each value read, checked by the framework and stored; then
+     * each accepted by the model, so that an accept that compares two
+     * variables sees the state's values (all of them checked already), not
+     * the start values beside them.  (m is a fresh model: a refusal frees it.) */
+    for (int round = 0; round < 2; round++) {
         size_t at_i = FMU_STATE_AT_INT, at_r = at_real();
         for (int pass = 0; pass < 2; pass++) /* the Float64 values first, then the others */
             for (unsigned vr = 0; vr < MODEL->nvariables; vr++) {
@@ -456,14 +464,15 @@ static int load_values(fmu_model *m, const unsigned char *buf, char *err)
                 const int64_t x = pass == 0 ? 0 : (int64_t)dmi_get_u64(buf, at_i);
                 const double value = pass == 0 ? dmi_get_double(buf, at_r) : (double)x;
                 *(pass == 0 ? &at_r : &at_i) += 8;
-                int bad = 0;
-                if (round == 0)
+                int bad;
+                if (round == 0) {
                     bad = (pass == 1 && (x < INT32_MIN || x > INT32_MAX)) ||
                           framework_check(m, vr, kind, value, err) != 0;
-                else if (round == 1)
-                    fmu_model_store(m, vr, value);
-                else
+                    if (!bad)
+                        fmu_model_store(m, vr, value);
+                } else {
                     bad = model_accept(m, vr, value, err) != 0;
+                }
                 if (bad)
                     return pass == 0 ? -1
                                      : fail(err, "state: %s = %lld is invalid", name_of(vr),

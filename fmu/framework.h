@@ -52,7 +52,6 @@ int fmu_is_set(unsigned kind);
 
 typedef struct {
     dmi_fmu_values *v;  /* the values (heap, fixed address: the solver's callbacks keep it) */
-    double *value;      /* v->value, writable (with v's block) */
     double t_comm;      /* the last communication point (t_start before any step) */
     dmi_solver *solver; /* NULL until fmu_model_start */
     double *out;        /* the outputs by value reference (with v's block) */

@@ -374,7 +374,7 @@ struct dmi_exp {
     uint64_t next; /* the next anchoring step: the multiple of period after the last anchor */
     term *terms;
     size_t *term_of, *col, *slot; /* per internal index */
-    size_t *series;               /* per internal index: offset of its column's series in the ring */
+    size_t *series;               /* per internal index: its column's series in the ring */
     double *pair;                 /* cap / 2 blocks: the sums and their multipliers */
     size_t *row_start;            /* n + 1 */
     size_t *psum;                 /* per part: its sum's place in pair (F_SRE's) */
@@ -565,6 +565,20 @@ int dmi_exp_create(dmi_exp **out, const dmi_expk *k, size_t N, double h)
     return 0;
 }
 
+/* Adds the parts of the pair of sums at internal indices q, q + 1 (their
+ * block pr) to a row of the matrix form: lanes w of C Re S, d of D Im S (Dr
+ * NULL: no D).  update_W and dmi_exp_advance both sum a row through it, so
+ * the two give the same bits by construction. */
+static inline void add_pair(const double *Cr, const double *Dr, size_t q, const double *pr,
+                            double w[2], double d[2])
+{
+    for (int c = 0; c < 2; c++)
+        w[c] += Cr[q + c] * pr[F_SRE + c];
+    if (Dr)
+        for (int c = 0; c < 2; c++)
+            d[c] += Dr[q + c] * pr[F_SIM + c];
+}
+
 /* A row of W in the matrix form from its partial sums: lanes w of the C
  * parts, d of the D parts (NULL: none). */
 static double row_total(const double w[2], const double d[2], double h)
@@ -574,30 +588,22 @@ static double row_total(const double w[2], const double d[2], double h)
 
 /* W = h sum of the parts, row by row (each row in locals, written once).
  * Two partial sums in a fixed order (even and odd internal indices in the
- * matrix form, each with its C and D parts apart), so a long row (a dense
- * block) is not one chain of dependent additions; without D (no sine part
- * in any term) the imaginary parts are not read.  A pad's entries are 0 and
- * its sums finite, so it adds +-0, which leaves any sum that starts at +0
- * unchanged; so does a real sum's D part (its imaginary part is 0).  With
- * one row, dmi_exp_advance sums it in the same order as the sums are made. */
+ * matrix form, each with its C and D parts apart: add_pair), so a long row
+ * (a dense block) is not one chain of dependent additions; without D (no
+ * sine part in any term) the imaginary parts are not read.  A pad's entries
+ * are 0 and its sums finite, so it adds +-0, which leaves any sum that
+ * starts at +0 unchanged. */
 static void update_W(dmi_exp *e)
 {
     const double *S = e->pair, *C = e->pC, *D = e->pD;
     const size_t *ps = e->psum, ns = e->cap;
     if (e->Cm) { /* the matrix form: no indices (the other rows stay 0) */
         for (size_t r = 0; r < e->nrows; r++) {
-            const double *restrict Cr = e->Cm + r * ns;
+            const double *Cr = e->Cm + r * ns, *Dr = e->Dm ? e->Dm + r * ns : NULL;
             double w[2] = {0, 0}, d[2] = {0, 0};
             for (size_t q = 0; q < ns; q += 2)
-                for (int c = 0; c < 2; c++)
-                    w[c] += Cr[q + c] * S[PAIR * (q / 2) + F_SRE + c];
-            if (e->Dm) {
-                const double *restrict Dr = e->Dm + r * ns;
-                for (size_t q = 0; q < ns; q += 2)
-                    for (int c = 0; c < 2; c++)
-                        d[c] += Dr[q + c] * S[PAIR * (q / 2) + F_SIM + c];
-            }
-            e->W[e->rows[r]] = row_total(w, e->Dm ? d : NULL, e->h);
+                add_pair(Cr, Dr, q, S + PAIR * (q / 2), w, d);
+            e->W[e->rows[r]] = row_total(w, Dr ? d : NULL, e->h);
         }
         return;
     }
@@ -683,7 +689,7 @@ void dmi_exp_advance(dmi_exp *e, const dmi_history *r, uint64_t p)
     const double *buf = r->buf + r->head;
     const size_t N = e->N, nr = e->nreal2, ns = e->cap, *off = e->series;
     /* W's one row of the matrix form, if so, is summed here as the sums are
-     * made, in update_W's order (its lanes c, C parts and D parts apart) */
+     * made, by update_W's add_pair */
     const double *Cr = e->nrows == 1 ? e->Cm : NULL, *Dr = Cr ? e->Dm : NULL;
     double w[2] = {0, 0}, d[2] = {0, 0};
     { /* (v, restrict, is the only access to the pairs in this block) */
@@ -697,9 +703,8 @@ void dmi_exp_advance(dmi_exp *e, const dmi_history *r, uint64_t p)
             }
             for (int c = 0; c < 2; c++)
                 v[F_SRE + c] = a[c];
-            if (Cr) /* (a real sum's D part adds nothing: see update_W) */
-                for (int c = 0; c < 2; c++)
-                    w[c] += Cr[q + c] * a[c];
+            if (Cr)
+                add_pair(Cr, Dr, q, v, w, d);
         }
         for (size_t q = nr; q < ns; q += 2, v += PAIR) {
             double a[2], b[2];
@@ -716,11 +721,7 @@ void dmi_exp_advance(dmi_exp *e, const dmi_history *r, uint64_t p)
                 v[F_SIM + c] = b[c];
             }
             if (Cr)
-                for (int c = 0; c < 2; c++)
-                    w[c] += Cr[q + c] * a[c];
-            if (Dr)
-                for (int c = 0; c < 2; c++)
-                    d[c] += Dr[q + c] * b[c];
+                add_pair(Cr, Dr, q, v, w, d);
         }
     }
     if (!Cr) {

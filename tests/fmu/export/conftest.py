@@ -52,6 +52,24 @@ def build(src, build_dir, prefix, check=True):
     return r.returncode, out
 
 
+def write_project(src, name, source, file=None):
+    """The CMake project of one model in src (made if missing): dmi_add_fmu(name SOURCES file)
+    from an installed dmi, file (default: name in lower case, .c) holding source. Returns src."""
+    file = file or f"{name.lower()}.c"
+    src.mkdir(parents=True, exist_ok=True)
+    (src / "CMakeLists.txt").write_text(f"cmake_minimum_required(VERSION 3.25)\n"
+                                        f"project({name.lower()} LANGUAGES C)\n"
+                                        f"find_package(dmi REQUIRED)\n"
+                                        f"dmi_add_fmu({name} SOURCES {file})\n")
+    (src / file).write_text(source)
+    return src
+
+
+def fmus(build_dir, name):
+    """The FMI 2.0 and 3.0 FMUs dmi_add_fmu(name) built in build_dir, by version ("2", "3")."""
+    return {"2": str(build_dir / f"{name}.fmu"), "3": str(build_dir / "fmi3" / f"{name}.fmu")}
+
+
 class Instance:
     """An FMU2Slave or FMU3Slave of the FMU at path with the calls the tests
     use under one name; self.log holds (status, category, message) (FMI 2.0:

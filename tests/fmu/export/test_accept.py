@@ -10,13 +10,7 @@
 import pytest
 from fmpy.fmi1 import FMICallException
 
-from conftest import Instance, build
-
-CMAKE = """cmake_minimum_required(VERSION 3.25)
-project(pair LANGUAGES C)
-find_package(dmi REQUIRED)
-dmi_add_fmu(Pair SOURCES pair.c)
-"""
+from conftest import Instance, build, fmus, write_project
 
 MODEL = r"""#include <stdio.h>
 #include "dmi_fmu.h"
@@ -65,11 +59,9 @@ const dmi_fmu_model DMI_FMU_MODEL = {"u' + u = 0", TABLE, NVARS, 1, VR_tau, VR_N
 
 @pytest.fixture(scope="module")
 def pair(prefix, tmp_path_factory):
-    src = tmp_path_factory.mktemp("pair")
-    (src / "CMakeLists.txt").write_text(CMAKE)
-    (src / "pair.c").write_text(MODEL)
+    src = write_project(tmp_path_factory.mktemp("pair"), "Pair", MODEL)
     build(src, src / "build", prefix)
-    return {"2": str(src / "build" / "Pair.fmu"), "3": str(src / "build" / "fmi3" / "Pair.fmu")}
+    return fmus(src / "build", "Pair")
 
 
 @pytest.mark.parametrize("version", ["2", "3"])

@@ -10,13 +10,7 @@
 import pytest
 from fmpy.fmi1 import FMICallException
 
-from conftest import Instance, build
-
-CMAKE = """cmake_minimum_required(VERSION 3.25)
-project(bad LANGUAGES C)
-find_package(dmi REQUIRED)
-dmi_add_fmu(Bad SOURCES bad.c)
-"""
+from conftest import Instance, build, fmus, write_project
 
 # w' = -k w + F, no friction, no kernel; ROW is the row under test.
 MODEL = r"""#include <stdio.h>
@@ -73,19 +67,15 @@ const dmi_fmu_model DMI_FMU_MODEL = {"w' + k w = 0", TABLE, DMI_FMU_COUNT(TABLE)
 """
 
 
-def project(tmp_path, row):
-    src = tmp_path / "src"
-    src.mkdir()
-    (src / "CMakeLists.txt").write_text(CMAKE)
-    (src / "bad.c").write_text(MODEL.replace("ROW", row))
-    return src
+def project(tmp_path, row, file=None):
+    return write_project(tmp_path / "src", "Bad", MODEL.replace("ROW", row), file)
 
 
 @pytest.fixture(scope="module")
 def good(prefix, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("good")
     build(project(tmp, ""), tmp / "build", prefix)
-    return tmp / "build"
+    return fmus(tmp / "build", "Bad")
 
 
 @pytest.mark.parametrize("row,message", [
@@ -106,7 +96,7 @@ def test_bad_table_fails_the_build(prefix, tmp_path, row, message):
 
 
 def test_control_model_runs(good):
-    for path in (good / "Bad.fmu", good / "fmi3" / "Bad.fmu"):
+    for path in (good["2"], good["3"]):
         inst = Instance(str(path))
         inst.start()
         inst.fmu.doStep(0.0, 1.0)
@@ -121,7 +111,7 @@ def test_control_model_runs(good):
     (0.0, "configuring the solver: dmi_set_friction"),
 ])
 def test_failing_configure_is_an_error(good, version, k, message):
-    inst = Instance(str(good / ("Bad.fmu" if version == "2" else "fmi3/Bad.fmu")))
+    inst = Instance(good[version])
     inst.set("k", k)
     with pytest.raises(FMICallException):
         inst.start()
@@ -137,16 +127,14 @@ def test_failing_configure_is_an_error(good, version, k, message):
 def test_model_file_named_like_the_framework(prefix, tmp_path):
     """sources/ is one folder: a model file called instance.c is refused at
     configure time, naming the file."""
-    src = project(tmp_path, "")
-    (src / "bad.c").rename(src / "instance.c")
-    (src / "CMakeLists.txt").write_text(CMAKE.replace("SOURCES bad.c", "SOURCES instance.c"))
+    src = project(tmp_path, "", "instance.c")
     rc, out = build(src, tmp_path / "build", prefix, check=False)
     assert rc != 0 and "dmi_add_fmu(Bad): the model's file" in out and "instance.c" in out, out
 
 
 @pytest.mark.parametrize("version", ["2", "3"])
 def test_check_warns_or_refuses(good, version):
-    path = str(good / ("Bad.fmu" if version == "2" else "fmi3/Bad.fmu"))
+    path = good[version]
     inst = Instance(path)
     inst.set("k", 15.0)  # h k = 1.5
     inst.start(stop=4.0)  # Warning: fmpy logs it and goes on

@@ -18,7 +18,7 @@ import pytest
 from fmpy.fmi1 import FMICallException
 from fmpy.validation import validate_fmu
 
-from conftest import Instance, build
+from conftest import Instance, build, fmus
 
 OUT = ["x1", "x2", "x3", "v1", "v2", "v3", "friction1", "friction2", "friction3"]
 NAME = "BurridgeKnopoffChain"
@@ -28,8 +28,7 @@ NAME = "BurridgeKnopoffChain"
 def chain(prefix, source_dir, tmp_path_factory):
     b = tmp_path_factory.mktemp("chain")
     build(os.path.join(source_dir, "examples", "fmu-chain"), b, prefix)
-    return {"2": str(b / f"{NAME}.fmu"), "3": str(b / "fmi3" / f"{NAME}.fmu"),
-            "native": str(b / "chain_native")}
+    return {**fmus(b, NAME), "native": str(b / "chain_native")}
 
 
 def run(inst, stop, dt, t_F=None, F=0.0, stop_time=None):

@@ -11,7 +11,7 @@ import re
 import pytest
 from fmpy.validation import validate_fmu
 
-from conftest import Instance, build
+from conftest import Instance, build, fmus
 
 
 def blocks(source_dir, lang):
@@ -25,8 +25,7 @@ def block_fmus(prefix, source_dir, tmp_path_factory):
     (src / "block.c").write_text(blocks(source_dir, "c")[0])
     (src / "CMakeLists.txt").write_text(blocks(source_dir, "cmake")[0])
     build(src, src / "build", prefix)
-    return {"2": str(src / "build" / "FrictionBlock.fmu"),
-            "3": str(src / "build" / "fmi3" / "FrictionBlock.fmu")}
+    return fmus(src / "build", "FrictionBlock")
 
 
 def test_model_is_short(source_dir):

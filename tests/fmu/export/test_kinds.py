@@ -8,13 +8,7 @@
 import pytest
 from fmpy.fmi1 import FMICallException
 
-from conftest import Instance, build
-
-CMAKE = """cmake_minimum_required(VERSION 3.25)
-project(kinds LANGUAGES C)
-find_package(dmi REQUIRED)
-dmi_add_fmu(Kinds SOURCES kinds.c)
-"""
+from conftest import Instance, build, fmus, write_project
 
 MODEL = r"""#include "dmi_fmu.h"
 #define VARS(X)                                                                  \
@@ -61,11 +55,9 @@ const dmi_fmu_model DMI_FMU_MODEL = {"u' + k u = 0", TABLE, NVARS, 1, VR_tau, VR
 
 @pytest.fixture(scope="module")
 def kinds(prefix, tmp_path_factory):
-    src = tmp_path_factory.mktemp("kinds")
-    (src / "CMakeLists.txt").write_text(CMAKE)
-    (src / "kinds.c").write_text(MODEL)
+    src = write_project(tmp_path_factory.mktemp("kinds"), "Kinds", MODEL)
     build(src, src / "build", prefix)
-    return {"2": str(src / "build" / "Kinds.fmu"), "3": str(src / "build" / "fmi3" / "Kinds.fmu")}
+    return fmus(src / "build", "Kinds")
 
 
 class Typed:
