@@ -29,7 +29,7 @@ module dmi
 
   ! Version of this binding (the same as the C header it mirrors).
   integer(c_int), parameter, public :: DMI_VERSION_MAJOR = 1
-  integer(c_int), parameter, public :: DMI_VERSION_MINOR = 1
+  integer(c_int), parameter, public :: DMI_VERSION_MINOR = 2
   integer(c_int), parameter, public :: DMI_VERSION_PATCH = 0
 
   ! Error codes.
@@ -52,7 +52,7 @@ module dmi
   public :: dmi_set_kernel, dmi_set_kernel_exp, dmi_set_history, dmi_set_convolution
   public :: dmi_init, dmi_step, dmi_advance
   public :: dmi_time, dmi_get_step_index, dmi_get_h, dmi_get_state, dmi_get_past
-  public :: dmi_get_step_terms
+  public :: dmi_get_step_terms, dmi_get_window, dmi_set_window
   public :: dmi_state_size, dmi_state_save, dmi_state_load
   public :: dmi_last_error, dmi_strerror
 
@@ -232,6 +232,21 @@ module dmi
       real(c_double), intent(out) :: u(*)
       integer(c_int) :: rc
     end function dmi_get_past
+
+    ! (since 1.2) u holds (N + 1) * n values: row k (0-based) at u(k * n + 1 : k * n + n).
+    function dmi_get_window(s, u) result(rc) bind(C, name='dmi_get_window')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: s
+      real(c_double), intent(out) :: u(*)
+      integer(c_int) :: rc
+    end function dmi_get_window
+
+    function dmi_set_window(s, u) result(rc) bind(C, name='dmi_set_window')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: s
+      real(c_double), intent(in) :: u(*)
+      integer(c_int) :: rc
+    end function dmi_set_window
 
     function dmi_get_step_terms(s, w, x) result(rc) bind(C, name='dmi_get_step_terms')
       import :: c_int, c_double, c_ptr

@@ -44,7 +44,7 @@ extern "C" {
 
 /* Version of this header; dmi_version() gives the version of the library. */
 #define DMI_VERSION_MAJOR 1
-#define DMI_VERSION_MINOR 1
+#define DMI_VERSION_MINOR 2
 #define DMI_VERSION_PATCH 0
 
 /* DMI_API marks the exported functions of the shared library. */
@@ -283,6 +283,29 @@ DMI_API int dmi_get_state(const dmi_solver *s, double *u);
 /* u[0..n-1] = U^{p-lag}, 0 <= lag <= N (history values z(t) for p - lag <= 0).
  * DMI_EINVAL for NULL or lag > N, DMI_ESTATE before dmi_init. */
 DMI_API int dmi_get_past(const dmi_solver *s, size_t lag, double *u);
+
+/*
+ * (Since 1.2.)  The window of stored states, the solution over the last delay
+ * that the next steps read: U[(k * n) + j] = U_j^{p-N+k}, k = 0..N, oldest
+ * first (row k = 0 is U^{p-N}, row N is U^p); (N + 1) * n doubles, written by
+ * dmi_get_window and read by dmi_set_window.  Together with the step counter
+ * p (t_p, for a rhs that depends on time) the window is the whole state of
+ * the scheme's step map: stepping on from a window set by dmi_set_window is
+ * the scheme started at t_p from that history.  This is the state that
+ * shooting for periodic orbits and the linearisation of the step map
+ * (characteristic roots, Floquet multipliers) work on.
+ * dmi_set_window replaces the stored states and keeps p; the delay sum's
+ * engine (FFT blocks, the recursion's sums) is recomputed from the new
+ * states, as dmi_set_convolution does (bitwise the same as a solver whose
+ * states were those all along for DIRECT and FFT; up to rounding for
+ * RECURSIVE); the last step's terms (dmi_get_step_terms) still describe the
+ * step before the call.  The array is copied.
+ * Errors: DMI_EINVAL for NULL arguments or (set) a NaN or infinite value
+ * (the message names its row and component); DMI_ESTATE before dmi_init;
+ * DMI_ENOMEM (set).  On error the solver is unchanged.
+ */
+DMI_API int dmi_get_window(const dmi_solver *s, double *U);
+DMI_API int dmi_set_window(dmi_solver *s, const double *U);
 
 /*
  * Terms of the last step taken, from t_{p-1} to t_p: W[0..n-1] = W^{p-1} and

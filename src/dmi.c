@@ -668,6 +668,36 @@ int dmi_get_past(const dmi_solver *s, size_t lag, double *u)
     return DMI_OK;
 }
 
+int dmi_get_window(const dmi_solver *s, double *U)
+{
+    int rc = dmi_check_query(s, U, "dmi_get_window");
+    if (rc != DMI_OK)
+        return rc;
+    for (size_t k = 0; k <= s->N; k++)
+        dmi_history_get(&s->ring, s->N - k, U + k * s->n);
+    return DMI_OK;
+}
+
+int dmi_set_window(dmi_solver *s, const double *U)
+{
+    int rc = dmi_check_query(s, U, "dmi_set_window");
+    if (rc != DMI_OK)
+        return rc;
+    const size_t n = s->n, N = s->N, bad = dmi_first_nonfinite(U, (N + 1) * n);
+    if (bad < (N + 1) * n)
+        return dmi_fail(s, DMI_EINVAL, "dmi_set_window: U[%zu] (row %zu = U^{p-%zu}, component "
+                        "%zu) is not finite", bad, bad / n, N - bad / n, bad % n);
+    dmi_history ring = {0};
+    if (dmi_history_alloc(&ring, n, N) != 0)
+        return dmi_fail(s, DMI_ENOMEM, "dmi_set_window: out of memory");
+    for (size_t k = 0; k <= N; k++)
+        dmi_history_put(&ring, N - k, U + k * n);
+    dmi_history_release(&s->ring);
+    s->ring = ring;
+    dmi_engine_rebuild(s, s->conv, s->rec);
+    return DMI_OK;
+}
+
 int dmi_get_step_terms(const dmi_solver *s, double *W, double *X)
 {
     if (!s)

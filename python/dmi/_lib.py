@@ -58,6 +58,8 @@ _PROTOTYPES = {
     "dmi_get_state": (c_int, [_solver_p, _d]),
     "dmi_get_past": (c_int, [_solver_p, c_size_t, _d]),
     "dmi_get_step_terms": (c_int, [_solver_p, _d, _d]),
+    "dmi_get_window": (c_int, [_solver_p, _d]),
+    "dmi_set_window": (c_int, [_solver_p, _d]),
     "dmi_state_size": (c_size_t, [_solver_p]),
     "dmi_state_save": (c_int, [_solver_p, c_void_p, c_size_t]),
     "dmi_state_load": (c_int, [_solver_p, c_void_p, c_size_t]),

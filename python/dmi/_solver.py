@@ -292,6 +292,23 @@ class Solver:
             self._check(_L.dmi_get_past(s, lag, _ptr(u)))
         return u
 
+    def get_window(self) -> np.ndarray:
+        """The window of stored states U^{p-N}, ..., U^p, oldest first, as a new array (N + 1, n)
+        (``dmi_get_window``, since libdmi 1.2): with the step counter, the whole state of the
+        scheme's step map."""
+        U = np.empty((self._N + 1, self._n))
+        with self._using() as s:
+            self._check(_L.dmi_get_window(s, _ptr(U)))
+        return U
+
+    def set_window(self, U: Any) -> None:
+        """Replaces the stored states by ``U``, shape (N + 1, n), oldest first (row N is the new
+        U^p), keeping the step counter (``dmi_set_window``, since libdmi 1.2); the delay sum's
+        engine is recomputed from them.  Non-finite values: InvalidArgument, solver unchanged."""
+        a = _array(U, (self._N + 1, self._n), "U")
+        with self._using() as s:
+            self._check(_L.dmi_set_window(s, _ptr(a)))
+
     def step_terms(self) -> tuple[np.ndarray, np.ndarray]:
         """Terms of the last step (t_{p-1} -> t_p): ``W`` = W^{p-1} (the delay sum) and ``X`` =
         X^{p-1} (the resolvent's argument; (X - U^p) / h is the element of A(U^p) selected, the

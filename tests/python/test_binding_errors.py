@@ -72,6 +72,10 @@ BAD_CALLS = {
     "run stride 0": (lambda s: s.run(5, 0), dmi.EINVAL, "stride = 0"),
     "past beyond N": (lambda s: s.past(N + 1), dmi.EINVAL, "lag = 51 > N = 50"),
     "load garbage": (lambda s: s.load_state(b"garbage"), dmi.EINVAL, "dmi_state_load"),
+    "window shape": (lambda s: s.set_window(np.zeros((N, 2))), dmi.EINVAL,
+                     "U has shape (50, 2); expected (51, 2)"),
+    "window NaN": (lambda s: s.set_window(np.where(np.arange(102).reshape(51, 2) == 9, np.nan, 0.0)),
+                   dmi.EINVAL, "row 4 = U^{p-46}, component 1) is not finite"),
 }
 
 
@@ -278,3 +282,19 @@ def test_user_array_kept_alive_and_checked():
     s.init()
     _, U = s.run(3)
     assert U[:, 0].tolist() == [1.0, 1.5, 2.25, 3.375]  # h = 1/4, c = 2: factor 1.5, exact
+
+
+def test_window_round_trip():
+    """get_window's rows are past(N - k); a window set into a solver at the same step makes it
+    step on bitwise as the solver it came from (libdmi 1.2)."""
+    s, other = model(), paper_solver(43, N, "python")
+    other.advance(20)
+    other.set_window(np.zeros((N + 1, 2)))        # elsewhere now
+    U = s.get_window()
+    assert U.shape == (N + 1, 2)
+    assert all(np.array_equal(U[k], s.past(N - k)) for k in range(N + 1))
+    assert not np.array_equal(other.get_window(), U)
+    other.set_window(U)
+    t1, U1 = s.run(40)
+    t2, U2 = other.run(40)
+    assert np.array_equal(t1, t2) and np.array_equal(U1, U2)
