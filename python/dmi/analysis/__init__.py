@@ -1,0 +1,6 @@
+# dmi.analysis: linear stability of equilibria and periodic orbits of the scheme's step map.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""dmi.analysis: the analysis of models ``make(p) -> dmi.Solver`` (filled in by issues 29 and 30)."""
+from __future__ import annotations
+
+__all__: list[str] = []
