@@ -101,11 +101,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     model m;
     model_default(&m);
     dmi_solver *s = NULL;
-    int rc = dmi_create(&s, n, tau, N);
+    /* (libdmi 1.2) or a step h that need not divide tau: N + 0..255/256 steps per tau */
+    int rc = k & 8 ? dmi_create_h(&s, n, tau, tau / ((double)N + byte(&in) / 256.0))
+                   : dmi_create(&s, n, tau, N);
     check_code(NULL, rc);
     must((rc == DMI_OK) == (s != NULL));
     if (!s)
         return 0;
+    must(dmi_get_N(s) == N || (k & 8 && dmi_get_N(s) == N + 1));
+    N = dmi_get_N(s);
     double *u = calloc(2 * n, sizeof *u);
     must(u != NULL);
     for (int ops = 0; ops < 64 && in.left; ops++) {

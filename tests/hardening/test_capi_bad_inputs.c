@@ -563,6 +563,22 @@ static void test_table(void)
 
 /* ---- cases that need their own setup ---------------------------------------- */
 
+/* The checks of a creation fn(input) that returned rc, *out = s (sentinel
+ * before the call; out NULL if null_out), having printed printed bytes (quiet:
+ * hard_quiet_begin's code): nothing printed, the expected code, *out NULL
+ * after a failure (untouched for out = NULL); the table's row. */
+static void created(const char *id, const char *fn, const char *input, int rc, int expect,
+                    int null_out, dmi_solver *s, const dmi_solver *sentinel, int quiet,
+                    long printed)
+{
+    CHECK(quiet == 0 && printed == 0, "%s: printed %ld bytes", id, printed);
+    CHECK(rc == expect, "%s %s(%s): %d, expected %d", id, fn, input, rc, expect);
+    CHECK(null_out ? s == sentinel : s == NULL, "%s: *out not NULL after failure", id);
+    row(id, fn, input, rc, dmi_strerror(rc));
+    if (rc == DMI_OK && s != sentinel)
+        dmi_free(&s);
+}
+
 static void test_create(void)
 {
     static const struct {
@@ -598,16 +614,83 @@ static void test_create(void)
         hard_quiet q;
         int quiet = hard_quiet_begin(&q);
         int rc = dmi_create(t[i].null_out ? NULL : &s, t[i].n, t[i].tau, t[i].N);
-        long printed = hard_quiet_end(&q);
-        CHECK(quiet == 0 && printed == 0, "%s: printed %ld bytes", t[i].id, printed);
-        CHECK(rc == t[i].expect, "%s dmi_create(%s): %d, expected %d", t[i].id, t[i].input, rc,
-              t[i].expect);
-        CHECK(t[i].null_out ? s == sentinel : s == NULL, "%s: *out not NULL after failure",
-              t[i].id);
-        row(t[i].id, "dmi_create", t[i].input, rc, dmi_strerror(rc));
-        if (rc == DMI_OK && s != sentinel)
-            dmi_free(&s);
+        created(t[i].id, "dmi_create", t[i].input, rc, t[i].expect, t[i].null_out, s, sentinel,
+                quiet, hard_quiet_end(&q));
     }
+}
+
+/* dmi_create_h (libdmi 1.2): the same checks as dmi_create, on h. */
+static void test_create_h(void)
+{
+    static const struct {
+        const char *id, *input;
+        int null_out;
+        size_t n;
+        double tau, h;
+        int expect;
+    } t[] = {
+        {"C134", "out = NULL", 1, 2, 1.0, 0.3, DMI_EINVAL},
+        {"C135", "n = 0", 0, 0, 1.0, 0.3, DMI_EINVAL},
+        {"C136", "h = 0", 0, 2, 1.0, 0.0, DMI_EINVAL},
+        {"C137", "h = -0.0", 0, 2, 1.0, -0.0, DMI_EINVAL},
+        {"C138", "h = -0.3", 0, 2, 1.0, -0.3, DMI_EINVAL},
+        {"C139", "h = NaN", 0, 2, 1.0, NAN, DMI_EINVAL},
+        {"C140", "h = +Inf", 0, 2, 1.0, INFINITY, DMI_EINVAL},
+        {"C141", "h = 1e-310 (subnormal)", 0, 2, 1.0, 1e-310, DMI_EINVAL},
+        {"C142", "tau = NaN", 0, 2, NAN, 0.3, DMI_EINVAL},
+        {"C143", "tau = 0", 0, 2, 0.0, 0.3, DMI_EINVAL},
+        {"C144", "tau / h = 1e300 cells", 0, 2, 1.0, 1e-300, DMI_ENOMEM},
+        {"C145", "tau / h = 2^50 cells", 0, 1, 1.0, 0x1p-50, DMI_ENOMEM},
+        {"C146", "n = SIZE_MAX (size overflows)", 0, SIZE_MAX, 1.0, 0.3, DMI_ENOMEM},
+        {"C147", "n = 2^44, h > tau (N = 1): history of 1 PiB cannot be allocated", 0,
+         (size_t)1 << 44, 1.0, 3.0, DMI_ENOMEM},
+    };
+    for (size_t i = 0; i < sizeof t / sizeof t[0]; i++) {
+        dmi_solver *sentinel = (dmi_solver *)&t[i]; /* never dereferenced */
+        dmi_solver *s = sentinel;
+        hard_quiet q;
+        int quiet = hard_quiet_begin(&q);
+        int rc = dmi_create_h(t[i].null_out ? NULL : &s, t[i].n, t[i].tau, t[i].h);
+        created(t[i].id, "dmi_create_h", t[i].input, rc, t[i].expect, t[i].null_out, s, sentinel,
+                quiet, hard_quiet_end(&q));
+    }
+    /* a state loads only into a solver with the same h (N = 41 for all three) */
+    dmi_solver *a = NULL, *b = NULL, *c = NULL;
+    CU_ASSERT_EQUAL_FATAL(dmi_create_h(&a, 2, 1.0, 1.0 / 40.37), DMI_OK);
+    CU_ASSERT_EQUAL_FATAL(dmi_create_h(&b, 2, 1.0, 1.0 / 40.5), DMI_OK);
+    CU_ASSERT_EQUAL_FATAL(dmi_create(&c, 2, 1.0, 41), DMI_OK);
+    CU_ASSERT(dmi_init(a) == DMI_OK && dmi_init(b) == DMI_OK && dmi_init(c) == DMI_OK);
+    static const struct {
+        const char *id, *input;
+        int to_b;
+        const char *msg;
+    } L[] = {
+        {"C148", "the state of dmi_create_h(2, 1, 1/40.37) into dmi_create_h(2, 1, 1/40.5) (both N = 41)",
+         1, "h = 0.024770869457517962"},
+        {"C149", "the state of dmi_create(2, 1, 41) into dmi_create_h(2, 1, 1/40.5) (N = 41)", 0,
+         "state of a solver with h = tau / N"},
+    };
+    for (size_t i = 0; i < sizeof L / sizeof L[0]; i++) {
+        const dmi_solver *from = L[i].to_b ? a : c;
+        size_t size = dmi_state_size(from), bsize = dmi_state_size(b);
+        unsigned char *bytes = malloc(size), *before = malloc(bsize), *after = malloc(bsize);
+        CU_ASSERT_FATAL(bytes && before && after);
+        CU_ASSERT(dmi_state_save(from, bytes, size) == DMI_OK);
+        CU_ASSERT(dmi_state_save(b, before, bsize) == DMI_OK);
+        int rc = dmi_state_load(b, bytes, size);
+        CHECK(rc == DMI_EINVAL, "%s dmi_state_load: %d, expected %d", L[i].id, rc, DMI_EINVAL);
+        CHECK(strstr(dmi_last_error(b), L[i].msg) != NULL, "%s: message \"%s\"", L[i].id,
+              dmi_last_error(b));
+        CHECK(dmi_state_save(b, after, bsize) == DMI_OK && memcmp(before, after, bsize) == 0,
+              "%s: the solver changed", L[i].id);
+        row(L[i].id, "dmi_state_load", L[i].input, rc, dmi_last_error(b));
+        free(bytes);
+        free(before);
+        free(after);
+    }
+    dmi_free(&a);
+    dmi_free(&b);
+    dmi_free(&c);
 }
 
 /* N * n^2 kernel samples too many to allocate (2^48 bytes), while the history
@@ -859,6 +942,7 @@ int main(int argc, char **argv)
         return 2;
     CU_pSuite suite = CU_add_suite("capi_bad_inputs", NULL, NULL);
     if (!suite || !CU_add_test(suite, "dmi_create", test_create) ||
+        !CU_add_test(suite, "dmi_create_h", test_create_h) ||
         !CU_add_test(suite, "init: kernel too large", test_init_kernel_too_large) ||
         !CU_add_test(suite, "step: delay term overflow", test_delay_term_overflow) ||
         !CU_add_test(suite, "step: resolvent argument overflow", test_resolvent_argument_overflow) ||
