@@ -6,7 +6,8 @@
  *   here from the window with plain loops (the last cell weighted theta h);
  * - DIRECT, FFT, RECURSIVE and AUTO agree to 1e-12 with h not in tau / N;
  * - order 1 on Example 4.2 (exact solution (4.10)) with h not in tau / N;
- * - the history is sampled at t = -k h, k < N, and at -tau;
+ * - the history is sampled at t = -k h, k < N, and at -tau; the oldest
+ *   stored state U^{p-N} is read by no step;
  * - saved states load only into a solver with the same h; bad arguments.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
@@ -315,6 +316,40 @@ static void test_history_times(void)
     history_times(0.6, 2.0, 1);   /* h > tau: 0 and -0.6 */
 }
 
+/* The oldest row of the window, U^{p-N}, is read by no step (dmi.h): two
+ * solvers whose windows differ only there step alike, bitwise, every method. */
+static void test_oldest_row_unread(void)
+{
+    static const int methods[] = {DMI_CONV_DIRECT, DMI_CONV_FFT, DMI_CONV_RECURSIVE};
+    const double h = 1.0 / 500.37; /* N = 501 */
+    for (size_t im = 0; im < 3; im++) {
+        core_model ma = {0}, mb = {0};
+        dmi_solver *a = model(&ma, 1.0, 0, h, 1, methods[im]);
+        dmi_solver *b = model(&mb, 1.0, 0, h, 1, methods[im]);
+        CU_ASSERT_FATAL(a && b);
+        CU_ASSERT_EQUAL(dmi_advance(a, 777), DMI_OK);
+        CU_ASSERT_EQUAL(dmi_advance(b, 777), DMI_OK); /* (the same t_p) */
+        double *U = window(a);
+        CU_ASSERT_FATAL(U != NULL);
+        CU_ASSERT_EQUAL(dmi_set_window(a, U), DMI_OK); /* (both engines rebuilt alike) */
+        U[0] = 1e3;
+        U[1] = -7;
+        CU_ASSERT_EQUAL(dmi_set_window(b, U), DMI_OK);
+        int same = 1;
+        double ua[2], ub[2];
+        for (int k = 0; k < 3 * 501; k++) {
+            same &= dmi_step(a) == DMI_OK && dmi_step(b) == DMI_OK;
+            dmi_get_state(a, ua);
+            dmi_get_state(b, ub);
+            same &= memcmp(ua, ub, sizeof ua) == 0;
+        }
+        CU_ASSERT(same);
+        free(U);
+        dmi_free(&a);
+        dmi_free(&b);
+    }
+}
+
 /* ---- saved states ------------------------------------------------------------------ */
 
 /* dmi_state_load of a's state into b: the code, and b unchanged on failure. */
@@ -420,6 +455,7 @@ int main(int argc, char **argv)
         {"DIRECT = FFT = RECURSIVE = AUTO to 1e-12, h not in tau / N", test_methods_agree},
         {"order 1 on Example 4.2 with h not in tau / N", test_order_example42},
         {"the history is sampled at -k h, k < N, and at -tau", test_history_times},
+        {"the window's oldest row is read by no step", test_oldest_row_unread},
         {"saved states record h", test_states},
         {"bad arguments", test_refused},
         {NULL, NULL},
