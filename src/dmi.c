@@ -270,6 +270,7 @@ int dmi_create_h(dmi_solver **out, size_t n, double tau, double h)
     const double N = q > 1 ? ceil(q) : 1;
     return create(out, n, tau, (size_t)N, h, q - (N - 1)); /* exact (N - 1 <= q <= 2 (N - 1)) */
 }
+
 void dmi_free(dmi_solver **ps)
 {
     if (!ps || !*ps)

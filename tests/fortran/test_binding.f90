@@ -84,6 +84,7 @@ program test_binding
   use binding_model
   implicit none
   integer, parameter :: p_max = 40
+  integer(c_int), parameter :: methods(3) = [DMI_CONV_DIRECT, DMI_CONV_FFT, DMI_CONV_RECURSIVE]
   ! The scheme written out: ue(:, p) = U^p, we(:, p) = W^p, xe(:, p) = X^p.
   real(c_double) :: ue(n, -n_tau:p_max), we(n, 0:p_max), xe(n, 0:p_max)
   type(rhs_data), target :: data
@@ -238,6 +239,39 @@ program test_binding
   end do
   call check(all(abs(w - we(:, 0)) <= 1e-15_c_double), 'W^0 of the exponential kernel')
   call dmi_free(s)
+
+  ! ---- a step that need not divide tau (libdmi 1.2) ---------------------------
+  ! h = tau / 3.5: N = 4 cells, the last weighted h / 2; the same kernel and z,
+  ! every method: W^0 = h sum_{l<3} H(l h) (1, -1) + (h / 2) H(3 h) (1, -1).
+  call check(dmi_create_h(s, int(n, c_size_t), tau, 0.0_c_double) == DMI_EINVAL, &
+             'dmi_create_h with h = 0')
+  call check(.not. c_associated(s), 'dmi_create_h failed but set a handle')
+  call check(dmi_get_N(c_null_ptr) == 0, 'dmi_get_N(NULL)')
+  do i = 1, 3
+    call expect_ok(dmi_create_h(s, int(n, c_size_t), tau, tau / 3.5_c_double), 'dmi_create_h')
+    call check(dmi_get_N(s) == 4, 'dmi_get_N')
+    call check(dmi_get_h(s) == tau / 3.5_c_double, 'dmi_get_h of dmi_create_h')
+    call expect_ok(dmi_set_history(s, c_funloc(constant_history), c_null_ptr), 'dmi_set_history')
+    call expect_ok(dmi_set_kernel_exp(s, 2_c_size_t, [-1.0_c_double, 0.0_c_double], &
+                   [0.0_c_double, 3.0_c_double], &
+                   [0.5_c_double, 0.0_c_double, 0.0_c_double, 0.0_c_double, &
+                    0.0_c_double, 0.0_c_double, 0.2_c_double, 0.0_c_double], &
+                   [0.0_c_double, 0.0_c_double, 0.0_c_double, 0.0_c_double, &
+                    0.0_c_double, 0.0_c_double, 0.0_c_double, 0.1_c_double]), 'dmi_set_kernel_exp')
+    call expect_ok(dmi_set_convolution(s, methods(i)), 'dmi_set_convolution')
+    call expect_ok(dmi_init(s), 'dmi_init')
+    call expect_ok(dmi_step(s), 'dmi_step')
+    call expect_ok(dmi_get_step_terms(s, w, x), 'dmi_get_step_terms')
+    we(:, 0) = 0
+    do lag = 0, 3
+      ua = [0.5_c_double * exp(-lag * (tau / 3.5_c_double)), &
+            0.2_c_double * cos(3 * lag * (tau / 3.5_c_double)) &
+            - 0.1_c_double * sin(3 * lag * (tau / 3.5_c_double))]
+      we(:, 0) = we(:, 0) + merge(0.5_c_double, 1.0_c_double, lag == 3) * (tau / 3.5_c_double) * ua
+    end do
+    call check(all(abs(w - we(:, 0)) <= 1e-15_c_double), 'W^0 with the partial last cell')
+    call dmi_free(s)
+  end do
   deallocate(buf, message) ! (main program variables are not freed at its end)
 
   if (failures > 0) then
