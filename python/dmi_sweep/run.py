@@ -397,7 +397,12 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
     if slurm is not None:
         if scheduler or workers:
             raise ValueError("slurm excludes scheduler and workers")
-        client = Client(slurm_jobs.start(slurm))
+        cluster = slurm_jobs.start(slurm)
+        try:
+            client = Client(cluster)
+        except BaseException:
+            cluster.close()
+            raise
         workers = slurm["cores"] * slurm["jobs"]
     elif scheduler:
         client = make_client(None, scheduler, sec)
