@@ -48,7 +48,7 @@ else
     apt=(-o Dir::Etc::SourceList=/dev/null -o "Dir::Etc::SourceParts=$gsl/apt/parts"
          -o "Dir::State::Lists=$gsl/apt/lists" -o "Dir::Cache=$gsl/apt/cache")
     apt-get -qq "${apt[@]}" update >&2
-    (cd "$gsl" && apt-get -qq "${apt[@]}" source --download-only gsl >&2 2>/dev/null)
+    (cd "$gsl" && apt-get -qq "${apt[@]}" source --download-only gsl >&2)
     (cd "$gsl" && dpkg-source -x gsl_*.dsc src >/dev/null)
     # Debian's source has no documentation sources (dfsg): the library only, not doc/
     sed -i 's/^\(SUBDIRS = .*\) doc$/\1/' "$gsl/src/Makefile.in"
