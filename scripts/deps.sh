@@ -8,9 +8,11 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 # Debian packages (dpkg name) that the build and tests use.
 # libtsan2: gcc's ThreadSanitizer runtime (the threads stage of test.sh).
 # openssl: the certificates of the TLS sweep test (python/tests/test_tls.py).
+# slurmctld slurmd slurm-client munge: the one-node Slurm of the SLURM sweep test
+# (python/tests/test_slurm.py; started by the test itself, never as services).
 debs=(build-essential cmake ninja-build pkg-config libgsl-dev libcunit1-dev gfortran
       abigail-tools clang libclang-rt-14-dev valgrind python3 python3-venv python3-pip libtsan2
-      gcc-mingw-w64-x86-64 wine64 openssl)
+      gcc-mingw-w64-x86-64 wine64 openssl slurmctld slurmd slurm-client munge)
 missing=()
 for d in "${debs[@]}"; do
   dpkg-query -W -f='${Status}' "$d" 2>/dev/null | grep -q "install ok installed" || missing+=("$d")

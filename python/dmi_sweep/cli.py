@@ -16,9 +16,11 @@ EXIT = """exit status:
   0    every point of the sweep succeeded (the folder holds all of them)
   1    every point was computed, but some failed: their rows hold the error (the count is printed)
   2    nothing was run: a bad spec or command line, [start] values the FMU refuses, a folder
-       that holds another sweep or that another client is using, missing or bad TLS certificates
+       that holds another sweep or that another client is using, missing or bad TLS certificates,
+       SLURM job settings that SLURM refuses
   3    the cluster was lost or could not be reached, or had no worker for --no-worker-timeout
-       seconds: the finished points are saved, and the same command resumes
+       seconds (with --slurm: and SLURM had none of its jobs left): the finished points are
+       saved, and the same command resumes
   130  interrupted (Ctrl-C): the finished points are saved, and the same command resumes"""
 
 
@@ -61,6 +63,21 @@ def parser() -> argparse.ArgumentParser:
                    "(default: one per core); the local cluster listens on 127.0.0.1 only")
     r.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler: "
                    "tls://host:port (with certificates), or tcp://host:port on a private network only")
+    g = r.add_argument_group("SLURM", "run the workers as SLURM jobs (dask-jobqueue's SLURMCluster, "
+                             "the scheduler in this process): these options, over the spec's [slurm] "
+                             "section, over Dask's jobqueue.slurm configuration")
+    g.add_argument("--slurm", action="store_true", help="submit the workers to SLURM (sbatch) instead "
+                   "of a local cluster; the job script is tried first (sbatch --test-only): a job SLURM "
+                   "refuses gives exit 2 with SLURM's message")
+    g.add_argument("--partition", help="the partition (SLURMCluster's queue; sbatch -p)")
+    g.add_argument("--account", help="the account charged (sbatch -A)")
+    g.add_argument("--cores", type=positive_int, help="cores per job: one single-threaded worker "
+                   "process on each (required, here or in the spec or configuration)")
+    g.add_argument("--memory", help="memory per job, such as 64GB (required, here or in the spec or "
+                   "configuration)")
+    g.add_argument("--walltime", help="the time limit of each job, such as 04:00:00 (default: "
+                   "Dask's jobqueue.slurm.walltime, 00:30:00)")
+    g.add_argument("--jobs", type=positive_int, help="jobs to submit (default: 1)")
     r.add_argument("--no-worker-timeout", metavar="SECONDS", type=positive_seconds,
                    default=NO_WORKER_TIMEOUT, help="stop the run (exit 3, the finished points saved) "
                    "when the cluster has had no worker for this long, as when every worker of a "
@@ -112,22 +129,38 @@ def main(argv: list[str] | None = None) -> int:
 
 def _run(a: argparse.Namespace) -> int:
     from .run import ClusterLost, ConnectionSetupError, run
+    from .slurm import KEYS, SlurmRefused, SlurmSettingError, check, resolve
     from .spec import SpecError, load
     from .store import StoreError
     if a.workers and a.scheduler:
         print("dmi-sweep: --workers is for the local cluster; with --scheduler the cluster's "
               "workers are used", file=sys.stderr)
         return 2
+    given = [f"--{k}" for k in KEYS if getattr(a, k) is not None]
+    if a.slurm and (a.workers or a.scheduler):
+        print(f"dmi-sweep: --slurm runs its own cluster: not with {'--workers' if a.workers else '--scheduler'}",
+              file=sys.stderr)
+        return 2
+    if given and not a.slurm:
+        print(f"dmi-sweep: {', '.join(given)} given without --slurm", file=sys.stderr)
+        return 2
     try:
         spec = load(a.spec)
+        slurm = None
+        if a.slurm:
+            try:
+                slurm = resolve(check({k: getattr(a, k) for k in KEYS}, "--"), spec.slurm)
+            except SlurmSettingError as e:
+                print(f"dmi-sweep: {e}", file=sys.stderr)
+                return 2
         s = run(spec, a.out, workers=a.workers, scheduler=a.scheduler, restart=a.restart,
                 chunk_size=a.chunk_size, progress=None if a.quiet else sys.stderr,
                 tls_ca_file=a.tls_ca_file, tls_cert=a.tls_cert, tls_key=a.tls_key,
-                dashboard=a.dashboard, no_worker_timeout=a.no_worker_timeout)
+                dashboard=a.dashboard, no_worker_timeout=a.no_worker_timeout, slurm=slurm)
     except SpecError as e:
         print(f"dmi-sweep: bad spec {a.spec}: {e}", file=sys.stderr)
         return 2
-    except (StoreError, ConnectionSetupError) as e:
+    except (StoreError, ConnectionSetupError, SlurmRefused) as e:
         print(f"dmi-sweep: {e}", file=sys.stderr)
         return 2
     except ClusterLost as e:

@@ -1,5 +1,6 @@
 # Runs a sweep on Dask: a LocalCluster of K single-threaded worker processes on
-# 127.0.0.1 by default, or an existing cluster (--scheduler, plain TCP or TLS).
+# 127.0.0.1 by default, an existing cluster (--scheduler, plain TCP or TLS), or
+# workers in SLURM jobs (--slurm, see slurm.py).
 # The FMU travels to each worker once, inside a worker plugin (removed at the
 # end); chunks of points are tasks; each finished chunk is written to the result
 # folder at once.  Dask's warnings and errors go to the folder's _log.jsonl, not
@@ -32,6 +33,7 @@ from distributed.comm.core import CommClosedError
 from distributed.security import Security
 
 from . import simulate
+from . import slurm as slurm_jobs
 from .cli import NO_WORKER_TIMEOUT
 from .simulate import FMUPlugin, PluginClosed, check_start, has_worker_plugin, run_chunk
 from .spec import Spec, SpecError
@@ -141,9 +143,12 @@ class WorkerWatch:
     worker died before it was fetched is computed again, and waits for a worker) end there."""
 
     def __init__(self, client: Client, timeout: float, where: str = "",
-                 clock: Callable[[], float] = time.monotonic):
-        """where: " at <address>" for the messages."""
+                 clock: Callable[[], float] = time.monotonic,
+                 waiting: Callable[[], bool] | None = None):
+        """where: " at <address>" for the messages; waiting(), asked when there is no worker: whether
+        workers are still to come (SLURM jobs still queued or starting), which stops the count."""
         self.client, self.timeout, self.where, self.clock = client, timeout, where, clock
+        self.waiting = waiting
         self.interval = min(1.0, timeout / 4)
         self.asked = -math.inf       # when the scheduler was last asked
         self.none_since: float | None = None    # the first answer "no worker" of the current run of them
@@ -155,12 +160,13 @@ class WorkerWatch:
         if now - self.asked < self.interval or self.client.status != "running":
             return
         self.asked = now
-        if self.client.nthreads():
+        if self.client.nthreads() or (self.waiting is not None and self.waiting()):
             self.none_since = None
         elif self.none_since is None:
             self.none_since = now
         elif now - self.none_since >= self.timeout:
-            raise ClusterLost(f"the scheduler{self.where} has had no worker for {self.timeout:g} s",
+            jobs = "" if self.waiting is None else " and SLURM has none of its jobs left"
+            raise ClusterLost(f"the scheduler{self.where} has had no worker for {self.timeout:g} s{jobs}",
                               resume="once the cluster has workers again")
 
     def start(self, on_lost: Callable[[], object]) -> None:
@@ -360,7 +366,8 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
         restart: bool = False, chunk_size: int | None = None,
         progress: TextIO | None = STDERR, tls_ca_file: str | None = None,
         tls_cert: str | None = None, tls_key: str | None = None, dashboard: bool = False,
-        messages: TextIO | None = STDERR, no_worker_timeout: float = NO_WORKER_TIMEOUT) -> Summary:
+        messages: TextIO | None = STDERR, no_worker_timeout: float = NO_WORKER_TIMEOUT,
+        slurm: dict[str, Any] | None = None) -> Summary:
     """Runs the sweep `spec` into the folder `out`, resuming what is there. The progress bar goes
     to `progress`, the lines about repairs, lost workers and the dashboard to `messages` (default:
     sys.stderr at the time of the call; None: nowhere).
@@ -370,7 +377,11 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
     Then the folder is locked (StoreError if another client holds it) and duplicates of older runs
     are repaired. Raises ClusterLost if the scheduler cannot be reached or is lost, or if the cluster
     has had no worker for no_worker_timeout seconds; the chunks written stay, and the same call
-    resumes."""
+    resumes.
+
+    slurm: the job settings of slurm.resolve(): the workers run in SLURM jobs of a SLURMCluster
+    started here (SlurmRefused, before the folder is made, if SLURM refuses its job script); the
+    no-worker count waits while SLURM still has one of its jobs."""
     if not no_worker_timeout > 0:
         raise ValueError(f"no_worker_timeout must be > 0 seconds, not {no_worker_timeout!r}")
     t0 = time.monotonic()
@@ -380,27 +391,50 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
     refusal = check_start(spec.fmu.read_bytes(), spec.job())
     if refusal:
         raise SpecError(f"the FMU refuses the [start] values: {refusal}")
-    # An external scheduler is reached (and its certificate checks passed) before the folder is made.
-    client = make_client(None, scheduler, sec) if scheduler else None
+    # An external scheduler is reached (and its certificate checks passed), or SLURM accepts the
+    # jobs, before the folder is made.
+    client = None
+    if slurm is not None:
+        if scheduler or workers:
+            raise ValueError("slurm excludes scheduler and workers")
+        cluster = slurm_jobs.start(slurm)
+        try:
+            client = Client(cluster)
+        except BaseException:
+            cluster.close()
+            raise
+        workers = slurm["cores"] * slurm["jobs"]
+    elif scheduler:
+        client = make_client(None, scheduler, sec)
     try:
         store = Store.open(out, spec, restart=restart)
     except BaseException:
         if client is not None:
-            client.close()
+            _close(client)
         raise
     try:
         with logs_to(store):
             return _run_locked(spec, store, t0, client, workers, chunk_size, progress, messages,
-                               dashboard, no_worker_timeout)
+                               dashboard, no_worker_timeout, slurm is not None)
     finally:
         store.close()
 
 
+def _close(client: Client) -> None:
+    """Closes the client, and its cluster if it started one (a LocalCluster, a SLURMCluster: its
+    jobs are cancelled)."""
+    cluster = client.cluster
+    with contextlib.suppress(Exception):
+        client.close(timeout=5 if client.status == "running" else 1)
+    if cluster is not None:
+        cluster.close()
+
+
 def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, workers: int | None,
                 chunk_size: int | None, progress: TextIO | None, messages: TextIO | None,
-                dashboard: bool, no_worker_timeout: float) -> Summary:
-    """The run once the folder is locked: with the client of the external cluster, or None for a
-    LocalCluster of `workers` processes (started only when points are missing)."""
+                dashboard: bool, no_worker_timeout: float, on_slurm: bool = False) -> Summary:
+    """The run once the folder is locked: with the client of the external or SLURM cluster, or None
+    for a LocalCluster of `workers` processes (started only when points are missing)."""
     scheduler = client.scheduler.address if client is not None else None
     say = messages.write if messages is not None else (lambda text: None)
     repaired, rewritten, removed = store.repair()
@@ -417,7 +451,7 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
             f"computing the {len(todo)} missing\n")
     if not todo:
         if client is not None:
-            client.close()
+            _close(client)
         return Summary(spec.n_points, len(done), 0, failed_before, time.monotonic() - t0, repaired)
 
     if client is None:
@@ -459,7 +493,8 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
         job = spec.job()
 
         where = f" at {scheduler}" if scheduler else ""
-        watch = WorkerWatch(client, no_worker_timeout, where)
+        watch = WorkerWatch(client, no_worker_timeout, where,
+                            waiting=(lambda: slurm_jobs.jobs_alive(cluster)) if on_slurm else None)
         futures: dict[str, Any] = {}             # key of a task -> its future, while pending
 
         def submit(points: list[int]):
@@ -553,9 +588,6 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
             if scheduler and registered:
                 with contextlib.suppress(Exception):
                     client.unregister_worker_plugin(plugin.name)
-        with contextlib.suppress(Exception):
-            client.close(timeout=5 if client.status == "running" else 1)
-        if not scheduler and cluster is not None:
-            cluster.close()
+        _close(client)
     return Summary(spec.n_points, len(done), computed, failed_before + failed,
                    time.monotonic() - t0, repaired)

@@ -15,8 +15,10 @@ from typing import Any
 import numpy as np
 from fmpy import read_model_description
 
+from . import slurm
+
 TOP_KEYS = {"fmu", "stop_time", "output_interval", "transient", "start", "grid", "outputs",
-            "poincare", "random"}
+            "poincare", "random", "slurm"}
 DEFAULT_FMU = Path(__file__).resolve().parents[2] / "build" / "fmu" / "DelayFrictionOscillator.fmu"
 
 
@@ -43,6 +45,7 @@ class Spec:
     poincare: float | str | None = None
     mode: str = "grid"
     types: dict[str, str] = field(default_factory=dict)   # parameter -> "float" | "int" | "bool"
+    slurm: dict[str, Any] = field(default_factory=dict)   # the [slurm] section (used with --slurm)
 
     @property
     def n_points(self) -> int:
@@ -60,9 +63,10 @@ class Spec:
 
     def identity(self) -> dict[str, Any]:
         """What must not change between a sweep and its resumption: the parsed spec without the
-        FMU's path, and the FMU's sha256."""
+        FMU's path and the [slurm] job settings (where it runs), and the FMU's sha256."""
         data = tomllib.loads(self.text.decode())
         data.pop("fmu", None)
+        data.pop("slurm", None)
         return {"spec": json.loads(json.dumps(data, sort_keys=True, default=str)),
                 "fmu_sha256": self.sha256}
 
@@ -241,10 +245,19 @@ def check(data: dict[str, Any], text: bytes, path: Path) -> Spec:
             raise SpecError("poincare: the FMU cannot handle variable communication step sizes, "
                             "so it cannot be sampled at the section's times")
 
+    # SLURM job settings (dmi-sweep run --slurm)
+    section = data.get("slurm", {})
+    if not isinstance(section, dict):
+        raise SpecError("slurm must be a table: [slurm] partition = \"compute\", cores = 32, ...")
+    try:
+        slurm_settings = slurm.check(section, "slurm.")
+    except slurm.SlurmSettingError as e:
+        raise SpecError(str(e)) from None
+
     return Spec(path=path, text=text, fmu=fmu, sha256=sha256, model=model, start_time=start_time,
                 stop_time=stop_time, output_interval=interval, transient=transient, start=start,
                 params=params, values=values, outputs=list(outputs), poincare=poincare, mode=mode,
-                types=types)
+                types=types, slurm=slurm_settings)
 
 
 def _grid_values(where: str, variable, entry: Any) -> np.ndarray:
