@@ -43,8 +43,12 @@ else
   if [[ ! -f $gsl/done ]]; then
     echo "wheel: GSL from Debian's source package, compiled for glibc $glibc (a few minutes, once)" >&2
     rm -rf "$gsl" && mkdir -p "$gsl/apt/parts" "$gsl/apt/lists/partial" "$gsl/apt/cache/archives/partial"
-    printf 'Types: deb-src\nURIs: http://deb.debian.org/debian\nSuites: bookworm\nComponents: main\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' \
-      >"$gsl/apt/parts/debian-src.sources"
+    # the machine's own Debian archive (its first deb entry), as deb-src
+    archive=$(awk '$1 == "URIs:" {print $2; exit}' /etc/apt/sources.list.d/debian.sources 2>/dev/null || true)
+    [[ -n $archive ]] || archive=$(awk '$1 == "deb" && $2 !~ /^\[/ {print $2; exit}' /etc/apt/sources.list 2>/dev/null || true)
+    [[ -n $archive ]] || { echo "wheel: no Debian archive in the machine's apt sources" >&2; exit 1; }
+    printf 'Types: deb-src\nURIs: %s\nSuites: bookworm\nComponents: main\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' \
+      "$archive" >"$gsl/apt/parts/debian-src.sources"
     apt=(-o Dir::Etc::SourceList=/dev/null -o "Dir::Etc::SourceParts=$gsl/apt/parts"
          -o "Dir::State::Lists=$gsl/apt/lists" -o "Dir::Cache=$gsl/apt/cache")
     apt-get -qq "${apt[@]}" update >&2
