@@ -536,7 +536,9 @@ def test_plugin_removed_while_a_point_runs(fmu_path, tmp_path):
     import time
     from dmi_sweep.simulate import Runner, unpack
     job = {"start_time": 0.0, "stop_time": 10.0, "output_interval": 0.01, "transient": 5.0,
-           "start": {"N": 4000}, "outputs": OUTPUTS, "poincare": None}
+           "start": {"N": 40000}, "outputs": OUTPUTS, "poincare": None}
+    # (400000 steps, a few tenths of a second: long enough that the loop below sees the point
+    # running on a loaded machine; with N = 4000 the point could end between two of its looks)
     runner = Runner(unpack(open(fmu_path, "rb").read(), str(tmp_path)))
     want = Runner(runner.unzipdir).run(job, {"g_amp": 1.5})
     out = {}
