@@ -4,3 +4,9 @@
 from __future__ import annotations
 
 __all__: list[str] = []
+
+# ---- periodic orbits (issue 30): shooting, Floquet multipliers, continuation ----------------
+from .floquet import floquet_multipliers  # noqa: E402
+from .shooting import Orbit, ShootingError, periodic_orbit  # noqa: E402
+
+__all__ += ["periodic_orbit", "Orbit", "ShootingError", "floquet_multipliers"]
