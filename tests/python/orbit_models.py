@@ -119,3 +119,51 @@ class StickSlip1:
             s.set_friction([1.0])
             return s
         return make
+
+
+class SlipOnly1:
+    """u' + a u + sigma(u) ∋ c sin t (c = 3 > 1 + ...: u crosses 0 transversally twice a period,
+    never sticks): f = a u - c sin t, A = sigma.  Without saltation its multiplier would be
+    exp(-2 pi a); the crossings make it much smaller."""
+
+    def __init__(self, a: float = 0.1, c: float = 3.0):
+        self.a, self.c, self.T = a, c, 2 * np.pi
+
+    def make_for(self, M: int):
+        a, c = self.a, self.c
+
+        def make(p: float) -> dmi.Solver:
+            s = dmi.Solver(1, self.T / M, 1)
+            s.set_rhs(lambda t, u: np.array([a * u[0] - c * np.sin(t)]))
+            s.set_friction([1.0])
+            return s
+        return make
+
+
+class Fold:
+    """u' = p - u^2 (f = u^2 - p, h = 0.1, M = 10 steps a period): the scheme's fixed points
+    u = +-sqrt(p) fold at p = 0; multiplier (1 - 2 h u)^M."""
+    h, M = 0.1, 10
+
+    def make(self, p: float) -> dmi.Solver:
+        s = dmi.Solver(1, self.h, 1)
+        s.set_rhs(lambda t, u: np.array([u[0] ** 2 - p]))
+        return s
+
+
+class Logistic:
+    """The scheme with h = 1 on u' = p u (1 - u): U+ = U + p U (1 - U), the logistic map
+    x -> r x (1 - x) with r = 1 + p, u = r x / p.  Fixed point u = 1, multiplier 1 - p:
+    period doubling at p = 2 (r = 3), the 2-cycle x = ((r + 1) +- sqrt((r + 1)(r - 3))) / (2 r)
+    with multiplier 4 + 2 r - r^2, doubling again at r = 1 + sqrt(6)."""
+
+    def make(self, p: float) -> dmi.Solver:
+        s = dmi.Solver(1, 1.0, 1)
+        s.set_rhs(lambda t, u: np.array([-p * u[0] * (1 - u[0])]))
+        return s
+
+    @staticmethod
+    def cycle(p: float) -> np.ndarray:
+        r = 1 + p
+        x = ((r + 1) + np.array([1, -1]) * np.sqrt((r + 1) * (r - 3))) / (2 * r)
+        return x * r / p

@@ -214,7 +214,8 @@ class Orbit:
     and ``u`` (M + 1, n): one period of U from t = 0; ``state``: the shooting state (L n values,
     rows oldest first, the last at t = 0); ``multipliers``: the leading Floquet multipliers,
     largest |mu| first; ``stable``: all |mu| < 1; ``stick_fraction`` (n,): the fraction of the M
-    steps where component i is stuck (U_i == 0 exactly after the resolvent: friction);
+    steps where component i is stuck (:func:`stuck_mask`: U_i == 0 exactly after the friction
+    resolvent, for 2 steps or more);
     ``iterations``: Newton iterations; ``residual``: the final |F(x) - x|_inf (state units)."""
     p: float
     period: float
@@ -237,9 +238,19 @@ class Orbit:
         return 0.5 * (self.u.max(axis=0) - self.u.min(axis=0))
 
 
+def stuck_mask(u: np.ndarray) -> np.ndarray:
+    """(M, n) booleans: step k (row k + 1 of u, M + 1 rows of one period) is stuck in component
+    i: U_i == 0 exactly (the friction resolvent's value in its dead zone |X_i| <= h alpha_i)
+    within a run of at least 2 such steps, on the period's circle.  A lone zero step is the
+    scheme's transversal crossing of a velocity reversal (|net force| > alpha: the next step
+    leaves zero), not a stick."""
+    z = np.asarray(u)[1:] == 0.0
+    return z & (np.roll(z, 1, axis=0) | np.roll(z, -1, axis=0))
+
+
 def stick_fraction(u: np.ndarray) -> np.ndarray:
-    """Fraction of the steps 1..M of u (M + 1 rows) with U_i == 0 exactly (stuck)."""
-    return np.mean(u[1:] == 0.0, axis=0)
+    """Fraction of the steps of one period (u: M + 1 rows) that are stuck (:func:`stuck_mask`)."""
+    return np.mean(stuck_mask(u), axis=0)
 
 
 def periodic_orbit(make: Model, p: float, period: float | None = None, guess: Any = None, *,
