@@ -47,11 +47,11 @@ module dmi
   integer(c_int), parameter, public :: DMI_CONV_RECURSIVE = 3 ! (since 1.1)
 
   public :: dmi_rhs_fn, dmi_resolvent_fn, dmi_kernel_fn, dmi_history_fn
-  public :: dmi_version, dmi_create, dmi_free
+  public :: dmi_version, dmi_create, dmi_create_h, dmi_free
   public :: dmi_set_rhs, dmi_set_resolvent, dmi_set_friction, dmi_set_box
   public :: dmi_set_kernel, dmi_set_kernel_exp, dmi_set_history, dmi_set_convolution
   public :: dmi_init, dmi_step, dmi_advance
-  public :: dmi_time, dmi_get_step_index, dmi_get_h, dmi_get_state, dmi_get_past
+  public :: dmi_time, dmi_get_step_index, dmi_get_h, dmi_get_N, dmi_get_state, dmi_get_past
   public :: dmi_get_step_terms, dmi_get_window, dmi_set_window
   public :: dmi_state_size, dmi_state_save, dmi_state_load
   public :: dmi_last_error, dmi_strerror
@@ -110,6 +110,16 @@ module dmi
       integer(c_size_t), value :: n_tau
       integer(c_int) :: rc
     end function dmi_create
+
+    ! (libdmi 1.2) h given, tau / h need not be an integer (dmi.h: the last
+    ! cell of the delay sum is weighted theta h, N = ceiling(tau / h)).
+    function dmi_create_h(out, n, tau, h) result(rc) bind(C, name='dmi_create_h')
+      import :: c_int, c_size_t, c_double, c_ptr
+      type(c_ptr), intent(out) :: out
+      integer(c_size_t), value :: n
+      real(c_double), value :: tau, h
+      integer(c_int) :: rc
+    end function dmi_create_h
 
     subroutine dmi_free(s) bind(C, name='dmi_free')
       import :: c_ptr
@@ -217,6 +227,14 @@ module dmi
       type(c_ptr), value :: s
       real(c_double) :: h
     end function dmi_get_h
+
+    ! (libdmi 1.2) N, the delay sum's cells: the window has N + 1 rows.
+    ! (Fortran ignores case: dmi_get_N and dmi_get_n are one name.)
+    function dmi_get_N(s) result(n_tau) bind(C, name='dmi_get_N')
+      import :: c_size_t, c_ptr
+      type(c_ptr), value :: s
+      integer(c_size_t) :: n_tau
+    end function dmi_get_N
 
     function dmi_get_state(s, u) result(rc) bind(C, name='dmi_get_state')
       import :: c_int, c_double, c_ptr

@@ -12,6 +12,10 @@
  *     W^p     = h * sum_{l=0}^{N-1} H(l h) U^{p-l},
  *     U^{p+1} = (I + h A)^{-1} ( U^p - h f(t_p, U^p) - h W^p ).
  *
+ * (Since 1.2) dmi_create_h takes h itself, tau / h need not be an integer:
+ * the last of the N cells of the delay sum is then partial and weighted
+ * theta h, 0 < theta <= 1 (see there).
+ *
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  *
  * Conventions that hold for every function below
@@ -116,6 +120,43 @@ DMI_API const char *dmi_version(void);
  */
 DMI_API int dmi_create(dmi_solver **out, size_t n, double tau, size_t N);
 
+/*
+ * (Since 1.2.)  Creates a solver for R^n with delay tau > 0 and step h > 0
+ * (both in time units), where tau / h need not be an integer (a period or a
+ * delay that moves freely while the step stays put).  The delay integral
+ * over [0, tau) is cut into N cells [l h, (l + 1) h), the last one cut off
+ * at tau, and summed by the rectangle rule at the cells' left ends:
+ *
+ *     W^p = h * sum_{l=0}^{N-2} H(l h) U^{p-l}  +  theta h * H((N-1) h) U^{p-N+1},
+ *
+ * with N = ceil(q), q = tau / h (the double quotient), N >= 1, and
+ * theta = q - (N - 1) in (0, 1] (theta h = tau - (N - 1) h is the last
+ * cell's length), so that the cells' weights add up to tau.  The scheme keeps
+ * order 1 (docs/mathematics.md) and is continuous in h: as theta -> 0 the
+ * last cell's term vanishes, and the sum tends to that of N - 1 full cells.
+ * One exception: when h == tau / M in double for the integer M nearest q
+ * (the h that dmi_create(out, n, tau, M) computes), N = M and theta = 1, and
+ * the solver is dmi_create's, bitwise (the same steps in every convolution
+ * method, the same saved states).
+ * h > tau is allowed: N = 1 and theta = tau / h, i.e. W^p = tau H(0) U^p.
+ * The kernel is sampled at s = l h, l = 0..N-1 (all < tau); the history at
+ * t = -k h, k = 0..N-1, and the oldest stored state U^{-N} (row 0 of
+ * dmi_get_window, read by no step: the sum reaches back to U^{p-N+1}) is
+ * z(-tau), so z is called on [-tau, 0] only.  The ring, the window
+ * (dmi_get_window) and the saved state have N + 1 rows, as for dmi_create
+ * with that N (dmi_get_N tells it); dmi_get_h returns h.  Every convolution
+ * method computes this sum (the exponential kernel's recursion too).  The
+ * saved state records h when it is not tau / N, so that it loads only into
+ * a solver with the same h (dmi_state_load).
+ * Ownership and errors as dmi_create: on success *out owns a new solver;
+ * on error *out = NULL and
+ *   DMI_EINVAL  out NULL, n = 0, tau <= 0 or not finite, h <= 0, not finite
+ *               or not a normal number;
+ *   DMI_ENOMEM  tau / h >= 2^50 cells, (N + 1) * n doubles overflow size_t,
+ *               or they cannot be allocated.
+ */
+DMI_API int dmi_create_h(dmi_solver **out, size_t n, double tau, double h);
+
 /* Frees *s and everything it owns and sets *s = NULL.  s == NULL and
  * *s == NULL are allowed and do nothing. */
 DMI_API void dmi_free(dmi_solver **s);
@@ -152,7 +193,8 @@ DMI_API int dmi_set_friction(dmi_solver *s, const double *alpha);
 DMI_API int dmi_set_box(dmi_solver *s, const double *lo, const double *hi);
 
 /* Kernel H(s), n*n row-major; H = NULL restores H = 0 (no delay term).
- * Sampled at s = l h, l = 0..N-1, once by dmi_init.  DMI_ESTATE after init. */
+ * Sampled at s = l h, l = 0..N-1, once by dmi_init (l h < tau; for
+ * dmi_create_h too).  DMI_ESTATE after init. */
 DMI_API int dmi_set_kernel(dmi_solver *s, dmi_kernel_fn H, void *user);
 
 /*
@@ -178,7 +220,9 @@ DMI_API int dmi_set_kernel_exp(dmi_solver *s, size_t K, const double *a, const d
                                const double *C, const double *D);
 
 /* History z(t) on [-tau, 0]; z = NULL restores z = 0.  Sampled at t = p h,
- * p = -N..0, once by dmi_init.  DMI_ESTATE after init. */
+ * p = -(N-1)..0, and at t = -tau for U^{-N} (= -N h for dmi_create, not for
+ * a partial last cell of dmi_create_h), once by dmi_init.  DMI_ESTATE after
+ * init. */
 DMI_API int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user);
 
 /*
@@ -274,8 +318,14 @@ DMI_API double dmi_time(const dmi_solver *s);
  * NULL arguments, DMI_ESTATE before dmi_init. */
 DMI_API int dmi_get_step_index(const dmi_solver *s, uint64_t *p);
 
-/* Step size h = tau / N (time units); 0 for s == NULL. */
+/* Step size h (time units): tau / N for dmi_create, the h given to
+ * dmi_create_h; 0 for s == NULL. */
 DMI_API double dmi_get_h(const dmi_solver *s);
+
+/* (Since 1.2.)  The number N of cells of the delay sum (steps per tau for
+ * dmi_create; ceil(tau / h) for dmi_create_h): the window and the ring have
+ * N + 1 rows.  0 for s == NULL. */
+DMI_API size_t dmi_get_N(const dmi_solver *s);
 
 /* u[0..n-1] = U^p.  DMI_EINVAL for NULL, DMI_ESTATE before dmi_init. */
 DMI_API int dmi_get_state(const dmi_solver *s, double *u);
@@ -324,9 +374,11 @@ DMI_API int dmi_get_step_terms(const dmi_solver *s, double *W, double *X);
  * DMI_EINVAL and a message naming that version and libdmi 1.0, whatever
  * their size); it does not include the callbacks, the resolvent choice,
  * the convolution method or the kernel (these stay as set on the solver that
- * loads it).  The bytes
+ * loads it).  A solver of dmi_create_h whose h is not tau / N writes format
+ * version 3 (since libdmi 1.2: version 2 and h, 8 bytes more); every other
+ * solver still writes version 2.  The bytes
  * are native-endian, begin with a magic and a format version, and are
- * checked on load: a state saved by a solver with other n, N or tau, or a
+ * checked on load: a state saved by a solver with other n, N, tau or h, or a
  * truncated or corrupted buffer, is rejected with DMI_EINVAL and the solver
  * is unchanged.
  */

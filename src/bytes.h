@@ -75,11 +75,16 @@ DMI_BYTES_AT(double, double)
  *   E = 2 dmi_expk_sums (0 without an exponential kernel),
  *   1 if the sums are those of a running recursion (else 0 and zeros),
  *   dmi_expk_signature (0 without an exponential kernel)
- * and E doubles, the sums (re, im).
+ * and E doubles, the sums (re, im).  Version 3 (libdmi 1.2) is version 2
+ * followed by the bits of h (DMI_STATE_H_BYTES): the state of a solver whose h
+ * is not the tau / N of dmi_create (one made by dmi_create_h with a partial
+ * last cell); every other solver writes version 2, whose h is tau / N.
  * checksum = dmi_fnv1a_skip(state, size, DMI_STATE_AT_CHECKSUM).
  */
 #define DMI_STATE_MAGIC UINT64_C(0x444d495354415445) /* "DMISTATE" */
 #define DMI_STATE_VERSION UINT64_C(2)
+#define DMI_STATE_VERSION_H UINT64_C(3)
+enum { DMI_STATE_H_BYTES = 8 };
 enum {
     DMI_STATE_AT_MAGIC = 0,
     DMI_STATE_AT_VERSION = 8,

@@ -125,3 +125,10 @@ void dmi_delay_sum(const dmi_kernel *k, const dmi_history *r, double h, double *
         W[row] = w * h;
     }
 }
+
+void dmi_delay_last(const dmi_kernel *k, const dmi_history *r, double w, double *W)
+{
+    const size_t last = k->N - 1;
+    for (size_t e = 0; e < k->nnz; e++)
+        W[k->row[e]] += w * (k->samples[e * k->N + last] * dmi_history_series(r, k->col[e])[last]);
+}

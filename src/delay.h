@@ -58,4 +58,9 @@ double dmi_dot(const double *a, const double *b, size_t len);
 /* W = h * sum_{l=0}^{N-1} H(l h) U^{p-l} (n values): the direct method. */
 void dmi_delay_sum(const dmi_kernel *k, const dmi_history *r, double h, double *W);
 
+/* W += w * H((N-1) h) U^{p-N+1}: with w = (theta - 1) h, it turns the sum of
+ * any method (whose last cell has the weight h) into the sum whose last cell
+ * has the weight theta h (dmi_create_h). */
+void dmi_delay_last(const dmi_kernel *k, const dmi_history *r, double w, double *W);
+
 #endif

@@ -142,9 +142,9 @@ void dmi_engine_rebuild(const dmi_solver *s, dmi_conv *conv, dmi_exp *rec)
         dmi_exp_anchor(rec, &s->ring, s->p);
 }
 
-/* W^p: the recursion's own array (valid until the engine moves on), or W
- * filled. */
-static const double *delay_sum(const dmi_solver *s, double *W)
+/* W^p with every cell's weight h: the recursion's own array (valid until
+ * the engine moves on), or W filled. */
+static const double *delay_sum_full(const dmi_solver *s, double *W)
 {
     if (s->rec)
         return dmi_exp_sum(s->rec);
@@ -155,6 +155,19 @@ static const double *delay_sum(const dmi_solver *s, double *W)
     }
 #endif
     dmi_delay_sum(&s->kernel, &s->ring, s->h, W);
+    return W;
+}
+
+/* W^p, the last cell weighted theta h (every method: its full sum, then the
+ * last cell's change; theta = 1 leaves the full sum's bits alone). */
+static const double *delay_sum(const dmi_solver *s, double *W)
+{
+    const double *full = delay_sum_full(s, W);
+    if (s->theta == 1)
+        return full;
+    if (full != W)
+        memcpy(W, full, s->n * sizeof *W);
+    dmi_delay_last(&s->kernel, &s->ring, (s->theta - 1) * s->h, W);
     return W;
 }
 
@@ -194,16 +207,10 @@ const char *dmi_last_error(const dmi_solver *s)
 
 /* ---- life cycle ---------------------------------------------------------- */
 
-int dmi_create(dmi_solver **out, size_t n, double tau, size_t N)
+/* A new solver with N cells of width h, the last weighted theta h; the
+ * arguments are checked, but not the sizes. */
+static int create(dmi_solver **out, size_t n, double tau, size_t N, double h, double theta)
 {
-    if (!out)
-        return DMI_EINVAL;
-    *out = NULL;
-    if (n == 0 || N == 0 || !isfinite(tau) || !(tau > 0))
-        return DMI_EINVAL;
-    double h = tau / (double)N;
-    if (!isnormal(h))
-        return DMI_EINVAL;
     if (N == SIZE_MAX || dmi_mul_size(2 * (N + 1) > N ? 2 * (N + 1) : 0, n, sizeof(double)) == 0 ||
         dmi_mul_size(5, n, sizeof(double)) == 0)
         return DMI_ENOMEM;
@@ -215,6 +222,7 @@ int dmi_create(dmi_solver **out, size_t n, double tau, size_t N)
     s->N = N;
     s->tau = tau;
     s->h = h;
+    s->theta = theta;
     s->a_kind = A_NONE;
     s->conv_method = DMI_CONV_AUTO;
     s->work = malloc(5 * n * sizeof(double));
@@ -228,6 +236,40 @@ int dmi_create(dmi_solver **out, size_t n, double tau, size_t N)
     return DMI_OK;
 }
 
+int dmi_create(dmi_solver **out, size_t n, double tau, size_t N)
+{
+    if (!out)
+        return DMI_EINVAL;
+    *out = NULL;
+    if (n == 0 || N == 0 || !isfinite(tau) || !(tau > 0))
+        return DMI_EINVAL;
+    double h = tau / (double)N;
+    if (!isnormal(h))
+        return DMI_EINVAL;
+    return create(out, n, tau, N, h, 1.0);
+}
+
+/* Beyond this many cells no machine holds the ring (2^50 rows of 16 bytes a
+ * component); below it tau / h and its integers are exact enough for the
+ * rule of dmi_create_h (round(q) is the M of h == tau / M). */
+#define MAX_CELLS 0x1p50
+
+int dmi_create_h(dmi_solver **out, size_t n, double tau, double h)
+{
+    if (!out)
+        return DMI_EINVAL;
+    *out = NULL;
+    if (n == 0 || !isfinite(tau) || !(tau > 0) || !isnormal(h) || !(h > 0))
+        return DMI_EINVAL;
+    const double q = tau / h; /* > 0; +inf when it overflows */
+    if (!(q < MAX_CELLS) || !(q < (double)(SIZE_MAX / 4)))
+        return DMI_ENOMEM;
+    const double M = round(q);
+    if (M >= 1 && tau / M == h) /* dmi_create(n, tau, M)'s h: its solver */
+        return create(out, n, tau, (size_t)M, h, 1.0);
+    const double N = q > 1 ? ceil(q) : 1;
+    return create(out, n, tau, (size_t)N, h, q - (N - 1)); /* exact (N - 1 <= q <= 2 (N - 1)) */
+}
 void dmi_free(dmi_solver **ps)
 {
     if (!ps || !*ps)
@@ -465,8 +507,10 @@ static int sample_history(dmi_solver *s, dmi_history *ring)
     const size_t n = s->n, N = s->N;
     double *u = s->work;
     for (size_t k = 0; k <= N; k++) { /* U^{-k} = z(-k h) */
-        /* t_{-k} = -k h, exactly -tau at k = N (-N h may round below it) */
-        double t = k == s->N ? -s->tau : k == 0 ? 0.0 : -(double)k * s->h;
+        /* t_{-k} = -k h, and -tau at k = N: -N h may round below it, and is
+         * below it for a partial last cell (dmi_create_h; U^{-N} is read by no
+         * step), and z is called on [-tau, 0] only */
+        double t = k == s->N ? -s->tau : k == 0 ? 0.0 : fmax(-(double)k * s->h, -s->tau);
         memset(u, 0, n * sizeof *u);
         if (s->z) {
             int rc = s->z(t, u, s->z_user);
@@ -628,6 +672,11 @@ double dmi_time(const dmi_solver *s)
 double dmi_get_h(const dmi_solver *s)
 {
     return s ? s->h : 0.0;
+}
+
+size_t dmi_get_N(const dmi_solver *s)
+{
+    return s ? s->N : 0;
 }
 
 int dmi_check_query(const dmi_solver *s, const void *out, const char *fn)

@@ -16,6 +16,7 @@
 struct dmi_solver {
     size_t n, N;
     double tau, h;
+    double theta;       /* the last cell's weight is theta h, 0 < theta <= 1 (dmi_create: 1) */
 
     dmi_rhs_fn f;
     void *f_user;
@@ -58,6 +59,13 @@ int dmi_check_query(const dmi_solver *s, const void *out, const char *fn);
 static inline int dmi_has_expk(const dmi_solver *s)
 {
     return s->H == dmi_expk_eval;
+}
+
+/* Whether h is the tau / N of dmi_create(n, tau, N) (not only theta = 1:
+ * the state format records h when it is not, state.c). */
+static inline int dmi_h_is_tau_over_N(const dmi_solver *s)
+{
+    return s->h == s->tau / (double)s->N;
 }
 
 /* Recomputes the engines (either may be NULL) for s's step p from the ring. */

@@ -16,9 +16,18 @@ static size_t state_sums(const dmi_solver *s)
     return dmi_has_expk(s) ? 2 * dmi_expk_sums(&s->expk) : 0;
 }
 
+/* The format version s writes: 3, with h, when h is not tau / N (bytes.h). */
+static uint64_t state_version(const dmi_solver *s)
+{
+    return dmi_h_is_tau_over_N(s) ? DMI_STATE_VERSION : DMI_STATE_VERSION_H;
+}
+
 size_t dmi_state_size(const dmi_solver *s)
 {
-    return s ? dmi_state_bytes(s->n, s->N, state_sums(s)) : 0;
+    if (!s)
+        return 0;
+    return dmi_state_bytes(s->n, s->N, state_sums(s)) +
+           (state_version(s) == DMI_STATE_VERSION_H ? DMI_STATE_H_BYTES : 0);
 }
 
 int dmi_state_save(const dmi_solver *s, void *buf, size_t size)
@@ -32,7 +41,7 @@ int dmi_state_save(const dmi_solver *s, void *buf, size_t size)
                         need);
     unsigned char *b = buf; /* buf may be unaligned: every value is copied as bytes */
     dmi_put_u64(b, DMI_STATE_AT_MAGIC, DMI_STATE_MAGIC);
-    dmi_put_u64(b, DMI_STATE_AT_VERSION, DMI_STATE_VERSION);
+    dmi_put_u64(b, DMI_STATE_AT_VERSION, state_version(s));
     dmi_put_u64(b, DMI_STATE_AT_n, (uint64_t)n);
     dmi_put_u64(b, DMI_STATE_AT_N, (uint64_t)N);
     dmi_put_double(b, DMI_STATE_AT_TAU, s->tau);
@@ -52,6 +61,8 @@ int dmi_state_save(const dmi_solver *s, void *buf, size_t size)
         dmi_exp_get(s->rec, rec + DMI_STATE_REC_BYTES);
     else
         memset(rec + DMI_STATE_REC_BYTES, 0, E * sizeof(double));
+    if (state_version(s) == DMI_STATE_VERSION_H)
+        dmi_put_double(b, need - DMI_STATE_H_BYTES, s->h);
     dmi_put_u64(b, DMI_STATE_AT_CHECKSUM, dmi_fnv1a_skip(b, need, DMI_STATE_AT_CHECKSUM));
     return DMI_OK;
 }
@@ -73,12 +84,20 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
     const uint64_t version = dmi_get_u64(b, DMI_STATE_AT_VERSION);
     if (version == 1)
         return dmi_fail(s, DMI_EINVAL, "dmi_state_load: state format version 1, written by libdmi "
-                                       "1.0; this libdmi reads version %llu only (save the state "
-                                       "again with it)", (unsigned long long)DMI_STATE_VERSION);
-    if (version != DMI_STATE_VERSION)
+                                       "1.0; this libdmi reads versions 2 and 3 only (save the "
+                                       "state again with it)");
+    if (version != DMI_STATE_VERSION && version != DMI_STATE_VERSION_H)
         return dmi_fail(s, DMI_EINVAL, "dmi_state_load: state format version %llu; this libdmi "
-                                       "reads version %llu only", (unsigned long long)version,
-                        (unsigned long long)DMI_STATE_VERSION);
+                                       "reads versions 2 and 3 only", (unsigned long long)version);
+    /* version 2: h = tau / N; version 3: h is its last word */
+    if (version != state_version(s) && version == DMI_STATE_VERSION)
+        return dmi_fail(s, DMI_EINVAL, "dmi_state_load: state of a solver with h = tau / N; this "
+                                       "one has h = %.17g, not tau / N = %.17g (dmi_create_h)",
+                        s->h, s->tau / (double)s->N);
+    if (version != state_version(s))
+        return dmi_fail(s, DMI_EINVAL, "dmi_state_load: state of a solver with h = %.17g, not "
+                                       "tau / N (dmi_create_h); this one has h = tau / N = %.17g",
+                        dmi_get_double(b, size - DMI_STATE_H_BYTES), s->h);
     if (size != need)
         return dmi_fail(s, DMI_EINVAL, "dmi_state_load: %zu bytes, this solver's state has %zu",
                         size, need);
@@ -91,6 +110,13 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
                         "dmi_state_load: state of a solver with n = %llu, N = %llu, tau = %g; "
                         "this one has n = %zu, N = %zu, tau = %g",
                         (unsigned long long)hn, (unsigned long long)hN, tau, n, N, s->tau);
+    if (version == DMI_STATE_VERSION_H) {
+        const double h = dmi_get_double(b, need - DMI_STATE_H_BYTES);
+        if (memcmp(&h, &s->h, sizeof h))
+            return dmi_fail(s, DMI_EINVAL, "dmi_state_load: state of a solver with h = %.17g; this "
+                                           "one has h = %.17g (n = %zu, N = %zu, tau = %g)",
+                            h, s->h, n, N, s->tau);
+    }
     if (dmi_get_u64(b, DMI_STATE_AT_CHECKSUM) != dmi_fnv1a_skip(b, need, DMI_STATE_AT_CHECKSUM))
         return dmi_fail(s, DMI_EINVAL, "dmi_state_load: corrupted state (checksum mismatch)");
     if (stepped != (uint64_t)(p != 0))

@@ -40,6 +40,7 @@ _d = POINTER(c_double)
 _PROTOTYPES = {
     "dmi_version": (c_char_p, []),
     "dmi_create": (c_int, [POINTER(c_void_p), c_size_t, c_double, c_size_t]),
+    "dmi_create_h": (c_int, [POINTER(c_void_p), c_size_t, c_double, c_double]),
     "dmi_free": (None, [POINTER(c_void_p)]),
     "dmi_set_rhs": (c_int, [_solver_p, c_void_p, c_void_p]),
     "dmi_set_resolvent": (c_int, [_solver_p, c_void_p, c_void_p]),
@@ -55,6 +56,7 @@ _PROTOTYPES = {
     "dmi_time": (c_double, [_solver_p]),
     "dmi_get_step_index": (c_int, [_solver_p, POINTER(c_uint64)]),
     "dmi_get_h": (c_double, [_solver_p]),
+    "dmi_get_N": (c_size_t, [_solver_p]),
     "dmi_get_state": (c_int, [_solver_p, _d]),
     "dmi_get_past": (c_int, [_solver_p, c_size_t, _d]),
     "dmi_get_step_terms": (c_int, [_solver_p, _d, _d]),

@@ -34,6 +34,17 @@ def _count(value: Any, name: str, minimum: int) -> int:
     return v
 
 
+def _positive(value: Any, name: str) -> float:
+    """value as a finite float > 0, or InvalidArgument."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InvalidArgument(_lib.EINVAL, f"{name} = {value!r} is not a number") from None
+    if not (math.isfinite(v) and v > 0):
+        raise InvalidArgument(_lib.EINVAL, f"{name} = {v}: must be finite and > 0")
+    return v
+
+
 def _array(value: Any, shape: tuple[int, ...], name: str) -> np.ndarray:
     """value as a C-contiguous float64 array of the given shape, or InvalidArgument."""
     try:
@@ -51,7 +62,9 @@ def _ptr(a: np.ndarray | None) -> Any:
 
 class Solver:
     """The implicit Euler scheme (3.12)-(3.13) for u' + A(u) + f(t, u) + int_0^tau H(s) u(t-s) ds ∋ 0,
-    u = z on [-tau, 0], in R^n, with h = tau / N (``dmi_create``).
+    u = z on [-tau, 0], in R^n, with h = tau / N (``Solver(n, tau, N)``, ``dmi_create``) or with a
+    step h that need not divide tau (``Solver(n, tau, h=h)``, ``dmi_create_h``: the delay sum's
+    last cell is partial, weighted theta h, see :meth:`__init__`).
 
     Nothing is set at first: f = 0, A = 0, H = 0, z = 0.  Set the model with the ``set_*``
     methods, then :meth:`init`, then :meth:`step`, :meth:`advance` or :meth:`run`.
@@ -67,24 +80,33 @@ class Solver:
     only by Python callbacks).
     """
 
-    def __init__(self, n: int, tau: float, N: int):
-        """A solver for R^n with delay tau > 0 (finite) and N >= 1 steps per tau (h = tau / N)."""
+    def __init__(self, n: int, tau: float, N: int | None = None, *, h: float | None = None):
+        """A solver for R^n with delay tau > 0 (finite) and either N >= 1 steps per tau
+        (h = tau / N, ``dmi_create``) or the step h > 0 itself (``dmi_create_h``, libdmi 1.2):
+        give exactly one of them.  With h, tau / h need not be an integer: the delay sum has
+        N = ceil(tau / h) cells, the last one weighted theta h = tau - (N - 1) h (0 < theta <= 1);
+        h = tau / N as ``Solver(n, tau, N)`` computes it gives that solver, bitwise; h > tau
+        gives N = 1.  :attr:`N` and :attr:`h` tell what the solver uses."""
         self._handle = None
         n = _count(n, "n", 1)
-        N = _count(N, "N", 1)
-        try:
-            tau = float(tau)
-        except (TypeError, ValueError):
-            raise InvalidArgument(_lib.EINVAL, f"tau = {tau!r} is not a number") from None
-        if not (math.isfinite(tau) and tau > 0):
-            raise InvalidArgument(_lib.EINVAL, f"tau = {tau}: must be finite and > 0")
+        if (N is None) == (h is None):
+            raise InvalidArgument(_lib.EINVAL, f"Solver(n, tau, N=..., h=...): give exactly one of "
+                                  f"N and h (got N = {N!r}, h = {h!r})")
+        tau = _positive(tau, "tau")
         handle = ctypes.c_void_p()
-        rc = _L.dmi_create(ctypes.byref(handle), n, tau, N)
+        if h is None:
+            N = _count(N, "N", 1)
+            rc = _L.dmi_create(ctypes.byref(handle), n, tau, N)
+            call = f"dmi_create(n = {n}, tau = {tau!r}, N = {N})"
+        else:
+            h = _positive(h, "h")
+            rc = _L.dmi_create_h(ctypes.byref(handle), n, tau, h)
+            call = f"dmi_create_h(n = {n}, tau = {tau!r}, h = {h!r})"
         if rc != _lib.OK:
-            raise from_code(rc, f"dmi_create(n = {n}, tau = {tau!r}, N = {N}): "
-                                f"{_L.dmi_strerror(rc).decode()}")
+            raise from_code(rc, f"{call}: {_L.dmi_strerror(rc).decode()}")
         self._handle = handle
-        self._n, self._tau, self._N = n, tau, N
+        self._n, self._tau, self._N = n, tau, int(_L.dmi_get_N(handle))
+        self._h_given = h  # (for repr)
         self._keep: dict[str, cb.Bound] = {}   # callbacks and data libdmi points to
         self._failure: list = [None]           # an exception raised in a Python callback
         self._busy = threading.Lock()
@@ -134,12 +156,14 @@ class Solver:
 
     @property
     def N(self) -> int:
-        """Steps per delay: h = tau / N."""
+        """Cells of the delay sum, ``dmi_get_N``: steps per delay (h = tau / N) for
+        ``Solver(n, tau, N)``; ceil(tau / h) for ``Solver(n, tau, h=h)``.  The window has N + 1
+        rows."""
         return self._N
 
     @property
     def h(self) -> float:
-        """Step size h = tau / N (time units), ``dmi_get_h``."""
+        """Step size h (time units), ``dmi_get_h``: tau / N, or the h given."""
         with self._using() as s:
             return _L.dmi_get_h(s)
 
@@ -331,7 +355,7 @@ class Solver:
         return buf.raw
 
     def load_state(self, data: bytes) -> None:
-        """Restores bytes of :meth:`save_state` from a solver with the same n, N, tau (and
+        """Restores bytes of :meth:`save_state` from a solver with the same n, N, tau, h (and
         exponential kernel); needs :meth:`init` first.  Bad bytes: InvalidArgument, solver
         unchanged.  Stepping on is bitwise the saving solver's."""
         try:
@@ -364,4 +388,6 @@ class Solver:
             self._handle = None
 
     def __repr__(self) -> str:
+        if self._h_given is not None:
+            return f"dmi.Solver(n={self._n}, tau={self._tau!r}, h={self._h_given!r})"
         return f"dmi.Solver(n={self._n}, tau={self._tau!r}, N={self._N})"

@@ -142,7 +142,7 @@ def check_fortran(header, module):
                  for n in re.findall(r"\w+", line))
     for name in sorted(api):
         check(name in bound, f"{module}: no interface bound to the C function {name}")
-        check(name in procedures and name in public,
+        check(name.lower() in procedures and name.lower() in public,  # (Fortran ignores case)
               f"{module}: no public Fortran procedure named {name}")
     parameters = {}  # name: (value, public)
     for attrs, name, value in re.findall(r"^\s*integer\b(.*\bparameter\b.*)::\s*(DMI_\w+)\s*=\s*(-?\d+)",

@@ -101,6 +101,20 @@ int core_close_rel(const char *what, double a, double b, double rel)
     return ok;
 }
 
+double core_ls_slope(const double *x, const double *y, size_t n)
+{
+    double mx = 0, my = 0, sxy = 0, sxx = 0;
+    for (size_t i = 0; i < n; i++) {
+        mx += x[i] / (double)n;
+        my += y[i] / (double)n;
+    }
+    for (size_t i = 0; i < n; i++) {
+        sxy += (x[i] - mx) * (y[i] - my);
+        sxx += (x[i] - mx) * (x[i] - mx);
+    }
+    return sxy / sxx;
+}
+
 dmi_solver *core_paper_solver(paper_example *ex, size_t N)
 {
     dmi_solver *s = NULL;

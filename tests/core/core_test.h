@@ -37,6 +37,9 @@ double *core_read_csv(const char *name, size_t ncols, size_t *rows);
 /* |a - b| <= rel * |b|, printing both values when it fails. */
 int core_close_rel(const char *what, double a, double b, double rel);
 
+/* Least-squares slope of y against x (n points). */
+double core_ls_slope(const double *x, const double *y, size_t n);
+
 /* A new initialised solver of a paper example (examples/paper.c) with
  * h = tau / N, tau = 1, or NULL; ex must outlive it. */
 dmi_solver *core_paper_solver(paper_example *ex, size_t N);

@@ -95,21 +95,6 @@ static void test_example_42(void)
     check_example(42, 4.2);
 }
 
-/* Least-squares slope of y against x. */
-static double ls_slope(const double *x, const double *y, size_t n)
-{
-    double mx = 0, my = 0, sxy = 0, sxx = 0;
-    for (size_t i = 0; i < n; i++) {
-        mx += x[i] / (double)n;
-        my += y[i] / (double)n;
-    }
-    for (size_t i = 0; i < n; i++) {
-        sxy += (x[i] - mx) * (y[i] - my);
-        sxx += (x[i] - mx) * (x[i] - mx);
-    }
-    return sxy / sxx;
-}
-
 /* Figure 4.3: Example 4.2 at h = 1/(1001 + 50k), k = 1..18. */
 static void test_order_study(void)
 {
@@ -131,7 +116,7 @@ static void test_order_study(void)
     }
     const char *name[3] = {"state", "w", "w'"};
     for (int c = 0; c < 3; c++) {
-        double slope = ls_slope(logh, loge[c], K);
+        double slope = core_ls_slope(logh, loge[c], K);
         printf("\n  observed order (least-squares slope, error in %s): %.4f", name[c], slope);
         CU_ASSERT(slope >= 0.95 && slope <= 1.05);
     }
