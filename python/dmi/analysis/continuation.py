@@ -7,8 +7,10 @@ predictor z + ds t, then Newton on  F_p(x) - x = 0,  <t, z - z_pred> = 0  with G
 bordered matrix-free Jacobian [[D_xF - I, D_pF], [t_x' / dim, t_p]] (D_xF by forward differences
 along the Krylov vectors, D_pF by one difference in p per iteration).  The inner product weighs
 x by 1 / dim (an RMS), so ds is a step in "p or RMS state units".  The period M h is kept: make(p)
-must keep h (a model over tau with a free step h: N may change with p; the state then gains
-rows, filled by M-periodicity).  The step grows by 1.5 after an easy corrector (<= 3 iterations),
+must keep h.  A model over tau with a free step h (libdmi 1.2's ``Solver(n, tau, h=...)``) has
+N = ceil(tau / h) changing with p: the states hold L = max N + 1 over the two ends of the range
+(+ 2 %) rows, the older ones filled by M-periodicity (:meth:`StepMap.extend`); the map reads
+the last N(p) + 1.  The step grows by 1.5 after an easy corrector (<= 3 iterations),
 halves after a failure, and the branch ends at p_end, at ``max_points``, when it leaves the
 p-range it started in, or when the step falls below ``min_step`` (``Branch.status`` says which).
 
@@ -39,7 +41,7 @@ import numpy as np
 import scipy.sparse.linalg as sla
 
 from .floquet import floquet_multipliers, monodromy_operator
-from .shooting import (Model, Orbit, ShootingError, StepMap, build, extend_periodic, newton,
+from .shooting import (Model, Orbit, ShootingError, StepMap, build, newton,
                        periodic_orbit, stuck_mask)
 
 
@@ -152,7 +154,8 @@ def _events(a: BranchPoint, b: BranchPoint, index: int) -> list[Event]:
     ev: list[Event] = []
 
     def at(fa: float, fb: float) -> float:
-        return a.p if fa == fb else a.p + (b.p - a.p) * fa / (fa - fb)
+        w = 0.5 if fa == fb or fa * fb > 0 else fa / (fa - fb)  # no sign change: the middle
+        return a.p + (b.p - a.p) * w
 
     if a.dpds * b.dpds < 0:
         ev.append(Event("fold", at(a.dpds, b.dpds), index, None, "dp/ds changes sign"))
@@ -242,7 +245,8 @@ def _locate_stick(maps: _Maps, a: BranchPoint, b: BranchPoint, e: Event, tol: fl
 
 
 class _Maps:
-    """StepMaps by p (the last few), the state grown to N(p) + 1 rows by periodicity."""
+    """StepMaps by p (the last few), all on states of ``rows`` rows; a p whose N + 1 exceeds it
+    is refused (ShootingError: the corrector retries with a shorter step)."""
 
     def __init__(self, make: Model, M: int, h: float, rows: int):
         self.make, self.M, self.h, self.rows = make, M, h, rows
@@ -255,7 +259,9 @@ class _Maps:
             if abs(s.h - self.h) > 1e-12 * self.h:
                 raise ValueError(f"make(p = {p!r}) has h = {s.h!r}; the branch keeps the period "
                                  f"M h with h = {self.h!r} (make(p) must keep h)")
-            self.rows = max(self.rows, s.N + 1)
+            if s.N + 1 > self.rows:
+                raise ShootingError(f"make(p = {p!r}) has N = {s.N}: the branch's states hold "
+                                    f"{self.rows} rows (N + 1 at the ends of its range, + 2 %)", [])
             F = StepMap(self.make, p, self.M, self.rows)
             if len(self._cache) > 4:
                 self._cache.pop(next(iter(self._cache)))
@@ -263,9 +269,11 @@ class _Maps:
         return F
 
 
-def _corrector(maps: _Maps, z: np.ndarray, t: np.ndarray, tol: float, max_iter: int
-               ) -> tuple[np.ndarray, int]:
-    """Newton on (F_p(x) - x, <t, z - z_pred>) from z = z_pred; returns (z, iterations)."""
+def _corrector(maps: _Maps, z: np.ndarray, t: np.ndarray, tol: float, max_iter: int,
+               ds: float) -> tuple[np.ndarray, int]:
+    """Newton on (F_p(x) - x, <t, z - z_pred>) from z = z_pred; returns (z, iterations).
+    ShootingError when an iterate strays more than ds from the predictor (weighted norm): the
+    step is then too long for the predictor, and another branch may lie on the hyperplane."""
     zp = z.copy()
     dim = z.size - 1
     w = np.full(z.size, 1.0 / dim)
@@ -301,6 +309,10 @@ def _corrector(maps: _Maps, z: np.ndarray, t: np.ndarray, tol: float, max_iter: 
         if not np.all(np.isfinite(dz)):
             break
         z = z + dz
+        d = z - zp
+        if math.sqrt(float(np.dot(w * d, d))) > ds:
+            raise ShootingError(f"corrector strayed {math.sqrt(float(np.dot(w * d, d))):.3g} > "
+                                f"ds = {ds:.3g} from the predictor at p = {float(z[-1])!r}", [rn])
     raise ShootingError(f"corrector did not converge at p = {float(z[-1])!r} "
                         f"(residual {rn:.3g} after {max_iter} iterations)", [rn])
 
@@ -322,12 +334,19 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     min_step = step / 1000 if min_step is None else min_step
     max_step = 4 * step if max_step is None else max_step
     lo, hi = sorted((orbit.p, float(p_end)))
-    maps = _Maps(orbit.make, orbit.steps, orbit.h, orbit.rows or orbit.state.size // orbit.u.shape[1])
     n = orbit.u.shape[1]
+    # rows for the whole range: N may grow with p (tau with a fixed h); probe both ends
+    rows = max(orbit.rows or orbit.state.size // n, build(orbit.make, orbit.p).N + 1)
+    try:
+        rows = max(rows, build(orbit.make, float(p_end)).N + 1)
+    except ValueError:
+        pass  # make refuses p_end: the branch will stop where make does
+    rows += max(2, rows // 50)  # room for a corrector a little beyond the ends
+    maps = _Maps(orbit.make, orbit.steps, orbit.h, rows)
     x0 = np.array(orbit.state)
     F0 = maps(orbit.p)
     if F0.dim != x0.size:
-        x0 = extend_periodic(x0, n, orbit.steps, F0.L)
+        x0 = F0.extend(x0)
     pts = [_point(F0, x0, multipliers, sections, direction, orbit.iterations)]
     events: list[Event] = []
     status = "max_points reached"
@@ -338,7 +357,7 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
         p1 = orbit.p + direction * ds
         try:
             F1 = maps(p1)
-            x1, res = newton(F1, extend_periodic(x0, n, orbit.steps, F1.L), tol=tol,
+            x1, res = newton(F1, F1.extend(x0), tol=tol,
                              max_iter=max_iter + 4, what=f"continuation at p = {p1!r}")
             break
         except (ShootingError, ValueError) as e:
@@ -347,8 +366,6 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                 return Branch(pts, events, f"first step failed: {e}", orbit.make, orbit.steps,
                               orbit.h, maps.rows, sections)
     z = np.concatenate([x1, [p1]])
-    if z_prev.size != z.size:
-        z_prev = np.concatenate([extend_periodic(x0, n, orbit.steps, F1.L), [orbit.p]])
     pts.append(_point(maps(p1), x1, multipliers, sections, direction, len(res) - 1))
     events += _events(pts[-2], pts[-1], 1)
     while len(pts) < max_points:
@@ -368,7 +385,7 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
             if (zp[-1] - p_end) * direction > 0 and abs(t[-1]) > 0.5:
                 zp = z + ((p_end - z[-1]) / t[-1]) * t
             try:
-                zn, its = _corrector(maps, zp, t, tol, max_iter)
+                zn, its = _corrector(maps, zp, t, tol, max_iter, ds)
                 break
             except (ShootingError, ValueError) as e:
                 ds /= 2
@@ -379,11 +396,6 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                     break
         if zn is None:
             break
-        L = maps.rows
-        if zn.size - 1 != L * n:  # N grew: more rows by periodicity
-            zn = np.concatenate([extend_periodic(zn[:-1], n, orbit.steps, L), zn[-1:]])
-        if z.size != zn.size:
-            z = np.concatenate([extend_periodic(z[:-1], n, orbit.steps, L), z[-1:]])
         z_prev, z = z, zn
         dpds = float(z[-1] - z_prev[-1])
         pts.append(_point(maps(float(z[-1])), z[:-1], multipliers, sections, dpds, its))
@@ -413,7 +425,7 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
     q = a if np.any(a.multipliers.real < -1) else b
     maps = _Maps(branch.make, branch.steps, branch.h, branch.rows)
     F = maps(q.p)
-    x = extend_periodic(q.state, F.n, branch.steps, F.L)
+    x = F.extend(q.state)
     A = monodromy_operator(F, x)
     if A.shape[0] <= 64:
         D = np.column_stack([A.matvec(np.eye(A.shape[0])[:, j]) for j in range(A.shape[0])])

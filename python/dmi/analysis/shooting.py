@@ -97,46 +97,49 @@ class StepMap:
         self.evaluations += 1
         return s.run(self.M)[1]
 
+    def extend(self, x: np.ndarray) -> np.ndarray:
+        """x (k >= N + 1 rows, flattened) as a state of L rows: the older rows by M-periodicity
+        from one run, row at t = -j being U^(M - j mod M) (exact at an M-periodic orbit; a guess
+        elsewhere).  The last L rows when k >= L."""
+        X = np.asarray(x, dtype=float).reshape(-1, self.n)
+        k = X.shape[0]
+        if k >= self.L:
+            return X[k - self.L:].ravel()
+        if k < self.N + 1:
+            raise ValueError(f"a state of {k} rows; the map reads N + 1 = {self.N + 1}")
+        s = self.solver
+        s.load_state(self._start)
+        s.set_window(X[k - self.N - 1:])
+        U = s.run(self.M)[1]
+        out = np.empty((self.L, self.n))
+        out[self.L - k:] = X
+        for j in range(k, self.L):
+            out[self.L - 1 - j] = U[(self.M - j) % self.M]
+        return out.ravel()
+
     def __call__(self, x: np.ndarray) -> np.ndarray:
         X = np.asarray(x, dtype=float).reshape(self.L, self.n)
         U = self.trajectory(X)
         return np.concatenate([X, U[1:]])[-self.L:].ravel()
 
 
-def state_of(solver: Solver, M: int, rows: int | None = None) -> np.ndarray:
-    """The state (L rows flattened) of a solver run onto an orbit of M steps, at the next step
-    index that is a multiple of M (the orbit's phase 0): the solver is advanced there and then
-    restored (``save_state`` / ``load_state``), so it is left as it was.  L > N + 1 rows are
-    filled by M-periodicity (:func:`extend_periodic`)."""
+def state_of(solver: Solver, M: int) -> np.ndarray:
+    """The window (N + 1 rows, flattened) of a solver run onto an orbit of M steps, at the next
+    step index that is a multiple of M (the orbit's phase 0): the solver is advanced there and
+    then restored (``save_state`` / ``load_state``), so it is left as it was."""
     saved = solver.save_state()
     try:
         solver.advance((-solver.step_index) % M)
-        W = solver.get_window()
+        return solver.get_window().ravel()
     finally:
         solver.load_state(saved)
-    L = solver.N + 1 if rows is None else rows
-    return extend_periodic(W, solver.n, M, L)
-
-
-def extend_periodic(x: np.ndarray, n: int, M: int, rows: int) -> np.ndarray:
-    """A state of a periodic orbit (k rows of n) extended to ``rows`` >= k rows by M-periodicity:
-    a row is the row M steps later (valid at an M-periodic orbit)."""
-    X = np.asarray(x, dtype=float).reshape(-1, n)
-    k = X.shape[0]
-    if rows <= k:
-        return X[k - rows:].ravel()
-    out = np.empty((rows, n))
-    out[rows - k:] = X
-    for r in range(rows - k - 1, -1, -1):
-        src = r + M
-        out[r] = out[src] if src < rows else out[rows - 1]  # src >= rows only if M > k
-    return out.ravel()
 
 
 def newton(F: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, *, tol: float = 1e-10,
            max_iter: int = 30, what: str = "x = F(x)") -> tuple[np.ndarray, list[float]]:
     """Solves x = F(x) by Newton's method with GMRES on the matrix-free Jacobian I - DF
-    (forward differences of F, step sqrt(eps) scaled to |x|).  Converged when |F(x) - x|_inf <=
+    (forward differences of F, step sqrt(eps_machine) max(1, |x|_inf): the derivative of the
+    map's smooth piece, a semismooth Newton).  Converged when |F(x) - x|_inf <=
     tol * max(1, |x|_inf).  Returns (x, residual history).  Raises ShootingError when F fails,
     the Jacobian is singular, or the residual stalls or does not fall below tol within
     max_iter iterations."""
@@ -188,12 +191,14 @@ def newton(F: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, *, tol: float 
                                 f"at Newton iteration {len(res)} (GMRES relative residual "
                                 f"{lin:.2g}, residuals {_fmt(res)}): a Floquet multiplier at 1, "
                                 "a non-isolated orbit, or no orbit", res)
-        # damped step: halve while the residual grows (at most 5 times)
+        # the full step, halved (at most 5 times) only while it makes the residual 100 times
+        # worse: a step into the next piece of a piecewise-smooth map may raise the residual for
+        # one iteration before the next lands on the fixed point
         lam = 1.0
         for _ in range(6):
             xn = x + lam * dx
             Fn = ev(xn)
-            if np.max(np.abs(Fn - xn)) < rn or lam < 0.05:
+            if np.max(np.abs(Fn - xn)) < 100 * rn or lam < 0.05:
                 break
             lam *= 0.5
         x, Fx = xn, Fn
@@ -282,14 +287,16 @@ def periodic_orbit(make: Model, p: float, period: float | None = None, guess: An
         if (guess.n, guess.N) != (F.n, F.N) or guess.h != F.h:
             raise ValueError(f"guess: a solver with n = {guess.n}, N = {guess.N}, h = {guess.h!r}; "
                              f"make(p) has n = {F.n}, N = {F.N}, h = {F.h!r}")
-        x0 = state_of(guess, M, F.L)
+        x0 = state_of(guess, M)
     else:
         x0 = np.asarray(guess, dtype=float).ravel()
         if x0.size == F.n and F.L > 1:
             x0 = np.tile(x0, F.L)  # a single state: a constant window
-        if x0.size != F.dim:
+        if x0.size % F.n or not F.N + 1 <= x0.size // F.n <= F.L:
             raise ValueError(f"guess has {x0.size} values; the state has L n = {F.L} x {F.n} = "
-                             f"{F.dim} (or give n = {F.n} values for a constant window)")
+                             f"{F.dim} (or give k rows, N + 1 = {F.N + 1} <= k <= L, or n = "
+                             f"{F.n} values for a constant window)")
+    x0 = F.extend(x0)
     x, res = newton(F, x0, tol=tol, max_iter=max_iter,
                     what=f"periodic orbit at p = {p!r}, period {period!r} = {M} steps")
     return make_orbit(F, x, res, multipliers)
