@@ -57,6 +57,27 @@ def model(M: int):
     return make
 
 
+def compare(branches, df) -> None:
+    """Prints how far the sweep's Poincare points lie from the stable parts of the branches:
+    at each swept tau inside a stable stretch, the largest distance from a sweep point to the
+    nearest section value of the branch (interpolated linearly in tau)."""
+    for k, br in enumerate(branches):
+        p, st = br.p, br.stable
+        sec = np.array([q.section[:, 0] for q in br.points])
+        worst, count = 0.0, 0
+        for tau, w in zip(df["tau"], df["w_poincare"]):
+            i = int(np.searchsorted(p, tau)) if p[-1] > p[0] else None
+            if i is None or i == 0 or i >= len(p) or not (st[i - 1] and st[i]):
+                continue
+            f = (tau - p[i - 1]) / (p[i] - p[i - 1])
+            ref = sec[i - 1] + f * (sec[i] - sec[i - 1])
+            d = np.abs(np.asarray(w, float)[:, None] - ref[None, :]).min(axis=1).max()
+            worst, count = max(worst, float(d)), count + 1
+        if count:
+            print(f"branch {k + 1}: sweep points at {count} stable values of tau lie within "
+                  f"{worst:.3g} of it (the sweep's h = tau / 1e4, the branch's h = 4 pi / M)")
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out")
@@ -119,6 +140,7 @@ def main(argv: list[str] | None = None) -> int:
         xs = np.concatenate([np.full(len(v), x) for x, v in zip(df["tau"], df["w_poincare"])])
         ys = np.concatenate([np.asarray(v, float) for v in df["w_poincare"]])
         ax.plot(xs, ys, ".", color="0.6", markersize=2, zorder=1)
+        compare(branches, df)
         ax.text(0.02, 0.03, "grey dots: dmi-sweep, w at t = k 4\u03c0, t \u2208 [400, 800], "
                 "h = \u03c4/10\u2074", transform=ax.transAxes, fontsize=8, color="0.35")
     for br, colour in zip(branches, ("C0", "C0", "C3")):

@@ -72,5 +72,5 @@ def test_stick_onset_located_and_passed():
     # the points past the kink are orbits: the map's residual at each
     from dmi.analysis.shooting import StepMap
     for q in b.points[-3:]:
-        F = StepMap(d.make_for(M), q.p, M)
+        F = StepMap(d.make_for(M), q.p, M, rows=b.rows)
         assert np.max(np.abs(F(q.state) - q.state)) < 1e-9

@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse.linalg as sla
 
-from .floquet import floquet_multipliers, monodromy_operator
+from .floquet import monodromy_operator, ritz
 from .shooting import (Model, Orbit, ShootingError, StepMap, build, newton,
                        periodic_orbit, stuck_mask)
 
@@ -106,8 +106,19 @@ class Branch:
         return np.array([getattr(q, name) for q in self.points])
 
 
-def _stick_profile(F: StepMap, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Stuck steps, stick phases and margins (see the module) over one period, step by step."""
+def _stick_profile(F: StepMap, x: np.ndarray, margins: bool = True, U: np.ndarray | None = None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Stuck steps, stick phases and margins (see the module) over one period.  The margins
+    need the resolvent's argument X of every step: one period step by step (M calls from
+    Python); ``margins=False`` reads the stuck steps from one run (or its trajectory ``U``)
+    and leaves the margins NaN."""
+    if not margins:
+        U = F.trajectory(x) if U is None else U
+        stuck = stuck_mask(U)
+        steps = stuck.sum(axis=0)
+        phases = np.sum(stuck & ~np.roll(stuck, 1, axis=0), axis=0)
+        phases[steps == F.M] = 1
+        return steps, phases, np.full(F.n, np.nan)
     s = F.solver
     X0 = np.asarray(x).reshape(F.L, F.n)
     s.load_state(F._start)
@@ -138,10 +149,18 @@ def _stick_profile(F: StepMap, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, n
 
 
 def _point(F: StepMap, x: np.ndarray, multipliers: int, sections: int, dpds: float,
-           iterations: int) -> BranchPoint:
+           iterations: int, margins: bool = True, warm: list | None = None) -> BranchPoint:
+    """The BranchPoint at the fixed point x of F; ``warm``: a one-element list holding the
+    previous point's Ritz basis (updated), for 1 sweep of subspace iteration instead of 3."""
     U = F.trajectory(x)
-    mu = floquet_multipliers(F, x, multipliers) if multipliers > 0 else np.empty(0, complex)
-    steps, phases, margin = _stick_profile(F, x)
+    mu = np.empty(0, complex)
+    if multipliers > 0:
+        start = warm[0] if warm else None
+        mu, basis = ritz(F, x, multipliers, start=start,
+                         iterations=1 if start is not None and start.shape[0] == x.size else 3)
+        if warm is not None:
+            warm[0] = basis
+    steps, phases, margin = _stick_profile(F, x, margins, U)
     k = F.M // sections
     return BranchPoint(p=F.p, period=F.M * F.h, amplitude=0.5 * (U.max(axis=0) - U.min(axis=0)),
                        multipliers=mu, stable=bool(mu.size and np.all(np.abs(mu) < 1)),
@@ -234,7 +253,7 @@ def _locate_stick(maps: _Maps, a: BranchPoint, b: BranchPoint, e: Event, tol: fl
             xm, _ = newton(F, 0.5 * (xa + xb), tol=tol, max_iter=12, what=f"locating at {pm!r}")
         except (ShootingError, ValueError):
             return e
-        st, ph, _ = _stick_profile(F, xm)
+        st, ph, _ = _stick_profile(F, xm, margins=False)
         if key((st[i], ph[i])) == ka:
             pa, xa = pm, xm
         else:
@@ -320,13 +339,14 @@ def _corrector(maps: _Maps, z: np.ndarray, t: np.ndarray, tol: float, max_iter: 
 def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points: int = 200,
                    min_step: float | None = None, max_step: float | None = None,
                    multipliers: int = 6, tol: float = 1e-10, max_iter: int = 8,
-                   sections: int = 1) -> Branch:
+                   sections: int = 1, margins: bool = True) -> Branch:
     """Continues ``orbit`` (from :func:`periodic_orbit`) in p towards ``p_end`` by
     pseudo-arclength with initial step ``step`` (p units; ``min_step`` default step / 1000,
     ``max_step`` default 4 step).  Every point gets ``multipliers`` Floquet multipliers and a
     stick profile; events are detected between consecutive points (see the module).
     ``sections``: the orbit spans this many forcing periods (a period-doubled branch: 2), for
-    ``BranchPoint.section``.  Returns a :class:`Branch`; a corrector that fails at the smallest
+    ``BranchPoint.section``.  ``margins=False`` skips the margins (NaN), which cost one period
+    stepped from Python a point (the stuck steps and phases then come from one run).  Returns a :class:`Branch`; a corrector that fails at the smallest
     step ends the branch with that ``status``, it does not raise."""
     if not (math.isfinite(step) and step > 0):
         raise ValueError(f"step = {step!r}: must be finite and > 0 (p units)")
@@ -347,7 +367,8 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     F0 = maps(orbit.p)
     if F0.dim != x0.size:
         x0 = F0.extend(x0)
-    pts = [_point(F0, x0, multipliers, sections, direction, orbit.iterations)]
+    warm: list = [None]
+    pts = [_point(F0, x0, multipliers, sections, direction, orbit.iterations, margins, warm)]
     events: list[Event] = []
     status = "max_points reached"
     # the first step: natural continuation in p
@@ -366,7 +387,8 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                 return Branch(pts, events, f"first step failed: {e}", orbit.make, orbit.steps,
                               orbit.h, maps.rows, sections)
     z = np.concatenate([x1, [p1]])
-    pts.append(_point(maps(p1), x1, multipliers, sections, direction, len(res) - 1))
+    pts.append(_point(maps(p1), x1, multipliers, sections, direction, len(res) - 1, margins,
+                      warm))
     events += _events(pts[-2], pts[-1], 1)
     while len(pts) < max_points:
         if (pts[-1].p - p_end) * direction >= 0:
@@ -398,7 +420,8 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
             break
         z_prev, z = z, zn
         dpds = float(z[-1] - z_prev[-1])
-        pts.append(_point(maps(float(z[-1])), z[:-1], multipliers, sections, dpds, its))
+        pts.append(_point(maps(float(z[-1])), z[:-1], multipliers, sections, dpds, its, margins,
+                          warm))
         for e in _events(pts[-2], pts[-1], len(pts) - 1):
             if e.kind == "fold":
                 e = _refine_fold(pts[-3:], e)
