@@ -7,16 +7,23 @@
 # off, from a run 10 periods from rest), the 10 leading multipliers, one continuation step
 # (continue_orbit with 6 multipliers a point, per point after the first; with the stick margins,
 # one period stepped from Python, and without).  Rounds interleave the quantities; the fastest round of
-# each counts; CPU times of the process (the machine may be shared).
+# each counts; CPU times of the process (the machine may be shared); one BLAS thread.
 # Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_orbit.py [--rounds 3] [--N 1000 10000]
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
-import argparse
-import math
-import sys
-import time
-from pathlib import Path
+import os
+
+# One BLAS thread: on the loaded 2-core machine OpenBLAS's spinning threads made GMRES and the
+# QR of the multipliers 10 times slower (in CPU time too) than with one thread.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import argparse  # noqa: E402
+import math  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "python" / "examples"))
