@@ -167,3 +167,42 @@ class Logistic:
         r = 1 + p
         x = ((r + 1) + np.array([1, -1]) * np.sqrt((r + 1) * (r - 3))) / (2 * r)
         return x * r / p
+
+
+class Belt:
+    """A mass on a moving belt with negative viscous damping, autonomous:
+    x'' - 2 d x' + x + alpha sigma(x' - v) ∋ 0, as u = (x, y), y = x' - v: f = (-(y + v),
+    x - 2 d (y + v)), A = (0, alpha sigma(y)).  Stick (y = 0) while |x - 2 d v| <= alpha; the slip
+    starts at x_e = alpha + 2 d v with x' = v and, x'' - 2 d x' + x = alpha (y < 0), grows until x'
+    is v again at x_r; the stick then carries x back to x_e at speed v.  Period and stick time
+    from the closed-form slip (one root of x'(t) = v)."""
+
+    def __init__(self, alpha: float = 1.0, v: float = 0.5, d: float = 0.05):
+        self.alpha, self.v, self.d = alpha, v, d
+        w = np.sqrt(1 - d * d)
+        z0, dz0 = 2 * d * v, v  # z = x - alpha
+
+        def z(t):
+            return np.exp(d * t) * (z0 * np.cos(w * t) + (dz0 - d * z0) / w * np.sin(w * t))
+
+        def dz(t):
+            e = np.exp(d * t)
+            a, b = z0, (dz0 - d * z0) / w
+            return e * ((d * a + w * b) * np.cos(w * t) + (d * b - w * a) * np.sin(w * t))
+        ts = np.linspace(1e-6, 2 * np.pi / w, 20001)
+        k = np.nonzero(dz(ts) - v >= 0)[0]
+        k = k[k > 10][0]  # the first return of x' to v
+        self.t_slip = so.brentq(lambda t: dz(t) - v, ts[k - 1], ts[k])
+        self.x_r = alpha + z(self.t_slip)
+        self.x_e = alpha + 2 * d * v
+        if abs(self.x_r - 2 * d * v) > alpha:
+            raise RuntimeError("no stick after the slip")
+        self.t_stick = (self.x_e - self.x_r) / v
+        self.T = self.t_slip + self.t_stick
+
+    def make(self, p: float, h: float = 0.01) -> dmi.Solver:
+        a, v, d = self.alpha, self.v, self.d
+        s = dmi.Solver(2, h, h=h)
+        s.set_rhs(lambda t, u: np.array([-(u[1] + v), u[0] - 2 * d * (u[1] + v)]))
+        s.set_friction([0.0, a])
+        return s

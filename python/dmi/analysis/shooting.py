@@ -259,8 +259,9 @@ def stick_fraction(u: np.ndarray) -> np.ndarray:
 
 
 def periodic_orbit(make: Model, p: float, period: float | None = None, guess: Any = None, *,
-                   guess_period: float | None = None, tol: float = 1e-10, max_iter: int = 30,
-                   multipliers: int = 10, rows: int | None = None) -> Orbit:
+                   guess_period: float | None = None, steps: int | None = None,
+                   tol: float = 1e-10, max_iter: int = 30, multipliers: int = 10,
+                   rows: int | None = None) -> Orbit:
     """The periodic orbit of the model ``make`` at ``p`` near ``guess``, by shooting.
 
     ``period`` (time units) must be a whole number M of steps h of ``make(p)`` (forced systems
@@ -270,16 +271,21 @@ def periodic_orbit(make: Model, p: float, period: float | None = None, guess: An
     multiple of M, the orbit's phase 0).  ``rows``: L (default N + 1).  Newton with GMRES on
     the matrix-free Jacobian converges to ``tol`` in the max norm (relative to max(1, |x|));
     ``multipliers``: how many leading Floquet multipliers to compute (0: none, ``stable`` is
-    then None-like False).  ``period=None`` with ``guess_period``: autonomous orbits, which need
-    a step h free of tau (libdmi 1.2's ``dmi.Solver(n, tau, h=...)``): not yet available here.
+    then False).  ``period=None`` with ``guess_period``: an autonomous orbit of unknown period
+    M h, ``steps`` = M fixed (default guess_period / make(p).h) and h unknown, with a phase
+    condition; the model must take the step, ``make(p, h=...)`` (libdmi 1.2's
+    ``dmi.Solver(n, tau, h=...)``), see :mod:`dmi.analysis.autonomous`.
 
     Raises ValueError for bad input (period <= 0 or not a multiple of h, make failing, a guess of
     the wrong shape) and :class:`ShootingError` when Newton fails (with the residuals tried)."""
-    if period is None:
-        raise NotImplementedError("period=None (autonomous orbits, unknown period) needs a step h "
-                                  "free of tau (libdmi 1.2's free-h solver); give the period")
     if guess is None:
         raise ValueError("guess: give a state or a dmi.Solver run onto the orbit")
+    if period is None:
+        if guess_period is None:
+            raise ValueError("period=None (an autonomous orbit) needs guess_period")
+        from .autonomous import autonomous_orbit
+        return autonomous_orbit(make, p, guess, guess_period, steps=steps, tol=tol,
+                                max_iter=max_iter, multipliers=multipliers)
     probe = build(make, p)
     M = steps_per_period(probe.h, period)
     F = StepMap(make, p, M, rows)
