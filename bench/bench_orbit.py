@@ -6,8 +6,8 @@
 # one period (advance(M)), one Newton solve (periodic_orbit from the run's window, multipliers
 # off, from a run 10 periods from rest), the 10 leading multipliers, one continuation step
 # (continue_orbit with 6 multipliers a point, per point after the first; with the stick margins,
-# one period stepped from Python, and without).  Rounds interleave the quantities; the fastest round of
-# each counts; CPU times of the process (the machine may be shared); one BLAS thread.
+# one period stepped from Python, and without).  Rounds interleave the quantities; the fastest
+# round of each counts; CPU times of the process (the machine may be shared); one BLAS thread.
 # Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_orbit.py [--rounds 3] [--N 1000 10000]
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations

@@ -8,8 +8,9 @@ A = (0, sigma(v)), H = [[0, 0], [0.5, 0]] (a constant kernel: the O(1) recursion
 period P = 4 pi is M steps of h = P / M for every tau (libdmi 1.2's free step: N = ceil(tau / h)
 changes with tau, the state gains rows by periodicity).  The period-1 orbit is found at tau_0
 from a plain run (the solver is the guess), continued down to tau_min and up to tau_1; the
-branch born at the first period doubling is continued too.  Writes OUT/orbit_tau.png (over OUT/sweep_ex43 when it exists)
-and OUT/orbit_tau.csv (tau, period, branch, w on the section, stable, events).
+branch born at the first period doubling is continued too.  Writes OUT/orbit_tau.png (over
+OUT/sweep_ex43 when it exists) and OUT/orbit_tau.csv (tau, period, branch, w on the section,
+stable, events).
 
 Usage: python orbit_tau.py OUT [--M 4000] [--tau0 2.0] [--tau-min 1.9] [--tau1 3.1] [--step 0.02]
 """
@@ -82,7 +83,8 @@ def compare(branches, df) -> None:
             at = tau
         worst, count = max(worst, float(d)), count + 1
     print(f"the sweep's points at the {count} values of tau on a stable stretch lie within "
-          f"{worst:.3g} of it (the farthest at tau = {at:g}; the sweep's h = tau / 1e4, the branches' h = 4 pi / M)")
+          f"{worst:.3g} of it (the farthest at tau = {at:g}; the sweep's h = tau / 1e4, the "
+          "branches' h = 4 pi / M)")
 
 
 def main(argv: list[str] | None = None) -> int:

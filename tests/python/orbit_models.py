@@ -81,7 +81,8 @@ class DenHartog:
         tt = (np.asarray(t) - self.t0) % self.T
         s = np.where(tt < Th, 1.0, -1.0)
         r = np.where(tt < Th, tt, tt - Th)
-        x = s * (-self.F0 + self.C1 * np.cos(r) + self.C2 * np.sin(r)) + Q * np.cos(w * np.asarray(t))
+        t = np.asarray(t)
+        x = s * (-self.F0 + self.C1 * np.cos(r) + self.C2 * np.sin(r)) + Q * np.cos(w * t)
         v = s * (-self.C1 * np.sin(r) + self.C2 * np.cos(r)) - Q * w * np.sin(w * np.asarray(t))
         return x, v
 

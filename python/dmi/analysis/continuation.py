@@ -346,7 +346,8 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     stick profile; events are detected between consecutive points (see the module).
     ``sections``: the orbit spans this many forcing periods (a period-doubled branch: 2), for
     ``BranchPoint.section``.  ``margins=False`` skips the margins (NaN), which cost one period
-    stepped from Python a point (the stuck steps and phases then come from one run).  Returns a :class:`Branch`; a corrector that fails at the smallest
+    stepped from Python a point (the stuck steps and phases then come from one run).  Returns a
+    :class:`Branch`; a corrector that fails at the smallest
     step ends the branch with that ``status``, it does not raise."""
     if not (math.isfinite(step) and step > 0):
         raise ValueError(f"step = {step!r}: must be finite and > 0 (p units)")

@@ -9,8 +9,8 @@ system, and its multipliers are wrong by O(1) however small h is.
 
 Here the monodromy operator is applied by *central differences with a step that moves the
 switches by many steps*: x +- eps v (|v|_inf = 1), with eps = c A M^(-1/3) (at most 0.05 A),
-A the orbit's amplitude and M = period / h the steps per period.  The quotient is the continuous system's
-linearisation (with its saltation) up to two errors: the switch's rounding to a step, at most
+A the orbit's amplitude and M = period / h the steps per period.  The quotient is the continuous
+system's linearisation (with its saltation) up to two errors: the switch's rounding to a step, at most
 (jump) h / eps, and the curvature, O(eps^2) (central differences); eps ~ A h^(1/3) balances
 them, error O(h^(2/3)) (0.2 % at M = 2e4 against Den Hartog's saltation oracle, see
 tests/python/test_analysis_orbit_oracles.py).  Multipliers of a stuck phase come out exactly
@@ -35,8 +35,8 @@ FD_CAP = 0.05
 
 
 def fd_step(F: StepMap, x: np.ndarray) -> float:
-    """The difference step eps = FD_FACTOR A min(M^(-1/3), FD_CAP) (state units), A the largest half range
-    (max - min) / 2 of a component over one period from x (one run of M steps).  If the orbit
+    """The difference step eps = FD_FACTOR A min(M^(-1/3), FD_CAP) (state units), A the largest
+    half range (max - min) / 2 of a component over one period from x (one run of M steps).  If the orbit
     is constant: an equilibrium has no switch to carry, and the step is then the usual
     eps_machine^(1/3) max(1, |x|) of central differences)."""
     U = F.trajectory(x)
