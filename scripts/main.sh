@@ -68,7 +68,7 @@ stage "dmi-sweep: bifurcation diagram of the oscillator over the delay tau (Poin
 DMI_BUILD_DIR="$build" scripts/sweep_ex43.sh "$out"
 
 stage "periodic orbits: the oscillator's branches over tau (dmi.analysis) over the sweep's diagram"
-MPLBACKEND=Agg "$py" python/examples/orbit_tau.py "$out" --M 4000 | tee "$out/orbit_tau.txt"
+OPENBLAS_NUM_THREADS=1 MPLBACKEND=Agg "$py" python/examples/orbit_tau.py "$out" --M 4000 | tee "$out/orbit_tau.txt"
 
 stage "figures and comparison with the paper and ../shared/reference"
 refarg=()
