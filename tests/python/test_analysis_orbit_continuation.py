@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import dmi
 from dmi.analysis import continue_orbit, period_doubled_orbit, periodic_orbit
 from orbit_models import DenHartog, Fold, Logistic
 
@@ -74,3 +75,25 @@ def test_stick_onset_located_and_passed():
     for q in b.points[-3:]:
         F = StepMap(d.make_for(M), q.p, M, rows=b.rows)
         assert np.max(np.abs(F(q.state) - q.state)) < 1e-9
+
+
+def test_torus_where_a_complex_pair_leaves_the_unit_circle():
+    """u' = [[p, -1], [1, p]] u, h = 0.1, M = 10: the orbit u = 0 has the multipliers
+    (1 + h (p +- i))^M, of modulus 1 at p* = (sqrt(1 - h^2) - 1) / h."""
+    h, M = 0.1, 10
+
+    def make(p):
+        s = dmi.Solver(2, h, h=h)
+        s.set_rhs(lambda t, u: np.array([-p * u[0] + u[1], -u[0] - p * u[1]]))
+        return s
+    o = periodic_orbit(make, -0.3, M * h, [0.0, 0.0], multipliers=2)
+    b = continue_orbit(o, 0.3, step=0.05, multipliers=2)
+    tori = [e for e in b.events if e.kind == "torus"]
+    pstar = (np.sqrt(1 - h * h) - 1) / h
+    assert len(tori) == 1 and abs(tori[0].p - pstar) < 5e-3, (b.events, pstar)
+    assert not [e for e in b.events if e.kind in ("period-doubling", "fold")]
+    for q in b.points:
+        mu = (1 + h * (q.p + 1j)) ** M
+        assert np.sort_complex(q.multipliers) == pytest.approx(np.sort_complex([mu, mu.conjugate()]),
+                                                               abs=1e-6)
+        assert q.stable == (q.p < pstar)
