@@ -5,7 +5,8 @@
 # Example 4.3 run by fmpy over the native run, the evidence for the erratum in
 # (4.4), the oscillator with a Prony-series memory (exponential kernel terms,
 # the recursion against the FFT), a bifurcation diagram of the oscillator over the
-# delay tau (dmi-sweep); prints the summary table.  Copies the figures
+# delay tau (dmi-sweep) and its periodic orbits continued over it (dmi.analysis,
+# python/examples/orbit_tau.py); prints the summary table.  Copies the figures
 # to docs/figures/.
 # Usage: scripts/main.sh
 # Environment: DMI_BUILD_DIR (default build), DMI_OUT_DIR (default out).
@@ -65,6 +66,9 @@ fi
 
 stage "dmi-sweep: bifurcation diagram of the oscillator over the delay tau (Poincare section of w)"
 DMI_BUILD_DIR="$build" scripts/sweep_ex43.sh "$out"
+
+stage "periodic orbits: the oscillator's branches over tau (dmi.analysis) over the sweep's diagram"
+OPENBLAS_NUM_THREADS=1 MPLBACKEND=Agg "$py" python/examples/orbit_tau.py "$out" --M 4000 | tee "$out/orbit_tau.txt"
 
 stage "figures and comparison with the paper and ../shared/reference"
 refarg=()

@@ -1,0 +1,92 @@
+#!/usr/bin/env python3
+# The cost of dmi.analysis's periodic orbits (issue 30; a benchmark, not a test), in periods of
+# plain simulation measured in the same run: the tau-diagram's oscillator
+# (python/examples/orbit_tau.py: numba right-hand side, constant kernel by the O(1) recursion)
+# at tau = 2.2 with h = 4 pi / M chosen so that N = ceil(tau / h) is about 1e3 and 1e4.  Per N:
+# one period (advance(M)), one Newton solve (periodic_orbit from the run's window, multipliers
+# off, from a run 10 periods from rest), the 10 leading multipliers, one continuation step
+# (continue_orbit with 6 multipliers a point, per point after the first; with the stick margins,
+# one period stepped from Python, and without).  Rounds interleave the quantities; the fastest
+# round of each counts; CPU times of the process (the machine may be shared); one BLAS thread.
+# Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_orbit.py [--rounds 3] [--N 1000 10000]
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+from __future__ import annotations
+
+import os
+
+# One BLAS thread: on the loaded 2-core machine OpenBLAS's spinning threads made GMRES and the
+# QR of the multipliers 10 times slower (in CPU time too) than with one thread.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import argparse  # noqa: E402
+import math  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "python" / "examples"))
+
+import orbit_tau  # noqa: E402
+
+from dmi.analysis import continue_orbit, periodic_orbit  # noqa: E402
+from dmi.analysis.floquet import floquet_multipliers  # noqa: E402
+from dmi.analysis.shooting import StepMap, state_of  # noqa: E402
+
+TAU = 2.2
+
+
+def cpu(f) -> float:
+    t = time.process_time()
+    f()
+    return time.process_time() - t
+
+
+def setup(N: int):
+    M = round(orbit_tau.P * N / TAU)
+    make = orbit_tau.model(M)
+    s = make(TAU)
+    s.init()
+    s.advance(10 * M)  # near the orbit, not on it: the Newton solve has work to do
+    return M, make, s
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description="periodic-orbit costs in periods of simulation")
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--N", type=int, nargs="+", default=[1000, 10000])
+    a = ap.parse_args(argv)
+    print(f"{'N':>6} {'M':>6} {'period s':>9} {'Newton':>8} {'its':>4} {'mult10':>8} "
+          f"{'cont.step':>9} {'no margins':>10}   (costs in periods of plain simulation; "
+          f"fastest of {a.rounds} rounds, CPU)")
+    for N in a.N:
+        M, make, s = setup(N)
+        x0 = state_of(s, M)
+        best = {k: math.inf for k in ("period", "newton", "mult", "step", "fast")}
+        its = 0
+        for _ in range(a.rounds):
+            best["period"] = min(best["period"], cpu(lambda: s.advance(M)))
+            o = None
+
+            def solve():
+                nonlocal o, its
+                o = periodic_orbit(make, TAU, orbit_tau.P, x0, multipliers=0)
+                its = o.iterations
+            best["newton"] = min(best["newton"], cpu(solve))
+            F = StepMap(make, TAU, M)
+            best["mult"] = min(best["mult"], cpu(lambda: floquet_multipliers(F, o.state, 10)))
+            for key, margins in (("step", True), ("fast", False)):
+                t = time.process_time()
+                b = continue_orbit(o, TAU + 0.1, step=0.02, max_points=4, multipliers=6,
+                                   margins=margins)
+                per = (time.process_time() - t) / max(1, len(b.points) - 1)
+                best[key] = min(best[key], per)
+        T = best["period"]
+        print(f"{N:>6} {M:>6} {T:9.4f} {best['newton'] / T:8.1f} {its:>4} {best['mult'] / T:8.1f} "
+              f"{best['step'] / T:9.1f} {best['fast'] / T:10.1f}", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

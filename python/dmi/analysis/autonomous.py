@@ -1,0 +1,126 @@
+# Periodic orbits of unknown period (autonomous systems) by shooting in (state, h) (issue 30).
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""Autonomous periodic orbits: the period P = M h with M fixed and the step h unknown.
+
+The model must then take the step: ``make(p, h=h) -> dmi.Solver`` (libdmi 1.2's
+``dmi.Solver(n, tau, h=h)``).  Unknowns (x, h); equations F_h(x) - x = 0 and the phase condition
+<xdot_0, x_0 - x_ref> = 0 on the last row (the state at t = 0), xdot_0 the guess's velocity there
+(central difference over its first run).  Newton with GMRES on the bordered Jacobian
+[[D_xF - I, D_hF], [xdot_0' on the last row, 0]] (D_hF by one difference in h a step).  N =
+ceil(tau / h) may change with h: the states hold L = ceil(tau / (0.8 h_0)) + 1 rows (h may fall by
+20 %), the older ones by periodicity.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import scipy.sparse.linalg as sla
+
+from .._solver import Solver
+from .shooting import (Model, Orbit, ShootingError, StepMap, _fmt, build, make_orbit)
+
+
+def _with_h(make: Model, h: float) -> Model:
+    def made(p: float) -> Solver:
+        return make(p, h=h)  # type: ignore[call-arg]
+    return made
+
+
+def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
+                     steps: int | None = None, tol: float = 1e-10, max_iter: int = 30,
+                     multipliers: int = 10) -> Orbit:
+    """See :func:`dmi.analysis.periodic_orbit` with ``period=None``.  ``steps``: M (default
+    round(guess_period / h) with the h of ``make(p)``).  ``guess``: a state (N + 1 rows of the
+    solver ``make(p, h=guess_period / M)``, or n values) or such a solver run near the orbit (its
+    window is taken as it is: any phase)."""
+    try:
+        P0 = float(guess_period)
+    except (TypeError, ValueError):
+        raise ValueError(f"guess_period = {guess_period!r} is not a number") from None
+    if not (math.isfinite(P0) and P0 > 0):
+        raise ValueError(f"guess_period = {P0}: must be finite and > 0 (time units)")
+    M = int(steps) if steps is not None else max(1, round(P0 / build(make, p).h))
+    if M < 1:
+        raise ValueError(f"steps = {steps}: must be >= 1")
+    h0 = P0 / M
+    try:
+        s0 = make(p, h=h0)  # type: ignore[call-arg]
+    except TypeError as e:
+        raise ValueError(f"period=None needs a model make(p, h=...) that takes the step ({e})") \
+            from e
+    rows = max(s0.N + 1, math.ceil(s0.tau / (0.8 * h0)) + 1)
+    cache: dict[float, StepMap] = {}
+
+    def F(h: float) -> StepMap:
+        if h not in cache:
+            if not (h > 0.5 * h0):
+                raise ShootingError(f"autonomous orbit at p = {p!r}: the step went to h = {h!r}, "
+                                    f"below half the guess's {h0!r}: no orbit near the guess", [])
+            m = StepMap(_with_h(make, h), p, M, rows)
+            if m.N + 1 > rows:
+                raise ShootingError(f"the step fell to h = {h!r}: N + 1 = {m.N + 1} > {rows} rows",
+                                    [])
+            if len(cache) > 3:
+                cache.pop(next(iter(cache)))
+            cache[h] = m
+        return cache[h]
+
+    F0 = F(h0)
+    if isinstance(guess, Solver):
+        if guess.n != F0.n or abs(guess.h - h0) > 1e-12 * h0 or guess.N != F0.N:
+            raise ValueError(f"guess: a solver with h = {guess.h!r}, N = {guess.N}; expected the "
+                             f"model's at h = guess_period / M = {h0!r} (N = {F0.N})")
+        x0 = guess.get_window().ravel()
+    else:
+        x0 = np.asarray(guess, dtype=float).ravel()
+        if x0.size == F0.n:
+            x0 = np.tile(x0, F0.N + 1)
+    x0 = F0.extend(x0)
+    n = F0.n
+    U = F0.trajectory(x0)
+    xdot = (U[1] - U[M - 1]) / (2 * h0) if M > 1 else U[1] - U[0]
+    if not np.any(xdot):
+        raise ValueError("the guess does not move at t = 0: no phase condition (an equilibrium?)")
+    xdot = xdot / np.linalg.norm(xdot)
+    ref = x0[-n:].copy()
+    x, h = x0.copy(), h0
+    res: list[float] = []
+    what = f"autonomous orbit at p = {p!r}, M = {M} steps, guess period {P0!r}"
+    for _ in range(max_iter + 1):
+        Fm = F(h)
+        Fx = Fm(x)
+        r = Fx - x
+        g = float(np.dot(xdot, x[-n:] - ref))
+        rn = float(np.max(np.abs(r)))
+        res.append(rn)
+        scale = max(1.0, float(np.max(np.abs(x))))
+        if not math.isfinite(rn):
+            raise ShootingError(f"{what}: non-finite residual (residuals {_fmt(res)})", res)
+        if rn <= tol * scale and abs(g) <= tol * scale:
+            return make_orbit(Fm, x, res, multipliers)
+        if len(res) > max_iter:
+            break
+        dh = 1e-7 * h
+        Fh = (F(h + dh)(x) - Fx) / dh
+        eps = math.sqrt(np.finfo(float).eps) * scale
+
+        def mv(v: np.ndarray, x: np.ndarray = x, Fx: np.ndarray = Fx, Fm: StepMap = Fm,
+               Fh: np.ndarray = Fh) -> np.ndarray:
+            vx, vh = v[:-1], v[-1]
+            nv = float(np.linalg.norm(vx))
+            DF = (Fm(x + (eps / nv) * vx) - Fx) * (nv / eps) if nv > 0 else 0.0 * vx
+            return np.concatenate([DF - vx + Fh * vh, [np.dot(xdot, vx[-n:])]])
+
+        J = sla.LinearOperator((x.size + 1, x.size + 1), matvec=mv, dtype=float)
+        rhs = -np.concatenate([r, [g]])
+        dz, _ = sla.gmres(J, rhs, rtol=1e-8, atol=0.0, restart=min(x.size + 1, 60), maxiter=4)
+        lin = float(np.linalg.norm(mv(dz) - rhs)) / max(float(np.linalg.norm(rhs)), 1e-300)
+        if not np.all(np.isfinite(dz)) or lin > 1e-2:
+            raise ShootingError(f"{what}: the bordered Jacobian is singular at Newton iteration "
+                                f"{len(res)} (GMRES relative residual {lin:.2g}, residuals "
+                                f"{_fmt(res)})", res)
+        x, h = x + dz[:-1], h + float(dz[-1])
+    raise ShootingError(f"{what}: no convergence in {max_iter} Newton iterations (residuals "
+                        f"{_fmt(res)})", res)

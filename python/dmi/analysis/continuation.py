@@ -1,0 +1,478 @@
+# Pseudo-arclength continuation of periodic orbits and their events (issue 30).
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""Continuation of a periodic orbit of the scheme in its parameter p.
+
+Pseudo-arclength on z = (x, p), x the shooting state (:mod:`dmi.analysis.shooting`): a secant
+predictor z + ds t, then Newton on  F_p(x) - x = 0,  <t, z - z_pred> = 0  with GMRES on the
+bordered matrix-free Jacobian [[D_xF - I, D_pF], [t_x' / dim, t_p]] (D_xF by forward differences
+along the Krylov vectors, D_pF by one difference in p per iteration).  The inner product weighs
+x by 1 / dim (an RMS), so ds is a step in "p or RMS state units".  The period M h is kept: make(p)
+must keep h.  A model over tau with a free step h (libdmi 1.2's ``Solver(n, tau, h=...)``) has
+N = ceil(tau / h) changing with p: the states hold L = max N + 1 over the two ends of the range
+(+ 2 %) rows, the older ones filled by M-periodicity (:meth:`StepMap.extend`); the map reads
+the last N(p) + 1.  The step grows by 1.5 after an easy corrector (<= 3 iterations),
+halves after a failure, and the branch ends at p_end, at ``max_points``, when it leaves the
+p-range it started in, or when the step falls below ``min_step`` (``Branch.status`` says which).
+
+Kinks, where the stick pattern changes, are passed: the map is piecewise smooth, its Newton
+semismooth, and a failing corrector retries with a halved step.
+
+Events between consecutive points (``Branch.events``):
+- ``fold``: dp/ds changes sign (the tangent's p component);
+- ``period-doubling``: the number of real multipliers < -1 changes;
+- ``torus``: the number of complex multipliers with |mu| > 1 changes;
+- ``stick-onset``: a component starts (or stops) sticking somewhere in the period: its number
+  of stuck steps goes from 0 to > 0 (or back);
+- ``grazing``: a component's number of stick phases changes while it sticks on both sides.
+A step is stuck when U_i == 0 for 2 steps or more (:func:`dmi.analysis.shooting.stuck_mask`).
+Every point carries ``margin``, the smallest distance of the resolvent's argument X_i from its
+threshold h alpha_i over the period (lone zero steps, the scheme's crossing of a velocity
+reversal, left out), divided by h (force units; alpha_i from the slip steps, |X_i - U_i| =
+h alpha_i): on a non-stick orbit it is the least net force beyond friction at a velocity
+reversal, and it goes to 0 at a stick-onset (it stays O(h) while a component sticks).
+Stick-onset and grazing events are located by bisection in p (6 halvings of the bracket).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse.linalg as sla
+
+from .floquet import monodromy_operator, ritz
+from .shooting import (Model, Orbit, ShootingError, StepMap, build, newton,
+                       periodic_orbit, stuck_mask)
+
+
+@dataclass
+class BranchPoint:
+    """One orbit of a branch: ``p``; ``period`` (time units); ``amplitude`` (n,): (max - min) / 2
+    per component; ``multipliers`` (largest |mu| first); ``stable``; ``stick_steps`` (n,): stuck
+    steps per period; ``stick_phases`` (n,): stuck intervals per period; ``margin`` (n,): see
+    the module; ``section`` (k, n): u at t = j period / k, j < k (k = ``sections``: a Poincare
+    section at the forcing period of a k-periodic orbit); ``state``: the shooting state;
+    ``dpds``: the tangent's p component (its sign flips at a fold); ``iterations``."""
+    p: float
+    period: float
+    amplitude: np.ndarray
+    multipliers: np.ndarray
+    stable: bool
+    stick_steps: np.ndarray
+    stick_phases: np.ndarray
+    margin: np.ndarray
+    section: np.ndarray
+    state: np.ndarray = field(repr=False)
+    dpds: float = 0.0
+    iterations: int = 0
+
+
+@dataclass
+class Event:
+    """A detected event between points ``index - 1`` and ``index`` of the branch: ``kind``
+    (``fold``, ``period-doubling``, ``torus``, ``stick-onset``, ``grazing``), ``p`` (linear
+    interpolation of the test function's zero), ``component`` (the friction component of a
+    stick event, else None) and a ``detail`` text."""
+    kind: str
+    p: float
+    index: int
+    component: int | None = None
+    detail: str = ""
+
+
+@dataclass
+class Branch:
+    """A continued branch: ``points`` (:class:`BranchPoint`), ``events`` (:class:`Event`),
+    ``status`` (why it ended), ``make``, ``steps`` (M), ``h``, ``rows`` (L) and ``sections``."""
+    points: list[BranchPoint]
+    events: list[Event]
+    status: str
+    make: Model = field(repr=False)
+    steps: int = 0
+    h: float = 0.0
+    rows: int = 0
+    sections: int = 1
+
+    @property
+    def p(self) -> np.ndarray:
+        return np.array([q.p for q in self.points])
+
+    @property
+    def stable(self) -> np.ndarray:
+        return np.array([q.stable for q in self.points])
+
+    def column(self, name: str) -> np.ndarray:
+        """An attribute of every point stacked: ``branch.column("amplitude")`` -> (points, n)."""
+        return np.array([getattr(q, name) for q in self.points])
+
+
+def _stick_profile(F: StepMap, x: np.ndarray, margins: bool = True, U: np.ndarray | None = None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Stuck steps, stick phases and margins (see the module) over one period.  The margins
+    need the resolvent's argument X of every step: one period step by step (M calls from
+    Python); ``margins=False`` reads the stuck steps from one run (or its trajectory ``U``)
+    and leaves the margins NaN."""
+    if not margins:
+        U = F.trajectory(x) if U is None else U
+        stuck = stuck_mask(U)
+        steps = stuck.sum(axis=0)
+        phases = np.sum(stuck & ~np.roll(stuck, 1, axis=0), axis=0)
+        phases[steps == F.M] = 1
+        return steps, phases, np.full(F.n, np.nan)
+    s = F.solver
+    X0 = np.asarray(x).reshape(F.L, F.n)
+    s.load_state(F._start)
+    s.set_window(X0[F.L - F.N - 1:])
+    U = np.empty((F.M + 1, F.n))
+    X = np.empty((F.M, F.n))
+    U[0] = X0[-1]
+    for k in range(F.M):
+        s.step()
+        U[k + 1] = s.state
+        X[k] = s.step_terms()[1]
+    stuck = stuck_mask(U)
+    U = U[1:]
+    steps = stuck.sum(axis=0)
+    # stick phases on the circle: starts of runs of stuck steps
+    phases = np.sum(stuck & ~np.roll(stuck, 1, axis=0), axis=0)
+    phases[steps == F.M] = 1
+    lone = (U == 0.0) & ~stuck  # the scheme's crossing of a velocity reversal
+    margin = np.full(F.n, np.inf)
+    for i in range(F.n):
+        slip = (U[:, i] != 0.0) & (X[:, i] != U[:, i])
+        if slip.any():
+            ha = float(np.median(np.abs(X[slip, i] - U[slip, i])))  # h alpha_i
+            keep = ~lone[:, i]
+            if keep.any():
+                margin[i] = float(np.min(np.abs(np.abs(X[keep, i]) - ha))) / F.h
+    return steps, phases, margin
+
+
+def _point(F: StepMap, x: np.ndarray, multipliers: int, sections: int, dpds: float,
+           iterations: int, margins: bool = True, warm: list | None = None) -> BranchPoint:
+    """The BranchPoint at the fixed point x of F; ``warm``: a one-element list holding the
+    previous point's Ritz basis (updated), for 1 sweep of subspace iteration instead of 3."""
+    U = F.trajectory(x)
+    mu = np.empty(0, complex)
+    if multipliers > 0:
+        start = warm[0] if warm else None
+        mu, basis = ritz(F, x, multipliers, start=start,
+                         iterations=1 if start is not None and start.shape[0] == x.size else 3)
+        if warm is not None:
+            warm[0] = basis
+    steps, phases, margin = _stick_profile(F, x, margins, U)
+    k = F.M // sections
+    return BranchPoint(p=F.p, period=F.M * F.h, amplitude=0.5 * (U.max(axis=0) - U.min(axis=0)),
+                       multipliers=mu, stable=bool(mu.size and np.all(np.abs(mu) < 1)),
+                       stick_steps=steps, stick_phases=phases, margin=margin,
+                       section=U[[j * k for j in range(sections)]], state=np.array(x),
+                       dpds=dpds, iterations=iterations)
+
+
+def _events(a: BranchPoint, b: BranchPoint, index: int) -> list[Event]:
+    ev: list[Event] = []
+
+    def at(fa: float, fb: float) -> float:
+        w = 0.5 if fa == fb or fa * fb > 0 else fa / (fa - fb)  # no sign change: the middle
+        return a.p + (b.p - a.p) * w
+
+    if a.dpds * b.dpds < 0:
+        ev.append(Event("fold", at(a.dpds, b.dpds), index, None, "dp/ds changes sign"))
+
+    def real_neg(m: np.ndarray) -> np.ndarray:
+        return m[(np.abs(m.imag) <= 1e-8 * np.maximum(np.abs(m), 1)) & (m.real < 0)].real
+
+    def cplx(m: np.ndarray) -> np.ndarray:
+        return m[np.abs(m.imag) > 1e-8 * np.maximum(np.abs(m), 1)]
+
+    na, nb = np.sum(real_neg(a.multipliers) < -1), np.sum(real_neg(b.multipliers) < -1)
+    if na != nb:
+        ma = real_neg(a.multipliers)
+        mb = real_neg(b.multipliers)
+        fa = float(np.min(ma)) + 1 if ma.size else 0.0
+        fb = float(np.min(mb)) + 1 if mb.size else 0.0
+        ev.append(Event("period-doubling", at(fa, fb), index, None,
+                        f"real multipliers < -1: {na} -> {nb}"))
+    ca, cb = np.sum(np.abs(cplx(a.multipliers)) > 1), np.sum(np.abs(cplx(b.multipliers)) > 1)
+    if ca != cb:
+        ma, mb = np.abs(cplx(a.multipliers)), np.abs(cplx(b.multipliers))
+        fa = float(np.max(ma)) - 1 if ma.size else 0.0
+        fb = float(np.max(mb)) - 1 if mb.size else 0.0
+        ev.append(Event("torus", at(fa, fb), index, None,
+                        f"complex multipliers with |mu| > 1: {ca} -> {cb}"))
+    for i in range(len(a.stick_steps)):
+        sa, sb = int(a.stick_steps[i]), int(b.stick_steps[i])
+        if (sa == 0) != (sb == 0):
+            ma = a.margin[i] if sa else -a.margin[i]
+            mb = b.margin[i] if sb else -b.margin[i]
+            ev.append(Event("stick-onset", at(ma, mb) if math.isfinite(ma + mb) else b.p, index,
+                            i, f"component {i}: stuck steps {sa} -> {sb}"))
+        elif sa and a.stick_phases[i] != b.stick_phases[i]:
+            ev.append(Event("grazing", 0.5 * (a.p + b.p), index, i,
+                            f"component {i}: stick phases {a.stick_phases[i]} -> "
+                            f"{b.stick_phases[i]} (stuck steps {sa} -> {sb})"))
+    return ev
+
+
+def _refine_fold(last: list[BranchPoint], e: Event) -> Event:
+    """The fold's p from the parabola p(s) through the last three points (s: arclength in the
+    weighted norm), when it has a vertex between them."""
+    if len(last) < 3:
+        return e
+    k = min(q.state.size for q in last)
+    s = [0.0]
+    for a, b in zip(last, last[1:]):
+        d = b.state[-k:] - a.state[-k:]
+        s.append(s[-1] + math.sqrt(float(np.dot(d, d)) / k + (b.p - a.p) ** 2))
+    c = np.polyfit(s, [q.p for q in last], 2)
+    if c[0] != 0:
+        sv = -c[1] / (2 * c[0])
+        if s[0] <= sv <= s[-1]:
+            e.p = float(np.polyval(c, sv))
+            e.detail += " (p from a parabola in arclength)"
+    return e
+
+
+def _locate_stick(maps: _Maps, a: BranchPoint, b: BranchPoint, e: Event, tol: float,
+                  bisections: int = 6) -> Event:
+    """Bisection in p between a and b on the stick pattern of component e.component (natural
+    continuation: orbits at the midpoints from the interpolated state); the event's p becomes
+    the final bracket's midpoint, 2^-bisections of |b.p - a.p| wide."""
+    i = e.component
+    key = (lambda q: (q[0] > 0, q[1])) if e.kind == "stick-onset" else (lambda q: (True, q[1]))
+    ka = key((a.stick_steps[i], a.stick_phases[i]))
+    pa, pb, xa, xb = a.p, b.p, a.state, b.state
+    k = min(xa.size, xb.size)
+    xa, xb = xa[-k:], xb[-k:]
+    for _ in range(bisections):
+        pm = 0.5 * (pa + pb)
+        try:
+            F = maps(pm)
+            if F.dim != k:
+                return e
+            xm, _ = newton(F, 0.5 * (xa + xb), tol=tol, max_iter=12, what=f"locating at {pm!r}")
+        except (ShootingError, ValueError):
+            return e
+        st, ph, _ = _stick_profile(F, xm, margins=False)
+        if key((st[i], ph[i])) == ka:
+            pa, xa = pm, xm
+        else:
+            pb, xb = pm, xm
+    e.p = 0.5 * (pa + pb)
+    e.detail += f" (located by bisection in [{min(pa, pb)!r}, {max(pa, pb)!r}])"
+    return e
+
+
+class _Maps:
+    """StepMaps by p (the last few), all on states of ``rows`` rows; a p whose N + 1 exceeds it
+    is refused (ShootingError: the corrector retries with a shorter step)."""
+
+    def __init__(self, make: Model, M: int, h: float, rows: int):
+        self.make, self.M, self.h, self.rows = make, M, h, rows
+        self._cache: dict[float, StepMap] = {}
+
+    def __call__(self, p: float) -> StepMap:
+        F = self._cache.get(p)
+        if F is None:
+            s = build(self.make, p)
+            if abs(s.h - self.h) > 1e-12 * self.h:
+                raise ValueError(f"make(p = {p!r}) has h = {s.h!r}; the branch keeps the period "
+                                 f"M h with h = {self.h!r} (make(p) must keep h)")
+            if s.N + 1 > self.rows:
+                raise ShootingError(f"make(p = {p!r}) has N = {s.N}: the branch's states hold "
+                                    f"{self.rows} rows (N + 1 at the ends of its range, + 2 %)", [])
+            F = StepMap(self.make, p, self.M, self.rows)
+            if len(self._cache) > 4:
+                self._cache.pop(next(iter(self._cache)))
+            self._cache[p] = F
+        return F
+
+
+def _corrector(maps: _Maps, z: np.ndarray, t: np.ndarray, tol: float, max_iter: int,
+               ds: float) -> tuple[np.ndarray, int]:
+    """Newton on (F_p(x) - x, <t, z - z_pred>) from z = z_pred; returns (z, iterations).
+    ShootingError when an iterate strays more than ds from the predictor (weighted norm): the
+    step is then too long for the predictor, and another branch may lie on the hyperplane."""
+    zp = z.copy()
+    dim = z.size - 1
+    w = np.full(z.size, 1.0 / dim)
+    w[-1] = 1.0
+    for it in range(max_iter + 1):
+        x, p = z[:-1], float(z[-1])
+        F = maps(p)
+        if F.dim != dim:
+            raise ShootingError(f"the state grew to {F.dim} values at p = {p!r}", [])
+        Fx = F(x)
+        r = Fx - x
+        g = float(np.dot(w * t, z - zp))
+        rn = float(np.max(np.abs(r)))
+        scale = max(1.0, float(np.max(np.abs(x))))
+        if rn <= tol * scale and abs(g) <= 1e-8 * max(1.0, abs(p)):
+            return z, it
+        if it == max_iter or not math.isfinite(rn):
+            break
+        dp = 1e-7 * max(1.0, abs(p))
+        Fp = (maps(p + dp)(x) - Fx) / dp
+        eps = math.sqrt(np.finfo(float).eps) * scale
+
+        def mv(v: np.ndarray, x: np.ndarray = x, Fx: np.ndarray = Fx, F: StepMap = F,
+               Fp: np.ndarray = Fp) -> np.ndarray:
+            vx, vp = v[:-1], v[-1]
+            nv = float(np.linalg.norm(vx))
+            DF = (F(x + (eps / nv) * vx) - Fx) * (nv / eps) if nv > 0 else 0.0 * vx
+            return np.concatenate([DF - vx + Fp * vp, [np.dot(w * t, v)]])
+
+        J = sla.LinearOperator((z.size, z.size), matvec=mv, dtype=float)
+        rhs = -np.concatenate([r, [g]])
+        dz, _ = sla.gmres(J, rhs, rtol=1e-6, atol=0.0, restart=min(z.size, 60), maxiter=4)
+        if not np.all(np.isfinite(dz)):
+            break
+        z = z + dz
+        d = z - zp
+        if math.sqrt(float(np.dot(w * d, d))) > ds:
+            raise ShootingError(f"corrector strayed {math.sqrt(float(np.dot(w * d, d))):.3g} > "
+                                f"ds = {ds:.3g} from the predictor at p = {float(z[-1])!r}", [rn])
+    raise ShootingError(f"corrector did not converge at p = {float(z[-1])!r} "
+                        f"(residual {rn:.3g} after {max_iter} iterations)", [rn])
+
+
+def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points: int = 200,
+                   min_step: float | None = None, max_step: float | None = None,
+                   multipliers: int = 6, tol: float = 1e-10, max_iter: int = 8,
+                   sections: int = 1, margins: bool = True) -> Branch:
+    """Continues ``orbit`` (from :func:`periodic_orbit`) in p towards ``p_end`` by
+    pseudo-arclength with initial step ``step`` (p units; ``min_step`` default step / 1000,
+    ``max_step`` default 4 step).  Every point gets ``multipliers`` Floquet multipliers and a
+    stick profile; events are detected between consecutive points (see the module).
+    ``sections``: the orbit spans this many forcing periods (a period-doubled branch: 2), for
+    ``BranchPoint.section``.  ``margins=False`` skips the margins (NaN), which cost one period
+    stepped from Python a point (the stuck steps and phases then come from one run).  Returns a
+    :class:`Branch`; a corrector that fails at the smallest
+    step ends the branch with that ``status``, it does not raise."""
+    if not (math.isfinite(step) and step > 0):
+        raise ValueError(f"step = {step!r}: must be finite and > 0 (p units)")
+    direction = 1.0 if p_end >= orbit.p else -1.0
+    min_step = step / 1000 if min_step is None else min_step
+    max_step = 4 * step if max_step is None else max_step
+    lo, hi = sorted((orbit.p, float(p_end)))
+    n = orbit.u.shape[1]
+    # rows for the whole range: N may grow with p (tau with a fixed h); probe both ends
+    rows = max(orbit.rows or orbit.state.size // n, build(orbit.make, orbit.p).N + 1)
+    try:
+        rows = max(rows, build(orbit.make, float(p_end)).N + 1)
+    except ValueError:
+        pass  # make refuses p_end: the branch will stop where make does
+    rows += max(2, rows // 50)  # room for a corrector a little beyond the ends
+    maps = _Maps(orbit.make, orbit.steps, orbit.h, rows)
+    x0 = np.array(orbit.state)
+    F0 = maps(orbit.p)
+    if F0.dim != x0.size:
+        x0 = F0.extend(x0)
+    warm: list = [None]
+    pts = [_point(F0, x0, multipliers, sections, direction, orbit.iterations, margins, warm)]
+    events: list[Event] = []
+    status = "max_points reached"
+    # the first step: natural continuation in p
+    ds = step
+    z_prev = np.concatenate([x0, [orbit.p]])
+    while True:
+        p1 = orbit.p + direction * ds
+        try:
+            F1 = maps(p1)
+            x1, res = newton(F1, F1.extend(x0), tol=tol,
+                             max_iter=max_iter + 4, what=f"continuation at p = {p1!r}")
+            break
+        except (ShootingError, ValueError) as e:
+            ds /= 2
+            if ds < min_step:
+                return Branch(pts, events, f"first step failed: {e}", orbit.make, orbit.steps,
+                              orbit.h, maps.rows, sections)
+    z = np.concatenate([x1, [p1]])
+    pts.append(_point(maps(p1), x1, multipliers, sections, direction, len(res) - 1, margins,
+                      warm))
+    events += _events(pts[-2], pts[-1], 1)
+    while len(pts) < max_points:
+        if (pts[-1].p - p_end) * direction >= 0:
+            status = f"reached p_end = {p_end!r}"
+            break
+        if pts[-1].p < lo - 1e-12 * max(1, abs(lo)) or pts[-1].p > hi + 1e-12 * max(1, abs(hi)):
+            status = f"left the range [{lo!r}, {hi!r}] after a fold"
+            break
+        w = np.full(z.size, 1.0 / (z.size - 1))
+        w[-1] = 1.0
+        sec = z - z_prev
+        t = sec / math.sqrt(float(np.dot(w * sec, sec)))
+        while True:
+            zp = z + ds * t
+            # do not overshoot p_end by more than needed
+            if (zp[-1] - p_end) * direction > 0 and abs(t[-1]) > 0.5:
+                zp = z + ((p_end - z[-1]) / t[-1]) * t
+            try:
+                zn, its = _corrector(maps, zp, t, tol, max_iter, ds)
+                break
+            except (ShootingError, ValueError) as e:
+                ds /= 2
+                if ds < min_step:
+                    status = f"corrector failed at the smallest step {min_step!r} near p = " \
+                             f"{float(z[-1])!r}: {e}"
+                    zn = None
+                    break
+        if zn is None:
+            break
+        z_prev, z = z, zn
+        dpds = float(z[-1] - z_prev[-1])
+        pts.append(_point(maps(float(z[-1])), z[:-1], multipliers, sections, dpds, its, margins,
+                          warm))
+        for e in _events(pts[-2], pts[-1], len(pts) - 1):
+            if e.kind == "fold":
+                e = _refine_fold(pts[-3:], e)
+            elif e.kind in ("stick-onset", "grazing") and pts[-2].dpds * pts[-1].dpds > 0:
+                e = _locate_stick(maps, pts[-2], pts[-1], e, tol)
+            events.append(e)
+        ds = min(max_step, ds * 1.5) if its <= 3 else ds
+    return Branch(pts, events, status, orbit.make, orbit.steps, orbit.h, maps.rows, sections)
+
+
+def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[float, ...] =
+                         (1.0, 0.3, 0.1, 0.03), multipliers: int = 6, tol: float = 1e-10
+                         ) -> Orbit:
+    """The period-2M orbit born at a ``period-doubling`` event of ``branch``: at the point of
+    the event's pair where the M-periodic orbit has a multiplier < -1 (its unstable side, where
+    a supercritical doubling's orbit lives) the M-periodic state x is perturbed along the
+    multiplier's eigenvector v (|v|_inf = 1), x + a A v, A the orbit's amplitude, a from
+    ``amplitudes``, and shot with period 2 M h; the first solution that is not the M-periodic
+    orbit is returned (continue it with ``continue_orbit(..., sections=2 * branch.sections)``).
+    ShootingError when none is found."""
+    if event.kind != "period-doubling":
+        raise ValueError(f"event {event.kind!r}: expected a 'period-doubling' event")
+    a, b = branch.points[event.index - 1], branch.points[event.index]
+    q = a if np.any(a.multipliers.real < -1) else b
+    maps = _Maps(branch.make, branch.steps, branch.h, branch.rows)
+    F = maps(q.p)
+    x = F.extend(q.state)
+    A = monodromy_operator(F, x)
+    if A.shape[0] <= 64:
+        D = np.column_stack([A.matvec(np.eye(A.shape[0])[:, j]) for j in range(A.shape[0])])
+        mu, V = np.linalg.eig(D)
+    else:
+        mu, V = sla.eigs(A, k=min(6, A.shape[0] - 2), which="LM", ncv=min(A.shape[0], 20))
+    j = int(np.argmin(np.abs(mu + 1) + 10 * np.abs(mu.imag)))
+    v = V[:, j].real
+    v /= np.max(np.abs(v))
+    amp = max(float(np.max(q.amplitude)), 0.1 * max(1.0, float(np.max(np.abs(x)))))
+    tried = []
+    for s in amplitudes:
+        try:
+            o = periodic_orbit(branch.make, q.p, 2 * branch.steps * branch.h, x + s * amp * v,
+                               rows=F.L, tol=tol, multipliers=multipliers)
+        except ShootingError as e:
+            tried.append(f"a = {s}: {e}")
+            continue
+        if np.max(np.abs(F(o.state) - o.state)) > 1e-6 * max(1.0, amp):
+            return o
+        tried.append(f"a = {s}: converged to the M-periodic orbit")
+    raise ShootingError(f"no period-doubled orbit at p = {q.p!r} (multiplier {mu[j]:.4g}): "
+                        + "; ".join(tried), [])
+
+
+__all__ = ["Branch", "BranchPoint", "Event", "continue_orbit", "period_doubled_orbit"]

@@ -1,0 +1,209 @@
+# Models and exact periodic solutions for the periodic-orbit tests (issue 30), derived here
+# from the equations, not from the code under test:
+# - Den Hartog's non-stick orbit of x'' + x + F0 sign(x') = F cos(w t) (Den Hartog 1931;
+#   Shaw 1986) and its Floquet multipliers by a saltation analysis;
+# - the stick-slip orbit of u' + sigma(u) ∋ c sin t, c > 1, slip phases in closed form.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+from __future__ import annotations
+
+import numpy as np
+import scipy.optimize as so
+
+import dmi
+
+
+class DenHartog:
+    """x'' + 2 zeta x' + x + F0 sign(x') = F cos(w t), as u = (x, v): u' + A(u) + f(t, u) ∋ 0
+    with f = (-v, x + 2 zeta v - F cos w t), A = (0, F0 sigma(v)).  ``zeta = 0``: Den Hartog's
+    closed form (attributes a, t0, exact(t), multipliers)."""
+
+    def __init__(self, w: float = 0.7, F: float = 1.0, F0: float = 0.3, zeta: float = 0.0):
+        self.w, self.F, self.F0, self.zeta = w, F, F0, zeta
+        self.T = 2 * np.pi / w
+        if zeta == 0.0:
+            self._solve()
+
+    def make_for(self, M: int):
+        """make(p) with h = T / M (no delay: tau = h, N = 1); p scales the forcing: F p."""
+        w, F0, z = self.w, self.F0, self.zeta
+
+        def make(p: float) -> dmi.Solver:
+            if not 0 <= p <= 10:
+                raise ValueError(f"p = {p}: the forcing scale must be in [0, 10]")
+            Fp = self.F * p
+            s = dmi.Solver(2, self.T / M, 1)
+            s.set_rhs(lambda t, u: np.array([-u[1], u[0] + 2 * z * u[1] - Fp * np.cos(w * t)]))
+            s.set_friction([0.0, F0])
+            return s
+        return make
+
+    # --- Den Hartog's orbit (zeta = 0): on [t0, t0 + T/2] x' > 0 and
+    #     x = -F0 + C1 cos(t - t0) + C2 sin(t - t0) + Q cos(w t), Q = F / (1 - w^2);
+    #     x(t0) = -a, x'(t0) = 0, x(t0 + T/2) = a, x'(t0 + T/2) = 0; x(t + T/2) = -x(t).
+    def _solve(self) -> None:
+        w, F0, T = self.w, self.F0, self.T
+        Q, Th = self.F / (1 - w * w), T / 2
+
+        def eqs(z):
+            C1, C2, a, t0 = z
+            s, c = np.sin(w * t0), np.cos(w * t0)
+            return [-F0 + C1 + Q * c + a, C2 - Q * w * s,
+                    -F0 + C1 * np.cos(Th) + C2 * np.sin(Th) - Q * c - a,
+                    -C1 * np.sin(Th) + C2 * np.cos(Th) + Q * w * s]
+        for t0 in np.linspace(0, T, 25, endpoint=False):
+            z, _, ier, _ = so.fsolve(eqs, [0, 0, abs(Q), t0], full_output=True, xtol=1e-14)
+            if ier == 1 and z[2] > 0 and max(map(abs, eqs(z))) < 1e-12:
+                break
+        else:
+            raise RuntimeError("no Den Hartog orbit")
+        self.C1, self.C2, self.a, self.t0 = z[0], z[1], z[2], z[3] % T
+        r = np.linspace(0, Th, 4001)[1:-1]  # x' > 0 inside the half [t0, t0 + T/2]
+        if np.any(self.exact(self.t0 + r)[1] <= 0):
+            raise RuntimeError("x' changes sign inside a half period: not Den Hartog's orbit")
+        # non-stick: x' keeps its sign on each half (checked), and at a reversal the net force
+        # exceeds F0 (no stick): |F cos(w ts) - a| > F0 at the maximum ts = t0 + T/2
+        ts1 = self.t0 + Th
+        if abs(self.F * np.cos(w * ts1) - self.a) <= F0:
+            raise RuntimeError("the orbit sticks")
+        # saltation at a reversal v: + -> - at x = a: S = diag(1, acc_after / acc_before)
+        acc_before = -self.a - F0 + self.F * np.cos(w * ts1)
+        acc_after = -self.a + F0 + self.F * np.cos(w * ts1)
+        R = np.array([[np.cos(Th), np.sin(Th)], [-np.sin(Th), np.cos(Th)]])  # x'' + x = 0, T/2
+        S = np.diag([1.0, acc_after / acc_before])
+        mu = np.linalg.eigvals(S @ R @ S @ R)  # the reversal at x = -a has the same S (symmetry)
+        self.multipliers = mu[np.argsort(-np.abs(mu))]
+        self.smooth_multipliers = np.linalg.eigvals(R @ R)  # without the saltation
+
+    def exact(self, t):
+        """(x(t), x'(t)) of Den Hartog's orbit."""
+        w, Th = self.w, self.T / 2
+        Q = self.F / (1 - w * w)
+        tt = (np.asarray(t) - self.t0) % self.T
+        s = np.where(tt < Th, 1.0, -1.0)
+        r = np.where(tt < Th, tt, tt - Th)
+        t = np.asarray(t)
+        x = s * (-self.F0 + self.C1 * np.cos(r) + self.C2 * np.sin(r)) + Q * np.cos(w * t)
+        v = s * (-self.C1 * np.sin(r) + self.C2 * np.cos(r)) - Q * w * np.sin(w * np.asarray(t))
+        return x, v
+
+
+class StickSlip1:
+    """u' + sigma(u) ∋ c sin t (c > 1): f = -c sin t, A = sigma.  The 2 pi-periodic orbit:
+    stuck at 0 until t1 = asin(1/c), then u = c (cos t1 - cos t) - (t - t1) > 0 until t2, stuck
+    again until pi + t1 (c sin t2 >= -1 checked), then the mirror image: u(t + pi) = -u(t)."""
+
+    def __init__(self, c: float = 1.5):
+        self.c = c
+        self.T = 2 * np.pi
+        self.t1 = np.arcsin(1 / c)
+        self.t2 = so.brentq(lambda t: self._slip(t), np.pi - self.t1, 2 * np.pi)
+        if c * np.sin(self.t2) < -1:
+            raise RuntimeError("no stick after the slip")
+        self.stick_fraction = 2 * (np.pi + self.t1 - self.t2) / (2 * np.pi)
+
+    def _slip(self, t):
+        return self.c * (np.cos(self.t1) - np.cos(t)) - (t - self.t1)
+
+    def exact(self, t):
+        s = (np.asarray(t) - self.t1) % (2 * np.pi)  # from the start of the positive slip
+        half = s >= np.pi
+        r = self.t1 + np.where(half, s - np.pi, s)
+        u = np.where(r < self.t2, self._slip(r), 0.0)
+        return np.where(half, -u, u)
+
+    def make_for(self, M: int):
+        c = self.c
+
+        def make(p: float) -> dmi.Solver:
+            s = dmi.Solver(1, self.T / M, 1)
+            s.set_rhs(lambda t, u: np.array([-c * np.sin(t)]))
+            s.set_friction([1.0])
+            return s
+        return make
+
+
+class SlipOnly1:
+    """u' + a u + sigma(u) ∋ c sin t (c = 3 > 1 + ...: u crosses 0 transversally twice a period,
+    never sticks): f = a u - c sin t, A = sigma.  Without saltation its multiplier would be
+    exp(-2 pi a); the crossings make it much smaller."""
+
+    def __init__(self, a: float = 0.1, c: float = 3.0):
+        self.a, self.c, self.T = a, c, 2 * np.pi
+
+    def make_for(self, M: int):
+        a, c = self.a, self.c
+
+        def make(p: float) -> dmi.Solver:
+            s = dmi.Solver(1, self.T / M, 1)
+            s.set_rhs(lambda t, u: np.array([a * u[0] - c * np.sin(t)]))
+            s.set_friction([1.0])
+            return s
+        return make
+
+
+class Fold:
+    """u' = p - u^2 (f = u^2 - p, h = 0.1, M = 10 steps a period): the scheme's fixed points
+    u = +-sqrt(p) fold at p = 0; multiplier (1 - 2 h u)^M."""
+    h, M = 0.1, 10
+
+    def make(self, p: float) -> dmi.Solver:
+        s = dmi.Solver(1, self.h, 1)
+        s.set_rhs(lambda t, u: np.array([u[0] ** 2 - p]))
+        return s
+
+
+class Logistic:
+    """The scheme with h = 1 on u' = p u (1 - u): U+ = U + p U (1 - U), the logistic map
+    x -> r x (1 - x) with r = 1 + p, u = r x / p.  Fixed point u = 1, multiplier 1 - p:
+    period doubling at p = 2 (r = 3), the 2-cycle x = ((r + 1) +- sqrt((r + 1)(r - 3))) / (2 r)
+    with multiplier 4 + 2 r - r^2, doubling again at r = 1 + sqrt(6)."""
+
+    def make(self, p: float) -> dmi.Solver:
+        s = dmi.Solver(1, 1.0, 1)
+        s.set_rhs(lambda t, u: np.array([-p * u[0] * (1 - u[0])]))
+        return s
+
+    @staticmethod
+    def cycle(p: float) -> np.ndarray:
+        r = 1 + p
+        x = ((r + 1) + np.array([1, -1]) * np.sqrt((r + 1) * (r - 3))) / (2 * r)
+        return x * r / p
+
+
+class Belt:
+    """A mass on a moving belt with negative viscous damping, autonomous:
+    x'' - 2 d x' + x + alpha sigma(x' - v) ∋ 0, as u = (x, y), y = x' - v: f = (-(y + v),
+    x - 2 d (y + v)), A = (0, alpha sigma(y)).  Stick (y = 0) while |x - 2 d v| <= alpha; the slip
+    starts at x_e = alpha + 2 d v with x' = v and, x'' - 2 d x' + x = alpha (y < 0), grows until x'
+    is v again at x_r; the stick then carries x back to x_e at speed v.  Period and stick time
+    from the closed-form slip (one root of x'(t) = v)."""
+
+    def __init__(self, alpha: float = 1.0, v: float = 0.5, d: float = 0.05):
+        self.alpha, self.v, self.d = alpha, v, d
+        w = np.sqrt(1 - d * d)
+        z0, dz0 = 2 * d * v, v  # z = x - alpha
+
+        def z(t):
+            return np.exp(d * t) * (z0 * np.cos(w * t) + (dz0 - d * z0) / w * np.sin(w * t))
+
+        def dz(t):
+            e = np.exp(d * t)
+            a, b = z0, (dz0 - d * z0) / w
+            return e * ((d * a + w * b) * np.cos(w * t) + (d * b - w * a) * np.sin(w * t))
+        ts = np.linspace(1e-6, 2 * np.pi / w, 20001)
+        k = np.nonzero(dz(ts) - v >= 0)[0]
+        k = k[k > 10][0]  # the first return of x' to v
+        self.t_slip = so.brentq(lambda t: dz(t) - v, ts[k - 1], ts[k])
+        self.x_r = alpha + z(self.t_slip)
+        self.x_e = alpha + 2 * d * v
+        if abs(self.x_r - 2 * d * v) > alpha:
+            raise RuntimeError("no stick after the slip")
+        self.t_stick = (self.x_e - self.x_r) / v
+        self.T = self.t_slip + self.t_stick
+
+    def make(self, p: float, h: float = 0.01) -> dmi.Solver:
+        a, v, d = self.alpha, self.v, self.d
+        s = dmi.Solver(2, h, h=h)
+        s.set_rhs(lambda t, u: np.array([-(u[1] + v), u[0] - 2 * d * (u[1] + v)]))
+        s.set_friction([0.0, a])
+        return s
