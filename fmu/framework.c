@@ -86,15 +86,16 @@ int fmu_model_new(fmu_model *m)
 {
     const unsigned nvr = count_vr();
     const size_t n = MODEL->n, nind = MODEL->indicators ? MODEL->nindicators : 0;
-    m->v = malloc(sizeof *m->v + (2 * nvr + 5 * n) * sizeof(double) + nvr * sizeof(unsigned) +
-                  2 * nind * sizeof(int) + nvr);
+    m->v = malloc(sizeof *m->v + (2 * nvr + 5 * n) * sizeof(double) +
+                  2 * nvr * sizeof(unsigned) + 2 * nind * sizeof(int) + nvr);
     if (!m->v)
         return -1;
     m->v->value = values_of(m);
     m->out = values_of(m) + nvr;
     m->work = m->out + nvr;
     m->run = (unsigned *)(m->work + 5 * n);
-    m->ind = (int *)(m->run + nvr);
+    m->out_run = m->run + nvr;
+    m->ind = (int *)(m->out_run + nvr);
     m->ind_new = m->ind + nind;
     m->kind = (unsigned char *)(m->ind_new + nind);
     m->nvr = nvr;
@@ -104,6 +105,7 @@ int fmu_model_new(fmu_model *m)
         const unsigned kind = m->kind[vr];
         const int real = (kind & FMU_FLOAT64) && !(kind & FMU_INDEPENDENT);
         m->run[vr] = real ? 1 + (vr + 1 < nvr ? m->run[vr + 1] : 0) : 0;
+        m->out_run[vr] = real && (kind & FMU_OUTPUT) ? 1 + (vr + 1 < nvr ? m->out_run[vr + 1] : 0) : 0;
     }
     m->solver = NULL;
     fmu_model_defaults(m);
@@ -463,8 +465,12 @@ int fmu_model_get_reals(fmu_model *m, const unsigned vr[], size_t nvr, unsigned 
                 outputs(m);
             const double *value = m->v->value + first, *out = m->out + first;
             const unsigned char *kind = m->kind + first;
-            for (i = 0; i < nvr; i++)
-                values[i] = kind[i] & FMU_OUTPUT ? out[i] : value[i];
+            if (m->out_run[first] >= nvr) /* outputs only: a copy */
+                for (i = 0; i < nvr; i++)
+                    values[i] = out[i];
+            else
+                for (i = 0; i < nvr; i++)
+                    values[i] = kind[i] & FMU_OUTPUT ? out[i] : value[i];
             return 0;
         }
     }

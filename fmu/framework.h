@@ -62,6 +62,7 @@ typedef struct {
     unsigned char *kind; /* fmu_kind of every value reference (with v's block) */
     unsigned *run;      /* run[vr]: the Float64 variables vr, vr + 1, ... in a row, the
                            independent one left out (the bulk get; with v's block) */
+    unsigned *out_run;  /* out_run[vr]: the same for Float64 outputs only (with v's block) */
     int *ind, *ind_new; /* the model's indicators at the solver's step; scratch (v's block) */
     uint64_t nevents;   /* steps at which an indicator changed (dmi_fmu_point) */
     uint64_t event_p;   /* the last of them, 0 if none */

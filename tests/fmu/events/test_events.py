@@ -170,3 +170,24 @@ def test_early_return_keeps_the_regular_points_bitwise():
     grid = np.isin(r["time"], plain["time"])
     assert grid.sum() == len(plain)
     assert digests(r, grid) == digests(plain)
+
+
+def test_c_master_couples_at_the_transitions(native):
+    """tests/fmu/event_master.c: the oscillator (early return) drives the
+    chain FMU with its friction force; the event times it prints are the
+    native run's transition steps, all of them, most by early return, and
+    the chain followed it to T."""
+    import subprocess
+    out = subprocess.run([os.environ["DMI_EVENT_MASTER"], os.environ["DMI_OSC3_SO"],
+                          os.environ["DMI_FMU_GUID"], os.environ["DMI_CHAIN3_SO"],
+                          os.environ["DMI_CHAIN_GUID"], str(T), "0.1"],
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.split("\n")
+    events = [(float(x.split()[1]), x.split()[2] == "1") for x in lines if x.startswith("event ")]
+    assert steps_of([t for t, _ in events]) == native
+    regular = {round(k * 0.1 / H) for k in range(round(T / 0.1) + 1)}
+    assert [early for _, early in events] == [p not in regular for p in native]
+    chain = [x.split() for x in lines if x.startswith("chain ")]
+    assert len(chain) == 1 and float(chain[0][4]) == T and math.isfinite(float(chain[0][2]))
+    assert f"events {len(native)} early {sum(p not in regular for p in native)}" in out.stdout
