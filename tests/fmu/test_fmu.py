@@ -1095,3 +1095,39 @@ def test_each_call_logged_once_with_its_outcome(sl):
     with pytest.raises(FMICallException):
         s.fmu.doStep(0.5, 0.01)
     assert len(s.log[n:]) == 1 and s.log[n][0] == 3 and s.log[n][2].startswith(f"{p}DoStep: ")
+
+
+# ---- state format 3 (issue 31) ----
+
+def test_state_format3_names_the_model_and_keeps_the_events(sl):
+    """A saved state is format 3: the model's name, and the event count and
+    last event's step that the outputs give; restored, the run goes on with
+    them bitwise.  A state whose name is another model's (checksum fixed) is
+    refused, naming both."""
+    s = sl()
+    start(s)
+    ev = [s.vr["stick_slip_events"]]
+    for k in range(50):
+        s.fmu.doStep(k * 0.1, 0.1)
+    data = saved_bytes(s)
+    count = s.fmu.getInteger(ev)[0]
+    last = s.fmu.getReal([s.vr["last_event_time"]])[0]
+    assert state_field(data, "version") == 3 and count > 10
+    assert state_field(data, "name").rstrip(b"\0") == b"DelayFrictionOscillator"
+    assert state_field(data, "nevents") == count
+    assert abs(state_field(data, "event_p") * 1e-3 - last) <= 1e-12
+    after = []
+    for _ in range(2):
+        for k in range(50, 80):
+            s.fmu.doStep(k * 0.1, 0.1)
+        after.append((s.fmu.getInteger(ev)[0], s.fmu.getReal([s.vr["last_event_time"]])[0],
+                      outputs(s, s.vr)))
+        st = s.fmu.deSerializeFMUstate(data)
+        s.fmu.setFMUstate(st)
+        s.fmu.freeFMUstate(st)
+        assert s.fmu.getInteger(ev)[0] == count
+    assert after[0] == after[1] and after[0][0] > count
+    b = bytearray(data[:-8])
+    struct.pack_into("=64s", b, STATE_AT["NAME"], b"OtherModel")
+    assert_refused(s, bytes(b) + struct.pack("=Q", fnv1a64(b)), 'the state is of model "OtherModel"',
+                   'this FMU is model "DelayFrictionOscillator"')
