@@ -418,12 +418,17 @@ static void outputs(fmu_model *m)
                 W[i] = 0.0;
             }
         } else {
-            dmi_get_past(m->solver, 1, prev);
             dmi_get_step_terms(m->solver, W, X);
             const double theta = (m->t_comm - m->v->t_start) / h - (double)(p - 1);
             const double th = theta > 0.0 ? theta : 0.0;
-            for (size_t i = 0; i < n; i++)
-                u[i] = theta >= 1.0 - FMU_TIME_TOL ? U[i] : prev[i] + th * (U[i] - prev[i]);
+            if (theta >= 1.0 - FMU_TIME_TOL) { /* at t_p (after every solver step): U^p */
+                for (size_t i = 0; i < n; i++)
+                    u[i] = U[i];
+            } else { /* between t_{p-1} and t_p */
+                dmi_get_past(m->solver, 1, prev);
+                for (size_t i = 0; i < n; i++)
+                    u[i] = prev[i] + th * (U[i] - prev[i]);
+            }
         }
         pt = (dmi_fmu_point){m->t_comm, h, p, n, u, U, W, X, m->nevents, m->event_p};
     }
