@@ -1131,3 +1131,38 @@ def test_state_format3_names_the_model_and_keeps_the_events(sl):
     struct.pack_into("=64s", b, STATE_AT["NAME"], b"OtherModel")
     assert_refused(s, bytes(b) + struct.pack("=Q", fnv1a64(b)), 'the state is of model "OtherModel"',
                    'this FMU is model "DelayFrictionOscillator"')
+
+
+# ---- the bulk path of Float64 gets (issue 31) ----
+
+def test_bulk_get_equals_value_by_value_and_refuses_the_same(sl, fmi_version):
+    """A run of consecutive value references (the bulk path) gives bitwise
+    the values of one-by-one gets, at a grid point and between two; a run
+    that crosses a variable of another type, or (FMI 2.0) the time, is
+    refused with the message of that value reference alone."""
+    s = sl()
+    start(s)
+    vr = s.vr
+    outs = [vr[n] for n in OUT[:4]]
+    assert outs == list(range(outs[0], outs[0] + 4))  # the four Real outputs are a run
+    runs = [outs, list(range(0, outs[-1] + 1)), [vr["stick_slip_events"] + 1]]
+    for t, dt in ((0.0, 0.5), (0.5, 0.0123)):  # t_p, then between grid points
+        s.fmu.doStep(t, dt)
+        for run in runs[:2]:
+            assert s.fmu.getReal(run) == [s.fmu.getReal([x])[0] for x in run]
+    messages = []
+    for bad in ([outs[-1], vr["N"]], [vr["last_event_time"], vr["last_event_time"] + 1]):
+        one = []
+        for call in (bad, [bad[-1]]):
+            try:
+                got = s.fmu.getReal(call)
+            except FMICallException:
+                one.append(s.errors()[-1])
+            else:  # FMI 3.0: the time is a Float64 variable
+                assert fmi_version == "3" and bad[-1] == vr["last_event_time"] + 1, call
+                assert got[-1] == 0.5123
+        messages.append(one)
+    assert len(messages[0]) == 2 and messages[0][0] == messages[0][1]
+    assert f"value reference {vr['N']} is not a Real variable" in messages[0][0]
+    if fmi_version == "2":
+        assert len(messages[1]) == 2 and messages[1][0] == messages[1][1]
