@@ -194,8 +194,8 @@ typedef void (*dmi_fmu_bytes_fn)(const dmi_fmu_values *v, double *peak, double *
 typedef void (*dmi_fmu_indicators_fn)(const dmi_fmu_values *v, const dmi_fmu_point *pt,
                                       int *state);
 
-/* Built-in indicator of dmi_set_friction's component i with coefficient
- * alpha_i (>= 0): 1 (stuck) when the resolvent's argument lies within
+/* dmi_fmu_stuck(pt, i, alpha_i), a built-in indicator of dmi_set_friction's
+ * component i with coefficient alpha_i (>= 0): 1 (stuck) when the resolvent's argument lies within
  * h alpha_i of zero, |X_i| <= h alpha_i (then U_i = 0), else 0 (slipping). */
 static inline int dmi_fmu_stuck(const dmi_fmu_point *pt, size_t i, double alpha_i)
 {
@@ -203,8 +203,8 @@ static inline int dmi_fmu_stuck(const dmi_fmu_point *pt, size_t i, double alpha_
     return (x < 0 ? -x : x) <= pt->h * alpha_i;
 }
 
-/* Built-in indicator of dmi_set_box's component i with faces lo_i <= hi_i:
- * -1 in contact with the lower face (X_i <= lo_i, then U_i = lo_i), +1 with
+/* dmi_fmu_contact(pt, i, lo_i, hi_i), a built-in indicator of dmi_set_box's
+ * component i with faces lo_i <= hi_i: -1 in contact with the lower face (X_i <= lo_i, then U_i = lo_i), +1 with
  * the upper face (X_i >= hi_i, U_i = hi_i), 0 inside. */
 static inline int dmi_fmu_contact(const dmi_fmu_point *pt, size_t i, double lo_i, double hi_i)
 {
