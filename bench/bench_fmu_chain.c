@@ -46,8 +46,15 @@ static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status sta
     fprintf(stderr, "bench_fmu_chain: %s: status %d: %s\n", name, (int)status, message);
 }
 
+/* Not inlined (GCC, Clang): callgrind counts each function's calls. */
+#if defined(__GNUC__)
+#define NOINLINE __attribute__((noinline))
+#else
+#define NOINLINE
+#endif
+
 /* CPU seconds of the FMU's loop to T; negative if a call failed. */
-static double fmu_run(const fmu_api *f, int N, double T, double dt, int get, double *sink)
+NOINLINE static double fmu_run(const fmu_api *f, int N, double T, double dt, int get, double *sink)
 {
     const fmi2CallbackFunctions cb = {logger, calloc, free, NULL, NULL};
     fmi2Component c = f->instantiate("bench", fmi2CoSimulation, DMI_CHAIN_GUID, "", &cb,
@@ -80,11 +87,8 @@ static double fmu_run(const fmu_api *f, int N, double T, double dt, int get, dou
 }
 
 /* The 9 outputs at t (step p of h) as the FMU computes them: u_h(t) and the
- * friction forces.  Not inlined: callgrind counts its calls. */
-#if defined(__GNUC__)
-__attribute__((noinline))
-#endif
-static void native_outputs(const dmi_solver *s, const chain *c, double t, double h, double *y)
+ * friction forces. */
+NOINLINE static void native_outputs(const dmi_solver *s, const chain *c, double t, double h, double *y)
 {
     double U[6], prev[6], W[6], X[6];
     uint64_t p = 0;
@@ -100,7 +104,7 @@ static void native_outputs(const dmi_solver *s, const chain *c, double t, double
 }
 
 /* CPU seconds of the native loop to T; negative on failure. */
-static double native_run(int N, double T, double dt, int get, double *sink)
+NOINLINE static double native_run(int N, double T, double dt, int get, double *sink)
 {
     chain c = CHAIN_DEFAULT;
     c.N = (size_t)N;

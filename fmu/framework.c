@@ -125,7 +125,8 @@ void fmu_model_defaults(fmu_model *m)
         values_of(m)[vr] = fmu_is_set(m->kind[vr]) ? MODEL->variables[vr].start : 0.0;
     m->t_comm = 0.0;
     m->out_valid = 0;
-    m->nevents = m->event_p = 0;
+    m->p = m->nevents = m->event_p = 0;
+    m->h = 0.0;
     m->event = 0;
 }
 
@@ -283,9 +284,8 @@ static void indicators_at(fmu_model *m, int *st)
 {
     const size_t n = MODEL->n;
     double *U = m->work + n, *W = U + 2 * n, *X = W + n;
-    uint64_t p = 0;
-    dmi_get_step_index(m->solver, &p);
-    const double h = dmi_get_h(m->solver);
+    const uint64_t p = m->p;
+    const double h = m->h;
     dmi_get_state(m->solver, U);
     if (p == 0) {
         for (size_t i = 0; i < n; i++) {
@@ -316,6 +316,8 @@ int fmu_model_start(fmu_model *m, double t_start, char *err, char *note)
     }
     dmi_free(&m->solver);
     m->solver = s;
+    m->p = 0;
+    m->h = dmi_get_h(s);
     m->v->t_start = t_start;
     m->t_comm = t_start;
     m->out_valid = 0;
@@ -335,17 +337,21 @@ static double steps_before(double t_start, double t, double h)
 
 /* Steps the solver from step p to step target, one at a time, the
  * indicators after each (see fmu_model_do_step): 0, 1 when stopped early at
- * an event, or a libdmi error code (negative). */
+ * an event, or a libdmi error code (negative).  Not inlined (GCC, Clang):
+ * the doStep of a model without indicators stays short. */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
 static int steps_with_events(fmu_model *m, uint64_t p, uint64_t target, fmu_stop_fn *stop,
                              void *ctx)
 {
     const size_t nind = n_indicators();
-    const double h = dmi_get_h(m->solver);
+    const double h = m->h;
     while (p < target) {
         int rc = dmi_step(m->solver);
         if (rc != DMI_OK)
             return rc;
-        p++;
+        m->p = ++p;
         indicators_at(m, m->ind_new);
         if (memcmp(m->ind_new, m->ind, nind * sizeof *m->ind) == 0)
             continue;
@@ -366,7 +372,7 @@ int fmu_model_do_step(fmu_model *m, double t_current, double step, fmu_stop_fn *
                       void *ctx, int *early, char *err)
 {
     *early = 0;
-    const double h = dmi_get_h(m->solver);
+    const double h = m->h;
     if (!isfinite(t_current) || !isfinite(step) || !(step > 0))
         return fail(err, "the time %.17g and the step %.17g must be finite and the step > 0",
                     t_current, step);
@@ -375,8 +381,7 @@ int fmu_model_do_step(fmu_model *m, double t_current, double step, fmu_stop_fn *
                     m->t_comm);
     const double t_end = t_current + step;
     const double target = steps_before(m->v->t_start, t_end, h);
-    uint64_t p = 0;
-    dmi_get_step_index(m->solver, &p);
+    const uint64_t p = m->p;
     if (!(target < 9007199254740992.0)) /* 2^53: beyond it p h has no meaning */
         return fail(err, "t = %.17g is too far from the start for the step h", t_end);
     m->out_valid = 0;
@@ -389,9 +394,11 @@ int fmu_model_do_step(fmu_model *m, double t_current, double step, fmu_stop_fn *
             return 0;
         }
         if (rc != DMI_OK) {
+            dmi_get_step_index(m->solver, &m->p); /* the steps taken are kept */
             solver_fail(err, "the solver failed", m->solver, rc);
             return -2;
         }
+        m->p = (uint64_t)target;
     }
     m->t_comm = t_end;
     return 0;
@@ -408,29 +415,26 @@ static void outputs(fmu_model *m)
     double *u = m->work, *U = u + n, *prev = U + n, *W = prev + n, *X = W + n;
     dmi_fmu_point pt = {m->t_comm, 0.0, 0, n, NULL, NULL, NULL, NULL, m->nevents, m->event_p};
     if (m->solver) {
-        uint64_t p = 0;
-        dmi_get_step_index(m->solver, &p);
-        const double h = dmi_get_h(m->solver);
+        const uint64_t p = m->p;
+        const double h = m->h;
         dmi_get_state(m->solver, U);
+        pt = (dmi_fmu_point){m->t_comm, h, p, n, U, U, W, X, m->nevents, m->event_p};
         if (p == 0) {
             for (size_t i = 0; i < n; i++) {
-                u[i] = X[i] = U[i];
+                X[i] = U[i];
                 W[i] = 0.0;
             }
         } else {
             dmi_get_step_terms(m->solver, W, X);
             const double theta = (m->t_comm - m->v->t_start) / h - (double)(p - 1);
-            const double th = theta > 0.0 ? theta : 0.0;
-            if (theta >= 1.0 - FMU_TIME_TOL) { /* at t_p (after every solver step): U^p */
-                for (size_t i = 0; i < n; i++)
-                    u[i] = U[i];
-            } else { /* between t_{p-1} and t_p */
+            if (theta < 1.0 - FMU_TIME_TOL) { /* between t_{p-1} and t_p; at t_p u = U^p */
+                const double th = theta > 0.0 ? theta : 0.0;
                 dmi_get_past(m->solver, 1, prev);
                 for (size_t i = 0; i < n; i++)
                     u[i] = prev[i] + th * (U[i] - prev[i]);
+                pt.u = u;
             }
         }
-        pt = (dmi_fmu_point){m->t_comm, h, p, n, u, U, W, X, m->nevents, m->event_p};
     }
     MODEL->outputs(m->v, &pt, m->out);
     m->out_valid = 1;
@@ -462,22 +466,20 @@ int fmu_model_get_reals(fmu_model *m, const unsigned vr[], size_t nvr, unsigned 
      * and outputs (run), read from the values and the outputs */
     const unsigned first = nvr > 0 ? vr[0] : 0;
     if (nvr > 0 && first < m->nvr && m->run[first] >= nvr) {
-        size_t i = 1;
-        while (i < nvr && vr[i] == first + i)
-            i++;
-        if (i == nvr) {
-            if (!m->out_valid)
-                outputs(m);
-            const double *value = m->v->value + first, *out = m->out + first;
-            const unsigned char *kind = m->kind + first;
-            if (m->out_run[first] >= nvr) /* outputs only: a copy */
-                for (i = 0; i < nvr; i++)
-                    values[i] = out[i];
-            else
-                for (i = 0; i < nvr; i++)
-                    values[i] = kind[i] & FMU_OUTPUT ? out[i] : value[i];
+        if (!m->out_valid)
+            outputs(m);
+        const double *value = m->v->value + first, *out = m->out + first;
+        const unsigned char *kind = m->kind + first;
+        size_t i = 0;
+        if (m->out_run[first] >= nvr) /* outputs only: a copy */
+            for (; i < nvr && vr[i] == first + i; i++)
+                values[i] = out[i];
+        else
+            for (; i < nvr && vr[i] == first + i; i++)
+                values[i] = kind[i] & FMU_OUTPUT ? out[i] : value[i];
+        if (i == nvr)
             return 0;
-        }
+        /* not a run after all: value by value (values[] is rewritten) */
     }
     for (size_t i = 0; i < nvr; i++)
         if (fmu_model_get(m, vr[i], type, &values[i], err) != 0)
@@ -660,6 +662,8 @@ static int load_solver(fmu_model *m, const unsigned char *b, uint64_t ndmi, char
         return -1;
     }
     m->solver = s;
+    m->p = p;
+    m->h = dmi_get_h(s);
     return 0;
 }
 
@@ -742,9 +746,7 @@ int fmu_model_state_load(fmu_model *into, uint32_t tags, uint32_t solver_tags, u
     }
     m.out_valid = 0;
     if (version >= 3) {
-        uint64_t p = 0;
-        if (m.solver)
-            dmi_get_step_index(m.solver, &p);
+        const uint64_t p = m.solver ? m.p : 0;
         m.nevents = dmi_get_u64(buf, FMU_STATE_AT_NEVENTS);
         m.event_p = dmi_get_u64(buf, FMU_STATE_AT_EVENT_P);
         if (m.event_p > p || m.nevents > p || (m.event_p > 0) != (m.nevents > 0)) {

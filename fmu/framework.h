@@ -57,6 +57,8 @@ typedef struct {
     dmi_fmu_values *v;  /* the values (heap, fixed address: the solver's callbacks keep it) */
     double t_comm;      /* the last communication point (t_start before any step) */
     dmi_solver *solver; /* NULL until fmu_model_start */
+    uint64_t p;         /* the solver's step index and step h, kept beside it (no query */
+    double h;           /* per doStep or get): set with the solver and by every step */
     double *out;        /* the outputs by value reference (with v's block) */
     double *work;       /* 5 n values: u, U, U^{p-1}, W, X (with v's block) */
     unsigned char *kind; /* fmu_kind of every value reference (with v's block) */
