@@ -278,16 +278,14 @@ static size_t n_indicators(void)
     return MODEL->indicators ? MODEL->nindicators : 0;
 }
 
-/* The model's indicators at the solver's step p into st (m->work as
- * scratch): u = U = U^p, W and X of step p (W = 0, X = U^0 when p = 0). */
-static void indicators_at(fmu_model *m, int *st)
+/* *pt: the point at time t of the solver's step p, in m->work (u, U,
+ * U^{p-1}, W, X): u = U = U^p, W and X of step p (W = 0, X = U^0 when p = 0). */
+static void step_point(fmu_model *m, double t, dmi_fmu_point *pt)
 {
     const size_t n = MODEL->n;
     double *U = m->work + n, *W = U + 2 * n, *X = W + n;
-    const uint64_t p = m->p;
-    const double h = m->h;
     dmi_get_state(m->solver, U);
-    if (p == 0) {
+    if (m->p == 0) {
         for (size_t i = 0; i < n; i++) {
             X[i] = U[i];
             W[i] = 0.0;
@@ -295,8 +293,19 @@ static void indicators_at(fmu_model *m, int *st)
     } else {
         dmi_get_step_terms(m->solver, W, X);
     }
-    const dmi_fmu_point pt = {m->v->t_start + (double)p * h, h, p, n, U, U, W, X,
-                              m->nevents, m->event_p};
+    pt->t = t;
+    pt->h = m->h;
+    pt->p = m->p;
+    pt->u = pt->U = U;
+    pt->W = W;
+    pt->X = X;
+}
+
+/* The model's indicators at the solver's step p into st. */
+static void indicators_at(fmu_model *m, int *st)
+{
+    dmi_fmu_point pt = {0.0, 0.0, 0, MODEL->n, NULL, NULL, NULL, NULL, m->nevents, m->event_p};
+    step_point(m, m->v->t_start + (double)m->p * m->h, &pt);
     MODEL->indicators(m->v, &pt, st);
 }
 
@@ -412,29 +421,19 @@ int fmu_model_do_step(fmu_model *m, double t_current, double step, fmu_stop_fn *
 static void outputs(fmu_model *m)
 {
     const size_t n = MODEL->n;
-    double *u = m->work, *U = u + n, *prev = U + n, *W = prev + n, *X = W + n;
+    double *u = m->work, *U = u + n, *prev = U + n;
     dmi_fmu_point pt = {m->t_comm, 0.0, 0, n, NULL, NULL, NULL, NULL, m->nevents, m->event_p};
     if (m->solver) {
-        const uint64_t p = m->p;
-        const double h = m->h;
-        dmi_get_state(m->solver, U);
-        pt = (dmi_fmu_point){m->t_comm, h, p, n, U, U, W, X, m->nevents, m->event_p};
-        if (p == 0) {
-            for (size_t i = 0; i < n; i++) {
-                X[i] = U[i];
-                W[i] = 0.0;
-            }
-        } else {
-            dmi_get_step_terms(m->solver, W, X);
-            const double theta = (m->t_comm - m->v->t_start) / h - (double)(p - 1);
-            if (theta < 1.0 - FMU_TIME_TOL) { /* between t_{p-1} and t_p; at t_p u = U^p */
-                const double th = theta > 0.0 ? theta : 0.0;
-                dmi_get_past(m->solver, 1, prev);
-                for (size_t i = 0; i < n; i++)
-                    u[i] = prev[i] + th * (U[i] - prev[i]);
-                pt.u = u;
-            }
-        }
+        step_point(m, m->t_comm, &pt);
+        const double theta =
+            m->p > 0 ? (m->t_comm - m->v->t_start) / m->h - (double)(m->p - 1) : 1.0;
+        if (theta < 1.0 - FMU_TIME_TOL) { /* between t_{p-1} and t_p */
+            const double th = theta > 0.0 ? theta : 0.0;
+            dmi_get_past(m->solver, 1, prev);
+            for (size_t i = 0; i < n; i++)
+                u[i] = prev[i] + th * (U[i] - prev[i]);
+            pt.u = u;
+        } /* else at t_p (or before the first step): u = U^p */
     }
     MODEL->outputs(m->v, &pt, m->out);
     m->out_valid = 1;

@@ -387,7 +387,9 @@ fmu_status fmu_set_state(fmu_instance *in, const char *fn, const void *state)
         return fmu_error(in, fn, "NULL state");
     if (fmu_model_state_load(&in->m, SAVABLE, HAS_SOLVER, &tag, s->bytes, s->size, err) != 0)
         return fmu_error(in, fn, "%s", err);
-    in->state = tag;
+    /* a state saved in event mode, restored into an instance without it (FMI
+     * 2.0, or eventModeUsed = false): step mode, the event handled */
+    in->state = tag == FMU_EVENT_MODE && !in->event_mode_used ? FMU_STEP_MODE : tag;
     return fmu_leave(in, fn, FMU_OK);
 }
 

@@ -192,3 +192,54 @@ def test_c_master_couples_at_the_transitions(native):
     chain = [x.split() for x in lines if x.startswith("chain ")]
     assert len(chain) == 1 and float(chain[0][4]) == T and math.isfinite(float(chain[0][2]))
     assert f"events {len(native)} early {sum(p not in regular for p in native)}" in out.stdout
+
+
+def test_event_mode_calling_sequence(tmp_path):
+    """eventModeUsed: event mode after initialization (doStep refused there,
+    UpdateDiscreteStates answers no update, no time event), EnterStepMode;
+    without eventModeUsed EnterEventMode is refused with a logged reason; a
+    state saved in event mode restores into an FMI 2.0 instance in step mode."""
+    from fmpy.fmi1 import FMICallException
+    from fmpy.fmi2 import FMU2Slave
+    from fmpy.fmi3 import FMU3Slave
+
+    def slave(version, log, **kw):
+        path = fmu_path(version)
+        md = read_model_description(path)
+        args = dict(guid=md.guid, unzipDirectory=extract(path, str(tmp_path / version)),
+                    modelIdentifier=md.coSimulation.modelIdentifier, instanceName="ev")
+        if version == "2":
+            f = FMU2Slave(**args)
+            f.instantiate()
+            return f
+        f = FMU3Slave(**args)
+        f.instantiate(logMessage=lambda env, st, cat, msg: log.append((st, msg.decode())), **kw)
+        return f
+
+    log = []
+    f = slave("3", log, eventModeUsed=True)
+    f.enterInitializationMode(startTime=0.0)
+    f.exitInitializationMode()
+    with pytest.raises(FMICallException):
+        f.doStep(0.0, 0.1)
+    assert "not allowed in state event mode" in log[-1][1]
+    assert list(f.updateDiscreteStates()) == [False, False, False, False, False, 0.0]
+    state = f.serializeFMUState(f.getFMUState())
+    f.enterStepMode()
+    f.doStep(0.0, 0.1)
+    f.terminate()
+    f.freeInstance()
+    log = []
+    f = slave("3", log)
+    f.enterInitializationMode(startTime=0.0)
+    f.exitInitializationMode()
+    with pytest.raises(FMICallException):
+        f.enterEventMode()
+    assert "eventModeUsed = false" in log[-1][1]
+    f.freeInstance()
+    f2 = slave("2", None)
+    f2.setFMUstate(f2.deSerializeFMUstate(bytes(state)))
+    f2.doStep(0.0, 0.1)  # step mode: allowed
+    assert f2.getReal([0])[0] == 1.0  # b, from the state
+    f2.terminate()
+    f2.freeInstance()
