@@ -362,9 +362,13 @@ static int steps_with_events(fmu_model *m, uint64_t p, uint64_t target, fmu_stop
             return rc;
         m->p = ++p;
         indicators_at(m, m->ind_new);
-        if (memcmp(m->ind_new, m->ind, nind * sizeof *m->ind) == 0)
+        int changed = 0;
+        for (size_t k = 0; k < nind; k++) {
+            changed |= m->ind_new[k] != m->ind[k];
+            m->ind[k] = m->ind_new[k];
+        }
+        if (!changed)
             continue;
-        memcpy(m->ind, m->ind_new, nind * sizeof *m->ind);
         m->nevents++;
         m->event_p = p;
         m->event = 1;
