@@ -680,7 +680,8 @@ static int check_identity(const unsigned char *buf, char *err)
         if (*c < ' ' || *c > '~')
             *c = '?';
     const uint64_t hash = dmi_get_u64(buf, FMU_STATE_AT_HASH), own = fmu_model_hash();
-    if (hash == own && strcmp(name, dmi_fmu_model_name) == 0)
+    /* the saved name is cut to FMU_STATE_NAMELEN - 1 characters */
+    if (hash == own && strncmp(name, dmi_fmu_model_name, FMU_STATE_NAMELEN - 1) == 0)
         return 0;
     return fail(err, "state: the state is of model \"%s\" (variables and GUID hash %016llx), "
                      "this FMU is model \"%s\" (hash %016llx)",
