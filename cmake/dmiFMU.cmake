@@ -196,6 +196,7 @@ function(dmi_add_fmu name)
 #include \"framework.h\"
 
 const char dmi_fmu_guid[] = \"@arg_GUID@\";
+const char dmi_fmu_model_name[] = \"${name}\";
 ")
   set(fw ${DMI_FMU_FRAMEWORK_DIR})
   set(framework ${fw}/framework.c ${fw}/framework.h ${fw}/instance.c ${fw}/instance.h

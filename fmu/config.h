@@ -52,6 +52,11 @@
       "so warning when (1 + h^2 b)^(T/h) > 2, T the experiment's length (stop - start time, 30 "   \
       "if not given), about N < tau b T / ln 2 (N < 44 for the default experiment)")               \
     X(sticking, Boolean, output, , "", "v = 0 at the end of the step containing t")               \
+    X(stick_slip_events, Int32, output, , "",                                                      \
+      "the stick-slip transitions so far: solver steps at which the friction's state (stuck: "    \
+      "|X_v| <= h alpha) differs from the step before")                                          \
+    X(last_event_time, Float64, output, , "",                                                      \
+      "the time t_start + p h of the last stick-slip transition's step p (t_start if none)")      \
     X(time, Float64, independent, , "", "the simulation time, the last communication point")
 
 #endif

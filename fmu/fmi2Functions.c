@@ -257,7 +257,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
     (void)noSetFMUStatePriorToCurrentPoint;
     ENTER(c, FN_DO_STEP, "fmi2DoStep");
     return (fmi2Status)fmu_do_step(in, "fmi2DoStep", currentCommunicationPoint,
-                                   communicationStepSize);
+                                   communicationStepSize, NULL, NULL);
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c)

@@ -5,10 +5,15 @@
  * the checks of fmi3InstantiateCoSimulation's arguments, and fmi3DoStep's
  * flags.
  *
- * The FMU has no event mode, never returns early and provides no
- * intermediate update (its model description says so): fmi3DoStep always
- * reports eventHandlingNeeded = terminateSimulation = earlyReturn = false.
- * Its variables are Float64, Int32 and Boolean scalars (the model's table,
+ * Events (a model's indicators, dmi_fmu.h): with earlyReturnAllowed,
+ * fmi3DoStep returns early at the first solver step at which an indicator
+ * changes (earlyReturn = true, lastSuccessfulTime = that step's time
+ * t_start + p h), after calling intermediateUpdate (if given; the importer
+ * may decline the early return there); with eventModeUsed it reports
+ * eventHandlingNeeded when an indicator changed in the step, and the FMU
+ * is in event mode after fmi3ExitInitializationMode and after
+ * fmi3EnterEventMode until fmi3EnterStepMode.  terminateSimulation is
+ * always false.  Its variables are Float64, Int32 and Boolean scalars (the model's table,
  * dmi_fmu.h); the functions of the other types, of
  * clocks, of model exchange and scheduled execution are exported as the
  * standard asks and refuse with fmi3Error and a logged reason.
@@ -29,6 +34,18 @@ static void sink(fmu_callback logger, void *environment, const char *name, fmu_s
 {
     (void)name;
     ((fmi3LogMessageCallback)logger)(environment, (fmi3Status)status, category, message);
+}
+
+/* intermediateUpdate at an event of time t: the step is finished there; no
+ * variable is to be set or got. */
+static int ask(fmu_callback intermediate, void *environment, double t, int can_return)
+{
+    fmi3Boolean requested = fmi3False;
+    fmi3Float64 when = t;
+    ((fmi3IntermediateUpdateCallback)intermediate)(environment, t, fmi3False, fmi3False,
+                                                   fmi3True, can_return ? fmi3True : fmi3False,
+                                                   &requested, &when);
+    return requested != fmi3False;
 }
 
 /* The reason every function of model exchange or scheduled execution gives. */
@@ -58,8 +75,7 @@ fmi3Instance fmi3InstantiateCoSimulation(
 {
     static const char fn[] = "fmi3InstantiateCoSimulation";
     const fmu_callback logger = (fmu_callback)logMessage;
-    (void)resourcePath, (void)visible, (void)earlyReturnAllowed;
-    (void)requiredIntermediateVariables, (void)intermediateUpdate;
+    (void)resourcePath, (void)visible, (void)requiredIntermediateVariables;
     if (instanceName && *instanceName) { /* (an empty name: refused by fmu_instantiate) */
         if (!instantiationToken || strcmp(instantiationToken, dmi_fmu_guid) != 0) {
             fmu_log_error(fn, instanceName, sink, logger, instanceEnvironment,
@@ -67,14 +83,19 @@ fmi3Instance fmi3InstantiateCoSimulation(
                           instantiationToken ? instantiationToken : "(null)", dmi_fmu_guid);
             return NULL;
         }
-        if (eventModeUsed || nRequiredIntermediateVariables > 0) {
+        if (nRequiredIntermediateVariables > 0) {
             fmu_log_error(fn, instanceName, sink, logger, instanceEnvironment, "%s",
-                          eventModeUsed ? "the FMU has no event mode (hasEventMode=\"false\")"
-                                        : "the FMU provides no intermediate update");
+                          "the FMU has no intermediate variables (intermediateUpdate is "
+                          "called at events, without getting or setting variables)");
             return NULL;
         }
     }
-    return fmu_instantiate(fn, instanceName, sink, logger, instanceEnvironment, loggingOn);
+    fmu_instance *in = fmu_instantiate(fn, instanceName, sink, logger, instanceEnvironment,
+                                       loggingOn);
+    if (in)
+        fmu_set_cosimulation(in, eventModeUsed, earlyReturnAllowed,
+                             (fmu_callback)intermediateUpdate, ask);
+    return in;
 }
 
 /* The instantiation of an interface type the FMU does not provide: NULL,
@@ -329,11 +350,12 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
     ENTER(instance, FN_DO_STEP, "fmi3DoStep");
     if (!eventHandlingNeeded || !terminateSimulation || !earlyReturn || !lastSuccessfulTime)
         return (fmi3Status)fmu_error(in, "fmi3DoStep", "NULL output argument");
+    int early = 0, event = 0;
     const fmi3Status st = (fmi3Status)fmu_do_step(in, "fmi3DoStep", currentCommunicationPoint,
-                                                  communicationStepSize);
-    *eventHandlingNeeded = fmi3False;
+                                                  communicationStepSize, &early, &event);
+    *eventHandlingNeeded = event ? fmi3True : fmi3False;
     *terminateSimulation = fmi3False;
-    *earlyReturn = fmi3False;
+    *earlyReturn = early ? fmi3True : fmi3False;
     *lastSuccessfulTime = fmu_time(in);
     return st;
 }
@@ -341,17 +363,18 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
 /* ---- what this FMU does not provide ---- */
 
 #define UNSUPPORTED(call, why) return (fmi3Status)fmu_unsupported(instance, call, why)
-#define NO_EVENTS "the FMU has no event mode and no clocks"
+#define NO_EVENTS "the FMU has no clocks"
 
 fmi3Status fmi3EnterEventMode(fmi3Instance instance)
 {
-    UNSUPPORTED("fmi3EnterEventMode", NO_EVENTS);
+    ENTER(instance, FN_ENTER_EVENT, "fmi3EnterEventMode");
+    return (fmi3Status)fmu_enter_event_mode(in, "fmi3EnterEventMode");
 }
 
 fmi3Status fmi3EnterStepMode(fmi3Instance instance)
 {
-    UNSUPPORTED("fmi3EnterStepMode", "the FMU is in step mode after "
-                                     "fmi3ExitInitializationMode (it has no event mode)");
+    ENTER(instance, FN_ENTER_STEP, "fmi3EnterStepMode");
+    return (fmi3Status)fmu_enter_step_mode(in, "fmi3EnterStepMode");
 }
 
 fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance instance,
@@ -475,7 +498,8 @@ fmi3Status fmi3SetShiftFraction(fmi3Instance instance, const fmi3ValueReference 
 
 fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance instance)
 {
-    UNSUPPORTED("fmi3EvaluateDiscreteStates", NO_EVENTS);
+    UNSUPPORTED("fmi3EvaluateDiscreteStates", "the FMU does not provide it "
+                                              "(providesEvaluateDiscreteStates=\"false\")");
 }
 
 fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discreteStatesNeedUpdate,
@@ -484,10 +508,18 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discrete
                                     fmi3Boolean *valuesOfContinuousStatesChanged,
                                     fmi3Boolean *nextEventTimeDefined, fmi3Float64 *nextEventTime)
 {
-    (void)discreteStatesNeedUpdate, (void)terminateSimulation;
-    (void)nominalsOfContinuousStatesChanged, (void)valuesOfContinuousStatesChanged;
-    (void)nextEventTimeDefined, (void)nextEventTime;
-    UNSUPPORTED("fmi3UpdateDiscreteStates", NO_EVENTS);
+    ENTER(instance, FN_UPDATE_DISCRETE, "fmi3UpdateDiscreteStates");
+    if (!discreteStatesNeedUpdate || !terminateSimulation || !nominalsOfContinuousStatesChanged ||
+        !valuesOfContinuousStatesChanged || !nextEventTimeDefined || !nextEventTime)
+        return (fmi3Status)fmu_error(in, "fmi3UpdateDiscreteStates", "NULL output argument");
+    /* the indicators are those of the current step already; no time event */
+    *discreteStatesNeedUpdate = fmi3False;
+    *terminateSimulation = fmi3False;
+    *nominalsOfContinuousStatesChanged = fmi3False;
+    *valuesOfContinuousStatesChanged = fmi3False;
+    *nextEventTimeDefined = fmi3False;
+    *nextEventTime = 0.0;
+    return (fmi3Status)fmu_update_discrete_states(in, "fmi3UpdateDiscreteStates");
 }
 
 fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance)

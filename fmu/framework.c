@@ -85,17 +85,28 @@ static double *values_of(const fmu_model *m)
 int fmu_model_new(fmu_model *m)
 {
     const unsigned nvr = count_vr();
-    const size_t n = MODEL->n;
-    m->v = malloc(sizeof *m->v + (2 * nvr + 5 * n) * sizeof(double) + nvr);
+    const size_t n = MODEL->n, nind = MODEL->indicators ? MODEL->nindicators : 0;
+    m->v = malloc(sizeof *m->v + (2 * nvr + 5 * n) * sizeof(double) +
+                  2 * nvr * sizeof(unsigned) + 2 * nind * sizeof(int) + nvr);
     if (!m->v)
         return -1;
     m->v->value = values_of(m);
     m->out = values_of(m) + nvr;
     m->work = m->out + nvr;
-    m->kind = (unsigned char *)(m->work + 5 * n);
+    m->run = (unsigned *)(m->work + 5 * n);
+    m->out_run = m->run + nvr;
+    m->ind = (int *)(m->out_run + nvr);
+    m->ind_new = m->ind + nind;
+    m->kind = (unsigned char *)(m->ind_new + nind);
     m->nvr = nvr;
     for (unsigned vr = 0; vr < nvr; vr++)
         m->kind[vr] = (unsigned char)fmu_kind(vr);
+    for (unsigned vr = nvr; vr-- > 0;) {
+        const unsigned kind = m->kind[vr];
+        const int real = (kind & FMU_FLOAT64) && !(kind & FMU_INDEPENDENT);
+        m->run[vr] = real ? 1 + (vr + 1 < nvr ? m->run[vr + 1] : 0) : 0;
+        m->out_run[vr] = real && (kind & FMU_OUTPUT) ? 1 + (vr + 1 < nvr ? m->out_run[vr + 1] : 0) : 0;
+    }
     m->solver = NULL;
     fmu_model_defaults(m);
     return 0;
@@ -114,6 +125,9 @@ void fmu_model_defaults(fmu_model *m)
         values_of(m)[vr] = fmu_is_set(m->kind[vr]) ? MODEL->variables[vr].start : 0.0;
     m->t_comm = 0.0;
     m->out_valid = 0;
+    m->p = m->nevents = m->event_p = 0;
+    m->h = 0.0;
+    m->event = 0;
 }
 
 void fmu_model_free(fmu_model *m)
@@ -258,6 +272,43 @@ int fmu_model_check_start(const fmu_model *m, double T, char *msg)
     return MODEL->check ? MODEL->check(m->v, T, msg) : 0;
 }
 
+/* The number of the model's indicators (0 without them). */
+static size_t n_indicators(void)
+{
+    return MODEL->indicators ? MODEL->nindicators : 0;
+}
+
+/* *pt: the point at time t of the solver's step p, in m->work (u, U,
+ * U^{p-1}, W, X): u = U = U^p, W and X of step p (W = 0, X = U^0 when p = 0). */
+static void step_point(fmu_model *m, double t, dmi_fmu_point *pt)
+{
+    const size_t n = MODEL->n;
+    double *U = m->work + n, *W = U + 2 * n, *X = W + n;
+    dmi_get_state(m->solver, U);
+    if (m->p == 0) {
+        for (size_t i = 0; i < n; i++) {
+            X[i] = U[i];
+            W[i] = 0.0;
+        }
+    } else {
+        dmi_get_step_terms(m->solver, W, X);
+    }
+    pt->t = t;
+    pt->h = m->h;
+    pt->p = m->p;
+    pt->u = pt->U = U;
+    pt->W = W;
+    pt->X = X;
+}
+
+/* The model's indicators at the solver's step p into st. */
+static void indicators_at(fmu_model *m, int *st)
+{
+    dmi_fmu_point pt = {0.0, 0.0, 0, MODEL->n, NULL, NULL, NULL, NULL, m->nevents, m->event_p};
+    step_point(m, m->v->t_start + (double)m->p * m->h, &pt);
+    MODEL->indicators(m->v, &pt, st);
+}
+
 int fmu_model_start(fmu_model *m, double t_start, char *err, char *note)
 {
     double kept, peak;
@@ -274,9 +325,15 @@ int fmu_model_start(fmu_model *m, double t_start, char *err, char *note)
     }
     dmi_free(&m->solver);
     m->solver = s;
+    m->p = 0;
+    m->h = dmi_get_h(s);
     m->v->t_start = t_start;
     m->t_comm = t_start;
     m->out_valid = 0;
+    m->nevents = m->event_p = 0;
+    m->event = 0;
+    if (n_indicators())
+        indicators_at(m, m->ind);
     return 0;
 }
 
@@ -287,9 +344,48 @@ static double steps_before(double t_start, double t, double h)
     return ceil((t - t_start) / h - FMU_TIME_TOL);
 }
 
-int fmu_model_do_step(fmu_model *m, double t_current, double step, char *err)
+/* Steps the solver from step p to step target, one at a time, the
+ * indicators after each (see fmu_model_do_step): 0, 1 when stopped early at
+ * an event, or a libdmi error code (negative).  Not inlined (GCC, Clang):
+ * the doStep of a model without indicators stays short. */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static int steps_with_events(fmu_model *m, uint64_t p, uint64_t target, fmu_stop_fn *stop,
+                             void *ctx)
 {
-    const double h = dmi_get_h(m->solver);
+    const size_t nind = n_indicators();
+    const double h = m->h;
+    while (p < target) {
+        int rc = dmi_step(m->solver);
+        if (rc != DMI_OK)
+            return rc;
+        m->p = ++p;
+        indicators_at(m, m->ind_new);
+        int changed = 0;
+        for (size_t k = 0; k < nind; k++) {
+            changed |= m->ind_new[k] != m->ind[k];
+            m->ind[k] = m->ind_new[k];
+        }
+        if (!changed)
+            continue;
+        m->nevents++;
+        m->event_p = p;
+        m->event = 1;
+        const double t_p = m->v->t_start + (double)p * h;
+        if (p < target && stop && stop(ctx, t_p)) {
+            m->t_comm = t_p;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+int fmu_model_do_step(fmu_model *m, double t_current, double step, fmu_stop_fn *stop,
+                      void *ctx, int *early, char *err)
+{
+    *early = 0;
+    const double h = m->h;
     if (!isfinite(t_current) || !isfinite(step) || !(step > 0))
         return fail(err, "the time %.17g and the step %.17g must be finite and the step > 0",
                     t_current, step);
@@ -298,17 +394,24 @@ int fmu_model_do_step(fmu_model *m, double t_current, double step, char *err)
                     m->t_comm);
     const double t_end = t_current + step;
     const double target = steps_before(m->v->t_start, t_end, h);
-    uint64_t p = 0;
-    dmi_get_step_index(m->solver, &p);
+    const uint64_t p = m->p;
     if (!(target < 9007199254740992.0)) /* 2^53: beyond it p h has no meaning */
         return fail(err, "t = %.17g is too far from the start for the step h", t_end);
     m->out_valid = 0;
+    m->event = 0;
     if (target > (double)p) {
-        int rc = dmi_advance(m->solver, (size_t)(target - (double)p));
+        int rc = n_indicators() ? steps_with_events(m, p, (uint64_t)target, stop, ctx)
+                                : dmi_advance(m->solver, (size_t)(target - (double)p));
+        if (rc == 1) {
+            *early = 1;
+            return 0;
+        }
         if (rc != DMI_OK) {
+            dmi_get_step_index(m->solver, &m->p); /* the steps taken are kept */
             solver_fail(err, "the solver failed", m->solver, rc);
             return -2;
         }
+        m->p = (uint64_t)target;
     }
     m->t_comm = t_end;
     return 0;
@@ -322,27 +425,19 @@ int fmu_model_do_step(fmu_model *m, double t_current, double step, char *err)
 static void outputs(fmu_model *m)
 {
     const size_t n = MODEL->n;
-    double *u = m->work, *U = u + n, *prev = U + n, *W = prev + n, *X = W + n;
-    dmi_fmu_point pt = {m->t_comm, 0.0, 0, n, NULL, NULL, NULL, NULL};
+    double *u = m->work, *U = u + n, *prev = U + n;
+    dmi_fmu_point pt = {m->t_comm, 0.0, 0, n, NULL, NULL, NULL, NULL, m->nevents, m->event_p};
     if (m->solver) {
-        uint64_t p = 0;
-        dmi_get_step_index(m->solver, &p);
-        const double h = dmi_get_h(m->solver);
-        dmi_get_state(m->solver, U);
-        if (p == 0) {
-            for (size_t i = 0; i < n; i++) {
-                u[i] = X[i] = U[i];
-                W[i] = 0.0;
-            }
-        } else {
-            dmi_get_past(m->solver, 1, prev);
-            dmi_get_step_terms(m->solver, W, X);
-            const double theta = (m->t_comm - m->v->t_start) / h - (double)(p - 1);
+        step_point(m, m->t_comm, &pt);
+        const double theta =
+            m->p > 0 ? (m->t_comm - m->v->t_start) / m->h - (double)(m->p - 1) : 1.0;
+        if (theta < 1.0 - FMU_TIME_TOL) { /* between t_{p-1} and t_p */
             const double th = theta > 0.0 ? theta : 0.0;
+            dmi_get_past(m->solver, 1, prev);
             for (size_t i = 0; i < n; i++)
-                u[i] = theta >= 1.0 - FMU_TIME_TOL ? U[i] : prev[i] + th * (U[i] - prev[i]);
-        }
-        pt = (dmi_fmu_point){m->t_comm, h, p, n, u, U, W, X};
+                u[i] = prev[i] + th * (U[i] - prev[i]);
+            pt.u = u;
+        } /* else at t_p (or before the first step): u = U^p */
     }
     MODEL->outputs(m->v, &pt, m->out);
     m->out_valid = 1;
@@ -370,6 +465,25 @@ int fmu_model_get(fmu_model *m, unsigned vr, unsigned type, double *value, char 
 int fmu_model_get_reals(fmu_model *m, const unsigned vr[], size_t nvr, unsigned type,
                         double *values, char *err)
 {
+    /* the bulk path: vr[0], vr[0] + 1, ..., all Float64 parameters, inputs
+     * and outputs (run), read from the values and the outputs */
+    const unsigned first = nvr > 0 ? vr[0] : 0;
+    if (nvr > 0 && first < m->nvr && m->run[first] >= nvr) {
+        if (!m->out_valid)
+            outputs(m);
+        const double *value = m->v->value + first, *out = m->out + first;
+        const unsigned char *kind = m->kind + first;
+        size_t i = 0;
+        if (m->out_run[first] >= nvr) /* outputs only: a copy */
+            for (; i < nvr && vr[i] == first + i; i++)
+                values[i] = out[i];
+        else
+            for (; i < nvr && vr[i] == first + i; i++)
+                values[i] = kind[i] & FMU_OUTPUT ? out[i] : value[i];
+        if (i == nvr)
+            return 0;
+        /* not a run after all: value by value (values[] is rewritten) */
+    }
     for (size_t i = 0; i < nvr; i++)
         if (fmu_model_get(m, vr[i], type, &values[i], err) != 0)
             return -1;
@@ -396,31 +510,58 @@ static void count_set(size_t *nreal, size_t *nint)
     }
 }
 
-/* The offset of the Float64 values (after the integers) and of libdmi's part
- * (after them, t_start and t_comm). */
-static size_t at_real(void)
+/* The offsets, in a state of format version, of the integers, of the
+ * Float64 values (after the integers) and of libdmi's part (after them,
+ * t_start and t_comm). */
+static size_t at_int(uint32_t version)
 {
-    size_t nreal, nint;
-    count_set(&nreal, &nint);
-    return FMU_STATE_AT_INT + 8 * nint;
+    return version >= 3 ? FMU_STATE_AT_INT : FMU_STATE_AT_INT_V2;
 }
 
-static size_t at_dmi(void)
+static size_t at_real(uint32_t version)
 {
     size_t nreal, nint;
     count_set(&nreal, &nint);
-    return FMU_STATE_AT_INT + 8 * (nint + nreal + 2);
+    return at_int(version) + 8 * nint;
+}
+
+static size_t at_dmi(uint32_t version)
+{
+    size_t nreal, nint;
+    count_set(&nreal, &nint);
+    return at_int(version) + 8 * (nint + nreal + 2);
+}
+
+/* FNV-1a 64 of a string and its NUL. */
+static uint64_t hash_text(uint64_t x, const char *text)
+{
+    return dmi_fnv1a(x, (const unsigned char *)text, strlen(text) + 1);
+}
+
+uint64_t fmu_model_hash(void)
+{
+    uint64_t x = DMI_FNV1A_INIT;
+    for (size_t vr = 0; vr < MODEL->nvariables; vr++) {
+        const dmi_fmu_variable *v = &MODEL->variables[vr];
+        const char *const text[] = {v->name, v->type, v->causality, v->start_text, v->unit,
+                                    v->description};
+        for (size_t k = 0; k < DMI_FMU_COUNT(text); k++)
+            x = hash_text(x, text[k] ? text[k] : "");
+    }
+    const uint64_t n = MODEL->n;
+    x = dmi_fnv1a(x, (const unsigned char *)&n, sizeof n);
+    return hash_text(x, dmi_fmu_guid);
 }
 
 size_t fmu_model_state_size(const fmu_model *m)
 {
-    return at_dmi() + dmi_state_size(m->solver) + 8;
+    return at_dmi(FMU_STATE_VERSION) + dmi_state_size(m->solver) + 8;
 }
 
 void fmu_model_state_save(const fmu_model *m, uint32_t tag, unsigned char *buf)
 {
     const size_t total = fmu_model_state_size(m), ndmi = dmi_state_size(m->solver);
-    size_t nreal, nint, at_i = FMU_STATE_AT_INT, at_r = at_real();
+    size_t nreal, nint, at_i = at_int(FMU_STATE_VERSION), at_r = at_real(FMU_STATE_VERSION);
     count_set(&nreal, &nint);
     memcpy(buf, FMU_STATE_MAGIC, 8);
     dmi_put_u32(buf, FMU_STATE_AT_VERSION, FMU_STATE_VERSION);
@@ -428,6 +569,12 @@ void fmu_model_state_save(const fmu_model *m, uint32_t tag, unsigned char *buf)
     dmi_put_u64(buf, FMU_STATE_AT_TOTAL, total);
     dmi_put_u64(buf, FMU_STATE_AT_NREAL, nreal);
     dmi_put_u64(buf, FMU_STATE_AT_NDMI, ndmi);
+    dmi_put_u64(buf, FMU_STATE_AT_HASH, fmu_model_hash());
+    dmi_put_u64(buf, FMU_STATE_AT_NEVENTS, m->nevents);
+    dmi_put_u64(buf, FMU_STATE_AT_EVENT_P, m->event_p);
+    memset(buf + FMU_STATE_AT_NAME, 0, FMU_STATE_NAMELEN);
+    for (size_t i = 0; dmi_fmu_model_name[i] && i + 1 < FMU_STATE_NAMELEN; i++)
+        buf[FMU_STATE_AT_NAME + i] = (unsigned char)dmi_fmu_model_name[i];
     for (unsigned vr = 0; vr < MODEL->nvariables; vr++) {
         const unsigned kind = m->kind[vr];
         if (!fmu_is_set(kind))
@@ -447,15 +594,16 @@ void fmu_model_state_save(const fmu_model *m, uint32_t tag, unsigned char *buf)
     dmi_put_u64(buf, total - 8, dmi_fnv1a(DMI_FNV1A_INIT, buf, total - 8));
 }
 
-/* The values of the state bytes into m (checked as if set); 0 or -1 (err). */
-static int load_values(fmu_model *m, const unsigned char *buf, char *err)
+/* The values of the state bytes (format version) into m (checked as if
+ * set); 0 or -1 (err). */
+static int load_values(fmu_model *m, uint32_t version, const unsigned char *buf, char *err)
 {
     /* Two rounds: each value read, checked by the framework and stored; then
      * each accepted by the model, so that an accept that compares two
      * variables sees the state's values (all of them checked already), not
      * the start values beside them.  (m is a fresh model: a refusal frees it.) */
     for (int round = 0; round < 2; round++) {
-        size_t at_i = FMU_STATE_AT_INT, at_r = at_real();
+        size_t at_i = at_int(version), at_r = at_real(version);
         for (int pass = 0; pass < 2; pass++) /* the Float64 values first, then the others */
             for (unsigned vr = 0; vr < MODEL->nvariables; vr++) {
                 const unsigned kind = m->kind[vr];
@@ -517,30 +665,54 @@ static int load_solver(fmu_model *m, const unsigned char *b, uint64_t ndmi, char
         return -1;
     }
     m->solver = s;
+    m->p = p;
+    m->h = dmi_get_h(s);
     return 0;
+}
+
+/* A state of format 3 names its model: another model's is refused (0 or -1). */
+static int check_identity(const unsigned char *buf, char *err)
+{
+    char name[FMU_STATE_NAMELEN];
+    memcpy(name, buf + FMU_STATE_AT_NAME, FMU_STATE_NAMELEN);
+    name[FMU_STATE_NAMELEN - 1] = '\0';
+    for (char *c = name; *c; c++) /* shown in a message: printable ASCII only */
+        if (*c < ' ' || *c > '~')
+            *c = '?';
+    const uint64_t hash = dmi_get_u64(buf, FMU_STATE_AT_HASH), own = fmu_model_hash();
+    /* the saved name is cut to FMU_STATE_NAMELEN - 1 characters */
+    if (hash == own && strncmp(name, dmi_fmu_model_name, FMU_STATE_NAMELEN - 1) == 0)
+        return 0;
+    return fail(err, "state: the state is of model \"%s\" (variables and GUID hash %016llx), "
+                     "this FMU is model \"%s\" (hash %016llx)",
+                name, (unsigned long long)hash, dmi_fmu_model_name, (unsigned long long)own);
 }
 
 int fmu_model_state_load(fmu_model *into, uint32_t tags, uint32_t solver_tags, uint32_t *tag,
                          const unsigned char *buf, size_t size, char *err)
 {
-    const size_t AT_DMI = at_dmi(), AT_REAL = at_real();
     size_t nreal_model, nint;
     count_set(&nreal_model, &nint);
-    if (!buf || size < AT_DMI + 8)
+    if (!buf || size < FMU_STATE_AT_VERSION + 4)
         return fail(err, "state: %zu bytes is too short for a saved state", size);
     if (memcmp(buf, FMU_STATE_MAGIC, 8) != 0)
         return fail(err, "state: the bytes are not a saved state of this FMU (bad magic)");
     const uint32_t version = dmi_get_u32(buf, FMU_STATE_AT_VERSION);
+    if (version != 2 && version != FMU_STATE_VERSION)
+        return fail(err, "state: format version %lu is not supported (this FMU reads versions 2 "
+                         "and %d%s)", (unsigned long)version, FMU_STATE_VERSION,
+                    version == 1 ? "; version 1 was written by the FMU of libdmi 1.0" : "");
+    const size_t AT_DMI = at_dmi(version), AT_REAL = at_real(version);
+    if (size < AT_DMI + 8)
+        return fail(err, "state: %zu bytes is too short for a saved state", size);
+    if (version >= 3 && check_identity(buf, err) != 0)
+        return -1;
     const uint64_t total = dmi_get_u64(buf, FMU_STATE_AT_TOTAL);
     const uint64_t nreal = dmi_get_u64(buf, FMU_STATE_AT_NREAL);
     const uint64_t ndmi = dmi_get_u64(buf, FMU_STATE_AT_NDMI);
     *tag = dmi_get_u32(buf, FMU_STATE_AT_TAG);
     if (*tag == 0 || (*tag & (*tag - 1)) != 0 || (*tag & tags) == 0)
         return fail(err, "state: the saved phase tag %lu is not allowed", (unsigned long)*tag);
-    if (version != FMU_STATE_VERSION)
-        return fail(err, "state: format version %lu is not supported (this FMU reads version %d%s)",
-                    (unsigned long)version, FMU_STATE_VERSION,
-                    version == 1 ? "; version 1 was written by the FMU of libdmi 1.0" : "");
     if (nreal != nreal_model || total != size || ndmi != size - (AT_DMI + 8))
         return fail(err, "state: the sizes recorded in the state do not match (%zu bytes given)",
                     size);
@@ -552,7 +724,7 @@ int fmu_model_state_load(fmu_model *into, uint32_t tags, uint32_t solver_tags, u
     fmu_model m;
     if (fmu_model_new(&m) != 0)
         return fail(err, "state: out of memory");
-    if (load_values(&m, buf, err) != 0)
+    if (load_values(&m, version, buf, err) != 0)
         goto refused;
     if (!isfinite(t_start) || !isfinite(t_comm) || t_comm < t_start) {
         fail(err, "state: invalid times (start %.17g, communication point %.17g)", t_start,
@@ -577,6 +749,19 @@ int fmu_model_state_load(fmu_model *into, uint32_t tags, uint32_t solver_tags, u
         goto refused;
     }
     m.out_valid = 0;
+    if (version >= 3) {
+        const uint64_t p = m.solver ? m.p : 0;
+        m.nevents = dmi_get_u64(buf, FMU_STATE_AT_NEVENTS);
+        m.event_p = dmi_get_u64(buf, FMU_STATE_AT_EVENT_P);
+        if (m.event_p > p || m.nevents > p || (m.event_p > 0) != (m.nevents > 0)) {
+            fail(err, "state: the events (%llu, the last at step %llu) do not fit the solver's "
+                      "step %llu", (unsigned long long)m.nevents, (unsigned long long)m.event_p,
+                 (unsigned long long)p);
+            goto refused;
+        }
+    }
+    if (m.solver && n_indicators())
+        indicators_at(&m, m.ind);
     if (into) {
         fmu_model_free(into);
         *into = m; /* the solver's callbacks keep m.v, which moves with it */

@@ -19,6 +19,9 @@
 /* The FMU's GUID (FMI 2.0) and instantiationToken (FMI 3.0): written by
  * dmi_add_fmu into the generated fmu_identity.c. */
 extern const char dmi_fmu_guid[];
+/* The FMU's model name (modelIdentifier), from dmi_add_fmu's NAME, in the
+ * same file. */
+extern const char dmi_fmu_model_name[];
 
 /* The log categories of both model descriptions: C(name, description), in
  * the order of instance.c's CAT_* numbers. */
@@ -54,9 +57,18 @@ typedef struct {
     dmi_fmu_values *v;  /* the values (heap, fixed address: the solver's callbacks keep it) */
     double t_comm;      /* the last communication point (t_start before any step) */
     dmi_solver *solver; /* NULL until fmu_model_start */
+    uint64_t p;         /* the solver's step index and step h, kept beside it (no query */
+    double h;           /* per doStep or get): set with the solver and by every step */
     double *out;        /* the outputs by value reference (with v's block) */
     double *work;       /* 5 n values: u, U, U^{p-1}, W, X (with v's block) */
     unsigned char *kind; /* fmu_kind of every value reference (with v's block) */
+    unsigned *run;      /* run[vr]: the Float64 variables vr, vr + 1, ... in a row, the
+                           independent one left out (the bulk get; with v's block) */
+    unsigned *out_run;  /* out_run[vr]: the same for Float64 outputs only (with v's block) */
+    int *ind, *ind_new; /* the model's indicators at the solver's step; scratch (v's block) */
+    uint64_t nevents;   /* steps at which an indicator changed (dmi_fmu_point) */
+    uint64_t event_p;   /* the last of them, 0 if none */
+    int event;          /* an indicator changed in the last doStep */
     unsigned nvr;       /* the number of value references */
     int out_valid;      /* out holds the outputs at t_comm */
 } fmu_model;
@@ -87,7 +99,10 @@ int fmu_model_get(fmu_model *m, unsigned vr, unsigned type, double *value, char 
 void fmu_model_set_start(fmu_model *m, double t_start);
 
 /* fmu_model_get of nvr Float64 variables vr[i] into values[i] (type has
- * FMU_FLOAT64): one call for an FMI get of Float64 values. */
+ * FMU_FLOAT64): one call for an FMI get of Float64 values.  A run of
+ * consecutive value references of Float64 parameters, inputs and outputs
+ * (the common case: all outputs) is copied without a check per value; any
+ * other array goes value by value (the same values and messages). */
 int fmu_model_get_reals(fmu_model *m, const unsigned vr[], size_t nvr, unsigned type,
                         double *values, char *err);
 
@@ -99,33 +114,57 @@ int fmu_model_check_start(const fmu_model *m, double T, char *msg);
  * more than FMU_NOTE_BYTES, else "". */
 int fmu_model_start(fmu_model *m, double t_start, char *err, char *note);
 
+/* Whether to end a communication step early at the event of time t (a
+ * solver step t_p = t_start + p h before the step's end): nonzero to stop. */
+typedef int fmu_stop_fn(void *ctx, double t);
+
 /* The communication step from t_current (which must be t_comm to within
  * FMU_TIME_TOL h) to t_current + step, step > 0: takes every step whose start
- * t_p is before the end (by more than FMU_TIME_TOL h).  -1 for bad arguments
- * (m unchanged), -2 for a solver failure (the steps taken are kept). */
-int fmu_model_do_step(fmu_model *m, double t_current, double step, char *err);
+ * t_p is before the end (by more than FMU_TIME_TOL h).  With the model's
+ * indicators, one solver step at a time: m->event tells whether an indicator
+ * changed (nevents and event_p count them); at such a step t_p before the
+ * step's last, stop(ctx, t_p) (when stop is not NULL) may end the
+ * communication step there: t_comm = t_p (start + p h) and *early = 1.  -1
+ * for bad arguments (m unchanged), -2 for a solver failure (the steps taken
+ * are kept). */
+int fmu_model_do_step(fmu_model *m, double t_current, double step, fmu_stop_fn *stop,
+                      void *ctx, int *early, char *err);
 
 /*
  * Saved state, native endian, at these byte offsets: a magic, the format
  * version, the caller's 32-bit tag (the FMI phase), the total size, the
  * number of Float64 values set (nreal), the size of libdmi's state (0: no
- * solver), one int64 per Int32 or Boolean parameter or input in the order of
- * the value references, then the Float64 parameters and inputs (in that
- * order), t_start, t_comm, libdmi's own checked state bytes (the whole
- * history) and the FNV-1a 64 (src/bytes.h) of all bytes before it.  (Version
- * 2 is the layout of the oscillator FMU of libdmi 1.1, which has one integer
- * parameter N: its states restore unchanged.)
+ * solver); format 3: the model's hash (the FNV-1a 64 of its variable table,
+ * n and GUID: fmu_model_hash), the events (nevents and event_p, uint64) and
+ * the model's name (FMU_STATE_NAMELEN bytes, NUL-padded, cut to fit); then
+ * one int64 per Int32 or Boolean parameter or input in the order of the
+ * value references, the Float64 parameters and inputs (in that order),
+ * t_start, t_comm, libdmi's own checked state bytes (the whole history) and
+ * the FNV-1a 64 (src/bytes.h) of all bytes before it.  States are saved in
+ * format 3; format 2 (the FMUs of libdmi 1.1, without identity and events:
+ * the oscillator FMU's layout, with its one integer parameter N) still
+ * restores.  A state of format 3 of another model (name or hash) is refused
+ * with both models' names.
  */
 #define FMU_STATE_MAGIC "dmiFMUst"
 enum {
-    FMU_STATE_VERSION = 2,
+    FMU_STATE_VERSION = 3,
     FMU_STATE_AT_VERSION = 8,
     FMU_STATE_AT_TAG = 12,
     FMU_STATE_AT_TOTAL = 16,
     FMU_STATE_AT_NREAL = 24,
     FMU_STATE_AT_NDMI = 32,
-    FMU_STATE_AT_INT = 40
+    FMU_STATE_AT_INT_V2 = 40, /* format 2: the values */
+    FMU_STATE_AT_HASH = 40,   /* format 3: uint64 */
+    FMU_STATE_AT_NEVENTS = 48, /* format 3: uint64 */
+    FMU_STATE_AT_EVENT_P = 56, /* format 3: uint64 */
+    FMU_STATE_AT_NAME = 64,   /* format 3: the name */
+    FMU_STATE_NAMELEN = 64,
+    FMU_STATE_AT_INT = FMU_STATE_AT_NAME + FMU_STATE_NAMELEN /* format 3: the values */
 };
+/* The model's hash: FNV-1a 64 of its variable table (every column), n, and
+ * the GUID. */
+uint64_t fmu_model_hash(void);
 size_t fmu_model_state_size(const fmu_model *m);
 void fmu_model_state_save(const fmu_model *m, uint32_t tag, unsigned char *buf);
 /* Checks the bytes and, when into is not NULL, replaces *into by the saved

@@ -12,12 +12,13 @@
 #include <string.h>
 
 #define ANY_STATE                                                                                 \
-    (FMU_INSTANTIATED | FMU_INIT_MODE | FMU_STEP_MODE | FMU_TERMINATED | FMU_ERROR_STATE)
+    (FMU_INSTANTIATED | FMU_INIT_MODE | FMU_STEP_MODE | FMU_TERMINATED | FMU_ERROR_STATE |      \
+     FMU_EVENT_MODE)
 /* The states an FMU state can be taken in (and restored to). */
-#define SAVABLE (FMU_INSTANTIATED | FMU_INIT_MODE | FMU_STEP_MODE | FMU_TERMINATED)
+#define SAVABLE (FMU_INSTANTIATED | FMU_INIT_MODE | FMU_STEP_MODE | FMU_TERMINATED | FMU_EVENT_MODE)
 /* The states with a solver (after ExitInitializationMode): their saved
  * states hold the history. */
-#define HAS_SOLVER (FMU_STEP_MODE | FMU_TERMINATED)
+#define HAS_SOLVER (FMU_STEP_MODE | FMU_TERMINATED | FMU_EVENT_MODE)
 
 /* The calling sequence: the states in which each function is allowed. */
 static const unsigned ALLOWED[FN_COUNT] = {
@@ -26,10 +27,10 @@ static const unsigned ALLOWED[FN_COUNT] = {
     [FN_SETUP_EXPERIMENT] = FMU_INSTANTIATED,
     [FN_ENTER_INIT] = FMU_INSTANTIATED,
     [FN_EXIT_INIT] = FMU_INIT_MODE,
-    [FN_TERMINATE] = FMU_STEP_MODE,
+    [FN_TERMINATE] = FMU_STEP_MODE | FMU_EVENT_MODE,
     [FN_RESET] = ANY_STATE,
-    [FN_GET] = FMU_INIT_MODE | FMU_STEP_MODE | FMU_TERMINATED | FMU_ERROR_STATE,
-    [FN_SET] = FMU_INSTANTIATED | FMU_INIT_MODE | FMU_STEP_MODE,
+    [FN_GET] = FMU_INIT_MODE | FMU_STEP_MODE | FMU_TERMINATED | FMU_ERROR_STATE | FMU_EVENT_MODE,
+    [FN_SET] = FMU_INSTANTIATED | FMU_INIT_MODE | FMU_STEP_MODE | FMU_EVENT_MODE,
     [FN_GET_STATE] = SAVABLE,
     [FN_SET_STATE] = ANY_STATE,
     [FN_FREE_STATE] = ANY_STATE,
@@ -37,6 +38,9 @@ static const unsigned ALLOWED[FN_COUNT] = {
     [FN_SERIALIZE] = ANY_STATE,
     [FN_DESERIALIZE] = ANY_STATE,
     [FN_DO_STEP] = FMU_STEP_MODE,
+    [FN_ENTER_EVENT] = FMU_STEP_MODE,
+    [FN_ENTER_STEP] = FMU_EVENT_MODE,
+    [FN_UPDATE_DISCRETE] = FMU_EVENT_MODE,
     [FN_STATUS] = FMU_INIT_MODE | FMU_STEP_MODE | FMU_TERMINATED | FMU_ERROR_STATE,
     [FN_UNSUPPORTED] = ANY_STATE,
 };
@@ -60,6 +64,9 @@ struct fmu_instance {
     unsigned state;
     int stop_defined;
     double stop_time;
+    int event_mode_used, early_return_allowed; /* FMI 3.0's options */
+    fmu_callback intermediate;                 /* FMI 3.0's intermediateUpdate, or NULL */
+    fmu_ask_fn *ask;                           /* calls it */
     fmu_model m;
 };
 
@@ -139,6 +146,7 @@ static const char *state_name(unsigned state)
     case FMU_INIT_MODE: return "initialization mode";
     case FMU_STEP_MODE: return "step mode";
     case FMU_TERMINATED: return "terminated";
+    case FMU_EVENT_MODE: return "event mode";
     default: return "error";
     }
 }
@@ -258,7 +266,8 @@ fmu_status fmu_exit_init(fmu_instance *in, const char *fn)
         return fmu_error(in, fn, "%s", msg);
     if (fmu_model_start(&in->m, in->m.v->t_start, err, note) != 0)
         return fmu_error(in, fn, "%s", err);
-    in->state = FMU_STEP_MODE;
+    /* FMI 3.0: with eventModeUsed the FMU is in event mode after initialization */
+    in->state = in->event_mode_used ? FMU_EVENT_MODE : FMU_STEP_MODE;
     if (note[0])
         send(in->sink, in->logger, in->environment, in->name, FMU_OK, CAT_MEMORY, fn, note);
     if (check > 0) {
@@ -378,7 +387,9 @@ fmu_status fmu_set_state(fmu_instance *in, const char *fn, const void *state)
         return fmu_error(in, fn, "NULL state");
     if (fmu_model_state_load(&in->m, SAVABLE, HAS_SOLVER, &tag, s->bytes, s->size, err) != 0)
         return fmu_error(in, fn, "%s", err);
-    in->state = tag;
+    /* a state saved in event mode, restored into an instance without it (FMI
+     * 2.0, or eventModeUsed = false): step mode, the event handled */
+    in->state = tag == FMU_EVENT_MODE && !in->event_mode_used ? FMU_STEP_MODE : tag;
     return fmu_leave(in, fn, FMU_OK);
 }
 
@@ -432,13 +443,63 @@ fmu_status fmu_deserialize(fmu_instance *in, const char *fn, const unsigned char
 
 /* ---- stepping ---- */
 
-fmu_status fmu_do_step(fmu_instance *in, const char *fn, double t, double h)
+void fmu_set_cosimulation(fmu_instance *in, int event_mode_used, int early_return_allowed,
+                          fmu_callback intermediate, fmu_ask_fn *ask)
+{
+    in->event_mode_used = event_mode_used != 0;
+    in->early_return_allowed = early_return_allowed != 0;
+    in->intermediate = intermediate;
+    in->ask = ask;
+}
+
+/* fmu_stop_fn of a doStep: at an event before the end, the importer's
+ * intermediateUpdate (if any) is told; the step ends there if early return
+ * is allowed and the importer did not decline it. */
+static int stop_at_event(void *ctx, double t)
+{
+    fmu_instance *in = ctx;
+    int stop = in->early_return_allowed;
+    if (in->intermediate && in->ask)
+        stop = in->ask(in->intermediate, in->environment, t, stop) && stop;
+    return stop;
+}
+
+fmu_status fmu_do_step(fmu_instance *in, const char *fn, double t, double h, int *early,
+                       int *event_handling)
 {
     char err[FMU_ERRLEN];
-    int rc = fmu_model_do_step(&in->m, t, h, err);
+    int stopped = 0;
+    /* without early return nor callback, never asked: FMI 2.0 runs as before */
+    const int asks = early && (in->early_return_allowed || in->intermediate);
+    int rc = fmu_model_do_step(&in->m, t, h, asks ? stop_at_event : NULL, in, &stopped, err);
     if (rc == -2)
         in->state = FMU_ERROR_STATE;
+    if (early)
+        *early = rc == 0 && stopped;
+    if (event_handling)
+        *event_handling = rc == 0 && in->event_mode_used && in->m.event;
     return rc == 0 ? fmu_leave(in, fn, FMU_OK) : fmu_error(in, fn, "%s", err);
+}
+
+fmu_status fmu_enter_event_mode(fmu_instance *in, const char *fn)
+{
+    if (!in->event_mode_used)
+        return fmu_error(in, fn, "the instance was created with eventModeUsed = false");
+    in->state = FMU_EVENT_MODE;
+    return fmu_leave(in, fn, FMU_OK);
+}
+
+fmu_status fmu_enter_step_mode(fmu_instance *in, const char *fn)
+{
+    in->state = FMU_STEP_MODE;
+    in->m.event = 0;
+    return fmu_leave(in, fn, FMU_OK);
+}
+
+fmu_status fmu_update_discrete_states(fmu_instance *in, const char *fn)
+{
+    in->m.event = 0;
+    return fmu_leave(in, fn, FMU_OK);
 }
 
 fmu_status fmu_unsupported(void *c, const char *fn, const char *why)

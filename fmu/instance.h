@@ -33,13 +33,15 @@
 /* Status codes: the same numbers as fmi2Status and fmi3Status. */
 typedef enum { FMU_OK, FMU_WARNING, FMU_DISCARD, FMU_ERROR, FMU_FATAL } fmu_status;
 
-/* The instance's states; FMI 3.0's step mode is FMI 2.0's step complete. */
+/* The instance's states; FMI 3.0's step mode is FMI 2.0's step complete;
+ * event mode is FMI 3.0's (with eventModeUsed). */
 enum {
     FMU_INSTANTIATED = 1 << 0,
     FMU_INIT_MODE = 1 << 1,
     FMU_STEP_MODE = 1 << 2,
     FMU_TERMINATED = 1 << 3,
-    FMU_ERROR_STATE = 1 << 4
+    FMU_ERROR_STATE = 1 << 4,
+    FMU_EVENT_MODE = 1 << 5
 };
 
 /* The functions of the calling sequence: each has one mask of allowed
@@ -61,6 +63,9 @@ typedef enum {
     FN_SERIALIZE,
     FN_DESERIALIZE,
     FN_DO_STEP,
+    FN_ENTER_EVENT, /* FMI 3.0 event mode */
+    FN_ENTER_STEP,
+    FN_UPDATE_DISCRETE,
     FN_STATUS,      /* FMI 2.0 status queries */
     FN_UNSUPPORTED, /* a function this FMU does not provide: always an error */
     FN_COUNT
@@ -134,8 +139,29 @@ fmu_status fmu_serialize(fmu_instance *in, const char *fn, const void *state,
 fmu_status fmu_deserialize(fmu_instance *in, const char *fn, const unsigned char *bytes,
                            size_t size, void **state);
 
-/* The communication step from t to t + h (fmu_model_do_step). */
-fmu_status fmu_do_step(fmu_instance *in, const char *fn, double t, double h);
+/* FMI 3.0 co-simulation's options: eventModeUsed, earlyReturnAllowed and the
+ * intermediateUpdate callback (NULL for none), which ask calls at an event
+ * of time t with canReturnEarly = can_return and gives earlyReturnRequested. */
+typedef int fmu_ask_fn(fmu_callback intermediate, void *environment, double t, int can_return);
+void fmu_set_cosimulation(fmu_instance *in, int event_mode_used, int early_return_allowed,
+                          fmu_callback intermediate, fmu_ask_fn *ask);
+
+/* The communication step from t to t + h (fmu_model_do_step).  At an event
+ * (a step at which one of the model's indicators changes) before the end:
+ * intermediateUpdate is called, if given; with earlyReturnAllowed the step
+ * ends there (*early = 1, the FMU's time is that step's) unless the callback
+ * declined the early return.  *event_handling: eventModeUsed and an
+ * indicator changed during the step.  early and event_handling may be NULL
+ * (FMI 2.0: never early). */
+fmu_status fmu_do_step(fmu_instance *in, const char *fn, double t, double h, int *early,
+                       int *event_handling);
+/* FMI 3.0: event mode (from step mode, with eventModeUsed) and back. */
+fmu_status fmu_enter_event_mode(fmu_instance *in, const char *fn);
+fmu_status fmu_enter_step_mode(fmu_instance *in, const char *fn);
+/* FMI 3.0's fmi3UpdateDiscreteStates in event mode: the model's discrete
+ * states (its indicators) are already those of the current step; nothing
+ * more to update, no time event. */
+fmu_status fmu_update_discrete_states(fmu_instance *in, const char *fn);
 /* The FMU's time (the last communication point). */
 double fmu_time(const fmu_instance *in);
 

@@ -15,6 +15,10 @@ typedef char state_layout_agrees[((int)MODEL_STATE_VERSION == (int)FMU_STATE_VER
                                   (int)MODEL_STATE_AT_TOTAL == (int)FMU_STATE_AT_TOTAL &&
                                   (int)MODEL_STATE_AT_NREAL == (int)FMU_STATE_AT_NREAL &&
                                   (int)MODEL_STATE_AT_NDMI == (int)FMU_STATE_AT_NDMI &&
+                                  (int)MODEL_STATE_AT_HASH == (int)FMU_STATE_AT_HASH &&
+                                  (int)MODEL_STATE_AT_NEVENTS == (int)FMU_STATE_AT_NEVENTS &&
+                                  (int)MODEL_STATE_AT_EVENT_P == (int)FMU_STATE_AT_EVENT_P &&
+                                  (int)MODEL_STATE_AT_NAME == (int)FMU_STATE_AT_NAME &&
                                   (int)MODEL_STATE_AT_N == (int)FMU_STATE_AT_INT &&
                                   (int)MODEL_STATE_AT_REAL == (int)FMU_STATE_AT_INT + 8)
                                      ? 1
@@ -95,6 +99,8 @@ static void outputs(const dmi_fmu_values *m, const dmi_fmu_point *pt, double *ou
         out[VR_v] = m->value[VR_v0];
         out[VR_friction] = out[VR_delay_force] = 0.0;
         out[VR_sticking] = m->value[VR_v0] == 0.0;
+        out[VR_stick_slip_events] = 0.0;
+        out[VR_last_event_time] = m->t_start;
         return;
     }
     /* the element of alpha sigma(v) the step selected: in [-alpha, alpha],
@@ -105,6 +111,15 @@ static void outputs(const dmi_fmu_values *m, const dmi_fmu_point *pt, double *ou
     out[VR_friction] = fmin(fmax((pt->X[1] - pt->U[1]) / pt->h, -alpha), alpha);
     out[VR_delay_force] = pt->W[1];
     out[VR_sticking] = pt->U[1] == 0.0;
+    out[VR_stick_slip_events] = (double)pt->nevents;
+    out[VR_last_event_time] = m->t_start + (double)pt->event_p * pt->h;
+}
+
+/* The one event indicator: the velocity's friction sticks or slips (the
+ * built-in of dmi_fmu.h for component 1, coefficient alpha). */
+static void indicators(const dmi_fmu_values *m, const dmi_fmu_point *pt, int *state)
+{
+    state[0] = dmi_fmu_stuck(pt, 1, m->value[VR_alpha]);
 }
 
 static int accept(const dmi_fmu_values *m, unsigned vr, double value, char *err)
@@ -178,4 +193,6 @@ const dmi_fmu_model DMI_FMU_MODEL = {
     .check = check_coarse_step,
     .bytes = solver_bytes,
     .author = "the dmi authors",
+    .nindicators = 1,
+    .indicators = indicators,
 };

@@ -25,7 +25,7 @@
 
 /* Value references (the numbers in both model descriptions): VR_<name>, in
  * the order of config.h.  The Real variables that are set (parameters and
- * g_in) come first, then the outputs, N, sticking, time. */
+ * g_in) come first, then the outputs, N, sticking, the event outputs, time. */
 enum { MODEL_VARIABLES(DMI_FMU_VR) MODEL_NVARS };
 #define MODEL_NREAL (VR_g_in + 1) /* Real variables that are set: parameters and g_in */
 
@@ -35,22 +35,28 @@ enum { MODEL_VARIABLES(DMI_FMU_VR) MODEL_NVARS };
 /*
  * Saved state (the framework's layout, framework.h, for this model's one
  * integer N): the bytes hold a magic, a format version, the sizes, the
- * variables, t_start, t_comm, an opaque 32-bit tag of the caller (the FMI
- * phase), libdmi's own checked state bytes (the whole history) and a
- * checksum.  Native endian, at these byte offsets (the tests read them from
- * here too); the last 8 bytes are the FNV-1a 64 (src/bytes.h) of all bytes
- * before them.
+ * model's identity (a hash of its variables and GUID, its event counts, its
+ * name), the variables, t_start, t_comm, an opaque 32-bit tag of the caller
+ * (the FMI phase), libdmi's own checked state bytes (the whole history) and
+ * a checksum.  Native endian, at these byte offsets (the tests read them
+ * from here too); the last 8 bytes are the FNV-1a 64 (src/bytes.h) of all
+ * bytes before them.  Format 2 (the FMUs of libdmi 1.1) had no identity: N
+ * at 40, the Reals at 48.
  */
 #define MODEL_STATE_MAGIC "dmiFMUst" /* its 8 bytes, without the NUL */
 enum {
-    MODEL_STATE_VERSION = 2, /* 1: FMUs of libdmi 1.0 (their libdmi state has format 1) */
+    MODEL_STATE_VERSION = 3, /* 1: FMUs of libdmi 1.0 (their libdmi state has format 1); 2: 1.1 */
     MODEL_STATE_AT_VERSION = 8, /* uint32 */
     MODEL_STATE_AT_TAG = 12,    /* uint32: the caller's tag */
     MODEL_STATE_AT_TOTAL = 16,  /* uint64: bytes of the whole state */
     MODEL_STATE_AT_NREAL = 24,  /* uint64: MODEL_NREAL */
     MODEL_STATE_AT_NDMI = 32,   /* uint64: bytes of libdmi's state (0: no solver) */
-    MODEL_STATE_AT_N = 40,      /* int64 */
-    MODEL_STATE_AT_REAL = 48,   /* MODEL_NREAL doubles, by value reference; t_start, t_comm */
+    MODEL_STATE_AT_HASH = 40,   /* uint64: the model's hash (variables, n, GUID) */
+    MODEL_STATE_AT_NEVENTS = 48, /* uint64: stick_slip_events */
+    MODEL_STATE_AT_EVENT_P = 56, /* uint64: the step of the last event */
+    MODEL_STATE_AT_NAME = 64,   /* 64 bytes: the model's name, NUL-padded */
+    MODEL_STATE_AT_N = 128,     /* int64 */
+    MODEL_STATE_AT_REAL = 136,  /* MODEL_NREAL doubles, by value reference; t_start, t_comm */
     MODEL_STATE_AT_DMI = MODEL_STATE_AT_REAL + 8 * (MODEL_NREAL + 2) /* libdmi's state */
 };
 

@@ -219,17 +219,22 @@ static void header(FILE *f, int v, const char *name, const char *guid, int nsour
         }
         fprintf(f, "    </SourceFiles>\n  </CoSimulation>\n");
     }
-    if (v == 3) /* no event mode, no early return, no intermediate update */
+    /* event mode always; with the model's indicators, early return at their
+     * events and intermediateUpdate called there (fmi3Functions.c) */
+    const char *events = MODEL->indicators && MODEL->nindicators > 0 ? "true" : "false";
+    if (v == 3)
         fprintf(f, "  <CoSimulation\n"
                    "    modelIdentifier=\"%s\"\n"
                    "    canHandleVariableCommunicationStepSize=\"true\"\n"
                    "    canGetAndSetFMUState=\"true\"\n"
                    "    canSerializeFMUState=\"true\"\n"
-                   "    providesIntermediateUpdate=\"false\"\n"
-                   "    canReturnEarlyAfterIntermediateUpdate=\"false\"\n"
-                   "    hasEventMode=\"false\"\n"
+                   "    providesIntermediateUpdate=\"%s\"\n"
+                   "    mightReturnEarlyFromDoStep=\"%s\"\n"
+                   "    canReturnEarlyAfterIntermediateUpdate=\"%s\"\n"
+                   "    hasEventMode=\"true\"\n"
+                   "    providesEvaluateDiscreteStates=\"false\"\n"
                    "    maxOutputDerivativeOrder=\"0\"/>\n",
-                name);
+                name, events, events, events);
     unit_definitions(f, nvr);
     fprintf(f, "  <LogCategories>\n");
 #define CAT(cat, description)                                                                      \

@@ -126,6 +126,11 @@ struct dmi_fmu_point {
     uint64_t p;
     size_t n;
     const double *u, *U, *W, *X;
+    /* The model's events (see dmi_fmu_indicators_fn) up to step p: nevents,
+     * the number of solver steps at which an indicator changed since the
+     * start (or since ExitInitializationMode); event_p, the last such step
+     * (0: none yet), whose time is t_start + event_p h. */
+    uint64_t nevents, event_p;
 };
 
 /*
@@ -171,6 +176,43 @@ typedef int (*dmi_fmu_check_fn)(const dmi_fmu_values *v, double T, char *msg);
 typedef void (*dmi_fmu_bytes_fn)(const dmi_fmu_values *v, double *peak, double *kept);
 
 /*
+ * Optional: the model's event indicators, the discrete states whose changes
+ * are the model's events (a stick-slip transition, a contact).  Writes
+ * state[k], k < nindicators (the model's field), for the step pt->p: any
+ * integer; an event is a solver step at which one of them differs from the
+ * step before.  Called by the framework after ExitInitializationMode (step 0:
+ * X = U = U^0), after every solver step and after a state is restored, with
+ * u = U = U^p and W, X of that step (never with u NULL).
+ *
+ * The framework steps one solver step at a time then (bitwise the same
+ * steps as without indicators), counts the events (dmi_fmu_point's nevents
+ * and event_p, which a model may give as outputs: an FMI 2.0 master reads
+ * them) and, in the FMI 3.0 FMU, returns early from fmi3DoStep at an event
+ * (earlyReturnAllowed) and asks for event mode (eventModeUsed): see
+ * docs/fmu-export.md.  The built-ins below give the usual indicators.
+ */
+typedef void (*dmi_fmu_indicators_fn)(const dmi_fmu_values *v, const dmi_fmu_point *pt,
+                                      int *state);
+
+/* dmi_fmu_stuck(pt, i, alpha_i), a built-in indicator of dmi_set_friction's
+ * component i with coefficient alpha_i (>= 0): 1 (stuck) when the resolvent's argument lies within
+ * h alpha_i of zero, |X_i| <= h alpha_i (then U_i = 0), else 0 (slipping). */
+static inline int dmi_fmu_stuck(const dmi_fmu_point *pt, size_t i, double alpha_i)
+{
+    const double x = pt->X[i];
+    return (x < 0 ? -x : x) <= pt->h * alpha_i;
+}
+
+/* dmi_fmu_contact(pt, i, lo_i, hi_i), a built-in indicator of dmi_set_box's
+ * component i with faces lo_i <= hi_i: -1 in contact with the lower face (X_i <= lo_i, then U_i = lo_i), +1 with
+ * the upper face (X_i >= hi_i, U_i = hi_i), 0 inside. */
+static inline int dmi_fmu_contact(const dmi_fmu_point *pt, size_t i, double lo_i, double hi_i)
+{
+    const double x = pt->X[i];
+    return x <= lo_i ? -1 : x >= hi_i ? 1 : 0;
+}
+
+/*
  * A model: what dmi_add_fmu builds an FMU of.  Fields: description (the
  * model descriptions', with " (libdmi <version>)" appended); variables and
  * nvariables (the table, value reference = index); n (the components of u);
@@ -179,7 +221,8 @@ typedef void (*dmi_fmu_bytes_fn)(const dmi_fmu_values *v, double *peak, double *
  * default experiment, which starts at 0); configure and outputs (required);
  * accept, check and bytes (optional: NULL for none; without bytes, the
  * figures of a dense kernel); author (the model descriptions' author, NULL
- * for none).  The model descriptions' generator checks it at build time (a
+ * for none); nindicators and indicators (optional: 0 and NULL for none; see
+ * dmi_fmu_indicators_fn).  The model descriptions' generator checks it at build time (a
  * table as described above, tau and N as said, n >= 1, configure and
  * outputs given).
  */
@@ -197,6 +240,8 @@ struct dmi_fmu_model {
     dmi_fmu_check_fn check;
     dmi_fmu_bytes_fn bytes;
     const char *author;
+    size_t nindicators;
+    dmi_fmu_indicators_fn indicators;
 };
 
 /* The model of the FMU: define it once, in one of its C files:

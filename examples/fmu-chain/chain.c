@@ -102,12 +102,16 @@ static void outputs(const dmi_fmu_values *m, const dmi_fmu_point *pt, double *ou
 {
     static const unsigned ALPHA[3] = {VR_alpha1, VR_alpha2, VR_alpha3};
     for (int i = 0; i < 3; i++) {
+        if (!pt->u) { /* before the solver: the history, at rest */
+            out[VR_x1 + i] = m->value[VR_x0_1 + i];
+            out[VR_v1 + i] = out[VR_friction1 + i] = 0.0;
+            continue;
+        }
         const double alpha = m->value[ALPHA[i]];
-        out[VR_x1 + i] = pt->u ? pt->u[i] : m->value[VR_x0_1 + i];
-        out[VR_v1 + i] = pt->u ? pt->u[3 + i] : 0.0;
+        out[VR_x1 + i] = pt->u[i];
+        out[VR_v1 + i] = pt->u[3 + i];
         /* (X - U)/h of the step: alpha_i sigma(v_i), clamped against rounding */
-        out[VR_friction1 + i] =
-            pt->u ? fmin(fmax((pt->X[3 + i] - pt->U[3 + i]) / pt->h, -alpha), alpha) : 0.0;
+        out[VR_friction1 + i] = fmin(fmax((pt->X[3 + i] - pt->U[3 + i]) / pt->h, -alpha), alpha);
     }
 }
 

@@ -22,6 +22,7 @@ from fmpy.validation import validate_fmu
 from native import START, Run
 
 OUT = ["w", "v", "friction", "delay_force", "sticking"]
+EVENT_OUT = ["stick_slip_events", "last_event_time"]  # issue 31: the events for an FMI 2.0 master
 REALS = ["b", "alpha", "tau", "w0", "v0", "H_c0", "H_c1", "H_lambda", "H_a1", "H_omega1", "H_a2",
          "H_omega2", "H_a3", "H_omega3", "g_offset", "g_amp", "g_omega", "g_phase"]
 T = 30.0
@@ -94,7 +95,8 @@ def test_model_description_contract(md, fmi_version):
     var = {v.name: v for v in md.modelVariables}
     # the variables (written from config.h's table) are exactly the contract's, value references 0, 1, ...
     # FMI 3.0 asks for the independent variable, time
-    assert sorted(var) == sorted(REALS + ["N", "g_in"] + OUT + (["time"] if fmi_version == "3" else []))
+    assert sorted(var) == sorted(REALS + ["N", "g_in"] + OUT + EVENT_OUT +
+                                 (["time"] if fmi_version == "3" else []))
     assert sorted(v.valueReference for v in md.modelVariables) == list(range(len(var)))
     for n in REALS + ["N"]:
         assert var[n].causality == "parameter", n
@@ -106,8 +108,10 @@ def test_model_description_contract(md, fmi_version):
     for n in OUT:
         assert var[n].causality == "output", n
     assert var["sticking"].type == "Boolean"
+    # the events for an FMI 2.0 master (issue 31): their count and the last one's time
+    assert var["stick_slip_events"].type == integer and var["last_event_time"].type == real
     # Outputs at a communication point come from the steps before it: no direct feedthrough of g_in.
-    assert sorted(o.variable.name for o in md.outputs) == sorted(OUT)
+    assert sorted(o.variable.name for o in md.outputs) == sorted(OUT + EVENT_OUT)
     assert all(o.dependencies == [] for o in md.outputs)
     assert [c.name for c in md.logCategories] == ["logStatusError", "logStatusWarning", "logCalls",
                                                   "logMemory"]
@@ -115,9 +119,9 @@ def test_model_description_contract(md, fmi_version):
         # libdmi allocates with the C library: the FMU must not be given allocateMemory to honour.
         assert md.coSimulation.canNotUseMemoryManagementFunctions is True
     else:
-        # no events, no early return, no intermediate update
-        assert cs.hasEventMode is not True and cs.canReturnEarlyAfterIntermediateUpdate is not True
-        assert cs.providesIntermediateUpdate is not True
+        # events (issue 31): event mode, early return, intermediateUpdate at the events
+        assert cs.hasEventMode is True and cs.canReturnEarlyAfterIntermediateUpdate is True
+        assert cs.providesIntermediateUpdate is True and cs.mightReturnEarlyFromDoStep is True
         assert var["time"].causality == "independent"
     de = md.defaultExperiment
     assert float(de.stopTime) == 30.0
@@ -391,7 +395,8 @@ def _model_state_layout():
 
 
 STATE_AT, STATE_MAGIC = _model_state_layout()
-STATE_FIELD = dict(version="I", tag="I", total="Q", nreal="Q", ndmi="Q", N="q")
+STATE_FIELD = dict(version="I", tag="I", total="Q", nreal="Q", ndmi="Q", N="q", hash="Q",
+                   nevents="Q", event_p="Q", name="64s")
 PHASE = dict(instantiated=1, init=2, step_complete=4, terminated=8)
 
 
@@ -911,13 +916,13 @@ def test_time_is_a_variable_of_fmi3_only(sl, md, fmi_version):
         assert f"value reference {time_vr}" in s.errors()[-1]
 
 
-def test_fmi3_refuses_event_mode_and_intermediate_update(fmu_paths, tmp_path):
+def test_fmi3_refuses_intermediate_variables(fmu_paths, tmp_path):
+    """Event mode is accepted (issue 31, tests/fmu/events); intermediate variables are not."""
     from fmpy import extract, read_model_description
     from fmpy.fmi3 import FMU3Slave
     md = read_model_description(fmu_paths["3"])
     unzip = extract(fmu_paths["3"], str(tmp_path / "u"))
-    for kw, word in ((dict(eventModeUsed=True), "event mode"),
-                     (dict(requiredIntermediateVariables=[19]), "intermediate")):
+    for kw, word in ((dict(requiredIntermediateVariables=[19]), "intermediate"),):
         log = []
         f = FMU3Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier="DelayFrictionOscillator",
                       instanceName="x")
@@ -1090,3 +1095,74 @@ def test_each_call_logged_once_with_its_outcome(sl):
     with pytest.raises(FMICallException):
         s.fmu.doStep(0.5, 0.01)
     assert len(s.log[n:]) == 1 and s.log[n][0] == 3 and s.log[n][2].startswith(f"{p}DoStep: ")
+
+
+# ---- state format 3 (issue 31) ----
+
+def test_state_format3_names_the_model_and_keeps_the_events(sl):
+    """A saved state is format 3: the model's name, and the event count and
+    last event's step that the outputs give; restored, the run goes on with
+    them bitwise.  A state whose name is another model's (checksum fixed) is
+    refused, naming both."""
+    s = sl()
+    start(s)
+    ev = [s.vr["stick_slip_events"]]
+    for k in range(50):
+        s.fmu.doStep(k * 0.1, 0.1)
+    data = saved_bytes(s)
+    count = s.fmu.getInteger(ev)[0]
+    last = s.fmu.getReal([s.vr["last_event_time"]])[0]
+    assert state_field(data, "version") == 3 and count > 10
+    assert state_field(data, "name").rstrip(b"\0") == b"DelayFrictionOscillator"
+    assert state_field(data, "nevents") == count
+    assert abs(state_field(data, "event_p") * 1e-3 - last) <= 1e-12
+    after = []
+    for _ in range(2):
+        for k in range(50, 80):
+            s.fmu.doStep(k * 0.1, 0.1)
+        after.append((s.fmu.getInteger(ev)[0], s.fmu.getReal([s.vr["last_event_time"]])[0],
+                      outputs(s, s.vr)))
+        st = s.fmu.deSerializeFMUstate(data)
+        s.fmu.setFMUstate(st)
+        s.fmu.freeFMUstate(st)
+        assert s.fmu.getInteger(ev)[0] == count
+    assert after[0] == after[1] and after[0][0] > count
+    b = bytearray(data[:-8])
+    struct.pack_into("=64s", b, STATE_AT["NAME"], b"OtherModel")
+    assert_refused(s, bytes(b) + struct.pack("=Q", fnv1a64(b)), 'the state is of model "OtherModel"',
+                   'this FMU is model "DelayFrictionOscillator"')
+
+
+# ---- the bulk path of Float64 gets (issue 31) ----
+
+def test_bulk_get_equals_value_by_value_and_refuses_the_same(sl, fmi_version):
+    """A run of consecutive value references (the bulk path) gives bitwise
+    the values of one-by-one gets, at a grid point and between two; a run
+    that crosses a variable of another type, or (FMI 2.0) the time, is
+    refused with the message of that value reference alone."""
+    s = sl()
+    start(s)
+    vr = s.vr
+    outs = [vr[n] for n in OUT[:4]]
+    assert outs == list(range(outs[0], outs[0] + 4))  # the four Real outputs are a run
+    runs = [outs, list(range(0, outs[-1] + 1)), [vr["stick_slip_events"] + 1]]
+    for t, dt in ((0.0, 0.5), (0.5, 0.0123)):  # t_p, then between grid points
+        s.fmu.doStep(t, dt)
+        for run in runs[:2]:
+            assert s.fmu.getReal(run) == [s.fmu.getReal([x])[0] for x in run]
+    messages = []
+    for bad in ([outs[-1], vr["N"]], [vr["last_event_time"], vr["last_event_time"] + 1]):
+        one = []
+        for call in (bad, [bad[-1]]):
+            try:
+                got = s.fmu.getReal(call)
+            except FMICallException:
+                one.append(s.errors()[-1])
+            else:  # FMI 3.0: the time is a Float64 variable
+                assert fmi_version == "3" and bad[-1] == vr["last_event_time"] + 1, call
+                assert got[-1] == 0.5123
+        messages.append(one)
+    assert len(messages[0]) == 2 and messages[0][0] == messages[0][1]
+    assert f"value reference {vr['N']} is not a Real variable" in messages[0][0]
+    if fmi_version == "2":
+        assert len(messages[1]) == 2 and messages[1][0] == messages[1][1]
