@@ -195,18 +195,24 @@ def check_python(src: Path, html: Path) -> None:
         if "tests" in init.parts or init.parent.name.startswith(("_", ".")):
             continue
         tree = ast.parse(init.read_text())
-        for node in tree.body:
-            if isinstance(node, ast.Assign) and any(getattr(t, "id", "") == "__all__" for t in node.targets):
-                try:
-                    names = ast.literal_eval(node.value)
-                except ValueError:      # computed: import the package (from python/ or as installed)
-                    import importlib
-                    sys.path.insert(0, str(init.parent.parent))
-                    names = importlib.import_module(init.parent.name).__all__
-                missing = [n for n in names if not re.search(rf"\b{re.escape(n)}\b", site)]
-                if missing:
-                    fail(f"the site does not document {init.parent.name}.{', '.join(missing)}")
-                checked += len(names)
+        # __all__ = [...], __all__: list[str] = [...] and __all__ += [...], in the order written
+        parts = [node.value for node in tree.body
+                 if (isinstance(node, (ast.Assign, ast.AnnAssign, ast.AugAssign)) and node.value is not None
+                     and any(getattr(t, "id", "") == "__all__"
+                             for t in (node.targets if isinstance(node, ast.Assign) else [node.target])))]
+        if not parts:
+            continue
+        try:
+            names = [n for part in parts for n in ast.literal_eval(part)]
+        except ValueError:      # computed: import the package (from python/ or as installed)
+            import importlib
+            sys.path.insert(0, str(src / "python"))
+            dotted = ".".join(init.parent.relative_to(src / "python").parts)
+            names = importlib.import_module(dotted).__all__
+        missing = [n for n in names if not re.search(rf"\b{re.escape(n)}\b", site)]
+        if missing:
+            fail(f"the site does not document {init.parent.name}.{', '.join(missing)}")
+        checked += len(names)
     print(f"Python: checked {checked} public names (__all__ of the packages under python/) against the site")
 
 
