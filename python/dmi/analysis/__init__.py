@@ -1,6 +1,13 @@
 # dmi.analysis: linear stability of equilibria and periodic orbits of the scheme's step map.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
-"""dmi.analysis: the analysis of models ``make(p) -> dmi.Solver`` (filled in by issues 29 and 30)."""
+"""dmi.analysis: the analysis of models ``make(p) -> dmi.Solver`` (filled in by issues 29 and 30).
+
+Stability of equilibria (docs/stability.md): :func:`roots`, :func:`hopf`,
+:func:`stability_chart` and :func:`plot_stability_chart`.
+"""
 from __future__ import annotations
 
-__all__: list[str] = []
+from ._model import KinkError
+from .stability import HopfPoint, hopf, roots
+
+__all__: list[str] = ["roots", "hopf", "HopfPoint", "KinkError"]

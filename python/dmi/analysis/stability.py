@@ -1,0 +1,147 @@
+# Characteristic roots of an equilibrium of the scheme, and the Hopf point of a one-parameter model.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""dmi.analysis.roots and dmi.analysis.hopf (see docs/stability.md for the method)."""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import scipy.linalg
+import scipy.optimize
+import scipy.sparse.linalg as sla
+
+from .._solver import Solver
+from ._model import Linearisation, call_make
+
+#: At most this many state dimensions n N: the one-step matrix is formed and its eigenvalues taken
+#: directly (Arnoldi needs a state larger than the roots asked for).
+DENSE_MAX = 64
+#: A tau-multiplier below this fraction of the largest one is taken as 0 (root -inf).
+ZERO = 1e-13
+
+
+def _seed(dim: int) -> np.ndarray:
+    """A fixed start vector for Arnoldi (the same roots on every call)."""
+    return np.random.default_rng(20260529).standard_normal(dim)
+
+
+def _one_step_roots(lin: Linearisation, count: int) -> np.ndarray:
+    """All roots from the dense one-step matrix (small states only)."""
+    I = np.eye(lin.dim)
+    M = np.column_stack([lin.apply(I[:, j], 1) for j in range(lin.dim)])
+    z = scipy.linalg.eigvals(M)
+    big = np.max(np.abs(z)) ** lin.N
+    z = np.where(np.abs(z) ** lin.N < ZERO * big, 0, z)   # as in _arnoldi_roots
+    with np.errstate(divide="ignore"):
+        return np.log(z.astype(complex)) / lin.h
+
+
+def _arnoldi_roots(lin: Linearisation, count: int) -> np.ndarray:
+    """The rightmost roots from the N-step map M^N (Arnoldi), each one's branch of log from the
+    one-step map restricted to the Ritz space."""
+    dim, N, h = lin.dim, lin.N, lin.h
+    k = min(count + 2, dim - 2)
+    op = sla.LinearOperator((dim, dim), matvec=lambda v: lin.apply(np.real(v), N), dtype=float)
+    ncv = min(dim, max(2 * k + 1, 20))
+    try:
+        mu, V = sla.eigs(op, k=k, which="LM", ncv=ncv, tol=0, v0=_seed(dim), maxiter=50 * dim)
+    except sla.ArpackNoConvergence as e:
+        raise RuntimeError(f"dmi.analysis: Arnoldi did not converge on the {N}-step map ({len(e.eigenvalues)} "
+                           f"of {k} multipliers)") from None
+    # The one-step map M commutes with M^N: the Ritz space of a group of multipliers is
+    # M-invariant, and M's eigenvalues z there (z^N = mu) give Im lambda beyond 2 pi / tau.
+    Q, _ = np.linalg.qr(V)
+    B = Q.conj().T @ lin.apply_complex(Q, 1)
+    z = scipy.linalg.eigvals(B)
+    # multipliers below ZERO of the largest are rounding errors of 0: roots -inf
+    mu = np.where(np.abs(mu) < ZERO * np.max(np.abs(mu)), 0, mu)
+    z = np.where(np.abs(z) ** N < ZERO * np.max(np.abs(mu)), 0, z)
+    lam = np.full(len(z), -np.inf, dtype=complex)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        logmu = np.log(mu.astype(complex))
+        for j, zj in enumerate(z):
+            if zj == 0:
+                continue
+            Nlogz = N * np.log(complex(zj))
+            d = logmu - Nlogz                                  # 2 pi i k + rounding
+            d -= 2j * np.pi * np.round(d.imag / (2 * np.pi))
+            i = int(np.nanargmin(np.abs(d)))
+            lam[j] = (Nlogz + d[i]) / (N * h)                  # log(mu_i) on z_j's branch
+    return lam
+
+
+def _order(lam: np.ndarray) -> np.ndarray:
+    """Rightmost first; of a conjugate pair, Im >= 0 first."""
+    key = np.round(lam.real, 9) if len(lam) else lam.real
+    idx = np.lexsort((-lam.imag, -key))
+    return lam[idx]
+
+
+def rightmost(lin: Linearisation, count: int) -> np.ndarray:
+    """The count rightmost roots of a linearisation."""
+    lam = _one_step_roots(lin, count) if lin.dim <= DENSE_MAX else _arnoldi_roots(lin, count)
+    return _order(lam)[:count]
+
+
+def roots(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 10, *,
+          tol: float = 1e-9) -> np.ndarray:
+    """The ``count`` rightmost characteristic roots lambda (1 / time unit) of the scheme's step map
+    linearised at the constant history ``u_eq``, rightmost first (of a pair, Im >= 0 first).
+
+    ``make(p)`` returns a configured, not initialised :class:`dmi.Solver` (any rhs, resolvent,
+    friction or box, kernel, convolution method); ``u_eq`` is an array (n,) or a function
+    ``u_eq(p)``.  A root is lambda = log(z) / h for a multiplier z of the one-step map: Re lambda is
+    the growth rate of the mode, Im lambda its angular frequency (radians / time unit), not reduced
+    modulo 2 pi / tau.  A root -inf is a multiplier 0 (a component held by the resolvent).
+    Raises ValueError if u_eq is not a fixed point of the step map (relative residual above
+    ``tol``), :class:`KinkError` (a ValueError) if the resolvent has a kink there.
+    """
+    if int(count) != count or count < 1:
+        raise ValueError(f"dmi.analysis.roots: count = {count!r}: must be an integer >= 1")
+    with Linearisation(lambda: call_make(make, p), u_eq, (p,), tol) as lin:
+        return rightmost(lin, int(count))
+
+
+@dataclass(frozen=True)
+class HopfPoint:
+    """Where the rightmost root crosses the imaginary axis: the parameter ``p``, the crossing
+    frequency ``omega`` = |Im lambda| (radians / time unit; 0: a real root crosses, a fold, not a
+    Hopf point) and the root ``root`` (Im >= 0) there."""
+    p: float
+    omega: float
+    root: complex
+
+
+def rightmost_real(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 4) -> float:
+    """Re of the rightmost root at p (1 / time unit)."""
+    return float(roots(make, p, u_eq, count)[0].real)
+
+
+def hopf(make: Callable[[float], Solver], p_lo: float, p_hi: float, u_eq: Any, *,
+         rtol: float = 1e-10, count: int = 4) -> HopfPoint:
+    """The parameter p in (p_lo, p_hi) where the rightmost root of :func:`roots` crosses the
+    imaginary axis, to ``rtol`` relative (Brent's method on Re lambda_1(p)).  Raises ValueError if
+    p_lo = p_hi or Re lambda_1 has the same sign at both ends (no crossing bracketed)."""
+    p_lo, p_hi = float(p_lo), float(p_hi)
+    if not (math.isfinite(p_lo) and math.isfinite(p_hi)) or p_lo == p_hi:
+        raise ValueError(f"dmi.analysis.hopf: [p_lo, p_hi] = [{p_lo!r}, {p_hi!r}] is not an "
+                         "interval (two different finite values)")
+    g_lo, g_hi = rightmost_real(make, p_lo, u_eq, count), rightmost_real(make, p_hi, u_eq, count)
+    if g_lo == 0:
+        p = p_lo
+    elif g_hi == 0:
+        p = p_hi
+    elif (g_lo > 0) == (g_hi > 0):
+        raise ValueError(f"dmi.analysis.hopf: no crossing bracketed: Re lambda_1 = {g_lo:.6g} at "
+                         f"p = {p_lo!r} and {g_hi:.6g} at p = {p_hi!r} (same sign)")
+    else:
+        scale = max(abs(p_lo), abs(p_hi))
+        p = scipy.optimize.brentq(lambda x: rightmost_real(make, x, u_eq, count), p_lo, p_hi,
+                                  xtol=rtol * scale * 1e-2, rtol=max(rtol * 1e-2, 4.5e-16),
+                                  maxiter=200)
+    lam = roots(make, p, u_eq, count)[0]
+    lam = complex(lam.real, abs(lam.imag))
+    return HopfPoint(p=float(p), omega=abs(lam.imag), root=lam)
