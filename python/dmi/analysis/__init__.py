@@ -8,6 +8,8 @@ Stability of equilibria (docs/stability.md): :func:`roots`, :func:`hopf`,
 from __future__ import annotations
 
 from ._model import KinkError
+from .chart import HopfCurve, StabilityChart, plot_stability_chart, stability_chart
 from .stability import HopfPoint, hopf, roots
 
-__all__: list[str] = ["roots", "hopf", "HopfPoint", "KinkError"]
+__all__: list[str] = ["roots", "hopf", "HopfPoint", "KinkError", "stability_chart",
+                      "StabilityChart", "HopfCurve", "plot_stability_chart"]

@@ -56,20 +56,27 @@ def _arnoldi_roots(lin: Linearisation, count: int) -> np.ndarray:
     Q, _ = np.linalg.qr(V)
     B = Q.conj().T @ lin.apply_complex(Q, 1)
     z = scipy.linalg.eigvals(B)
-    # multipliers below ZERO of the largest are rounding errors of 0: roots -inf
-    mu = np.where(np.abs(mu) < ZERO * np.max(np.abs(mu)), 0, mu)
-    z = np.where(np.abs(z) ** N < ZERO * np.max(np.abs(mu)), 0, z)
-    lam = np.full(len(z), -np.inf, dtype=complex)
+    # Each multiplier mu_i takes the unused z_j with z_j^N nearest to it (log(mu_i) = N log(z_j)
+    # + 2 pi i k): lambda_i = (log(mu_i) + 2 pi i k) / (N h).  Multipliers below ZERO of the
+    # largest are rounding errors of 0 (roots -inf); z with no multiplier (Ritz vectors of such
+    # zeros) are left out.
+    lam = np.full(len(mu), -np.inf, dtype=complex)
+    big = np.max(np.abs(mu))
+    free = [j for j in range(len(z)) if abs(z[j]) ** N >= ZERO * big]
     with np.errstate(divide="ignore", invalid="ignore"):
-        logmu = np.log(mu.astype(complex))
-        for j, zj in enumerate(z):
-            if zj == 0:
+        Nlogz = N * np.log(z.astype(complex))
+        for i in np.argsort(-np.abs(mu)):
+            if abs(mu[i]) < ZERO * big:
                 continue
-            Nlogz = N * np.log(complex(zj))
-            d = logmu - Nlogz                                  # 2 pi i k + rounding
+            logmu = np.log(complex(mu[i]))
+            d = logmu - Nlogz[free]                            # 2 pi i k + rounding
             d -= 2j * np.pi * np.round(d.imag / (2 * np.pi))
-            i = int(np.nanargmin(np.abs(d)))
-            lam[j] = (Nlogz + d[i]) / (N * h)                  # log(mu_i) on z_j's branch
+            if len(d) == 0 or np.min(np.abs(d)) > 1e-2:   # (a wrong z: |d| ~ 1)
+                lam[i] = np.nan     # no z: an inaccurate Ritz vector (refused if among count)
+                continue
+            j = free.pop(int(np.argmin(np.abs(d))))
+            turns = round((Nlogz[j] - logmu).imag / (2 * np.pi))
+            lam[i] = (logmu + 2j * np.pi * turns) / (N * h)
     return lam
 
 
@@ -83,7 +90,12 @@ def _order(lam: np.ndarray) -> np.ndarray:
 def rightmost(lin: Linearisation, count: int) -> np.ndarray:
     """The count rightmost roots of a linearisation."""
     lam = _one_step_roots(lin, count) if lin.dim <= DENSE_MAX else _arnoldi_roots(lin, count)
-    return _order(lam)[:count]
+    lam = _order(lam)
+    if np.any(np.isnan(lam[:count])):
+        raise RuntimeError(f"dmi.analysis: the one-step map has no multiplier z with z^{lin.N} = "
+                           "one of the N-step map's rightmost multipliers in Arnoldi's Ritz space "
+                           "(inaccurate vectors); try another count")
+    return lam[:count]
 
 
 def roots(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 10, *,
