@@ -18,7 +18,7 @@ from dmi import analysis
 B, C, THETA = 1.0, 0.3, 1.0   # stiffness b (1/s^2), damping c (1/s), kernel time theta (s)
 
 
-def oscillator(a: float, tau: float, N: int = 64, c: float = C) -> dmi.Solver:
+def oscillator(a: float, tau: float, N: int = 128, c: float = C) -> dmi.Solver:
     """u = (w, w'): u' + f(u) + int_0^tau H(s) u(t - s) ds = 0 with f(u) = (-w', c w' + b w) and
     H(s) = [[0, 0], [a G(s), 0]] as one exponential term (the O(1) recursion); h = tau / N."""
     s = dmi.Solver(2, tau, N)
@@ -31,7 +31,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("out", help="the figure (PNG); the Hopf curves go to the same name .csv")
     ap.add_argument("--grid", type=int, nargs=2, default=[100, 100], metavar=("P", "Q"))
-    ap.add_argument("--N", type=int, default=64, help="steps per delay tau")
+    ap.add_argument("--N", type=int, default=128, help="steps per delay tau")
     ap.add_argument("--workers", type=int, default=None)
     a = ap.parse_args()
     import functools

@@ -3,6 +3,7 @@
 """dmi.analysis.roots and dmi.analysis.hopf (see docs/stability.md for the method)."""
 from __future__ import annotations
 
+import contextlib
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -39,9 +40,21 @@ def _one_step_roots(lin: Linearisation, count: int) -> np.ndarray:
         return np.log(z.astype(complex)) / lin.h
 
 
+def _branch(logmu: complex, z: complex, N: int, h: float) -> complex:
+    """lambda = (log(mu) + 2 pi i k) / (N h) on the branch k where N log(z) = log(mu) + 2 pi i k;
+    nan if z^N is not mu (|N log z - log mu - 2 pi i k| > 1e-2: z belongs to another mu)."""
+    if z == 0:
+        return complex(np.nan, np.nan)
+    d = N * np.log(complex(z)) - logmu
+    turns = round(d.imag / (2 * np.pi))
+    if abs(d - 2j * np.pi * turns) > 1e-2:
+        return complex(np.nan, np.nan)
+    return (logmu + 2j * np.pi * turns) / (N * h)
+
+
 def _arnoldi_roots(lin: Linearisation, count: int) -> np.ndarray:
     """The rightmost roots from the N-step map M^N (Arnoldi), each one's branch of log from the
-    one-step map restricted to the Ritz space."""
+    one-step map M: Im lambda beyond 2 pi / tau."""
     dim, N, h = lin.dim, lin.N, lin.h
     k = min(count + 2, dim - 2)
     op = sla.LinearOperator((dim, dim), matvec=lambda v: lin.apply(np.real(v), N), dtype=float)
@@ -49,34 +62,38 @@ def _arnoldi_roots(lin: Linearisation, count: int) -> np.ndarray:
     try:
         mu, V = sla.eigs(op, k=k, which="LM", ncv=ncv, tol=0, v0=_seed(dim), maxiter=50 * dim)
     except sla.ArpackNoConvergence as e:
-        raise RuntimeError(f"dmi.analysis: Arnoldi did not converge on the {N}-step map ({len(e.eigenvalues)} "
-                           f"of {k} multipliers)") from None
-    # The one-step map M commutes with M^N: the Ritz space of a group of multipliers is
-    # M-invariant, and M's eigenvalues z there (z^N = mu) give Im lambda beyond 2 pi / tau.
-    Q, _ = np.linalg.qr(V)
-    B = Q.conj().T @ lin.apply_complex(Q, 1)
-    z = scipy.linalg.eigvals(B)
-    # Each multiplier mu_i takes the unused z_j with z_j^N nearest to it (log(mu_i) = N log(z_j)
-    # + 2 pi i k): lambda_i = (log(mu_i) + 2 pi i k) / (N h).  Multipliers below ZERO of the
-    # largest are rounding errors of 0 (roots -inf); z with no multiplier (Ritz vectors of such
-    # zeros) are left out.
-    lam = np.full(len(mu), -np.inf, dtype=complex)
+        raise RuntimeError(f"dmi.analysis: Arnoldi did not converge on the {N}-step map "
+                           f"({len(e.eigenvalues)} of {k} multipliers)") from None
     big = np.max(np.abs(mu))
-    free = [j for j in range(len(z)) if abs(z[j]) ** N >= ZERO * big]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        Nlogz = N * np.log(z.astype(complex))
-        for i in np.argsort(-np.abs(mu)):
-            if abs(mu[i]) < ZERO * big:
-                continue
-            logmu = np.log(complex(mu[i]))
-            d = logmu - Nlogz[free]                            # 2 pi i k + rounding
-            d -= 2j * np.pi * np.round(d.imag / (2 * np.pi))
-            if len(d) == 0 or np.min(np.abs(d)) > 1e-2:   # (a wrong z: |d| ~ 1)
-                lam[i] = np.nan     # no z: an inaccurate Ritz vector (refused if among count)
-                continue
-            j = free.pop(int(np.argmin(np.abs(d))))
-            turns = round((Nlogz[j] - logmu).imag / (2 * np.pi))
-            lam[i] = (logmu + 2j * np.pi * turns) / (N * h)
+    lam = np.full(len(mu), -np.inf, dtype=complex)  # multipliers below ZERO of the largest:
+    logmu = np.log(mu.astype(complex), where=np.abs(mu) >= ZERO * big,  # rounding errors of 0
+                   out=np.zeros(len(mu), dtype=complex))
+    # M commutes with M^N: the vector v of a simple multiplier mu is M's eigenvector too, of
+    # z = v^H M v / v^H v with z^N = mu.  A conjugate pair costs one vector.
+    for i in np.argsort(-np.abs(mu)):
+        if abs(mu[i]) < ZERO * big:
+            continue
+        pair = np.nonzero((np.abs(mu - np.conj(mu[i])) <= 1e-12 * abs(mu[i])) & ~np.isinf(lam.real)
+                          & ~np.isnan(lam.real))[0]
+        if mu[i].imag != 0 and len(pair):
+            lam[i] = np.conj(lam[pair[0]])
+            continue
+        v = V[:, i]
+        z = np.vdot(v, lin.apply_complex(v[:, None], 1)[:, 0]) / np.vdot(v, v)
+        lam[i] = _branch(logmu[i], z, N, h)
+    if np.any(np.isnan(lam.real)):   # a multiple mu: its vectors mix z's; M on their span
+        Q, _ = np.linalg.qr(V)
+        z = scipy.linalg.eigvals(Q.conj().T @ lin.apply_complex(Q, 1))
+        free = list(z)
+        for i in np.nonzero(np.isnan(lam.real))[0]:
+            cand = [_branch(logmu[i], zj, N, h) for zj in free]
+            ok = [j for j, c in enumerate(cand) if not np.isnan(c.real)]
+            if ok:                      # (none: an inaccurate Ritz vector, refused if among count)
+                j = min(ok, key=lambda j: abs(N * np.log(complex(free[j])) - logmu[i]
+                                              - 2j * np.pi * round((N * np.log(complex(free[j]))
+                                                                    - logmu[i]).imag / (2 * np.pi))))
+                lam[i] = cand[j]
+                free.pop(j)
     return lam
 
 
@@ -87,9 +104,26 @@ def _order(lam: np.ndarray) -> np.ndarray:
     return lam[idx]
 
 
+_BLAS: list = []
+
+
+def _one_blas_thread() -> Any:
+    """A context with BLAS on one thread (threadpoolctl, if installed): Arnoldi's vectors are long
+    and few, and OpenBLAS's threads spinning on a loaded machine made roots 40x slower (measured)."""
+    if not _BLAS:
+        try:
+            from threadpoolctl import ThreadpoolController
+            _BLAS.append(ThreadpoolController())
+        except ImportError:
+            _BLAS.append(None)
+    return contextlib.nullcontext() if _BLAS[0] is None else _BLAS[0].limit(limits=1,
+                                                                                user_api="blas")
+
+
 def rightmost(lin: Linearisation, count: int) -> np.ndarray:
     """The count rightmost roots of a linearisation."""
-    lam = _one_step_roots(lin, count) if lin.dim <= DENSE_MAX else _arnoldi_roots(lin, count)
+    with _one_blas_thread():
+        lam = _one_step_roots(lin, count) if lin.dim <= DENSE_MAX else _arnoldi_roots(lin, count)
     lam = _order(lam)
     if np.any(np.isnan(lam[:count])):
         raise RuntimeError(f"dmi.analysis: the one-step map has no multiplier z with z^{lin.N} = "
