@@ -65,6 +65,29 @@ def test_roots_count_and_order():
     assert got[0].imag > 0 and got[1] == pytest.approx(np.conj(got[0]), abs=1e-9)
 
 
+def test_multipliers_shared_by_two_roots():
+    # two rotations u -> r R(theta_k) u with theta_2 = theta_1 + 2 pi / N: one-step multipliers
+    # r e^{i theta_k}, the same tau-multiplier (r e^{i theta_1})^N twice; the roots differ by 2 pi i
+    # / tau and must both come out (M on the span of the two vectors)
+    N, r, th = 20, 0.98, 0.3
+    h = TAU / N
+
+    def rot(t):
+        return r * np.array([[np.cos(t), -np.sin(t)], [np.sin(t), np.cos(t)]])
+    step = np.zeros((4, 4))
+    step[:2, :2], step[2:, 2:] = rot(th), rot(th + 2 * np.pi / N)
+    J = (np.eye(4) - step) / h          # U^{p+1} = U^p - h J U^p = step U^p
+
+    def make(_p):
+        s = dmi.Solver(4, TAU, N)
+        s.set_rhs(lambda t, u: J @ u)
+        return s
+    got = analysis.roots(make, 0.0, np.zeros(4), 4)
+    want = order(np.log(r) / h + 1j * np.array([th, -th, th + 2 * np.pi / N,
+                                                -th - 2 * np.pi / N]) / h)
+    assert np.max(np.abs(got - want)) <= 1e-9
+
+
 def hopf_closed_form(b: float) -> tuple[float, float]:
     """lambda = i w in lambda + b + (a / (tau lambda)) (1 - e^{-lambda tau}) = 0:
     b = -w cot(w tau / 2), a = w^2 tau / (1 - cos w tau); for b > 0, w tau in (pi, 2 pi)."""

@@ -42,12 +42,13 @@ def _one_step_roots(lin: Linearisation, count: int) -> np.ndarray:
 
 def _branch(logmu: complex, z: complex, N: int, h: float) -> complex:
     """lambda = (log(mu) + 2 pi i k) / (N h) on the branch k where N log(z) = log(mu) + 2 pi i k;
-    nan if z^N is not mu (|N log z - log mu - 2 pi i k| > 1e-2: z belongs to another mu)."""
+    nan if z^N is not mu (|N log z - log mu - 2 pi i k| > 0.5: z belongs to another mu; deep
+    multipliers, 1e-7 of the largest, match their z to 1e-2 only, as Arnoldi resolves them)."""
     if z == 0:
         return complex(np.nan, np.nan)
     d = N * np.log(complex(z)) - logmu
     turns = round(d.imag / (2 * np.pi))
-    if abs(d - 2j * np.pi * turns) > 1e-2:
+    if abs(d - 2j * np.pi * turns) > 0.5:
         return complex(np.nan, np.nan)
     return (logmu + 2j * np.pi * turns) / (N * h)
 
@@ -69,9 +70,16 @@ def _arnoldi_roots(lin: Linearisation, count: int) -> np.ndarray:
     logmu = np.log(mu.astype(complex), where=np.abs(mu) >= ZERO * big,  # rounding errors of 0
                    out=np.zeros(len(mu), dtype=complex))
     # M commutes with M^N: the vector v of a simple multiplier mu is M's eigenvector too, of
-    # z = v^H M v / v^H v with z^N = mu.  A conjugate pair costs one vector.
+    # z = v^H M v / v^H v with z^N = mu.  A conjugate pair costs one vector.  A multiple mu (two
+    # z with the same z^N) has vectors that mix its z's: then M on the span of all the vectors.
+    live = mu[np.abs(mu) >= ZERO * big]
+    gaps = np.abs(live[:, None] - live[None, :]) + np.eye(len(live)) * big
+    multiple = np.any(gaps <= 1e-6 * np.maximum.outer(np.abs(live), np.abs(live)))
     for i in np.argsort(-np.abs(mu)):
         if abs(mu[i]) < ZERO * big:
+            continue
+        if multiple:
+            lam[i] = np.nan
             continue
         pair = np.nonzero((np.abs(mu - np.conj(mu[i])) <= 1e-12 * abs(mu[i])) & ~np.isinf(lam.real)
                           & ~np.isnan(lam.real))[0]
@@ -81,7 +89,7 @@ def _arnoldi_roots(lin: Linearisation, count: int) -> np.ndarray:
         v = V[:, i]
         z = np.vdot(v, lin.apply_complex(v[:, None], 1)[:, 0]) / np.vdot(v, v)
         lam[i] = _branch(logmu[i], z, N, h)
-    if np.any(np.isnan(lam.real)):   # a multiple mu: its vectors mix z's; M on their span
+    if np.any(np.isnan(lam.real)):   # M on the span of the vectors
         Q, _ = np.linalg.qr(V)
         z = scipy.linalg.eigvals(Q.conj().T @ lin.apply_complex(Q, 1))
         free = list(z)
