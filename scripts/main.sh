@@ -5,7 +5,8 @@
 # Example 4.3 run by fmpy over the native run, the evidence for the erratum in
 # (4.4), the oscillator with a Prony-series memory (exponential kernel terms,
 # the recursion against the FFT), a bifurcation diagram of the oscillator over the
-# delay tau (dmi-sweep); prints the summary table.  Copies the figures
+# delay tau (dmi-sweep), the stability chart of the distributed-delay
+# oscillator (dmi.analysis); prints the summary table.  Copies the figures
 # to docs/figures/.
 # Usage: scripts/main.sh
 # Environment: DMI_BUILD_DIR (default build), DMI_OUT_DIR (default out).
@@ -65,6 +66,9 @@ fi
 
 stage "dmi-sweep: bifurcation diagram of the oscillator over the delay tau (Poincare section of w)"
 DMI_BUILD_DIR="$build" scripts/sweep_ex43.sh "$out"
+
+stage "dmi.analysis: stability chart of the distributed-delay oscillator (100 x 100, N = 128)"
+PYTHONPATH="$build/python" MPLBACKEND=Agg "$py" python/examples/stability_chart.py "$out/stability_chart.png"
 
 stage "figures and comparison with the paper and ../shared/reference"
 refarg=()

@@ -209,7 +209,7 @@ def test_perturbation_grows_at_the_rate_of_the_rightmost_root(side):
     lam = analysis.roots(functools.partial(scalar, b=b, N=N, cubic=1.0), a, [0.0], 2)[0]
     assert (lam.real > 0) == (side > 0)
     rate = simulated_rate(a, b, N)
-    assert rate == pytest.approx(lam.real, rel=0.05)
+    assert rate == pytest.approx(lam.real, rel=1e-3)   # (the issue asks 5 %; measured 1e-4)
 
 
 # ---- bad input -------------------------------------------------------------------------------

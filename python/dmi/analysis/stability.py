@@ -40,17 +40,18 @@ def _one_step_roots(lin: Linearisation, count: int) -> np.ndarray:
         return np.log(z.astype(complex)) / lin.h
 
 
-def _branch(logmu: complex, z: complex, N: int, h: float) -> complex:
-    """lambda = (log(mu) + 2 pi i k) / (N h) on the branch k where N log(z) = log(mu) + 2 pi i k;
-    nan if z^N is not mu (|N log z - log mu - 2 pi i k| > 0.5: z belongs to another mu; deep
-    multipliers, 1e-7 of the largest, match their z to 1e-2 only, as Arnoldi resolves them)."""
+def _branch(logmu: complex, z: complex, N: int, h: float) -> tuple[complex, float]:
+    """(lambda, miss): lambda = (log(mu) + 2 pi i k) / (N h) on the branch k where N log(z) = log(mu)
+    + 2 pi i k + e, miss = |e|; lambda nan if miss > 0.5 (z belongs to another mu; deep multipliers,
+    1e-7 of the largest, miss by 1e-2, as Arnoldi resolves them)."""
     if z == 0:
-        return complex(np.nan, np.nan)
+        return complex(np.nan, np.nan), np.inf
     d = N * np.log(complex(z)) - logmu
     turns = round(d.imag / (2 * np.pi))
-    if abs(d - 2j * np.pi * turns) > 0.5:
-        return complex(np.nan, np.nan)
-    return (logmu + 2j * np.pi * turns) / (N * h)
+    miss = abs(d - 2j * np.pi * turns)
+    if miss > 0.5:
+        return complex(np.nan, np.nan), miss
+    return (logmu + 2j * np.pi * turns) / (N * h), miss
 
 
 def _arnoldi_roots(lin: Linearisation, count: int) -> np.ndarray:
@@ -88,20 +89,18 @@ def _arnoldi_roots(lin: Linearisation, count: int) -> np.ndarray:
             continue
         v = V[:, i]
         z = np.vdot(v, lin.apply_complex(v[:, None], 1)[:, 0]) / np.vdot(v, v)
-        lam[i] = _branch(logmu[i], z, N, h)
+        lam[i] = _branch(logmu[i], z, N, h)[0]
     if np.any(np.isnan(lam.real)):   # M on the span of the vectors
         Q, _ = np.linalg.qr(V)
         z = scipy.linalg.eigvals(Q.conj().T @ lin.apply_complex(Q, 1))
         free = list(z)
-        for i in np.nonzero(np.isnan(lam.real))[0]:
+        for i in np.nonzero(np.isnan(lam.real))[0]:   # each mu its nearest unused z
             cand = [_branch(logmu[i], zj, N, h) for zj in free]
-            ok = [j for j, c in enumerate(cand) if not np.isnan(c.real)]
-            if ok:                      # (none: an inaccurate Ritz vector, refused if among count)
-                j = min(ok, key=lambda j: abs(N * np.log(complex(free[j])) - logmu[i]
-                                              - 2j * np.pi * round((N * np.log(complex(free[j]))
-                                                                    - logmu[i]).imag / (2 * np.pi))))
-                lam[i] = cand[j]
-                free.pop(j)
+            if cand:   # (no match: an inaccurate Ritz vector, refused if among count)
+                j = min(range(len(cand)), key=lambda j: cand[j][1])
+                lam[i] = cand[j][0]
+                if not np.isnan(lam[i].real):
+                    free.pop(j)
     return lam
 
 
