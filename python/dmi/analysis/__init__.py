@@ -11,5 +11,5 @@ from ._model import KinkError
 from .chart import HopfCurve, StabilityChart, plot_stability_chart, stability_chart
 from .stability import HopfPoint, hopf, roots
 
-__all__: list[str] = ["roots", "hopf", "HopfPoint", "KinkError", "stability_chart",
-                      "StabilityChart", "HopfCurve", "plot_stability_chart"]
+__all__ = ["roots", "hopf", "HopfPoint", "KinkError", "stability_chart",
+           "StabilityChart", "HopfCurve", "plot_stability_chart"]

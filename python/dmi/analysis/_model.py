@@ -184,13 +184,13 @@ class Linearisation:
                              f"at {args!r}: one step moves it by {moved!r} (max {res:.3g}, "
                              f"{res / scale if scale else float('inf'):.3g} relative to "
                              f"max(|u_eq|, |u_eq - X*|) = {scale:.3g}; tolerance {tol:g})")
-        scale_u = max(np.max(np.abs(u)), np.max(np.abs(X)), 1e-300)
+        scale_u = max(np.max(np.abs(u)), np.max(np.abs(X))) or 1.0
         bound = s._keep.get("rhs")
         if bound is None or bound.address is None:
             J = np.zeros((n, n))
         else:
             J = _central(lambda x: _call(_lib.RhsFn, bound, s, t0, x, "rhs"), u,
-                         max(np.max(np.abs(u)), 1.0 if not np.any(u) else 0.0), None)
+                         np.max(np.abs(u)) or 1.0, None)
         self.D = _resolvent_derivative(s, X, h, scale_u)
         self.J, self.u_eq, self.X = J, u, X
         self.n, self.N, self.h, self.tau = n, N, h, s.tau

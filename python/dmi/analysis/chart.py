@@ -99,9 +99,15 @@ def _trace(make2: Callable, p_values: np.ndarray, q_values: np.ndarray, u_eq: An
                 pred_l = 2 * path[-1][1] - path[-2][1]
             else:
                 pred_p, pred_l = path[-1]
-            found = _secant(lambda p: _tracked(make2, p, q, u_eq, count, tol, pred_l), pred_p,
-                            1e-3 * span, TRACE_TOL * span)
-            if found is None or not (lo <= found[0] <= hi):
+            try:
+                found = _secant(lambda p: _tracked(make2, p, q, u_eq, count, tol, pred_l), pred_p,
+                                1e-3 * span, TRACE_TOL * span)
+            except (RuntimeError, ValueError):   # e.g. a kink or no equilibrium off the grid
+                found = None
+            # the curve ends where it leaves the p range, turns back in q (no convergence) or
+            # where the tracked root is lost among the count rightmost (a jump in the root)
+            if (found is None or not (lo <= found[0] <= hi)
+                    or abs(found[1] - pred_l) > 0.25 * max(abs(pred_l), 1e-6)):
                 break
             path.append(found)
             points[j] = found
