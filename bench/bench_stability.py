@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
 # dmi.analysis's speed (issue 29; a benchmark, not a test).
-# 1. roots(count = 10) of the distributed-delay oscillator (n = 2, python/examples/stability_chart.py)
-#    at N = 1e3, 1e4, 1e5, with its kernel as one exponential term (the O(1) recursion) and as a
-#    general callback (numba cfunc; the FFT), against simulating one delay tau (N steps, dmi_advance)
-#    of the same model in the same round: the ratio, the applications of the tangent map, and the
-#    growth with N.  The rhs is a numba cfunc (C speed in both).  Rounds interleave the cases; the
-#    fastest round of each counts; CPU time of this process.
+# 1. roots(count = 10) of the distributed-delay oscillator (n = 2,
+#    python/examples/stability_chart.py) at N = 1e3, 1e4, 1e5, with its kernel as one exponential
+#    term (the O(1) recursion) and as a general callback (numba cfunc; the FFT), against simulating
+#    one delay tau (N steps, dmi_advance) of the same model in the same round: the ratio, the
+#    applications of the tangent map, and the growth with N.  The rhs is a numba cfunc (C speed in
+#    both).  Rounds interleave the cases; the fastest round of each counts; CPU time of this process.
 # 2. A stability chart of the oscillator over (a, tau) on the local processes (--workers), and the
 #    same chart through a Dask LocalCluster of as many workers; wall-clock time.
 # Usage: bench/bench_stability.py [--N 1000 10000 100000] [--rounds R] [--chart P Q] [--chart-N N]
@@ -114,7 +114,8 @@ def bench_roots(Ns: list[int], rounds: int) -> None:
     for k in ("exp", "callback"):
         for N0, N1 in zip(Ns, Ns[1:]):
             g = best[(k, N1)][0] / best[(k, N0)][0]
-            print(f"growth {k}: N {N0} -> {N1}: x{g:.2f} (N log N: x{N1 * math.log(N1) / (N0 * math.log(N0)):.2f})")
+            nlogn = N1 * math.log(N1) / (N0 * math.log(N0))
+            print(f"growth {k}: N {N0} -> {N1}: x{g:.2f} (N log N: x{nlogn:.2f})")
 
 
 def bench_chart(P: int, Q: int, N: int, workers: int, dask: bool) -> None:

@@ -47,7 +47,7 @@ def main() -> None:
     dt = time.perf_counter() - t0
     ax = analysis.plot_stability_chart(chart, p_label="delay gain a (1/s²)",
                                        q_label="delay τ (s)",
-                                       title=f"w'' + c w' + b w + a ∫₀^τ G(s) w(t−s) ds = 0, "
+                                       title="w'' + c w' + b w + a ∫₀^τ G(s) w(t−s) ds = 0, "
                                              f"G(s) = e^(−s/θ)/θ\nc = {C:g}/s, b = {B:g}/s², "
                                              f"θ = {THETA:g} s, N = {a.N} steps per τ")
     ax.figure.savefig(a.out, dpi=130)

@@ -34,7 +34,8 @@ def G_hat(lam: complex) -> complex:
 
 
 def d_curve(w: float) -> tuple[float, float]:
-    """(a, c) with -w^2 + i c w + b + a G_hat(i w) = 0: a from the real part, c from the imaginary."""
+    """(a, c) with -w^2 + i c w + b + a G_hat(i w) = 0: a from the real part, c from the
+    imaginary part."""
     g = G_hat(1j * w)
     a = (w * w - B) / g.real
     return a, -a * g.imag / w

@@ -1,7 +1,7 @@
 # Tests of dmi.analysis.roots and dmi.analysis.hopf (issue 29) against oracles computed here,
-# independently of the code under test: the scalar equation's characteristic polynomial (numpy.roots)
-# and its continuous Hopf curve in closed form, the block companion matrix of a mass on a belt with
-# dry friction (numpy), and plain simulations with dmi.Solver.
+# independently of the code under test: the scalar equation's characteristic polynomial
+# (numpy.roots) and its continuous Hopf curve in closed form, the block companion matrix of a mass
+# on a belt with dry friction (numpy), and plain simulations with dmi.Solver.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -105,7 +105,8 @@ def test_hopf_is_the_polynomials_crossing_and_converges_at_order_one():
         # the scheme's own crossing, from the polynomial: Re of its rightmost root changes sign
         # within 1e-10 relative around hp.p
         d = 1e-10 * hp.p
-        assert polynomial_roots(hp.p - d, b, N)[0].real < 0 < polynomial_roots(hp.p + d, b, N)[0].real
+        below, above = polynomial_roots(hp.p - d, b, N)[0], polynomial_roots(hp.p + d, b, N)[0]
+        assert below.real < 0 < above.real
         assert hp.omega == pytest.approx(polynomial_roots(hp.p, b, N)[0].imag, abs=1e-8)
         assert hp.root.real == pytest.approx(0, abs=1e-9) and hp.root.imag == hp.omega
         errors.append(abs(hp.p - a_c))
@@ -157,6 +158,8 @@ def test_sliding_on_a_belt_is_the_smooth_linearisation(c, friction, tol):
     # (a callback's derivative is taken by central differences: tol 1e-8; 6 roots, Re lambda down
     # to -8: deeper roots lose digits as exp(Re lambda tau) falls, see docs/stability.md)
     u_eq = [ALPHA / (K_ + G_), -VB]
+    if friction == "builtin":   # u_eq as a function of the parameter
+        u_eq = (lambda _c, u=u_eq: u)
     got = analysis.roots(functools.partial(belt, N=50, friction=friction), c, u_eq, 6)
     want = belt_companion_roots(c, 50)[:6]
     assert np.max(np.abs(got - want)) <= tol

@@ -210,9 +210,9 @@ def stability_chart(make2: Callable[[float, float], Solver], p_values: Sequence[
         try:
             pickle.dumps((make2, u_eq))
         except Exception as e:
-            raise TypeError(f"dmi.analysis.stability_chart: make2 and u_eq go to other processes by "
-                            f"pickle, and {e}: use a module-level function or a functools.partial "
-                            "of one, not a lambda or a closure") from e
+            raise TypeError(f"dmi.analysis.stability_chart: make2 and u_eq go to other processes "
+                            f"by pickle, and {e}: use a module-level function or a "
+                            "functools.partial of one, not a lambda or a closure") from e
         n = workers or len(os.sched_getaffinity(0))
         pool = ProcessPoolExecutor(max_workers=max(1, min(n, len(Q))))
     try:

@@ -41,9 +41,9 @@ def _one_step_roots(lin: Linearisation, count: int) -> np.ndarray:
 
 
 def _branch(logmu: complex, z: complex, N: int, h: float) -> tuple[complex, float]:
-    """(lambda, miss): lambda = (log(mu) + 2 pi i k) / (N h) on the branch k where N log(z) = log(mu)
-    + 2 pi i k + e, miss = |e|; lambda nan if miss > 0.5 (z belongs to another mu; deep multipliers,
-    1e-7 of the largest, miss by 1e-2, as Arnoldi resolves them)."""
+    """(lambda, miss): lambda = (log(mu) + 2 pi i k) / (N h) on the branch k where
+    N log(z) = log(mu) + 2 pi i k + e, miss = |e|; lambda nan if miss > 0.5 (z belongs to another
+    mu; deep multipliers, 1e-7 of the largest, miss by 1e-2, as Arnoldi resolves them)."""
     if z == 0:
         return complex(np.nan, np.nan), np.inf
     d = N * np.log(complex(z)) - logmu
@@ -116,7 +116,8 @@ _BLAS: list = []
 
 def _one_blas_thread() -> Any:
     """A context with BLAS on one thread (threadpoolctl, if installed): Arnoldi's vectors are long
-    and few, and OpenBLAS's threads spinning on a loaded machine made roots 40x slower (measured)."""
+    and few, and OpenBLAS's threads spinning on a loaded machine made roots 40x slower
+    (measured)."""
     if not _BLAS:
         try:
             from threadpoolctl import ThreadpoolController
