@@ -5,11 +5,12 @@
 #    term (the O(1) recursion) and as a general callback (numba cfunc; the FFT), against simulating
 #    one delay tau (N steps, dmi_advance) of the same model in the same round: the ratio, the
 #    applications of the tangent map, and the growth with N.  The rhs is a numba cfunc (C speed in
-#    both).  Rounds interleave the cases; the fastest round of each counts; CPU time of this process.
+#    both).  Rounds interleave the cases; the fastest round of each counts; CPU time (the process).
 # 2. A stability chart of the oscillator over (a, tau) on the local processes (--workers), and the
-#    same chart through a Dask LocalCluster of as many workers; wall-clock time.
+#    same chart through a Dask LocalCluster of as many workers, interleaved; wall-clock time.
 # Usage: bench/bench_stability.py [--N 1000 10000 100000] [--rounds R] [--chart P Q] [--chart-N N]
-#        [--workers W] [--no-dask]      (needs dmi importable: PYTHONPATH=<build>/python; numba)
+#        [--workers W] [--no-dask] [--chart-rounds R]
+#        (needs dmi importable: PYTHONPATH=<build>/python; numba)
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -118,26 +119,37 @@ def bench_roots(Ns: list[int], rounds: int) -> None:
             print(f"growth {k}: N {N0} -> {N1}: x{g:.2f} (N log N: x{nlogn:.2f})")
 
 
-def bench_chart(P: int, Q: int, N: int, workers: int, dask: bool) -> None:
+def bench_chart(P: int, Q: int, N: int, workers: int, dask: bool, rounds: int) -> None:
     gains, delays = np.linspace(-1.5, 3.0, P), np.linspace(0.2, 8.0, Q)
     make2 = functools.partial(oscillator, N=N)
-    t0 = time.perf_counter()
-    chart = analysis.stability_chart(make2, gains, delays, [0.0, 0.0], workers=workers)
-    t_pool = time.perf_counter() - t0
-    print(f"stability chart {P}x{Q}, N = {N}, {workers} processes: {t_pool:.1f} s wall "
-          f"({1e3 * t_pool / (P * Q):.1f} ms a point with the tracing), {len(chart.curves)} curves")
-    if not dask:
-        return
-    from distributed import Client, LocalCluster
-    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      dashboard_address=None) as cluster, Client(cluster) as client:
+    cluster = client = None
+    if dask:
+        from distributed import Client, LocalCluster
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                               host="127.0.0.1", dashboard_address=None)
+        client = Client(cluster)
         client.submit(abs, -1).result()       # workers up before the clock
-        t0 = time.perf_counter()
-        chart2 = analysis.stability_chart(make2, gains, delays, [0.0, 0.0], client=client)
-        t_dask = time.perf_counter() - t0
-    same = np.array_equal(chart.re, chart2.re)
-    print(f"the same chart on a Dask LocalCluster of {workers} workers: {t_dask:.1f} s wall "
-          f"(x{t_dask / t_pool:.2f} the processes'), same grid bitwise: {same}")
+    times: dict[str, list[float]] = {"processes": [], "dask": []}
+    charts = {}
+    try:
+        for _ in range(rounds):               # interleaved: processes, then Dask, each round
+            for how in ("processes", "dask") if dask else ("processes",):
+                t0 = time.perf_counter()
+                charts[how] = analysis.stability_chart(
+                    make2, gains, delays, [0.0, 0.0], workers=workers,
+                    client=client if how == "dask" else None)
+                times[how].append(time.perf_counter() - t0)
+    finally:
+        if client is not None:
+            client.close()
+            cluster.close()
+    for how, ts in times.items():
+        if ts:
+            print(f"stability chart {P}x{Q}, N = {N}, {workers} {how}: "
+                  f"{', '.join(f'{t:.1f}' for t in ts)} s wall ({1e3 * min(ts) / (P * Q):.1f} ms a "
+                  f"point at best, tracing included), {len(charts[how].curves)} curves")
+    if dask:
+        print("the same grid bitwise:", np.array_equal(charts["processes"].re, charts["dask"].re))
 
 
 def main() -> None:
@@ -149,10 +161,11 @@ def main() -> None:
     ap.add_argument("--chart-N", type=int, default=128)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--no-dask", action="store_true")
+    ap.add_argument("--chart-rounds", type=int, default=2)
     a = ap.parse_args()
     bench_roots(a.N, a.rounds)
     if a.chart[0] > 0:
-        bench_chart(a.chart[0], a.chart[1], a.chart_N, a.workers, not a.no_dask)
+        bench_chart(a.chart[0], a.chart[1], a.chart_N, a.workers, not a.no_dask, a.chart_rounds)
 
 
 if __name__ == "__main__":

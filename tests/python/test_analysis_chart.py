@@ -100,6 +100,17 @@ def test_grid_is_the_rightmost_root(charts):
     assert np.array_equal(chart.stable, chart.re < 0)
 
 
+def test_one_start_per_chain_of_sign_changes():
+    from dmi.analysis.chart import _brackets
+    re = np.ones((8, 12))
+    re[:, :2] = -1                       # a vertical boundary between columns 1 and 2
+    for j in range(6):                   # a diagonal one, one column further left each row
+        re[j, 11 - j:] = -1
+    starts = _brackets(re)
+    assert len(starts) == 2
+    assert sorted(i for _, i in starts)[0] == 1
+
+
 def test_figure(charts, tmp_path):
     import matplotlib
     matplotlib.use("Agg")
