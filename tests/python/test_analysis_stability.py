@@ -231,6 +231,9 @@ def test_bad_input_gives_clear_errors():
         analysis.roots(make, 3.0, [0.0, 0.0])
     with pytest.raises(ValueError, match="count"):
         analysis.roots(make, 3.0, [0.0], 0)
+    with pytest.raises(ValueError, match="count = 51 roots asked; the step map has n N = 50"):
+        analysis.roots(make, 3.0, [0.0], 51)
+    assert len(analysis.roots(functools.partial(scalar, N=70), 3.0, [0.0], 68)) == 68   # dense
     with pytest.raises(ValueError, match="not an interval"):
         analysis.hopf(make, 5.0, 5.0, [0.0])
     with pytest.raises(ValueError, match="no crossing bracketed"):

@@ -130,8 +130,12 @@ def _one_blas_thread() -> Any:
 
 def rightmost(lin: Linearisation, count: int) -> np.ndarray:
     """The count rightmost roots of a linearisation."""
+    if count > lin.dim:
+        raise ValueError(f"dmi.analysis: count = {count} roots asked; the step map has n N = "
+                         f"{lin.dim}")
+    dense = lin.dim <= max(DENSE_MAX, count + 4)      # (Arnoldi needs k < n N - 1)
     with _one_blas_thread():
-        lam = _one_step_roots(lin, count) if lin.dim <= DENSE_MAX else _arnoldi_roots(lin, count)
+        lam = _one_step_roots(lin, count) if dense else _arnoldi_roots(lin, count)
     lam = _order(lam)
     if np.any(np.isnan(lam[:count])):
         raise RuntimeError(f"dmi.analysis: the one-step map has no multiplier z with z^{lin.N} = "
