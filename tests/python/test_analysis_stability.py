@@ -166,11 +166,12 @@ def test_sliding_on_a_belt_is_the_smooth_linearisation(c, friction, tol):
     assert (got[0].real > 0) == (c < 1)    # enough damping stabilises the sliding
 
 
-def test_sticking_equilibria_form_a_continuum():
+@pytest.mark.parametrize("N", [40, 400])
+def test_sticking_equilibria_form_a_continuum(N):
     # belt at rest, |k x + g x| < alpha: every such x sticks; the multiplier 1 (root 0) says so,
     # the velocity held by the friction gives multipliers 0 (roots -inf)
     x = 0.2
-    got = analysis.roots(functools.partial(belt, vb=0.0, N=40), 0.2, [x, 0.0], 3)
+    got = analysis.roots(functools.partial(belt, vb=0.0, N=N), 0.2, [x, 0.0], 3)
     assert got[0] == pytest.approx(0.0, abs=1e-12)
     assert np.all(np.isneginf(got[1:].real))
 

@@ -20,13 +20,15 @@ from ._model import Linearisation, call_make
 #: At most this many state dimensions n N: the one-step matrix is formed and its eigenvalues taken
 #: directly (Arnoldi needs a state larger than the roots asked for).
 DENSE_MAX = 64
+#: Where ARPACK fails twice, the one-step matrix is formed up to this n N.
+DENSE_FALLBACK = 2000
 #: A tau-multiplier below this fraction of the largest one is taken as 0 (root -inf).
 ZERO = 1e-13
 
 
-def _seed(dim: int) -> np.ndarray:
+def _seed(dim: int, attempt: int = 0) -> np.ndarray:
     """A fixed start vector for Arnoldi (the same roots on every call)."""
-    return np.random.default_rng(20260529).standard_normal(dim)
+    return np.random.default_rng(20260529 + attempt).standard_normal(dim)
 
 
 def _one_step_roots(lin: Linearisation, count: int) -> np.ndarray:
@@ -61,11 +63,21 @@ def _arnoldi_roots(lin: Linearisation, count: int) -> np.ndarray:
     k = min(count + 2, dim - 2)
     op = sla.LinearOperator((dim, dim), matvec=lambda v: lin.apply(np.real(v), N), dtype=float)
     ncv = min(dim, max(2 * k + 1, 20))
-    try:
-        mu, V = sla.eigs(op, k=k, which="LM", ncv=ncv, tol=0, v0=_seed(dim), maxiter=50 * dim)
-    except sla.ArpackNoConvergence as e:
-        raise RuntimeError(f"dmi.analysis: Arnoldi did not converge on the {N}-step map "
-                           f"({len(e.eigenvalues)} of {k} multipliers)") from None
+    failure = None
+    for ncv_try, seed in ((ncv, 0), (min(dim, 2 * ncv + 1), 1)):
+        try:
+            mu, V = sla.eigs(op, k=k, which="LM", ncv=ncv_try, tol=0, v0=_seed(dim, seed),
+                             maxiter=50 * dim)
+            break
+        except sla.ArpackError as e:   # also ArpackNoConvergence
+            failure = e
+    else:
+        # ARPACK breaks down where the N-step map has few nonzero multipliers (a resolvent
+        # holding most components, as sticking friction does): the one-step matrix, if small
+        if dim <= DENSE_FALLBACK:
+            return _one_step_roots(lin, count)
+        raise RuntimeError(f"dmi.analysis: Arnoldi failed on the {N}-step map (n N = {dim}, "
+                           f"{k} multipliers asked): {failure}") from None
     big = np.max(np.abs(mu))
     lam = np.full(len(mu), -np.inf, dtype=complex)  # multipliers below ZERO of the largest:
     logmu = np.log(mu.astype(complex), where=np.abs(mu) >= ZERO * big,  # rounding errors of 0
