@@ -1,6 +1,8 @@
 /*
  * dmi_py_run: the loop behind dmi.Solver.run (python/dmi/_solver.py): steps a
  * solver and records the states in C, with no Python between the steps.
+ * dmi_py_linear: out = M x, the rhs and the resolvent of the tangent map of
+ * dmi.analysis (python/dmi/analysis/_model.py), called by libdmi directly.
  * Part of the Python package dmi only (libdmipy.so beside libdmi.so.1 in the
  * package): libdmi's own API has no such call.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -44,4 +46,29 @@ DMI_PY_API int dmi_py_run(dmi_solver *s, size_t n, size_t steps, size_t stride, 
     }
     *rows = r;
     return rc;
+}
+
+/* A dense n x n matrix, row-major (ctypes builds it in _model.py). */
+typedef struct {
+    size_t n;
+    double m[];
+} dmi_py_matrix;
+
+/*
+ * out = M x for M = *user (a dmi_py_matrix): libdmi's rhs signature (t
+ * ignored: f(t, u) = J u) and its resolvent signature (lam ignored: the
+ * resolvent's derivative D x).  Always returns 0.
+ */
+DMI_PY_API int dmi_py_linear(double t, const double *x, double *out, void *user)
+{
+    const dmi_py_matrix *a = user;
+    const size_t n = a->n;
+    (void)t;
+    for (size_t i = 0; i < n; i++) {
+        double sum = 0.0;
+        for (size_t j = 0; j < n; j++)
+            sum += a->m[i * n + j] * x[j];
+        out[i] = sum;
+    }
+    return 0;
 }

@@ -108,6 +108,7 @@ class Solver:
         self._n, self._tau, self._N = n, tau, int(_L.dmi_get_N(handle))
         self._h_given = h  # (for repr)
         self._keep: dict[str, cb.Bound] = {}   # callbacks and data libdmi points to
+        self._resolvent: tuple = ()             # the built-in resolvent and its data (dmi.analysis)
         self._failure: list = [None]           # an exception raised in a Python callback
         self._busy = threading.Lock()
 
@@ -184,6 +185,7 @@ class Solver:
         (``dmi.RESOLVENT_SIGNATURE``).  None restores A = 0.  Replaces an earlier resolvent,
         friction or box."""
         self._set_callback("resolvent", cb.RESOLVENT, _L.dmi_set_resolvent, r, user)
+        self._resolvent = ()
 
     def set_friction(self, alpha: Any) -> None:
         """Built-in dry friction A(u)_i = alpha_i sigma(u_i): alpha has n finite values >= 0
@@ -192,6 +194,7 @@ class Solver:
         with self._using() as s:
             self._check(_L.dmi_set_friction(s, _ptr(a)))
         self._keep["resolvent"] = cb.Bound(None, None, ())
+        self._resolvent = ("friction", a.copy())
 
     def set_box(self, lo: Any, hi: Any) -> None:
         """Built-in normal cone of the box prod_i [lo_i, hi_i] (the resolvent is the projection):
@@ -201,6 +204,7 @@ class Solver:
         with self._using() as s:
             self._check(_L.dmi_set_box(s, _ptr(lo_a), _ptr(hi_a)))
         self._keep["resolvent"] = cb.Bound(None, None, ())
+        self._resolvent = ("box", lo_a.copy(), hi_a.copy())
 
     def set_kernel(self, H: Callback | None, user: Any = None) -> None:
         """Kernel: ``H(s) -> array (n, n)`` for 0 <= s < tau, or a C function

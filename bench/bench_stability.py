@@ -1,0 +1,172 @@
+#!/usr/bin/env python3
+# dmi.analysis's speed (issue 29; a benchmark, not a test).
+# 1. roots(count = 10) of the distributed-delay oscillator (n = 2,
+#    python/examples/stability_chart.py) at N = 1e3, 1e4, 1e5, with its kernel as one exponential
+#    term (the O(1) recursion) and as a general callback (numba cfunc; the FFT), against simulating
+#    one delay tau (N steps, dmi_advance) of the same model in the same round: the ratio, the
+#    applications of the tangent map, and the growth with N.  The rhs is a numba cfunc (C speed in
+#    both).  Rounds interleave the cases; the fastest round of each counts; CPU time (the process).
+# 2. A stability chart of the oscillator over (a, tau) on the local processes (--workers), and the
+#    same chart through a Dask LocalCluster of as many workers, interleaved; wall-clock time.
+# Usage: bench/bench_stability.py [--N 1000 10000 100000] [--rounds R] [--chart P Q] [--chart-N N]
+#        [--workers W] [--no-dask] [--chart-rounds R]
+#        (needs dmi importable: PYTHONPATH=<build>/python; numba)
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+from __future__ import annotations
+
+import argparse
+import functools
+import math
+import sys
+import time
+from pathlib import Path
+
+import numba
+import numpy as np
+
+import dmi
+from dmi import analysis
+from dmi.analysis import _model
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "python" / "examples"))
+from stability_chart import B, C, THETA, oscillator  # noqa: E402
+
+A_GAIN, TAU = 1.0, 2.0
+
+
+@numba.cfunc(dmi.RHS_SIGNATURE)
+def rhs_c(t, u, out, user):
+    out[0] = -u[1]
+    out[1] = C * u[1] + B * u[0]
+    return 0
+
+
+@numba.cfunc(dmi.KERNEL_SIGNATURE)
+def kernel_c(s, out, user):   # H(s) = [[0, 0], [a e^{-s/theta} / theta, 0]], a = 1
+    out[0] = 0.0
+    out[1] = 0.0
+    out[2] = A_GAIN * math.exp(-s / THETA) / THETA
+    out[3] = 0.0
+    return 0
+
+
+def model(kind: str, N: int, a: float = A_GAIN) -> dmi.Solver:
+    s = dmi.Solver(2, TAU, N)
+    s.set_rhs(rhs_c)
+    if kind == "exp":
+        s.set_kernel_exp([-1.0 / THETA], [0.0], [[[0.0, 0.0], [a / THETA, 0.0]]])
+    else:
+        s.set_kernel(kernel_c)
+    return s
+
+
+def one_tau(kind: str, N: int) -> float:
+    s = model(kind, N)
+    s.set_history(lambda t: np.array([1e-3, 0.0]))
+    s.init()
+    t0 = time.process_time()
+    s.advance(N)
+    return time.process_time() - t0
+
+
+class Count:
+    """Counts the steps of the tangent map (Linearisation.apply)."""
+    def __init__(self):
+        self.steps = 0
+        self._apply = _model.Linearisation.apply
+
+    def __enter__(self):
+        count = self
+
+        def apply(lin, v, steps):
+            count.steps += steps
+            return count._apply(lin, v, steps)
+        _model.Linearisation.apply = apply
+        return self
+
+    def __exit__(self, *exc):
+        _model.Linearisation.apply = self._apply
+
+
+def time_roots(kind: str, N: int) -> tuple[float, float, np.ndarray]:
+    with Count() as c:
+        t0 = time.process_time()
+        lam = analysis.roots(lambda a: model(kind, N, a), A_GAIN, [0.0, 0.0], 10)
+        dt = time.process_time() - t0
+    return dt, c.steps / N, lam
+
+
+def bench_roots(Ns: list[int], rounds: int) -> None:
+    cases = [(k, N) for N in Ns for k in ("exp", "callback")]
+    best = {c: [math.inf, math.inf, 0.0, None] for c in cases}
+    for _ in range(rounds):
+        for c in cases:
+            sim = one_tau(*c)
+            dt, taus, lam = time_roots(*c)
+            b = best[c]
+            b[0], b[1], b[2], b[3] = min(b[0], dt), min(b[1], sim), taus, lam
+    print(f"roots(count = 10), n = 2, tau = {TAU}: best of {rounds} interleaved rounds, CPU time")
+    print(f"{'kernel':>8} {'N':>7} {'roots (s)':>10} {'one tau (s)':>12} {'ratio':>8} "
+          f"{'tau-maps':>9} {'rightmost root':>26}")
+    for (k, N), (dt, sim, taus, lam) in best.items():
+        print(f"{k:>8} {N:>7} {dt:10.4f} {sim:12.6f} {dt / sim:8.1f} {taus:9.1f} "
+              f"{lam[0].real:+.10f}{lam[0].imag:+.10f}j")
+    for k in ("exp", "callback"):
+        for N0, N1 in zip(Ns, Ns[1:]):
+            g = best[(k, N1)][0] / best[(k, N0)][0]
+            nlogn = N1 * math.log(N1) / (N0 * math.log(N0))
+            print(f"growth {k}: N {N0} -> {N1}: x{g:.2f} (N log N: x{nlogn:.2f})")
+
+
+def bench_chart(P: int, Q: int, N: int, workers: int, dask: bool, rounds: int) -> None:
+    gains, delays = np.linspace(-1.5, 3.0, P), np.linspace(0.2, 8.0, Q)
+    make2 = functools.partial(oscillator, N=N)
+    cluster = client = None
+    if dask:
+        from distributed import Client, LocalCluster
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                               host="127.0.0.1", dashboard_address=None)
+        client = Client(cluster)
+        client.submit(abs, -1).result()       # workers up before the clock
+    times: dict[str, list[float]] = {"processes": [], "dask": []}
+    charts = {}
+    try:
+        for _ in range(rounds):               # interleaved: processes, then Dask, each round
+            for how in ("processes", "dask") if dask else ("processes",):
+                t0 = time.perf_counter()
+                charts[how] = analysis.stability_chart(
+                    make2, gains, delays, [0.0, 0.0], workers=workers,
+                    client=client if how == "dask" else None)
+                times[how].append(time.perf_counter() - t0)
+    finally:
+        if client is not None:
+            client.close()
+            cluster.close()
+    for how, ts in times.items():
+        if ts:
+            print(f"stability chart {P}x{Q}, N = {N}, {workers} {how}: "
+                  f"{', '.join(f'{t:.1f}' for t in ts)} s wall ({1e3 * min(ts) / (P * Q):.1f} ms a "
+                  f"point at best, tracing included), {len(charts[how].curves)} curves")
+    if dask:
+        print("the same grid bitwise:", np.array_equal(charts["processes"].re, charts["dask"].re))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--N", type=int, nargs="+", default=[1000, 10000, 100000])
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--chart", type=int, nargs=2, default=[100, 100], metavar=("P", "Q"),
+                    help="grid of the chart (0 0: no chart)")
+    ap.add_argument("--chart-N", type=int, default=128)
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--no-dask", action="store_true")
+    ap.add_argument("--chart-rounds", type=int, default=2)
+    a = ap.parse_args()
+    bench_roots(a.N, a.rounds)
+    if a.chart[0] > 0:
+        bench_chart(a.chart[0], a.chart[1], a.chart_N, a.workers, not a.no_dask, a.chart_rounds)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,226 @@
+# The scheme's step map linearised at a constant history, and its tangent map run by libdmi.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""The linearisation shared by the analyses of dmi.analysis; private to the package.
+
+A model is ``make(p) -> dmi.Solver`` (configured, not initialised).  The scheme's step map is
+
+    U^{p+1} = R(X^p),   X^p = U^p - h f(t_p, U^p) - h W^p,   W^p = h sum_{l<N} H(l h) U^{p-l},
+
+R the resolvent (I + hA)^{-1}.  Its state is the window (U^{p-N+1}, ..., U^p), n N numbers.  At a
+constant history u_eq with X* = u_eq - h f(u_eq) - h W* the linearisation is
+
+    dU^{p+1} = D (dU^p - h J dU^p - h dW^p),   J = f_u(u_eq),   D = R'(X*),
+
+the same scheme with f(t, u) = J u, resolvent D x and the model's own kernel and convolution
+method: the *tangent solver*, a second solver from ``make`` whose rhs and resolvent are replaced by
+``dmi_py_linear`` (python/run.c), so that the tangent map runs in C at the speed of a simulation.
+"""
+from __future__ import annotations
+
+import ctypes
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from .. import _lib
+from .._solver import Solver
+
+#: Relative step of the central differences of f and of a user resolvent: about eps^(1/3).
+FD_STEP = 2.0 ** -17
+#: A built-in resolvent's argument closer than this (relative) to a kink is reported as on it.
+KINK_TOL = 1e-9
+
+
+class KinkError(ValueError):
+    """The resolvent is not differentiable at the equilibrium's argument X* (a kink: dry friction
+    sticking exactly at its threshold, a box constraint exactly on its face)."""
+
+
+def call_make(make: Callable[..., Any], *args: Any) -> Solver:
+    """make(*args), checked to be a dmi.Solver; its exception gets a note naming the call."""
+    try:
+        s = make(*args)
+    except Exception as e:
+        e.add_note(f"dmi.analysis: raised by the model make{args!r}")
+        raise
+    if not isinstance(s, Solver):
+        raise TypeError(f"dmi.analysis: the model make{args!r} returned {type(s).__name__}, "
+                        "not a dmi.Solver")
+    return s
+
+
+def equilibrium(u_eq: Any, n: int, args: tuple) -> np.ndarray:
+    """u_eq as a float array (n,): an array, or a function of the model's parameters."""
+    u = u_eq(*args) if callable(u_eq) else u_eq
+    a = np.array(u, dtype=float, ndmin=1)
+    if a.shape != (n,) or not np.all(np.isfinite(a)):
+        raise ValueError(f"dmi.analysis: u_eq = {u!r} is not {n} finite numbers (the model's n)")
+    return a
+
+
+class _Matrix:
+    """An n x n matrix as the C struct dmi_py_matrix {size_t n; double m[];} of python/run.c."""
+
+    def __init__(self, M: np.ndarray):
+        n = M.shape[0]
+        cls = type("dmi_py_matrix", (ctypes.Structure,),
+                   {"_fields_": [("n", ctypes.c_size_t), ("m", ctypes.c_double * (n * n))]})
+        self.c = cls()
+        self.c.n = n
+        self.c.m[:] = [float(x) for x in np.ravel(M)]
+
+
+def _call(fn_type: Any, bound: Any, solver: Solver, first: float, x: np.ndarray,
+          what: str) -> np.ndarray:
+    """Calls the model's C-level callback (libdmi's signature) at (first, x): out (n,)."""
+    out = np.zeros(solver.n)
+    x = np.ascontiguousarray(x, dtype=float)
+    rc = fn_type(bound.address)(first, x.ctypes.data, out.ctypes.data, bound.user)
+    failure, solver._failure[0] = solver._failure[0], None
+    if failure is not None:
+        failure.add_note(f"dmi.analysis: raised by the model's {what} at {x!r}")
+        raise failure
+    if rc != 0:
+        raise ValueError(f"dmi.analysis: the model's {what} returned {rc} at {x!r}")
+    if not np.all(np.isfinite(out)):
+        raise ValueError(f"dmi.analysis: the model's {what} is not finite at {x!r}: {out!r}")
+    return out
+
+
+def _central(g: Callable[[np.ndarray], np.ndarray], x: np.ndarray, scale: float,
+             kink: str | None) -> np.ndarray:
+    """Jacobian of g at x by central differences, step FD_STEP max(|x_j|, scale); with kink (a
+    name), one-sided differences that disagree raise KinkError."""
+    n = len(x)
+    Jac = np.empty((n, n))
+    g0 = g(x) if kink else None
+    for j in range(n):
+        e = np.zeros(n)
+        e[j] = FD_STEP * max(abs(x[j]), scale)
+        gp, gm = g(x + e), g(x - e)
+        Jac[:, j] = (gp - gm) / (2 * e[j])
+        if kink:
+            fwd, bwd = (gp - g0) / e[j], (g0 - gm) / e[j]
+            if np.max(np.abs(fwd - bwd)) > 1e-3 * max(1.0, np.max(np.abs(Jac[:, j]))):
+                raise KinkError(f"dmi.analysis: the {kink} is not differentiable at X*[{j}] = "
+                                f"{x[j]!r} (one-sided derivatives {fwd!r} and {bwd!r}): a kink "
+                                "(sticking exactly at the threshold?)")
+    return Jac
+
+
+def _resolvent_derivative(s: Solver, X: np.ndarray, h: float, scale: float) -> np.ndarray:
+    """D = R'(X): exact for the built-in friction and box, central differences for a callback."""
+    n = s.n
+    kind = getattr(s, "_resolvent", ())
+    if kind and kind[0] == "friction":
+        alpha = kind[1]
+        d = np.ones(n)
+        for i in range(n):
+            lam = h * alpha[i]
+            if lam == 0:
+                continue
+            if abs(abs(X[i]) - lam) <= KINK_TOL * max(abs(X[i]), lam):
+                raise KinkError(f"dmi.analysis: dry friction component {i} sticks exactly at its "
+                                f"threshold (|X*| = {abs(X[i])!r}, h alpha = {lam!r}): a kink of "
+                                "the resolvent, no linearisation there")
+            d[i] = 1.0 if abs(X[i]) > lam else 0.0
+        return np.diag(d)
+    if kind and kind[0] == "box":
+        lo, hi = kind[1], kind[2]
+        d = np.ones(n)
+        for i in range(n):
+            for b in (lo[i], hi[i]):
+                if np.isfinite(b) and abs(X[i] - b) <= KINK_TOL * max(abs(X[i]), abs(b)):
+                    raise KinkError(f"dmi.analysis: box component {i}: X*[{i}] = {X[i]!r} is on "
+                                    f"the face {b!r}: a kink of the projection, no linearisation "
+                                    "there")
+            d[i] = 1.0 if lo[i] < X[i] < hi[i] else 0.0
+        return np.diag(d)
+    bound = s._keep.get("resolvent")
+    if bound is None or bound.address is None:
+        return np.eye(n)
+    return _central(lambda x: _call(_lib.ResolventFn, bound, s, h, x, "resolvent"), X, scale,
+                    "resolvent")
+
+
+class Linearisation:
+    """The step map of the model's solver linearised at the constant history u_eq, and the
+    tangent solver that applies it (:meth:`apply`).  Use as a context manager (frees both)."""
+
+    def __init__(self, factory: Callable[[], Solver], u_eq: Any, args: tuple = (),
+                 tol: float = 1e-9):
+        s = factory()
+        try:
+            self._linearise(s, u_eq, args, tol)
+        finally:
+            s.close()
+        t = factory()
+        try:
+            self._rhs, self._res = _Matrix(self.J), _Matrix(self.D)
+            t.set_rhs(_lib.pylib.dmi_py_linear, self._rhs.c)
+            t.set_resolvent(_lib.pylib.dmi_py_linear, self._res.c)
+            t.init()
+        except BaseException:
+            t.close()
+            raise
+        self.tangent = t
+        self._window = np.zeros((self.N + 1, self.n))
+
+    def _linearise(self, s: Solver, u_eq: Any, args: tuple, tol: float) -> None:
+        n, N = s.n, s.N
+        u = equilibrium(u_eq, n, args)
+        s.init()
+        h = s.h
+        s.set_window(np.tile(u, (N + 1, 1)))
+        t0 = s.time
+        s.step()
+        _, X = s.step_terms()
+        moved = s.state - u
+        scale = max(np.max(np.abs(u)), np.max(np.abs(u - X)))
+        res = np.max(np.abs(moved))
+        if not res <= tol * scale:
+            raise ValueError(f"dmi.analysis: u_eq = {u!r} is not an equilibrium of the step map "
+                             f"at {args!r}: one step moves it by {moved!r} (max {res:.3g}, "
+                             f"{res / scale if scale else float('inf'):.3g} relative to "
+                             f"max(|u_eq|, |u_eq - X*|) = {scale:.3g}; tolerance {tol:g})")
+        scale_u = max(np.max(np.abs(u)), np.max(np.abs(X))) or 1.0
+        bound = s._keep.get("rhs")
+        if bound is None or bound.address is None:
+            J = np.zeros((n, n))
+        else:
+            J = _central(lambda x: _call(_lib.RhsFn, bound, s, t0, x, "rhs"), u,
+                         np.max(np.abs(u)) or 1.0, None)
+        self.D = _resolvent_derivative(s, X, h, scale_u)
+        self.J, self.u_eq, self.X = J, u, X
+        self.n, self.N, self.h, self.tau = n, N, h, s.tau
+
+    @property
+    def dim(self) -> int:
+        """Dimension n N of the step map's state."""
+        return self.n * self.N
+
+    def apply(self, v: np.ndarray, steps: int) -> np.ndarray:
+        """M^steps v for a state v (n N,) (the window's last N rows, oldest first), real."""
+        w = self._window
+        w[0] = 0.0           # U^{p-N}: not read by the step map
+        w[1:] = np.reshape(v, (self.N, self.n))
+        self.tangent.set_window(w)
+        self.tangent.advance(steps)
+        return self.tangent.get_window()[1:].reshape(-1)
+
+    def apply_complex(self, V: np.ndarray, steps: int) -> np.ndarray:
+        """M^steps on the columns of a complex array V (n N, k)."""
+        out = np.empty(V.shape, dtype=complex)
+        for j in range(V.shape[1]):
+            out[:, j] = self.apply(V[:, j].real, steps) + 1j * self.apply(V[:, j].imag, steps)
+        return out
+
+    def close(self) -> None:
+        self.tangent.close()
+
+    def __enter__(self) -> Linearisation:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

@@ -1,0 +1,268 @@
+# Stability charts of a two-parameter model: the rightmost root on a grid, in processes or on Dask,
+# and the Hopf curves traced by continuation; the chart's figure.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""dmi.analysis.stability_chart and dmi.analysis.plot_stability_chart."""
+from __future__ import annotations
+
+import functools
+import os
+import pickle
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.optimize
+
+from .._solver import Solver
+from ._model import Linearisation, call_make
+from .stability import rightmost
+
+#: Relative tolerance (of the range of p) of a traced point's p.
+TRACE_TOL = 1e-9
+
+
+@dataclass
+class HopfCurve:
+    """A curve of the (p, q) plane where one root lambda = i omega sits on the imaginary axis,
+    traced by continuation in q: arrays ``p``, ``q`` and ``omega`` (radians / time unit) of its
+    points, in the order traced.  omega = 0 throughout: a real root crosses (a fold, not Hopf)."""
+    p: np.ndarray
+    q: np.ndarray
+    omega: np.ndarray
+
+    @property
+    def is_hopf(self) -> bool:
+        """True if the crossing root is complex (omega > 0)."""
+        return bool(np.median(self.omega) > 1e-8)
+
+
+@dataclass
+class StabilityChart:
+    """The result of :func:`stability_chart`: ``re[j, i]`` and ``im[j, i]`` are the real and
+    imaginary parts (1 / time unit) of the rightmost root at (p_values[i], q_values[j]) (< 0:
+    stable); ``curves`` the traced :class:`HopfCurve` s."""
+    p_values: np.ndarray
+    q_values: np.ndarray
+    re: np.ndarray
+    im: np.ndarray
+    curves: list[HopfCurve] = field(default_factory=list)
+
+    @property
+    def stable(self) -> np.ndarray:
+        """re < 0: the grid points whose equilibrium is asymptotically stable."""
+        return self.re < 0
+
+
+def _root_at(make2: Callable[[float, float], Solver], p: float, q: float, u_eq: Any, count: int,
+             tol: float) -> np.ndarray:
+    with Linearisation(lambda: call_make(make2, p, q), u_eq, (p, q), tol) as lin:
+        return rightmost(lin, count)
+
+
+def _row(make2: Callable, p_values: np.ndarray, q: float, u_eq: Any, count: int,
+         tol: float) -> np.ndarray:
+    """The rightmost root at every p of one row q (a task of the pool or of Dask)."""
+    return np.array([_root_at(make2, p, q, u_eq, count, tol)[0] for p in p_values])
+
+
+def _tracked(make2: Callable, p: float, q: float, u_eq: Any, count: int, tol: float,
+             ref: complex) -> complex:
+    """The root nearest ref (Im >= 0) among the count rightmost at (p, q)."""
+    lam = _root_at(make2, p, q, u_eq, count, tol)
+    lam = lam[np.isfinite(lam.real)]
+    lam = np.where(lam.imag < 0, lam.conj(), lam)
+    return complex(lam[np.argmin(np.abs(lam - ref))])
+
+
+def _trace(make2: Callable, p_values: np.ndarray, q_values: np.ndarray, u_eq: Any, count: int,
+           tol: float, j0: int, p_a: float, p_b: float) -> HopfCurve:
+    """The curve through the crossing of the rightmost root between p_a and p_b on row j0,
+    continued over the rows q_values (both ways): on each row, the p where the tracked root has
+    Re = 0, by the secant method from the secant prediction of the two rows before (a task)."""
+    q0 = float(q_values[j0])
+    span = float(np.ptp(p_values)) or 1.0
+    lo, hi = float(np.min(p_values)), float(np.max(p_values))
+    g = lambda p: float(_root_at(make2, p, q0, u_eq, count, tol)[0].real)  # noqa: E731
+    p0 = scipy.optimize.brentq(g, p_a, p_b, xtol=TRACE_TOL * span)
+    lam0 = _root_at(make2, p0, q0, u_eq, count, tol)[0]
+    lam0 = complex(lam0.real, abs(lam0.imag))
+    points = {j0: (p0, lam0)}
+    for direction in (1, -1):
+        path = [(p0, lam0)]
+        j = j0 + direction
+        while 0 <= j < len(q_values):
+            q = float(q_values[j])
+            if len(path) >= 2:   # secant prediction of p and of the root
+                pred_p = 2 * path[-1][0] - path[-2][0]
+                pred_l = 2 * path[-1][1] - path[-2][1]
+            else:
+                pred_p, pred_l = path[-1]
+            try:
+                found = _secant(lambda p: _tracked(make2, p, q, u_eq, count, tol, pred_l), pred_p,
+                                1e-3 * span, TRACE_TOL * span)
+            except (RuntimeError, ValueError):   # e.g. a kink or no equilibrium off the grid
+                found = None
+            # the curve ends where it leaves the p range, turns back in q (no convergence) or
+            # where the tracked root is lost among the count rightmost (a jump in the root)
+            if (found is None or not (lo <= found[0] <= hi)
+                    or abs(found[1] - pred_l) > 0.25 * max(abs(pred_l), 1e-6)):
+                break
+            path.append(found)
+            points[j] = found
+            j += direction
+    js = sorted(points)
+    return HopfCurve(p=np.array([points[j][0] for j in js]), q=np.array([q_values[j] for j in js],
+                     dtype=float), omega=np.array([abs(points[j][1].imag) for j in js]))
+
+
+def _secant(root_of: Callable[[float], complex], p0: float, dp: float, xtol: float,
+            maxiter: int = 15) -> tuple[float, complex] | None:
+    """Re root_of(p) = 0 by the secant method from p0, p0 + dp; None if it does not converge."""
+    l0 = root_of(p0)
+    p1 = p0 + dp
+    l1 = root_of(p1)
+    for _ in range(maxiter):
+        d = l1.real - l0.real
+        if d == 0 or not np.isfinite(d):
+            return None
+        p2 = p1 - l1.real * (p1 - p0) / d
+        p0, l0 = p1, l1
+        p1, l1 = p2, root_of(p2)
+        if abs(p1 - p0) <= xtol:
+            return p1, l1
+    return None
+
+
+def _brackets(re: np.ndarray) -> list[tuple[int, int]]:
+    """(row j, column i) of the sign changes of re between columns i and i + 1, one per chain of
+    such changes linked from row to row (at most one column apart): one start per curve."""
+    changes = [(j, i) for j in range(re.shape[0]) for i in range(re.shape[1] - 1)
+               if np.isfinite(re[j, i]) and np.isfinite(re[j, i + 1])
+               and (re[j, i] < 0) != (re[j, i + 1] < 0)]
+    parent = {c: c for c in changes}
+
+    def find(c):
+        while parent[c] != c:
+            parent[c] = parent[parent[c]]
+            c = parent[c]
+        return c
+    for (j, i) in changes:
+        for di in (-1, 0, 1):
+            other = (j + 1, i + di)
+            if other in parent:
+                parent[find(other)] = find((j, i))
+    chains: dict = {}
+    for c in changes:
+        chains.setdefault(find(c), []).append(c)
+    return [sorted(chain)[len(chain) // 2] for chain in chains.values()]
+
+
+def _same_curve(a: HopfCurve, b: HopfCurve, span: float) -> bool:
+    """b lies on a: at least 80 % of b's points at a row of a within 1e-6 span in p."""
+    on = 0
+    for p, q in zip(b.p, b.q):
+        k = np.nonzero(a.q == q)[0]
+        on += bool(len(k)) and abs(a.p[k[0]] - p) <= 1e-6 * span
+    return on >= 0.8 * len(b.p)
+
+
+def _run_all(executor: Any, tasks: list[Callable[[], Any]]) -> list[Any]:
+    """Runs the tasks (callables without arguments) on executor (.submit(fn) -> future with
+    .result(): a concurrent.futures executor or a dask.distributed Client), in order; the first
+    failure cancels the others and is raised."""
+    futures = [executor.submit(t) for t in tasks]
+    try:
+        return [f.result() for f in futures]
+    except BaseException:
+        for f in futures:
+            f.cancel()
+        raise
+
+
+def stability_chart(make2: Callable[[float, float], Solver], p_values: Sequence[float],
+                    q_values: Sequence[float], u_eq: Any, *, count: int = 4,
+                    workers: int | None = None, client: Any = None, trace: bool = True,
+                    tol: float = 1e-9) -> StabilityChart:
+    """The stability chart of the two-parameter model ``make2(p, q) -> dmi.Solver`` (configured, not
+    initialised) at the constant history ``u_eq`` (an array (n,), or a function ``u_eq(p, q)``).
+
+    Returns a :class:`StabilityChart`: the rightmost root (:func:`roots`) at every grid point,
+    computed row by row (one task per q) in ``workers`` processes (default: the cores this process
+    may use), or on a Dask cluster through ``client`` (a ``dask.distributed.Client``, e.g. from
+    ``dmi_sweep.run.make_client``; any object with ``submit(fn)`` returning futures); and, with
+    ``trace``, the :class:`HopfCurve` s traced by continuation from each chain of sign changes of
+    the grid (one task per chain).  ``make2`` and ``u_eq`` travel to other processes by pickle: a
+    module-level function or a ``functools.partial`` of one, not a lambda or a closure.
+    The pool this function starts is shut down before it returns, also on an error.
+    """
+    P = np.array(p_values, dtype=float, ndmin=1)
+    Q = np.array(q_values, dtype=float, ndmin=1)
+    if P.ndim != 1 or Q.ndim != 1 or len(P) < 2 or len(Q) < 1:
+        raise ValueError("dmi.analysis.stability_chart: p_values needs >= 2 values and q_values "
+                         ">= 1, one-dimensional")
+    if not (np.all(np.isfinite(P)) and np.all(np.isfinite(Q))):
+        raise ValueError("dmi.analysis.stability_chart: p_values and q_values must be finite")
+    args = (make2, u_eq, int(count), float(tol))
+    pool = None
+    if client is None:
+        try:
+            pickle.dumps((make2, u_eq))
+        except Exception as e:
+            raise TypeError(f"dmi.analysis.stability_chart: make2 and u_eq go to other processes "
+                            f"by pickle, and {e}: use a module-level function or a "
+                            "functools.partial of one, not a lambda or a closure") from e
+        n = workers or len(os.sched_getaffinity(0))
+        pool = ProcessPoolExecutor(max_workers=max(1, min(n, len(Q))))
+    try:
+        ex = client if client is not None else pool
+        lam = np.array(_run_all(ex, [functools.partial(_row, make2, P, q, u_eq, args[2], args[3])
+                                     for q in Q]))
+        chart = StabilityChart(P, Q, lam.real.copy(), lam.imag.copy())
+        if trace:
+            starts = _brackets(chart.re)
+            curves = _run_all(ex, [functools.partial(_trace, make2, P, Q, u_eq, args[2], args[3],
+                                                     j, P[i], P[i + 1]) for j, i in starts])
+            span = float(np.ptp(P))
+            for c in sorted(curves, key=lambda c: -len(c.p)):
+                if not any(_same_curve(k, c, span) for k in chart.curves):
+                    chart.curves.append(c)
+        return chart
+    finally:
+        if pool is not None:
+            pool.shutdown(wait=True, cancel_futures=True)
+
+
+def plot_stability_chart(chart: StabilityChart, ax: Any = None, *, p_label: str = "parameter p",
+                         q_label: str = "parameter q", title: str | None = None) -> Any:
+    """Draws ``chart`` on the matplotlib Axes ``ax`` (a new figure if None) and returns the Axes:
+    the stable region (Re lambda_1 < 0) shaded, the traced Hopf curves as solid lines and the fold
+    curves (a real root crossing) dashed, p on the horizontal axis, q on the vertical one; the
+    labels name the parameters in words and symbols with units (e.g. ``"delay gain a (1/s^2)"``).
+    The key sits below the axes, not over the data."""
+    import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    if ax is None:
+        _, ax = plt.subplots(figsize=(6.4, 5.2), constrained_layout=True)
+    P, Q = chart.p_values, chart.q_values
+    if len(Q) > 1:   # Re lambda_1 < 0, its zero level interpolated between the grid points
+        re = np.nan_to_num(chart.re, nan=np.inf, neginf=-1e300)
+        ax.contourf(P, Q, np.clip(re, -1.0, 1.0), levels=[-2.0, 0.0], colors=["#c6dbef"])
+    for c in chart.curves:
+        ax.plot(c.p, c.q, color="black", lw=1.4, ls="-" if c.is_hopf else "--")
+    ax.set_xlim(P.min(), P.max())
+    if len(Q) > 1:
+        ax.set_ylim(Q.min(), Q.max())
+    ax.set_xlabel(p_label)
+    ax.set_ylabel(q_label)
+    if title:
+        ax.set_title(title)
+    handles = [Patch(facecolor="#c6dbef", label="stable: Re λ₁ < 0"),
+               Line2D([], [], color="black", lw=1.4, label="Hopf curve: λ = ±iω"),
+               Line2D([], [], color="black", lw=1.4, ls="--", label="fold: λ = 0")]
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=3,
+              frameon=False, fontsize="small")
+    return ax
