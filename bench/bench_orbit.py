@@ -53,9 +53,14 @@ def setup(N: int):
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description="periodic-orbit costs in periods of simulation")
-    ap.add_argument("--rounds", type=int, default=3)
-    ap.add_argument("--N", type=int, nargs="+", default=[1000, 10000])
+    ap = argparse.ArgumentParser(
+        description="Prints the cost of one Newton solve, the 10 leading multipliers and one "
+                    "continuation step of the tau-diagram's oscillator, in periods of plain "
+                    "simulation measured in the same run.",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    ap.add_argument("--rounds", type=int, default=3, help="interleaved rounds")
+    ap.add_argument("--N", type=int, nargs="+", default=[1000, 10000],
+                    help="delay cells N = ceil(tau / h) of the cases")
     a = ap.parse_args(argv)
     print(f"{'N':>6} {'M':>6} {'period s':>9} {'Newton':>8} {'its':>4} {'mult10':>8} "
           f"{'cont.step':>9} {'no margins':>10}   (costs in periods of plain simulation; "

@@ -153,15 +153,20 @@ def bench_chart(P: int, Q: int, N: int, workers: int, dask: bool, rounds: int) -
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--N", type=int, nargs="+", default=[1000, 10000, 100000])
-    ap.add_argument("--rounds", type=int, default=3)
+    ap = argparse.ArgumentParser(
+        description="Prints the cost of roots(count = 10) of the distributed-delay oscillator "
+                    "against simulating one delay tau, and the time of a stability chart on local "
+                    "processes and on a Dask LocalCluster.",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    ap.add_argument("--N", type=int, nargs="+", default=[1000, 10000, 100000],
+                    help="steps per delay of the roots cases")
+    ap.add_argument("--rounds", type=int, default=3, help="interleaved rounds of the roots cases")
     ap.add_argument("--chart", type=int, nargs=2, default=[100, 100], metavar=("P", "Q"),
                     help="grid of the chart (0 0: no chart)")
-    ap.add_argument("--chart-N", type=int, default=128)
-    ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--no-dask", action="store_true")
-    ap.add_argument("--chart-rounds", type=int, default=2)
+    ap.add_argument("--chart-N", type=int, default=128, help="steps per delay of the chart's model")
+    ap.add_argument("--workers", type=int, default=2, help="processes, and Dask workers, of the chart")
+    ap.add_argument("--no-dask", action="store_true", help="time the chart on processes only")
+    ap.add_argument("--chart-rounds", type=int, default=2, help="interleaved rounds of the chart")
     a = ap.parse_args()
     bench_roots(a.N, a.rounds)
     if a.chart[0] > 0:
