@@ -181,44 +181,51 @@ void fmu_model_store(fmu_model *m, unsigned vr, double value)
 
 /* ---- memory ---- */
 
+/* The N parameter: dmi_create's N (a model without a step function). */
 static size_t steps_per_tau(const dmi_fmu_values *v)
 {
     return (size_t)v->value[MODEL->N];
 }
 
-/* The bytes the solver allocates: the model's figures, or the bound of a
- * dense kernel (the history ring, 2 (N + 1) n doubles; n^2 N kernel samples
- * kept, the same again while sampling). */
-static void solver_bytes(const dmi_fmu_values *v, double *peak, double *kept)
+/* The bytes the solver of N cells allocates: the model's figures, or the
+ * bound of a dense kernel (the history ring, 2 (N + 1) n doubles; n^2 N
+ * kernel samples kept, the same again while sampling). */
+static void solver_bytes(const dmi_fmu_values *v, size_t N_cells, double *peak, double *kept)
 {
     if (MODEL->bytes) {
         MODEL->bytes(v, peak, kept);
         return;
     }
-    const double n = (double)MODEL->n, N = (double)steps_per_tau(v), d = sizeof(double);
+    const double n = (double)MODEL->n, N = (double)N_cells, d = sizeof(double);
     const double ring = 2 * (N + 1) * n * d, samples = n * n * N * d;
     *kept = ring + samples;
     *peak = 2 * ring + 2 * samples;
 }
 
 /* "N = .. steps per tau: <bytes> while initialising, <bytes> after" into out
- * (size bytes; cut to fit). */
-static void describe_bytes(const dmi_fmu_values *v, char *out, size_t size)
+ * (size bytes; cut to fit) for the solver's N (dmi_get_N; with a step
+ * function: "N = .. cells of h = ..", libdmi's N for that h). */
+static void describe_bytes(const dmi_fmu_values *v, size_t N, double h, char *out, size_t size)
 {
     double kept, peak;
-    solver_bytes(v, &peak, &kept);
-    snprintf(out, size, "%s = %zu steps per tau: the solver allocates %.0f bytes (%.3g GB) "
+    solver_bytes(v, N, &peak, &kept);
+    char what[96];
+    if (MODEL->step)
+        snprintf(what, sizeof what, "N = %zu cells of h = %.17g in tau", N, h);
+    else
+        snprintf(what, sizeof what, "%s = %zu steps per tau", name_of(MODEL->N), N);
+    snprintf(out, size, "%s: the solver allocates %.0f bytes (%.3g GB) "
                         "while initialising and keeps %.0f bytes (%.3g GB): a history of "
                         "2(N+1) states and N kernel samples",
-             name_of(MODEL->N), steps_per_tau(v), peak, peak / 1e9, kept, kept / 1e9);
+             what, peak, peak / 1e9, kept, kept / 1e9);
 }
 
-/* Out of memory: the error names N and the bytes needed. */
-static int memory_fail(char *err, const char *what, const dmi_fmu_values *v)
+/* Out of memory in the solver s: the error names N and the bytes needed. */
+static int memory_fail(char *err, const char *what, const dmi_fmu_values *v, const dmi_solver *s)
 {
     int len = snprintf(err, FMU_ERRLEN, "%s: out of memory: ", what);
     if (len >= 0 && len < FMU_ERRLEN)
-        describe_bytes(v, err + len, (size_t)(FMU_ERRLEN - len));
+        describe_bytes(v, dmi_get_N(s), dmi_get_h(s), err + len, (size_t)(FMU_ERRLEN - len));
     return -1;
 }
 
@@ -235,15 +242,34 @@ static int solver_fail(char *err, const char *what, dmi_solver *s, int rc)
  * allocates: the kernel's terms), nothing is sampled yet. */
 static int solver_create(const dmi_fmu_values *v, dmi_solver **out, char *err)
 {
-    int rc = dmi_create(out, MODEL->n, v->value[MODEL->tau], steps_per_tau(v));
-    if (rc == DMI_ENOMEM)
-        return memory_fail(err, "creating the solver", v);
-    if (rc != DMI_OK)
-        return solver_fail(err, "creating the solver (tau, N)", NULL, rc);
+    const double tau = v->value[MODEL->tau];
+    int rc;
+    if (MODEL->step) { /* the model's h: libdmi's N for it */
+        const double h = MODEL->step(v);
+        if (!isfinite(h) || !(h > 0))
+            return fail(err, "creating the solver: the model's step h = %.17g must be finite "
+                             "and > 0", h);
+        rc = dmi_create_h(out, MODEL->n, tau, h);
+        if (rc == DMI_ENOMEM)
+            return fail(err, "creating the solver: out of memory: tau = %.17g, h = %.17g: a "
+                             "history of tau / h = %.17g states", tau, h, tau / h);
+        if (rc != DMI_OK)
+            return fail(err, "creating the solver (tau = %.17g, h = %.17g): %s", tau, h,
+                        dmi_strerror(rc));
+    } else {
+        rc = dmi_create(out, MODEL->n, tau, steps_per_tau(v));
+        if (rc == DMI_ENOMEM) { /* describe_bytes for that N and h */
+            int len = snprintf(err, FMU_ERRLEN, "creating the solver: out of memory: ");
+            describe_bytes(v, steps_per_tau(v), 0.0, err + len, (size_t)(FMU_ERRLEN - len));
+            return -1;
+        }
+        if (rc != DMI_OK)
+            return solver_fail(err, "creating the solver (tau, N)", NULL, rc);
+    }
     char msg[FMU_ERRLEN] = "";
     if ((rc = MODEL->configure(v, *out, msg)) != 0) {
         if (rc == DMI_ENOMEM)
-            memory_fail(err, "configuring the solver", v);
+            memory_fail(err, "configuring the solver", v, *out);
         else { /* the model's message after the prefix, cut to fit */
             const char *why = msg[0] ? msg : dmi_last_error(*out);
             size_t len = strlen(strcpy(err, "configuring the solver: "));
@@ -262,7 +288,7 @@ static int solver_init(const dmi_fmu_values *v, dmi_solver *s, char *err)
 {
     int rc = dmi_init(s);
     if (rc == DMI_ENOMEM)
-        return memory_fail(err, "initialising the solver", v);
+        return memory_fail(err, "initialising the solver", v, s);
     return rc == DMI_OK ? 0 : solver_fail(err, "initialising the solver", s, rc);
 }
 
@@ -311,14 +337,14 @@ static void indicators_at(fmu_model *m, int *st)
 
 int fmu_model_start(fmu_model *m, double t_start, char *err, char *note)
 {
-    double kept, peak;
-    solver_bytes(m->v, &peak, &kept);
     note[0] = '\0';
-    if (peak > FMU_NOTE_BYTES)
-        describe_bytes(m->v, note, FMU_ERRLEN);
     dmi_solver *s = NULL;
-    if (solver_create(m->v, &s, err) != 0)
+    if (solver_create(m->v, &s, err) != 0) /* allocates the ring only */
         return -1;
+    double kept, peak; /* for libdmi's N, before dmi_init allocates the rest */
+    solver_bytes(m->v, dmi_get_N(s), &peak, &kept);
+    if (peak > FMU_NOTE_BYTES)
+        describe_bytes(m->v, dmi_get_N(s), dmi_get_h(s), note, FMU_ERRLEN);
     if (solver_init(m->v, s, err) != 0) {
         dmi_free(&s);
         return -1;
@@ -631,23 +657,37 @@ static int load_values(fmu_model *m, uint32_t version, const unsigned char *buf,
 }
 
 /* The solver of the saved history b (ndmi bytes) for the values of m. */
+/* "N = 12" (the N parameter) or "N = 12 cells of h = .." (a step function's). */
+static void name_N(const dmi_solver *s, char *out, size_t size)
+{
+    if (MODEL->step)
+        snprintf(out, size, "N = %zu cells of h = %.17g", dmi_get_N(s), dmi_get_h(s));
+    else
+        snprintf(out, size, "%s = %zu", name_of(MODEL->N), dmi_get_N(s));
+}
+
+/* The solver of the saved history b (ndmi bytes) for the values of m. */
 static int load_solver(fmu_model *m, const unsigned char *b, uint64_t ndmi, char *err)
 {
-    const size_t N = steps_per_tau(m->v);
     /* libdmi's state holds the N + 1 stored states U^{p-N..p} of n doubles:
-     * fewer bytes cannot be a history for this N (checked before the solver
-     * for N is allocated); then the exact size from libdmi. */
-    if (ndmi / (MODEL->n * sizeof(double)) < (uint64_t)N + 1)
+     * fewer bytes cannot be a history for this N, refused before the
+     * solver's ring for N is allocated when N is dmi_create's, the N
+     * parameter (a model's step gives libdmi's N only from the created
+     * solver: the exact size below); then the exact size from libdmi. */
+    if (!MODEL->step &&
+        ndmi / (MODEL->n * sizeof(double)) < (uint64_t)steps_per_tau(m->v) + 1)
         return fail(err, "state: the solver's history of %llu bytes is too short for %s = %zu",
-                    (unsigned long long)ndmi, name_of(MODEL->N), N);
+                    (unsigned long long)ndmi, name_of(MODEL->N), steps_per_tau(m->v));
     dmi_solver *s = NULL;
     if (solver_create(m->v, &s, err) != 0)
         return -1;
     const size_t need = dmi_state_size(s);
     if (need != ndmi) {
+        char N[96];
+        name_N(s, N, sizeof N);
         dmi_free(&s);
-        return fail(err, "state: the solver's history has %llu bytes, %s = %zu needs %zu",
-                    (unsigned long long)ndmi, name_of(MODEL->N), N, need);
+        return fail(err, "state: the solver's history has %llu bytes, %s needs %zu",
+                    (unsigned long long)ndmi, N, need);
     }
     int rc = solver_init(m->v, s, err);
     if (rc == 0 && (rc = dmi_state_load(s, b, (size_t)ndmi)) != DMI_OK)
