@@ -666,8 +666,10 @@ static void name_N(const dmi_solver *s, char *out, size_t size)
         snprintf(out, size, "%s = %zu", name_of(MODEL->N), dmi_get_N(s));
 }
 
-/* The solver of the saved history b (ndmi bytes) for the values of m. */
-static int load_solver(fmu_model *m, const unsigned char *b, uint64_t ndmi, char *err)
+/* The solver of the saved history b (ndmi bytes, in a state of format
+ * version) for the values of m. */
+static int load_solver(fmu_model *m, uint32_t version, const unsigned char *b, uint64_t ndmi,
+                       char *err)
 {
     /* libdmi's state holds the N + 1 stored states U^{p-N..p} of n doubles:
      * fewer bytes cannot be a history for this N, refused before the
@@ -681,7 +683,10 @@ static int load_solver(fmu_model *m, const unsigned char *b, uint64_t ndmi, char
     dmi_solver *s = NULL;
     if (solver_create(m->v, &s, err) != 0)
         return -1;
-    const size_t need = dmi_state_size(s);
+    /* format 1 (the FMU of libdmi 1.0) holds libdmi's state of format 1,
+     * which ends before the recursion's part (bytes.h) */
+    const size_t need = version == 1 ? dmi_state_at_rec(MODEL->n, dmi_get_N(s))
+                                     : dmi_state_size(s);
     if (need != ndmi) {
         char N[96];
         name_N(s, N, sizeof N);
@@ -738,10 +743,9 @@ int fmu_model_state_load(fmu_model *into, uint32_t tags, uint32_t solver_tags, u
     if (memcmp(buf, FMU_STATE_MAGIC, 8) != 0)
         return fail(err, "state: the bytes are not a saved state of this FMU (bad magic)");
     const uint32_t version = dmi_get_u32(buf, FMU_STATE_AT_VERSION);
-    if (version != 2 && version != FMU_STATE_VERSION)
-        return fail(err, "state: format version %lu is not supported (this FMU reads versions 2 "
-                         "and %d%s)", (unsigned long)version, FMU_STATE_VERSION,
-                    version == 1 ? "; version 1 was written by the FMU of libdmi 1.0" : "");
+    if (version < 1 || version > FMU_STATE_VERSION)
+        return fail(err, "state: format version %lu is not supported (this FMU reads versions 1 "
+                         "to %d)", (unsigned long)version, FMU_STATE_VERSION);
     const size_t AT_DMI = at_dmi(version), AT_REAL = at_real(version);
     if (size < AT_DMI + 8)
         return fail(err, "state: %zu bytes is too short for a saved state", size);
@@ -781,7 +785,7 @@ int fmu_model_state_load(fmu_model *into, uint32_t tags, uint32_t solver_tags, u
         goto refused;
     }
     if (has_solver) {
-        if (load_solver(&m, buf + AT_DMI, ndmi, err) != 0)
+        if (load_solver(&m, version, buf + AT_DMI, ndmi, err) != 0)
             goto refused;
     } else if (t_comm != t_start) { /* before initialization: no step taken */
         fail(err, "state: invalid times (start %.17g, communication point %.17g)", t_start,
