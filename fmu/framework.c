@@ -202,22 +202,28 @@ static void solver_bytes(const dmi_fmu_values *v, size_t N_cells, double *peak, 
     *peak = 2 * ring + 2 * samples;
 }
 
+/* The solver's N (dmi_get_N) in messages: "N = 12" (the N parameter's name)
+ * or, with a step function, "N = 12 cells of h = .." (libdmi's N for h). */
+static void name_N(size_t N, double h, char *out, size_t size)
+{
+    if (MODEL->step)
+        snprintf(out, size, "N = %zu cells of h = %.17g", N, h);
+    else
+        snprintf(out, size, "%s = %zu", name_of(MODEL->N), N);
+}
+
 /* "N = .. steps per tau: <bytes> while initialising, <bytes> after" into out
- * (size bytes; cut to fit) for the solver's N (dmi_get_N; with a step
- * function: "N = .. cells of h = ..", libdmi's N for that h). */
+ * (size bytes; cut to fit) for the solver's N and h (name_N). */
 static void describe_bytes(const dmi_fmu_values *v, size_t N, double h, char *out, size_t size)
 {
     double kept, peak;
     solver_bytes(v, N, &peak, &kept);
     char what[96];
-    if (MODEL->step)
-        snprintf(what, sizeof what, "N = %zu cells of h = %.17g in tau", N, h);
-    else
-        snprintf(what, sizeof what, "%s = %zu steps per tau", name_of(MODEL->N), N);
-    snprintf(out, size, "%s: the solver allocates %.0f bytes (%.3g GB) "
+    name_N(N, h, what, sizeof what);
+    snprintf(out, size, "%s %s: the solver allocates %.0f bytes (%.3g GB) "
                         "while initialising and keeps %.0f bytes (%.3g GB): a history of "
                         "2(N+1) states and N kernel samples",
-             what, peak, peak / 1e9, kept, kept / 1e9);
+             what, MODEL->step ? "in tau" : "steps per tau", peak, peak / 1e9, kept, kept / 1e9);
 }
 
 /* Out of memory in the solver s: the error names N and the bytes needed. */
@@ -258,7 +264,7 @@ static int solver_create(const dmi_fmu_values *v, dmi_solver **out, char *err)
                         dmi_strerror(rc));
     } else {
         rc = dmi_create(out, MODEL->n, tau, steps_per_tau(v));
-        if (rc == DMI_ENOMEM) { /* describe_bytes for that N and h */
+        if (rc == DMI_ENOMEM) { /* N is the parameter: no solver to ask */
             int len = snprintf(err, FMU_ERRLEN, "creating the solver: out of memory: ");
             describe_bytes(v, steps_per_tau(v), 0.0, err + len, (size_t)(FMU_ERRLEN - len));
             return -1;
@@ -656,16 +662,6 @@ static int load_values(fmu_model *m, uint32_t version, const unsigned char *buf,
     return 0;
 }
 
-/* The solver of the saved history b (ndmi bytes) for the values of m. */
-/* "N = 12" (the N parameter) or "N = 12 cells of h = .." (a step function's). */
-static void name_N(const dmi_solver *s, char *out, size_t size)
-{
-    if (MODEL->step)
-        snprintf(out, size, "N = %zu cells of h = %.17g", dmi_get_N(s), dmi_get_h(s));
-    else
-        snprintf(out, size, "%s = %zu", name_of(MODEL->N), dmi_get_N(s));
-}
-
 /* The solver of the saved history b (ndmi bytes, in a state of format
  * version) for the values of m. */
 static int load_solver(fmu_model *m, uint32_t version, const unsigned char *b, uint64_t ndmi,
@@ -689,7 +685,7 @@ static int load_solver(fmu_model *m, uint32_t version, const unsigned char *b, u
                                      : dmi_state_size(s);
     if (need != ndmi) {
         char N[96];
-        name_N(s, N, sizeof N);
+        name_N(dmi_get_N(s), dmi_get_h(s), N, sizeof N);
         dmi_free(&s);
         return fail(err, "state: the solver's history has %llu bytes, %s needs %zu",
                     (unsigned long long)ndmi, N, need);
