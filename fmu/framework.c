@@ -181,44 +181,57 @@ void fmu_model_store(fmu_model *m, unsigned vr, double value)
 
 /* ---- memory ---- */
 
+/* The N parameter: dmi_create's N (a model without a step function). */
 static size_t steps_per_tau(const dmi_fmu_values *v)
 {
     return (size_t)v->value[MODEL->N];
 }
 
-/* The bytes the solver allocates: the model's figures, or the bound of a
- * dense kernel (the history ring, 2 (N + 1) n doubles; n^2 N kernel samples
- * kept, the same again while sampling). */
-static void solver_bytes(const dmi_fmu_values *v, double *peak, double *kept)
+/* The bytes the solver of N cells allocates: the model's figures, or the
+ * bound of a dense kernel (the history ring, 2 (N + 1) n doubles; n^2 N
+ * kernel samples kept, the same again while sampling). */
+static void solver_bytes(const dmi_fmu_values *v, size_t N_cells, double *peak, double *kept)
 {
     if (MODEL->bytes) {
         MODEL->bytes(v, peak, kept);
         return;
     }
-    const double n = (double)MODEL->n, N = (double)steps_per_tau(v), d = sizeof(double);
+    const double n = (double)MODEL->n, N = (double)N_cells, d = sizeof(double);
     const double ring = 2 * (N + 1) * n * d, samples = n * n * N * d;
     *kept = ring + samples;
     *peak = 2 * ring + 2 * samples;
 }
 
-/* "N = .. steps per tau: <bytes> while initialising, <bytes> after" into out
- * (size bytes; cut to fit). */
-static void describe_bytes(const dmi_fmu_values *v, char *out, size_t size)
+/* The solver's N (dmi_get_N) in messages: "N = 12" (the N parameter's name)
+ * or, with a step function, "N = 12 cells of h = .." (libdmi's N for h). */
+static void name_N(size_t N, double h, char *out, size_t size)
 {
-    double kept, peak;
-    solver_bytes(v, &peak, &kept);
-    snprintf(out, size, "%s = %zu steps per tau: the solver allocates %.0f bytes (%.3g GB) "
-                        "while initialising and keeps %.0f bytes (%.3g GB): a history of "
-                        "2(N+1) states and N kernel samples",
-             name_of(MODEL->N), steps_per_tau(v), peak, peak / 1e9, kept, kept / 1e9);
+    if (MODEL->step)
+        snprintf(out, size, "N = %zu cells of h = %.17g", N, h);
+    else
+        snprintf(out, size, "%s = %zu", name_of(MODEL->N), N);
 }
 
-/* Out of memory: the error names N and the bytes needed. */
-static int memory_fail(char *err, const char *what, const dmi_fmu_values *v)
+/* "N = .. steps per tau: <bytes> while initialising, <bytes> after" into out
+ * (size bytes; cut to fit) for the solver's N and h (name_N). */
+static void describe_bytes(const dmi_fmu_values *v, size_t N, double h, char *out, size_t size)
+{
+    double kept, peak;
+    solver_bytes(v, N, &peak, &kept);
+    char what[96];
+    name_N(N, h, what, sizeof what);
+    snprintf(out, size, "%s %s: the solver allocates %.0f bytes (%.3g GB) "
+                        "while initialising and keeps %.0f bytes (%.3g GB): a history of "
+                        "2(N+1) states and N kernel samples",
+             what, MODEL->step ? "in tau" : "steps per tau", peak, peak / 1e9, kept, kept / 1e9);
+}
+
+/* Out of memory in the solver s: the error names N and the bytes needed. */
+static int memory_fail(char *err, const char *what, const dmi_fmu_values *v, const dmi_solver *s)
 {
     int len = snprintf(err, FMU_ERRLEN, "%s: out of memory: ", what);
     if (len >= 0 && len < FMU_ERRLEN)
-        describe_bytes(v, err + len, (size_t)(FMU_ERRLEN - len));
+        describe_bytes(v, dmi_get_N(s), dmi_get_h(s), err + len, (size_t)(FMU_ERRLEN - len));
     return -1;
 }
 
@@ -235,15 +248,34 @@ static int solver_fail(char *err, const char *what, dmi_solver *s, int rc)
  * allocates: the kernel's terms), nothing is sampled yet. */
 static int solver_create(const dmi_fmu_values *v, dmi_solver **out, char *err)
 {
-    int rc = dmi_create(out, MODEL->n, v->value[MODEL->tau], steps_per_tau(v));
-    if (rc == DMI_ENOMEM)
-        return memory_fail(err, "creating the solver", v);
-    if (rc != DMI_OK)
-        return solver_fail(err, "creating the solver (tau, N)", NULL, rc);
+    const double tau = v->value[MODEL->tau];
+    int rc;
+    if (MODEL->step) { /* the model's h: libdmi's N for it */
+        const double h = MODEL->step(v);
+        if (!isfinite(h) || !(h > 0))
+            return fail(err, "creating the solver: the model's step h = %.17g must be finite "
+                             "and > 0", h);
+        rc = dmi_create_h(out, MODEL->n, tau, h);
+        if (rc == DMI_ENOMEM)
+            return fail(err, "creating the solver: out of memory: tau = %.17g, h = %.17g: a "
+                             "history of tau / h = %.17g states", tau, h, tau / h);
+        if (rc != DMI_OK)
+            return fail(err, "creating the solver (tau = %.17g, h = %.17g): %s", tau, h,
+                        dmi_strerror(rc));
+    } else {
+        rc = dmi_create(out, MODEL->n, tau, steps_per_tau(v));
+        if (rc == DMI_ENOMEM) { /* N is the parameter: no solver to ask */
+            int len = snprintf(err, FMU_ERRLEN, "creating the solver: out of memory: ");
+            describe_bytes(v, steps_per_tau(v), 0.0, err + len, (size_t)(FMU_ERRLEN - len));
+            return -1;
+        }
+        if (rc != DMI_OK)
+            return solver_fail(err, "creating the solver (tau, N)", NULL, rc);
+    }
     char msg[FMU_ERRLEN] = "";
     if ((rc = MODEL->configure(v, *out, msg)) != 0) {
         if (rc == DMI_ENOMEM)
-            memory_fail(err, "configuring the solver", v);
+            memory_fail(err, "configuring the solver", v, *out);
         else { /* the model's message after the prefix, cut to fit */
             const char *why = msg[0] ? msg : dmi_last_error(*out);
             size_t len = strlen(strcpy(err, "configuring the solver: "));
@@ -262,7 +294,7 @@ static int solver_init(const dmi_fmu_values *v, dmi_solver *s, char *err)
 {
     int rc = dmi_init(s);
     if (rc == DMI_ENOMEM)
-        return memory_fail(err, "initialising the solver", v);
+        return memory_fail(err, "initialising the solver", v, s);
     return rc == DMI_OK ? 0 : solver_fail(err, "initialising the solver", s, rc);
 }
 
@@ -311,14 +343,14 @@ static void indicators_at(fmu_model *m, int *st)
 
 int fmu_model_start(fmu_model *m, double t_start, char *err, char *note)
 {
-    double kept, peak;
-    solver_bytes(m->v, &peak, &kept);
     note[0] = '\0';
-    if (peak > FMU_NOTE_BYTES)
-        describe_bytes(m->v, note, FMU_ERRLEN);
     dmi_solver *s = NULL;
-    if (solver_create(m->v, &s, err) != 0)
+    if (solver_create(m->v, &s, err) != 0) /* allocates the ring only */
         return -1;
+    double kept, peak; /* for libdmi's N, before dmi_init allocates the rest */
+    solver_bytes(m->v, dmi_get_N(s), &peak, &kept);
+    if (peak > FMU_NOTE_BYTES)
+        describe_bytes(m->v, dmi_get_N(s), dmi_get_h(s), note, FMU_ERRLEN);
     if (solver_init(m->v, s, err) != 0) {
         dmi_free(&s);
         return -1;
@@ -630,24 +662,33 @@ static int load_values(fmu_model *m, uint32_t version, const unsigned char *buf,
     return 0;
 }
 
-/* The solver of the saved history b (ndmi bytes) for the values of m. */
-static int load_solver(fmu_model *m, const unsigned char *b, uint64_t ndmi, char *err)
+/* The solver of the saved history b (ndmi bytes, in a state of format
+ * version) for the values of m. */
+static int load_solver(fmu_model *m, uint32_t version, const unsigned char *b, uint64_t ndmi,
+                       char *err)
 {
-    const size_t N = steps_per_tau(m->v);
     /* libdmi's state holds the N + 1 stored states U^{p-N..p} of n doubles:
-     * fewer bytes cannot be a history for this N (checked before the solver
-     * for N is allocated); then the exact size from libdmi. */
-    if (ndmi / (MODEL->n * sizeof(double)) < (uint64_t)N + 1)
+     * fewer bytes cannot be a history for this N, refused before the
+     * solver's ring for N is allocated when N is dmi_create's, the N
+     * parameter (a model's step gives libdmi's N only from the created
+     * solver: the exact size below); then the exact size from libdmi. */
+    if (!MODEL->step &&
+        ndmi / (MODEL->n * sizeof(double)) < (uint64_t)steps_per_tau(m->v) + 1)
         return fail(err, "state: the solver's history of %llu bytes is too short for %s = %zu",
-                    (unsigned long long)ndmi, name_of(MODEL->N), N);
+                    (unsigned long long)ndmi, name_of(MODEL->N), steps_per_tau(m->v));
     dmi_solver *s = NULL;
     if (solver_create(m->v, &s, err) != 0)
         return -1;
-    const size_t need = dmi_state_size(s);
+    /* format 1 (the FMU of libdmi 1.0) holds libdmi's state of format 1,
+     * which ends before the recursion's part (bytes.h) */
+    const size_t need = version == 1 ? dmi_state_at_rec(MODEL->n, dmi_get_N(s))
+                                     : dmi_state_size(s);
     if (need != ndmi) {
+        char N[96];
+        name_N(dmi_get_N(s), dmi_get_h(s), N, sizeof N);
         dmi_free(&s);
-        return fail(err, "state: the solver's history has %llu bytes, %s = %zu needs %zu",
-                    (unsigned long long)ndmi, name_of(MODEL->N), N, need);
+        return fail(err, "state: the solver's history has %llu bytes, %s needs %zu",
+                    (unsigned long long)ndmi, N, need);
     }
     int rc = solver_init(m->v, s, err);
     if (rc == 0 && (rc = dmi_state_load(s, b, (size_t)ndmi)) != DMI_OK)
@@ -698,10 +739,9 @@ int fmu_model_state_load(fmu_model *into, uint32_t tags, uint32_t solver_tags, u
     if (memcmp(buf, FMU_STATE_MAGIC, 8) != 0)
         return fail(err, "state: the bytes are not a saved state of this FMU (bad magic)");
     const uint32_t version = dmi_get_u32(buf, FMU_STATE_AT_VERSION);
-    if (version != 2 && version != FMU_STATE_VERSION)
-        return fail(err, "state: format version %lu is not supported (this FMU reads versions 2 "
-                         "and %d%s)", (unsigned long)version, FMU_STATE_VERSION,
-                    version == 1 ? "; version 1 was written by the FMU of libdmi 1.0" : "");
+    if (version < 1 || version > FMU_STATE_VERSION)
+        return fail(err, "state: format version %lu is not supported (this FMU reads versions 1 "
+                         "to %d)", (unsigned long)version, FMU_STATE_VERSION);
     const size_t AT_DMI = at_dmi(version), AT_REAL = at_real(version);
     if (size < AT_DMI + 8)
         return fail(err, "state: %zu bytes is too short for a saved state", size);
@@ -741,7 +781,7 @@ int fmu_model_state_load(fmu_model *into, uint32_t tags, uint32_t solver_tags, u
         goto refused;
     }
     if (has_solver) {
-        if (load_solver(&m, buf + AT_DMI, ndmi, err) != 0)
+        if (load_solver(&m, version, buf + AT_DMI, ndmi, err) != 0)
             goto refused;
     } else if (t_comm != t_start) { /* before initialization: no step taken */
         fail(err, "state: invalid times (start %.17g, communication point %.17g)", t_start,

@@ -143,8 +143,10 @@ int fmu_model_do_step(fmu_model *m, double t_current, double step, fmu_stop_fn *
  * the FNV-1a 64 (src/bytes.h) of all bytes before it.  States are saved in
  * format 3; format 2 (the FMUs of libdmi 1.1, without identity and events:
  * the oscillator FMU's layout, with its one integer parameter N) still
- * restores.  A state of format 3 of another model (name or hash) is refused
- * with both models' names.
+ * restores, and so does format 1 (the FMU of libdmi 1.0: format 2's layout,
+ * holding libdmi's state of format 1, without the recursion's sums, which
+ * libdmi rebuilds from the stored states).  A state of format 3 of another
+ * model (name or hash) is refused with both models' names.
  */
 #define FMU_STATE_MAGIC "dmiFMUst"
 enum {

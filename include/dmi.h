@@ -370,13 +370,16 @@ DMI_API int dmi_get_step_terms(const dmi_solver *s, double *W, double *X);
  * The state is the step counter, the N + 1 stored states U^{p-N..p}, the
  * last step's terms and, for a kernel set by dmi_set_kernel_exp, the
  * recursion's sums (so its size depends on that kernel; format version 2
- * since libdmi 1.1: states of libdmi 1.0, version 1, are refused with
- * DMI_EINVAL and a message naming that version and libdmi 1.0, whatever
- * their size); it does not include the callbacks, the resolvent choice,
+ * since libdmi 1.1); it does not include the callbacks, the resolvent choice,
  * the convolution method or the kernel (these stay as set on the solver that
  * loads it).  A solver of dmi_create_h whose h is not tau / N writes format
  * version 3 (since libdmi 1.2: version 2 and h, 8 bytes more); every other
- * solver still writes version 2.  The bytes
+ * solver still writes version 2.  dmi_state_load reads versions 1, 2 and 3:
+ * version 1, written by libdmi 1.0 (version 2 without the recursion's sums,
+ * refused by libdmi 1.1), loads since libdmi 1.2 into a solver whose h is
+ * tau / N, and the sums of an exponential kernel's recursion are then
+ * anchored afresh from the stored states (as for a state of another method;
+ * stepping on agrees with the saving run to rounding).  The bytes
  * are native-endian, begin with a magic and a format version, and are
  * checked on load: a state saved by a solver with other n, N, tau or h, or a
  * truncated or corrupted buffer, is rejected with DMI_EINVAL and the solver
@@ -391,7 +394,9 @@ DMI_API size_t dmi_state_size(const dmi_solver *s);
 DMI_API int dmi_state_save(const dmi_solver *s, void *buf, size_t size);
 
 /* Restores a state written by dmi_state_save; size must equal
- * dmi_state_size(s).  Requires dmi_init to have run (the kernel samples come
+ * dmi_state_size(s) (for a state of format version 1, of libdmi 1.0: the
+ * size that version had, dmi_state_size(s) less the recursion's part of 24
+ * bytes and its sums; the error message says which size it expected).  Requires dmi_init to have run (the kernel samples come
  * from it).  DMI_EINVAL for bad bytes or another size, DMI_ESTATE before
  * dmi_init, DMI_ENOMEM; the solver is unchanged on error.  Stepping on from a
  * restored state gives bitwise the same results as the saving solver if both

@@ -12,7 +12,7 @@
  *
  * The framework owns everything else, for every model: the FMI 2.0 and 3.0
  * functions and their calling sequence; the time grid t_p = t_start + p h
- * (h = tau / N) from an integer step counter; a doStep takes every step whose
+ * (h = tau / N, or the model's step) from an integer step counter; a doStep takes every step whose
  * start t_p is before the end of the communication step; the outputs are
  * computed at any communication point from the piecewise-linear interpolant
  * of the scheme; inputs are held per step (step p uses the values set at or
@@ -113,7 +113,7 @@ struct dmi_fmu_values {
 /*
  * The outputs' arguments at a communication point t (the FMU's time), in
  * step p (from t_{p-1} to t_p, t_{p-1} < t <= t_p; p = 0 before the first
- * step): t; h = tau / N; p; n, the solver's dimension; u = u_h(t), the
+ * step): t; h, the solver's step (tau / N, or the model's step); p; n, the solver's dimension; u = u_h(t), the
  * scheme's piecewise-linear interpolant, NULL before ExitInitializationMode
  * (no solver yet: give the outputs from the parameters); U = U^p; W, the
  * delay term of step p (zeros when p = 0); X, the resolvent's argument of
@@ -135,7 +135,8 @@ struct dmi_fmu_point {
 
 /*
  * Configures the new solver s, created by the framework with dmi_create(s,
- * model n, tau, N) from the parameters: sets rhs, the maximal monotone part
+ * model n, tau, N) from the parameters (dmi_create_h(s, n, tau, h) for a
+ * model with a step function): sets rhs, the maximal monotone part
  * (dmi_set_friction, dmi_set_box or dmi_set_resolvent), the kernel
  * (dmi_set_kernel_exp or dmi_set_kernel) and the history, with v as user
  * data if the callbacks need the variables.  The framework calls dmi_init
@@ -213,6 +214,24 @@ static inline int dmi_fmu_contact(const dmi_fmu_point *pt, size_t i, double lo_i
 }
 
 /*
+ * Optional (since libdmi 1.2): the step h of the solver from the parameters
+ * (e.g. 2 pi / (omega steps) for a whole number of steps per forcing period),
+ * in the units of the FMU's time; tau / h need not be an integer.  With it,
+ * the framework creates the solver with dmi_create_h(s, n, tau, h) (the last
+ * cell of the delay sum partial, weighted as dmi.h says) instead of
+ * dmi_create(s, n, tau, N); the solver's N, the number of cells of the delay
+ * sum, is then libdmi's (dmi_get_N: ceil(tau / h), or tau / h when h is
+ * tau / N exactly), and it is that N the memory messages and the saved
+ * states' checks use.  The model's N variable stays an Int32 parameter >= 1
+ * that the model may read here (e.g. the steps per period).  Called at
+ * ExitInitializationMode and when a state with a solver is restored, with
+ * the values the solver is made for; an h that is not finite and > 0 (or
+ * not a normal double) refuses them with a logged error ("creating the
+ * solver: ...").  Without it (NULL), h = tau / N.
+ */
+typedef double (*dmi_fmu_step_fn)(const dmi_fmu_values *v);
+
+/*
  * A model: what dmi_add_fmu builds an FMU of.  Fields: description (the
  * model descriptions', with " (libdmi <version>)" appended); variables and
  * nvariables (the table, value reference = index); n (the components of u);
@@ -222,7 +241,8 @@ static inline int dmi_fmu_contact(const dmi_fmu_point *pt, size_t i, double lo_i
  * accept, check and bytes (optional: NULL for none; without bytes, the
  * figures of a dense kernel); author (the model descriptions' author, NULL
  * for none); nindicators and indicators (optional: 0 and NULL for none; see
- * dmi_fmu_indicators_fn).  The model descriptions' generator checks it at build time (a
+ * dmi_fmu_indicators_fn); step (optional, the last field: NULL for
+ * h = tau / N; see dmi_fmu_step_fn).  The model descriptions' generator checks it at build time (a
  * table as described above, tau and N as said, n >= 1, configure and
  * outputs given).
  */
@@ -242,6 +262,8 @@ struct dmi_fmu_model {
     const char *author;
     size_t nindicators;
     dmi_fmu_indicators_fn indicators;
+    /* (Since libdmi 1.2.)  Optional, NULL for none: see dmi_fmu_step_fn. */
+    dmi_fmu_step_fn step;
 };
 
 /* The model of the FMU: define it once, in one of its C files:

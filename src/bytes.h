@@ -70,7 +70,8 @@ DMI_BYTES_AT(double, double)
  * Native endian.  A header of 8 uint64 words at the byte offsets below:
  *   magic, version, n, N, bits of tau, p, p != 0 (a step was taken), checksum;
  * then (N + 1) n doubles U_j^{p-lag}, lag = 0..N (lag-major), n doubles W^{p-1},
- * n doubles X^{p-1}; then (version 2, libdmi 1.1) the recursion's part:
+ * n doubles X^{p-1}: that is all of version 1 (libdmi 1.0), whose checksum
+ * is the same; then (version 2, libdmi 1.1) the recursion's part:
  * 3 uint64 words
  *   E = 2 dmi_expk_sums (0 without an exponential kernel),
  *   1 if the sums are those of a running recursion (else 0 and zeros),
@@ -82,6 +83,7 @@ DMI_BYTES_AT(double, double)
  * checksum = dmi_fnv1a_skip(state, size, DMI_STATE_AT_CHECKSUM).
  */
 #define DMI_STATE_MAGIC UINT64_C(0x444d495354415445) /* "DMISTATE" */
+#define DMI_STATE_VERSION_1 UINT64_C(1) /* read only */
 #define DMI_STATE_VERSION UINT64_C(2)
 #define DMI_STATE_VERSION_H UINT64_C(3)
 enum { DMI_STATE_H_BYTES = 8 };

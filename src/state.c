@@ -82,25 +82,26 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
     if (dmi_get_u64(b, DMI_STATE_AT_MAGIC) != DMI_STATE_MAGIC)
         return dmi_fail(s, DMI_EINVAL, "dmi_state_load: not a dmi state (bad magic)");
     const uint64_t version = dmi_get_u64(b, DMI_STATE_AT_VERSION);
-    if (version == 1)
-        return dmi_fail(s, DMI_EINVAL, "dmi_state_load: state format version 1, written by libdmi "
-                                       "1.0; this libdmi reads versions 2 and 3 only (save the "
-                                       "state again with it)");
-    if (version != DMI_STATE_VERSION && version != DMI_STATE_VERSION_H)
+    if (version != DMI_STATE_VERSION_1 && version != DMI_STATE_VERSION &&
+        version != DMI_STATE_VERSION_H)
         return dmi_fail(s, DMI_EINVAL, "dmi_state_load: state format version %llu; this libdmi "
-                                       "reads versions 2 and 3 only", (unsigned long long)version);
-    /* version 2: h = tau / N; version 3: h is its last word */
-    if (version != state_version(s) && version == DMI_STATE_VERSION)
+                                       "reads versions 1, 2 and 3 only",
+                        (unsigned long long)version);
+    /* versions 1 and 2: h = tau / N; version 3: h is its last word */
+    if (version != DMI_STATE_VERSION_H && state_version(s) == DMI_STATE_VERSION_H)
         return dmi_fail(s, DMI_EINVAL, "dmi_state_load: state of a solver with h = tau / N; this "
                                        "one has h = %.17g, not tau / N = %.17g (dmi_create_h)",
                         s->h, s->tau / (double)s->N);
-    if (version != state_version(s))
+    if (version == DMI_STATE_VERSION_H && state_version(s) != DMI_STATE_VERSION_H)
         return dmi_fail(s, DMI_EINVAL, "dmi_state_load: state of a solver with h = %.17g, not "
                                        "tau / N (dmi_create_h); this one has h = tau / N = %.17g",
                         dmi_get_double(b, size - DMI_STATE_H_BYTES), s->h);
-    if (size != need)
-        return dmi_fail(s, DMI_EINVAL, "dmi_state_load: %zu bytes, this solver's state has %zu",
-                        size, need);
+    /* version 1 (libdmi 1.0) has no recursion's part: its bytes end before it */
+    const int v1 = version == DMI_STATE_VERSION_1;
+    const size_t have = v1 ? dmi_state_at_rec(n, N) : need;
+    if (size != have)
+        return dmi_fail(s, DMI_EINVAL, "dmi_state_load: %zu bytes, this solver's state has %zu%s",
+                        size, have, v1 ? " in format version 1" : "");
     const uint64_t hn = dmi_get_u64(b, DMI_STATE_AT_n), hN = dmi_get_u64(b, DMI_STATE_AT_N);
     const uint64_t p = dmi_get_u64(b, DMI_STATE_AT_P);
     const uint64_t stepped = dmi_get_u64(b, DMI_STATE_AT_STEPPED);
@@ -117,16 +118,16 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
                                            "one has h = %.17g (n = %zu, N = %zu, tau = %g)",
                             h, s->h, n, N, s->tau);
     }
-    if (dmi_get_u64(b, DMI_STATE_AT_CHECKSUM) != dmi_fnv1a_skip(b, need, DMI_STATE_AT_CHECKSUM))
+    if (dmi_get_u64(b, DMI_STATE_AT_CHECKSUM) != dmi_fnv1a_skip(b, have, DMI_STATE_AT_CHECKSUM))
         return dmi_fail(s, DMI_EINVAL, "dmi_state_load: corrupted state (checksum mismatch)");
     if (stepped != (uint64_t)(p != 0))
         return dmi_fail(s, DMI_EINVAL, "dmi_state_load: corrupted state (step flag %llu at p = "
                                        "%llu)", (unsigned long long)stepped,
                         (unsigned long long)p);
-    const size_t E = state_sums(s), nd = (N + 3) * n + E;
-    const unsigned char *rec = b + dmi_state_at_rec(n, N);
-    const uint64_t rec_E = dmi_get_u64(rec, DMI_STATE_REC_E);
-    const uint64_t running = dmi_get_u64(rec, DMI_STATE_REC_RUNNING);
+    const size_t E = v1 ? 0 : state_sums(s), nd = (N + 3) * n + E;
+    const unsigned char *rec = b + dmi_state_at_rec(n, N); /* version 1: its end */
+    const uint64_t rec_E = v1 ? 0 : dmi_get_u64(rec, DMI_STATE_REC_E);
+    const uint64_t running = v1 ? 0 : dmi_get_u64(rec, DMI_STATE_REC_RUNNING);
     if (rec_E != E || running > 1)
         return dmi_fail(s, DMI_EINVAL, "dmi_state_load: corrupted state (recursion words %llu, "
                                        "%llu; this solver has %zu sums)",
@@ -136,7 +137,8 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
     if (!d)
         return dmi_fail(s, DMI_ENOMEM, "dmi_state_load: out of memory");
     memcpy(d, b + dmi_state_at_double(n, 0, 0), (nd - E) * sizeof *d);
-    memcpy(d + nd - E, rec + DMI_STATE_REC_BYTES, E * sizeof *d);
+    if (E)
+        memcpy(d + nd - E, rec + DMI_STATE_REC_BYTES, E * sizeof *d);
     /* The states, W and X of a committed step are finite.  The recursion's
      * sums need not be: a finite but huge history can overflow them, and the
      * next step then fails with DMI_ENONFINITE; they are restored as saved,
@@ -158,7 +160,8 @@ int dmi_state_load(dmi_solver *s, const void *buf, size_t size)
     memcpy(s->last_X, d + (N + 2) * n, n * sizeof *d);
     s->p = p;
     /* The sums of the same recursion continue bitwise; any others (a state
-     * of another method or kernel) are anchored afresh from the states, and
+     * of another method or kernel, or of version 1, which has none) are
+     * anchored afresh from the states, and
      * the FFT engine is rebuilt from them (s->rec and s->conv are never both
      * set). */
     if (s->rec && running == 1 &&

@@ -5,6 +5,7 @@
  * DMI_EINVAL and leave the solver unchanged.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -211,6 +212,150 @@ static void test_refused(void)
     dmi_free(&t);
 }
 
+/* The state of s (n components, N steps per tau, delay tau; initialised)
+ * in format version 1, as libdmi 1.0 wrote it (src/dmi.c of the 1.0.0
+ * release, 5cd99de; written here from that layout, not with bytes.h): 8
+ * uint64 words magic "DMISTATE", 1, n, N, bits of tau, p, p != 0, FNV-1a 64
+ * of all bytes with this word zero; then (N + 1) n doubles U_j^{p-lag}
+ * (lag-major), n doubles W^{p-1}, n doubles X^{p-1} (zeros before a step).
+ * Caller frees; NULL on failure. */
+static unsigned char *state_v1(const dmi_solver *s, size_t n, size_t N, double tau,
+                               size_t *size)
+{
+    uint64_t w[8] = {UINT64_C(0x444d495354415445), 1, n, N, 0, 0, 0, 0};
+    memcpy(&w[4], &tau, sizeof tau);
+    const size_t nd = (N + 3) * n;
+    double *d = calloc(nd, sizeof *d);
+    unsigned char *b = malloc(sizeof w + nd * sizeof *d);
+    int ok = d && b && dmi_get_step_index(s, &w[5]) == DMI_OK;
+    w[6] = w[5] != 0;
+    for (size_t lag = 0; ok && lag <= N; lag++)
+        ok = dmi_get_past(s, lag, d + lag * n) == DMI_OK;
+    if (ok && w[5] > 0)
+        ok = dmi_get_step_terms(s, d + (N + 1) * n, d + (N + 2) * n) == DMI_OK;
+    if (!ok) {
+        free(d);
+        free(b);
+        return NULL;
+    }
+    *size = sizeof w + nd * sizeof *d;
+    memcpy(b, w, sizeof w);
+    memcpy(b + sizeof w, d, nd * sizeof *d);
+    uint64_t hsh = UINT64_C(0xcbf29ce484222325);
+    for (size_t i = 0; i < *size; i++) {
+        hsh ^= b[i];
+        hsh *= UINT64_C(0x100000001b3);
+    }
+    memcpy(b + 7 * sizeof(uint64_t), &hsh, sizeof hsh);
+    free(d);
+    return b;
+}
+
+/* The model's solver with its kernel replaced by the exponential kernel
+ * H(s) = [[exp(-s), 0.3], [0.5 cos(2 pi s), -0.2 exp(-3 s) cos(5 s)]] (summed
+ * by the recursion), N = 16, initialised; NULL on failure. */
+static dmi_solver *exp_solver(core_model *m)
+{
+    const double a[3] = {-1.0, 0.0, -3.0}, b[3] = {0.0, 6.283185307179586, 5.0};
+    const double C[3 * 4] = {1.0, 0.3, 0, 0, /**/ 0, 0, 0.5, 0, /**/ 0, 0, 0, -0.2};
+    dmi_solver *s = NULL;
+    if (dmi_create(&s, 2, 1.0, N) != DMI_OK)
+        return NULL;
+    if (core_model_setup(s, m) != DMI_OK || dmi_set_kernel_exp(s, 3, a, b, C, NULL) != DMI_OK ||
+        dmi_init(s) != DMI_OK)
+        dmi_free(&s);
+    return s;
+}
+
+/* A state of libdmi 1.0 (format version 1, no recursion sums), built from
+ * that layout, loads since libdmi 1.2 (into a solver ahead, behind, or never
+ * stepped) and the run goes on as the saving solver's: bitwise with the
+ * model's callback kernel (the direct sum from the same stored states); with
+ * an exponential kernel, whose recursion sums are rebuilt from the stored
+ * states, to 1e-13 of the states' magnitude (rounding).  A version-1 state
+ * with a byte changed, of another size, or loaded into a solver whose h is
+ * not tau / N is refused, the solver unchanged. */
+static void test_version_1(void)
+{
+    core_model ma = {0}, mb = {0}, mc = {0};
+    dmi_solver *a = model_after(&ma, SAVED_AT), *b = model_after(&mb, 5), *c = model_after(&mc, 0);
+    CU_ASSERT_FATAL(a && b && c);
+    size_t size, size_b;
+    unsigned char *v1 = state_v1(a, 2, N, 1.0, &size), *before_b = core_save(b, &size_b);
+    CU_ASSERT_FATAL(v1 && before_b);
+    CU_ASSERT_EQUAL(size, dmi_state_size(a) - DMI_STATE_REC_BYTES); /* no sums either way */
+
+    unsigned char *bad = malloc(size + DMI_STATE_REC_BYTES);
+    CU_ASSERT_FATAL(bad != NULL);
+    memcpy(bad, v1, size);
+    bad[size / 2] ^= 0x01;
+    CU_ASSERT(refused(b, bad, size, before_b, size_b));
+    memcpy(bad, v1, size);
+    memset(bad + size, 0, DMI_STATE_REC_BYTES);
+    CU_ASSERT(refused(b, bad, size - 8, before_b, size_b));
+    CU_ASSERT(refused(b, bad, size + DMI_STATE_REC_BYTES, before_b, size_b));
+    dmi_solver *h = NULL; /* h = 1/15.5: not tau / N, N = 16 cells */
+    CU_ASSERT_EQUAL_FATAL(dmi_create_h(&h, 2, 1.0, 1.0 / 15.5), DMI_OK);
+    CU_ASSERT_EQUAL_FATAL(core_model_setup(h, &mc), DMI_OK);
+    CU_ASSERT_EQUAL_FATAL(dmi_init(h), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_get_N(h), N);
+    size_t size_h;
+    unsigned char *before_h = core_save(h, &size_h);
+    CU_ASSERT(refused(h, v1, size, before_h, size_h));
+
+    CU_ASSERT_EQUAL(dmi_state_load(b, v1, size), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_state_load(c, v1, size), DMI_OK);
+    uint64_t p = 0;
+    CU_ASSERT_EQUAL(dmi_get_step_index(b, &p), DMI_OK);
+    CU_ASSERT_EQUAL(p, SAVED_AT);
+    CU_ASSERT(core_same_state(a, b)); /* the version-2 bytes of the same state */
+    CU_ASSERT_EQUAL(dmi_advance(a, MORE), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_advance(b, MORE), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_advance(c, MORE), DMI_OK);
+    CU_ASSERT(core_same_state(a, b));
+    CU_ASSERT(core_same_state(a, c));
+
+    /* the exponential kernel: the recursion's sums rebuilt */
+    core_model me = {0}, mf = {0};
+    dmi_solver *e = exp_solver(&me), *f = exp_solver(&mf);
+    CU_ASSERT_FATAL(e && f);
+    CU_ASSERT_EQUAL(dmi_advance(e, SAVED_AT), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_advance(f, 5), DMI_OK);
+    size_t size_e;
+    unsigned char *v1e = state_v1(e, 2, N, 1.0, &size_e);
+    CU_ASSERT_FATAL(v1e != NULL);
+    CU_ASSERT_EQUAL(size_e, dmi_state_at_rec(2, N));
+    CU_ASSERT(size_e < dmi_state_size(e)); /* version 2 holds the sums */
+    CU_ASSERT_EQUAL(dmi_state_load(f, v1e, size_e), DMI_OK);
+    double worst = 0, scale = 0;
+    for (size_t k = 0; k < MORE; k++) {
+        double ue[2], uf[2];
+        CU_ASSERT_EQUAL(dmi_step(e), DMI_OK);
+        CU_ASSERT_EQUAL(dmi_step(f), DMI_OK);
+        CU_ASSERT(dmi_get_state(e, ue) == DMI_OK && dmi_get_state(f, uf) == DMI_OK);
+        for (int j = 0; j < 2; j++) {
+            worst = fmax(worst, fabs(ue[j] - uf[j]));
+            scale = fmax(scale, fabs(ue[j]));
+        }
+    }
+    if (!(worst <= 1e-13 * scale))
+        printf("\n  exponential kernel from a version-1 state: |U - U_saving| = %g, |U| = %g",
+               worst, scale);
+    CU_ASSERT(scale > 0.1 && worst <= 1e-13 * scale);
+
+    free(v1e);
+    free(before_h);
+    free(bad);
+    free(before_b);
+    free(v1);
+    dmi_free(&h);
+    dmi_free(&a);
+    dmi_free(&b);
+    dmi_free(&c);
+    dmi_free(&e);
+    dmi_free(&f);
+}
+
 /* bytes.h, the one description of the state's bytes (libdmi, the FMU and the
  * tests use it): its FNV-1a against the published test vectors, and a saved
  * state read at its offsets against what the solver's queries return. */
@@ -295,6 +440,8 @@ int main(int argc, char **argv)
         {"other n/N/tau, truncated, corrupted, bad magic: refused, solver unchanged",
          test_refused},
         {"the layout of bytes.h: FNV-1a vectors, the saved bytes at its offsets", test_layout},
+        {"a state of libdmi 1.0 (format version 1) loads and steps on as the saving run",
+         test_version_1},
         {NULL, NULL}};
     return core_main(argc, argv, "core: state save and load", tests);
 }

@@ -302,7 +302,7 @@ CALL(t_empty, fmi2Status r = fmi2Fatal; size_t n; unsigned char *b = fmu_snapsho
      if (b) r = restore(x, b, 0); free(b); return r;)
 CALL(t_long1, return restore_edited(x, E_NONE, 0, 0, 1, 0);)
 CALL(t_magic, return restore_edited(x, E_XOR, 2, 0, 0, 0);) /* a byte of the magic (0-7) */
-CALL(t_version, return restore_edited(x, E_U32, MODEL_STATE_AT_VERSION, 1, 0, 1);)
+CALL(t_version, return restore_edited(x, E_U32, MODEL_STATE_AT_VERSION, 4, 0, 1);)
 CALL(t_tag0, return restore_edited(x, E_U32, MODEL_STATE_AT_TAG, 0, 0, 1);)
 CALL(t_tag_error, return restore_edited(x, E_U32, MODEL_STATE_AT_TAG, 16, 0, 1);)
 CALL(t_tag_two, return restore_edited(x, E_U32, MODEL_STATE_AT_TAG, 6, 0, 1);)
@@ -430,7 +430,7 @@ static const bad_case cases[] = {
     {"F88", "fmi2DeSerializeFMUstate", "size = 0", F_INIT, t_empty, "too short", 0},
     {"F89", "fmi2DeSerializeFMUstate", "one byte too many", F_STEP, t_long1, "state", 0},
     {"F90", "fmi2DeSerializeFMUstate", "magic altered", F_STEP, t_magic, "magic", 0},
-    {"F91", "fmi2DeSerializeFMUstate", "format version 1 of libdmi 1.0's FMU (checksums valid)", F_STEP, t_version, "version", 0},
+    {"F91", "fmi2DeSerializeFMUstate", "format version 4, unknown (checksums valid)", F_STEP, t_version, "version", 0},
     {"F92", "fmi2DeSerializeFMUstate", "phase tag 0 (checksums valid)", F_STEP, t_tag0, "tag", 0},
     {"F93", "fmi2DeSerializeFMUstate", "phase tag = the error state (checksums valid)", F_STEP, t_tag_error, "tag", 0},
     {"F94", "fmi2DeSerializeFMUstate", "phase tag with two bits (checksums valid)", F_INIT, t_tag_two, "tag", 0},
