@@ -41,7 +41,7 @@ import numpy as np
 import scipy.sparse.linalg as sla
 
 from .floquet import monodromy_operator, ritz
-from .shooting import (Model, Orbit, ShootingError, StepMap, build, newton,
+from .shooting import (Model, Orbit, ShootingError, StepMap, bordered_step, build, newton,
                        periodic_orbit, stuck_mask)
 
 
@@ -281,7 +281,7 @@ class _Maps:
             if s.N + 1 > self.rows:
                 raise ShootingError(f"make(p = {p!r}) has N = {s.N}: the branch's states hold "
                                     f"{self.rows} rows (N + 1 at the ends of its range, + 2 %)", [])
-            F = StepMap(self.make, p, self.M, self.rows)
+            F = StepMap(self.make, p, self.M, self.rows, solver=s)
             if len(self._cache) > 4:
                 self._cache.pop(next(iter(self._cache)))
             self._cache[p] = F
@@ -313,20 +313,10 @@ def _corrector(maps: _Maps, z: np.ndarray, t: np.ndarray, tol: float, max_iter: 
             break
         dp = 1e-7 * max(1.0, abs(p))
         Fp = (maps(p + dp)(x) - Fx) / dp
-        eps = math.sqrt(np.finfo(float).eps) * scale
-
-        def mv(v: np.ndarray, x: np.ndarray = x, Fx: np.ndarray = Fx, F: StepMap = F,
-               Fp: np.ndarray = Fp) -> np.ndarray:
-            vx, vp = v[:-1], v[-1]
-            nv = float(np.linalg.norm(vx))
-            DF = (F(x + (eps / nv) * vx) - Fx) * (nv / eps) if nv > 0 else 0.0 * vx
-            return np.concatenate([DF - vx + Fp * vp, [np.dot(w * t, v)]])
-
-        J = sla.LinearOperator((z.size, z.size), matvec=mv, dtype=float)
-        rhs = -np.concatenate([r, [g]])
-        dz, _ = sla.gmres(J, rhs, rtol=1e-6, atol=0.0, restart=min(z.size, 60), maxiter=4)
-        if not np.all(np.isfinite(dz)):
-            break
+        dz, lin = bordered_step(F, x, Fx, Fp, w * t, g, rtol=1e-6)
+        if lin > 1e-2:
+            raise ShootingError(f"the bordered Jacobian is singular at p = {p!r} (GMRES "
+                                f"relative residual {lin:.2g})", [rn])
         z = z + dz
         d = z - zp
         if math.sqrt(float(np.dot(w * d, d))) > ds:
