@@ -94,7 +94,7 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
         if not math.isfinite(rn):
             raise ShootingError(f"{what}: non-finite residual (residuals {_fmt(res)})", res)
         if rn <= tol * scale and abs(g) <= tol * scale:
-            return make_orbit(Fm, x, res, multipliers)
+            return _without_phase(make_orbit(Fm, x, res, multipliers))
         if len(res) > max_iter:
             break
         dh = 1e-7 * h
@@ -109,3 +109,14 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
         x, h = x + dz[:-1], h + float(dz[-1])
     raise ShootingError(f"{what}: no convergence in {max_iter} Newton iterations (residuals "
                         f"{_fmt(res)})", res)
+
+
+def _without_phase(o: Orbit) -> Orbit:
+    """An autonomous orbit always has the multiplier 1 (a shift along the orbit, the phase):
+    ``stable`` is judged on the other multipliers (the one nearest 1 left out; False if no other
+    was computed).  ``multipliers`` keeps them all."""
+    mu = o.multipliers
+    if mu.size:
+        rest = np.delete(mu, int(np.argmin(np.abs(mu - 1))))
+        o.stable = bool(rest.size and np.all(np.abs(rest) < 1))
+    return o

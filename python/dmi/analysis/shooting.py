@@ -266,7 +266,8 @@ class Orbit:
     ``p``: the parameter; ``period`` = ``steps`` h (time units); ``h``: the step; ``t`` (M + 1,)
     and ``u`` (M + 1, n): one period of U from t = 0; ``state``: the shooting state (L n values,
     rows oldest first, the last at t = 0); ``multipliers``: the leading Floquet multipliers,
-    largest |mu| first; ``stable``: all |mu| < 1; ``stick_fraction`` (n,): the fraction of the M
+    largest |mu| first; ``stable``: all |mu| < 1 (an autonomous orbit: all but
+    its phase's multiplier 1); ``stick_fraction`` (n,): the fraction of the M
     steps where component i is stuck (:func:`stuck_mask`: U_i == 0 exactly after the friction
     resolvent, for 2 steps or more);
     ``iterations``: Newton iterations; ``residual``: the final |F(x) - x|_inf (state units)."""
