@@ -30,6 +30,9 @@ def test_parameter_out_of_range(dh):
     with pytest.raises(ValueError, match=r"make\(p = 20\.0\) failed: .*forcing scale"):
         periodic_orbit(dh.make_for(400), 20.0, dh.T, [1.0, 0.0])
     o = periodic_orbit(dh.make_for(400), 1.0, dh.T, [1.0, 0.0], multipliers=0)
+    for bad in (float("nan"), 1.0):   # (nan: it ran to max_points, never reaching p_end)
+        with pytest.raises(ValueError, match="p_end = .*must be finite and differ"):
+            continue_orbit(o, bad, step=0.5, multipliers=0)
     b = continue_orbit(o, 12.0, step=4.0, multipliers=0, max_step=8.0)  # make refuses p > 10
     assert all(q.p <= 10 for q in b.points) and "failed" in b.status, b.status
 

@@ -341,6 +341,11 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     step ends the branch with that ``status``, it does not raise."""
     if not (math.isfinite(step) and step > 0):
         raise ValueError(f"step = {step!r}: must be finite and > 0 (p units)")
+    if not math.isfinite(p_end) or p_end == orbit.p:
+        raise ValueError(f"p_end = {p_end!r}: must be finite and differ from the orbit's "
+                         f"p = {orbit.p!r}")
+    if max_points < 2:
+        raise ValueError(f"max_points = {max_points!r}: must be >= 2")
     direction = 1.0 if p_end >= orbit.p else -1.0
     min_step = step / 1000 if min_step is None else min_step
     max_step = 4 * step if max_step is None else max_step
