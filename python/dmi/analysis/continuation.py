@@ -95,10 +95,12 @@ class Branch:
 
     @property
     def p(self) -> np.ndarray:
+        """The points' parameters p, in the order continued."""
         return np.array([q.p for q in self.points])
 
     @property
     def stable(self) -> np.ndarray:
+        """The points' ``stable`` flags (booleans)."""
         return np.array([q.stable for q in self.points])
 
     def column(self, name: str) -> np.ndarray:
@@ -330,9 +332,10 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                    min_step: float | None = None, max_step: float | None = None,
                    multipliers: int = 6, tol: float = 1e-10, max_iter: int = 8,
                    sections: int = 1, margins: bool = True) -> Branch:
-    """Continues ``orbit`` (from :func:`periodic_orbit`) in p towards ``p_end`` by
-    pseudo-arclength with initial step ``step`` (p units; ``min_step`` default step / 1000,
-    ``max_step`` default 4 step).  Every point gets ``multipliers`` Floquet multipliers and a
+    """Continues ``orbit`` (from :func:`periodic_orbit`) in p towards ``p_end`` (finite, not
+    orbit.p) by pseudo-arclength with initial step ``step`` (the first point at p + step, p units;
+    then arclengths in the norm sqrt(|dx|^2 / dim + dp^2), p and RMS state units; ``min_step``
+    default step / 1000, ``max_step`` default 4 step).  Every point gets ``multipliers`` Floquet multipliers and a
     stick profile; events are detected between consecutive points (see the module).
     ``sections``: the orbit spans this many forcing periods (a period-doubled branch: 2), for
     ``BranchPoint.section``.  ``margins=False`` skips the margins (NaN), which cost one period
