@@ -47,16 +47,20 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
             from e
     rows = max(s0.N + 1, math.ceil(s0.tau / (0.8 * h0)) + 1)
     cache: dict[float, StepMap] = {}
+    res: list[float] = []   # the Newton residuals, also in the errors of F(h)
 
     def F(h: float) -> StepMap:
         if h not in cache:
             if not (h > 0.5 * h0):
                 raise ShootingError(f"autonomous orbit at p = {p!r}: the step went to h = {h!r}, "
-                                    f"below half the guess's {h0!r}: no orbit near the guess", [])
+                                    f"below half the guess's {h0!r} after {len(res)} Newton "
+                                    f"iterations (residuals {_fmt(res)}): no orbit near the "
+                                    "guess", res)
             m = StepMap(_with_h(make, h), p, M, rows)
             if m.N + 1 > rows:
-                raise ShootingError(f"the step fell to h = {h!r}: N + 1 = {m.N + 1} > {rows} rows",
-                                    [])
+                raise ShootingError(f"autonomous orbit at p = {p!r}: the step fell to h = {h!r}: "
+                                    f"N + 1 = {m.N + 1} > {rows} rows (residuals {_fmt(res)})",
+                                    res)
             if len(cache) > 3:
                 cache.pop(next(iter(cache)))
             cache[h] = m
@@ -81,7 +85,6 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
     xdot = xdot / np.linalg.norm(xdot)
     ref = x0[-n:].copy()
     x, h = x0.copy(), h0
-    res: list[float] = []
     what = f"autonomous orbit at p = {p!r}, M = {M} steps, guess period {P0!r}"
     for _ in range(max_iter + 1):
         Fm = F(h)
