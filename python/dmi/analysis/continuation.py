@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse.linalg as sla
 
+from .._errors import Error
 from .floquet import monodromy_operator, ritz
 from .shooting import (Model, Orbit, ShootingError, StepMap, bordered_step, build, newton,
                        periodic_orbit, stuck_mask)
@@ -253,7 +254,7 @@ def _locate_stick(maps: _Maps, a: BranchPoint, b: BranchPoint, e: Event, tol: fl
             if F.dim != k:
                 return e
             xm, _ = newton(F, 0.5 * (xa + xb), tol=tol, max_iter=12, what=f"locating at {pm!r}")
-        except (ShootingError, ValueError):
+        except (ShootingError, ValueError, Error):
             return e
         st, ph, _ = _stick_profile(F, xm, margins=False)
         if key((st[i], ph[i])) == ka:
@@ -408,7 +409,7 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
             try:
                 zn, its = _corrector(maps, zp, t, tol, max_iter, ds)
                 break
-            except (ShootingError, ValueError) as e:
+            except (ShootingError, ValueError, Error) as e:   # Error: the map failed there
                 ds /= 2
                 if ds < min_step:
                     status = f"corrector failed at the smallest step {min_step!r} near p = " \
