@@ -28,6 +28,9 @@ def test_belt_period_order1_stick_and_multipliers():
         hs.append(o.h)
         assert o.stick_fraction[1] == pytest.approx(b.t_stick / b.T, abs=0.01)
         assert np.sort(np.abs(o.multipliers)) == pytest.approx([0.0, 1.0], abs=2e-3)
+        # stable: the stick forgets (multiplier 0); the phase's multiplier 1 (computed 1.0002)
+        # does not count
+        assert o.stable
     slope = np.log(errs[0] / errs[1]) / np.log(hs[0] / hs[1])
     assert 0.9 <= slope <= 1.1 and errs[1] < 0.01, (errs, slope)
 

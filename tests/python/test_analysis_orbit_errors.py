@@ -30,8 +30,25 @@ def test_parameter_out_of_range(dh):
     with pytest.raises(ValueError, match=r"make\(p = 20\.0\) failed: .*forcing scale"):
         periodic_orbit(dh.make_for(400), 20.0, dh.T, [1.0, 0.0])
     o = periodic_orbit(dh.make_for(400), 1.0, dh.T, [1.0, 0.0], multipliers=0)
+    for bad in (float("nan"), 1.0):   # (nan: it ran to max_points, never reaching p_end)
+        with pytest.raises(ValueError, match="p_end = .*must be finite and differ"):
+            continue_orbit(o, bad, step=0.5, multipliers=0)
     b = continue_orbit(o, 12.0, step=4.0, multipliers=0, max_step=8.0)  # make refuses p > 10
     assert all(q.p <= 10 for q in b.points) and "failed" in b.status, b.status
+
+
+def test_continuation_into_a_failing_map_ends_the_branch():
+    def make(p):  # u' + u = p cos t; beyond p = 5 the rhs overflows the scheme (a dmi.Error)
+        s = dmi.Solver(1, 2 * np.pi / 200, 1)
+        big = 1e300 if p > 5 else 1.0
+        s.set_rhs(lambda t, u: np.array([big * big * u[0] - p * np.cos(t)]))
+        return s
+    o = periodic_orbit(make, 1.0, 2 * np.pi, [0.5], multipliers=0)
+    b = continue_orbit(o, 8.0, step=1.0, multipliers=0, max_step=2.0)  # does not raise
+    assert b.status.startswith("corrector failed") and "non-finite" in b.status, b.status
+    assert 4.9 < b.p[-1] <= 5.0
+    for q in b.points:   # u = p (cos t + sin t) / 2 sampled by the scheme: amplitude ~ p / sqrt 2
+        assert q.amplitude[0] == pytest.approx(q.p / np.sqrt(2), rel=0.02)
 
 
 def test_singular_jacobian():

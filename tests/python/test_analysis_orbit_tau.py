@@ -16,7 +16,7 @@ from dmi.analysis import continue_orbit, period_doubled_orbit, periodic_orbit
 
 sys.path.insert(0, str(Path(os.environ.get("DMI_SOURCE_DIR", Path(__file__).parents[2]))
                        / "python" / "examples"))
-orbit_tau = pytest.importorskip("orbit_tau")
+import orbit_tau  # noqa: E402  (python/examples/orbit_tau.py; a missing file must fail, not skip)
 M = 2000
 
 

@@ -57,6 +57,18 @@ def test_scalar_roots_are_the_characteristic_polynomials(N, a, b, method):
     assert np.max(np.abs(got.imag)) > 2 * np.pi / TAU
 
 
+def test_strongly_unstable_small_map():
+    # the dense one-step path (n N <= 64) with one-step multipliers ~ 2e6: z^N overflows a
+    # double, which once zeroed every multiplier (and raised a misleading Arnoldi error)
+    got = analysis.roots(functools.partial(scalar, b=-1e8, N=50), 3.0, [0.0], 3)
+    want = polynomial_roots(3.0, -1e8, 50)
+    assert abs(got[0] - want[0]) <= 1e-12 * abs(want[0])
+    # the polynomial's other roots: tau-multipliers e^{lambda tau} below 1e-13 of the largest,
+    # which roots() reports as multipliers 0 (documented): -inf
+    assert np.all(np.exp((want[1:].real - want[0].real) * TAU) < 1e-13)
+    assert np.all(np.isneginf(got[1:].real))
+
+
 def test_roots_count_and_order():
     got = analysis.roots(functools.partial(scalar, N=200), 3.0, [0.0], 3)
     want = polynomial_roots(3.0, 0.3, 200)
@@ -166,10 +178,11 @@ def test_sliding_on_a_belt_is_the_smooth_linearisation(c, friction, tol):
     assert (got[0].real > 0) == (c < 1)    # enough damping stabilises the sliding
 
 
-@pytest.mark.parametrize("N", [40, 400])
+@pytest.mark.parametrize("N", [20, 40, 400])
 def test_sticking_equilibria_form_a_continuum(N):
     # belt at rest, |k x + g x| < alpha: every such x sticks; the multiplier 1 (root 0) says so,
-    # the velocity held by the friction gives multipliers 0 (roots -inf)
+    # the velocity held by the friction gives multipliers 0 (roots -inf).  N = 20: n N = 40, the
+    # dense one-step matrix (also ARPACK's fallback), whose zero multipliers once gave nan
     x = 0.2
     got = analysis.roots(functools.partial(belt, vb=0.0, N=N), 0.2, [x, 0.0], 3)
     assert got[0] == pytest.approx(0.0, abs=1e-12)

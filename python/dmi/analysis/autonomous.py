@@ -16,10 +16,10 @@ import math
 from typing import Any
 
 import numpy as np
-import scipy.sparse.linalg as sla
 
 from .._solver import Solver
-from .shooting import (Model, Orbit, ShootingError, StepMap, _fmt, build, make_orbit)
+from .shooting import (Model, Orbit, ShootingError, StepMap, _fmt, bordered_step, build,
+                       make_orbit, positive_time)
 
 
 def _with_h(make: Model, h: float) -> Model:
@@ -35,12 +35,7 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
     round(guess_period / h) with the h of ``make(p)``).  ``guess``: a state (N + 1 rows of the
     solver ``make(p, h=guess_period / M)``, or n values) or such a solver run near the orbit (its
     window is taken as it is: any phase)."""
-    try:
-        P0 = float(guess_period)
-    except (TypeError, ValueError):
-        raise ValueError(f"guess_period = {guess_period!r} is not a number") from None
-    if not (math.isfinite(P0) and P0 > 0):
-        raise ValueError(f"guess_period = {P0}: must be finite and > 0 (time units)")
+    P0 = positive_time("guess_period", guess_period)
     M = int(steps) if steps is not None else max(1, round(P0 / build(make, p).h))
     if M < 1:
         raise ValueError(f"steps = {steps}: must be >= 1")
@@ -52,16 +47,20 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
             from e
     rows = max(s0.N + 1, math.ceil(s0.tau / (0.8 * h0)) + 1)
     cache: dict[float, StepMap] = {}
+    res: list[float] = []   # the Newton residuals, also in the errors of F(h)
 
     def F(h: float) -> StepMap:
         if h not in cache:
             if not (h > 0.5 * h0):
                 raise ShootingError(f"autonomous orbit at p = {p!r}: the step went to h = {h!r}, "
-                                    f"below half the guess's {h0!r}: no orbit near the guess", [])
+                                    f"below half the guess's {h0!r} after {len(res)} Newton "
+                                    f"iterations (residuals {_fmt(res)}): no orbit near the "
+                                    "guess", res)
             m = StepMap(_with_h(make, h), p, M, rows)
             if m.N + 1 > rows:
-                raise ShootingError(f"the step fell to h = {h!r}: N + 1 = {m.N + 1} > {rows} rows",
-                                    [])
+                raise ShootingError(f"autonomous orbit at p = {p!r}: the step fell to h = {h!r}: "
+                                    f"N + 1 = {m.N + 1} > {rows} rows (residuals {_fmt(res)})",
+                                    res)
             if len(cache) > 3:
                 cache.pop(next(iter(cache)))
             cache[h] = m
@@ -86,7 +85,6 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
     xdot = xdot / np.linalg.norm(xdot)
     ref = x0[-n:].copy()
     x, h = x0.copy(), h0
-    res: list[float] = []
     what = f"autonomous orbit at p = {p!r}, M = {M} steps, guess period {P0!r}"
     for _ in range(max_iter + 1):
         Fm = F(h)
@@ -99,28 +97,29 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
         if not math.isfinite(rn):
             raise ShootingError(f"{what}: non-finite residual (residuals {_fmt(res)})", res)
         if rn <= tol * scale and abs(g) <= tol * scale:
-            return make_orbit(Fm, x, res, multipliers)
+            return _without_phase(make_orbit(Fm, x, res, multipliers))
         if len(res) > max_iter:
             break
         dh = 1e-7 * h
         Fh = (F(h + dh)(x) - Fx) / dh
-        eps = math.sqrt(np.finfo(float).eps) * scale
-
-        def mv(v: np.ndarray, x: np.ndarray = x, Fx: np.ndarray = Fx, Fm: StepMap = Fm,
-               Fh: np.ndarray = Fh) -> np.ndarray:
-            vx, vh = v[:-1], v[-1]
-            nv = float(np.linalg.norm(vx))
-            DF = (Fm(x + (eps / nv) * vx) - Fx) * (nv / eps) if nv > 0 else 0.0 * vx
-            return np.concatenate([DF - vx + Fh * vh, [np.dot(xdot, vx[-n:])]])
-
-        J = sla.LinearOperator((x.size + 1, x.size + 1), matvec=mv, dtype=float)
-        rhs = -np.concatenate([r, [g]])
-        dz, _ = sla.gmres(J, rhs, rtol=1e-8, atol=0.0, restart=min(x.size + 1, 60), maxiter=4)
-        lin = float(np.linalg.norm(mv(dz) - rhs)) / max(float(np.linalg.norm(rhs)), 1e-300)
-        if not np.all(np.isfinite(dz)) or lin > 1e-2:
+        border = np.zeros(x.size + 1)
+        border[x.size - n:x.size] = xdot   # the phase condition: xdot . dx_0 (h free)
+        dz, lin = bordered_step(Fm, x, Fx, Fh, border, g, rtol=1e-8)
+        if lin > 1e-2:
             raise ShootingError(f"{what}: the bordered Jacobian is singular at Newton iteration "
                                 f"{len(res)} (GMRES relative residual {lin:.2g}, residuals "
                                 f"{_fmt(res)})", res)
         x, h = x + dz[:-1], h + float(dz[-1])
     raise ShootingError(f"{what}: no convergence in {max_iter} Newton iterations (residuals "
                         f"{_fmt(res)})", res)
+
+
+def _without_phase(o: Orbit) -> Orbit:
+    """An autonomous orbit always has the multiplier 1 (a shift along the orbit, the phase):
+    ``stable`` is judged on the other multipliers (the one nearest 1 left out; False if no other
+    was computed).  ``multipliers`` keeps them all."""
+    mu = o.multipliers
+    if mu.size:
+        rest = np.delete(mu, int(np.argmin(np.abs(mu - 1))))
+        o.stable = bool(rest.size and np.all(np.abs(rest) < 1))
+    return o

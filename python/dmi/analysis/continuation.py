@@ -40,8 +40,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse.linalg as sla
 
+from .._errors import Error
 from .floquet import monodromy_operator, ritz
-from .shooting import (Model, Orbit, ShootingError, StepMap, build, newton,
+from .shooting import (Model, Orbit, ShootingError, StepMap, bordered_step, build, newton,
                        periodic_orbit, stuck_mask)
 
 
@@ -95,10 +96,12 @@ class Branch:
 
     @property
     def p(self) -> np.ndarray:
+        """The points' parameters p, in the order continued."""
         return np.array([q.p for q in self.points])
 
     @property
     def stable(self) -> np.ndarray:
+        """The points' ``stable`` flags (booleans)."""
         return np.array([q.stable for q in self.points])
 
     def column(self, name: str) -> np.ndarray:
@@ -251,7 +254,7 @@ def _locate_stick(maps: _Maps, a: BranchPoint, b: BranchPoint, e: Event, tol: fl
             if F.dim != k:
                 return e
             xm, _ = newton(F, 0.5 * (xa + xb), tol=tol, max_iter=12, what=f"locating at {pm!r}")
-        except (ShootingError, ValueError):
+        except (ShootingError, ValueError, Error):
             return e
         st, ph, _ = _stick_profile(F, xm, margins=False)
         if key((st[i], ph[i])) == ka:
@@ -281,7 +284,7 @@ class _Maps:
             if s.N + 1 > self.rows:
                 raise ShootingError(f"make(p = {p!r}) has N = {s.N}: the branch's states hold "
                                     f"{self.rows} rows (N + 1 at the ends of its range, + 2 %)", [])
-            F = StepMap(self.make, p, self.M, self.rows)
+            F = StepMap(self.make, p, self.M, self.rows, solver=s)
             if len(self._cache) > 4:
                 self._cache.pop(next(iter(self._cache)))
             self._cache[p] = F
@@ -313,20 +316,10 @@ def _corrector(maps: _Maps, z: np.ndarray, t: np.ndarray, tol: float, max_iter: 
             break
         dp = 1e-7 * max(1.0, abs(p))
         Fp = (maps(p + dp)(x) - Fx) / dp
-        eps = math.sqrt(np.finfo(float).eps) * scale
-
-        def mv(v: np.ndarray, x: np.ndarray = x, Fx: np.ndarray = Fx, F: StepMap = F,
-               Fp: np.ndarray = Fp) -> np.ndarray:
-            vx, vp = v[:-1], v[-1]
-            nv = float(np.linalg.norm(vx))
-            DF = (F(x + (eps / nv) * vx) - Fx) * (nv / eps) if nv > 0 else 0.0 * vx
-            return np.concatenate([DF - vx + Fp * vp, [np.dot(w * t, v)]])
-
-        J = sla.LinearOperator((z.size, z.size), matvec=mv, dtype=float)
-        rhs = -np.concatenate([r, [g]])
-        dz, _ = sla.gmres(J, rhs, rtol=1e-6, atol=0.0, restart=min(z.size, 60), maxiter=4)
-        if not np.all(np.isfinite(dz)):
-            break
+        dz, lin = bordered_step(F, x, Fx, Fp, w * t, g, rtol=1e-6)
+        if lin > 1e-2:
+            raise ShootingError(f"the bordered Jacobian is singular at p = {p!r} (GMRES "
+                                f"relative residual {lin:.2g})", [rn])
         z = z + dz
         d = z - zp
         if math.sqrt(float(np.dot(w * d, d))) > ds:
@@ -340,9 +333,10 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                    min_step: float | None = None, max_step: float | None = None,
                    multipliers: int = 6, tol: float = 1e-10, max_iter: int = 8,
                    sections: int = 1, margins: bool = True) -> Branch:
-    """Continues ``orbit`` (from :func:`periodic_orbit`) in p towards ``p_end`` by
-    pseudo-arclength with initial step ``step`` (p units; ``min_step`` default step / 1000,
-    ``max_step`` default 4 step).  Every point gets ``multipliers`` Floquet multipliers and a
+    """Continues ``orbit`` (from :func:`periodic_orbit`) in p towards ``p_end`` (finite, not
+    orbit.p) by pseudo-arclength with initial step ``step`` (the first point at p + step, p units;
+    then arclengths in the norm sqrt(|dx|^2 / dim + dp^2), p and RMS state units; ``min_step``
+    default step / 1000, ``max_step`` default 4 step).  Every point gets ``multipliers`` Floquet multipliers and a
     stick profile; events are detected between consecutive points (see the module).
     ``sections``: the orbit spans this many forcing periods (a period-doubled branch: 2), for
     ``BranchPoint.section``.  ``margins=False`` skips the margins (NaN), which cost one period
@@ -351,6 +345,11 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     step ends the branch with that ``status``, it does not raise."""
     if not (math.isfinite(step) and step > 0):
         raise ValueError(f"step = {step!r}: must be finite and > 0 (p units)")
+    if not math.isfinite(p_end) or p_end == orbit.p:
+        raise ValueError(f"p_end = {p_end!r}: must be finite and differ from the orbit's "
+                         f"p = {orbit.p!r}")
+    if max_points < 2:
+        raise ValueError(f"max_points = {max_points!r}: must be >= 2")
     direction = 1.0 if p_end >= orbit.p else -1.0
     min_step = step / 1000 if min_step is None else min_step
     max_step = 4 * step if max_step is None else max_step
@@ -410,7 +409,7 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
             try:
                 zn, its = _corrector(maps, zp, t, tol, max_iter, ds)
                 break
-            except (ShootingError, ValueError) as e:
+            except (ShootingError, ValueError, Error) as e:   # Error: the map failed there
                 ds /= 2
                 if ds < min_step:
                     status = f"corrector failed at the smallest step {min_step!r} near p = " \

@@ -75,8 +75,10 @@ def monodromy_operator(F: StepMap, x: np.ndarray, eps: float | None = None,
 def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
                         eps: float | None = None, iterations: int = 3,
                         central: bool = True) -> np.ndarray:
-    """The ``count`` Floquet multipliers of largest modulus at the fixed point x of F, largest
-    first (complex).  States of at most 64 values: the eigenvalues of the dense matrix (its
+    """The ``count`` Floquet multipliers (dimensionless) of largest modulus at the fixed point x of
+    the M-step map F, largest first (complex).  F is a :class:`dmi.analysis.shooting.StepMap`, e.g.
+    ``StepMap(orbit.make, orbit.p, orbit.steps, orbit.rows)`` with x = ``orbit.state``; ``eps``
+    (state units) overrides the difference step of :func:`fd_step`.  States of at most 64 values: the eigenvalues of the dense matrix (its
     columns by the operator).  Larger: subspace iteration with Rayleigh-Ritz on a block of
     b = count + 4 vectors, ``iterations`` sweeps (b (iterations + 1) products of 2 periods each,
     1 with ``central=False``, see :func:`monodromy_operator`): the eigenvalues of Q' A Q.  Not

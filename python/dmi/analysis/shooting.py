@@ -51,14 +51,20 @@ def build(make: Model, p: float) -> Solver:
     return s
 
 
+def positive_time(name: str, value: Any) -> float:
+    """value as a float, finite and > 0 (a period, time units); ValueError naming it otherwise."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} = {value!r} is not a number") from None
+    if not (math.isfinite(v) and v > 0):
+        raise ValueError(f"{name} = {v}: must be finite and > 0 (time units)")
+    return v
+
+
 def steps_per_period(h: float, period: float) -> int:
     """M = period / h, which must be a whole number (to 1e-9 relative); ValueError otherwise."""
-    try:
-        period = float(period)
-    except (TypeError, ValueError):
-        raise ValueError(f"period = {period!r} is not a number") from None
-    if not (math.isfinite(period) and period > 0):
-        raise ValueError(f"period = {period}: must be finite and > 0 (time units)")
+    period = positive_time("period", period)
     M = round(period / h)
     if M < 1 or abs(M * h - period) > 1e-9 * period:
         raise ValueError(f"period = {period!r} is not a whole number of steps h = {h!r} "
@@ -73,9 +79,11 @@ class StepMap:
     (``load_state`` of the state saved after ``init``), sets the window and runs M steps.
     ``evaluations`` counts the calls (each costs M steps)."""
 
-    def __init__(self, make: Model, p: float, M: int, rows: int | None = None):
+    def __init__(self, make: Model, p: float, M: int, rows: int | None = None,
+                 solver: Solver | None = None):
         self.make, self.p, self.M = make, float(p), int(M)
-        self.solver = build(make, self.p)
+        # solver: make(p) already built by the caller (not initialised), else built here
+        self.solver = build(make, self.p) if solver is None else solver
         self.n, self.N, self.h = self.solver.n, self.solver.N, self.solver.h
         self.L = self.N + 1 if rows is None else int(rows)
         if self.L < self.N + 1:
@@ -135,6 +143,50 @@ def state_of(solver: Solver, M: int) -> np.ndarray:
         solver.load_state(saved)
 
 
+def fd_eps(x: np.ndarray) -> float:
+    """The forward-difference step of Newton's matrix-free Jacobians: sqrt(eps_machine)
+    max(1, |x|_inf) (state units)."""
+    return math.sqrt(np.finfo(float).eps) * max(1.0, float(np.max(np.abs(x))))
+
+
+def directional(F: Callable[[np.ndarray], np.ndarray], x: np.ndarray, Fx: np.ndarray,
+                v: np.ndarray, eps: float) -> np.ndarray:
+    """DF(x) v by a forward difference of step eps along v / |v|_2 (one evaluation of F; 0 for
+    v = 0)."""
+    nv = float(np.linalg.norm(v))
+    if nv == 0.0:
+        return np.zeros_like(v)
+    return (F(x + (eps / nv) * v) - Fx) * (nv / eps)
+
+
+def bordered_step(F: Callable[[np.ndarray], np.ndarray], x: np.ndarray, Fx: np.ndarray,
+                  Fq: np.ndarray, border: np.ndarray, g: float, *, rtol: float
+                  ) -> tuple[np.ndarray, float]:
+    """One Newton step for x = F_q(x) with one more unknown q (the period's step h of an
+    autonomous orbit, the parameter p of a continuation) and one more equation g = 0 (a phase
+    condition, the pseudo-arclength hyperplane): dz = (dx, dq) solves the bordered system
+
+        (D_xF - I) dx + F_q dq = -(F(x) - x),     border . dz = -g,
+
+    by GMRES on the matrix-free operator (D_xF v by :func:`directional`, step :func:`fd_eps`;
+    ``Fq`` = dF/dq, a column computed by the caller).  Returns (dz, GMRES's relative residual
+    |J dz - rhs| / |rhs|, one more product): above about 1e-2 the system is singular."""
+    eps = fd_eps(x)
+
+    def mv(v: np.ndarray) -> np.ndarray:
+        vx = v[:-1]
+        return np.concatenate([directional(F, x, Fx, vx, eps) - vx + Fq * v[-1],
+                               [np.dot(border, v)]])
+
+    size = x.size + 1
+    J = sla.LinearOperator((size, size), matvec=mv, dtype=float)
+    rhs = -np.concatenate([Fx - x, [g]])
+    dz, _ = sla.gmres(J, rhs, rtol=rtol, atol=0.0, restart=min(size, 60), maxiter=4)
+    if not np.all(np.isfinite(dz)):
+        return dz, math.inf
+    return dz, float(np.linalg.norm(mv(dz) - rhs)) / max(float(np.linalg.norm(rhs)), 1e-300)
+
+
 def newton(F: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, *, tol: float = 1e-10,
            max_iter: int = 30, what: str = "x = F(x)") -> tuple[np.ndarray, list[float]]:
     """Solves x = F(x) by Newton's method with GMRES on the matrix-free Jacobian I - DF
@@ -174,14 +226,10 @@ def newton(F: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, *, tol: float 
                 raise ShootingError(f"{what}: Newton stalls after {len(res) - 1} iterations "
                                     f"(residuals {_fmt(res)}; tolerance {tol * scale:.3g}): no "
                                     "orbit near the guess, or the orbit is not isolated", res)
-        eps = math.sqrt(np.finfo(float).eps) * scale
+        eps = fd_eps(x)
 
         def mv(v: np.ndarray, Fx: np.ndarray = Fx, x: np.ndarray = x) -> np.ndarray:
-            nv = float(np.linalg.norm(v))
-            if nv == 0.0:
-                return np.zeros_like(v)
-            e = eps / nv
-            return v - (ev(x + e * v) - Fx) / e
+            return v - directional(ev, x, Fx, v, eps)
 
         J = sla.LinearOperator((x.size, x.size), matvec=mv, dtype=float)
         dx, _info = sla.gmres(J, r, rtol=1e-6, atol=0.0, restart=min(x.size, 60), maxiter=4)
@@ -218,7 +266,8 @@ class Orbit:
     ``p``: the parameter; ``period`` = ``steps`` h (time units); ``h``: the step; ``t`` (M + 1,)
     and ``u`` (M + 1, n): one period of U from t = 0; ``state``: the shooting state (L n values,
     rows oldest first, the last at t = 0); ``multipliers``: the leading Floquet multipliers,
-    largest |mu| first; ``stable``: all |mu| < 1; ``stick_fraction`` (n,): the fraction of the M
+    largest |mu| first; ``stable``: all |mu| < 1 (an autonomous orbit: all but
+    its phase's multiplier 1); ``stick_fraction`` (n,): the fraction of the M
     steps where component i is stuck (:func:`stuck_mask`: U_i == 0 exactly after the friction
     resolvent, for 2 steps or more);
     ``iterations``: Newton iterations; ``residual``: the final |F(x) - x|_inf (state units)."""
@@ -288,7 +337,7 @@ def periodic_orbit(make: Model, p: float, period: float | None = None, guess: An
                                 max_iter=max_iter, multipliers=multipliers)
     probe = build(make, p)
     M = steps_per_period(probe.h, period)
-    F = StepMap(make, p, M, rows)
+    F = StepMap(make, p, M, rows, solver=probe)
     if isinstance(guess, Solver):
         if (guess.n, guess.N) != (F.n, F.N) or guess.h != F.h:
             raise ValueError(f"guess: a solver with n = {guess.n}, N = {guess.N}, h = {guess.h!r}; "

@@ -36,10 +36,12 @@ def _one_step_roots(lin: Linearisation, count: int) -> np.ndarray:
     I = np.eye(lin.dim)
     M = np.column_stack([lin.apply(I[:, j], 1) for j in range(lin.dim)])
     z = scipy.linalg.eigvals(M)
-    big = np.max(np.abs(z)) ** lin.N
-    z = np.where(np.abs(z) ** lin.N < ZERO * big, 0, z)   # as in _arnoldi_roots
-    with np.errstate(divide="ignore"):
-        return np.log(z.astype(complex)) / lin.h
+    # as in _arnoldi_roots, 0 where |z|^N < ZERO max|z|^N (written without the powers: they
+    # overflow a double for |z| > 1.43 at N = 2000)
+    live = (np.abs(z) > 0) & (np.abs(z) >= ZERO ** (1.0 / lin.N) * np.max(np.abs(z)))
+    lam = np.full(len(z), -np.inf, dtype=complex)   # a multiplier 0: root -inf (log(0) / h in
+    lam[live] = np.log(z[live].astype(complex)) / lin.h   # complex arithmetic is nan, not -inf)
+    return lam
 
 
 def _branch(logmu: complex, z: complex, N: int, h: float) -> tuple[complex, float]:
