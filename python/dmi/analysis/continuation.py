@@ -6,11 +6,14 @@ Pseudo-arclength on z = (x, p), x the shooting state (:mod:`dmi.analysis.shootin
 predictor z + ds t, then Newton on  F_p(x) - x = 0,  <t, z - z_pred> = 0  with GMRES on the
 bordered matrix-free Jacobian [[D_xF - I, D_pF], [t_x' / dim, t_p]] (D_xF by forward differences
 along the Krylov vectors, D_pF by one difference in p per iteration).  The inner product weighs
-x by 1 / dim (an RMS), so ds is a step in "p or RMS state units".  The period M h is kept: make(p)
-must keep h.  A model over tau with a free step h (libdmi 1.2's ``Solver(n, tau, h=...)``) has
-N = ceil(tau / h) changing with p: the states hold L = max N + 1 over the two ends of the range
-(+ 2 %) rows, the older ones filled by M-periodicity (:meth:`StepMap.extend`); the map reads
-the last N(p) + 1.  The step grows by 1.5 after an easy corrector (<= 3 iterations),
+x by 1 / dim (an RMS), so ds is a step in "p or RMS state units".  By default the period M h is
+kept: make(p) must keep h.  With ``period=P`` (a function p -> the period, time units, e.g. the
+forcing period 2 pi / p of a continuation in the frequency) M is kept and the step follows p:
+the map at p is built by ``make(p, h=P(p) / M)`` (libdmi 1.2's ``Solver(n, tau, h=...)``, as for
+an autonomous orbit).  A model over tau with a free step h has N = ceil(tau / h) changing with p
+(with tau, or with h): the states hold L = max N + 1 over the two ends of the range (+ 2 %) rows,
+the older ones filled by M-periodicity (:meth:`StepMap.extend`); the map reads the last
+N(p) + 1.  The step grows by 1.5 after an easy corrector (<= 3 iterations),
 halves after a failure, and the branch ends at p_end, at ``max_points``, when it leaves the
 p-range it started in, or when the step falls below ``min_step`` (``Branch.status`` says which).
 
@@ -35,15 +38,17 @@ Stick-onset and grazing events are located by bisection in p (6 halvings of the 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse.linalg as sla
 
 from .._errors import Error
+from .._solver import Solver
 from .floquet import monodromy_operator, ritz
 from .shooting import (Model, Orbit, ShootingError, StepMap, bordered_step, build, newton,
-                       periodic_orbit, stuck_mask)
+                       periodic_orbit, positive_time, stuck_mask)
 
 
 @dataclass
@@ -84,7 +89,9 @@ class Event:
 @dataclass
 class Branch:
     """A continued branch: ``points`` (:class:`BranchPoint`), ``events`` (:class:`Event`),
-    ``status`` (why it ended), ``make``, ``steps`` (M), ``h``, ``rows`` (L) and ``sections``."""
+    ``status`` (why it ended), ``make``, ``steps`` (M), ``h`` (the start's step), ``rows`` (L),
+    ``sections`` and ``period`` (the function p -> period given to :func:`continue_orbit`, or
+    None: the period M h was kept)."""
     points: list[BranchPoint]
     events: list[Event]
     status: str
@@ -93,6 +100,7 @@ class Branch:
     h: float = 0.0
     rows: int = 0
     sections: int = 1
+    period: Callable[[float], float] | None = field(default=None, repr=False)
 
     @property
     def p(self) -> np.ndarray:
@@ -268,23 +276,57 @@ def _locate_stick(maps: _Maps, a: BranchPoint, b: BranchPoint, e: Event, tol: fl
 
 class _Maps:
     """StepMaps by p (the last few), all on states of ``rows`` rows; a p whose N + 1 exceeds it
-    is refused (ShootingError: the corrector retries with a shorter step)."""
+    is refused (ShootingError: the corrector retries with a shorter step).  ``period``: None
+    (make(p) must keep the step h) or p -> the period, the map at p then built by
+    make(p, h=period(p) / M)."""
 
-    def __init__(self, make: Model, M: int, h: float, rows: int):
-        self.make, self.M, self.h, self.rows = make, M, h, rows
+    def __init__(self, make: Model, M: int, h: float, rows: int,
+                 period: Callable[[float], float] | None = None):
+        self.make, self.M, self.h, self.rows, self.period = make, M, h, rows, period
         self._cache: dict[float, StepMap] = {}
+
+    def step(self, p: float) -> float:
+        """The step h at p: period(p) / M, or the branch's h."""
+        if self.period is None:
+            return self.h
+        try:
+            P = self.period(p)
+        except Exception as e:  # the period function refuses p: out of range
+            raise ValueError(f"period(p = {p!r}) failed: {type(e).__name__}: {e}") from e
+        return positive_time(f"period(p = {p!r})", P) / self.M
+
+    def model(self, p: float) -> Model:
+        """make as a function of p alone at p's step (the StepMap's and an Orbit's ``make``)."""
+        if self.period is None:
+            return self.make
+        h = self.step(p)
+        return lambda q: self.make(q, h=h)  # type: ignore[call-arg]
+
+    def build(self, p: float) -> Solver:
+        if self.period is None:
+            return build(self.make, p)
+        h = self.step(p)
+        try:
+            return build(self.model(p), p)
+        except ValueError as e:
+            if isinstance(e.__cause__, TypeError):
+                raise ValueError(f"continue_orbit(period=...) needs a model make(p, h=...) that "
+                                 f"takes the step (h = period(p) / M = {h!r}): {e}") from e
+            raise
 
     def __call__(self, p: float) -> StepMap:
         F = self._cache.get(p)
         if F is None:
-            s = build(self.make, p)
-            if abs(s.h - self.h) > 1e-12 * self.h:
-                raise ValueError(f"make(p = {p!r}) has h = {s.h!r}; the branch keeps the period "
-                                 f"M h with h = {self.h!r} (make(p) must keep h)")
+            s = self.build(p)
+            h = self.step(p)
+            if abs(s.h - h) > 1e-12 * h:
+                what = ("the branch keeps the period M h (make(p) must keep h)"
+                        if self.period is None else "expected period(p) / M")
+                raise ValueError(f"make(p = {p!r}) has h = {s.h!r}; {what}: h = {h!r}")
             if s.N + 1 > self.rows:
                 raise ShootingError(f"make(p = {p!r}) has N = {s.N}: the branch's states hold "
                                     f"{self.rows} rows (N + 1 at the ends of its range, + 2 %)", [])
-            F = StepMap(self.make, p, self.M, self.rows, solver=s)
+            F = StepMap(self.model(p), p, self.M, self.rows, solver=s)
             if len(self._cache) > 4:
                 self._cache.pop(next(iter(self._cache)))
             self._cache[p] = F
@@ -332,7 +374,8 @@ def _corrector(maps: _Maps, z: np.ndarray, t: np.ndarray, tol: float, max_iter: 
 def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points: int = 200,
                    min_step: float | None = None, max_step: float | None = None,
                    multipliers: int = 6, tol: float = 1e-10, max_iter: int = 8,
-                   sections: int = 1, margins: bool = True) -> Branch:
+                   sections: int = 1, margins: bool = True,
+                   period: Callable[[float], float] | None = None) -> Branch:
     """Continues ``orbit`` (from :func:`periodic_orbit`) in p towards ``p_end`` (finite, not
     orbit.p) by pseudo-arclength with initial step ``step`` (the first point at p + step, p units;
     then arclengths in the norm sqrt(|dx|^2 / dim + dp^2), p and RMS state units; ``min_step``
@@ -340,7 +383,11 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     stick profile; events are detected between consecutive points (see the module).
     ``sections``: the orbit spans this many forcing periods (a period-doubled branch: 2), for
     ``BranchPoint.section``.  ``margins=False`` skips the margins (NaN), which cost one period
-    stepped from Python a point (the stuck steps and phases then come from one run).  Returns a
+    stepped from Python a point (the stuck steps and phases then come from one run).
+    ``period``: None keeps the period M h (make(p) keeps h); a function p -> period (time units;
+    a forced orbit in its frequency w: ``period=lambda w: 2 * math.pi / w``) keeps M = orbit.steps
+    and gives the model the step h = period(p) / M through ``make(p, h=...)`` (orbit.make must
+    take it; orbit.period must equal period(orbit.p)).  Returns a
     :class:`Branch`; a corrector that fails at the smallest
     step ends the branch with that ``status``, it does not raise."""
     if not (math.isfinite(step) and step > 0):
@@ -355,14 +402,23 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     max_step = 4 * step if max_step is None else max_step
     lo, hi = sorted((orbit.p, float(p_end)))
     n = orbit.u.shape[1]
-    # rows for the whole range: N may grow with p (tau with a fixed h); probe both ends
-    rows = max(orbit.rows or orbit.state.size // n, build(orbit.make, orbit.p).N + 1)
+    if period is not None:
+        if not callable(period):
+            raise ValueError(f"period = {period!r}: give a function p -> period (time units)")
+        P0 = _Maps(orbit.make, orbit.steps, orbit.h, 0, period).step(orbit.p) * orbit.steps
+        if abs(P0 - orbit.period) > 1e-9 * orbit.period:
+            raise ValueError(f"period(p = {orbit.p!r}) = {P0!r} but the orbit's period is "
+                             f"{orbit.period!r} (= {orbit.steps} steps h = {orbit.h!r})")
+    probe = _Maps(orbit.make, orbit.steps, orbit.h, 0, period)
+    # rows for the whole range: N may grow with p (tau with a fixed h, or h with the period);
+    # probe both ends
+    rows = max(orbit.rows or orbit.state.size // n, probe.build(orbit.p).N + 1)
     try:
-        rows = max(rows, build(orbit.make, float(p_end)).N + 1)
+        rows = max(rows, probe.build(float(p_end)).N + 1)
     except ValueError:
         pass  # make refuses p_end: the branch will stop where make does
     rows += max(2, rows // 50)  # room for a corrector a little beyond the ends
-    maps = _Maps(orbit.make, orbit.steps, orbit.h, rows)
+    maps = _Maps(orbit.make, orbit.steps, orbit.h, rows, period)
     x0 = np.array(orbit.state)
     F0 = maps(orbit.p)
     if F0.dim != x0.size:
@@ -385,7 +441,7 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
             ds /= 2
             if ds < min_step:
                 return Branch(pts, events, f"first step failed: {e}", orbit.make, orbit.steps,
-                              orbit.h, maps.rows, sections)
+                              orbit.h, maps.rows, sections, period)
     z = np.concatenate([x1, [p1]])
     pts.append(_point(maps(p1), x1, multipliers, sections, direction, len(res) - 1, margins,
                       warm))
@@ -429,7 +485,8 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                 e = _locate_stick(maps, pts[-2], pts[-1], e, tol)
             events.append(e)
         ds = min(max_step, ds * 1.5) if its <= 3 else ds
-    return Branch(pts, events, status, orbit.make, orbit.steps, orbit.h, maps.rows, sections)
+    return Branch(pts, events, status, orbit.make, orbit.steps, orbit.h, maps.rows, sections,
+                  period)
 
 
 def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[float, ...] =
@@ -440,13 +497,14 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
     a supercritical doubling's orbit lives) the M-periodic state x is perturbed along the
     multiplier's eigenvector v (|v|_inf = 1), x + a A v, A the orbit's amplitude, a from
     ``amplitudes``, and shot with period 2 M h; the first solution that is not the M-periodic
-    orbit is returned (continue it with ``continue_orbit(..., sections=2 * branch.sections)``).
-    ShootingError when none is found."""
+    orbit is returned (continue it with ``continue_orbit(..., sections=2 * branch.sections)``,
+    and ``period=lambda p: 2 * P(p)`` for a branch continued with ``period=P``: its ``make``
+    is then make(p, h=None), h = P(p) / M by default).  ShootingError when none is found."""
     if event.kind != "period-doubling":
         raise ValueError(f"event {event.kind!r}: expected a 'period-doubling' event")
     a, b = branch.points[event.index - 1], branch.points[event.index]
     q = a if np.any(a.multipliers.real < -1) else b
-    maps = _Maps(branch.make, branch.steps, branch.h, branch.rows)
+    maps = _Maps(branch.make, branch.steps, branch.h, branch.rows, branch.period)
     F = maps(q.p)
     x = F.extend(q.state)
     A = monodromy_operator(F, x)
@@ -459,10 +517,14 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
     v = V[:, j].real
     v /= np.max(np.abs(v))
     amp = max(float(np.max(q.amplitude)), 0.1 * max(1.0, float(np.max(np.abs(x)))))
+    make = branch.make
+    if branch.period is not None:   # make(p) at the branch's step period(p) / M unless h is given
+        def make(p: float, h: float | None = None) -> Solver:
+            return branch.make(p, h=maps.step(p) if h is None else h)  # type: ignore[call-arg]
     tried = []
     for s in amplitudes:
         try:
-            o = periodic_orbit(branch.make, q.p, 2 * branch.steps * branch.h, x + s * amp * v,
+            o = periodic_orbit(make, q.p, 2 * branch.steps * F.h, x + s * amp * v,
                                rows=F.L, tol=tol, multipliers=multipliers)
         except ShootingError as e:
             tried.append(f"a = {s}: {e}")
