@@ -30,17 +30,25 @@ static void test_rows_are_the_past(void)
     dmi_free(&s);
 }
 
+/* A new initialised solver of the model but with the history z = 0, or NULL. */
+static dmi_solver *zero_history_twin(core_model *m)
+{
+    dmi_solver *s = NULL;
+    if (dmi_create(&s, 2, 1.0, N) != DMI_OK)
+        return NULL;
+    if (core_model_setup(s, m) != DMI_OK || dmi_set_history(s, NULL, NULL) != DMI_OK ||
+        dmi_init(s) != DMI_OK)
+        dmi_free(&s);
+    return s;
+}
+
 /* b, stepped to AT from the zero history, takes a's window at AT: both step
  * on alike. */
 static void window_moves_run(int method, double tol)
 {
     core_model ma = {0}, mb = {0};
-    dmi_solver *a = core_model_solver(&ma, N), *b = NULL;
-    CU_ASSERT_FATAL(a != NULL);
-    CU_ASSERT_EQUAL_FATAL(dmi_create(&b, 2, 1.0, N), DMI_OK);
-    CU_ASSERT_EQUAL(core_model_setup(b, &mb), DMI_OK);
-    CU_ASSERT_EQUAL(dmi_set_history(b, NULL, NULL), DMI_OK);
-    CU_ASSERT_EQUAL(dmi_init(b), DMI_OK);
+    dmi_solver *a = core_model_solver(&ma, N), *b = zero_history_twin(&mb);
+    CU_ASSERT_FATAL(a != NULL && b != NULL);
     CU_ASSERT_EQUAL(dmi_set_convolution(a, method), DMI_OK);
     CU_ASSERT_EQUAL(dmi_set_convolution(b, method), DMI_OK);
     CU_ASSERT_EQUAL(dmi_advance(a, AT), DMI_OK);
@@ -107,12 +115,8 @@ static void test_moves_recursive(void)
 static void test_window_is_history(void)
 {
     core_model ma = {0}, mb = {0};
-    dmi_solver *a = core_model_solver(&ma, N), *b = NULL;
-    CU_ASSERT_FATAL(a != NULL);
-    CU_ASSERT_EQUAL_FATAL(dmi_create(&b, 2, 1.0, N), DMI_OK);
-    CU_ASSERT_EQUAL(core_model_setup(b, &mb), DMI_OK);
-    CU_ASSERT_EQUAL(dmi_set_history(b, NULL, NULL), DMI_OK);
-    CU_ASSERT_EQUAL(dmi_init(b), DMI_OK);
+    dmi_solver *a = core_model_solver(&ma, N), *b = zero_history_twin(&mb);
+    CU_ASSERT_FATAL(a != NULL && b != NULL);
     core_model mz = {0};
     double U[(N + 1) * 2];
     for (size_t k = 0; k <= N; k++) { /* lag N - k at t = -(N - k) h, as dmi_init samples */
