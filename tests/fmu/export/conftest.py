@@ -52,15 +52,19 @@ def build(src, build_dir, prefix, check=True):
     return r.returncode, out
 
 
-def write_project(src, name, source, file=None):
+def write_project(src, name, source, file=None, guid=None):
     """The CMake project of one model in src (made if missing): dmi_add_fmu(name SOURCES file)
-    from an installed dmi, file (default: name in lower case, .c) holding source. Returns src."""
-    file = file or f"{name.lower()}.c"
+    from an installed dmi, file (default: the first name in lower case, .c) holding source.
+    name may be a list: one dmi_add_fmu per name, all from the one file; guid: the GUID of
+    dmi_add_fmu (one name only). Returns src."""
+    names = [name] if isinstance(name, str) else list(name)
+    assert guid is None or len(names) == 1, "one GUID for one FMU"
+    file = file or f"{names[0].lower()}.c"
     src.mkdir(parents=True, exist_ok=True)
+    calls = "".join(f"dmi_add_fmu({n} SOURCES {file}{' GUID ' + guid if guid else ''})\n" for n in names)
     (src / "CMakeLists.txt").write_text(f"cmake_minimum_required(VERSION 3.25)\n"
-                                        f"project({name.lower()} LANGUAGES C)\n"
-                                        f"find_package(dmi REQUIRED)\n"
-                                        f"dmi_add_fmu({name} SOURCES {file})\n")
+                                        f"project({names[0].lower()} LANGUAGES C)\n"
+                                        f"find_package(dmi REQUIRED)\n" + calls)
     (src / file).write_text(source)
     return src
 

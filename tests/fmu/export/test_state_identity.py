@@ -6,7 +6,7 @@
 import pytest
 from fmpy.fmi1 import FMICallException
 
-from conftest import Instance, build, fmus
+from conftest import Instance, build, fmus, write_project
 
 SOURCE = r"""
 #include "dmi_fmu.h"
@@ -65,13 +65,7 @@ def twins(tmp_path_factory, prefix):
     paths = {}
     for project, names, var, guid in (("same", ["TwinA", "TwinB"], "k", None),
                                       ("renamed", ["TwinA"], "c", "{0f0e0d0c-0b0a-4908-8706-050403020100}")):
-        src = root / project
-        src.mkdir()
-        (src / "twin.c").write_text(SOURCE.replace("@K@", var))
-        lines = [f"dmi_add_fmu({n} SOURCES twin.c{' GUID ' + guid if guid else ''})" for n in names]
-        (src / "CMakeLists.txt").write_text("cmake_minimum_required(VERSION 3.25)\n"
-                                            f"project({project} LANGUAGES C)\n"
-                                            "find_package(dmi REQUIRED)\n" + "\n".join(lines) + "\n")
+        src = write_project(root / project, names, SOURCE.replace("@K@", var), "twin.c", guid)
         build(src, root / (project + "-build"), prefix)
         for n in names:
             paths[(project, n)] = fmus(root / (project + "-build"), n)
