@@ -148,11 +148,11 @@ def slurm(tmp_path_factory):
         _stop(cluster, processes)
 
 
-def sweep(slurm: Slurm, cwd: Path, *args) -> subprocess.Popen:
+def sweep(slurm: Slurm, *args) -> subprocess.Popen:
+    """dmi-sweep run args, started with the package and the Slurm's environment."""
     env = env_with_package()
     env.update(slurm.env, PYTHONPATH=env["PYTHONPATH"])
-    p = start_group(sweep_cmd("run", *args), env)
-    return p
+    return start_group(sweep_cmd("run", *args), env)
 
 
 def finish(p: subprocess.Popen, timeout: float = 300) -> subprocess.CompletedProcess:
@@ -165,7 +165,7 @@ def frame(out: Path) -> pd.DataFrame:
 
 def test_sweep_over_slurm_equals_local(slurm, tmp_path, fmu_path):
     spec = write_spec(tmp_path, spec_text(fmu_path, 8, extra="[slurm]\ncores = 1\nmemory = \"1GB\"\n"))
-    r = finish(sweep(slurm, tmp_path, spec, "--out", tmp_path / "slurm", "--slurm", "--jobs", "2",
+    r = finish(sweep(slurm, spec, "--out", tmp_path / "slurm", "--slurm", "--jobs", "2",
                      "--partition", "debug", "--walltime", "00:10:00", "--chunk-size", "1"))
     assert r.returncode == 0, r.stderr
     r2 = run_sweep("run", spec, "--out", tmp_path / "local", "--workers", "1")
@@ -204,7 +204,7 @@ def test_scancel_mid_sweep_loses_and_doubles_no_point(slurm, tmp_path, fmu_path)
     spec = write_spec(tmp_path, spec_text(fmu_path, num, stop=30.0))
     args = [spec, "--out", tmp_path / "slurm", "--slurm", "--cores", "1", "--memory", "1GB", "--jobs", "2",
             "--chunk-size", "1", "--no-worker-timeout", "5", "--quiet"]
-    p = sweep(slurm, tmp_path, *args)
+    p = sweep(slurm, *args)
     try:
         wait_for_parts(tmp_path / "slurm", 1, p)
         slurm.wait("both jobs' workers computing", lambda: len(chunk_workers(tmp_path / "slurm")) == 2, 120)
@@ -221,7 +221,7 @@ def test_scancel_mid_sweep_loses_and_doubles_no_point(slurm, tmp_path, fmu_path)
 
     # every job cancelled mid-sweep: exit 3 once --no-worker-timeout passed with no job left
     out2 = tmp_path / "again"
-    p = sweep(slurm, tmp_path, *[out2 if a == tmp_path / "slurm" else a for a in args])
+    p = sweep(slurm, *[out2 if a == tmp_path / "slurm" else a for a in args])
     try:
         wait_for_parts(out2, 3, p)
         slurm.cmd("scancel", "--partition", "debug")
@@ -232,7 +232,7 @@ def test_scancel_mid_sweep_loses_and_doubles_no_point(slurm, tmp_path, fmu_path)
     assert "SLURM has none of its jobs left" in r.stderr and "the same command resumes" in r.stderr
     saved = pd.read_parquet(out2)
     assert 3 <= len(saved) < num and saved["point"].is_unique
-    r = finish(sweep(slurm, tmp_path, *[out2 if a == tmp_path / "slurm" else a for a in args]))
+    r = finish(sweep(slurm, *[out2 if a == tmp_path / "slurm" else a for a in args]))
     assert r.returncode == 0, r.stderr
     assert f"{len(saved)} of {num} points already in" in r.stderr
     pd.testing.assert_frame_equal(frame(out2), got, check_exact=True)
@@ -243,14 +243,14 @@ def test_scancel_mid_sweep_loses_and_doubles_no_point(slurm, tmp_path, fmu_path)
 
 def test_bad_partition_exit_2_with_slurms_message(slurm, tmp_path, fmu_path):
     spec = write_spec(tmp_path, spec_text(fmu_path, 2, extra="[slurm]\npartition = \"nope\"\n"))
-    r = finish(sweep(slurm, tmp_path, spec, "--out", tmp_path / "out", "--slurm", "--cores", "1",
+    r = finish(sweep(slurm, spec, "--out", tmp_path / "out", "--slurm", "--cores", "1",
                      "--memory", "1GB"))
     assert r.returncode == 2, (r.returncode, r.stderr)
     assert "SLURM refuses the job (partition nope" in r.stderr
     assert "Invalid partition name specified" in r.stderr and "Nothing was run" in r.stderr
     assert not (tmp_path / "out").exists() and not slurm.jobs()
     # the command line wins over the spec: the same spec with --partition debug runs
-    r = finish(sweep(slurm, tmp_path, spec, "--out", tmp_path / "out", "--slurm", "--cores", "1",
+    r = finish(sweep(slurm, spec, "--out", tmp_path / "out", "--slurm", "--cores", "1",
                      "--memory", "1GB", "--partition", "debug"))
     assert r.returncode == 0, r.stderr
 
