@@ -28,6 +28,27 @@ def fmu_path() -> str:
     return path
 
 
+# A grid of g_amp over the oscillator FMU: at stop = 30, transient = 20 about 0.1 s per point on
+# this machine (long enough to kill something mid-sweep); stop = 3, transient = 2 for quick runs.
+GRID_SPEC = """
+fmu = "{fmu}"
+stop_time = {stop}
+output_interval = 0.01
+transient = {transient}
+outputs = ["w", "sticking"]
+[start]
+N = 9991
+[grid]
+g_amp = {{ start = 0.5, stop = 2.5, num = {num} }}
+{extra}
+"""
+
+
+def grid_spec(fmu: str, num: int, stop: float = 30.0, transient: float = 20.0, extra: str = "") -> str:
+    """GRID_SPEC of `num` points, with `extra` (such as a [slurm] section) at its end."""
+    return GRID_SPEC.format(fmu=fmu, num=num, stop=stop, transient=transient, extra=extra)
+
+
 def write_spec(directory: Path, text: str, name: str = "spec.toml") -> Path:
     p = directory / name
     p.write_text(text)

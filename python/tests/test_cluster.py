@@ -16,21 +16,8 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from conftest import (env_with_package, finish_group, group_members, kill_group, log_entries, run_sweep,
-                      start_cluster, start_sweep, sweep_cmd, write_spec)
-
-# about 0.1 s per point on this machine: long enough to kill something mid-sweep
-SLOW = """
-fmu = "{fmu}"
-stop_time = 30.0
-output_interval = 0.01
-transient = 20.0
-outputs = ["w", "sticking"]
-[start]
-N = 9991
-[grid]
-g_amp = {{ start = 0.5, stop = 2.5, num = {num} }}
-"""
+from conftest import (env_with_package, finish_group, grid_spec, group_members, kill_group, log_entries,
+                      run_sweep, start_cluster, start_sweep, sweep_cmd, write_spec)
 
 
 def worker_address(cluster, pid: int) -> str:
@@ -75,8 +62,8 @@ def test_two_clients_one_cluster(cluster, tmp_path, fmu_path):
     """Two clients sweep the same FMU on one external cluster at once: the first one ends (and
     removes its worker plugin) while the second one runs; the second still computes every point
     (each run has its own plugin: with one shared, the first end took the FMU from the other)."""
-    first_spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=200), "first.toml")   # ~10 s
-    second_spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=100), "second.toml")
+    first_spec = write_spec(tmp_path, grid_spec(fmu_path, 200), "first.toml")   # ~10 s
+    second_spec = write_spec(tmp_path, grid_spec(fmu_path, 100), "second.toml")
     first = start_sweep("run", first_spec, "--out", tmp_path / "first", "--scheduler", cluster.address,
                         "--chunk-size", "1")
     second = None
@@ -102,8 +89,7 @@ def test_two_clients_one_cluster(cluster, tmp_path, fmu_path):
 def test_scheduler_and_workers_elsewhere(cluster, tmp_path, fmu_path):
     """The sweep through --scheduler equals the LocalCluster's; the FMU reached the workers through
     Dask only (their folder is another one, they have no path to the FMU)."""
-    spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=6).replace("30.0", "3.0")
-                      .replace("20.0", "2.0"))
+    spec = write_spec(tmp_path, grid_spec(fmu_path, 6, stop=3.0, transient=2.0))
     r = run_sweep("run", spec, "--out", tmp_path / "remote", "--scheduler", cluster.address,
                   "--chunk-size", "1")
     assert r.returncode == 0, r.stderr
@@ -130,7 +116,7 @@ def test_scheduler_and_workers_elsewhere(cluster, tmp_path, fmu_path):
 
 def test_worker_killed_mid_sweep(cluster, tmp_path, fmu_path, processes):
     total = 40
-    spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=total))
+    spec = write_spec(tmp_path, grid_spec(fmu_path, total))
     out = tmp_path / "out"
     client, address = kill_worker_mid_sweep(processes, cluster, spec, out, 4, "--quiet")
     assert len(list(out.glob("part-*.parquet"))) < total       # killed mid-sweep
@@ -160,7 +146,7 @@ def test_worker_killed_mid_sweep(cluster, tmp_path, fmu_path, processes):
 def test_client_killed_then_rerun(cluster, tmp_path, fmu_path, processes):
     """Only the points missing after the kill are computed by the rerun, each once."""
     total = 40
-    spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=total))
+    spec = write_spec(tmp_path, grid_spec(fmu_path, total))
     out = tmp_path / "out"
     args = ("run", spec, "--out", out, "--scheduler", cluster.address, "--chunk-size", "1", "--quiet")
     client = processes.start(sweep_cmd(*args), env=env_with_package(), stdout=subprocess.DEVNULL,
@@ -189,7 +175,7 @@ def test_client_killed_then_rerun(cluster, tmp_path, fmu_path, processes):
 def test_timed_out_sweep_leaves_no_process(tmp_path, fmu_path):
     """A sweep that exceeds its timeout in the tests is killed with its LocalCluster: its process
     group (client, nannies, workers) is empty afterwards."""
-    spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=40))
+    spec = write_spec(tmp_path, grid_spec(fmu_path, 40))
     out = tmp_path / "out"
     p = start_sweep("run", spec, "--out", out, "--workers", "2", "--chunk-size", "1", "--quiet")
     try:
@@ -212,7 +198,7 @@ def test_scheduler_killed_mid_sweep(cluster, tmp_path, fmu_path, processes):
     same command resumes), no traceback, Dask's log lines in _log.jsonl and not on the terminal; a
     rerun on a local cluster computes exactly the missing points."""
     total = 40
-    spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=total))
+    spec = write_spec(tmp_path, grid_spec(fmu_path, total))
     out = tmp_path / "out"
     client = processes.start(sweep_cmd("run", spec, "--out", out, "--scheduler", cluster.address,
                                        "--chunk-size", "1"),
@@ -250,7 +236,7 @@ def test_every_worker_lost(processes, tmp_path_factory, tmp_path, fmu_path):
     points. (Before this timeout existed, the client waited forever: communicate() times out.)"""
     cluster = start_cluster(processes, tmp_path_factory, 1)
     total = 40
-    spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=total))
+    spec = write_spec(tmp_path, grid_spec(fmu_path, total))
     out = tmp_path / "out"
     client, address = kill_worker_mid_sweep(processes, cluster, spec, out, 3, "--no-worker-timeout", "3")
     t = time.monotonic()
@@ -286,7 +272,7 @@ def test_ctrl_c(tmp_path, fmu_path):
     """SIGINT to the whole process group, as Ctrl-C in a terminal sends it: exit 130, one message,
     no traceback and no leaked-semaphore warning; the rerun completes the sweep."""
     total = 40
-    spec = write_spec(tmp_path, SLOW.format(fmu=fmu_path, num=total))
+    spec = write_spec(tmp_path, grid_spec(fmu_path, total))
     out = tmp_path / "out"
     p = start_sweep("run", spec, "--out", out, "--workers", "2", "--chunk-size", "1")
     try:

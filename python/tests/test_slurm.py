@@ -24,27 +24,14 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from conftest import (Processes, env_with_package, finish_group, free_port, kill_group, log_entries, run_sweep,
-                      start_group, sweep_cmd, write_spec)
+from conftest import (Processes, env_with_package, finish_group, free_port, grid_spec, kill_group, log_entries,
+                      run_sweep, start_group, sweep_cmd, write_spec)
 
 PROGRAMS = ("munged", "slurmctld", "slurmd", "sbatch", "squeue", "scancel", "sinfo")
 
-SPEC = """
-fmu = "{fmu}"
-stop_time = {stop}
-output_interval = 0.01
-transient = 2.0
-outputs = ["w", "sticking"]
-[start]
-N = 9991
-[grid]
-g_amp = {{ start = 0.5, stop = 2.5, num = {num} }}
-{extra}
-"""
-
 
 def spec_text(fmu: str, num: int, stop: float = 3.0, extra: str = "") -> str:
-    return SPEC.format(fmu=fmu, num=num, stop=stop, extra=extra)
+    return grid_spec(fmu, num, stop=stop, transient=2.0, extra=extra)
 
 
 class Slurm:
