@@ -144,11 +144,12 @@ class WorkerWatch:
 
     def __init__(self, client: Client, timeout: float, where: str = "",
                  clock: Callable[[], float] = time.monotonic,
-                 waiting: Callable[[], bool] | None = None):
+                 waiting: Callable[[], bool] | None = None, waiting_gone: str = ""):
         """where: " at <address>" for the messages; waiting(), asked when there is no worker: whether
-        workers are still to come (SLURM jobs still queued or starting), which stops the count."""
+        workers are still to come (SLURM jobs still queued or starting), which stops the count;
+        waiting_gone: what the lost message adds when waiting() said no ("and ...")."""
         self.client, self.timeout, self.where, self.clock = client, timeout, where, clock
-        self.waiting = waiting
+        self.waiting, self.waiting_gone = waiting, waiting_gone
         self.interval = min(1.0, timeout / 4)
         self.asked = -math.inf       # when the scheduler was last asked
         self.none_since: float | None = None    # the first answer "no worker" of the current run of them
@@ -165,8 +166,8 @@ class WorkerWatch:
         elif self.none_since is None:
             self.none_since = now
         elif now - self.none_since >= self.timeout:
-            jobs = "" if self.waiting is None else " and SLURM has none of its jobs left"
-            raise ClusterLost(f"the scheduler{self.where} has had no worker for {self.timeout:g} s{jobs}",
+            gone = f" and {self.waiting_gone}" if self.waiting_gone else ""
+            raise ClusterLost(f"the scheduler{self.where} has had no worker for {self.timeout:g} s{gone}",
                               resume="once the cluster has workers again")
 
     def start(self, on_lost: Callable[[], object]) -> None:
@@ -494,7 +495,8 @@ def _run_locked(spec: Spec, store: Store, t0: float, client: Client | None, work
 
         where = f" at {scheduler}" if scheduler else ""
         watch = WorkerWatch(client, no_worker_timeout, where,
-                            waiting=(lambda: slurm_jobs.jobs_alive(cluster)) if on_slurm else None)
+                            waiting=(lambda: slurm_jobs.jobs_alive(cluster)) if on_slurm else None,
+                            waiting_gone="SLURM has none of its jobs left" if on_slurm else "")
         futures: dict[str, Any] = {}             # key of a task -> its future, while pending
 
         def submit(points: list[int]):
