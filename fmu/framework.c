@@ -226,12 +226,13 @@ static void describe_bytes(const dmi_fmu_values *v, size_t N, double h, char *ou
              what, MODEL->step ? "in tau" : "steps per tau", peak, peak / 1e9, kept, kept / 1e9);
 }
 
-/* Out of memory in the solver s: the error names N and the bytes needed. */
-static int memory_fail(char *err, const char *what, const dmi_fmu_values *v, const dmi_solver *s)
+/* Out of memory in a solver of N cells of h (describe_bytes): the error
+ * names N and the bytes needed. */
+static int memory_fail(char *err, const char *what, const dmi_fmu_values *v, size_t N, double h)
 {
     int len = snprintf(err, FMU_ERRLEN, "%s: out of memory: ", what);
     if (len >= 0 && len < FMU_ERRLEN)
-        describe_bytes(v, dmi_get_N(s), dmi_get_h(s), err + len, (size_t)(FMU_ERRLEN - len));
+        describe_bytes(v, N, h, err + len, (size_t)(FMU_ERRLEN - len));
     return -1;
 }
 
@@ -264,18 +265,15 @@ static int solver_create(const dmi_fmu_values *v, dmi_solver **out, char *err)
                         dmi_strerror(rc));
     } else {
         rc = dmi_create(out, MODEL->n, tau, steps_per_tau(v));
-        if (rc == DMI_ENOMEM) { /* N is the parameter: no solver to ask */
-            int len = snprintf(err, FMU_ERRLEN, "creating the solver: out of memory: ");
-            describe_bytes(v, steps_per_tau(v), 0.0, err + len, (size_t)(FMU_ERRLEN - len));
-            return -1;
-        }
+        if (rc == DMI_ENOMEM) /* N is the parameter: no solver to ask */
+            return memory_fail(err, "creating the solver", v, steps_per_tau(v), 0.0);
         if (rc != DMI_OK)
             return solver_fail(err, "creating the solver (tau, N)", NULL, rc);
     }
     char msg[FMU_ERRLEN] = "";
     if ((rc = MODEL->configure(v, *out, msg)) != 0) {
         if (rc == DMI_ENOMEM)
-            memory_fail(err, "configuring the solver", v, *out);
+            memory_fail(err, "configuring the solver", v, dmi_get_N(*out), dmi_get_h(*out));
         else { /* the model's message after the prefix, cut to fit */
             const char *why = msg[0] ? msg : dmi_last_error(*out);
             size_t len = strlen(strcpy(err, "configuring the solver: "));
@@ -294,7 +292,7 @@ static int solver_init(const dmi_fmu_values *v, dmi_solver *s, char *err)
 {
     int rc = dmi_init(s);
     if (rc == DMI_ENOMEM)
-        return memory_fail(err, "initialising the solver", v, s);
+        return memory_fail(err, "initialising the solver", v, dmi_get_N(s), dmi_get_h(s));
     return rc == DMI_OK ? 0 : solver_fail(err, "initialising the solver", s, rc);
 }
 

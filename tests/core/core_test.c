@@ -156,6 +156,37 @@ int core_same_state(const dmi_solver *a, const dmi_solver *b)
     return same;
 }
 
+unsigned char *core_state_v1(const dmi_solver *s, size_t n, size_t N, double tau, size_t *size)
+{
+    uint64_t w[8] = {UINT64_C(0x444d495354415445), 1, n, N, 0, 0, 0, 0};
+    memcpy(&w[4], &tau, sizeof tau);
+    const size_t nd = (N + 3) * n;
+    double *d = calloc(nd, sizeof *d);
+    unsigned char *b = malloc(sizeof w + nd * sizeof *d);
+    int ok = d && b && dmi_get_step_index(s, &w[5]) == DMI_OK;
+    w[6] = w[5] != 0;
+    for (size_t lag = 0; ok && lag <= N; lag++)
+        ok = dmi_get_past(s, lag, d + lag * n) == DMI_OK;
+    if (ok && w[5] > 0)
+        ok = dmi_get_step_terms(s, d + (N + 1) * n, d + (N + 2) * n) == DMI_OK;
+    if (!ok) {
+        free(d);
+        free(b);
+        return NULL;
+    }
+    *size = sizeof w + nd * sizeof *d;
+    memcpy(b, w, sizeof w);
+    memcpy(b + sizeof w, d, nd * sizeof *d);
+    uint64_t hsh = UINT64_C(0xcbf29ce484222325);
+    for (size_t i = 0; i < *size; i++) {
+        hsh ^= b[i];
+        hsh *= UINT64_C(0x100000001b3);
+    }
+    memcpy(b + 7 * sizeof(uint64_t), &hsh, sizeof hsh);
+    free(d);
+    return b;
+}
+
 /* ---- the fault-injection model ------------------------------------------------- */
 
 /* Counts the call; if the callback is to misbehave now, spoils out[k] or

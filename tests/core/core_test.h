@@ -55,6 +55,15 @@ int core_same_state(const dmi_solver *a, const dmi_solver *b);
 /* 1 iff dmi_state_save(s) gives exactly bytes[0..size-1]. */
 int core_state_is(const dmi_solver *s, const unsigned char *bytes, size_t size);
 
+/* The state of s (n components, N steps per tau, delay tau; initialised)
+ * in format version 1, as libdmi 1.0 wrote it (src/dmi.c of the 1.0.0
+ * release, 5cd99de; written here from that layout, not with bytes.h): 8
+ * uint64 words magic "DMISTATE", 1, n, N, bits of tau, p, p != 0, FNV-1a 64
+ * of all bytes with this word zero; then (N + 1) n doubles U_j^{p-lag}
+ * (lag-major), n doubles W^{p-1}, n doubles X^{p-1} (zeros before a step).
+ * Caller frees; NULL on failure. */
+unsigned char *core_state_v1(const dmi_solver *s, size_t n, size_t N, double tau, size_t *size);
+
 /* ---- the fault-injection model ----------------------------------------------
  * n = 2, u' + A u + f(t, u) + int_0^tau H(s) u(t - s) ds = 0 with
  *   f(t, u) = (0.3 u0 - u1 + sin t, u0 + 0.1 u1 - 0.5 cos 2t),

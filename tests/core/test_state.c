@@ -212,45 +212,6 @@ static void test_refused(void)
     dmi_free(&t);
 }
 
-/* The state of s (n components, N steps per tau, delay tau; initialised)
- * in format version 1, as libdmi 1.0 wrote it (src/dmi.c of the 1.0.0
- * release, 5cd99de; written here from that layout, not with bytes.h): 8
- * uint64 words magic "DMISTATE", 1, n, N, bits of tau, p, p != 0, FNV-1a 64
- * of all bytes with this word zero; then (N + 1) n doubles U_j^{p-lag}
- * (lag-major), n doubles W^{p-1}, n doubles X^{p-1} (zeros before a step).
- * Caller frees; NULL on failure. */
-static unsigned char *state_v1(const dmi_solver *s, size_t n, size_t N, double tau,
-                               size_t *size)
-{
-    uint64_t w[8] = {UINT64_C(0x444d495354415445), 1, n, N, 0, 0, 0, 0};
-    memcpy(&w[4], &tau, sizeof tau);
-    const size_t nd = (N + 3) * n;
-    double *d = calloc(nd, sizeof *d);
-    unsigned char *b = malloc(sizeof w + nd * sizeof *d);
-    int ok = d && b && dmi_get_step_index(s, &w[5]) == DMI_OK;
-    w[6] = w[5] != 0;
-    for (size_t lag = 0; ok && lag <= N; lag++)
-        ok = dmi_get_past(s, lag, d + lag * n) == DMI_OK;
-    if (ok && w[5] > 0)
-        ok = dmi_get_step_terms(s, d + (N + 1) * n, d + (N + 2) * n) == DMI_OK;
-    if (!ok) {
-        free(d);
-        free(b);
-        return NULL;
-    }
-    *size = sizeof w + nd * sizeof *d;
-    memcpy(b, w, sizeof w);
-    memcpy(b + sizeof w, d, nd * sizeof *d);
-    uint64_t hsh = UINT64_C(0xcbf29ce484222325);
-    for (size_t i = 0; i < *size; i++) {
-        hsh ^= b[i];
-        hsh *= UINT64_C(0x100000001b3);
-    }
-    memcpy(b + 7 * sizeof(uint64_t), &hsh, sizeof hsh);
-    free(d);
-    return b;
-}
-
 /* The model's solver with its kernel replaced by the exponential kernel
  * H(s) = [[exp(-s), 0.3], [0.5 cos(2 pi s), -0.2 exp(-3 s) cos(5 s)]] (summed
  * by the recursion), N = 16, initialised; NULL on failure. */
@@ -281,7 +242,7 @@ static void test_version_1(void)
     dmi_solver *a = model_after(&ma, SAVED_AT), *b = model_after(&mb, 5), *c = model_after(&mc, 0);
     CU_ASSERT_FATAL(a && b && c);
     size_t size, size_b;
-    unsigned char *v1 = state_v1(a, 2, N, 1.0, &size), *before_b = core_save(b, &size_b);
+    unsigned char *v1 = core_state_v1(a, 2, N, 1.0, &size), *before_b = core_save(b, &size_b);
     CU_ASSERT_FATAL(v1 && before_b);
     CU_ASSERT_EQUAL(size, dmi_state_size(a) - DMI_STATE_REC_BYTES); /* no sums either way */
 
@@ -322,7 +283,7 @@ static void test_version_1(void)
     CU_ASSERT_EQUAL(dmi_advance(e, SAVED_AT), DMI_OK);
     CU_ASSERT_EQUAL(dmi_advance(f, 5), DMI_OK);
     size_t size_e;
-    unsigned char *v1e = state_v1(e, 2, N, 1.0, &size_e);
+    unsigned char *v1e = core_state_v1(e, 2, N, 1.0, &size_e);
     CU_ASSERT_FATAL(v1e != NULL);
     CU_ASSERT_EQUAL(size_e, dmi_state_at_rec(2, N));
     CU_ASSERT(size_e < dmi_state_size(e)); /* version 2 holds the sums */

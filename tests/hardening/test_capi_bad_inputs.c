@@ -21,6 +21,7 @@
 
 #include "bytes.h" /* the state's layout (src/) */
 #include "capi_model.h"
+#include "core_test.h" /* core_state_v1: a state of libdmi 1.0 */
 #include "dmi.h"
 #include "hard_util.h"
 
@@ -162,48 +163,14 @@ static void fix_checksum(unsigned char *b, size_t size)
 {
     dmi_put_u64(b, DMI_STATE_AT_CHECKSUM, dmi_fnv1a_skip(b, size, DMI_STATE_AT_CHECKSUM));
 }
-/* The state of s (initialised and stepped) in format version 1, built as
- * libdmi 1.0 wrote it (src/dmi.c of the 1.0.0 release, independent of
- * bytes.h): 8 uint64 words magic "DMISTATE", 1, n, N, bits of tau, p,
- * p != 0, FNV-1a 64 of all bytes with this word zero; then (N + 1) n doubles
- * U_j^{p-lag} (lag-major), n doubles W, n doubles X.  Caller frees. */
-static unsigned char *state_v1(const dmi_solver *s, size_t *size)
-{
-    enum { n = MODEL_n, N = MODEL_N };
-    const double tau = MODEL_TAU;
-    uint64_t w[8] = {UINT64_C(0x444d495354415445), 1, n, N, 0, 0, 0, 0};
-    double d[(N + 3) * n];
-    memcpy(&w[4], &tau, sizeof tau);
-    if (dmi_get_step_index(s, &w[5]) != DMI_OK)
-        return NULL;
-    w[6] = w[5] != 0;
-    for (size_t lag = 0; lag <= N; lag++)
-        if (dmi_get_past(s, lag, d + lag * n) != DMI_OK)
-            return NULL;
-    if (dmi_get_step_terms(s, d + (N + 1) * n, d + (N + 2) * n) != DMI_OK)
-        return NULL;
-    *size = sizeof w + sizeof d; /* 176 bytes */
-    unsigned char *b = malloc(*size);
-    if (!b)
-        return NULL;
-    memcpy(b, w, sizeof w);
-    memcpy(b + sizeof w, d, sizeof d);
-    uint64_t hsh = UINT64_C(0xcbf29ce484222325);
-    for (size_t i = 0; i < *size; i++) {
-        hsh ^= b[i];
-        hsh *= UINT64_C(0x100000001b3);
-    }
-    memcpy(b + 7 * sizeof(uint64_t), &hsh, sizeof hsh);
-    return b;
-}
-
 /* A state of libdmi 1.0 (format version 1, which libdmi reads since 1.2)
  * given with 24 bytes more, the size of a version-2 state of s: refused by
  * its size. */
 static int load_v1_long(dmi_solver *s)
 {
     size_t size;
-    unsigned char *b = state_v1(s, &size), *longer = b ? calloc(size + 24, 1) : NULL;
+    unsigned char *b = core_state_v1(s, MODEL_n, MODEL_N, MODEL_TAU, &size);
+    unsigned char *longer = b ? calloc(size + 24, 1) : NULL;
     int rc = -100;
     if (longer) {
         memcpy(longer, b, size);
