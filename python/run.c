@@ -22,12 +22,14 @@
  * t_p and U^p (n values, rows of U) at p = p0, p0 + stride, ..., every
  * stride-th step, and at p0 + steps if that is not among them: at most
  * steps / stride + 2 rows, the caller's arrays t and U hold that many.
- * *rows = the number of rows written, also on failure.  Returns DMI_OK or
- * the code of the first failing step (the steps before it are kept, as in
+ * *rows = the number of rows written, also on failure.  X: NULL, or room for
+ * as many rows less one: row r - 1 = X^{q-1}, the resolvent's argument of the
+ * last step into row r (at step q) of U (dmi_get_step_terms).  Returns DMI_OK
+ * or the code of the first failing step (the steps before it are kept, as in
  * dmi_advance).  stride >= 1.
  */
 DMI_PY_API int dmi_py_run(dmi_solver *s, size_t n, size_t steps, size_t stride, double *t,
-                          double *U, size_t *rows)
+                          double *U, double *X, size_t *rows)
 {
     size_t r = 0;
     int rc = dmi_get_state(s, U);
@@ -41,6 +43,8 @@ DMI_PY_API int dmi_py_run(dmi_solver *s, size_t n, size_t steps, size_t stride, 
             done += chunk;
             t[r] = dmi_time(s);
             dmi_get_state(s, U + r * n);
+            if (X != NULL)
+                dmi_get_step_terms(s, NULL, X + (r - 1) * n);
             r++;
         }
     }

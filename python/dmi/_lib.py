@@ -73,7 +73,8 @@ for _name, (_res, _args) in _PROTOTYPES.items():
     _f.restype, _f.argtypes = _res, _args
 
 pylib.dmi_py_run.restype = c_int
-pylib.dmi_py_run.argtypes = [_solver_p, c_size_t, c_size_t, c_size_t, _d, _d, POINTER(c_size_t)]
+pylib.dmi_py_run.argtypes = [_solver_p, c_size_t, c_size_t, c_size_t, _d, _d, _d,
+                             POINTER(c_size_t)]
 # out = M x (libdmi's rhs and resolvent signature), the tangent map of dmi.analysis
 pylib.dmi_py_linear.restype = c_int
 pylib.dmi_py_linear.argtypes = [c_double, c_void_p, c_void_p, c_void_p]

@@ -271,20 +271,34 @@ class Solver:
         (rows, n) at p0, p0 + stride, ..., p0 + k stride <= p0 + steps, and at p0 + steps (the
         last row), p0 the step index at the call.  On a failing step the steps before it are
         kept, and the exception has the rows recorded until then as ``partial = (t, U)``."""
+        t, U, _ = self._run(steps, stride, False)
+        return t, U
+
+    def run_terms(self, steps: int, stride: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`run` that also records the resolvent's argument: returns ``t``, ``U`` (rows,
+        n) and ``X`` (rows - 1, n), X[k] the argument X^{q-1} of the step into U[k + 1] (at
+        step q; :meth:`step_terms` after that step), still in one call to C."""
+        return self._run(steps, stride, True)  # type: ignore[return-value]
+
+    def _run(self, steps: int, stride: int, terms: bool
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
         steps = _count(steps, "steps", 0)
         stride = _count(stride, "stride", 1)
         cap = steps // stride + 2
         t = np.empty(cap)
         U = np.empty((cap, self._n))
+        X = np.empty((cap - 1, self._n)) if terms else None
         rows = ctypes.c_size_t(0)
         with self._using() as s:
-            rc = _lib.pylib.dmi_py_run(s, self._n, steps, stride, _ptr(t), _ptr(U), ctypes.byref(rows))
+            rc = _lib.pylib.dmi_py_run(s, self._n, steps, stride, _ptr(t), _ptr(U),
+                                       None if X is None else _ptr(X), ctypes.byref(rows))
             try:
                 self._check(rc)
             except BaseException as e:
                 e.partial = (t[:rows.value].copy(), U[:rows.value].copy())
                 raise
-        return t[:rows.value].copy(), U[:rows.value].copy()
+        r = rows.value
+        return t[:r].copy(), U[:r].copy(), None if X is None else X[:r - 1].copy()
 
     # ---- queries ---------------------------------------------------------------------------------
 

@@ -69,6 +69,18 @@ def test_stick_onset_located_and_passed():
     assert abs(onsets[0].p - hi) < 2 * d.T / M, (onsets[0].p, hi)  # O(h)
     steps = b.column("stick_steps")[:, 1]
     assert np.all(steps[b.p > hi + 0.01] == 0) and np.all(steps[b.p < hi - 0.01] > 0)
+    # the margin: on the non-stick side Den Hartog's net force beyond friction at the velocity
+    # reversal, |F cos(w t_r) - x(t_r)| - F0 at x(t_r) = a (F = p), to O(h) wherever the steps
+    # fall about the reversal; below 0 where it sticks
+    for q in b.points:
+        if q.stick_steps[1] == 0:
+            e = DenHartog(F=q.p)
+            exact = abs(e.F * np.cos(e.w * (e.t0 + e.T / 2)) - e.a) - e.F0
+            assert abs(q.margin[1] - exact) < 2 * d.T / M, (q.p, q.margin, exact)
+        else:
+            assert q.margin[1] < 0, (q.p, q.margin)
+    # the corrector: Newton-Picard on the previous point's basis (here the dense Jacobian)
+    assert [q.corrector for q in b.points[1:]].count("newton-picard") >= len(b.points) - 2
     assert np.all(b.column("stick_steps")[:, 0] == 0)
     # the points past the kink are orbits: the map's residual at each
     from dmi.analysis.shooting import StepMap

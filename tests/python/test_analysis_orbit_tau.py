@@ -58,6 +58,20 @@ def test_stable_branch_is_the_runs_attractor(branches):
     assert not any(q.stable for q in b.points if q.p > pd.p + 0.01)
 
 
+def test_branch_points_are_orbits_of_fresh_maps(branches):
+    """Every point of both branches is a fixed point of the map built anew at its p (the
+    corrector's own residual not trusted), and Newton-Picard (on the subspace of the 6 leading
+    multipliers) converged at most of them."""
+    from dmi.analysis.shooting import StepMap
+    _, b, _, b2 = branches
+    for br in (b, b2):
+        for q in br.points:
+            F = StepMap(br.make, q.p, br.steps, rows=br.rows)
+            assert np.max(np.abs(F(q.state) - q.state)) < 1e-9, q.p
+        used = [q.corrector for q in br.points[1:]]
+        assert used.count("newton-picard") >= 0.7 * len(used), used
+
+
 def test_period_doubling_where_the_runs_double(branches):
     make, b, pd, b2 = branches
     # the runs: period 1 just below the detected doubling, period 2 just above

@@ -298,3 +298,26 @@ def test_window_round_trip():
     t1, U1 = s.run(40)
     t2, U2 = other.run(40)
     assert np.array_equal(t1, t2) and np.array_equal(U1, U2)
+
+
+@pytest.mark.parametrize("stride", [1, 3])
+def test_run_terms_records_each_steps_argument(stride):
+    """run_terms's X rows are step_terms()'s X after the step into each recorded row (Example 4.3,
+    friction: X differs from U on every slip step), its t and U are run's; a failing step keeps
+    the rows before it, as run does."""
+    a, b = model(), model()
+    t, U, X = a.run_terms(40, stride)
+    Xs, rows = [], []
+    for k in range(1, 41):
+        b.step()
+        if k % stride == 0 or k == 40:
+            Xs.append(b.step_terms()[1])
+            rows.append(b.state)
+    assert X.shape == (len(U) - 1, 2) and np.array_equal(X, np.array(Xs))
+    assert np.array_equal(U[1:], np.array(rows)) and not np.array_equal(X, U[1:])
+    assert a.save_state() == b.save_state()
+    s, raised = model(), []
+    s.set_rhs(failing(python_callbacks(43)[0], 15, raised))
+    with pytest.raises(Boom):
+        s.run_terms(40, stride)
+    assert s.step_index == 20 + 14

@@ -3,9 +3,17 @@
 """Continuation of a periodic orbit of the scheme in its parameter p.
 
 Pseudo-arclength on z = (x, p), x the shooting state (:mod:`dmi.analysis.shooting`): a secant
-predictor z + ds t, then Newton on  F_p(x) - x = 0,  <t, z - z_pred> = 0  with GMRES on the
+predictor z + ds t (the first step: x at p + step), then a corrector on  F_p(x) - x = 0,
+<t, z - z_pred> = 0.  The corrector is Newton-Picard: the previous point's multipliers leave a
+basis Q of the dominant subspace and its image Z = D_xF Q (:func:`dmi.analysis.floquet.ritz`),
+and the bordered system with D_xF replaced by Z Q' is solved exactly in b + 1 unknowns, one
+evaluation of the map an iteration: a chord Newton step on span Q, a Picard step on its
+complement, which contracts at the rate of the largest multiplier left out (Lust, Roose, Spence
+and Champneys, SIAM J. Sci. Comput. 19 (1998) 1188).  When that contracts too slowly (by less
+than half an iteration) or there is no basis yet (``multipliers=0``), Newton with GMRES on the
 bordered matrix-free Jacobian [[D_xF - I, D_pF], [t_x' / dim, t_p]] (D_xF by forward differences
-along the Krylov vectors, D_pF by one difference in p per iteration).  The inner product weighs
+along the Krylov vectors, D_pF by one difference in p per iteration) takes over from the
+predictor; ``BranchPoint.corrector`` says which converged.  The inner product weighs
 x by 1 / dim (an RMS), so ds is a step in "p or RMS state units".  By default the period M h is
 kept: make(p) must keep h.  With ``period=P`` (a function p -> the period, time units, e.g. the
 forcing period 2 pi / p of a continuation in the frequency) M is kept and the step follows p:
@@ -13,7 +21,8 @@ the map at p is built by ``make(p, h=P(p) / M)`` (libdmi 1.2's ``Solver(n, tau, 
 an autonomous orbit).  A model over tau with a free step h has N = ceil(tau / h) changing with p
 (with tau, or with h): the states hold L = max N + 1 over the two ends of the range (+ 2 %) rows,
 the older ones filled by M-periodicity (:meth:`StepMap.extend`); the map reads the last
-N(p) + 1.  The step grows by 1.5 after an easy corrector (<= 3 iterations),
+N(p) + 1.  The step grows by 1.5 after an easy corrector (Newton-Picard in <= 6 iterations,
+Newton in <= 3),
 halves after a failure, and the branch ends at p_end, at ``max_points``, when it leaves the
 p-range it started in, or when the step falls below ``min_step`` (``Branch.status`` says which).
 
@@ -28,11 +37,13 @@ Events between consecutive points (``Branch.events``):
   of stuck steps goes from 0 to > 0 (or back);
 - ``grazing``: a component's number of stick phases changes while it sticks on both sides.
 A step is stuck when U_i == 0 for 2 steps or more (:func:`dmi.analysis.shooting.stuck_mask`).
-Every point carries ``margin``, the smallest distance of the resolvent's argument X_i from its
-threshold h alpha_i over the period (lone zero steps, the scheme's crossing of a velocity
-reversal, left out), divided by h (force units; alpha_i from the slip steps, |X_i - U_i| =
-h alpha_i): on a non-stick orbit it is the least net force beyond friction at a velocity
-reversal, and it goes to 0 at a stick-onset (it stays O(h) while a component sticks).
+Every point carries ``margin``, a component's least force besides friction at its velocity
+reversals, less the friction threshold alpha_i (force units): min |X_i - U_i^p| / h - alpha_i
+over the steps p where U_i reaches 0 or changes sign (X the resolvent's argument, from the same
+run as the point's states, :meth:`dmi.Solver.run_terms`; alpha_i = |X_i - U_i^(p+1)| / h on the
+slip steps).  It is > 0 where every reversal slips through (Den Hartog's net force beyond
+friction), <= 0 where the component sticks, and crosses 0 at a stick-onset; it does not depend
+on where the steps fall about the reversal (a lone zero step or a sign change), to O(h).
 Stick-onset and grazing events are located by bisection in p (6 halvings of the bracket).
 """
 from __future__ import annotations
@@ -42,11 +53,10 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse.linalg as sla
 
 from .._errors import Error
 from .._solver import Solver
-from .floquet import monodromy_operator, ritz
+from .floquet import fd_step, ritz
 from .shooting import (Model, Orbit, ShootingError, StepMap, bordered_step, build, newton,
                        periodic_orbit, positive_time, stuck_mask)
 
@@ -58,7 +68,8 @@ class BranchPoint:
     steps per period; ``stick_phases`` (n,): stuck intervals per period; ``margin`` (n,): see
     the module; ``section`` (k, n): u at t = j period / k, j < k (k = ``sections``: a Poincare
     section at the forcing period of a k-periodic orbit); ``state``: the shooting state;
-    ``dpds``: the tangent's p component (its sign flips at a fold); ``iterations``."""
+    ``dpds``: the tangent's p component (its sign flips at a fold); ``iterations`` and
+    ``corrector`` (``newton-picard`` or ``newton``, see the module; empty at the start)."""
     p: float
     period: float
     amplitude: np.ndarray
@@ -71,6 +82,7 @@ class BranchPoint:
     state: np.ndarray = field(repr=False)
     dpds: float = 0.0
     iterations: int = 0
+    corrector: str = ""
 
 
 @dataclass
@@ -117,67 +129,60 @@ class Branch:
         return np.array([getattr(q, name) for q in self.points])
 
 
-def _stick_profile(F: StepMap, x: np.ndarray, margins: bool = True, U: np.ndarray | None = None
+def _stick_profile(F: StepMap, U: np.ndarray, X: np.ndarray | None
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Stuck steps, stick phases and margins (see the module) over one period.  The margins
-    need the resolvent's argument X of every step: one period step by step (M calls from
-    Python); ``margins=False`` reads the stuck steps from one run (or its trajectory ``U``)
-    and leaves the margins NaN."""
-    if not margins:
-        U = F.trajectory(x) if U is None else U
-        stuck = stuck_mask(U)
-        steps = stuck.sum(axis=0)
-        phases = np.sum(stuck & ~np.roll(stuck, 1, axis=0), axis=0)
-        phases[steps == F.M] = 1
-        return steps, phases, np.full(F.n, np.nan)
-    s = F.solver
-    X0 = np.asarray(x).reshape(F.L, F.n)
-    s.load_state(F._start)
-    s.set_window(X0[F.L - F.N - 1:])
-    U = np.empty((F.M + 1, F.n))
-    X = np.empty((F.M, F.n))
-    U[0] = X0[-1]
-    for k in range(F.M):
-        s.step()
-        U[k + 1] = s.state
-        X[k] = s.step_terms()[1]
+    """Stuck steps, stick phases and margins (see the module) over one period, from its M + 1
+    states U and the resolvent's arguments X of its M steps (:meth:`StepMap.trajectory_terms`);
+    X None: the margins are NaN."""
     stuck = stuck_mask(U)
-    U = U[1:]
     steps = stuck.sum(axis=0)
     # stick phases on the circle: starts of runs of stuck steps
     phases = np.sum(stuck & ~np.roll(stuck, 1, axis=0), axis=0)
     phases[steps == F.M] = 1
-    lone = (U == 0.0) & ~stuck  # the scheme's crossing of a velocity reversal
-    margin = np.full(F.n, np.inf)
+    margin = np.full(F.n, np.nan if X is None else np.inf)
+    if X is None:
+        return steps, phases, margin
+    u0, u1 = U[:-1], U[1:]          # U^p and U^(p+1) of the steps p = 0 .. M - 1
     for i in range(F.n):
-        slip = (U[:, i] != 0.0) & (X[:, i] != U[:, i])
-        if slip.any():
-            ha = float(np.median(np.abs(X[slip, i] - U[slip, i])))  # h alpha_i
-            keep = ~lone[:, i]
-            if keep.any():
-                margin[i] = float(np.min(np.abs(np.abs(X[keep, i]) - ha))) / F.h
+        slip = (u1[:, i] != 0.0) & (X[:, i] != u1[:, i])
+        if not slip.any():
+            continue                    # no friction on this component
+        alpha = float(np.median(np.abs(X[slip, i] - u1[slip, i]))) / F.h
+        # the steps where the velocity reaches 0 or crosses it (all steps of a component stuck
+        # throughout), and the force there besides friction, |X - U^p| / h
+        entry = ((u1[:, i] == 0.0) & (u0[:, i] != 0.0)) | (u0[:, i] * u1[:, i] < 0.0)
+        if not entry.any():
+            entry = stuck[:, i]
+        if entry.any():
+            margin[i] = float(np.min(np.abs(X[entry, i] - u0[entry, i]))) / F.h - alpha
     return steps, phases, margin
 
 
 def _point(F: StepMap, x: np.ndarray, multipliers: int, sections: int, dpds: float,
-           iterations: int, margins: bool = True, warm: list | None = None) -> BranchPoint:
+           iterations: int, margins: bool = True, warm: list | None = None,
+           corrector: str = "") -> BranchPoint:
     """The BranchPoint at the fixed point x of F; ``warm``: a one-element list holding the
-    previous point's Ritz basis (updated), for 1 sweep of subspace iteration instead of 3."""
-    U = F.trajectory(x)
+    previous point's (Q, Z) of :func:`ritz` (replaced by this point's): the Ritz step starts
+    from qr(Z), b products instead of 4 b from random vectors."""
+    U, X = F.trajectory_terms(x) if margins else (F.trajectory(x), None)
     mu = np.empty(0, complex)
     if multipliers > 0:
-        start = warm[0] if warm else None
-        mu, basis = ritz(F, x, multipliers, start=start,
-                         iterations=1 if start is not None and start.shape[0] == x.size else 3)
+        prev = warm[0] if warm else None
+        eps = fd_step(F, x, U)
+        if prev is not None and prev[1].shape[0] == x.size:
+            mu, Q, Z = ritz(F, x, multipliers, start=np.linalg.qr(prev[1])[0], iterations=0,
+                            eps=eps)
+        else:
+            mu, Q, Z = ritz(F, x, multipliers, eps=eps)
         if warm is not None:
-            warm[0] = basis
-    steps, phases, margin = _stick_profile(F, x, margins, U)
+            warm[0] = (Q, Z)
+    steps, phases, margin = _stick_profile(F, U, X)
     k = F.M // sections
     return BranchPoint(p=F.p, period=F.M * F.h, amplitude=0.5 * (U.max(axis=0) - U.min(axis=0)),
                        multipliers=mu, stable=bool(mu.size and np.all(np.abs(mu) < 1)),
                        stick_steps=steps, stick_phases=phases, margin=margin,
                        section=U[[j * k for j in range(sections)]], state=np.array(x),
-                       dpds=dpds, iterations=iterations)
+                       dpds=dpds, iterations=iterations, corrector=corrector)
 
 
 def _events(a: BranchPoint, b: BranchPoint, index: int) -> list[Event]:
@@ -214,8 +219,7 @@ def _events(a: BranchPoint, b: BranchPoint, index: int) -> list[Event]:
     for i in range(len(a.stick_steps)):
         sa, sb = int(a.stick_steps[i]), int(b.stick_steps[i])
         if (sa == 0) != (sb == 0):
-            ma = a.margin[i] if sa else -a.margin[i]
-            mb = b.margin[i] if sb else -b.margin[i]
+            ma, mb = a.margin[i], b.margin[i]
             ev.append(Event("stick-onset", at(ma, mb) if math.isfinite(ma + mb) else b.p, index,
                             i, f"component {i}: stuck steps {sa} -> {sb}"))
         elif sa and a.stick_phases[i] != b.stick_phases[i]:
@@ -264,7 +268,7 @@ def _locate_stick(maps: _Maps, a: BranchPoint, b: BranchPoint, e: Event, tol: fl
             xm, _ = newton(F, 0.5 * (xa + xb), tol=tol, max_iter=12, what=f"locating at {pm!r}")
         except (ShootingError, ValueError, Error):
             return e
-        st, ph, _ = _stick_profile(F, xm, margins=False)
+        st, ph, _ = _stick_profile(F, F.trajectory(xm), None)
         if key((st[i], ph[i])) == ka:
             pa, xa = pm, xm
         else:
@@ -333,15 +337,128 @@ class _Maps:
         return F
 
 
-def _corrector(maps: _Maps, z: np.ndarray, t: np.ndarray, tol: float, max_iter: int,
-               ds: float) -> tuple[np.ndarray, int]:
-    """Newton on (F_p(x) - x, <t, z - z_pred>) from z = z_pred; returns (z, iterations).
-    ShootingError when an iterate strays more than ds from the predictor (weighted norm): the
-    step is then too long for the predictor, and another branch may lie on the hyperplane."""
-    zp = z.copy()
-    dim = z.size - 1
-    w = np.full(z.size, 1.0 / dim)
+def _weights(size: int) -> np.ndarray:
+    """The arclength's inner product weights: 1 / dim on x (an RMS), 1 on p."""
+    w = np.full(size, 1.0 / (size - 1))
     w[-1] = 1.0
+    return w
+
+
+class _Slow(Exception):
+    """The Newton-Picard corrector contracts too slowly: Newton takes over."""
+
+
+def _too_slow(rn: float, prev: float, target: float, left: int) -> bool:
+    """A linear iteration whose residual went from prev to rn contracts too slowly: by less than
+    half, or at a rate that would not bring rn below target in ``left`` more iterations."""
+    rate = rn / prev
+    if rate > 0.5:
+        return True
+    return 0 < rate and target < rn and math.log(target / rn) / math.log(rate) > left
+
+
+def _newton_picard(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, ds: float,
+                   Q: np.ndarray, Z: np.ndarray, max_iter: int = 16) -> tuple[np.ndarray, int]:
+    """The corrector by Newton-Picard (Lust, Roose, Spence & Champneys 1998) from the predictor
+    zp: the Jacobian D_xF is replaced by its rank-b approximation Z Q' on the previous point's
+    dominant subspace (Q orthonormal, Z = D_xF Q there, from :func:`ritz`), D_pF by one difference
+    in p at the predictor, and the bordered system
+
+        (Z Q' - I) dx + F_p dp = -(F(x) - x),     w t . (dx, dp) = -g,
+
+    is solved exactly: dx = Q xi + (I - Q Q')(r + F_p dp + Z xi), with (xi, dp) from b + 1
+    equations.  On the complement of span Q that is a Picard step (x takes F(x)'s component), which
+    contracts at the rate of the largest multiplier left out; on span Q a chord Newton step.  One
+    evaluation of F an iteration (one more for F_p); S = Q' Z gets Broyden's update from each
+    step (ZC = Z - Q S, the leak off span Q, is kept).  Returns (z, iterations); raises _Slow when,
+    after the second iteration, the residual falls by less than half in one, or at its rate would
+    not reach tol within max_iter; ShootingError as :func:`_corrector`."""
+    dim = zp.size - 1
+    wt = _weights(zp.size) * t
+    wx, tp = wt[:-1], float(t[-1])
+    x, p = zp[:-1], float(zp[-1])
+    F = maps(p)
+    if F.dim != dim or Q.shape[0] != dim:
+        raise _Slow("the state's size changed")
+    Fx = F(x)
+    dp = 1e-7 * max(1.0, abs(p))
+    Fp = (maps(p + dp)(x) - Fx) / dp
+    S = Q.T @ Z
+    ZC = Z - Q @ S                   # (I - Q Q') Z
+    FpC = Fp - Q @ (Q.T @ Fp)
+    b = Q.shape[1]
+    K = np.zeros((b + 1, b + 1))
+    K[:b, :b] = S - np.eye(b)
+    K[:b, b] = Q.T @ Fp
+    K[b, :b] = wx @ Q + wx @ ZC
+    K[b, b] = wx @ FpC + tp
+    z = zp.copy()
+    prev = math.inf
+    for it in range(max_iter + 1):
+        r = Fx - x
+        g = float(np.dot(wt, z - zp))
+        rn = float(np.max(np.abs(r)))
+        if not math.isfinite(rn):
+            raise ShootingError(f"non-finite residual at p = {p!r}", [rn])
+        scale = max(1.0, float(np.max(np.abs(x))))
+        if rn <= tol * scale and abs(g) <= 1e-8 * max(1.0, abs(p)):
+            return z, it
+        if it == max_iter or (it >= 2 and _too_slow(rn, prev, tol * scale, max_iter - it)):
+            raise _Slow(f"residual {rn:.3g} after {it} iterations (previous {prev:.3g})")
+        prev = rn
+        Qr = Q.T @ r
+        rC = r - Q @ Qr
+        try:
+            sol = np.linalg.solve(K, np.concatenate([-Qr, [-g - wx @ rC]]))
+        except np.linalg.LinAlgError:
+            raise _Slow("singular reduced system") from None
+        xi, dpp = sol[:b], float(sol[b])
+        z = z + np.concatenate([Q @ xi + rC + FpC * dpp + ZC @ xi, [dpp]])
+        d = z - zp
+        far = math.sqrt(float(np.dot(_weights(z.size) * d, d)))
+        if far > ds:
+            raise ShootingError(f"corrector strayed {far:.3g} > ds = {ds:.3g} from the predictor "
+                                f"at p = {float(z[-1])!r}", [rn])
+        x, p = z[:-1], float(z[-1])
+        F = maps(p)
+        if F.dim != dim:
+            raise ShootingError(f"the state grew to {F.dim} values at p = {p!r}", [])
+        Fx, Fold = F(x), Fx
+        # Broyden's update of the reduced Jacobian S = Q' D_xF Q by the step just taken (Q' dx =
+        # xi): S xi := Q' (F(x_new) - F(x_old) - F_p dp); no evaluation, and a multiplier that
+        # moved since the previous point (near 1, the chord's rate |dmu| / |1 - mu|) is caught
+        nxi = float(np.dot(xi, xi))
+        if nxi > 0:
+            S = S + np.outer(Q.T @ (Fx - Fold - Fp * dpp) - S @ xi, xi / nxi)
+            K[:b, :b] = S - np.eye(b)
+    raise AssertionError("unreachable")
+
+
+def _correct(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, max_iter: int, ds: float,
+             dominant: tuple[np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, int, str]:
+    """The corrector from the predictor zp: Newton-Picard on the previous point's ``dominant``
+    (Q, Z) when there is one, Newton (GMRES) from zp when it contracts too slowly.
+    Returns (z, iterations, which): ``newton-picard`` or ``newton``."""
+    z = zp
+    if dominant is not None:
+        try:
+            z, its = _newton_picard(maps, zp, t, tol, ds, *dominant)
+            return z, its, "newton-picard"
+        except _Slow:
+            z = zp
+    z, its = _corrector(maps, z, t, tol, max_iter, ds, zp)
+    return z, its, "newton"
+
+
+def _corrector(maps: _Maps, z: np.ndarray, t: np.ndarray, tol: float, max_iter: int,
+               ds: float, zp: np.ndarray | None = None) -> tuple[np.ndarray, int]:
+    """Newton on (F_p(x) - x, <t, z - zp>) from z (zp: the predictor, default z); returns (z,
+    iterations).  ShootingError when an iterate strays more than ds from the predictor (weighted
+    norm): the step is then too long for the predictor, and another branch may lie on the
+    hyperplane."""
+    zp = z.copy() if zp is None else zp
+    dim = z.size - 1
+    w = _weights(z.size)
     for it in range(max_iter + 1):
         x, p = z[:-1], float(z[-1])
         F = maps(p)
@@ -379,11 +496,12 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     """Continues ``orbit`` (from :func:`periodic_orbit`) in p towards ``p_end`` (finite, not
     orbit.p) by pseudo-arclength with initial step ``step`` (the first point at p + step, p units;
     then arclengths in the norm sqrt(|dx|^2 / dim + dp^2), p and RMS state units; ``min_step``
-    default step / 1000, ``max_step`` default 4 step).  Every point gets ``multipliers`` Floquet multipliers and a
-    stick profile; events are detected between consecutive points (see the module).
-    ``sections``: the orbit spans this many forcing periods (a period-doubled branch: 2), for
-    ``BranchPoint.section``.  ``margins=False`` skips the margins (NaN), which cost one period
-    stepped from Python a point (the stuck steps and phases then come from one run).
+    default step / 1000, ``max_step`` default 4 step).  Every point gets ``multipliers`` Floquet
+    multipliers (they also make the Newton-Picard corrector's basis: with 0 every step is a
+    Newton-GMRES solve) and a stick profile; events are detected between consecutive points
+    (see the module).  ``sections``: the orbit spans this many forcing periods (a period-doubled
+    branch: 2), for ``BranchPoint.section``.  ``margins=False`` leaves the margins NaN (they come
+    from the run that gives the point's states, at no extra evaluation).
     ``period``: None keeps the period M h (make(p) keeps h); a function p -> period (time units;
     a forced orbit in its frequency w: ``period=lambda w: 2 * math.pi / w``) keeps M = orbit.steps
     and gives the model the step h = period(p) / M through ``make(p, h=...)`` (orbit.make must
@@ -427,24 +545,24 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     pts = [_point(F0, x0, multipliers, sections, direction, orbit.iterations, margins, warm)]
     events: list[Event] = []
     status = "max_points reached"
-    # the first step: natural continuation in p
+    # the first step: natural continuation in p (the hyperplane p = p1)
     ds = step
     z_prev = np.concatenate([x0, [orbit.p]])
+    t_p = np.zeros(x0.size + 1)
+    t_p[-1] = 1.0
     while True:
         p1 = orbit.p + direction * ds
         try:
-            F1 = maps(p1)
-            x1, res = newton(F1, F1.extend(x0), tol=tol,
-                             max_iter=max_iter + 4, what=f"continuation at p = {p1!r}")
+            z, its, how = _correct(maps, np.concatenate([x0, [p1]]), t_p, tol, max_iter + 4,
+                                 math.inf, warm[0])
             break
-        except (ShootingError, ValueError) as e:
+        except (ShootingError, ValueError, Error) as e:
             ds /= 2
             if ds < min_step:
                 return Branch(pts, events, f"first step failed: {e}", orbit.make, orbit.steps,
                               orbit.h, maps.rows, sections, period)
-    z = np.concatenate([x1, [p1]])
-    pts.append(_point(maps(p1), x1, multipliers, sections, direction, len(res) - 1, margins,
-                      warm))
+    pts.append(_point(maps(float(z[-1])), z[:-1], multipliers, sections, direction, its, margins,
+                      warm, how))
     events += _events(pts[-2], pts[-1], 1)
     while len(pts) < max_points:
         if (pts[-1].p - p_end) * direction >= 0:
@@ -453,8 +571,7 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
         if pts[-1].p < lo - 1e-12 * max(1, abs(lo)) or pts[-1].p > hi + 1e-12 * max(1, abs(hi)):
             status = f"left the range [{lo!r}, {hi!r}] after a fold"
             break
-        w = np.full(z.size, 1.0 / (z.size - 1))
-        w[-1] = 1.0
+        w = _weights(z.size)
         sec = z - z_prev
         t = sec / math.sqrt(float(np.dot(w * sec, sec)))
         while True:
@@ -463,7 +580,7 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
             if (zp[-1] - p_end) * direction > 0 and abs(t[-1]) > 0.5:
                 zp = z + ((p_end - z[-1]) / t[-1]) * t
             try:
-                zn, its = _corrector(maps, zp, t, tol, max_iter, ds)
+                zn, its, how = _correct(maps, zp, t, tol, max_iter, ds, warm[0])
                 break
             except (ShootingError, ValueError, Error) as e:   # Error: the map failed there
                 ds /= 2
@@ -477,26 +594,28 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
         z_prev, z = z, zn
         dpds = float(z[-1] - z_prev[-1])
         pts.append(_point(maps(float(z[-1])), z[:-1], multipliers, sections, dpds, its, margins,
-                          warm))
+                          warm, how))
         for e in _events(pts[-2], pts[-1], len(pts) - 1):
             if e.kind == "fold":
                 e = _refine_fold(pts[-3:], e)
             elif e.kind in ("stick-onset", "grazing") and pts[-2].dpds * pts[-1].dpds > 0:
                 e = _locate_stick(maps, pts[-2], pts[-1], e, tol)
             events.append(e)
-        ds = min(max_step, ds * 1.5) if its <= 3 else ds
+        easy = its <= (6 if how == "newton-picard" else 3)
+        ds = min(max_step, ds * 1.5) if easy else ds
     return Branch(pts, events, status, orbit.make, orbit.steps, orbit.h, maps.rows, sections,
                   period)
 
 
 def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[float, ...] =
-                         (1.0, 0.3, 0.1, 0.03), multipliers: int = 6, tol: float = 1e-10
+                         (0.03, 0.1, 0.3, 1.0), multipliers: int = 6, tol: float = 1e-10
                          ) -> Orbit:
     """The period-2M orbit born at a ``period-doubling`` event of ``branch``: at the point of
     the event's pair where the M-periodic orbit has a multiplier < -1 (its unstable side, where
     a supercritical doubling's orbit lives) the M-periodic state x is perturbed along the
-    multiplier's eigenvector v (|v|_inf = 1), x + a A v, A the orbit's amplitude, a from
-    ``amplitudes``, and shot with period 2 M h; the first solution that is not the M-periodic
+    multiplier's Ritz vector v (:func:`dmi.analysis.floquet.ritz`, |v|_inf = 1), x + a A v, A
+    the orbit's amplitude, a from ``amplitudes`` (smallest first: the orbit born at the event is
+    the nearest), and shot with period 2 M h; the first solution that is not the M-periodic
     orbit is returned (continue it with ``continue_orbit(..., sections=2 * branch.sections)``,
     and ``period=lambda p: 2 * P(p)`` for a branch continued with ``period=P``: its ``make``
     is then make(p, h=None), h = P(p) / M by default).  ShootingError when none is found."""
@@ -507,14 +626,10 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
     maps = _Maps(branch.make, branch.steps, branch.h, branch.rows, branch.period)
     F = maps(q.p)
     x = F.extend(q.state)
-    A = monodromy_operator(F, x)
-    if A.shape[0] <= 64:
-        D = np.column_stack([A.matvec(np.eye(A.shape[0])[:, j]) for j in range(A.shape[0])])
-        mu, V = np.linalg.eig(D)
-    else:
-        mu, V = sla.eigs(A, k=min(6, A.shape[0] - 2), which="LM", ncv=min(A.shape[0], 20))
+    _, Q, Z = ritz(F, x, 6)
+    mu, Y = np.linalg.eig(Q.T @ Z)   # Ritz pairs: the eigenvector Q y
     j = int(np.argmin(np.abs(mu + 1) + 10 * np.abs(mu.imag)))
-    v = V[:, j].real
+    v = (Q @ Y[:, j]).real
     v /= np.max(np.abs(v))
     amp = max(float(np.max(q.amplitude)), 0.1 * max(1.0, float(np.max(np.abs(x)))))
     make = branch.make

@@ -34,12 +34,12 @@ FD_FACTOR = 1.0
 FD_CAP = 0.05
 
 
-def fd_step(F: StepMap, x: np.ndarray) -> float:
+def fd_step(F: StepMap, x: np.ndarray, U: np.ndarray | None = None) -> float:
     """The difference step eps = FD_FACTOR A min(M^(-1/3), FD_CAP) (state units), A the largest
-    half range (max - min) / 2 of a component over one period from x (one run of M steps).  If the orbit
-    is constant: an equilibrium has no switch to carry, and the step is then the usual
-    eps_machine^(1/3) max(1, |x|) of central differences)."""
-    U = F.trajectory(x)
+    half range (max - min) / 2 of a component over one period from x (its trajectory ``U``, else
+    one run of M steps).  If the orbit is constant: an equilibrium has no switch to carry, and
+    the step is then the usual eps_machine^(1/3) max(1, |x|) of central differences)."""
+    U = F.trajectory(x) if U is None else U
     A = float(np.max(0.5 * (U.max(axis=0) - U.min(axis=0))))
     scale = max(1.0, float(np.max(np.abs(U))))
     if not A > 1e-9 * scale:
@@ -73,15 +73,16 @@ def monodromy_operator(F: StepMap, x: np.ndarray, eps: float | None = None,
 
 
 def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
-                        eps: float | None = None, iterations: int = 3,
+                        eps: float | None = None, iterations: int = 2,
                         central: bool = True) -> np.ndarray:
     """The ``count`` Floquet multipliers (dimensionless) of largest modulus at the fixed point x of
     the M-step map F, largest first (complex).  F is a :class:`dmi.analysis.shooting.StepMap`, e.g.
     ``StepMap(orbit.make, orbit.p, orbit.steps, orbit.rows)`` with x = ``orbit.state``; ``eps``
-    (state units) overrides the difference step of :func:`fd_step`.  States of at most 64 values: the eigenvalues of the dense matrix (its
-    columns by the operator).  Larger: subspace iteration with Rayleigh-Ritz on a block of
-    b = count + 4 vectors, ``iterations`` sweeps (b (iterations + 1) products of 2 periods each,
-    1 with ``central=False``, see :func:`monodromy_operator`): the eigenvalues of Q' A Q.  Not
+    (state units) overrides the difference step of :func:`fd_step`.  States of at most 64 values:
+    the eigenvalues of the dense matrix (its columns by the operator).  Larger: subspace
+    iteration with Rayleigh-Ritz on a block of b = count + 2 vectors, ``iterations`` sweeps (b
+    (iterations + 1) products of 2 evaluations each, 1 with ``central=False``, see
+    :func:`monodromy_operator`): the eigenvalues of Q' A Q.  Not
     ARPACK's eigs: the difference operator is linear only up to the switches' rounding to a
     step (O(h / eps)), and a Krylov recurrence amplifies that (two eigs calls at one orbit of
     the tau-diagram, M = 2000: 0.226 and 0.279), while a Ritz matrix of independently
@@ -90,29 +91,33 @@ def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
     return ritz(F, x, count, iterations=iterations, eps=eps, central=central)[0]
 
 
-def ritz(F: StepMap, x: np.ndarray, count: int, *, iterations: int = 3,
+def ritz(F: StepMap, x: np.ndarray, count: int, *, iterations: int = 2,
          start: np.ndarray | None = None, eps: float | None = None, central: bool = True
-         ) -> tuple[np.ndarray, np.ndarray | None]:
-    """(multipliers, basis) of :func:`floquet_multipliers`; ``basis`` (dim, b) is the next
-    subspace iterate, a warm ``start`` for a nearby orbit (continuation: 1 sweep from the
-    previous point's basis instead of 3 from random vectors); None for a dense state."""
+         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(multipliers, Q, Z) of :func:`floquet_multipliers`: Q (dim, b) the orthonormal basis of the
+    Rayleigh-Ritz step and Z = A Q its image (A the difference operator), so that Q' Z is the Ritz
+    matrix and Z Q' the operator's rank-b approximation on the dominant subspace (the
+    continuation's Newton-Picard corrector, see :mod:`dmi.analysis.continuation`); qr(Z) is the
+    next subspace iterate, the ``start`` for a nearby orbit (a continuation: ``iterations=0``,
+    b products a point, one sweep of subspace iteration along the branch).  A dense state (<= 64
+    values): Q = I and Z the whole matrix."""
     A = monodromy_operator(F, x, eps, central)
     dim = A.shape[0]
     count = min(count, dim)
-    basis = None
     if dim <= 64:
-        D = np.column_stack([A.matvec(np.eye(dim)[:, j]) for j in range(dim)])
-        mu = np.linalg.eigvals(D)
+        Q = np.eye(dim)
+        Z = np.column_stack([A.matvec(Q[:, j]) for j in range(dim)])
+        mu = np.linalg.eigvals(Z)
     else:
-        b = min(dim, count + 4)
+        b = min(dim, count + 2)
         if start is None or start.shape != (dim, b):
             start = np.random.default_rng(0).standard_normal((dim, b))
+            iterations = max(iterations, 1)
         Q = np.linalg.qr(start)[0]
         for _ in range(iterations):
             Q = np.linalg.qr(np.column_stack([A.matvec(Q[:, j]) for j in range(b)]))[0]
         Z = np.column_stack([A.matvec(Q[:, j]) for j in range(b)])
         mu = np.linalg.eigvals(Q.T @ Z)
-        basis = np.linalg.qr(Z)[0]
     mu = np.asarray(mu, dtype=complex)
     mu[np.abs(mu) < 1e-12] = 0.0
-    return mu[np.argsort(-np.abs(mu), kind="stable")][:count], basis
+    return mu[np.argsort(-np.abs(mu), kind="stable")][:count], Q, Z

@@ -96,14 +96,24 @@ class StepMap:
     def dim(self) -> int:
         return self.L * self.n
 
-    def trajectory(self, x: np.ndarray) -> np.ndarray:
-        """The M + 1 states U^0 .. U^M (rows) from the state x (U^0 its last row)."""
+    def _start_at(self, x: np.ndarray) -> Solver:
+        """The solver at step 0 with the window the last N + 1 rows of x (one evaluation)."""
         X = np.asarray(x, dtype=float).reshape(self.L, self.n)
         s = self.solver
         s.load_state(self._start)
         s.set_window(X[self.L - self.N - 1:])
         self.evaluations += 1
-        return s.run(self.M)[1]
+        return s
+
+    def trajectory(self, x: np.ndarray) -> np.ndarray:
+        """The M + 1 states U^0 .. U^M (rows) from the state x (U^0 its last row)."""
+        return self._start_at(x).run(self.M)[1]
+
+    def trajectory_terms(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`trajectory` and the resolvent's arguments X^0 .. X^(M-1) (M rows: X^k the
+        argument of the step into U^(k+1)), from one run."""
+        _, U, X = self._start_at(x).run_terms(self.M)
+        return U, X
 
     def extend(self, x: np.ndarray) -> np.ndarray:
         """x (k >= N + 1 rows, flattened) as a state of L rows: the older rows by M-periodicity
@@ -126,9 +136,20 @@ class StepMap:
         return out.ravel()
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
-        X = np.asarray(x, dtype=float).reshape(self.L, self.n)
-        U = self.trajectory(X)
-        return np.concatenate([X, U[1:]])[-self.L:].ravel()
+        """F(x): the last L rows of x's rows followed by U^1 .. U^M.  Only the last L rows are
+        read back: M - (L - N - 1) steps in C (advance), the window, and a run of the last
+        L - N - 1 steps (none when L = N + 1)."""
+        tail = self.L - self.N - 1
+        K = self.M - tail
+        if K < 0:  # fewer steps than extra rows: older rows of x move up
+            X = np.asarray(x, dtype=float).reshape(self.L, self.n)
+            return np.concatenate([X, self.trajectory(X)[1:]])[-self.L:].ravel()
+        s = self._start_at(x)
+        s.advance(K)
+        W = s.get_window()
+        if tail:
+            W = np.concatenate([W, s.run(tail)[1][1:]])
+        return W.ravel()
 
 
 def state_of(solver: Solver, M: int) -> np.ndarray:
