@@ -207,3 +207,59 @@ class Belt:
         s.set_rhs(lambda t, u: np.array([-(u[1] + v), u[0] - 2 * d * (u[1] + v)]))
         s.set_friction([0.0, a])
         return s
+
+
+class ParametricDuffing:
+    """x'' + d x' + (1 + b cos w t) x + x^3 = 0 (Mathieu with a hardening cubic), as u = (x, v):
+    f = (-v, d v + (1 + b cos w t) x + x^3), no friction, no delay (tau = h, N = 1), M steps a
+    forcing period 2 pi / w.  The rest u = 0 is an orbit for every w; its multipliers cross -1
+    at the lower edge w* of the principal parametric resonance tongue (w near 2), where a stable
+    orbit of twice the forcing period is born (x -> -x half a period later).  With f explicit
+    the scheme is U+ = U - h f(t_k, U), t_k = k h: its period map and exact derivative (the
+    product of I - h Df) are computed here in numpy, independent of dmi.analysis."""
+
+    def __init__(self, d: float = 0.1, b: float = 0.4, M: int = 100):
+        self.d, self.b, self.M = d, b, M
+
+    def make(self, w: float, h: float | None = None) -> dmi.Solver:
+        """The model at frequency w, step h (default 2 pi / (w M))."""
+        h = 2 * np.pi / (w * self.M) if h is None else h
+        d, b = self.d, self.b
+        s = dmi.Solver(2, h, h=h)
+        s.set_rhs(lambda t, u: np.array([-u[1], d * u[1] + (1 + b * np.cos(w * t)) * u[0]
+                                         + u[0] ** 3]))
+        return s
+
+    def run(self, x, w: float, periods: int = 1) -> tuple[np.ndarray, np.ndarray]:
+        """(U after periods M steps from U^0 = x at t = 0, its derivative in x) by numpy."""
+        h = 2 * np.pi / (w * self.M)
+        u, D = np.array(x, dtype=float), np.eye(2)
+        for k in range(periods * self.M):
+            c = 1 + self.b * np.cos(w * (k * h))
+            D = (np.eye(2) - h * np.array([[0.0, -1.0], [c + 3 * u[0] ** 2, self.d]])) @ D
+            u = u - h * np.array([-u[1], self.d * u[1] + c * u[0] + u[0] ** 3])
+        return u, D
+
+    def rest_multipliers(self, w: float) -> np.ndarray:
+        return np.linalg.eigvals(self.run([0.0, 0.0], w)[1])
+
+    def doubling(self, lo: float = 1.79, hi: float = 1.85) -> float:
+        """w* in [lo, hi]: the rest's real multiplier through -1 (brentq)."""
+        def g(w):
+            mu = self.rest_multipliers(w)
+            return float(np.min(mu[np.abs(mu.imag) < 1e-12].real, initial=0.0)) + 1
+        return so.brentq(g, lo, hi, xtol=1e-14)
+
+    def two_cycle(self, w: float, guess) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(U at t = 0, U one forcing period later, multipliers) of the orbit of period
+        2 (2 pi / w) near guess (U at t = 0): Newton on the two-period map in numpy."""
+        x = np.array(guess, dtype=float)
+        for _ in range(50):
+            u, D = self.run(x, w, 2)
+            if np.max(np.abs(u - x)) < 1e-14:
+                break
+            x = x - np.linalg.solve(D - np.eye(2), u - x)
+        else:
+            raise RuntimeError(f"no two-cycle near {guess} at w = {w}")
+        u, D = self.run(x, w, 2)
+        return x, self.run(x, w)[0], np.linalg.eigvals(D)
