@@ -263,3 +263,68 @@ class ParametricDuffing:
             raise RuntimeError(f"no two-cycle near {guess} at w = {w}")
         u, D = self.run(x, w, 2)
         return x, self.run(x, w)[0], np.linalg.eigvals(D)
+
+
+class BumpStick:
+    """u' + sigma(u) ∋ F_p(t) = a + c sin t - p sin 3t (friction alpha = 1; f = -F_p, no delay:
+    tau = h, N = 1; M steps a period 2 pi).  Around t = 3 pi / 2, F_p(3 pi / 2 + s) =
+    a - c cos s - p cos 3s >= a - c - p (c, p > 0): the minimum a - c - p sits at s = 0.
+    With a = 0.2, c = 1 the orbit slips once a period (F > 1 around pi / 2) and sticks in one
+    phase around 3 pi / 2 while F >= -1 there, i.e. p <= p* = 1 + a - c; above p* the bump of
+    -F reaches the friction, a short negative slip splits the stick phase in two (a grazing).
+    For the scheme the same p* holds exactly: a stuck step stays stuck while |F_p(t_k)| <= 1,
+    and t_k = 3 pi / 2 is a step when 4 divides M.  Slips in closed form (brentq on the
+    antiderivative of F): :meth:`stick_time`."""
+
+    def __init__(self, a: float = 0.2, c: float = 1.0):
+        self.a, self.c = a, c
+        self.p_star = 1.0 + a - c
+
+    def F(self, t, p: float):
+        return self.a + self.c * np.sin(t) - p * np.sin(3 * t)
+
+    def _G(self, t, p: float):   # an antiderivative of F
+        return self.a * t - self.c * np.cos(t) + p / 3 * np.cos(3 * t)
+
+    def make_for(self, M: int):
+        a, c = self.a, self.c
+
+        def make(p: float) -> dmi.Solver:
+            s = dmi.Solver(1, 2 * np.pi / M, 1)
+            s.set_rhs(lambda t, u: np.array([-(a + c * np.sin(t) - p * np.sin(3 * t))]))
+            s.set_friction([1.0])
+            return s
+        return make
+
+    def stick_time(self, p: float) -> tuple[float, int]:
+        """(stuck time per period, stick phases) of the continuous orbit at p: the positive slip
+        from t_a (F = 1, rising) until u = int_ta^t (F - 1) is 0 again, the negative one (p > p*)
+        from t_b (F = -1, falling, before 3 pi / 2) until int_tb^t (F + 1) is 0; checked: one
+        interval each where |F| > 1, and |F| <= 1 on the rest of the period (the sticks)."""
+        t = np.linspace(0, 2 * np.pi, 200001)
+        Ft = self.F(t, p)
+        up, down = Ft > 1, Ft < -1
+        ta = so.brentq(lambda s: self.F(s, p) - 1, 0, np.pi / 2)
+        tpk = so.brentq(lambda s: self.F(s, p) - 1, np.pi / 2, np.pi)  # F back to 1
+        if np.any(up & ((t < ta - 1e-4) | (t > tpk + 1e-4))):
+            raise RuntimeError("F > 1 outside one interval")
+        te = so.brentq(lambda s: self._G(s, p) - self._G(ta, p) - (s - ta), tpk, 3 * np.pi / 2)
+        slip = te - ta
+        phases = 1
+        if p > self.p_star + 1e-12:
+            tb = so.brentq(lambda s: self.F(s, p) + 1, np.pi, 3 * np.pi / 2)
+            tb2 = 3 * np.pi - tb   # F is even about 3 pi / 2
+            if np.any(down & ((t < tb - 1e-4) | (t > tb2 + 1e-4))):
+                raise RuntimeError("F < -1 outside one interval")
+            tc = so.brentq(lambda s: self._G(s, p) - self._G(tb, p) + (s - tb), tb2,
+                           ta + 2 * np.pi)
+            if tc >= ta + 2 * np.pi:
+                raise RuntimeError("the negative slip does not end before the positive one")
+            slip += tc - tb
+            phases = 2
+        elif np.any(down):
+            raise RuntimeError("F < -1 at p <= p*")
+        stuck = (t > te) & (t < 2 * np.pi + ta) | (t < ta)
+        if np.any(np.abs(Ft[stuck & ~down]) > 1 + 1e-12):
+            raise RuntimeError("|F| > 1 in a stick phase")
+        return 2 * np.pi - slip, phases
