@@ -207,3 +207,124 @@ class Belt:
         s.set_rhs(lambda t, u: np.array([-(u[1] + v), u[0] - 2 * d * (u[1] + v)]))
         s.set_friction([0.0, a])
         return s
+
+
+class ParametricDuffing:
+    """x'' + d x' + (1 + b cos w t) x + x^3 = 0 (Mathieu with a hardening cubic), as u = (x, v):
+    f = (-v, d v + (1 + b cos w t) x + x^3), no friction, no delay (tau = h, N = 1), M steps a
+    forcing period 2 pi / w.  The rest u = 0 is an orbit for every w; its multipliers cross -1
+    at the lower edge w* of the principal parametric resonance tongue (w near 2), where a stable
+    orbit of twice the forcing period is born (x -> -x half a period later).  With f explicit
+    the scheme is U+ = U - h f(t_k, U), t_k = k h: its period map and exact derivative (the
+    product of I - h Df) are computed here in numpy, independent of dmi.analysis."""
+
+    def __init__(self, d: float = 0.1, b: float = 0.4, M: int = 100):
+        self.d, self.b, self.M = d, b, M
+
+    def make(self, w: float, h: float | None = None) -> dmi.Solver:
+        """The model at frequency w, step h (default 2 pi / (w M))."""
+        h = 2 * np.pi / (w * self.M) if h is None else h
+        d, b = self.d, self.b
+        s = dmi.Solver(2, h, h=h)
+        s.set_rhs(lambda t, u: np.array([-u[1], d * u[1] + (1 + b * np.cos(w * t)) * u[0]
+                                         + u[0] ** 3]))
+        return s
+
+    def run(self, x, w: float, periods: int = 1) -> tuple[np.ndarray, np.ndarray]:
+        """(U after periods M steps from U^0 = x at t = 0, its derivative in x) by numpy."""
+        h = 2 * np.pi / (w * self.M)
+        u, D = np.array(x, dtype=float), np.eye(2)
+        for k in range(periods * self.M):
+            c = 1 + self.b * np.cos(w * (k * h))
+            D = (np.eye(2) - h * np.array([[0.0, -1.0], [c + 3 * u[0] ** 2, self.d]])) @ D
+            u = u - h * np.array([-u[1], self.d * u[1] + c * u[0] + u[0] ** 3])
+        return u, D
+
+    def rest_multipliers(self, w: float) -> np.ndarray:
+        return np.linalg.eigvals(self.run([0.0, 0.0], w)[1])
+
+    def doubling(self, lo: float = 1.79, hi: float = 1.85) -> float:
+        """w* in [lo, hi]: the rest's real multiplier through -1 (brentq)."""
+        def g(w):
+            mu = self.rest_multipliers(w)
+            return float(np.min(mu[np.abs(mu.imag) < 1e-12].real, initial=0.0)) + 1
+        return so.brentq(g, lo, hi, xtol=1e-14)
+
+    def two_cycle(self, w: float, guess) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(U at t = 0, U one forcing period later, multipliers) of the orbit of period
+        2 (2 pi / w) near guess (U at t = 0): Newton on the two-period map in numpy."""
+        x = np.array(guess, dtype=float)
+        for _ in range(50):
+            u, D = self.run(x, w, 2)
+            if np.max(np.abs(u - x)) < 1e-14:
+                break
+            x = x - np.linalg.solve(D - np.eye(2), u - x)
+        else:
+            raise RuntimeError(f"no two-cycle near {guess} at w = {w}")
+        u, D = self.run(x, w, 2)
+        return x, self.run(x, w)[0], np.linalg.eigvals(D)
+
+
+class BumpStick:
+    """u' + sigma(u) ∋ F_p(t) = a + c sin t - p sin 3t (friction alpha = 1; f = -F_p, no delay:
+    tau = h, N = 1; M steps a period 2 pi).  Around t = 3 pi / 2, F_p(3 pi / 2 + s) =
+    a - c cos s - p cos 3s >= a - c - p (c, p > 0): the minimum a - c - p sits at s = 0.
+    With a = 0.2, c = 1 the orbit slips once a period (F > 1 around pi / 2) and sticks in one
+    phase around 3 pi / 2 while F >= -1 there, i.e. p <= p* = 1 + a - c; above p* the bump of
+    -F reaches the friction, a short negative slip splits the stick phase in two (a grazing).
+    For the scheme the same p* holds exactly: a stuck step stays stuck while |F_p(t_k)| <= 1,
+    and t_k = 3 pi / 2 is a step when 4 divides M.  Slips in closed form (brentq on the
+    antiderivative of F): :meth:`stick_time`."""
+
+    def __init__(self, a: float = 0.2, c: float = 1.0):
+        self.a, self.c = a, c
+        self.p_star = 1.0 + a - c
+
+    def F(self, t, p: float):
+        return self.a + self.c * np.sin(t) - p * np.sin(3 * t)
+
+    def _G(self, t, p: float):   # an antiderivative of F
+        return self.a * t - self.c * np.cos(t) + p / 3 * np.cos(3 * t)
+
+    def make_for(self, M: int):
+        a, c = self.a, self.c
+
+        def make(p: float) -> dmi.Solver:
+            s = dmi.Solver(1, 2 * np.pi / M, 1)
+            s.set_rhs(lambda t, u: np.array([-(a + c * np.sin(t) - p * np.sin(3 * t))]))
+            s.set_friction([1.0])
+            return s
+        return make
+
+    def stick_time(self, p: float) -> tuple[float, int]:
+        """(stuck time per period, stick phases) of the continuous orbit at p: the positive slip
+        from t_a (F = 1, rising) until u = int_ta^t (F - 1) is 0 again, the negative one (p > p*)
+        from t_b (F = -1, falling, before 3 pi / 2) until int_tb^t (F + 1) is 0; checked: one
+        interval each where |F| > 1, and |F| <= 1 on the rest of the period (the sticks)."""
+        t = np.linspace(0, 2 * np.pi, 200001)
+        Ft = self.F(t, p)
+        up, down = Ft > 1, Ft < -1
+        ta = so.brentq(lambda s: self.F(s, p) - 1, 0, np.pi / 2)
+        tpk = so.brentq(lambda s: self.F(s, p) - 1, np.pi / 2, np.pi)  # F back to 1
+        if np.any(up & ((t < ta - 1e-4) | (t > tpk + 1e-4))):
+            raise RuntimeError("F > 1 outside one interval")
+        te = so.brentq(lambda s: self._G(s, p) - self._G(ta, p) - (s - ta), tpk, 3 * np.pi / 2)
+        slip = te - ta
+        phases = 1
+        if p > self.p_star + 1e-12:
+            tb = so.brentq(lambda s: self.F(s, p) + 1, np.pi, 3 * np.pi / 2)
+            tb2 = 3 * np.pi - tb   # F is even about 3 pi / 2
+            if np.any(down & ((t < tb - 1e-4) | (t > tb2 + 1e-4))):
+                raise RuntimeError("F < -1 outside one interval")
+            tc = so.brentq(lambda s: self._G(s, p) - self._G(tb, p) + (s - tb), tb2,
+                           ta + 2 * np.pi)
+            if tc >= ta + 2 * np.pi:
+                raise RuntimeError("the negative slip does not end before the positive one")
+            slip += tc - tb
+            phases = 2
+        elif np.any(down):
+            raise RuntimeError("F < -1 at p <= p*")
+        stuck = (t > te) & (t < 2 * np.pi + ta) | (t < ta)
+        if np.any(np.abs(Ft[stuck & ~down]) > 1 + 1e-12):
+            raise RuntimeError("|F| > 1 in a stick phase")
+        return 2 * np.pi - slip, phases
