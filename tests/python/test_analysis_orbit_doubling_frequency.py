@@ -56,6 +56,8 @@ def test_doubling_in_w_and_the_doubled_orbit(model, branch):
     e = pds[0]
     a, c = b.points[e.index - 1].p, b.points[e.index].p
     assert a < ws < c and a <= e.p <= c, (a, ws, c, e)   # between the two points around w*
+    # interpolated on 1 + min Re mu (at a the multiplier is half of a complex pair)
+    assert abs(e.p - ws) < 0.25 * (c - a), (a, ws, c, e)
 
     o2 = period_doubled_orbit(b, e, multipliers=2)
     assert o2.steps == 2 * model.M and o2.period == pytest.approx(2 * period(o2.p), rel=1e-12)

@@ -78,3 +78,41 @@ def test_stick_slip_orbit_and_zero_multiplier(ss):
     slope = np.log(errs[0] / errs[1]) / np.log(hs[0] / hs[1])
     assert 0.8 <= slope <= 1.2, (errs, slope)
     assert errs[-1] < 10 * hs[-1]
+
+
+def test_smooth_nonlinear_orbit_multipliers_are_the_schemes():
+    """A forced pendulum x'' + 0.5 x' + sin x = 1.1 cos(0.7 t) (no friction: no switch, the
+    difference step must be small, not 5 % of the amplitude): the orbit and multipliers of its
+    explicit scheme (N = 1, no kernel: U+ = U - h f(t, U)) solved in numpy, the multipliers as the
+    eigenvalues of the product of the steps' Jacobians I - h Df."""
+    import math
+
+    import dmi
+    import scipy.optimize as so
+
+    M, w = 200, 0.7
+    h = 2 * math.pi / (w * M)
+
+    def f(t, u):
+        return np.array([-u[1], 0.5 * u[1] + np.sin(u[0]) - 1.1 * np.cos(w * t)])
+
+    def period_map(u, jac=False):
+        J = np.eye(2)
+        for k in range(M):
+            t = k * h
+            J = (np.eye(2) - h * np.array([[0.0, -1.0], [np.cos(u[0]), 0.5]])) @ J
+            u = u - h * f(t, u)
+        return (u, J) if jac else u
+
+    u0 = so.fsolve(lambda u: period_map(u) - u, [-0.59, 1.96], xtol=1e-12)
+    exact = np.linalg.eigvals(period_map(u0, jac=True)[1])
+    exact = exact[np.argsort(-np.abs(exact))]
+
+    def make(p):
+        s = dmi.Solver(2, h, h=h)
+        s.set_rhs(f)
+        return s
+    o = periodic_orbit(make, 0.0, 2 * math.pi / w, [-0.59, 1.96], multipliers=2)
+    assert o.u[0] == pytest.approx(u0, abs=1e-9)
+    assert np.abs(exact[0]) > 0.4  # a multiplier far from 0, that a 5 % step got wrong (-1.16)
+    assert o.multipliers == pytest.approx(exact, abs=1e-6)

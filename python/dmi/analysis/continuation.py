@@ -164,11 +164,11 @@ def _point(F: StepMap, x: np.ndarray, multipliers: int, sections: int, dpds: flo
     """The BranchPoint at the fixed point x of F; ``warm``: a one-element list holding the
     previous point's (Q, Z) of :func:`ritz` (replaced by this point's): the Ritz step starts
     from qr(Z), b products instead of 4 b from random vectors."""
-    U, X = F.trajectory_terms(x) if margins else (F.trajectory(x), None)
+    U, X = F.trajectory_terms(x)
     mu = np.empty(0, complex)
     if multipliers > 0:
         prev = warm[0] if warm else None
-        eps = fd_step(F, x, U)
+        eps = fd_step(F, x, U, X)
         if prev is not None and prev[1].shape[0] == x.size:
             mu, Q, Z = ritz(F, x, multipliers, start=np.linalg.qr(prev[1])[0], iterations=0,
                             eps=eps)
@@ -176,7 +176,7 @@ def _point(F: StepMap, x: np.ndarray, multipliers: int, sections: int, dpds: flo
             mu, Q, Z = ritz(F, x, multipliers, eps=eps)
         if warm is not None:
             warm[0] = (Q, Z)
-    steps, phases, margin = _stick_profile(F, U, X)
+    steps, phases, margin = _stick_profile(F, U, X if margins else None)
     k = F.M // sections
     return BranchPoint(p=F.p, period=F.M * F.h, amplitude=0.5 * (U.max(axis=0) - U.min(axis=0)),
                        multipliers=mu, stable=bool(mu.size and np.all(np.abs(mu) < 1)),
@@ -203,10 +203,9 @@ def _events(a: BranchPoint, b: BranchPoint, index: int) -> list[Event]:
 
     na, nb = np.sum(real_neg(a.multipliers) < -1), np.sum(real_neg(b.multipliers) < -1)
     if na != nb:
-        ma = real_neg(a.multipliers)
-        mb = real_neg(b.multipliers)
-        fa = float(np.min(ma)) + 1 if ma.size else 0.0
-        fb = float(np.min(mb)) + 1 if mb.size else 0.0
+        # the test function 1 + min Re mu: the multiplier that crosses -1 may have been half
+        # of a complex pair at the previous point (a pair that met on the negative axis)
+        fa, fb = (1 + float(np.min(q.multipliers.real)) for q in (a, b))
         ev.append(Event("period-doubling", at(fa, fb), index, None,
                         f"real multipliers < -1: {na} -> {nb}"))
     ca, cb = np.sum(np.abs(cplx(a.multipliers)) > 1), np.sum(np.abs(cplx(b.multipliers)) > 1)

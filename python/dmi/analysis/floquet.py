@@ -30,19 +30,25 @@ from .shooting import StepMap
 #: c in eps = c A min(M^(-1/3), FD_CAP) (see the module's docstring).
 FD_FACTOR = 1.0
 #: Few steps a period (M < 8000) have no switch to resolve finely; the cap keeps eps / A <= 5 %
-#: there, so that the curvature error O((eps / A)^2) of a smooth orbit stays below 0.3 %.
+#: there, so that the curvature error O((eps / A)^2) of a mildly nonlinear orbit stays below
+#: 0.3 % (an orbit where no resolvent acts takes the small step, see :func:`fd_step`).
 FD_CAP = 0.05
 
 
-def fd_step(F: StepMap, x: np.ndarray, U: np.ndarray | None = None) -> float:
+def fd_step(F: StepMap, x: np.ndarray, U: np.ndarray | None = None,
+            X: np.ndarray | None = None) -> float:
     """The difference step eps = FD_FACTOR A min(M^(-1/3), FD_CAP) (state units), A the largest
-    half range (max - min) / 2 of a component over one period from x (its trajectory ``U``, else
-    one run of M steps).  If the orbit is constant: an equilibrium has no switch to carry, and
-    the step is then the usual eps_machine^(1/3) max(1, |x|) of central differences)."""
-    U = F.trajectory(x) if U is None else U
+    half range (max - min) / 2 of a component over one period from x (its trajectory ``U`` and
+    the resolvent's arguments ``X``, :meth:`StepMap.trajectory_terms`, else one run of M steps).
+    If the orbit has no switch to carry, the step is the usual eps_machine^(1/3) max(1, |x|) of
+    central differences: an equilibrium (a constant orbit), or an orbit where the resolvent is
+    the identity at every step (X = U^(p+1): no friction or contact acts, the map is smooth and
+    a large step would only add curvature error, 100 % on a strongly nonlinear pendulum)."""
+    if U is None or X is None:
+        U, X = F.trajectory_terms(x)
     A = float(np.max(0.5 * (U.max(axis=0) - U.min(axis=0))))
     scale = max(1.0, float(np.max(np.abs(U))))
-    if not A > 1e-9 * scale:
+    if not A > 1e-9 * scale or np.array_equal(X, U[1:]):
         return float(np.finfo(float).eps) ** (1 / 3) * scale
     return FD_FACTOR * A * min(F.M ** (-1.0 / 3.0), FD_CAP)
 
