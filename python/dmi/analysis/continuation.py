@@ -57,8 +57,8 @@ import numpy as np
 from .._errors import Error
 from .._solver import Solver
 from .floquet import fd_step, ritz
-from .shooting import (Model, Orbit, ShootingError, StepMap, bordered_step, build, newton,
-                       periodic_orbit, positive_time, stuck_mask)
+from .shooting import (Model, Orbit, ShootingError, StepMap, bordered_step, build, fd_eps,
+                       newton, periodic_orbit, positive_time, stuck_mask)
 
 
 @dataclass
@@ -163,15 +163,14 @@ def _point(F: StepMap, x: np.ndarray, multipliers: int, sections: int, dpds: flo
            corrector: str = "") -> BranchPoint:
     """The BranchPoint at the fixed point x of F; ``warm``: a one-element list holding the
     previous point's (Q, Z) of :func:`ritz` (replaced by this point's): the Ritz step starts
-    from qr(Z), b products instead of 4 b from random vectors."""
+    from Z, one block of products instead of two from random vectors."""
     U, X = F.trajectory_terms(x)
     mu = np.empty(0, complex)
     if multipliers > 0:
         prev = warm[0] if warm else None
         eps = fd_step(F, x, U, X)
         if prev is not None and prev[1].shape[0] == x.size:
-            mu, Q, Z = ritz(F, x, multipliers, start=np.linalg.qr(prev[1])[0], iterations=0,
-                            eps=eps)
+            mu, Q, Z = ritz(F, x, multipliers, start=prev[1], eps=eps)
         else:
             mu, Q, Z = ritz(F, x, multipliers, eps=eps)
         if warm is not None:
@@ -344,7 +343,12 @@ def _weights(size: int) -> np.ndarray:
 
 
 class _Slow(Exception):
-    """The Newton-Picard corrector contracts too slowly: Newton takes over."""
+    """The Newton-Picard corrector contracts too slowly; ``z``: its iterate of least residual
+    (None if it could not start), ``iterations``: the steps it took."""
+
+    def __init__(self, message: str, z: np.ndarray | None = None, iterations: int = 0):
+        super().__init__(message)
+        self.z, self.iterations = z, iterations
 
 
 def _too_slow(rn: float, prev: float, target: float, left: int) -> bool:
@@ -357,9 +361,10 @@ def _too_slow(rn: float, prev: float, target: float, left: int) -> bool:
 
 
 def _newton_picard(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, ds: float,
-                   Q: np.ndarray, Z: np.ndarray, max_iter: int = 16) -> tuple[np.ndarray, int]:
-    """The corrector by Newton-Picard (Lust, Roose, Spence & Champneys 1998) from the predictor
-    zp: the Jacobian D_xF is replaced by its rank-b approximation Z Q' on the previous point's
+                   Q: np.ndarray, Z: np.ndarray, z0: np.ndarray | None = None,
+                   max_iter: int = 16) -> tuple[np.ndarray, int]:
+    """The corrector by Newton-Picard (Lust, Roose, Spence & Champneys 1998) from z0 (default the
+    predictor zp) on the hyperplane through zp: the Jacobian D_xF is replaced by its rank-b approximation Z Q' on the previous point's
     dominant subspace (Q orthonormal, Z = D_xF Q there, from :func:`ritz`), D_pF by one difference
     in p at the predictor, and the bordered system
 
@@ -375,7 +380,8 @@ def _newton_picard(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, ds: f
     dim = zp.size - 1
     wt = _weights(zp.size) * t
     wx, tp = wt[:-1], float(t[-1])
-    x, p = zp[:-1], float(zp[-1])
+    z = zp.copy() if z0 is None else z0.copy()
+    x, p = z[:-1], float(z[-1])
     F = maps(p)
     if F.dim != dim or Q.shape[0] != dim:
         raise _Slow("the state's size changed")
@@ -391,8 +397,7 @@ def _newton_picard(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, ds: f
     K[:b, b] = Q.T @ Fp
     K[b, :b] = wx @ Q + wx @ ZC
     K[b, b] = wx @ FpC + tp
-    z = zp.copy()
-    prev = math.inf
+    prev, best, z_best = math.inf, math.inf, z
     for it in range(max_iter + 1):
         r = Fx - x
         g = float(np.dot(wt, z - zp))
@@ -402,15 +407,18 @@ def _newton_picard(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, ds: f
         scale = max(1.0, float(np.max(np.abs(x))))
         if rn <= tol * scale and abs(g) <= 1e-8 * max(1.0, abs(p)):
             return z, it
+        if rn < best:
+            best, z_best = rn, z
         if it == max_iter or (it >= 2 and _too_slow(rn, prev, tol * scale, max_iter - it)):
-            raise _Slow(f"residual {rn:.3g} after {it} iterations (previous {prev:.3g})")
+            raise _Slow(f"residual {rn:.3g} after {it} iterations (previous {prev:.3g})",
+                        z_best, it)
         prev = rn
         Qr = Q.T @ r
         rC = r - Q @ Qr
         try:
             sol = np.linalg.solve(K, np.concatenate([-Qr, [-g - wx @ rC]]))
         except np.linalg.LinAlgError:
-            raise _Slow("singular reduced system") from None
+            raise _Slow("singular reduced system", None, it) from None
         xi, dpp = sol[:b], float(sol[b])
         z = z + np.concatenate([Q @ xi + rC + FpC * dpp + ZC @ xi, [dpp]])
         d = z - zp
@@ -434,18 +442,52 @@ def _newton_picard(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, ds: f
 
 
 def _correct(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, max_iter: int, ds: float,
-             dominant: tuple[np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, int, str]:
+             dominant: tuple[np.ndarray, np.ndarray] | None, sections: int = 1
+             ) -> tuple[np.ndarray, int, str]:
+    """:func:`_solve`, refused (ShootingError: the step is halved) when the orbit of a branch
+    of ``sections`` > 1 forcing periods is periodic over a part of them: the corrector fell
+    onto the branch it was born from (a doubled branch near its doubling, where both cross the
+    first step's hyperplane p = p1 close together)."""
+    z, its, how = _solve(maps, zp, t, tol, max_iter, ds, dominant)
+    F = maps(float(z[-1]))
+    for q in range(2, sections + 1):
+        if sections % q or F.M % q:
+            continue
+        U, k = F.trajectory(z[:-1]), F.M // q
+        if np.max(np.abs(U[k:] - U[:-k])) <= 1e-6 * max(1.0, float(np.max(np.abs(U)))):
+            raise ShootingError(f"the corrector fell onto an orbit of {F.M // q} steps (period "
+                                f"{sections // q} of the branch's {sections} forcing periods) "
+                                f"at p = {float(z[-1])!r}", [])
+    return z, its, how
+
+
+def _solve(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, max_iter: int, ds: float,
+           dominant: tuple[np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, int, str]:
     """The corrector from the predictor zp: Newton-Picard on the previous point's ``dominant``
-    (Q, Z) when there is one, Newton (GMRES) from zp when it contracts too slowly.
-    Returns (z, iterations, which): ``newton-picard`` or ``newton``."""
-    z = zp
+    (Q, Z) when there is one; when it contracts too slowly, once more from its iterate of least
+    residual with (Q, Z) renewed there: one block of forward differences of Newton's step
+    (:func:`dmi.analysis.shooting.fd_eps`) from qr(Z), the dominant subspace of the derivative
+    the iteration actually sees (:func:`ritz`); then Newton (GMRES) from zp (not from an
+    iterate: near a period doubling, Newton-Picard may have headed for the other branch that
+    crosses the first step's hyperplane p = p1).  Returns (z, iterations, which): ``newton-picard`` or ``newton``."""
     if dominant is not None:
-        try:
-            z, its = _newton_picard(maps, zp, t, tol, ds, *dominant)
-            return z, its, "newton-picard"
-        except _Slow:
-            z = zp
-    z, its = _corrector(maps, z, t, tol, max_iter, ds, zp)
+        z, done = zp, 0
+        Q, Z = dominant
+        for renew in (False, True):
+            try:
+                if renew:
+                    F, x = maps(float(z[-1])), z[:-1]
+                    if F.dim != x.size:
+                        break
+                    _, Q, Z = ritz(F, x, max(1, Q.shape[1] - 2), start=Z, eps=fd_eps(x),
+                                   central=False)
+                z, its = _newton_picard(maps, zp, t, tol, ds, Q, Z, z)
+                return z, done + its, "newton-picard"
+            except _Slow as e:
+                if e.z is None:
+                    break
+                z, done = e.z, done + e.iterations
+    z, its = _corrector(maps, zp, t, tol, max_iter, ds, zp)
     return z, its, "newton"
 
 
@@ -553,7 +595,7 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
         p1 = orbit.p + direction * ds
         try:
             z, its, how = _correct(maps, np.concatenate([x0, [p1]]), t_p, tol, max_iter + 4,
-                                 math.inf, warm[0])
+                                   math.inf, warm[0], sections)
             break
         except (ShootingError, ValueError, Error) as e:
             ds /= 2
@@ -564,7 +606,7 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                       warm, how))
     events += _events(pts[-2], pts[-1], 1)
     while len(pts) < max_points:
-        if (pts[-1].p - p_end) * direction >= 0:
+        if (pts[-1].p - p_end) * direction >= -1e-7 * max(1.0, abs(p_end)):
             status = f"reached p_end = {p_end!r}"
             break
         if pts[-1].p < lo - 1e-12 * max(1, abs(lo)) or pts[-1].p > hi + 1e-12 * max(1, abs(hi)):
@@ -574,12 +616,13 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
         sec = z - z_prev
         t = sec / math.sqrt(float(np.dot(w * sec, sec)))
         while True:
-            zp = z + ds * t
-            # do not overshoot p_end by more than needed
+            zp, tc = z + ds * t, t
+            # do not overshoot p_end: the last step ends on the hyperplane p = p_end (on the
+            # secant's, the curvature would leave it short, and one more step repeat the point)
             if (zp[-1] - p_end) * direction > 0 and abs(t[-1]) > 0.5:
-                zp = z + ((p_end - z[-1]) / t[-1]) * t
+                zp, tc = z + ((p_end - z[-1]) / t[-1]) * t, t_p
             try:
-                zn, its, how = _correct(maps, zp, t, tol, max_iter, ds, warm[0])
+                zn, its, how = _correct(maps, zp, tc, tol, max_iter, ds, warm[0], sections)
                 break
             except (ShootingError, ValueError, Error) as e:   # Error: the map failed there
                 ds /= 2

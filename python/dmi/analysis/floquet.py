@@ -17,12 +17,15 @@ tests/python/test_analysis_orbit_oracles.py).  Multipliers of a stuck phase come
 0: a perturbation that keeps the stick is wiped out.
 
 The leading multipliers are the eigenvalues of largest modulus of that operator (a
-``scipy.sparse.linalg.LinearOperator``): subspace iteration with Rayleigh-Ritz (a dense matrix
-for small states), see :func:`floquet_multipliers`.
+``scipy.sparse.linalg.LinearOperator``): Rayleigh-Ritz on a block Krylov space of two blocks (a
+dense matrix for small states), see :func:`floquet_multipliers`.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
+import scipy.linalg as sl
 import scipy.sparse.linalg as sla
 
 from .shooting import StepMap
@@ -79,51 +82,76 @@ def monodromy_operator(F: StepMap, x: np.ndarray, eps: float | None = None,
 
 
 def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
-                        eps: float | None = None, iterations: int = 2,
+                        eps: float | None = None, blocks: int = 2,
                         central: bool = True) -> np.ndarray:
     """The ``count`` Floquet multipliers (dimensionless) of largest modulus at the fixed point x of
     the M-step map F, largest first (complex).  F is a :class:`dmi.analysis.shooting.StepMap`, e.g.
     ``StepMap(orbit.make, orbit.p, orbit.steps, orbit.rows)`` with x = ``orbit.state``; ``eps``
     (state units) overrides the difference step of :func:`fd_step`.  States of at most 64 values:
-    the eigenvalues of the dense matrix (its columns by the operator).  Larger: subspace
-    iteration with Rayleigh-Ritz on a block of b = count + 2 vectors, ``iterations`` sweeps (b
-    (iterations + 1) products of 2 evaluations each, 1 with ``central=False``, see
-    :func:`monodromy_operator`): the eigenvalues of Q' A Q.  Not
-    ARPACK's eigs: the difference operator is linear only up to the switches' rounding to a
-    step (O(h / eps)), and a Krylov recurrence amplifies that (two eigs calls at one orbit of
-    the tau-diagram, M = 2000: 0.226 and 0.279), while a Ritz matrix of independently
-    differenced columns carries it once.  Multipliers below 1e-12 in modulus are returned as 0
-    (the stick's)."""
-    return ritz(F, x, count, iterations=iterations, eps=eps, central=central)[0]
+    the eigenvalues of the dense matrix (its columns by the operator).  Larger: Rayleigh-Ritz on
+    ``blocks`` blocks of a block Krylov space, b = count + 2 vectors a block from random ones
+    (b ``blocks`` products of 2 evaluations each, 1 with ``central=False``, see
+    :func:`monodromy_operator`): the eigenvalues of B' A B, B the space's orthonormal basis.
+    Not ARPACK's eigs: the difference operator is linear only up to the switches' rounding to a
+    step (O(h / eps)), and a long Krylov recurrence with restarts amplifies that (two eigs calls
+    at one orbit of the tau-diagram, M = 2000: 0.226 and 0.279), while a Ritz matrix of
+    independently differenced columns, few blocks deep, carries it once.  Multipliers below
+    1e-12 in modulus are returned as 0 (the stick's)."""
+    return ritz(F, x, count, blocks=blocks, eps=eps, central=central)[0]
 
 
-def ritz(F: StepMap, x: np.ndarray, count: int, *, iterations: int = 2,
+def ritz(F: StepMap, x: np.ndarray, count: int, *, blocks: int = 2,
          start: np.ndarray | None = None, eps: float | None = None, central: bool = True
          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(multipliers, Q, Z) of :func:`floquet_multipliers`: Q (dim, b) the orthonormal basis of the
-    Rayleigh-Ritz step and Z = A Q its image (A the difference operator), so that Q' Z is the Ritz
-    matrix and Z Q' the operator's rank-b approximation on the dominant subspace (the
-    continuation's Newton-Picard corrector, see :mod:`dmi.analysis.continuation`); qr(Z) is the
-    next subspace iterate, the ``start`` for a nearby orbit (a continuation: ``iterations=0``,
-    b products a point, one sweep of subspace iteration along the branch).  A dense state (<= 64
-    values): Q = I and Z the whole matrix."""
+    """(multipliers, Q, Z) of :func:`floquet_multipliers`: Q (dim, k) an orthonormal basis of the
+    dominant invariant subspace of the Ritz matrix (its k >= count + 2 eigenvalues of largest
+    modulus; k = b, or b + 1 when a complex pair straddles the cut) and Z = A Q, so that Q' Z is
+    the Ritz matrix there and Z Q' the operator's rank-k approximation on that subspace (the
+    continuation's Newton-Picard corrector, see :mod:`dmi.analysis.continuation`).  ``start``:
+    vectors to begin from instead of random ones, and then a single block (its columns):
+    Z of a nearby orbit (a continuation: k products a point, one step of subspace iteration
+    along the branch).  A dense state (<= 64 values): Q = I and Z the whole matrix."""
     A = monodromy_operator(F, x, eps, central)
     dim = A.shape[0]
     count = min(count, dim)
+
+    def image(V: np.ndarray) -> np.ndarray:
+        return np.column_stack([A.matvec(V[:, j]) for j in range(V.shape[1])])
+
     if dim <= 64:
         Q = np.eye(dim)
-        Z = np.column_stack([A.matvec(Q[:, j]) for j in range(dim)])
+        Z = image(Q)
         mu = np.linalg.eigvals(Z)
     else:
-        b = min(dim, count + 2)
-        if start is None or start.shape != (dim, b):
-            start = np.random.default_rng(0).standard_normal((dim, b))
-            iterations = max(iterations, 1)
-        Q = np.linalg.qr(start)[0]
-        for _ in range(iterations):
-            Q = np.linalg.qr(np.column_stack([A.matvec(Q[:, j]) for j in range(b)]))[0]
-        Z = np.column_stack([A.matvec(Q[:, j]) for j in range(b)])
-        mu = np.linalg.eigvals(Q.T @ Z)
+        if start is None:
+            b = min(dim // max(1, blocks), count + 2)
+            V = np.linalg.qr(np.random.default_rng(0).standard_normal((dim, b)))[0]
+            Bs, Zs = [V], [image(V)]
+            for _ in range(blocks - 1):   # the next block: the last image, orthogonalised
+                B = np.column_stack(Bs)
+                W = Zs[-1] - B @ (B.T @ Zs[-1])
+                W -= B @ (B.T @ W)
+                V = np.linalg.qr(W)[0]
+                Bs.append(V)
+                Zs.append(image(V))
+            B, ZB = np.column_stack(Bs), np.column_stack(Zs)
+        else:
+            B = np.linalg.qr(start)[0]
+            ZB = image(B)
+        mu, Q, Z = _dominant(B, ZB, min(count + 2, B.shape[1]))
     mu = np.asarray(mu, dtype=complex)
     mu[np.abs(mu) < 1e-12] = 0.0
     return mu[np.argsort(-np.abs(mu), kind="stable")][:count], Q, Z
+
+
+def _dominant(B: np.ndarray, ZB: np.ndarray, k: int
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Rayleigh-Ritz on span B (orthonormal, ZB = A B): the Ritz values, and (B U, ZB U) for U the
+    real Schur vectors of the k Ritz values of largest modulus (k + 1 if a pair straddles)."""
+    S = B.T @ ZB
+    mu = np.linalg.eigvals(S)
+    if k >= S.shape[0]:
+        return mu, B, ZB
+    cut = np.sort(np.abs(mu))[::-1][k - 1] * (1 - 1e-12)
+    T, U, sdim = sl.schur(S, output="real", sort=lambda re, im: math.hypot(re, im) >= cut)
+    return mu, B @ U[:, :sdim], ZB @ U[:, :sdim]
