@@ -85,7 +85,7 @@ def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
                         eps: float | None = None, blocks: int = 2,
                         central: bool = True) -> np.ndarray:
     """The ``count`` Floquet multipliers (dimensionless) of largest modulus at the fixed point x of
-    the M-step map F, largest first (complex).  F is a :class:`dmi.analysis.shooting.StepMap`, e.g.
+    the M-step map F, largest first (complex).  F is a :class:`dmi.analysis.StepMap`, e.g.
     ``StepMap(orbit.make, orbit.p, orbit.steps, orbit.rows)`` with x = ``orbit.state``; ``eps``
     (state units) overrides the difference step of :func:`fd_step`.  States of at most 64 values:
     the eigenvalues of the dense matrix (its columns by the operator).  Larger: Rayleigh-Ritz on
