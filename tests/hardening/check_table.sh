@@ -1,13 +1,13 @@
 #!/bin/sh
 # Checks that docs/bad-inputs.md lists exactly the rows a test program runs,
-# with the same function, input and answer (the message column may differ:
-# regenerate it with the program's --table output).
+# with the same function, input, answer and message (regenerate a row with the
+# program's --table output).
 # Usage: check_table.sh <doc> <row prefix C|F> <test program> [args...]
 # SPDX-License-Identifier: GPL-3.0-or-later
 set -eu
 doc=$1 prefix=$2
 shift 2
-cols() { grep -E "^\| $prefix[0-9]+ \|" | cut -d'|' -f2-5 | sort; }
+cols() { grep -E "^\| $prefix[0-9]+ \|" | cut -d'|' -f2-6 | sort; }
 "$@" --table | cols >"${TMPDIR:-/tmp}/run.$$" || true
 cols <"$doc" >"${TMPDIR:-/tmp}/doc.$$"
 status=0
