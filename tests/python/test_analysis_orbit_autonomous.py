@@ -5,6 +5,8 @@
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -22,7 +24,9 @@ def test_belt_period_order1_stick_and_multipliers():
         s.init()
         s.set_window([[b.x_e, 0.0]] * 2)
         s.advance(5 * M)
-        o = periodic_orbit(b.make, 0.0, None, s, guess_period=P0, steps=M, multipliers=2)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # a single loop: no multi-loop warning
+            o = periodic_orbit(b.make, 0.0, None, s, guess_period=P0, steps=M, multipliers=2)
         assert o.steps == M and o.period == pytest.approx(M * o.h, rel=1e-14)
         errs.append(abs(o.period - b.T))
         hs.append(o.h)
@@ -33,6 +37,20 @@ def test_belt_period_order1_stick_and_multipliers():
         assert o.stable
     slope = np.log(errs[0] / errs[1]) / np.log(hs[0] / hs[1])
     assert 0.9 <= slope <= 1.1 and errs[1] < 0.01, (errs, slope)
+
+
+def test_multi_loop_orbit_is_said():
+    """A guess 1.6 periods long converges to the orbit of 4 loops (4 T, T in closed form) in
+    M = 1000 steps: a periodic orbit, but not the one sought, and periodic_orbit says so."""
+    b, M = Belt(), 1000
+    P0 = 1.6 * b.T
+    s = b.make(0.0, h=P0 / M)
+    s.init()
+    s.set_window([[b.x_e, 0.0]] * 2)
+    s.advance(5 * M)
+    with pytest.warns(RuntimeWarning, match="repeats 4 times in its M steps"):
+        o = periodic_orbit(b.make, 0.0, None, s, guess_period=P0, steps=M, multipliers=0)
+    assert o.period == pytest.approx(4 * b.T, rel=0.02)
 
 
 def test_autonomous_bad_input():

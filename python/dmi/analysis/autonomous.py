@@ -13,6 +13,7 @@ ceil(tau / h) may change with h: the states hold L = ceil(tau / (0.8 h_0)) + 1 r
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Any
 
 import numpy as np
@@ -97,7 +98,14 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
         if not math.isfinite(rn):
             raise ShootingError(f"{what}: non-finite residual (residuals {_fmt(res)})", res)
         if rn <= tol * scale and abs(g) <= tol * scale:
-            return _without_phase(make_orbit(Fm, x, res, multipliers))
+            o = _without_phase(make_orbit(Fm, x, res, multipliers))
+            k = loops(o.u)
+            if k > 1:
+                warnings.warn(f"{what}: the orbit found repeats {k} times in its M steps (its "
+                              f"least period is about {o.period / k:.6g}, the orbit's "
+                              f"{o.period:.6g}): give a guess_period near the period sought, "
+                              f"or steps = M / {k}", RuntimeWarning, stacklevel=3)
+            return o
         if len(res) > max_iter:
             break
         dh = 1e-7 * h
@@ -112,6 +120,21 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
         x, h = x + dz[:-1], h + float(dz[-1])
     raise ShootingError(f"{what}: no convergence in {max_iter} Newton iterations (residuals "
                         f"{_fmt(res)})", res)
+
+
+def loops(u: np.ndarray, most: int = 64) -> int:
+    """How many times one period u (M + 1 rows, the last = the first) repeats itself: the largest
+    k in 2 .. min(most, M / 8) whose shift by round(M / k) steps moves no state by more than two
+    steps' largest travel (a fractional shift costs at most half of one; a single loop shifted by
+    8 steps or more moves its fastest part by about that many), else 1."""
+    U = np.asarray(u)[:-1]
+    M = U.shape[0]
+    travel = float(np.max(np.abs(np.diff(np.asarray(u), axis=0)))) if M else 0.0
+    found = 1
+    for k in range(2, min(most, M // 8) + 1):
+        if float(np.max(np.abs(np.roll(U, -round(M / k), axis=0) - U))) <= 2 * travel:
+            found = k
+    return found
 
 
 def _without_phase(o: Orbit) -> Orbit:
