@@ -2,7 +2,7 @@
 # and the workers' arguments parsed by distributed's own command lines (valid options; one thread per
 # worker), the scheduler's environment read by Dask's configuration (worker-saturation 1.0), the
 # Service selecting the scheduler pod's labels and naming its ports, a YAML round trip as kubectl gets
-# it; bad inputs refused.  Against dask-kubernetes' own make_cluster_spec where it is installed.
+# it; bad inputs refused.  Against dask-kubernetes' own make_cluster_spec.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -43,11 +43,26 @@ def test_spec_parsed_by_dask_and_consistent():
 
 
 def test_same_shape_as_dask_kubernetes():
-    make_cluster_spec = pytest.importorskip("dask_kubernetes.operator").make_cluster_spec
+    """Against dask-kubernetes' own make_cluster_spec (pinned in scripts/requirements.txt: a
+    missing package fails here, it does not skip): the same resource, the same scheduler Service
+    and ports, the same layout."""
+    from dask_kubernetes.operator import make_cluster_spec
     theirs = make_cluster_spec("sweep", image="img", n_workers=3)
     ours = cluster_spec("sweep", "img", 3)
-    assert ours.keys() == theirs.keys() and ours["spec"]["scheduler"].keys() == theirs["spec"]["scheduler"].keys()
-    assert ours["spec"]["scheduler"]["service"]["selector"] == theirs["spec"]["scheduler"]["service"]["selector"]
+    assert ours.keys() == theirs.keys()
+    for key in ("apiVersion", "kind"):
+        assert ours[key] == theirs[key]
+    assert ours["metadata"]["name"] == theirs["metadata"]["name"]
+    # theirs also writes idleTimeout: 0, the DaskCluster resource's default (no idle shutdown),
+    # which ours leaves out
+    assert theirs["spec"].get("idleTimeout") == 0
+    assert ours["spec"].keys() == theirs["spec"].keys() - {"idleTimeout"}
+    assert ours["spec"]["scheduler"].keys() == theirs["spec"]["scheduler"].keys()
+    assert ours["spec"]["worker"].keys() == theirs["spec"]["worker"].keys()
+    assert ours["spec"]["worker"]["replicas"] == theirs["spec"]["worker"]["replicas"] == 3
+    assert ours["spec"]["scheduler"]["service"] == theirs["spec"]["scheduler"]["service"]
+    (o,), (t,) = (x["spec"]["scheduler"]["spec"]["containers"] for x in (ours, theirs))
+    assert o["ports"] == t["ports"]
 
 
 @pytest.mark.parametrize("kw, message", [
