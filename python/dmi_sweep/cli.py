@@ -83,7 +83,9 @@ def parser() -> argparse.ArgumentParser:
                    "when the cluster has had no worker for this long, as when every worker of a "
                    f"--scheduler died (default: {NO_WORKER_TIMEOUT:g})")
     r.add_argument("--tls-ca-file", metavar="PEM", help="the CA certificate(s) that signed the "
-                   "scheduler's certificate (default: Dask's distributed.comm.tls.ca-file)")
+                   "scheduler's certificate (default: Dask's distributed.comm.tls.ca-file); with "
+                   "--slurm, the --tls-* files turn TLS on between the scheduler, the workers and "
+                   "this client, each with --tls-cert and --tls-key (on the shared filesystem)")
     r.add_argument("--tls-cert", metavar="PEM", help="this client's certificate (default: Dask's "
                    "distributed.comm.tls.client.cert)")
     r.add_argument("--tls-key", metavar="PEM", help="this client's private key, unless --tls-cert "

@@ -199,25 +199,35 @@ TLS_KEYS = ("distributed.comm.tls.ca-file", "distributed.comm.tls.client.cert",
 
 
 def security(scheduler: str | None, tls_ca_file: str | None = None, tls_cert: str | None = None,
-             tls_key: str | None = None) -> Security | None:
+             tls_key: str | None = None, slurm: bool = False) -> Security | None:
     """The Security of the connection to `scheduler`: the --tls-* options over Dask's configuration
     (distributed.comm.tls.*), checked before connecting: a tls:// address needs a CA file and a
     client certificate, from either source; every file must be readable and make an SSL context.
-    None for a plain address without TLS options (Dask's own defaults)."""
+    None for a plain address without TLS options (Dask's own defaults).  With `slurm` (the
+    scheduler in this process, the workers in SLURM jobs) the --tls-* options turn TLS on: the
+    certificate and key serve the scheduler, the workers and this client, all signed by the CA
+    file; the paths are made absolute (the jobs read them from the shared filesystem)."""
     options = {"tls_ca_file": tls_ca_file, "tls_client_cert": tls_cert, "tls_client_key": tls_key}
     given = [f"--{k.replace('tls_client_', 'tls-').replace('_', '-')}" for k, v in options.items() if v]
-    tls = bool(scheduler) and scheduler.startswith("tls://")
+    tls = bool(scheduler) and scheduler.startswith("tls://") or slurm and bool(given)
     if given and not tls:
         raise ConnectionSetupError(
             f"{', '.join(given)} given, but {'--scheduler ' + scheduler if scheduler else 'no --scheduler'}"
             " is not a tls:// address: the TLS options are for a scheduler started with "
-            "--protocol tls (the local cluster listens on 127.0.0.1 only and needs none)")
+            "--protocol tls, or for --slurm (the local cluster listens on 127.0.0.1 only and needs "
+            "none)")
     if not tls:
         return None
+    if slurm:
+        options = {k: os.path.abspath(v) for k, v in options.items() if v}
+        cert, key = options.get("tls_client_cert"), options.get("tls_client_key")
+        options.update(tls_scheduler_cert=cert, tls_scheduler_key=key, tls_worker_cert=cert,
+                       tls_worker_key=key)
     sec = Security(require_encryption=True, **{k: v for k, v in options.items() if v})
     if not sec.tls_ca_file or not sec.tls_client_cert:
+        where = "--slurm with --tls-* options" if slurm else f"{scheduler} is a TLS address"
         raise ConnectionSetupError(
-            f"{scheduler} is a TLS address, but no certificates were given: pass --tls-ca-file (the CA "
+            f"{where}, but no certificates were given: pass --tls-ca-file (the CA "
             "that signed the scheduler's certificate), --tls-cert (this client's certificate) and "
             "--tls-key (its private key, unless the certificate file holds it), or set them in Dask's "
             f"configuration ({', '.join(TLS_KEYS)}; in the environment "
@@ -233,7 +243,8 @@ def security(scheduler: str | None, tls_ca_file: str | None = None, tls_cert: st
                 raise ConnectionSetupError(f"cannot read the TLS {what} {path}: {e.strerror}. "
                                            "Nothing was run") from None
     try:
-        sec.get_connection_args("client")
+        for role in ("client", "scheduler") if slurm else ("client",):
+            sec.get_connection_args(role)
     except (ssl.SSLError, ValueError, OSError) as e:
         raise ConnectionSetupError(
             f"the TLS files do not make a client context ({e}): --tls-cert must be a PEM "
@@ -382,13 +393,14 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
 
     slurm: the job settings of slurm.resolve(): the workers run in SLURM jobs of a SLURMCluster
     started here (SlurmRefused, before the folder is made, if SLURM refuses its job script); the
-    no-worker count waits while SLURM still has one of its jobs."""
+    no-worker count waits while SLURM still has one of its jobs.  With the tls_* files the
+    scheduler, its workers and this client talk TLS (see :func:`security`)."""
     if not no_worker_timeout > 0:
         raise ValueError(f"no_worker_timeout must be > 0 seconds, not {no_worker_timeout!r}")
     t0 = time.monotonic()
     progress = sys.stderr if progress is STDERR else progress
     messages = sys.stderr if messages is STDERR else messages
-    sec = security(scheduler, tls_ca_file, tls_cert, tls_key)
+    sec = security(scheduler, tls_ca_file, tls_cert, tls_key, slurm is not None)
     refusal = check_start(spec.fmu.read_bytes(), spec.job())
     if refusal:
         raise SpecError(f"the FMU refuses the [start] values: {refusal}")
@@ -398,7 +410,7 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
     if slurm is not None:
         if scheduler or workers:
             raise ValueError("slurm excludes scheduler and workers")
-        cluster = slurm_jobs.start(slurm)
+        cluster = slurm_jobs.start(slurm, sec)
         try:
             client = Client(cluster)
         except BaseException:

@@ -93,9 +93,11 @@ class SlurmRefused(RuntimeError):
     """SLURM refuses the job script (sbatch --test-only), or cannot be asked: nothing was run."""
 
 
-def start(settings: dict[str, Any]):
+def start(settings: dict[str, Any], security=None):
     """A SLURMCluster for the settings whose job script SLURM accepts (`sbatch --test-only`), with
-    its jobs submitted; raises SlurmRefused with SLURM's message otherwise (the cluster closed)."""
+    its jobs submitted; raises SlurmRefused with SLURM's message otherwise (the cluster closed).
+    `security`: a distributed Security (files on the shared filesystem): the scheduler listens on
+    tls:// and the job script gives the workers --protocol tls:// and the worker's files."""
     sbatch = shutil.which("sbatch")
     if sbatch is None:
         raise SlurmRefused("--slurm: SLURM's sbatch is not on the PATH of this machine (run "
@@ -108,7 +110,7 @@ def start(settings: dict[str, Any]):
     import dask
     # One task per worker at a time: a job that ends takes only its running chunks with it.
     with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}):
-        cluster = SLURMCluster(**cluster_kwargs(settings))
+        cluster = SLURMCluster(**cluster_kwargs(settings), security=security)
     try:
         r = subprocess.run([sbatch, "--test-only"], input=cluster.job_script(), capture_output=True,
                            text=True, timeout=60)

@@ -223,3 +223,21 @@ def listening(pid: int) -> list[tuple[str, int]]:
     import psutil
     return sorted((c.laddr.ip, c.laddr.port) for c in psutil.Process(pid).net_connections(kind="inet")
                   if c.status == psutil.CONN_LISTEN)
+
+
+def openssl(*args: str, cwd: Path) -> None:
+    subprocess.run(["openssl", *args], cwd=cwd, check=True, capture_output=True, timeout=60)
+
+
+def make_certs(d: Path) -> None:
+    """ca.pem/key and other.pem/key (two self-signed CAs); node (scheduler and workers) and client
+    signed by ca, stranger signed by other; each leaf valid for 127.0.0.1."""
+    for ca in ("ca", "other"):
+        openssl("req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", f"{ca}.key", "-out",
+                f"{ca}.pem", "-days", "2", "-subj", f"/CN=dmi-sweep test {ca}", cwd=d)
+    (d / "san.ext").write_text("subjectAltName=IP:127.0.0.1,DNS:localhost\n")
+    for leaf, ca in (("node", "ca"), ("client", "ca"), ("stranger", "other")):
+        openssl("req", "-newkey", "rsa:2048", "-nodes", "-keyout", f"{leaf}.key", "-out", f"{leaf}.csr",
+                "-subj", f"/CN={leaf}", cwd=d)
+        openssl("x509", "-req", "-in", f"{leaf}.csr", "-CA", f"{ca}.pem", "-CAkey", f"{ca}.key",
+                "-CAcreateserial", "-out", f"{leaf}.pem", "-days", "2", "-extfile", "san.ext", cwd=d)

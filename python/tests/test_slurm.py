@@ -8,7 +8,8 @@
 # scancel mid-sweep loses and doubles no point (exit 0), every job cancelled
 # ends the run with exit 3 and the same command resumes; a partition SLURM does
 # not know gives exit 2 with SLURM's message and nothing is written; bad
-# settings are refused before anything runs (exit 2). And, without Slurm, the
+# settings are refused before anything runs (exit 2); over TLS (the --tls-* files)
+# the sweep equals a local one and the jobs' workers start on tls://. And, without Slurm, the
 # keywords of SLURMCluster built from the settings.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
@@ -25,7 +26,7 @@ import pandas as pd
 import pytest
 
 from conftest import (Processes, env_with_package, finish_group, free_port, grid_spec, kill_group, log_entries,
-                      run_sweep, start_group, sweep_cmd, write_spec)
+                      make_certs, run_sweep, start_group, sweep_cmd, write_spec)
 
 PROGRAMS = ("munged", "slurmctld", "slurmd", "sbatch", "squeue", "scancel", "sinfo")
 
@@ -164,6 +165,28 @@ def test_sweep_over_slurm_equals_local(slurm, tmp_path, fmu_path):
     assert list(slurm.root.glob("log/*.out")) and not slurm.jobs()   # and the jobs ended with the run
 
 
+def test_tls_sweep_over_slurm_equals_local(slurm, tmp_path, fmu_path):
+    """--slurm with the --tls-* files (a CA of the test's and a certificate signed by it, made with
+    openssl): the same table as a local run, bit for bit, and the job's worker started on tls://
+    (its log in the Slurm folder)."""
+    certs = tmp_path / "certs"
+    certs.mkdir()
+    make_certs(certs)
+    spec = write_spec(tmp_path, spec_text(fmu_path, 4, extra="[slurm]\ncores = 1\nmemory = \"1GB\"\n"))
+    before = set(slurm.root.glob("log/*"))
+    r = finish(sweep(slurm, spec, "--out", tmp_path / "slurm", "--slurm", "--partition", "debug",
+                     "--walltime", "00:10:00", "--chunk-size", "1", "--tls-ca-file", certs / "ca.pem",
+                     "--tls-cert", certs / "node.pem", "--tls-key", certs / "node.key"))
+    assert r.returncode == 0, r.stderr
+    r2 = run_sweep("run", spec, "--out", tmp_path / "local", "--workers", "1")
+    assert r2.returncode == 0, r2.stderr
+    pd.testing.assert_frame_equal(frame(tmp_path / "slurm"), frame(tmp_path / "local"), check_exact=True)
+    logs = [f.read_text(errors="replace") for f in set(slurm.root.glob("log/*")) - before]
+    started = [line for text in logs for line in text.splitlines() if "Start worker at:" in line]
+    assert started and all("tls://" in line for line in started), (started, logs)
+    assert not slurm.jobs()
+
+
 def wait_for_parts(out: Path, n: int, proc: subprocess.Popen, timeout: float = 180):
     deadline = time.monotonic() + timeout
     while len(list(out.glob("part-*.parquet"))) < n:
@@ -252,6 +275,10 @@ def test_bad_partition_exit_2_with_slurms_message(slurm, tmp_path, fmu_path):
     (["--slurm"], "[slurm]\ncores = 1\nqueue = \"x\"\n", "unknown SLURM settings slurm.queue"),
     (["--partition", "debug"], "", "--partition given without --slurm"),
     (["--slurm", "--workers", "2"], "", "--slurm runs its own cluster: not with --workers"),
+    (["--slurm", "--cores", "1", "--memory", "1GB", "--tls-cert", "client.pem"], "",
+     "--slurm with --tls-* options, but no certificates were given: pass --tls-ca-file"),
+    (["--slurm", "--cores", "1", "--memory", "1GB", "--tls-ca-file", "ca.pem", "--tls-cert", "c.pem"], "",
+     "cannot read the TLS CA file /"),
 ])
 def test_bad_settings_refused_before_running(tmp_path, fmu_path, args, extra, message):
     spec = write_spec(tmp_path, spec_text(fmu_path, 2, extra=extra))

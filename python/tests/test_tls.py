@@ -17,7 +17,8 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from conftest import Processes, free_port, listening, run_sweep, wait_for_cluster, write_spec
+from conftest import (Processes, free_port, listening, make_certs, run_sweep, wait_for_cluster,
+                      write_spec)
 
 SPEC = """
 fmu = "{fmu}"
@@ -30,24 +31,6 @@ N = 400
 [grid]
 g_amp = {{ start = 0.5, stop = 2.5, num = 4 }}
 """
-
-
-def openssl(*args: str, cwd: Path) -> None:
-    subprocess.run(["openssl", *args], cwd=cwd, check=True, capture_output=True, timeout=60)
-
-
-def make_certs(d: Path) -> None:
-    """ca.pem/key and other.pem/key (two self-signed CAs); node (scheduler and workers) and client
-    signed by ca, stranger signed by other; each leaf valid for 127.0.0.1."""
-    for ca in ("ca", "other"):
-        openssl("req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", f"{ca}.key", "-out",
-                f"{ca}.pem", "-days", "2", "-subj", f"/CN=dmi-sweep test {ca}", cwd=d)
-    (d / "san.ext").write_text("subjectAltName=IP:127.0.0.1,DNS:localhost\n")
-    for leaf, ca in (("node", "ca"), ("client", "ca"), ("stranger", "other")):
-        openssl("req", "-newkey", "rsa:2048", "-nodes", "-keyout", f"{leaf}.key", "-out", f"{leaf}.csr",
-                "-subj", f"/CN={leaf}", cwd=d)
-        openssl("x509", "-req", "-in", f"{leaf}.csr", "-CA", f"{ca}.pem", "-CAkey", f"{ca}.key",
-                "-CAcreateserial", "-out", f"{leaf}.pem", "-days", "2", "-extfile", "san.ext", cwd=d)
 
 
 class TLSCluster:
