@@ -30,7 +30,9 @@ def options(help_text: str) -> dict[str, tuple[bool, str]]:
     section = help_text.split("\noptions:\n", 1)[1]
     entry = None
     for line in section.splitlines():
-        m = re.match(r"  (-\S+(?: \S+)?(?:, -\S+(?: \S+)?)*)(?:  +(.*))?$", line)
+        # names, each with its metavar words (one space apart: "--N N [N ...]", "--chart P Q"),
+        # then the help text after two spaces or more
+        m = re.match(r"  (-\S+(?: [^\s-]\S*)*(?:, -\S+(?: [^\s-]\S*)*)*)(?:  +(.*))?$", line)
         if m:
             names = [n.strip() for n in m.group(1).split(",")]
             entry = [n.split()[0] for n in names], any(" " in n for n in names), [m.group(2) or ""]
@@ -64,10 +66,12 @@ def test_help(prog):
 def test_option_parser_reads_argparse_help():
     """The parser of the help text on a known case (so that test_help cannot pass on nothing)."""
     text = ("usage: x\n\nPrints.\n\noptions:\n  -h, --help  show this help\n  --a A       first\n"
-            "              (default: 1)\n  --bee BEE\n              second\n  --flag      a switch\n")
+            "              (default: 1)\n  --bee BEE\n              second\n  --flag      a switch\n"
+            "  --N N [N ...]\n              cells (default: [1000])\n  --chart P Q  a chart\n")
     assert options(text) == {"-h": (False, "show this help"), "--help": (False, "show this help"),
                              "--a": (True, "first (default: 1)"), "--bee": (True, "second"),
-                             "--flag": (False, "a switch")}
+                             "--flag": (False, "a switch"), "--N": (True, "cells (default: [1000])"),
+                             "--chart": (True, "a chart")}
 
 
 @pytest.mark.parametrize("prog", PROGRAMS, ids=lambda p: p.name)
