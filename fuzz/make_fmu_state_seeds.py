@@ -7,7 +7,9 @@ changes (fmu/model.h MODEL_STATE_VERSION, src/bytes.h), then commit the corpus:
 
     .venv/bin/python fuzz/make_fmu_state_seeds.py build/fmu/DelayFrictionOscillator.fmu
 
-The FMI 3.0 target shares this corpus (both FMUs write the same bytes).
+The FMI 3.0 target shares this corpus (both FMUs write the same bytes).  The *_format2
+seeds are states of format 2 (written by the FMU before format 3), kept by hand so that the
+fuzzer also reaches the older format's restore path; this script does not write them.
 SPDX-License-Identifier: GPL-3.0-or-later
 """
 import argparse
