@@ -218,12 +218,17 @@ def security(scheduler: str | None, tls_ca_file: str | None = None, tls_cert: st
             "none)")
     if not tls:
         return None
-    if slurm:
-        options = {k: os.path.abspath(v) for k, v in options.items() if v}
-        cert, key = options.get("tls_client_cert"), options.get("tls_client_key")
-        options.update(tls_scheduler_cert=cert, tls_scheduler_key=key, tls_worker_cert=cert,
-                       tls_worker_key=key)
     sec = Security(require_encryption=True, **{k: v for k, v in options.items() if v})
+    if slurm and sec.tls_ca_file and sec.tls_client_cert:
+        # the client's files (given or configured) serve the scheduler and the workers too, as
+        # absolute paths (the job script names them); a certificate file that holds its key is
+        # also the key file (a worker given "--tls-key None" would not start)
+        files = {k: os.path.abspath(v) if v and "\n" not in v else v for k, v in
+                 (("ca", sec.tls_ca_file), ("cert", sec.tls_client_cert),
+                  ("key", sec.tls_client_key or sec.tls_client_cert))}
+        roles = {f"tls_{r}_{w}": files[w] for r in ("client", "scheduler", "worker")
+                 for w in ("cert", "key")}
+        sec = Security(require_encryption=True, tls_ca_file=files["ca"], **roles)
     if not sec.tls_ca_file or not sec.tls_client_cert:
         where = "--slurm with --tls-* options" if slurm else f"{scheduler} is a TLS address"
         raise ConnectionSetupError(

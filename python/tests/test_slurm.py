@@ -167,16 +167,18 @@ def test_sweep_over_slurm_equals_local(slurm, tmp_path, fmu_path):
 
 def test_tls_sweep_over_slurm_equals_local(slurm, tmp_path, fmu_path):
     """--slurm with the --tls-* files (a CA of the test's and a certificate signed by it, made with
-    openssl): the same table as a local run, bit for bit, and the job's worker started on tls://
-    (its log in the Slurm folder)."""
+    openssl; the certificate file holds its key, no --tls-key: the workers must get that file as
+    their key too): the same table as a local run, bit for bit, and the job's worker started on
+    tls:// (its log in the Slurm folder)."""
     certs = tmp_path / "certs"
     certs.mkdir()
     make_certs(certs)
+    (certs / "node+key.pem").write_text((certs / "node.pem").read_text() + (certs / "node.key").read_text())
     spec = write_spec(tmp_path, spec_text(fmu_path, 4, extra="[slurm]\ncores = 1\nmemory = \"1GB\"\n"))
     before = set(slurm.root.glob("log/*"))
     r = finish(sweep(slurm, spec, "--out", tmp_path / "slurm", "--slurm", "--partition", "debug",
                      "--walltime", "00:10:00", "--chunk-size", "1", "--tls-ca-file", certs / "ca.pem",
-                     "--tls-cert", certs / "node.pem", "--tls-key", certs / "node.key"))
+                     "--tls-cert", certs / "node+key.pem"))
     assert r.returncode == 0, r.stderr
     r2 = run_sweep("run", spec, "--out", tmp_path / "local", "--workers", "1")
     assert r2.returncode == 0, r2.stderr
@@ -185,6 +187,35 @@ def test_tls_sweep_over_slurm_equals_local(slurm, tmp_path, fmu_path):
     started = [line for text in logs for line in text.splitlines() if "Start worker at:" in line]
     assert started and all("tls://" in line for line in started), (started, logs)
     assert not slurm.jobs()
+
+
+def test_tls_security_for_slurm(tmp_path, monkeypatch):
+    """The Security of --slurm with TLS: the client's files serve the scheduler and the workers,
+    as absolute paths (the job script names them); a certificate that holds its key is the key
+    file of every role; the client certificate may come from Dask's configuration."""
+    from distributed.security import Security
+    from dmi_sweep.run import security
+    make_certs(tmp_path)
+    (tmp_path / "both.pem").write_text((tmp_path / "node.pem").read_text() + (tmp_path / "node.key").read_text())
+    monkeypatch.chdir(tmp_path)
+    roles = ("client", "scheduler", "worker")
+    sec = security(None, "ca.pem", "node.pem", "node.key", slurm=True)
+    for r in roles:
+        assert (getattr(sec, f"tls_{r}_cert"), getattr(sec, f"tls_{r}_key")) == \
+            (str(tmp_path / "node.pem"), str(tmp_path / "node.key"))
+    assert sec.tls_ca_file == str(tmp_path / "ca.pem") and sec.require_encryption
+    sec = security(None, "ca.pem", "both.pem", None, slurm=True)
+    assert {getattr(sec, f"tls_{r}_{w}") for r in roles for w in ("cert", "key")} == {str(tmp_path / "both.pem")}
+    monkeypatch.setenv("DASK_DISTRIBUTED__COMM__TLS__CLIENT__CERT", str(tmp_path / "both.pem"))
+    import dask
+    dask.config.refresh()
+    try:
+        sec = security(None, "ca.pem", None, None, slurm=True)
+    finally:
+        monkeypatch.delenv("DASK_DISTRIBUTED__COMM__TLS__CLIENT__CERT")
+        dask.config.refresh()
+    assert sec.tls_worker_cert == sec.tls_worker_key == str(tmp_path / "both.pem")
+    assert security(None, slurm=True) is None and isinstance(sec, Security)
 
 
 def wait_for_parts(out: Path, n: int, proc: subprocess.Popen, timeout: float = 180):

@@ -53,6 +53,21 @@ def test_multi_loop_orbit_is_said():
     assert o.period == pytest.approx(4 * b.T, rel=0.02)
 
 
+def test_loops_counts_repeats_and_not_single_loops():
+    """loops() on curves of known loop count: k turns of a closed curve in M = 1000 steps (also
+    k = 3 and 7, 333.3 and 142.9 steps a loop), and single loops that a global threshold took for
+    repeats (found in review): a sawtooth with a fast return, components of scales 0.01 and 5, a
+    constant."""
+    from dmi.analysis.autonomous import loops
+    M = 1000
+    s = np.arange(M + 1) / M * 2 * np.pi
+    for k in (1, 2, 3, 4, 7):
+        assert loops(np.column_stack([np.sin(k * s), np.cos(k * s) ** 3])) == k
+    assert loops(((np.arange(M + 1) % M) / M)[:, None]) == 1
+    assert loops(np.column_stack([0.01 * np.sin(s), 5 * np.sin(2 * s)])) == 1
+    assert loops(np.ones((M + 1, 2))) == 1
+
+
 def test_autonomous_bad_input():
     b = Belt()
     with pytest.raises(ValueError, match="needs guess_period"):

@@ -116,3 +116,25 @@ def test_smooth_nonlinear_orbit_multipliers_are_the_schemes():
     assert o.u[0] == pytest.approx(u0, abs=1e-9)
     assert np.abs(exact[0]) > 0.4  # a multiplier far from 0, that a 5 % step got wrong (-1.16)
     assert o.multipliers == pytest.approx(exact, abs=1e-6)
+
+
+def test_ritz_on_a_rank_deficient_map():
+    """The Krylov blocks of a map of rank 3 (a stuck phase wipes the other directions out) in 100
+    dimensions, eigenvalues 0.9, -0.6, 0.3 and 0: the Ritz values are those, the basis handed to
+    the continuation orthonormal (a block orthogonalised by qr of its own columns alone was not:
+    0.904 for 0.9, |Q'Q - I| = 0.14, found in review)."""
+    from dmi.analysis.floquet import ritz
+    dim = 100
+    P = np.linalg.qr(np.random.default_rng(1).standard_normal((dim, dim)))[0]
+    A = P @ np.diag(np.r_[0.9, -0.6, 0.3, np.zeros(dim - 3)]) @ P.T
+
+    class Linear:
+        M = 100
+
+        def __call__(self, x):
+            return A @ x
+    mu, Q, Z = ritz(Linear(), np.zeros(dim), 6, eps=1e-3, central=False)
+    assert mu[:3] == pytest.approx([0.9, -0.6, 0.3], abs=1e-10) and np.all(mu[3:] == 0)
+    assert np.abs(Q.T @ Q - np.eye(Q.shape[1])).max() < 1e-12
+    assert np.abs(Z - A @ Q).max() < 1e-10
+

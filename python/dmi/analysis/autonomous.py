@@ -124,15 +124,23 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
 
 def loops(u: np.ndarray, most: int = 64) -> int:
     """How many times one period u (M + 1 rows, the last = the first) repeats itself: the largest
-    k in 2 .. min(most, M / 8) whose shift by round(M / k) steps moves no state by more than two
-    steps' largest travel (a fractional shift costs at most half of one; a single loop shifted by
-    8 steps or more moves its fastest part by about that many), else 1."""
-    U = np.asarray(u)[:-1]
+    k in 2 .. min(most, M / 8) whose shift by j = round(M / k) steps moves every value by at most
+    twice its own travel over the steps next to it, at both ends (a loop of M / k steps shifted
+    by a whole number of steps is off by at most half a step's travel; a single loop shifted by
+    8 steps or more moves somewhere by about that many steps' travel), else 1 (also for a
+    constant u)."""
+    U = np.asarray(u, dtype=float)[:-1]
     M = U.shape[0]
-    travel = float(np.max(np.abs(np.diff(np.asarray(u), axis=0)))) if M else 0.0
+    d = np.abs(np.roll(U, -1, axis=0) - U)           # travel of step i -> i + 1, per component
+    if M < 16 or not np.any(d):
+        return 1
+    local = np.maximum(d, np.roll(d, 1, axis=0))       # of the steps on either side of each point
+    tiny = 1e-12 * max(1.0, float(np.max(np.abs(U))))
     found = 1
     for k in range(2, min(most, M // 8) + 1):
-        if float(np.max(np.abs(np.roll(U, -round(M / k), axis=0) - U))) <= 2 * travel:
+        j = round(M / k)
+        err = np.abs(np.roll(U, -j, axis=0) - U)
+        if np.all(err <= 2 * np.maximum(local, np.roll(local, -j, axis=0)) + tiny):
             found = k
     return found
 

@@ -366,7 +366,7 @@ def _newton_picard(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, ds: f
     """The corrector by Newton-Picard (Lust, Roose, Spence & Champneys 1998) from z0 (default the
     predictor zp) on the hyperplane through zp: the Jacobian D_xF is replaced by its rank-b approximation Z Q' on the previous point's
     dominant subspace (Q orthonormal, Z = D_xF Q there, from :func:`ritz`), D_pF by one difference
-    in p at the predictor, and the bordered system
+    in p at z0, and the bordered system
 
         (Z Q' - I) dx + F_p dp = -(F(x) - x),     w t . (dx, dp) = -g,
 
@@ -469,9 +469,11 @@ def _solve(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, max_iter: int
     (:func:`dmi.analysis.shooting.fd_eps`) from qr(Z), the dominant subspace of the derivative
     the iteration actually sees (:func:`ritz`); then Newton (GMRES) from zp (not from an
     iterate: near a period doubling, Newton-Picard may have headed for the other branch that
-    crosses the first step's hyperplane p = p1).  Returns (z, iterations, which): ``newton-picard`` or ``newton``."""
+    crosses the first step's hyperplane p = p1).  Returns (z, iterations, which): the iterations
+    of all tries, and ``newton-picard`` or ``newton`` (which converged)."""
+    done = 0   # Newton-Picard iterations spent, counted in the step's (the step control's)
     if dominant is not None:
-        z, done = zp, 0
+        z = zp
         Q, Z = dominant
         for renew in (False, True):
             try:
@@ -484,11 +486,12 @@ def _solve(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, max_iter: int
                 z, its = _newton_picard(maps, zp, t, tol, ds, Q, Z, z)
                 return z, done + its, "newton-picard"
             except _Slow as e:
+                done += e.iterations
                 if e.z is None:
                     break
-                z, done = e.z, done + e.iterations
+                z = e.z
     z, its = _corrector(maps, zp, t, tol, max_iter, ds, zp)
-    return z, its, "newton"
+    return z, done + its, "newton"
 
 
 def _corrector(maps: _Maps, z: np.ndarray, t: np.ndarray, tol: float, max_iter: int,
@@ -625,6 +628,8 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                 zn, its, how = _correct(maps, zp, tc, tol, max_iter, ds, warm[0], sections)
                 break
             except (ShootingError, ValueError, Error) as e:   # Error: the map failed there
+                if tc is t_p:   # aimed at p_end: halve the step actually taken
+                    ds = min(ds, abs((p_end - z[-1]) / t[-1]))
                 ds /= 2
                 if ds < min_step:
                     status = f"corrector failed at the smallest step {min_step!r} near p = " \

@@ -111,6 +111,9 @@ def ritz(F: StepMap, x: np.ndarray, count: int, *, blocks: int = 2,
     vectors to begin from instead of random ones, and then a single block (its columns):
     Z of a nearby orbit (a continuation: k products a point, one step of subspace iteration
     along the branch).  A dense state (<= 64 values): Q = I and Z the whole matrix."""
+    if start is None and blocks < 2:
+        raise ValueError(f"blocks = {blocks!r}: the Krylov space needs 2 blocks or more (one "
+                         "block of random vectors has Ritz values of a random subspace)")
     A = monodromy_operator(F, x, eps, central)
     dim = A.shape[0]
     count = min(count, dim)
@@ -131,7 +134,9 @@ def ritz(F: StepMap, x: np.ndarray, count: int, *, blocks: int = 2,
                 B = np.column_stack(Bs)
                 W = Zs[-1] - B @ (B.T @ Zs[-1])
                 W -= B @ (B.T @ W)
-                V = np.linalg.qr(W)[0]
+                # the new block's basis orthogonal to B even where W is rank-deficient (stuck
+                # phases zero most directions out): qr of [B, W], its last columns
+                V = np.linalg.qr(np.column_stack([B, W]))[0][:, B.shape[1]:]
                 Bs.append(V)
                 Zs.append(image(V))
             B, ZB = np.column_stack(Bs), np.column_stack(Zs)
@@ -153,5 +158,8 @@ def _dominant(B: np.ndarray, ZB: np.ndarray, k: int
     if k >= S.shape[0]:
         return mu, B, ZB
     cut = np.sort(np.abs(mu))[::-1][k - 1] * (1 - 1e-12)
-    T, U, sdim = sl.schur(S, output="real", sort=lambda re, im: math.hypot(re, im) >= cut)
+    try:
+        T, U, sdim = sl.schur(S, output="real", sort=lambda re, im: math.hypot(re, im) >= cut)
+    except np.linalg.LinAlgError:   # moduli tied at the cut, reordered past LAPACK's tolerance
+        return mu, B, ZB
     return mu, B @ U[:, :sdim], ZB @ U[:, :sdim]
