@@ -7,8 +7,10 @@
 # off, from a run 10 periods from rest), the 10 leading multipliers, the start of a branch
 # (continue_orbit to 2 points: the first point's multipliers from scratch and the first step) and
 # one continuation step along it (with 6 multipliers and the stick profile a point: a branch of
-# 8 points less one of 4, over 4).  Rounds interleave the quantities; the fastest round of each
-# counts; CPU times of the process (the machine may be shared); one BLAS thread.
+# 8 points less one of 4, over 4), and what such a step is made of: one evaluation of the M-step
+# map and building the map at a new p (make(p), init), each the mean of 10.  Rounds interleave
+# the quantities; the fastest round of each counts; CPU times of the process (the machine may be
+# shared); one BLAS thread.
 # Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_orbit.py [--rounds 3] [--N 1000 10000]
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
@@ -55,21 +57,23 @@ def setup(N: int):
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(
-        description="Prints the cost of one Newton solve, the 10 leading multipliers and one "
-                    "continuation step of the tau-diagram's oscillator, in periods of plain "
-                    "simulation measured in the same run.",
+        description="Prints the cost of one Newton solve, the 10 leading multipliers, one "
+                    "continuation step, one evaluation of the step map and one build of it, for "
+                    "the tau-diagram's oscillator, in periods of plain simulation measured in "
+                    "the same run.",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     ap.add_argument("--rounds", type=int, default=3, help="interleaved rounds")
     ap.add_argument("--N", type=int, nargs="+", default=[1000, 10000],
                     help="delay cells N = ceil(tau / h) of the cases")
     a = ap.parse_args(argv)
     print(f"{'N':>6} {'M':>6} {'period s':>9} {'Newton':>8} {'its':>4} {'mult10':>8} "
-          f"{'start':>7} {'cont.step':>9}   (costs in periods of plain simulation; "
+          f"{'start':>7} {'cont.step':>9} {'eval':>5} {'build':>5}   (costs in periods of plain "
+          f"simulation; "
           f"fastest of {a.rounds} rounds, CPU)")
     for N in a.N:
         M, make, s = setup(N)
         x0 = state_of(s, M)
-        best = {k: math.inf for k in ("period", "newton", "mult", "start", "step")}
+        best = {k: math.inf for k in ("period", "newton", "mult", "start", "step", "eval", "build")}
         its = 0
         for _ in range(a.rounds):
             best["period"] = min(best["period"], cpu(lambda: s.advance(M)))
@@ -82,6 +86,9 @@ def main(argv: list[str] | None = None) -> int:
             best["newton"] = min(best["newton"], cpu(solve))
             F = StepMap(make, TAU, M)
             best["mult"] = min(best["mult"], cpu(lambda: floquet_multipliers(F, o.state, 10)))
+            best["eval"] = min(best["eval"], cpu(lambda: [F(o.state) for _ in range(10)]) / 10)
+            best["build"] = min(best["build"],
+                                cpu(lambda: [StepMap(make, TAU, M) for _ in range(10)]) / 10)
             cost = {}
             for points in (2, 4, 8):
                 cost[points] = cpu(lambda: continue_orbit(o, TAU + 0.2, step=0.02,
@@ -90,7 +97,8 @@ def main(argv: list[str] | None = None) -> int:
             best["step"] = min(best["step"], (cost[8] - cost[4]) / 4)
         T = best["period"]
         print(f"{N:>6} {M:>6} {T:9.4f} {best['newton'] / T:8.1f} {its:>4} {best['mult'] / T:8.1f} "
-              f"{best['start'] / T:7.1f} {best['step'] / T:9.1f}", flush=True)
+              f"{best['start'] / T:7.1f} {best['step'] / T:9.1f} {best['eval'] / T:5.2f} "
+              f"{best['build'] / T:5.2f}", flush=True)
     return 0
 
 

@@ -223,12 +223,12 @@ def security(scheduler: str | None, tls_ca_file: str | None = None, tls_cert: st
         # the client's files (given or configured) serve the scheduler and the workers too, as
         # absolute paths (the job script names them); a certificate file that holds its key is
         # also the key file (a worker given "--tls-key None" would not start)
-        files = {k: os.path.abspath(v) if v and "\n" not in v else v for k, v in
+        paths = {k: os.path.abspath(v) if v and "\n" not in v else v for k, v in
                  (("ca", sec.tls_ca_file), ("cert", sec.tls_client_cert),
                   ("key", sec.tls_client_key or sec.tls_client_cert))}
-        roles = {f"tls_{r}_{w}": files[w] for r in ("client", "scheduler", "worker")
+        roles = {f"tls_{r}_{w}": paths[w] for r in ("client", "scheduler", "worker")
                  for w in ("cert", "key")}
-        sec = Security(require_encryption=True, tls_ca_file=files["ca"], **roles)
+        sec = Security(require_encryption=True, tls_ca_file=paths["ca"], **roles)
     if not sec.tls_ca_file or not sec.tls_client_cert:
         where = "--slurm with --tls-* options" if slurm else f"{scheduler} is a TLS address"
         raise ConnectionSetupError(
@@ -248,8 +248,7 @@ def security(scheduler: str | None, tls_ca_file: str | None = None, tls_cert: st
                 raise ConnectionSetupError(f"cannot read the TLS {what} {path}: {e.strerror}. "
                                            "Nothing was run") from None
     try:
-        for role in ("client", "scheduler") if slurm else ("client",):
-            sec.get_connection_args(role)
+        sec.get_connection_args("client")   # with --slurm every role has the client's files
     except (ssl.SSLError, ValueError, OSError) as e:
         raise ConnectionSetupError(
             f"the TLS files do not make a client context ({e}): --tls-cert must be a PEM "

@@ -231,7 +231,8 @@ def openssl(*args: str, cwd: Path) -> None:
 
 def make_certs(d: Path) -> None:
     """ca.pem/key and other.pem/key (two self-signed CAs); node (scheduler and workers) and client
-    signed by ca, stranger signed by other; each leaf valid for 127.0.0.1."""
+    signed by ca, stranger signed by other; each leaf valid for 127.0.0.1; node+key.pem: node's
+    certificate and key in one file."""
     for ca in ("ca", "other"):
         openssl("req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", f"{ca}.key", "-out",
                 f"{ca}.pem", "-days", "2", "-subj", f"/CN=dmi-sweep test {ca}", cwd=d)
@@ -241,3 +242,4 @@ def make_certs(d: Path) -> None:
                 "-subj", f"/CN={leaf}", cwd=d)
         openssl("x509", "-req", "-in", f"{leaf}.csr", "-CA", f"{ca}.pem", "-CAkey", f"{ca}.key",
                 "-CAcreateserial", "-out", f"{leaf}.pem", "-days", "2", "-extfile", "san.ext", cwd=d)
+    (d / "node+key.pem").write_text((d / "node.pem").read_text() + (d / "node.key").read_text())

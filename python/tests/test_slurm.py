@@ -151,14 +151,19 @@ def frame(out: Path) -> pd.DataFrame:
     return pd.read_parquet(out).sort_values("point").reset_index(drop=True)
 
 
+def local_frame(spec: Path, out: Path, *args) -> pd.DataFrame:
+    """The table of the same spec run on the local cluster into out (the reference)."""
+    r = run_sweep("run", spec, "--out", out, *args)
+    assert r.returncode == 0, r.stderr
+    return frame(out)
+
+
 def test_sweep_over_slurm_equals_local(slurm, tmp_path, fmu_path):
     spec = write_spec(tmp_path, spec_text(fmu_path, 8, extra="[slurm]\ncores = 1\nmemory = \"1GB\"\n"))
     r = finish(sweep(slurm, spec, "--out", tmp_path / "slurm", "--slurm", "--jobs", "2",
                      "--partition", "debug", "--walltime", "00:10:00", "--chunk-size", "1"))
     assert r.returncode == 0, r.stderr
-    r2 = run_sweep("run", spec, "--out", tmp_path / "local", "--workers", "1")
-    assert r2.returncode == 0, r2.stderr
-    got, want = frame(tmp_path / "slurm"), frame(tmp_path / "local")
+    got, want = frame(tmp_path / "slurm"), local_frame(spec, tmp_path / "local", "--workers", "1")
     assert list(got["point"]) == list(range(8))
     pd.testing.assert_frame_equal(got, want, check_exact=True)
     # the workers ran in SLURM jobs: their output files are there (one per job, at least one)
@@ -173,16 +178,14 @@ def test_tls_sweep_over_slurm_equals_local(slurm, tmp_path, fmu_path):
     certs = tmp_path / "certs"
     certs.mkdir()
     make_certs(certs)
-    (certs / "node+key.pem").write_text((certs / "node.pem").read_text() + (certs / "node.key").read_text())
     spec = write_spec(tmp_path, spec_text(fmu_path, 4, extra="[slurm]\ncores = 1\nmemory = \"1GB\"\n"))
     before = set(slurm.root.glob("log/*"))
     r = finish(sweep(slurm, spec, "--out", tmp_path / "slurm", "--slurm", "--partition", "debug",
                      "--walltime", "00:10:00", "--chunk-size", "1", "--tls-ca-file", certs / "ca.pem",
                      "--tls-cert", certs / "node+key.pem"))
     assert r.returncode == 0, r.stderr
-    r2 = run_sweep("run", spec, "--out", tmp_path / "local", "--workers", "1")
-    assert r2.returncode == 0, r2.stderr
-    pd.testing.assert_frame_equal(frame(tmp_path / "slurm"), frame(tmp_path / "local"), check_exact=True)
+    pd.testing.assert_frame_equal(frame(tmp_path / "slurm"),
+                                  local_frame(spec, tmp_path / "local", "--workers", "1"), check_exact=True)
     logs = [f.read_text(errors="replace") for f in set(slurm.root.glob("log/*")) - before]
     started = [line for text in logs for line in text.splitlines() if "Start worker at:" in line]
     assert started and all("tls://" in line for line in started), (started, logs)
@@ -193,10 +196,10 @@ def test_tls_security_for_slurm(tmp_path, monkeypatch):
     """The Security of --slurm with TLS: the client's files serve the scheduler and the workers,
     as absolute paths (the job script names them); a certificate that holds its key is the key
     file of every role; the client certificate may come from Dask's configuration."""
-    from distributed.security import Security
+    import dask
     from dmi_sweep.run import security
     make_certs(tmp_path)
-    (tmp_path / "both.pem").write_text((tmp_path / "node.pem").read_text() + (tmp_path / "node.key").read_text())
+    both = str(tmp_path / "node+key.pem")
     monkeypatch.chdir(tmp_path)
     roles = ("client", "scheduler", "worker")
     sec = security(None, "ca.pem", "node.pem", "node.key", slurm=True)
@@ -204,18 +207,12 @@ def test_tls_security_for_slurm(tmp_path, monkeypatch):
         assert (getattr(sec, f"tls_{r}_cert"), getattr(sec, f"tls_{r}_key")) == \
             (str(tmp_path / "node.pem"), str(tmp_path / "node.key"))
     assert sec.tls_ca_file == str(tmp_path / "ca.pem") and sec.require_encryption
-    sec = security(None, "ca.pem", "both.pem", None, slurm=True)
-    assert {getattr(sec, f"tls_{r}_{w}") for r in roles for w in ("cert", "key")} == {str(tmp_path / "both.pem")}
-    monkeypatch.setenv("DASK_DISTRIBUTED__COMM__TLS__CLIENT__CERT", str(tmp_path / "both.pem"))
-    import dask
-    dask.config.refresh()
-    try:
+    sec = security(None, "ca.pem", "node+key.pem", None, slurm=True)
+    assert {getattr(sec, f"tls_{r}_{w}") for r in roles for w in ("cert", "key")} == {both}
+    with dask.config.set({"distributed.comm.tls.client.cert": both}):
         sec = security(None, "ca.pem", None, None, slurm=True)
-    finally:
-        monkeypatch.delenv("DASK_DISTRIBUTED__COMM__TLS__CLIENT__CERT")
-        dask.config.refresh()
-    assert sec.tls_worker_cert == sec.tls_worker_key == str(tmp_path / "both.pem")
-    assert security(None, slurm=True) is None and isinstance(sec, Security)
+    assert sec.tls_worker_cert == sec.tls_worker_key == both
+    assert security(None, slurm=True) is None
 
 
 def wait_for_parts(out: Path, n: int, proc: subprocess.Popen, timeout: float = 180):
@@ -277,9 +274,7 @@ def test_scancel_mid_sweep_loses_and_doubles_no_point(slurm, tmp_path, fmu_path)
     assert r.returncode == 0, r.stderr
     assert f"{len(saved)} of {num} points already in" in r.stderr
     pd.testing.assert_frame_equal(frame(out2), got, check_exact=True)
-    r = run_sweep("run", spec, "--out", tmp_path / "local")
-    assert r.returncode == 0, r.stderr
-    pd.testing.assert_frame_equal(got, frame(tmp_path / "local"), check_exact=True)
+    pd.testing.assert_frame_equal(got, local_frame(spec, tmp_path / "local"), check_exact=True)
 
 
 def test_bad_partition_exit_2_with_slurms_message(slurm, tmp_path, fmu_path):

@@ -160,11 +160,13 @@ def _stick_profile(F: StepMap, U: np.ndarray, X: np.ndarray | None
 
 def _point(F: StepMap, x: np.ndarray, multipliers: int, sections: int, dpds: float,
            iterations: int, margins: bool = True, warm: list | None = None,
-           corrector: str = "") -> BranchPoint:
+           corrector: str = "", terms: tuple[np.ndarray, np.ndarray] | None = None
+           ) -> BranchPoint:
     """The BranchPoint at the fixed point x of F; ``warm``: a one-element list holding the
     previous point's (Q, Z) of :func:`ritz` (replaced by this point's): the Ritz step starts
-    from Z, one block of products instead of two from random vectors."""
-    U, X = F.trajectory_terms(x)
+    from Z, one block of products instead of two from random vectors.  ``terms``: x's
+    :meth:`StepMap.trajectory_terms` when the caller has them (:func:`_correct`)."""
+    U, X = F.trajectory_terms(x) if terms is None else terms
     mu = np.empty(0, complex)
     if multipliers > 0:
         prev = warm[0] if warm else None
@@ -443,22 +445,23 @@ def _newton_picard(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, ds: f
 
 def _correct(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, max_iter: int, ds: float,
              dominant: tuple[np.ndarray, np.ndarray] | None, sections: int = 1
-             ) -> tuple[np.ndarray, int, str]:
-    """:func:`_solve`, refused (ShootingError: the step is halved) when the orbit of a branch
-    of ``sections`` > 1 forcing periods is periodic over a part of them: the corrector fell
-    onto the branch it was born from (a doubled branch near its doubling, where both cross the
-    first step's hyperplane p = p1 close together)."""
+             ) -> tuple[np.ndarray, int, str, tuple[np.ndarray, np.ndarray]]:
+    """:func:`_solve` and the solution's trajectory terms (:meth:`StepMap.trajectory_terms`, for
+    :func:`_point`); refused (ShootingError: the step is halved) when the orbit of a branch of
+    ``sections`` > 1 forcing periods is periodic over a part of them: the corrector fell onto
+    the branch it was born from (a doubled branch near its doubling, where both cross the first
+    step's hyperplane p = p1 close together)."""
     z, its, how = _solve(maps, zp, t, tol, max_iter, ds, dominant)
     F = maps(float(z[-1]))
+    U, X = F.trajectory_terms(z[:-1])
     for q in range(2, sections + 1):
-        if sections % q or F.M % q:
-            continue
-        U, k = F.trajectory(z[:-1]), F.M // q
-        if np.max(np.abs(U[k:] - U[:-k])) <= 1e-6 * max(1.0, float(np.max(np.abs(U)))):
-            raise ShootingError(f"the corrector fell onto an orbit of {F.M // q} steps (period "
+        k = F.M // q
+        if sections % q == 0 and F.M % q == 0 and \
+                np.max(np.abs(U[k:] - U[:-k])) <= 1e-6 * max(1.0, float(np.max(np.abs(U)))):
+            raise ShootingError(f"the corrector fell onto an orbit of {k} steps (period "
                                 f"{sections // q} of the branch's {sections} forcing periods) "
                                 f"at p = {float(z[-1])!r}", [])
-    return z, its, how
+    return z, its, how, (U, X)
 
 
 def _solve(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, max_iter: int, ds: float,
@@ -597,8 +600,8 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     while True:
         p1 = orbit.p + direction * ds
         try:
-            z, its, how = _correct(maps, np.concatenate([x0, [p1]]), t_p, tol, max_iter + 4,
-                                   math.inf, warm[0], sections)
+            z, its, how, terms = _correct(maps, np.concatenate([x0, [p1]]), t_p, tol,
+                                          max_iter + 4, math.inf, warm[0], sections)
             break
         except (ShootingError, ValueError, Error) as e:
             ds /= 2
@@ -606,7 +609,7 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                 return Branch(pts, events, f"first step failed: {e}", orbit.make, orbit.steps,
                               orbit.h, maps.rows, sections, period)
     pts.append(_point(maps(float(z[-1])), z[:-1], multipliers, sections, direction, its, margins,
-                      warm, how))
+                      warm, how, terms))
     events += _events(pts[-2], pts[-1], 1)
     while len(pts) < max_points:
         if (pts[-1].p - p_end) * direction >= -1e-7 * max(1.0, abs(p_end)):
@@ -625,7 +628,8 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
             if (zp[-1] - p_end) * direction > 0 and abs(t[-1]) > 0.5:
                 zp, tc = z + ((p_end - z[-1]) / t[-1]) * t, t_p
             try:
-                zn, its, how = _correct(maps, zp, tc, tol, max_iter, ds, warm[0], sections)
+                zn, its, how, terms = _correct(maps, zp, tc, tol, max_iter, ds, warm[0],
+                                               sections)
                 break
             except (ShootingError, ValueError, Error) as e:   # Error: the map failed there
                 if tc is t_p:   # aimed at p_end: halve the step actually taken
@@ -641,7 +645,7 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
         z_prev, z = z, zn
         dpds = float(z[-1] - z_prev[-1])
         pts.append(_point(maps(float(z[-1])), z[:-1], multipliers, sections, dpds, its, margins,
-                          warm, how))
+                          warm, how, terms))
         for e in _events(pts[-2], pts[-1], len(pts) - 1):
             if e.kind == "fold":
                 e = _refine_fold(pts[-3:], e)

@@ -127,19 +127,16 @@ def ritz(F: StepMap, x: np.ndarray, count: int, *, blocks: int = 2,
         mu = np.linalg.eigvals(Z)
     else:
         if start is None:
-            b = min(dim // max(1, blocks), count + 2)
-            V = np.linalg.qr(np.random.default_rng(0).standard_normal((dim, b)))[0]
-            Bs, Zs = [V], [image(V)]
-            for _ in range(blocks - 1):   # the next block: the last image, orthogonalised
-                B = np.column_stack(Bs)
-                W = Zs[-1] - B @ (B.T @ Zs[-1])
-                W -= B @ (B.T @ W)
-                # the new block's basis orthogonal to B even where W is rank-deficient (stuck
-                # phases zero most directions out): qr of [B, W], its last columns
-                V = np.linalg.qr(np.column_stack([B, W]))[0][:, B.shape[1]:]
-                Bs.append(V)
-                Zs.append(image(V))
-            B, ZB = np.column_stack(Bs), np.column_stack(Zs)
+            b = min(dim // blocks, count + 2)
+            B = np.linalg.qr(np.random.default_rng(0).standard_normal((dim, b)))[0]
+            ZB = last = image(B)
+            for _ in range(blocks - 1):
+                # the next block: the last image orthogonalised against B, as the last columns
+                # of qr([B, last]) (orthogonal to B also where the image is rank-deficient, as
+                # when stuck phases zero most directions out)
+                V = np.linalg.qr(np.column_stack([B, last]))[0][:, B.shape[1]:]
+                last = image(V)
+                B, ZB = np.column_stack([B, V]), np.column_stack([ZB, last])
         else:
             B = np.linalg.qr(start)[0]
             ZB = image(B)
