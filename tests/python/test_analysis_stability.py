@@ -257,7 +257,7 @@ def test_bad_input_gives_clear_errors():
         raise ZeroDivisionError("the model is broken")
     with pytest.raises(ZeroDivisionError, match="broken") as e:
         analysis.hopf(broken, 1.0, 2.0, [0.0])
-    assert any("make(1.0,)" in note for note in e.value.__notes__)
+    assert any("make(p = 1.0)" in note for note in e.value.__notes__)
     with pytest.raises(TypeError, match="not a dmi.Solver"):
         analysis.roots(lambda p: 42, 1.0, [0.0])
 

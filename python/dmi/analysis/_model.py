@@ -37,15 +37,18 @@ class KinkError(ValueError):
     sticking exactly at its threshold, a box constraint exactly on its face)."""
 
 
-def call_make(make: Callable[..., Any], *args: Any) -> Solver:
-    """make(*args), checked to be a dmi.Solver; its exception gets a note naming the call."""
+def call_make(make: Callable[..., Any], *args: Any, **kw: Any) -> Solver:
+    """make(*args, **kw), checked to be a dmi.Solver; its exception (the model's own) gets a
+    note naming the call, ``make(p = ...)``."""
+    call = ", ".join([f"p = {a!r}" if i == 0 else repr(a) for i, a in enumerate(args)]
+                     + [f"{k}={v!r}" for k, v in kw.items()])
     try:
-        s = make(*args)
+        s = make(*args, **kw)
     except Exception as e:
-        e.add_note(f"dmi.analysis: raised by the model make{args!r}")
+        e.add_note(f"dmi.analysis: raised by the model make({call})")
         raise
     if not isinstance(s, Solver):
-        raise TypeError(f"dmi.analysis: the model make{args!r} returned {type(s).__name__}, "
+        raise TypeError(f"dmi.analysis: the model make({call}) returned {type(s).__name__}, "
                         "not a dmi.Solver")
     return s
 
@@ -177,13 +180,14 @@ class Linearisation:
         s.step()
         _, X = s.step_terms()
         moved = s.state - u
-        scale = max(np.max(np.abs(u)), np.max(np.abs(u - X)))
+        scale = max(1.0, np.max(np.abs(u)), np.max(np.abs(u - X)))
         res = np.max(np.abs(moved))
         if not res <= tol * scale:
             raise ValueError(f"dmi.analysis: u_eq = {u!r} is not an equilibrium of the step map "
                              f"at {args!r}: one step moves it by {moved!r} (max {res:.3g}, "
-                             f"{res / scale if scale else float('inf'):.3g} relative to "
-                             f"max(|u_eq|, |u_eq - X*|) = {scale:.3g}; tolerance {tol:g})")
+                             f"{res / scale:.3g} relative to max(1, |u_eq|, |u_eq - X*|) = "
+                             f"{scale:.3g}; tolerance {tol:g}): correct it with "
+                             "dmi.analysis.equilibrium")
         scale_u = max(np.max(np.abs(u)), np.max(np.abs(X))) or 1.0
         bound = s._keep.get("rhs")
         if bound is None or bound.address is None:
@@ -208,6 +212,26 @@ class Linearisation:
         self.tangent.set_window(w)
         self.tangent.advance(steps)
         return self.tangent.get_window()[1:].reshape(-1)
+
+    def characteristic(self, z: complex) -> np.ndarray:
+        """The scheme's characteristic matrix at the multiplier z (n x n, complex): column j is
+        one tangent step of the mode U^(p-k) = z^(-k) e_j (k = 0 .. N) less z e_j, so that a
+        root lambda = log(z) / h has a null vector, the mode's last row."""
+        n, N = self.n, self.N
+        powers = complex(z) ** -np.arange(N, -1, -1.0)   # z^-N .. z^0, oldest row first
+        R = np.empty((n, n), dtype=complex)
+        t = self.tangent
+        for j in range(n):
+            col = np.zeros(n, dtype=complex)
+            for part, unit in ((np.real, 1.0), (np.imag, 1j)):
+                w = np.zeros((N + 1, n))
+                w[:, j] = part(powers)
+                t.set_window(w)
+                t.advance(1)
+                col += unit * t.get_window()[-1]
+            col[j] -= z
+            R[:, j] = col
+        return R
 
     def apply_complex(self, V: np.ndarray, steps: int) -> np.ndarray:
         """M^steps on the columns of a complex array V (n N, k)."""

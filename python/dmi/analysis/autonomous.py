@@ -1,14 +1,21 @@
-# Periodic orbits of unknown period (autonomous systems) by shooting in (state, h) (issue 30).
+# Periodic orbits of unknown period (autonomous systems): shooting in (state, h), and the orbit
+# born at a Hopf point with its parameter free.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """Autonomous periodic orbits: the period P = M h with M fixed and the step h unknown.
 
 The model must then take the step: ``make(p, h=h) -> dmi.Solver`` (libdmi 1.2's
 ``dmi.Solver(n, tau, h=h)``).  Unknowns (x, h); equations F_h(x) - x = 0 and the phase condition
-<xdot_0, x_0 - x_ref> = 0 on the last row (the state at t = 0), xdot_0 the guess's velocity there
-(central difference over its first run).  Newton with GMRES on the bordered Jacobian
-[[D_xF - I, D_hF], [xdot_0' on the last row, 0]] (D_hF by one difference in h a step).  N =
-ceil(tau / h) may change with h: the states hold L = ceil(tau / (0.8 h_0)) + 1 rows (h may fall by
-20 %), the older ones by periodicity.
+<xdot_0, x_0 - x_ref> = 0 on the last row (the state at t = 0), xdot_0 the guess's velocity there:
+a Poincare section through the guess, across the flow.  Newton with GMRES on the bordered
+Jacobian (:func:`dmi.analysis.newton.bordered_newton`, D_hF by one difference in h a step).
+N = ceil(tau / h) may change with h: the states hold L = ceil(tau / (0.8 h_0)) + 1 rows (h may
+fall by 20 %), the older ones by periodicity.
+
+:func:`hopf_orbit` starts the branch born at a Hopf point: the unknowns are (x, h, p), and an
+amplitude condition (the half range of one component over the period) replaces the parameter,
+so that it works where the branch leaves the Hopf point vertically (piecewise-linear friction)
+as well as where it grows like sqrt|p - p_H|.  Its states hold a whole period (L >= M + 1), from
+which the amplitude is read.
 """
 from __future__ import annotations
 
@@ -19,14 +26,86 @@ from typing import Any
 import numpy as np
 
 from .._solver import Solver
-from .shooting import (Model, Orbit, ShootingError, StepMap, _fmt, bordered_step, build,
-                       make_orbit, positive_time)
+from ._model import Linearisation
+from .equilibria import equilibrium
+from .newton import ShootingError, bordered_newton, fmt_residuals
+from .orbit import Orbit, loops, make_orbit
+from .stability import HopfPoint, roots
+from .stepmap import Model, StepMap, build, positive_time
 
 
-def _with_h(make: Model, h: float) -> Model:
-    def made(p: float) -> Solver:
+def fixed_step(make: Model, h: float) -> Model:
+    """make at the step h: ``made(p)`` is ``make(p, h=h)``, and ``made(p, h=other)`` another
+    step (an autonomous Orbit's ``make``: StepMap(orbit.make, ...) runs at the orbit's step and
+    continuation changes it)."""
+    def made(p: float, h: float = h) -> Solver:
         return make(p, h=h)  # type: ignore[call-arg]
+    made.base = getattr(make, "base", make)  # type: ignore[attr-defined]
     return made
+
+
+def step_model(make: Model, p: float, h: float) -> Solver:
+    """make(p, h=h), with a model that does not take the step named."""
+    try:
+        return build(make, p, h=h)
+    except TypeError as e:
+        if "h" in str(e) or "argument" in str(e):
+            raise ValueError(f"an autonomous orbit needs a model make(p, h=...) that takes the "
+                             f"step ({e})") from e
+        raise
+
+
+class AutonomousMaps:
+    """The StepMaps of make(p, h=h) by (h, p) on states of ``rows`` rows, the last few cached;
+    a step h <= h_min, or an N + 1 above ``rows``, is refused (ShootingError)."""
+
+    def __init__(self, make: Model, M: int, rows: int, h_min: float):
+        self.make, self.M, self.rows, self.h_min = make, int(M), int(rows), float(h_min)
+        self._cache: dict[tuple[float, float], StepMap] = {}
+
+    def __call__(self, h: float, p: float) -> StepMap:
+        key = (float(h), float(p))
+        F = self._cache.get(key)
+        if F is None:
+            if not h > self.h_min:
+                raise ShootingError(f"the step went to h = {h!r} (period {self.M * h!r}), below "
+                                    f"{self.h_min!r}: no orbit near the guess", [])
+            s = step_model(self.make, p, h)
+            if s.N + 1 > self.rows:
+                raise ShootingError(f"the step fell to h = {h!r}: N + 1 = {s.N + 1} > "
+                                    f"{self.rows} rows of the state", [])
+            F = StepMap(fixed_step(self.make, h), p, self.M, self.rows, solver=s)
+            if len(self._cache) > 5:
+                self._cache.pop(next(iter(self._cache)))
+            self._cache[key] = F
+        return F
+
+
+def velocity(U: np.ndarray, h: float) -> np.ndarray:
+    """The velocity at t = 0 of one period U (M + 1 rows), by a central difference across it."""
+    M = U.shape[0] - 1
+    return (U[1] - U[M - 1]) / (2 * h) if M > 1 else (U[1] - U[0]) / h
+
+
+def phase_row(x: np.ndarray, xdot: np.ndarray, ref: np.ndarray, k: int
+              ) -> tuple[float, np.ndarray]:
+    """The phase condition <xdot, x_0 - ref> (x_0 the last row of x) and its row over (x, q)."""
+    n = xdot.size
+    row = np.zeros(x.size + k)
+    row[x.size - n:x.size] = xdot
+    return float(np.dot(xdot, x[-n:] - ref)), row
+
+
+def no_equilibrium(o: Orbit, tol: float, what: str) -> Orbit:
+    """o, refused (ShootingError) when its amplitude is below 1e3 tol: shooting converged to an
+    equilibrium, a constant orbit of any period."""
+    amp = float(np.max(o.amplitude))
+    scale = max(1.0, float(np.max(np.abs(o.u))))
+    if amp <= 1e3 * tol * scale:
+        raise ShootingError(f"{what}: converged to an equilibrium, not an orbit (amplitude "
+                            f"{amp:.3g}; the state {o.u[0]!r}): start nearer the orbit, or from "
+                            "a Hopf point with hopf_orbit", [o.residual])
+    return o
 
 
 def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
@@ -41,33 +120,11 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
     if M < 1:
         raise ValueError(f"steps = {steps}: must be >= 1")
     h0 = P0 / M
-    try:
-        s0 = make(p, h=h0)  # type: ignore[call-arg]
-    except TypeError as e:
-        raise ValueError(f"period=None needs a model make(p, h=...) that takes the step ({e})") \
-            from e
+    s0 = step_model(make, p, h0)
     rows = max(s0.N + 1, math.ceil(s0.tau / (0.8 * h0)) + 1)
-    cache: dict[float, StepMap] = {}
-    res: list[float] = []   # the Newton residuals, also in the errors of F(h)
-
-    def F(h: float) -> StepMap:
-        if h not in cache:
-            if not (h > 0.5 * h0):
-                raise ShootingError(f"autonomous orbit at p = {p!r}: the step went to h = {h!r}, "
-                                    f"below half the guess's {h0!r} after {len(res)} Newton "
-                                    f"iterations (residuals {_fmt(res)}): no orbit near the "
-                                    "guess", res)
-            m = StepMap(_with_h(make, h), p, M, rows)
-            if m.N + 1 > rows:
-                raise ShootingError(f"autonomous orbit at p = {p!r}: the step fell to h = {h!r}: "
-                                    f"N + 1 = {m.N + 1} > {rows} rows (residuals {_fmt(res)})",
-                                    res)
-            if len(cache) > 3:
-                cache.pop(next(iter(cache)))
-            cache[h] = m
-        return cache[h]
-
-    F0 = F(h0)
+    maps = AutonomousMaps(make, M, rows, 0.5 * h0)
+    F0 = maps(h0, p)
+    n = F0.n
     if isinstance(guess, Solver):
         if guess.n != F0.n or abs(guess.h - h0) > 1e-12 * h0 or guess.N != F0.N:
             raise ValueError(f"guess: a solver with h = {guess.h!r}, N = {guess.N}; expected the "
@@ -75,82 +132,129 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
         x0 = guess.get_window().ravel()
     else:
         x0 = np.asarray(guess, dtype=float).ravel()
-        if x0.size == F0.n:
+        if x0.size == n:
             x0 = np.tile(x0, F0.N + 1)
+        if x0.size % n or not F0.N + 1 <= x0.size // n:
+            raise ValueError(f"guess has {x0.size} values ({np.shape(guess)}); give n = {n} "
+                             f"values (a constant window), or k >= N + 1 = {F0.N + 1} rows of "
+                             f"n = {n} (an (k, {n}) array or k {n} values), the last at t = 0")
     x0 = F0.extend(x0)
-    n = F0.n
-    U = F0.trajectory(x0)
-    xdot = (U[1] - U[M - 1]) / (2 * h0) if M > 1 else U[1] - U[0]
+    xdot = velocity(F0.trajectory(x0), h0)
     if not np.any(xdot):
         raise ValueError("the guess does not move at t = 0: no phase condition (an equilibrium?)")
     xdot = xdot / np.linalg.norm(xdot)
     ref = x0[-n:].copy()
-    x, h = x0.copy(), h0
     what = f"autonomous orbit at p = {p!r}, M = {M} steps, guess period {P0!r}"
-    for _ in range(max_iter + 1):
-        Fm = F(h)
-        Fx = Fm(x)
-        r = Fx - x
-        g = float(np.dot(xdot, x[-n:] - ref))
-        rn = float(np.max(np.abs(r)))
-        res.append(rn)
-        scale = max(1.0, float(np.max(np.abs(x))))
-        if not math.isfinite(rn):
-            raise ShootingError(f"{what}: non-finite residual (residuals {_fmt(res)})", res)
-        if rn <= tol * scale and abs(g) <= tol * scale:
-            o = _without_phase(make_orbit(Fm, x, res, multipliers))
-            k = loops(o.u)
-            if k > 1:
-                warnings.warn(f"{what}: the orbit found repeats {k} times in its M steps (its "
-                              f"least period is about {o.period / k:.6g}, the orbit's "
-                              f"{o.period:.6g}): give a guess_period near the period sought, "
-                              f"or steps = M / {k}", RuntimeWarning, stacklevel=3)
-            return o
-        if len(res) > max_iter:
-            break
-        dh = 1e-7 * h
-        Fh = (F(h + dh)(x) - Fx) / dh
-        border = np.zeros(x.size + 1)
-        border[x.size - n:x.size] = xdot   # the phase condition: xdot . dx_0 (h free)
-        dz, lin = bordered_step(Fm, x, Fx, Fh, border, g, rtol=1e-8)
-        if lin > 1e-2:
-            raise ShootingError(f"{what}: the bordered Jacobian is singular at Newton iteration "
-                                f"{len(res)} (GMRES relative residual {lin:.2g}, residuals "
-                                f"{_fmt(res)})", res)
-        x, h = x + dz[:-1], h + float(dz[-1])
-    raise ShootingError(f"{what}: no convergence in {max_iter} Newton iterations (residuals "
-                        f"{_fmt(res)})", res)
 
+    def spread(x: np.ndarray) -> float:   # how far the state's rows differ: 0 at equilibrium
+        X = x.reshape(-1, n)
+        return float(np.max(X.max(axis=0) - X.min(axis=0)))
 
-def loops(u: np.ndarray, most: int = 64) -> int:
-    """How many times one period u (M + 1 rows, the last = the first) repeats itself: the largest
-    k in 2 .. min(most, M / 8) whose shift by j = round(M / k) steps moves every value by at most
-    twice its own travel over the steps next to it, at both ends (a loop of M / k steps shifted
-    by a whole number of steps is off by at most half a step's travel; a single loop shifted by
-    8 steps or more moves somewhere by about that many steps' travel), else 1 (also for a
-    constant u)."""
-    U = np.asarray(u, dtype=float)[:-1]
-    M = U.shape[0]
-    d = np.abs(np.roll(U, -1, axis=0) - U)           # travel of step i -> i + 1, per component
-    if M < 16 or not np.any(d):
-        return 1
-    local = np.maximum(d, np.roll(d, 1, axis=0))       # of the steps on either side of each point
-    tiny = 1e-12 * max(1.0, float(np.max(np.abs(U))))
-    found = 1
-    for k in range(2, min(most, M // 8) + 1):
-        j = round(M / k)
-        err = np.abs(np.roll(U, -j, axis=0) - U)
-        if np.all(err <= 2 * np.maximum(local, np.roll(local, -j, axis=0)) + tiny):
-            found = k
-    return found
-
-
-def _without_phase(o: Orbit) -> Orbit:
-    """An autonomous orbit always has the multiplier 1 (a shift along the orbit, the phase):
-    ``stable`` is judged on the other multipliers (the one nearest 1 left out; False if no other
-    was computed).  ``multipliers`` keeps them all."""
-    mu = o.multipliers
-    if mu.size:
-        rest = np.delete(mu, int(np.argmin(np.abs(mu - 1))))
-        o.stable = bool(rest.size and np.all(np.abs(rest) < 1))
+    spreads = [spread(x0)]
+    try:
+        z, res = bordered_newton(lambda q: maps(q[0], p), np.concatenate([x0, [h0]]), 1,
+                                 lambda z: _one(phase_row(z[:-1], xdot, ref, 1)), tol=tol,
+                                 max_iter=max_iter, what=what, steps=np.array([1e-7 * h0]),
+                                 check=lambda z: spreads.append(spread(z[:-1])))
+    except ShootingError as e:
+        if min(spreads) <= 1e-3 * spreads[0]:   # Newton went for a constant state
+            raise ShootingError(f"{what}: Newton went to an equilibrium, not an orbit (the "
+                                f"state's rows came to differ by {min(spreads):.3g}, from "
+                                f"{spreads[0]:.3g} in the guess), then failed: {e}; start nearer "
+                                "the orbit, or from a Hopf point with hopf_orbit",
+                                e.residuals) from e
+        raise
+    o = make_orbit(maps(z[-1], p), z[:-1], res, multipliers, autonomous=True)
+    no_equilibrium(o, tol, what)
+    k = loops(o.u)
+    if k > 1:
+        warnings.warn(f"{what}: the orbit found repeats {k} times in its M steps (its least "
+                      f"period is about {o.period / k:.6g}, the orbit's {o.period:.6g}): give a "
+                      f"guess_period near the period sought, or steps = M / {k}",
+                      RuntimeWarning, stacklevel=3)
     return o
+
+
+def _one(gr: tuple[float, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    return np.array([gr[0]]), gr[1][None, :]
+
+
+def critical_vector(lin: Linearisation, lam: complex) -> np.ndarray:
+    """The null vector v (n,) of the scheme's characteristic matrix at the root lam (the last
+    row of the mode U^j = z^j v, z = exp(lam h)), |v|_2 = 1, by the SVD."""
+    R = lin.characteristic(np.exp(complex(lam) * lin.h))
+    _, _, Vh = np.linalg.svd(R)
+    return Vh[-1].conj()
+
+
+def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: float, steps: int,
+               component: int | None = None, multipliers: int = 10, tol: float = 1e-10,
+               max_iter: int = 30) -> Orbit:
+    """The autonomous orbit of the branch born at ``hopf_point`` (from :func:`dmi.analysis.hopf`
+    or a ``hopf`` event of :func:`dmi.analysis.continue_equilibrium`) whose amplitude is
+    ``amplitude``: the half range (max - min) / 2 over the period of the state component
+    ``component`` (default: the largest component of the critical eigenvector), state units.
+
+    The parameter p is free: an amplitude condition replaces it, so the branch may leave the
+    Hopf point as sqrt|p - p_H| (smooth) or vertically (piecewise-linear friction, up to
+    grazing).  ``steps``: M steps a period; the model must take the step, ``make(p, h=...)``.
+    ``u_eq``: the equilibrium at the Hopf point (n values, corrected by Newton at the orbit's
+    step).  The first guess is u_eq + a Re(v e^(i omega t)) over one period 2 pi / omega, v the
+    null vector of the scheme's characteristic matrix at the root.  Returns an :class:`Orbit`
+    (``autonomous``; its p is the branch's at that amplitude, its period M h); continue it with
+    :func:`dmi.analysis.continue_orbit`.  Raises ValueError for bad input, ShootingError when
+    Newton fails (every residual listed)."""
+    if not isinstance(hopf_point, HopfPoint):
+        raise ValueError(f"hopf_point = {hopf_point!r}: give a dmi.analysis.HopfPoint")
+    if not (hopf_point.omega > 0 and math.isfinite(hopf_point.omega)):
+        raise ValueError(f"hopf_point.omega = {hopf_point.omega!r}: a Hopf point has omega > 0 "
+                         "(omega = 0 is a fold)")
+    a = positive_time("amplitude", amplitude)
+    M = int(steps)
+    if M != steps or M < 8:
+        raise ValueError(f"steps = {steps!r}: give a whole number of steps a period, >= 8")
+    p = float(hopf_point.p)
+    h0 = 2 * math.pi / hopf_point.omega / M
+    made = fixed_step(make, h0)
+    eq = equilibrium(made, p, u_eq, tol=tol, count=4)
+    n = eq.u.size
+    with Linearisation(lambda: build(made, p), eq.u, (p,), 1e-6) as lin:
+        lam = eq.roots[np.argmin(np.abs(eq.roots - 1j * hopf_point.omega))]
+        v = critical_vector(lin, lam)
+        tau = lin.tau
+    c = int(np.argmax(np.abs(v))) if component is None else int(component)
+    if not 0 <= c < n:
+        raise ValueError(f"component = {component!r}: the model has n = {n} components")
+    if abs(v[c]) < 1e-8:
+        raise ValueError(f"component {c} does not move in the critical mode (|v_c| = "
+                         f"{abs(v[c]):.2g}): choose another")
+    omega = abs(lam.imag)
+    h0 = 2 * math.pi / omega / M
+    rows = max(M + 1, math.ceil(tau / (0.8 * h0)) + 1)
+    maps = AutonomousMaps(make, M, rows, 0.5 * h0)
+    t = (np.arange(rows) - (rows - 1)) * h0
+    s = a / abs(v[c])
+    X = eq.u + s * np.real(np.outer(np.exp(1j * omega * t), v))
+    x0 = X.ravel()
+    xdot = np.real(1j * omega * s * v)
+    xdot = xdot / np.linalg.norm(xdot)
+    ref = x0[-n:].copy()
+    dim = x0.size
+    last = slice(dim - (M + 1) * n + c, dim, n)   # component c over the last period
+
+    def conditions(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        g1, r1 = phase_row(z[:dim], xdot, ref, 2)
+        w = z[last]
+        imax, imin = int(np.argmax(w)), int(np.argmin(w))
+        r2 = np.zeros(dim + 2)
+        idx = np.arange(dim)[last]
+        r2[idx[imax]] += 0.5
+        r2[idx[imin]] -= 0.5
+        return np.array([g1, 0.5 * (w[imax] - w[imin]) - a]), np.vstack([r1, r2])
+
+    what = f"orbit born at the Hopf point p = {p!r}, amplitude {a!r}, M = {M} steps"
+    z, res = bordered_newton(lambda q: maps(q[0], q[1]), np.concatenate([x0, [h0, p]]), 2,
+                             conditions, tol=tol, max_iter=max_iter, what=what,
+                             steps=np.array([1e-7 * h0, 1e-7 * max(1.0, abs(p))]))
+    o = make_orbit(maps(z[-2], z[-1]), z[:dim], res, multipliers, autonomous=True)
+    return no_equilibrium(o, tol, what)

@@ -1,4 +1,4 @@
-# Pseudo-arclength continuation of periodic orbits and their events (issue 30).
+# Pseudo-arclength continuation of periodic orbits and their events.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """Continuation of a periodic orbit of the scheme in its parameter p.
 
@@ -50,83 +50,18 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from .._errors import Error
 from .._solver import Solver
-from .floquet import fd_step, ritz
-from .shooting import (Model, Orbit, ShootingError, StepMap, bordered_step, build, fd_eps,
-                       newton, periodic_orbit, positive_time, stuck_mask)
-
-
-@dataclass
-class BranchPoint:
-    """One orbit of a branch: ``p``; ``period`` (time units); ``amplitude`` (n,): (max - min) / 2
-    per component; ``multipliers`` (largest |mu| first); ``stable``; ``stick_steps`` (n,): stuck
-    steps per period; ``stick_phases`` (n,): stuck intervals per period; ``margin`` (n,): see
-    the module; ``section`` (k, n): u at t = j period / k, j < k (k = ``sections``: a Poincare
-    section at the forcing period of a k-periodic orbit); ``state``: the shooting state;
-    ``dpds``: the tangent's p component (its sign flips at a fold); ``iterations`` and
-    ``corrector`` (``newton-picard`` or ``newton``, see the module; empty at the start)."""
-    p: float
-    period: float
-    amplitude: np.ndarray
-    multipliers: np.ndarray
-    stable: bool
-    stick_steps: np.ndarray
-    stick_phases: np.ndarray
-    margin: np.ndarray
-    section: np.ndarray
-    state: np.ndarray = field(repr=False)
-    dpds: float = 0.0
-    iterations: int = 0
-    corrector: str = ""
-
-
-@dataclass
-class Event:
-    """A detected event between points ``index - 1`` and ``index`` of the branch: ``kind``
-    (``fold``, ``period-doubling``, ``torus``, ``stick-onset``, ``grazing``), ``p`` (linear
-    interpolation of the test function's zero), ``component`` (the friction component of a
-    stick event, else None) and a ``detail`` text."""
-    kind: str
-    p: float
-    index: int
-    component: int | None = None
-    detail: str = ""
-
-
-@dataclass
-class Branch:
-    """A continued branch: ``points`` (:class:`BranchPoint`), ``events`` (:class:`Event`),
-    ``status`` (why it ended), ``make``, ``steps`` (M), ``h`` (the start's step), ``rows`` (L),
-    ``sections`` and ``period`` (the function p -> period given to :func:`continue_orbit`, or
-    None: the period M h was kept)."""
-    points: list[BranchPoint]
-    events: list[Event]
-    status: str
-    make: Model = field(repr=False)
-    steps: int = 0
-    h: float = 0.0
-    rows: int = 0
-    sections: int = 1
-    period: Callable[[float], float] | None = field(default=None, repr=False)
-
-    @property
-    def p(self) -> np.ndarray:
-        """The points' parameters p, in the order continued."""
-        return np.array([q.p for q in self.points])
-
-    @property
-    def stable(self) -> np.ndarray:
-        """The points' ``stable`` flags (booleans)."""
-        return np.array([q.stable for q in self.points])
-
-    def column(self, name: str) -> np.ndarray:
-        """An attribute of every point stacked: ``branch.column("amplitude")`` -> (points, n)."""
-        return np.array([getattr(q, name) for q in self.points])
+from .branch import Branch, BranchPoint, Event
+from .floquet import fd_step, phase_free, ritz
+from .autonomous import AutonomousMaps, phase_row, velocity
+from .newton import ShootingError, bordered_newton, bordered_step, fd_eps, newton
+from .orbit import Orbit, stuck_mask
+from .shooting import periodic_orbit
+from .stepmap import Model, StepMap, build, positive_time
 
 
 def _stick_profile(F: StepMap, U: np.ndarray, X: np.ndarray | None
@@ -160,12 +95,13 @@ def _stick_profile(F: StepMap, U: np.ndarray, X: np.ndarray | None
 
 def _point(F: StepMap, x: np.ndarray, multipliers: int, sections: int, dpds: float,
            iterations: int, margins: bool = True, warm: list | None = None,
-           corrector: str = "", terms: tuple[np.ndarray, np.ndarray] | None = None
-           ) -> BranchPoint:
+           corrector: str = "", terms: tuple[np.ndarray, np.ndarray] | None = None,
+           autonomous: bool = False) -> BranchPoint:
     """The BranchPoint at the fixed point x of F; ``warm``: a one-element list holding the
     previous point's (Q, Z) of :func:`ritz` (replaced by this point's): the Ritz step starts
     from Z, one block of products instead of two from random vectors.  ``terms``: x's
-    :meth:`StepMap.trajectory_terms` when the caller has them (:func:`_correct`)."""
+    :meth:`StepMap.trajectory_terms` when the caller has them (:func:`_correct`).  An
+    ``autonomous`` orbit's ``stable`` leaves out its phase multiplier."""
     U, X = F.trajectory_terms(x) if terms is None else terms
     mu = np.empty(0, complex)
     if multipliers > 0:
@@ -179,21 +115,31 @@ def _point(F: StepMap, x: np.ndarray, multipliers: int, sections: int, dpds: flo
             warm[0] = (Q, Z)
     steps, phases, margin = _stick_profile(F, U, X if margins else None)
     k = F.M // sections
+    rest = phase_free(mu) if autonomous else mu
     return BranchPoint(p=F.p, period=F.M * F.h, amplitude=0.5 * (U.max(axis=0) - U.min(axis=0)),
-                       multipliers=mu, stable=bool(mu.size and np.all(np.abs(mu) < 1)),
+                       multipliers=mu, stable=bool(rest.size and np.all(np.abs(rest) < 1)),
                        stick_steps=steps, stick_phases=phases, margin=margin,
                        section=U[[j * k for j in range(sections)]], state=np.array(x),
                        dpds=dpds, iterations=iterations, corrector=corrector)
 
 
-def _events(a: BranchPoint, b: BranchPoint, index: int) -> list[Event]:
+#: |dp/ds| (the unit tangent's p component) below which a branch is vertical: a sign change of
+#: dp/ds there is noise, not a fold.
+VERTICAL = 1e-6
+
+
+def _events(a: BranchPoint, b: BranchPoint, index: int, autonomous: bool = False
+            ) -> list[Event]:
+    """The events between a and b (see the module); an ``autonomous`` branch's phase multiplier
+    is left out of the multipliers' events."""
     ev: list[Event] = []
+    mua, mub = (phase_free(q.multipliers) if autonomous else q.multipliers for q in (a, b))
 
     def at(fa: float, fb: float) -> float:
         w = 0.5 if fa == fb or fa * fb > 0 else fa / (fa - fb)  # no sign change: the middle
         return a.p + (b.p - a.p) * w
 
-    if a.dpds * b.dpds < 0:
+    if a.dpds * b.dpds < 0 and min(abs(a.dpds), abs(b.dpds)) > VERTICAL:
         ev.append(Event("fold", at(a.dpds, b.dpds), index, None, "dp/ds changes sign"))
 
     def real_neg(m: np.ndarray) -> np.ndarray:
@@ -202,16 +148,16 @@ def _events(a: BranchPoint, b: BranchPoint, index: int) -> list[Event]:
     def cplx(m: np.ndarray) -> np.ndarray:
         return m[np.abs(m.imag) > 1e-8 * np.maximum(np.abs(m), 1)]
 
-    na, nb = np.sum(real_neg(a.multipliers) < -1), np.sum(real_neg(b.multipliers) < -1)
+    na, nb = np.sum(real_neg(mua) < -1), np.sum(real_neg(mub) < -1)
     if na != nb:
         # the test function 1 + min Re mu: the multiplier that crosses -1 may have been half
         # of a complex pair at the previous point (a pair that met on the negative axis)
-        fa, fb = (1 + float(np.min(q.multipliers.real)) for q in (a, b))
+        fa, fb = (1 + float(np.min(m.real)) for m in (mua, mub))
         ev.append(Event("period-doubling", at(fa, fb), index, None,
                         f"real multipliers < -1: {na} -> {nb}"))
-    ca, cb = np.sum(np.abs(cplx(a.multipliers)) > 1), np.sum(np.abs(cplx(b.multipliers)) > 1)
+    ca, cb = np.sum(np.abs(cplx(mua)) > 1), np.sum(np.abs(cplx(mub)) > 1)
     if ca != cb:
-        ma, mb = np.abs(cplx(a.multipliers)), np.abs(cplx(b.multipliers))
+        ma, mb = np.abs(cplx(mua)), np.abs(cplx(mub))
         fa = float(np.max(ma)) - 1 if ma.size else 0.0
         fb = float(np.max(mb)) - 1 if mb.size else 0.0
         ev.append(Event("torus", at(fa, fb), index, None,
@@ -248,41 +194,44 @@ def _refine_fold(last: list[BranchPoint], e: Event) -> Event:
     return e
 
 
-def _locate_stick(maps: _Maps, a: BranchPoint, b: BranchPoint, e: Event, tol: float,
-                  bisections: int = 6) -> Event:
+def _locate_stick(maps: _Maps | _AutoMaps, a: BranchPoint, b: BranchPoint, e: Event,
+                  tol: float, bisections: int = 6) -> Event:
     """Bisection in p between a and b on the stick pattern of component e.component (natural
-    continuation: orbits at the midpoints from the interpolated state); the event's p becomes
-    the final bracket's midpoint, 2^-bisections of |b.p - a.p| wide."""
+    continuation: orbits at the midpoints from the interpolated state, p fixed); the event's p
+    becomes the final bracket's midpoint, 2^-bisections of |b.p - a.p| wide."""
     i = e.component
     key = (lambda q: (q[0] > 0, q[1])) if e.kind == "stick-onset" else (lambda q: (True, q[1]))
     ka = key((a.stick_steps[i], a.stick_phases[i]))
-    pa, pb, xa, xb = a.p, b.p, a.state, b.state
-    k = min(xa.size, xb.size)
-    xa, xb = xa[-k:], xb[-k:]
+    za, zb = maps.z_of(a), maps.z_of(b)
+    if za.size != zb.size:
+        return e
     for _ in range(bisections):
-        pm = 0.5 * (pa + pb)
+        zm = 0.5 * (za + zb)
+        pm = float(zm[-1])
         try:
-            F = maps(pm)
-            if F.dim != k:
-                return e
-            xm, _ = newton(F, 0.5 * (xa + xb), tol=tol, max_iter=12, what=f"locating at {pm!r}")
+            zm = maps.at_p(zm, tol, f"locating at p = {pm!r}")
         except (ShootingError, ValueError, Error):
             return e
-        st, ph, _ = _stick_profile(F, F.trajectory(xm), None)
+        F = maps.of(zm[-maps.k:])
+        st, ph, _ = _stick_profile(F, F.trajectory(zm[:-maps.k]), None)
         if key((st[i], ph[i])) == ka:
-            pa, xa = pm, xm
+            za = zm
         else:
-            pb, xb = pm, xm
+            zb = zm
+    pa, pb = float(za[-1]), float(zb[-1])
     e.p = 0.5 * (pa + pb)
     e.detail += f" (located by bisection in [{min(pa, pb)!r}, {max(pa, pb)!r}])"
     return e
 
 
 class _Maps:
-    """StepMaps by p (the last few), all on states of ``rows`` rows; a p whose N + 1 exceeds it
-    is refused (ShootingError: the corrector retries with a shorter step).  ``period``: None
-    (make(p) must keep the step h) or p -> the period, the map at p then built by
-    make(p, h=period(p) / M)."""
+    """The maps of a forced branch: StepMaps by p (the last few), all on states of ``rows``
+    rows; a p whose N + 1 exceeds it is refused (ShootingError: the corrector retries with a
+    shorter step).  ``period``: None (make(p) must keep the step h) or p -> the period, the map
+    at p then built by make(p, h=period(p) / M).  The unknowns are z = (x, p): k = 1 extra
+    unknown, no equation besides the arclength."""
+    k = 1
+    autonomous = False
 
     def __init__(self, make: Model, M: int, h: float, rows: int,
                  period: Callable[[float], float] | None = None):
@@ -312,11 +261,9 @@ class _Maps:
         h = self.step(p)
         try:
             return build(self.model(p), p)
-        except ValueError as e:
-            if isinstance(e.__cause__, TypeError):
-                raise ValueError(f"continue_orbit(period=...) needs a model make(p, h=...) that "
-                                 f"takes the step (h = period(p) / M = {h!r}): {e}") from e
-            raise
+        except TypeError as e:
+            raise ValueError(f"continue_orbit(period=...) needs a model make(p, h=...) that "
+                             f"takes the step (h = period(p) / M = {h!r}): {e}") from e
 
     def __call__(self, p: float) -> StepMap:
         F = self._cache.get(p)
@@ -336,12 +283,87 @@ class _Maps:
             self._cache[p] = F
         return F
 
+    def of(self, q: np.ndarray) -> StepMap:
+        """The map at the extra unknowns q = (p,)."""
+        return self(float(q[-1]))
 
-def _weights(size: int) -> np.ndarray:
-    """The arclength's inner product weights: 1 / dim on x (an RMS), 1 on p."""
-    w = np.full(size, 1.0 / (size - 1))
-    w[-1] = 1.0
-    return w
+    def z_of(self, pt: BranchPoint) -> np.ndarray:
+        return np.concatenate([pt.state, [pt.p]])
+
+    def col_steps(self, q: np.ndarray) -> np.ndarray:
+        return np.array([1e-7 * max(1.0, abs(float(q[-1])))])
+
+    def conditions(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The equations besides the arclength: none."""
+        return np.empty(0), np.empty((0, z.size))
+
+    def weights(self, size: int) -> np.ndarray:
+        """The arclength's inner product weights: 1 / dim on x (an RMS), 1 on p."""
+        w = np.full(size, 1.0 / (size - 1))
+        w[-1] = 1.0
+        return w
+
+    def reference(self, z: np.ndarray, U: np.ndarray) -> None:
+        """A new point on the branch (nothing to update)."""
+
+    def at_p(self, z: np.ndarray, tol: float, what: str) -> np.ndarray:
+        """The orbit at z's p from z's state (p fixed)."""
+        x, _ = newton(self.of(z[-1:]), z[:-1], tol=tol, max_iter=12, what=what)
+        return np.concatenate([x, z[-1:]])
+
+
+class _AutoMaps(_Maps):
+    """The maps of an autonomous branch: the unknowns are z = (x, h, p) (k = 2), the maps
+    StepMaps of make(p, h=h) (:class:`dmi.analysis.autonomous.AutonomousMaps`), and the phase
+    condition <xdot, x_0 - x0_ref> = 0 holds besides the arclength, its reference the last
+    point's state at t = 0 and velocity there (:meth:`reference`)."""
+    k = 2
+    autonomous = True
+
+    def __init__(self, make: Model, M: int, h: float, rows: int):
+        super().__init__(make, M, h, rows)
+        self.auto = AutonomousMaps(make, M, rows, 0.25 * h)
+        self.xdot = np.zeros(0)
+        self.ref = np.zeros(0)
+
+    def __call__(self, p: float) -> StepMap:
+        return self.auto(self.h, p)
+
+    def of(self, q: np.ndarray) -> StepMap:
+        return self.auto(float(q[0]), float(q[1]))
+
+    def z_of(self, pt: BranchPoint) -> np.ndarray:
+        return np.concatenate([pt.state, [pt.period / self.M, pt.p]])
+
+    def col_steps(self, q: np.ndarray) -> np.ndarray:
+        return np.array([1e-7 * float(q[0]), 1e-7 * max(1.0, abs(float(q[1])))])
+
+    def conditions(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        g, row = phase_row(z[:-2], self.xdot, self.ref, 2)
+        return np.array([g]), row[None, :]
+
+    def weights(self, size: int) -> np.ndarray:
+        """1 / dim on x, 1 on p, M^2 on h (the period's change counts as p's)."""
+        w = np.full(size, 1.0 / (size - 2))
+        w[-2], w[-1] = float(self.M) ** 2, 1.0
+        return w
+
+    def reference(self, z: np.ndarray, U: np.ndarray) -> None:
+        v = velocity(U, float(z[-2]))
+        self.xdot = v / max(float(np.linalg.norm(v)), 1e-300)
+        self.ref = z[-2 - v.size:-2].copy()
+
+    def at_p(self, z: np.ndarray, tol: float, what: str) -> np.ndarray:
+        p = float(z[-1])
+
+        def conditions(y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            g, rows = self.conditions(y)
+            fix = np.zeros(y.size)
+            fix[-1] = 1.0
+            return np.concatenate([g, [y[-1] - p]]), np.vstack([rows, fix])
+        y, _ = bordered_newton(self.of, z, 2, conditions, tol=tol, max_iter=12, what=what,
+                               steps=self.col_steps(z[-2:]))
+        return y
 
 
 class _Slow(Exception):
@@ -362,52 +384,77 @@ def _too_slow(rn: float, prev: float, target: float, left: int) -> bool:
     return 0 < rate and target < rn and math.log(target / rn) / math.log(rate) > left
 
 
+def _columns(maps: _Maps, z: np.ndarray, Fx: np.ndarray) -> np.ndarray:
+    """dF/dq at z (dim, k) by one forward difference a column."""
+    k = maps.k
+    x, q = z[:-k], z[-k:]
+    d = maps.col_steps(q)
+    cols = np.empty((x.size, k))
+    for j in range(k):
+        qd = q.copy()
+        qd[j] += d[j]
+        cols[:, j] = (maps.of(qd)(x) - Fx) / d[j]
+    return cols
+
+
+def _borders(maps: _Maps, z: np.ndarray, zp: np.ndarray, t: np.ndarray
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """The k equations besides F(x) = x at z: the family's (a phase condition) and the
+    arclength <w t, z - zp> = 0; their values and rows (k, dim + k)."""
+    g, rows = maps.conditions(z)
+    wt = maps.weights(z.size) * t
+    return np.concatenate([g, [float(np.dot(wt, z - zp))]]), np.vstack([rows, wt])
+
+
 def _newton_picard(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, ds: float,
                    Q: np.ndarray, Z: np.ndarray, z0: np.ndarray | None = None,
                    max_iter: int = 16) -> tuple[np.ndarray, int]:
     """The corrector by Newton-Picard (Lust, Roose, Spence & Champneys 1998) from z0 (default the
-    predictor zp) on the hyperplane through zp: the Jacobian D_xF is replaced by its rank-b approximation Z Q' on the previous point's
-    dominant subspace (Q orthonormal, Z = D_xF Q there, from :func:`ritz`), D_pF by one difference
-    in p at z0, and the bordered system
+    predictor zp) on the hyperplane through zp: the Jacobian D_xF is replaced by its rank-b
+    approximation Z Q' on the previous point's dominant subspace (Q orthonormal, Z = D_xF Q
+    there, from :func:`ritz`), D_qF (the k extra unknowns' columns) by one difference each at
+    z0, and the bordered system
 
-        (Z Q' - I) dx + F_p dp = -(F(x) - x),     w t . (dx, dp) = -g,
+        (Z Q' - I) dx + F_q dq = -(F(x) - x),     B_x dx + B_q dq = -g,
 
-    is solved exactly: dx = Q xi + (I - Q Q')(r + F_p dp + Z xi), with (xi, dp) from b + 1
-    equations.  On the complement of span Q that is a Picard step (x takes F(x)'s component), which
-    contracts at the rate of the largest multiplier left out; on span Q a chord Newton step.  One
-    evaluation of F an iteration (one more for F_p); S = Q' Z gets Broyden's update from each
-    step (ZC = Z - Q S, the leak off span Q, is kept).  Returns (z, iterations); raises _Slow when,
-    after the second iteration, the residual falls by less than half in one, or at its rate would
-    not reach tol within max_iter; ShootingError as :func:`_corrector`."""
-    dim = zp.size - 1
-    wt = _weights(zp.size) * t
-    wx, tp = wt[:-1], float(t[-1])
+    (B, g: the k equations of :func:`_borders`) is solved exactly: dx = Q xi + (I - Q Q')(r +
+    F_q dq + Z xi), with (xi, dq) from b + k equations.  On the complement of span Q that is a
+    Picard step (x takes F(x)'s component), which contracts at the rate of the largest
+    multiplier left out; on span Q a chord Newton step.  One evaluation of F an iteration (k
+    more for F_q); S = Q' Z gets Broyden's update from each step (ZC = Z - Q S, the leak off
+    span Q, is kept).  Returns (z, iterations); raises _Slow when, after the second iteration,
+    the residual falls by less than half in one, or at its rate would not reach tol within
+    max_iter; ShootingError as :func:`_corrector`."""
+    k = maps.k
+    dim = zp.size - k
     z = zp.copy() if z0 is None else z0.copy()
-    x, p = z[:-1], float(z[-1])
-    F = maps(p)
+    x = z[:-k]
+    F = maps.of(z[-k:])
     if F.dim != dim or Q.shape[0] != dim:
         raise _Slow("the state's size changed")
     Fx = F(x)
-    dp = 1e-7 * max(1.0, abs(p))
-    Fp = (maps(p + dp)(x) - Fx) / dp
+    Fq = _columns(maps, z, Fx)
     S = Q.T @ Z
     ZC = Z - Q @ S                   # (I - Q Q') Z
-    FpC = Fp - Q @ (Q.T @ Fp)
+    FqC = Fq - Q @ (Q.T @ Fq)
     b = Q.shape[1]
-    K = np.zeros((b + 1, b + 1))
+    _, B = _borders(maps, z, zp, t)  # linear equations: constant rows
+    Bx, Bq = B[:, :dim], B[:, dim:]
+    K = np.zeros((b + k, b + k))
     K[:b, :b] = S - np.eye(b)
-    K[:b, b] = Q.T @ Fp
-    K[b, :b] = wx @ Q + wx @ ZC
-    K[b, b] = wx @ FpC + tp
+    K[:b, b:] = Q.T @ Fq
+    K[b:, :b] = Bx @ Q + Bx @ ZC
+    K[b:, b:] = Bx @ FqC + Bq
+    w = maps.weights(zp.size)
     prev, best, z_best = math.inf, math.inf, z
     for it in range(max_iter + 1):
         r = Fx - x
-        g = float(np.dot(wt, z - zp))
+        g, _ = _borders(maps, z, zp, t)
         rn = float(np.max(np.abs(r)))
         if not math.isfinite(rn):
-            raise ShootingError(f"non-finite residual at p = {p!r}", [rn])
+            raise ShootingError(f"non-finite residual at p = {float(z[-1])!r}", [rn])
         scale = max(1.0, float(np.max(np.abs(x))))
-        if rn <= tol * scale and abs(g) <= 1e-8 * max(1.0, abs(p)):
+        if rn <= tol * scale and float(np.max(np.abs(g))) <= 1e-8 * max(1.0, abs(z[-1])):
             return z, it
         if rn < best:
             best, z_best = rn, z
@@ -418,27 +465,27 @@ def _newton_picard(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, ds: f
         Qr = Q.T @ r
         rC = r - Q @ Qr
         try:
-            sol = np.linalg.solve(K, np.concatenate([-Qr, [-g - wx @ rC]]))
+            sol = np.linalg.solve(K, np.concatenate([-Qr, -g - Bx @ rC]))
         except np.linalg.LinAlgError:
             raise _Slow("singular reduced system", None, it) from None
-        xi, dpp = sol[:b], float(sol[b])
-        z = z + np.concatenate([Q @ xi + rC + FpC * dpp + ZC @ xi, [dpp]])
+        xi, dq = sol[:b], sol[b:]
+        z = z + np.concatenate([Q @ xi + rC + FqC @ dq + ZC @ xi, dq])
         d = z - zp
-        far = math.sqrt(float(np.dot(_weights(z.size) * d, d)))
+        far = math.sqrt(float(np.dot(w * d, d)))
         if far > ds:
             raise ShootingError(f"corrector strayed {far:.3g} > ds = {ds:.3g} from the predictor "
                                 f"at p = {float(z[-1])!r}", [rn])
-        x, p = z[:-1], float(z[-1])
-        F = maps(p)
+        x = z[:-k]
+        F = maps.of(z[-k:])
         if F.dim != dim:
-            raise ShootingError(f"the state grew to {F.dim} values at p = {p!r}", [])
+            raise ShootingError(f"the state grew to {F.dim} values at p = {float(z[-1])!r}", [])
         Fx, Fold = F(x), Fx
         # Broyden's update of the reduced Jacobian S = Q' D_xF Q by the step just taken (Q' dx =
-        # xi): S xi := Q' (F(x_new) - F(x_old) - F_p dp); no evaluation, and a multiplier that
+        # xi): S xi := Q' (F(x_new) - F(x_old) - F_q dq); no evaluation, and a multiplier that
         # moved since the previous point (near 1, the chord's rate |dmu| / |1 - mu|) is caught
         nxi = float(np.dot(xi, xi))
         if nxi > 0:
-            S = S + np.outer(Q.T @ (Fx - Fold - Fp * dpp) - S @ xi, xi / nxi)
+            S = S + np.outer(Q.T @ (Fx - Fold - Fq @ dq) - S @ xi, xi / nxi)
             K[:b, :b] = S - np.eye(b)
     raise AssertionError("unreachable")
 
@@ -452,13 +499,14 @@ def _correct(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, max_iter: i
     the branch it was born from (a doubled branch near its doubling, where both cross the first
     step's hyperplane p = p1 close together)."""
     z, its, how = _solve(maps, zp, t, tol, max_iter, ds, dominant)
-    F = maps(float(z[-1]))
-    U, X = F.trajectory_terms(z[:-1])
+    k = maps.k
+    F = maps.of(z[-k:])
+    U, X = F.trajectory_terms(z[:-k])
     for q in range(2, sections + 1):
-        k = F.M // q
+        m = F.M // q
         if sections % q == 0 and F.M % q == 0 and \
-                np.max(np.abs(U[k:] - U[:-k])) <= 1e-6 * max(1.0, float(np.max(np.abs(U)))):
-            raise ShootingError(f"the corrector fell onto an orbit of {k} steps (period "
+                np.max(np.abs(U[m:] - U[:-m])) <= 1e-6 * max(1.0, float(np.max(np.abs(U)))):
+            raise ShootingError(f"the corrector fell onto an orbit of {m} steps (period "
                                 f"{sections // q} of the branch's {sections} forcing periods) "
                                 f"at p = {float(z[-1])!r}", [])
     return z, its, how, (U, X)
@@ -469,19 +517,20 @@ def _solve(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, max_iter: int
     """The corrector from the predictor zp: Newton-Picard on the previous point's ``dominant``
     (Q, Z) when there is one; when it contracts too slowly, once more from its iterate of least
     residual with (Q, Z) renewed there: one block of forward differences of Newton's step
-    (:func:`dmi.analysis.shooting.fd_eps`) from qr(Z), the dominant subspace of the derivative
+    (:func:`dmi.analysis.newton.fd_eps`) from qr(Z), the dominant subspace of the derivative
     the iteration actually sees (:func:`ritz`); then Newton (GMRES) from zp (not from an
     iterate: near a period doubling, Newton-Picard may have headed for the other branch that
     crosses the first step's hyperplane p = p1).  Returns (z, iterations, which): the iterations
     of all tries, and ``newton-picard`` or ``newton`` (which converged)."""
     done = 0   # Newton-Picard iterations spent, counted in the step's (the step control's)
+    k = maps.k
     if dominant is not None:
         z = zp
         Q, Z = dominant
         for renew in (False, True):
             try:
                 if renew:
-                    F, x = maps(float(z[-1])), z[:-1]
+                    F, x = maps.of(z[-k:]), z[:-k]
                     if F.dim != x.size:
                         break
                     _, Q, Z = ritz(F, x, max(1, Q.shape[1] - 2), start=Z, eps=fd_eps(x),
@@ -493,46 +542,87 @@ def _solve(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, max_iter: int
                 if e.z is None:
                     break
                 z = e.z
-    z, its = _corrector(maps, zp, t, tol, max_iter, ds, zp)
+    z, its = _corrector(maps, zp, t, tol, max_iter, ds)
     return z, done + its, "newton"
 
 
-def _corrector(maps: _Maps, z: np.ndarray, t: np.ndarray, tol: float, max_iter: int,
-               ds: float, zp: np.ndarray | None = None) -> tuple[np.ndarray, int]:
-    """Newton on (F_p(x) - x, <t, z - zp>) from z (zp: the predictor, default z); returns (z,
-    iterations).  ShootingError when an iterate strays more than ds from the predictor (weighted
-    norm): the step is then too long for the predictor, and another branch may lie on the
-    hyperplane."""
-    zp = z.copy() if zp is None else zp
-    dim = z.size - 1
-    w = _weights(z.size)
-    for it in range(max_iter + 1):
-        x, p = z[:-1], float(z[-1])
-        F = maps(p)
-        if F.dim != dim:
-            raise ShootingError(f"the state grew to {F.dim} values at p = {p!r}", [])
-        Fx = F(x)
-        r = Fx - x
-        g = float(np.dot(w * t, z - zp))
-        rn = float(np.max(np.abs(r)))
-        scale = max(1.0, float(np.max(np.abs(x))))
-        if rn <= tol * scale and abs(g) <= 1e-8 * max(1.0, abs(p)):
-            return z, it
-        if it == max_iter or not math.isfinite(rn):
-            break
-        dp = 1e-7 * max(1.0, abs(p))
-        Fp = (maps(p + dp)(x) - Fx) / dp
-        dz, lin = bordered_step(F, x, Fx, Fp, w * t, g, rtol=1e-6)
-        if lin > 1e-2:
-            raise ShootingError(f"the bordered Jacobian is singular at p = {p!r} (GMRES "
-                                f"relative residual {lin:.2g})", [rn])
-        z = z + dz
+def _corrector(maps: _Maps, zp: np.ndarray, t: np.ndarray, tol: float, max_iter: int,
+               ds: float) -> tuple[np.ndarray, int]:
+    """Newton (:func:`dmi.analysis.newton.bordered_newton`) on (F_q(x) - x, the family's
+    equations, <w t, z - zp>) from the predictor zp; returns (z, iterations).  ShootingError
+    when an iterate strays more than ds from the predictor (weighted norm): the step is then
+    too long for the predictor, and another branch may lie on the hyperplane."""
+    w = maps.weights(zp.size)
+    dim = zp.size - maps.k
+
+    def far(z: np.ndarray) -> None:
         d = z - zp
         if math.sqrt(float(np.dot(w * d, d))) > ds:
             raise ShootingError(f"corrector strayed {math.sqrt(float(np.dot(w * d, d))):.3g} > "
-                                f"ds = {ds:.3g} from the predictor at p = {float(z[-1])!r}", [rn])
-    raise ShootingError(f"corrector did not converge at p = {float(z[-1])!r} "
-                        f"(residual {rn:.3g} after {max_iter} iterations)", [rn])
+                                f"ds = {ds:.3g} from the predictor at p = {float(z[-1])!r}", [])
+
+    def of(q: np.ndarray) -> StepMap:
+        F = maps.of(q)
+        if F.dim != dim:
+            raise ShootingError(f"the state grew to {F.dim} values at p = {float(q[-1])!r}", [])
+        return F
+
+    z, res = bordered_newton(of, zp, maps.k, lambda z: _borders(maps, z, zp, t), tol=tol,
+                             max_iter=max_iter, what=f"corrector near p = {float(zp[-1])!r}",
+                             steps=maps.col_steps(zp[-maps.k:]), check=far)
+    return z, len(res) - 1
+
+
+def _corner(maps: _Maps, z: np.ndarray, t: np.ndarray, ds: float, direction: float,
+            tol: float, max_iter: int, dominant: tuple[np.ndarray, np.ndarray] | None,
+            sections: int) -> tuple | None:
+    """Past a corner of the branch (a stick onset or a grazing, where the map's derivative jumps
+    and the secant's hyperplane may miss the branch's new piece): natural steps, the orbit at p
+    = p(z) + s delta from z's state (p fixed), delta = ds and 4 ds (p units), s towards p_end
+    first; the first that converges ahead of z along the branch (<w t, z_new - z> > 0) is taken.
+    None if none does."""
+    w = maps.weights(z.size)
+    e_p = np.zeros(z.size)
+    e_p[-1] = 1.0
+    for delta in (ds, 4 * ds):
+        for sign in (direction, -direction):
+            zp = z.copy()
+            zp[-1] += sign * delta
+            try:
+                got = _correct(maps, zp, e_p, tol, max_iter + 4, math.inf, dominant, sections)
+            except Exception:   # the model's, the map's or the corrector's failure
+                continue
+            if float(np.dot(w * t, got[0] - z)) > 0:
+                return got
+    return None
+
+
+def _first_tangent(maps: _Maps, z: np.ndarray, direction: float) -> np.ndarray:
+    """The branch's unit tangent (weighted norm) at its first point z: the null vector of the
+    bordered Jacobian [[D_xF - I, F_q], [the family's rows]], from one bordered solve with the
+    extra row r . dz = 1, r = e_p + the state's deviation from its mean (not orthogonal to a
+    tangent that moves p, nor to one that only scales the orbit, as on a branch leaving a Hopf
+    point vertically).  Oriented towards p_end, or, where dp/ds is below VERTICAL, to a growing
+    deviation."""
+    k = maps.k
+    x = z[:-k]
+    F = maps.of(z[-k:])
+    Fx = F(x)
+    g, rows = maps.conditions(z)
+    dev = x - np.mean(x)
+    r = np.zeros(z.size)
+    r[:-k] = dev / max(float(np.linalg.norm(dev)), 1e-300)
+    r[-1] = 1.0
+    t, lin = bordered_step(F, x, x, _columns(maps, z, Fx), np.vstack([rows, r]),
+                           np.concatenate([np.zeros(len(g)), [-1.0]]), rtol=1e-8)
+    if lin > 1e-2:
+        raise ShootingError(f"no tangent at the branch's start (GMRES relative residual "
+                            f"{lin:.2g}): a singular point", [])
+    w = maps.weights(z.size)
+    t = t / math.sqrt(float(np.dot(w * t, t)))
+    if abs(t[-1]) > VERTICAL:
+        return t if t[-1] * direction > 0 else -t
+    return t if float(np.dot(t[:-k], dev)) > 0 else -t
 
 
 def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points: int = 200,
@@ -540,20 +630,26 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                    multipliers: int = 6, tol: float = 1e-10, max_iter: int = 8,
                    sections: int = 1, margins: bool = True,
                    period: Callable[[float], float] | None = None) -> Branch:
-    """Continues ``orbit`` (from :func:`periodic_orbit`) in p towards ``p_end`` (finite, not
-    orbit.p) by pseudo-arclength with initial step ``step`` (the first point at p + step, p units;
-    then arclengths in the norm sqrt(|dx|^2 / dim + dp^2), p and RMS state units; ``min_step``
-    default step / 1000, ``max_step`` default 4 step).  Every point gets ``multipliers`` Floquet
-    multipliers (they also make the Newton-Picard corrector's basis: with 0 every step is a
-    Newton-GMRES solve) and a stick profile; events are detected between consecutive points
-    (see the module).  ``sections``: the orbit spans this many forcing periods (a period-doubled
-    branch: 2), for ``BranchPoint.section``.  ``margins=False`` leaves the margins NaN (they come
-    from the run that gives the point's states, at no extra evaluation).
+    """Continues ``orbit`` (from :func:`periodic_orbit` or :func:`hopf_orbit`) in p towards
+    ``p_end`` (finite, not orbit.p) by pseudo-arclength with initial step ``step`` (the first
+    point at p + step, p units; then arclengths in the norm sqrt(|dx|^2 / dim + dp^2), p and
+    RMS state units; ``min_step`` default step / 1000, ``max_step`` default 4 step).  Every
+    point gets ``multipliers`` Floquet multipliers (they also make the Newton-Picard corrector's
+    basis: with 0 every step is a Newton-GMRES solve) and a stick profile; events are detected
+    between consecutive points (see the module).  ``sections``: the orbit spans this many
+    forcing periods (a period-doubled branch: 2), for ``BranchPoint.section``.
+    ``margins=False`` leaves the margins NaN (they come from the run that gives the point's
+    states, at no extra evaluation).
     ``period``: None keeps the period M h (make(p) keeps h); a function p -> period (time units;
     a forced orbit in its frequency w: ``period=lambda w: 2 * math.pi / w``) keeps M = orbit.steps
     and gives the model the step h = period(p) / M through ``make(p, h=...)`` (orbit.make must
-    take it; orbit.period must equal period(orbit.p)).  Returns a
-    :class:`Branch`; a corrector that fails at the smallest
+    take it; orbit.period must equal period(orbit.p)).
+    An autonomous orbit (``orbit.autonomous``: from ``periodic_orbit(period=None)`` or
+    :func:`hopf_orbit`) has its period as an unknown: h = P / M with M = orbit.steps, N =
+    ceil(tau / h) changing along the branch (the states hold room for h down to 60 % of the
+    start's), and a phase condition through the previous point; its phase multiplier is left out
+    of ``stable`` and of the events; ``period`` must then be None.  Returns a
+    :class:`Branch` (``kind`` "orbits" or "autonomous"); a corrector that fails at the smallest
     step ends the branch with that ``status``, it does not raise."""
     if not (math.isfinite(step) and step > 0):
         raise ValueError(f"step = {step!r}: must be finite and > 0 (p units)")
@@ -567,60 +663,90 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     max_step = 4 * step if max_step is None else max_step
     lo, hi = sorted((orbit.p, float(p_end)))
     n = orbit.u.shape[1]
-    if period is not None:
-        if not callable(period):
-            raise ValueError(f"period = {period!r}: give a function p -> period (time units)")
-        P0 = _Maps(orbit.make, orbit.steps, orbit.h, 0, period).step(orbit.p) * orbit.steps
-        if abs(P0 - orbit.period) > 1e-9 * orbit.period:
-            raise ValueError(f"period(p = {orbit.p!r}) = {P0!r} but the orbit's period is "
-                             f"{orbit.period!r} (= {orbit.steps} steps h = {orbit.h!r})")
-    probe = _Maps(orbit.make, orbit.steps, orbit.h, 0, period)
-    # rows for the whole range: N may grow with p (tau with a fixed h, or h with the period);
-    # probe both ends
-    rows = max(orbit.rows or orbit.state.size // n, probe.build(orbit.p).N + 1)
-    try:
-        rows = max(rows, probe.build(float(p_end)).N + 1)
-    except ValueError:
-        pass  # make refuses p_end: the branch will stop where make does
-    rows += max(2, rows // 50)  # room for a corrector a little beyond the ends
-    maps = _Maps(orbit.make, orbit.steps, orbit.h, rows, period)
     x0 = np.array(orbit.state)
-    F0 = maps(orbit.p)
-    if F0.dim != x0.size:
-        x0 = F0.extend(x0)
+    if orbit.autonomous:
+        if period is not None:
+            raise ValueError("period=...: an autonomous orbit's period is an unknown of the "
+                             "branch; continue it with period=None")
+        tau = build(orbit.make, orbit.p).tau
+        rows = max(orbit.rows or x0.size // n, math.ceil(tau / (0.6 * orbit.h)) + 1)
+        maps: _Maps = _AutoMaps(orbit.make, orbit.steps, orbit.h, rows)
+        F0 = maps(orbit.p)
+        if F0.dim != x0.size:
+            x0 = F0.extend(x0)
+        maps.reference(np.concatenate([x0, [orbit.h, orbit.p]]), F0.trajectory(x0))
+        q0 = np.array([orbit.h, orbit.p])
+    else:
+        if period is not None:
+            if not callable(period):
+                raise ValueError(f"period = {period!r}: give a function p -> period (time "
+                                 "units)")
+            P0 = _Maps(orbit.make, orbit.steps, orbit.h, 0, period).step(orbit.p) * orbit.steps
+            if abs(P0 - orbit.period) > 1e-9 * orbit.period:
+                raise ValueError(f"period(p = {orbit.p!r}) = {P0!r} but the orbit's period is "
+                                 f"{orbit.period!r} (= {orbit.steps} steps h = {orbit.h!r})")
+        probe = _Maps(orbit.make, orbit.steps, orbit.h, 0, period)
+        # rows for the whole range: N may grow with p (tau with a fixed h, or h with the
+        # period); probe both ends
+        rows = max(orbit.rows or x0.size // n, probe.build(orbit.p).N + 1)
+        try:
+            rows = max(rows, probe.build(float(p_end)).N + 1)
+        except Exception:
+            pass  # make refuses p_end: the branch will stop where make does
+        rows += max(2, rows // 50)  # room for a corrector a little beyond the ends
+        maps = _Maps(orbit.make, orbit.steps, orbit.h, rows, period)
+        F0 = maps(orbit.p)
+        if F0.dim != x0.size:
+            x0 = F0.extend(x0)
+        q0 = np.array([orbit.p])
+    k = maps.k
+    auto = maps.autonomous
     warm: list = [None]
-    pts = [_point(F0, x0, multipliers, sections, direction, orbit.iterations, margins, warm)]
+    pts = [_point(F0, x0, multipliers, sections, direction, orbit.iterations, margins, warm,
+                  autonomous=auto)]
     events: list[Event] = []
     status = "max_points reached"
+    z = np.concatenate([x0, q0])
     # the first step: natural continuation in p (the hyperplane p = p1)
     ds = step
-    z_prev = np.concatenate([x0, [orbit.p]])
-    t_p = np.zeros(x0.size + 1)
+    z_prev = z
+    t_p = np.zeros(z.size)
     t_p[-1] = 1.0
+    t0 = _first_tangent(maps, z, direction) if auto else None
     while True:
-        p1 = orbit.p + direction * ds
+        if t0 is None:
+            zp, tc, far = z.copy(), t_p, math.inf
+            zp[-1] = orbit.p + direction * ds
+        else:
+            zp, tc, far = z + ds * t0, t0, ds
         try:
-            z, its, how, terms = _correct(maps, np.concatenate([x0, [p1]]), t_p, tol,
-                                          max_iter + 4, math.inf, warm[0], sections)
+            z, its, how, terms = _correct(maps, zp, tc, tol, max_iter + 4, far, warm[0],
+                                          sections)
             break
-        except (ShootingError, ValueError, Error) as e:
+        except Exception as e:   # the model's, the map's or the corrector's failure
             ds /= 2
             if ds < min_step:
                 return Branch(pts, events, f"first step failed: {e}", orbit.make, orbit.steps,
-                              orbit.h, maps.rows, sections, period)
-    pts.append(_point(maps(float(z[-1])), z[:-1], multipliers, sections, direction, its, margins,
-                      warm, how, terms))
-    events += _events(pts[-2], pts[-1], 1)
+                              orbit.h, maps.rows, sections, period,
+                              "autonomous" if auto else "orbits")
+    d = z - z_prev
+    dpds = float(d[-1]) / math.sqrt(float(np.dot(maps.weights(z.size) * d, d)))
+    pts[0].dpds = dpds if t0 is None else float(t0[-1])
+    pts.append(_point(maps.of(z[-k:]), z[:-k], multipliers, sections, dpds, its, margins,
+                      warm, how, terms, auto))
+    maps.reference(z, terms[0])
+    events += _events(pts[-2], pts[-1], 1, auto)
     while len(pts) < max_points:
         if (pts[-1].p - p_end) * direction >= -1e-7 * max(1.0, abs(p_end)):
             status = f"reached p_end = {p_end!r}"
             break
-        if pts[-1].p < lo - 1e-12 * max(1, abs(lo)) or pts[-1].p > hi + 1e-12 * max(1, abs(hi)):
+        if pts[-1].p < lo - 1e-7 * max(1, abs(lo)) or pts[-1].p > hi + 1e-7 * max(1, abs(hi)):
             status = f"left the range [{lo!r}, {hi!r}] after a fold"
             break
-        w = _weights(z.size)
+        w = maps.weights(z.size)
         sec = z - z_prev
         t = sec / math.sqrt(float(np.dot(w * sec, sec)))
+        cornered = False
         while True:
             zp, tc = z + ds * t, t
             # do not overshoot p_end: the last step ends on the hyperplane p = p_end (on the
@@ -631,10 +757,16 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                 zn, its, how, terms = _correct(maps, zp, tc, tol, max_iter, ds, warm[0],
                                                sections)
                 break
-            except (ShootingError, ValueError, Error) as e:   # Error: the map failed there
+            except Exception as e:   # the model's, the map's or the corrector's failure
                 if tc is t_p:   # aimed at p_end: halve the step actually taken
                     ds = min(ds, abs((p_end - z[-1]) / t[-1]))
                 ds /= 2
+                if ds < step / 8 and not cornered:
+                    cornered = True
+                    got = _corner(maps, z, t, ds, direction, tol, max_iter, warm[0], sections)
+                    if got is not None:
+                        zn, its, how, terms = got
+                        break
                 if ds < min_step:
                     status = f"corrector failed at the smallest step {min_step!r} near p = " \
                              f"{float(z[-1])!r}: {e}"
@@ -643,10 +775,12 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
         if zn is None:
             break
         z_prev, z = z, zn
-        dpds = float(z[-1] - z_prev[-1])
-        pts.append(_point(maps(float(z[-1])), z[:-1], multipliers, sections, dpds, its, margins,
-                          warm, how, terms))
-        for e in _events(pts[-2], pts[-1], len(pts) - 1):
+        d = z - z_prev
+        dpds = float(d[-1]) / math.sqrt(float(np.dot(w * d, d)))
+        pts.append(_point(maps.of(z[-k:]), z[:-k], multipliers, sections, dpds, its, margins,
+                          warm, how, terms, auto))
+        maps.reference(z, terms[0])
+        for e in _events(pts[-2], pts[-1], len(pts) - 1, auto):
             if e.kind == "fold":
                 e = _refine_fold(pts[-3:], e)
             elif e.kind in ("stick-onset", "grazing") and pts[-2].dpds * pts[-1].dpds > 0:
@@ -655,7 +789,7 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
         easy = its <= (6 if how == "newton-picard" else 3)
         ds = min(max_step, ds * 1.5) if easy else ds
     return Branch(pts, events, status, orbit.make, orbit.steps, orbit.h, maps.rows, sections,
-                  period)
+                  period, "autonomous" if auto else "orbits")
 
 
 def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[float, ...] =

@@ -1,4 +1,4 @@
-# Floquet multipliers of periodic orbits that carry the stick/slip switching (issue 30).
+# Floquet multipliers of periodic orbits that carry the stick/slip switching.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """Floquet multipliers of a periodic orbit of the scheme, right at stick/slip transitions.
 
@@ -28,7 +28,7 @@ import numpy as np
 import scipy.linalg as sl
 import scipy.sparse.linalg as sla
 
-from .shooting import StepMap
+from .stepmap import StepMap
 
 #: c in eps = c A min(M^(-1/3), FD_CAP) (see the module's docstring).
 FD_FACTOR = 1.0
@@ -144,6 +144,15 @@ def ritz(F: StepMap, x: np.ndarray, count: int, *, blocks: int = 2,
     mu = np.asarray(mu, dtype=complex)
     mu[np.abs(mu) < 1e-12] = 0.0
     return mu[np.argsort(-np.abs(mu), kind="stable")][:count], Q, Z
+
+
+def phase_free(mu: np.ndarray) -> np.ndarray:
+    """The multipliers of an autonomous orbit without its phase multiplier: the one nearest 1
+    (a shift along the orbit; 1 up to the scheme's and the differences' errors) left out."""
+    mu = np.asarray(mu)
+    if not mu.size:
+        return mu
+    return np.delete(mu, int(np.argmin(np.abs(mu - 1))))
 
 
 def _dominant(B: np.ndarray, ZB: np.ndarray, k: int

@@ -1,4 +1,4 @@
-# Drawing a continued branch of periodic orbits (issue 30).
+# Drawing a continued branch of periodic orbits or equilibria.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """plot_branch: a branch's Poincare-section values over p, stable solid, unstable dashed,
 events marked and named beside the marker (no legend over the data)."""
@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from .continuation import Branch
+from .branch import Branch
 
 #: marker of each event kind
 MARKERS = {"fold": "s", "period-doubling": "D", "torus": "^", "stick-onset": "o", "grazing": "v"}

@@ -1,0 +1,89 @@
+# The records of a continued branch: its points, its events, the branch.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""Branch, BranchPoint and Event: what :func:`dmi.analysis.continue_orbit` and
+:func:`dmi.analysis.continue_equilibrium` return."""
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .stability import HopfPoint
+from .stepmap import Model
+
+
+@dataclass
+class BranchPoint:
+    """One orbit of a branch: ``p``; ``period`` (time units); ``amplitude`` (n,): (max - min) / 2
+    per component; ``multipliers`` (largest |mu| first); ``stable``; ``stick_steps`` (n,): stuck
+    steps per period; ``stick_phases`` (n,): stuck intervals per period; ``margin`` (n,): see
+    the module; ``section`` (k, n): u at t = j period / k, j < k (k = ``sections``: a Poincare
+    section at the forcing period of a k-periodic orbit); ``state``: the shooting state;
+    ``dpds``: the tangent's p component (its sign flips at a fold); ``iterations`` and
+    ``corrector`` (``newton-picard`` or ``newton``, see the module; empty at the start)."""
+    p: float
+    period: float
+    amplitude: np.ndarray
+    multipliers: np.ndarray
+    stable: bool
+    stick_steps: np.ndarray
+    stick_phases: np.ndarray
+    margin: np.ndarray
+    section: np.ndarray
+    state: np.ndarray = field(repr=False)
+    dpds: float = 0.0
+    iterations: int = 0
+    corrector: str = ""
+
+
+@dataclass
+class Event:
+    """A detected event between points ``index - 1`` and ``index`` of the branch: ``kind``
+    (``fold``, ``period-doubling``, ``torus``, ``stick-onset``, ``grazing``), ``p`` (linear
+    interpolation of the test function's zero), ``component`` (the friction component of a
+    stick event, else None) and a ``detail`` text.  On a branch of equilibria (``fold``, ``hopf``):
+    ``u``, the equilibrium at the event, and ``hopf``, the :class:`HopfPoint` of a ``hopf``
+    event."""
+    kind: str
+    p: float
+    index: int
+    component: int | None = None
+    detail: str = ""
+    u: np.ndarray | None = field(default=None, repr=False)
+    hopf: HopfPoint | None = None
+
+
+@dataclass
+class Branch:
+    """A continued branch: ``points`` (:class:`BranchPoint`), ``events`` (:class:`Event`),
+    ``status`` (why it ended), ``make``, ``steps`` (M), ``h`` (the start's step), ``rows`` (L),
+    ``sections`` and ``period`` (the function p -> period given to :func:`continue_orbit`, or
+    None: the period M h was kept); ``kind``: ``"orbits"`` (forced), ``"autonomous"`` (orbits
+    of free period: ``column("period")``) or ``"equilibria"`` (points are
+    :class:`dmi.analysis.equilibria.EquilibriumPoint`)."""
+    points: list[Any]
+    events: list[Event]
+    status: str
+    make: Model = field(repr=False)
+    steps: int = 0
+    h: float = 0.0
+    rows: int = 0
+    sections: int = 1
+    period: Callable[[float], float] | None = field(default=None, repr=False)
+    kind: str = "orbits"
+
+    @property
+    def p(self) -> np.ndarray:
+        """The points' parameters p, in the order continued."""
+        return np.array([q.p for q in self.points])
+
+    @property
+    def stable(self) -> np.ndarray:
+        """The points' ``stable`` flags (booleans)."""
+        return np.array([q.stable for q in self.points])
+
+    def column(self, name: str) -> np.ndarray:
+        """An attribute of every point stacked: ``branch.column("amplitude")`` -> (points, n)."""
+        return np.array([getattr(q, name) for q in self.points])

@@ -1,0 +1,339 @@
+# Equilibria of the scheme: Newton's correction, and their branches with fold and Hopf events.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""Equilibria of the scheme and their continuation in a parameter.
+
+An equilibrium of the scheme (3.12)-(3.13) is a constant history u with one step leaving it in
+place: G(u) = R(u - h f(0, u) - h W*) - u = 0, W* = h sum_l H(l h) u.  :func:`equilibrium`
+solves G(u) = 0 by Newton (the n x n Jacobian by forward differences of single steps: a
+semismooth Newton where a resolvent holds a component, as sticking friction does), so that a
+rough guess, or the equilibrium of the equation (the continuous integral, O(h) away), is
+corrected.  Its roots are those of :func:`dmi.analysis.roots`.
+
+:func:`continue_equilibrium` follows y = (u, p) by pseudo-arclength: the tangent is the null
+vector of [G_u, G_p] (SVD), the predictor y + ds t, the corrector Newton on (G(y), <t, y -
+y_pred>).  Events between two points, each located by its test function on the branch (Brent's
+method in the arclength from the first point, every evaluation a corrected equilibrium), to
+1e-8 relative in p or better:
+
+- ``fold``: the tangent's p component dp/ds changes sign;
+- ``hopf``: Re of the rightmost non-real root changes sign (the event carries its
+  :class:`dmi.analysis.HopfPoint` in ``Event.hopf`` and the equilibrium in ``Event.u``).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.optimize
+
+from ._model import KinkError
+from .branch import Branch, Event
+from .newton import NO_PROGRESS, ShootingError, fmt_residuals, stalled
+from .stability import HopfPoint, roots
+from .stepmap import Model, build
+
+#: Roots computed at each point of a branch (the Hopf test function reads them).
+ROOTS = 6
+
+
+@dataclass
+class Equilibrium:
+    """An equilibrium of the scheme: ``make``, ``p``, ``u`` (n,) (state units); ``roots``: the
+    rightmost characteristic roots of :func:`dmi.analysis.roots` (rightmost first, 1 / time
+    unit; empty at a kink of the resolvent); ``stable``: Re roots[0] < 0; ``residual``:
+    |G(u)|_inf (state units); ``iterations``: Newton's."""
+    make: Model = field(repr=False)
+    p: float
+    u: np.ndarray
+    roots: np.ndarray
+    stable: bool
+    residual: float = 0.0
+    iterations: int = 0
+
+
+@dataclass
+class EquilibriumPoint:
+    """A point of a branch of equilibria: ``p``, ``u`` (n,), ``roots`` (rightmost first),
+    ``stable``, ``dpds``: the unit tangent's p component (its sign flips at a fold)."""
+    p: float
+    u: np.ndarray
+    roots: np.ndarray
+    stable: bool
+    dpds: float = 0.0
+
+    @property
+    def rightmost(self) -> complex:
+        """The rightmost root (nan if none was computed)."""
+        return complex(self.roots[0]) if self.roots.size else complex(np.nan)
+
+
+class _OneStep:
+    """G(u) = one step from the constant history u, less u, of make(p) (one solver, restored to
+    step 0 before each evaluation)."""
+
+    def __init__(self, make: Model, p: float):
+        self.solver = build(make, p)
+        self.solver.init()
+        self.start = self.solver.save_state()
+        self.n, self.N = self.solver.n, self.solver.N
+
+    def __call__(self, u: np.ndarray) -> np.ndarray:
+        s = self.solver
+        s.load_state(self.start)
+        s.set_window(np.tile(u, (self.N + 1, 1)))
+        s.step()
+        return s.state - u
+
+
+class _Steps:
+    """_OneStep by p, the last few kept."""
+
+    def __init__(self, make: Model):
+        self.make = make
+        self._cache: dict[float, _OneStep] = {}
+
+    def __call__(self, p: float) -> _OneStep:
+        G = self._cache.get(p)
+        if G is None:
+            G = _OneStep(self.make, p)
+            if len(self._cache) > 4:
+                self._cache.pop(next(iter(self._cache)))
+            self._cache[p] = G
+        return G
+
+    def G(self, y: np.ndarray) -> np.ndarray:
+        return self(float(y[-1]))(y[:-1])
+
+    def jacobian(self, y: np.ndarray, Gy: np.ndarray) -> np.ndarray:
+        """[G_u, G_p] at y = (u, p) by forward differences, (n, n + 1)."""
+        m = y.size
+        J = np.empty((m - 1, m))
+        for j in range(m):
+            d = 1e-7 * max(1.0, abs(y[j]))
+            e = y.copy()
+            e[j] += d
+            J[:, j] = (self.G(e) - Gy) / d
+        return J
+
+
+def _check_guess(guess: Any, n: int) -> np.ndarray:
+    u = np.array(guess, dtype=float, ndmin=1).ravel()
+    if u.shape != (n,) or not np.all(np.isfinite(u)):
+        raise ValueError(f"guess = {guess!r}: give n = {n} finite numbers (the model's n)")
+    return u
+
+
+def _newton(steps: _Steps, y0: np.ndarray, tol: float, max_iter: int, what: str,
+            row: np.ndarray | None = None, target: float = 0.0) -> tuple[np.ndarray, list[float]]:
+    """Newton on G(y) = 0 with p fixed (row None) or with the extra equation row . y = target
+    (the pseudo-arclength hyperplane).  Returns (y, residuals); ShootingError (every residual
+    listed) when it fails."""
+    y = np.array(y0, dtype=float)
+    res: list[float] = []
+    moved = math.inf   # the last Newton correction (max norm)
+    for _ in range(max_iter + 1):
+        Gy = steps.G(y)
+        g = 0.0 if row is None else float(row @ y - target)
+        rn = max(float(np.max(np.abs(Gy))), abs(g))
+        res.append(rn)
+        if not math.isfinite(rn):
+            raise ShootingError(f"{what}: non-finite residual (residuals {fmt_residuals(res)})",
+                                res)
+        # G is one step's movement, O(h) times the error: the correction must be small too
+        scale = tol * max(1.0, float(np.max(np.abs(y[:-1]))))
+        if rn <= scale and moved <= scale:
+            return y, res
+        if len(res) > max_iter or stalled(res):
+            break
+        J = steps.jacobian(y, Gy)
+        if row is None:
+            A, b = J[:, :-1], -Gy
+        else:
+            A, b = np.vstack([J, row]), -np.concatenate([Gy, [g]])
+        try:
+            d = np.linalg.solve(A, b)
+        except np.linalg.LinAlgError:
+            raise ShootingError(f"{what}: the Jacobian is singular (residuals "
+                                f"{fmt_residuals(res)}): a fold, or no isolated equilibrium",
+                                res) from None
+        moved = float(np.max(np.abs(d)))
+        if row is None:
+            y[:-1] += d
+        else:
+            y += d
+    why = (f"no new least residual in {NO_PROGRESS} iterations" if stalled(res)
+           else f"no convergence in {max_iter} iterations")
+    raise ShootingError(f"{what}: {why} (residuals {fmt_residuals(res)})", res)
+
+
+def _roots(make: Model, p: float, u: np.ndarray, count: int, tol: float) -> np.ndarray:
+    try:
+        return roots(make, p, u, count, tol=max(tol * 1e3, 1e-9))
+    except KinkError:
+        return np.empty(0, complex)
+
+
+def equilibrium(make: Model, p: float, guess: Any, *, tol: float = 1e-10, count: int = ROOTS,
+                max_iter: int = 30) -> Equilibrium:
+    """The equilibrium of the scheme of ``make(p)`` near ``guess`` (n values, state units), by
+    Newton on one step from a constant history, until |G(u)|_inf and the last correction are
+    <= tol max(1, |u|_inf) (G is O(h) times the error: the correction bounds it); with its
+    ``count`` rightmost roots (:func:`dmi.analysis.roots`).  The model's exception when make
+    fails (a note names the call); ValueError for a guess of the wrong shape; ShootingError,
+    every residual listed, when Newton fails."""
+    steps = _Steps(make)
+    n = steps(float(p)).n
+    u0 = _check_guess(guess, n)
+    y, res = _newton(steps, np.concatenate([u0, [float(p)]]), tol, max_iter,
+                     f"equilibrium at p = {p!r}")
+    u = y[:-1]
+    lam = _roots(make, float(p), u, count, tol)
+    return Equilibrium(make=make, p=float(p), u=u, roots=lam,
+                       stable=bool(lam.size and lam[0].real < 0), residual=res[-1],
+                       iterations=len(res) - 1)
+
+
+def _tangent(J: np.ndarray, prev: np.ndarray) -> np.ndarray:
+    """The unit null vector of J (n, n + 1), oriented along prev."""
+    t = np.linalg.svd(J)[2][-1]
+    return t if float(t @ prev) >= 0 else -t
+
+
+def _complex_re(lam: np.ndarray) -> float:
+    """Re of the rightmost non-real root (-inf if none)."""
+    c = lam[np.abs(lam.imag) > 1e-8 * np.maximum(1.0, np.abs(lam))]
+    c = c[np.isfinite(c.real)]
+    return float(np.max(c.real)) if c.size else -math.inf
+
+
+def continue_equilibrium(eq: Equilibrium, p_end: float, step: float = 0.05, *,
+                         max_points: int = 200, min_step: float | None = None,
+                         max_step: float | None = None, count: int = ROOTS,
+                         tol: float = 1e-10, max_iter: int = 8) -> Branch:
+    """Continues the equilibrium ``eq`` (from :func:`equilibrium`) in p towards ``p_end`` by
+    pseudo-arclength, first step ``step`` (p units; then arclengths in the Euclidean norm of
+    (u, p); ``min_step`` default step / 1000, ``max_step`` default 4 step).  Each point gets its
+    ``count`` rightmost roots.  Returns a :class:`Branch` (``kind`` "equilibria") of
+    :class:`EquilibriumPoint`, with ``fold`` and ``hopf`` events located on the branch (see the
+    module).  A corrector failing at the smallest step ends the branch (``status``)."""
+    if not isinstance(eq, Equilibrium):
+        raise ValueError(f"eq = {eq!r}: give a dmi.analysis.Equilibrium")
+    if not (math.isfinite(step) and step > 0):
+        raise ValueError(f"step = {step!r}: must be finite and > 0 (p units)")
+    if not math.isfinite(p_end) or p_end == eq.p:
+        raise ValueError(f"p_end = {p_end!r}: must be finite and differ from eq.p = {eq.p!r}")
+    direction = 1.0 if p_end > eq.p else -1.0
+    min_step = step / 1000 if min_step is None else min_step
+    max_step = 4 * step if max_step is None else max_step
+    make = eq.make
+    steps = _Steps(make)
+    y = np.concatenate([eq.u, [eq.p]])
+    m = y.size
+    t = np.zeros(m)
+    t[-1] = direction
+    t = _tangent(steps.jacobian(y, steps.G(y)), t)
+
+    def point(y: np.ndarray, t: np.ndarray) -> EquilibriumPoint:
+        lam = _roots(make, float(y[-1]), y[:-1], count, tol)
+        return EquilibriumPoint(p=float(y[-1]), u=y[:-1].copy(), roots=lam,
+                                stable=bool(lam.size and lam[0].real < 0), dpds=float(t[-1]))
+
+    def correct(yp: np.ndarray, row: np.ndarray, target: float) -> np.ndarray:
+        return _newton(steps, yp, tol, max_iter, f"equilibrium branch near p = {yp[-1]!r}",
+                       row, target)[0]
+
+    pts = [point(y, t)]
+    ts = [t]
+    ys = [y]
+    events: list[Event] = []
+    status = "max_points reached"
+    ds = step
+    while len(pts) < max_points:
+        if (y[-1] - p_end) * direction >= -1e-12 * max(1.0, abs(p_end)):
+            status = f"reached p_end = {p_end!r}"
+            break
+        while True:
+            yp, row = y + ds * t, t
+            target = float(t @ yp)
+            if (yp[-1] - p_end) * direction > 0 and abs(t[-1]) > 0.5:   # end on p = p_end
+                yp = y + ((p_end - y[-1]) / t[-1]) * t
+                row = np.zeros(m)
+                row[-1] = 1.0
+                target = float(p_end)
+            try:
+                yn = correct(yp, row, target)
+                break
+            except Exception as e:   # the model's or the corrector's failure: a shorter step
+                ds /= 2
+                if ds < min_step:
+                    status = f"corrector failed at the smallest step {min_step!r} near p = " \
+                             f"{float(y[-1])!r}: {e}"
+                    yn = None
+                    break
+        if yn is None:
+            break
+        tn = _tangent(steps.jacobian(yn, steps.G(yn)), t)
+        pts.append(point(yn, tn))
+        events += _events(steps, make, ys[-1], ts[-1], pts[-2], yn, pts[-1], len(pts) - 1,
+                          count, tol, correct)
+        y, t = yn, tn
+        ys.append(y)
+        ts.append(t)
+        ds = min(max_step, ds * 1.5)
+    return Branch(pts, events, status, make, kind="equilibria")
+
+
+def _events(steps: _Steps, make: Model, ya: np.ndarray, ta: np.ndarray, a: EquilibriumPoint,
+            yb: np.ndarray, b: EquilibriumPoint, index: int, count: int, tol: float,
+            correct: Any) -> list[Event]:
+    """The fold and Hopf events between a and b, each located by Brent's method on its test
+    function in the arclength s along ta from ya (the equilibrium at s on the hyperplane
+    <ta, y - ya> = s)."""
+    sb = float(ta @ (yb - ya))
+    out: list[Event] = []
+    if sb <= 0:
+        return out
+    cache: dict[float, np.ndarray] = {0.0: ya, sb: yb}
+
+    def at(s: float) -> np.ndarray:
+        if s not in cache:
+            cache[s] = correct(ya + s * ta, ta, float(ta @ ya) + s)
+        return cache[s]
+
+    def locate(fn: Any, fa: float, fb: float) -> float | None:
+        if not (fa * fb < 0):
+            return None
+        try:
+            return float(scipy.optimize.brentq(fn, 0.0, sb, xtol=1e-12 * max(1.0, sb),
+                                               rtol=1e-15, maxiter=100))
+        except (ShootingError, ValueError, RuntimeError):
+            return None
+
+    if a.dpds * b.dpds < 0:
+        def dpds(s: float) -> float:
+            y = at(s)
+            return float(_tangent(steps.jacobian(y, steps.G(y)), ta)[-1])
+        s = locate(dpds, a.dpds, b.dpds)
+        if s is not None:
+            y = at(s)
+            out.append(Event("fold", float(y[-1]), index, None,
+                             "dp/ds changes sign (located on the branch)", u=y[:-1].copy()))
+    fa, fb = _complex_re(a.roots), _complex_re(b.roots)
+    if math.isfinite(fa) and math.isfinite(fb) and fa * fb < 0:
+        def re(s: float) -> float:
+            y = at(s)
+            return _complex_re(_roots(make, float(y[-1]), y[:-1], count, tol))
+        s = locate(re, fa, fb)
+        if s is not None:
+            y = at(s)
+            lam = _roots(make, float(y[-1]), y[:-1], count, tol)
+            c = lam[np.abs(lam.imag) > 1e-8 * np.maximum(1.0, np.abs(lam))]
+            root = c[np.argmax(c.real)]
+            root = complex(root.real, abs(root.imag))
+            hp = HopfPoint(p=float(y[-1]), omega=root.imag, root=root)
+            out.append(Event("hopf", hp.p, index, None,
+                             f"a pair of roots crosses the imaginary axis at omega = "
+                             f"{hp.omega:.8g}", u=y[:-1].copy(), hopf=hp))
+    return out

@@ -1,0 +1,215 @@
+# Newton's method on fixed points of the step map, plain and bordered, matrix-free.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""Newton's method for x = F(x), x a shooting state, with GMRES on the matrix-free Jacobian
+(forward differences of F: the derivative of the map's smooth piece, a semismooth Newton), and
+the bordered step of a system with extra unknowns and equations (an autonomous orbit's step h,
+a continuation's parameter p; a phase condition, an amplitude condition, an arclength).
+
+Every iteration's residual is kept; an iteration gives up when the residual has made no new
+minimum in :data:`NO_PROGRESS` iterations (the semismooth Newton may rise once on its way into
+the next smooth piece of the map, never three times), and its error lists every residual tried.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+import scipy.sparse.linalg as sla
+
+from .._errors import Error
+
+#: Iterations without a new least residual after which Newton gives up.
+NO_PROGRESS = 3
+
+
+class ShootingError(RuntimeError):
+    """Newton's iteration for a periodic orbit (or an equilibrium) failed: ``residuals`` is the
+    history of max-norm residuals |F(x) - x| per iteration (state units), ``iterations`` their
+    count."""
+
+    def __init__(self, message: str, residuals: list[float] | None = None):
+        super().__init__(message)
+        self.residuals = list(residuals or [])
+        self.iterations = len(self.residuals)
+
+
+def fmt_residuals(res: list[float]) -> str:
+    """Every residual tried, for an error message."""
+    return "[" + ", ".join(f"{r:.2g}" for r in res) + "]"
+
+
+def stalled(res: list[float]) -> bool:
+    """The residuals ``res`` (one an iteration) made no new minimum in the last NO_PROGRESS."""
+    return len(res) > NO_PROGRESS and min(res[-NO_PROGRESS:]) >= min(res[:-NO_PROGRESS])
+
+
+def fd_eps(x: np.ndarray) -> float:
+    """The forward-difference step of Newton's matrix-free Jacobians: sqrt(eps_machine)
+    max(1, |x|_inf) (state units)."""
+    return math.sqrt(np.finfo(float).eps) * max(1.0, float(np.max(np.abs(x))))
+
+
+def directional(F: Callable[[np.ndarray], np.ndarray], x: np.ndarray, Fx: np.ndarray,
+                v: np.ndarray, eps: float) -> np.ndarray:
+    """DF(x) v by a forward difference of step eps along v / |v|_2 (one evaluation of F; 0 for
+    v = 0)."""
+    nv = float(np.linalg.norm(v))
+    if nv == 0.0:
+        return np.zeros_like(v)
+    return (F(x + (eps / nv) * v) - Fx) * (nv / eps)
+
+
+def bordered_step(F: Callable[[np.ndarray], np.ndarray], x: np.ndarray, Fx: np.ndarray,
+                  Fq: np.ndarray, border: np.ndarray, g: float | np.ndarray, *, rtol: float
+                  ) -> tuple[np.ndarray, float]:
+    """One Newton step for x = F_q(x) with k more unknowns q (an autonomous orbit's step h, a
+    continuation's parameter p) and k more equations g = 0 (a phase condition, an amplitude
+    condition, the pseudo-arclength hyperplane): dz = (dx, dq) solves the bordered system
+
+        (D_xF - I) dx + F_q dq = -(F(x) - x),     border dz = -g,
+
+    by GMRES on the matrix-free operator (D_xF v by :func:`directional`, step :func:`fd_eps`).
+    ``Fq``: dF/dq, (dim,) or (dim, k) columns computed by the caller; ``border``: (dim + k,) or
+    (k, dim + k) rows, linear in dz; ``g``: k values.  Returns (dz, GMRES's relative residual
+    |J dz - rhs| / |rhs|, one more product): above about 1e-2 the system is singular."""
+    Fq = np.asarray(Fq, dtype=float).reshape(x.size, -1)
+    B = np.atleast_2d(np.asarray(border, dtype=float))
+    g = np.atleast_1d(np.asarray(g, dtype=float))
+    k = Fq.shape[1]
+    eps = fd_eps(x)
+
+    def mv(v: np.ndarray) -> np.ndarray:
+        vx = v[:-k]
+        return np.concatenate([directional(F, x, Fx, vx, eps) - vx + Fq @ v[-k:], B @ v])
+
+    size = x.size + k
+    J = sla.LinearOperator((size, size), matvec=mv, dtype=float)
+    rhs = -np.concatenate([Fx - x, g])
+    dz, _ = sla.gmres(J, rhs, rtol=rtol, atol=0.0, restart=min(size, 60), maxiter=4)
+    if not np.all(np.isfinite(dz)):
+        return dz, math.inf
+    return dz, float(np.linalg.norm(mv(dz) - rhs)) / max(float(np.linalg.norm(rhs)), 1e-300)
+
+
+def newton(F: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, *, tol: float = 1e-10,
+           max_iter: int = 30, what: str = "x = F(x)") -> tuple[np.ndarray, list[float]]:
+    """Solves x = F(x) by Newton's method with GMRES on the matrix-free Jacobian I - DF
+    (forward differences of F, step sqrt(eps_machine) max(1, |x|_inf): the derivative of the
+    map's smooth piece, a semismooth Newton).  Converged when |F(x) - x|_inf <=
+    tol * max(1, |x|_inf).  Returns (x, residual history).  Raises ShootingError, with every
+    residual tried, when F fails, the Jacobian is singular, the residual makes no new minimum in
+    :data:`NO_PROGRESS` iterations, or it does not fall below tol within max_iter iterations."""
+    x = np.array(x0, dtype=float)
+    res: list[float] = []
+
+    def ev(z: np.ndarray) -> np.ndarray:
+        try:
+            return F(z)
+        except Error as e:
+            raise ShootingError(f"{what}: the map failed after {len(res)} Newton iterations "
+                                f"(residuals {fmt_residuals(res)}): {e}; the guess is too far "
+                                "from any orbit, or the orbit leaves the model's domain",
+                                res) from e
+
+    Fx = ev(x)
+    for _ in range(max_iter + 1):
+        r = Fx - x
+        rn = float(np.max(np.abs(r)))
+        res.append(rn)
+        if not math.isfinite(rn):
+            raise ShootingError(f"{what}: non-finite residual (residuals {fmt_residuals(res)}): "
+                                "the guess is too far from any orbit", res)
+        scale = max(1.0, float(np.max(np.abs(x))))
+        if rn <= tol * scale:
+            return x, res
+        if len(res) > max_iter:
+            break
+        if stalled(res):
+            raise ShootingError(f"{what}: Newton makes no progress: no new least residual in "
+                                f"{NO_PROGRESS} iterations (residuals {fmt_residuals(res)}; "
+                                f"tolerance {tol * scale:.3g}): no orbit near the guess, or the "
+                                "orbit is not isolated", res)
+        eps = fd_eps(x)
+
+        def mv(v: np.ndarray, Fx: np.ndarray = Fx, x: np.ndarray = x) -> np.ndarray:
+            return v - directional(ev, x, Fx, v, eps)
+
+        J = sla.LinearOperator((x.size, x.size), matvec=mv, dtype=float)
+        dx, _info = sla.gmres(J, r, rtol=1e-6, atol=0.0, restart=min(x.size, 60), maxiter=4)
+        lin = float(np.linalg.norm(mv(dx) - r)) / max(float(np.linalg.norm(r)), 1e-300)
+        if not np.all(np.isfinite(dx)) or lin > 1e-2 or float(np.max(np.abs(dx))) > 1e8 * scale:
+            raise ShootingError(f"{what}: the Jacobian I - DF is singular or too ill-conditioned "
+                                f"at Newton iteration {len(res)} (GMRES relative residual "
+                                f"{lin:.2g}, residuals {fmt_residuals(res)}): a Floquet "
+                                "multiplier at 1, a non-isolated orbit, or no orbit", res)
+        # the full step, halved (at most 5 times) only while it makes the residual 100 times
+        # worse: a step into the next piece of a piecewise-smooth map may raise the residual for
+        # one iteration before the next lands on the fixed point
+        lam = 1.0
+        for _ in range(6):
+            xn = x + lam * dx
+            Fn = ev(xn)
+            if np.max(np.abs(Fn - xn)) < 100 * rn or lam < 0.05:
+                break
+            lam *= 0.5
+        x, Fx = xn, Fn
+    raise ShootingError(f"{what}: no convergence in {max_iter} Newton iterations (residuals "
+                        f"{fmt_residuals(res)}; tolerance {tol:.3g} relative): the guess is too "
+                        "far from any orbit", res)
+
+
+def bordered_newton(maps: Callable[[np.ndarray], Callable[[np.ndarray], np.ndarray]],
+                    z0: np.ndarray, k: int,
+                    conditions: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], *,
+                    tol: float = 1e-10, max_iter: int = 30, what: str = "x = F_q(x)",
+                    steps: np.ndarray | None = None,
+                    check: Callable[[np.ndarray], None] | None = None
+                    ) -> tuple[np.ndarray, list[float]]:
+    """Newton on z = (x, q), q the last k values: F_q(x) - x = 0 and the k equations
+    ``conditions(z) -> (g (k,), rows (k, dim + k))`` (values and their linearisation), by
+    :func:`bordered_step` (dF/dq by one forward difference of ``steps`` (k,) a column, default
+    1e-7 max(1, |q_j|)).  ``maps(q)`` is the map at q.  ``check(z)``: called on each new
+    iterate, raises to stop (a step outside the model's range).  Converged when
+    |F(x) - x|_inf and |g|_inf are <= tol max(1, |x|_inf).  Returns (z, residuals); raises
+    ShootingError with every residual tried (no new least residual in NO_PROGRESS iterations,
+    a singular bordered system, non-finite values, max_iter reached)."""
+    z = np.array(z0, dtype=float)
+    dim = z.size - k
+    res: list[float] = []
+    for _ in range(max_iter + 1):
+        x, q = z[:dim], z[dim:]
+        F = maps(q)
+        Fx = F(x)
+        r = Fx - x
+        g, rows = conditions(z)
+        rn = max(float(np.max(np.abs(r))), float(np.max(np.abs(g))) if len(g) else 0.0)
+        res.append(rn)
+        if not math.isfinite(rn):
+            raise ShootingError(f"{what}: non-finite residual (residuals "
+                                f"{fmt_residuals(res)})", res)
+        scale = max(1.0, float(np.max(np.abs(x))))
+        if rn <= tol * scale:
+            return z, res
+        if len(res) > max_iter:
+            break
+        if stalled(res):
+            raise ShootingError(f"{what}: Newton makes no progress: no new least residual in "
+                                f"{NO_PROGRESS} iterations (residuals {fmt_residuals(res)}; "
+                                f"tolerance {tol * scale:.3g})", res)
+        cols = np.empty((dim, k))
+        for j in range(k):
+            d = 1e-7 * max(1.0, abs(q[j])) if steps is None else float(steps[j])
+            qd = q.copy()
+            qd[j] += d
+            cols[:, j] = (maps(qd)(x) - Fx) / d
+        dz, lin = bordered_step(F, x, Fx, cols, rows, g, rtol=1e-8)
+        if lin > 1e-2:
+            raise ShootingError(f"{what}: the bordered Jacobian is singular at Newton iteration "
+                                f"{len(res)} (GMRES relative residual {lin:.2g}, residuals "
+                                f"{fmt_residuals(res)})", res)
+        z = z + dz
+        if check is not None:
+            check(z)
+    raise ShootingError(f"{what}: no convergence in {max_iter} Newton iterations (residuals "
+                        f"{fmt_residuals(res)})", res)

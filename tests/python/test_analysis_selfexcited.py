@@ -1,0 +1,233 @@
+# Self-excited oscillations: equilibria and their branches, the orbit born at a Hopf point, and
+# autonomous continuation into stick-slip, against closed forms derived here and long plain runs;
+# and the silent wrong answers refused.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import scipy.optimize as so
+
+import dmi
+from dmi import analysis as da
+from dmi.analysis.newton import NO_PROGRESS, newton
+from orbit_models import DenHartog
+
+# ---- a closed-form autonomous orbit with a distributed delay ------------------------------------
+# u' = (mu - |u|^2) u + w0 J u - int_0^tau g(s) u(t - s) ds in R^2, J the rotation by pi/2,
+# g(s) = k e^(-a s).  In z = u_1 + i u_2: z' = (mu - |z|^2) z + i w0 z - int g(s) z(t - s) ds.
+# z = r e^(i w t): i w = mu - r^2 + i w0 - G(w), G(w) = int_0^tau g(s) e^(-i w s) ds, so
+# r^2 = mu - Re G(w) and w = w0 - Im G(w) (the issue's ghat(w) = conj G(w)).  r = 0: the Hopf
+# point mu_H = Re G(w) with the same w, which does not depend on mu: the period is constant along
+# the branch.  In dmi's form u' + f + int H u = 0: f = -(mu - |u|^2) u - w0 J u, H = g I.
+W0, KG, AG, TAU = 1.0, 0.5, 1.0, 1.0
+
+
+def G(w: float) -> complex:
+    z = -AG - 1j * w
+    return KG * (np.exp(z * TAU) - 1) / z
+
+
+OMEGA = so.brentq(lambda w: w - W0 + G(w).imag, 0.1, 3.0)
+MU_H = G(OMEGA).real
+
+
+def landau(mu: float, h: float | None = None, N: int = 100) -> dmi.Solver:
+    s = dmi.Solver(2, TAU, N) if h is None else dmi.Solver(2, TAU, h=h)
+
+    def f(t, u):
+        g = mu - u[0] ** 2 - u[1] ** 2
+        return np.array([-g * u[0] + W0 * u[1], -g * u[1] - W0 * u[0]])
+    s.set_rhs(f)
+    s.set_kernel_exp([-AG], [0.0], [KG * np.eye(2)])
+    return s
+
+
+def test_closed_form_constants():
+    # the closed form itself: the linear equation's root at mu_H is i omega (independent check
+    # of G by quadrature)
+    from scipy.integrate import quad
+    re = quad(lambda s: KG * np.exp(-AG * s) * np.cos(OMEGA * s), 0, TAU)[0]
+    im = -quad(lambda s: KG * np.exp(-AG * s) * np.sin(OMEGA * s), 0, TAU)[0]
+    assert G(OMEGA) == pytest.approx(complex(re, im), abs=1e-12)
+    assert 0.2 < MU_H < 0.3 and 1.0 < OMEGA < 1.3
+
+
+def _hopf_event(N: int) -> da.Event:
+    make = (lambda mu, h=None: landau(mu, h, N))
+    eq = da.equilibrium(make, 0.0, [0.02, -0.01])
+    assert np.max(np.abs(eq.u)) < 1e-10 and eq.stable
+    br = da.continue_equilibrium(eq, 0.6, step=0.1)
+    assert br.kind == "equilibria" and br.status.startswith("reached")
+    hopf = [e for e in br.events if e.kind == "hopf"]
+    assert len(hopf) == 1 and not [e for e in br.events if e.kind == "fold"], br.events
+    assert br.stable[0] and not br.stable[-1]
+    return hopf[0]
+
+
+def test_equilibrium_branch_finds_the_hopf_point_at_order_one():
+    errs = []
+    for N in (50, 100, 200):
+        e = _hopf_event(N)
+        hp = e.hopf
+        assert abs(hp.root.real) < 1e-8          # located on the branch, not interpolated
+        assert hp.omega == pytest.approx(hp.root.imag)
+        errs.append((abs(hp.p - MU_H), abs(hp.omega - OMEGA)))
+    errs = np.array(errs)
+    ratios = errs[:-1] / errs[1:]
+    assert np.all((ratios > 1.7) & (ratios < 2.4)), (errs, ratios)   # order 1 in h
+    assert errs[-1, 0] < 5e-3
+
+
+def _branch_error(N: int) -> tuple[float, float, da.Branch]:
+    make = (lambda mu, h=None: landau(mu, h, N))
+    e = _hopf_event(N)
+    M = round(2 * math.pi / e.hopf.omega / (TAU / N))
+    o = da.hopf_orbit(make, e.hopf, e.u, amplitude=0.1, steps=M)
+    assert o.autonomous and np.max(o.amplitude) == pytest.approx(0.1, rel=1e-6)
+    br = da.continue_orbit(o, 0.6, step=0.05, max_points=5, multipliers=4)
+    assert br.kind == "autonomous" and len(br.points) == 5
+    assert not br.events, br.events                  # no phase multiplier read as an event
+    assert np.all(br.stable), [q.multipliers for q in br.points]
+    r = br.column("amplitude")[:, 0]
+    assert np.all(np.diff(r) > 0) and r[-1] > 0.3
+    err_p = np.max(np.abs(br.p - (MU_H + r ** 2)))   # the branch p(r) = mu_H + r^2
+    err_P = np.max(np.abs(br.column("period") - 2 * math.pi / OMEGA))
+    return err_p, err_P, br
+
+
+def test_hopf_orbit_and_its_continuation_match_the_closed_form_at_order_one():
+    e1 = _branch_error(50)
+    e2 = _branch_error(100)
+    for a, b in zip(e1[:2], e2[:2]):
+        assert 1.6 < a / b < 2.5, (e1[:2], e2[:2])
+    assert e2[0] < 0.02 and e2[1] < 0.02
+
+
+# ---- a belt with a memory that destabilises sliding ---------------------------------------------
+# x' = v + v_b, v' + k x + c (v + v_b) + alpha sigma(v) + (g / tau) int_0^tau x(t - s) ds ∋ 0,
+# v = x' - v_b; sliding equilibrium x = alpha / (k + g), v = -v_b; the memory makes it lose
+# stability as the damping c falls.  While the orbit slips the system is linear: the branch leaves
+# the Hopf point vertically up to grazing (v reaches 0), then sticks.
+KB, GB, ALPHA, VB = 1.0, 0.8, 0.5, 0.3
+
+
+def belt(c: float, h: float | None = None, N: int = 50) -> dmi.Solver:
+    s = dmi.Solver(2, TAU, N) if h is None else dmi.Solver(2, TAU, h=h)
+    s.set_rhs(lambda t, u: np.array([-(u[1] + VB), KB * u[0] + c * (u[1] + VB)]))
+    s.set_kernel_exp([0.0], [0.0], [np.array([[0.0, 0.0], [GB / TAU, 0.0]])])
+    s.set_friction([0.0, ALPHA])
+    return s
+
+
+def _plain_run(c: float, h: float, M: int) -> tuple[float, float, np.ndarray]:
+    """Period (upward crossings of x's mean, interpolated) and half range of v over the last
+    periods of a long run from the sliding equilibrium kicked."""
+    s = belt(c, h=h)
+    x_eq = ALPHA / (KB + GB)
+    s.set_history(lambda t: np.array([x_eq + 0.05, -VB]))
+    s.init()
+    _, U = s.run(80 * M)
+    x = U[-20 * M:, 0]
+    y = x - 0.5 * (x.max() + x.min())
+    k = np.nonzero((y[:-1] < 0) & (y[1:] >= 0))[0]
+    t = (k + y[k] / (y[k] - y[k + 1])) * h
+    v = U[-5 * M:, 1]
+    return float(np.mean(np.diff(t))), 0.5 * float(v.max() - v.min()), U
+
+
+def test_belt_from_equilibrium_to_stick_slip_against_plain_runs():
+    eq = da.equilibrium(belt, 1.0, [0.2, -0.2])
+    assert eq.u == pytest.approx([ALPHA / (KB + GB), -VB], abs=1e-12)
+    br = da.continue_equilibrium(eq, -0.5, step=0.2)
+    hopf = [e for e in br.events if e.kind == "hopf"]
+    assert len(hopf) == 1
+    o = da.hopf_orbit(belt, hopf[0].hopf, hopf[0].u, amplitude=0.1, steps=200)
+    assert abs(o.p - hopf[0].p) < 0.01 and np.max(o.stick_fraction) == 0
+    b = da.continue_orbit(o, 0.0, step=0.02, max_points=16, multipliers=4)
+    kinds = [e.kind for e in b.events]
+    assert "fold" not in kinds, b.events     # the vertical stretch is no fold
+    assert "stick-onset" in kinds, b.events
+    stuck = [q for q in b.points if q.stick_steps[1] > 0]
+    assert len(stuck) >= 4
+    # before grazing: vertical (p constant), v's half range below v_b
+    slip = [q for q in b.points if q.stick_steps[1] == 0]
+    assert np.ptp([q.p for q in slip]) < 1e-6 and all(q.amplitude[1] < VB + 1e-9 for q in slip)
+    for q in stuck[1::2]:
+        h = q.period / b.steps
+        P, A, _ = _plain_run(q.p, h, b.steps)
+        assert q.stable
+        assert abs(P - q.period) <= h, (q.p, P, q.period)
+        assert abs(A - q.amplitude[1]) <= 1e-3 * A, (q.p, A, q.amplitude)
+
+
+# ---- no silent wrong answers --------------------------------------------------------------------
+def test_autonomous_shooting_onto_the_equilibrium_is_refused():
+    make = (lambda mu, h=None: landau(mu, h, 50))
+    P = 2 * math.pi / OMEGA
+    s = landau(0.1, h=P / 100, N=50)   # mu below mu_H: the equilibrium attracts
+    s.set_history(lambda t: np.array([1e-11 * np.cos(OMEGA * t), 1e-11 * np.sin(OMEGA * t)]))
+    s.init()
+    with pytest.raises(da.ShootingError, match="equilibrium, not an orbit"):
+        da.periodic_orbit(make, 0.1, guess=s.get_window(), guess_period=P, steps=100)
+
+
+def test_a_period_that_is_not_the_models_is_refused():
+    def make(p):   # u' + u = cos t: the map over 3 pi (1.5 periods) contracts to a fixed point
+        s = dmi.Solver(1, 2 * math.pi / 400, 1)
+        s.set_rhs(lambda t, u: np.array([u[0] - np.cos(t)]))
+        return s
+    o = da.periodic_orbit(make, 0.0, 2 * math.pi, [0.0], multipliers=0)   # the true period
+    assert o.amplitude[0] > 0.5
+    with pytest.raises(ValueError, match="not a period of the model"):
+        da.periodic_orbit(make, 0.0, 3 * math.pi, [0.0], multipliers=2)
+
+
+def test_newton_gives_up_without_progress_and_lists_every_residual():
+    def F(x):   # x + 1 + sin(3 x) / 2 has no fixed point; I - DF is rarely singular
+        return x + 1 + 0.5 * np.sin(3 * x)
+    with pytest.raises(da.ShootingError, match="no progress") as e:
+        newton(F, np.array([0.3]), max_iter=50)
+    res = e.value.residuals
+    best = int(np.argmin(res))
+    assert len(res) == best + 1 + NO_PROGRESS            # stopped right after 3 iterations
+    assert len(res) < 50
+    assert all(f"{r:.2g}" in str(e.value) for r in res)  # every residual listed
+
+
+def test_forced_guess_of_the_wrong_shape_names_n():
+    dh = DenHartog()
+    with pytest.raises(ValueError, match=r"n = 2: give n = 2 values.*N \+ 1 = 2 <= k"):
+        da.periodic_orbit(dh.make_for(400), 1.0, dh.T, np.zeros((3, 3)))
+
+
+def test_nan_from_the_rhs_names_the_call_and_p():
+    def make(p):
+        s = dmi.Solver(1, 0.01, 1)
+        s.set_rhs(lambda t, u: np.array([np.nan if u[0] > 0.3 else -np.cos(t)]))
+        return s
+    with pytest.raises(da.ShootingError, match=r"p = 2\.0.*f\(.*nan"):
+        da.periodic_orbit(make, 2.0, 6.28, [0.0])
+
+
+def test_make_failing_is_the_models_exception_with_a_note():
+    def make(p, h=None):
+        if p > 1:
+            raise KeyError("p too large")
+        return landau(p, h, 50)
+    with pytest.raises(KeyError) as e:
+        da.equilibrium(make, 2.0, [0.0, 0.0])
+    assert any("make(p = 2.0)" in n for n in e.value.__notes__)
+    eq = da.equilibrium(make, 0.0, [0.0, 0.0])
+    br = da.continue_equilibrium(eq, 1.5, step=0.3)   # stops where make refuses, no raise
+    assert br.p[-1] <= 1.0 and "failed" in br.status
+
+
+def test_equilibrium_of_the_equation_is_corrected():
+    # the continuous equation's equilibrium of the belt is the scheme's too (the kernel's
+    # integral: tau g / tau); one moved by 7e-9 is corrected, and a rough guess converges
+    eq = da.equilibrium(belt, 0.5, [0.28 + 7e-9, -0.3])
+    assert eq.u == pytest.approx([ALPHA / (KB + GB), -VB], abs=1e-13)
+    assert eq.residual <= 1e-10 and eq.roots.size and eq.stable
