@@ -231,3 +231,65 @@ def test_equilibrium_of_the_equation_is_corrected():
     eq = da.equilibrium(belt, 0.5, [0.28 + 7e-9, -0.3])
     assert eq.u == pytest.approx([ALPHA / (KB + GB), -VB], abs=1e-13)
     assert eq.residual <= 1e-10 and eq.roots.size and eq.stable
+
+
+# ---- a forced pure-slip orbit near stick onset, and a forced branch through it -----------------
+# The belt with memory forced: v' + ... = F cos(w t).  While v < 0 throughout (pure slip) the
+# friction force is the constant -alpha and the system is linear: the M-step map's multipliers
+# are exactly z^M = exp(lambda P) for the scheme's roots lambda of the unforced equilibrium
+# (dmi.analysis.roots), and the response's amplitude is proportional to F, so that stick onset
+# (max v = 0) is at F_on = v_b F_1 / A_1 from one orbit at a small F_1.
+CF, WF, MF = 0.6, 1.3, 400
+PF = 2 * math.pi / WF
+
+
+def forced_belt(F: float) -> dmi.Solver:
+    s = dmi.Solver(2, TAU, h=PF / MF)
+    s.set_rhs(lambda t, u: np.array([-(u[1] + VB),
+                                     KB * u[0] + CF * (u[1] + VB) - F * np.cos(WF * t)]))
+    s.set_kernel_exp([0.0], [0.0], [np.array([[0.0, 0.0], [GB / TAU, 0.0]])])
+    s.set_friction([0.0, ALPHA])
+    return s
+
+
+U_EQ = [ALPHA / (KB + GB), -VB]
+
+
+@pytest.fixture(scope="module")
+def onset() -> tuple[float, np.ndarray]:
+    o = da.periodic_orbit(forced_belt, 0.01, PF, U_EQ, multipliers=0)
+    assert o.u[:, 1].mean() == pytest.approx(-VB, abs=1e-3) and np.max(o.stick_fraction) == 0
+    lam = da.roots(forced_belt, 0.0, U_EQ, 8)
+    mu = np.exp(lam * PF)
+    return 0.01 * VB / o.amplitude[1], mu[np.argsort(-np.abs(mu))]
+
+
+def _close(got: np.ndarray, want: np.ndarray, rel: float) -> bool:
+    """The leading multipliers agree (each of want's two largest has one of got within rel)."""
+    return all(np.min(np.abs(got - w)) <= rel * abs(w) for w in want[:2])
+
+
+def test_pure_slip_multipliers_near_stick_onset_are_exp_lambda_P(onset):
+    F_on, mu = onset
+    o = da.periodic_orbit(forced_belt, 0.995 * F_on, PF, U_EQ, multipliers=6)
+    assert np.max(o.stick_fraction) == 0 and -0.01 * VB < o.u[:, 1].max() < 0   # just below
+    assert _close(o.multipliers, mu, 5e-3), (o.multipliers, mu[:2])
+    assert _close(o.multipliers, mu, 1e-6), (o.multipliers, mu[:2])
+
+
+def test_forced_branch_passes_stick_onset_both_ways(onset):
+    F_on, mu = onset
+    for a, b in ((0.9, 1.6), (1.6, 0.8)):
+        o = da.periodic_orbit(forced_belt, a * F_on, PF, U_EQ, multipliers=6)
+        br = da.continue_orbit(o, b * F_on, step=0.05 * F_on, max_points=40)
+        assert br.status.startswith("reached"), br.status
+        kinds = [e.kind for e in br.events]
+        assert kinds == ["stick-onset"], br.events
+        assert abs(br.events[0].p / F_on - 1) < 2e-3, br.events
+        for q in br.points:
+            if q.p < 0.999 * F_on:
+                # pure slip: the branch's multipliers are exp(lambda P) (the linear response)
+                assert q.stick_steps[1] == 0 and _close(q.multipliers, mu, 1e-3), \
+                    (q.p / F_on, q.multipliers, mu[:2])
+            elif q.p > 1.01 * F_on:
+                assert q.stick_steps[1] > 0

@@ -40,19 +40,35 @@ FD_CAP = 0.05
 
 def fd_step(F: StepMap, x: np.ndarray, U: np.ndarray | None = None,
             X: np.ndarray | None = None) -> float:
-    """The difference step eps = FD_FACTOR A min(M^(-1/3), FD_CAP) (state units), A the largest
-    half range (max - min) / 2 of a component over one period from x (its trajectory ``U`` and
-    the resolvent's arguments ``X``, :meth:`StepMap.trajectory_terms`, else one run of M steps).
-    If the orbit has no switch to carry, the step is the usual eps_machine^(1/3) max(1, |x|) of
-    central differences: an equilibrium (a constant orbit), or an orbit where the resolvent is
-    the identity at every step (X = U^(p+1): no friction or contact acts, the map is smooth and
-    a large step would only add curvature error, 100 % on a strongly nonlinear pendulum)."""
+    """The difference step (state units) at the fixed point x, from its trajectory ``U`` and the
+    resolvent's arguments ``X`` (:meth:`StepMap.trajectory_terms`, else one run of M steps).
+
+    - An orbit that carries switches (a velocity reversal, a stick, a contact that starts or
+      ends: some component where the resolvent acts reaches 0 or changes sign): eps = FD_FACTOR
+      A min(M^(-1/3), FD_CAP), A the largest half range (max - min) / 2 of a component over the
+      period, large enough to move the switches by many steps (see the module).
+    - An orbit with no switch to carry, where the map is smooth: the usual eps_machine^(1/3)
+      max(1, |x|) of central differences, at most a tenth of the orbit's *margin*, its distance
+      from the nearest switch: the least |U_i| over the period of the components where the
+      resolvent acts (X_i != U_i: a friction component that slips throughout, whose velocity
+      never reaches the dead zone).  So a perturbed run of a pure-slip orbit near stick onset
+      slips too, and its multipliers are the smooth map's.  This covers an equilibrium (a
+      constant orbit) and an orbit where no resolvent acts at all (X = U^(p+1))."""
     if U is None or X is None:
         U, X = F.trajectory_terms(x)
     A = float(np.max(0.5 * (U.max(axis=0) - U.min(axis=0))))
     scale = max(1.0, float(np.max(np.abs(U))))
-    if not A > 1e-9 * scale or np.array_equal(X, U[1:]):
-        return float(np.finfo(float).eps) ** (1 / 3) * scale
+    smooth = float(np.finfo(float).eps) ** (1 / 3) * scale
+    if not A > 1e-9 * scale:
+        return smooth
+    u1 = U[1:]
+    acts = np.any(X != u1, axis=0)             # components the resolvent moves somewhere
+    if not acts.any():
+        return smooth
+    v = u1[:, acts]
+    if np.all((v > 0).all(axis=0) | (v < 0).all(axis=0)):   # each keeps its sign
+        margin = float(np.min(np.abs(v)))      # no switch: the distance to the nearest one
+        return min(smooth, 0.1 * margin)
     return FD_FACTOR * A * min(F.M ** (-1.0 / 3.0), FD_CAP)
 
 
