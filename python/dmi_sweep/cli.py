@@ -6,11 +6,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from . import __version__
+from . import NO_WORKER_TIMEOUT, __version__
 
-# seconds without any worker after which a run stops (exit 3): --no-worker-timeout, and run()'s
-# no_worker_timeout
-NO_WORKER_TIMEOUT = 60.0
 
 EXIT = """exit status:
   0    every point of the sweep succeeded (the folder holds all of them)

@@ -34,7 +34,7 @@ from distributed.security import Security
 
 from . import simulate
 from . import slurm as slurm_jobs
-from .cli import NO_WORKER_TIMEOUT
+from . import NO_WORKER_TIMEOUT
 from .simulate import FMUPlugin, PluginClosed, check_start, has_worker_plugin, run_chunk
 from .spec import Spec, SpecError
 from .store import Store
