@@ -85,8 +85,8 @@ def _branch_error(N: int) -> tuple[float, float, da.Branch]:
     make = (lambda mu, h=None: landau(mu, h, N))
     e = _hopf_event(N)
     M = round(2 * math.pi / e.hopf.omega / (TAU / N))
-    o = da.hopf_orbit(make, e.hopf, e.u, amplitude=0.1, steps=M)
-    assert o.autonomous and np.max(o.amplitude) == pytest.approx(0.1, rel=1e-6)
+    o = da.hopf_orbit(make, e.hopf, e.u, amplitude=0.1, steps=M, component=0)
+    assert o.autonomous and o.amplitude[0] == pytest.approx(0.1, rel=1e-9)
     br = da.continue_orbit(o, 0.6, step=0.05, max_points=5, multipliers=4)
     assert br.kind == "autonomous" and len(br.points) == 5
     assert not br.events, br.events                  # no phase multiplier read as an event
@@ -293,3 +293,24 @@ def test_forced_branch_passes_stick_onset_both_ways(onset):
                     (q.p / F_on, q.multipliers, mu[:2])
             elif q.p > 1.01 * F_on:
                 assert q.stick_steps[1] > 0
+
+
+def test_a_guess_period_too_long_says_so():
+    make = (lambda mu, h=None: landau(mu, h, 50))
+    P = 2 * math.pi / OMEGA
+    s = landau(0.4, h=1.6 * P / 200, N=50)   # on the orbit (r^2 ~ mu - mu_H), 1.6 periods long
+    s.set_history(lambda t: np.array([0.36 * np.cos(OMEGA * t), 0.36 * np.sin(OMEGA * t)]))
+    s.init()
+    s.advance(1000)
+    with pytest.raises(da.ShootingError, match="guess period is too long") as e:
+        da.periodic_orbit(make, 0.4, guess=s, guess_period=1.6 * P, steps=200)
+    assert "rows = " not in str(e.value)
+
+
+def test_hopf_takes_the_equilibrium_tolerance():
+    make = (lambda mu: landau(mu, None, 50))
+    u = [1e-8, 0.0]   # one step moves it by about h 1e-8 = 2e-10 (state units)
+    with pytest.raises(ValueError, match="not an equilibrium"):
+        da.hopf(make, 0.1, 0.4, u, tol=1e-11)
+    hp = da.hopf(make, 0.1, 0.4, u, tol=1e-8)
+    assert hp.p == pytest.approx(_hopf_event(50).p, rel=1e-8)

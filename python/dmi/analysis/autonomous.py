@@ -68,12 +68,17 @@ class AutonomousMaps:
         F = self._cache.get(key)
         if F is None:
             if not h > self.h_min:
-                raise ShootingError(f"the step went to h = {h!r} (period {self.M * h!r}), below "
-                                    f"{self.h_min!r}: no orbit near the guess", [])
+                raise ShootingError(f"the period M h went to {self.M * h:.6g} (h = {h:.6g}), "
+                                    f"below the least the state holds, {self.M * self.h_min:.6g}"
+                                    f": the guess period is too long for the orbit (a period "
+                                    f"near the orbit's?), or there is no orbit near the guess",
+                                    [])
             s = step_model(self.make, p, h)
             if s.N + 1 > self.rows:
-                raise ShootingError(f"the step fell to h = {h!r}: N + 1 = {s.N + 1} > "
-                                    f"{self.rows} rows of the state", [])
+                raise ShootingError(f"the period M h went to {self.M * h:.6g}: its N + 1 = "
+                                    f"{s.N + 1} steps of memory exceed the {self.rows} rows the "
+                                    "state holds (the guess period is too long for the orbit?)",
+                                    [])
             F = StepMap(fixed_step(self.make, h), p, self.M, self.rows, solver=s)
             if len(self._cache) > 5:
                 self._cache.pop(next(iter(self._cache)))
@@ -122,7 +127,7 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
     h0 = P0 / M
     s0 = step_model(make, p, h0)
     rows = max(s0.N + 1, math.ceil(s0.tau / (0.8 * h0)) + 1)
-    maps = AutonomousMaps(make, M, rows, 0.5 * h0)
+    maps = AutonomousMaps(make, M, rows, 0.8 * h0)
     F0 = maps(h0, p)
     n = F0.n
     if isinstance(guess, Solver):
@@ -231,7 +236,7 @@ def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: floa
     omega = abs(lam.imag)
     h0 = 2 * math.pi / omega / M
     rows = max(M + 1, math.ceil(tau / (0.8 * h0)) + 1)
-    maps = AutonomousMaps(make, M, rows, 0.5 * h0)
+    maps = AutonomousMaps(make, M, rows, 0.8 * h0)
     t = (np.arange(rows) - (rows - 1)) * h0
     s = a / abs(v[c])
     X = eq.u + s * np.real(np.outer(np.exp(1j * omega * t), v))

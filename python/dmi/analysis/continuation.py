@@ -322,7 +322,7 @@ class _AutoMaps(_Maps):
 
     def __init__(self, make: Model, M: int, h: float, rows: int):
         super().__init__(make, M, h, rows)
-        self.auto = AutonomousMaps(make, M, rows, 0.25 * h)
+        self.auto = AutonomousMaps(make, M, rows, 0.6 * h)
         self.xdot = np.zeros(0)
         self.ref = np.zeros(0)
 

@@ -187,21 +187,24 @@ class HopfPoint:
     root: complex
 
 
-def rightmost_real(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 4) -> float:
+def rightmost_real(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 4,
+                   tol: float = 1e-9) -> float:
     """Re of the rightmost root at p (1 / time unit)."""
-    return float(roots(make, p, u_eq, count)[0].real)
+    return float(roots(make, p, u_eq, count, tol=tol)[0].real)
 
 
 def hopf(make: Callable[[float], Solver], p_lo: float, p_hi: float, u_eq: Any, *,
-         rtol: float = 1e-10, count: int = 4) -> HopfPoint:
+         rtol: float = 1e-10, count: int = 4, tol: float = 1e-9) -> HopfPoint:
     """The parameter p in (p_lo, p_hi) where the rightmost root of :func:`roots` crosses the
-    imaginary axis, to ``rtol`` relative (Brent's method on Re lambda_1(p)).  Raises ValueError if
-    p_lo = p_hi or Re lambda_1 has the same sign at both ends (no crossing bracketed)."""
+    imaginary axis, to ``rtol`` relative (Brent's method on Re lambda_1(p)); ``tol``: the
+    equilibrium-residual tolerance of :func:`roots`.  Raises ValueError if p_lo = p_hi or Re
+    lambda_1 has the same sign at both ends (no crossing bracketed)."""
     p_lo, p_hi = float(p_lo), float(p_hi)
     if not (math.isfinite(p_lo) and math.isfinite(p_hi)) or p_lo == p_hi:
         raise ValueError(f"dmi.analysis.hopf: [p_lo, p_hi] = [{p_lo!r}, {p_hi!r}] is not an "
                          "interval (two different finite values)")
-    g_lo, g_hi = rightmost_real(make, p_lo, u_eq, count), rightmost_real(make, p_hi, u_eq, count)
+    g_lo = rightmost_real(make, p_lo, u_eq, count, tol)
+    g_hi = rightmost_real(make, p_hi, u_eq, count, tol)
     if g_lo == 0:
         p = p_lo
     elif g_hi == 0:
@@ -211,9 +214,9 @@ def hopf(make: Callable[[float], Solver], p_lo: float, p_hi: float, u_eq: Any, *
                          f"p = {p_lo!r} and {g_hi:.6g} at p = {p_hi!r} (same sign)")
     else:
         scale = max(abs(p_lo), abs(p_hi))
-        p = scipy.optimize.brentq(lambda x: rightmost_real(make, x, u_eq, count), p_lo, p_hi,
+        p = scipy.optimize.brentq(lambda x: rightmost_real(make, x, u_eq, count, tol), p_lo, p_hi,
                                   xtol=rtol * scale * 1e-2, rtol=max(rtol * 1e-2, 4.5e-16),
                                   maxiter=200)
-    lam = roots(make, p, u_eq, count)[0]
+    lam = roots(make, p, u_eq, count, tol=tol)[0]
     lam = complex(lam.real, abs(lam.imag))
     return HopfPoint(p=float(p), omega=abs(lam.imag), root=lam)
