@@ -314,3 +314,26 @@ def test_hopf_takes_the_equilibrium_tolerance():
         da.hopf(make, 0.1, 0.4, u, tol=1e-11)
     hp = da.hopf(make, 0.1, 0.4, u, tol=1e-8)
     assert hp.p == pytest.approx(_hopf_event(50).p, rel=1e-8)
+
+
+def test_plot_branch_draws_equilibria_and_amplitudes_with_labelled_axes():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    make = (lambda mu, h=None: landau(mu, h, 50))
+    eb = da.continue_equilibrium(da.equilibrium(make, 0.0, [0.0, 0.0]), 0.5, step=0.1)
+    e = [q for q in eb.events if q.kind == "hopf"][0]
+    ob = da.continue_orbit(da.hopf_orbit(make, e.hopf, e.u, amplitude=0.1, steps=277,
+                                         component=0), 0.5, step=0.05, max_points=3)
+    fig, (a1, a2) = plt.subplots(1, 2)
+    da.plot_branch(eb, a1, component=1)
+    da.plot_branch(ob, a2, component=0, p_label="mu")
+    ys = np.concatenate([ln.get_ydata() for ln in a1.lines if len(ln.get_ydata()) > 1])
+    assert np.allclose(np.unique(ys), np.unique([q.u[1] for q in eb.points]))
+    star = [ln for ln in a1.lines if ln.get_marker() == "*"]
+    assert len(star) == 1 and star[0].get_xdata()[0] == e.p
+    ys = np.concatenate([ln.get_ydata() for ln in a2.lines if len(ln.get_ydata()) > 1])
+    assert np.allclose(np.sort(np.unique(ys)), np.sort(ob.column("amplitude")[:, 0]))
+    assert a1.get_xlabel() == "parameter p" and "equilibrium" in a1.get_ylabel()
+    assert a2.get_xlabel() == "mu" and "amplitude" in a2.get_ylabel()
+    plt.close(fig)

@@ -1,7 +1,7 @@
 # Drawing a continued branch of periodic orbits or equilibria.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
-"""plot_branch: a branch's Poincare-section values over p, stable solid, unstable dashed,
-events marked and named beside the marker (no legend over the data)."""
+"""plot_branch: a branch's values over p, stable solid, unstable dashed, events marked and named
+beside the marker (no legend over the data), both axes labelled with what is drawn."""
 from __future__ import annotations
 
 from typing import Any
@@ -11,20 +11,42 @@ import numpy as np
 from .branch import Branch
 
 #: marker of each event kind
-MARKERS = {"fold": "s", "period-doubling": "D", "torus": "^", "stick-onset": "o", "grazing": "v"}
+MARKERS = {"fold": "s", "period-doubling": "D", "torus": "^", "stick-onset": "o", "grazing": "v",
+           "hopf": "*"}
+
+
+def branch_values(branch: Branch, component: int = 0) -> tuple[np.ndarray, str]:
+    """What :func:`plot_branch` draws against p, (points, k) curves, and its axis label:
+
+    - a branch of equilibria: u_component of each equilibrium (one curve);
+    - a forced branch: u_component at t = 0 of each orbit and at the other Poincare sections
+      of a k-periodic orbit (``BranchPoint.section``: t = j period / k), one curve each;
+    - an autonomous branch: the half range (max - min) / 2 of u_component over the period
+      (``BranchPoint.amplitude``; u at t = 0 is an arbitrary phase there), one curve."""
+    if branch.kind == "equilibria":
+        return (np.array([[q.u[component]] for q in branch.points]),
+                f"equilibrium $u_{{{component}}}$")
+    if branch.kind == "autonomous":
+        return (np.array([[q.amplitude[component]] for q in branch.points]),
+                f"amplitude of $u_{{{component}}}$, (max - min) / 2 over the period")
+    values = np.array([q.section[:, component] for q in branch.points])
+    if branch.sections > 1:
+        return values, f"$u_{{{component}}}$ at $t = j P / {branch.sections}$ (Poincare sections)"
+    return values, f"$u_{{{component}}}$ at $t = 0$ (Poincare section at the forcing period)"
 
 
 def plot_branch(branch: Branch, ax: Any, component: int = 0, color: str = "C0",
-                label_events: bool = True) -> None:
-    """Draws ``branch`` on the matplotlib Axes ``ax``: u_component on the Poincare section
-    (``BranchPoint.section``, one curve per section of a k-periodic orbit) against p; solid
-    where the orbit is stable, dashed where it is not; each event a black marker
-    (:data:`MARKERS`) on the curve at the event's p, its kind written beside it."""
+                label_events: bool = True, p_label: str = "parameter p") -> None:
+    """Draws ``branch`` (from :func:`continue_orbit` or :func:`continue_equilibrium`) on the
+    matplotlib Axes ``ax``: the values of :func:`branch_values` against p; solid where the orbit
+    or equilibrium is stable, dashed where it is not; each event a black marker
+    (:data:`MARKERS`) on the curve at the event's p, its kind written beside it; the x axis
+    labelled ``p_label``, the y axis with what is drawn."""
     p = branch.p
     if p.size == 0:
         return
     st = branch.stable
-    sec = np.array([q.section[:, component] for q in branch.points])  # (points, k)
+    sec, label = branch_values(branch, component)
     for j in range(sec.shape[1]):
         y = sec[:, j]
         # runs of equal stability, each joined to the next point so the curve is unbroken
@@ -39,10 +61,15 @@ def plot_branch(branch: Branch, ax: Any, component: int = 0, color: str = "C0",
         i = min(max(e.index, 1), len(p) - 1)
         for j in range(sec.shape[1]):
             a, b = sec[i - 1, j], sec[i, j]
-            w = 0.0 if p[i] == p[i - 1] else (e.p - p[i - 1]) / (p[i] - p[i - 1])
-            y = a + min(max(w, 0.0), 1.0) * (b - a)
+            if e.u is not None and branch.kind == "equilibria":
+                y = float(e.u[component])
+            else:
+                w = 0.0 if p[i] == p[i - 1] else (e.p - p[i - 1]) / (p[i] - p[i - 1])
+                y = a + min(max(w, 0.0), 1.0) * (b - a)
             ax.plot([e.p], [y], MARKERS.get(e.kind, "x"), color="k", ms=5, zorder=4,
                     fillstyle="none")
             if label_events and j == 0:
                 ax.annotate(e.kind, (e.p, y), xytext=(4, 6), textcoords="offset points",
                             fontsize=7)
+    ax.set_xlabel(p_label)
+    ax.set_ylabel(label)
