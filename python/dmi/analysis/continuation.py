@@ -613,7 +613,7 @@ def _first_tangent(maps: _Maps, z: np.ndarray, direction: float) -> np.ndarray:
     r = np.zeros(z.size)
     r[:-k] = dev / max(float(np.linalg.norm(dev)), 1e-300)
     r[-1] = 1.0
-    t, lin = bordered_step(F, x, x, _columns(maps, z, Fx), np.vstack([rows, r]),
+    t, lin = bordered_step(F, x, Fx, _columns(maps, z, Fx), np.vstack([rows, r]),
                            np.concatenate([np.zeros(len(g)), [-1.0]]), rtol=1e-8)
     if lin > 1e-2:
         raise ShootingError(f"no tangent at the branch's start (GMRES relative residual "
