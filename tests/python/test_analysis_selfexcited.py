@@ -155,6 +155,10 @@ def test_belt_from_equilibrium_to_stick_slip_against_plain_runs():
     # before grazing: vertical (p constant), v's half range below v_b
     slip = [q for q in b.points if q.stick_steps[1] == 0]
     assert np.ptp([q.p for q in slip]) < 1e-6 and all(q.amplitude[1] < VB + 1e-9 for q in slip)
+    # the stick onset is the vertical stretch's top: located along the branch, at its p
+    onset = [e for e in b.events if e.kind == "stick-onset"][0]
+    span = abs(b.points[onset.index].p - b.points[onset.index - 1].p)
+    assert abs(onset.p - slip[0].p) <= span / 32, (onset, slip[0].p, span)
     for q in stuck[1::2]:
         h = q.period / b.steps
         P, A, _ = _plain_run(q.p, h, b.steps)

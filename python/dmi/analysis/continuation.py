@@ -44,7 +44,8 @@ run as the point's states, :meth:`dmi.Solver.run_terms`; alpha_i = |X_i - U_i^(p
 slip steps).  It is > 0 where every reversal slips through (Den Hartog's net force beyond
 friction), <= 0 where the component sticks, and crosses 0 at a stick-onset; it does not depend
 on where the steps fall about the reversal (a lone zero step or a sign change), to O(h).
-Stick-onset and grazing events are located by bisection in p (6 halvings of the bracket).
+Stick-onset and grazing events are located by bisection along the branch (the chord between the
+two points shortened 64 times, each middle corrected across the chord).
 """
 from __future__ import annotations
 
@@ -58,7 +59,7 @@ from .._solver import Solver
 from .branch import Branch, BranchPoint, Event
 from .floquet import fd_step, phase_free, ritz
 from .autonomous import AutonomousMaps, phase_row, velocity
-from .newton import ShootingError, bordered_newton, bordered_step, fd_eps, newton
+from .newton import ShootingError, bordered_newton, bordered_step, fd_eps
 from .orbit import Orbit, stuck_mask
 from .shooting import periodic_orbit
 from .stepmap import Model, StepMap, build, positive_time
@@ -194,33 +195,46 @@ def _refine_fold(last: list[BranchPoint], e: Event) -> Event:
     return e
 
 
-def _locate_stick(maps: _Maps | _AutoMaps, a: BranchPoint, b: BranchPoint, e: Event,
-                  tol: float, bisections: int = 6) -> Event:
-    """Bisection in p between a and b on the stick pattern of component e.component (natural
-    continuation: orbits at the midpoints from the interpolated state, p fixed); the event's p
-    becomes the final bracket's midpoint, 2^-bisections of |b.p - a.p| wide."""
+def _locate_stick(maps: _Maps, a: BranchPoint, b: BranchPoint, e: Event, tol: float,
+                  max_iter: int, bisections: int = 6) -> Event:
+    """Bisection between a and b on the stick pattern of component e.component, along the
+    branch: the orbit at the middle of the bracket's chord, corrected on the hyperplane through
+    it across the chord (a step of the continuation's corrector; also where the branch turns at
+    the event, as a vertical branch does at grazing), until the bracket's chord is 2^-bisections
+    of the first (a corrected middle off a bent chord shortens it by less than half); the event's
+    p becomes the final bracket's midpoint."""
     i = e.component
     key = (lambda q: (q[0] > 0, q[1])) if e.kind == "stick-onset" else (lambda q: (True, q[1]))
     ka = key((a.stick_steps[i], a.stick_phases[i]))
     za, zb = maps.z_of(a), maps.z_of(b)
     if za.size != zb.size:
         return e
-    for _ in range(bisections):
+    k = maps.k
+    w = maps.weights(za.size)
+    d = zb - za
+    first = math.sqrt(float(np.dot(w * d, d)))
+    for _ in range(4 * bisections):
+        d = zb - za
+        chord = math.sqrt(float(np.dot(w * d, d)))
+        if chord <= first * 2.0 ** -bisections:
+            break
+        t = d / chord
         zm = 0.5 * (za + zb)
-        pm = float(zm[-1])
         try:
-            zm = maps.at_p(zm, tol, f"locating at p = {pm!r}")
-        except (ShootingError, ValueError, Error):
+            if k == 2:   # the phase condition through the bracket's first point
+                maps.reference(za, maps.of(za[-k:]).trajectory(za[:-k]))
+            zm = _corrector(maps, zm, t, tol, max_iter, math.inf)[0]
+        except Exception:   # the model's, the map's or the corrector's failure
             return e
-        F = maps.of(zm[-maps.k:])
-        st, ph, _ = _stick_profile(F, F.trajectory(zm[:-maps.k]), None)
+        F = maps.of(zm[-k:])
+        st, ph, _ = _stick_profile(F, F.trajectory(zm[:-k]), None)
         if key((st[i], ph[i])) == ka:
             za = zm
         else:
             zb = zm
     pa, pb = float(za[-1]), float(zb[-1])
     e.p = 0.5 * (pa + pb)
-    e.detail += f" (located by bisection in [{min(pa, pb)!r}, {max(pa, pb)!r}])"
+    e.detail += f" (located by bisection along the branch in [{min(pa, pb)!r}, {max(pa, pb)!r}])"
     return e
 
 
@@ -306,11 +320,6 @@ class _Maps:
     def reference(self, z: np.ndarray, U: np.ndarray) -> None:
         """A new point on the branch (nothing to update)."""
 
-    def at_p(self, z: np.ndarray, tol: float, what: str) -> np.ndarray:
-        """The orbit at z's p from z's state (p fixed)."""
-        x, _ = newton(self.of(z[-1:]), z[:-1], tol=tol, max_iter=12, what=what)
-        return np.concatenate([x, z[-1:]])
-
 
 class _AutoMaps(_Maps):
     """The maps of an autonomous branch: the unknowns are z = (x, h, p) (k = 2), the maps
@@ -352,18 +361,6 @@ class _AutoMaps(_Maps):
         v = velocity(U, float(z[-2]))
         self.xdot = v / max(float(np.linalg.norm(v)), 1e-300)
         self.ref = z[-2 - v.size:-2].copy()
-
-    def at_p(self, z: np.ndarray, tol: float, what: str) -> np.ndarray:
-        p = float(z[-1])
-
-        def conditions(y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            g, rows = self.conditions(y)
-            fix = np.zeros(y.size)
-            fix[-1] = 1.0
-            return np.concatenate([g, [y[-1] - p]]), np.vstack([rows, fix])
-        y, _ = bordered_newton(self.of, z, 2, conditions, tol=tol, max_iter=12, what=what,
-                               steps=self.col_steps(z[-2:]))
-        return y
 
 
 class _Slow(Exception):
@@ -783,8 +780,9 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
         for e in _events(pts[-2], pts[-1], len(pts) - 1, auto):
             if e.kind == "fold":
                 e = _refine_fold(pts[-3:], e)
-            elif e.kind in ("stick-onset", "grazing") and pts[-2].dpds * pts[-1].dpds > 0:
-                e = _locate_stick(maps, pts[-2], pts[-1], e, tol)
+            elif e.kind in ("stick-onset", "grazing"):
+                e = _locate_stick(maps, pts[-2], pts[-1], e, tol, max_iter)
+                maps.reference(z, terms[0])
             events.append(e)
         easy = its <= (6 if how == "newton-picard" else 3)
         ds = min(max_step, ds * 1.5) if easy else ds
