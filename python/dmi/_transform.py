@@ -1,0 +1,145 @@
+# Closed forms of exponential-sum kernels: phi1, the truncated Laplace transform, exact cell weights.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""Closed forms for the exponential-sum kernels of ``dmi_set_kernel_exp``.
+
+The kernel is, with K terms, exponents ``a`` (decay, <= 0 for the recursion), angular frequencies ``b``
+and n x n coefficient matrices ``C``, ``D`` (``D`` None: zero)::
+
+    H(s) = sum_k exp(a_k s) (C_k cos(b_k s) + D_k sin(b_k s))
+         = sum_k Re[(C_k - i D_k) exp(mu_k s)],   mu_k = a_k + i b_k.
+
+Everything here follows from the one function :func:`phi1`, ``phi1(z) = (e^z - 1) / z``, the mean of
+``e^{z x}`` over ``x`` in [0, 1]:
+
+- :func:`laplace` (``Hhat``): ``int_0^tau H(s) e^{-lambda s} ds``; each term gives
+  ``tau phi1((mu - lambda) tau)``, for complex ``lambda`` too, and ``tau = inf`` is the full Laplace transform;
+- :func:`cell_weights`: the exact integral of ``H`` over each cell ``[l h, (l + 1) h)``,
+  ``h e^{mu l h} phi1(mu h)`` per term, and ``theta h e^{mu (N - 1) h} phi1(mu theta h)`` for a partial
+  last cell of length ``theta h``.
+
+Shapes: a scalar kernel has ``C`` of shape (K,) and gives scalars per point; a matrix kernel has ``C`` of
+shape (K, n, n) and gives an n x n matrix per point (trailing axes).
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+__all__ = ["phi1", "laplace", "Hhat", "cell_weights", "evaluate"]
+
+# Below this |z| the series 1 + z/2 + z^2/6 is exact to rounding (the next term z^3/24 < 4e-17).
+_SERIES = 1e-5
+
+
+def phi1(z: Any) -> np.ndarray:
+    """``phi1(z) = (e^z - 1) / z``, 1 at ``z = 0``, elementwise, for real or complex ``z``.
+
+    Accurate to a few units of rounding everywhere (no cancellation near 0): the numerator is
+    ``expm1(x) cos y - 2 sin^2(y / 2) + i e^x sin y`` for ``z = x + i y``, and below ``|z| = 1e-5`` the
+    Taylor series is used.  Real input gives real output (float64), complex gives complex128.
+    ``phi1(z) -> -1/z`` as ``Re z -> -inf``; it overflows only where ``e^z`` does.
+    """
+    z = np.asarray(z)
+    if not np.iscomplexobj(z):
+        x = z.astype(np.float64)
+        small = np.abs(x) < _SERIES
+        safe = np.where(small, 1.0, x)
+        with np.errstate(over="ignore"):
+            out = np.expm1(safe) / safe
+        return np.where(small, 1.0 + x / 2 + x * x / 6, out)
+    z = z.astype(np.complex128)
+    small = np.abs(z) < _SERIES
+    safe = np.where(small, 1.0, z)
+    x, y = safe.real, safe.imag
+    with np.errstate(over="ignore", invalid="ignore"):
+        num = (np.expm1(x) * np.cos(y) - 2.0 * np.sin(y / 2) ** 2) + 1j * (np.exp(x) * np.sin(y))
+        out = num / safe
+    return np.where(small, 1.0 + z / 2 + z * z / 6, out)
+
+
+def _terms(a: Any, b: Any, C: Any, D: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """mu (K,) and the complex coefficients G = C - i D, (K,) or (K, n, n), checked."""
+    a = np.atleast_1d(np.asarray(a, dtype=np.float64))
+    b = np.atleast_1d(np.asarray(b, dtype=np.float64))
+    C = np.asarray(C, dtype=np.float64)
+    if a.ndim != 1 or b.shape != a.shape or C.shape[:1] != a.shape or C.ndim not in (1, 3):
+        raise ValueError(f"a {a.shape}, b {b.shape}, C {C.shape}: expected (K,), (K,), (K,) or (K, n, n)")
+    if C.ndim == 3 and C.shape[1] != C.shape[2]:
+        raise ValueError(f"C has shape {C.shape}: the matrices must be square")
+    G = C.astype(np.complex128)
+    if D is not None:
+        D = np.asarray(D, dtype=np.float64)
+        if D.shape != C.shape:
+            raise ValueError(f"D has shape {D.shape}, C {C.shape}: expected the same")
+        G = G - 1j * D
+    return a + 1j * b, G, C
+
+
+def _combine(weights: np.ndarray, G: np.ndarray) -> np.ndarray:
+    """sum_k Re[weights[..., k] G_k]: shape weights.shape[:-1] (+ (n, n))."""
+    out = np.tensordot(weights, G, axes=([-1], [0]))
+    return out.real
+
+
+def evaluate(s: Any, a: Any, b: Any, C: Any, D: Any = None) -> np.ndarray:
+    """``H(s)`` at the points ``s`` (any shape): shape ``s.shape`` (+ (n, n))."""
+    mu, G, _ = _terms(a, b, C, D)
+    s = np.asarray(s, dtype=np.float64)
+    with np.errstate(over="ignore", invalid="ignore"):
+        e = np.exp(np.multiply.outer(s, mu))
+    return _combine(e, G)
+
+
+def laplace(lam: Any, a: Any, b: Any, C: Any, D: Any = None, tau: float = np.inf) -> np.ndarray:
+    """``Hhat(lambda) = int_0^tau H(s) e^{-lambda s} ds`` in closed form, at the (complex) points ``lam``.
+
+    Each term ``Re[G e^{mu s}]`` (``G = C - i D``) is ``(G e^{mu s} + conj(G) e^{conj(mu) s}) / 2``, and
+    ``int_0^tau e^{(mu - lambda) s} ds = tau phi1((mu - lambda) tau)``.  With ``tau = inf`` (the default)
+    this is the Laplace transform ``1 / (lambda - mu)`` per exponential, valid for ``Re lambda > max a``
+    (elsewhere the integral diverges and the result is inf or nan).  Returns complex values of shape
+    ``lam.shape`` (+ (n, n) for a matrix kernel).
+    """
+    mu, G, _ = _terms(a, b, C, D)
+    lam = np.asarray(lam, dtype=np.complex128)
+    tau = float(tau)
+    if not tau > 0:
+        raise ValueError(f"tau = {tau}: expected > 0 (or inf)")
+    out = 0
+    for m, g in ((mu, G), (mu.conj(), G.conj())):
+        z = np.subtract.outer(-lam, -m)  # mu - lambda, shape lam.shape + (K,)
+        if np.isinf(tau):
+            with np.errstate(divide="ignore", invalid="ignore"):
+                w = np.where(z.real < 0, -1.0 / z, np.inf)
+        else:
+            w = tau * phi1(z * tau)
+        out = out + 0.5 * np.tensordot(w, g, axes=([-1], [0]))
+    return out
+
+
+#: The name the characteristic-root code uses for :func:`laplace`.
+Hhat = laplace
+
+
+def cell_weights(a: Any, b: Any, C: Any, D: Any = None, *, h: float, N: int,
+                 theta: float = 1.0) -> np.ndarray:
+    """The exact integrals ``int H`` over the N cells ``[l h, (l + 1) h)``, ``l < N - 1``, and the last cell
+    ``[(N - 1) h, (N - 1 + theta) h]`` (``0 < theta <= 1``): shape (N,) (+ (n, n)).
+
+    Per term ``mu = a + i b`` the cell integral of ``e^{mu s}`` is ``h e^{mu l h} phi1(mu h)`` (the
+    constant kernel, ``mu = 0``, gives ``h``), the partial last cell ``theta h e^{mu (N-1) h}
+    phi1(mu theta h)``; the complex factor mixes ``C`` and ``D``: the weight is ``Re[(C - i D) ...]``.
+    """
+    mu, G, _ = _terms(a, b, C, D)
+    if not (h > 0 and np.isfinite(h)):
+        raise ValueError(f"h = {h}: expected a finite h > 0")
+    if int(N) != N or N < 1:
+        raise ValueError(f"N = {N}: expected an integer >= 1")
+    if not 0 < theta <= 1:
+        raise ValueError(f"theta = {theta}: expected 0 < theta <= 1")
+    N = int(N)
+    l = np.arange(N, dtype=np.float64)
+    with np.errstate(over="ignore", invalid="ignore"):
+        w = np.exp(np.multiply.outer(l * h, mu)) * (h * phi1(mu * h))
+        w[-1] = np.exp(mu * ((N - 1) * h)) * (theta * h * phi1(mu * (theta * h)))
+    return _combine(w, G)
