@@ -227,7 +227,8 @@ class Solver:
         D_a = None if D is None else _array(D, (K, n, n), "D")
         with self._using() as s:
             self._check(_L.dmi_set_kernel_exp(s, K, _ptr(a_a), _ptr(b_a), _ptr(C_a), _ptr(D_a)))
-        self._keep["kernel"] = cb.Bound(None, None, ())
+        # no callback; the terms kept for dmi.analysis (the equation's characteristic matrix)
+        self._keep["kernel"] = cb.Bound(None, None, (a_a, b_a, C_a, D_a))
 
     def set_history(self, z: Callback | None, user: Any = None) -> None:
         """History: ``z(t) -> array (n)`` for -tau <= t <= 0, or a C function

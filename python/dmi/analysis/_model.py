@@ -18,6 +18,7 @@ method: the *tangent solver*, a second solver from ``make`` whose rhs and resolv
 from __future__ import annotations
 
 import ctypes
+import math
 from collections.abc import Callable
 from typing import Any
 
@@ -25,11 +26,14 @@ import numpy as np
 
 from .. import _lib
 from .._solver import Solver
+from .._transform import laplace
 
 #: Relative step of the central differences of f and of a user resolvent: about eps^(1/3).
 FD_STEP = 2.0 ** -17
 #: A built-in resolvent's argument closer than this (relative) to a kink is reported as on it.
 KINK_TOL = 1e-9
+#: Gauss-Legendre nodes per panel of a callback kernel's quadrature (:func:`kernel_panels`).
+PANEL_NODES = 16
 
 
 class KinkError(ValueError):
@@ -91,6 +95,20 @@ def _call(fn_type: Any, bound: Any, solver: Solver, first: float, x: np.ndarray,
     return out
 
 
+def _call_kernel(bound: Any, solver: Solver, s: float) -> np.ndarray:
+    """The model's C-level kernel callback (libdmi's signature) at s: H(s) (n, n)."""
+    n = solver.n
+    out = np.zeros(n * n)
+    rc = _lib.KernelFn(bound.address)(s, out.ctypes.data, bound.user)
+    failure, solver._failure[0] = solver._failure[0], None
+    if failure is not None:
+        failure.add_note(f"dmi.analysis: raised by the model's kernel at s = {s!r}")
+        raise failure
+    if rc != 0 or not np.all(np.isfinite(out)):
+        raise ValueError(f"dmi.analysis: the model's kernel returned {rc} at s = {s!r}: {out!r}")
+    return out.reshape(n, n)
+
+
 def _central(g: Callable[[np.ndarray], np.ndarray], x: np.ndarray, scale: float,
              kink: str | None) -> np.ndarray:
     """Jacobian of g at x by central differences, step FD_STEP max(|x_j|, scale); with kink (a
@@ -147,15 +165,84 @@ def _resolvent_derivative(s: Solver, X: np.ndarray, h: float, scale: float) -> n
                     "resolvent")
 
 
+def resolvent_of(s: Solver) -> Callable[[np.ndarray], np.ndarray]:
+    """The model's resolvent (I + h A)^-1 as a function of X: the built-in friction (a soft
+    threshold by h alpha) or box (a clip), a callback, or the identity."""
+    h = s.h
+    kind = getattr(s, "_resolvent", ())
+    if kind and kind[0] == "friction":
+        lam = h * kind[1]
+        return lambda X: np.sign(X) * np.maximum(np.abs(X) - lam, 0.0)
+    if kind and kind[0] == "box":
+        lo, hi = kind[1], kind[2]
+        return lambda X: np.clip(X, lo, hi)
+    bound = s._keep.get("resolvent")
+    if bound is None or bound.address is None:
+        return lambda X: X
+    return lambda X: _call(_lib.ResolventFn, bound, s, h, X, "resolvent")
+
+
+def rhs_of(s: Solver, t: float = 0.0) -> Callable[[np.ndarray], np.ndarray]:
+    """The model's f(t, u) as a function of u (0 without a right-hand side)."""
+    bound = s._keep.get("rhs")
+    if bound is None or bound.address is None:
+        return lambda u: np.zeros(s.n)
+    return lambda u: _call(_lib.RhsFn, bound, s, t, u, "rhs")
+
+
+def kernel_of(s: Solver) -> tuple[tuple | None, Callable[[float], np.ndarray] | None]:
+    """The model's kernel: (the exponential-sum terms (a, b, C, D) of ``set_kernel_exp``, None)
+    or (None, H(s) -> (n, n) of a callback), (None, None) without a kernel."""
+    kernel = s._keep.get("kernel")
+    if kernel is None:
+        return None, None
+    if kernel.address is None:
+        return (kernel.keep or None), None
+    return None, (lambda x: _call_kernel(kernel, s, x))
+
+
+def kernel_panels(call: Callable[[float], np.ndarray], tau: float, reach: float
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes s, weights w and kernel samples H(s) (k, n, n) on panels of [0, tau]
+    of width at most min(tau / 8, 1 / reach), PANEL_NODES nodes each."""
+    panels = max(8, math.ceil(tau * reach))
+    x, wx = np.polynomial.legendre.leggauss(PANEL_NODES)
+    edges = np.linspace(0.0, tau, panels + 1)
+    half = 0.5 * np.diff(edges)
+    s = (edges[:-1, None] + half[:, None] * (x[None, :] + 1)).ravel()
+    w = (half[:, None] * wx[None, :]).ravel()
+    H = np.array([call(float(si)) for si in s])
+    return s, w, H
+
+
+def kernel_integral(s: Solver) -> np.ndarray:
+    """int_0^tau H(s) ds (n x n) of the model's kernel: Hhat(0) in closed form for an
+    exponential sum, by the panels' quadrature for a callback, 0 without a kernel."""
+    terms, kernel = kernel_of(s)
+    if terms is not None:
+        return np.real(laplace(0.0, *terms, tau=s.tau))
+    if kernel is not None:
+        _, w, H = kernel_panels(kernel, s.tau, 1.0)
+        return np.tensordot(w, H, axes=(0, 0))
+    return np.zeros((s.n, s.n))
+
+
+def equation_step(s: Solver) -> Callable[[np.ndarray], np.ndarray]:
+    """G(u) = R(u - h f(0, u) - h K u) - u with the continuous integral K = int_0^tau H: zero at
+    the equation's equilibria (the scheme's has h sum_l H(l h) for K)."""
+    h, f, R, K = s.h, rhs_of(s), resolvent_of(s), kernel_integral(s)
+    return lambda u: R(u - h * f(u) - h * (K @ u)) - u
+
+
 class Linearisation:
     """The step map of the model's solver linearised at the constant history u_eq, and the
     tangent solver that applies it (:meth:`apply`).  Use as a context manager (frees both)."""
 
     def __init__(self, factory: Callable[[], Solver], u_eq: Any, args: tuple = (),
-                 tol: float = 1e-9):
+                 tol: float = 1e-9, of: str = "scheme"):
         s = factory()
         try:
-            self._linearise(s, u_eq, args, tol)
+            self._linearise(s, u_eq, args, tol, of)
         finally:
             s.close()
         t = factory()
@@ -169,21 +256,32 @@ class Linearisation:
             raise
         self.tangent = t
         self._window = np.zeros((self.N + 1, self.n))
+        # what the equation's characteristic matrix needs (dmi.analysis.equation)
+        self.resolvent_kind = s._resolvent[0] if s._resolvent else ""
+        self.kernel_terms, self.kernel = kernel_of(t)
 
-    def _linearise(self, s: Solver, u_eq: Any, args: tuple, tol: float) -> None:
+    def _linearise(self, s: Solver, u_eq: Any, args: tuple, tol: float, of: str) -> None:
+        """J, D and the equilibrium's check: one step of the scheme from the constant history
+        u_eq, or (``of="equation"``) of the equation's step with the continuous integral."""
         n, N = s.n, s.N
         u = equilibrium(u_eq, n, args)
-        s.init()
         h = s.h
-        s.set_window(np.tile(u, (N + 1, 1)))
-        t0 = s.time
-        s.step()
-        _, X = s.step_terms()
-        moved = s.state - u
+        t0 = 0.0
+        if of == "equation":
+            X = u - h * rhs_of(s)(u) - h * (kernel_integral(s) @ u)
+            moved = resolvent_of(s)(X) - u
+        else:
+            s.init()
+            s.set_window(np.tile(u, (N + 1, 1)))
+            t0 = s.time
+            s.step()
+            _, X = s.step_terms()
+            moved = s.state - u
         scale = max(1.0, np.max(np.abs(u)), np.max(np.abs(u - X)))
         res = np.max(np.abs(moved))
         if not res <= tol * scale:
-            raise ValueError(f"dmi.analysis: u_eq = {u!r} is not an equilibrium of the step map "
+            raise ValueError(f"dmi.analysis: u_eq = {u!r} is not an equilibrium of the "
+                             f"{'equation' if of == 'equation' else 'step map'} "
                              f"at {args!r}: one step moves it by {moved!r} (max {res:.3g}, "
                              f"{res / scale:.3g} relative to max(1, |u_eq|, |u_eq - X*|) = "
                              f"{scale:.3g}; tolerance {tol:g}): correct it with "

@@ -17,7 +17,7 @@ import scipy.optimize
 
 from .._solver import Solver
 from ._model import Linearisation, call_make
-from .stability import rightmost
+from .stability import check_of, rightmost_of
 
 #: Relative tolerance (of the range of p) of a traced point's p.
 TRACE_TOL = 1e-9
@@ -56,37 +56,37 @@ class StabilityChart:
 
 
 def _root_at(make2: Callable[[float, float], Solver], p: float, q: float, u_eq: Any, count: int,
-             tol: float) -> np.ndarray:
-    with Linearisation(lambda: call_make(make2, p, q), u_eq, (p, q), tol) as lin:
-        return rightmost(lin, count)
+             tol: float, of: str = "scheme") -> np.ndarray:
+    with Linearisation(lambda: call_make(make2, p, q), u_eq, (p, q), tol, of) as lin:
+        return rightmost_of(lin, count, of)
 
 
 def _row(make2: Callable, p_values: np.ndarray, q: float, u_eq: Any, count: int,
-         tol: float) -> np.ndarray:
+         tol: float, of: str = "scheme") -> np.ndarray:
     """The rightmost root at every p of one row q (a task of the pool or of Dask)."""
-    return np.array([_root_at(make2, p, q, u_eq, count, tol)[0] for p in p_values])
+    return np.array([_root_at(make2, p, q, u_eq, count, tol, of)[0] for p in p_values])
 
 
 def _tracked(make2: Callable, p: float, q: float, u_eq: Any, count: int, tol: float,
-             ref: complex) -> complex:
+             ref: complex, of: str = "scheme") -> complex:
     """The root nearest ref (Im >= 0) among the count rightmost at (p, q)."""
-    lam = _root_at(make2, p, q, u_eq, count, tol)
+    lam = _root_at(make2, p, q, u_eq, count, tol, of)
     lam = lam[np.isfinite(lam.real)]
     lam = np.where(lam.imag < 0, lam.conj(), lam)
     return complex(lam[np.argmin(np.abs(lam - ref))])
 
 
 def _trace(make2: Callable, p_values: np.ndarray, q_values: np.ndarray, u_eq: Any, count: int,
-           tol: float, j0: int, p_a: float, p_b: float) -> HopfCurve:
+           tol: float, j0: int, p_a: float, p_b: float, of: str = "scheme") -> HopfCurve:
     """The curve through the crossing of the rightmost root between p_a and p_b on row j0,
     continued over the rows q_values (both ways): on each row, the p where the tracked root has
     Re = 0, by the secant method from the secant prediction of the two rows before (a task)."""
     q0 = float(q_values[j0])
     span = float(np.ptp(p_values)) or 1.0
     lo, hi = float(np.min(p_values)), float(np.max(p_values))
-    g = lambda p: float(_root_at(make2, p, q0, u_eq, count, tol)[0].real)  # noqa: E731
+    g = lambda p: float(_root_at(make2, p, q0, u_eq, count, tol, of)[0].real)  # noqa: E731
     p0 = scipy.optimize.brentq(g, p_a, p_b, xtol=TRACE_TOL * span)
-    lam0 = _root_at(make2, p0, q0, u_eq, count, tol)[0]
+    lam0 = _root_at(make2, p0, q0, u_eq, count, tol, of)[0]
     lam0 = complex(lam0.real, abs(lam0.imag))
     points = {j0: (p0, lam0)}
     for direction in (1, -1):
@@ -100,7 +100,7 @@ def _trace(make2: Callable, p_values: np.ndarray, q_values: np.ndarray, u_eq: An
             else:
                 pred_p, pred_l = path[-1]
             try:
-                found = _secant(lambda p: _tracked(make2, p, q, u_eq, count, tol, pred_l), pred_p,
+                found = _secant(lambda p: _tracked(make2, p, q, u_eq, count, tol, pred_l, of), pred_p,
                                 1e-3 * span, TRACE_TOL * span)
             except (RuntimeError, ValueError):   # e.g. a kink or no equilibrium off the grid
                 found = None
@@ -184,7 +184,7 @@ def _run_all(executor: Any, tasks: list[Callable[[], Any]]) -> list[Any]:
 def stability_chart(make2: Callable[[float, float], Solver], p_values: Sequence[float],
                     q_values: Sequence[float], u_eq: Any, *, count: int = 4,
                     workers: int | None = None, client: Any = None, trace: bool = True,
-                    tol: float = 1e-9) -> StabilityChart:
+                    tol: float = 1e-9, of: str = "scheme") -> StabilityChart:
     """The stability chart of the two-parameter model ``make2(p, q) -> dmi.Solver`` (configured, not
     initialised) at the constant history ``u_eq`` (an array (n,), or a function ``u_eq(p, q)``).
 
@@ -196,7 +196,10 @@ def stability_chart(make2: Callable[[float, float], Solver], p_values: Sequence[
     the grid (one task per chain).  ``make2`` and ``u_eq`` travel to other processes by pickle: a
     module-level function or a ``functools.partial`` of one, not a lambda or a closure.
     The pool this function starts is shut down before it returns, also on an error.
+    ``of``: ``"scheme"`` (the default: the roots that match simulation) or ``"equation"`` (each
+    root refined to the continuous equation's, :func:`roots`).
     """
+    of = check_of(of)
     P = np.array(p_values, dtype=float, ndmin=1)
     Q = np.array(q_values, dtype=float, ndmin=1)
     if P.ndim != 1 or Q.ndim != 1 or len(P) < 2 or len(Q) < 1:
@@ -217,13 +220,13 @@ def stability_chart(make2: Callable[[float, float], Solver], p_values: Sequence[
         pool = ProcessPoolExecutor(max_workers=max(1, min(n, len(Q))))
     try:
         ex = client if client is not None else pool
-        lam = np.array(_run_all(ex, [functools.partial(_row, make2, P, q, u_eq, args[2], args[3])
-                                     for q in Q]))
+        lam = np.array(_run_all(ex, [functools.partial(_row, make2, P, q, u_eq, args[2], args[3],
+                                                       of) for q in Q]))
         chart = StabilityChart(P, Q, lam.real.copy(), lam.imag.copy())
         if trace:
             starts = _brackets(chart.re)
             curves = _run_all(ex, [functools.partial(_trace, make2, P, Q, u_eq, args[2], args[3],
-                                                     j, P[i], P[i + 1]) for j, i in starts])
+                                                     j, P[i], P[i + 1], of) for j, i in starts])
             span = float(np.ptp(P))
             for c in sorted(curves, key=lambda c: -len(c.p)):
                 if not any(_same_curve(k, c, span) for k in chart.curves):

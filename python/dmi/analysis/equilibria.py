@@ -28,10 +28,10 @@ from typing import Any
 import numpy as np
 import scipy.optimize
 
-from ._model import KinkError
+from ._model import KinkError, equation_step
 from .branch import Branch, Event
 from .newton import NO_PROGRESS, ShootingError, fmt_residuals, stalled
-from .stability import HopfPoint, roots
+from .stability import HopfPoint, check_of, roots
 from .stepmap import Model, build
 
 #: Roots computed at each point of a branch (the Hopf test function reads them).
@@ -43,7 +43,8 @@ class Equilibrium:
     """An equilibrium of the scheme: ``make``, ``p``, ``u`` (n,) (state units); ``roots``: the
     rightmost characteristic roots of :func:`dmi.analysis.roots` (rightmost first, 1 / time
     unit; empty at a kink of the resolvent); ``stable``: Re roots[0] < 0; ``residual``:
-    |G(u)|_inf (state units); ``iterations``: Newton's."""
+    |G(u)|_inf (state units); ``iterations``: Newton's; ``of``: ``"scheme"`` or ``"equation"``
+    (whose equilibrium and roots, see :func:`equilibrium`)."""
     make: Model = field(repr=False)
     p: float
     u: np.ndarray
@@ -51,6 +52,7 @@ class Equilibrium:
     stable: bool
     residual: float = 0.0
     iterations: int = 0
+    of: str = "scheme"
 
 
 @dataclass
@@ -71,15 +73,20 @@ class EquilibriumPoint:
 
 class _OneStep:
     """G(u) = one step from the constant history u, less u, of make(p) (one solver, restored to
-    step 0 before each evaluation)."""
+    step 0 before each evaluation); ``of="equation"``: the step with the continuous integral
+    (:func:`dmi.analysis.equation.equation_step`)."""
 
-    def __init__(self, make: Model, p: float):
+    def __init__(self, make: Model, p: float, of: str = "scheme"):
         self.solver = build(make, p)
-        self.solver.init()
-        self.start = self.solver.save_state()
         self.n, self.N = self.solver.n, self.solver.N
+        self.equation = equation_step(self.solver) if of == "equation" else None
+        if self.equation is None:
+            self.solver.init()
+            self.start = self.solver.save_state()
 
     def __call__(self, u: np.ndarray) -> np.ndarray:
+        if self.equation is not None:
+            return self.equation(u)
         s = self.solver
         s.load_state(self.start)
         s.set_window(np.tile(u, (self.N + 1, 1)))
@@ -90,14 +97,14 @@ class _OneStep:
 class _Steps:
     """_OneStep by p, the last few kept."""
 
-    def __init__(self, make: Model):
-        self.make = make
+    def __init__(self, make: Model, of: str = "scheme"):
+        self.make, self.of = make, of
         self._cache: dict[float, _OneStep] = {}
 
     def __call__(self, p: float) -> _OneStep:
         G = self._cache.get(p)
         if G is None:
-            G = _OneStep(self.make, p)
+            G = _OneStep(self.make, p, self.of)
             if len(self._cache) > 4:
                 self._cache.pop(next(iter(self._cache)))
             self._cache[p] = G
@@ -168,31 +175,37 @@ def _newton(steps: _Steps, y0: np.ndarray, tol: float, max_iter: int, what: str,
     raise ShootingError(f"{what}: {why} (residuals {fmt_residuals(res)})", res)
 
 
-def _roots(make: Model, p: float, u: np.ndarray, count: int, tol: float) -> np.ndarray:
+def _roots(make: Model, p: float, u: np.ndarray, count: int, tol: float, of: str
+           ) -> np.ndarray:
+    """The roots at an equilibrium (empty at a kink; none asked: empty)."""
+    if count < 1:
+        return np.empty(0, complex)
     try:
-        return roots(make, p, u, count, tol=max(tol * 1e3, 1e-9))
+        return roots(make, p, u, count, tol=max(tol * 1e3, 1e-9), of=of)
     except KinkError:
         return np.empty(0, complex)
 
 
 def equilibrium(make: Model, p: float, guess: Any, *, tol: float = 1e-10, count: int = ROOTS,
-                max_iter: int = 30) -> Equilibrium:
+                max_iter: int = 30, of: str = "scheme") -> Equilibrium:
     """The equilibrium of the scheme of ``make(p)`` near ``guess`` (n values, state units), by
     Newton on one step from a constant history, until |G(u)|_inf and the last correction are
     <= tol max(1, |u|_inf) (G is O(h) times the error: the correction bounds it); with its
     ``count`` rightmost roots (:func:`dmi.analysis.roots`).  The model's exception when make
     fails (a note names the call); ValueError for a guess of the wrong shape; ShootingError,
-    every residual listed, when Newton fails."""
-    steps = _Steps(make)
+    every residual listed, when Newton fails.  ``of="equation"``: the equilibrium of the
+    equation, with the continuous integral int_0^tau H instead of the scheme's sum h sum_l
+    H(l h) (O(h) apart), and the equation's roots (:func:`dmi.analysis.roots`)."""
+    steps = _Steps(make, check_of(of))
     n = steps(float(p)).n
     u0 = _check_guess(guess, n)
     y, res = _newton(steps, np.concatenate([u0, [float(p)]]), tol, max_iter,
                      f"equilibrium at p = {p!r}")
     u = y[:-1]
-    lam = _roots(make, float(p), u, count, tol)
+    lam = _roots(make, float(p), u, count, tol, of)
     return Equilibrium(make=make, p=float(p), u=u, roots=lam,
                        stable=bool(lam.size and lam[0].real < 0), residual=res[-1],
-                       iterations=len(res) - 1)
+                       iterations=len(res) - 1, of=of)
 
 
 def _tangent(J: np.ndarray, prev: np.ndarray) -> np.ndarray:
@@ -215,7 +228,9 @@ def continue_equilibrium(eq: Equilibrium, p_end: float, step: float = 0.05, *,
     """Continues the equilibrium ``eq`` (from :func:`equilibrium`) in p towards ``p_end`` by
     pseudo-arclength, first step ``step`` (p units; then arclengths in the Euclidean norm of
     (u, p); ``min_step`` default step / 1000, ``max_step`` default 4 step).  Each point gets its
-    ``count`` rightmost roots.  Returns a :class:`Branch` (``kind`` "equilibria") of
+    ``count`` rightmost roots; the branch is of the scheme's or the equation's equilibria as
+    ``eq`` is (``eq.of``), with their roots and events.  Returns a :class:`Branch` (``kind``
+    "equilibria") of
     :class:`EquilibriumPoint`, with ``fold`` and ``hopf`` events located on the branch (see the
     module).  A corrector failing at the smallest step ends the branch (``status``)."""
     if not isinstance(eq, Equilibrium):
@@ -227,8 +242,8 @@ def continue_equilibrium(eq: Equilibrium, p_end: float, step: float = 0.05, *,
     direction = 1.0 if p_end > eq.p else -1.0
     min_step = step / 1000 if min_step is None else min_step
     max_step = 4 * step if max_step is None else max_step
-    make = eq.make
-    steps = _Steps(make)
+    make, of = eq.make, eq.of
+    steps = _Steps(make, of)
     y = np.concatenate([eq.u, [eq.p]])
     m = y.size
     t = np.zeros(m)
@@ -236,7 +251,7 @@ def continue_equilibrium(eq: Equilibrium, p_end: float, step: float = 0.05, *,
     t = _tangent(steps.jacobian(y, steps.G(y)), t)
 
     def point(y: np.ndarray, t: np.ndarray) -> EquilibriumPoint:
-        lam = _roots(make, float(y[-1]), y[:-1], count, tol)
+        lam = _roots(make, float(y[-1]), y[:-1], count, tol, of)
         return EquilibriumPoint(p=float(y[-1]), u=y[:-1].copy(), roots=lam,
                                 stable=bool(lam.size and lam[0].real < 0), dpds=float(t[-1]))
 
@@ -277,7 +292,7 @@ def continue_equilibrium(eq: Equilibrium, p_end: float, step: float = 0.05, *,
         tn = _tangent(steps.jacobian(yn, steps.G(yn)), t)
         pts.append(point(yn, tn))
         events += _events(steps, make, ys[-1], ts[-1], pts[-2], yn, pts[-1], len(pts) - 1,
-                          count, tol, correct)
+                          count, tol, correct, of)
         y, t = yn, tn
         ys.append(y)
         ts.append(t)
@@ -287,7 +302,7 @@ def continue_equilibrium(eq: Equilibrium, p_end: float, step: float = 0.05, *,
 
 def _events(steps: _Steps, make: Model, ya: np.ndarray, ta: np.ndarray, a: EquilibriumPoint,
             yb: np.ndarray, b: EquilibriumPoint, index: int, count: int, tol: float,
-            correct: Any) -> list[Event]:
+            correct: Any, of: str) -> list[Event]:
     """The fold and Hopf events between a and b, each located by Brent's method on its test
     function in the arclength s along ta from ya (the equilibrium at s on the hyperplane
     <ta, y - ya> = s)."""
@@ -324,11 +339,11 @@ def _events(steps: _Steps, make: Model, ya: np.ndarray, ta: np.ndarray, a: Equil
     if math.isfinite(fa) and math.isfinite(fb) and fa * fb < 0:
         def re(s: float) -> float:
             y = at(s)
-            return _complex_re(_roots(make, float(y[-1]), y[:-1], count, tol))
+            return _complex_re(_roots(make, float(y[-1]), y[:-1], count, tol, of))
         s = locate(re, fa, fb)
         if s is not None:
             y = at(s)
-            lam = _roots(make, float(y[-1]), y[:-1], count, tol)
+            lam = _roots(make, float(y[-1]), y[:-1], count, tol, of)
             c = lam[np.abs(lam.imag) > 1e-8 * np.maximum(1.0, np.abs(lam))]
             root = c[np.argmax(c.real)]
             root = complex(root.real, abs(root.imag))

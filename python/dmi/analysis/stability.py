@@ -16,6 +16,7 @@ import scipy.sparse.linalg as sla
 
 from .._solver import Solver
 from ._model import Linearisation, call_make
+from .equation import equation_roots
 
 #: At most this many state dimensions n N: the one-step matrix is formed and its eigenvalues taken
 #: directly (Arnoldi needs a state larger than the roots asked for).
@@ -158,8 +159,22 @@ def rightmost(lin: Linearisation, count: int) -> np.ndarray:
     return lam[:count]
 
 
+def check_of(of: str) -> str:
+    """``of`` checked: ``"scheme"`` or ``"equation"``."""
+    if of not in ("scheme", "equation"):
+        raise ValueError(f"dmi.analysis: of = {of!r}: give 'scheme' (the roots that match "
+                         "simulation) or 'equation' (the continuous equation's)")
+    return of
+
+
+def rightmost_of(lin: Linearisation, count: int, of: str = "scheme") -> np.ndarray:
+    """The count rightmost roots of the scheme, or refined to the equation's (re-ordered)."""
+    lam = rightmost(lin, count)
+    return _order(equation_roots(lin, lam)) if of == "equation" else lam
+
+
 def roots(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 10, *,
-          tol: float = 1e-9) -> np.ndarray:
+          tol: float = 1e-9, of: str = "scheme") -> np.ndarray:
     """The ``count`` rightmost characteristic roots lambda (1 / time unit) of the scheme's step map
     linearised at the constant history ``u_eq``, rightmost first (of a pair, Im >= 0 first).
 
@@ -168,13 +183,19 @@ def roots(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 10,
     ``u_eq(p)``.  A root is lambda = log(z) / h for a multiplier z of the one-step map: Re lambda is
     the growth rate of the mode, Im lambda its angular frequency (radians / time unit), not reduced
     modulo 2 pi / tau.  A root -inf is a multiplier 0 (a component held by the resolvent).
+    ``of="equation"``: u_eq is the equation's equilibrium (the continuous integral,
+    :func:`dmi.analysis.equilibrium` with ``of="equation"``), and each root is refined to one of
+    the continuous equation, det Delta(lambda) = 0
+    (:mod:`dmi.analysis.equation`), to |dlambda| <= 1e-10 max(1, |lambda|); a root that cannot be
+    refined is nan, with a :class:`dmi.analysis.equation.RefinementWarning` saying why.
     Raises ValueError if u_eq is not a fixed point of the step map (relative residual above
     ``tol``), :class:`KinkError` (a ValueError) if the resolvent has a kink there.
     """
     if int(count) != count or count < 1:
         raise ValueError(f"dmi.analysis.roots: count = {count!r}: must be an integer >= 1")
-    with Linearisation(lambda: call_make(make, p), u_eq, (p,), tol) as lin:
-        return rightmost(lin, int(count))
+    check_of(of)
+    with Linearisation(lambda: call_make(make, p), u_eq, (p,), tol, of) as lin:
+        return rightmost_of(lin, int(count), of)
 
 
 @dataclass(frozen=True)
@@ -188,23 +209,26 @@ class HopfPoint:
 
 
 def rightmost_real(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 4,
-                   tol: float = 1e-9) -> float:
+                   tol: float = 1e-9, of: str = "scheme") -> float:
     """Re of the rightmost root at p (1 / time unit)."""
-    return float(roots(make, p, u_eq, count, tol=tol)[0].real)
+    return float(roots(make, p, u_eq, count, tol=tol, of=of)[0].real)
 
 
 def hopf(make: Callable[[float], Solver], p_lo: float, p_hi: float, u_eq: Any, *,
-         rtol: float = 1e-10, count: int = 4, tol: float = 1e-9) -> HopfPoint:
+         rtol: float = 1e-10, count: int = 4, tol: float = 1e-9, of: str = "scheme"
+         ) -> HopfPoint:
     """The parameter p in (p_lo, p_hi) where the rightmost root of :func:`roots` crosses the
     imaginary axis, to ``rtol`` relative (Brent's method on Re lambda_1(p)); ``tol``: the
-    equilibrium-residual tolerance of :func:`roots`.  Raises ValueError if p_lo = p_hi or Re
-    lambda_1 has the same sign at both ends (no crossing bracketed)."""
+    equilibrium-residual tolerance of :func:`roots`; ``of``: the scheme's roots (default) or the
+    equation's (see :func:`roots`).  Raises ValueError if p_lo = p_hi or Re lambda_1 has the same
+    sign at both ends (no crossing bracketed)."""
+    check_of(of)
     p_lo, p_hi = float(p_lo), float(p_hi)
     if not (math.isfinite(p_lo) and math.isfinite(p_hi)) or p_lo == p_hi:
         raise ValueError(f"dmi.analysis.hopf: [p_lo, p_hi] = [{p_lo!r}, {p_hi!r}] is not an "
                          "interval (two different finite values)")
-    g_lo = rightmost_real(make, p_lo, u_eq, count, tol)
-    g_hi = rightmost_real(make, p_hi, u_eq, count, tol)
+    g_lo = rightmost_real(make, p_lo, u_eq, count, tol, of)
+    g_hi = rightmost_real(make, p_hi, u_eq, count, tol, of)
     if g_lo == 0:
         p = p_lo
     elif g_hi == 0:
@@ -214,9 +238,10 @@ def hopf(make: Callable[[float], Solver], p_lo: float, p_hi: float, u_eq: Any, *
                          f"p = {p_lo!r} and {g_hi:.6g} at p = {p_hi!r} (same sign)")
     else:
         scale = max(abs(p_lo), abs(p_hi))
-        p = scipy.optimize.brentq(lambda x: rightmost_real(make, x, u_eq, count, tol), p_lo, p_hi,
+        p = scipy.optimize.brentq(lambda x: rightmost_real(make, x, u_eq, count, tol, of), p_lo,
+                                  p_hi,
                                   xtol=rtol * scale * 1e-2, rtol=max(rtol * 1e-2, 4.5e-16),
                                   maxiter=200)
-    lam = roots(make, p, u_eq, count, tol=tol)[0]
+    lam = roots(make, p, u_eq, count, tol=tol, of=of)[0]
     lam = complex(lam.real, abs(lam.imag))
     return HopfPoint(p=float(p), omega=abs(lam.imag), root=lam)
