@@ -6,7 +6,9 @@ Equilibria and their stability (docs/stability.md): :func:`equilibrium`,
 :func:`continue_equilibrium`, :func:`roots`, :func:`hopf`, :func:`stability_chart` and
 :func:`plot_stability_chart`.  Periodic orbits (docs/orbits.md): :func:`periodic_orbit`,
 :func:`hopf_orbit`, :func:`floquet_multipliers` (on a :class:`StepMap`), :func:`continue_orbit`,
-:func:`period_doubled_orbit` and :func:`plot_branch`.
+:func:`period_doubled_orbit`, :func:`refine_orbit` and :func:`plot_branch`.  The answers are the
+scheme's (they match simulation); ``of="equation"`` (:func:`roots`, :func:`hopf`,
+:func:`stability_chart`, :func:`equilibrium`) and :func:`refine_orbit` give the equation's.
 """
 from __future__ import annotations
 
@@ -20,6 +22,7 @@ from .floquet import floquet_multipliers
 from .newton import ShootingError
 from .orbit import Orbit
 from .orbit_plot import plot_branch
+from .refine import Refined, refine_orbit
 from .shooting import periodic_orbit
 from .stability import HopfPoint, hopf, roots
 from .stepmap import StepMap
@@ -32,4 +35,5 @@ __all__ = [
     # periodic orbits (docs/orbits.md): shooting, Floquet multipliers, continuation
     "periodic_orbit", "hopf_orbit", "Orbit", "ShootingError", "StepMap", "floquet_multipliers",
     "continue_orbit", "period_doubled_orbit", "Branch", "BranchPoint", "Event", "plot_branch",
+    "refine_orbit", "Refined",
 ]

@@ -60,7 +60,8 @@ from .branch import Branch, BranchPoint, Event
 from .floquet import fd_step, phase_free, ritz
 from .autonomous import AutonomousMaps, phase_row, velocity
 from .newton import ShootingError, bordered_newton, bordered_step, fd_eps
-from .orbit import Orbit, stuck_mask
+from .orbit import Orbit, make_orbit, stuck_mask
+from .refine import refine_orbit
 from .shooting import periodic_orbit
 from .stepmap import Model, StepMap, build, positive_time
 
@@ -129,6 +130,22 @@ def _point(F: StepMap, x: np.ndarray, multipliers: int, sections: int, dpds: flo
 VERTICAL = 1e-6
 
 
+def _complex(m: np.ndarray) -> np.ndarray:
+    """The non-real multipliers."""
+    return m[np.abs(m.imag) > 1e-8 * np.maximum(np.abs(m), 1)]
+
+
+def _test_function(kind: str, mu: np.ndarray) -> float:
+    """The test function of a multiplier event, zero at it: 1 + min Re mu for a period doubling
+    (the multiplier that crosses -1 may have been half of a complex pair at the previous point,
+    a pair that met on the negative axis), max |mu| - 1 over the non-real multipliers for a
+    torus (-1 if there is none)."""
+    if kind == "period-doubling":
+        return 1 + float(np.min(mu.real))
+    c = np.abs(_complex(mu))
+    return float(np.max(c)) - 1 if c.size else -1.0
+
+
 def _events(a: BranchPoint, b: BranchPoint, index: int, autonomous: bool = False
             ) -> list[Event]:
     """The events between a and b (see the module); an ``autonomous`` branch's phase multiplier
@@ -146,21 +163,15 @@ def _events(a: BranchPoint, b: BranchPoint, index: int, autonomous: bool = False
     def real_neg(m: np.ndarray) -> np.ndarray:
         return m[(np.abs(m.imag) <= 1e-8 * np.maximum(np.abs(m), 1)) & (m.real < 0)].real
 
-    def cplx(m: np.ndarray) -> np.ndarray:
-        return m[np.abs(m.imag) > 1e-8 * np.maximum(np.abs(m), 1)]
 
     na, nb = np.sum(real_neg(mua) < -1), np.sum(real_neg(mub) < -1)
     if na != nb:
-        # the test function 1 + min Re mu: the multiplier that crosses -1 may have been half
-        # of a complex pair at the previous point (a pair that met on the negative axis)
-        fa, fb = (1 + float(np.min(m.real)) for m in (mua, mub))
+        fa, fb = (_test_function("period-doubling", m) for m in (mua, mub))
         ev.append(Event("period-doubling", at(fa, fb), index, None,
                         f"real multipliers < -1: {na} -> {nb}"))
-    ca, cb = np.sum(np.abs(cplx(mua)) > 1), np.sum(np.abs(cplx(mub)) > 1)
+    ca, cb = np.sum(np.abs(_complex(mua)) > 1), np.sum(np.abs(_complex(mub)) > 1)
     if ca != cb:
-        ma, mb = np.abs(cplx(mua)), np.abs(cplx(mub))
-        fa = float(np.max(ma)) - 1 if ma.size else 0.0
-        fb = float(np.max(mb)) - 1 if mb.size else 0.0
+        fa, fb = (_test_function("torus", m) for m in (mua, mub))
         ev.append(Event("torus", at(fa, fb), index, None,
                         f"complex multipliers with |mu| > 1: {ca} -> {cb}"))
     for i in range(len(a.stick_steps)):
@@ -626,7 +637,8 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                    min_step: float | None = None, max_step: float | None = None,
                    multipliers: int = 6, tol: float = 1e-10, max_iter: int = 8,
                    sections: int = 1, margins: bool = True,
-                   period: Callable[[float], float] | None = None) -> Branch:
+                   period: Callable[[float], float] | None = None,
+                   refine: bool = False) -> Branch:
     """Continues ``orbit`` (from :func:`periodic_orbit` or :func:`hopf_orbit`) in p towards
     ``p_end`` (finite, not orbit.p) by pseudo-arclength with initial step ``step`` (the first
     point at p + step, p units; then arclengths in the norm sqrt(|dx|^2 / dim + dp^2), p and
@@ -645,7 +657,10 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     :func:`hopf_orbit`) has its period as an unknown: h = P / M with M = orbit.steps, N =
     ceil(tau / h) changing along the branch (the states hold room for h down to 60 % of the
     start's), and a phase condition through the previous point; its phase multiplier is left out
-    of ``stable`` and of the events; ``period`` must then be None.  Returns a
+    of ``stable`` and of the events; ``period`` must then be None.  ``refine``: the
+    period-doubling and torus events are placed from the refined multipliers of their two points
+    (:func:`dmi.analysis.refine_orbit`, 3 levels: the equation's, O(h^2)) instead of the
+    scheme's; the model must take the step, ``make(p, h=...)``.  Returns a
     :class:`Branch` (``kind`` "orbits" or "autonomous"); a corrector that fails at the smallest
     step ends the branch with that ``status``, it does not raise."""
     if not (math.isfinite(step) and step > 0):
@@ -786,8 +801,37 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
             events.append(e)
         easy = its <= (6 if how == "newton-picard" else 3)
         ds = min(max_step, ds * 1.5) if easy else ds
+    if refine:
+        for e in events:
+            if e.kind in ("period-doubling", "torus"):
+                _refined_event(maps, pts[e.index - 1], pts[e.index], e, multipliers, tol)
     return Branch(pts, events, status, orbit.make, orbit.steps, orbit.h, maps.rows, sections,
                   period, "autonomous" if auto else "orbits")
+
+
+def _refined_event(maps: _Maps, a: BranchPoint, b: BranchPoint, e: Event, multipliers: int,
+                   tol: float) -> None:
+    """e.p from the test function of the refined multipliers at a and b (linear in p through
+    them; up to a spacing of the points beyond them), the phase multiplier left out of an
+    autonomous branch's."""
+    f = []
+    for q in (a, b):
+        z = maps.z_of(q)
+        F = maps.of(z[-maps.k:])
+        o = make_orbit(F, q.state, [0.0], multipliers, maps.autonomous)
+        mu = refine_orbit(o, tol=tol).multipliers
+        f.append(_test_function(e.kind, phase_free(mu) if maps.autonomous else mu))
+    w = f[0] / (f[0] - f[1]) if f[0] != f[1] else math.nan
+    if 0 <= w <= 1:
+        e.p = a.p + (b.p - a.p) * w
+        e.detail += " (placed from refined multipliers)"
+    elif -1 <= w <= 2:   # the equation's event lies up to a point spacing beyond the scheme's
+        e.p = a.p + (b.p - a.p) * w
+        e.detail += (" (placed from refined multipliers, extrapolated beyond the points: the "
+                     "scheme's event is more than a step of the branch off the equation's)")
+    else:
+        e.detail += (" (the refined multipliers do not change sign near the points: placed "
+                     "from the scheme's)")
 
 
 def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[float, ...] =
