@@ -66,26 +66,29 @@ class Characteristic:
             s, w, H = kernel_panels(lin.kernel, lin.tau, max(1.0, float(reach)))
             self._panel = (s, w, H[:, free][:, :, free])
 
-    def hhat(self, lam: complex) -> np.ndarray:
-        """Hhat(lambda) on the free components (m x m, complex)."""
+    def hhat(self, lam: complex | np.ndarray) -> np.ndarray:
+        """Hhat(lambda) on the free components, (m, m) complex, or (k, m, m) for k values."""
+        lam = np.asarray(lam, dtype=complex)
         if self._terms is not None:
             a, b, C, D = self._terms
-            H = laplace(complex(lam), a, b, C, D, tau=self.tau)
-            return H[np.ix_(self.free, self.free)]
+            H = laplace(lam, a, b, C, D, tau=self.tau)
+            return H[..., self.free[:, None], self.free[None, :]]
         if self._panel is not None:
             s, w, H = self._panel
-            return np.tensordot(w * np.exp(-complex(lam) * s), H, axes=(0, 0))
-        return np.zeros((self.m, self.m), dtype=complex)
+            return np.tensordot(w * np.exp(-np.multiply.outer(lam, s)), H, axes=(-1, 0))
+        return np.zeros(lam.shape + (self.m, self.m), dtype=complex)
 
     def __call__(self, lam: complex) -> np.ndarray:
         """Delta(lambda) (m x m, complex)."""
         return complex(lam) * np.eye(self.m) + self.B + self.hhat(lam)
 
     def newton_step(self, lam: complex) -> complex:
-        """det Delta / (det Delta)' = 1 / tr(Delta^-1 Delta'(lambda))."""
+        """det Delta / (det Delta)' = 1 / tr(Delta^-1 Delta'(lambda)) (Hhat at lambda and
+        lambda +- d in one evaluation)."""
         d = 1e-6 * max(1.0, abs(lam))
-        dH = (self.hhat(lam + d) - self.hhat(lam - d)) / (2 * d)
-        Dl = self(lam)
+        H = self.hhat(np.array([lam, lam + d, lam - d]))
+        dH = (H[1] - H[2]) / (2 * d)
+        Dl = complex(lam) * np.eye(self.m) + self.B + H[0]
         tr = np.trace(np.linalg.solve(Dl, np.eye(self.m) + dH))
         return 1.0 / tr
 
