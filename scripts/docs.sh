@@ -50,17 +50,19 @@ if [[ -z $(find "$build/fmu" -name '*.fmu' 2>/dev/null | head -n 1) ]]; then
   cmake --build "$build" -j "$(nproc)" >/dev/null
 fi
 
+build_abs=$(cd "$build" && pwd)
 src="$build/docs/src"
 html="$build/docs/html"
 rm -rf "$src" "$html"
 mkdir -p "$src"
 cp -r docs/. "$src/"
-"$py" docs/gen/capi.py include/*.h >"$src/c-api.md"
 mapfile -t fmus < <(find "$build" -name '*.fmu' -not -path "$build/docs/*" -not -path '*/Testing/*' | sort)
 ((${#fmus[@]})) || { echo "docs: no FMU in $build" >&2; exit 1; }
 "$py" docs/gen/fmu_variables.py "$build" "${fmus[@]}" >"$src/fmu-variables.md"
 
-"$py" -m sphinx -W --keep-going -q -b html "$src" "$html"
+# the gallery's examples import dmi from the build and dmi_sweep from the checkout, and find the FMU
+DMI_SOURCE_DIR="$root" DMI_BUILD_DIR="$build_abs" PYTHONPATH="$build_abs/python:$root/python" MPLBACKEND=Agg \
+  OPENBLAS_NUM_THREADS=1 "$py" -m sphinx -W --keep-going -q -b html "$src" "$html"
 echo "docs: the site is in $html/index.html"
 
 if ((check)); then
