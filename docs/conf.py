@@ -108,4 +108,5 @@ sphinx_gallery_conf = {
     "show_memory": False,
     "show_signature": False,
     "min_reported_time": 0,
+    "write_computation_times": False,     # its pages load jQuery and DataTables from CDNs
 }
