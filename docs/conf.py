@@ -31,6 +31,8 @@ html_theme_options = {"page_width": "1100px", "body_max_width": "none"}
 html_show_sourcelink = False
 html_static_path = ["_static"]
 html_css_files = ["custom.css"]
+# an unknown TeX command is an error (MathJax marks it, tests/docs/browser_check.py finds it), not red text
+mathjax3_config = {"tex": {"packages": {"[-]": ["noundefined"]}}}
 
 # ---- the C API: hawkmoth ------------------------------------------------------------------------
 hawkmoth_root = str(SOURCE / "include")
