@@ -36,7 +36,6 @@ from urllib.parse import unquote, urlparse
 import websocket
 
 FAILURES: list[str] = []
-CHECKS = ("maths", "capi", "python", "offline")
 MATH_PAGES = ("mathematics.html", "paper.html", "stability.html", "orbits.html", "python.html")
 
 
@@ -120,6 +119,18 @@ class Browser:
             raise RuntimeError(f"{js[:60]}...: {r['exceptionDetails'].get('text')}: "
                                f"{r['exceptionDetails'].get('exception', {}).get('description')}")
         return r["result"].get("value")
+
+    def mouse(self, kind: str, x: float, y: float) -> None:
+        """A real mouse event at page coordinates (x, y) (CSS pixels of the viewport): "move" (a
+        hover), or "click" (press and release of the left button)."""
+        if kind == "move":
+            self.call("Input.dispatchMouseEvent", session=True, type="mouseMoved", x=x, y=y)
+        elif kind == "click":
+            for t in ("mousePressed", "mouseReleased"):
+                self.call("Input.dispatchMouseEvent", session=True, type=t, x=x, y=y,
+                          button="left", clickCount=1)
+        else:
+            raise ValueError(f"mouse event {kind!r}: 'move' or 'click'")
 
     def close(self) -> None:
         try:
@@ -233,28 +244,47 @@ def check_python(b: Browser, build: Path, html: Path) -> None:
     print(f"python: reference.html shows the {total} names of dmi.__all__ and dmi.analysis.__all__")
 
 
+def outside(events: list[dict], root: Path) -> list[str]:
+    """What a page's network log shows besides its own folder: the URLs it requested outside `root`
+    (not file:, or a file elsewhere; data:, blob: and about: URLs are inside anything) and the
+    requests that failed."""
+    bad = []
+    root = root.resolve()
+    for e in events:
+        if e["method"] == "Network.requestWillBeSent":
+            url = e["params"]["request"]["url"]
+            u = urlparse(url)
+            if u.scheme in ("data", "blob", "about"):
+                continue
+            if u.scheme != "file" or not Path(unquote(u.path)).resolve().is_relative_to(root):
+                bad.append(f"loads {url[:120]} from outside {root}")
+        elif e["method"] == "Network.loadingFailed":
+            bad.append(f"a request failed: {e['params'].get('errorText')}")
+    return bad
+
+
 def check_offline(b: Browser, html: Path) -> None:
     pages = sorted(html.rglob("*.html"))
-    root = html.resolve()
     requests = 0
     for page in pages:
         events = b.open(page.as_uri())
         if page.name in MATH_PAGES:        # let MathJax load its fonts and components
             b.eval(MATHS_JS)
             events += [e for e in b.events if e.get("method", "").startswith("Network.")]
-        rel = page.relative_to(html)
-        for e in events:
-            if e["method"] == "Network.requestWillBeSent":
-                url = e["params"]["request"]["url"]
-                requests += 1
-                u = urlparse(url)
-                if u.scheme in ("data", "blob", "about"):
-                    continue
-                if u.scheme != "file" or not Path(unquote(u.path)).resolve().is_relative_to(root):
-                    fail(f"{rel} loads {url[:120]} from outside the site")
-            elif e["method"] == "Network.loadingFailed":
-                fail(f"{rel}: a request failed: {e['params'].get('errorText')}")
+        requests += sum(e["method"] == "Network.requestWillBeSent" for e in events)
+        for msg in outside(events, html):
+            fail(f"{page.relative_to(html)} {msg}")
     print(f"offline: {len(pages)} pages made {requests} requests, all inside {html}")
+
+
+# The checks by name: each takes the browser, the source folder, the build folder and the site.
+# A new check is a function here and a name in tests/docs/CMakeLists.txt.
+CHECKS = {
+    "maths": lambda b, src, build, html: check_maths(b, html),
+    "capi": lambda b, src, build, html: check_capi(b, src, html),
+    "python": lambda b, src, build, html: check_python(b, build, html),
+    "offline": lambda b, src, build, html: check_offline(b, html),
+}
 
 
 def main(argv: list[str]) -> int:
@@ -269,8 +299,7 @@ def main(argv: list[str]) -> int:
     b = Browser()
     try:
         for check in argv[3:]:
-            {"maths": lambda: check_maths(b, html), "capi": lambda: check_capi(b, src, html),
-             "python": lambda: check_python(b, build, html), "offline": lambda: check_offline(b, html)}[check]()
+            CHECKS[check](b, src, build, html)
     finally:
         b.close()
     print(f"{len(FAILURES)} failures")
