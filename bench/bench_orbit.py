@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # The cost of dmi.analysis's periodic orbits (issue 30; a benchmark, not a test), in periods of
 # plain simulation measured in the same run: the tau-diagram's oscillator
-# (python/examples/orbit_tau.py: numba right-hand side, constant kernel by the O(1) recursion)
+# (examples/python/orbit_tau.py: numba right-hand side, constant kernel by the O(1) recursion)
 # at tau = 2.2 with h = 4 pi / M chosen so that N = ceil(tau / h) is about 1e3 and 1e4.  Per N:
 # one period (advance(M)), one Newton solve (periodic_orbit from the run's window, multipliers
 # off, from a run 10 periods from rest), the 10 leading multipliers, the start of a branch
@@ -29,7 +29,7 @@ import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "python" / "examples"))
+sys.path.insert(0, str(ROOT / "examples" / "python"))
 
 import orbit_tau  # noqa: E402
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # dmi.analysis's speed (issue 29; a benchmark, not a test).
 # 1. roots(count = 10) of the distributed-delay oscillator (n = 2,
-#    python/examples/stability_chart.py) at N = 1e3, 1e4, 1e5, with its kernel as one exponential
+#    examples/python/stability_chart.py) at N = 1e3, 1e4, 1e5, with its kernel as one exponential
 #    term (the O(1) recursion) and as a general callback (numba cfunc; the FFT), against simulating
 #    one delay tau (N steps, dmi_advance) of the same model in the same round: the ratio, the
 #    applications of the tangent map, and the growth with N.  The rhs is a numba cfunc (C speed in
@@ -29,7 +29,7 @@ from dmi import analysis
 from dmi.analysis import _model
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "python" / "examples"))
+sys.path.insert(0, str(ROOT / "examples" / "python"))
 from stability_chart import B, C, THETA, oscillator  # noqa: E402
 
 A_GAIN, TAU = 1.0, 2.0

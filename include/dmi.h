@@ -1,4 +1,4 @@
-/*
+/**
  * dmi.h — public API of libdmi, the implicit Euler scheme for differential
  * inclusions with a delay term of convolution type:
  *
@@ -36,6 +36,7 @@
  *   Distinct solvers may be used concurrently from distinct threads; one
  *   solver must not be used from two threads at once.
  */
+/**/
 #ifndef DMI_H
 #define DMI_H
 
@@ -46,68 +47,80 @@
 extern "C" {
 #endif
 
-/* Version of this header; dmi_version() gives the version of the library. */
+/** Major version of this header; dmi_version() gives the version of the library. */
 #define DMI_VERSION_MAJOR 1
+/** Minor version of this header. */
 #define DMI_VERSION_MINOR 2
+/** Patch version of this header. */
 #define DMI_VERSION_PATCH 0
 
-/* DMI_API marks the exported functions of the shared library. */
+/** DMI_API marks the exported functions of the shared library. */
 #if defined(DMI_BUILDING_SHARED) && (defined(__GNUC__) || defined(__clang__))
 #define DMI_API __attribute__((visibility("default")))
 #else
 #define DMI_API
 #endif
 
-/* Opaque solver handle. */
+/** Opaque solver handle. */
 typedef struct dmi_solver dmi_solver;
 
-/*
+/**
  * Callbacks.  Each returns 0 on success; any other value makes the calling
  * library function fail with DMI_ECALLBACK and leaves the solver unchanged.
  * The output array is set to zero before every call, so a callback may write
  * only the nonzero entries.  Non-finite outputs give DMI_ENONFINITE.
  */
 
-/* out = f(t, u): n values.  t = t_p in time units. */
+/** out = f(t, u): n values.  t = t_p in time units. */
 typedef int (*dmi_rhs_fn)(double t, const double *u, double *out, void *user);
 
-/* out = (I + lambda A)^{-1} x: n values; lambda = h > 0.  x and out never
+/** out = (I + lambda A)^{-1} x: n values; lambda = h > 0.  x and out never
  * alias.  Must be the resolvent of a maximal monotone A for the theory to
  * hold (the library cannot check that). */
 typedef int (*dmi_resolvent_fn)(double lambda, const double *x, double *out, void *user);
 
-/* out = H(s): n*n values, row-major, for 0 <= s < tau (s = l h, l = 0..N-1). */
+/** out = H(s): n*n values, row-major, for 0 <= s < tau (s = l h, l = 0..N-1). */
 typedef int (*dmi_kernel_fn)(double s, double *out, void *user);
 
-/* out = z(t): n values, for -tau <= t <= 0 (t = p h, p = -N..0). */
+/** out = z(t): n values, for -tau <= t <= 0 (t = p h, p = -N..0). */
 typedef int (*dmi_history_fn)(double t, double *out, void *user);
 
-/* Error codes. */
+/** Error codes. */
 enum {
+    /** Success. */
     DMI_OK = 0,
-    DMI_EINVAL = -1,     /* an argument is invalid (NULL, out of range, NaN) */
-    DMI_ENOMEM = -2,     /* memory could not be allocated (or its size overflows) */
-    DMI_ECALLBACK = -3,  /* a user callback returned nonzero */
-    DMI_ENONFINITE = -4, /* a NaN or infinity appeared (callback output or new state) */
-    DMI_ESTATE = -5      /* the call is not allowed in the solver's current state */
+    /** An argument is invalid (NULL, out of range, NaN). */
+    DMI_EINVAL = -1,
+    /** Memory could not be allocated (or its size overflows). */
+    DMI_ENOMEM = -2,
+    /** A user callback returned nonzero. */
+    DMI_ECALLBACK = -3,
+    /** A NaN or infinity appeared (callback output or new state). */
+    DMI_ENONFINITE = -4,
+    /** The call is not allowed in the solver's current state. */
+    DMI_ESTATE = -5
 };
 
-/* Methods of computing the delay sum W^p (see dmi_set_convolution). */
+/** Methods of computing the delay sum W^p (see dmi_set_convolution). */
 enum {
-    DMI_CONV_AUTO = 0,   /* the default: the fastest method for this n and N */
-    DMI_CONV_DIRECT = 1, /* the plain sum, N multiply-adds per nonzero kernel entry */
-    DMI_CONV_FFT = 2,    /* exact block convolution with FFTs (same sum, other rounding) */
-    DMI_CONV_RECURSIVE = 3 /* (since 1.1) O(1) recursion of an exponential-sum kernel */
+    /** The default: the fastest method for this n and N. */
+    DMI_CONV_AUTO = 0,
+    /** The plain sum, N multiply-adds per nonzero kernel entry. */
+    DMI_CONV_DIRECT = 1,
+    /** Exact block convolution with FFTs (same sum, other rounding). */
+    DMI_CONV_FFT = 2,
+    /** (Since 1.1.)  O(1) recursion of an exponential-sum kernel. */
+    DMI_CONV_RECURSIVE = 3
 };
 
-/* ---- version --------------------------------------------------------- */
+/** ---- version --------------------------------------------------------- */
 
-/* "MAJOR.MINOR.PATCH" of the library actually linked.  Static string. */
+/** "MAJOR.MINOR.PATCH" of the library actually linked.  Static string. */
 DMI_API const char *dmi_version(void);
 
-/* ---- life cycle ------------------------------------------------------ */
+/** ---- life cycle ------------------------------------------------------ */
 
-/*
+/**
  * Creates a solver for R^n with delay tau > 0 (time units) and N >= 1 steps
  * per tau, so h = tau / N.  Allocates the history ring of (N + 1) * n values.
  * Nothing else is set: f = 0, A = 0 (identity resolvent), H = 0, z = 0.
@@ -120,7 +133,7 @@ DMI_API const char *dmi_version(void);
  */
 DMI_API int dmi_create(dmi_solver **out, size_t n, double tau, size_t N);
 
-/*
+/**
  * (Since 1.2.)  Creates a solver for R^n with delay tau > 0 and step h > 0
  * (both in time units), where tau / h need not be an integer (a period or a
  * delay that moves freely while the step stays put).  The delay integral
@@ -157,11 +170,11 @@ DMI_API int dmi_create(dmi_solver **out, size_t n, double tau, size_t N);
  */
 DMI_API int dmi_create_h(dmi_solver **out, size_t n, double tau, double h);
 
-/* Frees *s and everything it owns and sets *s = NULL.  s == NULL and
+/** Frees *s and everything it owns and sets *s = NULL.  s == NULL and
  * *s == NULL are allowed and do nothing. */
 DMI_API void dmi_free(dmi_solver **s);
 
-/* ---- setup ------------------------------------------------------------
+/** ---- setup ------------------------------------------------------------
  * dmi_set_rhs, dmi_set_resolvent, dmi_set_friction, dmi_set_box and
  * dmi_set_convolution may be called at any time: they take effect from the
  * next step on and do not alter U^p or the history.  dmi_set_kernel and
@@ -170,14 +183,14 @@ DMI_API void dmi_free(dmi_solver **s);
  * All return DMI_EINVAL if s is NULL.
  */
 
-/* f: n -> n right-hand side; f = NULL restores f = 0. */
+/** f: n -> n right-hand side; f = NULL restores f = 0. */
 DMI_API int dmi_set_rhs(dmi_solver *s, dmi_rhs_fn f, void *user);
 
-/* A through its resolvent (I + lambda A)^{-1}; r = NULL restores A = 0.
+/** A through its resolvent (I + lambda A)^{-1}; r = NULL restores A = 0.
  * Replaces any earlier dmi_set_resolvent / dmi_set_friction / dmi_set_box. */
 DMI_API int dmi_set_resolvent(dmi_solver *s, dmi_resolvent_fn r, void *user);
 
-/* Built-in dry friction: A(u) = (alpha_1 sigma(u_1), ..., alpha_n sigma(u_n)),
+/** Built-in dry friction: A(u) = (alpha_1 sigma(u_1), ..., alpha_n sigma(u_n)),
  * sigma the sign graph (sigma(0) = [-1, 1]); the resolvent is the soft
  * threshold out_i = sign(x_i) max(|x_i| - lambda alpha_i, 0).  Copies the n
  * values of alpha, each finite and >= 0 (alpha_i = 0: no friction on u_i).
@@ -185,19 +198,19 @@ DMI_API int dmi_set_resolvent(dmi_solver *s, dmi_resolvent_fn r, void *user);
  * Replaces any earlier resolvent setting. */
 DMI_API int dmi_set_friction(dmi_solver *s, const double *alpha);
 
-/* Built-in normal cone of the box K = prod_i [lo_i, hi_i]: the resolvent is
+/** Built-in normal cone of the box K = prod_i [lo_i, hi_i]: the resolvent is
  * the projection onto K, out_i = min(max(x_i, lo_i), hi_i).  Copies n values
  * of each; lo_i = -INFINITY and hi_i = +INFINITY are allowed.  DMI_EINVAL if
  * lo or hi is NULL, a value is NaN, lo_i > hi_i, lo_i = +INFINITY or
  * hi_i = -INFINITY (K must be nonempty).  Replaces any earlier resolvent. */
 DMI_API int dmi_set_box(dmi_solver *s, const double *lo, const double *hi);
 
-/* Kernel H(s), n*n row-major; H = NULL restores H = 0 (no delay term).
+/** Kernel H(s), n*n row-major; H = NULL restores H = 0 (no delay term).
  * Sampled at s = l h, l = 0..N-1, once by dmi_init (l h < tau; for
  * dmi_create_h too).  DMI_ESTATE after init. */
 DMI_API int dmi_set_kernel(dmi_solver *s, dmi_kernel_fn H, void *user);
 
-/*
+/**
  * (Since 1.1.)  Kernel as a sum of K exponential terms,
  *
  *     H(s) = sum_{k<K} exp(a[k] s) * (C_k cos(b[k] s) + D_k sin(b[k] s)),
@@ -219,13 +232,13 @@ DMI_API int dmi_set_kernel(dmi_solver *s, dmi_kernel_fn H, void *user);
 DMI_API int dmi_set_kernel_exp(dmi_solver *s, size_t K, const double *a, const double *b,
                                const double *C, const double *D);
 
-/* History z(t) on [-tau, 0]; z = NULL restores z = 0.  Sampled at t = p h,
+/** History z(t) on [-tau, 0]; z = NULL restores z = 0.  Sampled at t = p h,
  * p = -(N-1)..0, and at t = -tau for U^{-N} (= -N h for dmi_create, not for
  * a partial last cell of dmi_create_h), once by dmi_init.  DMI_ESTATE after
  * init. */
 DMI_API int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user);
 
-/*
+/**
  * Method for the delay sum W^p: DMI_CONV_AUTO (default), DMI_CONV_DIRECT,
  * DMI_CONV_FFT or DMI_CONV_RECURSIVE.  All compute the same sum (the same
  * rectangle rule) and differ only by rounding (about 1e-16 relative on the
@@ -281,9 +294,9 @@ DMI_API int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user);
  */
 DMI_API int dmi_set_convolution(dmi_solver *s, int method);
 
-/* ---- time stepping ----------------------------------------------------- */
+/** ---- time stepping ----------------------------------------------------- */
 
-/*
+/**
  * Samples the kernel H(l h), l = 0..N-1, and the history U^p = z(p h),
  * p = -N..0, and sets p = 0.  May be called again to restart from t = 0.
  * Memory: the nonzero kernel entries take N doubles each (at most N n^2).
@@ -293,7 +306,7 @@ DMI_API int dmi_set_convolution(dmi_solver *s, int method);
  */
 DMI_API int dmi_init(dmi_solver *s);
 
-/*
+/**
  * One step t_p -> t_{p+1}: evaluates f(t_p, U^p), W^p, the resolvent's
  * argument X^p = U^p - h f(t_p, U^p) - h W^p and U^{p+1} = (I + hA)^{-1} X^p.
  * Errors: DMI_ESTATE before dmi_init; DMI_ECALLBACK if f or the resolvent
@@ -304,37 +317,37 @@ DMI_API int dmi_init(dmi_solver *s);
  */
 DMI_API int dmi_step(dmi_solver *s);
 
-/* steps calls of dmi_step.  Stops at the first failure and returns its code;
+/** steps calls of dmi_step.  Stops at the first failure and returns its code;
  * the steps done before it are kept (dmi_time tells where the solver is). */
 DMI_API int dmi_advance(dmi_solver *s, size_t steps);
 
-/* ---- queries ------------------------------------------------------------ */
+/** ---- queries ------------------------------------------------------------ */
 
-/* t_p = p * h (time units), computed from the integer step counter; 0 before
+/** t_p = p * h (time units), computed from the integer step counter; 0 before
  * init and for s == NULL. */
 DMI_API double dmi_time(const dmi_solver *s);
 
-/* *p = the step counter p (number of steps since dmi_init).  DMI_EINVAL for
+/** *p = the step counter p (number of steps since dmi_init).  DMI_EINVAL for
  * NULL arguments, DMI_ESTATE before dmi_init. */
 DMI_API int dmi_get_step_index(const dmi_solver *s, uint64_t *p);
 
-/* Step size h (time units): tau / N for dmi_create, the h given to
+/** Step size h (time units): tau / N for dmi_create, the h given to
  * dmi_create_h; 0 for s == NULL. */
 DMI_API double dmi_get_h(const dmi_solver *s);
 
-/* (Since 1.2.)  The number N of cells of the delay sum (steps per tau for
+/** (Since 1.2.)  The number N of cells of the delay sum (steps per tau for
  * dmi_create; ceil(tau / h) for dmi_create_h): the window and the ring have
  * N + 1 rows.  0 for s == NULL. */
 DMI_API size_t dmi_get_N(const dmi_solver *s);
 
-/* u[0..n-1] = U^p.  DMI_EINVAL for NULL, DMI_ESTATE before dmi_init. */
+/** u[0..n-1] = U^p.  DMI_EINVAL for NULL, DMI_ESTATE before dmi_init. */
 DMI_API int dmi_get_state(const dmi_solver *s, double *u);
 
-/* u[0..n-1] = U^{p-lag}, 0 <= lag <= N (history values z(t) for p - lag <= 0).
+/** u[0..n-1] = U^{p-lag}, 0 <= lag <= N (history values z(t) for p - lag <= 0).
  * DMI_EINVAL for NULL or lag > N, DMI_ESTATE before dmi_init. */
 DMI_API int dmi_get_past(const dmi_solver *s, size_t lag, double *u);
 
-/*
+/**
  * (Since 1.2.)  The window of stored states, the solution over the last delay
  * that the next steps read: U[(k * n) + j] = U_j^{p-N+k}, k = 0..N, oldest
  * first (row k = 0 is U^{p-N}, row N is U^p); (N + 1) * n doubles, written by
@@ -355,9 +368,10 @@ DMI_API int dmi_get_past(const dmi_solver *s, size_t lag, double *u);
  * DMI_ENOMEM (set).  On error the solver is unchanged.
  */
 DMI_API int dmi_get_window(const dmi_solver *s, double *U);
+/** (Since 1.2.)  Replaces the window of stored states by U: see dmi_get_window. */
 DMI_API int dmi_set_window(dmi_solver *s, const double *U);
 
-/*
+/**
  * Terms of the last step taken, from t_{p-1} to t_p: W[0..n-1] = W^{p-1} and
  * X[0..n-1] = X^{p-1}, the resolvent's argument, so that (X - U^p) / h is the
  * element of A(U^p) the step selected (the friction force, for friction).
@@ -366,7 +380,7 @@ DMI_API int dmi_set_window(dmi_solver *s, const double *U);
  */
 DMI_API int dmi_get_step_terms(const dmi_solver *s, double *W, double *X);
 
-/* ---- saving and restoring the time-stepping state -----------------------
+/** ---- saving and restoring the time-stepping state -----------------------
  * The state is the step counter, the N + 1 stored states U^{p-N..p}, the
  * last step's terms and, for a kernel set by dmi_set_kernel_exp, the
  * recursion's sums (so its size depends on that kernel; format version 2
@@ -386,14 +400,14 @@ DMI_API int dmi_get_step_terms(const dmi_solver *s, double *W, double *X);
  * is unchanged.
  */
 
-/* Number of bytes dmi_state_save writes; 0 for s == NULL. */
+/** Number of bytes dmi_state_save writes; 0 for s == NULL. */
 DMI_API size_t dmi_state_size(const dmi_solver *s);
 
-/* Writes the state into buf[0..size-1].  DMI_EINVAL for NULL or size smaller
+/** Writes the state into buf[0..size-1].  DMI_EINVAL for NULL or size smaller
  * than dmi_state_size(s); DMI_ESTATE before dmi_init. */
 DMI_API int dmi_state_save(const dmi_solver *s, void *buf, size_t size);
 
-/* Restores a state written by dmi_state_save; size must equal
+/** Restores a state written by dmi_state_save; size must equal
  * dmi_state_size(s) (for a state of format version 1, of libdmi 1.0: the
  * size that version had, dmi_state_size(s) less the recursion's part of 24
  * bytes and its sums; the error message says which size it expected).  Requires dmi_init to have run (the kernel samples come
@@ -404,13 +418,13 @@ DMI_API int dmi_state_save(const dmi_solver *s, void *buf, size_t size);
  * rounding only). */
 DMI_API int dmi_state_load(dmi_solver *s, const void *buf, size_t size);
 
-/* ---- errors -------------------------------------------------------------- */
+/** ---- errors -------------------------------------------------------------- */
 
-/* Message of the last failure on s ("" if none, a generic text if s is
+/** Message of the last failure on s ("" if none, a generic text if s is
  * NULL).  Owned by s, valid until the next call on s. */
 DMI_API const char *dmi_last_error(const dmi_solver *s);
 
-/* Static description of an error code ("unknown error code" otherwise). */
+/** Static description of an error code ("unknown error code" otherwise). */
 DMI_API const char *dmi_strerror(int code);
 
 #ifdef __cplusplus

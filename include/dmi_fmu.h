@@ -1,4 +1,4 @@
-/*
+/**
  * dmi_fmu.h: a dmi model as an FMI 2.0 and 3.0 co-simulation FMU.
  *
  * A model provides only what is its own: its variables (one table), a
@@ -32,6 +32,7 @@
  * it never prints, aborts or exits.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
+/**/
 #ifndef DMI_FMU_H
 #define DMI_FMU_H
 
@@ -44,11 +45,11 @@
 extern "C" {
 #endif
 
-/* The size of the message buffers (err, msg) the framework passes to a
+/** The size of the message buffers (err, msg) the framework passes to a
  * model's functions, with the NUL: longer messages are cut (use snprintf). */
 #define DMI_FMU_ERRLEN 256
 
-/*
+/**
  * One variable of the table, in the order of the value references 0, 1, ...
  * Write the table as an X-macro list and expand it with DMI_FMU_VARIABLE:
  *
@@ -84,15 +85,15 @@ struct dmi_fmu_variable {
     const char *unit, *description;
 };
 
-/* One table entry from an X-macro row (see dmi_fmu_variable).  An empty
+/** One table entry from an X-macro row (see dmi_fmu_variable).  An empty
  * start gives start_text "" (the value is then unused). */
 #define DMI_FMU_VARIABLE(name, type, causality, start, unit, description)                        \
     {#name, #type, #causality, #start, (start - 0.0), unit, description},
 
-/* The value reference VR_<name> of an X-macro row, for an enum. */
+/** The value reference VR_<name> of an X-macro row, for an enum. */
 #define DMI_FMU_VR(name, ...) VR_##name,
 
-/*
+/**
  * The values of an instance's variables that are set (parameters, inputs),
  * owned by the framework.  value[vr] holds variable vr, by value reference
  * (Int32 and Boolean as exact doubles; outputs: unspecified); value points
@@ -110,7 +111,7 @@ struct dmi_fmu_values {
     const double *value;
 };
 
-/*
+/**
  * The outputs' arguments at a communication point t (the FMU's time), in
  * step p (from t_{p-1} to t_p, t_{p-1} < t <= t_p; p = 0 before the first
  * step): t; h, the solver's step (tau / N, or the model's step); p; n, the solver's dimension; u = u_h(t), the
@@ -126,14 +127,14 @@ struct dmi_fmu_point {
     uint64_t p;
     size_t n;
     const double *u, *U, *W, *X;
-    /* The model's events (see dmi_fmu_indicators_fn) up to step p: nevents,
+    /** The model's events (see dmi_fmu_indicators_fn) up to step p: nevents,
      * the number of solver steps at which an indicator changed since the
      * start (or since ExitInitializationMode); event_p, the last such step
      * (0: none yet), whose time is t_start + event_p h. */
     uint64_t nevents, event_p;
 };
 
-/*
+/**
  * Configures the new solver s, created by the framework with dmi_create(s,
  * model n, tau, N) from the parameters (dmi_create_h(s, n, tau, h) for a
  * model with a step function): sets rhs, the maximal monotone part
@@ -147,7 +148,7 @@ struct dmi_fmu_point {
  */
 typedef int (*dmi_fmu_configure_fn)(const dmi_fmu_values *v, dmi_solver *s, char *err);
 
-/* Writes the outputs at pt into out[vr] for every output vr (Int32 and
+/** Writes the outputs at pt into out[vr] for every output vr (Int32 and
  * Boolean outputs as exact doubles); the other entries are not read.  Called
  * at the first get of an output after a step, a set or a restored state
  * (the values are kept until the next change); out has one entry per value
@@ -155,7 +156,7 @@ typedef int (*dmi_fmu_configure_fn)(const dmi_fmu_values *v, dmi_solver *s, char
 typedef void (*dmi_fmu_outputs_fn)(const dmi_fmu_values *v, const dmi_fmu_point *pt,
                                    double *out);
 
-/* Optional: accepts the value of parameter or input vr (before it is
+/** Optional: accepts the value of parameter or input vr (before it is
  * stored; v holds the values before the call): 0, or nonzero with the reason
  * in err (the set call is refused, nothing changes).  When an FMU state is
  * restored, v holds all of the state's values (vr's too) and each is checked
@@ -163,20 +164,20 @@ typedef void (*dmi_fmu_outputs_fn)(const dmi_fmu_values *v, const dmi_fmu_point 
  * refuses non-finite values, tau <= 0 and N < 1. */
 typedef int (*dmi_fmu_accept_fn)(const dmi_fmu_values *v, unsigned vr, double value, char *err);
 
-/* Optional: run at ExitInitializationMode, before the solver is created,
+/** Optional: run at ExitInitializationMode, before the solver is created,
  * for an experiment of length T (stop - start time, or the default
  * experiment's stop time).  0: fine; 1: a warning (msg, status Warning);
  * -1: refused (msg, status Error). */
 typedef int (*dmi_fmu_check_fn)(const dmi_fmu_values *v, double T, char *msg);
 
-/* Optional: the bytes the solver allocates while initialising (peak) and
+/** Optional: the bytes the solver allocates while initialising (peak) and
  * keeps (kept), for the memory messages (logMemory when peak > 100 MB, and
  * the out-of-memory error).  Without it the framework uses the figures of a
  * dense kernel (every entry of H sampled): 2 (N + 1) n doubles of history
  * and n^2 N samples kept, twice that while initialising. */
 typedef void (*dmi_fmu_bytes_fn)(const dmi_fmu_values *v, double *peak, double *kept);
 
-/*
+/**
  * Optional: the model's event indicators, the discrete states whose changes
  * are the model's events (a stick-slip transition, a contact).  Writes
  * state[k], k < nindicators (the model's field), for the step pt->p: any
@@ -195,7 +196,7 @@ typedef void (*dmi_fmu_bytes_fn)(const dmi_fmu_values *v, double *peak, double *
 typedef void (*dmi_fmu_indicators_fn)(const dmi_fmu_values *v, const dmi_fmu_point *pt,
                                       int *state);
 
-/* dmi_fmu_stuck(pt, i, alpha_i), a built-in indicator of dmi_set_friction's
+/** dmi_fmu_stuck(pt, i, alpha_i), a built-in indicator of dmi_set_friction's
  * component i with coefficient alpha_i (>= 0): 1 (stuck) when the resolvent's argument lies within
  * h alpha_i of zero, |X_i| <= h alpha_i (then U_i = 0), else 0 (slipping). */
 static inline int dmi_fmu_stuck(const dmi_fmu_point *pt, size_t i, double alpha_i)
@@ -204,7 +205,7 @@ static inline int dmi_fmu_stuck(const dmi_fmu_point *pt, size_t i, double alpha_
     return (x < 0 ? -x : x) <= pt->h * alpha_i;
 }
 
-/* dmi_fmu_contact(pt, i, lo_i, hi_i), a built-in indicator of dmi_set_box's
+/** dmi_fmu_contact(pt, i, lo_i, hi_i), a built-in indicator of dmi_set_box's
  * component i with faces lo_i <= hi_i: -1 in contact with the lower face (X_i <= lo_i, then U_i = lo_i), +1 with
  * the upper face (X_i >= hi_i, U_i = hi_i), 0 inside. */
 static inline int dmi_fmu_contact(const dmi_fmu_point *pt, size_t i, double lo_i, double hi_i)
@@ -213,7 +214,7 @@ static inline int dmi_fmu_contact(const dmi_fmu_point *pt, size_t i, double lo_i
     return x <= lo_i ? -1 : x >= hi_i ? 1 : 0;
 }
 
-/*
+/**
  * Optional (since libdmi 1.2): the step h of the solver from the parameters
  * (e.g. 2 pi / (omega steps) for a whole number of steps per forcing period),
  * in the units of the FMU's time; tau / h need not be an integer.  With it,
@@ -231,7 +232,7 @@ static inline int dmi_fmu_contact(const dmi_fmu_point *pt, size_t i, double lo_i
  */
 typedef double (*dmi_fmu_step_fn)(const dmi_fmu_values *v);
 
-/*
+/**
  * A model: what dmi_add_fmu builds an FMU of.  Fields: description (the
  * model descriptions', with " (libdmi <version>)" appended); variables and
  * nvariables (the table, value reference = index); n (the components of u);
@@ -262,16 +263,16 @@ struct dmi_fmu_model {
     const char *author;
     size_t nindicators;
     dmi_fmu_indicators_fn indicators;
-    /* (Since libdmi 1.2.)  Optional, NULL for none: see dmi_fmu_step_fn. */
+    /** (Since libdmi 1.2.)  Optional, NULL for none: see dmi_fmu_step_fn. */
     dmi_fmu_step_fn step;
 };
 
-/* The model of the FMU: define it once, in one of its C files:
+/** The model of the FMU: define it once, in one of its C files:
  *   const dmi_fmu_model DMI_FMU_MODEL = {...}; */
 #define DMI_FMU_MODEL dmi_fmu_model_definition
 extern const dmi_fmu_model DMI_FMU_MODEL;
 
-/* The number of entries of a table array. */
+/** The number of entries of a table array. */
 #define DMI_FMU_COUNT(table) (sizeof(table) / sizeof((table)[0]))
 
 #ifdef __cplusplus

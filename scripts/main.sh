@@ -6,7 +6,7 @@
 # (4.4), the oscillator with a Prony-series memory (exponential kernel terms,
 # the recursion against the FFT), a bifurcation diagram of the oscillator over the
 # delay tau (dmi-sweep) and its periodic orbits continued over it (dmi.analysis,
-# python/examples/orbit_tau.py), the stability chart of the distributed-delay
+# examples/python/orbit_tau.py), the stability chart of the distributed-delay
 # oscillator (dmi.analysis); prints the summary table.  Copies the figures
 # to docs/figures/.
 # Usage: scripts/main.sh
@@ -69,10 +69,10 @@ stage "dmi-sweep: bifurcation diagram of the oscillator over the delay tau (Poin
 DMI_BUILD_DIR="$build" scripts/sweep_ex43.sh "$out"
 
 stage "periodic orbits: the oscillator's branches over tau (dmi.analysis) over the sweep's diagram"
-OPENBLAS_NUM_THREADS=1 MPLBACKEND=Agg "$py" python/examples/orbit_tau.py "$out" --M 4000 | tee "$out/orbit_tau.txt"
+OPENBLAS_NUM_THREADS=1 MPLBACKEND=Agg "$py" examples/python/orbit_tau.py "$out" --M 4000 | tee "$out/orbit_tau.txt"
 
 stage "dmi.analysis: stability chart of the distributed-delay oscillator (100 x 100, N = 128)"
-PYTHONPATH="$build/python" MPLBACKEND=Agg "$py" python/examples/stability_chart.py "$out/stability_chart.png"
+PYTHONPATH="$build/python" MPLBACKEND=Agg "$py" examples/python/stability_chart.py "$out/stability_chart.png"
 
 stage "figures and comparison with the paper and ../shared/reference"
 refarg=()

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The main job's bifurcation diagram (scripts/main.sh runs it): dmi-sweep runs
-# the spec (default python/examples/oscillator_tau.toml: the oscillator over the delay
+# the spec (default examples/python/oscillator_tau.toml: the oscillator over the delay
 # tau, Poincare section of w) into OUT/sweep_ex43 and plots, over the
 # spec's first swept parameter, OUT/bifurcation_ex43.png and
 # OUT/stick_fraction_ex43.png; prints the points, N and T of the spec and the
@@ -17,7 +17,7 @@ if [[ $# -lt 1 || $# -gt 2 ]]; then
   exit 2
 fi
 out=$1
-spec=${2:-$root/python/examples/oscillator_tau.toml}
+spec=${2:-$root/examples/python/oscillator_tau.toml}
 build=${DMI_BUILD_DIR:-$root/build}
 fmu="$build/fmu/DelayFrictionOscillator.fmu"
 sweep=${DMI_SWEEP:-$root/.venv/bin/dmi-sweep}

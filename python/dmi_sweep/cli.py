@@ -22,7 +22,23 @@ EXIT = """exit status:
 
 
 def positive_int(text: str) -> int:
-    """argparse type: an integer >= 1 (the message names the bad text)."""
+    """argparse type: an integer >= 1.
+
+    Parameters
+    ----------
+    text : str
+        The command-line text.
+
+    Returns
+    -------
+    int
+        Its value.
+
+    Raises
+    ------
+    argparse.ArgumentTypeError
+        If it is not an integer >= 1 (the message names the text).
+    """
     try:
         n = int(text)
     except ValueError:
@@ -33,7 +49,23 @@ def positive_int(text: str) -> int:
 
 
 def positive_seconds(text: str) -> float:
-    """argparse type: a finite number of seconds > 0 (the message names the bad text)."""
+    """argparse type: a finite number of seconds > 0.
+
+    Parameters
+    ----------
+    text : str
+        The command-line text.
+
+    Returns
+    -------
+    float
+        Its value.
+
+    Raises
+    ------
+    argparse.ArgumentTypeError
+        If it is not a finite number > 0 (the message names the text).
+    """
     try:
         x = float(text)
     except ValueError:
@@ -44,6 +76,13 @@ def positive_seconds(text: str) -> float:
 
 
 def parser() -> argparse.ArgumentParser:
+    """The command line of ``dmi-sweep``: the subcommands ``run`` and ``plot`` with their options.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        A new parser.
+    """
     fmt = argparse.RawDescriptionHelpFormatter
     ap = argparse.ArgumentParser(prog="dmi-sweep", formatter_class=fmt, epilog=EXIT,
                                  description="Parameter sweeps of a co-simulation FMU on Dask, and "
@@ -112,7 +151,25 @@ def parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Runs the command line; returns the exit status."""
+    """Runs the command line.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments after the program name (default: ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        The exit status: 0 every point succeeded, 1 some points failed, 2 nothing was run (bad
+        input), 3 the cluster was lost (the finished points saved), 130 interrupted; :data:`EXIT`
+        (the epilog of ``dmi-sweep run --help``) says each in full.
+
+    Raises
+    ------
+    SystemExit
+        From argparse, for bad options, ``--help`` and ``--version``.
+    """
     a = parser().parse_args(argv)
     if a.command == "run":
         return _run(a)

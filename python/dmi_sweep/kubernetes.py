@@ -16,12 +16,36 @@ QUANTITY = re.compile(r"[0-9]+(\.[0-9]+)?(m|k|M|G|T|Ki|Mi|Gi|Ti)?")
 
 
 def cluster_spec(name: str, image: str, workers: int, memory: str = "2Gi", cpu: str = "1") -> dict[str, Any]:
-    """The DaskCluster resource (kubernetes.dask.org/v1) of `workers` worker pods of `cpu` CPU and
-    `memory` each (Kubernetes quantities; requests = limits), running `image` (which must hold
-    Python with fmpy, numpy and distributed at the client's versions). Workers: `dask worker
-    --nthreads 1`, their memory limit the pod's. Scheduler: worker-saturation 1.0 (a dying worker takes
-    no queued chunk with it), reached in the cluster at tcp://<name>-scheduler:8786. ValueError
-    for a bad name, count or quantity."""
+    """The DaskCluster resource (``kubernetes.dask.org/v1``) of a sweep's cluster.
+
+    Workers: ``dask worker --nthreads 1``, their memory limit the pod's. Scheduler:
+    worker-saturation 1.0 (a dying worker takes no queued chunk with it), reached in the cluster at
+    ``tcp://<name>-scheduler:8786``.
+
+    Parameters
+    ----------
+    name : str
+        The cluster's name: a Kubernetes name (lower-case letters, digits and '-', at most 42
+        characters).
+    image : str
+        The container image of the scheduler and workers; it must hold Python with fmpy, numpy and
+        distributed at the client's versions.
+    workers : int
+        The number of worker pods, >= 1.
+    memory, cpu : str
+        Each worker pod's memory and CPU, Kubernetes quantities (requests = limits), e.g. ``"2Gi"``,
+        ``"500m"``.
+
+    Returns
+    -------
+    dict
+        The resource, ready for ``kubectl apply`` (as JSON or YAML).
+
+    Raises
+    ------
+    ValueError
+        For a bad name, worker count or quantity.
+    """
     if not NAME.fullmatch(name):
         raise ValueError(f"name {name!r} is not a Kubernetes name (lower-case letters, digits and '-', "
                          "at most 42 characters)")

@@ -32,18 +32,36 @@ STATS = {"final": "{} at the stop time", "min": "minimum of {}", "max": "maximum
 
 
 class PlotError(ValueError):
-    """A column that is not there, a parameter left out, or no result folder."""
+    """A column that is not there, a parameter left out, or no result folder (a ``ValueError``)."""
 
 
 class Labels:
     """Axis labels: words and the symbol ("forcing amplitude g_amp", "stick fraction") for the
-    oscillator's columns, the column's name for another FMU's."""
+    oscillator's columns, the column's name for another FMU's.
+
+    Parameters
+    ----------
+    meta : dict
+        The sweep folder's ``_meta.json`` (``model_name``, ``output_types``); ``{}`` when it has none.
+    """
 
     def __init__(self, meta: dict):
         self.words = WORDS if meta.get("model_name") == OSCILLATOR else {}
         self.types = meta.get("output_types", {})
 
     def variable(self, name: str) -> str:
+        """The label of a variable.
+
+        Parameters
+        ----------
+        name : str
+            A parameter or output name.
+
+        Returns
+        -------
+        str
+            Its words and name for the oscillator's variables, else the name.
+        """
         return f"{self.words[name]} {name}" if name in self.words else name
 
     def __call__(self, column: str) -> str:
@@ -59,9 +77,40 @@ class Labels:
 
 def plot(directory: str | os.PathLike, x: str, y: str | None, metric: str | None,
          output: str | os.PathLike, hue: str | None = None):
-    """Writes the plot of the sweep in `directory` to `output` (PNG): against the parameter x, one
-    set per value of `hue`, or a heatmap over x and y. Every swept parameter must be x, y or hue, or
-    hold a single value among the successful points. Returns the (closed) matplotlib Figure."""
+    """Writes the plot of the sweep in `directory` to `output` (PNG).
+
+    Against the parameter `x`: one set of points per value of `hue`, or a heatmap over `x` and `y`.
+    Every swept parameter must be `x`, `y` or `hue`, or hold a single value among the successful
+    points.
+
+    Parameters
+    ----------
+    directory : str or os.PathLike
+        The sweep's folder (``dmi-sweep run --out``).
+    x : str
+        The parameter on the horizontal axis.
+    y : str or None
+        A second parameter: a heatmap of `metric` over `x` and `y`.
+    metric : str or None
+        The column to show (default: the first ``*_poincare`` column, or with `y` the first
+        ``*_mean`` column).
+    output : str or os.PathLike
+        The PNG to write.
+    hue : str, optional
+        A second parameter: one set of points (or line) per value of it; excludes `y`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure, already written and closed.
+
+    Raises
+    ------
+    PlotError
+        If `directory` is not a folder or holds no results, a name is not a column or not a swept
+        parameter, both `y` and `hue` are given, a swept parameter is left out, there is no metric
+        column or no successful point, or a heatmap is asked of a list column.
+    """
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

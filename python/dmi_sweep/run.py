@@ -56,7 +56,21 @@ class _Call:
 
 
 def task(fn, *args) -> bytes:
-    """The bytes of a task for pickle.loads (see _Call)."""
+    """The bytes of a task for ``pickle.loads``: the scheduler, which unpickles task graphs, sees
+    only bytes; the worker runs `fn`, sent by value (see ``_Call``).
+
+    Parameters
+    ----------
+    fn : callable
+        The function the worker runs.
+    *args
+        Its arguments.
+
+    Returns
+    -------
+    bytes
+        ``cloudpickle.dumps`` of the call.
+    """
     return cloudpickle.dumps(_Call(fn, *args))
 
 
@@ -65,8 +79,22 @@ class Progress:
 
     def __init__(self, total: int, done: int, stream: TextIO | None = sys.stderr, width: int = 30,
                  clock: Callable[[], float] = time.monotonic):
-        """total points, of which `done` were done before; a line at most every 0.2 s on a terminal,
-        every 5 s elsewhere (a log file), and at close()."""
+        """A bar at `done` of `total` points.
+
+        Parameters
+        ----------
+        total : int
+            The points of the sweep.
+        done : int
+            Those done before this run.
+        stream : TextIO or None, optional
+            Where the bar goes (None: nowhere). A line at most every 0.2 s on a terminal, every 5 s
+            elsewhere (a log file), and at :meth:`close`.
+        width : int, optional
+            The bar's width in characters.
+        clock : callable, optional
+            The time in seconds (``time.monotonic``).
+        """
         self.total, self.start_done, self.done = total, done, done
         self.stream, self.width, self.clock = stream, width, clock
         self.t0 = clock()
@@ -75,7 +103,15 @@ class Progress:
         self.tty = stream is not None and stream.isatty()
 
     def update(self, n: int, force: bool = False) -> None:
-        """n more points done."""
+        """Counts `n` more points done and shows the bar if it is time.
+
+        Parameters
+        ----------
+        n : int
+            Points done since the last call.
+        force : bool, optional
+            Show the line now.
+        """
         self.done += n
         now = self.clock()
         if self.stream is None or (not force and now - self.last < (0.2 if self.tty else 5.0)):
@@ -96,8 +132,16 @@ class Progress:
         self.stream.flush()
 
     def note(self, stream: TextIO | None, text: str) -> None:
-        """A line of its own (a lost worker, say) on `stream`; on the bar's terminal, the bar is
-        cleared first and shown again below at the next update."""
+        """Writes a line of its own (a lost worker, say); on the bar's terminal, the bar is cleared
+        first and shown again below at the next update.
+
+        Parameters
+        ----------
+        stream : TextIO or None
+            Where the line goes (None: nowhere).
+        text : str
+            The line.
+        """
         if stream is None:
             return
         clear = stream is self.stream and self.tty and self.shown >= 0
@@ -108,7 +152,7 @@ class Progress:
             self.shown = -1          # the bar's line is gone: close() shows it again
 
     def close(self) -> None:
-        """The last line, unless the line last shown has the same count."""
+        """Shows the last line, unless the line last shown has the same count."""
         if self.done != self.shown:
             self.update(0, force=True)
         if self.stream is not None and self.tty and self.shown >= 0:
@@ -117,8 +161,22 @@ class Progress:
 
 
 def chunks(todo: list[int], n_workers: int, chunk_size: int | None) -> list[list[int]]:
-    """Consecutive runs of the points to do, about 8 chunks per worker (at most 64 points each)
-    unless chunk_size is given."""
+    """Consecutive runs of the points to do.
+
+    Parameters
+    ----------
+    todo : list of int
+        The points to compute, in order.
+    n_workers : int
+        The workers they are for.
+    chunk_size : int or None
+        Points per chunk; None: about 8 chunks per worker, at most 64 points each.
+
+    Returns
+    -------
+    list of list of int
+        The chunks, in order.
+    """
     if chunk_size is None:
         chunk_size = max(1, min(64, len(todo) // (8 * max(n_workers, 1))))
     return [todo[i:i + chunk_size] for i in range(0, len(todo), chunk_size)]
@@ -126,28 +184,57 @@ def chunks(todo: list[int], n_workers: int, chunk_size: int | None) -> list[list
 
 class ClusterLost(RuntimeError):
     """The scheduler (or the connection to it) is gone, or could not be reached, or it has had no
-    worker for too long; the chunks written so far stay in the folder."""
+    worker for too long; the chunks written so far stay in the folder.
+    """
 
     def __init__(self, reason: str, saved: int | None = None, total: int = 0,
                  resume: str = "once the scheduler is back"):
-        """saved: the points in the folder (None: the folder was not opened); resume: when the same
-        command can resume the sweep."""
+        """The loss and what is saved.
+
+        Parameters
+        ----------
+        reason : str
+            What happened (the exception's message).
+        saved : int or None, optional
+            The points in the folder (None: the folder was not opened).
+        total : int, optional
+            The points of the sweep.
+        resume : str, optional
+            When the same command can resume the sweep.
+        """
         super().__init__(reason)
         self.reason, self.saved, self.total, self.resume = reason, saved, total, resume
 
 
 class WorkerWatch:
     """Asks the scheduler how many workers it has, at most every `interval` seconds (1 s, or a
-    quarter of the timeout if shorter); check() raises ClusterLost once every answer for `timeout`
-    seconds was none. start() does this in a thread of its own: the client's waits (a result whose
-    worker died before it was fetched is computed again, and waits for a worker) end there."""
+    quarter of the timeout if shorter); :meth:`check` raises ClusterLost once every answer for
+    `timeout` seconds was none. :meth:`start` does this in a thread of its own: the client's waits (a
+    result whose worker died before it was fetched is computed again, and waits for a worker) end
+    there.
+    """
 
     def __init__(self, client: Client, timeout: float, where: str = "",
                  clock: Callable[[], float] = time.monotonic,
                  waiting: Callable[[], bool] | None = None, waiting_gone: str = ""):
-        """where: " at <address>" for the messages; waiting(), asked when there is no worker: whether
-        workers are still to come (SLURM jobs still queued or starting), which stops the count;
-        waiting_gone: what the lost message adds when waiting() said no ("and ...")."""
+        """A watch of the client's cluster.
+
+        Parameters
+        ----------
+        client : distributed.Client
+            The client.
+        timeout : float
+            Seconds without a worker after which the cluster counts as lost.
+        where : str, optional
+            ``" at <address>"`` for the messages.
+        clock : callable, optional
+            The time in seconds (``time.monotonic``).
+        waiting : callable, optional
+            Asked when there is no worker: whether workers are still to come (SLURM jobs still queued or
+            starting), which stops the count.
+        waiting_gone : str, optional
+            What the lost message adds when `waiting` said no (``"and ..."``).
+        """
         self.client, self.timeout, self.where, self.clock = client, timeout, where, clock
         self.waiting, self.waiting_gone = waiting, waiting_gone
         self.interval = min(1.0, timeout / 4)
@@ -157,6 +244,13 @@ class WorkerWatch:
         self.stopped = threading.Event()
 
     def check(self) -> None:
+        """Asks the scheduler (at most once per interval, while the client runs).
+
+        Raises
+        ------
+        ClusterLost
+            When every answer for `timeout` seconds was "no worker" (and `waiting` said none is to come).
+        """
         now = self.clock()
         if now - self.asked < self.interval or self.client.status != "running":
             return
@@ -171,8 +265,14 @@ class WorkerWatch:
                               resume="once the cluster has workers again")
 
     def start(self, on_lost: Callable[[], object]) -> None:
-        """check() every interval in a daemon thread until stop(); when it raises, the ClusterLost
-        goes to self.lost and on_lost() is called (it cancels the run's futures)."""
+        """Runs :meth:`check` every interval in a daemon thread until :meth:`stop`.
+
+        Parameters
+        ----------
+        on_lost : callable
+            Called (with no argument) when :meth:`check` raises; the ClusterLost is then in
+            ``self.lost``. The run passes a function that cancels its futures.
+        """
         def watch():
             while not self.stopped.wait(self.interval):
                 try:
@@ -186,12 +286,14 @@ class WorkerWatch:
         threading.Thread(target=watch, name="dmi-sweep-worker-watch", daemon=True).start()
 
     def stop(self) -> None:
+        """Stops the thread of :meth:`start` (at its next interval)."""
         self.stopped.set()
 
 
 class ConnectionSetupError(RuntimeError):
-    """TLS options or configuration that cannot work (missing certificates, unreadable files, options
-    without a tls:// address, a certificate the scheduler rejects): nothing was run."""
+    """TLS options or configuration that cannot work (missing certificates, unreadable files,
+    options without a tls:// address, a certificate the scheduler rejects): nothing was run.
+    """
 
 
 TLS_KEYS = ("distributed.comm.tls.ca-file", "distributed.comm.tls.client.cert",
@@ -200,13 +302,36 @@ TLS_KEYS = ("distributed.comm.tls.ca-file", "distributed.comm.tls.client.cert",
 
 def security(scheduler: str | None, tls_ca_file: str | None = None, tls_cert: str | None = None,
              tls_key: str | None = None, slurm: bool = False) -> Security | None:
-    """The Security of the connection to `scheduler`: the --tls-* options over Dask's configuration
-    (distributed.comm.tls.*), checked before connecting: a tls:// address needs a CA file and a
-    client certificate, from either source; every file must be readable and make an SSL context.
-    None for a plain address without TLS options (Dask's own defaults).  With `slurm` (the
-    scheduler in this process, the workers in SLURM jobs) the --tls-* options turn TLS on: the
-    certificate and key serve the scheduler, the workers and this client, all signed by the CA
-    file; the paths are made absolute (the jobs read them from the shared filesystem)."""
+    """The Security of the connection to `scheduler`: the ``--tls-*`` options over Dask's
+    configuration (``distributed.comm.tls.*``), checked before connecting.
+
+    A ``tls://`` address needs a CA file and a client certificate, from either source; every file
+    must be readable and make an SSL context. With `slurm` (the scheduler in this process, the
+    workers in SLURM jobs) the options turn TLS on: the certificate and key serve the scheduler, the
+    workers and this client, all signed by the CA file; the paths are made absolute (the jobs read
+    them from the shared filesystem).
+
+    Parameters
+    ----------
+    scheduler : str or None
+        The scheduler's address (None: a local or SLURM cluster).
+    tls_ca_file, tls_cert, tls_key : str, optional
+        PEM files: the CA that signed the scheduler's certificate, this client's certificate, its key
+        (unless the certificate file holds it).
+    slurm : bool, optional
+        The cluster is a SLURMCluster started here.
+
+    Returns
+    -------
+    distributed.Security or None
+        None for a plain address without TLS options (Dask's own defaults).
+
+    Raises
+    ------
+    ConnectionSetupError
+        TLS options without a tls:// address or ``--slurm``, a TLS address without certificates, an
+        unreadable file, files that make no SSL context.
+    """
     options = {"tls_ca_file": tls_ca_file, "tls_client_cert": tls_cert, "tls_client_key": tls_key}
     given = [f"--{k.replace('tls_client_', 'tls-').replace('_', '-')}" for k, v in options.items() if v]
     tls = bool(scheduler) and scheduler.startswith("tls://") or slurm and bool(given)
@@ -277,8 +402,18 @@ class _LogFileHandler(logging.Handler):
 
 @contextlib.contextmanager
 def logs_to(store: Store) -> Iterator[None]:
-    """While inside: the warnings and errors of Dask, Tornado and asyncio in this process, and
-    Python warnings, go to the folder's _log.jsonl instead of the terminal."""
+    """A context manager: while inside, the warnings and errors of Dask, Tornado and asyncio in this
+    process, and Python warnings, go to the folder's ``_log.jsonl`` instead of the terminal.
+
+    Parameters
+    ----------
+    store : Store
+        The open store whose log receives them.
+
+    Yields
+    ------
+    None
+    """
     handler = _LogFileHandler(store)
     names = {"distributed", "tornado", "asyncio", "bokeh", "py.warnings"}
     names |= {n for n, lg in logging.root.manager.loggerDict.items()
@@ -315,10 +450,32 @@ def _sigint_ignored() -> Iterator[None]:
 
 def make_client(workers: int | None, scheduler: str | None, sec: Security | None = None,
                 dashboard: bool = False) -> Client:
-    """A client of the cluster at `scheduler`, or of a new LocalCluster on 127.0.0.1 of `workers`
-    processes (default: one per core) with one thread each, its dashboard on a free port of
-    127.0.0.1 if asked. Raises ClusterLost if the scheduler cannot be reached, ConnectionSetupError
-    if it refuses this client's certificate."""
+    """A client of the cluster at `scheduler`, or of a new LocalCluster.
+
+    Parameters
+    ----------
+    workers : int or None
+        Processes of the new LocalCluster on 127.0.0.1, one thread each (default: one per core).
+    scheduler : str or None
+        The address of an existing scheduler; then `workers` is not used.
+    sec : distributed.Security, optional
+        The connection's security (:func:`security`).
+    dashboard : bool, optional
+        Start the local cluster's dashboard on a free port of 127.0.0.1.
+
+    Returns
+    -------
+    distributed.Client
+        The client; close it, and its ``cluster`` when it made one.
+
+    Raises
+    ------
+    ClusterLost
+        If the scheduler cannot be reached.
+    ConnectionSetupError
+        If the TLS handshake fails (the scheduler refuses this client's certificate, or the CA does
+        not match).
+    """
     if scheduler:
         try:
             return Client(scheduler, timeout="30s", security=sec)
@@ -370,6 +527,23 @@ STDERR: Any = object()   # run()'s default stream: sys.stderr when called (pytes
 
 @dataclass
 class Summary:
+    """What a run did (:func:`run` returns it).
+
+    Attributes
+    ----------
+    total : int
+        The points of the sweep.
+    skipped : int
+        Those already in the folder when this run started.
+    computed : int
+        Those computed and written by this run.
+    failed : int
+        The points of the folder whose row has an error (this run's and earlier).
+    seconds : float
+        The run's wall time.
+    repaired : int
+        Duplicate rows of older runs dropped before computing.
+    """
     total: int          # points of the sweep
     skipped: int        # already in the folder when this run started
     computed: int       # computed and written by this run
@@ -384,21 +558,63 @@ def run(spec: Spec, out: str | os.PathLike, workers: int | None = None, schedule
         tls_cert: str | None = None, tls_key: str | None = None, dashboard: bool = False,
         messages: TextIO | None = STDERR, no_worker_timeout: float = NO_WORKER_TIMEOUT,
         slurm: dict[str, Any] | None = None) -> Summary:
-    """Runs the sweep `spec` into the folder `out`, resuming what is there. The progress bar goes
-    to `progress`, the lines about repairs, lost workers and the dashboard to `messages` (default:
-    sys.stderr at the time of the call; None: nowhere).
+    """Runs the sweep `spec` into the folder `out`, resuming what is there.
 
-    Before anything is written: the TLS options are checked (ConnectionSetupError) and the FMU is
-    instantiated here with the [start] values (SpecError with the FMU's message if it refuses them).
-    Then the folder is locked (StoreError if another client holds it) and duplicates of older runs
-    are repaired. Raises ClusterLost if the scheduler cannot be reached or is lost, or if the cluster
-    has had no worker for no_worker_timeout seconds; the chunks written stay, and the same call
-    resumes.
+    Before anything is written: the TLS options are checked and the FMU is instantiated here with
+    the ``[start]`` values. Then the folder is locked and duplicates of older runs are repaired; the
+    points missing from the folder are computed in chunks on the cluster, each chunk written as it
+    arrives. The cluster started here (local or SLURM) is closed before the function returns.
 
-    slurm: the job settings of slurm.resolve(): the workers run in SLURM jobs of a SLURMCluster
-    started here (SlurmRefused, before the folder is made, if SLURM refuses its job script); the
-    no-worker count waits while SLURM still has one of its jobs.  With the tls_* files the
-    scheduler, its workers and this client talk TLS (see :func:`security`)."""
+    Parameters
+    ----------
+    spec : Spec
+        The sweep (:func:`dmi_sweep.spec.load`).
+    out : str or os.PathLike
+        The result folder.
+    workers : int, optional
+        Processes of a new local cluster (default: one per core).
+    scheduler : str, optional
+        The address of a running scheduler to use instead (``tcp://``, ``tls://``).
+    restart : bool, optional
+        Delete the folder's results and start again.
+    chunk_size : int, optional
+        Points per task (default: about 8 tasks per worker, at most 64 points each).
+    progress : TextIO or None, optional
+        Where the progress bar goes (default: sys.stderr at the time of the call; None: nowhere).
+    tls_ca_file, tls_cert, tls_key : str, optional
+        TLS files (:func:`security`).
+    dashboard : bool, optional
+        Start the local cluster's dashboard and print its address.
+    messages : TextIO or None, optional
+        Where the lines about repairs, lost workers and the dashboard go (default: sys.stderr at the
+        time of the call; None: nowhere).
+    no_worker_timeout : float, optional
+        Seconds without any worker after which the cluster counts as lost.
+    slurm : dict, optional
+        The job settings of :func:`dmi_sweep.slurm.resolve`: the workers run in SLURM jobs of a
+        SLURMCluster started here; the no-worker count waits while SLURM still has one of its jobs.
+
+    Returns
+    -------
+    Summary
+        The counts of the run.
+
+    Raises
+    ------
+    ValueError
+        If `no_worker_timeout` is not > 0, or `slurm` is given with `scheduler` or `workers`.
+    ConnectionSetupError
+        For TLS options that cannot work (:func:`security`).
+    SpecError
+        If the FMU refuses the ``[start]`` values (its message).
+    SlurmRefused
+        If SLURM refuses the job script (before the folder is made).
+    StoreError
+        If the folder holds another sweep (without `restart`) or another client holds it.
+    ClusterLost
+        If the scheduler cannot be reached or is lost, or the cluster has had no worker for
+        `no_worker_timeout` seconds; the chunks written stay, and the same call resumes.
+    """
     if not no_worker_timeout > 0:
         raise ValueError(f"no_worker_timeout must be > 0 seconds, not {no_worker_timeout!r}")
     t0 = time.monotonic()

@@ -26,10 +26,27 @@ STATUS = ["OK", "Warning", "Discard", "Error", "Fatal", "Pending"]
 
 def communication_plan(start_time: float, stop_time: float, interval: float, variable_step: bool,
                        events: list[float]) -> list[tuple[float, bool, bool]]:
-    """The communication points after start_time, in order, as (time, recorded, event): the loop of
-    fmpy.simulate_fmu (co-simulation) with `events` (sorted) playing the part of its input events.
-    `recorded` is False only for an event point that is not one of simulate_fmu's own points
-    (start_time + k interval, and stop_time)."""
+    """The communication points after `start_time`, in order: the loop of
+    ``fmpy.simulate_fmu`` (co-simulation) with `events` playing the part of its input events.
+
+    Parameters
+    ----------
+    start_time, stop_time : float
+        The simulated interval (time units of the FMU).
+    interval : float
+        The output interval, > 0.
+    variable_step : bool
+        Whether the FMU takes variable communication steps (then the steps are cut at the events,
+        and the last one ends at `stop_time`).
+    events : list of float
+        Sorted times at which a point is wanted (the Poincare samples).
+
+    Returns
+    -------
+    list of (float, bool, bool)
+        ``(time, recorded, event)`` per point; `recorded` is False only for an event point that is
+        not one of simulate_fmu's own points (``start_time + k interval``, and `stop_time`).
+    """
     plan = []
     time = start_time
     n_steps = 0
@@ -58,13 +75,32 @@ def communication_plan(start_time: float, stop_time: float, interval: float, var
 
 
 def in_window(time: float, transient: float) -> bool:
-    """Whether a communication point belongs to the statistics window [transient, stop_time]."""
+    """Whether a communication point belongs to the statistics window [`transient`, stop_time].
+
+    Parameters
+    ----------
+    time : float
+        The point's time.
+    transient : float
+        The window's start.
+
+    Returns
+    -------
+    bool
+        ``time >= transient``, equal within rounding included.
+    """
     return time >= transient or isclose(time, transient)
 
 
 class Runner:
     """One instance of an unpacked co-simulation FMU, instantiated on first use and reset between
-    points."""
+    points.
+
+    Parameters
+    ----------
+    unzipdir : str
+        The folder of the unpacked FMU (:func:`unpack`).
+    """
 
     def __init__(self, unzipdir: str):
         self.unzipdir = unzipdir
@@ -98,7 +134,7 @@ class Runner:
         self.instantiations += 1
 
     def discard(self) -> None:
-        """Frees the instance (after a failure; the next point gets a new one)."""
+        """Frees the instance (after a failure; the next point gets a new one). Never raises."""
         if self.fmu is not None:
             try:
                 self.fmu.freeInstance()
@@ -121,8 +157,28 @@ class Runner:
         return order, getters
 
     def run(self, job: dict, values: dict) -> dict:
-        """Simulates one point: the job's start values updated by `values`. Returns the statistics
-        (and Poincare samples), or {"error": message} if the FMU failed."""
+        """Simulates one point.
+
+        Parameters
+        ----------
+        job : dict
+            :meth:`dmi_sweep.spec.Spec.job`: the interval, start values, outputs and Poincare period.
+        values : dict
+            The point's swept values, over the job's start values.
+
+        Returns
+        -------
+        dict
+            Per output its statistics (``<name>_final``, ``_min``, ``_max``, ``_mean``, and with a
+            Poincare period ``_poincare``, the samples), or ``{"error": message}`` if the FMU failed
+            (with its logged messages).
+
+        Raises
+        ------
+        PluginClosed
+            If the runner was closed while the point waited (not a result: the client runs the chunk
+            again elsewhere).
+        """
         with self.lock:
             if self.closing:   # not a result: the client runs the chunk again elsewhere
                 raise PluginClosed("the worker plugin was removed while the point waited")
@@ -246,10 +302,22 @@ class Runner:
         return v.start
 
     def check_start(self, job: dict) -> str | None:
-        """Instantiates the FMU, sets the job's [start] values (in the modes fmpy sets them) and
-        leaves initialization mode (where a model may check its parameters together), the swept
-        parameters at their start values, without stepping: None if the FMU takes them, else its
-        reason with its logged messages."""
+        """Whether the FMU takes the job's ``[start]`` values.
+
+        Instantiates the FMU, sets the values (in the modes fmpy sets them) and leaves initialization
+        mode (where a model may check its parameters together), the swept parameters at their start
+        values, without stepping.
+
+        Parameters
+        ----------
+        job : dict
+            :meth:`dmi_sweep.spec.Spec.job`.
+
+        Returns
+        -------
+        str or None
+            None if the FMU takes them, else its reason with its logged messages.
+        """
         self.messages.clear()
         try:
             self._fresh()
@@ -283,8 +351,25 @@ class Runner:
 
 
 def unpack(fmu_bytes: bytes, directory: str) -> str:
-    """Extracts the FMU (zip bytes) into a new folder under `directory` with fmpy.extract (which
-    refuses absolute and backslash paths); returns the folder."""
+    """Extracts an FMU into a new folder.
+
+    Parameters
+    ----------
+    fmu_bytes : bytes
+        The FMU (zip) file's bytes.
+    directory : str
+        Where the new folder is made.
+
+    Returns
+    -------
+    str
+        The new folder (``fmpy.extract``, which refuses absolute and backslash paths).
+
+    Raises
+    ------
+    Exception
+        fmpy's and zipfile's errors for a file that is not an FMU or has unsafe paths.
+    """
     return str(extract(io.BytesIO(fmu_bytes), tempfile.mkdtemp(prefix="dmi-sweep-fmu-", dir=directory)))
 
 
@@ -300,12 +385,29 @@ class FMUPlugin(WorkerPlugin):
     idempotent = True
 
     def __init__(self, fmu_bytes: bytes, sha256: str, run_id: str = ""):
-        """The name is dmi-sweep-<sha256[:16]>, a plugin a caller may register to keep the FMU on the
-        workers across runs, or with run_id that of one run, which removes it at its end."""
+        """The plugin of an FMU.
+
+        Parameters
+        ----------
+        fmu_bytes : bytes
+            The FMU's bytes, sent to each worker once.
+        sha256 : str
+            Their SHA-256: the plugin's name is ``dmi-sweep-<sha256[:16]>``, a plugin a caller may
+            register to keep the FMU on the workers across runs.
+        run_id : str, optional
+            With it, the name is that of one run (``-<run_id>`` appended), which removes it at its end.
+        """
         self.fmu_bytes = fmu_bytes
         self.name = "dmi-sweep-" + sha256[:16] + (f"-{run_id}" if run_id else "")
 
     def setup(self, worker: Any = None) -> None:
+        """Unpacks the FMU into the worker's local directory (Dask calls it on each worker).
+
+        Parameters
+        ----------
+        worker : distributed.Worker, optional
+            The worker (its ``local_directory``; else the system's temporary folder).
+        """
         base = getattr(worker, "local_directory", None) or tempfile.gettempdir()
         self.unzipdir = unpack(self.fmu_bytes, base)
         self.local = threading.local()
@@ -313,6 +415,13 @@ class FMUPlugin(WorkerPlugin):
         self.lock = threading.Lock()
 
     def runner(self) -> Runner:
+        """This thread's Runner, made on first use.
+
+        Returns
+        -------
+        Runner
+            The runner of the calling thread.
+        """
         r = getattr(self.local, "runner", None)
         if r is None:
             r = Runner(self.unzipdir)
@@ -322,28 +431,80 @@ class FMUPlugin(WorkerPlugin):
         return r
 
     def teardown(self, worker: Any = None) -> None:
+        """Closes every runner and removes the unpacked FMU (Dask calls it when the plugin is removed
+        or the worker closes).
+
+        Parameters
+        ----------
+        worker : distributed.Worker, optional
+            The worker.
+        """
         for r in self.runners:
             r.close()
         shutil.rmtree(self.unzipdir, ignore_errors=True)
 
 
 def has_worker_plugin(dask_scheduler: Any, name: str) -> bool:
-    """On the scheduler (Client.run_on_scheduler): whether a worker plugin of that name is
-    registered."""
+    """On the scheduler (``Client.run_on_scheduler``): whether a worker plugin is registered.
+
+    Parameters
+    ----------
+    dask_scheduler : distributed.Scheduler
+        The scheduler (passed by Dask).
+    name : str
+        The plugin's name.
+
+    Returns
+    -------
+    bool
+        Whether it is registered.
+    """
     return name in dask_scheduler.worker_plugins
 
 
 def check_start(fmu_bytes: bytes, job: dict) -> str | None:
-    """Runner.check_start on the FMU unpacked into a temporary folder (removed after)."""
+    """:meth:`Runner.check_start` on the FMU unpacked into a temporary folder (removed after).
+
+    Parameters
+    ----------
+    fmu_bytes : bytes
+        The FMU's bytes.
+    job : dict
+        :meth:`dmi_sweep.spec.Spec.job`.
+
+    Returns
+    -------
+    str or None
+        None if the FMU takes the ``[start]`` values, else its reason.
+    """
     with tempfile.TemporaryDirectory(prefix="dmi-sweep-check-") as d:
         runner = Runner(unpack(fmu_bytes, d))
         return runner.check_start(job)
 
 
 def run_chunk(plugin_name: str, job: dict, points: list[tuple[int, dict]]) -> list[dict]:
-    """A Dask task: simulates the points [(index, {name: value})] with this worker's FMU instance;
-    each result carries `point`, the worker's pid, and how many times this worker has instantiated
-    the FMU so far."""
+    """A Dask task: simulates points with this worker's FMU instance.
+
+    Parameters
+    ----------
+    plugin_name : str
+        The name of the registered :class:`FMUPlugin`.
+    job : dict
+        :meth:`dmi_sweep.spec.Spec.job`.
+    points : list of (int, dict)
+        ``(index, {name: value})`` per point.
+
+    Returns
+    -------
+    list of dict
+        One :meth:`Runner.run` result per point, each with ``point`` (its index), ``pid`` (the
+        worker's) and ``instantiations`` (how many times this worker has instantiated the FMU so far).
+
+    Raises
+    ------
+    PluginClosed
+        If the worker has no plugin of that name, or it was removed while the chunk waited.
+    """
     plugin = get_worker().plugins.get(plugin_name)
     if plugin is None:
         raise PluginClosed(f"the worker has no plugin {plugin_name}")

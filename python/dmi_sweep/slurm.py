@@ -21,12 +21,33 @@ WALLTIME = re.compile(r"\d+(:\d+){0,2}|\d+-\d+(:\d+){0,2}")
 
 
 class SlurmSettingError(ValueError):
-    """A bad SLURM setting: the message says which and why."""
+    """A bad SLURM setting: the message says which and why (a ``ValueError``)."""
 
 
 def check(settings: dict[str, Any], where: str) -> dict[str, Any]:
-    """The settings checked and normalised (None values dropped); `where` prefixes the messages
-    ("slurm." for the spec's section, "--" for the command line)."""
+    """The SLURM settings checked and normalised.
+
+    Parameters
+    ----------
+    settings : dict
+        Some of :data:`KEYS` (``partition``, ``account``, ``cores``, ``memory``, ``walltime``,
+        ``jobs``); None values are dropped.
+    where : str
+        The prefix of the names in the messages: ``"slurm."`` for the spec's section, ``"--"`` for
+        the command line.
+
+    Returns
+    -------
+    dict
+        The settings without the None values.
+
+    Raises
+    ------
+    SlurmSettingError
+        For an unknown key, ``cores`` or ``jobs`` not an integer >= 1, a text that is empty or has
+        spaces, a ``memory`` that is not an amount (``"4GB"``), a ``walltime`` that is not a SLURM
+        time limit.
+    """
     from dask.utils import parse_bytes
     unknown = sorted(set(settings) - set(KEYS))
     if unknown:
@@ -57,9 +78,26 @@ def check(settings: dict[str, Any], where: str) -> dict[str, Any]:
 
 
 def resolve(command_line: dict[str, Any], section: dict[str, Any]) -> dict[str, Any]:
-    """The settings of a run: the command line's over the spec's [slurm] section over Dask's
-    configuration (jobqueue.slurm.queue, .account, .cores, .memory, .walltime). cores and memory
-    must come from one of them; jobs defaults to 1."""
+    """The settings of a run: the command line's over the spec's ``[slurm]`` section over Dask's
+    configuration (``jobqueue.slurm.queue``, ``.account``, ``.cores``, ``.memory``, ``.walltime``).
+
+    Parameters
+    ----------
+    command_line : dict
+        The checked command-line settings (None: not given).
+    section : dict
+        The checked ``[slurm]`` section of the spec.
+
+    Returns
+    -------
+    dict
+        The merged settings; ``jobs`` defaults to 1.
+
+    Raises
+    ------
+    SlurmSettingError
+        If ``cores`` or ``memory`` comes from none of the three.
+    """
     import dask
     config = {k: dask.config.get(f"jobqueue.slurm.{v}", None) for k, v in JOBQUEUE.items()}
     merged = {k: v for k, v in config.items() if v is not None}
@@ -75,11 +113,23 @@ def resolve(command_line: dict[str, Any], section: dict[str, Any]) -> dict[str, 
 
 
 def cluster_kwargs(settings: dict[str, Any]) -> dict[str, Any]:
-    """The keywords of SLURMCluster for the settings: one single-threaded worker process per core
-    of a job (processes = cores), the scheduler's dashboard on a free port of 127.0.0.1 (reach it
-    through an SSH tunnel) unless Dask's
-    jobqueue.slurm.scheduler-options says otherwise. What is not given here (interface, python,
-    job-extra-directives, log-directory, ...) comes from Dask's jobqueue.slurm configuration."""
+    """The keywords of ``dask_jobqueue.SLURMCluster`` for the settings.
+
+    One single-threaded worker process per core of a job (processes = cores), the scheduler's
+    dashboard on a free port of 127.0.0.1 (reach it through an SSH tunnel) unless Dask's
+    ``jobqueue.slurm.scheduler-options`` says otherwise. What is not given here (interface, python,
+    job-extra-directives, log-directory, ...) comes from Dask's ``jobqueue.slurm`` configuration.
+
+    Parameters
+    ----------
+    settings : dict
+        Resolved settings (:func:`resolve`); ``cores`` is required.
+
+    Returns
+    -------
+    dict
+        The keywords.
+    """
     import dask
     kw = {JOBQUEUE[k]: v for k, v in settings.items() if k in JOBQUEUE}
     kw["processes"] = settings["cores"]
@@ -90,14 +140,31 @@ def cluster_kwargs(settings: dict[str, Any]) -> dict[str, Any]:
 
 
 class SlurmRefused(RuntimeError):
-    """SLURM refuses the job script (sbatch --test-only), or cannot be asked: nothing was run."""
+    """SLURM refuses the job script (``sbatch --test-only``), or cannot be asked: nothing was run."""
 
 
 def start(settings: dict[str, Any], security=None):
-    """A SLURMCluster for the settings whose job script SLURM accepts (`sbatch --test-only`), with
-    its jobs submitted; raises SlurmRefused with SLURM's message otherwise (the cluster closed).
-    `security`: a distributed Security (files on the shared filesystem): the scheduler listens on
-    tls:// and the job script gives the workers --protocol tls:// and the worker's files."""
+    """A SLURMCluster for the settings, its jobs submitted.
+
+    Parameters
+    ----------
+    settings : dict
+        Resolved settings (:func:`resolve`).
+    security : distributed.Security, optional
+        TLS files on the shared filesystem: the scheduler listens on ``tls://`` and the job script
+        gives the workers ``--protocol tls://`` and the worker's files.
+
+    Returns
+    -------
+    dask_jobqueue.SLURMCluster
+        The cluster, whose job script SLURM accepted, with ``jobs`` jobs submitted.
+
+    Raises
+    ------
+    SlurmRefused
+        If ``sbatch`` is not on the PATH, dask-jobqueue is missing, or SLURM refuses the job script
+        (its message; the cluster is closed).
+    """
     sbatch = shutil.which("sbatch")
     if sbatch is None:
         raise SlurmRefused("--slurm: SLURM's sbatch is not on the PATH of this machine (run "
@@ -127,7 +194,19 @@ def start(settings: dict[str, Any], security=None):
 
 def jobs_alive(cluster) -> bool:
     """Whether SLURM still has a job of the cluster (pending, configuring or running): its workers
-    may yet come. False when squeue cannot say."""
+    may yet come.
+
+    Parameters
+    ----------
+    cluster : dask_jobqueue.SLURMCluster
+        A cluster of :func:`start`.
+
+    Returns
+    -------
+    bool
+        True if ``squeue`` lists one of its jobs as PENDING, CONFIGURING or RUNNING; False when it
+        has none, or when squeue cannot say (missing, failing, timing out).
+    """
     ids = [str(job.job_id) for job in getattr(cluster, "workers", {}).values()
            if getattr(job, "job_id", None)]
     squeue = shutil.which("squeue")

@@ -23,12 +23,46 @@ DEFAULT_FMU = Path(__file__).resolve().parents[2] / "build" / "fmu" / "DelayFric
 
 
 class SpecError(ValueError):
-    """A bad specification: the message says what and where."""
+    """A bad specification: the message says what and where (a ``ValueError``)."""
 
 
 @dataclass
 class Spec:
-    """A checked sweep specification."""
+    """A checked sweep specification, as :func:`load` returns it.
+
+    Attributes
+    ----------
+    path : Path
+        The spec file.
+    text : bytes
+        Its bytes as read.
+    fmu : Path
+        The FMU (the spec's ``fmu``, relative to the spec file, or the default build's oscillator).
+    sha256 : str
+        The FMU's SHA-256, hex.
+    model : fmpy.model_description.ModelDescription
+        The FMU's model description.
+    start_time, stop_time, output_interval, transient : float
+        The simulated interval, the communication interval and the start of the recorded window
+        (time units of the FMU).
+    start : dict
+        The fixed start values of ``[start]``, converted to the variables' types.
+    params : list of str
+        The swept parameters, in the order of the columns of `values`.
+    values : numpy.ndarray
+        (points, params): the points in full-factorial (``[grid]``) or sampling (``[random]``) order.
+    outputs : list of str
+        The recorded outputs.
+    poincare : float, str or None
+        The Poincare period: a number (time units), a parameter name whose value is the angular
+        frequency (period 2 pi / value), or None for no section.
+    mode : str
+        ``"grid"`` or ``"random"``.
+    types : dict
+        Parameter name to ``"float"``, ``"int"`` or ``"bool"``.
+    slurm : dict
+        The ``[slurm]`` section (job settings, used with ``--slurm``).
+    """
     path: Path
     text: bytes
     fmu: Path
@@ -52,18 +86,47 @@ class Spec:
         return len(self.values)
 
     def point(self, i: int) -> dict[str, Any]:
-        """The swept values of point i, converted to the variables' types."""
+        """The swept values of point `i`, converted to the variables' types.
+
+        Parameters
+        ----------
+        i : int
+            The point's index, 0 <= i < :attr:`n_points`.
+
+        Returns
+        -------
+        dict
+            Parameter name to value.
+
+        Raises
+        ------
+        IndexError
+            If `i` is out of range.
+        """
         return {p: _convert(self.types[p], self.values[i, j]) for j, p in enumerate(self.params)}
 
     def job(self) -> dict[str, Any]:
-        """What a worker needs besides the point's values."""
+        """What a worker needs besides the point's values.
+
+        Returns
+        -------
+        dict
+            ``start_time``, ``stop_time``, ``output_interval``, ``transient``, ``start``, ``outputs`` and
+            ``poincare``.
+        """
         return {"start_time": self.start_time, "stop_time": self.stop_time,
                 "output_interval": self.output_interval, "transient": self.transient,
                 "start": dict(self.start), "outputs": list(self.outputs), "poincare": self.poincare}
 
     def identity(self) -> dict[str, Any]:
-        """What must not change between a sweep and its resumption: the parsed spec without the
-        FMU's path and the [slurm] job settings (where it runs), and the FMU's sha256."""
+        """What must not change between a sweep and its resumption.
+
+        Returns
+        -------
+        dict
+            ``spec``: the parsed spec without the FMU's path and the ``[slurm]`` job settings (where it
+            runs), key-sorted; ``fmu_sha256``: the FMU's SHA-256.
+        """
         data = tomllib.loads(self.text.decode())
         data.pop("fmu", None)
         data.pop("slurm", None)
@@ -113,7 +176,24 @@ def _check_value(where: str, variable, x: Any) -> Any:
 
 
 def load(path: str | os.PathLike) -> Spec:
-    """Reads and checks the spec file; raises SpecError with a clear message if anything is wrong."""
+    """Reads and checks a spec file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The TOML file.
+
+    Returns
+    -------
+    Spec
+        The checked specification (see :func:`check`).
+
+    Raises
+    ------
+    SpecError
+        If the file cannot be read, is not TOML, or anything in it is wrong (the message says what
+        and where).
+    """
     path = Path(path)
     try:
         text = path.read_bytes()
@@ -127,6 +207,30 @@ def load(path: str | os.PathLike) -> Spec:
 
 
 def check(data: dict[str, Any], text: bytes, path: Path) -> Spec:
+    """Checks parsed spec data against its FMU's model description.
+
+    Parameters
+    ----------
+    data : dict
+        The parsed TOML.
+    text : bytes
+        The file's bytes (kept in the Spec; its identity for resumption).
+    path : Path
+        The spec file (a relative ``fmu`` is taken relative to its folder).
+
+    Returns
+    -------
+    Spec
+        The checked specification with its points.
+
+    Raises
+    ------
+    SpecError
+        For an unknown key, a missing or unreadable FMU or one without co-simulation, a bad time
+        interval, an unknown or unsettable variable, a value of the wrong type or range, an empty or
+        duplicated output list, a parameter both fixed and swept, a bad ``[grid]``, ``[random]``,
+        ``[poincare]`` or ``[slurm]`` section.
+    """
     unknown = sorted(set(data) - TOP_KEYS)
     if unknown:
         raise SpecError(f"unknown entries {', '.join(unknown)}; valid: {', '.join(sorted(TOP_KEYS))}")

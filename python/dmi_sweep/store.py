@@ -35,7 +35,8 @@ TMP = ".tmp-"            # temporary files: .tmp-<pid of the writer>-<name>
 
 class StoreError(RuntimeError):
     """The folder holds something else than this sweep, or another client uses it (the message says
-    what to do)."""
+    what to do).
+    """
 
 
 # The operating system's lock, the one place that depends on the platform. Both locks belong to the
@@ -83,10 +84,21 @@ else:                        # POSIX
 
 
 class FolderLock:
-    """The operating system's lock (flock on POSIX, msvcrt.locking on Windows) on the folder's _lock
-    file, held by one client while it runs: it dies with its holder, also with a killed one. The
-    file says who holds the lock (host, pid, start time); the file itself stays, empty of meaning
-    once unlocked."""
+    """The operating system's lock (flock on POSIX, msvcrt.locking on Windows) on the folder's
+    ``_lock`` file, held by one client while it runs: it dies with its holder, also with a killed one.
+    The file says who holds the lock (host, pid, start time); the file itself stays, empty of meaning
+    once unlocked.
+
+    Parameters
+    ----------
+    directory : Path
+        The sweep's folder (it must exist).
+
+    Raises
+    ------
+    StoreError
+        If the filesystem cannot lock, or another client holds the lock (the message names it).
+    """
 
     def __init__(self, directory: Path):
         self.path = directory / LOCK
@@ -117,6 +129,7 @@ class FolderLock:
         os.write(fd, json.dumps(me).encode())
 
     def release(self) -> None:
+        """Unlocks and closes the file; again: nothing."""
         if self.fd is not None:
             with contextlib.suppress(OSError):
                 _unlock(self.fd)
@@ -141,8 +154,20 @@ def _versions() -> dict[str, str]:
 
 
 def schema(spec: Spec) -> pa.Schema:
-    """Columns: the swept parameters, point, per output y: y_final, y_min, y_max, y_mean
-    (and y_poincare, a list), error (null when the point succeeded)."""
+    """The Arrow schema of a sweep's rows.
+
+    Parameters
+    ----------
+    spec : Spec
+        The sweep.
+
+    Returns
+    -------
+    pyarrow.Schema
+        The swept parameters (their types), ``point``, per output ``y``: ``y_final``, ``y_min``,
+        ``y_max``, ``y_mean`` (and ``y_poincare``, a list, with a Poincare period), ``error`` (null
+        when the point succeeded).
+    """
     kinds = {"float": pa.float64(), "int": pa.int64(), "bool": pa.bool_()}
     fields = [pa.field(p, kinds[spec.types[p]]) for p in spec.params]
     fields.append(pa.field("point", pa.int64()))
@@ -155,7 +180,16 @@ def schema(spec: Spec) -> pa.Schema:
 
 
 class Store:
-    """The result folder of one sweep."""
+    """The result folder of one sweep: Parquet chunk files ``part-<first point>.parquet``, the
+    metadata ``_meta.json``, the log ``_log.jsonl`` and the lock. Made by :meth:`open`.
+
+    Parameters
+    ----------
+    directory : Path
+        The folder.
+    spec : Spec
+        The sweep.
+    """
 
     def __init__(self, directory: Path, spec: Spec):
         self.dir = directory
@@ -165,9 +199,29 @@ class Store:
 
     @classmethod
     def open(cls, directory: str | os.PathLike, spec: Spec, restart: bool = False) -> "Store":
-        """Creates the folder, or reopens it to resume the same sweep, and locks it (close() unlocks).
-        A folder of another sweep (spec or FMU changed) is an error unless restart, which deletes its
-        results; so is a folder another client holds."""
+        """Creates the folder, or reopens it to resume the same sweep, and locks it (:meth:`close`
+        unlocks).
+
+        Parameters
+        ----------
+        directory : str or os.PathLike
+            The folder.
+        spec : Spec
+            The sweep.
+        restart : bool, optional
+            Delete the folder's results, whatever sweep they came from, and start again.
+
+        Returns
+        -------
+        Store
+            The open, locked store.
+
+        Raises
+        ------
+        StoreError
+            If the path is a file, a non-empty folder without dmi-sweep results, a folder of another
+            sweep (spec or FMU changed) without `restart`, or a folder another client holds.
+        """
         d = Path(directory)
         store = cls(d, spec)
         meta_path = d / META
@@ -212,23 +266,36 @@ class Store:
         self._remove_stale_temporaries()
 
     def close(self) -> None:
-        """Unlocks the folder."""
+        """Unlocks the folder; again: nothing."""
         if self.lock is not None:
             self.lock.release()
             self.lock = None
 
     def log(self, entry: dict[str, Any]) -> None:
-        """Appends one line to _log.jsonl: the entry with the time and the client's pid."""
+        """Appends one line to ``_log.jsonl``: the entry with the time and the client's pid.
+
+        Parameters
+        ----------
+        entry : dict
+            What to log (JSON-serialisable, else written as text).
+        """
         with open(self.dir / LOG, "a") as f:
             f.write(json.dumps({"time": time.time(), "client": os.getpid(), **entry}, default=str) + "\n")
 
     def repair(self) -> tuple[int, int, int]:
         """Drops the extra copies of points that several chunk files hold (overlapping chunks of
-        older runs, before the lock existed): keeps one row per point, a successful one if there is
-        one, else the one in the first file. A file that loses rows is rewritten under its own name
-        (write then rename: it holds either all its old rows or the kept ones), a file that keeps
-        none is removed; the kept copy of a point is never touched, so a crash at any moment loses
-        no point. Returns (rows dropped, files rewritten, files removed)."""
+        older runs, before the lock existed).
+
+        Keeps one row per point, a successful one if there is one, else the one in the first file. A
+        file that loses rows is rewritten under its own name (write then rename: it holds either all its
+        old rows or the kept ones), a file that keeps none is removed; the kept copy of a point is never
+        touched, so a crash at any moment loses no point.
+
+        Returns
+        -------
+        tuple of int
+            (rows dropped, files rewritten, files removed).
+        """
         parts = self.parts()
         keep: dict[int, tuple[int, int, bool]] = {}   # point -> (file, row, succeeded)
         tables = []
@@ -290,17 +357,36 @@ class Store:
                 p.unlink(missing_ok=True)
 
     def parts(self) -> list[Path]:
+        """The chunk files.
+
+        Returns
+        -------
+        list of Path
+            ``part-*.parquet`` of the folder, sorted by name.
+        """
         return sorted(self.dir.glob("part-*.parquet"))
 
     def done(self) -> set[int]:
-        """The points already in the dataset."""
+        """The points already in the dataset.
+
+        Returns
+        -------
+        set of int
+            Their indices.
+        """
         done: set[int] = set()
         for p in self.parts():
             done.update(pq.read_table(p, columns=["point"]).column("point").to_pylist())
         return done
 
     def failed(self) -> int:
-        """The rows of the dataset whose point failed (error not null)."""
+        """The rows of the dataset whose point failed.
+
+        Returns
+        -------
+        int
+            The number of rows whose ``error`` is not null.
+        """
         n = 0
         for p in self.parts():
             error = pq.read_table(p, columns=["error"]).column("error")
@@ -308,8 +394,20 @@ class Store:
         return n
 
     def write(self, results: list[dict[str, Any]]) -> Path:
-        """Writes one chunk of results (each with its "point") as part-<first point>.parquet:
-        to a temporary file, then renamed, so a reader never sees half a chunk."""
+        """Writes one chunk of results as ``part-<first point>.parquet``: to a temporary file, then
+        renamed, so a reader never sees half a chunk.
+
+        Parameters
+        ----------
+        results : list of dict
+            :func:`dmi_sweep.simulate.run_chunk`'s results, each with its ``point``; statistics it
+            lacks are NaN (null for ``error`` and ``*_poincare``).
+
+        Returns
+        -------
+        Path
+            The file written.
+        """
         results = sorted(results, key=lambda r: r["point"])
         cols: dict[str, list] = {f.name: [] for f in self.schema}
         for r in results:

@@ -67,7 +67,7 @@ def test_plots_over_the_swept_parameter(tmp_path, build, sweep_command):
 def test_main_spec_is_valid():
     """The main job's default spec loads (every key and parameter known to dmi-sweep)."""
     from dmi_sweep.spec import load
-    spec = load(PYTHON_DIR / "examples" / "oscillator_tau.toml")
+    spec = load(PYTHON_DIR.parent / "examples" / "python" / "oscillator_tau.toml")
     assert spec.n_points >= 50
 
 

@@ -1,5 +1,5 @@
-# dmi.analysis on the tau-diagram's friction oscillator (python/examples/orbit_tau.py, the model
-# of python/examples/oscillator_tau.toml with libdmi 1.2's free step h = 4 pi / M): the continued
+# dmi.analysis on the tau-diagram's friction oscillator (examples/python/orbit_tau.py, the model
+# of examples/python/oscillator_tau.toml with libdmi 1.2's free step h = 4 pi / M): the continued
 # period-1 branch against brute-force plain runs at the same h, the detected period doubling
 # where the runs' Poincare section doubles, and the period-2 branch born there.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -15,8 +15,8 @@ import pytest
 from dmi.analysis import continue_orbit, period_doubled_orbit, periodic_orbit
 
 sys.path.insert(0, str(Path(os.environ.get("DMI_SOURCE_DIR", Path(__file__).parents[2]))
-                       / "python" / "examples"))
-import orbit_tau  # noqa: E402  (python/examples/orbit_tau.py; a missing file must fail, not skip)
+                       / "examples" / "python"))
+import orbit_tau  # noqa: E402  (examples/python/orbit_tau.py; a missing file must fail, not skip)
 M = 2000
 
 

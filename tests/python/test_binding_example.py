@@ -1,4 +1,4 @@
-# python/examples/two_mass_chain.py runs as a user runs it (a program, numba
+# examples/python/two_mass_chain.py runs as a user runs it (a program, numba
 # callbacks, matplotlib): it writes its plot, and its trajectory is the scheme
 # (3.12)-(3.13) computed here independently, in plain NumPy with the direct
 # delay sum (libdmi computes it by the recursion of exponential terms).
@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-EXAMPLE = Path(os.environ.get("DMI_SOURCE_DIR", Path(__file__).parents[2])) / "python" / "examples" / \
+EXAMPLE = Path(os.environ.get("DMI_SOURCE_DIR", Path(__file__).parents[2])) / "examples" / "python" / \
     "two_mass_chain.py"
 
 

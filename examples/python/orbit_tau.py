@@ -1,4 +1,4 @@
-# The friction oscillator of the tau-diagram (python/examples/oscillator_tau.toml) continued in
+# The friction oscillator of the tau-diagram (examples/python/oscillator_tau.toml) continued in
 # the delay tau with dmi.analysis, over the sweep's brute-force diagram (scripts/main.sh runs it).
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """w'' + w + int_0^tau 0.5 w(t - s) ds + sigma(w') + 1.3 cos(0.5 t) ∋ 0 over tau.

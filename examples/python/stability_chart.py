@@ -2,7 +2,7 @@
 # The stability chart of an oscillator with a distributed delay (dmi.analysis, issue 29):
 #     w'' + c w' + b w + a int_0^tau G(s) w(t - s) ds = 0,   G(s) = exp(-s / theta) / theta,
 # over the delay gain a and the delay tau; writes the figure (PNG) and the Hopf curves (CSV).
-# Usage: python/examples/stability_chart.py OUT.png [--grid P Q] [--N N] [--workers W]
+# Usage: examples/python/stability_chart.py OUT.png [--grid P Q] [--N N] [--workers W]
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """The distributed-delay oscillator as a two-parameter model for dmi.analysis.stability_chart."""
 from __future__ import annotations
