@@ -7,7 +7,8 @@
 # the recursion against the FFT), a bifurcation diagram of the oscillator over the
 # delay tau (dmi-sweep) and its periodic orbits continued over it (dmi.analysis,
 # examples/python/orbit_tau.py), the stability chart of the distributed-delay
-# oscillator (dmi.analysis); prints the summary table.  Copies the figures
+# oscillator (dmi.analysis), the belt with memory from its equilibrium to its
+# stick-slip branch (dmi.analysis, self-excited); prints the summary table.  Copies the figures
 # to docs/figures/.
 # Usage: scripts/main.sh
 # Environment: DMI_BUILD_DIR (default build), DMI_OUT_DIR (default out).
@@ -73,6 +74,10 @@ OPENBLAS_NUM_THREADS=1 MPLBACKEND=Agg "$py" examples/python/orbit_tau.py "$out" 
 
 stage "dmi.analysis: stability chart of the distributed-delay oscillator (100 x 100, N = 128)"
 PYTHONPATH="$build/python" MPLBACKEND=Agg "$py" examples/python/stability_chart.py "$out/stability_chart.png"
+
+stage "dmi.analysis: the belt with memory from its equilibrium to the stick-slip branch"
+PYTHONPATH="$build/python" MPLBACKEND=Agg DMI_FIGURE="$out/belt_selfexcited.png" "$py" \
+  examples/python/plot_belt_selfexcited.py | tee "$out/belt_selfexcited.txt"
 
 stage "figures and comparison with the paper and ../shared/reference"
 refarg=()
