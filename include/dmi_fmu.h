@@ -127,7 +127,7 @@ struct dmi_fmu_point {
     uint64_t p;
     size_t n;
     const double *u, *U, *W, *X;
-    /** The model's events (see dmi_fmu_indicators_fn) up to step p: nevents,
+    /* The model's events (see dmi_fmu_indicators_fn) up to step p: nevents,
      * the number of solver steps at which an indicator changed since the
      * start (or since ExitInitializationMode); event_p, the last such step
      * (0: none yet), whose time is t_start + event_p h. */
@@ -263,7 +263,7 @@ struct dmi_fmu_model {
     const char *author;
     size_t nindicators;
     dmi_fmu_indicators_fn indicators;
-    /** (Since libdmi 1.2.)  Optional, NULL for none: see dmi_fmu_step_fn. */
+    /* (Since libdmi 1.2.)  Optional, NULL for none: see dmi_fmu_step_fn. */
     dmi_fmu_step_fn step;
 };
 

@@ -59,6 +59,7 @@ html="$build/docs/html"
 rm -rf "$src" "$html"
 mkdir -p "$src"
 cp -r docs/. "$src/"
+mkdir -p "$src/include" && cp include/*.h "$src/include/"     # c-api.md shows the structures as declared
 mapfile -t fmus < <(find "$build" -name '*.fmu' -not -path "$build/docs/*" -not -path '*/Testing/*' | sort)
 ((${#fmus[@]})) || { echo "docs: no FMU in $build" >&2; exit 1; }
 "$py" docs/gen/fmu_variables.py "$build" "${fmus[@]}" >"$src/fmu-variables.md"
