@@ -341,3 +341,14 @@ def test_plot_branch_draws_equilibria_and_amplitudes_with_labelled_axes():
     assert a1.get_xlabel() == "parameter p" and "equilibrium" in a1.get_ylabel()
     assert a2.get_xlabel() == "mu" and "amplitude" in a2.get_ylabel()
     plt.close(fig)
+
+
+def test_branch_points_keep_a_thinned_period():
+    make = (lambda mu, h=None: landau(mu, h, 50))
+    e = _hopf_event(50)
+    o = da.hopf_orbit(make, e.hopf, e.u, amplitude=0.1, steps=600, component=0)
+    br = da.continue_orbit(o, 0.5, step=0.05, max_points=2, multipliers=0)
+    for q in br.points:
+        assert q.u.shape == (200, 2) and q.t[0] == 0 and q.t[-1] == pytest.approx(q.period)
+        r = np.hypot(q.u[:, 0], q.u[:, 1])             # a circle of the amplitude's radius
+        assert np.allclose(r, q.amplitude[0], rtol=2e-3)

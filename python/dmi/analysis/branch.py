@@ -14,6 +14,18 @@ from .stability import HopfPoint
 from .stepmap import Model
 
 
+#: Samples of the period a branch point keeps (:attr:`BranchPoint.u`).
+ORBIT_SAMPLES = 200
+
+
+def thinned(U: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
+    """(t, u) of one period U (M + 1 rows, step h) thinned to at most ORBIT_SAMPLES rows, the
+    first and the last kept."""
+    M = U.shape[0] - 1
+    idx = np.unique(np.round(np.linspace(0, M, min(M + 1, ORBIT_SAMPLES))).astype(int))
+    return idx * h, np.array(U[idx])
+
+
 @dataclass
 class BranchPoint:
     """One orbit of a branch: ``p``; ``period`` (time units); ``amplitude`` (n,): (max - min) / 2
@@ -22,7 +34,9 @@ class BranchPoint:
     the module; ``section`` (k, n): u at t = j period / k, j < k (k = ``sections``: a Poincare
     section at the forcing period of a k-periodic orbit); ``state``: the shooting state;
     ``dpds``: the tangent's p component (its sign flips at a fold); ``iterations`` and
-    ``corrector`` (``newton-picard`` or ``newton``, see the module; empty at the start)."""
+    ``corrector`` (``newton-picard`` or ``newton``, see the module; empty at the start); ``t``
+    and ``u`` (k, n): one period of the orbit from t = 0, thinned to at most
+    :data:`ORBIT_SAMPLES` samples (both ends kept), for plots."""
     p: float
     period: float
     amplitude: np.ndarray
@@ -36,6 +50,8 @@ class BranchPoint:
     dpds: float = 0.0
     iterations: int = 0
     corrector: str = ""
+    t: np.ndarray = field(default_factory=lambda: np.empty(0), repr=False)
+    u: np.ndarray = field(default_factory=lambda: np.empty((0, 0)), repr=False)
 
 
 @dataclass

@@ -56,7 +56,7 @@ import numpy as np
 
 from .._errors import Error
 from .._solver import Solver
-from .branch import Branch, BranchPoint, Event
+from .branch import Branch, BranchPoint, Event, thinned
 from .floquet import fd_step, phase_free, ritz
 from .autonomous import AutonomousMaps, phase_row, velocity
 from .newton import ShootingError, bordered_newton, bordered_step, fd_eps
@@ -118,11 +118,13 @@ def _point(F: StepMap, x: np.ndarray, multipliers: int, sections: int, dpds: flo
     steps, phases, margin = _stick_profile(F, U, X if margins else None)
     k = F.M // sections
     rest = phase_free(mu) if autonomous else mu
+    t, u = thinned(U, F.h)
     return BranchPoint(p=F.p, period=F.M * F.h, amplitude=0.5 * (U.max(axis=0) - U.min(axis=0)),
                        multipliers=mu, stable=bool(rest.size and np.all(np.abs(rest) < 1)),
                        stick_steps=steps, stick_phases=phases, margin=margin,
                        section=U[[j * k for j in range(sections)]], state=np.array(x),
-                       dpds=dpds, iterations=iterations, corrector=corrector)
+                       dpds=dpds, iterations=iterations, corrector=corrector,
+                       t=t, u=u)
 
 
 #: |dp/ds| (the unit tangent's p component) below which a branch is vertical: a sign change of
