@@ -195,20 +195,52 @@ def critical_vector(lin: Linearisation, lam: complex) -> np.ndarray:
 def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: float, steps: int,
                component: int | None = None, multipliers: int = 10, tol: float = 1e-10,
                max_iter: int = 30) -> Orbit:
-    """The autonomous orbit of the branch born at ``hopf_point`` (from :func:`dmi.analysis.hopf`
-    or a ``hopf`` event of :func:`dmi.analysis.continue_equilibrium`) whose amplitude is
-    ``amplitude``: the half range (max - min) / 2 over the period of the state component
-    ``component`` (default: the largest component of the critical eigenvector), state units.
+    """The autonomous orbit born at a Hopf point, of a given amplitude, its parameter free.
 
-    The parameter p is free: an amplitude condition replaces it, so the branch may leave the
-    Hopf point as sqrt|p - p_H| (smooth) or vertically (piecewise-linear friction, up to
-    grazing).  ``steps``: M steps a period; the model must take the step, ``make(p, h=...)``.
-    ``u_eq``: the equilibrium at the Hopf point (n values, corrected by Newton at the orbit's
-    step).  The first guess is u_eq + a Re(v e^(i omega t)) over one period 2 pi / omega, v the
-    null vector of the scheme's characteristic matrix at the root.  Returns an :class:`Orbit`
-    (``autonomous``; its p is the branch's at that amplitude, its period M h); continue it with
-    :func:`dmi.analysis.continue_orbit`.  Raises ValueError for bad input, ShootingError when
-    Newton fails (every residual listed)."""
+    An amplitude condition replaces the parameter: the unknowns are the state, the step h (the
+    period is M h) and p, the equations the fixed point, a phase condition and the amplitude.
+    So the branch may leave the Hopf point as sqrt|p - p_H| (smooth) or vertically
+    (piecewise-linear friction, up to grazing).  The first guess is u_eq + a Re(v e^(i omega
+    t)) over one period 2 pi / omega, v the null vector of the scheme's characteristic matrix at
+    the root.
+
+    Parameters
+    ----------
+    make : callable
+        The model ``make(p, h=...) -> dmi.Solver``: it must take the step.
+    hopf_point : HopfPoint
+        From :func:`dmi.analysis.hopf` or a ``hopf`` event of
+        :func:`dmi.analysis.continue_equilibrium` (``Event.hopf``).
+    u_eq : array_like, shape (n,)
+        The equilibrium at the Hopf point (``Event.u``), corrected by Newton at the orbit's step.
+    amplitude : float
+        The half range (max - min) / 2 over the period of the component ``component`` (state
+        units), > 0.
+    steps : int
+        M, steps a period (>= 8).
+    component : int, optional
+        Default: the largest component of the critical eigenvector.
+    multipliers : int
+        Leading Floquet multipliers to compute.
+    tol : float
+        Newton's tolerance.
+    max_iter : int
+        Newton iterations at most.
+
+    Returns
+    -------
+    Orbit
+        ``autonomous``; its ``p`` is the branch's at that amplitude, its period M h; continue it
+        with :func:`dmi.analysis.continue_orbit`.
+
+    Raises
+    ------
+    ValueError
+        Bad input: not a HopfPoint, omega <= 0 (a fold), amplitude <= 0, steps < 8, a component
+        out of range or not moving in the critical mode, a model that does not take h.
+    ShootingError
+        Newton fails (every residual listed).
+    """
     if not isinstance(hopf_point, HopfPoint):
         raise ValueError(f"hopf_point = {hopf_point!r}: give a dmi.analysis.HopfPoint")
     if not (hopf_point.omega > 0 and math.isfinite(hopf_point.omega)):

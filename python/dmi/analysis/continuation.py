@@ -641,30 +641,65 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                    sections: int = 1, margins: bool = True,
                    period: Callable[[float], float] | None = None,
                    refine: bool = False) -> Branch:
-    """Continues ``orbit`` (from :func:`periodic_orbit` or :func:`hopf_orbit`) in p towards
-    ``p_end`` (finite, not orbit.p) by pseudo-arclength with initial step ``step`` (the first
-    point at p + step, p units; then arclengths in the norm sqrt(|dx|^2 / dim + dp^2), p and
-    RMS state units; ``min_step`` default step / 1000, ``max_step`` default 4 step).  Every
-    point gets ``multipliers`` Floquet multipliers (they also make the Newton-Picard corrector's
-    basis: with 0 every step is a Newton-GMRES solve) and a stick profile; events are detected
-    between consecutive points (see the module).  ``sections``: the orbit spans this many
-    forcing periods (a period-doubled branch: 2), for ``BranchPoint.section``.
-    ``margins=False`` leaves the margins NaN (they come from the run that gives the point's
-    states, at no extra evaluation).
-    ``period``: None keeps the period M h (make(p) keeps h); a function p -> period (time units;
-    a forced orbit in its frequency w: ``period=lambda w: 2 * math.pi / w``) keeps M = orbit.steps
-    and gives the model the step h = period(p) / M through ``make(p, h=...)`` (orbit.make must
-    take it; orbit.period must equal period(orbit.p)).
-    An autonomous orbit (``orbit.autonomous``: from ``periodic_orbit(period=None)`` or
-    :func:`hopf_orbit`) has its period as an unknown: h = P / M with M = orbit.steps, N =
-    ceil(tau / h) changing along the branch (the states hold room for h down to 60 % of the
-    start's), and a phase condition through the previous point; its phase multiplier is left out
-    of ``stable`` and of the events; ``period`` must then be None.  ``refine``: the
-    period-doubling and torus events are placed from the refined multipliers of their two points
-    (:func:`dmi.analysis.refine_orbit`, 3 levels: the equation's, O(h^2)) instead of the
-    scheme's; the model must take the step, ``make(p, h=...)``.  Returns a
-    :class:`Branch` (``kind`` "orbits" or "autonomous"); a corrector that fails at the smallest
-    step ends the branch with that ``status``, it does not raise."""
+    """Continues a periodic orbit in its parameter by pseudo-arclength, with its events.
+
+    The corrector is Newton-Picard on the previous point's dominant subspace, Newton-GMRES when
+    that contracts too slowly (see the module); every point gets Floquet multipliers and a stick
+    profile; events (fold, period doubling, torus, stick onset, grazing) are detected between
+    consecutive points, and stick events located along the branch.  Corners (stick onset,
+    grazing) are passed by natural steps when the secant's hyperplane misses the branch's new
+    piece.
+
+    Parameters
+    ----------
+    orbit : Orbit
+        The start, from :func:`periodic_orbit` or :func:`hopf_orbit`.  An autonomous orbit
+        (``orbit.autonomous``) has its period as an unknown: h = P / M with M = orbit.steps, N =
+        ceil(tau / h) changing along the branch (the states hold room for h down to 60 % of the
+        start's), a phase condition through the previous point, and its phase multiplier left out
+        of ``stable`` and of the events.
+    p_end : float
+        Where to stop (finite, not orbit.p).
+    step : float
+        The first point's step in p; then arclengths in the norm sqrt(|dx|^2 / dim + dp^2) (p
+        and RMS state units; an autonomous branch weighs the period's change as p's).
+    max_points : int
+        Points at most.
+    min_step, max_step : float, optional
+        Step bounds (default step / 1000 and 4 step).
+    multipliers : int
+        Floquet multipliers a point (they also make the Newton-Picard basis; 0: Newton-GMRES).
+    tol : float
+        The corrector's tolerance.
+    max_iter : int
+        Newton iterations a step.
+    sections : int
+        The orbit spans this many forcing periods (a period-doubled branch: 2), for
+        ``BranchPoint.section``.
+    margins : bool
+        Compute the points' margins (no extra evaluation; False leaves them NaN).
+    period : callable, optional
+        None keeps the period M h (make(p) keeps h); a function p -> period (time units; a forced
+        orbit in its frequency w: ``period=lambda w: 2 * math.pi / w``) keeps M and gives the model
+        the step h = period(p) / M through ``make(p, h=...)``.  Must be None for an autonomous
+        orbit.
+    refine : bool
+        Place period-doubling and torus events from the refined multipliers of their two points
+        (:func:`dmi.analysis.refine_orbit`: the equation's, O(h^2)); the model must take h.
+
+    Returns
+    -------
+    Branch
+        ``kind`` "orbits" or "autonomous"; ``points``, ``events``, ``status``.  A corrector that
+        fails at the smallest step, or the model failing there, ends the branch with that
+        ``status``: it does not raise.
+
+    Raises
+    ------
+    ValueError
+        A bad ``step``, ``p_end``, ``max_points`` or ``period``; ``period`` for an autonomous
+        orbit; ``period(orbit.p)`` not the orbit's period.
+    """
     if not (math.isfinite(step) and step > 0):
         raise ValueError(f"step = {step!r}: must be finite and > 0 (p units)")
     if not math.isfinite(p_end) or p_end == orbit.p:
@@ -839,15 +874,41 @@ def _refined_event(maps: _Maps, a: BranchPoint, b: BranchPoint, e: Event, multip
 def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[float, ...] =
                          (0.03, 0.1, 0.3, 1.0), multipliers: int = 6, tol: float = 1e-10
                          ) -> Orbit:
-    """The period-2M orbit born at a ``period-doubling`` event of ``branch``: at the point of
-    the event's pair where the M-periodic orbit has a multiplier < -1 (its unstable side, where
-    a supercritical doubling's orbit lives) the M-periodic state x is perturbed along the
-    multiplier's Ritz vector v (:func:`dmi.analysis.floquet.ritz`, |v|_inf = 1), x + a A v, A
-    the orbit's amplitude, a from ``amplitudes`` (smallest first: the orbit born at the event is
-    the nearest), and shot with period 2 M h; the first solution that is not the M-periodic
-    orbit is returned (continue it with ``continue_orbit(..., sections=2 * branch.sections)``,
-    and ``period=lambda p: 2 * P(p)`` for a branch continued with ``period=P``: its ``make``
-    is then make(p, h=None), h = P(p) / M by default).  ShootingError when none is found."""
+    """The period-2M orbit born at a ``period-doubling`` event of a forced branch.
+
+    At the point of the event's pair where the M-periodic orbit has a multiplier < -1 (its
+    unstable side, where a supercritical doubling's orbit lives) the M-periodic state x is
+    perturbed along the multiplier's Ritz vector v (|v|_inf = 1), x + a A v, A the orbit's
+    amplitude, a from ``amplitudes`` (smallest first: the orbit born at the event is the nearest),
+    and shot with period 2 M h; the first solution that is not the M-periodic orbit is returned.
+    Continue it with ``continue_orbit(..., sections=2 * branch.sections)``, and
+    ``period=lambda p: 2 * P(p)`` for a branch continued with ``period=P``.
+
+    Parameters
+    ----------
+    branch : Branch
+        A forced branch from :func:`continue_orbit`.
+    event : Event
+        One of its ``period-doubling`` events.
+    amplitudes : tuple of float
+        The relative kicks tried.
+    multipliers : int
+        Floquet multipliers of the orbit returned.
+    tol : float
+        Newton's tolerance.
+
+    Returns
+    -------
+    Orbit
+        The period-doubled orbit.
+
+    Raises
+    ------
+    ValueError
+        The event is not a period doubling.
+    ShootingError
+        No period-doubled orbit found (what each kick gave is listed).
+    """
     if event.kind != "period-doubling":
         raise ValueError(f"event {event.kind!r}: expected a 'period-doubling' event")
     a, b = branch.points[event.index - 1], branch.points[event.index]

@@ -188,14 +188,45 @@ def _roots(make: Model, p: float, u: np.ndarray, count: int, tol: float, of: str
 
 def equilibrium(make: Model, p: float, guess: Any, *, tol: float = 1e-10, count: int = ROOTS,
                 max_iter: int = 30, of: str = "scheme") -> Equilibrium:
-    """The equilibrium of the scheme of ``make(p)`` near ``guess`` (n values, state units), by
-    Newton on one step from a constant history, until |G(u)|_inf and the last correction are
-    <= tol max(1, |u|_inf) (G is O(h) times the error: the correction bounds it); with its
-    ``count`` rightmost roots (:func:`dmi.analysis.roots`).  The model's exception when make
-    fails (a note names the call); ValueError for a guess of the wrong shape; ShootingError,
-    every residual listed, when Newton fails.  ``of="equation"``: the equilibrium of the
-    equation, with the continuous integral int_0^tau H instead of the scheme's sum h sum_l
-    H(l h) (O(h) apart), and the equation's roots (:func:`dmi.analysis.roots`)."""
+    """The equilibrium of the scheme of ``make(p)`` near ``guess``, by Newton's method.
+
+    Newton on one step from a constant history (the n x n Jacobian by forward differences of
+    single steps), until |G(u)|_inf and the last correction are <= tol max(1, |u|_inf) (G is
+    O(h) times the error: the correction bounds it); with its rightmost roots.
+
+    Parameters
+    ----------
+    make : callable
+        The model: ``make(p) -> dmi.Solver``, configured, not initialised.
+    p : float
+        The parameter.
+    guess : array_like, shape (n,)
+        A rough guess (state units); the equation's equilibrium is corrected too.
+    tol : float
+        Tolerance, relative to max(1, |u|_inf).
+    count : int
+        How many rightmost roots (:func:`roots`) to compute (0: none).
+    max_iter : int
+        Newton iterations at most.
+    of : {"scheme", "equation"}
+        ``"equation"``: the equation's equilibrium, with the continuous integral int_0^tau H
+        instead of the scheme's h sum_l H(l h) (O(h) apart), and the equation's roots.
+
+    Returns
+    -------
+    Equilibrium
+        ``.u``, ``.roots`` (rightmost first), ``.stable`` (Re roots[0] < 0), ``.residual``.
+
+    Raises
+    ------
+    ValueError
+        A guess that is not n finite numbers, or ``of`` not one of the two.
+    ShootingError
+        Newton fails: no new least residual in 3 iterations, a singular Jacobian, max_iter
+        reached (every residual is listed).
+    Exception
+        The model's own, when ``make(p)`` fails (a note names the call).
+    """
     steps = _Steps(make, check_of(of))
     n = steps(float(p)).n
     u0 = _check_guess(guess, n)
@@ -225,14 +256,45 @@ def continue_equilibrium(eq: Equilibrium, p_end: float, step: float = 0.05, *,
                          max_points: int = 200, min_step: float | None = None,
                          max_step: float | None = None, count: int = ROOTS,
                          tol: float = 1e-10, max_iter: int = 8) -> Branch:
-    """Continues the equilibrium ``eq`` (from :func:`equilibrium`) in p towards ``p_end`` by
-    pseudo-arclength, first step ``step`` (p units; then arclengths in the Euclidean norm of
-    (u, p); ``min_step`` default step / 1000, ``max_step`` default 4 step).  Each point gets its
-    ``count`` rightmost roots; the branch is of the scheme's or the equation's equilibria as
-    ``eq`` is (``eq.of``), with their roots and events.  Returns a :class:`Branch` (``kind``
-    "equilibria") of
-    :class:`EquilibriumPoint`, with ``fold`` and ``hopf`` events located on the branch (see the
-    module).  A corrector failing at the smallest step ends the branch (``status``)."""
+    """Continues an equilibrium in p by pseudo-arclength, with fold and Hopf events.
+
+    The tangent is the null vector of [G_u, G_p], the predictor y + ds t, the corrector Newton
+    on (G(y), <t, y - y_pred>); each point gets its ``count`` rightmost roots.  Events are
+    located on the branch by Brent's method in the arclength (see the module).
+
+    Parameters
+    ----------
+    eq : Equilibrium
+        The start, from :func:`equilibrium` (the branch is of the scheme's or the equation's
+        equilibria as ``eq.of`` is).
+    p_end : float
+        Where to stop (finite, not eq.p).
+    step : float
+        The first step (p units); later steps are arclengths in the Euclidean norm of (u, p).
+    max_points : int
+        Points at most.
+    min_step, max_step : float, optional
+        Step bounds (default step / 1000 and 4 step).
+    count : int
+        Roots a point.
+    tol : float
+        Newton's tolerance.
+    max_iter : int
+        Corrector iterations a step.
+
+    Returns
+    -------
+    Branch
+        ``kind`` "equilibria": ``points`` of :class:`EquilibriumPoint`, ``events`` (``fold``,
+        ``hopf`` with its :class:`HopfPoint` in ``Event.hopf`` and the equilibrium in
+        ``Event.u``), ``status`` (why it ended: a corrector failing at the smallest step, or
+        the model failing there, ends the branch; it does not raise).
+
+    Raises
+    ------
+    ValueError
+        ``eq`` not an Equilibrium, a bad ``step`` or ``p_end``.
+    """
     if not isinstance(eq, Equilibrium):
         raise ValueError(f"eq = {eq!r}: give a dmi.analysis.Equilibrium")
     if not (math.isfinite(step) and step > 0):

@@ -100,19 +100,41 @@ def monodromy_operator(F: StepMap, x: np.ndarray, eps: float | None = None,
 def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
                         eps: float | None = None, blocks: int = 2,
                         central: bool = True) -> np.ndarray:
-    """The ``count`` Floquet multipliers (dimensionless) of largest modulus at the fixed point x of
-    the M-step map F, largest first (complex).  F is a :class:`dmi.analysis.StepMap`, e.g.
-    ``StepMap(orbit.make, orbit.p, orbit.steps, orbit.rows)`` with x = ``orbit.state``; ``eps``
-    (state units) overrides the difference step of :func:`fd_step`.  States of at most 64 values:
-    the eigenvalues of the dense matrix (its columns by the operator).  Larger: Rayleigh-Ritz on
-    ``blocks`` blocks of a block Krylov space, b = count + 2 vectors a block from random ones
-    (b ``blocks`` products of 2 evaluations each, 1 with ``central=False``, see
-    :func:`monodromy_operator`): the eigenvalues of B' A B, B the space's orthonormal basis.
-    Not ARPACK's eigs: the difference operator is linear only up to the switches' rounding to a
-    step (O(h / eps)), and a long Krylov recurrence with restarts amplifies that (two eigs calls
-    at one orbit of the tau-diagram, M = 2000: 0.226 and 0.279), while a Ritz matrix of
-    independently differenced columns, few blocks deep, carries it once.  Multipliers below
-    1e-12 in modulus are returned as 0 (the stick's)."""
+    """The leading Floquet multipliers of a periodic orbit, right at stick/slip transitions.
+
+    The monodromy operator by central differences with a step that moves the switches by many
+    steps (:func:`fd_step`; the smooth step on an orbit with no switch to carry); its eigenvalues
+    of largest modulus by Rayleigh-Ritz on ``blocks`` blocks of a block Krylov space of b =
+    count + 2 vectors (states of at most 64 values: the dense matrix).  Not ARPACK's eigs: the
+    difference operator is linear only up to the switches' rounding to a step (O(h / eps)), and a
+    long Krylov recurrence with restarts amplifies that, while a Ritz matrix of independently
+    differenced columns, few blocks deep, carries it once.
+
+    Parameters
+    ----------
+    F : StepMap
+        The M-step map, e.g. ``StepMap(orbit.make, orbit.p, orbit.steps, orbit.rows)``.
+    x : numpy.ndarray
+        Its fixed point, e.g. ``orbit.state``.
+    count : int
+        How many multipliers.
+    eps : float, optional
+        The difference step (state units), instead of :func:`fd_step`'s.
+    blocks : int
+        Krylov blocks (>= 2).
+    central : bool
+        Central differences (2 evaluations a product), else forward (1).
+
+    Returns
+    -------
+    numpy.ndarray of complex, shape (count,)
+        Largest |mu| first (dimensionless); below 1e-12 in modulus: 0 (a stuck phase's).
+
+    Raises
+    ------
+    ValueError
+        blocks < 2.
+    """
     return ritz(F, x, count, blocks=blocks, eps=eps, central=central)[0]
 
 

@@ -44,6 +44,26 @@ def stalled(res: list[float]) -> bool:
     return len(res) > NO_PROGRESS and min(res[-NO_PROGRESS:]) >= min(res[:-NO_PROGRESS])
 
 
+def judge(res: list[float], rn: float, tol: float, max_iter: int, what: str, hint: str = ""
+          ) -> str:
+    """Appends an iteration's residual rn to res and judges it: ``"converged"`` (rn <= tol),
+    ``"exhausted"`` (max_iter iterations done) or ``"go on"``; raises ShootingError on a
+    non-finite residual or when there is no new least residual in NO_PROGRESS iterations."""
+    res.append(rn)
+    if not math.isfinite(rn):
+        raise ShootingError(f"{what}: non-finite residual (residuals {fmt_residuals(res)}): "
+                            "the guess is too far from any orbit", res)
+    if rn <= tol:
+        return "converged"
+    if len(res) > max_iter:
+        return "exhausted"
+    if stalled(res):
+        raise ShootingError(f"{what}: Newton makes no progress: no new least residual in "
+                            f"{NO_PROGRESS} iterations (residuals {fmt_residuals(res)}; tolerance "
+                            f"{tol:.3g}){hint}", res)
+    return "go on"
+
+
 def fd_eps(x: np.ndarray) -> float:
     """The forward-difference step of Newton's matrix-free Jacobians: sqrt(eps_machine)
     max(1, |x|_inf) (state units)."""
@@ -116,20 +136,13 @@ def newton(F: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, *, tol: float 
     for _ in range(max_iter + 1):
         r = Fx - x
         rn = float(np.max(np.abs(r)))
-        res.append(rn)
-        if not math.isfinite(rn):
-            raise ShootingError(f"{what}: non-finite residual (residuals {fmt_residuals(res)}): "
-                                "the guess is too far from any orbit", res)
         scale = max(1.0, float(np.max(np.abs(x))))
-        if rn <= tol * scale:
+        verdict = judge(res, rn, tol * scale, max_iter, what,
+                        ": no orbit near the guess, or the orbit is not isolated")
+        if verdict == "converged":
             return x, res
-        if len(res) > max_iter:
+        if verdict == "exhausted":
             break
-        if stalled(res):
-            raise ShootingError(f"{what}: Newton makes no progress: no new least residual in "
-                                f"{NO_PROGRESS} iterations (residuals {fmt_residuals(res)}; "
-                                f"tolerance {tol * scale:.3g}): no orbit near the guess, or the "
-                                "orbit is not isolated", res)
         eps = fd_eps(x)
 
         def mv(v: np.ndarray, Fx: np.ndarray = Fx, x: np.ndarray = x) -> np.ndarray:
@@ -184,19 +197,12 @@ def bordered_newton(maps: Callable[[np.ndarray], Callable[[np.ndarray], np.ndarr
         r = Fx - x
         g, rows = conditions(z)
         rn = max(float(np.max(np.abs(r))), float(np.max(np.abs(g))) if len(g) else 0.0)
-        res.append(rn)
-        if not math.isfinite(rn):
-            raise ShootingError(f"{what}: non-finite residual (residuals "
-                                f"{fmt_residuals(res)})", res)
         scale = max(1.0, float(np.max(np.abs(x))))
-        if rn <= tol * scale:
+        verdict = judge(res, rn, tol * scale, max_iter, what)
+        if verdict == "converged":
             return z, res
-        if len(res) > max_iter:
+        if verdict == "exhausted":
             break
-        if stalled(res):
-            raise ShootingError(f"{what}: Newton makes no progress: no new least residual in "
-                                f"{NO_PROGRESS} iterations (residuals {fmt_residuals(res)}; "
-                                f"tolerance {tol * scale:.3g})", res)
         cols = np.empty((dim, k))
         for j in range(k):
             d = 1e-7 * max(1.0, abs(q[j])) if steps is None else float(steps[j])

@@ -111,12 +111,36 @@ def _orders(X: np.ndarray, tiny: np.ndarray) -> np.ndarray:
 
 
 def refine_orbit(orbit: Orbit, *, levels: int = 3, tol: float = 1e-10) -> Refined:
-    """``orbit`` (from :func:`periodic_orbit` or :func:`hopf_orbit`) recomputed at M, 2 M, ...,
-    2^(levels - 1) M steps a period, its period, amplitude and leading multipliers (as many as
-    the orbit has) extrapolated to h = 0 where the levels show the scheme's first order, with
-    error estimates (see the module).  The model must take the step, ``make(p, h=...)``, for a
-    forced orbit too.  Raises ValueError for levels < 3 or a model that does not take h, and
-    ShootingError when a level's shooting fails."""
+    """The orbit recomputed at finer steps and extrapolated to h = 0, with error estimates.
+
+    Levels M, 2 M, ..., 2^(levels - 1) M steps a period, each started from the one before; the
+    period, amplitudes and leading multipliers (as many as the orbit has) are extrapolated where
+    the levels show the scheme's first order (see the module).
+
+    Parameters
+    ----------
+    orbit : Orbit
+        From :func:`periodic_orbit` or :func:`hopf_orbit`; its model must take the step,
+        ``make(p, h=...)``, for a forced orbit too.
+    levels : int
+        Levels (>= 3).
+    tol : float
+        Newton's tolerance at each level.
+
+    Returns
+    -------
+    Refined
+        ``period``, ``amplitude``, ``multipliers``, ``errors`` (a dict keyed by those three
+        names), ``order`` (2 after Richardson; else the smallest observed order), ``orbits``,
+        ``steps``.
+
+    Raises
+    ------
+    ValueError
+        levels < 3, or a model that does not take h.
+    ShootingError
+        A level's shooting fails.
+    """
     if int(levels) != levels or levels < 3:
         raise ValueError(f"levels = {levels!r}: give 3 or more (M, 2 M, 4 M, ...)")
     count = int(orbit.multipliers.size)

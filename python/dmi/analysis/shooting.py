@@ -19,25 +19,60 @@ def periodic_orbit(make: Model, p: float, period: float | None = None, guess: An
                    guess_period: float | None = None, steps: int | None = None,
                    tol: float = 1e-10, max_iter: int = 30, multipliers: int = 10,
                    rows: int | None = None) -> Orbit:
-    """The periodic orbit of the model ``make`` at ``p`` near ``guess``, by shooting.
+    """The periodic orbit of the model near a guess, by shooting.
 
-    ``period`` (time units) must be a whole number M of steps h of ``make(p)`` (forced systems
-    with period P: take h = P / M).  ``guess``: a state (L n values, or an (L, n) array: the
-    last L stored states, the last at t = 0) or a ``dmi.Solver`` of the same model run onto the
-    orbit (it is not changed: a copy of its state is advanced to the next step index that is a
-    multiple of M, the orbit's phase 0).  ``rows``: L (default N + 1).  Newton with GMRES on
-    the matrix-free Jacobian converges to ``tol`` in the max norm (relative to max(1, |x|));
-    ``multipliers``: how many leading Floquet multipliers to compute (0: none, ``stable`` is
-    then False).  ``period=None`` with ``guess_period``: an autonomous orbit of unknown period
-    M h, ``steps`` = M fixed (default guess_period / make(p).h) and h unknown, with a phase
-    condition; the model must take the step, ``make(p, h=...)`` (libdmi 1.2's
-    ``dmi.Solver(n, tau, h=...)``), see :mod:`dmi.analysis.autonomous`.
+    Newton with GMRES on the matrix-free Jacobian of the M-step map (:mod:`dmi.analysis.stepmap`)
+    to ``tol`` in the max norm (relative to max(1, |x|)).  A forced orbit: ``period`` is a whole
+    number M of steps h of ``make(p)`` (take h = P / M), and the result is checked to be a period
+    of the model (one more period run from t = P, in the model's own time).  An autonomous orbit:
+    ``period=None`` with ``guess_period``, M = ``steps`` fixed and h unknown, with a phase
+    condition (:mod:`dmi.analysis.autonomous`); the model must take the step, ``make(p, h=...)``.
 
-    Raises ValueError for bad input (period <= 0 or not a multiple of h, a guess of the wrong
-    shape, a ``period`` that is not a period of the model: one more period run from t = P, not
-    from t = 0, differs from the first), the model's own exception when ``make(p)`` fails (with a
-    note naming the call), and :class:`ShootingError` when Newton fails (with every residual
-    tried)."""
+    Parameters
+    ----------
+    make : callable
+        The model ``make(p) -> dmi.Solver``, configured, not initialised.
+    p : float
+        The parameter.
+    period : float or None
+        The period (time units), or None for an autonomous orbit.
+    guess : array_like or dmi.Solver
+        A state (L n values or (L, n) rows, oldest first, the last at t = 0; N + 1 <= k <= L
+        rows; or n values: a constant window), or a solver of the same model run onto the orbit
+        (not changed: a copy of its state is advanced to the orbit's phase 0; an autonomous
+        orbit takes its window as it is).
+    guess_period : float, optional
+        An autonomous orbit's period guess (time units).
+    steps : int, optional
+        An autonomous orbit's M (default guess_period / h of ``make(p)``).
+    tol : float
+        Newton's tolerance.
+    max_iter : int
+        Newton iterations at most.
+    multipliers : int
+        Leading Floquet multipliers to compute (0: none; ``stable`` is then False).
+    rows : int, optional
+        L, the rows of the state (default N + 1).
+
+    Returns
+    -------
+    Orbit
+        The orbit: one period ``t``, ``u``, its ``state``, ``multipliers``, ``stable`` (an
+        autonomous orbit's leaves out its phase multiplier), ``stick_fraction``.
+
+    Raises
+    ------
+    ValueError
+        Bad input: a period <= 0 or not a whole number of steps, a guess of the wrong shape (the
+        message names n and the shapes accepted), a ``period`` that is not a period of the model
+        (the mismatch is given), a model that does not take h for an autonomous orbit.
+    ShootingError
+        Newton fails, with every residual tried: no new least residual in 3 iterations, a
+        singular Jacobian, max_iter reached, the map failing (a NaN from the rhs names the call
+        and p), an autonomous orbit converging to an equilibrium or a guess period too long.
+    Exception
+        The model's own, when ``make(p)`` fails (a note names the call).
+    """
     if guess is None:
         raise ValueError("guess: give a state or a dmi.Solver run onto the orbit")
     if period is None:

@@ -175,21 +175,47 @@ def rightmost_of(lin: Linearisation, count: int, of: str = "scheme") -> np.ndarr
 
 def roots(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 10, *,
           tol: float = 1e-9, of: str = "scheme") -> np.ndarray:
-    """The ``count`` rightmost characteristic roots lambda (1 / time unit) of the scheme's step map
-    linearised at the constant history ``u_eq``, rightmost first (of a pair, Im >= 0 first).
+    """The rightmost characteristic roots of an equilibrium.
 
-    ``make(p)`` returns a configured, not initialised :class:`dmi.Solver` (any rhs, resolvent,
-    friction or box, kernel, convolution method); ``u_eq`` is an array (n,) or a function
-    ``u_eq(p)``.  A root is lambda = log(z) / h for a multiplier z of the one-step map: Re lambda is
-    the growth rate of the mode, Im lambda its angular frequency (radians / time unit), not reduced
-    modulo 2 pi / tau.  A root -inf is a multiplier 0 (a component held by the resolvent).
-    ``of="equation"``: u_eq is the equation's equilibrium (the continuous integral,
-    :func:`dmi.analysis.equilibrium` with ``of="equation"``), and each root is refined to one of
-    the continuous equation, det Delta(lambda) = 0
-    (:mod:`dmi.analysis.equation`), to |dlambda| <= 1e-10 max(1, |lambda|); a root that cannot be
-    refined is nan, with a :class:`dmi.analysis.equation.RefinementWarning` saying why.
-    Raises ValueError if u_eq is not a fixed point of the step map (relative residual above
-    ``tol``), :class:`KinkError` (a ValueError) if the resolvent has a kink there.
+    The roots lambda (1 / time unit) of the scheme's step map linearised at the constant history
+    ``u_eq``: lambda = log(z) / h for a multiplier z of the one-step map.  Re lambda is the mode's
+    growth rate, Im lambda its angular frequency (radians / time unit), not reduced modulo
+    2 pi / tau.  A root -inf is a multiplier 0 (a component held by the resolvent).
+
+    Parameters
+    ----------
+    make : callable
+        The model: ``make(p) -> dmi.Solver`` (any rhs, resolvent, friction or box, kernel,
+        convolution method), configured, not initialised.
+    p : float
+        The parameter.
+    u_eq : array_like, shape (n,), or callable
+        The equilibrium, or a function ``u_eq(p)``.
+    count : int
+        How many roots.
+    tol : float
+        The equilibrium's residual tolerance: one step may move u_eq by tol max(1, |u_eq|,
+        |u_eq - X*|).
+    of : {"scheme", "equation"}
+        ``"equation"``: u_eq is the equation's equilibrium (the continuous integral), and each
+        root is refined to one of the continuous equation, det Delta(lambda) = 0
+        (:mod:`dmi.analysis.equation`), to |dlambda| <= 1e-10 max(1, |lambda|); a root that
+        cannot be refined is nan, with a :class:`dmi.analysis.equation.RefinementWarning`
+        saying why.
+
+    Returns
+    -------
+    numpy.ndarray of complex, shape (count,)
+        Rightmost first; of a conjugate pair, Im >= 0 first.
+
+    Raises
+    ------
+    ValueError
+        u_eq is not an equilibrium (relative residual above ``tol``), count < 1, ``of`` unknown.
+    KinkError
+        The resolvent has a kink at the equilibrium (a ValueError).
+    Exception
+        The model's own, when ``make(p)`` fails (a note names the call).
     """
     if int(count) != count or count < 1:
         raise ValueError(f"dmi.analysis.roots: count = {count!r}: must be an integer >= 1")
@@ -217,11 +243,38 @@ def rightmost_real(make: Callable[[float], Solver], p: float, u_eq: Any, count: 
 def hopf(make: Callable[[float], Solver], p_lo: float, p_hi: float, u_eq: Any, *,
          rtol: float = 1e-10, count: int = 4, tol: float = 1e-9, of: str = "scheme"
          ) -> HopfPoint:
-    """The parameter p in (p_lo, p_hi) where the rightmost root of :func:`roots` crosses the
-    imaginary axis, to ``rtol`` relative (Brent's method on Re lambda_1(p)); ``tol``: the
-    equilibrium-residual tolerance of :func:`roots`; ``of``: the scheme's roots (default) or the
-    equation's (see :func:`roots`).  Raises ValueError if p_lo = p_hi or Re lambda_1 has the same
-    sign at both ends (no crossing bracketed)."""
+    """The parameter where the rightmost root crosses the imaginary axis.
+
+    Brent's method on Re lambda_1(p), each value from :func:`roots`.
+
+    Parameters
+    ----------
+    make : callable
+        The model ``make(p) -> dmi.Solver``.
+    p_lo, p_hi : float
+        The bracket (Re lambda_1 of opposite signs at its ends).
+    u_eq : array_like or callable
+        The equilibrium, or a function ``u_eq(p)``.
+    rtol : float
+        Tolerance on p, relative.
+    count : int
+        Roots computed at each p.
+    tol : float
+        The equilibrium-residual tolerance of :func:`roots`.
+    of : {"scheme", "equation"}
+        The scheme's roots (default) or the equation's (see :func:`roots`).
+
+    Returns
+    -------
+    HopfPoint
+        ``.p``, ``.omega`` (|Im lambda_1|; 0: a real root crosses, a fold) and ``.root``.
+
+    Raises
+    ------
+    ValueError
+        p_lo = p_hi, or Re lambda_1 has the same sign at both ends (no crossing bracketed); the
+        errors of :func:`roots`.
+    """
     check_of(of)
     p_lo, p_hi = float(p_lo), float(p_hi)
     if not (math.isfinite(p_lo) and math.isfinite(p_hi)) or p_lo == p_hi:

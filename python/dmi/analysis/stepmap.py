@@ -58,7 +58,28 @@ class StepMap:
 
     One solver is made and initialised once; every evaluation restores its step counter to 0
     (``load_state`` of the state saved after ``init``), sets the window and runs M steps.
-    ``evaluations`` counts the calls (each costs M steps)."""
+    ``evaluations`` counts the calls (each costs M steps).
+
+    Parameters
+    ----------
+    make : callable
+        The model ``make(p) -> dmi.Solver``.
+    p : float
+        The parameter.
+    M : int
+        Steps of the map (a period).
+    rows : int, optional
+        L, the state's rows (default N + 1; extra rows are a nilpotent block).
+    solver : dmi.Solver, optional
+        ``make(p)`` already built by the caller (not initialised).
+
+    Raises
+    ------
+    ValueError
+        rows < N + 1.
+    Exception
+        The model's own, when ``make(p)`` fails (a note names the call).
+    """
 
     def __init__(self, make: Model, p: float, M: int, rows: int | None = None,
                  solver: Solver | None = None):
@@ -75,6 +96,7 @@ class StepMap:
 
     @property
     def dim(self) -> int:
+        """The state's size, L n values."""
         return self.L * self.n
 
     def _start_at(self, x: np.ndarray) -> Solver:
@@ -87,24 +109,75 @@ class StepMap:
         return s
 
     def trajectory(self, x: np.ndarray) -> np.ndarray:
-        """The M + 1 states U^0 .. U^M (rows) from the state x (U^0 its last row)."""
+        """The M + 1 states from a state.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            A state (L n values).
+
+        Returns
+        -------
+        numpy.ndarray, shape (M + 1, n)
+            U^0 .. U^M (U^0 is x's last row).
+        """
         return self._start_at(x).run(self.M)[1]
 
     def run_from(self, x: np.ndarray, steps: int) -> np.ndarray:
-        """The steps + 1 states U^0 .. U^steps from the state x, in the model's own time from
-        t = 0 (a run over several periods: one evaluation)."""
+        """The states of a run from a state, in the model's own time from t = 0.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            A state (L n values).
+        steps : int
+            Steps to run (several periods: one evaluation).
+
+        Returns
+        -------
+        numpy.ndarray, shape (steps + 1, n)
+            U^0 .. U^steps.
+        """
         return self._start_at(x).run(int(steps))[1]
 
     def trajectory_terms(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`trajectory` and the resolvent's arguments X^0 .. X^(M-1) (M rows: X^k the
-        argument of the step into U^(k+1)), from one run."""
+        """The trajectory and the resolvent's arguments, from one run.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            A state (L n values).
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            U, shape (M + 1, n), as :meth:`trajectory`; X, shape (M, n): X^k the resolvent's
+            argument of the step into U^(k+1).
+        """
         _, U, X = self._start_at(x).run_terms(self.M)
         return U, X
 
     def extend(self, x: np.ndarray) -> np.ndarray:
-        """x (k >= N + 1 rows, flattened) as a state of L rows: the older rows by M-periodicity
-        from one run, row at t = -j being U^(M - j mod M) (exact at an M-periodic orbit; a guess
-        elsewhere).  The last L rows when k >= L."""
+        """A state of k rows as one of L rows.
+
+        The older rows by M-periodicity from one run, the row at t = -j being U^(M - j mod M)
+        (exact at an M-periodic orbit; a guess elsewhere); the last L rows when k >= L.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            k >= N + 1 rows of n, flattened.
+
+        Returns
+        -------
+        numpy.ndarray
+            L n values.
+
+        Raises
+        ------
+        ValueError
+            k < N + 1.
+        """
         X = np.asarray(x, dtype=float).reshape(-1, self.n)
         k = X.shape[0]
         if k >= self.L:
