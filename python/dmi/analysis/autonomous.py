@@ -38,9 +38,11 @@ def fixed_step(make: Model, h: float) -> Model:
     """make at the step h: ``made(p)`` is ``make(p, h=h)``, and ``made(p, h=other)`` another
     step (an autonomous Orbit's ``make``: StepMap(orbit.make, ...) runs at the orbit's step and
     continuation changes it)."""
+    base = getattr(make, "base", make)     # the user's model, not a made of a made
+
     def made(p: float, h: float = h) -> Solver:
-        return make(p, h=h)  # type: ignore[call-arg]
-    made.base = getattr(make, "base", make)  # type: ignore[attr-defined]
+        return base(p, h=h)  # type: ignore[call-arg]
+    made.base = base  # type: ignore[attr-defined]
     return made
 
 
