@@ -48,7 +48,7 @@ extern "C" {
 
 /* Version of this header; dmi_version() gives the version of the library. */
 #define DMI_VERSION_MAJOR 1
-#define DMI_VERSION_MINOR 2
+#define DMI_VERSION_MINOR 3
 #define DMI_VERSION_PATCH 0
 
 /* DMI_API marks the exported functions of the shared library. */
@@ -98,6 +98,12 @@ enum {
     DMI_CONV_DIRECT = 1, /* the plain sum, N multiply-adds per nonzero kernel entry */
     DMI_CONV_FFT = 2,    /* exact block convolution with FFTs (same sum, other rounding) */
     DMI_CONV_RECURSIVE = 3 /* (since 1.1) O(1) recursion of an exponential-sum kernel */
+};
+
+/* Quadrature rules of the delay sum (see dmi_set_quadrature; since 1.3). */
+enum {
+    DMI_QUAD_LEFT = 0, /* the default: the paper's rectangle rule, h H(l h) per cell */
+    DMI_QUAD_CELL = 1  /* exact cell weights: the integral of H over each cell */
 };
 
 /* ---- version --------------------------------------------------------- */
@@ -218,6 +224,38 @@ DMI_API int dmi_set_kernel(dmi_solver *s, dmi_kernel_fn H, void *user);
  */
 DMI_API int dmi_set_kernel_exp(dmi_solver *s, size_t K, const double *a, const double *b,
                                const double *C, const double *D);
+
+/*
+ * (Since 1.3.)  The quadrature rule of the delay integral, before dmi_init:
+ *   DMI_QUAD_LEFT  (the default) the paper's rule, the weight h H(l h) per
+ *                  cell (theta h H((N-1) h) for a partial last cell); the
+ *                  results of libdmi 1.2, bitwise.
+ *   DMI_QUAD_CELL  exact cell weights: each cell's weight is the integral of
+ *                  H over it,
+ *                    W^p = sum_{l<N-1} int_{l h}^{(l+1) h} H(s) ds U^{p-l}
+ *                        + int_{(N-1) h}^{tau} H(s) ds U^{p-N+1},
+ *                  the last cell partial as for dmi_create_h.  A kernel that
+ *                  is singular at s = 0 but integrable (s^-alpha, alpha < 1:
+ *                  fractional damping) then runs: H is never evaluated at 0.
+ *                  Exponential kernels (dmi_set_kernel_exp) in closed form,
+ *                  per term mu = a + i b the cell weight
+ *                  h Re((C - i D) phi1(mu h) e^{mu l h}), phi1(z) = (e^z - 1)/z
+ *                  (the partial last cell: theta h and phi1(mu theta h)); the
+ *                  recursion runs the same weights at the same cost.  Callback
+ *                  kernels by tanh-sinh quadrature on each cell (the step
+ *                  halved until two levels agree to 1e-14 of the cell's
+ *                  integral of |H|, at most 8193 calls a cell; typically 30 to
+ *                  70 calls for a smooth kernel), by dmi_init, which then calls
+ *                  H at points inside the cells (0 < s < tau), not at l h.
+ *                  Every method (DIRECT, FFT, RECURSIVE) computes this same
+ *                  sum (up to rounding).  The error of the rule is that of the
+ *                  product U(t - s) ~ U^{p-l} on the cell, order 1 in h, as the
+ *                  left rule's for smooth H (docs/kernels.md).
+ * The rule is not part of the saved state (set it alike on the solver that
+ * loads one).  Errors: DMI_EINVAL for s NULL or another rule; DMI_ESTATE
+ * after dmi_init (the weights are computed there; create a new solver).
+ */
+DMI_API int dmi_set_quadrature(dmi_solver *s, int rule);
 
 /* History z(t) on [-tau, 0]; z = NULL restores z = 0.  Sampled at t = p h,
  * p = -(N-1)..0, and at t = -tau for U^{-N} (= -N h for dmi_create, not for

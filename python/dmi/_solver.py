@@ -405,6 +405,19 @@ class Solver:
             _L.dmi_free(ctypes.byref(self._handle))
             self._handle = None
 
+    def set_quadrature(self, rule: str) -> None:
+        """Quadrature rule of the delay integral, before :meth:`init` (``dmi_set_quadrature``):
+        ``"left"`` (default) the paper's rectangle rule h H(l h) per cell; ``"cell"`` exact cell
+        weights, the integral of H over each cell (closed form for :meth:`set_kernel_exp`, tanh-sinh
+        quadrature for a callback, which is then called inside the cells, never at s = 0: kernels
+        singular at 0 such as s^-1/2 run).  Every convolution method computes the same sum."""
+        code = _lib.QUAD.get(rule) if isinstance(rule, str) else None
+        if code is None:
+            raise InvalidArgument(_lib.EINVAL, f"set_quadrature: rule {rule!r}: expected one of "
+                                  f"{', '.join(map(repr, _lib.QUAD))}")
+        with self._using() as s:
+            self._check(_L.dmi_set_quadrature(s, code))
+
     def __repr__(self) -> str:
         if self._h_given is not None:
             return f"dmi.Solver(n={self._n}, tau={self._tau!r}, h={self._h_given!r})"
