@@ -257,6 +257,28 @@ DMI_API int dmi_set_kernel_exp(dmi_solver *s, size_t K, const double *a, const d
  */
 DMI_API int dmi_set_quadrature(dmi_solver *s, int rule);
 
+/*
+ * (Since 1.3.)  A kernel singular at 0 in O(1) per step: the exponential sum
+ * set by dmi_set_kernel_exp (a fit of the kernel on [delta, tau], e.g. by
+ * Python's dmi.kernels.fit or dmi-kernel-fit) for the far cells, and the
+ * exact kernel H (n*n row-major, a dmi_kernel_fn) for the m = ceil(delta / h)
+ * near cells [l h, (l + 1) h), l < m, whose weights are H's exact integrals
+ * over them (tanh-sinh quadrature by dmi_init, as for DMI_QUAD_CELL: H is
+ * called inside those cells, 0 < s <= m h, never at 0).  The far cells
+ * follow the rule of dmi_set_quadrature (use DMI_QUAD_CELL: the left rule
+ * samples the sum at l h).  Every method computes the same sum;
+ * RECURSIVE (and AUTO) runs the recursion of the sum over all N cells and
+ * adds the near cells' exact weights less the sum's: O(K n^2 + m nnz) per
+ * step.  delta = 0 (m = 0) or H = NULL: no near cells (H = NULL removes
+ * them).  The user pointer is stored and passed back.
+ * Errors: DMI_EINVAL for s NULL or delta negative or not finite; from
+ * dmi_init, DMI_EINVAL when the kernel is not one of dmi_set_kernel_exp or
+ * when m + 1 > N (the last cell must be the sum's), and the kernel
+ * callback's errors (DMI_ECALLBACK, DMI_ENONFINITE); DMI_ESTATE after
+ * dmi_init.
+ */
+DMI_API int dmi_set_kernel_near(dmi_solver *s, dmi_kernel_fn H, void *user, double delta);
+
 /* History z(t) on [-tau, 0]; z = NULL restores z = 0.  Sampled at t = p h,
  * p = -(N-1)..0, and at t = -tau for U^{-N} (= -N h for dmi_create, not for
  * a partial last cell of dmi_create_h), once by dmi_init.  DMI_ESTATE after

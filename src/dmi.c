@@ -149,6 +149,11 @@ void dmi_engine_rebuild(const dmi_solver *s, dmi_conv *conv, dmi_exp *rec)
  * the engine moves on), or W filled. */
 static const double *delay_sum_full(const dmi_solver *s, double *W)
 {
+    if (s->rec && s->near.nnz) { /* the near cells' exact weights less the sum's */
+        memcpy(W, dmi_exp_sum(s->rec), s->n * sizeof *W);
+        dmi_quad_near_add(&s->near, &s->ring, s->h, W);
+        return W;
+    }
     if (s->rec)
         return dmi_exp_sum(s->rec);
 #ifdef DMI_HAVE_FFT
@@ -289,6 +294,7 @@ void dmi_free(dmi_solver **ps)
     dmi_expk_release(&s->expk);
     dmi_expk_release(&s->cell_expk);
     free(s->cell_last);
+    dmi_kernel_release(&s->near);
     engine_free(s->conv, s->rec);
     free(s->last_W);
     free(s->last_X);
@@ -442,6 +448,22 @@ int dmi_set_quadrature(dmi_solver *s, int rule)
     return DMI_OK;
 }
 
+int dmi_set_kernel_near(dmi_solver *s, dmi_kernel_fn H, void *user, double delta)
+{
+    if (!s)
+        return DMI_EINVAL;
+    if (s->initialized)
+        return dmi_fail(s, DMI_ESTATE, "dmi_set_kernel_near: the kernel's weights are computed by "
+                                       "dmi_init and cannot change afterwards");
+    if (H && !(isfinite(delta) && delta >= 0))
+        return dmi_fail(s, DMI_EINVAL, "dmi_set_kernel_near: delta = %g; expected a finite "
+                                       "delta >= 0", delta);
+    s->near_H = H;
+    s->near_user = H ? user : NULL;
+    s->near_delta = H ? delta : 0.0;
+    return DMI_OK;
+}
+
 int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user)
 {
     if (!s)
@@ -579,7 +601,14 @@ int dmi_init(dmi_solver *s)
     dmi_conv *c = NULL;
     dmi_exp *e = NULL;
     double *last = NULL;
-    rc = s->quad == DMI_QUAD_CELL ? quad_prepare(s, &k, &last) : sample_kernel(s, &k);
+    dmi_kernel near = {0};
+    if (s->near_H && !dmi_has_expk(s))
+        rc = dmi_fail(s, DMI_EINVAL, "dmi_init: the near cells of dmi_set_kernel_near need a kernel "
+                                     "given by dmi_set_kernel_exp");
+    if (rc == DMI_OK)
+        rc = s->quad == DMI_QUAD_CELL ? quad_prepare(s, &k, &last) : sample_kernel(s, &k);
+    if (rc == DMI_OK && s->near_H)
+        rc = dmi_quad_near(s, &k, &last, &near);
     if (rc == DMI_OK)
         rc = sample_history(s, &ring);
     if (rc == DMI_OK)
@@ -588,10 +617,13 @@ int dmi_init(dmi_solver *s)
         dmi_kernel_release(&k);
         dmi_history_release(&ring);
         free(last);
+        dmi_kernel_release(&near);
         return rc;
     }
     free(s->cell_last);
     s->cell_last = last;
+    dmi_kernel_release(&s->near);
+    s->near = near;
     dmi_kernel_release(&s->kernel);
     dmi_history_release(&s->ring);
     s->kernel = k;

@@ -106,6 +106,8 @@ static double expk_last(const dmi_expk *k, size_t q, size_t N, double h, double 
 
 typedef struct {
     dmi_solver *s;
+    dmi_kernel_fn H;
+    void *user;
     size_t nn;
     double *val; /* nn: H at the node */
 } integrand;
@@ -114,7 +116,7 @@ typedef struct {
 static int add_node(integrand *g, double x, double wt, double *acc, double *absacc)
 {
     memset(g->val, 0, g->nn * sizeof *g->val);
-    int rc = g->s->H(x, g->val, g->s->H_user);
+    int rc = g->H(x, g->val, g->user);
     if (rc != 0)
         return dmi_fail(g->s, DMI_ECALLBACK, "dmi_init: kernel callback returned %d at s = %.17g",
                         rc, x);
@@ -222,7 +224,7 @@ int dmi_quad_sample(dmi_solver *s, dmi_kernel *k, double **last)
         return dmi_fail(s, DMI_ENOMEM, "dmi_init: cannot allocate %zu x %zu x %zu cell weights", N,
                         n, n);
     }
-    integrand g = {s, nn, scratch + 4 * nn};
+    integrand g = {s, s->H, s->H_user, nn, scratch + 4 * nn};
     int rc = DMI_OK;
     for (size_t l = 0; l < N && rc == DMI_OK; l++) {
         const double lo = (double)l * h, hi = l + 1 == N ? s->tau : (double)(l + 1) * h;
@@ -253,4 +255,81 @@ void dmi_quad_last(const dmi_kernel *k, const dmi_history *r, const double *last
     const size_t lag = k->N - 1;
     for (size_t e = 0; e < k->nnz; e++)
         W[k->row[e]] += last[e] * dmi_history_series(r, k->col[e])[lag];
+}
+
+/* ---- the near cells of a fitted kernel ---------------------------------- */
+
+int dmi_quad_near(dmi_solver *s, dmi_kernel *k, double **last, dmi_kernel *near)
+{
+    const size_t n = s->n, N = s->N, nn = n * n;
+    const double h = s->h;
+    dmi_kernel_alloc(near, n, 0, NULL);
+    const double q = s->near_delta / h;
+    const size_t m = q >= (double)N ? N : (size_t)ceil(q); /* the cells with l h < delta */
+    if (m == 0)
+        return DMI_OK;
+    if (m + 1 > N)
+        return dmi_fail(s, DMI_EINVAL, "dmi_init: the near cells (delta = %g, %zu cells of h = %g) "
+                                       "must leave at least the last of the N = %zu cells to the "
+                                       "exponential sum", s->near_delta, m, h, N);
+    /* (m < N <= the ring's rows: m n n doubles fit) */
+    size_t bytes = dmi_mul_size(N, nn, sizeof(double)), sbytes = dmi_mul_size(5, nn, sizeof(double));
+    double *dense = bytes ? calloc(N * nn, sizeof *dense) : NULL;
+    double *diff = calloc(m * nn, sizeof *diff), *scratch = sbytes ? malloc(sbytes) : NULL;
+    double *last2 = calloc(nn, sizeof *last2); /* by entry, then by the new kernel's entries */
+    dmi_kernel k2 = {0};
+    int rc = dense && diff && scratch && last2 ? DMI_OK
+                                               : dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory "
+                                                          "for the near cells");
+    for (size_t e = 0; rc == DMI_OK && e < k->nnz; e++) { /* the sum's means, dense */
+        const size_t qe = k->row[e] * n + k->col[e];
+        for (size_t l = 0; l < N; l++)
+            dense[l * nn + qe] = k->samples[e * N + l];
+        if (*last)
+            last2[qe] = (*last)[e];
+    }
+    integrand g = {s, s->near_H, s->near_user, nn, scratch ? scratch + 4 * nn : NULL};
+    for (size_t l = 0; l < m && rc == DMI_OK; l++) { /* the exact means of the near cells */
+        double *row = dense + l * nn;
+        rc = integrate(&g, (double)l * h, (double)(l + 1) * h, diff + l * nn, scratch);
+        for (size_t qe = 0; qe < nn && rc == DMI_OK; qe++) {
+            const double exact = diff[l * nn + qe] / h;
+            diff[l * nn + qe] = exact - row[qe]; /* what the recursion's sum lacks */
+            row[qe] = exact;
+        }
+    }
+    if (rc == DMI_OK && (dmi_kernel_alloc(&k2, n, N, dense) != 0 ||
+                         dmi_kernel_alloc(near, n, m, diff) != 0))
+        rc = dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for the near cells");
+    double *l2 = NULL;
+    if (rc == DMI_OK && *last) {
+        l2 = calloc(k2.nnz ? k2.nnz : 1, sizeof *l2);
+        if (!l2)
+            rc = dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for the near cells");
+        for (size_t e = 0; l2 && e < k2.nnz; e++)
+            l2[e] = last2[k2.row[e] * n + k2.col[e]];
+    }
+    free(dense);
+    free(diff);
+    free(scratch);
+    free(last2);
+    if (rc != DMI_OK) {
+        dmi_kernel_release(&k2);
+        dmi_kernel_release(near);
+        return rc;
+    }
+    dmi_kernel_release(k);
+    *k = k2;
+    if (*last) {
+        free(*last);
+        *last = l2;
+    }
+    return DMI_OK;
+}
+
+void dmi_quad_near_add(const dmi_kernel *near, const dmi_history *r, double h, double *W)
+{
+    for (size_t e = 0; e < near->nnz; e++)
+        W[near->row[e]] += h * dmi_dot(near->samples + e * near->N,
+                                       dmi_history_series(r, near->col[e]), near->N);
 }

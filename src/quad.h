@@ -27,4 +27,16 @@ int dmi_quad_sample(dmi_solver *s, dmi_kernel *k, double **last);
 /* W += last[e] U_{col e}^{p-N+1} for each stored kernel entry e. */
 void dmi_quad_last(const dmi_kernel *k, const dmi_history *r, const double *last, double *W);
 
+/* The near cells of a kernel given as an exponential sum (the far part, in k
+ * and *last as sampled for s's rule) and an exact callback below delta
+ * (dmi_set_kernel_near): k's first m = ceil(delta / h) cells become the
+ * callback's exact cell means (tanh-sinh), *last is re-indexed to the new
+ * entries, and near = the m cells' exact means less the sum's, which the
+ * recursion adds (dmi_quad_near_add).  m = 0: nothing changes, near empty.
+ * DMI_OK or an error (message set; k, *last unchanged, near empty). */
+int dmi_quad_near(dmi_solver *s, dmi_kernel *k, double **last, dmi_kernel *near);
+
+/* W += h sum_{l<m} near_l U^{p-l}. */
+void dmi_quad_near_add(const dmi_kernel *near, const dmi_history *r, double h, double *W);
+
 #endif

@@ -50,6 +50,13 @@ struct dmi_solver {
     int quad;
     double *cell_last;
     dmi_expk cell_expk;
+    /* (since 1.3) the exact kernel of the cells below near_delta
+     * (dmi_set_kernel_near; NULL: none) and what those cells add to the
+     * recursion's sum (nonzero entries over the m near cells) */
+    dmi_kernel_fn near_H;
+    void *near_user;
+    double near_delta;
+    dmi_kernel near;
 };
 
 /* Writes the message (printf format) for dmi_last_error; returns code. */

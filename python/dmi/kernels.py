@@ -76,7 +76,9 @@ class KernelFit:
     is one term).  ``max_error`` is the largest error (relative if ``relative``) measured on the check grid,
     ``l1_error`` = int_delta^tau ||H - H~|| ds and ``kernel_l1`` = int_0^tau ||H|| ds (Frobenius norms,
     trapezoidal rule on that grid; for tabulated data: on the samples).  ``certified``: the error bound
-    holds between the grid points too (a derivative bound, docs/kernels.md).  Picklable.
+    holds between the grid points too (a derivative bound, docs/kernels.md).  ``kernel``: the fitted
+    :class:`PowerKernel`, if it was one (``Solver.set_kernel_fit`` takes the near cells from it).
+    Picklable.
     """
     a: np.ndarray
     b: np.ndarray
@@ -91,6 +93,7 @@ class KernelFit:
     kernel_l1: float
     method: str
     grid_points: int = field(default=0)
+    kernel: PowerKernel | None = field(default=None)
 
     @property
     def terms(self) -> int:
@@ -419,7 +422,8 @@ def _with_l1(f: KernelFit, H, samples) -> KernelFit:
     else:
         from scipy.integrate import quad
         l1 = quad(lambda x: float(_frob(_values(H, np.array([x])))[0]), 0, f.tau, limit=200)[0]
-    return KernelFit(**{**f.__dict__, "kernel_l1": float(l1)})
+    exact = H if isinstance(H, PowerKernel) else None  # (picklable: kept for the near cells)
+    return KernelFit(**{**f.__dict__, "kernel_l1": float(l1), "kernel": exact})
 
 
 def _interpolated(s: np.ndarray, V: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:

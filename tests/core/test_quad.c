@@ -6,6 +6,9 @@
  *   with h = tau / N and with a partial last cell (dmi_create_h);
  * - DIRECT, FFT, RECURSIVE and AUTO agree under the cell rule, for the
  *   exponential kernel and for the same kernel as a callback (tanh-sinh);
+ * - dmi_set_kernel_near: W^0 against the exact integrals of a near kernel
+ *   that differs from the sum (2 e^{-s} below delta, e^{-s} beyond), every
+ *   method the same, the recursion's sum and the near cells together; errors;
  * - errors: an unknown rule, a call after dmi_init.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
@@ -219,6 +222,96 @@ static void test_errors(void)
     dmi_free(&s);
 }
 
+static const double NA[1] = {-1}, NB[1] = {0}, NC[1] = {1};
+
+static int twice_exp(double s, double *out, void *user)
+{
+    (void)user;
+    out[0] = 2 * exp(-s);
+    return 0;
+}
+
+/* u' + W = 0 with e^{-s} as a sum and 2 e^{-s} on the cells below delta. */
+static dmi_solver *near_solver(int method, dmi_history_fn z, double tau, size_t N, double h,
+                               double delta)
+{
+    dmi_solver *s = NULL;
+    int rc = h > 0 ? dmi_create_h(&s, 1, tau, h) : dmi_create(&s, 1, tau, N);
+    if (rc == DMI_OK)
+        rc = dmi_set_kernel_exp(s, 1, NA, NB, NC, NULL);
+    if (rc == DMI_OK)
+        rc = dmi_set_kernel_near(s, twice_exp, NULL, delta);
+    if (rc == DMI_OK)
+        rc = dmi_set_history(s, z, NULL);
+    if (rc == DMI_OK)
+        rc = dmi_set_quadrature(s, DMI_QUAD_CELL);
+    if (rc == DMI_OK)
+        rc = dmi_set_convolution(s, method);
+    if (rc == DMI_OK)
+        rc = dmi_init(s);
+    if (rc != DMI_OK) {
+        printf("\n  near_solver(method %d): %s\n", method, dmi_last_error(s));
+        dmi_free(&s);
+    }
+    return s;
+}
+
+static void test_near_cells(void)
+{
+    const double hs[2] = {0, 0.0237};
+    for (int hi = 0; hi < 2; hi++)
+        for (int method = DMI_CONV_DIRECT; method <= DMI_CONV_RECURSIVE; method++) {
+            /* z = 1: W^0 = int_0^{m h} 2 e^{-s} + int_{m h}^tau e^{-s}, m = ceil(delta / h) */
+            dmi_solver *s = near_solver(method, one, 1.0, 100, hs[hi], 0.05);
+            CU_ASSERT_FATAL(s != NULL);
+            const double h = dmi_get_h(s), mh = ceil(0.05 / h) * h;
+            const double ref = 2 * (1 - exp(-mh)) + (exp(-mh) - exp(-1.0));
+            char what[64];
+            snprintf(what, sizeof what, "W^0 with near cells, h %g, method %d", h, method);
+            CU_ASSERT(core_close_rel(what, first_W(s), ref, 1e-13));
+            dmi_free(&s);
+        }
+    /* a wave history over many steps (the recursion anchored and run): every method the same */
+    dmi_solver *ref = near_solver(DMI_CONV_DIRECT, wave, 1.0, 300, 0, 0.02);
+    CU_ASSERT_FATAL(ref != NULL);
+    CU_ASSERT_EQUAL(dmi_advance(ref, 2000), DMI_OK);
+    double u_ref;
+    dmi_get_state(ref, &u_ref);
+    for (int method = DMI_CONV_FFT; method <= DMI_CONV_RECURSIVE; method++) {
+        dmi_solver *s = near_solver(method, wave, 1.0, 300, 0, 0.02);
+        CU_ASSERT_FATAL(s != NULL);
+        CU_ASSERT_EQUAL(dmi_advance(s, 2000), DMI_OK);
+        double u;
+        dmi_get_state(s, &u);
+        CU_ASSERT(core_close_rel("near cells, method against DIRECT", u, u_ref, 1e-12));
+        dmi_free(&s);
+    }
+    dmi_free(&ref);
+}
+
+static void test_near_errors(void)
+{
+    dmi_solver *s = NULL;
+    CU_ASSERT_EQUAL(dmi_set_kernel_near(NULL, twice_exp, NULL, 0.1), DMI_EINVAL);
+    CU_ASSERT_FATAL(dmi_create(&s, 1, 1.0, 10) == DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_kernel_near(s, twice_exp, NULL, -0.1), DMI_EINVAL);
+    CU_ASSERT_EQUAL(dmi_set_kernel_near(s, twice_exp, NULL, NAN), DMI_EINVAL);
+    /* a callback kernel has no sum to complete */
+    CU_ASSERT_EQUAL(dmi_set_kernel(s, exp_kernel, NULL), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_kernel_near(s, twice_exp, NULL, 0.1), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_init(s), DMI_EINVAL);
+    CU_ASSERT(strstr(dmi_last_error(s), "dmi_set_kernel_exp") != NULL);
+    /* the near cells must leave the last cell to the sum: delta = 0.95 is 10 of 10 cells */
+    CU_ASSERT_EQUAL(dmi_set_kernel_exp(s, 1, NA, NB, NC, NULL), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_kernel_near(s, twice_exp, NULL, 0.95), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_init(s), DMI_EINVAL);
+    CU_ASSERT(strstr(dmi_last_error(s), "near cells") != NULL);
+    CU_ASSERT_EQUAL(dmi_set_kernel_near(s, twice_exp, NULL, 0.85), DMI_OK); /* 9 cells */
+    CU_ASSERT_EQUAL(dmi_init(s), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_kernel_near(s, NULL, NULL, 0), DMI_ESTATE);
+    dmi_free(&s);
+}
+
 int main(int argc, char **argv)
 {
     static const core_test tests[] = {
@@ -226,6 +319,8 @@ int main(int argc, char **argv)
         {"cell weights against exact integrals", test_weights_against_integrals},
         {"every engine, the same sum", test_engines_agree},
         {"errors", test_errors},
+        {"near cells of a singular kernel", test_near_cells},
+        {"near cells: errors", test_near_errors},
         {NULL, NULL}};
     return core_main(argc, argv, "quad", tests);
 }

@@ -1,6 +1,7 @@
 # Solver.set_quadrature("cell"): the first step's delay term against dmi._transform's closed-form cell
 # weights, every engine the same, the default unchanged, and the fractional relaxation
 # u' + int_0^t s^-1/2 / Gamma(1/2) u(t - s) ds = 0, u(0) = 1, against u = E_{3/2}(-t^{3/2}) (mpmath series).
+# Solver.set_kernel_fit: the fitted singular kernel (O(1), exact near cells) within the fit's solution bound.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 import math
 
@@ -10,6 +11,7 @@ import pytest
 
 import dmi
 from dmi import _transform as tr
+from dmi import kernels
 
 A = [-1.0, 0.0]
 B = [0.0, 3.0]
@@ -95,3 +97,53 @@ def test_fractional_relaxation_converges():
     order = np.polyfit(np.log(np.array(Ns, float)), np.log(errors), 1)[0]
     assert -order >= 0.9, errors
     assert errors[-1] <= 5e-3
+
+
+def relaxation(N, T, *, fit=None, method="auto"):
+    """u' + int_0^t s^-1/2 / Gamma(1/2) u(t - s) ds = 0, u(0) = 1, tau = T: the cell rule with the exact
+    kernel (fit None) or the fitted sum and exact near cells."""
+    c = 1 / math.sqrt(math.pi)
+    s = dmi.Solver(1, T, N)
+    s.set_history(lambda t: np.array([1.0 if t == 0 else 0.0]))
+    s.set_quadrature("cell")
+    if fit is None:
+        s.set_kernel(lambda x: np.array([[c * x ** -0.5]]))
+    else:
+        s.set_kernel_fit(fit)
+    s.set_convolution(method)
+    s.init()
+    return s.run(N)[1][:, 0]
+
+
+@pytest.mark.parametrize("N", [200, 1000])
+def test_fitted_singular_kernel_within_the_solution_bound(N):
+    T = 2.0
+    h = T / N
+    f = kernels.fit(kernels.PowerKernel(0.5, 1 / math.sqrt(math.pi)), T, tol=1e-8, relative=True, delta=h)
+    exact = relaxation(N, T)
+    fitted = relaxation(N, T, fit=f)  # AUTO: the recursion and the near cell
+    assert np.max(np.abs(relaxation(N, T, fit=f, method="direct") - fitted)) <= 1e-13
+    bound = f.solution_bound(T, 0.0, float(np.max(np.abs(fitted))), h=h)
+    assert bound < 1e-7  # informative at T = 2
+    assert np.max(np.abs(fitted - exact)) <= bound
+
+
+def test_set_kernel_fit_entries():
+    f = kernels.fit(lambda x: np.exp(-x) * np.cos(3 * x), 1.0, tol=1e-10)
+    s = dmi.Solver(2, 1.0, 20)
+    with pytest.raises(dmi.InvalidArgument):
+        s.set_kernel_fit(f)  # a scalar fit needs an entry when n = 2
+    with pytest.raises(dmi.InvalidArgument):
+        s.set_kernel_fit(f, entry=(2, 0))
+    s.set_kernel_fit(f, entry=(1, 0))
+    s.set_history(lambda t: np.array([1.0, 1.0]))
+    s.set_quadrature("cell")
+    s.init()
+    s.step()
+    W, _ = s.step_terms()
+    # entry (1, 0) alone: W = (0, int_0^1 e^{-s} cos 3s ds) with the constant history
+    ref = (1 - math.exp(-1) * (math.cos(3) - 3 * math.sin(3))) / 10
+    assert W[0] == 0 and W[1] == pytest.approx(ref, rel=1e-9)
+    singular = kernels.fit(lambda x: x ** -0.5, 1.0, tol=1e-6, relative=True, delta=0.1)
+    with pytest.raises(dmi.InvalidArgument, match="near"):
+        dmi.Solver(1, 1.0, 20).set_kernel_fit(singular)  # no exact kernel for the near cells
