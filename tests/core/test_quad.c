@@ -59,18 +59,32 @@ static int wave(double t, double *out, void *user)
     return 0;
 }
 
+/* e^{-s} as a sum, and 2 e^{-s} for the near cells (dmi_set_kernel_near). */
+static const double NA[1] = {-1}, NB[1] = {0}, NC[1] = {1};
+
+static int twice_exp(double s, double *out, void *user)
+{
+    (void)user;
+    out[0] = 2 * exp(-s);
+    return 0;
+}
+
 /* A solver for u' + W = 0 (n = 1) with the kernel (0 exponential, 1 exp
- * callback, 2 power callback), the history z, the rule and method; h > 0:
- * dmi_create_h, else N cells.  Initialised, or NULL. */
-static dmi_solver *solver(int kernel, dmi_history_fn z, int rule, int method, double tau, size_t N,
-                          double h)
+ * callback, 2 power callback, 3 e^{-s} as a sum with 2 e^{-s} on the cells
+ * below delta), the history z, the rule and method; h > 0: dmi_create_h,
+ * else N cells.  Initialised, or NULL. */
+static dmi_solver *solver_near(int kernel, dmi_history_fn z, int rule, int method, double tau,
+                               size_t N, double h, double delta)
 {
     dmi_solver *s = NULL;
     int rc = h > 0 ? dmi_create_h(&s, 1, tau, h) : dmi_create(&s, 1, tau, N);
     if (rc == DMI_OK)
         rc = kernel == 0   ? dmi_set_kernel_exp(s, 1, KA, KB, KC, NULL)
              : kernel == 1 ? dmi_set_kernel(s, exp_kernel, NULL)
-                           : dmi_set_kernel(s, power_kernel, NULL);
+             : kernel == 2 ? dmi_set_kernel(s, power_kernel, NULL)
+                           : dmi_set_kernel_exp(s, 1, NA, NB, NC, NULL);
+    if (rc == DMI_OK && kernel == 3)
+        rc = dmi_set_kernel_near(s, twice_exp, NULL, delta);
     if (rc == DMI_OK)
         rc = dmi_set_history(s, z, NULL);
     if (rc == DMI_OK && rule >= 0)
@@ -85,6 +99,21 @@ static dmi_solver *solver(int kernel, dmi_history_fn z, int rule, int method, do
         dmi_free(&s);
     }
     return s;
+}
+
+static dmi_solver *solver(int kernel, dmi_history_fn z, int rule, int method, double tau, size_t N,
+                          double h)
+{
+    return solver_near(kernel, z, rule, method, tau, N, h, 0);
+}
+
+/* U after steps more steps of s (NAN if a step fails). */
+static double state_after(dmi_solver *s, size_t steps)
+{
+    double u = NAN;
+    if (dmi_advance(s, steps) != DMI_OK || dmi_get_state(s, &u) != DMI_OK)
+        return NAN;
+    return u;
 }
 
 /* W^0 of s (one step taken). */
@@ -175,30 +204,22 @@ static void test_engines_agree(void)
         for (int kernel = 0; kernel <= 1; kernel++) {
             dmi_solver *ref = solver(kernel, wave, DMI_QUAD_CELL, DMI_CONV_DIRECT, 1.0, 500, hs[hi]);
             CU_ASSERT_FATAL(ref != NULL);
-            CU_ASSERT_EQUAL(dmi_advance(ref, 1200), DMI_OK);
-            double u_ref;
-            dmi_get_state(ref, &u_ref);
+            const double u_ref = state_after(ref, 1200);
             const int methods[3] = {DMI_CONV_FFT, DMI_CONV_RECURSIVE, DMI_CONV_AUTO};
             for (int m = 0; m < 3; m++) {
                 if (kernel == 1 && methods[m] == DMI_CONV_RECURSIVE)
                     continue; /* (a callback runs no recursion) */
                 dmi_solver *s = solver(kernel, wave, DMI_QUAD_CELL, methods[m], 1.0, 500, hs[hi]);
                 CU_ASSERT_FATAL(s != NULL);
-                CU_ASSERT_EQUAL(dmi_advance(s, 1200), DMI_OK);
-                double u;
-                dmi_get_state(s, &u);
                 char what[64];
                 snprintf(what, sizeof what, "kernel %d, h %g, method %d", kernel, hs[hi], methods[m]);
-                CU_ASSERT(core_close_rel(what, u, u_ref, 1e-12));
+                CU_ASSERT(core_close_rel(what, state_after(s, 1200), u_ref, 1e-12));
                 dmi_free(&s);
             }
             /* the callback's tanh-sinh weights equal the closed form's */
             dmi_solver *x = solver(1 - kernel, wave, DMI_QUAD_CELL, DMI_CONV_DIRECT, 1.0, 500, hs[hi]);
             CU_ASSERT_FATAL(x != NULL);
-            CU_ASSERT_EQUAL(dmi_advance(x, 1200), DMI_OK);
-            double u;
-            dmi_get_state(x, &u);
-            CU_ASSERT(core_close_rel("callback vs closed form", u, u_ref, 1e-12));
+            CU_ASSERT(core_close_rel("callback vs closed form", state_after(x, 1200), u_ref, 1e-12));
             dmi_free(&x);
             dmi_free(&ref);
         }
@@ -222,47 +243,13 @@ static void test_errors(void)
     dmi_free(&s);
 }
 
-static const double NA[1] = {-1}, NB[1] = {0}, NC[1] = {1};
-
-static int twice_exp(double s, double *out, void *user)
-{
-    (void)user;
-    out[0] = 2 * exp(-s);
-    return 0;
-}
-
-/* u' + W = 0 with e^{-s} as a sum and 2 e^{-s} on the cells below delta. */
-static dmi_solver *near_solver(int method, dmi_history_fn z, double tau, size_t N, double h,
-                               double delta)
-{
-    dmi_solver *s = NULL;
-    int rc = h > 0 ? dmi_create_h(&s, 1, tau, h) : dmi_create(&s, 1, tau, N);
-    if (rc == DMI_OK)
-        rc = dmi_set_kernel_exp(s, 1, NA, NB, NC, NULL);
-    if (rc == DMI_OK)
-        rc = dmi_set_kernel_near(s, twice_exp, NULL, delta);
-    if (rc == DMI_OK)
-        rc = dmi_set_history(s, z, NULL);
-    if (rc == DMI_OK)
-        rc = dmi_set_quadrature(s, DMI_QUAD_CELL);
-    if (rc == DMI_OK)
-        rc = dmi_set_convolution(s, method);
-    if (rc == DMI_OK)
-        rc = dmi_init(s);
-    if (rc != DMI_OK) {
-        printf("\n  near_solver(method %d): %s\n", method, dmi_last_error(s));
-        dmi_free(&s);
-    }
-    return s;
-}
-
 static void test_near_cells(void)
 {
     const double hs[2] = {0, 0.0237};
     for (int hi = 0; hi < 2; hi++)
         for (int method = DMI_CONV_DIRECT; method <= DMI_CONV_RECURSIVE; method++) {
             /* z = 1: W^0 = int_0^{m h} 2 e^{-s} + int_{m h}^tau e^{-s}, m = ceil(delta / h) */
-            dmi_solver *s = near_solver(method, one, 1.0, 100, hs[hi], 0.05);
+            dmi_solver *s = solver_near(3, one, DMI_QUAD_CELL, method, 1.0, 100, hs[hi], 0.05);
             CU_ASSERT_FATAL(s != NULL);
             const double h = dmi_get_h(s), mh = ceil(0.05 / h) * h;
             const double ref = 2 * (1 - exp(-mh)) + (exp(-mh) - exp(-1.0));
@@ -272,18 +259,14 @@ static void test_near_cells(void)
             dmi_free(&s);
         }
     /* a wave history over many steps (the recursion anchored and run): every method the same */
-    dmi_solver *ref = near_solver(DMI_CONV_DIRECT, wave, 1.0, 300, 0, 0.02);
+    dmi_solver *ref = solver_near(3, wave, DMI_QUAD_CELL, DMI_CONV_DIRECT, 1.0, 300, 0, 0.02);
     CU_ASSERT_FATAL(ref != NULL);
-    CU_ASSERT_EQUAL(dmi_advance(ref, 2000), DMI_OK);
-    double u_ref;
-    dmi_get_state(ref, &u_ref);
+    const double u_ref = state_after(ref, 2000);
     for (int method = DMI_CONV_FFT; method <= DMI_CONV_RECURSIVE; method++) {
-        dmi_solver *s = near_solver(method, wave, 1.0, 300, 0, 0.02);
+        dmi_solver *s = solver_near(3, wave, DMI_QUAD_CELL, method, 1.0, 300, 0, 0.02);
         CU_ASSERT_FATAL(s != NULL);
-        CU_ASSERT_EQUAL(dmi_advance(s, 2000), DMI_OK);
-        double u;
-        dmi_get_state(s, &u);
-        CU_ASSERT(core_close_rel("near cells, method against DIRECT", u, u_ref, 1e-12));
+        CU_ASSERT(core_close_rel("near cells, method against DIRECT", state_after(s, 2000), u_ref,
+                                 1e-12));
         dmi_free(&s);
     }
     dmi_free(&ref);
