@@ -9,7 +9,8 @@
  * - dmi_set_kernel_near: W^0 against the exact integrals of a near kernel
  *   that differs from the sum (2 e^{-s} below delta, e^{-s} beyond), every
  *   method the same, the recursion's sum and the near cells together; errors;
- * - errors: an unknown rule, a call after dmi_init.
+ * - errors: an unknown rule, a call after dmi_init; a kernel callback that
+ *   fails inside the cells' quadrature leaves the solver as it was.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include <math.h>
@@ -225,6 +226,42 @@ static void test_engines_agree(void)
         }
 }
 
+/* e^{-2 s} cos 3 s, failing once *user (a call budget) is spent. */
+static int budget_kernel(double s, double *out, void *user)
+{
+    long *left = user;
+    if ((*left)-- <= 0)
+        return 7;
+    return exp_kernel(s, out, NULL);
+}
+
+static void test_failed_init_leaves_solver(void)
+{
+    long left = 1000000;
+    dmi_solver *s = NULL;
+    CU_ASSERT_FATAL(dmi_create_h(&s, 1, 1.0, 0.0213) == DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_kernel(s, budget_kernel, &left), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_history(s, wave, NULL), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_quadrature(s, DMI_QUAD_CELL), DMI_OK);
+    CU_ASSERT_FATAL(dmi_init(s) == DMI_OK);
+    CU_ASSERT_EQUAL(dmi_advance(s, 30), DMI_OK);
+    size_t size = 0;
+    unsigned char *before = core_save(s, &size);
+    CU_ASSERT_FATAL(before != NULL);
+    left = 500; /* the quadrature of the cells runs out of calls: the restart fails */
+    CU_ASSERT_EQUAL(dmi_init(s), DMI_ECALLBACK);
+    CU_ASSERT(strstr(dmi_last_error(s), "kernel callback returned 7") != NULL);
+    CU_ASSERT(core_state_is(s, before, size));
+    /* stepping on is the run that never restarted */
+    dmi_solver *ref = solver(1, wave, DMI_QUAD_CELL, DMI_CONV_AUTO, 1.0, 0, 0.0213);
+    CU_ASSERT_FATAL(ref != NULL);
+    CU_ASSERT_EQUAL(dmi_advance(ref, 30), DMI_OK);
+    CU_ASSERT(core_close_rel("after a failed restart", state_after(s, 40), state_after(ref, 40), 0));
+    free(before);
+    dmi_free(&ref);
+    dmi_free(&s);
+}
+
 static void test_errors(void)
 {
     dmi_solver *s = NULL;
@@ -302,6 +339,7 @@ int main(int argc, char **argv)
         {"cell weights against exact integrals", test_weights_against_integrals},
         {"every engine, the same sum", test_engines_agree},
         {"errors", test_errors},
+        {"a failed restart leaves the solver as it was", test_failed_init_leaves_solver},
         {"near cells of a singular kernel", test_near_cells},
         {"near cells: errors", test_near_errors},
         {NULL, NULL}};
