@@ -43,8 +43,8 @@ __all__ = ["KernelFit", "PowerKernel", "fit", "main"]
 
 @dataclass(frozen=True)
 class PowerKernel:
-    """The power kernel ``c s^{-beta}``, ``0 < beta``, singular at 0 (``beta < 1``: integrable, the
-    Caputo derivative of order ``beta``... of order ``1 - beta``, with ``c = 1 / Gamma(beta)``).
+    """The power kernel ``c s^{-beta}``, ``beta > 0``, singular at 0 (integrable for ``beta < 1``: with
+    ``c = 1 / Gamma(beta)`` it is the kernel of the Caputo derivative of order ``1 - beta``).
 
     A callable ``s -> c s^{-beta}`` that also carries its Laplace measure, ``s^{-beta} = 1/Gamma(beta)
     int exp(-s e^x + beta x) dx``, so :func:`fit` discretises that integral instead of fitting samples,
