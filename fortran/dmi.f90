@@ -29,7 +29,7 @@ module dmi
 
   ! Version of this binding (the same as the C header it mirrors).
   integer(c_int), parameter, public :: DMI_VERSION_MAJOR = 1
-  integer(c_int), parameter, public :: DMI_VERSION_MINOR = 2
+  integer(c_int), parameter, public :: DMI_VERSION_MINOR = 3
   integer(c_int), parameter, public :: DMI_VERSION_PATCH = 0
 
   ! Error codes.
@@ -45,11 +45,15 @@ module dmi
   integer(c_int), parameter, public :: DMI_CONV_DIRECT = 1
   integer(c_int), parameter, public :: DMI_CONV_FFT = 2
   integer(c_int), parameter, public :: DMI_CONV_RECURSIVE = 3 ! (since 1.1)
+  ! Quadrature rules of the delay sum (since 1.3), see dmi_set_quadrature.
+  integer(c_int), parameter, public :: DMI_QUAD_LEFT = 0
+  integer(c_int), parameter, public :: DMI_QUAD_CELL = 1
 
   public :: dmi_rhs_fn, dmi_resolvent_fn, dmi_kernel_fn, dmi_history_fn
   public :: dmi_version, dmi_create, dmi_create_h, dmi_free
   public :: dmi_set_rhs, dmi_set_resolvent, dmi_set_friction, dmi_set_box
   public :: dmi_set_kernel, dmi_set_kernel_exp, dmi_set_history, dmi_set_convolution
+  public :: dmi_set_quadrature, dmi_set_kernel_near
   public :: dmi_init, dmi_step, dmi_advance
   public :: dmi_time, dmi_get_step_index, dmi_get_h, dmi_get_N, dmi_get_state, dmi_get_past
   public :: dmi_get_step_terms, dmi_get_window, dmi_set_window
@@ -181,6 +185,23 @@ module dmi
       integer(c_int) :: rc
     end function dmi_set_history
 
+    ! (since 1.3) rule = DMI_QUAD_LEFT (the default) or DMI_QUAD_CELL; before dmi_init.
+    function dmi_set_quadrature(s, rule) result(rc) bind(C, name='dmi_set_quadrature')
+      import :: c_ptr, c_int
+      type(c_ptr), value :: s
+      integer(c_int), value :: rule
+      integer(c_int) :: rc
+    end function dmi_set_quadrature
+    ! (since 1.3) the exact kernel h on the cells below delta, the exponential
+    ! sum of dmi_set_kernel_exp beyond; before dmi_init.
+    function dmi_set_kernel_near(s, h, user, delta) result(rc) bind(C, name='dmi_set_kernel_near')
+      import :: c_int, c_ptr, c_funptr, c_double
+      type(c_ptr), value :: s
+      type(c_funptr), value :: h
+      type(c_ptr), value :: user
+      real(c_double), value :: delta
+      integer(c_int) :: rc
+    end function dmi_set_kernel_near
     function dmi_set_convolution(s, method) result(rc) bind(C, name='dmi_set_convolution')
       import :: c_int, c_ptr
       type(c_ptr), value :: s

@@ -50,7 +50,7 @@ extern "C" {
 /** Major version of this header; dmi_version() gives the version of the library. */
 #define DMI_VERSION_MAJOR 1
 /** Minor version of this header. */
-#define DMI_VERSION_MINOR 2
+#define DMI_VERSION_MINOR 3
 /** Patch version of this header. */
 #define DMI_VERSION_PATCH 0
 
@@ -111,6 +111,14 @@ enum {
     DMI_CONV_FFT = 2,
     /** (Since 1.1.)  O(1) recursion of an exponential-sum kernel. */
     DMI_CONV_RECURSIVE = 3
+};
+
+/** Quadrature rules of the delay sum (see dmi_set_quadrature; since 1.3). */
+enum {
+    /** The default: the paper's rectangle rule, h H(l h) per cell. */
+    DMI_QUAD_LEFT = 0,
+    /** Exact cell weights: the integral of H over each cell. */
+    DMI_QUAD_CELL = 1
 };
 
 /** ---- version --------------------------------------------------------- */
@@ -231,6 +239,60 @@ DMI_API int dmi_set_kernel(dmi_solver *s, dmi_kernel_fn H, void *user);
  */
 DMI_API int dmi_set_kernel_exp(dmi_solver *s, size_t K, const double *a, const double *b,
                                const double *C, const double *D);
+
+/**
+ * (Since 1.3.)  The quadrature rule of the delay integral, before dmi_init:
+ *   DMI_QUAD_LEFT  (the default) the paper's rule, the weight h H(l h) per
+ *                  cell (theta h H((N-1) h) for a partial last cell); the
+ *                  results of libdmi 1.2, bitwise.
+ *   DMI_QUAD_CELL  exact cell weights: each cell's weight is the integral of
+ *                  H over it,
+ *                    W^p = sum_{l<N-1} int_{l h}^{(l+1) h} H(s) ds U^{p-l}
+ *                        + int_{(N-1) h}^{tau} H(s) ds U^{p-N+1},
+ *                  the last cell partial as for dmi_create_h.  A kernel that
+ *                  is singular at s = 0 but integrable (s^-alpha, alpha < 1:
+ *                  fractional damping) then runs: H is never evaluated at 0.
+ *                  Exponential kernels (dmi_set_kernel_exp) in closed form,
+ *                  per term mu = a + i b the cell weight
+ *                  h Re((C - i D) phi1(mu h) e^{mu l h}), phi1(z) = (e^z - 1)/z
+ *                  (the partial last cell: theta h and phi1(mu theta h)); the
+ *                  recursion runs the same weights at the same cost.  Callback
+ *                  kernels by tanh-sinh quadrature on each cell (the step
+ *                  halved until two levels agree to 1e-14 of the cell's
+ *                  integral of |H|, at most 8193 calls a cell; typically 30 to
+ *                  70 calls for a smooth kernel), by dmi_init, which then calls
+ *                  H at points inside the cells (0 < s < tau), not at l h.
+ *                  Every method (DIRECT, FFT, RECURSIVE) computes this same
+ *                  sum (up to rounding).  The error of the rule is that of the
+ *                  product U(t - s) ~ U^{p-l} on the cell, order 1 in h, as the
+ *                  left rule's for smooth H (docs/kernels.md).
+ * The rule is not part of the saved state (set it alike on the solver that
+ * loads one).  Errors: DMI_EINVAL for s NULL or another rule; DMI_ESTATE
+ * after dmi_init (the weights are computed there; create a new solver).
+ */
+DMI_API int dmi_set_quadrature(dmi_solver *s, int rule);
+
+/**
+ * (Since 1.3.)  A kernel singular at 0 in O(1) per step: the exponential sum
+ * set by dmi_set_kernel_exp (a fit of the kernel on [delta, tau], e.g. by
+ * Python's dmi.kernels.fit or dmi-kernel-fit) for the far cells, and the
+ * exact kernel H (n*n row-major, a dmi_kernel_fn) for the m = ceil(delta / h)
+ * near cells [l h, (l + 1) h), l < m, whose weights are H's exact integrals
+ * over them (tanh-sinh quadrature by dmi_init, as for DMI_QUAD_CELL: H is
+ * called inside those cells, 0 < s <= m h, never at 0).  The far cells
+ * follow the rule of dmi_set_quadrature (use DMI_QUAD_CELL: the left rule
+ * samples the sum at l h).  Every method computes the same sum;
+ * RECURSIVE (and AUTO) runs the recursion of the sum over all N cells and
+ * adds the near cells' exact weights less the sum's: O(K n^2 + m nnz) per
+ * step.  delta = 0 (m = 0) or H = NULL: no near cells (H = NULL removes
+ * them).  The user pointer is stored and passed back.
+ * Errors: DMI_EINVAL for s NULL or delta negative or not finite; from
+ * dmi_init, DMI_EINVAL when the kernel is not one of dmi_set_kernel_exp or
+ * when m + 1 > N (the last cell must be the sum's), and the kernel
+ * callback's errors (DMI_ECALLBACK, DMI_ENONFINITE); DMI_ESTATE after
+ * dmi_init.
+ */
+DMI_API int dmi_set_kernel_near(dmi_solver *s, dmi_kernel_fn H, void *user, double delta);
 
 /** History z(t) on [-tau, 0]; z = NULL restores z = 0.  Sampled at t = p h,
  * p = -(N-1)..0, and at t = -tau for U^{-N} (= -N h for dmi_create, not for

@@ -5,6 +5,8 @@
  */
 #include "solver.h"
 
+#include "quad.h"
+
 #include "bytes.h"
 
 #include <math.h>
@@ -106,7 +108,8 @@ static int engine_make(const dmi_solver *s, const dmi_kernel *k, int method, dmi
     if (method == DMI_CONV_AUTO && dmi_has_expk(s) && first_unfit(s, &aliased) == s->expk.K)
         method = DMI_CONV_RECURSIVE;
     if (method == DMI_CONV_RECURSIVE) {
-        if (dmi_has_expk(s) && dmi_exp_create(rec, &s->expk, s->N, s->h) != 0)
+        const dmi_expk *x = s->quad == DMI_QUAD_CELL ? &s->cell_expk : &s->expk;
+        if (dmi_has_expk(s) && dmi_exp_create(rec, x, s->N, s->h) != 0)
             return dmi_fail(s, DMI_ENOMEM, "%s: out of memory for the recursion's sums", fn);
         return DMI_OK;
     }
@@ -146,6 +149,11 @@ void dmi_engine_rebuild(const dmi_solver *s, dmi_conv *conv, dmi_exp *rec)
  * the engine moves on), or W filled. */
 static const double *delay_sum_full(const dmi_solver *s, double *W)
 {
+    if (s->rec && s->near.nnz) { /* the near cells' exact weights less the sum's */
+        memcpy(W, dmi_exp_sum(s->rec), s->n * sizeof *W);
+        dmi_quad_near_add(&s->near, &s->ring, s->h, W);
+        return W;
+    }
     if (s->rec)
         return dmi_exp_sum(s->rec);
 #ifdef DMI_HAVE_FFT
@@ -167,7 +175,10 @@ static const double *delay_sum(const dmi_solver *s, double *W)
         return full;
     if (full != W)
         memcpy(W, full, s->n * sizeof *W);
-    dmi_delay_last(&s->kernel, &s->ring, (s->theta - 1) * s->h, W);
+    if (s->quad == DMI_QUAD_CELL)
+        dmi_quad_last(&s->kernel, &s->ring, s->cell_last, W);
+    else
+        dmi_delay_last(&s->kernel, &s->ring, (s->theta - 1) * s->h, W);
     return W;
 }
 
@@ -281,6 +292,9 @@ void dmi_free(dmi_solver **ps)
     dmi_history_release(&s->ring);
     dmi_kernel_release(&s->kernel);
     dmi_expk_release(&s->expk);
+    dmi_expk_release(&s->cell_expk);
+    free(s->cell_last);
+    dmi_kernel_release(&s->near);
     engine_free(s->conv, s->rec);
     free(s->last_W);
     free(s->last_X);
@@ -420,6 +434,36 @@ int dmi_set_kernel_exp(dmi_solver *s, size_t K, const double *a, const double *b
     return DMI_OK;
 }
 
+int dmi_set_quadrature(dmi_solver *s, int rule)
+{
+    if (!s)
+        return DMI_EINVAL;
+    if (rule != DMI_QUAD_LEFT && rule != DMI_QUAD_CELL)
+        return dmi_fail(s, DMI_EINVAL, "dmi_set_quadrature: unknown rule %d (DMI_QUAD_LEFT = 0, "
+                                       "DMI_QUAD_CELL = 1)", rule);
+    if (s->initialized)
+        return dmi_fail(s, DMI_ESTATE, "dmi_set_quadrature: the kernel's weights are computed by "
+                                       "dmi_init and cannot change afterwards");
+    s->quad = rule;
+    return DMI_OK;
+}
+
+int dmi_set_kernel_near(dmi_solver *s, dmi_kernel_fn H, void *user, double delta)
+{
+    if (!s)
+        return DMI_EINVAL;
+    if (s->initialized)
+        return dmi_fail(s, DMI_ESTATE, "dmi_set_kernel_near: the kernel's weights are computed by "
+                                       "dmi_init and cannot change afterwards");
+    if (H && !(isfinite(delta) && delta >= 0))
+        return dmi_fail(s, DMI_EINVAL, "dmi_set_kernel_near: delta = %g; expected a finite "
+                                       "delta >= 0", delta);
+    s->near_H = H;
+    s->near_user = H ? user : NULL;
+    s->near_delta = H ? delta : 0.0;
+    return DMI_OK;
+}
+
 int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user)
 {
     if (!s)
@@ -528,6 +572,21 @@ static int sample_history(dmi_solver *s, dmi_history *ring)
     return DMI_OK;
 }
 
+/* The cell rule's samples into k and its last-cell change into *last
+ * (quad.c), and s->cell_expk, the kernel the recursion runs (rebuilt: the
+ * kernel or h may differ from the last init's; a function of them alone). */
+static int quad_prepare(dmi_solver *s, dmi_kernel *k, double **last)
+{
+    if (dmi_has_expk(s)) { /* (an initialised solver gets the same values again) */
+        dmi_expk x;
+        if (dmi_quad_expk(&s->expk, s->h, &x) != 0)
+            return dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for the cell weights");
+        dmi_expk_release(&s->cell_expk);
+        s->cell_expk = x;
+    }
+    return dmi_quad_sample(s, k, last);
+}
+
 int dmi_init(dmi_solver *s)
 {
     if (!s)
@@ -541,7 +600,15 @@ int dmi_init(dmi_solver *s)
         return dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for the history");
     dmi_conv *c = NULL;
     dmi_exp *e = NULL;
-    rc = sample_kernel(s, &k);
+    double *last = NULL;
+    dmi_kernel near = {0};
+    if (s->near_H && !dmi_has_expk(s))
+        rc = dmi_fail(s, DMI_EINVAL, "dmi_init: the near cells of dmi_set_kernel_near need a kernel "
+                                     "given by dmi_set_kernel_exp");
+    if (rc == DMI_OK)
+        rc = s->quad == DMI_QUAD_CELL ? quad_prepare(s, &k, &last) : sample_kernel(s, &k);
+    if (rc == DMI_OK && s->near_H)
+        rc = dmi_quad_near(s, &k, &last, &near);
     if (rc == DMI_OK)
         rc = sample_history(s, &ring);
     if (rc == DMI_OK)
@@ -549,8 +616,14 @@ int dmi_init(dmi_solver *s)
     if (rc != DMI_OK) {
         dmi_kernel_release(&k);
         dmi_history_release(&ring);
+        free(last);
+        dmi_kernel_release(&near);
         return rc;
     }
+    free(s->cell_last);
+    s->cell_last = last;
+    dmi_kernel_release(&s->near);
+    s->near = near;
     dmi_kernel_release(&s->kernel);
     dmi_history_release(&s->ring);
     s->kernel = k;

@@ -43,6 +43,20 @@ struct dmi_solver {
     double *work;       /* 5 n scratch values: U^p, f, W, X, U^{p+1} */
 
     char err[256];
+
+    /* (since 1.3) the quadrature rule DMI_QUAD_* of the delay sum; for the cell
+     * rule: what the last cell adds (nnz values, quad.c) and the exponential
+     * kernel whose samples are the cells' means (the recursion's, K = 0: none) */
+    int quad;
+    double *cell_last;
+    dmi_expk cell_expk;
+    /* (since 1.3) the exact kernel of the cells below near_delta
+     * (dmi_set_kernel_near; NULL: none) and what those cells add to the
+     * recursion's sum (nonzero entries over the m near cells) */
+    dmi_kernel_fn near_H;
+    void *near_user;
+    double near_delta;
+    dmi_kernel near;
 };
 
 /* Writes the message (printf format) for dmi_last_error; returns code. */

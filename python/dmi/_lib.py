@@ -15,6 +15,8 @@ SONAME = "libdmi.so.1"
 
 OK, EINVAL, ENOMEM, ECALLBACK, ENONFINITE, ESTATE = 0, -1, -2, -3, -4, -5
 CONV = {"auto": 0, "direct": 1, "fft": 2, "recursive": 3}
+#: dmi_set_quadrature's rules DMI_QUAD_*.
+QUAD = {"left": 0, "cell": 1}
 
 # The callback types of dmi.h (pointers as c_void_p: a Python callback gets addresses).
 RhsFn = ctypes.CFUNCTYPE(c_int, c_double, c_void_p, c_void_p, c_void_p)
@@ -50,6 +52,8 @@ _PROTOTYPES = {
     "dmi_set_kernel_exp": (c_int, [_solver_p, c_size_t, _d, _d, _d, _d]),
     "dmi_set_history": (c_int, [_solver_p, c_void_p, c_void_p]),
     "dmi_set_convolution": (c_int, [_solver_p, c_int]),
+    "dmi_set_quadrature": (c_int, [_solver_p, c_int]),
+    "dmi_set_kernel_near": (c_int, [_solver_p, c_void_p, c_void_p, c_double]),
     "dmi_init": (c_int, [_solver_p]),
     "dmi_step": (c_int, [_solver_p]),
     "dmi_advance": (c_int, [_solver_p, c_size_t]),

@@ -406,6 +406,72 @@ class Solver:
             _L.dmi_free(ctypes.byref(self._handle))
             self._handle = None
 
+    def set_quadrature(self, rule: str) -> None:
+        """Quadrature rule of the delay integral, before :meth:`init` (``dmi_set_quadrature``):
+        ``"left"`` (default) the paper's rectangle rule h H(l h) per cell; ``"cell"`` exact cell
+        weights, the integral of H over each cell (closed form for :meth:`set_kernel_exp`, tanh-sinh
+        quadrature for a callback, which is then called inside the cells, never at s = 0: kernels
+        singular at 0 such as s^-1/2 run).  Every convolution method computes the same sum."""
+        code = _lib.QUAD.get(rule) if isinstance(rule, str) else None
+        if code is None:
+            raise InvalidArgument(_lib.EINVAL, f"set_quadrature: rule {rule!r}: expected one of "
+                                  f"{', '.join(map(repr, _lib.QUAD))}")
+        with self._using() as s:
+            self._check(_L.dmi_set_quadrature(s, code))
+
+    def set_kernel_near(self, H: Callback | None, delta: float, user: Any = None) -> None:
+        """The exact kernel ``H(s) -> array (n, n)`` (or a C kernel function) on the cells below
+        ``delta``, whose weights become H's exact cell integrals, while the kernel of
+        :meth:`set_kernel_exp` (a fit on [delta, tau]) gives the other cells: a kernel singular at 0 in
+        O(1) per step (``dmi_set_kernel_near``).  None removes it.  Before :meth:`init`."""
+        def setter(s: Any, address: Any, u: Any) -> int:
+            return _L.dmi_set_kernel_near(s, address, u, float(delta))
+        self._set_callback("kernel_near", cb.KERNEL, setter, H, user)
+
+    def set_kernel_fit(self, fit: Any, entry: tuple[int, int] | None = None, near: Callback | None = None,
+                       ) -> None:
+        """The kernel of a :class:`dmi.kernels.KernelFit`: an n x n fit fills the whole kernel; a scalar
+        fit goes to ``entry=(i, j)`` (the other entries zero), or fills the kernel of an n = 1 solver.
+        A fit with ``delta > 0`` (a kernel singular at 0) gets its near cells from ``near``, the exact
+        scalar or n x n kernel (default: the fit's own ``kernel`` when it carries one, a
+        :class:`dmi.kernels.PowerKernel`); use :meth:`set_quadrature` ``("cell")`` with it.
+        Before :meth:`init`."""
+        n = self._n
+        C, D = np.asarray(fit.C, float), np.asarray(fit.D, float)
+        K = len(fit.a)
+        if C.ndim == 3:
+            if entry is not None or C.shape[1:] != (n, n):
+                raise InvalidArgument(_lib.EINVAL, f"set_kernel_fit: a {C.shape[1]} x {C.shape[2]} fit "
+                                      f"fills the whole kernel of this n = {n} solver (entry=None)")
+            i = j = None
+        else:
+            if entry is None and n != 1:
+                raise InvalidArgument(_lib.EINVAL, f"set_kernel_fit: a scalar fit needs entry=(i, j) "
+                                      f"for this n = {n} solver")
+            i, j = (0, 0) if entry is None else (int(entry[0]), int(entry[1]))
+            if not (0 <= i < n and 0 <= j < n):
+                raise InvalidArgument(_lib.EINVAL, f"set_kernel_fit: entry {entry} is outside {n} x {n}")
+            Cm, Dm = np.zeros((K, n, n)), np.zeros((K, n, n))
+            Cm[:, i, j], Dm[:, i, j] = C, D
+            C, D = Cm, Dm
+        exact = near if near is not None else getattr(fit, "kernel", None)
+        if fit.delta > 0 and exact is None:
+            raise InvalidArgument(_lib.EINVAL, "set_kernel_fit: the fit starts at delta = "
+                                  f"{fit.delta!r}: give the exact kernel of the near cells (near=...)")
+        self.set_kernel_exp(fit.a, fit.b, C, D)
+        if fit.delta > 0:
+            if i is not None and callable(exact) and not isinstance(exact, ctypes._CFuncPtr) \
+                    and not hasattr(exact, "address"):  # a Python scalar kernel: as an n x n one
+                scalar = exact
+
+                def exact(s: float, _i: int = i, _j: int = j) -> np.ndarray:
+                    out = np.zeros((n, n))
+                    out[_i, _j] = scalar(s)
+                    return out
+            self.set_kernel_near(exact, fit.delta)
+        else:
+            self.set_kernel_near(None, 0.0)
+
     def __repr__(self) -> str:
         if self._h_given is not None:
             return f"dmi.Solver(n={self._n}, tau={self._tau!r}, h={self._h_given!r})"

@@ -1,0 +1,555 @@
+# Exponential-sum fits of memory kernels, with their error and the bound they put on the solution.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""Fitting a kernel by a sum of exponentials, the form ``Solver.set_kernel_exp`` runs in O(1) per step.
+
+:func:`fit` returns a :class:`KernelFit`: the arrays ``a, b, C, D`` of
+
+    H~(s) = sum_k exp(a_k s) (C_k cos(b_k s) + D_k sin(b_k s)),   a_k <= 0, b_k >= 0,
+
+its measured error on a grid ten times finer than the fit's, and :meth:`KernelFit.solution_bound`, what
+the error does to the solution.  Two methods (docs/kernels.md says why these):
+
+- **ESPRIT** (a matrix pencil of the Hankel matrix of uniform samples on ``[delta, tau]``): for smooth and
+  oscillating kernels and for tabulated (also noisy) data.  A kernel that is an exponential sum is found
+  with its own number of terms; a matrix kernel's entries are stacked side by side, so they share the
+  exponents.  The rank grows until the error meets ``tol``; for noisy data it stops at the singular
+  values' noise floor.
+- **Laplace quadrature and compression** for completely monotone kernels ``H(s) = int e^{-t s} dmu(t)``,
+  ``mu >= 0`` (power laws ``s^{-beta}``, ``1/(1+s)``, relaxation moduli) over many scales: the
+  Bernstein integral discretised (for :class:`PowerKernel` by the trapezoidal rule in ``x = log t``, an
+  a priori accurate quadrature; for any other positive decreasing kernel by non-negative least squares
+  over a geometric dictionary of rates), then compressed by a Galerkin projection of the symmetric
+  state-space realisation onto its dominant singular directions on ``[delta, tau]`` and a
+  non-negative refit.  Every weight is positive: no cancelling terms, ``sum C = H~(0)``.
+
+Both run when both apply; the fit with fewer terms that meets ``tol`` is returned.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import warnings
+from dataclasses import dataclass, field
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+from . import _transform
+
+__all__ = ["KernelFit", "PowerKernel", "fit", "main"]
+
+
+@dataclass(frozen=True)
+class PowerKernel:
+    """The power kernel ``c s^{-beta}``, ``beta > 0``, singular at 0 (integrable for ``beta < 1``: with
+    ``c = 1 / Gamma(beta)`` it is the kernel of the Caputo derivative of order ``1 - beta``).
+
+    A callable ``s -> c s^{-beta}`` that also carries its Laplace measure, ``s^{-beta} = 1/Gamma(beta)
+    int exp(-s e^x + beta x) dx``, so :func:`fit` discretises that integral instead of fitting samples,
+    and the error between grid points is bounded with the derivative (the fit is then ``certified``).
+    """
+    beta: float
+    c: float = 1.0
+
+    def __post_init__(self) -> None:
+        if not (self.beta > 0 and math.isfinite(self.beta)):
+            raise ValueError(f"PowerKernel: beta = {self.beta}; expected a finite beta > 0")
+        if not math.isfinite(self.c) or self.c == 0:
+            raise ValueError(f"PowerKernel: c = {self.c}; expected a finite nonzero c")
+
+    def __call__(self, s: Any) -> Any:
+        return self.c * np.asarray(s, dtype=np.float64) ** -self.beta
+
+    def derivative_bound(self, s: np.ndarray) -> np.ndarray:
+        """``|H'(s)|``, decreasing in s."""
+        return abs(self.c) * self.beta * s ** (-self.beta - 1)
+
+
+@dataclass(frozen=True, eq=False)
+class KernelFit:
+    """An exponential-sum fit of a kernel on ``[delta, tau]``.
+
+    ``a, b`` (K,) and ``C, D`` ((K,) for a scalar kernel, (K, n, n) for a matrix one) are what
+    ``Solver.set_kernel_exp`` (``dmi_set_kernel_exp``) takes; ``terms`` = K counts (a, b) pairs (a cosine
+    is one term).  ``max_error`` is the largest error (relative if ``relative``) measured on the check grid,
+    ``l1_error`` = int_delta^tau ||H - H~|| ds and ``kernel_l1`` = int_0^tau ||H|| ds (Frobenius norms,
+    trapezoidal rule on that grid; for tabulated data: on the samples).  ``certified``: the error bound
+    holds between the grid points too (a derivative bound, docs/kernels.md).  ``kernel``: the fitted
+    :class:`PowerKernel`, if it was one (``Solver.set_kernel_fit`` takes the near cells from it).
+    Picklable.
+    """
+    a: np.ndarray
+    b: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+    tau: float
+    delta: float
+    max_error: float
+    relative: bool
+    certified: bool
+    l1_error: float
+    kernel_l1: float
+    method: str
+    grid_points: int = field(default=0)
+    kernel: PowerKernel | None = field(default=None)
+
+    @property
+    def terms(self) -> int:
+        return int(len(self.a))
+
+    @property
+    def n(self) -> int:
+        """1 for a scalar kernel, else the matrices' size."""
+        return 1 if self.C.ndim == 1 else int(self.C.shape[1])
+
+    def __call__(self, s: Any) -> np.ndarray:
+        """``H~(s)``: shape ``s.shape`` (+ (n, n))."""
+        return _transform.evaluate(s, self.a, self.b, self.C, self.D)
+
+    def coefficient_sum(self) -> float:
+        """``sum_k (|C_k| + |D_k|)`` (largest entry): compare with max |H| to see there is no cancellation."""
+        return float(np.max(np.sum(np.abs(self.C) + np.abs(self.D), axis=0)))
+
+    def solution_bound(self, T: float, lipschitz: float, u_max: float, *, h: float | None = None) -> float:
+        """A bound on ``max_{t <= T} |u(t) - u~(t)|``, u the solution with the kernel H, u~ with this fit.
+
+        With ``eps = l1_error`` and ``gamma = lipschitz + kernel_l1`` (docs/kernels.md):
+
+        - ``h`` None, the equation: ``eps u_max (e^{gamma T} - 1) / gamma``; ``lipschitz`` is the one-sided
+          Lipschitz constant L of ``-f`` (``-(f(u) - f(v)).(u - v) <= L |u - v|^2``), ``u_max`` a bound
+          of ``|u~|`` on ``[-tau, T]``; the maximal monotone A drops out.
+        - ``h`` given, the scheme with exact cell weights (f explicit: ``lipschitz`` is f's Lipschitz
+          constant): ``eps u_max ((1 + h gamma)^n - 1) / gamma``, ``n = ceil(T / h)``.
+        A kernel singular at 0 counts from ``delta`` on (the cells below it are exact).
+        """
+        if not (T >= 0 and lipschitz >= 0 and u_max >= 0):
+            raise ValueError(f"T = {T}, lipschitz = {lipschitz}, u_max = {u_max}: expected >= 0")
+        gamma = lipschitz + self.kernel_l1
+        if h is None:
+            growth = T if gamma == 0 else math.expm1(gamma * T) / gamma
+        else:
+            if not h > 0:
+                raise ValueError(f"h = {h}: expected > 0")
+            steps = math.ceil(T / h - 1e-12)
+            growth = steps * h if gamma == 0 else math.expm1(steps * math.log1p(h * gamma)) / gamma
+        return self.l1_error * u_max * growth
+
+    # ---- printing for C and Fortran users ------------------------------------------------------
+    def to_json(self) -> str:
+        return json.dumps({"terms": self.terms, "n": self.n, "tau": self.tau, "delta": self.delta,
+                           "max_error": self.max_error, "relative": self.relative,
+                           "certified": self.certified, "method": self.method,
+                           "a": self.a.tolist(), "b": self.b.tolist(), "C": self.C.tolist(),
+                           "D": self.D.tolist()}, indent=1)
+
+    def to_c(self, name: str = "kernel") -> str:
+        def arr(tag: str, x: np.ndarray) -> str:
+            vals = ", ".join(repr(float(v)) for v in x.ravel())
+            return f"static const double {name}_{tag}[{x.size}] = {{{vals}}};"
+        head = (f"/* {self.terms} terms, n = {self.n}, max error {self.max_error:.3g} "
+                f"({'relative' if self.relative else 'absolute'}) on [{self.delta!r}, {self.tau!r}]:\n"
+                f"   dmi_set_kernel_exp(s, {name}_K, {name}_a, {name}_b, {name}_C, {name}_D); */")
+        return "\n".join([head, f"enum {{ {name}_K = {self.terms} }};", arr("a", self.a), arr("b", self.b),
+                          arr("C", self.C), arr("D", self.D)]) + "\n"
+
+    def to_fortran(self, name: str = "kernel") -> str:
+        def arr(tag: str, x: np.ndarray) -> list[str]:
+            # C, D: the C layout (row-major per term) as one flat array, as dmi_set_kernel_exp reads it
+            vals = [repr(float(v)).replace("e", "d") if "e" in repr(float(v)) else repr(float(v)) + "d0"
+                    for v in x.ravel()]
+            lines = [f"real(c_double) :: {name}_{tag}({x.size})", f"data {name}_{tag} / &"]
+            for i in range(0, len(vals), 3):
+                sep = ", &" if i + 3 < len(vals) else " /"
+                lines.append("  " + ", ".join(vals[i:i + 3]) + sep)
+            return lines
+        out = [f"! {self.terms} terms, n = {self.n}, max error {self.max_error:.3g}: "
+               f"dmi_set_kernel_exp(s, {name}_K, {name}_a, {name}_b, {name}_C, {name}_D)",
+               f"integer(c_size_t), parameter :: {name}_K = {self.terms}"]
+        for tag, x in (("a", self.a), ("b", self.b), ("C", self.C), ("D", self.D)):
+            out += arr(tag, x)
+        return "\n".join(out) + "\n"
+
+
+# ---- helpers ---------------------------------------------------------------------------------------
+
+def _values(H: Callable[[float], Any], s: np.ndarray) -> np.ndarray:
+    """H at the points s: (M,) or (M, n, n), vectorised when H takes arrays, else point by point."""
+    try:
+        v = np.asarray(H(s), dtype=np.float64)
+        if v.shape[:1] == s.shape:
+            return v
+    except Exception:  # noqa: BLE001 - a scalar-only callable: evaluate point by point below
+        pass
+    return np.array([np.asarray(H(float(x)), dtype=np.float64) for x in s])
+
+
+def _err(ref: np.ndarray, got: np.ndarray, relative: bool) -> np.ndarray:
+    """Pointwise error (largest over matrix entries), relative to max |H| at the point if asked."""
+    d = np.abs(ref - got).reshape(len(ref), -1).max(axis=1)
+    if relative:
+        d = d / np.maximum(np.abs(ref).reshape(len(ref), -1).max(axis=1), np.finfo(float).tiny)
+    return d
+
+
+def _frob(x: np.ndarray) -> np.ndarray:
+    return np.sqrt((x.reshape(len(x), -1) ** 2).sum(axis=1))
+
+
+def _trapezoid(y: np.ndarray, s: np.ndarray) -> float:
+    return float(np.sum((y[1:] + y[:-1]) * np.diff(s)) / 2)
+
+
+def _real_basis(s: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Columns exp(a_k s) cos(b_k s) and, for b_k > 0, exp(a_k s) sin(b_k s)."""
+    e = np.exp(np.multiply.outer(s, a))
+    cols = [e * np.cos(np.multiply.outer(s, b))]
+    osc = b > 0
+    if osc.any():
+        cols.append(e[:, osc] * np.sin(np.multiply.outer(s, b[osc])))
+    return np.hstack(cols)
+
+
+def _coefficients(s: np.ndarray, V: np.ndarray, a: np.ndarray, b: np.ndarray,
+                  w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Least-squares C, D (K, E) for values V (M, E) at s, rows weighted by w."""
+    B = _real_basis(s, a, b)
+    X = np.linalg.lstsq(B * w[:, None], V * w[:, None], rcond=None)[0]
+    K = len(a)
+    C = X[:K]
+    D = np.zeros_like(C)
+    D[b > 0] = X[K:]
+    return C, D
+
+
+# ---- ESPRIT ------------------------------------------------------------------------------------------
+
+def _esprit_candidates(s: np.ndarray, V: np.ndarray, max_rank: int, noisy: bool):
+    """Yields (a, b) for ranks 1, 2, ... of the block-Hankel matrix of the uniform samples V (M, E)."""
+    M, E = V.shape
+    ds = s[1] - s[0]
+    L = M // 2
+    cols = M - L + 1
+    Hk = np.hstack([np.lib.stride_tricks.sliding_window_view(V[:, e], L).T[:, :cols] for e in range(E)])
+    U, sig, _ = np.linalg.svd(Hk, full_matrices=False)
+    top = min(max_rank, len(sig) - 1)
+    if noisy:  # the singular values of the noise: about the median of the lower half
+        floor = np.median(sig[len(sig) // 2:])
+        top = min(top, max(1, int(np.sum(sig > 8 * floor))))
+    for r in range(1, top + 1):
+        Ur = U[:, :r]
+        Phi = np.linalg.lstsq(Ur[:-1], Ur[1:], rcond=None)[0]
+        z = np.linalg.eigvals(Phi)
+        z = z[np.abs(z) > 1e-300]
+        mu = np.log(z.astype(np.complex128)) / ds
+        a = np.minimum(mu.real, 0.0)  # a decaying or constant term: the recursion refuses growth
+        b = np.abs(mu.imag)
+        # conjugate pairs (real data) give one (a, b) term: merge equal (a, |b|)
+        order = np.lexsort((a, b))
+        a, b = a[order], b[order]
+        keep = np.ones(len(a), bool)
+        for i in range(1, len(a)):
+            if keep[i - 1] and b[i] > 0 and abs(b[i] - b[i - 1]) <= 1e-8 * (1 + b[i]) \
+                    and abs(a[i] - a[i - 1]) <= 1e-8 * (1 + abs(a[i])):
+                keep[i] = False
+        b = np.where(b * ds < 1e-12, 0.0, b)
+        yield r, a[keep], b[keep]
+
+
+# ---- completely monotone kernels: Laplace quadrature and compression ---------------------------------
+
+def _power_nodes(k: PowerKernel, delta: float, tau: float, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """Rates t_j and weights w_j of the trapezoidal rule in x = log t for c s^-beta on [delta, tau]."""
+    from scipy.special import gamma, gammainccinv
+    beta = k.beta
+    eps = tol / 10
+    x_lo = (math.log(eps * beta * gamma(beta)) + beta * math.log(tau)) / beta  # left tail <= eps H(tau)
+    x_hi = math.log(gammainccinv(beta, eps) / delta)                           # right tail <= eps H(delta)
+    step = 2 * math.pi * 1.0 / math.log(3 / eps)  # strip half-width 1 < pi/2
+    x = np.arange(x_lo, x_hi + step, step)
+    return np.exp(x), k.c * step * np.exp(beta * x) / gamma(beta)
+
+
+def _log_grid(lo: float, hi: float, m: int) -> np.ndarray:
+    if lo > 0:
+        return np.geomspace(lo, hi, m)
+    g = np.geomspace(hi * 1e-6, hi, m - m // 4)  # H smooth at 0: a uniform part too
+    return np.unique(np.concatenate([np.linspace(0.0, hi, m // 4), g]))
+
+
+def _nnls(A: np.ndarray, y: np.ndarray) -> np.ndarray:
+    from scipy.optimize import nnls
+    scale = np.maximum(np.linalg.norm(A, axis=0), 1e-300)
+    x = nnls(A / scale, y, maxiter=50 * A.shape[1])[0]
+    return x / scale
+
+
+def _compressor(t: np.ndarray, w: np.ndarray, s: np.ndarray, y: np.ndarray, rw: np.ndarray):
+    """A function k -> (rates, positive weights) of k terms from the positive sum sum_j w_j e^{-t_j s}:
+    Galerkin projection of the symmetric realisation (x' = -T x + sqrt(w) u, y = sqrt(w).x) onto the k
+    leading right singular vectors of its weighted impulse-response samples on s (the directions that
+    matter on [delta, tau]; the projected T is symmetric positive semi-definite, so the rates are real and
+    >= 0), then a non-negative least-squares refit of y."""
+    Psi = np.exp(-np.multiply.outer(s, t)) * np.sqrt(w) * rw[:, None]
+    Vt = np.linalg.svd(Psi, full_matrices=False)[2]
+
+    def compress(k: int) -> tuple[np.ndarray, np.ndarray]:
+        V = Vt[:k].T
+        Tk = V.T @ (t[:, None] * V)
+        rates = np.maximum(np.linalg.eigvalsh((Tk + Tk.T) / 2), 0.0)
+        c = _nnls(np.exp(-np.multiply.outer(s, rates)) * rw[:, None], y * rw)
+        used = c > 0
+        return rates[used], c[used]
+    return compress
+
+
+def _cm_fit(H, lo: float, tau: float, tol: float, relative: bool, max_terms: int, m: int):
+    """(a, C) of a positive-weight fit, or None when H does not look completely monotone."""
+    s = _log_grid(lo, tau, m)
+    y = _values(H, s)
+    if y.ndim != 1 or not np.all(np.isfinite(y)) or np.any(y <= 0) or np.any(np.diff(y) > 1e-12 * y[:-1]):
+        return None
+    rw = 1 / y if relative else np.ones_like(y) / y.max()
+    if isinstance(H, PowerKernel):
+        t, w = _power_nodes(H, max(lo, 1e-300), tau, tol)
+    else:  # a dictionary of rates, weights by non-negative least squares
+        t_hi = 60 / (lo if lo > 0 else tau * 1e-6)
+        t = np.concatenate([[0.0], np.geomspace(0.05 / tau, t_hi, 12 * int(math.log10(t_hi * tau / 0.05) + 1))])
+        w = _nnls(np.exp(-np.multiply.outer(s, t)) * rw[:, None], y * rw)
+        t, w = t[w > 0], w[w > 0]
+    compress = _compressor(t, w, s, y, rw)
+    scale = 1 if relative else y.max()
+
+    def ok(k: int) -> tuple[bool, tuple[np.ndarray, np.ndarray]]:
+        rates, c = compress(k)
+        got = np.exp(-np.multiply.outer(s, rates)) @ c
+        return bool(np.max(np.abs(got - y) * rw * scale) <= tol * 0.8), (rates, c)
+    hi = min(max_terms, len(t))
+    good, fit_hi = ok(hi)
+    if not good:
+        return -fit_hi[0], fit_hi[1]
+    lo_k = 0  # bisection for the fewest terms (the error falls with k)
+    while hi - lo_k > 1:
+        mid = (lo_k + hi) // 2
+        good, f = ok(mid)
+        if good:
+            hi, fit_hi = mid, f
+        else:
+            lo_k = mid
+    return -fit_hi[0], fit_hi[1]
+
+
+# ---- the fit ---------------------------------------------------------------------------------------
+
+def _build(a, b, C, D, shape, tau, delta, relative, method, check_s, check_v, certified_fn, l1_s, l1_v):
+    C = C.reshape((len(a),) + shape)
+    D = D.reshape((len(a),) + shape)
+    fitted = _transform.evaluate(check_s, a, b, C, D)
+    err = _err(check_v, fitted, relative)
+    max_error = float(err.max())
+    certified = bool(certified_fn(a, b, C, D, err)) if certified_fn else False
+    diff = _frob(l1_v - _transform.evaluate(l1_s, a, b, C, D))
+    return KernelFit(a=a, b=b, C=C, D=D, tau=tau, delta=delta, max_error=max_error, relative=relative,
+                     certified=certified, l1_error=_trapezoid(diff, l1_s), kernel_l1=0.0, method=method,
+                     grid_points=len(check_s))
+
+
+def fit(H: Callable[[float], Any] | None, tau: float, *, tol: float = 1e-8, relative: bool = False,
+        max_terms: int = 64, delta: float | None = None,
+        samples: tuple[Sequence[float], Any] | None = None) -> KernelFit:
+    """Fits ``H`` on ``[delta, tau]`` (``delta`` None: ``[0, tau]``) by an exponential sum.
+
+    ``H``: a function of s giving a scalar or an n x n matrix (vectorised or not), a :class:`PowerKernel`,
+    or None with ``samples=(s, values)`` (values (M,) or (M, n, n); uniform s for a matrix kernel).
+    ``tol``: the largest error wanted, absolute or (``relative``) relative to max |H(s)| at each s.
+    ``delta``: the left end for a kernel singular at 0 (the cells below it are integrated exactly).
+    Returns the fit with the fewest terms that meets ``tol`` (at most ``max_terms``); when none does, the
+    best found, with a warning.
+    """
+    if not (tau > 0 and math.isfinite(tau)):
+        raise ValueError(f"fit: tau = {tau}; expected a finite tau > 0")
+    if not tol > 0:
+        raise ValueError(f"fit: tol = {tol}; expected > 0")
+    if int(max_terms) != max_terms or max_terms < 1:
+        raise ValueError(f"fit: max_terms = {max_terms}; expected an integer >= 1")
+    lo = 0.0 if delta is None else float(delta)
+    if not 0 <= lo < tau:
+        raise ValueError(f"fit: delta = {delta}; expected 0 <= delta < tau")
+    if (H is None) == (samples is None):
+        raise ValueError("fit: give H, or H = None and samples = (s, values)")
+    candidates: list[KernelFit] = []
+    if samples is not None:
+        s = np.asarray(samples[0], dtype=np.float64)
+        V = np.asarray(samples[1], dtype=np.float64)
+        if s.ndim != 1 or len(s) < 8 or V.shape[:1] != s.shape or V.ndim not in (1, 3):
+            raise ValueError(f"fit: samples of shapes {s.shape}, {V.shape}; expected (M,), (M,) or (M, n, n)"
+                             ", M >= 8")
+        if not (np.all(np.isfinite(s)) and np.all(np.isfinite(V)) and np.all(np.diff(s) > 0)):
+            raise ValueError("fit: the sample points must be finite and increasing, the values finite")
+        inside = (s >= lo) & (s <= tau)
+        s, V = s[inside], V[inside]
+        ds = np.diff(s)
+        if np.ptp(ds) > 1e-6 * ds.mean():
+            fn = _interpolated(s, V)
+            candidates += _fit_callable(fn, tau, lo, tol, relative, max_terms, noisy=True, esprit=False)
+            if not candidates:
+                raise ValueError("fit: samples on a non-uniform grid are fitted only when positive and "
+                                 "decreasing (a completely monotone kernel); resample them uniformly")
+        else:
+            candidates += _fit_esprit(s, V, tau, lo, tol, relative, max_terms, noisy=True, check=(s, V))
+    else:
+        candidates += _fit_callable(H, tau, lo, tol, relative, max_terms, noisy=False, esprit=True)
+    good = [c for c in candidates if c.max_error <= tol]
+    if good:
+        best = min(good, key=lambda c: (c.terms, c.max_error))
+    else:
+        best = min(candidates, key=lambda c: c.max_error)
+        if samples is None:
+            warnings.warn(f"fit: no fit of at most {max_terms} terms meets tol = {tol:g}; the best has "
+                          f"{best.terms} terms and error {best.max_error:.3g}", stacklevel=2)
+    return _with_l1(best, H, samples)
+
+
+def _with_l1(f: KernelFit, H, samples) -> KernelFit:
+    """The fit with kernel_l1 = int_0^tau ||H||."""
+    if samples is not None:
+        s = np.asarray(samples[0], float)
+        v = _frob(np.asarray(samples[1], float))
+        l1 = _trapezoid(v, s) + float(v[0] * s[0]) if s[0] > 0 else _trapezoid(v, s)
+    elif isinstance(H, PowerKernel) and H.beta < 1:
+        l1 = abs(H.c) * f.tau ** (1 - H.beta) / (1 - H.beta)
+    else:
+        from scipy.integrate import quad
+        l1 = quad(lambda x: float(_frob(_values(H, np.array([x])))[0]), 0, f.tau, limit=200)[0]
+    exact = H if isinstance(H, PowerKernel) else None  # (picklable: kept for the near cells)
+    return KernelFit(**{**f.__dict__, "kernel_l1": float(l1), "kernel": exact})
+
+
+def _interpolated(s: np.ndarray, V: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+    def fn(x):
+        return np.interp(np.log(x), np.log(s), V) if s[0] > 0 else np.interp(x, s, V)
+    return fn
+
+
+def _fit_esprit(s, V, tau, lo, tol, relative, max_terms, noisy, check, certified_fn=None):
+    shape = V.shape[1:]
+    Vf = V.reshape(len(s), -1)
+    cs, cv = check
+    rw = np.ones(len(s))
+    if relative:
+        rw = 1 / np.maximum(np.abs(Vf).max(axis=1), np.finfo(float).tiny)
+    best = None
+    errors = []
+    for r, a, b in _esprit_candidates(s, Vf, 2 * max_terms, noisy):
+        if len(a) > max_terms:
+            continue
+        C, D = _coefficients(s, Vf, a, b, rw)
+        f = _build(a, b, C, D, shape, tau, lo, relative, "esprit", cs, cv, certified_fn, cs, cv)
+        errors.append((f.max_error, f))
+        if best is None or f.max_error < best.max_error:
+            best = f
+        if f.max_error <= tol:
+            return [f]
+    if best is None:
+        return []
+    if noisy:  # the smallest fit whose error is within 1.5 times the least: the count saturates
+        least = min(e for e, _ in errors)
+        return [next(f for e, f in errors if e <= 1.5 * least)]
+    return [best]
+
+
+def _fit_callable(H, tau, lo, tol, relative, max_terms, noisy, esprit):
+    out = []
+    m = 1000
+    check_u = np.linspace(lo, tau, 10 * m + 1)
+    check_l = _log_grid(lo, tau, 10 * 2000) if lo > 0 else check_u
+    check_s = np.unique(np.concatenate([check_u, check_l]))
+    if lo == 0 and isinstance(H, PowerKernel):
+        raise ValueError("fit: a PowerKernel is singular at 0: give delta > 0")
+    check_v = _values(H, check_s)
+    if not np.all(np.isfinite(check_v)):
+        raise ValueError("fit: H is not finite on [delta, tau] (a kernel singular at 0 needs delta > 0)")
+    certified_fn = _certifier(H, lo, tau, tol, relative) if isinstance(H, PowerKernel) else None
+    fewest = max_terms
+    if check_v.ndim == 1:
+        cm = _cm_fit(H, lo, tau, tol, relative, max_terms, 2000)
+        if cm is not None:
+            a, C = cm
+            zero = np.zeros_like(a)
+            out.append(_build(a, zero, C, np.zeros_like(C), (), tau, lo, relative, "laplace", check_s,
+                              check_v, certified_fn, check_s, check_v))
+            if out[-1].max_error <= tol:
+                fewest = out[-1].terms - 1  # ESPRIT is of use only with fewer terms
+    if esprit and not isinstance(H, PowerKernel) and fewest >= 1:
+        s = np.linspace(lo, tau, m)
+        out += _fit_esprit(s, _values(H, s), tau, lo, tol, relative, fewest, noisy, (check_s, check_v))
+    return out
+
+
+def _certifier(H: PowerKernel, lo: float, hi: float, tol: float, relative: bool):
+    """Whether the error stays within tol between points too, on a geometric grid of its own: on
+    [s_i, s_i+1] the error is at most the larger end value plus (s_i+1 - s_i)^2 / 8 max|e''|, and
+    |e''| <= |H''(s_i)| + sum_k |C_k| a_k^2 e^{a_k s_i} (H and the fit are completely monotone: both second
+    derivatives decrease).  Rigorous up to rounding."""
+    def certify(a, b, C, D, err):
+        if np.any(b != 0) or np.any(C < 0):
+            return False
+        beta = H.beta
+        r = math.sqrt(tol / 4 * 8 / (beta * (beta + 1) * 2))  # relative spacing: H'' term <= tol / 4
+        m = int(math.log(hi / lo) / math.log1p(r)) + 2
+        if m > 2_000_000:
+            return False
+        s = np.geomspace(lo, hi, m)
+        ref = H(s)
+        e = np.abs(_transform.evaluate(s, a, b, C) - ref)
+        d2 = abs(H.c) * beta * (beta + 1) * s[:-1] ** (-beta - 2) \
+            + np.exp(np.multiply.outer(s[:-1], a)) @ (C * a * a)
+        between = np.maximum(e[:-1], e[1:]) + np.diff(s) ** 2 / 8 * d2
+        scale = np.abs(ref[1:]) if relative else 1.0
+        return bool(np.all(between / scale <= tol))
+    return certify
+
+
+# ---- console script --------------------------------------------------------------------------------
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``dmi-kernel-fit``: fits a kernel given as a Python expression in s (numpy as np) or the power
+    kernel, and prints the coefficients as C arrays, Fortran data statements or JSON."""
+    p = argparse.ArgumentParser(prog="dmi-kernel-fit", description=main.__doc__)
+    g = p.add_mutually_exclusive_group(required=True)
+    g.add_argument("--expr", help="H(s) as a numpy expression in s, e.g. '1/(1+s)'")
+    g.add_argument("--power", type=float, metavar="BETA", help="the kernel s^-BETA (times --scale)")
+    g.add_argument("--samples", metavar="FILE", help="two columns s, H(s) (whitespace separated)")
+    p.add_argument("--scale", type=float, default=1.0, help="factor of the power kernel (default 1)")
+    p.add_argument("--tau", type=float, required=True)
+    p.add_argument("--delta", type=float, default=None)
+    p.add_argument("--tol", type=float, default=1e-8)
+    p.add_argument("--relative", action="store_true")
+    p.add_argument("--max-terms", type=int, default=64)
+    p.add_argument("--format", choices=["c", "fortran", "json"], default="c")
+    p.add_argument("--name", default="kernel", help="prefix of the printed names (default kernel)")
+    args = p.parse_args(argv)
+    try:
+        if args.power is not None:
+            H: Any = PowerKernel(args.power, args.scale)
+            samples = None
+        elif args.expr is not None:
+            expr = compile(args.expr, "<expr>", "eval")
+            H = lambda s: eval(expr, {"np": np, "__builtins__": {}}, {"s": s})  # noqa: E731,S307
+            samples = None
+        else:
+            data = np.loadtxt(args.samples)
+            H, samples = None, (data[:, 0], data[:, 1])
+        f = fit(H, args.tau, tol=args.tol, relative=args.relative, max_terms=args.max_terms,
+                delta=args.delta, samples=samples)
+    except (ValueError, OSError, SyntaxError, NameError, IndexError) as e:
+        print(f"dmi-kernel-fit: {e}", file=sys.stderr)
+        return 2
+    out = {"c": f.to_c, "fortran": f.to_fortran}.get(args.format)
+    sys.stdout.write(out(args.name) if out else f.to_json() + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
