@@ -115,12 +115,10 @@ static void outputs(const dmi_fmu_values *m, const dmi_fmu_point *pt, double *ou
     out[VR_last_event_time] = m->t_start + (double)pt->event_p * pt->h;
 }
 
-/* The one event indicator: the velocity's friction sticks or slips (the
- * built-in of dmi_fmu.h for component 1, coefficient alpha). */
-static void indicators(const dmi_fmu_values *m, const dmi_fmu_point *pt, int *state)
-{
-    state[0] = dmi_fmu_stuck(pt, 1, m->value[VR_alpha]);
-}
+/* The one event indicator: the velocity's friction sticks or slips, the
+ * built-in dmi_fmu_stuck of component 1 with the solver's alpha, which
+ * libdmi takes from each step (dmi_fmu_model's held). */
+static const size_t HELD[1] = {1};
 
 static int accept(const dmi_fmu_values *m, unsigned vr, double value, char *err)
 {
@@ -194,5 +192,5 @@ const dmi_fmu_model DMI_FMU_MODEL = {
     .bytes = solver_bytes,
     .author = "the dmi authors",
     .nindicators = 1,
-    .indicators = indicators,
+    .held = HELD,
 };

@@ -663,6 +663,65 @@ int dmi_advance(dmi_solver *s, size_t steps)
     return DMI_OK;
 }
 
+/* The hold of component i for the resolvent's argument x (see dmi_watch). */
+static int held_of(const dmi_solver *s, size_t i, double x)
+{
+    if (s->a_kind == A_FRICTION) {
+        const double lam = s->h * s->a_lo[i];
+        return !(x > lam) && !(x < -lam);
+    }
+    return x <= s->a_lo[i] ? -1 : x >= s->a_hi[i] ? 1 : 0;
+}
+
+int dmi_watch_start(dmi_solver *s, dmi_watch *w)
+{
+    if (!s || !w)
+        return DMI_EINVAL;
+    if (!s->initialized)
+        return dmi_fail(s, DMI_ESTATE, "dmi_watch_start: call dmi_init first");
+    if (s->a_kind != A_FRICTION && s->a_kind != A_BOX)
+        return dmi_fail(s, DMI_EINVAL, "dmi_watch_start: the hold of a component needs "
+                                       "dmi_set_friction or dmi_set_box");
+    for (size_t k = 0; k < w->m; k++)
+        if (w->comp[k] >= s->n)
+            return dmi_fail(s, DMI_EINVAL, "dmi_watch_start: component %zu >= n = %zu",
+                            w->comp[k], s->n);
+    const double *X = s->last_X;
+    if (s->p == 0) {
+        dmi_history_get(&s->ring, 0, s->work);
+        X = s->work;
+    }
+    for (size_t k = 0; k < w->m; k++)
+        w->held[k] = held_of(s, w->comp[k], X[w->comp[k]]);
+    return DMI_OK;
+}
+
+int dmi_advance_watch(dmi_solver *s, size_t steps, dmi_watch *w, int stop, size_t *taken)
+{
+    *taken = 0;
+    if (!s)
+        return DMI_EINVAL;
+    for (size_t k = 0; k < steps; k++) {
+        int rc = dmi_step(s);
+        if (rc != DMI_OK)
+            return rc;
+        ++*taken;
+        int changed = 0;
+        for (size_t j = 0; j < w->m; j++) {
+            const int now = held_of(s, w->comp[j], s->last_X[w->comp[j]]);
+            changed |= now != w->held[j];
+            w->held[j] = now;
+        }
+        if (changed) {
+            w->changes++;
+            w->last_p = s->p;
+            if (stop)
+                break;
+        }
+    }
+    return DMI_OK;
+}
+
 /* ---- queries ---------------------------------------------------------------- */
 
 double dmi_time(const dmi_solver *s)
