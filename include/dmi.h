@@ -349,10 +349,11 @@ DMI_API int dmi_get_past(const dmi_solver *s, size_t lag, double *u);
  * states, as dmi_set_convolution does (bitwise the same as a solver whose
  * states were those all along for DIRECT and FFT; up to rounding for
  * RECURSIVE); the last step's terms (dmi_get_step_terms) still describe the
- * step before the call.  The array is copied.
+ * step before the call.  The array is copied (set: into the solver's own
+ * storage, nothing is allocated).
  * Errors: DMI_EINVAL for NULL arguments or (set) a NaN or infinite value
- * (the message names its row and component); DMI_ESTATE before dmi_init;
- * DMI_ENOMEM (set).  On error the solver is unchanged.
+ * (the message names its row and component); DMI_ESTATE before dmi_init.
+ * On error the solver is unchanged.
  */
 DMI_API int dmi_get_window(const dmi_solver *s, double *U);
 DMI_API int dmi_set_window(dmi_solver *s, const double *U);

@@ -42,7 +42,8 @@ static void write_slot(dmi_history *r, size_t slot, const double *u)
 
 void dmi_history_put(dmi_history *r, size_t lag, const double *u)
 {
-    write_slot(r, (r->head + lag) % r->L, u);
+    const size_t slot = r->head + lag; /* (head, lag < L: no division) */
+    write_slot(r, slot < r->L ? slot : slot - r->L, u);
 }
 
 void dmi_history_push(dmi_history *r, const double *u)

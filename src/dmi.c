@@ -796,13 +796,9 @@ int dmi_set_window(dmi_solver *s, const double *U)
     if (bad < (N + 1) * n)
         return dmi_fail(s, DMI_EINVAL, "dmi_set_window: U[%zu] (row %zu = U^{p-%zu}, component "
                         "%zu) is not finite", bad, bad / n, N - bad / n, bad % n);
-    dmi_history ring = {0};
-    if (dmi_history_alloc(&ring, n, N) != 0)
-        return dmi_fail(s, DMI_ENOMEM, "dmi_set_window: out of memory");
+    s->ring.head = 0; /* the ring rewritten in place: every slot and its mirror */
     for (size_t k = 0; k <= N; k++)
-        dmi_history_put(&ring, N - k, U + k * n);
-    dmi_history_release(&s->ring);
-    s->ring = ring;
+        dmi_history_put(&s->ring, N - k, U + k * n);
     dmi_engine_rebuild(s, s->conv, s->rec);
     return DMI_OK;
 }

@@ -636,14 +636,6 @@ static size_t internal(const dmi_exp *e, size_t k)
     return k < e->nreal ? k : e->nreal2 + (k - e->nreal);
 }
 
-/* acc += x, error-free: acc.hi + acc.lo carries the sum's rounding. */
-static void accumulate(dd *acc, double x)
-{
-    dd s = two_sum(acc->hi, x);
-    acc->hi = s.hi;
-    acc->lo += s.lo;
-}
-
 /* The step after p at which the sums are anchored next. */
 static void set_next(dmi_exp *e, uint64_t p)
 {
@@ -657,25 +649,30 @@ void dmi_exp_anchor(dmi_exp *e, const dmi_history *r, uint64_t p)
         const size_t q = internal(e, k);
         const term *t = &e->terms[e->term_of[q]];
         const double *u = dmi_history_series(r, e->col[q]); /* u[l] = U^{p-l} */
-        dd re = {0, 0}, im = {0, 0};
+        /* lanes c = 0, 1: the real and imaginary parts, each summed error-free
+         * (two_sum into hi, its rounding into lo), side by side (vector operations; a real sum's lane 1 stays 0) */
+        double hi[2] = {0, 0}, lo[2] = {0, 0};
+        const double cplx = t->real ? 0.0 : 1.0;
         cdd base = cdd_one(); /* r^l0 */
         for (size_t l0 = 0; l0 < e->N; l0 += BLOCK) {
             const double br = base.re.hi, bi = base.im.hi;
             if (fabs(br) + fabs(bi) < TINY)
                 break;
             const size_t len = e->N - l0 < BLOCK ? e->N - l0 : BLOCK;
+            const double *tab = t->tab, *ul = u + l0;
             for (size_t i = 0; i < len; i++) {
-                double wr = br * t->tab[2 * i] - bi * t->tab[2 * i + 1];
-                accumulate(&re, wr * u[l0 + i]);
-                if (!t->real) {
-                    double wi = br * t->tab[2 * i + 1] + bi * t->tab[2 * i];
-                    accumulate(&im, wi * u[l0 + i]);
+                const double w[2] = {br * tab[2 * i] - bi * tab[2 * i + 1],
+                                     (br * tab[2 * i + 1] + bi * tab[2 * i]) * cplx};
+                for (int c = 0; c < 2; c++) {
+                    const double x = w[c] * ul[i], sum = hi[c] + x, bb = sum - hi[c];
+                    lo[c] += (hi[c] - (sum - bb)) + (x - bb);
+                    hi[c] = sum;
                 }
             }
             base = cdd_mul(base, t->rB);
         }
-        *field(e, q, F_SRE) = re.hi + re.lo;
-        *field(e, q, F_SIM) = im.hi + im.lo;
+        *field(e, q, F_SRE) = hi[0] + lo[0];
+        *field(e, q, F_SIM) = hi[1] + lo[1];
     }
     update_W(e);
 }
