@@ -46,6 +46,19 @@ void dmi_history_put(dmi_history *r, size_t lag, const double *u)
     write_slot(r, slot < r->L ? slot : slot - r->L, u);
 }
 
+void dmi_history_put_window(dmi_history *r, const double *U)
+{
+    const size_t n = r->n, N = r->N, L = r->L;
+    for (size_t j = 0; j < n; j++) { /* row k is U^{p-(N-k)}: slot N - k, head 0 */
+        double *series = r->buf + j * 2 * L;
+        for (size_t k = 0; k <= N; k++) {
+            const double x = U[k * n + j];
+            series[N - k] = x;
+            series[N - k + L] = x;
+        }
+    }
+}
+
 void dmi_history_push(dmi_history *r, const double *u)
 {
     r->head = r->head == 0 ? r->L - 1 : r->head - 1;

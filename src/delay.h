@@ -21,6 +21,9 @@ int dmi_history_alloc(dmi_history *r, size_t n, size_t N); /* 0 or -1; zero-fill
 void dmi_history_release(dmi_history *r);
 /* U^{p-lag} = u (only while filling a fresh ring: head must be 0). */
 void dmi_history_put(dmi_history *r, size_t lag, const double *u);
+/* Every state from the window U, (N + 1) rows of n values, oldest first:
+ * row k is U^{p-(N-k)} (only while filling a fresh ring: head must be 0). */
+void dmi_history_put_window(dmi_history *r, const double *U);
 /* Makes u the newest state U^{p+1}; U^{p-N} is dropped. */
 void dmi_history_push(dmi_history *r, const double *u);
 /* Pointer to U_j^{p-l}, l = 0..N (contiguous). */

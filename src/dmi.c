@@ -95,17 +95,23 @@ static int check_method(const dmi_solver *s, int method, const char *fn)
                                    "FFT)", fn, method, k, s->expk.a[k]);
 }
 
+/* Whether method is the recursion (AUTO: for an exponential kernel it
+ * takes, see first_unfit), which needs no kernel samples. */
+static int is_recursion(const dmi_solver *s, int method)
+{
+    int aliased;
+    return method == DMI_CONV_RECURSIVE ||
+           (method == DMI_CONV_AUTO && dmi_has_expk(s) && first_unfit(s, &aliased) == s->expk.K);
+}
+
 /* The engines that method asks for with kernel samples k (AUTO: the
- * recursion for an exponential kernel it takes, see first_unfit). */
+ * recursion for an exponential kernel it takes). */
 static int engine_make(const dmi_solver *s, const dmi_kernel *k, int method, dmi_conv **conv,
                        dmi_exp **rec, const char *fn)
 {
     *conv = NULL;
     *rec = NULL;
-    int aliased;
-    if (method == DMI_CONV_AUTO && dmi_has_expk(s) && first_unfit(s, &aliased) == s->expk.K)
-        method = DMI_CONV_RECURSIVE;
-    if (method == DMI_CONV_RECURSIVE) {
+    if (is_recursion(s, method)) {
         if (dmi_has_expk(s) && dmi_exp_create(rec, &s->expk, s->N, s->h) != 0)
             return dmi_fail(s, DMI_ENOMEM, "%s: out of memory for the recursion's sums", fn);
         return DMI_OK;
@@ -432,6 +438,8 @@ int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user)
     return DMI_OK;
 }
 
+static int sample_kernel(dmi_solver *s, dmi_kernel *k, const char *fn);
+
 int dmi_set_convolution(dmi_solver *s, int method)
 {
     if (!s)
@@ -442,9 +450,20 @@ int dmi_set_convolution(dmi_solver *s, int method)
     if (s->initialized) { /* the engine follows the method from the next step on */
         dmi_conv *c = NULL;
         dmi_exp *e = NULL;
-        rc = engine_make(s, &s->kernel, method, &c, &e, "dmi_set_convolution");
-        if (rc != DMI_OK)
+        dmi_kernel k = {0};
+        const int sample = !s->kernel_sampled && !is_recursion(s, method);
+        if (sample && (rc = sample_kernel(s, &k, "dmi_set_convolution")) != DMI_OK)
             return rc;
+        rc = engine_make(s, sample ? &k : &s->kernel, method, &c, &e, "dmi_set_convolution");
+        if (rc != DMI_OK) {
+            dmi_kernel_release(&k);
+            return rc;
+        }
+        if (sample) { /* the samples the recursion went without, now */
+            dmi_kernel_release(&s->kernel);
+            s->kernel = k;
+            s->kernel_sampled = 1;
+        }
         dmi_engine_rebuild(s, c, e);
         engine_free(s->conv, s->rec);
         s->conv = c;
@@ -456,20 +475,21 @@ int dmi_set_convolution(dmi_solver *s, int method)
 
 /* ---- init ------------------------------------------------------------------ */
 
-/* Samples H(l h), l = 0..N-1, into k (nonzero entries only).  An
- * exponential kernel is sampled entry by entry (dmi_expk_sample: no N n n
- * array); where a sample is not finite, the general path below names it. */
-static int sample_kernel(dmi_solver *s, dmi_kernel *k)
+/* Samples H(l h), l = 0..N-1, into k (nonzero entries only), for fn's
+ * messages.  An exponential kernel is sampled entry by entry
+ * (dmi_expk_sample: no N n n array); where a sample is not finite, the
+ * general path below names it. */
+static int sample_kernel(dmi_solver *s, dmi_kernel *k, const char *fn)
 {
     const size_t n = s->n, N = s->N, nn = n * n;
     if (!s->H)
         return dmi_kernel_alloc(k, n, N, NULL) == 0
                    ? DMI_OK
-                   : dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory");
+                   : dmi_fail(s, DMI_ENOMEM, "%s: out of memory", fn);
     if (dmi_has_expk(s)) {
         int rc = dmi_expk_sample(&s->expk, N, s->h, k);
         if (rc < 0)
-            return dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for kernel samples");
+            return dmi_fail(s, DMI_ENOMEM, "%s: out of memory for kernel samples", fn);
         if (rc == 0)
             return DMI_OK;
     }
@@ -477,8 +497,8 @@ static int sample_kernel(dmi_solver *s, dmi_kernel *k)
     size_t bytes = dmi_mul_size(n, n, 1) ? dmi_mul_size(N, nn, sizeof(double)) : 0;
     double *dense = bytes ? malloc(bytes) : NULL;
     if (!dense)
-        return dmi_fail(s, DMI_ENOMEM, "dmi_init: cannot allocate %zu x %zu x %zu kernel samples",
-                        N, n, n);
+        return dmi_fail(s, DMI_ENOMEM, "%s: cannot allocate %zu x %zu x %zu kernel samples",
+                        fn, N, n, n);
     for (size_t l = 0; l < N; l++) {
         double t = (double)l * s->h;
         double *Hl = dense + l * nn;
@@ -486,20 +506,20 @@ static int sample_kernel(dmi_solver *s, dmi_kernel *k)
         int rc = s->H(t, Hl, s->H_user);
         if (rc != 0) {
             free(dense);
-            return dmi_fail(s, DMI_ECALLBACK, "dmi_init: kernel callback returned %d at s = %.17g",
-                            rc, t);
+            return dmi_fail(s, DMI_ECALLBACK, "%s: kernel callback returned %d at s = %.17g",
+                            fn, rc, t);
         }
         size_t bad = dmi_first_nonfinite(Hl, nn);
         if (bad < nn) {
-            rc = dmi_fail(s, DMI_ENONFINITE, "dmi_init: kernel H(%.17g)[%zu][%zu] = %g", t, bad / n,
-                          bad % n, Hl[bad]);
+            rc = dmi_fail(s, DMI_ENONFINITE, "%s: kernel H(%.17g)[%zu][%zu] = %g", fn, t,
+                          bad / n, bad % n, Hl[bad]);
             free(dense);
             return rc;
         }
     }
     int rc = dmi_kernel_alloc(k, n, N, dense);
     free(dense);
-    return rc == 0 ? DMI_OK : dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for kernel samples");
+    return rc == 0 ? DMI_OK : dmi_fail(s, DMI_ENOMEM, "%s: out of memory for kernel samples", fn);
 }
 
 /* Samples z(p h), p = -N..0, into ring. */
@@ -511,8 +531,10 @@ static int sample_history(dmi_solver *s, dmi_history *ring)
         /* t_{-k} = -k h, and -tau at k = N: -N h may round below it, and is
          * below it for a partial last cell (dmi_create_h; U^{-N} is read by no
          * step), and z is called on [-tau, 0] only */
-        double t = k == s->N ? -s->tau : k == 0 ? 0.0 : fmax(-(double)k * s->h, -s->tau);
-        memset(u, 0, n * sizeof *u);
+        const double tk = -(double)k * s->h; /* (fmax of the two, without a libm call) */
+        double t = k == s->N ? -s->tau : k == 0 ? 0.0 : tk < -s->tau ? -s->tau : tk;
+        for (size_t j = 0; j < n; j++) /* (a loop: n is small) */
+            u[j] = 0;
         if (s->z) {
             int rc = s->z(t, u, s->z_user);
             if (rc != 0)
@@ -541,7 +563,13 @@ int dmi_init(dmi_solver *s)
         return dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for the history");
     dmi_conv *c = NULL;
     dmi_exp *e = NULL;
-    rc = sample_kernel(s, &k);
+    /* the recursion (with full cells) needs no samples: taken if another
+     * method is chosen later (dmi_set_convolution) */
+    const int sample = s->theta != 1 || !is_recursion(s, s->conv_method);
+    if (sample)
+        rc = sample_kernel(s, &k, "dmi_init");
+    else
+        dmi_kernel_alloc(&k, s->n, s->N, NULL); /* none (allocates nothing) */
     if (rc == DMI_OK)
         rc = sample_history(s, &ring);
     if (rc == DMI_OK)
@@ -554,6 +582,7 @@ int dmi_init(dmi_solver *s)
     dmi_kernel_release(&s->kernel);
     dmi_history_release(&s->ring);
     s->kernel = k;
+    s->kernel_sampled = sample;
     s->ring = ring;
     engine_free(s->conv, s->rec);
     s->conv = c;
@@ -797,8 +826,7 @@ int dmi_set_window(dmi_solver *s, const double *U)
         return dmi_fail(s, DMI_EINVAL, "dmi_set_window: U[%zu] (row %zu = U^{p-%zu}, component "
                         "%zu) is not finite", bad, bad / n, N - bad / n, bad % n);
     s->ring.head = 0; /* the ring rewritten in place: every slot and its mirror */
-    for (size_t k = 0; k <= N; k++)
-        dmi_history_put(&s->ring, N - k, U + k * n);
+    dmi_history_put_window(&s->ring, U);
     dmi_engine_rebuild(s, s->conv, s->rec);
     return DMI_OK;
 }

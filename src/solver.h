@@ -36,6 +36,7 @@ struct dmi_solver {
     uint64_t p;         /* step counter: t_p = p h */
     dmi_history ring;   /* U^{p-N..p} */
     dmi_kernel kernel;  /* nonzero entries of H(l h) */
+    int kernel_sampled; /* kernel holds them (dmi_init leaves them out for the recursion) */
     dmi_conv *conv;     /* FFT engine, or NULL */
     dmi_exp *rec;       /* recursion engine, or NULL (both NULL: the direct sum) */
     double *last_W;     /* W^{p-1} (n) */
