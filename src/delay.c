@@ -31,20 +31,6 @@ void dmi_history_release(dmi_history *r)
     memset(r, 0, sizeof *r);
 }
 
-static void write_slot(dmi_history *r, size_t slot, const double *u)
-{
-    for (size_t j = 0; j < r->n; j++) {
-        double *series = r->buf + j * 2 * r->L;
-        series[slot] = u[j];
-        series[slot + r->L] = u[j];
-    }
-}
-
-void dmi_history_put(dmi_history *r, size_t lag, const double *u)
-{
-    const size_t slot = r->head + lag; /* (head, lag < L: no division) */
-    write_slot(r, slot < r->L ? slot : slot - r->L, u);
-}
 
 void dmi_history_put_window(dmi_history *r, const double *U)
 {
@@ -62,7 +48,7 @@ void dmi_history_put_window(dmi_history *r, const double *U)
 void dmi_history_push(dmi_history *r, const double *u)
 {
     r->head = r->head == 0 ? r->L - 1 : r->head - 1;
-    write_slot(r, r->head, u);
+    dmi_history_write_slot(r, r->head, u);
 }
 
 int dmi_kernel_alloc(dmi_kernel *k, size_t n, size_t N, const double *dense)

@@ -38,6 +38,23 @@ size_t dmi_first_nonfinite(const double *x, size_t n)
     return i;
 }
 
+/* dmi_first_nonfinite for long arrays: blocks of 8 without a branch per
+ * value (x * 0 is 0 for a finite x, NaN otherwise), the block with one then
+ * searched value by value. */
+static size_t first_nonfinite_long(const double *x, size_t n)
+{
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        double z[2] = {0, 0};
+        for (size_t k = 0; k < 8; k += 2)
+            for (int c = 0; c < 2; c++)
+                z[c] += x[i + k + (size_t)c] * 0.0;
+        if (!(z[0] == 0 && z[1] == 0))
+            break;
+    }
+    return i + dmi_first_nonfinite(x + i, n - i);
+}
+
 /* ---- the delay sum's engine ------------------------------------------------
  * s->conv is the FFT engine, s->rec the recursion's; both NULL when the
  * direct sum is in use.  The FFT engine exists only when built with
@@ -572,7 +589,12 @@ int dmi_init(dmi_solver *s)
         dmi_kernel_alloc(&k, s->n, s->N, NULL); /* none (allocates nothing) */
     if (rc == DMI_OK)
         rc = sample_history(s, &ring);
-    if (rc == DMI_OK)
+    /* a restart keeps the recursion's engine: it depends on the kernel, N and
+     * h only, which cannot change after dmi_init, and is anchored below */
+    const int keep_rec = s->initialized && s->rec && is_recursion(s, s->conv_method);
+    if (rc == DMI_OK && keep_rec)
+        e = s->rec;
+    else if (rc == DMI_OK)
         rc = engine_make(s, &k, s->conv_method, &c, &e, "dmi_init");
     if (rc != DMI_OK) {
         dmi_kernel_release(&k);
@@ -584,7 +606,8 @@ int dmi_init(dmi_solver *s)
     s->kernel = k;
     s->kernel_sampled = sample;
     s->ring = ring;
-    engine_free(s->conv, s->rec);
+    if (!keep_rec)
+        engine_free(s->conv, s->rec);
     s->conv = c;
     s->rec = e;
     s->p = 0;
@@ -821,7 +844,7 @@ int dmi_set_window(dmi_solver *s, const double *U)
     int rc = dmi_check_query(s, U, "dmi_set_window");
     if (rc != DMI_OK)
         return rc;
-    const size_t n = s->n, N = s->N, bad = dmi_first_nonfinite(U, (N + 1) * n);
+    const size_t n = s->n, N = s->N, bad = first_nonfinite_long(U, (N + 1) * n);
     if (bad < (N + 1) * n)
         return dmi_fail(s, DMI_EINVAL, "dmi_set_window: U[%zu] (row %zu = U^{p-%zu}, component "
                         "%zu) is not finite", bad, bad / n, N - bad / n, bad % n);
