@@ -123,7 +123,8 @@ int main(int argc, char **argv)
                     rc = dmi_set_window(s, U);
                 const double t_window = (cpu_now() - t0) / (double)reps;
                 if (rc != DMI_OK) {
-                    fprintf(stderr, "bench_init: N = %zu, %s: %s\n", N, NAMES[k], dmi_last_error(s));
+                    fprintf(stderr, "bench_init: N = %zu, %s: %s\n", N, NAMES[k],
+                            dmi_last_error(s));
                     return 1;
                 }
                 init_best[i][k] = fmin(init_best[i][k], t_init);
@@ -136,7 +137,7 @@ int main(int argc, char **argv)
     printf("%-20s %8s %10s %12s\n", "kernel", "N", "init/N", "set_window/N");
     for (int k = 0; k < KINDS; k++)
         for (int i = 0; i < NN; i++)
-            printf("%-20s %8zu %10.1f %12.1f\n", NAMES[k], Ns[i], 1e9 * init_best[i][k] / (double)Ns[i],
-                   1e9 * window_best[i][k] / (double)Ns[i]);
+            printf("%-20s %8zu %10.1f %12.1f\n", NAMES[k], Ns[i],
+                   1e9 * init_best[i][k] / (double)Ns[i], 1e9 * window_best[i][k] / (double)Ns[i]);
     return 0;
 }

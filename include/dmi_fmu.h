@@ -247,9 +247,9 @@ typedef double (*dmi_fmu_step_fn)(const dmi_fmu_values *v);
  * for none); nindicators and indicators (optional: 0 and NULL for none; see
  * dmi_fmu_indicators_fn); step (optional: NULL for h = tau / N; see
  * dmi_fmu_step_fn); held (optional, the last field: the built-in indicators
- * from the solver's step instead of an indicators function).  The model descriptions' generator checks it at build time (a
- * table as described above, tau and N as said, n >= 1, configure and
- * outputs given).
+ * from the solver's step instead of an indicators function).  The model
+ * descriptions' generator checks it at build time (a table as described
+ * above, tau and N as said, n >= 1, configure and outputs given).
  */
 typedef struct dmi_fmu_model dmi_fmu_model;
 struct dmi_fmu_model {

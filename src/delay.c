@@ -31,7 +31,6 @@ void dmi_history_release(dmi_history *r)
     memset(r, 0, sizeof *r);
 }
 
-
 void dmi_history_put_window(dmi_history *r, const double *U)
 {
     const size_t n = r->n, N = r->N, L = r->L;

@@ -657,7 +657,8 @@ void dmi_exp_anchor(dmi_exp *e, const dmi_history *r, uint64_t p)
         const term *t = &e->terms[e->term_of[q]];
         const double *u = dmi_history_series(r, e->col[q]); /* u[l] = U^{p-l} */
         /* lanes c = 0, 1: the real and imaginary parts, each summed error-free
-         * (two_sum into hi, its rounding into lo), side by side (vector operations; a real sum's lane 1 stays 0) */
+         * (two_sum into hi, its rounding into lo), side by side (vector
+         * operations; a real sum's lane 1 stays 0) */
         double hi[2] = {0, 0}, lo[2] = {0, 0};
         const double *keep = t->keep; /* (read from memory: both lanes multiply) */
         cdd base = cdd_one(); /* r^l0 */

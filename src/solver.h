@@ -88,9 +88,9 @@ typedef struct {
     uint64_t last_p;    /* the last of them (set when one is counted) */
 } dmi_watch;
 
-/* Fills w->held for s's current step: DMI_OK, or DMI_EINVAL (a message)
- * when s is not initialized, its operator is neither friction nor a box,
- * or a component is not below n. */
+/* Fills w->held for s's current step: DMI_OK; DMI_ESTATE before dmi_init;
+ * DMI_EINVAL when its operator is neither friction nor a box or a
+ * component is not below n (with a message). */
 int dmi_watch_start(dmi_solver *s, dmi_watch *w);
 
 /* dmi_advance of up to steps steps that updates w (started) after each

@@ -155,7 +155,8 @@ int main(void)
     CU_pSuite suite = CU_add_suite("lazy", NULL, NULL);
     CU_add_test(suite, "recursion takes no samples", test_recursion_takes_no_samples);
     CU_add_test(suite, "restart keeps the engine", test_restart_keeps_the_engine);
-    CU_add_test(suite, "non-finite sample at the switch", test_nonfinite_sample_named_at_the_switch);
+    CU_add_test(suite, "non-finite sample at the switch",
+                test_nonfinite_sample_named_at_the_switch);
     CU_add_test(suite, "partial cell samples", test_partial_cell_samples);
     CU_add_test(suite, "set_window names the first non-finite value",
                 test_set_window_names_the_first_nonfinite);
