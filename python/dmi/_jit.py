@@ -41,7 +41,8 @@ def compilations() -> int:
 # ---- the closure's values ------------------------------------------------------------------------
 
 def _param_type(name: str, value: Any, what: str) -> tuple:
-    """The type key of a closure value: ("f",), ("i",), ("b",) or ("a", dtype, ndim)."""
+    """The type key of a closure value: ("f",), ("i",), ("b",), ("a", dtype, ndim), or ("k", id)
+    for a module or function (not passed: a constant of the compiled code)."""
     if isinstance(value, (bool, np.bool_)):
         return ("b",)
     if isinstance(value, (int, np.integer)):
@@ -191,7 +192,11 @@ def _numba_helpers() -> dict[str, Any]:
     libdmi's output (0, or 2 when the result does not have libdmi's shape)."""
     if _helpers:
         return _helpers
-    import numba
+    try:
+        import numba
+    except ImportError as e:
+        raise InvalidArgument(_lib.EINVAL, f"jit=True needs numba (pip install 'dmi[numba]'): "
+                              f"{e}") from None
     from numba import types as nt
     from numba.extending import intrinsic, overload
 
