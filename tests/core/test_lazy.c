@@ -21,26 +21,12 @@
 
 #include <CUnit/Basic.h>
 
+#include "forced_oscillator.h"
 #include "solver.h"
 
 #define PI 3.14159265358979323846
 enum { n = 2, STEPS = 3000 };
 
-static int rhs(double t, const double *u, double *out, void *user)
-{
-    (void)user;
-    out[0] = -u[1];
-    out[1] = u[0] + 1.3 * cos(8 * t);
-    return 0;
-}
-
-static int history(double t, double *out, void *user)
-{
-    (void)user;
-    out[0] = 0.1 * t;
-    out[1] = 0.2;
-    return 0;
-}
 
 /* A solver of the model, the kernel's coefficients scaled by c, h = 1/N (or
  * h given, h > 0), method set before dmi_init; NULL on failure. */

@@ -6,8 +6,8 @@
  * dmi_fmu_stuck and dmi_fmu_contact; with stop, it returns after each change;
  * refused without friction or a box, for a component >= n, before dmi_init.
  *
- *   u' = (-u_1, u_0 + 1.3 cos 8t) - A(u), u(t) = (0, 0.5) for t <= 0, tau = 1,
- *   friction alpha = (0, 1), or the box [-0.3, 0.3] x [-0.4, 0.4].
+ *   u' = (-u_1, u_0 + 1.3 cos 8t) - A(u), u(t) = (0.1 t, 0.2) for t <= 0, tau = 1,
+ *   friction alpha = (0, 1), or the box [-0.1, 0.1] x [-0.15, 0.15].
  *
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
@@ -18,28 +18,13 @@
 
 #include <CUnit/Basic.h>
 
+#include "forced_oscillator.h"
 #include "solver.h"
 
 enum { n = 2, N = 200, STEPS = 2000 };
 static const double ALPHA[n] = {0.0, 1.0};
-static const double LO[n] = {-0.3, -0.4}, HI[n] = {0.3, 0.4};
+static const double LO[n] = {-0.1, -0.15}, HI[n] = {0.1, 0.15};
 
-static int rhs(double t, const double *u, double *out, void *user)
-{
-    (void)user;
-    out[0] = -u[1];
-    out[1] = u[0] + 1.3 * cos(8 * t);
-    return 0;
-}
-
-static int history(double t, double *out, void *user)
-{
-    (void)t;
-    (void)user;
-    out[0] = 0.0;
-    out[1] = 0.5;
-    return 0;
-}
 
 static dmi_solver *solver(int box)
 {
