@@ -14,7 +14,9 @@
  * early (an FMI 3.0 binary) the FMU is instantiated with earlyReturnAllowed: each
  * fmi3DoStep ends at the first stick-slip transition and the master goes on
  * from there (the event detection's cost).  Prints the time per doStep, per
- * solver step of the FMU and of the library, and their ratio.
+ * solver step of the FMU and of the library, and their ratio; and the
+ * library's loop counting the model's built-in indicators as the FMU does
+ * (dmi_advance_watch) over the plain loop: what counting the events costs.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include "clock.h"
@@ -29,7 +31,8 @@
 #include "dmi_fmu.h"
 #include "fmi3FunctionTypes.h"
 #include "fmu_loader.h"
-#include "model.h" /* VR_N, VR_tau */
+#include "model.h"  /* VR_N, VR_tau */
+#include "solver.h" /* libdmi's core: dmi_advance_watch, the FMU's count of its indicators */
 
 #ifndef DMI_FMU_BINARY
 #define DMI_FMU_BINARY "DelayFrictionOscillator.so"
@@ -141,8 +144,10 @@ static double fmu3_early_run(void *lib, int N, double T, double dt, double *tau,
 
 /* CPU seconds of libdmi's loop on the solver the FMU's model configures
  * (its start values, N), stepping the FMU's solver steps of each
- * communication step with dmi_advance; negative if a call failed. */
-static double library_run(int N, double T, double dt)
+ * communication step with dmi_advance, or with watch, with libdmi's count
+ * of the model's built-in indicators (dmi_advance_watch, as the FMU does
+ * without early return); negative if a call failed. */
+static double library_run(int N, double T, double dt, int watch)
 {
     const dmi_fmu_model *model = &DMI_FMU_MODEL;
     double value[64];
@@ -155,8 +160,11 @@ static double library_run(int N, double T, double dt)
     dmi_solver *s = NULL;
     char err[DMI_FMU_ERRLEN] = "";
     double secs = -1;
+    int held[8];
+    dmi_watch w = {model->nindicators, model->held, held, 0, 0};
     if (dmi_create(&s, model->n, value[VR_tau], (size_t)N) == DMI_OK &&
-        model->configure(&v, s, err) == 0 && dmi_init(s) == DMI_OK) {
+        model->configure(&v, s, err) == 0 && dmi_init(s) == DMI_OK && w.m <= 8 &&
+        (!watch || dmi_watch_start(s, &w) == DMI_OK)) {
         const long steps = lround(T / dt);
         const double h = dmi_get_h(s);
         uint64_t p = 0;
@@ -164,7 +172,9 @@ static double library_run(int N, double T, double dt)
         long k = 0;
         for (; k < steps; k++) {
             const uint64_t target = steps_before((double)(k + 1) * dt, h);
-            if (dmi_advance(s, (size_t)(target - p)) != DMI_OK)
+            size_t taken;
+            if ((watch ? dmi_advance_watch(s, (size_t)(target - p), &w, 0, &taken)
+                       : dmi_advance(s, (size_t)(target - p))) != DMI_OK)
                 break;
             p = target;
         }
@@ -218,21 +228,22 @@ int main(int argc, char **argv)
     }
     enum { NN = 4 };
     const int Ns[NN] = {1000, 10000, 100000, 1000000};
-    double best[NN], lib[NN], tau = 0;
+    double best[NN], lib[NN], watched[NN], tau = 0;
     long returns[NN] = {0};
     for (int i = 0; i < NN; i++)
-        best[i] = lib[i] = INFINITY;
+        best[i] = lib[i] = watched[i] = INFINITY;
     for (size_t r = 0; r < rounds; r++)
         for (int i = 0; i < NN; i++) {
-            double s = -1, l = -1;
-            for (int j = 0; j < 2; j++) {
-                if ((j + (int)r) % 2 == 0)
+            double s = -1, l = -1, w = -1;
+            for (int j = 0; j < 3; j++) { /* the order rotates between rounds */
+                const int which = (j + (int)r) % 3;
+                if (which == 0)
                     s = early ? fmu3_early_run(f.lib, Ns[i], T, dt, &tau, &returns[i])
                               : fmu_run(&f, Ns[i], T, dt, &tau);
                 else
-                    l = library_run(Ns[i], T, dt);
+                    *(which == 1 ? &l : &w) = library_run(Ns[i], T, dt, which == 2);
             }
-            if (s < 0 || l < 0) {
+            if (s < 0 || l < 0 || w < 0) {
                 fprintf(stderr, "bench_fmu_loop: N = %d: a call to the %s failed\n", Ns[i],
                         s < 0 ? "FMU" : "library");
                 fmu_unload(&f);
@@ -240,6 +251,7 @@ int main(int argc, char **argv)
             }
             best[i] = fmin(best[i], s);
             lib[i] = fmin(lib[i], l);
+            watched[i] = fmin(watched[i], w);
         }
     const int version = f.version;
     fmu_unload(&f);
@@ -248,12 +260,12 @@ int main(int argc, char **argv)
     printf("C loop over fmi%dDoStep%s, communication step %g, T = %g per run, tau = %g, best of "
            "%zu interleaved rounds (CPU time); libdmi: dmi_advance on the model's solver\n",
            version, early ? " with early return" : "", dt, T, tau, rounds);
-    printf("%8s | %13s | %11s | %14s | %12s%s\n", "N", "us per doStep", "FMU ns/step",
-           "libdmi ns/step", "FMU / libdmi", early ? " | early returns" : "");
+    printf("%8s | %13s | %11s | %14s | %12s | %15s%s\n", "N", "us per doStep", "FMU ns/step",
+           "libdmi ns/step", "FMU / libdmi", "counted / libdmi", early ? " | early returns" : "");
     for (int i = 0; i < NN; i++) {
         const double steps = comm * dt * Ns[i] / tau;
-        printf("%8d | %13.2f | %11.1f | %14.1f | %11.3fx", Ns[i], 1e6 * best[i] / comm,
-               1e9 * best[i] / steps, 1e9 * lib[i] / steps, best[i] / lib[i]);
+        printf("%8d | %13.2f | %11.1f | %14.1f | %11.3fx | %15.3fx", Ns[i], 1e6 * best[i] / comm,
+               1e9 * best[i] / steps, 1e9 * lib[i] / steps, best[i] / lib[i], watched[i] / lib[i]);
         if (early)
             printf(" | %14ld", returns[i]);
         printf("\n");

@@ -58,7 +58,8 @@ def cpu(f) -> float:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(
         description="Times a shooting solve and a continuation step of a forced belt model with "
-                    "a Python right-hand side, as it is and with jit=True, and their ratio.",
+                    "a Python right-hand side, as it is and with jit=True, and prints their CPU "
+                    "seconds and ratio.",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     ap.add_argument("--rounds", type=int, default=2, help="interleaved rounds")
     ap.add_argument("--M", type=int, default=400, help="steps a forcing period")
