@@ -75,9 +75,10 @@ class Solver:
     ``H(s) -> (n, n)``, ``z(t) -> (n,)``, float64 NumPy arrays in and out) or C functions with
     libdmi's signature, called by the library with no Python in between: a numba ``cfunc``
     (signatures ``dmi.RHS_SIGNATURE`` etc.), a ctypes function pointer or a
-    ``scipy.LowLevelCallable``.  A solver may be used by one thread at a time; distinct solvers
-    run in parallel in distinct threads (the GIL is released in every call into libdmi and taken
-    only by Python callbacks).
+    ``scipy.LowLevelCallable``; or, with ``jit=True``, Python functions compiled by numba into
+    such C functions (closure values passed at each call).  A solver may be used by one thread at a
+    time; distinct solvers run in parallel in distinct threads (the GIL is released in every call
+    into libdmi and taken only by Python callbacks).
     """
 
     def __init__(self, n: int, tau: float, N: int | None = None, *, h: float | None = None):
