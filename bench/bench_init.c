@@ -23,6 +23,7 @@
 
 #include "cli.h"
 #include "dmi.h"
+#include "forced_oscillator.h" /* rhs and history (tests/core) */
 #include "layout.h"
 
 #define PI 3.14159265358979323846
@@ -30,22 +31,6 @@
 enum { EXP, EXP_DIRECT, CALLBACK, NONE, KINDS };
 static const char *const NAMES[KINDS] = {"exp (recursion)", "exp, DIRECT", "callback (default)",
                                          "no kernel"};
-
-static int rhs(double t, const double *u, double *out, void *user)
-{
-    (void)user;
-    out[0] = -u[1];
-    out[1] = u[0] + 1.3 * cos(8 * t);
-    return 0;
-}
-
-static int history(double t, double *out, void *user)
-{
-    (void)user;
-    out[0] = 0.1 * t;
-    out[1] = 0.1;
-    return 0;
-}
 
 static int kernel(double s, double *out, void *user)
 {
