@@ -5,7 +5,7 @@
 # function compiled with set_rhs(..., jit=True), against the C
 # program bench_binding (the rhs in C) and a plain NumPy implementation of the
 # scheme as a user would write it (direct delay sum).  Rounds interleave the
-# four; the fastest round of each counts; CPU times of the process (the
+# five; the fastest round of each counts; CPU times of the process (the
 # machine may be shared).  Needs dmi importable (.venv after scripts/deps.sh,
 # or PYTHONPATH=<build>/python) and numba.  The C program runs with the
 # binding's libdmi.so.1 (LD_LIBRARY_PATH), so both time the same library.
@@ -43,9 +43,9 @@ def program(text: str) -> str:
 def parse() -> argparse.Namespace:
     ap = argparse.ArgumentParser(description="Times Example 4.3 (N = 1e4, exponential kernel, "
                                  "friction) through the Python binding with a numba cfunc rhs and "
-                                 "a Python rhs (also compiled with jit=True), beside the C program bench_binding and plain "
-                                 "NumPy; "
-                                 "prints ns per step and the ratios to C.")
+                                 "a Python rhs (also compiled with jit=True), beside the C program "
+                                 "bench_binding and plain NumPy; prints ns per step and the ratios "
+                                 "to C.")
     ap.add_argument("--N", type=positive, default=10000, help="steps per delay, h = 1/N (default: 10000)")
     ap.add_argument("--steps", type=positive, default=1000000,
                     help="steps of the C, numba and jit=True runs (default: 1000000)")
