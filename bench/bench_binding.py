@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 # The Python binding's speed (issue 21; a benchmark, not a test): Example 4.3
 # at N = 1e4 with its kernel as exponential terms and the built-in friction,
-# the right-hand side as a numba cfunc and as a Python function, against the C
+# the right-hand side as a numba cfunc, as a Python function and as that same
+# function compiled with set_rhs(..., jit=True), against the C
 # program bench_binding (the rhs in C) and a plain NumPy implementation of the
 # scheme as a user would write it (direct delay sum).  Rounds interleave the
-# four; the fastest round of each counts; CPU times of the process (the
+# five; the fastest round of each counts; CPU times of the process (the
 # machine may be shared).  Needs dmi importable (.venv after scripts/deps.sh,
 # or PYTHONPATH=<build>/python) and numba.  The C program runs with the
 # binding's libdmi.so.1 (LD_LIBRARY_PATH), so both time the same library.
@@ -42,11 +43,12 @@ def program(text: str) -> str:
 def parse() -> argparse.Namespace:
     ap = argparse.ArgumentParser(description="Times Example 4.3 (N = 1e4, exponential kernel, "
                                  "friction) through the Python binding with a numba cfunc rhs and "
-                                 "a Python rhs, beside the C program bench_binding and plain NumPy; "
-                                 "prints ns per step and the ratios to C.")
+                                 "a Python rhs (also compiled with jit=True), beside the C program "
+                                 "bench_binding and plain NumPy; prints ns per step and the ratios "
+                                 "to C.")
     ap.add_argument("--N", type=positive, default=10000, help="steps per delay, h = 1/N (default: 10000)")
     ap.add_argument("--steps", type=positive, default=1000000,
-                    help="steps of the C and numba runs (default: 1000000)")
+                    help="steps of the C, numba and jit=True runs (default: 1000000)")
     ap.add_argument("--python-steps", type=positive, default=30000,
                     help="steps of the Python-rhs and NumPy runs (default: 30000)")
     ap.add_argument("--rounds", type=positive, default=7, help="interleaved rounds (default: 7)")
@@ -65,10 +67,10 @@ def c_run(program: str, N: int, steps: int) -> tuple[float, list[float]]:
     return float(lines[0].split()[1]), [float(x) for x in lines[1].split()]
 
 
-def solver(N: int, rhs):
+def solver(N: int, rhs, jit: bool = False):
     import dmi
     s = dmi.Solver(2, 1.0, N)
-    s.set_rhs(rhs)
+    s.set_rhs(rhs, jit=jit)
     s.set_friction([0.0, 1.0])
     s.set_kernel_exp([0.0, 0.0, 0.0], [2 * math.pi, 10 * math.pi, 20 * math.pi],
                      [[[0.0, 0.0], [1.0, 0.0]]] * 3)
@@ -76,8 +78,8 @@ def solver(N: int, rhs):
     return s
 
 
-def timed_advance(N: int, rhs, steps: int) -> tuple[float, list[float]]:
-    s = solver(N, rhs)
+def timed_advance(N: int, rhs, steps: int, jit: bool = False) -> tuple[float, list[float]]:
+    s = solver(N, rhs, jit)
     t0 = time.process_time()
     s.advance(steps)
     return 1e9 * (time.process_time() - t0) / steps, list(s.state)
@@ -117,12 +119,14 @@ def main() -> None:
         return np.array([-u[1], u[0] + 1.3 * math.cos(8 * t)])
 
     N, big, small = args.N, args.steps, args.python_steps
-    best = {"C": math.inf, "numba": math.inf, "Python": math.inf, "NumPy": math.inf}
+    best = {"C": math.inf, "numba": math.inf, "jit": math.inf, "Python": math.inf, "NumPy": math.inf}
     for _ in range(args.rounds):
         ns, c_state = c_run(args.c_program, N, big)
         best["C"] = min(best["C"], ns)
         ns, nb_state = timed_advance(N, rhs_numba, big)
         best["numba"] = min(best["numba"], ns)
+        ns, jit_state = timed_advance(N, rhs_python, big, jit=True)  # compiled once (cached)
+        best["jit"] = min(best["jit"], ns)
         ns, py_state = timed_advance(N, rhs_python, small)
         best["Python"] = min(best["Python"], ns)
         ns, np_state = numpy_run(N, small)
@@ -133,6 +137,7 @@ def main() -> None:
           f"program), numba {numba.__version__}, numpy {np.__version__}")
     print(f"{'rhs':<28} {'steps':>9} {'ns/step':>10} {'x C':>8}")
     rows = [("C (bench_binding)", "C", big), ("numba cfunc (dmi.Solver)", "numba", big),
+            ("Python function, jit=True", "jit", big),
             ("Python function (dmi.Solver)", "Python", small), ("plain NumPy scheme", "NumPy", small)]
     for label, key, steps in rows:
         print(f"{label:<28} {steps:>9} {best[key]:>10.1f} {best[key] / best['C']:>7.2f}x")
@@ -140,7 +145,11 @@ def main() -> None:
     dev_np = max(abs(a - b) for a, b in zip(np_state, py_state))
     print(f"final state: numba - C {dev_nb:.1e} (after {big} steps), NumPy - Python rhs {dev_np:.1e} "
           f"(after {small} steps)")
+    dev_jit = max(abs(a - b) for a, b in zip(jit_state, nb_state))
+    print(f"final state: jit=True - numba cfunc {dev_jit:.1e} (after {big} steps)")
     print(f"numba / C = {best['numba'] / best['C']:.2f} (target <= 1.2)")
+    print(f"jit=True / numba cfunc = {best['jit'] / best['numba']:.2f} (target <= 1.3), "
+          f"Python / jit=True = {best['Python'] / best['jit']:.1f} (target >= 20)")
 
 
 if __name__ == "__main__":

@@ -46,7 +46,7 @@
       "the element r of alpha sigma(v) selected by the step containing t, in [-alpha, alpha]")     \
     X(delay_force, Float64, output, , "", "the delay term W of the step containing t")            \
     X(N, Int32, parameter, 1000, "",                                                               \
-      "steps per tau (h = tau / N); the solver takes about 40 N bytes (N = 10^8: 4 GB).  "         \
+      "steps per tau (h = tau / N); the solver takes about 32 N bytes (N = 10^8: 3.2 GB).  "       \
       "ExitInitializationMode warns (status Warning) when the step is coarse: the explicit part "  \
       "of the scheme amplifies an undamped oscillation by about (1 + h^2 b) per step (b > 0), "    \
       "so warning when (1 + h^2 b)^(T/h) > 2, T the experiment's length (stop - start time, 30 "   \

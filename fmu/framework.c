@@ -4,7 +4,8 @@
  */
 #include "framework.h"
 
-#include "bytes.h" /* libdmi's: FNV-1a, values at a byte offset */
+#include "bytes.h"  /* libdmi's: FNV-1a, values at a byte offset */
+#include "solver.h" /* libdmi's: dmi_watch, the resolvent's hold step by step */
 
 #include <math.h>
 #include <stdarg.h>
@@ -85,7 +86,7 @@ static double *values_of(const fmu_model *m)
 int fmu_model_new(fmu_model *m)
 {
     const unsigned nvr = count_vr();
-    const size_t n = MODEL->n, nind = MODEL->indicators ? MODEL->nindicators : 0;
+    const size_t n = MODEL->n, nind = MODEL->indicators || MODEL->held ? MODEL->nindicators : 0;
     m->v = malloc(sizeof *m->v + (2 * nvr + 5 * n) * sizeof(double) +
                   2 * nvr * sizeof(unsigned) + 2 * nind * sizeof(int) + nvr);
     if (!m->v)
@@ -305,7 +306,14 @@ int fmu_model_check_start(const fmu_model *m, double T, char *msg)
 /* The number of the model's indicators (0 without them). */
 static size_t n_indicators(void)
 {
-    return MODEL->indicators ? MODEL->nindicators : 0;
+    return MODEL->indicators || MODEL->held ? MODEL->nindicators : 0;
+}
+
+/* The watch of the model's built-in indicators (held) on m->ind. */
+static dmi_watch held_watch(const fmu_model *m)
+{
+    dmi_watch w = {MODEL->nindicators, MODEL->held, m->ind, 0, 0};
+    return w;
 }
 
 /* *pt: the point at time t of the solver's step p, in m->work (u, U,
@@ -339,6 +347,23 @@ static void indicators_at(fmu_model *m, int *st)
     MODEL->indicators(m->v, &pt, st);
 }
 
+/* The indicators at the solver's step into m->ind (none: nothing): 0, or -1
+ * with the reason in err (built-ins of an operator that has none). */
+static int indicators_start(fmu_model *m, char *err)
+{
+    if (!n_indicators())
+        return 0;
+    if (!MODEL->held) {
+        indicators_at(m, m->ind);
+        return 0;
+    }
+    dmi_watch w = held_watch(m);
+    return dmi_watch_start(m->solver, &w) == DMI_OK
+               ? 0
+               : fail(err, "the model's built-in indicators (held): %s",
+                      dmi_last_error(m->solver));
+}
+
 int fmu_model_start(fmu_model *m, double t_start, char *err, char *note)
 {
     note[0] = '\0';
@@ -362,8 +387,10 @@ int fmu_model_start(fmu_model *m, double t_start, char *err, char *note)
     m->out_valid = 0;
     m->nevents = m->event_p = 0;
     m->event = 0;
-    if (n_indicators())
-        indicators_at(m, m->ind);
+    if (indicators_start(m, err) != 0) {
+        dmi_free(&m->solver);
+        return -1;
+    }
     return 0;
 }
 
@@ -411,6 +438,33 @@ static int steps_with_events(fmu_model *m, uint64_t p, uint64_t target, fmu_stop
     return 0;
 }
 
+/* steps_with_events for the built-in indicators (held): libdmi counts the
+ * changes as it steps, and stops at one only when it may end the
+ * communication step (stop). */
+static int steps_with_held(fmu_model *m, uint64_t p, uint64_t target, fmu_stop_fn *stop,
+                           void *ctx)
+{
+    dmi_watch w = held_watch(m);
+    while (p < target) {
+        size_t taken = 0;
+        w.changes = 0;
+        int rc = dmi_advance_watch(m->solver, (size_t)(target - p), &w, stop != NULL, &taken);
+        m->p = p += taken;
+        if (w.changes) {
+            m->nevents += w.changes;
+            m->event_p = w.last_p;
+            m->event = 1;
+        }
+        if (rc != DMI_OK)
+            return rc;
+        if (w.changes && p < target && stop && stop(ctx, m->v->t_start + (double)p * m->h)) {
+            m->t_comm = m->v->t_start + (double)p * m->h;
+            return 1;
+        }
+    }
+    return 0;
+}
+
 int fmu_model_do_step(fmu_model *m, double t_current, double step, fmu_stop_fn *stop,
                       void *ctx, int *early, char *err)
 {
@@ -430,8 +484,9 @@ int fmu_model_do_step(fmu_model *m, double t_current, double step, fmu_stop_fn *
     m->out_valid = 0;
     m->event = 0;
     if (target > (double)p) {
-        int rc = n_indicators() ? steps_with_events(m, p, (uint64_t)target, stop, ctx)
-                                : dmi_advance(m->solver, (size_t)(target - (double)p));
+        int rc = MODEL->held     ? steps_with_held(m, p, (uint64_t)target, stop, ctx)
+                 : n_indicators() ? steps_with_events(m, p, (uint64_t)target, stop, ctx)
+                                  : dmi_advance(m->solver, (size_t)(target - (double)p));
         if (rc == 1) {
             *early = 1;
             return 0;
@@ -798,8 +853,8 @@ int fmu_model_state_load(fmu_model *into, uint32_t tags, uint32_t solver_tags, u
             goto refused;
         }
     }
-    if (m.solver && n_indicators())
-        indicators_at(&m, m.ind);
+    if (m.solver && indicators_start(&m, err) != 0)
+        goto refused;
     if (into) {
         fmu_model_free(into);
         *into = m; /* the solver's callbacks keep m.v, which moves with it */

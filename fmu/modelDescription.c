@@ -221,7 +221,8 @@ static void header(FILE *f, int v, const char *name, const char *guid, int nsour
     }
     /* event mode always; with the model's indicators, early return at their
      * events and intermediateUpdate called there (fmi3Functions.c) */
-    const char *events = MODEL->indicators && MODEL->nindicators > 0 ? "true" : "false";
+    const char *events =
+        (MODEL->indicators || MODEL->held) && MODEL->nindicators > 0 ? "true" : "false";
     if (v == 3)
         fprintf(f, "  <CoSimulation\n"
                    "    modelIdentifier=\"%s\"\n"

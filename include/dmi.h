@@ -353,6 +353,9 @@ DMI_API int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user);
  * without the definition DMI_HAVE_FFT, as inside the FMU; AUTO then never
  * picks it); DMI_ENOMEM if the
  * FFT engine cannot be allocated after dmi_init (the former method stays).
+ * Leaving the recursion after dmi_init samples the kernel (see dmi_init):
+ * DMI_ENOMEM or DMI_ENONFINITE (a sample, named) then, the former method
+ * staying.
  */
 DMI_API int dmi_set_convolution(dmi_solver *s, int method);
 
@@ -362,6 +365,11 @@ DMI_API int dmi_set_convolution(dmi_solver *s, int method);
  * Samples the kernel H(l h), l = 0..N-1, and the history U^p = z(p h),
  * p = -N..0, and sets p = 0.  May be called again to restart from t = 0.
  * Memory: the nonzero kernel entries take N doubles each (at most N n^2).
+ * (Since 1.2.)  Under DMI_CONV_RECURSIVE (also as chosen by AUTO) with full
+ * cells (dmi_create, or theta = 1) the kernel is not sampled: the recursion
+ * needs no samples (its O(K n) sums are computed from the history instead),
+ * and a later dmi_set_convolution to another method samples it then; a
+ * restart keeps the recursion's engine.
  * Errors: DMI_ECALLBACK / DMI_ENONFINITE (kernel or history callback),
  * DMI_ENOMEM; the solver is then unchanged (still uninitialised, or still at
  * its former t_p if it had been initialised).
@@ -424,10 +432,11 @@ DMI_API int dmi_get_past(const dmi_solver *s, size_t lag, double *u);
  * states, as dmi_set_convolution does (bitwise the same as a solver whose
  * states were those all along for DIRECT and FFT; up to rounding for
  * RECURSIVE); the last step's terms (dmi_get_step_terms) still describe the
- * step before the call.  The array is copied.
+ * step before the call.  The array is copied (set: into the solver's own
+ * storage, nothing is allocated).
  * Errors: DMI_EINVAL for NULL arguments or (set) a NaN or infinite value
- * (the message names its row and component); DMI_ESTATE before dmi_init;
- * DMI_ENOMEM (set).  On error the solver is unchanged.
+ * (the message names its row and component); DMI_ESTATE before dmi_init.
+ * On error the solver is unchanged.
  */
 DMI_API int dmi_get_window(const dmi_solver *s, double *U);
 /** (Since 1.2.)  Replaces the window of stored states by U: see dmi_get_window. */

@@ -196,6 +196,10 @@ typedef void (*dmi_fmu_bytes_fn)(const dmi_fmu_values *v, double *peak, double *
 typedef void (*dmi_fmu_indicators_fn)(const dmi_fmu_values *v, const dmi_fmu_point *pt,
                                       int *state);
 
+/* Built-in indicators without an indicators function: see dmi_fmu_model's
+ * held, which takes dmi_fmu_stuck or dmi_fmu_contact of the solver's own
+ * operator from the solver's step. */
+
 /** dmi_fmu_stuck(pt, i, alpha_i), a built-in indicator of dmi_set_friction's
  * component i with coefficient alpha_i (>= 0): 1 (stuck) when the resolvent's argument lies within
  * h alpha_i of zero, |X_i| <= h alpha_i (then U_i = 0), else 0 (slipping). */
@@ -242,10 +246,11 @@ typedef double (*dmi_fmu_step_fn)(const dmi_fmu_values *v);
  * accept, check and bytes (optional: NULL for none; without bytes, the
  * figures of a dense kernel); author (the model descriptions' author, NULL
  * for none); nindicators and indicators (optional: 0 and NULL for none; see
- * dmi_fmu_indicators_fn); step (optional, the last field: NULL for
- * h = tau / N; see dmi_fmu_step_fn).  The model descriptions' generator checks it at build time (a
- * table as described above, tau and N as said, n >= 1, configure and
- * outputs given).
+ * dmi_fmu_indicators_fn); step (optional: NULL for h = tau / N; see
+ * dmi_fmu_step_fn); held (optional, the last field: the built-in indicators
+ * from the solver's step instead of an indicators function).  The model
+ * descriptions' generator checks it at build time (a table as described
+ * above, tau and N as said, n >= 1, configure and outputs given).
  */
 typedef struct dmi_fmu_model dmi_fmu_model;
 struct dmi_fmu_model {
@@ -265,6 +270,17 @@ struct dmi_fmu_model {
     dmi_fmu_indicators_fn indicators;
     /* (Since libdmi 1.2.)  Optional, NULL for none: see dmi_fmu_step_fn. */
     dmi_fmu_step_fn step;
+    /* (Since libdmi 1.2.)  Optional, NULL for none: the built-in indicators
+     * of the solver's own operator, indicator k (k < nindicators) for
+     * component held[k]: dmi_fmu_stuck(pt, i, alpha_i) with the alpha of
+     * dmi_set_friction, or dmi_fmu_contact(pt, i, lo_i, hi_i) with the faces
+     * of dmi_set_box.  libdmi takes them from each step's resolvent argument
+     * as it steps (no indicators call, no state read back: the FMU steps at
+     * about libdmi's own speed, docs/fmu-export.md); indicators is then not
+     * called (leave it NULL).  A solver configured with another operator (a
+     * resolvent callback, none) fails ExitInitializationMode with a logged
+     * error. */
+    const size_t *held;
 };
 
 /** The model of the FMU: define it once, in one of its C files:

@@ -31,24 +31,23 @@ void dmi_history_release(dmi_history *r)
     memset(r, 0, sizeof *r);
 }
 
-static void write_slot(dmi_history *r, size_t slot, const double *u)
+void dmi_history_put_window(dmi_history *r, const double *U)
 {
-    for (size_t j = 0; j < r->n; j++) {
-        double *series = r->buf + j * 2 * r->L;
-        series[slot] = u[j];
-        series[slot + r->L] = u[j];
+    const size_t n = r->n, N = r->N, L = r->L;
+    for (size_t j = 0; j < n; j++) { /* row k is U^{p-(N-k)}: slot N - k, head 0 */
+        double *series = r->buf + j * 2 * L;
+        for (size_t k = 0; k <= N; k++) {
+            const double x = U[k * n + j];
+            series[N - k] = x;
+            series[N - k + L] = x;
+        }
     }
-}
-
-void dmi_history_put(dmi_history *r, size_t lag, const double *u)
-{
-    write_slot(r, (r->head + lag) % r->L, u);
 }
 
 void dmi_history_push(dmi_history *r, const double *u)
 {
     r->head = r->head == 0 ? r->L - 1 : r->head - 1;
-    write_slot(r, r->head, u);
+    dmi_history_write_slot(r, r->head, u);
 }
 
 int dmi_kernel_alloc(dmi_kernel *k, size_t n, size_t N, const double *dense)

@@ -19,8 +19,24 @@ typedef struct {
 
 int dmi_history_alloc(dmi_history *r, size_t n, size_t N); /* 0 or -1; zero-filled, head = 0 */
 void dmi_history_release(dmi_history *r);
+/* u (n values) into slot slot of every series and of its mirror. */
+static inline void dmi_history_write_slot(dmi_history *r, size_t slot, const double *u)
+{
+    for (size_t j = 0; j < r->n; j++) {
+        double *series = r->buf + j * 2 * r->L;
+        series[slot] = u[j];
+        series[slot + r->L] = u[j];
+    }
+}
 /* U^{p-lag} = u (only while filling a fresh ring: head must be 0). */
-void dmi_history_put(dmi_history *r, size_t lag, const double *u);
+static inline void dmi_history_put(dmi_history *r, size_t lag, const double *u)
+{
+    const size_t slot = r->head + lag; /* (head, lag < L: no division) */
+    dmi_history_write_slot(r, slot < r->L ? slot : slot - r->L, u);
+}
+/* Every state from the window U, (N + 1) rows of n values, oldest first:
+ * row k is U^{p-(N-k)} (only while filling a fresh ring: head must be 0). */
+void dmi_history_put_window(dmi_history *r, const double *U);
 /* Makes u the newest state U^{p+1}; U^{p-N} is dropped. */
 void dmi_history_push(dmi_history *r, const double *u);
 /* Pointer to U_j^{p-l}, l = 0..N (contiguous). */

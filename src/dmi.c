@@ -40,6 +40,23 @@ size_t dmi_first_nonfinite(const double *x, size_t n)
     return i;
 }
 
+/* dmi_first_nonfinite for long arrays: blocks of 8 without a branch per
+ * value (x * 0 is 0 for a finite x, NaN otherwise), the block with one then
+ * searched value by value. */
+static size_t first_nonfinite_long(const double *x, size_t n)
+{
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        double z[2] = {0, 0};
+        for (size_t k = 0; k < 8; k += 2)
+            for (int c = 0; c < 2; c++)
+                z[c] += x[i + k + (size_t)c] * 0.0;
+        if (!(z[0] == 0 && z[1] == 0))
+            break;
+    }
+    return i + dmi_first_nonfinite(x + i, n - i);
+}
+
 /* ---- the delay sum's engine ------------------------------------------------
  * s->conv is the FFT engine, s->rec the recursion's; both NULL when the
  * direct sum is in use.  The FFT engine exists only when built with
@@ -97,17 +114,23 @@ static int check_method(const dmi_solver *s, int method, const char *fn)
                                    "FFT)", fn, method, k, s->expk.a[k]);
 }
 
+/* Whether method is the recursion (AUTO: for an exponential kernel it
+ * takes, see first_unfit), which needs no kernel samples. */
+static int is_recursion(const dmi_solver *s, int method)
+{
+    int aliased;
+    return method == DMI_CONV_RECURSIVE ||
+           (method == DMI_CONV_AUTO && dmi_has_expk(s) && first_unfit(s, &aliased) == s->expk.K);
+}
+
 /* The engines that method asks for with kernel samples k (AUTO: the
- * recursion for an exponential kernel it takes, see first_unfit). */
+ * recursion for an exponential kernel it takes). */
 static int engine_make(const dmi_solver *s, const dmi_kernel *k, int method, dmi_conv **conv,
                        dmi_exp **rec, const char *fn)
 {
     *conv = NULL;
     *rec = NULL;
-    int aliased;
-    if (method == DMI_CONV_AUTO && dmi_has_expk(s) && first_unfit(s, &aliased) == s->expk.K)
-        method = DMI_CONV_RECURSIVE;
-    if (method == DMI_CONV_RECURSIVE) {
+    if (is_recursion(s, method)) {
         const dmi_expk *x = s->quad == DMI_QUAD_CELL ? &s->cell_expk : &s->expk;
         if (dmi_has_expk(s) && dmi_exp_create(rec, x, s->N, s->h) != 0)
             return dmi_fail(s, DMI_ENOMEM, "%s: out of memory for the recursion's sums", fn);
@@ -476,6 +499,8 @@ int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user)
     return DMI_OK;
 }
 
+static int sample_kernel(dmi_solver *s, dmi_kernel *k, const char *fn);
+
 int dmi_set_convolution(dmi_solver *s, int method)
 {
     if (!s)
@@ -486,9 +511,20 @@ int dmi_set_convolution(dmi_solver *s, int method)
     if (s->initialized) { /* the engine follows the method from the next step on */
         dmi_conv *c = NULL;
         dmi_exp *e = NULL;
-        rc = engine_make(s, &s->kernel, method, &c, &e, "dmi_set_convolution");
-        if (rc != DMI_OK)
+        dmi_kernel k = {0};
+        const int sample = !s->kernel_sampled && !is_recursion(s, method);
+        if (sample && (rc = sample_kernel(s, &k, "dmi_set_convolution")) != DMI_OK)
             return rc;
+        rc = engine_make(s, sample ? &k : &s->kernel, method, &c, &e, "dmi_set_convolution");
+        if (rc != DMI_OK) {
+            dmi_kernel_release(&k);
+            return rc;
+        }
+        if (sample) { /* the samples the recursion went without, now */
+            dmi_kernel_release(&s->kernel);
+            s->kernel = k;
+            s->kernel_sampled = 1;
+        }
         dmi_engine_rebuild(s, c, e);
         engine_free(s->conv, s->rec);
         s->conv = c;
@@ -500,20 +536,21 @@ int dmi_set_convolution(dmi_solver *s, int method)
 
 /* ---- init ------------------------------------------------------------------ */
 
-/* Samples H(l h), l = 0..N-1, into k (nonzero entries only).  An
- * exponential kernel is sampled entry by entry (dmi_expk_sample: no N n n
- * array); where a sample is not finite, the general path below names it. */
-static int sample_kernel(dmi_solver *s, dmi_kernel *k)
+/* Samples H(l h), l = 0..N-1, into k (nonzero entries only), for fn's
+ * messages.  An exponential kernel is sampled entry by entry
+ * (dmi_expk_sample: no N n n array); where a sample is not finite, the
+ * general path below names it. */
+static int sample_kernel(dmi_solver *s, dmi_kernel *k, const char *fn)
 {
     const size_t n = s->n, N = s->N, nn = n * n;
     if (!s->H)
         return dmi_kernel_alloc(k, n, N, NULL) == 0
                    ? DMI_OK
-                   : dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory");
+                   : dmi_fail(s, DMI_ENOMEM, "%s: out of memory", fn);
     if (dmi_has_expk(s)) {
         int rc = dmi_expk_sample(&s->expk, N, s->h, k);
         if (rc < 0)
-            return dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for kernel samples");
+            return dmi_fail(s, DMI_ENOMEM, "%s: out of memory for kernel samples", fn);
         if (rc == 0)
             return DMI_OK;
     }
@@ -521,8 +558,8 @@ static int sample_kernel(dmi_solver *s, dmi_kernel *k)
     size_t bytes = dmi_mul_size(n, n, 1) ? dmi_mul_size(N, nn, sizeof(double)) : 0;
     double *dense = bytes ? malloc(bytes) : NULL;
     if (!dense)
-        return dmi_fail(s, DMI_ENOMEM, "dmi_init: cannot allocate %zu x %zu x %zu kernel samples",
-                        N, n, n);
+        return dmi_fail(s, DMI_ENOMEM, "%s: cannot allocate %zu x %zu x %zu kernel samples",
+                        fn, N, n, n);
     for (size_t l = 0; l < N; l++) {
         double t = (double)l * s->h;
         double *Hl = dense + l * nn;
@@ -530,20 +567,20 @@ static int sample_kernel(dmi_solver *s, dmi_kernel *k)
         int rc = s->H(t, Hl, s->H_user);
         if (rc != 0) {
             free(dense);
-            return dmi_fail(s, DMI_ECALLBACK, "dmi_init: kernel callback returned %d at s = %.17g",
-                            rc, t);
+            return dmi_fail(s, DMI_ECALLBACK, "%s: kernel callback returned %d at s = %.17g",
+                            fn, rc, t);
         }
         size_t bad = dmi_first_nonfinite(Hl, nn);
         if (bad < nn) {
-            rc = dmi_fail(s, DMI_ENONFINITE, "dmi_init: kernel H(%.17g)[%zu][%zu] = %g", t, bad / n,
-                          bad % n, Hl[bad]);
+            rc = dmi_fail(s, DMI_ENONFINITE, "%s: kernel H(%.17g)[%zu][%zu] = %g", fn, t,
+                          bad / n, bad % n, Hl[bad]);
             free(dense);
             return rc;
         }
     }
     int rc = dmi_kernel_alloc(k, n, N, dense);
     free(dense);
-    return rc == 0 ? DMI_OK : dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for kernel samples");
+    return rc == 0 ? DMI_OK : dmi_fail(s, DMI_ENOMEM, "%s: out of memory for kernel samples", fn);
 }
 
 /* Samples z(p h), p = -N..0, into ring. */
@@ -555,8 +592,10 @@ static int sample_history(dmi_solver *s, dmi_history *ring)
         /* t_{-k} = -k h, and -tau at k = N: -N h may round below it, and is
          * below it for a partial last cell (dmi_create_h; U^{-N} is read by no
          * step), and z is called on [-tau, 0] only */
-        double t = k == s->N ? -s->tau : k == 0 ? 0.0 : fmax(-(double)k * s->h, -s->tau);
-        memset(u, 0, n * sizeof *u);
+        const double tk = -(double)k * s->h; /* (fmax of the two, without a libm call) */
+        double t = k == s->N ? -s->tau : k == 0 ? 0.0 : tk < -s->tau ? -s->tau : tk;
+        for (size_t j = 0; j < n; j++) /* (a loop: n is small) */
+            u[j] = 0;
         if (s->z) {
             int rc = s->z(t, u, s->z_user);
             if (rc != 0)
@@ -605,13 +644,25 @@ int dmi_init(dmi_solver *s)
     if (s->near_H && !dmi_has_expk(s))
         rc = dmi_fail(s, DMI_EINVAL, "dmi_init: the near cells of dmi_set_kernel_near need a kernel "
                                      "given by dmi_set_kernel_exp");
-    if (rc == DMI_OK)
-        rc = s->quad == DMI_QUAD_CELL ? quad_prepare(s, &k, &last) : sample_kernel(s, &k);
+    /* the recursion with full cells, the paper's rule and no near cells needs no samples: taken
+     * if another method is chosen later (dmi_set_convolution) */
+    const int sample = s->theta != 1 || !is_recursion(s, s->conv_method) ||
+                       s->quad == DMI_QUAD_CELL || s->near_H;
+    if (rc == DMI_OK && !sample)
+        dmi_kernel_alloc(&k, s->n, s->N, NULL); /* none (allocates nothing) */
+    else if (rc == DMI_OK)
+        rc = s->quad == DMI_QUAD_CELL ? quad_prepare(s, &k, &last)
+                                      : sample_kernel(s, &k, "dmi_init");
     if (rc == DMI_OK && s->near_H)
         rc = dmi_quad_near(s, &k, &last, &near);
     if (rc == DMI_OK)
         rc = sample_history(s, &ring);
-    if (rc == DMI_OK)
+    /* a restart keeps the recursion's engine: it depends on the kernel, N and
+     * h only, which cannot change after dmi_init, and is anchored below */
+    const int keep_rec = s->initialized && s->rec && is_recursion(s, s->conv_method);
+    if (rc == DMI_OK && keep_rec)
+        e = s->rec;
+    else if (rc == DMI_OK)
         rc = engine_make(s, &k, s->conv_method, &c, &e, "dmi_init");
     if (rc != DMI_OK) {
         dmi_kernel_release(&k);
@@ -627,8 +678,10 @@ int dmi_init(dmi_solver *s)
     dmi_kernel_release(&s->kernel);
     dmi_history_release(&s->ring);
     s->kernel = k;
+    s->kernel_sampled = sample;
     s->ring = ring;
-    engine_free(s->conv, s->rec);
+    if (!keep_rec)
+        engine_free(s->conv, s->rec);
     s->conv = c;
     s->rec = e;
     s->p = 0;
@@ -736,6 +789,65 @@ int dmi_advance(dmi_solver *s, size_t steps)
     return DMI_OK;
 }
 
+/* The hold of component i for the resolvent's argument x (see dmi_watch). */
+static int held_of(const dmi_solver *s, size_t i, double x)
+{
+    if (s->a_kind == A_FRICTION) {
+        const double lam = s->h * s->a_lo[i];
+        return !(x > lam) && !(x < -lam);
+    }
+    return x <= s->a_lo[i] ? -1 : x >= s->a_hi[i] ? 1 : 0;
+}
+
+int dmi_watch_start(dmi_solver *s, dmi_watch *w)
+{
+    if (!s || !w)
+        return DMI_EINVAL;
+    if (!s->initialized)
+        return dmi_fail(s, DMI_ESTATE, "dmi_watch_start: call dmi_init first");
+    if (s->a_kind != A_FRICTION && s->a_kind != A_BOX)
+        return dmi_fail(s, DMI_EINVAL, "dmi_watch_start: the hold of a component needs "
+                                       "dmi_set_friction or dmi_set_box");
+    for (size_t k = 0; k < w->m; k++)
+        if (w->comp[k] >= s->n)
+            return dmi_fail(s, DMI_EINVAL, "dmi_watch_start: component %zu >= n = %zu",
+                            w->comp[k], s->n);
+    const double *X = s->last_X;
+    if (s->p == 0) {
+        dmi_history_get(&s->ring, 0, s->work);
+        X = s->work;
+    }
+    for (size_t k = 0; k < w->m; k++)
+        w->held[k] = held_of(s, w->comp[k], X[w->comp[k]]);
+    return DMI_OK;
+}
+
+int dmi_advance_watch(dmi_solver *s, size_t steps, dmi_watch *w, int stop, size_t *taken)
+{
+    *taken = 0;
+    if (!s)
+        return DMI_EINVAL;
+    for (size_t k = 0; k < steps; k++) {
+        int rc = dmi_step(s);
+        if (rc != DMI_OK)
+            return rc;
+        ++*taken;
+        int changed = 0;
+        for (size_t j = 0; j < w->m; j++) {
+            const int now = held_of(s, w->comp[j], s->last_X[w->comp[j]]);
+            changed |= now != w->held[j];
+            w->held[j] = now;
+        }
+        if (changed) {
+            w->changes++;
+            w->last_p = s->p;
+            if (stop)
+                break;
+        }
+    }
+    return DMI_OK;
+}
+
 /* ---- queries ---------------------------------------------------------------- */
 
 double dmi_time(const dmi_solver *s)
@@ -806,17 +918,12 @@ int dmi_set_window(dmi_solver *s, const double *U)
     int rc = dmi_check_query(s, U, "dmi_set_window");
     if (rc != DMI_OK)
         return rc;
-    const size_t n = s->n, N = s->N, bad = dmi_first_nonfinite(U, (N + 1) * n);
+    const size_t n = s->n, N = s->N, bad = first_nonfinite_long(U, (N + 1) * n);
     if (bad < (N + 1) * n)
         return dmi_fail(s, DMI_EINVAL, "dmi_set_window: U[%zu] (row %zu = U^{p-%zu}, component "
                         "%zu) is not finite", bad, bad / n, N - bad / n, bad % n);
-    dmi_history ring = {0};
-    if (dmi_history_alloc(&ring, n, N) != 0)
-        return dmi_fail(s, DMI_ENOMEM, "dmi_set_window: out of memory");
-    for (size_t k = 0; k <= N; k++)
-        dmi_history_put(&ring, N - k, U + k * n);
-    dmi_history_release(&s->ring);
-    s->ring = ring;
+    s->ring.head = 0; /* the ring rewritten in place: every slot and its mirror */
+    dmi_history_put_window(&s->ring, U);
     dmi_engine_rebuild(s, s->conv, s->rec);
     return DMI_OK;
 }

@@ -344,6 +344,8 @@ typedef struct {
     double rN_re, rN_im;         /* r^N */
     cdd rB;                      /* r^BLOCK, for the anchors */
     double tab[2 * BLOCK];       /* r^i, i < BLOCK: re, im */
+    double tabx[2 * BLOCK];      /* i r^i: -im, re (the anchor's weights in two lanes) */
+    double keep[2];              /* 1, and 0 for a real r (the anchor's imaginary lane) */
 } term;
 
 /*
@@ -437,8 +439,12 @@ static void term_init(term *t, double a, double b, double h, size_t N)
     for (size_t i = 0; i < BLOCK; i++) {
         t->tab[2 * i] = flush(w.re.hi);
         t->tab[2 * i + 1] = flush(w.im.hi);
+        t->tabx[2 * i] = -t->tab[2 * i + 1];
+        t->tabx[2 * i + 1] = t->tab[2 * i];
         w = cdd_mul(w, r);
     }
+    t->keep[0] = 1.0;
+    t->keep[1] = b == 0 ? 0.0 : 1.0;
     t->rB = w;
     /* Only N = 1 can have finite samples H(0) but an r that overflows (a h
      * or b h beyond the range): then r^l, l >= 1, weighs nothing. */
@@ -446,7 +452,8 @@ static void term_init(term *t, double a, double b, double h, size_t N)
           isfinite(t->rl_im) && isfinite(t->rN_re) && isfinite(t->rN_im))) {
         memset(t, 0, sizeof *t);
         t->real = b == 0;
-        t->tab[0] = 1.0;
+        t->tab[0] = t->tabx[1] = t->keep[0] = 1.0;
+        t->keep[1] = b == 0 ? 0.0 : 1.0;
     }
 }
 
@@ -636,14 +643,6 @@ static size_t internal(const dmi_exp *e, size_t k)
     return k < e->nreal ? k : e->nreal2 + (k - e->nreal);
 }
 
-/* acc += x, error-free: acc.hi + acc.lo carries the sum's rounding. */
-static void accumulate(dd *acc, double x)
-{
-    dd s = two_sum(acc->hi, x);
-    acc->hi = s.hi;
-    acc->lo += s.lo;
-}
-
 /* The step after p at which the sums are anchored next. */
 static void set_next(dmi_exp *e, uint64_t p)
 {
@@ -657,25 +656,35 @@ void dmi_exp_anchor(dmi_exp *e, const dmi_history *r, uint64_t p)
         const size_t q = internal(e, k);
         const term *t = &e->terms[e->term_of[q]];
         const double *u = dmi_history_series(r, e->col[q]); /* u[l] = U^{p-l} */
-        dd re = {0, 0}, im = {0, 0};
+        /* lanes c = 0, 1: the real and imaginary parts, each summed error-free
+         * (two_sum into hi, its rounding into lo), side by side (vector
+         * operations; a real sum's lane 1 stays 0) */
+        double hi[2] = {0, 0}, lo[2] = {0, 0};
+        const double *keep = t->keep; /* (read from memory: both lanes multiply) */
         cdd base = cdd_one(); /* r^l0 */
         for (size_t l0 = 0; l0 < e->N; l0 += BLOCK) {
             const double br = base.re.hi, bi = base.im.hi;
             if (fabs(br) + fabs(bi) < TINY)
                 break;
             const size_t len = e->N - l0 < BLOCK ? e->N - l0 : BLOCK;
+            const double *ul = u + l0;
             for (size_t i = 0; i < len; i++) {
-                double wr = br * t->tab[2 * i] - bi * t->tab[2 * i + 1];
-                accumulate(&re, wr * u[l0 + i]);
-                if (!t->real) {
-                    double wi = br * t->tab[2 * i + 1] + bi * t->tab[2 * i];
-                    accumulate(&im, wi * u[l0 + i]);
+                /* the weight r^(l0 + i) = (br + i bi) r^i: re = br Re r^i - bi Im r^i,
+                 * im = br Im r^i + bi Re r^i */
+                const double *T = t->tab + 2 * i, *X = t->tabx + 2 * i;
+                double w[2];
+                for (int c = 0; c < 2; c++)
+                    w[c] = (br * T[c] + bi * X[c]) * keep[c];
+                for (int c = 0; c < 2; c++) {
+                    const double x = w[c] * ul[i], sum = hi[c] + x, bb = sum - hi[c];
+                    lo[c] += (hi[c] - (sum - bb)) + (x - bb);
+                    hi[c] = sum;
                 }
             }
             base = cdd_mul(base, t->rB);
         }
-        *field(e, q, F_SRE) = re.hi + re.lo;
-        *field(e, q, F_SIM) = im.hi + im.lo;
+        *field(e, q, F_SRE) = hi[0] + lo[0];
+        *field(e, q, F_SIM) = hi[1] + lo[1];
     }
     update_W(e);
 }

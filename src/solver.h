@@ -36,6 +36,7 @@ struct dmi_solver {
     uint64_t p;         /* step counter: t_p = p h */
     dmi_history ring;   /* U^{p-N..p} */
     dmi_kernel kernel;  /* nonzero entries of H(l h) */
+    int kernel_sampled; /* kernel holds them (dmi_init leaves them out for the recursion) */
     dmi_conv *conv;     /* FFT engine, or NULL */
     dmi_exp *rec;       /* recursion engine, or NULL (both NULL: the direct sum) */
     double *last_W;     /* W^{p-1} (n) */
@@ -84,5 +85,32 @@ static inline int dmi_h_is_tau_over_N(const dmi_solver *s)
 
 /* Recomputes the engines (either may be NULL) for s's step p from the ring. */
 void dmi_engine_rebuild(const dmi_solver *s, dmi_conv *conv, dmi_exp *rec);
+
+/*
+ * The resolvent's hold of some components, watched step by step (not part of
+ * the public API: the FMU framework, which compiles libdmi's core, counts its
+ * built-in event indicators with it).  The hold of component i at step p,
+ * from the resolvent's argument X^p (U^0 at p = 0): with dmi_set_friction,
+ * 1 when |X_i| <= h alpha_i (the resolvent held U_i at 0), else 0; with
+ * dmi_set_box, -1 when X_i <= lo_i, +1 when X_i >= hi_i, else 0.
+ */
+typedef struct {
+    size_t m;           /* the watched components comp[0..m-1], each < n */
+    const size_t *comp;
+    int *held;          /* their holds at the solver's step (m values, the caller's) */
+    uint64_t changes;   /* steps at which a hold changed: counted on */
+    uint64_t last_p;    /* the last of them (set when one is counted) */
+} dmi_watch;
+
+/* Fills w->held for s's current step: DMI_OK; DMI_ESTATE before dmi_init;
+ * DMI_EINVAL when its operator is neither friction nor a box or a
+ * component is not below n (with a message). */
+int dmi_watch_start(dmi_solver *s, dmi_watch *w);
+
+/* dmi_advance of up to steps steps that updates w (started) after each
+ * step; with stop nonzero it returns after the first step at which a hold
+ * changed.  *taken: the steps taken (also on an error, which leaves the
+ * failed step untaken, as dmi_advance). */
+int dmi_advance_watch(dmi_solver *s, size_t steps, dmi_watch *w, int stop, size_t *taken);
 
 #endif

@@ -75,9 +75,10 @@ class Solver:
     ``H(s) -> (n, n)``, ``z(t) -> (n,)``, float64 NumPy arrays in and out) or C functions with
     libdmi's signature, called by the library with no Python in between: a numba ``cfunc``
     (signatures ``dmi.RHS_SIGNATURE`` etc.), a ctypes function pointer or a
-    ``scipy.LowLevelCallable``.  A solver may be used by one thread at a time; distinct solvers
-    run in parallel in distinct threads (the GIL is released in every call into libdmi and taken
-    only by Python callbacks).
+    ``scipy.LowLevelCallable``; or, with ``jit=True``, Python functions compiled by numba into
+    such C functions (closure values passed at each call).  A solver may be used by one thread at a
+    time; distinct solvers run in parallel in distinct threads (the GIL is released in every call
+    into libdmi and taken only by Python callbacks).
     """
 
     def __init__(self, n: int, tau: float, N: int | None = None, *, h: float | None = None):
@@ -135,10 +136,19 @@ class Solver:
             return
         if failure is not None:
             raise failure
-        raise from_code(rc, _L.dmi_last_error(self._handle).decode())
+        message = _L.dmi_last_error(self._handle).decode()
+        if rc == _lib.ECALLBACK and "callback returned 2 " in message:
+            message += (" (a jit=True callback returns 2 when its result does not have libdmi's "
+                        "shape: (n,), or (n, n) for the kernel)")
+        raise from_code(rc, message)
 
-    def _set_callback(self, slot: str, kind: cb.Kind, setter: Any, f: Any, user: Any) -> None:
-        bound = cb.bind(kind, f, user, self._n, self._failure)
+    def _set_callback(self, slot: str, kind: cb.Kind, setter: Any, f: Any, user: Any,
+                      jit: bool) -> None:
+        if jit and f is not None:
+            from . import _jit  # (numba is imported only for jit=True)
+            bound = _jit.bind(kind, f, user, self._n)
+        else:
+            bound = cb.bind(kind, f, user, self._n, self._failure)
         with self._using() as s:
             self._check(setter(s, bound.address, bound.user))
         self._keep[slot] = bound  # only now: a refused call keeps the former callback alive
@@ -170,21 +180,24 @@ class Solver:
 
     # ---- setup -------------------------------------------------------------------------------
 
-    def set_rhs(self, f: Callback | None, user: Any = None) -> None:
+    def set_rhs(self, f: Callback | None, user: Any = None, *, jit: bool = False) -> None:
         """Right-hand side f: ``f(t, u) -> array (n)``, or a C function
         ``int f(double t, const double *u, double *out, void *user)`` (``dmi.RHS_SIGNATURE``).
         None restores f = 0.  ``user``: the C function's user pointer: a NumPy array or ctypes
         object (its data; the solver keeps the object alive), a ctypes pointer or an int address
         (the memory is yours to keep alive); a LowLevelCallable's own user_data otherwise.  Takes
-        effect from the next step; may be called at any time."""
-        self._set_callback("rhs", cb.RHS, _L.dmi_set_rhs, f, user)
+        effect from the next step; may be called at any time.  ``jit=True``: ``f(t, u)`` is a plain
+        Python function (def or lambda), compiled by numba into the C function; numbers and NumPy
+        arrays of its closure are passed at each call (docs/python.md, "jit=True"); the same
+        holds for the other ``set_*`` callbacks."""
+        self._set_callback("rhs", cb.RHS, _L.dmi_set_rhs, f, user, jit)
 
-    def set_resolvent(self, r: Callback | None, user: Any = None) -> None:
+    def set_resolvent(self, r: Callback | None, user: Any = None, *, jit: bool = False) -> None:
         """A through its resolvent: ``r(lam, x) -> (I + lam A)^{-1} x``, array (n), lam = h; or a
         C function ``int r(double lam, const double *x, double *out, void *user)``
         (``dmi.RESOLVENT_SIGNATURE``).  None restores A = 0.  Replaces an earlier resolvent,
         friction or box."""
-        self._set_callback("resolvent", cb.RESOLVENT, _L.dmi_set_resolvent, r, user)
+        self._set_callback("resolvent", cb.RESOLVENT, _L.dmi_set_resolvent, r, user, jit)
         self._resolvent = ()
 
     def set_friction(self, alpha: Any) -> None:
@@ -206,11 +219,11 @@ class Solver:
         self._keep["resolvent"] = cb.Bound(None, None, ())
         self._resolvent = ("box", lo_a.copy(), hi_a.copy())
 
-    def set_kernel(self, H: Callback | None, user: Any = None) -> None:
+    def set_kernel(self, H: Callback | None, user: Any = None, *, jit: bool = False) -> None:
         """Kernel: ``H(s) -> array (n, n)`` for 0 <= s < tau, or a C function
         ``int H(double s, double *out, void *user)`` writing n*n values row-major
         (``dmi.KERNEL_SIGNATURE``).  None: H = 0.  Sampled by :meth:`init`, so refused after it."""
-        self._set_callback("kernel", cb.KERNEL, _L.dmi_set_kernel, H, user)
+        self._set_callback("kernel", cb.KERNEL, _L.dmi_set_kernel, H, user, jit)
 
     def set_kernel_exp(self, a: Any, b: Any, C: Any, D: Any = None) -> None:
         """Kernel as K exponential terms H(s) = sum_k exp(a_k s) (C_k cos(b_k s) + D_k sin(b_k s)):
@@ -230,11 +243,11 @@ class Solver:
         # no callback; the terms kept for dmi.analysis (the equation's characteristic matrix)
         self._keep["kernel"] = cb.Bound(None, None, (a_a, b_a, C_a, D_a))
 
-    def set_history(self, z: Callback | None, user: Any = None) -> None:
+    def set_history(self, z: Callback | None, user: Any = None, *, jit: bool = False) -> None:
         """History: ``z(t) -> array (n)`` for -tau <= t <= 0, or a C function
         ``int z(double t, double *out, void *user)`` (``dmi.HISTORY_SIGNATURE``).  None: z = 0.
         Sampled by :meth:`init`, so refused after it."""
-        self._set_callback("history", cb.HISTORY, _L.dmi_set_history, z, user)
+        self._set_callback("history", cb.HISTORY, _L.dmi_set_history, z, user, jit)
 
     def set_convolution(self, method: str) -> None:
         """Method of the delay sum: ``"auto"`` (default), ``"direct"``, ``"fft"`` or

@@ -986,14 +986,14 @@ def test_friction_lies_in_minus_alpha_alpha(fmu_path, native43):
 def solver_bytes(N, nonzero_terms=3):
     """(allocated while initialising, kept after) in bytes, from libdmi's
     documented layout (src/delay.h: the history ring holds 2(N+1) states of
-    n doubles, the series and its mirror; the kernel samples N doubles per
-    nonzero entry; src/exp.h: a complex sum per exponential term and column;
-    dmi_init samples the kernel densely, N n^2 doubles, while dmi_create's
-    ring is still held): n = 2, one nonzero entry (H acts on w in the v
-    equation), the default kernel's three cosine terms."""
+    n doubles, the series and its mirror; src/exp.h: a complex sum per
+    exponential term and column; dmi_init allocates its ring while
+    dmi_create's is still held; under the recursion, the default method for
+    the default kernel's three cosine terms once |omega| h <= pi, it takes no
+    kernel samples, include/dmi.h): n = 2."""
     n, d = 2, 8
-    ring, samples = 2 * (N + 1) * n * d, N * d
-    return 2 * ring + N * n * n * d + samples, ring + samples + 2 * nonzero_terms * d
+    ring = 2 * (N + 1) * n * d
+    return 2 * ring, ring + 2 * nonzero_terms * d
 
 
 CHILD_OUT_OF_MEMORY = textwrap.dedent("""
@@ -1022,7 +1022,7 @@ CHILD_OUT_OF_MEMORY = textwrap.dedent("""
 def test_out_of_memory_names_N_and_the_bytes(fmu_path, unzipdir, N):
     """In a child process whose address space is limited (RLIMIT_AS) to 512 MB
     beyond what it holds: the allocation fails on any machine.  N = 2e9: the
-    history alone (64 GB) fails in dmi_create; N = 3e7 (1.2 GB kept) fails in
+    history alone (64 GB) fails in dmi_create; N = 3e7 (0.96 GB kept) fails in
     dmi_init."""
     code = CHILD_OUT_OF_MEMORY.format(here=os.path.dirname(__file__), fmu=fmu_path,
                                       unzip=str(unzipdir), N=N)
@@ -1071,7 +1071,7 @@ def test_large_N_logs_what_initialization_allocates(fmu_path, unzipdir, sl):
     peak, kept = solver_bytes(N)
     assert f"allocates {peak} bytes" in notes[0] and f"keeps {kept} bytes" in notes[0], notes
     # what the process takes: dmi_create's ring is allocated but not touched, so the resident
-    # peak is that of the kept bytes (the dense samples are freed before the new ring is written)
+    # peak is that of the kept bytes (dmi_init's ring)
     assert peak > 100e6 and abs(grown - kept) < 0.3 * kept, (grown, kept)
     s = sl()
     start(s)  # N = 1000: nothing to say

@@ -34,4 +34,4 @@ static void outputs(const dmi_fmu_values *m, const dmi_fmu_point *pt, double *ou
 
 const dmi_fmu_model DMI_FMU_MODEL = {"u' + k u = 0", TABLE, NVARS, 1, VR_tau, VR_N,
                                      1.0, 0.1, configure, outputs, NULL, NULL, NULL, NULL,
-                                     0, NULL, NULL};
+                                     0, NULL, NULL, NULL};

@@ -16,6 +16,7 @@ from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.simulation import instantiate_fmu
 
 import dmi
+from event_run import EVENT_RUNS, event_run
 from plain_run import OUT, RUNS, digests, plain_run
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -160,6 +161,17 @@ def test_early_return_off_is_bitwise_as_before(version, run):
         want = json.load(f)[f"{version} {run}"]
     r = plain_run(fmu_path(version), **RUNS[run])
     assert len(r) == want["rows"] and digests(r) == want["digests"]
+
+
+@pytest.mark.parametrize("run", sorted(EVENT_RUNS))
+def test_event_runs_bitwise_as_main(run):
+    """Early return on and off, event mode, FMI 2.0 and 3.0, the event
+    outputs too: the digests of the FMUs whose indicators read the state back
+    after every step (event_run.json), bitwise."""
+    with open(os.path.join(HERE, "event_run.json")) as f:
+        want = json.load(f)[run]
+    rows, got = event_run(fmu_path(run[0]), run)
+    assert rows == want["rows"] and got == want["digests"]
 
 
 def test_early_return_keeps_the_regular_points_bitwise():

@@ -1,0 +1,102 @@
+#!/usr/bin/env python3
+# The speed of jit=True where dmi.analysis spends it (a benchmark, not a test): a forced mass on
+# a moving belt with dry friction and a fading memory, its right-hand side a plain Python
+# function given to Solver.set_rhs as it is and with jit=True (the same function, compiled by
+# numba).  Per variant: one shooting solve (dmi.analysis.periodic_orbit from a run near the
+# orbit, no multipliers) and one continuation step (continue_orbit: a branch of 4 points less
+# one of 2, over 2, 4 multipliers a point), and the ratio Python / jit=True.  The model:
+#   x'' + c x' + x + g int_0^tau exp(-s / theta) x(t - s) ds + alpha sigma(x' - v) ∋ a cos(w t),
+# u = (x, y), y = x' - v (friction on y), p = a; the orbit has the forcing's period, M steps.
+# Rounds interleave the variants; the fastest round of each counts; CPU times of the process
+# (the machine may be shared); one BLAS thread.  jit=True compiles once per process, before the
+# rounds (the compilation time is printed apart).
+# Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_jit.py [--rounds 2] [--M 400]
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # (see bench_orbit.py)
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import argparse  # noqa: E402
+import math  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+import dmi  # noqa: E402
+from dmi.analysis import continue_orbit, periodic_orbit  # noqa: E402
+from dmi.analysis.shooting import state_of  # noqa: E402
+
+C, V, ALPHA, G, THETA, TAU, W = 0.1, 0.4, 0.3, 0.2, 0.5, 1.0, 1.1
+A = 1.0  # the forcing amplitude p at the start
+
+
+def belt(M: int, jit: bool):
+    """make(p): the belt model at forcing amplitude p, M steps a forcing period."""
+    h = 2 * math.pi / (W * M)
+
+    def make(a: float) -> dmi.Solver:
+        def rhs(t, u):
+            return np.array([-(u[1] + V), u[0] + C * (u[1] + V) - a * math.cos(W * t)])
+        s = dmi.Solver(2, TAU, h=h)
+        s.set_rhs(rhs, jit=jit)
+        s.set_friction([0.0, ALPHA])
+        s.set_kernel_exp([-1.0 / THETA], [0.0], [[[0.0, 0.0], [G, 0.0]]])
+        return s
+    return make
+
+
+def cpu(f) -> float:
+    t = time.process_time()
+    f()
+    return time.process_time() - t
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(
+        description="Times a shooting solve and a continuation step of a forced belt model with "
+                    "a Python right-hand side, as it is and with jit=True, and prints their CPU "
+                    "seconds and ratio.",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    ap.add_argument("--rounds", type=int, default=2, help="interleaved rounds")
+    ap.add_argument("--M", type=int, default=400, help="steps a forcing period")
+    a = ap.parse_args(argv)
+    if a.rounds < 1 or a.M < 10:
+        ap.error("--rounds must be >= 1 and --M >= 10")
+    P = 2 * math.pi / W
+    compile_s = cpu(lambda: belt(a.M, True)(A))
+    best = {(k, jit): math.inf for k in ("solve", "step", "period") for jit in (False, True)}
+    for _ in range(a.rounds):
+        for jit in (False, True):
+            make = belt(a.M, jit)
+            s = make(A)
+            s.init()
+            s.advance(20 * a.M)  # near the orbit, not on it
+            x0 = state_of(s, a.M)
+            best["period", jit] = min(best["period", jit], cpu(lambda: s.advance(a.M)))
+            o = None
+
+            def solve():
+                nonlocal o
+                o = periodic_orbit(make, A, P, x0, multipliers=0)
+            best["solve", jit] = min(best["solve", jit], cpu(solve))
+            o = periodic_orbit(make, A, P, x0, multipliers=4)
+            cost = {k: cpu(lambda: continue_orbit(o, A + 0.5, step=0.02, max_points=k,
+                                                  multipliers=4)) for k in (2, 4)}
+            best["step", jit] = min(best["step", jit], (cost[4] - cost[2]) / 2)
+    print(f"forced belt, M = {a.M} steps a period, N = {dmi.Solver(2, TAU, h=P / a.M).N} delay "
+          f"cells; fastest of {a.rounds} interleaved rounds, CPU seconds; jit=True compiled once "
+          f"in {compile_s:.2f} s")
+    print(f"{'':<22} {'Python rhs':>11} {'jit=True':>9} {'Python / jit':>13}")
+    for k, label in (("period", "one period (advance)"), ("solve", "shooting solve"),
+                     ("step", "continuation step")):
+        py, jt = best[k, False], best[k, True]
+        print(f"{label:<22} {py:11.4f} {jt:9.4f} {py / jt:12.1f}x")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
