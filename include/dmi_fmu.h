@@ -270,7 +270,7 @@ struct dmi_fmu_model {
     dmi_fmu_indicators_fn indicators;
     /* (Since libdmi 1.2.)  Optional, NULL for none: see dmi_fmu_step_fn. */
     dmi_fmu_step_fn step;
-    /* (Since libdmi 1.2.)  Optional, NULL for none: the built-in indicators
+    /* (Since libdmi 1.3.)  Optional, NULL for none: the built-in indicators
      * of the solver's own operator, indicator k (k < nindicators) for
      * component held[k]: dmi_fmu_stuck(pt, i, alpha_i) with the alpha of
      * dmi_set_friction, or dmi_fmu_contact(pt, i, lo_i, hi_i) with the faces
