@@ -36,7 +36,6 @@ dotted line the belt's speed, where the mass sticks.
 import os
 
 import matplotlib.pyplot as plt
-import numba
 import numpy as np
 
 import dmi
@@ -45,21 +44,12 @@ from dmi import analysis
 K, G, ALPHA, VB, TAU = 1.0, 0.8, 0.5, 0.3, 1.0   # stiffness, memory gain, friction, belt speed, memory
 
 
-# f(u) compiled once; the damping c comes in through the user pointer (c = user[0])
-@numba.cfunc(numba.types.intc(numba.float64, numba.types.CPointer(numba.float64),
-                              numba.types.CPointer(numba.float64), numba.types.CPointer(numba.float64)))
-def rhs(t, u, out, c):
-    out[0] = -(u[1] + VB)
-    out[1] = K * u[0] + c[0] * (u[1] + VB)
-    return 0
-
-
 def make(c: float, h: float = TAU / 100) -> dmi.Solver:
-    """The belt at the damping c, with the step h (an autonomous orbit's period sets h)."""
+    """The belt at the damping c, with the step h (an autonomous orbit's period sets h).  The
+    right-hand side is plain Python compiled to C by numba (``jit=True``): compiled once for every
+    c, which it reads from its closure at run time."""
     s = dmi.Solver(2, TAU, h=h)
-    par = np.array([c])
-    s.set_rhs(rhs, user=par)
-    s._keep["c"] = par                                   # the user data lives with the solver
+    s.set_rhs(lambda t, u: np.array([-(u[1] + VB), K * u[0] + c * (u[1] + VB)]), jit=True)
     s.set_friction([0.0, ALPHA])
     s.set_kernel_exp([0.0], [0.0], [[[0.0, 0.0], [G / TAU, 0.0]]])
     return s
