@@ -4,6 +4,7 @@
 :func:`dmi.analysis.continue_equilibrium` return."""
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -103,3 +104,14 @@ class Branch:
     def column(self, name: str) -> np.ndarray:
         """An attribute of every point stacked: ``branch.column("amplitude")`` -> (points, n)."""
         return np.array([getattr(q, name) for q in self.points])
+
+    def to_html(self, path: str | os.PathLike, **options: Any) -> None:
+        """Writes the interactive figure of the branch to the standalone HTML file ``path``
+        (hover a point for its orbit's data, click it to draw the orbit):
+        :func:`dmi.analysis.interactive.branch_html`, which takes the ``options``."""
+        from .interactive import branch_html
+        branch_html(self, path, **options)
+
+    def _repr_html_(self) -> str:
+        from .interactive import branch_summary
+        return branch_summary(self)
