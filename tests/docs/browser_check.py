@@ -14,7 +14,13 @@
 #            dmi.__all__ and dmi.analysis.__all__ (imported from the build, BUILD/python);
 #   offline  every page of the site loads nothing from outside the site folder: the network log of
 #            each page has only file: URLs inside BUILD/docs/html (and data:/blob:/about: ones),
-#            and no request failed.
+#            and no request failed;
+#   figures  dmi.analysis's interactive HTML figures, written here (into a temporary folder) from
+#            the small model of tests/python/interactive_models.py, no site needed: hovering a
+#            point of the orbit branch shows its p and period, clicking it makes the orbit panel's
+#            lines draw that point's BranchPoint.t and .u; hovering a point of the branch of
+#            equilibria and a cell of the chart shows its rightmost root; a branch of equilibria
+#            has no orbit panel; nothing loads from outside the folder (the network log).
 # The browser is started by this script and stopped (its process group killed) before it exits.
 # Prints what it checked; exit status 1 with every failure listed, 2 for bad usage.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -342,19 +348,28 @@ def hover_text(b: Browser, figure: str, x: float, y: float) -> str:
 
 
 def read_field(text: str, name: str, pattern: str = NUMBER) -> re.Match | None:
+    """The value shown after "name:" in a tooltip's text."""
     return re.search(rf"{name}\s*:?\s*{pattern}", text)
 
 
-def figure_page(b: Browser, page: Path, folder: Path) -> list[dict]:
-    """Opens a figure and waits until BokehJS has drawn it; returns the page's network events."""
-    events = b.open(page.as_uri())
+def shown_root(text: str) -> complex | None:
+    """The rightmost root a tooltip shows ("rightmost root: a + bi"), or None."""
+    m = read_field(text, "rightmost root", NUMBER + " ([-+]) " + NUMBER + "i")
+    return complex(float(m.group(1)), float(m.group(2) + m.group(3))) if m else None
+
+
+def figure_page(b: Browser, page: Path) -> bool:
+    """Opens a figure and waits until BokehJS has drawn it (False, a failure, if it did not)."""
+    b.open(page.as_uri())
     if b.eval(BOKEH_READY_JS) is None:
         fail(f"{page.name}: BokehJS did not draw the figure")
-    return events
+        return False
+    return True
 
 
-def check_orbit_branch(b: Browser, branch, page: Path, folder: Path) -> list[dict]:
-    events = figure_page(b, page, folder)
+def check_orbit_branch(b: Browser, branch, page: Path) -> None:
+    if not figure_page(b, page):
+        return
     pts = branch.points
     y = [q.amplitude[0] for q in pts]      # what an autonomous branch draws against p
     for k in (len(pts) - 1, len(pts) // 2):
@@ -381,39 +396,34 @@ def check_orbit_branch(b: Browser, branch, page: Path, folder: Path) -> list[dic
                      f"not draw BranchPoint.t, .u of that point ({t.shape} values)")
         print(f"figures: {page.name}: point {k} hovered (period {period and period.group(1)}) "
               f"and clicked (orbit panel: its {len(q.t)} samples)")
-    return events + [e for e in b.events if e.get("method", "").startswith("Network.")]
 
 
-def check_equilibrium_branch(b: Browser, branch, page: Path, folder: Path) -> list[dict]:
-    events = figure_page(b, page, folder)
+def check_equilibrium_branch(b: Browser, branch, page: Path) -> None:
+    if not figure_page(b, page):
+        return
     k = len(branch.points) - 2
     q = branch.points[k]
     text = hover_text(b, "branch", q.p, q.u[0])
-    root = read_field(text, "rightmost root", NUMBER + " ([-+]) " + NUMBER + "i")
-    lam = q.roots[0]
-    if root is None or abs(complex(float(root.group(1)), float(root.group(2) + root.group(3)))
-                           - lam) > 1e-5 * abs(lam):
+    root, lam = shown_root(text), q.roots[0]
+    if root is None or abs(root - lam) > 1e-5 * abs(lam):
         fail(f"{page.name}: hovering point {k} does not show its rightmost root {lam:.6g}: "
              f"{text!r}")
     if b.eval(PLOTTED_JS) is not None:
         fail(f"{page.name}: a branch of equilibria has an orbit panel")
-    print(f"figures: {page.name}: point {k} hovered (rightmost root {root and root.group(0)}), "
-          "no orbit panel")
-    return events + [e for e in b.events if e.get("method", "").startswith("Network.")]
+    print(f"figures: {page.name}: point {k} hovered (rightmost root {root}), no orbit panel")
 
 
-def check_chart(b: Browser, chart, page: Path, folder: Path) -> list[dict]:
-    events = figure_page(b, page, folder)
+def check_chart(b: Browser, chart, page: Path) -> None:
+    if not figure_page(b, page):
+        return
     for j, i in ((1, 2), (2, 0)):
         lam = complex(chart.re[j, i], chart.im[j, i])
         text = hover_text(b, "chart", chart.p_values[i], chart.q_values[j])
-        root = read_field(text, "rightmost root", NUMBER + " ([-+]) " + NUMBER + "i")
-        if root is None or abs(complex(float(root.group(1)), float(root.group(2) + root.group(3)))
-                               - lam) > 1e-5 * abs(lam):
+        root = shown_root(text)
+        if root is None or abs(root - lam) > 1e-5 * abs(lam):
             fail(f"{page.name}: hovering grid point ({i}, {j}) does not show its rightmost root "
                  f"{lam:.6g}: {text!r}")
-        print(f"figures: {page.name}: grid point ({i}, {j}) hovered: {root and root.group(0)}")
-    return events + [e for e in b.events if e.get("method", "").startswith("Network.")]
+        print(f"figures: {page.name}: grid point ({i}, {j}) hovered: rightmost root {root}")
 
 
 def check_figures(b: Browser, src: Path, build: Path) -> None:
@@ -429,9 +439,13 @@ def check_figures(b: Browser, src: Path, build: Path) -> None:
                                  ("equilibria.html", equilibria, check_equilibrium_branch),
                                  ("chart.html", chart, check_chart)):
             obj.to_html(folder / name)
-            for msg in outside(check(b, obj, folder / name, folder), folder):
+            check(b, obj, folder / name)
+            # every request since the page was opened (Browser.open keeps them in b.events)
+            log = [e for e in b.events if e.get("method", "").startswith("Network.")]
+            bad = outside(log, folder)
+            for msg in bad:
                 fail(f"{name} {msg}")
-    print("figures: the three figures loaded nothing from outside their folder")
+            print(f"figures: {name}: {len(bad)} requests outside its folder or failed")
 
 
 # The checks by name: each takes the browser, the source folder, the build folder and the site.
