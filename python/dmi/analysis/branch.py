@@ -105,12 +105,14 @@ class Branch:
         """An attribute of every point stacked: ``branch.column("amplitude")`` -> (points, n)."""
         return np.array([getattr(q, name) for q in self.points])
 
-    def to_html(self, path: str | os.PathLike, **options: Any) -> None:
+    def to_html(self, path: str | os.PathLike, component: int = 0,
+                p_label: str = "parameter p") -> None:
         """Writes the interactive figure of the branch to the standalone HTML file ``path``
-        (hover a point for its orbit's data, click it to draw the orbit):
-        :func:`dmi.analysis.interactive.branch_html`, which takes the ``options``."""
-        from .interactive import branch_html
-        branch_html(self, path, **options)
+        (hover a point for its data, click it to draw its orbit):
+        ``plot_branch(self, html=path, component=component, p_label=p_label)``, see
+        :func:`dmi.analysis.interactive.branch_html`."""
+        from .orbit_plot import plot_branch
+        plot_branch(self, html=path, component=component, p_label=p_label)
 
     def _repr_html_(self) -> str:
         from .interactive import branch_summary

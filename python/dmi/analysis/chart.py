@@ -54,12 +54,12 @@ class StabilityChart:
         """re < 0: the grid points whose equilibrium is asymptotically stable."""
         return self.re < 0
 
-    def to_html(self, path: str | os.PathLike, **options: Any) -> None:
+    def to_html(self, path: str | os.PathLike, p_label: str = "parameter p",
+                q_label: str = "parameter q", title: str | None = None) -> None:
         """Writes the interactive chart to the standalone HTML file ``path`` (hover a grid point
-        for its rightmost root): :func:`dmi.analysis.interactive.chart_html`, which takes the
-        ``options``."""
+        for its rightmost root): :func:`dmi.analysis.interactive.chart_html`."""
         from .interactive import chart_html
-        chart_html(self, path, **options)
+        chart_html(self, path, p_label=p_label, q_label=q_label, title=title)
 
     def _repr_html_(self) -> str:
         from .interactive import chart_summary

@@ -22,12 +22,13 @@ from typing import Any
 
 import numpy as np
 
-from .orbit_plot import branch_values
-
 #: colour of the stable and of the unstable parts of a branch
 STABLE_COLOR, UNSTABLE_COLOR = "#1f77b4", "#d62728"
 #: The orbit panel's line colours, one per component (then repeated).
 COMPONENT_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2")
+#: What a branch of each kind is a branch of (titles and summaries).
+KIND_NAMES = {"orbits": "forced orbits", "autonomous": "autonomous orbits",
+              "equilibria": "equilibria"}
 #: Multipliers listed in a branch point's hover text.
 HOVER_MULTIPLIERS = 3
 
@@ -146,34 +147,36 @@ def _event_y(branch: Any, e: Any, p: np.ndarray, y: np.ndarray, component: int) 
     return float(y[i - 1] + min(max(w, 0.0), 1.0) * (y[i] - y[i - 1]))
 
 
-def branch_html(branch: Any, path: str | os.PathLike | None = None, *, component: int = 0,
+def branch_html(branch: Any, values: np.ndarray, label: str,
+                path: str | os.PathLike | None = None, *, component: int = 0,
                 p_label: str = "parameter p", title: str | None = None, width: int = 560,
                 height: int = 420) -> str:
     """Writes the interactive figure of ``branch`` (a :class:`dmi.analysis.Branch`) to ``path``
     (an HTML file that needs nothing else: BokehJS is inlined) and returns its text (also with
-    ``path=None``, which writes nothing).
+    ``path=None``, which writes nothing).  ``values`` (points, k) and ``label``: what is drawn
+    against p and its name (:func:`dmi.analysis.orbit_plot.branch_values` of ``component``;
+    :func:`dmi.analysis.plot_branch` with ``html`` and ``Branch.to_html`` call this).
 
-    The left panel draws what :func:`plot_branch` draws (the values of :func:`branch_values`
-    against p, solid blue where stable, dashed red where not, the events marked and named) with a
-    marker per point.  Hovering a point shows p, the period, the amplitude (per component), the
+    The left panel draws what :func:`plot_branch` draws (the values against p, solid blue where
+    stable, dashed red where not, the events marked and named) with a marker per point.  Hovering a point shows p, the period, the amplitude (per component), the
     leading multipliers (:data:`HOVER_MULTIPLIERS`, with their moduli) and the stability of its
     orbit; clicking it draws that orbit (``BranchPoint.t``, ``BranchPoint.u``, every component)
     in the right panel, which starts with the first point's.  A branch of equilibria has no orbit
     panel, and hovering a point shows p, the rightmost root and the stability.
 
-    Raises ValueError for a branch without points or a component out of range."""
+    Raises ValueError for a branch without points."""
     from bokeh.layouts import row
     from bokeh.models import ColumnDataSource, HoverTool, LabelSet
     from bokeh.plotting import figure
 
     if not branch.points:
         raise ValueError("dmi.analysis.branch_html: the branch has no points")
-    values, label = branch_values(branch, component)  # IndexError for a bad component
     p = np.asarray(branch.p, float)
     stable = np.asarray(branch.stable, bool)
     fig = figure(width=width, height=height, name="branch", x_axis_label=p_label,
                  y_axis_label=_plain(label), tools="pan,wheel_zoom,box_zoom,reset,save,tap",
-                 title=title or f"branch of {branch.kind} ({len(p)} points; {branch.status})")
+                 title=title or f"branch of {KIND_NAMES.get(branch.kind, branch.kind)} "
+                                f"({len(p)} points; {branch.status})")
     for j in range(values.shape[1]):
         _stability_lines(fig, p, values[:, j], stable)
     points = ColumnDataSource({"p": p, "y": values[:, 0], **_point_texts(branch),
@@ -282,7 +285,7 @@ def branch_summary(branch: Any) -> str:
     range of p, how many points are stable, the events (kind at p) and the status."""
     p = np.array([q.p for q in branch.points])
     events = ", ".join(f"{e.kind} at p = {number(e.p)}" for e in branch.events) or "none"
-    return _table(f"Branch of {branch.kind}", [
+    return _table(f"Branch of {KIND_NAMES.get(branch.kind, branch.kind)}", [
         ("points", str(len(branch.points))), ("p", _range(p)),
         ("stable points", f"{sum(bool(q.stable) for q in branch.points)} of {len(branch.points)}"),
         ("events", events), ("status", str(branch.status))])

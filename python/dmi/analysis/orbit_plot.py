@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 # Branch in the annotations is dmi.analysis.branch.Branch, not imported here: Branch.to_html
-# reaches this module (through dmi.analysis.interactive), and the imports have no circles.
+# calls plot_branch, and the imports have no circles.
 
 #: marker of each event kind
 MARKERS = {"fold": "s", "period-doubling": "D", "torus": "^", "stick-onset": "o", "grazing": "v",
@@ -46,10 +46,11 @@ def plot_branch(branch: Branch, ax: Any = None, component: int = 0, color: str =
     (:data:`MARKERS`) on the curve at the event's p, its kind written beside it; the x axis
     labelled ``p_label``, the y axis with what is drawn.  ``html``: a path, where the interactive
     figure of :func:`dmi.analysis.interactive.branch_html` is written too (``ax`` may then be
-    None)."""
+    None: only the HTML file)."""
     if html is not None:
         from .interactive import branch_html
-        branch_html(branch, html, component=component, p_label=p_label)
+        branch_html(branch, *branch_values(branch, component), html, component=component,
+                    p_label=p_label)
         if ax is None:
             return
     elif ax is None:
