@@ -218,11 +218,11 @@ def chart_html(chart: Any, path: str | os.PathLike | None = None, *,
     """Writes the interactive figure of ``chart`` (a :class:`dmi.analysis.StabilityChart`) to
     ``path`` (a standalone HTML file, BokehJS inlined) and returns its text (``path=None``: only
     returns it).  One cell per grid point, coloured by Re of its rightmost root (blue < 0:
-    stable, red > 0, grey where no root was found) on a scale symmetric about 0; the traced Hopf
-    curves solid black, the fold curves dashed.  Hovering a cell shows p, q, the rightmost root
+    stable, red > 0, grey where no root was found) on a scale symmetric about 0 whose ten
+    colours change at 0; the traced Hopf curves solid black, the fold curves dashed.  Hovering a cell shows p, q, the rightmost root
     and the stability."""
     from bokeh.models import ColorBar, ColumnDataSource, HoverTool, LinearColorMapper
-    from bokeh.palettes import RdBu11
+    from bokeh.palettes import RdBu10
     from bokeh.plotting import figure
 
     P = np.asarray(chart.p_values, float)
@@ -240,7 +240,7 @@ def chart_html(chart: Any, path: str | os.PathLike | None = None, *,
         "root_text": [complex_text(complex(a, b)) for a, b in zip(re.ravel(), im.ravel())],
         "stable_text": ["stable" if a < 0 else ("unstable" if a >= 0 else "no root")
                         for a in re.ravel()]}, name="cells")
-    mapper = LinearColorMapper(palette=RdBu11, low=-scale or -1.0, high=scale or 1.0,
+    mapper = LinearColorMapper(palette=RdBu10, low=-scale or -1.0, high=scale or 1.0,
                                nan_color="#bbbbbb")
     fig = figure(width=width, height=height, name="chart", x_axis_label=p_label,
                  y_axis_label=q_label, x_range=(pe[0], pe[-1]), y_range=(qe[0], qe[-1]),
