@@ -16,7 +16,8 @@ finds the Hopf point, :func:`~dmi.analysis.hopf_orbit` and :func:`~dmi.analysis.
 follow the orbits, and ``branch.to_html(path)`` writes the branch as one standalone HTML file
 (BokehJS inlined: it opens offline).  In the figure at the end of this page, hover a point of the
 branch for its :math:`\\mu`, period, amplitude, leading Floquet multipliers and stability, and click
-it to draw its orbit in the right panel.  See :doc:`/orbits` (Interactive figures).
+it to draw its orbit in the right panel.  The model is ``make(mu)`` of ``landau_memory.py`` beside
+this example.  See :doc:`/orbits` (Interactive figures).
 """
 # SPDX-License-Identifier: GPL-3.0-or-later
 import html
@@ -25,26 +26,9 @@ import tempfile
 from pathlib import Path
 
 import matplotlib.pyplot as plt
-import numpy as np
 
-import dmi
 from dmi import analysis
-
-W0, B, K, A, TAU, N = 1.0, 1.5, 0.5, 1.0, 1.0, 40
-
-
-def make(mu: float, h: float | None = None) -> dmi.Solver:
-    """The oscillator at mu; in dmi's form u' + f(u) + int H u = 0 (H = k e^(-a s) I), step
-    tau / N or h (an autonomous orbit's period sets h)."""
-    s = dmi.Solver(2, TAU, N) if h is None else dmi.Solver(2, TAU, h=h)
-
-    def f(t, u):
-        r2 = u[0] ** 2 + u[1] ** 2
-        g, w = mu - r2, W0 + B * r2
-        return np.array([-g * u[0] + w * u[1], -g * u[1] - w * u[0]])
-    s.set_rhs(f)
-    s.set_kernel_exp([-A], [0.0], [K * np.eye(2)])
-    return s
+from landau_memory import N, TAU, make     # examples/python/landau_memory.py: the model
 
 
 eq = analysis.equilibrium(make, 0.0, [0.02, -0.01])

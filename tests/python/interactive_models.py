@@ -1,37 +1,26 @@
 # Small, fast branches and a chart for the interactive figures' tests (test_analysis_interactive.py
-# and tests/docs/browser_check.py figures): a Stuart-Landau oscillator with a distributed delay
-# whose frequency grows with the amplitude, so that the period changes along its orbit branch.
+# and tests/docs/browser_check.py figures): the Stuart-Landau oscillator with a distributed memory
+# of examples/python/landau_memory.py, whose frequency grows with the amplitude, so that the period
+# changes along its orbit branch.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
 import math
-
-import numpy as np
+import os
+import sys
+from pathlib import Path
 
 import dmi
 from dmi import analysis as da
 
-# z' = (mu - |z|^2) z + i (w0 + b |z|^2) z - int_0^tau k e^(-a s) z(t - s) ds, z = u_1 + i u_2;
-# in dmi's form u' + f + int H u = 0: f = -(mu - r^2) u - (w0 + b r^2) J u, H = k e^(-a s) I.
-W0, B, KG, AG, TAU, N = 1.0, 1.5, 0.5, 1.0, 1.0, 40
-
-
-def landau(mu: float, h: float | None = None, q: float = KG) -> dmi.Solver:
-    """The oscillator at mu (kernel gain q), step tau / N (or h)."""
-    s = dmi.Solver(2, TAU, N) if h is None else dmi.Solver(2, TAU, h=h)
-
-    def f(t, u):
-        r2 = u[0] ** 2 + u[1] ** 2
-        g, w = mu - r2, W0 + B * r2
-        return np.array([-g * u[0] + w * u[1], -g * u[1] - w * u[0]])
-    s.set_rhs(f)
-    s.set_kernel_exp([-AG], [0.0], [q * np.eye(2)])
-    return s
+sys.path.insert(0, str(Path(os.environ.get("DMI_SOURCE_DIR", Path(__file__).resolve().parents[2]))
+                       / "examples" / "python"))
+from landau_memory import N, TAU, make as landau  # noqa: E402  (the gallery example's model)
 
 
 def landau2(mu: float, q: float) -> dmi.Solver:
     """The two-parameter model of the chart: mu and the kernel gain q."""
-    return landau(mu, q=q)
+    return landau(mu, k=q)
 
 
 def branches(points: int = 5) -> tuple[da.Branch, da.Branch]:
