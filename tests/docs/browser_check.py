@@ -385,7 +385,7 @@ def check_orbit_branch(b: Browser, branch, page: Path) -> None:
             fail(f"{page.name}: hovering point {k} does not show its leading multiplier "
                  f"{q.multipliers[0]:.6g}: {text!r}")
         px, py = b.eval(POINT_JS % ('"branch"', float(q.p), float(y[k])))
-        time.sleep(0.5)     # apart from the gestures before (two taps in a short time: a double tap)
+        time.sleep(0.5)     # apart from the gestures before (two quick taps: a double tap)
         b.mouse("click", px, py)
         lines = b.eval(PLOTTED_JS) or {}
         for j in range(q.u.shape[1]):

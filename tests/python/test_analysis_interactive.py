@@ -192,6 +192,17 @@ def test_a_100_point_branch_file_stays_small(n, tmp_path):
     assert size < js + 4 / 3 * data + 0.4e6
 
 
+def test_bad_branches_get_a_clear_error(tmp_path):
+    empty = da.Branch([], [], "nothing", make=None)
+    with pytest.raises(ValueError, match="no points"):
+        empty.to_html(tmp_path / "empty.html")
+    old = _synthetic_branch(3, 2)
+    old.points[1].t, old.points[1].u = np.empty(0), np.empty((0, 0))   # a point without its orbit
+    with pytest.raises(ValueError, match="keep no orbit"):
+        old.to_html(tmp_path / "old.html")
+    assert not (tmp_path / "old.html").exists()
+
+
 # ---- the Jupyter summaries ----------------------------------------------------------------------
 def rows(html: str) -> dict[str, str]:
     """The table's rows, header -> cell (HTML entities left as written)."""

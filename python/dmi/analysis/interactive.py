@@ -3,9 +3,9 @@
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """Standalone HTML figures drawn with Bokeh, its JavaScript inlined (the file opens offline):
 
-- :func:`branch_html`: a branch over p (the values of :func:`branch_values`); hovering a point
-  shows p, the period, the amplitude, the leading multipliers and the stability of its orbit, and
-  clicking it draws that orbit (``BranchPoint.t``, ``BranchPoint.u``) in the panel beside; on a
+- :func:`branch_html`: a branch over p (what :func:`dmi.analysis.plot_branch` draws); hovering a
+  point shows p, the period, the amplitude, the leading multipliers and the stability of its orbit,
+  and clicking it draws that orbit (``BranchPoint.t``, ``BranchPoint.u``) in the panel beside; on a
   branch of equilibria, hovering shows p and the rightmost root, and there is no orbit panel;
 - :func:`chart_html`: a stability chart, one cell per grid point coloured by Re of its rightmost
   root; hovering a cell shows that root;
@@ -158,19 +158,24 @@ def branch_html(branch: Any, values: np.ndarray, label: str,
     :func:`dmi.analysis.plot_branch` with ``html`` and ``Branch.to_html`` call this).
 
     The left panel draws what :func:`plot_branch` draws (the values against p, solid blue where
-    stable, dashed red where not, the events marked and named) with a marker per point.  Hovering a point shows p, the period, the amplitude (per component), the
-    leading multipliers (:data:`HOVER_MULTIPLIERS`, with their moduli) and the stability of its
-    orbit; clicking it draws that orbit (``BranchPoint.t``, ``BranchPoint.u``, every component)
-    in the right panel, which starts with the first point's.  A branch of equilibria has no orbit
-    panel, and hovering a point shows p, the rightmost root and the stability.
+    stable, dashed red where not, the events marked and named) with a marker per point.
+    Hovering a point shows p, the period, the amplitude (per component), the leading multipliers
+    (:data:`HOVER_MULTIPLIERS`, with their moduli) and the stability of its orbit; clicking it
+    draws that orbit (``BranchPoint.t``, ``BranchPoint.u``, every component) in the right panel,
+    which starts with the first point's.  A branch of equilibria has no orbit panel, and
+    hovering a point shows p, the rightmost root and the stability.
 
-    Raises ValueError for a branch without points."""
+    Raises ValueError for a branch without points, or of orbits whose points keep no orbit
+    (empty ``BranchPoint.t``)."""
     from bokeh.layouts import row
     from bokeh.models import ColumnDataSource, HoverTool, LabelSet
     from bokeh.plotting import figure
 
     if not branch.points:
         raise ValueError("dmi.analysis.branch_html: the branch has no points")
+    if branch.kind != "equilibria" and any(len(q.t) == 0 for q in branch.points):
+        raise ValueError("dmi.analysis.branch_html: the branch's points keep no orbit "
+                         "(BranchPoint.t and .u are empty): continue the orbit again")
     p = np.asarray(branch.p, float)
     stable = np.asarray(branch.stable, bool)
     fig = figure(width=width, height=height, name="branch", x_axis_label=p_label,
@@ -219,8 +224,8 @@ def chart_html(chart: Any, path: str | os.PathLike | None = None, *,
     ``path`` (a standalone HTML file, BokehJS inlined) and returns its text (``path=None``: only
     returns it).  One cell per grid point, coloured by Re of its rightmost root (blue < 0:
     stable, red > 0, grey where no root was found) on a scale symmetric about 0 whose ten
-    colours change at 0; the traced Hopf curves solid black, the fold curves dashed.  Hovering a cell shows p, q, the rightmost root
-    and the stability."""
+    colours change at 0; the traced Hopf curves solid black, the fold curves dashed.  Hovering a
+    cell shows p, q, the rightmost root and the stability."""
     from bokeh.models import ColorBar, ColumnDataSource, HoverTool, LinearColorMapper
     from bokeh.palettes import RdBu10
     from bokeh.plotting import figure
