@@ -24,8 +24,6 @@ from dmi.analysis.orbit import Orbit
 
 import interactive_models as im
 
-pytest.importorskip("bokeh")
-
 NUM = r"(-?\d+(?:\.\d*)?(?:e[-+]?\d+)?)"
 
 
@@ -190,6 +188,9 @@ def test_a_100_point_branch_file_stays_small(n, tmp_path):
           f"orbits {data / 1e6:.2f} MB raw)")
     assert size < 5e6
     assert size < js + 4 / 3 * data + 0.4e6
+    # a forced branch draws u_0 at the section t = 0 of each orbit
+    y = sources(path.read_text())["points"]["y"]
+    assert np.array_equal(y, [q.section[0, 0] for q in branch.points])
 
 
 def test_bad_branches_get_a_clear_error(tmp_path):
