@@ -93,7 +93,7 @@ def _point_texts(branch: Any) -> dict[str, list[str]]:
     return out
 
 
-def _orbit_panel(branch: Any, points: Any, width: int, height: int) -> Any:
+def _orbit_panel(branch: Any, points: Any, height: int) -> Any:
     """The panel that draws the orbit of the selected point, and the callback that fills it: all
     orbits stacked in one data source (a point's rows are start .. stop), the shown one in
     another (name ``orbit``), which the tap on a point replaces."""
@@ -112,8 +112,8 @@ def _orbit_panel(branch: Any, points: Any, width: int, height: int) -> Any:
     points.data["stop"] = stop
     first = slice(0, sizes[0])
     shown = ColumnDataSource({c: store.data[c][first] for c in ["t"] + names}, name="orbit")
-    fig = figure(width=width, height=height, name="orbit_panel",
-                 title=f"orbit at p = {number(pts[0].p)} (click a point of the branch)",
+    fig = figure(sizing_mode="stretch_width", height=height, name="orbit_panel",
+                 title=f"orbit at p = {number(pts[0].p)} (click a point)",
                  x_axis_label="t (time units, from the section t = 0)", y_axis_label="u",
                  tools="pan,wheel_zoom,box_zoom,reset,save")
     for j, c in enumerate(names):
@@ -131,7 +131,7 @@ const a = points.data.start[i], b = points.data.stop[i];
 const data = {};
 for (const c of names) data[c] = store.data[c].slice(a, b);
 shown.data = data;
-title.text = "orbit at p = " + points.data.p_text[i] + " (click a point of the branch)";
+title.text = "orbit at p = " + points.data.p_text[i] + " (click a point)";
 """))
     points.selected.indices = [0]
     return fig
@@ -149,11 +149,12 @@ def _event_y(branch: Any, e: Any, p: np.ndarray, y: np.ndarray, component: int) 
 
 def branch_html(branch: Any, values: np.ndarray, label: str,
                 path: str | os.PathLike | None = None, *, component: int = 0,
-                p_label: str = "parameter p", title: str | None = None, width: int = 560,
+                p_label: str = "parameter p", title: str | None = None,
                 height: int = 420) -> str:
     """Writes the interactive figure of ``branch`` (a :class:`dmi.analysis.Branch`) to ``path``
     (an HTML file that needs nothing else: BokehJS is inlined) and returns its text (also with
-    ``path=None``, which writes nothing).  ``values`` (points, k) and ``label``: what is drawn
+    ``path=None``, which writes nothing).  The panels share the width of the window and are
+    ``height`` pixels high.  ``values`` (points, k) and ``label``: what is drawn
     against p and its name (:func:`dmi.analysis.orbit_plot.branch_values` of ``component``;
     :func:`dmi.analysis.plot_branch` with ``html`` and ``Branch.to_html`` call this).
 
@@ -178,10 +179,9 @@ def branch_html(branch: Any, values: np.ndarray, label: str,
                          "(BranchPoint.t and .u are empty): continue the orbit again")
     p = np.asarray(branch.p, float)
     stable = np.asarray(branch.stable, bool)
-    fig = figure(width=width, height=height, name="branch", x_axis_label=p_label,
+    fig = figure(sizing_mode="stretch_width", height=height, name="branch", x_axis_label=p_label,
                  y_axis_label=_plain(label), tools="pan,wheel_zoom,box_zoom,reset,save,tap",
-                 title=title or f"branch of {KIND_NAMES.get(branch.kind, branch.kind)} "
-                                f"({len(p)} points; {branch.status})")
+                 title=title or f"{KIND_NAMES.get(branch.kind, branch.kind)}: {len(p)} points")
     for j in range(values.shape[1]):
         _stability_lines(fig, p, values[:, j], stable)
     points = ColumnDataSource({"p": p, "y": values[:, 0], **_point_texts(branch),
@@ -206,7 +206,8 @@ def branch_html(branch: Any, values: np.ndarray, label: str,
                                 text_font_size="9pt"))
     if branch.kind == "equilibria":
         return _write(fig, path, fig.title.text)
-    return _write(row(fig, _orbit_panel(branch, points, width, height)), path, fig.title.text)
+    return _write(row(fig, _orbit_panel(branch, points, height), sizing_mode="stretch_width"),
+                  path, fig.title.text)
 
 
 def _edges(v: np.ndarray) -> np.ndarray:
@@ -219,13 +220,14 @@ def _edges(v: np.ndarray) -> np.ndarray:
 
 def chart_html(chart: Any, path: str | os.PathLike | None = None, *,
                p_label: str = "parameter p", q_label: str = "parameter q",
-               title: str | None = None, width: int = 640, height: int = 520) -> str:
+               title: str | None = None, height: int = 520) -> str:
     """Writes the interactive figure of ``chart`` (a :class:`dmi.analysis.StabilityChart`) to
     ``path`` (a standalone HTML file, BokehJS inlined) and returns its text (``path=None``: only
-    returns it).  One cell per grid point, coloured by Re of its rightmost root (blue < 0:
-    stable, red > 0, grey where no root was found) on a scale symmetric about 0 whose ten
-    colours change at 0; the traced Hopf curves solid black, the fold curves dashed.  Hovering a
-    cell shows p, q, the rightmost root and the stability."""
+    returns it).  The chart is as wide as the window and ``height`` pixels high: one cell per
+    grid point, coloured by Re of its rightmost root (blue < 0: stable, red > 0, grey where no
+    root was found) on a scale symmetric about 0 whose ten colours change at 0; the traced Hopf
+    curves solid black, the fold curves dashed.  Hovering a cell shows p, q, the rightmost root
+    and the stability."""
     from bokeh.models import ColorBar, ColumnDataSource, HoverTool, LinearColorMapper
     from bokeh.palettes import RdBu10
     from bokeh.plotting import figure
@@ -247,7 +249,7 @@ def chart_html(chart: Any, path: str | os.PathLike | None = None, *,
                         for a in re.ravel()]}, name="cells")
     mapper = LinearColorMapper(palette=RdBu10, low=-scale or -1.0, high=scale or 1.0,
                                nan_color="#bbbbbb")
-    fig = figure(width=width, height=height, name="chart", x_axis_label=p_label,
+    fig = figure(sizing_mode="stretch_width", height=height, name="chart", x_axis_label=p_label,
                  y_axis_label=q_label, x_range=(pe[0], pe[-1]), y_range=(qe[0], qe[-1]),
                  tools="pan,wheel_zoom,box_zoom,reset,save",
                  title=title or "stability chart: Re of the rightmost root (< 0: stable)")
