@@ -255,6 +255,15 @@ def test_chart_summary():
     assert r["curves"] == "1 Hopf, 1 fold"
 
 
+def test_without_bokeh_the_figures_say_what_to_install(tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "bokeh", None)          # import bokeh raises ImportError
+    c = da.StabilityChart(np.array([0.0, 1.0]), np.array([0.0]), np.zeros((1, 2)), np.zeros((1, 2)))
+    with pytest.raises(ImportError, match="pip install bokeh"):
+        c.to_html(tmp_path / "c.html")
+    with pytest.raises(ImportError, match="pip install bokeh"):
+        _synthetic_branch(2, 2).to_html(tmp_path / "b.html")
+
+
 def test_summaries_and_import_do_not_need_bokeh():
     # the package and the Jupyter summaries load no plotting library; only the figures do
     code = ("import sys, numpy as np; import dmi.analysis as da;"

@@ -51,6 +51,15 @@ def _plain(label: str) -> str:
     return re.sub(r"\$([^$]*)\$", lambda m: m.group(1).replace("{", "").replace("}", ""), label)
 
 
+def _bokeh() -> None:
+    """Raises ImportError with what to install when Bokeh is missing."""
+    try:
+        import bokeh  # noqa: F401
+    except ImportError as e:
+        raise ImportError("dmi.analysis's interactive figures need Bokeh: pip install bokeh "
+                          "(or the extra dmi[analysis])") from e
+
+
 def _write(models: Any, path: str | os.PathLike | None, title: str) -> str:
     """The standalone HTML of the Bokeh models, BokehJS inlined; written to path if given."""
     from bokeh.embed import file_html
@@ -168,6 +177,7 @@ def branch_html(branch: Any, values: np.ndarray, label: str,
 
     Raises ValueError for a branch without points, or of orbits whose points keep no orbit
     (empty ``BranchPoint.t``)."""
+    _bokeh()
     from bokeh.layouts import row
     from bokeh.models import ColumnDataSource, HoverTool, LabelSet
     from bokeh.plotting import figure
@@ -228,6 +238,7 @@ def chart_html(chart: Any, path: str | os.PathLike | None = None, *,
     root was found) on a scale symmetric about 0 whose ten colours change at 0; the traced Hopf
     curves solid black, the fold curves dashed.  Hovering a cell shows p, q, the rightmost root
     and the stability."""
+    _bokeh()
     from bokeh.models import ColorBar, ColumnDataSource, HoverTool, LinearColorMapper
     from bokeh.palettes import RdBu10
     from bokeh.plotting import figure
