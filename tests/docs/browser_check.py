@@ -294,7 +294,7 @@ BOKEH_READY_JS = """(async () => {
   return null;
 })()"""
 
-# page coordinates (CSS pixels) of the data point (x, y) in the Bokeh figure named FIG
+# page coordinates (CSS pixels) of the data point (x, y) in the Bokeh figure of the given name
 POINT_JS = """(() => {
   const plot = Bokeh.documents[0].get_model_by_name(%s);
   const view = Bokeh.index.find_one(plot);
