@@ -14,7 +14,13 @@
 #            dmi.__all__ and dmi.analysis.__all__ (imported from the build, BUILD/python);
 #   offline  every page of the site loads nothing from outside the site folder: the network log of
 #            each page has only file: URLs inside BUILD/docs/html (and data:/blob:/about: ones),
-#            and no request failed.
+#            and no request failed;
+#   figures  dmi.analysis's interactive HTML figures, written here (into a temporary folder) from
+#            the small model of tests/python/interactive_models.py, no site needed: hovering a
+#            point of the orbit branch shows its p and period, clicking it makes the orbit panel's
+#            lines draw that point's BranchPoint.t and .u; hovering a point of the branch of
+#            equilibria and a cell of the chart shows its rightmost root; a branch of equilibria
+#            has no orbit panel; nothing loads from outside the folder (the network log).
 # The browser is started by this script and stopped (its process group killed) before it exits.
 # Prints what it checked; exit status 1 with every failure listed, 2 for bad usage.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -33,6 +39,7 @@ import time
 from pathlib import Path
 from urllib.parse import unquote, urlparse
 
+import numpy as np
 import websocket
 
 FAILURES: list[str] = []
@@ -277,6 +284,170 @@ def check_offline(b: Browser, html: Path) -> None:
     print(f"offline: {len(pages)} pages made {requests} requests, all inside {html}")
 
 
+# ---- the interactive figures of dmi.analysis (written here from small models, no site needed) ----
+BOKEH_READY_JS = """(async () => {
+  for (let k = 0; k < 200; k++) {
+    if (window.Bokeh && Bokeh.documents && Bokeh.documents.length && Bokeh.index
+        && [...Bokeh.index.roots].length) return Bokeh.version;
+    await new Promise(r => setTimeout(r, 50));
+  }
+  return null;
+})()"""
+
+# page coordinates (CSS pixels) of the data point (x, y) in the Bokeh figure of the given name
+POINT_JS = """(() => {
+  const plot = Bokeh.documents[0].get_model_by_name(%s);
+  const view = Bokeh.index.find_one(plot);
+  const box = view.canvas_view.el.getBoundingClientRect();
+  return [box.left + view.frame.x_scale.compute(%r), box.top + view.frame.y_scale.compute(%r)];
+})()"""
+
+# the texts of the visible tooltips (Bokeh draws them inside shadow roots), after waiting for one
+TOOLTIP_JS = """(async () => {
+  const texts = () => {
+    const found = [];
+    const walk = root => {
+      for (const e of root.querySelectorAll('*')) {
+        if (e.classList.contains('bk-tooltip-content') && e.getClientRects().length
+            && e.innerText.trim()) found.push(e.innerText);
+        if (e.shadowRoot) walk(e.shadowRoot);
+      }
+    };
+    walk(document);
+    return found;
+  };
+  for (let k = 0; k < 40 && !texts().length; k++) await new Promise(r => setTimeout(r, 50));
+  return texts().join('\\n');
+})()"""
+
+# the data that the orbit panel's lines draw, by the name of the line: [x values, y values]
+PLOTTED_JS = """(async () => {
+  await new Promise(r => setTimeout(r, 200));
+  const plot = Bokeh.documents[0].get_model_by_name('orbit_panel');
+  if (!plot) return null;
+  const out = {};
+  for (const r of plot.renderers) {
+    const d = r.data_source.data;
+    out[r.name] = [Array.from(d[r.glyph.x.field]), Array.from(d[r.glyph.y.field])];
+  }
+  return out;
+})()"""
+
+NUMBER = r"(-?\d+(?:\.\d*)?(?:e[-+]?\d+)?)"
+
+
+def hover_text(b: Browser, figure: str, x: float, y: float) -> str:
+    """The tooltip shown with the mouse over the data point (x, y) of the named figure (moved
+    away first, so the tooltip is the new point's; then onto the point in two moves, the first
+    entering the figure's canvas)."""
+    b.mouse("move", 1, 1)
+    px, py = b.eval(POINT_JS % (json.dumps(figure), float(x), float(y)))
+    b.mouse("move", px - 2, py - 2)
+    b.mouse("move", px, py)
+    return b.eval(TOOLTIP_JS)
+
+
+def read_field(text: str, name: str, pattern: str = NUMBER) -> re.Match | None:
+    """The value shown after "name:" in a tooltip's text."""
+    return re.search(rf"{name}\s*:?\s*{pattern}", text)
+
+
+def shown_root(text: str) -> complex | None:
+    """The rightmost root a tooltip shows ("rightmost root: a + bi"), or None."""
+    m = read_field(text, "rightmost root", NUMBER + " ([-+]) " + NUMBER + "i")
+    return complex(float(m.group(1)), float(m.group(2) + m.group(3))) if m else None
+
+
+def figure_page(b: Browser, page: Path) -> bool:
+    """Opens a figure and waits until BokehJS has drawn it (False, a failure, if it did not)."""
+    b.open(page.as_uri())
+    if b.eval(BOKEH_READY_JS) is None:
+        fail(f"{page.name}: BokehJS did not draw the figure")
+        return False
+    return True
+
+
+def check_orbit_branch(b: Browser, branch, page: Path) -> None:
+    if not figure_page(b, page):
+        return
+    pts = branch.points
+    y = [q.amplitude[0] for q in pts]      # what an autonomous branch draws against p
+    for k in (len(pts) - 1, len(pts) // 2):
+        q = pts[k]
+        text = hover_text(b, "branch", q.p, y[k])
+        period, p = read_field(text, "period"), read_field(text, "p")
+        if (period is None or p is None or abs(float(period.group(1)) - q.period) > 1e-5 * q.period
+                or abs(float(p.group(1)) - q.p) > 1e-5 * abs(q.p)):
+            fail(f"{page.name}: hovering point {k} (p = {q.p:.6g}, period {q.period:.6g}) shows "
+                 f"{text!r}")
+        mu = read_field(text, "multipliers", NUMBER + " [-+] " + NUMBER + "i")
+        if mu is None or abs(float(mu.group(1)) - q.multipliers[0].real) > 1e-5:
+            fail(f"{page.name}: hovering point {k} does not show its leading multiplier "
+                 f"{q.multipliers[0]:.6g}: {text!r}")
+        px, py = b.eval(POINT_JS % ('"branch"', float(q.p), float(y[k])))
+        time.sleep(0.5)     # apart from the gestures before (two quick taps: a double tap)
+        b.mouse("click", px, py)
+        lines = b.eval(PLOTTED_JS) or {}
+        for j in range(q.u.shape[1]):
+            t, u = (np.array(v) for v in lines.get(f"orbit_u{j}", ([], [])))
+            if t.shape != q.t.shape or u.shape != q.u[:, j].shape or not (
+                    np.array_equal(t, q.t) and np.array_equal(u, q.u[:, j])):
+                fail(f"{page.name}: after a click on point {k} the orbit panel's line u_{j} does "
+                     f"not draw BranchPoint.t, .u of that point ({t.shape} values)")
+        print(f"figures: {page.name}: point {k} hovered (period {period and period.group(1)}) "
+              f"and clicked (orbit panel: its {len(q.t)} samples)")
+
+
+def check_equilibrium_branch(b: Browser, branch, page: Path) -> None:
+    if not figure_page(b, page):
+        return
+    k = len(branch.points) - 2
+    q = branch.points[k]
+    text = hover_text(b, "branch", q.p, q.u[0])
+    root, lam = shown_root(text), q.roots[0]
+    if root is None or abs(root - lam) > 1e-5 * abs(lam):
+        fail(f"{page.name}: hovering point {k} does not show its rightmost root {lam:.6g}: "
+             f"{text!r}")
+    if b.eval(PLOTTED_JS) is not None:
+        fail(f"{page.name}: a branch of equilibria has an orbit panel")
+    print(f"figures: {page.name}: point {k} hovered (rightmost root {root}), no orbit panel")
+
+
+def check_chart(b: Browser, chart, page: Path) -> None:
+    if not figure_page(b, page):
+        return
+    for j, i in ((1, 2), (2, 0)):
+        lam = complex(chart.re[j, i], chart.im[j, i])
+        text = hover_text(b, "chart", chart.p_values[i], chart.q_values[j])
+        root = shown_root(text)
+        if root is None or abs(root - lam) > 1e-5 * abs(lam):
+            fail(f"{page.name}: hovering grid point ({i}, {j}) does not show its rightmost root "
+                 f"{lam:.6g}: {text!r}")
+        print(f"figures: {page.name}: grid point ({i}, {j}) hovered: rightmost root {root}")
+
+
+def check_figures(b: Browser, src: Path, build: Path) -> None:
+    """The HTML figures of a small model's branches and chart (tests/python/interactive_models.py)
+    in the browser: hover and click on the data points, and the network log."""
+    sys.path[:0] = [str(build / "python"), str(src / "tests" / "python")]
+    import interactive_models as im
+    equilibria, orbits = im.branches()
+    chart = im.chart()
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        for name, obj, check in (("orbits.html", orbits, check_orbit_branch),
+                                 ("equilibria.html", equilibria, check_equilibrium_branch),
+                                 ("chart.html", chart, check_chart)):
+            obj.to_html(folder / name)
+            check(b, obj, folder / name)
+            # every request since the page was opened (Browser.open keeps them in b.events)
+            log = [e for e in b.events if e.get("method", "").startswith("Network.")]
+            bad = outside(log, folder)
+            for msg in bad:
+                fail(f"{name} {msg}")
+            print(f"figures: {name}: {len(bad)} requests outside its folder or failed")
+
+
 # The checks by name: each takes the browser, the source folder, the build folder and the site.
 # A new check is a function here and a name in tests/docs/CMakeLists.txt.
 CHECKS = {
@@ -284,7 +455,10 @@ CHECKS = {
     "capi": lambda b, src, build, html: check_capi(b, src, html),
     "python": lambda b, src, build, html: check_python(b, build, html),
     "offline": lambda b, src, build, html: check_offline(b, html),
+    "figures": lambda b, src, build, html: check_figures(b, src, build),
 }
+#: The checks that do not read the built site.
+SITE_FREE = {"figures"}
 
 
 def main(argv: list[str]) -> int:
@@ -293,7 +467,7 @@ def main(argv: list[str]) -> int:
         return 2
     src, build = Path(argv[1]).resolve(), Path(argv[2]).resolve()
     html = build / "docs" / "html"
-    if not (html / "index.html").exists():
+    if not set(argv[3:]) <= SITE_FREE and not (html / "index.html").exists():
         print(f"no site in {html} (scripts/docs.sh builds it)")
         return 1
     b = Browser()

@@ -9,6 +9,9 @@ Equilibria and their stability (docs/stability.md): :func:`equilibrium`,
 :func:`period_doubled_orbit`, :func:`refine_orbit` and :func:`plot_branch`.  The answers are the
 scheme's (they match simulation); ``of="equation"`` (:func:`roots`, :func:`hopf`,
 :func:`stability_chart`, :func:`equilibrium`) and :func:`refine_orbit` give the equation's.
+Interactive HTML figures (:mod:`dmi.analysis.interactive`, Bokeh): ``Branch.to_html``,
+``StabilityChart.to_html`` and the ``html`` of :func:`plot_branch` and
+:func:`plot_stability_chart`.
 """
 from __future__ import annotations
 

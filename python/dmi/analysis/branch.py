@@ -4,6 +4,7 @@
 :func:`dmi.analysis.continue_equilibrium` return."""
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -103,3 +104,16 @@ class Branch:
     def column(self, name: str) -> np.ndarray:
         """An attribute of every point stacked: ``branch.column("amplitude")`` -> (points, n)."""
         return np.array([getattr(q, name) for q in self.points])
+
+    def to_html(self, path: str | os.PathLike, component: int = 0,
+                p_label: str = "parameter p") -> None:
+        """Writes the interactive figure of the branch to the standalone HTML file ``path``
+        (hover a point for its data, click it to draw its orbit):
+        ``plot_branch(self, html=path, component=component, p_label=p_label)``, see
+        :func:`dmi.analysis.interactive.branch_html`."""
+        from .orbit_plot import plot_branch
+        plot_branch(self, html=path, component=component, p_label=p_label)
+
+    def _repr_html_(self) -> str:
+        from .interactive import branch_summary
+        return branch_summary(self)

@@ -54,6 +54,17 @@ class StabilityChart:
         """re < 0: the grid points whose equilibrium is asymptotically stable."""
         return self.re < 0
 
+    def to_html(self, path: str | os.PathLike, p_label: str = "parameter p",
+                q_label: str = "parameter q", title: str | None = None) -> None:
+        """Writes the interactive chart to the standalone HTML file ``path`` (hover a grid point
+        for its rightmost root): :func:`dmi.analysis.interactive.chart_html`."""
+        from .interactive import chart_html
+        chart_html(self, path, p_label=p_label, q_label=q_label, title=title)
+
+    def _repr_html_(self) -> str:
+        from .interactive import chart_summary
+        return chart_summary(self)
+
 
 def _root_at(make2: Callable[[float, float], Solver], p: float, q: float, u_eq: Any, count: int,
              tol: float, of: str = "scheme") -> np.ndarray:
@@ -238,12 +249,17 @@ def stability_chart(make2: Callable[[float, float], Solver], p_values: Sequence[
 
 
 def plot_stability_chart(chart: StabilityChart, ax: Any = None, *, p_label: str = "parameter p",
-                         q_label: str = "parameter q", title: str | None = None) -> Any:
+                         q_label: str = "parameter q", title: str | None = None,
+                         html: str | os.PathLike | None = None) -> Any:
     """Draws ``chart`` on the matplotlib Axes ``ax`` (a new figure if None) and returns the Axes:
     the stable region (Re lambda_1 < 0) shaded, the traced Hopf curves as solid lines and the fold
     curves (a real root crossing) dashed, p on the horizontal axis, q on the vertical one; the
     labels name the parameters in words and symbols with units (e.g. ``"delay gain a (1/s^2)"``).
-    The key sits below the axes, not over the data."""
+    The key sits below the axes, not over the data.  ``html``: a path, where the interactive
+    chart of :func:`dmi.analysis.interactive.chart_html` is written too."""
+    if html is not None:
+        from .interactive import chart_html
+        chart_html(chart, html, p_label=p_label, q_label=q_label, title=title)
     import matplotlib.pyplot as plt
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch

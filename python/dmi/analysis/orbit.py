@@ -44,6 +44,10 @@ class Orbit:
         """(max - min) / 2 of each component over the period (state units)."""
         return 0.5 * (self.u.max(axis=0) - self.u.min(axis=0))
 
+    def _repr_html_(self) -> str:
+        from .interactive import orbit_summary
+        return orbit_summary(self)
+
 
 
 def stuck_mask(u: np.ndarray) -> np.ndarray:

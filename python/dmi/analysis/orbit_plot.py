@@ -4,11 +4,13 @@
 beside the marker (no legend over the data), both axes labelled with what is drawn."""
 from __future__ import annotations
 
+import os
 from typing import Any
 
 import numpy as np
 
-from .branch import Branch
+# Branch in the annotations is dmi.analysis.branch.Branch, not imported here: Branch.to_html
+# calls plot_branch, and the imports have no circles.
 
 #: marker of each event kind
 MARKERS = {"fold": "s", "period-doubling": "D", "torus": "^", "stick-onset": "o", "grazing": "v",
@@ -35,13 +37,24 @@ def branch_values(branch: Branch, component: int = 0) -> tuple[np.ndarray, str]:
     return values, f"$u_{{{component}}}$ at $t = 0$ (Poincare section at the forcing period)"
 
 
-def plot_branch(branch: Branch, ax: Any, component: int = 0, color: str = "C0",
-                label_events: bool = True, p_label: str = "parameter p") -> None:
+def plot_branch(branch: Branch, ax: Any = None, component: int = 0, color: str = "C0",
+                label_events: bool = True, p_label: str = "parameter p",
+                html: str | os.PathLike | None = None) -> None:
     """Draws ``branch`` (from :func:`continue_orbit` or :func:`continue_equilibrium`) on the
     matplotlib Axes ``ax``: the values of :func:`branch_values` against p; solid where the orbit
     or equilibrium is stable, dashed where it is not; each event a black marker
     (:data:`MARKERS`) on the curve at the event's p, its kind written beside it; the x axis
-    labelled ``p_label``, the y axis with what is drawn."""
+    labelled ``p_label``, the y axis with what is drawn.  ``html``: a path, where the interactive
+    figure of :func:`dmi.analysis.interactive.branch_html` is written too (``ax`` may then be
+    None: only the HTML file)."""
+    if html is not None:
+        from .interactive import branch_html
+        branch_html(branch, *branch_values(branch, component), html, component=component,
+                    p_label=p_label)
+        if ax is None:
+            return
+    elif ax is None:
+        raise ValueError("dmi.analysis.plot_branch: give the Axes ax, or html (a path)")
     p = branch.p
     if p.size == 0:
         return
