@@ -143,7 +143,7 @@ class Solver:
         raise from_code(rc, message)
 
     def _set_callback(self, slot: str, kind: cb.Kind, setter: Any, f: Any, user: Any,
-                      jit: bool) -> None:
+                      jit: bool = False) -> None:
         if jit and f is not None:
             from . import _jit  # (numba is imported only for jit=True)
             bound = _jit.bind(kind, f, user, self._n)
