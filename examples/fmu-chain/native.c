@@ -24,7 +24,7 @@ typedef struct {
     double t_F, F; /* the force on block 1: F from t_F on */
 } chain;
 
-/* The start values of the model (issue 20). */
+/* The start values of the model. */
 static const chain CHAIN_DEFAULT = {1.0, 2.0, 0.1, {1.0, 1.2, 0.9}, {0.3, 0.1}, {0.5, 3.0}, 10.0,
                                     {0.0, 0.0, 0.0}, 1000, INFINITY, 0.0};
 

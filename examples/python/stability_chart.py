@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-# The stability chart of an oscillator with a distributed delay (dmi.analysis, issue 29):
+# The stability chart of an oscillator with a distributed delay (dmi.analysis):
 #     w'' + c w' + b w + a int_0^tau G(s) w(t - s) ds = 0,   G(s) = exp(-s / theta) / theta,
 # over the delay gain a and the delay tau; writes the figure (PNG) and the Hopf curves (CSV).
 # Usage: examples/python/stability_chart.py OUT.png [--grid P Q] [--N N] [--workers W]

@@ -1,4 +1,4 @@
-# scripts/fmu_run.py as a new user meets it (issue 16, item 2): --help with a
+# scripts/fmu_run.py as a new user meets it: --help with a
 # description and the defaults, a bad output folder refused before the
 # simulation with exit 2, and the place of the CSV printed.  DMI_FMU = the
 # packed FMU, DMI_SOURCE_DIR = the source tree.

@@ -1,4 +1,4 @@
-# The command line of every program in bench/ and examples/ (issue 16, item 1):
+# The command line of every program in bench/ and examples/:
 # --help exits 0 with a usage that names each argument and says what the
 # program prints; a bad argument exits 2 with a message that names it.  The
 # programs are found in the build folders DMI_BENCH_DIR and DMI_EXAMPLES_DIR,
@@ -69,7 +69,7 @@ def test_empty_argument_rejected(prog):
 
 
 @pytest.mark.parametrize("name, args, message", [
-    # issue 16: bench_conv 0 and abc died with SIGFPE, -1 said "out of memory"
+    # bench_conv 0 and abc used to die with SIGFPE, -1 said "out of memory"
     ("bench_conv", ["0"], "T = '0': must be > 0"),
     ("bench_conv", ["abc"], "T = 'abc': must be a number"),
     ("bench_conv", ["-1"], "T = '-1': must be > 0"),

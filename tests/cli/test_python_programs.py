@@ -1,5 +1,5 @@
-# The command line of every Python program in bench/ and scripts/ (issue 16,
-# item 1), found in the source tree DMI_SOURCE_DIR, so that a new program is
+# The command line of every Python program in bench/ and scripts/, found in
+# the source tree DMI_SOURCE_DIR, so that a new program is
 # checked without a change here: --help exits 0 with a usage, a description
 # that says what the program prints, and a help text for each option (with its
 # default when it takes a value); an unknown option and an empty value for any

@@ -1,5 +1,5 @@
 /*
- * Accuracy of DMI_CONV_RECURSIVE over long runs (issue 13): at checkpoints
+ * Accuracy of DMI_CONV_RECURSIVE over long runs: at checkpoints
  * spread over runs of at least 10^6 steps, the delay term W^p of the step
  * (dmi_get_step_terms) against an independent sum h sum_l H(l h) U^{p-l}
  * over the solver's stored states (dmi_get_past), with H(l h) evaluated in
@@ -159,7 +159,7 @@ static void test_n1_N1e6(void)
  * sums then sit on a fixed point of the rounding, where a multiplier that
  * is not r to double-double accuracy every step shows: a recursion that
  * multiplied by r rounded to double and corrected that every 1024th step
- * (tried in issue 23, found wrong by review) was 2.8e-11 off for
+ * (tried once, found wrong by review) was 2.8e-11 off for
  * a = -0.001 and 5.1e-12 for the four terms; with r's two parts every
  * step, 6.8e-17 and 1.7e-18. */
 static void test_at_rest(void)

@@ -1,5 +1,5 @@
 /*
- * White-box tests of the engines on matrix kernels (issue 23): the FFT
+ * White-box tests of the engines on matrix kernels: the FFT
  * engine (with its low-rank form) and the recursion against the direct sum,
  * at every step of 10^5 steps with random states, on diagonal, banded and
  * dense blocks for n up to 64; the sparse sampling of exponential kernels

@@ -1,5 +1,5 @@
 /*
- * Support code of the core test suite (issue 2): the CUnit runner, the
+ * Support code of the core test suite: the CUnit runner, the
  * reference files, saved-state comparisons and a small n = 2 model whose
  * callbacks can be made to fail on demand.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later

@@ -1,6 +1,6 @@
 /*
  * The box operator A = normal cone of K = prod [lo_i, hi_i] (dmi_set_box) on
- * an n = 3 system with a full 3x3 kernel (issue 2): every U^p lies in K, the
+ * an n = 3 system with a full 3x3 kernel: every U^p lies in K, the
  * scheme is of order one (Proposition 3.11), and libdmi agrees with a plain
  * computation of (3.12)-(3.13) written here.
  *

@@ -1,5 +1,5 @@
 /*
- * Every error path of the core library (issue 2): invalid arguments, calls in
+ * Every error path of the core library: invalid arguments, calls in
  * the wrong state, sizes too large to allocate, callbacks that fail or return
  * NaN / Inf at each stage, and the guarantee that after any failure the
  * solver is bitwise unchanged and, once the cause is fixed, goes on exactly

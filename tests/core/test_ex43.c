@@ -1,5 +1,5 @@
 /*
- * Example 4.3 of the paper (issue 2): the friction oscillator (4.1) with
+ * Example 4.3 of the paper: the friction oscillator (4.1) with
  * H(s) = cos 2 pi s + cos 10 pi s + cos 20 pi s, g(t) = 1.3 cos 8t, z = 0,
  * b = alpha = tau = 1, to T = 30.  Checked against a straightforward
  * computation written here (the errata's scalar update, plain arrays, no

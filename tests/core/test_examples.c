@@ -1,6 +1,6 @@
 /*
  * Examples 4.1 and 4.2 of the paper against their exact solutions, and the
- * order study of Figure 4.3 (issue 2).  The errors are measured here, from
+ * order study of Figure 4.3.  The errors are measured here, from
  * the exact solutions (4.8) and (4.10) of the paper, and compared with the
  * independent reference values of ../shared/reference/errors_ex41_ex42.csv.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later

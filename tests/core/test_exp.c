@@ -1,5 +1,5 @@
 /*
- * Exponential-sum kernels (issue 13): dmi_set_kernel_exp's errors, the choice
+ * Exponential-sum kernels: dmi_set_kernel_exp's errors, the choice
  * of DMI_CONV_RECURSIVE, and what must stay exact with it: a failed step
  * leaves the solver bitwise unchanged, a loaded state continues bitwise
  * (across the recursion's anchors), the method may change between steps;

@@ -1,5 +1,5 @@
 /*
- * Solver life cycle and settings (issue 2): independent solvers, dmi_free,
+ * Solver life cycle and settings: independent solvers, dmi_free,
  * the last-wins rule among dmi_set_resolvent / dmi_set_friction / dmi_set_box,
  * the defaults (nothing set), a user resolvent equal to the built-in
  * friction, the clock t_p = p h, restarting with dmi_init.

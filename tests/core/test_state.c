@@ -1,5 +1,5 @@
 /*
- * dmi_state_save / dmi_state_load (issue 2): a run replayed from a loaded
+ * dmi_state_save / dmi_state_load: a run replayed from a loaded
  * state is bitwise the run of the saving solver; states of other solvers
  * (n, N, tau), truncated, corrupted or foreign bytes are refused with
  * DMI_EINVAL and leave the solver unchanged.

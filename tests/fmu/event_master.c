@@ -1,5 +1,5 @@
 /*
- * A plain FMI 3.0 co-simulation master with early return (issue 31): the
+ * A plain FMI 3.0 co-simulation master with early return: the
  * oscillator FMU (Example 4.3, its default parameters) drives a second FMU,
  * the Burridge-Knopoff chain of examples/fmu-chain, with its friction force
  * (the chain's input F_in = the oscillator's friction).  Communication step

@@ -22,7 +22,7 @@ from fmpy.validation import validate_fmu
 from native import START, Run
 
 OUT = ["w", "v", "friction", "delay_force", "sticking"]
-EVENT_OUT = ["stick_slip_events", "last_event_time"]  # issue 31: the events for an FMI 2.0 master
+EVENT_OUT = ["stick_slip_events", "last_event_time"]  # the events for an FMI 2.0 master
 REALS = ["b", "alpha", "tau", "w0", "v0", "H_c0", "H_c1", "H_lambda", "H_a1", "H_omega1", "H_a2",
          "H_omega2", "H_a3", "H_omega3", "g_offset", "g_amp", "g_omega", "g_phase"]
 T = 30.0
@@ -108,7 +108,7 @@ def test_model_description_contract(md, fmi_version):
     for n in OUT:
         assert var[n].causality == "output", n
     assert var["sticking"].type == "Boolean"
-    # the events for an FMI 2.0 master (issue 31): their count and the last one's time
+    # the events for an FMI 2.0 master: their count and the last one's time
     assert var["stick_slip_events"].type == integer and var["last_event_time"].type == real
     # Outputs at a communication point come from the steps before it: no direct feedthrough of g_in.
     assert sorted(o.variable.name for o in md.outputs) == sorted(OUT + EVENT_OUT)
@@ -119,7 +119,7 @@ def test_model_description_contract(md, fmi_version):
         # libdmi allocates with the C library: the FMU must not be given allocateMemory to honour.
         assert md.coSimulation.canNotUseMemoryManagementFunctions is True
     else:
-        # events (issue 31): event mode, early return, intermediateUpdate at the events
+        # events: event mode, early return, intermediateUpdate at the events
         assert cs.hasEventMode is True and cs.canReturnEarlyAfterIntermediateUpdate is True
         assert cs.providesIntermediateUpdate is True and cs.mightReturnEarlyFromDoStep is True
         assert var["time"].causality == "independent"
@@ -171,7 +171,7 @@ def test_simulate_matches_native(fmu_path, native43, interval):
 
 
 def test_varying_steps_match_native(sl, native43):
-    """Uneven FMU2Slave steps; a zero step among them is a bad input (issue 6):
+    """Uneven FMU2Slave steps; a zero step among them is a bad input:
     fmi2Error with a logged reason, and the instance goes on unchanged."""
     s = sl()
     start(s)
@@ -917,7 +917,7 @@ def test_time_is_a_variable_of_fmi3_only(sl, md, fmi_version):
 
 
 def test_fmi3_refuses_intermediate_variables(fmu_paths, tmp_path):
-    """Event mode is accepted (issue 31, tests/fmu/events); intermediate variables are not."""
+    """Event mode is accepted (tests/fmu/events); intermediate variables are not."""
     from fmpy import extract, read_model_description
     from fmpy.fmi3 import FMU3Slave
     md = read_model_description(fmu_paths["3"])
@@ -931,7 +931,7 @@ def test_fmi3_refuses_intermediate_variables(fmu_paths, tmp_path):
     assert len(log) == 1 and log[0][0] == 3 and "intermediate" in log[0][1], log
 
 
-# ---- what a new user hit (issue 16, items 3-6) ----
+# ---- what a new user hit ----
 
 def coarse(N, T, b=1.0, tau=1.0):
     """The criterion, computed here: (1 + h^2 b)^(T/h) > 2."""
@@ -1097,7 +1097,7 @@ def test_each_call_logged_once_with_its_outcome(sl):
     assert len(s.log[n:]) == 1 and s.log[n][0] == 3 and s.log[n][2].startswith(f"{p}DoStep: ")
 
 
-# ---- state format 3 (issue 31) ----
+# ---- state format 3 ----
 
 def test_state_format3_names_the_model_and_keeps_the_events(sl):
     """A saved state is format 3: the model's name, and the event count and
@@ -1133,7 +1133,7 @@ def test_state_format3_names_the_model_and_keeps_the_events(sl):
                    'this FMU is model "DelayFrictionOscillator"')
 
 
-# ---- the bulk path of Float64 gets (issue 31) ----
+# ---- the bulk path of Float64 gets ----
 
 def test_bulk_get_equals_value_by_value_and_refuses_the_same(sl, fmi_version):
     """A run of consecutive value references (the bulk path) gives bitwise

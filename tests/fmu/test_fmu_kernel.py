@@ -1,4 +1,4 @@
-# The FMU's kernel as a sum of exponentials (issue 13): the recursion, and the
+# The FMU's kernel as a sum of exponentials: the recursion, and the
 # direct sum where the recursion refuses a growing term (H_lambda < 0), give
 # the outputs of a native libdmi run with the kernel as a callback (sampled,
 # default method) to 1e-12.

@@ -1,4 +1,4 @@
-# Models and exact periodic solutions for the periodic-orbit tests (issue 30), derived here
+# Models and exact periodic solutions for the periodic-orbit tests, derived here
 # from the equations, not from the code under test:
 # - Den Hartog's non-stick orbit of x'' + x + F0 sign(x') = F cos(w t) (Den Hartog 1931;
 #   Shaw 1986) and its Floquet multipliers by a saltation analysis;

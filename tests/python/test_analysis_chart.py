@@ -1,4 +1,4 @@
-# Tests of dmi.analysis.stability_chart (issue 29): the traced Hopf curves of an oscillator with an
+# Tests of dmi.analysis.stability_chart: the traced Hopf curves of an oscillator with an
 # exponential memory kernel against its D-curves, from the characteristic equation at lambda = i w
 # written here; the grid against roots(); the Dask path; bad input and no process left behind.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later

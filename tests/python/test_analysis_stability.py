@@ -1,4 +1,4 @@
-# Tests of dmi.analysis.roots and dmi.analysis.hopf (issue 29) against oracles computed here,
+# Tests of dmi.analysis.roots and dmi.analysis.hopf against oracles computed here,
 # independently of the code under test: the scalar equation's characteristic polynomial
 # (numpy.roots) and its continuous Hopf curve in closed form, the block companion matrix of a mass
 # on a belt with dry friction (numpy), and plain simulations with dmi.Solver.

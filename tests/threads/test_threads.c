@@ -1,5 +1,5 @@
 /*
- * Threads (issue 16, item 10): dmi.h promises that distinct solvers may run at
+ * Threads: dmi.h promises that distinct solvers may run at
  * once on distinct threads, and co-simulation masters step FMU instances on
  * parallel threads.  THREADS threads start together (a barrier); thread i runs
  * Example 4.3 with N = 100 (i + 1) under every method of the delay sum, each

@@ -1,4 +1,4 @@
-# Events of the oscillator FMU (issue 31): every stick-slip transition of
+# Events of the oscillator FMU: every stick-slip transition of
 # Example 4.3 over t in [0, 30], as fmpy's simulate_fmu sees it with early
 # return and with event mode, lies at the solver step where a native libdmi
 # run (the Python binding dmi.Solver, the same kernel as sums of exponentials,

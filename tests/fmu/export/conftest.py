@@ -1,4 +1,4 @@
-# The tests of FMU export (dmi_add_fmu, issue 20) as a user does it: dmi is
+# The tests of FMU export (dmi_add_fmu) as a user does it: dmi is
 # installed from this build into a temporary prefix (DMI_BUILD_DIR), and each
 # project (examples/fmu-chain, the page docs/fmu-export.md, the bad models
 # here) is configured and built from that prefix alone.  Helpers: an FMU

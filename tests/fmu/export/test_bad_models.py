@@ -1,4 +1,4 @@
-# Errors in a model's table or code (issue 20, item 5), built from an
+# Errors in a model's table or code, built from an
 # installed dmi: a duplicate name, an output with a start value, an unknown
 # type or causality fail the build with a message naming the variable; a
 # configure function that fails makes ExitInitializationMode log its message

@@ -164,7 +164,7 @@ def test_windows_dll(chain, version, platform, tmp_path):
 
 def test_state_of_another_model_refused(chain):
     """The chain's state bytes given to the oscillator FMU (and back): refused
-    by the state's identity (format 3, issue 31), the logged reason naming
+    by the state's identity (format 3), the logged reason naming
     both models.  (One instance at a time: fmpy's FMI 2.0 logger proxy is
     shared.)"""
     paths = {"chain": chain["2"],

@@ -5,7 +5,7 @@
 # explicit Euler for x'' + k x = F_in (a recurrence computed here), with
 # friction above the spring's force the block never moves; with the page's
 # event indicators (its second C block) the FMI 3.0 FMU returns early at the
-# scheme's stick-slip transitions (issue 31).
+# scheme's stick-slip transitions.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 import os
 import re

@@ -1,4 +1,4 @@
-# FMU state format 3 names its model (issue 31): two models with the same
+# FMU state format 3 names its model: two models with the same
 # variable counts (the same table, or one variable renamed) no longer accept
 # each other's states; the refusal names both models.  Each model's own state
 # still restores.  Built from an installed dmi as a user does (conftest.py).

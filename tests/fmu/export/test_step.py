@@ -1,4 +1,4 @@
-# A model that gives its step h (dmi_fmu_model's step, issue 30): a forced
+# A model that gives its step h (dmi_fmu_model's step): a forced
 # dry-friction oscillator with an exponential memory kernel whose h is a
 # whole fraction of the forcing period, h = period / N with period =
 # 2 pi / omega, so that tau / h is not an integer (tau = 1, omega = 1.3,

@@ -2,7 +2,7 @@
 # of libdmi 1.1 before it (the fixtures of make_old_state.py): a state that
 # FMU saved restores, and the run from it gives the same outputs; the
 # default experiment's first 5 s too.  Both FMI 2.0 and 3.0.  The framework
-# itself changed no bit (checked when it landed); issue 23 then summed the
+# itself changed no bit (checked when it landed); a later change summed the
 # recursion's parts in another order (two partial sums), which moves the last
 # bits: delay_force (W) by 2e-19 in the fresh run, and from the old state,
 # whose sums were made the old way, v by 7e-18 and friction ((X - U)/h) by
