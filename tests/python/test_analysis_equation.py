@@ -205,3 +205,34 @@ def test_equilibrium_branch_of_the_equation_locates_its_hopf_point():
     assert len(hopf) == 1
     hp = hopf[0].hopf
     assert abs(hp.p - c_h) <= 1e-10 * max(1, abs(c_h)) and abs(hp.omega - w_h) <= 1e-10 * w_h
+
+
+# ---- a fold of equilibria, the scheme's and the equation's -------------------------------------
+# u' + u^2 - (p - 1/2) + k int_0^tau e^(-s) u(t - s) ds = 0: equilibria p = 1/2 + u^2 + k K u, a fold
+# at u = -k K / 2, p = 1/2 - (k K)^2 / 4, with K = 1 - e^(-tau) for the equation and the scheme's
+# K_h = h sum_{l<N} e^(-l h) = h (1 - e^(-N h)) / (1 - e^(-h)).
+KF, NF = 1.5, 20
+
+
+def folding(p: float) -> dmi.Solver:
+    s = dmi.Solver(1, TAU, NF)
+    s.set_rhs(lambda t, u: np.array([u[0] ** 2 - (p - 0.5)]))
+    s.set_kernel_exp([-1.0], [0.0], [[[KF]]])
+    return s
+
+
+@pytest.mark.parametrize("of", ["scheme", "equation"])
+def test_fold_of_equilibria_located_on_the_branch(of):
+    h = TAU / NF
+    K = (1 - math.exp(-TAU)) if of == "equation" else h * (1 - math.exp(-NF * h)) / (1 - math.exp(-h))
+    p_fold, u_fold = 0.5 - (KF * K) ** 2 / 4, -KF * K / 2
+    u0 = 1.0
+    e = da.equilibrium(folding, 0.5 + u0 ** 2 + KF * K * u0, [u0 + 0.01], of=of)
+    assert e.u[0] == pytest.approx(u0, abs=1e-12)
+    br = da.continue_equilibrium(e, -2.0, step=0.2, max_points=30)
+    folds = [ev for ev in br.events if ev.kind == "fold"]
+    assert len(folds) == 1, br.events
+    tol = 1e-10 if of == "equation" else 1e-8
+    assert abs(folds[0].p - p_fold) <= tol * max(1.0, abs(p_fold)), (folds[0].p, p_fold)
+    assert folds[0].u[0] == pytest.approx(u_fold, abs=1e-4)
+    assert min(q.u[0] for q in br.points) < u_fold - 0.1        # passed to the other side

@@ -352,3 +352,24 @@ def test_branch_points_keep_a_thinned_period():
         assert q.u.shape == (200, 2) and q.t[0] == 0 and q.t[-1] == pytest.approx(q.period)
         r = np.hypot(q.u[:, 0], q.u[:, 1])             # a circle of the amplitude's radius
         assert np.allclose(r, q.amplitude[0], rtol=2e-3)
+
+
+def test_belt_from_stick_slip_back_through_grazing_onto_the_vertical_branch():
+    # the other direction: from a stick-slip orbit, c growing, through grazing onto the vertical
+    # stretch at the Hopf point's c, amplitude falling
+    M, P = 200, 4.98
+    s = belt(0.33, h=P / M)
+    s.set_history(lambda t: np.array([ALPHA / (KB + GB) + 0.05, -VB]))
+    s.init()
+    s.advance(round(80 / s.h))
+    o = da.periodic_orbit(belt, 0.33, guess=s, guess_period=P, steps=M, multipliers=4)
+    assert o.stick_fraction[1] > 0
+    b = da.continue_orbit(o, 0.5, step=0.02, max_points=12, multipliers=4)
+    kinds = [e.kind for e in b.events]
+    assert kinds == ["stick-onset"], b.events
+    slip = [q for q in b.points if q.stick_steps[1] == 0]
+    assert len(slip) >= 4, [(q.p, q.stick_steps) for q in b.points]
+    amp = [q.amplitude[1] for q in slip]
+    assert np.ptp([q.p for q in slip[1:]]) < 1e-6 and np.all(np.diff(amp) < 0), (amp, slip)
+    hp = da.hopf(lambda c: belt(c, h=P / M), 0.3, 0.45, [ALPHA / (KB + GB), -VB])
+    assert abs(slip[-1].p - hp.p) < 1e-3, (slip[-1].p, hp.p)   # the vertical stretch's c

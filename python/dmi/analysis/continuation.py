@@ -587,23 +587,30 @@ def _corner(maps: _Maps, z: np.ndarray, t: np.ndarray, ds: float, direction: flo
             tol: float, max_iter: int, dominant: tuple[np.ndarray, np.ndarray] | None,
             sections: int) -> tuple | None:
     """Past a corner of the branch (a stick onset or a grazing, where the map's derivative jumps
-    and the secant's hyperplane may miss the branch's new piece): natural steps, the orbit at p
-    = p(z) + s delta from z's state (p fixed), delta = ds and 4 ds (p units), s towards p_end
-    first; the first that converges ahead of z along the branch (<w t, z_new - z> > 0) is taken.
-    None if none does."""
+    and the secant's hyperplane may miss the branch's new piece): natural steps from z, first in
+    p (the orbit at p(z) + s delta, p fixed, towards p_end first), then in the state with p free
+    (the orbit on the hyperplane s delta along the tangent's state part: the new piece may be
+    vertical, as a branch of orbits born at a nonsmooth Hopf point is), delta = ds and 4 ds; the
+    first that converges ahead of z along the branch (<w t, z_new - z> > 0) is taken.  None if
+    none does."""
     w = maps.weights(z.size)
     e_p = np.zeros(z.size)
     e_p[-1] = 1.0
-    for delta in (ds, 4 * ds):
-        for sign in (direction, -direction):
-            zp = z.copy()
-            zp[-1] += sign * delta
-            try:
-                got = _correct(maps, zp, e_p, tol, max_iter + 4, math.inf, dominant, sections)
-            except Exception:   # the model's, the map's or the corrector's failure
-                continue
-            if float(np.dot(w * t, got[0] - z)) > 0:
-                return got
+    t_x = t.copy()
+    t_x[-1] = 0.0
+    nx = math.sqrt(float(np.dot(w * t_x, t_x)))
+    tries = [(e_p * sign * delta, e_p) for delta in (ds, 4 * ds) for sign in (direction, -direction)]
+    if nx > 0:
+        t_x /= nx
+        tries += [(t_x * sign * delta, t_x) for delta in (ds, 4 * ds) for sign in (1.0, -1.0)]
+    for step, normal in tries:
+        try:
+            got = _correct(maps, z + step, normal, tol, max_iter + 4, math.inf, dominant,
+                           sections)
+        except Exception:   # the model's, the map's or the corrector's failure
+            continue
+        if float(np.dot(w * t, got[0] - z)) > 0:
+            return got
     return None
 
 
