@@ -8,7 +8,8 @@
 # delay tau (dmi-sweep) and its periodic orbits continued over it (dmi.analysis,
 # examples/python/orbit_tau.py), the stability chart of the distributed-delay
 # oscillator (dmi.analysis), the belt with memory from its equilibrium to its
-# stick-slip branch (dmi.analysis, self-excited); prints the summary table.  Copies the figures
+# stick-slip branch (dmi.analysis, self-excited), the forced Bagley-Torvik oscillator with dry
+# friction (fractional damping, dmi.analysis); prints the summary table.  Copies the figures
 # to docs/figures/.
 # Usage: scripts/main.sh
 # Environment: DMI_BUILD_DIR (default build), DMI_OUT_DIR (default out).
@@ -78,6 +79,10 @@ PYTHONPATH="$build/python" MPLBACKEND=Agg "$py" examples/python/stability_chart.
 stage "dmi.analysis: the belt with memory from its equilibrium to the stick-slip branch"
 PYTHONPATH="$build/python" MPLBACKEND=Agg DMI_FIGURE="$out/belt_selfexcited.png" "$py" \
   examples/python/plot_belt_selfexcited.py | tee "$out/belt_selfexcited.txt"
+
+stage "dmi.analysis: the forced Bagley-Torvik oscillator with dry friction (fitted s^-1/2 kernel, O(1))"
+PYTHONPATH="$build/python" MPLBACKEND=Agg DMI_FIGURE="$out/bagley_torvik.png" "$py" \
+  examples/python/plot_bagley_torvik.py | tee "$out/bagley_torvik.txt"
 
 stage "figures and comparison with the paper and ../shared/reference"
 refarg=()

@@ -439,7 +439,7 @@ class Solver:
         O(1) per step (``dmi_set_kernel_near``).  None removes it.  Before :meth:`init`."""
         def setter(s: Any, address: Any, u: Any) -> int:
             return _L.dmi_set_kernel_near(s, address, u, float(delta))
-        self._set_callback("kernel_near", cb.KERNEL, setter, H, user)
+        self._set_callback("kernel_near", cb.KERNEL, setter, H, user, False)
 
     def set_kernel_fit(self, fit: Any, entry: tuple[int, int] | None = None, near: Callback | None = None,
                        ) -> None:

@@ -25,6 +25,7 @@ RELEASED_CONSTANTS = {
     "DMI_ENONFINITE": -4, "DMI_ESTATE": -5,
     "DMI_CONV_AUTO": 0, "DMI_CONV_DIRECT": 1, "DMI_CONV_FFT": 2,
     "DMI_CONV_RECURSIVE": 3,  # libdmi 1.1
+    "DMI_QUAD_LEFT": 0, "DMI_QUAD_CELL": 1,  # libdmi 1.3
 }
 
 
