@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-# The Python binding's speed (issue 21; a benchmark, not a test): Example 4.3
+# The Python binding's speed (a benchmark, not a test): Example 4.3
 # at N = 1e4 with its kernel as exponential terms and the built-in friction,
 # the right-hand side as a numba cfunc, as a Python function and as that same
 # function compiled with set_rhs(..., jit=True), against the C

@@ -1,5 +1,5 @@
 /*
- * Benchmark of exponential-sum kernels (issue 13; not a test): Example 4.3
+ * Benchmark of exponential-sum kernels (not a test): Example 4.3
  * (tau = 1, h = 1/N) with its kernel cos 2 pi s + cos 10 pi s + cos 20 pi s
  * given as three exponential terms (dmi_set_kernel_exp) under the default
  * method (AUTO, which takes the recursion), at N = 10^3, 10^4, 10^5, 10^6,

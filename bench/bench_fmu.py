@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-# Benchmark of the FMU (issue 13; not a test): an fmpy FMU2Slave loop with
+# Benchmark of the FMU (not a test): an fmpy FMU2Slave loop with
 # communication step 0.01 over Example 4.3 at N = 1e3, 1e4, 1e5, 1e6 (the
 # kernel as exponential terms: the recursion), alternating in rounds so that
 # machine load hits each N alike; the fastest round counts.  Then the same

@@ -1,5 +1,5 @@
 /*
- * Benchmark of FMU export (issue 20; not a test): the Burridge-Knopoff chain
+ * Benchmark of FMU export (not a test): the Burridge-Knopoff chain
  * of examples/fmu-chain as its FMU (built in-tree with dmi_add_fmu, loaded
  * with tests/fmu's loader) against the native libdmi loop of the same model
  * (examples/fmu-chain/native.c, the same parameters, libdmi.so).  Each case
@@ -13,7 +13,7 @@
  * the other, the order alternating), the fastest of the rounds counts; times
  * are CPU times of the process, initialization not timed.  Prints the time
  * per solver step and the ratio FMU / native (target <= 1.1), and, for the
- * reads alone (issue 31: <= 1.2), the extra time of the runs that read the
+ * reads alone (<= 1.2), the extra time of the runs that read the
  * outputs, FMU / native.  The native reads are one function, native_outputs,
  * so that callgrind gives their instructions per call beside fmi2GetReal's
  * (docs/fmu-export.md).

@@ -1,5 +1,5 @@
 /*
- * Benchmark of the delay term's cost as the system grows (issue 23; not a
+ * Benchmark of the delay term's cost as the system grows (not a
  * test).  A chain of m masses, n = 2m states u = (x_1..x_m, v_1..v_m):
  *     x' = v,   v' = -K x - int_0^tau G(s) B x(t - s) ds - alpha sign(v)
  * with K tridiagonal (2k on the diagonal, -k beside it), dry friction alpha

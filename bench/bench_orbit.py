@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-# The cost of dmi.analysis's periodic orbits (issue 30; a benchmark, not a test), in periods of
+# The cost of dmi.analysis's periodic orbits (a benchmark, not a test), in periods of
 # plain simulation measured in the same run: the tau-diagram's oscillator
 # (examples/python/orbit_tau.py: numba right-hand side, constant kernel by the O(1) recursion)
 # at tau = 2.2 with h = 4 pi / M chosen so that N = ceil(tau / h) is about 1e3 and 1e4.  Per N:

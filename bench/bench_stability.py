@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-# dmi.analysis's speed (issue 29; a benchmark, not a test).
+# dmi.analysis's speed (a benchmark, not a test).
 # 1. roots(count = 10) of the distributed-delay oscillator (n = 2,
 #    examples/python/stability_chart.py) at N = 1e3, 1e4, 1e5, with its kernel as one exponential
 #    term (the O(1) recursion) and as a general callback (numba cfunc; the FFT), against simulating
