@@ -56,6 +56,16 @@ def _array(value: Any, shape: tuple[int, ...], name: str) -> np.ndarray:
     return a
 
 
+def _choice(table: dict[str, int], value: Any, what: str) -> int:
+    """libdmi's code of a named choice (a convolution method, a quadrature rule); InvalidArgument
+    naming the choices otherwise."""
+    code = table.get(value) if isinstance(value, str) else None
+    if code is None:
+        raise InvalidArgument(_lib.EINVAL, f"{what} {value!r}: expected one of "
+                              f"{', '.join(map(repr, table))}")
+    return code
+
+
 def _ptr(a: np.ndarray | None) -> Any:
     return None if a is None else a.ctypes.data_as(_DP)
 
@@ -253,10 +263,7 @@ class Solver:
         """Method of the delay sum: ``"auto"`` (default), ``"direct"``, ``"fft"`` or
         ``"recursive"`` (exponential kernels, see ``dmi_set_convolution``).  Any time, also
         between steps; the methods differ by rounding only."""
-        code = _lib.CONV.get(method) if isinstance(method, str) else None
-        if code is None:
-            raise InvalidArgument(_lib.EINVAL, f"set_convolution: method {method!r}: expected one of "
-                                  f"{', '.join(map(repr, _lib.CONV))}")
+        code = _choice(_lib.CONV, method, "set_convolution: method")
         with self._using() as s:
             self._check(_L.dmi_set_convolution(s, code))
 
@@ -425,10 +432,7 @@ class Solver:
         weights, the integral of H over each cell (closed form for :meth:`set_kernel_exp`, tanh-sinh
         quadrature for a callback, which is then called inside the cells, never at s = 0: kernels
         singular at 0 such as s^-1/2 run).  Every convolution method computes the same sum."""
-        code = _lib.QUAD.get(rule) if isinstance(rule, str) else None
-        if code is None:
-            raise InvalidArgument(_lib.EINVAL, f"set_quadrature: rule {rule!r}: expected one of "
-                                  f"{', '.join(map(repr, _lib.QUAD))}")
+        code = _choice(_lib.QUAD, rule, "set_quadrature: rule")
         with self._using() as s:
             self._check(_L.dmi_set_quadrature(s, code))
 
