@@ -19,23 +19,23 @@ from . import _lib
 from ._errors import Error, InvalidArgument
 from ._solver import Solver
 
-#: ``DMI_OK`` (0): success.
+#: ``DMI_OK`` (0), success.
 OK: int = _lib.OK
-#: ``DMI_EINVAL`` (-1): an invalid argument (NULL, out of range, NaN); :class:`InvalidArgument`.
+#: ``DMI_EINVAL`` (-1), an invalid argument (NULL, out of range, NaN); :class:`InvalidArgument`.
 EINVAL: int = _lib.EINVAL
-#: ``DMI_ENOMEM`` (-2): memory could not be allocated (or its size overflows); :class:`Error`.
+#: ``DMI_ENOMEM`` (-2), memory could not be allocated (or its size overflows); :class:`Error`.
 ENOMEM: int = _lib.ENOMEM
-#: ``DMI_ECALLBACK`` (-3): a callback failed: a C callback returned nonzero (:class:`Error`), or a
+#: ``DMI_ECALLBACK`` (-3), a callback failed; a C callback returned nonzero (:class:`Error`), or a
 #: Python callback returned a result of another shape or type (:class:`InvalidArgument`).
 ECALLBACK: int = _lib.ECALLBACK
-#: ``DMI_ENONFINITE`` (-4): a NaN or infinity appeared (a callback's output or the new state);
+#: ``DMI_ENONFINITE`` (-4), a NaN or infinity appeared (a callback's output or the new state);
 #: :class:`Error`.
 ENONFINITE: int = _lib.ENONFINITE
-#: ``DMI_ESTATE`` (-5): a call not allowed in the solver's state (a step before ``init``, a
+#: ``DMI_ESTATE`` (-5), a call not allowed in the solver's state (a step before ``init``, a
 #: kernel or history set after it, a closed solver or one in use); :class:`InvalidArgument`.
 ESTATE: int = _lib.ESTATE
 
-#: numba signature of the right-hand side f(t, u): ``@numba.cfunc(dmi.RHS_SIGNATURE)``.
+#: numba signature of the right-hand side f(t, u), for ``@numba.cfunc(dmi.RHS_SIGNATURE)``.
 RHS_SIGNATURE: str = _cb.RHS.numba
 #: numba signature of the resolvent r(lam, x) (``Solver.set_resolvent``).
 RESOLVENT_SIGNATURE: str = _cb.RESOLVENT.numba

@@ -64,7 +64,7 @@ class Solver:
     """The implicit Euler scheme (3.12)-(3.13) for u' + A(u) + f(t, u) + int_0^tau H(s) u(t-s) ds ∋ 0,
     u = z on [-tau, 0], in R^n, with h = tau / N (``Solver(n, tau, N)``, ``dmi_create``) or with a
     step h that need not divide tau (``Solver(n, tau, h=h)``, ``dmi_create_h``: the delay sum's
-    last cell is partial, weighted theta h, see `h` below).
+    last cell is partial, weighted theta h, see the parameter ``h``).
 
     Nothing is set at first: f = 0, A = 0, H = 0, z = 0.  Set the model with the ``set_*``
     methods, then :meth:`init`, then :meth:`step`, :meth:`advance` or :meth:`run`.
@@ -78,9 +78,9 @@ class Solver:
     ``scipy.LowLevelCallable``; or, with ``jit=True``, Python functions compiled by numba into
     such C functions (closure values passed at each call).  A solver may be used by one thread at a
     time; distinct solvers run in parallel in distinct threads (the GIL is released in every call
-    into libdmi and taken only by Python callbacks).  Every method raises
-    :class:`dmi.InvalidArgument` with code ``dmi.ESTATE`` when the solver is closed or in use (by
-    another thread, or by a callback of this solver calling it).
+    into libdmi and taken only by Python callbacks).  A call on a closed solver, or on one in use
+    (by another thread, or by a callback of this solver calling it), raises
+    :class:`dmi.InvalidArgument` with code ``dmi.ESTATE``.
 
     Parameters
     ----------
@@ -224,9 +224,10 @@ class Solver:
         ------
         dmi.InvalidArgument
             Code ``dmi.EINVAL``: f is neither callable nor a C function, a C function or
-            LowLevelCallable without libdmi's signature, ``user`` with a Python function or of
-            an unusable type; with ``jit=True``: numba missing, a function numba cannot compile,
-            a closure value that is not a number or float64 array, or a ``user``.
+            LowLevelCallable without libdmi's signature, ``user`` without a function, with a
+            Python function or of an unusable type; with ``jit=True``: numba missing, a
+            function numba cannot compile, a closure value that is not a number or float64
+            array, or a ``user``.
         """
         self._set_callback("rhs", cb.RHS, _L.dmi_set_rhs, f, user, jit)
 
@@ -511,7 +512,9 @@ class Solver:
 
         Raises
         ------
-        dmi.InvalidArgument, dmi.Error
+        dmi.InvalidArgument
+            As :meth:`run`.
+        dmi.Error
             As :meth:`run`.
         """
         return self._run(steps, stride, True)  # type: ignore[return-value]

@@ -37,23 +37,23 @@ class BranchPoint:
         The parameter.
     period : float
         The period (time units).
-    amplitude : numpy.ndarray, shape (n,)
-        (max - min) / 2 per component (state units).
+    amplitude : numpy.ndarray
+        Shape (n,): (max - min) / 2 per component (state units).
     multipliers : numpy.ndarray of complex
         The leading Floquet multipliers, largest |mu| first.
     stable : bool
-        All |mu| < 1.
-    stick_steps : numpy.ndarray, shape (n,)
-        Stuck steps per period.
-    stick_phases : numpy.ndarray, shape (n,)
-        Stuck intervals per period.
-    margin : numpy.ndarray, shape (n,)
-        A component's least force besides friction at its velocity reversals, less the friction
-        threshold (force units): > 0 where every reversal slips through, <= 0 where the
+        All |mu| < 1 (on an autonomous branch: all but its phase's multiplier 1).
+    stick_steps : numpy.ndarray
+        Shape (n,): stuck steps per period.
+    stick_phases : numpy.ndarray
+        Shape (n,): stuck intervals per period.
+    margin : numpy.ndarray
+        Shape (n,): a component's least force besides friction at its velocity reversals, less the
+        friction threshold (force units): > 0 where every reversal slips through, <= 0 where the
         component sticks (:mod:`dmi.analysis.continuation`).
-    section : numpy.ndarray, shape (k, n)
-        u at t = j period / k, j < k (k = ``Branch.sections``: a Poincare section at the forcing
-        period of a k-periodic orbit).
+    section : numpy.ndarray
+        Shape (k, n): u at t = j period / k, j < k (k = ``Branch.sections``: a Poincare section at
+        the forcing period of a k-periodic orbit).
     state : numpy.ndarray
         The shooting state.
     dpds : float
@@ -66,8 +66,8 @@ class BranchPoint:
     t : numpy.ndarray, shape (k,)
         Times of one period of the orbit from t = 0, thinned to at most :data:`ORBIT_SAMPLES`
         samples (both ends kept), for plots (time units).
-    u : numpy.ndarray, shape (k, n)
-        The orbit at those times (state units).
+    u : numpy.ndarray
+        Shape (k, n): the orbit at those times (state units).
     """
     p: float
     period: float

@@ -48,8 +48,8 @@ class Equilibrium:
         The model ``make(p) -> dmi.Solver``.
     p : float
         The parameter.
-    u : numpy.ndarray, shape (n,)
-        The equilibrium (state units).
+    u : numpy.ndarray
+        Shape (n,): the equilibrium (state units).
     roots : numpy.ndarray of complex
         The rightmost characteristic roots of :func:`dmi.analysis.roots` (rightmost first,
         1 / time unit; empty at a kink of the resolvent).
@@ -80,8 +80,8 @@ class EquilibriumPoint:
     ----------
     p : float
         The parameter.
-    u : numpy.ndarray, shape (n,)
-        The equilibrium (state units).
+    u : numpy.ndarray
+        Shape (n,): the equilibrium (state units).
     roots : numpy.ndarray of complex
         The rightmost roots, rightmost first (1 / time unit).
     stable : bool

@@ -27,17 +27,17 @@ class Orbit:
         The step (time units).
     t : numpy.ndarray, shape (M + 1,)
         The times of one period from t = 0 (time units).
-    u : numpy.ndarray, shape (M + 1, n)
-        U over that period (state units).
+    u : numpy.ndarray
+        Shape (M + 1, n): U over that period (state units).
     state : numpy.ndarray
         The shooting state: L n values, rows oldest first, the last at t = 0.
     multipliers : numpy.ndarray of complex
         The leading Floquet multipliers, largest |mu| first.
     stable : bool
         All |mu| < 1 (an autonomous orbit: all but its phase's multiplier 1).
-    stick_fraction : numpy.ndarray, shape (n,)
-        The fraction of the M steps where component i is stuck (:func:`stuck_mask`: U_i == 0
-        exactly after the friction resolvent, for 2 steps or more).
+    stick_fraction : numpy.ndarray
+        Shape (n,): the fraction of the M steps where component i is stuck (:func:`stuck_mask`: U_i
+        == 0 exactly after the friction resolvent, for 2 steps or more).
     iterations : int
         Newton iterations.
     residual : float

@@ -43,8 +43,8 @@ class Refined:
     ----------
     period : float
         The period (time units).
-    amplitude : numpy.ndarray, shape (n,)
-        (max - min) / 2 per component (state units).
+    amplitude : numpy.ndarray
+        Shape (n,): (max - min) / 2 per component (state units).
     multipliers : numpy.ndarray of complex
         The leading Floquet multipliers, largest |mu| first.
     errors : dict
