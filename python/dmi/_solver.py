@@ -241,10 +241,9 @@ class Solver:
             ``r(lam, x) -> (I + lam A)^{-1} x``, array (n), lam = h (time units); or a C function
             ``int r(double lam, const double *x, double *out, void *user)``
             (``dmi.RESOLVENT_SIGNATURE``).  None restores A = 0.
-        user : optional
-            The C function's user pointer, as for :meth:`set_rhs`.
-        jit : bool, optional
-            Compile the Python function r with numba, as for :meth:`set_rhs`.
+        user, jit : optional
+            The C function's user pointer, and ``jit=True`` to compile the Python function r
+            with numba, as for :meth:`set_rhs`.
 
         Raises
         ------
@@ -305,10 +304,9 @@ class Solver:
             ``H(s) -> array (n, n)`` for 0 <= s < tau (time units), or a C function
             ``int H(double s, double *out, void *user)`` writing n*n values row-major
             (``dmi.KERNEL_SIGNATURE``).  None: H = 0.
-        user : optional
-            The C function's user pointer, as for :meth:`set_rhs`.
-        jit : bool, optional
-            Compile the Python function H with numba, as for :meth:`set_rhs`.
+        user, jit : optional
+            The C function's user pointer, and ``jit=True`` to compile the Python function H
+            with numba, as for :meth:`set_rhs`.
 
         Raises
         ------
@@ -361,10 +359,9 @@ class Solver:
         z : callable, C function or None
             ``z(t) -> array (n)`` (state units) for -tau <= t <= 0 (time units), or a C function
             ``int z(double t, double *out, void *user)`` (``dmi.HISTORY_SIGNATURE``).  None: z = 0.
-        user : optional
-            The C function's user pointer, as for :meth:`set_rhs`.
-        jit : bool, optional
-            Compile the Python function z with numba, as for :meth:`set_rhs`.
+        user, jit : optional
+            The C function's user pointer, and ``jit=True`` to compile the Python function z
+            with numba, as for :meth:`set_rhs`.
 
         Raises
         ------

@@ -243,9 +243,9 @@ def stability_chart(make2: Callable[[float, float], Solver], p_values: Sequence[
         The grid's p, >= 2 finite values.
     q_values : sequence of float
         The grid's q, >= 1 finite values.
-    u_eq : array_like, shape (n,), or callable
-        The constant history (the equilibrium), or a function ``u_eq(p, q)``; pickled as
-        ``make2``.
+    u_eq : array_like or callable
+        The constant history (the equilibrium), shape (n,), or a function ``u_eq(p, q)``;
+        pickled as ``make2``.
     count : int, optional
         Roots computed at each point (the rightmost is kept).
     workers : int, optional

@@ -230,8 +230,8 @@ def equilibrium(make: Model, p: float, guess: Any, *, tol: float = 1e-10, count:
         The model: ``make(p) -> dmi.Solver``, configured, not initialised.
     p : float
         The parameter.
-    guess : array_like, shape (n,)
-        A rough guess (state units); the equation's equilibrium is corrected too.
+    guess : array_like
+        Shape (n,): a rough guess (state units); the equation's equilibrium is corrected too.
     tol : float
         Tolerance, relative to max(1, |u|_inf).
     count : int

@@ -189,8 +189,8 @@ def roots(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 10,
         convolution method), configured, not initialised.
     p : float
         The parameter.
-    u_eq : array_like, shape (n,), or callable
-        The equilibrium, or a function ``u_eq(p)``.
+    u_eq : array_like or callable
+        The equilibrium, shape (n,), or a function ``u_eq(p)``.
     count : int
         How many roots.
     tol : float
