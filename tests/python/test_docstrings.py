@@ -1,8 +1,9 @@
 # The Python reference (docs/reference.md, autodoc + napoleon) is complete: every public function,
-# method and class of dmi, dmi.kernels, dmi.analysis (and dmi.analysis.interactive) and dmi_sweep
-# has a NumPy-style docstring whose Parameters section names each of its parameters, a Returns (or
-# Yields) section when it returns something, and, for a dataclass, an Attributes section naming
-# each field.  The sections are read as napoleon reads them: a title line over a line of dashes.
+# method and class of the modules it lists (dmi, dmi.kernels, dmi.analysis, dmi_sweep and their
+# documented submodules) has a NumPy-style docstring whose Parameters section names each of its
+# parameters, a Returns (or Yields) section when it returns something, and, for a dataclass, an
+# Attributes section naming each field.  The sections are read as napoleon reads them: a title
+# line over a line of dashes.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -18,9 +19,9 @@ from typing import Any
 import pytest
 
 SOURCE = Path(os.environ.get("DMI_SOURCE_DIR", Path(__file__).resolve().parents[2]))
-SWEEP = ["dmi_sweep", "dmi_sweep.spec", "dmi_sweep.run", "dmi_sweep.plot", "dmi_sweep.store",
-         "dmi_sweep.simulate", "dmi_sweep.slurm", "dmi_sweep.kubernetes", "dmi_sweep.cli"]
-MODULES = ["dmi", "dmi.kernels", "dmi.analysis", "dmi.analysis.interactive"] + SWEEP
+#: The modules of the Python reference: its automodule directives.
+MODULES = re.findall(r"^\.\. automodule:: (\S+)", (SOURCE / "docs" / "reference.md").read_text(),
+                     re.M)
 #: Names whose docstring serves something else, with the reason.
 EXEMPT = {"dmi.kernels.main": "its docstring is dmi-kernel-fit's argparse description (--help)"}
 
@@ -83,7 +84,8 @@ def function_problems(name: str, f: Any, method: bool) -> list[str]:
         if missing:
             problems.append(f"{name}: Parameters lacks {sorted(missing)}")
     ret = inspect.signature(f).return_annotation
-    if ret not in (None, "None", inspect.Signature.empty) and not ({"Returns", "Yields"} & set(doc)):
+    returns = ret not in (None, "None", inspect.Signature.empty)
+    if returns and not ({"Returns", "Yields"} & set(doc)):
         problems.append(f"{name}: no Returns section")
     return problems
 
@@ -129,13 +131,17 @@ def problems_of(module_name: str) -> list[str]:
     return out
 
 
+def test_the_reference_lists_the_packages() -> None:
+    assert {"dmi", "dmi.kernels", "dmi.analysis", "dmi_sweep"} <= set(MODULES)
+
+
 @pytest.mark.parametrize("module_name", MODULES)
 def test_public_names_have_their_sections(module_name: str) -> None:
     if module_name.startswith("dmi_sweep"):
         pytest.importorskip("fmpy")
         pytest.importorskip("dask.distributed")
         if str(SOURCE / "python") not in sys.path:
-            sys.path.append(str(SOURCE / "python"))   # after the build's dmi: only dmi_sweep from it
+            sys.path.append(str(SOURCE / "python"))   # after the build's dmi: dmi_sweep from it
     elif module_name.startswith("dmi.analysis"):
         pytest.importorskip("scipy")
         pytest.importorskip("bokeh")
