@@ -19,22 +19,37 @@ from . import _lib
 from ._errors import Error, InvalidArgument
 from ._solver import Solver
 
+#: ``DMI_OK`` (0), success.
 OK: int = _lib.OK
+#: ``DMI_EINVAL`` (-1), an invalid argument (NULL, out of range, NaN); :class:`InvalidArgument`.
 EINVAL: int = _lib.EINVAL
+#: ``DMI_ENOMEM`` (-2), memory could not be allocated (or its size overflows); :class:`Error`.
 ENOMEM: int = _lib.ENOMEM
+#: ``DMI_ECALLBACK`` (-3), a callback failed; a C callback returned nonzero (:class:`Error`), or a
+#: Python callback returned a result of another shape or type (:class:`InvalidArgument`).
 ECALLBACK: int = _lib.ECALLBACK
+#: ``DMI_ENONFINITE`` (-4), a NaN or infinity appeared (a callback's output or the new state);
+#: :class:`Error`.
 ENONFINITE: int = _lib.ENONFINITE
+#: ``DMI_ESTATE`` (-5), a call not allowed in the solver's state (a step before ``init``, a
+#: kernel or history set after it, a closed solver or one in use); :class:`InvalidArgument`.
 ESTATE: int = _lib.ESTATE
 
-#: numba signatures: ``@numba.cfunc(dmi.RHS_SIGNATURE)`` etc.
+#: numba signature of the right-hand side f(t, u), for ``@numba.cfunc(dmi.RHS_SIGNATURE)``.
 RHS_SIGNATURE: str = _cb.RHS.numba
+#: numba signature of the resolvent r(lam, x) (``Solver.set_resolvent``).
 RESOLVENT_SIGNATURE: str = _cb.RESOLVENT.numba
+#: numba signature of the kernel H(s) (``Solver.set_kernel``, ``Solver.set_kernel_near``).
 KERNEL_SIGNATURE: str = _cb.KERNEL.numba
+#: numba signature of the history z(t) (``Solver.set_history``).
 HISTORY_SIGNATURE: str = _cb.HISTORY.numba
-#: C signatures, as scipy.LowLevelCallable(..., signature=...) takes them.
+#: C type of the right-hand side, as ``scipy.LowLevelCallable(..., signature=...)`` takes it.
 RHS_C_SIGNATURE: str = _cb.RHS.c
+#: C type of the resolvent, as ``scipy.LowLevelCallable(..., signature=...)`` takes it.
 RESOLVENT_C_SIGNATURE: str = _cb.RESOLVENT.c
+#: C type of the kernel, as ``scipy.LowLevelCallable(..., signature=...)`` takes it.
 KERNEL_C_SIGNATURE: str = _cb.KERNEL.c
+#: C type of the history, as ``scipy.LowLevelCallable(..., signature=...)`` takes it.
 HISTORY_C_SIGNATURE: str = _cb.HISTORY.c
 #: ctypes prototypes of the callbacks (pointers as c_void_p): ``dmi.RhsFn(address)``.
 RhsFn = _lib.RhsFn
@@ -44,7 +59,13 @@ HistoryFn = _lib.HistoryFn
 
 
 def version() -> str:
-    """Version "MAJOR.MINOR.PATCH" of the libdmi in this package (``dmi_version``)."""
+    """The version of the libdmi in this package (``dmi_version``).
+
+    Returns
+    -------
+    str
+        ``"MAJOR.MINOR.PATCH"``.
+    """
     return _lib.lib.dmi_version().decode()
 
 

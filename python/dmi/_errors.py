@@ -7,10 +7,20 @@ from . import _lib
 
 
 class Error(Exception):
-    """A failure of libdmi or of the binding: ``code`` is the ``DMI_E*`` value of include/dmi.h
-    (``dmi.EINVAL``, ``dmi.ENOMEM``, ``dmi.ECALLBACK``, ``dmi.ENONFINITE``, ``dmi.ESTATE``) and
-    ``message`` the library's description (``dmi_last_error``).  The solver is as it was before
-    the failing call (``advance`` and ``run`` keep the steps before the failing one)."""
+    """A failure of libdmi or of the binding.  The solver is as it was before the failing call
+    (``advance`` and ``run`` keep the steps before the failing one).  ``str()`` gives the message
+    and the code's generic description (``dmi_strerror``).
+
+    Parameters
+    ----------
+    code : int
+        The ``DMI_E*`` value of include/dmi.h: ``dmi.EINVAL``, ``dmi.ENOMEM``,
+        ``dmi.ECALLBACK``, ``dmi.ENONFINITE`` or ``dmi.ESTATE``.
+    message : str
+        What failed: the library's description (``dmi_last_error``) or the binding's.
+
+    Both are kept as the attributes ``code`` and ``message``.
+    """
 
     def __init__(self, code: int, message: str):
         super().__init__(message)
@@ -24,9 +34,16 @@ class Error(Exception):
 class InvalidArgument(Error, ValueError):
     """An invalid argument or call (a wrong shape, NaN, a negative friction coefficient, n = 0,
     a setter of sampled data after init, a step before init, a callback's result of the wrong
-    shape): both a :class:`dmi.Error` and a :class:`ValueError`.  ``code`` is ``dmi.EINVAL``,
-    ``dmi.ESTATE`` (a call not allowed in the solver's state) or ``dmi.ECALLBACK`` (a Python
-    callback returned something unusable).  The solver is unchanged."""
+    shape): both a :class:`dmi.Error` and a :class:`ValueError`.  The solver is unchanged.
+
+    Parameters
+    ----------
+    code : int
+        ``dmi.EINVAL``, ``dmi.ESTATE`` (a call not allowed in the solver's state) or
+        ``dmi.ECALLBACK`` (a Python callback returned something unusable).
+    message : str
+        What was wrong.
+    """
 
 
 def from_code(code: int, message: str) -> Error:

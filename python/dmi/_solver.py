@@ -74,7 +74,7 @@ class Solver:
     """The implicit Euler scheme (3.12)-(3.13) for u' + A(u) + f(t, u) + int_0^tau H(s) u(t-s) ds ∋ 0,
     u = z on [-tau, 0], in R^n, with h = tau / N (``Solver(n, tau, N)``, ``dmi_create``) or with a
     step h that need not divide tau (``Solver(n, tau, h=h)``, ``dmi_create_h``: the delay sum's
-    last cell is partial, weighted theta h, see :meth:`__init__`).
+    last cell is partial, weighted theta h, see the parameter ``h``).
 
     Nothing is set at first: f = 0, A = 0, H = 0, z = 0.  Set the model with the ``set_*``
     methods, then :meth:`init`, then :meth:`step`, :meth:`advance` or :meth:`run`.
@@ -88,16 +88,37 @@ class Solver:
     ``scipy.LowLevelCallable``; or, with ``jit=True``, Python functions compiled by numba into
     such C functions (closure values passed at each call).  A solver may be used by one thread at a
     time; distinct solvers run in parallel in distinct threads (the GIL is released in every call
-    into libdmi and taken only by Python callbacks).
+    into libdmi and taken only by Python callbacks).  A call on a closed solver, or on one in use
+    (by another thread, or by a callback of this solver calling it), raises
+    :class:`dmi.InvalidArgument` with code ``dmi.ESTATE``.
+
+    Parameters
+    ----------
+    n : int
+        Dimension of the state, >= 1.
+    tau : float
+        Delay tau > 0, finite (time units).
+    N : int, optional
+        Steps per delay, >= 1: h = tau / N (``dmi_create``).  Give exactly one of N and h.
+    h : float, optional
+        The step itself, finite and > 0 (time units; ``dmi_create_h``, libdmi 1.2).  tau / h
+        need not be an integer: the delay sum has N = ceil(tau / h) cells, the last one weighted
+        theta h = tau - (N - 1) h (0 < theta <= 1); h = tau / N as ``Solver(n, tau, N)`` computes
+        it gives that solver, bitwise; h > tau gives N = 1.  :attr:`N` and :attr:`h` tell what
+        the solver uses.
+
+    Raises
+    ------
+    dmi.InvalidArgument
+        Code ``dmi.EINVAL``: n or N not an integer >= 1, tau or h not finite and > 0, both or
+        neither of N and h given, or h = tau / N not a positive normal number.
+    dmi.Error
+        Code ``dmi.ENOMEM``: the (N + 1) n stored values cannot be allocated (or tau / h >= 2^50
+        cells).
     """
 
     def __init__(self, n: int, tau: float, N: int | None = None, *, h: float | None = None):
-        """A solver for R^n with delay tau > 0 (finite) and either N >= 1 steps per tau
-        (h = tau / N, ``dmi_create``) or the step h > 0 itself (``dmi_create_h``, libdmi 1.2):
-        give exactly one of them.  With h, tau / h need not be an integer: the delay sum has
-        N = ceil(tau / h) cells, the last one weighted theta h = tau - (N - 1) h (0 < theta <= 1);
-        h = tau / N as ``Solver(n, tau, N)`` computes it gives that solver, bitwise; h > tau
-        gives N = 1.  :attr:`N` and :attr:`h` tell what the solver uses."""
+        """A solver for R^n with delay tau and N steps per tau or step h: see :class:`Solver`."""
         self._handle = None
         n = _count(n, "n", 1)
         if (N is None) == (h is None):
@@ -191,28 +212,71 @@ class Solver:
     # ---- setup -------------------------------------------------------------------------------
 
     def set_rhs(self, f: Callback | None, user: Any = None, *, jit: bool = False) -> None:
-        """Right-hand side f: ``f(t, u) -> array (n)``, or a C function
-        ``int f(double t, const double *u, double *out, void *user)`` (``dmi.RHS_SIGNATURE``).
-        None restores f = 0.  ``user``: the C function's user pointer: a NumPy array or ctypes
-        object (its data; the solver keeps the object alive), a ctypes pointer or an int address
-        (the memory is yours to keep alive); a LowLevelCallable's own user_data otherwise.  Takes
-        effect from the next step; may be called at any time.  ``jit=True``: ``f(t, u)`` is a plain
-        Python function (def or lambda), compiled by numba into the C function; numbers and NumPy
-        arrays of its closure are passed at each call (docs/python.md, "jit=True"); the same
-        holds for the other ``set_*`` callbacks."""
+        """Sets the right-hand side f (``dmi_set_rhs``).  Takes effect from the next step; may be
+        called at any time.
+
+        Parameters
+        ----------
+        f : callable, C function or None
+            ``f(t, u) -> array (n)`` (t in time units, u in state units), or a C function
+            ``int f(double t, const double *u, double *out, void *user)``
+            (``dmi.RHS_SIGNATURE``).  None restores f = 0.
+        user : optional
+            The C function's user pointer: a NumPy array or ctypes object (its data; the solver
+            keeps the object alive), a ctypes pointer or an int address (the memory is yours to
+            keep alive); a LowLevelCallable's own user_data when None.  Not for Python functions.
+        jit : bool, optional
+            True: ``f(t, u)`` is a plain Python function (def or lambda), compiled by numba into
+            the C function; numbers and NumPy arrays of its closure are passed at each call
+            (docs/python.md, "jit=True"); the same holds for the other ``set_*`` callbacks.
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: f is neither callable nor a C function, a C function or
+            LowLevelCallable without libdmi's signature, ``user`` without a function, with a
+            Python function or of an unusable type; with ``jit=True``: numba missing, a
+            function numba cannot compile, a closure value that is not a number or float64
+            array, or a ``user``.
+        """
         self._set_callback("rhs", cb.RHS, _L.dmi_set_rhs, f, user, jit)
 
     def set_resolvent(self, r: Callback | None, user: Any = None, *, jit: bool = False) -> None:
-        """A through its resolvent: ``r(lam, x) -> (I + lam A)^{-1} x``, array (n), lam = h; or a
-        C function ``int r(double lam, const double *x, double *out, void *user)``
-        (``dmi.RESOLVENT_SIGNATURE``).  None restores A = 0.  Replaces an earlier resolvent,
-        friction or box."""
+        """Sets A through its resolvent (``dmi_set_resolvent``).  Replaces an earlier resolvent,
+        friction or box; may be called at any time.
+
+        Parameters
+        ----------
+        r : callable, C function or None
+            ``r(lam, x) -> (I + lam A)^{-1} x``, array (n), lam = h (time units); or a C function
+            ``int r(double lam, const double *x, double *out, void *user)``
+            (``dmi.RESOLVENT_SIGNATURE``).  None restores A = 0.
+        user, jit : optional
+            The C function's user pointer, and ``jit=True`` to compile the Python function r
+            with numba, as for :meth:`set_rhs`.
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: r, ``user`` or ``jit`` refused as in :meth:`set_rhs`.
+        """
         self._set_callback("resolvent", cb.RESOLVENT, _L.dmi_set_resolvent, r, user, jit)
         self._resolvent = ()
 
     def set_friction(self, alpha: Any) -> None:
-        """Built-in dry friction A(u)_i = alpha_i sigma(u_i): alpha has n finite values >= 0
-        (``dmi_set_friction``).  Replaces an earlier resolvent, friction or box."""
+        """Sets the built-in dry friction A(u)_i = alpha_i sigma(u_i), sigma the sign graph
+        (``dmi_set_friction``).  Replaces an earlier resolvent, friction or box.
+
+        Parameters
+        ----------
+        alpha : array_like, shape (n,)
+            The coefficients, finite and >= 0 (alpha_i = 0: no friction on u_i; units of f).
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: alpha is not n numbers, or a value is negative, NaN or infinite.
+        """
         a = _array(alpha, (self._n,), "alpha")
         with self._using() as s:
             self._check(_L.dmi_set_friction(s, _ptr(a)))
@@ -220,9 +284,20 @@ class Solver:
         self._resolvent = ("friction", a.copy())
 
     def set_box(self, lo: Any, hi: Any) -> None:
-        """Built-in normal cone of the box prod_i [lo_i, hi_i] (the resolvent is the projection):
-        n values each, no NaN, lo_i <= hi_i, infinite bounds allowed (``dmi_set_box``).  Replaces
-        an earlier resolvent, friction or box."""
+        """Sets the built-in normal cone of the box prod_i [lo_i, hi_i] (the resolvent is the
+        projection, ``dmi_set_box``).  Replaces an earlier resolvent, friction or box.
+
+        Parameters
+        ----------
+        lo, hi : array_like, shape (n,)
+            The bounds (state units), no NaN, lo_i <= hi_i; infinite bounds allowed.
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: lo or hi is not n numbers, has a NaN, lo_i > hi_i,
+            lo_i = +inf or hi_i = -inf (an empty box).
+        """
         lo_a, hi_a = _array(lo, (self._n,), "lo"), _array(hi, (self._n,), "hi")
         with self._using() as s:
             self._check(_L.dmi_set_box(s, _ptr(lo_a), _ptr(hi_a)))
@@ -230,15 +305,47 @@ class Solver:
         self._resolvent = ("box", lo_a.copy(), hi_a.copy())
 
     def set_kernel(self, H: Callback | None, user: Any = None, *, jit: bool = False) -> None:
-        """Kernel: ``H(s) -> array (n, n)`` for 0 <= s < tau, or a C function
-        ``int H(double s, double *out, void *user)`` writing n*n values row-major
-        (``dmi.KERNEL_SIGNATURE``).  None: H = 0.  Sampled by :meth:`init`, so refused after it."""
+        """Sets the kernel H (``dmi_set_kernel``); replaces one of :meth:`set_kernel_exp`.  Sampled
+        by :meth:`init`, so refused after it.
+
+        Parameters
+        ----------
+        H : callable, C function or None
+            ``H(s) -> array (n, n)`` for 0 <= s < tau (time units), or a C function
+            ``int H(double s, double *out, void *user)`` writing n*n values row-major
+            (``dmi.KERNEL_SIGNATURE``).  None: H = 0.
+        user, jit : optional
+            The C function's user pointer, and ``jit=True`` to compile the Python function H
+            with numba, as for :meth:`set_rhs`.
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: H, ``user`` or ``jit`` refused as in :meth:`set_rhs`; code
+            ``dmi.ESTATE``: after :meth:`init`.
+        """
         self._set_callback("kernel", cb.KERNEL, _L.dmi_set_kernel, H, user, jit)
 
     def set_kernel_exp(self, a: Any, b: Any, C: Any, D: Any = None) -> None:
-        """Kernel as K exponential terms H(s) = sum_k exp(a_k s) (C_k cos(b_k s) + D_k sin(b_k s)):
-        a and b of shape (K,) (1 / time unit), C and D of shape (K, n, n) (D None: zero)
-        (``dmi_set_kernel_exp``).  Refused after :meth:`init`."""
+        """Sets the kernel as K exponential terms
+        H(s) = sum_k exp(a_k s) (C_k cos(b_k s) + D_k sin(b_k s)) (``dmi_set_kernel_exp``);
+        replaces one of :meth:`set_kernel`.  Refused after :meth:`init`.
+
+        Parameters
+        ----------
+        a, b : array_like, shape (K,)
+            Rates (a decay if negative) and angular frequencies, K >= 1, finite (1 / time unit).
+        C, D : array_like, shape (K, n, n)
+            The matrices of the cosines and the sines, finite (units of H); D None: zero.
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: a is not of shape (K,) with K >= 1, b, C or D of another shape,
+            or a NaN or infinite value; code ``dmi.ESTATE``: after :meth:`init`.
+        dmi.Error
+            Code ``dmi.ENOMEM``: the terms cannot be stored.
+        """
         if np.ndim(a) != 1 or len(a) == 0:
             raise InvalidArgument(_lib.EINVAL, f"set_kernel_exp: a has shape {np.shape(a)}; expected "
                                   "(K,), K >= 1 terms (set_kernel(None) removes the kernel)")
@@ -254,15 +361,46 @@ class Solver:
         self._keep["kernel"] = cb.Bound(None, None, (a_a, b_a, C_a, D_a))
 
     def set_history(self, z: Callback | None, user: Any = None, *, jit: bool = False) -> None:
-        """History: ``z(t) -> array (n)`` for -tau <= t <= 0, or a C function
-        ``int z(double t, double *out, void *user)`` (``dmi.HISTORY_SIGNATURE``).  None: z = 0.
-        Sampled by :meth:`init`, so refused after it."""
+        """Sets the history z, u = z on [-tau, 0] (``dmi_set_history``).  Sampled by :meth:`init`,
+        so refused after it.
+
+        Parameters
+        ----------
+        z : callable, C function or None
+            ``z(t) -> array (n)`` (state units) for -tau <= t <= 0 (time units), or a C function
+            ``int z(double t, double *out, void *user)`` (``dmi.HISTORY_SIGNATURE``).  None: z = 0.
+        user, jit : optional
+            The C function's user pointer, and ``jit=True`` to compile the Python function z
+            with numba, as for :meth:`set_rhs`.
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: z, ``user`` or ``jit`` refused as in :meth:`set_rhs`; code
+            ``dmi.ESTATE``: after :meth:`init`.
+        """
         self._set_callback("history", cb.HISTORY, _L.dmi_set_history, z, user, jit)
 
     def set_convolution(self, method: str) -> None:
-        """Method of the delay sum: ``"auto"`` (default), ``"direct"``, ``"fft"`` or
-        ``"recursive"`` (exponential kernels, see ``dmi_set_convolution``).  Any time, also
-        between steps; the methods differ by rounding only."""
+        """Sets the method of the delay sum (``dmi_set_convolution``).  Any time, also between
+        steps; the methods differ by rounding only.
+
+        Parameters
+        ----------
+        method : str
+            ``"auto"`` (default), ``"direct"``, ``"fft"`` or ``"recursive"`` (exponential kernels
+            of :meth:`set_kernel_exp`, see ``dmi_set_convolution``).
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: another method; ``"recursive"`` for a callback kernel, a growing
+            term (a_k > 0) or one with |b_k| h > pi; ``"fft"`` in a libdmi built without the FFT.
+        dmi.Error
+            Code ``dmi.ENOMEM`` (the FFT engine cannot be allocated after :meth:`init`) or
+            ``dmi.ENONFINITE`` (a kernel sample, when leaving the recursion after :meth:`init`);
+            the former method stays.
+        """
         code = _choice(_lib.CONV, method, "set_convolution: method")
         with self._using() as s:
             self._check(_L.dmi_set_convolution(s, code))
@@ -270,35 +408,119 @@ class Solver:
     # ---- time stepping -------------------------------------------------------------------------
 
     def init(self) -> None:
-        """Samples the kernel and the history and sets t = 0 (p = 0); again: restarts from t = 0."""
+        """Samples the kernel and the history and sets t = 0 (p = 0, ``dmi_init``); again: restarts
+        from t = 0.
+
+        Raises
+        ------
+        Exception
+            The exception a Python kernel or history callback raised, as it is.
+        dmi.InvalidArgument
+            Code ``dmi.ECALLBACK``: a Python callback returned a result of another shape or type;
+            code ``dmi.EINVAL``: near cells of :meth:`set_kernel_near` without a kernel of
+            :meth:`set_kernel_exp` or with ceil(delta / h) + 1 > N, or ``"recursive"`` for a
+            kernel it refuses (see :meth:`set_convolution`).
+        dmi.Error
+            Code ``dmi.ECALLBACK`` (a C callback returned nonzero), ``dmi.ENONFINITE`` (a NaN or
+            infinite sample) or ``dmi.ENOMEM``.  The solver is then unchanged.
+        """
         with self._using() as s:
             self._check(_L.dmi_init(s))
 
     def step(self) -> None:
-        """One step t_p -> t_{p+1}.  On failure the solver is bitwise where it was, and a retry
-        gives a clean run's result; an exception raised by a Python callback comes out as it is."""
+        """One step t_p -> t_{p+1} (``dmi_step``).  On failure the solver is bitwise where it was,
+        and a retry gives a clean run's result.
+
+        Raises
+        ------
+        Exception
+            The exception a Python callback (f, the resolvent) raised, as it is.
+        dmi.InvalidArgument
+            Code ``dmi.ESTATE``: before :meth:`init`; code ``dmi.ECALLBACK``: a Python callback
+            returned a result of another shape or type.
+        dmi.Error
+            Code ``dmi.ECALLBACK``: a C callback returned nonzero; code ``dmi.ENONFINITE``:
+            f, the delay sum W^p, the resolvent's argument X^p or U^{p+1} has a NaN or infinity.
+        """
         with self._using() as s:
             self._check(_L.dmi_step(s))
 
     def advance(self, steps: int) -> None:
-        """``steps`` steps in C.  Stops at the first failing step (the steps before it are kept,
-        :attr:`step_index` tells how many) and raises its error."""
+        """Takes ``steps`` steps in C (``dmi_advance``).  Stops at the first failing step (the
+        steps before it are kept, :attr:`step_index` tells how many) and raises its error.
+
+        Parameters
+        ----------
+        steps : int
+            Number of steps, >= 0.
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: steps is not an integer >= 0; otherwise as :meth:`step`.
+        dmi.Error
+            As :meth:`step`.
+        """
         steps = _count(steps, "steps", 0)
         with self._using() as s:
             self._check(_L.dmi_advance(s, steps))
 
     def run(self, steps: int, stride: int = 1) -> tuple[np.ndarray, np.ndarray]:
-        """``steps`` steps in C, recording the states there: returns ``t`` (rows,) and ``U``
-        (rows, n) at p0, p0 + stride, ..., p0 + k stride <= p0 + steps, and at p0 + steps (the
-        last row), p0 the step index at the call.  On a failing step the steps before it are
-        kept, and the exception has the rows recorded until then as ``partial = (t, U)``."""
+        """Takes ``steps`` steps in C, recording the states at p0, p0 + stride, ...,
+        p0 + k stride <= p0 + steps, and at p0 + steps (the last row), p0 the step index at the
+        call.
+
+        Parameters
+        ----------
+        steps : int
+            Number of steps, >= 0.
+        stride : int, optional
+            Steps between recorded rows, >= 1.
+
+        Returns
+        -------
+        t : numpy.ndarray, shape (rows,)
+            The times (time units).
+        U : numpy.ndarray, shape (rows, n)
+            The states there (state units).
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: steps or stride is not an integer >= 0 or >= 1; otherwise as
+            :meth:`step`.
+        dmi.Error
+            As :meth:`step`.  On a failing step the steps before it are kept, and the exception
+            (of any type) has the rows recorded until then as ``partial = (t, U)``.
+        """
         t, U, _ = self._run(steps, stride, False)
         return t, U
 
     def run_terms(self, steps: int, stride: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """:meth:`run` that also records the resolvent's argument: returns ``t``, ``U`` (rows,
-        n) and ``X`` (rows - 1, n), X[k] the argument X^{q-1} of the step into U[k + 1] (at
-        step q; :meth:`step_terms` after that step), still in one call to C."""
+        """:meth:`run` that also records the resolvent's argument, still in one call to C.
+
+        Parameters
+        ----------
+        steps, stride : int
+            As for :meth:`run`.
+
+        Returns
+        -------
+        t : numpy.ndarray, shape (rows,)
+            The times (time units).
+        U : numpy.ndarray, shape (rows, n)
+            The states there (state units).
+        X : numpy.ndarray, shape (rows - 1, n)
+            X[k] the argument X^{q-1} of the step into U[k + 1] (at step q; :meth:`step_terms`
+            after that step; state units).
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            As :meth:`run`.
+        dmi.Error
+            As :meth:`run`.
+        """
         return self._run(steps, stride, True)  # type: ignore[return-value]
 
     def _run(self, steps: int, stride: int, terms: bool
@@ -331,7 +553,8 @@ class Solver:
 
     @property
     def step_index(self) -> int:
-        """The step counter p (steps since :meth:`init`); InvalidArgument before it."""
+        """The step counter p (steps since :meth:`init`); :class:`dmi.InvalidArgument` (code
+        ``dmi.ESTATE``) before it."""
         p = ctypes.c_uint64()
         with self._using() as s:
             self._check(_L.dmi_get_step_index(s, ctypes.byref(p)))
@@ -339,14 +562,32 @@ class Solver:
 
     @property
     def state(self) -> np.ndarray:
-        """U^p, a new array (n,)."""
+        """U^p, a new array (n,) (state units); :class:`dmi.InvalidArgument` (code ``dmi.ESTATE``)
+        before :meth:`init`."""
         u = np.empty(self._n)
         with self._using() as s:
             self._check(_L.dmi_get_state(s, _ptr(u)))
         return u
 
     def past(self, lag: int) -> np.ndarray:
-        """U^{p - lag}, 0 <= lag <= N (history values for p - lag <= 0), a new array (n,)."""
+        """A stored state (``dmi_get_past``).
+
+        Parameters
+        ----------
+        lag : int
+            0 <= lag <= N steps back.
+
+        Returns
+        -------
+        numpy.ndarray, shape (n,)
+            U^{p - lag}, a new array (history values for p - lag <= 0; state units).
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: lag is not an integer in [0, N]; code ``dmi.ESTATE``: before
+            :meth:`init`.
+        """
         lag = _count(lag, "lag", 0)
         if lag > self._N:
             raise InvalidArgument(_lib.EINVAL, f"past: lag = {lag} > N = {self._N}")
@@ -356,26 +597,59 @@ class Solver:
         return u
 
     def get_window(self) -> np.ndarray:
-        """The window of stored states U^{p-N}, ..., U^p, oldest first, as a new array (N + 1, n)
-        (``dmi_get_window``, since libdmi 1.2): with the step counter, the whole state of the
-        scheme's step map."""
+        """The window of stored states (``dmi_get_window``, since libdmi 1.2): with the step
+        counter, the whole state of the scheme's step map.
+
+        Returns
+        -------
+        numpy.ndarray, shape (N + 1, n)
+            U^{p-N}, ..., U^p, oldest first, a new array (state units).
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.ESTATE``: before :meth:`init`.
+        """
         U = np.empty((self._N + 1, self._n))
         with self._using() as s:
             self._check(_L.dmi_get_window(s, _ptr(U)))
         return U
 
     def set_window(self, U: Any) -> None:
-        """Replaces the stored states by ``U``, shape (N + 1, n), oldest first (row N is the new
-        U^p), keeping the step counter (``dmi_set_window``, since libdmi 1.2); the delay sum's
-        engine is recomputed from them.  Non-finite values: InvalidArgument, solver unchanged."""
+        """Replaces the stored states, keeping the step counter (``dmi_set_window``, since libdmi
+        1.2); the delay sum's engine is recomputed from them.
+
+        Parameters
+        ----------
+        U : array_like, shape (N + 1, n)
+            The new window, oldest first (row N is the new U^p; state units), finite.
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: U has another shape or a NaN or infinite value (the solver is
+            unchanged); code ``dmi.ESTATE``: before :meth:`init`.
+        """
         a = _array(U, (self._N + 1, self._n), "U")
         with self._using() as s:
             self._check(_L.dmi_set_window(s, _ptr(a)))
 
     def step_terms(self) -> tuple[np.ndarray, np.ndarray]:
-        """Terms of the last step (t_{p-1} -> t_p): ``W`` = W^{p-1} (the delay sum) and ``X`` =
-        X^{p-1} (the resolvent's argument; (X - U^p) / h is the element of A(U^p) selected, the
-        friction force for friction).  InvalidArgument before the first step."""
+        """Terms of the last step, t_{p-1} -> t_p (``dmi_get_step_terms``).
+
+        Returns
+        -------
+        W : numpy.ndarray, shape (n,)
+            W^{p-1}, the delay sum.
+        X : numpy.ndarray, shape (n,)
+            X^{p-1}, the resolvent's argument (state units); (X - U^p) / h is the element of
+            A(U^p) selected, the friction force for friction.
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.ESTATE``: before :meth:`init` or before the first step.
+        """
         W, X = np.empty(self._n), np.empty(self._n)
         with self._using() as s:
             self._check(_L.dmi_get_step_terms(s, _ptr(W), _ptr(X)))
@@ -384,9 +658,19 @@ class Solver:
     # ---- saving and restoring ------------------------------------------------------------------
 
     def save_state(self) -> bytes:
-        """The time-stepping state (step counter, the N + 1 stored states, the last terms, an
-        exponential kernel's sums) as bytes (``dmi_state_save``); not the callbacks, resolvent,
-        method or kernel."""
+        """Saves the time-stepping state (``dmi_state_save``).
+
+        Returns
+        -------
+        bytes
+            The step counter, the N + 1 stored states, the last terms and an exponential kernel's
+            sums; not the callbacks, resolvent, method or kernel.
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.ESTATE``: before :meth:`init`.
+        """
         with self._using() as s:
             size = _L.dmi_state_size(s)
             buf = ctypes.create_string_buffer(size)
@@ -394,9 +678,23 @@ class Solver:
         return buf.raw
 
     def load_state(self, data: bytes) -> None:
-        """Restores bytes of :meth:`save_state` from a solver with the same n, N, tau, h (and
-        exponential kernel); needs :meth:`init` first.  Bad bytes: InvalidArgument, solver
-        unchanged.  Stepping on is bitwise the saving solver's."""
+        """Restores a state of :meth:`save_state` (``dmi_state_load``); needs :meth:`init` first.
+        Stepping on is bitwise the saving solver's.
+
+        Parameters
+        ----------
+        data : bytes-like
+            Bytes of :meth:`save_state` from a solver with the same n, N, tau, h (and exponential
+            kernel).
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: data is not bytes-like, or bad bytes (another size, solver or
+            format; the solver is unchanged); code ``dmi.ESTATE``: before :meth:`init`.
+        dmi.Error
+            Code ``dmi.ENOMEM``.
+        """
         try:
             raw = bytes(data)
         except TypeError:
@@ -427,32 +725,80 @@ class Solver:
             self._handle = None
 
     def set_quadrature(self, rule: str) -> None:
-        """Quadrature rule of the delay integral, before :meth:`init` (``dmi_set_quadrature``):
-        ``"left"`` (default) the paper's rectangle rule h H(l h) per cell; ``"cell"`` exact cell
-        weights, the integral of H over each cell (closed form for :meth:`set_kernel_exp`, tanh-sinh
-        quadrature for a callback, which is then called inside the cells, never at s = 0: kernels
-        singular at 0 such as s^-1/2 run).  Every convolution method computes the same sum."""
+        """Sets the quadrature rule of the delay integral, before :meth:`init`
+        (``dmi_set_quadrature``).  Every convolution method computes the same sum.
+
+        Parameters
+        ----------
+        rule : str
+            ``"left"`` (default) the paper's rectangle rule h H(l h) per cell; ``"cell"`` exact
+            cell weights, the integral of H over each cell (closed form for
+            :meth:`set_kernel_exp`, tanh-sinh quadrature for a callback, which is then called
+            inside the cells, never at s = 0: kernels singular at 0 such as s^-1/2 run).
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: another rule; code ``dmi.ESTATE``: after :meth:`init`.
+        """
         code = _choice(_lib.QUAD, rule, "set_quadrature: rule")
         with self._using() as s:
             self._check(_L.dmi_set_quadrature(s, code))
 
     def set_kernel_near(self, H: Callback | None, delta: float, user: Any = None) -> None:
-        """The exact kernel ``H(s) -> array (n, n)`` (or a C kernel function) on the cells below
-        ``delta``, whose weights become H's exact cell integrals, while the kernel of
-        :meth:`set_kernel_exp` (a fit on [delta, tau]) gives the other cells: a kernel singular at 0 in
-        O(1) per step (``dmi_set_kernel_near``).  None removes it.  Before :meth:`init`."""
+        """Sets the exact kernel of the cells below ``delta``, whose weights become H's exact cell
+        integrals, while the kernel of :meth:`set_kernel_exp` (a fit on [delta, tau]) gives the
+        other cells: a kernel singular at 0 in O(1) per step (``dmi_set_kernel_near``).  Before
+        :meth:`init`, which checks the combination.
+
+        Parameters
+        ----------
+        H : callable, C function or None
+            ``H(s) -> array (n, n)`` (or a C kernel function, as for :meth:`set_kernel`), called
+            for 0 < s <= ceil(delta / h) h.  None removes the near cells.
+        delta : float
+            Length of the near part, finite and >= 0 (time units); 0: no near cells.
+        user : optional
+            The C function's user pointer, as for :meth:`set_rhs`.
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: delta negative or not finite, H or ``user`` refused as in
+            :meth:`set_rhs`; code ``dmi.ESTATE``: after :meth:`init`.
+        TypeError, ValueError
+            delta is not a number.
+        """
         def setter(s: Any, address: Any, u: Any) -> int:
             return _L.dmi_set_kernel_near(s, address, u, float(delta))
         self._set_callback("kernel_near", cb.KERNEL, setter, H, user, False)
 
     def set_kernel_fit(self, fit: Any, entry: tuple[int, int] | None = None, near: Callback | None = None,
                        ) -> None:
-        """The kernel of a :class:`dmi.kernels.KernelFit`: an n x n fit fills the whole kernel; a scalar
-        fit goes to ``entry=(i, j)`` (the other entries zero), or fills the kernel of an n = 1 solver.
-        A fit with ``delta > 0`` (a kernel singular at 0) gets its near cells from ``near``, the exact
-        scalar or n x n kernel (default: the fit's own ``kernel`` when it carries one, a
-        :class:`dmi.kernels.PowerKernel`); use :meth:`set_quadrature` ``("cell")`` with it.
-        Before :meth:`init`."""
+        """Sets the kernel of a :class:`dmi.kernels.KernelFit` (:meth:`set_kernel_exp`, and
+        :meth:`set_kernel_near` for its near cells).  Use :meth:`set_quadrature` ``("cell")``
+        with a fit of ``delta > 0``.  Before :meth:`init`.
+
+        Parameters
+        ----------
+        fit : dmi.kernels.KernelFit
+            An n x n fit fills the whole kernel; a scalar fit goes to ``entry``, or fills the
+            kernel of an n = 1 solver.
+        entry : tuple of int, optional
+            ``(i, j)``: the entry of a scalar fit (the other entries zero).
+        near : callable or C function, optional
+            For a fit with ``delta > 0`` (a kernel singular at 0): the exact scalar or n x n
+            kernel of the near cells (default: the fit's own ``kernel`` when it carries one, a
+            :class:`dmi.kernels.PowerKernel`).
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: a matrix fit of another size or with ``entry``, a scalar fit
+            without ``entry`` for n > 1 or with an entry outside n x n, a fit with ``delta > 0``
+            and no exact kernel, or as :meth:`set_kernel_exp` and :meth:`set_kernel_near`; code
+            ``dmi.ESTATE``: after :meth:`init`.
+        """
         n = self._n
         C, D = np.asarray(fit.C, float), np.asarray(fit.D, float)
         K = len(fit.a)

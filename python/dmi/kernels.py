@@ -49,6 +49,18 @@ class PowerKernel:
     A callable ``s -> c s^{-beta}`` that also carries its Laplace measure, ``s^{-beta} = 1/Gamma(beta)
     int exp(-s e^x + beta x) dx``, so :func:`fit` discretises that integral instead of fitting samples,
     and the error between grid points is bounded with the derivative (the fit is then ``certified``).
+
+    Attributes
+    ----------
+    beta : float
+        The exponent, finite and > 0.
+    c : float
+        The factor, finite and nonzero.
+
+    Raises
+    ------
+    ValueError
+        beta or c out of range (at construction).
     """
     beta: float
     c: float = 1.0
@@ -63,7 +75,18 @@ class PowerKernel:
         return self.c * np.asarray(s, dtype=np.float64) ** -self.beta
 
     def derivative_bound(self, s: np.ndarray) -> np.ndarray:
-        """``|H'(s)|``, decreasing in s."""
+        """The derivative's modulus, decreasing in s.
+
+        Parameters
+        ----------
+        s : numpy.ndarray
+            Points s > 0 (time units).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``|H'(s)| = |c| beta s^{-beta-1}``, the shape of s.
+        """
         return abs(self.c) * self.beta * s ** (-self.beta - 1)
 
 
@@ -71,14 +94,39 @@ class PowerKernel:
 class KernelFit:
     """An exponential-sum fit of a kernel on ``[delta, tau]``.
 
-    ``a, b`` (K,) and ``C, D`` ((K,) for a scalar kernel, (K, n, n) for a matrix one) are what
-    ``Solver.set_kernel_exp`` (``dmi_set_kernel_exp``) takes; ``terms`` = K counts (a, b) pairs (a cosine
-    is one term).  ``max_error`` is the largest error (relative if ``relative``) measured on the check grid,
-    ``l1_error`` = int_delta^tau ||H - H~|| ds and ``kernel_l1`` = int_0^tau ||H|| ds (Frobenius norms,
-    trapezoidal rule on that grid; for tabulated data: on the samples).  ``certified``: the error bound
-    holds between the grid points too (a derivative bound, docs/kernels.md).  ``kernel``: the fitted
-    :class:`PowerKernel`, if it was one (``Solver.set_kernel_fit`` takes the near cells from it).
+    ``a, b, C, D`` are what ``Solver.set_kernel_exp`` (``dmi_set_kernel_exp``) takes;
+    :attr:`terms` = K counts (a, b) pairs (a cosine is one term).  The norms are Frobenius norms,
+    the integrals by the trapezoidal rule on the check grid (for tabulated data: on the samples).
     Picklable.
+
+    Attributes
+    ----------
+    a, b : numpy.ndarray, shape (K,)
+        Rates (a_k <= 0) and angular frequencies (b_k >= 0), 1 / time unit.
+    C, D : numpy.ndarray
+        The cosines' and sines' coefficients: (K,) for a scalar kernel, (K, n, n) for a matrix one
+        (units of H).
+    tau : float
+        The right end of the fit (time units).
+    delta : float
+        Its left end (time units); > 0 for a kernel singular at 0.
+    max_error : float
+        The largest error (relative if ``relative``) measured on the check grid.
+    relative : bool
+        Whether ``max_error`` is relative to max |H(s)| at each s.
+    certified : bool
+        The error bound holds between the grid points too (a derivative bound, docs/kernels.md).
+    l1_error : float
+        int_delta^tau ||H - H~|| ds.
+    kernel_l1 : float
+        int_0^tau ||H|| ds.
+    method : str
+        The method of the fit returned: ``"esprit"`` or ``"laplace"``.
+    grid_points : int
+        Points of the check grid.
+    kernel : PowerKernel or None
+        The fitted :class:`PowerKernel`, if it was one (``Solver.set_kernel_fit`` takes the near
+        cells from it).
     """
     a: np.ndarray
     b: np.ndarray
@@ -97,6 +145,7 @@ class KernelFit:
 
     @property
     def terms(self) -> int:
+        """K, the number of (a, b) pairs (a cosine is one term)."""
         return int(len(self.a))
 
     @property
@@ -105,11 +154,28 @@ class KernelFit:
         return 1 if self.C.ndim == 1 else int(self.C.shape[1])
 
     def __call__(self, s: Any) -> np.ndarray:
-        """``H~(s)``: shape ``s.shape`` (+ (n, n))."""
+        """The fit's value.
+
+        Parameters
+        ----------
+        s : array_like
+            Points (time units).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``H~(s)``: shape ``s.shape`` (+ (n, n)).
+        """
         return _transform.evaluate(s, self.a, self.b, self.C, self.D)
 
     def coefficient_sum(self) -> float:
-        """``sum_k (|C_k| + |D_k|)`` (largest entry): compare with max |H| to see there is no cancellation."""
+        """The coefficients' size: compare with max |H| to see there is no cancellation.
+
+        Returns
+        -------
+        float
+            ``sum_k (|C_k| + |D_k|)``, its largest entry.
+        """
         return float(np.max(np.sum(np.abs(self.C) + np.abs(self.D), axis=0)))
 
     def solution_bound(self, T: float, lipschitz: float, u_max: float, *, h: float | None = None) -> float:
@@ -122,7 +188,29 @@ class KernelFit:
           of ``|u~|`` on ``[-tau, T]``; the maximal monotone A drops out.
         - ``h`` given, the scheme with exact cell weights (f explicit: ``lipschitz`` is f's Lipschitz
           constant): ``eps u_max ((1 + h gamma)^n - 1) / gamma``, ``n = ceil(T / h)``.
+
         A kernel singular at 0 counts from ``delta`` on (the cells below it are exact).
+
+        Parameters
+        ----------
+        T : float
+            The end of the interval, >= 0 (time units).
+        lipschitz : float
+            L as above, >= 0 (1 / time unit).
+        u_max : float
+            A bound of ``|u~|``, >= 0 (state units).
+        h : float, optional
+            The scheme's step, > 0 (time units); None: the equation.
+
+        Returns
+        -------
+        float
+            The bound (state units).
+
+        Raises
+        ------
+        ValueError
+            T, lipschitz or u_max negative (or NaN), or h not > 0.
         """
         if not (T >= 0 and lipschitz >= 0 and u_max >= 0):
             raise ValueError(f"T = {T}, lipschitz = {lipschitz}, u_max = {u_max}: expected >= 0")
@@ -138,6 +226,14 @@ class KernelFit:
 
     # ---- printing for C and Fortran users ------------------------------------------------------
     def to_json(self) -> str:
+        """The fit as JSON.
+
+        Returns
+        -------
+        str
+            An object with ``terms``, ``n``, ``tau``, ``delta``, ``max_error``, ``relative``,
+            ``certified``, ``method`` and the arrays ``a``, ``b``, ``C``, ``D`` as nested lists.
+        """
         return json.dumps({"terms": self.terms, "n": self.n, "tau": self.tau, "delta": self.delta,
                            "max_error": self.max_error, "relative": self.relative,
                            "certified": self.certified, "method": self.method,
@@ -145,6 +241,19 @@ class KernelFit:
                            "D": self.D.tolist()}, indent=1)
 
     def to_c(self, name: str = "kernel") -> str:
+        """The fit as C source for ``dmi_set_kernel_exp``.
+
+        Parameters
+        ----------
+        name : str, optional
+            The prefix of the names.
+
+        Returns
+        -------
+        str
+            A comment with the call, the constant ``<name>_K`` and the ``static const double``
+            arrays ``<name>_a``, ``<name>_b``, ``<name>_C``, ``<name>_D``.
+        """
         def arr(tag: str, x: np.ndarray) -> str:
             vals = ", ".join(repr(float(v)) for v in x.ravel())
             return f"static const double {name}_{tag}[{x.size}] = {{{vals}}};"
@@ -155,6 +264,20 @@ class KernelFit:
                           arr("C", self.C), arr("D", self.D)]) + "\n"
 
     def to_fortran(self, name: str = "kernel") -> str:
+        """The fit as Fortran declarations for ``dmi_set_kernel_exp`` of the Fortran binding.
+
+        Parameters
+        ----------
+        name : str, optional
+            The prefix of the names.
+
+        Returns
+        -------
+        str
+            The parameter ``<name>_K`` and ``real(c_double)`` arrays with ``data`` statements;
+            C and D flat in the C layout (row-major per term), as ``dmi_set_kernel_exp`` reads
+            them.
+        """
         def arr(tag: str, x: np.ndarray) -> list[str]:
             # C, D: the C layout (row-major per term) as one flat array, as dmi_set_kernel_exp reads it
             vals = [repr(float(v)).replace("e", "d") if "e" in repr(float(v)) else repr(float(v)) + "d0"
@@ -360,12 +483,38 @@ def fit(H: Callable[[float], Any] | None, tau: float, *, tol: float = 1e-8, rela
         samples: tuple[Sequence[float], Any] | None = None) -> KernelFit:
     """Fits ``H`` on ``[delta, tau]`` (``delta`` None: ``[0, tau]``) by an exponential sum.
 
-    ``H``: a function of s giving a scalar or an n x n matrix (vectorised or not), a :class:`PowerKernel`,
-    or None with ``samples=(s, values)`` (values (M,) or (M, n, n); uniform s for a matrix kernel).
-    ``tol``: the largest error wanted, absolute or (``relative``) relative to max |H(s)| at each s.
-    ``delta``: the left end for a kernel singular at 0 (the cells below it are integrated exactly).
-    Returns the fit with the fewest terms that meets ``tol`` (at most ``max_terms``); when none does, the
-    best found, with a warning.
+    Parameters
+    ----------
+    H : callable, PowerKernel or None
+        A function of s giving a scalar or an n x n matrix (vectorised or not), a
+        :class:`PowerKernel`, or None with ``samples``.
+    tau : float
+        The right end, finite and > 0 (time units).
+    tol : float, optional
+        The largest error wanted, > 0: absolute, or (``relative``) relative to max |H(s)| at each s.
+    relative : bool, optional
+        Whether ``tol`` is relative.
+    max_terms : int, optional
+        The most terms, >= 1.
+    delta : float, optional
+        The left end for a kernel singular at 0, 0 <= delta < tau (the cells below it are integrated
+        exactly).
+    samples : tuple, optional
+        ``(s, values)`` with H None: M >= 8 finite increasing points s and values (M,) or (M, n, n);
+        uniform s for a matrix kernel (a non-uniform grid only for positive decreasing values).
+
+    Returns
+    -------
+    KernelFit
+        The fit with the fewest terms that meets ``tol`` (at most ``max_terms``); when none does,
+        the best found, with a ``UserWarning`` (for a callable H).
+
+    Raises
+    ------
+    ValueError
+        tau, tol, max_terms or delta out of range; both or neither of H and samples; samples of
+        other shapes, not finite or not increasing, or on a non-uniform grid and not positive and
+        decreasing.
     """
     if not (tau > 0 and math.isfinite(tau)):
         raise ValueError(f"fit: tau = {tau}; expected a finite tau > 0")

@@ -38,7 +38,13 @@ PANEL_NODES = 16
 
 class KinkError(ValueError):
     """The resolvent is not differentiable at the equilibrium's argument X* (a kink: dry friction
-    sticking exactly at its threshold, a box constraint exactly on its face)."""
+    sticking exactly at its threshold, a box constraint exactly on its face); a ``ValueError``.
+
+    Parameters
+    ----------
+    message : str
+        Which component, and where.
+    """
 
 
 def call_make(make: Callable[..., Any], *args: Any, **kw: Any) -> Solver:

@@ -213,8 +213,9 @@ def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: floa
     hopf_point : HopfPoint
         From :func:`dmi.analysis.hopf` or a ``hopf`` event of
         :func:`dmi.analysis.continue_equilibrium` (``Event.hopf``).
-    u_eq : array_like, shape (n,)
-        The equilibrium at the Hopf point (``Event.u``), corrected by Newton at the orbit's step.
+    u_eq : array_like
+        Shape (n,): the equilibrium at the Hopf point (``Event.u``), corrected by Newton at the
+        orbit's step.
     amplitude : float
         The half range (max - min) / 2 over the period of the component ``component`` (state
         units), > 0.

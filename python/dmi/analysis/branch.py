@@ -29,15 +29,46 @@ def thinned(U: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
 
 @dataclass
 class BranchPoint:
-    """One orbit of a branch: ``p``; ``period`` (time units); ``amplitude`` (n,): (max - min) / 2
-    per component; ``multipliers`` (largest |mu| first); ``stable``; ``stick_steps`` (n,): stuck
-    steps per period; ``stick_phases`` (n,): stuck intervals per period; ``margin`` (n,): see
-    the module; ``section`` (k, n): u at t = j period / k, j < k (k = ``sections``: a Poincare
-    section at the forcing period of a k-periodic orbit); ``state``: the shooting state;
-    ``dpds``: the tangent's p component (its sign flips at a fold); ``iterations`` and
-    ``corrector`` (``newton-picard`` or ``newton``, see the module; empty at the start); ``t``
-    and ``u`` (k, n): one period of the orbit from t = 0, thinned to at most
-    :data:`ORBIT_SAMPLES` samples (both ends kept), for plots."""
+    """One orbit of a branch.
+
+    Attributes
+    ----------
+    p : float
+        The parameter.
+    period : float
+        The period (time units).
+    amplitude : numpy.ndarray
+        Shape (n,): (max - min) / 2 per component (state units).
+    multipliers : numpy.ndarray of complex
+        The leading Floquet multipliers, largest |mu| first.
+    stable : bool
+        All |mu| < 1 (on an autonomous branch: all but its phase's multiplier 1).
+    stick_steps : numpy.ndarray
+        Shape (n,): stuck steps per period.
+    stick_phases : numpy.ndarray
+        Shape (n,): stuck intervals per period.
+    margin : numpy.ndarray
+        Shape (n,): a component's least force besides friction at its velocity reversals, less the
+        friction threshold (force units): > 0 where every reversal slips through, <= 0 where the
+        component sticks (:mod:`dmi.analysis.continuation`).
+    section : numpy.ndarray
+        Shape (k, n): u at t = j period / k, j < k (k = ``Branch.sections``: a Poincare section at
+        the forcing period of a k-periodic orbit).
+    state : numpy.ndarray
+        The shooting state.
+    dpds : float
+        The tangent's p component (its sign flips at a fold).
+    iterations : int
+        The corrector's iterations.
+    corrector : str
+        ``"newton-picard"`` or ``"newton"`` (:mod:`dmi.analysis.continuation`); empty at the
+        start.
+    t : numpy.ndarray, shape (k,)
+        Times of one period of the orbit from t = 0, thinned to at most :data:`ORBIT_SAMPLES`
+        samples (both ends kept), for plots (time units).
+    u : numpy.ndarray
+        Shape (k, n): the orbit at those times (state units).
+    """
     p: float
     period: float
     amplitude: np.ndarray
@@ -57,12 +88,27 @@ class BranchPoint:
 
 @dataclass
 class Event:
-    """A detected event between points ``index - 1`` and ``index`` of the branch: ``kind``
-    (``fold``, ``period-doubling``, ``torus``, ``stick-onset``, ``grazing``), ``p`` (linear
-    interpolation of the test function's zero), ``component`` (the friction component of a
-    stick event, else None) and a ``detail`` text.  On a branch of equilibria (``fold``, ``hopf``):
-    ``u``, the equilibrium at the event, and ``hopf``, the :class:`HopfPoint` of a ``hopf``
-    event."""
+    """A detected event between points ``index - 1`` and ``index`` of the branch.
+
+    Attributes
+    ----------
+    kind : str
+        ``"fold"``, ``"period-doubling"``, ``"torus"``, ``"stick-onset"`` or ``"grazing"``; on a
+        branch of equilibria ``"fold"`` or ``"hopf"``.
+    p : float
+        Where: the linear interpolation of the test function's zero (located further on a
+        branch of equilibria).
+    index : int
+        The branch point after the event.
+    component : int or None
+        The friction component of a stick event, else None.
+    detail : str
+        A description.
+    u : numpy.ndarray or None
+        On a branch of equilibria: the equilibrium at the event (state units).
+    hopf : HopfPoint or None
+        The :class:`HopfPoint` of a ``hopf`` event.
+    """
     kind: str
     p: float
     index: int
@@ -74,12 +120,33 @@ class Event:
 
 @dataclass
 class Branch:
-    """A continued branch: ``points`` (:class:`BranchPoint`), ``events`` (:class:`Event`),
-    ``status`` (why it ended), ``make``, ``steps`` (M), ``h`` (the start's step), ``rows`` (L),
-    ``sections`` and ``period`` (the function p -> period given to :func:`continue_orbit`, or
-    None: the period M h was kept); ``kind``: ``"orbits"`` (forced), ``"autonomous"`` (orbits
-    of free period: ``column("period")``) or ``"equilibria"`` (points are
-    :class:`dmi.analysis.equilibria.EquilibriumPoint`)."""
+    """A continued branch.
+
+    Attributes
+    ----------
+    points : list of BranchPoint or EquilibriumPoint
+        The points, in the order continued.
+    events : list of Event
+        The detected events.
+    status : str
+        Why it ended.
+    make : callable
+        The model ``make(p) -> dmi.Solver``.
+    steps : int
+        M, the steps of a period.
+    h : float
+        The start's step (time units).
+    rows : int
+        L, the rows of the shooting state.
+    sections : int
+        The Poincare sections per period (:attr:`BranchPoint.section`).
+    period : callable or None
+        The function p -> period given to :func:`continue_orbit`, or None: the period M h was
+        kept.
+    kind : str
+        ``"orbits"`` (forced), ``"autonomous"`` (orbits of free period: ``column("period")``) or
+        ``"equilibria"`` (points are :class:`dmi.analysis.equilibria.EquilibriumPoint`).
+    """
     points: list[Any]
     events: list[Event]
     status: str
@@ -102,15 +169,46 @@ class Branch:
         return np.array([q.stable for q in self.points])
 
     def column(self, name: str) -> np.ndarray:
-        """An attribute of every point stacked: ``branch.column("amplitude")`` -> (points, n)."""
+        """An attribute of every point, stacked.
+
+        Parameters
+        ----------
+        name : str
+            An attribute of the points, e.g. ``"amplitude"``.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (points,) + the attribute's shape: ``branch.column("amplitude")`` -> (points, n).
+
+        Raises
+        ------
+        AttributeError
+            The points have no attribute ``name``.
+        """
         return np.array([getattr(q, name) for q in self.points])
 
     def to_html(self, path: str | os.PathLike, component: int = 0,
                 p_label: str = "parameter p") -> None:
-        """Writes the interactive figure of the branch to the standalone HTML file ``path``
-        (hover a point for its data, click it to draw its orbit):
+        """Writes the interactive figure of the branch to a standalone HTML file (hover a point
+        for its data, click it to draw its orbit):
         ``plot_branch(self, html=path, component=component, p_label=p_label)``, see
-        :func:`dmi.analysis.interactive.branch_html`."""
+        :func:`dmi.analysis.interactive.branch_html`.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The HTML file.
+        component : int, optional
+            The state component plotted.
+        p_label : str, optional
+            The horizontal axis' label.
+
+        Raises
+        ------
+        ImportError
+            Bokeh is not installed.
+        """
         from .orbit_plot import plot_branch
         plot_branch(self, html=path, component=component, p_label=p_label)
 

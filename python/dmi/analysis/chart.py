@@ -26,8 +26,16 @@ TRACE_TOL = 1e-9
 @dataclass
 class HopfCurve:
     """A curve of the (p, q) plane where one root lambda = i omega sits on the imaginary axis,
-    traced by continuation in q: arrays ``p``, ``q`` and ``omega`` (radians / time unit) of its
-    points, in the order traced.  omega = 0 throughout: a real root crosses (a fold, not Hopf)."""
+    traced by continuation in q.
+
+    Attributes
+    ----------
+    p, q : numpy.ndarray
+        The parameters of its points, in the order traced.
+    omega : numpy.ndarray
+        The crossing frequency at each point (radians / time unit); 0 throughout: a real root
+        crosses (a fold, not Hopf).
+    """
     p: np.ndarray
     q: np.ndarray
     omega: np.ndarray
@@ -40,9 +48,18 @@ class HopfCurve:
 
 @dataclass
 class StabilityChart:
-    """The result of :func:`stability_chart`: ``re[j, i]`` and ``im[j, i]`` are the real and
-    imaginary parts (1 / time unit) of the rightmost root at (p_values[i], q_values[j]) (< 0:
-    stable); ``curves`` the traced :class:`HopfCurve` s."""
+    """The result of :func:`stability_chart`.
+
+    Attributes
+    ----------
+    p_values, q_values : numpy.ndarray
+        The grid's parameters, shapes (P,) and (Q,).
+    re, im : numpy.ndarray, shape (Q, P)
+        ``re[j, i]`` and ``im[j, i]``: the real and imaginary parts (1 / time unit) of the
+        rightmost root at (p_values[i], q_values[j]) (re < 0: stable).
+    curves : list of HopfCurve
+        The traced Hopf and fold curves.
+    """
     p_values: np.ndarray
     q_values: np.ndarray
     re: np.ndarray
@@ -56,8 +73,23 @@ class StabilityChart:
 
     def to_html(self, path: str | os.PathLike, p_label: str = "parameter p",
                 q_label: str = "parameter q", title: str | None = None) -> None:
-        """Writes the interactive chart to the standalone HTML file ``path`` (hover a grid point
-        for its rightmost root): :func:`dmi.analysis.interactive.chart_html`."""
+        """Writes the interactive chart to a standalone HTML file (hover a grid point for its
+        rightmost root): :func:`dmi.analysis.interactive.chart_html`.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The HTML file.
+        p_label, q_label : str, optional
+            The axes' labels.
+        title : str, optional
+            The figure's title.
+
+        Raises
+        ------
+        ImportError
+            Bokeh is not installed.
+        """
         from .interactive import chart_html
         chart_html(self, path, p_label=p_label, q_label=q_label, title=title)
 
@@ -196,19 +228,53 @@ def stability_chart(make2: Callable[[float, float], Solver], p_values: Sequence[
                     q_values: Sequence[float], u_eq: Any, *, count: int = 4,
                     workers: int | None = None, client: Any = None, trace: bool = True,
                     tol: float = 1e-9, of: str = "scheme") -> StabilityChart:
-    """The stability chart of the two-parameter model ``make2(p, q) -> dmi.Solver`` (configured, not
-    initialised) at the constant history ``u_eq`` (an array (n,), or a function ``u_eq(p, q)``).
+    """The stability chart of a two-parameter model: the rightmost root (:func:`roots`) at every
+    grid point, computed row by row (one task per q), and the :class:`HopfCurve` s traced by
+    continuation from each chain of sign changes of the grid (one task per chain).  The pool this
+    function starts is shut down before it returns, also on an error.
 
-    Returns a :class:`StabilityChart`: the rightmost root (:func:`roots`) at every grid point,
-    computed row by row (one task per q) in ``workers`` processes (default: the cores this process
-    may use), or on a Dask cluster through ``client`` (a ``dask.distributed.Client``, e.g. from
-    ``dmi_sweep.run.make_client``; any object with ``submit(fn)`` returning futures); and, with
-    ``trace``, the :class:`HopfCurve` s traced by continuation from each chain of sign changes of
-    the grid (one task per chain).  ``make2`` and ``u_eq`` travel to other processes by pickle: a
-    module-level function or a ``functools.partial`` of one, not a lambda or a closure.
-    The pool this function starts is shut down before it returns, also on an error.
-    ``of``: ``"scheme"`` (the default: the roots that match simulation) or ``"equation"`` (each
-    root refined to the continuous equation's, :func:`roots`).
+    Parameters
+    ----------
+    make2 : callable
+        The model ``make2(p, q) -> dmi.Solver``, configured, not initialised.  It travels to other
+        processes by pickle: a module-level function or a ``functools.partial`` of one, not a
+        lambda or a closure.
+    p_values : sequence of float
+        The grid's p, >= 2 finite values.
+    q_values : sequence of float
+        The grid's q, >= 1 finite values.
+    u_eq : array_like or callable
+        The constant history (the equilibrium), shape (n,), or a function ``u_eq(p, q)``;
+        pickled as ``make2``.
+    count : int, optional
+        Roots computed at each point (the rightmost is kept).
+    workers : int, optional
+        Processes of the pool (default: the cores this process may use).
+    client : optional
+        A Dask cluster's ``dask.distributed.Client`` (e.g. from ``dmi_sweep.run.make_client``; any
+        object with ``submit(fn)`` returning futures) that runs the tasks instead of a pool.
+    trace : bool, optional
+        Trace the Hopf and fold curves.
+    tol : float, optional
+        The equilibrium's residual tolerance, as for :func:`roots`.
+    of : {"scheme", "equation"}, optional
+        ``"scheme"`` (the default: the roots that match simulation) or ``"equation"`` (each root
+        refined to the continuous equation's, :func:`roots`).
+
+    Returns
+    -------
+    StabilityChart
+        The grid's rightmost roots and the traced curves.
+
+    Raises
+    ------
+    ValueError
+        Fewer than 2 p values or 1 q value, not one-dimensional or not finite, ``of`` unknown, or
+        as :func:`roots` at a grid point (u_eq not an equilibrium, :class:`KinkError`).
+    TypeError
+        ``make2`` or ``u_eq`` cannot be pickled (without ``client``).
+    Exception
+        The model's own, when ``make2(p, q)`` fails.
     """
     of = check_of(of)
     P = np.array(p_values, dtype=float, ndmin=1)
@@ -251,12 +317,35 @@ def stability_chart(make2: Callable[[float, float], Solver], p_values: Sequence[
 def plot_stability_chart(chart: StabilityChart, ax: Any = None, *, p_label: str = "parameter p",
                          q_label: str = "parameter q", title: str | None = None,
                          html: str | os.PathLike | None = None) -> Any:
-    """Draws ``chart`` on the matplotlib Axes ``ax`` (a new figure if None) and returns the Axes:
-    the stable region (Re lambda_1 < 0) shaded, the traced Hopf curves as solid lines and the fold
-    curves (a real root crossing) dashed, p on the horizontal axis, q on the vertical one; the
-    labels name the parameters in words and symbols with units (e.g. ``"delay gain a (1/s^2)"``).
-    The key sits below the axes, not over the data.  ``html``: a path, where the interactive
-    chart of :func:`dmi.analysis.interactive.chart_html` is written too."""
+    """Draws a stability chart: the stable region (Re lambda_1 < 0) shaded, the traced Hopf curves
+    as solid lines and the fold curves (a real root crossing) dashed, p on the horizontal axis,
+    q on the vertical one.  The key sits below the axes, not over the data.
+
+    Parameters
+    ----------
+    chart : StabilityChart
+        The chart, from :func:`stability_chart`.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (a new figure if None).
+    p_label, q_label : str, optional
+        The axes' labels: the parameters in words and symbols with units (e.g.
+        ``"delay gain a (1/s^2)"``).
+    title : str, optional
+        The title.
+    html : str or os.PathLike, optional
+        A path, where the interactive chart of :func:`dmi.analysis.interactive.chart_html` is
+        written too.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The Axes drawn on.
+
+    Raises
+    ------
+    ImportError
+        ``html`` given and Bokeh not installed.
+    """
     if html is not None:
         from .interactive import chart_html
         chart_html(chart, html, p_label=p_label, q_label=q_label, title=title)

@@ -40,11 +40,28 @@ ROOTS = 6
 
 @dataclass
 class Equilibrium:
-    """An equilibrium of the scheme: ``make``, ``p``, ``u`` (n,) (state units); ``roots``: the
-    rightmost characteristic roots of :func:`dmi.analysis.roots` (rightmost first, 1 / time
-    unit; empty at a kink of the resolvent); ``stable``: Re roots[0] < 0; ``residual``:
-    |G(u)|_inf (state units); ``iterations``: Newton's; ``of``: ``"scheme"`` or ``"equation"``
-    (whose equilibrium and roots, see :func:`equilibrium`)."""
+    """An equilibrium of the scheme (or of the equation), as :func:`equilibrium` returns it.
+
+    Attributes
+    ----------
+    make : callable
+        The model ``make(p) -> dmi.Solver``.
+    p : float
+        The parameter.
+    u : numpy.ndarray
+        Shape (n,): the equilibrium (state units).
+    roots : numpy.ndarray of complex
+        The rightmost characteristic roots of :func:`dmi.analysis.roots` (rightmost first,
+        1 / time unit; empty at a kink of the resolvent).
+    stable : bool
+        Re roots[0] < 0.
+    residual : float
+        |G(u)|_inf (state units).
+    iterations : int
+        Newton's.
+    of : str
+        ``"scheme"`` or ``"equation"``: whose equilibrium and roots, see :func:`equilibrium`.
+    """
     make: Model = field(repr=False)
     p: float
     u: np.ndarray
@@ -57,8 +74,21 @@ class Equilibrium:
 
 @dataclass
 class EquilibriumPoint:
-    """A point of a branch of equilibria: ``p``, ``u`` (n,), ``roots`` (rightmost first),
-    ``stable``, ``dpds``: the unit tangent's p component (its sign flips at a fold)."""
+    """A point of a branch of equilibria (:func:`continue_equilibrium`).
+
+    Attributes
+    ----------
+    p : float
+        The parameter.
+    u : numpy.ndarray
+        Shape (n,): the equilibrium (state units).
+    roots : numpy.ndarray of complex
+        The rightmost roots, rightmost first (1 / time unit).
+    stable : bool
+        Re roots[0] < 0.
+    dpds : float
+        The unit tangent's p component (its sign flips at a fold).
+    """
     p: float
     u: np.ndarray
     roots: np.ndarray
@@ -200,8 +230,8 @@ def equilibrium(make: Model, p: float, guess: Any, *, tol: float = 1e-10, count:
         The model: ``make(p) -> dmi.Solver``, configured, not initialised.
     p : float
         The parameter.
-    guess : array_like, shape (n,)
-        A rough guess (state units); the equation's equilibrium is corrected too.
+    guess : array_like
+        Shape (n,): a rough guess (state units); the equation's equilibrium is corrected too.
     tol : float
         Tolerance, relative to max(1, |u|_inf).
     count : int

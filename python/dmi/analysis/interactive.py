@@ -34,12 +34,34 @@ HOVER_MULTIPLIERS = 3
 
 
 def number(x: float) -> str:
-    """x with 6 significant digits (the hover texts' format)."""
+    """A number as the hover texts write it.
+
+    Parameters
+    ----------
+    x : float
+        The number.
+
+    Returns
+    -------
+    str
+        x with 6 significant digits.
+    """
     return f"{x:.6g}"
 
 
 def complex_text(z: complex) -> str:
-    """a + bi (or a - bi) with 6 significant digits; "none" if not finite."""
+    """A complex number (a root, a multiplier) as the hover texts write it.
+
+    Parameters
+    ----------
+    z : complex
+        The number.
+
+    Returns
+    -------
+    str
+        ``"a + bi"`` (or ``"a - bi"``) with 6 significant digits; ``"none"`` if not finite.
+    """
     z = complex(z)
     if not (np.isfinite(z.real) and np.isfinite(z.imag)):
         return "none"
@@ -160,12 +182,9 @@ def branch_html(branch: Any, values: np.ndarray, label: str,
                 path: str | os.PathLike | None = None, *, component: int = 0,
                 p_label: str = "parameter p", title: str | None = None,
                 height: int = 420) -> str:
-    """Writes the interactive figure of ``branch`` (a :class:`dmi.analysis.Branch`) to ``path``
-    (an HTML file that needs nothing else: BokehJS is inlined) and returns its text (also with
-    ``path=None``, which writes nothing).  The panels share the width of the window and are
-    ``height`` pixels high.  ``values`` (points, k) and ``label``: what is drawn
-    against p and its name (:func:`dmi.analysis.orbit_plot.branch_values` of ``component``;
-    :func:`dmi.analysis.plot_branch` with ``html`` and ``Branch.to_html`` call this).
+    """The interactive figure of a branch, as an HTML file that needs nothing else (BokehJS is
+    inlined).  The panels share the width of the window.  :func:`dmi.analysis.plot_branch` with
+    ``html`` and ``Branch.to_html`` call this.
 
     The left panel draws what :func:`plot_branch` draws (the values against p, solid blue where
     stable, dashed red where not, the events marked and named) with a marker per point.
@@ -175,8 +194,42 @@ def branch_html(branch: Any, values: np.ndarray, label: str,
     which starts with the first point's.  A branch of equilibria has no orbit panel, and
     hovering a point shows p, the rightmost root and the stability.
 
-    Raises ValueError for a branch without points, or of orbits whose points keep no orbit
-    (empty ``BranchPoint.t``)."""
+    Parameters
+    ----------
+    branch : dmi.analysis.Branch
+        The branch.
+    values : numpy.ndarray, shape (points, k)
+        What is drawn against p (:func:`dmi.analysis.orbit_plot.branch_values` of
+        ``component``).
+    label : str
+        Its name, the vertical axis' label (matplotlib's ``$...$`` maths shown as plain text).
+    path : str or os.PathLike, optional
+        The HTML file; None writes nothing.
+    component : int, optional
+        The state component of ``values`` (where the events are marked on a branch of
+        equilibria).
+    p_label : str, optional
+        The horizontal axis' label.
+    title : str, optional
+        The title (default: the branch's kind and number of points).
+    height : int, optional
+        The panels' height in pixels.
+
+    Returns
+    -------
+    str
+        The HTML text (also with ``path=None``).
+
+    Raises
+    ------
+    ValueError
+        A branch without points, or of orbits whose points keep no orbit (empty
+        ``BranchPoint.t``).
+    ImportError
+        Bokeh is not installed.
+    OSError
+        ``path`` cannot be written.
+    """
     _bokeh()
     from bokeh.layouts import row
     from bokeh.models import ColumnDataSource, HoverTool, LabelSet
@@ -231,13 +284,37 @@ def _edges(v: np.ndarray) -> np.ndarray:
 def chart_html(chart: Any, path: str | os.PathLike | None = None, *,
                p_label: str = "parameter p", q_label: str = "parameter q",
                title: str | None = None, height: int = 520) -> str:
-    """Writes the interactive figure of ``chart`` (a :class:`dmi.analysis.StabilityChart`) to
-    ``path`` (a standalone HTML file, BokehJS inlined) and returns its text (``path=None``: only
-    returns it).  The chart is as wide as the window and ``height`` pixels high: one cell per
-    grid point, coloured by Re of its rightmost root (blue < 0: stable, red > 0, grey where no
-    root was found) on a scale symmetric about 0 whose ten colours change at 0; the traced Hopf
-    curves solid black, the fold curves dashed.  Hovering a cell shows p, q, the rightmost root
-    and the stability."""
+    """The interactive figure of a stability chart, as a standalone HTML file (BokehJS inlined).
+    The chart is as wide as the window: one cell per grid point, coloured by Re of its rightmost
+    root (blue < 0: stable, red > 0, grey where no root was found) on a scale symmetric about 0
+    whose ten colours change at 0; the traced Hopf curves solid black, the fold curves dashed.
+    Hovering a cell shows p, q, the rightmost root and the stability.
+
+    Parameters
+    ----------
+    chart : dmi.analysis.StabilityChart
+        The chart.
+    path : str or os.PathLike, optional
+        The HTML file; None writes nothing.
+    p_label, q_label : str, optional
+        The axes' labels.
+    title : str, optional
+        The title.
+    height : int, optional
+        The height in pixels.
+
+    Returns
+    -------
+    str
+        The HTML text (also with ``path=None``).
+
+    Raises
+    ------
+    ImportError
+        Bokeh is not installed.
+    OSError
+        ``path`` cannot be written.
+    """
     _bokeh()
     from bokeh.models import ColorBar, ColumnDataSource, HoverTool, LinearColorMapper
     from bokeh.palettes import RdBu10
@@ -287,8 +364,19 @@ def _range(x: np.ndarray) -> str:
 
 
 def orbit_summary(orbit: Any) -> str:
-    """The HTML table Jupyter shows for an :class:`Orbit`: p, the period (steps x h), the
-    amplitude, the leading multipliers and the stability."""
+    """The HTML table Jupyter shows for an orbit (``Orbit._repr_html_``).
+
+    Parameters
+    ----------
+    orbit : dmi.analysis.Orbit
+        The orbit.
+
+    Returns
+    -------
+    str
+        A table of p, the period (steps x h), the amplitude, the leading multipliers and the
+        stability.
+    """
     mu = np.atleast_1d(orbit.multipliers)[:HOVER_MULTIPLIERS]
     return _table("Orbit" + (" (autonomous)" if orbit.autonomous else ""), [
         ("p", number(orbit.p)),
@@ -299,8 +387,19 @@ def orbit_summary(orbit: Any) -> str:
 
 
 def branch_summary(branch: Any) -> str:
-    """The HTML table Jupyter shows for a :class:`Branch`: its kind, the number of points, the
-    range of p, how many points are stable, the events (kind at p) and the status."""
+    """The HTML table Jupyter shows for a branch (``Branch._repr_html_``).
+
+    Parameters
+    ----------
+    branch : dmi.analysis.Branch
+        The branch.
+
+    Returns
+    -------
+    str
+        A table of its kind, the number of points, the range of p, how many points are stable,
+        the events (kind at p) and the status.
+    """
     p = np.array([q.p for q in branch.points])
     events = ", ".join(f"{e.kind} at p = {number(e.p)}" for e in branch.events) or "none"
     return _table(f"Branch of {KIND_NAMES.get(branch.kind, branch.kind)}", [
@@ -310,8 +409,19 @@ def branch_summary(branch: Any) -> str:
 
 
 def chart_summary(chart: Any) -> str:
-    """The HTML table Jupyter shows for a :class:`StabilityChart`: the grid (sizes, ranges of p
-    and q), how many grid points are stable, the largest Re of a rightmost root, the curves."""
+    """The HTML table Jupyter shows for a stability chart (``StabilityChart._repr_html_``).
+
+    Parameters
+    ----------
+    chart : dmi.analysis.StabilityChart
+        The chart.
+
+    Returns
+    -------
+    str
+        A table of the grid (sizes, ranges of p and q), how many grid points are stable, the
+        largest Re of a rightmost root and the curves.
+    """
     re = np.asarray(chart.re, float)
     hopf = sum(c.is_hopf for c in chart.curves)
     return _table("StabilityChart", [

@@ -24,9 +24,22 @@ NO_PROGRESS = 3
 
 
 class ShootingError(RuntimeError):
-    """Newton's iteration for a periodic orbit (or an equilibrium) failed: ``residuals`` is the
-    history of max-norm residuals |F(x) - x| per iteration (state units), ``iterations`` their
-    count."""
+    """Newton's iteration for a periodic orbit (or an equilibrium) failed (a ``RuntimeError``).
+
+    Parameters
+    ----------
+    message : str
+        What failed, and what to try.
+    residuals : list of float, optional
+        The history of max-norm residuals |F(x) - x| per iteration (state units).
+
+    Attributes
+    ----------
+    residuals : list of float
+        As given (empty if None).
+    iterations : int
+        Their count.
+    """
 
     def __init__(self, message: str, residuals: list[float] | None = None):
         super().__init__(message)

@@ -15,14 +15,40 @@ from .stepmap import Model, StepMap
 class Orbit:
     """A periodic orbit of the scheme.
 
-    ``p``: the parameter; ``period`` = ``steps`` h (time units); ``h``: the step; ``t`` (M + 1,)
-    and ``u`` (M + 1, n): one period of U from t = 0; ``state``: the shooting state (L n values,
-    rows oldest first, the last at t = 0); ``multipliers``: the leading Floquet multipliers,
-    largest |mu| first; ``stable``: all |mu| < 1 (an autonomous orbit: all but
-    its phase's multiplier 1); ``stick_fraction`` (n,): the fraction of the M
-    steps where component i is stuck (:func:`stuck_mask`: U_i == 0 exactly after the friction
-    resolvent, for 2 steps or more);
-    ``iterations``: Newton iterations; ``residual``: the final |F(x) - x|_inf (state units)."""
+    Attributes
+    ----------
+    p : float
+        The parameter.
+    period : float
+        ``steps`` h (time units).
+    steps : int
+        M, the steps of one period.
+    h : float
+        The step (time units).
+    t : numpy.ndarray, shape (M + 1,)
+        The times of one period from t = 0 (time units).
+    u : numpy.ndarray
+        Shape (M + 1, n): U over that period (state units).
+    state : numpy.ndarray
+        The shooting state: L n values, rows oldest first, the last at t = 0.
+    multipliers : numpy.ndarray of complex
+        The leading Floquet multipliers, largest |mu| first.
+    stable : bool
+        All |mu| < 1 (an autonomous orbit: all but its phase's multiplier 1).
+    stick_fraction : numpy.ndarray
+        Shape (n,): the fraction of the M steps where component i is stuck (:func:`stuck_mask`: U_i
+        == 0 exactly after the friction resolvent, for 2 steps or more).
+    iterations : int
+        Newton iterations.
+    residual : float
+        The final |F(x) - x|_inf (state units).
+    make : callable
+        The model ``make(p) -> dmi.Solver``.
+    rows : int
+        L, the rows of the shooting state.
+    autonomous : bool
+        True for an orbit of free period (its phase's multiplier is 1).
+    """
     p: float
     period: float
     steps: int

@@ -18,13 +18,28 @@ MARKERS = {"fold": "s", "period-doubling": "D", "torus": "^", "stick-onset": "o"
 
 
 def branch_values(branch: Branch, component: int = 0) -> tuple[np.ndarray, str]:
-    """What :func:`plot_branch` draws against p, (points, k) curves, and its axis label:
+    """What :func:`plot_branch` draws against p, and its axis label:
 
     - a branch of equilibria: u_component of each equilibrium (one curve);
     - a forced branch: u_component at t = 0 of each orbit and at the other Poincare sections
       of a k-periodic orbit (``BranchPoint.section``: t = j period / k), one curve each;
     - an autonomous branch: the half range (max - min) / 2 of u_component over the period
-      (``BranchPoint.amplitude``; u at t = 0 is an arbitrary phase there), one curve."""
+      (``BranchPoint.amplitude``; u at t = 0 is an arbitrary phase there), one curve.
+
+    Parameters
+    ----------
+    branch : Branch
+        The branch.
+    component : int, optional
+        The state component.
+
+    Returns
+    -------
+    values : numpy.ndarray, shape (points, k)
+        The k curves (state units).
+    label : str
+        Their axis label (matplotlib ``$...$`` maths).
+    """
     if branch.kind == "equilibria":
         return (np.array([[q.u[component]] for q in branch.points]),
                 f"equilibrium $u_{{{component}}}$")
@@ -40,13 +55,37 @@ def branch_values(branch: Branch, component: int = 0) -> tuple[np.ndarray, str]:
 def plot_branch(branch: Branch, ax: Any = None, component: int = 0, color: str = "C0",
                 label_events: bool = True, p_label: str = "parameter p",
                 html: str | os.PathLike | None = None) -> None:
-    """Draws ``branch`` (from :func:`continue_orbit` or :func:`continue_equilibrium`) on the
-    matplotlib Axes ``ax``: the values of :func:`branch_values` against p; solid where the orbit
-    or equilibrium is stable, dashed where it is not; each event a black marker
-    (:data:`MARKERS`) on the curve at the event's p, its kind written beside it; the x axis
-    labelled ``p_label``, the y axis with what is drawn.  ``html``: a path, where the interactive
-    figure of :func:`dmi.analysis.interactive.branch_html` is written too (``ax`` may then be
-    None: only the HTML file)."""
+    """Draws a branch: the values of :func:`branch_values` against p; solid where the orbit or
+    equilibrium is stable, dashed where it is not; each event a black marker (:data:`MARKERS`) on
+    the curve at the event's p, its kind written beside it; the x axis labelled ``p_label``, the
+    y axis with what is drawn.
+
+    Parameters
+    ----------
+    branch : Branch
+        From :func:`continue_orbit` or :func:`continue_equilibrium`.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw; may be None only with ``html`` (then only the HTML file is written).
+    component : int, optional
+        The state component drawn.
+    color : str, optional
+        The curves' matplotlib colour.
+    label_events : bool, optional
+        Write each event's kind beside its marker.
+    p_label : str, optional
+        The x axis' label.
+    html : str or os.PathLike, optional
+        A path, where the interactive figure of :func:`dmi.analysis.interactive.branch_html` is
+        written too.
+
+    Raises
+    ------
+    ValueError
+        Neither ``ax`` nor ``html`` given; with ``html``, as
+        :func:`dmi.analysis.interactive.branch_html` (no points, or points without orbits).
+    ImportError
+        ``html`` given and Bokeh not installed.
+    """
     if html is not None:
         from .interactive import branch_html
         branch_html(branch, *branch_values(branch, component), html, component=component,

@@ -36,12 +36,28 @@ from .stepmap import build
 
 @dataclass
 class Refined:
-    """What :func:`refine_orbit` returns: ``period`` (time units), ``amplitude`` (n,) and
-    ``multipliers`` (the leading ones, largest |mu| first), extrapolated to h = 0 where the
-    levels are smooth; ``errors``: their estimated errors, keyed "period", "amplitude",
-    "multipliers" (arrays of the same shapes); ``order``: the order of those answers as the
-    levels show it (2 after Richardson, else the smallest observed order); ``orbits``: the
-    orbits of the levels, coarsest first; ``steps``: their M."""
+    """What :func:`refine_orbit` returns: the answers extrapolated to h = 0 where the levels are
+    smooth.
+
+    Attributes
+    ----------
+    period : float
+        The period (time units).
+    amplitude : numpy.ndarray
+        Shape (n,): (max - min) / 2 per component (state units).
+    multipliers : numpy.ndarray of complex
+        The leading Floquet multipliers, largest |mu| first.
+    errors : dict
+        Their estimated errors, keyed ``"period"``, ``"amplitude"``, ``"multipliers"`` (arrays
+        of the same shapes, same units).
+    order : float
+        The order of those answers as the levels show it (2 after Richardson, else the smallest
+        observed order).
+    orbits : list of Orbit
+        The orbits of the levels, coarsest first.
+    steps : list of int
+        Their M, the steps per period.
+    """
     period: float
     amplitude: np.ndarray
     multipliers: np.ndarray

@@ -189,8 +189,8 @@ def roots(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 10,
         convolution method), configured, not initialised.
     p : float
         The parameter.
-    u_eq : array_like, shape (n,), or callable
-        The equilibrium, or a function ``u_eq(p)``.
+    u_eq : array_like or callable
+        The equilibrium, shape (n,), or a function ``u_eq(p)``.
     count : int
         How many roots.
     tol : float
@@ -226,9 +226,18 @@ def roots(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 10,
 
 @dataclass(frozen=True)
 class HopfPoint:
-    """Where the rightmost root crosses the imaginary axis: the parameter ``p``, the crossing
-    frequency ``omega`` = |Im lambda| (radians / time unit; 0: a real root crosses, a fold, not a
-    Hopf point) and the root ``root`` (Im >= 0) there."""
+    """Where the rightmost root crosses the imaginary axis.
+
+    Attributes
+    ----------
+    p : float
+        The parameter.
+    omega : float
+        The crossing frequency |Im lambda| (radians / time unit); 0: a real root crosses (a fold,
+        not a Hopf point).
+    root : complex
+        The root there, Im >= 0 (1 / time unit).
+    """
     p: float
     omega: float
     root: complex

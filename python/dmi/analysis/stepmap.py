@@ -118,8 +118,8 @@ class StepMap:
 
         Returns
         -------
-        numpy.ndarray, shape (M + 1, n)
-            U^0 .. U^M (U^0 is x's last row).
+        numpy.ndarray
+            Shape (M + 1, n): U^0 .. U^M (U^0 is x's last row).
         """
         return self._start_at(x).run(self.M)[1]
 
@@ -135,8 +135,8 @@ class StepMap:
 
         Returns
         -------
-        numpy.ndarray, shape (steps + 1, n)
-            U^0 .. U^steps.
+        numpy.ndarray
+            Shape (steps + 1, n): U^0 .. U^steps.
         """
         return self._start_at(x).run(int(steps))[1]
 
