@@ -236,3 +236,30 @@ def test_fold_of_equilibria_located_on_the_branch(of):
     assert abs(folds[0].p - p_fold) <= tol * max(1.0, abs(p_fold)), (folds[0].p, p_fold)
     assert folds[0].u[0] == pytest.approx(u_fold, abs=1e-4)
     assert min(q.u[0] for q in br.points) < u_fold - 0.1        # passed to the other side
+
+
+def sticking_block(p: float, friction: str) -> dmi.Solver:
+    # x' = v, v' + x + c v + 2 sigma(v) + p int e^(-s) x(t - s) ds ∋ 0: at x = 0.5 the velocity
+    # sticks (the force on it is below 2), and x is then a neutral direction
+    s = dmi.Solver(2, TAU, 50)
+    s.set_rhs(lambda t, u: np.array([-u[1], u[0] + 0.3 * u[1]]))
+    s.set_kernel_exp([-1.0], [0.0], [[[0.0, 0.0], [p, 0.0]]])
+    if friction == "builtin":
+        s.set_friction([0.0, 2.0])
+    else:
+        def r(lam, x):
+            y = x.copy()
+            y[1] = np.sign(x[1]) * max(abs(x[1]) - lam * 2.0, 0.0)
+            return y
+        s.set_resolvent(r)
+    return s
+
+
+@pytest.mark.parametrize("friction", ["builtin", "callback"])
+def test_a_held_component_is_removed(friction):
+    # the stuck velocity is removed: Delta is 1 x 1 on x, lambda + (f_u)_xx = lambda + 0 = 0
+    # (x' = v = 0 while stuck): the equation's one root is 0, for the built-in friction and for the
+    # same friction as a callback resolvent alike
+    got = da.roots(functools.partial(sticking_block, friction=friction), 0.4, [0.5, 0.0], 1,
+                   of="equation")
+    assert abs(got[0]) <= 1e-12, got

@@ -46,18 +46,20 @@ class Characteristic:
     asked about (sets a callback kernel's panels)."""
 
     def __init__(self, lin: Linearisation, reach: float = 10.0):
-        n, h, D = lin.n, lin.h, lin.D
+        h, D = lin.h, lin.D
+        # the components the resolvent holds: a zero row and column of its derivative
+        held = np.all(np.abs(D) <= 1e-12, axis=0) & np.all(np.abs(D) <= 1e-12, axis=1)
+        free = np.nonzero(~held)[0]
+        Df = D[np.ix_(free, free)]
         if lin.resolvent_kind in ("friction", "box"):
-            free = np.nonzero(np.diag(D) != 0.0)[0]
-            Ap = np.zeros((n, n))
+            Ap = np.zeros_like(Df)                   # A' = 0 away from the thresholds
         else:
-            free = np.arange(n)
-            if abs(np.linalg.det(D)) < 1e-12:
+            if abs(np.linalg.det(Df)) < 1e-12:
                 raise ValueError("dmi.analysis: the resolvent's derivative at the equilibrium is "
-                                 "singular (it holds a direction): no generator A' there")
-            Ap = (np.linalg.inv(D) - np.eye(n)) / h
+                                 "singular on its free components: no generator A' there")
+            Ap = (np.linalg.inv(Df) - np.eye(len(free))) / h
         self.free = free
-        self.B = (lin.J + Ap)[np.ix_(free, free)]
+        self.B = lin.J[np.ix_(free, free)] + Ap
         self.m = len(free)
         self.tau = lin.tau
         self._terms = lin.kernel_terms
