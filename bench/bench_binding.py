@@ -18,18 +18,9 @@ import os
 import subprocess
 import time
 from pathlib import Path
+from benchtools import positive_int
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def positive(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{value} is not >= 1")
-    return value
 
 
 def program(text: str) -> str:
@@ -46,12 +37,12 @@ def parse() -> argparse.Namespace:
                                  "a Python rhs (also compiled with jit=True), beside the C program "
                                  "bench_binding and plain NumPy; prints ns per step and the ratios "
                                  "to C.")
-    ap.add_argument("--N", type=positive, default=10000, help="steps per delay, h = 1/N (default: 10000)")
-    ap.add_argument("--steps", type=positive, default=1000000,
+    ap.add_argument("--N", type=positive_int, default=10000, help="steps per delay, h = 1/N (default: 10000)")
+    ap.add_argument("--steps", type=positive_int, default=1000000,
                     help="steps of the C, numba and jit=True runs (default: 1000000)")
-    ap.add_argument("--python-steps", type=positive, default=30000,
+    ap.add_argument("--python-steps", type=positive_int, default=30000,
                     help="steps of the Python-rhs and NumPy runs (default: 30000)")
-    ap.add_argument("--rounds", type=positive, default=7, help="interleaved rounds (default: 7)")
+    ap.add_argument("--rounds", type=positive_int, default=7, help="interleaved rounds (default: 7)")
     ap.add_argument("--c-program", type=program, default=str(ROOT / "build" / "bench" / "bench_binding"),
                     help="the C program (default: build/bench/bench_binding)")
     return ap.parse_args()

@@ -18,13 +18,13 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
 import math  # noqa: E402
-import time  # noqa: E402
 import warnings  # noqa: E402
 
 import numpy as np  # noqa: E402
 
 import dmi  # noqa: E402
 from dmi import analysis as da  # noqa: E402
+from benchtools import cpu  # noqa: E402
 
 TAU, B, C = 1.0, 1.0, 0.3
 
@@ -44,12 +44,6 @@ def vdp(p: float, h: float | None = None) -> dmi.Solver:
     s.set_rhs(lambda t, u: np.array([-u[1], (u[0] ** 2 - 1) * u[1] + u[0]]))
     s.set_kernel_exp([0.0], [0.0], [[[0.0, 0.0], [0.5, 0.0]]])
     return s
-
-
-def cpu(f) -> float:
-    t = time.process_time()
-    f()
-    return time.process_time() - t
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -15,19 +15,10 @@ import argparse
 import math
 import time
 from pathlib import Path
+from benchtools import positive_int
 
 ROOT = Path(__file__).resolve().parents[1]
 TAU, COMM = 10.0, 0.1
-
-
-def positive(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{value} is not >= 1")
-    return value
 
 
 def fmu_file(text: str) -> str:
@@ -42,13 +33,13 @@ def parse() -> argparse.Namespace:
                                  "oscillator with dry friction, tau = 10) with its fitted s^-1/2 kernel "
                                  "against the same FMU with the exact kernel (DIRECT); prints ns per "
                                  "solver step of each, their ratio and the largest output difference.")
-    ap.add_argument("--N", type=positive, nargs="+", default=[100000],
+    ap.add_argument("--N", type=positive_int, nargs="+", default=[100000],
                     help="steps per tau, h = 10 / N (default: [100000])")
     ap.add_argument("--chunk", type=float, default=1.0,
                     help="time the fitted FMU advances per round, <= 10 / rounds (default: 1.0)")
     ap.add_argument("--exact-chunk", type=float, default=0.2,
                     help="time the exact FMU advances per round (default: 0.2)")
-    ap.add_argument("--rounds", type=positive, default=5, help="interleaved rounds (default: 5)")
+    ap.add_argument("--rounds", type=positive_int, default=5, help="interleaved rounds (default: 5)")
     ap.add_argument("--fmu", type=fmu_file,
                     default=str(ROOT / "build" / "bench" / "FractionalOscillator.fmu"),
                     help="the FMI 2.0 FMU (default: build/bench/FractionalOscillator.fmu)")

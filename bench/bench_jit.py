@@ -22,13 +22,13 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 import argparse  # noqa: E402
 import math  # noqa: E402
 import sys  # noqa: E402
-import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
 import dmi  # noqa: E402
 from dmi.analysis import continue_orbit, periodic_orbit  # noqa: E402
 from dmi.analysis.shooting import state_of  # noqa: E402
+from benchtools import cpu  # noqa: E402
 
 C, V, ALPHA, G, THETA, TAU, W = 0.1, 0.4, 0.3, 0.2, 0.5, 1.0, 1.1
 A = 1.0  # the forcing amplitude p at the start
@@ -47,12 +47,6 @@ def belt(M: int, jit: bool):
         s.set_kernel_exp([-1.0 / THETA], [0.0], [[[0.0, 0.0], [G, 0.0]]])
         return s
     return make
-
-
-def cpu(f) -> float:
-    t = time.process_time()
-    f()
-    return time.process_time() - t
 
 
 def main(argv: list[str] | None = None) -> int:

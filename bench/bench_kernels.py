@@ -14,16 +14,7 @@ from __future__ import annotations
 import argparse
 import math
 import time
-
-
-def positive(text: str) -> int:
-    try:
-        value = int(float(text)) if "e" in text.lower() else int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{value} is not >= 1")
-    return value
+from benchtools import positive_int
 
 
 def tolerance(text: str) -> float:
@@ -41,15 +32,15 @@ def parse() -> argparse.Namespace:
                                  "exact cell weights, h = 1e-3, tau = N h) with the kernel fitted by "
                                  "dmi.kernels.fit through the recursion, against the exact kernel by the "
                                  "FFT and by DIRECT; prints the fit, ns per step of each and the ratios.")
-    ap.add_argument("--N", type=positive, nargs="+", default=[100000, 1000000],
+    ap.add_argument("--N", type=positive_int, nargs="+", default=[100000, 1000000],
                     help="cells per delay (default: [100000, 1000000])")
     ap.add_argument("--tol", type=tolerance, default=1e-8,
                     help="the fit's relative tolerance on [h, tau] (default: 1e-08)")
-    ap.add_argument("--steps", type=positive, default=20000,
+    ap.add_argument("--steps", type=positive_int, default=20000,
                     help="steps of the recursion and the FFT per round (default: 20000)")
-    ap.add_argument("--direct-work", type=positive, default=200000000,
+    ap.add_argument("--direct-work", type=positive_int, default=200000000,
                     help="DIRECT's steps per round are this / N (default: 200000000)")
-    ap.add_argument("--rounds", type=positive, default=5, help="interleaved rounds (default: 5)")
+    ap.add_argument("--rounds", type=positive_int, default=5, help="interleaved rounds (default: 5)")
     return ap.parse_args()
 
 

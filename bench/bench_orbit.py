@@ -25,7 +25,6 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 import argparse  # noqa: E402
 import math  # noqa: E402
 import sys  # noqa: E402
-import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -36,14 +35,9 @@ import orbit_tau  # noqa: E402
 from dmi.analysis import continue_orbit, periodic_orbit  # noqa: E402
 from dmi.analysis.floquet import floquet_multipliers  # noqa: E402
 from dmi.analysis.shooting import StepMap, state_of  # noqa: E402
+from benchtools import cpu  # noqa: E402
 
 TAU = 2.2
-
-
-def cpu(f) -> float:
-    t = time.process_time()
-    f()
-    return time.process_time() - t
 
 
 def setup(N: int):

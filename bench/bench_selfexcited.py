@@ -26,7 +26,6 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
 import math  # noqa: E402
-import time  # noqa: E402
 
 import numba  # noqa: E402
 import numpy as np  # noqa: E402
@@ -34,6 +33,7 @@ import numpy as np  # noqa: E402
 import dmi  # noqa: E402
 from dmi import analysis as da  # noqa: E402
 from dmi.analysis.newton import ShootingError  # noqa: E402
+from benchtools import cpu  # noqa: E402
 
 K, G, ALPHA, VB, TAU = 1.0, 0.8, 0.5, 0.3, 1.0
 C_ORBIT = 0.2   # the damping of the stick-slip orbits (the sliding equilibrium is unstable)
@@ -62,12 +62,6 @@ def model(N: int):
         s.set_friction([0.0, ALPHA])
         return s
     return make
-
-
-def cpu(f) -> float:
-    t = time.process_time()
-    f()
-    return time.process_time() - t
 
 
 def orbit_at(make, N: int) -> da.Orbit:
