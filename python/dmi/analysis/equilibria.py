@@ -30,7 +30,7 @@ import scipy.optimize
 
 from ._model import KinkError, equation_step
 from .branch import Branch, Event
-from .newton import NO_PROGRESS, ShootingError, fmt_residuals, stalled
+from .newton import ShootingError, fmt_residuals, judge
 from .stability import HopfPoint, check_of, roots
 from .stepmap import Model, build
 
@@ -174,15 +174,12 @@ def _newton(steps: _Steps, y0: np.ndarray, tol: float, max_iter: int, what: str,
         Gy = steps.G(y)
         g = 0.0 if row is None else float(row @ y - target)
         rn = max(float(np.max(np.abs(Gy))), abs(g))
-        res.append(rn)
-        if not math.isfinite(rn):
-            raise ShootingError(f"{what}: non-finite residual (residuals {fmt_residuals(res)})",
-                                res)
-        # G is one step's movement, O(h) times the error: the correction must be small too
         scale = tol * max(1.0, float(np.max(np.abs(y[:-1]))))
-        if rn <= scale and moved <= scale:
+        verdict = judge(res, rn, scale, max_iter, what)
+        # G is one step's movement, O(h) times the error: the correction must be small too
+        if verdict == "converged" and moved <= scale:
             return y, res
-        if len(res) > max_iter or stalled(res):
+        if verdict == "exhausted":
             break
         J = steps.jacobian(y, Gy)
         if row is None:
@@ -200,9 +197,8 @@ def _newton(steps: _Steps, y0: np.ndarray, tol: float, max_iter: int, what: str,
             y[:-1] += d
         else:
             y += d
-    why = (f"no new least residual in {NO_PROGRESS} iterations" if stalled(res)
-           else f"no convergence in {max_iter} iterations")
-    raise ShootingError(f"{what}: {why} (residuals {fmt_residuals(res)})", res)
+    raise ShootingError(f"{what}: no convergence in {max_iter} iterations (residuals "
+                        f"{fmt_residuals(res)})", res)
 
 
 def _roots(make: Model, p: float, u: np.ndarray, count: int, tol: float, of: str
