@@ -10,7 +10,6 @@ import math
 
 import mpmath as mp
 import numpy as np
-import pytest
 import scipy.integrate as si
 import scipy.optimize as so
 
@@ -139,6 +138,18 @@ def test_stick_slip_orbit_does_not_claim_order_two():
     assert r.order < 1.5, r.order
     P = [q.period for q in r.orbits]
     assert r.period == P[-1] and r.errors["period"] >= max(abs(x - P[-1]) for x in P[:-1])
+    # the estimate covers a plain run at twice the finest level's steps (the period from the
+    # upward crossings of x's mean over its last periods, interpolated)
+    h = r.period / (8 * M)
+    s = belt(0.2, h=h)
+    s.set_history(lambda t: np.array([0.5 / 1.8 + 0.05, -0.3]))
+    s.init()
+    _, U = s.run(round(120 / h))
+    x = U[-round(40 / h):, 0]
+    y = x - 0.5 * (x.max() + x.min())
+    k = np.nonzero((y[:-1] < 0) & (y[1:] >= 0))[0]
+    P_fine = float(np.mean(np.diff((k + y[k] / (y[k] - y[k + 1])) * h)))
+    assert abs(r.period - P_fine) <= r.errors["period"], (r.period, P_fine, r.errors)
 
 
 # ---- events placed from refined multipliers: the damped Mathieu equation's period doubling -----
@@ -174,3 +185,7 @@ def test_period_doubling_placed_from_refined_multipliers():
     (e1,) = [e for e in refined.events if e.kind == "period-doubling"]
     assert "refined" in e1.detail
     assert abs(e1.p - d_true) < abs(e0.p - d_true) / 5, (e0.p, e1.p, d_true)
+    # the same with the period given as a function of p (the branch's maps build make(p, h=...))
+    timed = da.continue_orbit(o, 0.35, refine=True, period=lambda p: 2 * math.pi, **kw)
+    (e2,) = [e for e in timed.events if e.kind == "period-doubling"]
+    assert "refined" in e2.detail and abs(e2.p - d_true) < abs(e0.p - d_true) / 5, e2

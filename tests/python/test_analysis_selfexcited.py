@@ -229,7 +229,7 @@ def test_make_failing_is_the_models_exception_with_a_note():
     assert br.p[-1] <= 1.0 and "failed" in br.status
 
 
-def test_equilibrium_of_the_equation_is_corrected():
+def test_an_equilibrium_guess_off_by_7e_9_is_corrected():
     # the continuous equation's equilibrium of the belt is the scheme's too (the kernel's
     # integral: tau g / tau); one moved by 7e-9 is corrected, and a rough guess converges
     eq = da.equilibrium(belt, 0.5, [0.28 + 7e-9, -0.3])
@@ -277,8 +277,7 @@ def test_pure_slip_multipliers_near_stick_onset_are_exp_lambda_P(onset):
     F_on, mu = onset
     o = da.periodic_orbit(forced_belt, 0.995 * F_on, PF, U_EQ, multipliers=6)
     assert np.max(o.stick_fraction) == 0 and -0.01 * VB < o.u[:, 1].max() < 0   # just below
-    assert _close(o.multipliers, mu, 5e-3), (o.multipliers, mu[:2])
-    assert _close(o.multipliers, mu, 1e-6), (o.multipliers, mu[:2])
+    assert _close(o.multipliers, mu, 1e-6), (o.multipliers, mu[:2])   # (the issue asks 0.5 %)
 
 
 def test_forced_branch_passes_stick_onset_both_ways(onset):

@@ -233,11 +233,22 @@ def kernel_integral(s: Solver) -> np.ndarray:
     return np.zeros((s.n, s.n))
 
 
-def equation_step(s: Solver) -> Callable[[np.ndarray], np.ndarray]:
-    """G(u) = R(u - h f(0, u) - h K u) - u with the continuous integral K = int_0^tau H: zero at
-    the equation's equilibria (the scheme's has h sum_l H(l h) for K)."""
+def equation_terms(s: Solver) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
+    """u -> (X, G): the resolvent's argument X = u - h f(0, u) - h K u with the continuous
+    integral K = int_0^tau H (the scheme's has h sum_l H(l h) for K), and G(u) = R(X) - u, zero at
+    the equation's equilibria."""
     h, f, R, K = s.h, rhs_of(s), resolvent_of(s), kernel_integral(s)
-    return lambda u: R(u - h * f(u) - h * (K @ u)) - u
+
+    def terms(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        X = u - h * f(u) - h * (K @ u)
+        return X, R(X) - u
+    return terms
+
+
+def equation_step(s: Solver) -> Callable[[np.ndarray], np.ndarray]:
+    """G(u) of :func:`equation_terms`."""
+    terms = equation_terms(s)
+    return lambda u: terms(u)[1]
 
 
 class Linearisation:
@@ -274,8 +285,7 @@ class Linearisation:
         h = s.h
         t0 = 0.0
         if of == "equation":
-            X = u - h * rhs_of(s)(u) - h * (kernel_integral(s) @ u)
-            moved = resolvent_of(s)(X) - u
+            X, moved = equation_terms(s)(u)
         else:
             s.init()
             s.set_window(np.tile(u, (N + 1, 1)))

@@ -28,22 +28,10 @@ import numpy as np
 from .._solver import Solver
 from ._model import Linearisation
 from .equilibria import equilibrium
-from .newton import ShootingError, bordered_newton, fmt_residuals
+from .newton import ShootingError, bordered_newton
 from .orbit import Orbit, loops, make_orbit
-from .stability import HopfPoint, roots
-from .stepmap import Model, StepMap, build, positive_time
-
-
-def fixed_step(make: Model, h: float) -> Model:
-    """make at the step h: ``made(p)`` is ``make(p, h=h)``, and ``made(p, h=other)`` another
-    step (an autonomous Orbit's ``make``: StepMap(orbit.make, ...) runs at the orbit's step and
-    continuation changes it)."""
-    base = getattr(make, "base", make)     # the user's model, not a made of a made
-
-    def made(p: float, h: float = h) -> Solver:
-        return base(p, h=h)  # type: ignore[call-arg]
-    made.base = base  # type: ignore[attr-defined]
-    return made
+from .stability import HopfPoint
+from .stepmap import Model, StepMap, build, fixed_step, positive_time
 
 
 def step_model(make: Model, p: float, h: float) -> Solver:

@@ -54,7 +54,6 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .._errors import Error
 from .._solver import Solver
 from .branch import Branch, BranchPoint, Event, thinned
 from .floquet import fd_step, phase_free, ritz
@@ -63,7 +62,8 @@ from .newton import ShootingError, bordered_newton, bordered_step, fd_eps
 from .orbit import Orbit, make_orbit, stuck_mask
 from .refine import refine_orbit
 from .shooting import periodic_orbit
-from .stepmap import Model, StepMap, build, positive_time
+from .stability import non_real
+from .stepmap import Model, StepMap, build, fixed_step, positive_time
 
 
 def _stick_profile(F: StepMap, U: np.ndarray, X: np.ndarray | None
@@ -132,11 +132,6 @@ def _point(F: StepMap, x: np.ndarray, multipliers: int, sections: int, dpds: flo
 VERTICAL = 1e-6
 
 
-def _complex(m: np.ndarray) -> np.ndarray:
-    """The non-real multipliers."""
-    return m[np.abs(m.imag) > 1e-8 * np.maximum(np.abs(m), 1)]
-
-
 def _test_function(kind: str, mu: np.ndarray) -> float:
     """The test function of a multiplier event, zero at it: 1 + min Re mu for a period doubling
     (the multiplier that crosses -1 may have been half of a complex pair at the previous point,
@@ -144,7 +139,7 @@ def _test_function(kind: str, mu: np.ndarray) -> float:
     torus (-1 if there is none)."""
     if kind == "period-doubling":
         return 1 + float(np.min(mu.real))
-    c = np.abs(_complex(mu))
+    c = np.abs(non_real(mu))
     return float(np.max(c)) - 1 if c.size else -1.0
 
 
@@ -171,7 +166,7 @@ def _events(a: BranchPoint, b: BranchPoint, index: int, autonomous: bool = False
         fa, fb = (_test_function("period-doubling", m) for m in (mua, mub))
         ev.append(Event("period-doubling", at(fa, fb), index, None,
                         f"real multipliers < -1: {na} -> {nb}"))
-    ca, cb = np.sum(np.abs(_complex(mua)) > 1), np.sum(np.abs(_complex(mub)) > 1)
+    ca, cb = np.sum(np.abs(non_real(mua)) > 1), np.sum(np.abs(non_real(mub)) > 1)
     if ca != cb:
         fa, fb = (_test_function("torus", m) for m in (mua, mub))
         ev.append(Event("torus", at(fa, fb), index, None,
@@ -279,8 +274,7 @@ class _Maps:
         """make as a function of p alone at p's step (the StepMap's and an Orbit's ``make``)."""
         if self.period is None:
             return self.make
-        h = self.step(p)
-        return lambda q: self.make(q, h=h)  # type: ignore[call-arg]
+        return fixed_step(self.make, self.step(p))
 
     def build(self, p: float) -> Solver:
         if self.period is None:

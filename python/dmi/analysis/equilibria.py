@@ -31,7 +31,7 @@ import scipy.optimize
 from ._model import KinkError, equation_step
 from .branch import Branch, Event
 from .newton import ShootingError, fmt_residuals, judge
-from .stability import HopfPoint, check_of, roots
+from .stability import HopfPoint, check_of, non_real, roots
 from .stepmap import Model, build
 
 #: Roots computed at each point of a branch (the Hopf test function reads them).
@@ -273,7 +273,7 @@ def _tangent(J: np.ndarray, prev: np.ndarray) -> np.ndarray:
 
 def _complex_re(lam: np.ndarray) -> float:
     """Re of the rightmost non-real root (-inf if none)."""
-    c = lam[np.abs(lam.imag) > 1e-8 * np.maximum(1.0, np.abs(lam))]
+    c = non_real(lam)
     c = c[np.isfinite(c.real)]
     return float(np.max(c.real)) if c.size else -math.inf
 
@@ -425,14 +425,18 @@ def _events(steps: _Steps, make: Model, ya: np.ndarray, ta: np.ndarray, a: Equil
                              "dp/ds changes sign (located on the branch)", u=y[:-1].copy()))
     fa, fb = _complex_re(a.roots), _complex_re(b.roots)
     if math.isfinite(fa) and math.isfinite(fb) and fa * fb < 0:
+        roots_at: dict[float, np.ndarray] = {}
+
         def re(s: float) -> float:
             y = at(s)
-            return _complex_re(_roots(make, float(y[-1]), y[:-1], count, tol, of))
+            roots_at[s] = _roots(make, float(y[-1]), y[:-1], count, tol, of)
+            return _complex_re(roots_at[s])
         s = locate(re, fa, fb)
         if s is not None:
             y = at(s)
-            lam = _roots(make, float(y[-1]), y[:-1], count, tol, of)
-            c = lam[np.abs(lam.imag) > 1e-8 * np.maximum(1.0, np.abs(lam))]
+            lam = roots_at[s] if s in roots_at else _roots(make, float(y[-1]), y[:-1], count,
+                                                           tol, of)
+            c = non_real(lam)
             root = c[np.argmax(c.real)]
             root = complex(root.real, abs(root.imag))
             hp = HopfPoint(p=float(y[-1]), omega=root.imag, root=root)

@@ -31,7 +31,7 @@ import numpy as np
 from .newton import ShootingError
 from .orbit import Orbit
 from .shooting import periodic_orbit
-from .stepmap import build
+from .stepmap import build, fixed_step
 
 
 @dataclass
@@ -89,10 +89,8 @@ def _level(o: Orbit, M: int, count: int, tol: float) -> Orbit:
     if o.autonomous:
         return periodic_orbit(o.make, o.p, guess=guess, guess_period=o.period, steps=M, tol=tol,
                               multipliers=count)
-
-    def made(p: float, h: float = h) -> Any:
-        return o.make(p, h=h)
-    return periodic_orbit(made, o.p, o.period, guess, tol=tol, multipliers=count)
+    return periodic_orbit(fixed_step(o.make, h), o.p, o.period, guess, tol=tol,
+                          multipliers=count)
 
 
 def _matched(levels: list[np.ndarray]) -> np.ndarray:

@@ -159,6 +159,12 @@ def rightmost(lin: Linearisation, count: int) -> np.ndarray:
     return lam[:count]
 
 
+def non_real(values: np.ndarray) -> np.ndarray:
+    """The values (roots, multipliers) that are not real: |Im| > 1e-8 max(1, |value|)."""
+    values = np.asarray(values)
+    return values[np.abs(values.imag) > 1e-8 * np.maximum(1.0, np.abs(values))]
+
+
 def check_of(of: str) -> str:
     """``of`` checked: ``"scheme"`` or ``"equation"``."""
     if of not in ("scheme", "equation"):

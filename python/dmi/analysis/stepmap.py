@@ -27,6 +27,18 @@ from ._model import call_make
 Model = Callable[..., Solver]
 
 
+def fixed_step(make: Model, h: float) -> Model:
+    """make at the step h: ``made(p)`` is ``make(p, h=h)``, and ``made(p, h=other)`` another
+    step (an autonomous Orbit's ``make``: StepMap(orbit.make, ...) runs at the orbit's step and
+    continuation changes it)."""
+    base = getattr(make, "base", make)     # the user's model, not a made of a made
+
+    def made(p: float, h: float = h) -> Solver:
+        return base(p, h=h)  # type: ignore[call-arg]
+    made.base = base  # type: ignore[attr-defined]
+    return made
+
+
 def build(make: Model, p: float, **kw: Any) -> Solver:
     """``make(p, **kw)``: the model's own exception, with a note naming the call, when it
     fails (:func:`dmi.analysis._model.call_make`); TypeError when it returns no dmi.Solver."""
