@@ -140,6 +140,7 @@ class Solver:
         self._n, self._tau, self._N = n, tau, int(_L.dmi_get_N(handle))
         self._h_given = h  # (for repr)
         self._keep: dict[str, cb.Bound] = {}   # callbacks and data libdmi points to
+        self._jit_slots: set[str] = set()
         self._resolvent: tuple = ()             # the built-in resolvent and its data (dmi.analysis)
         self._failure: list = [None]           # an exception raised in a Python callback
         self._busy = threading.Lock()
@@ -168,7 +169,8 @@ class Solver:
         if failure is not None:
             raise failure
         message = _L.dmi_last_error(self._handle).decode()
-        if rc == _lib.ECALLBACK and "callback returned 2 " in message:
+        if rc == _lib.ECALLBACK and "callback returned 2 " in message and \
+                self._jit_slots:
             message += (" (a jit=True callback returns 2 when its result does not have libdmi's "
                         "shape: (n,), or (n, n) for the kernel)")
         raise from_code(rc, message)
@@ -183,6 +185,10 @@ class Solver:
         with self._using() as s:
             self._check(setter(s, bound.address, bound.user))
         self._keep[slot] = bound  # only now: a refused call keeps the former callback alive
+        if jit and f is not None:   # (the slots a jit=True callback fills: their error hint)
+            self._jit_slots.add(slot)
+        else:
+            self._jit_slots.discard(slot)
 
     # ---- sizes ---------------------------------------------------------------------------------
 
@@ -821,11 +827,15 @@ class Solver:
         if fit.delta > 0 and exact is None:
             raise InvalidArgument(_lib.EINVAL, "set_kernel_fit: the fit starts at delta = "
                                   f"{fit.delta!r}: give the exact kernel of the near cells (near=...)")
-        self.set_kernel_exp(fit.a, fit.b, C, D)
+        # the near cells first: a kernel they refuse leaves the solver's kernel as it was
         if fit.delta > 0:
-            if i is not None and callable(exact) and not isinstance(exact, ctypes._CFuncPtr) \
-                    and not hasattr(exact, "address"):  # a Python scalar kernel: as an n x n one
-                scalar = exact
+            c_kernel = isinstance(exact, ctypes._CFuncPtr) or hasattr(exact, "address")
+            if i is not None and c_kernel and n > 1:
+                raise InvalidArgument(_lib.EINVAL, "set_kernel_fit: a scalar fit's near kernel "
+                                      "for entry (i, j) of an n > 1 solver must be a Python "
+                                      "function (a C kernel writes all n x n values)")
+            if i is not None and callable(exact) and not c_kernel:
+                scalar = exact   # a Python scalar kernel: as an n x n one
 
                 def exact(s: float, _i: int = i, _j: int = j) -> np.ndarray:
                     out = np.zeros((n, n))
@@ -834,6 +844,7 @@ class Solver:
             self.set_kernel_near(exact, fit.delta)
         else:
             self.set_kernel_near(None, 0.0)
+        self.set_kernel_exp(fit.a, fit.b, C, D)
 
     def __repr__(self) -> str:
         if self._h_given is not None:

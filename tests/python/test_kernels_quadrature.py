@@ -3,6 +3,7 @@
 # u' + int_0^t s^-1/2 / Gamma(1/2) u(t - s) ds = 0, u(0) = 1, against u = E_{3/2}(-t^{3/2}) (mpmath series).
 # Solver.set_kernel_fit: the fitted singular kernel (O(1), exact near cells) within the fit's solution bound.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+import ctypes
 import math
 
 import mpmath as mp
@@ -147,3 +148,25 @@ def test_set_kernel_fit_entries():
     singular = kernels.fit(lambda x: x ** -0.5, 1.0, tol=1e-6, relative=True, delta=0.1)
     with pytest.raises(dmi.InvalidArgument, match="near"):
         dmi.Solver(1, 1.0, 20).set_kernel_fit(singular)  # no exact kernel for the near cells
+
+
+def test_set_kernel_fit_refused_near_kernel_leaves_the_kernel():
+    # the near cells are set first: a near kernel refused (a C kernel for one entry of an n = 2
+    # solver) leaves the solver's former kernel, whose run is then bitwise a fresh solver's
+    singular = kernels.fit(lambda x: x ** -0.5, 1.0, tol=1e-6, relative=True, delta=0.1)
+    C_kernel = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, ctypes.c_void_p,
+                                ctypes.c_void_p)(lambda s, out, user: 0)
+
+    def fresh() -> dmi.Solver:
+        s = dmi.Solver(2, 1.0, 20)
+        s.set_kernel_exp([-1.0], [0.0], [[[0.0, 0.0], [0.5, 0.0]]])
+        s.set_history(lambda t: np.array([1.0, 0.5]))
+        return s
+    s = fresh()
+    with pytest.raises(dmi.InvalidArgument, match="Python function"):
+        s.set_kernel_fit(singular, entry=(1, 0), near=C_kernel)
+    ref = fresh()
+    for x in (s, ref):
+        x.init()
+        x.advance(30)
+    assert np.array_equal(s.get_window(), ref.get_window())
