@@ -501,6 +501,13 @@ int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user)
 
 static int sample_kernel(dmi_solver *s, dmi_kernel *k, const char *fn);
 
+/* Whether method's engine needs the kernel's weights per cell: all but the recursion with full
+ * cells, the paper's rule and no near cells (which runs on the exponential terms alone). */
+static int needs_samples(const dmi_solver *s, int method)
+{
+    return s->theta != 1 || !is_recursion(s, method) || s->quad == DMI_QUAD_CELL || s->near_H;
+}
+
 int dmi_set_convolution(dmi_solver *s, int method)
 {
     if (!s)
@@ -512,7 +519,9 @@ int dmi_set_convolution(dmi_solver *s, int method)
         dmi_conv *c = NULL;
         dmi_exp *e = NULL;
         dmi_kernel k = {0};
-        const int sample = !s->kernel_sampled && !is_recursion(s, method);
+        /* dmi_init went without samples only under the paper's rule with full cells and no
+         * near cells (needs_samples): the plain samples are then the weights */
+        const int sample = !s->kernel_sampled && needs_samples(s, method);
         if (sample && (rc = sample_kernel(s, &k, "dmi_set_convolution")) != DMI_OK)
             return rc;
         rc = engine_make(s, sample ? &k : &s->kernel, method, &c, &e, "dmi_set_convolution");
@@ -612,8 +621,9 @@ static int sample_history(dmi_solver *s, dmi_history *ring)
 }
 
 /* The cell rule's samples into k and its last-cell change into *last
- * (quad.c), and s->cell_expk, the kernel the recursion runs (rebuilt: the
- * kernel or h may differ from the last init's; a function of them alone). */
+ * (quad.c), and s->cell_expk, the kernel the recursion runs: a function of
+ * the exponential terms and h alone, so that setting it before dmi_init can
+ * still fail changes no result. */
 static int quad_prepare(dmi_solver *s, dmi_kernel *k, double **last)
 {
     if (dmi_has_expk(s)) { /* (an initialised solver gets the same values again) */
@@ -644,10 +654,9 @@ int dmi_init(dmi_solver *s)
     if (s->near_H && !dmi_has_expk(s))
         rc = dmi_fail(s, DMI_EINVAL, "dmi_init: the near cells of dmi_set_kernel_near need a kernel "
                                      "given by dmi_set_kernel_exp");
-    /* the recursion with full cells, the paper's rule and no near cells needs no samples: taken
-     * if another method is chosen later (dmi_set_convolution) */
-    const int sample = s->theta != 1 || !is_recursion(s, s->conv_method) ||
-                       s->quad == DMI_QUAD_CELL || s->near_H;
+    /* without samples where the method needs none: taken if another method is chosen later
+     * (dmi_set_convolution) */
+    const int sample = needs_samples(s, s->conv_method);
     if (rc == DMI_OK && !sample)
         dmi_kernel_alloc(&k, s->n, s->N, NULL); /* none (allocates nothing) */
     else if (rc == DMI_OK)
