@@ -141,7 +141,10 @@ class Solver:
         self._h_given = h  # (for repr)
         self._keep: dict[str, cb.Bound] = {}   # callbacks and data libdmi points to
         self._jit_slots: set[str] = set()
-        self._resolvent: tuple = ()             # the built-in resolvent and its data (dmi.analysis)
+        self._resolvent: tuple = ()             # the built-in resolvent and its data
+        self._choices = {"convolution": "auto", "quadrature": "left"}
+        self._near_delta = 0.0                  # delta of set_kernel_near (0: no near cells)
+        self._fit: tuple | None = None          # (fit, entry) of set_kernel_fit
         self._failure: list = [None]           # an exception raised in a Python callback
         self._busy = threading.Lock()
 
@@ -267,7 +270,7 @@ class Solver:
             Code ``dmi.EINVAL``: r, ``user`` or ``jit`` refused as in :meth:`set_rhs`.
         """
         self._set_callback("resolvent", cb.RESOLVENT, _L.dmi_set_resolvent, r, user, jit)
-        self._resolvent = ()
+        self._resolvent = ("callback",) if r is not None else ()
 
     def set_friction(self, alpha: Any) -> None:
         """Sets the built-in dry friction A(u)_i = alpha_i sigma(u_i), sigma the sign graph
@@ -331,6 +334,7 @@ class Solver:
             ``dmi.ESTATE``: after :meth:`init`.
         """
         self._set_callback("kernel", cb.KERNEL, _L.dmi_set_kernel, H, user, jit)
+        self._fit = None
 
     def set_kernel_exp(self, a: Any, b: Any, C: Any, D: Any = None) -> None:
         """Sets the kernel as K exponential terms
@@ -365,6 +369,7 @@ class Solver:
             self._check(_L.dmi_set_kernel_exp(s, K, _ptr(a_a), _ptr(b_a), _ptr(C_a), _ptr(D_a)))
         # no callback; the terms kept for dmi.analysis (the equation's characteristic matrix)
         self._keep["kernel"] = cb.Bound(None, None, (a_a, b_a, C_a, D_a))
+        self._fit = None
 
     def set_history(self, z: Callback | None, user: Any = None, *, jit: bool = False) -> None:
         """Sets the history z, u = z on [-tau, 0] (``dmi_set_history``).  Sampled by :meth:`init`,
@@ -410,6 +415,7 @@ class Solver:
         code = _choice(_lib.CONV, method, "set_convolution: method")
         with self._using() as s:
             self._check(_L.dmi_set_convolution(s, code))
+        self._choices["convolution"] = method
 
     # ---- time stepping -------------------------------------------------------------------------
 
@@ -750,6 +756,7 @@ class Solver:
         code = _choice(_lib.QUAD, rule, "set_quadrature: rule")
         with self._using() as s:
             self._check(_L.dmi_set_quadrature(s, code))
+        self._choices["quadrature"] = rule
 
     def set_kernel_near(self, H: Callback | None, delta: float, user: Any = None) -> None:
         """Sets the exact kernel of the cells below ``delta``, whose weights become H's exact cell
@@ -778,6 +785,7 @@ class Solver:
         def setter(s: Any, address: Any, u: Any) -> int:
             return _L.dmi_set_kernel_near(s, address, u, float(delta))
         self._set_callback("kernel_near", cb.KERNEL, setter, H, user, False)
+        self._near_delta = float(delta) if H is not None else 0.0
 
     def set_kernel_fit(self, fit: Any, entry: tuple[int, int] | None = None, near: Callback | None = None,
                        ) -> None:
@@ -845,6 +853,248 @@ class Solver:
         else:
             self.set_kernel_near(None, 0.0)
         self.set_kernel_exp(fit.a, fit.b, C, D)
+        self._fit = (fit, None if i is None else (i, j))
+
+    # ---- the model as set (what dmi.analysis and dmi.identify read) -------------------------------
+
+    @property
+    def resolvent_kind(self) -> str:
+        """What A is: ``""`` (A = 0), ``"friction"`` (:meth:`set_friction`), ``"box"``
+        (:meth:`set_box`) or ``"callback"`` (:meth:`set_resolvent`)."""
+        return self._resolvent[0] if self._resolvent else ""
+
+    @property
+    def friction(self) -> np.ndarray | None:
+        """The coefficients alpha (n,) of :meth:`set_friction` (a copy), None for another A."""
+        return self._resolvent[1].copy() if self.resolvent_kind == "friction" else None
+
+    @property
+    def box(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The bounds (lo, hi), each (n,), of :meth:`set_box` (copies), None for another A."""
+        if self.resolvent_kind != "box":
+            return None
+        return self._resolvent[1].copy(), self._resolvent[2].copy()
+
+    @property
+    def kernel_kind(self) -> str:
+        """What H is: ``""`` (H = 0), ``"exp"`` (:meth:`set_kernel_exp`, :meth:`set_kernel_fit`)
+        or ``"callback"`` (:meth:`set_kernel`)."""
+        bound = self._keep.get("kernel")
+        if bound is None or (bound.address is None and not bound.keep):
+            return ""
+        return "exp" if bound.address is None else "callback"
+
+    @property
+    def kernel_terms(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+        """The terms (a (K,), b (K,), C (K, n, n), D (K, n, n)) of an exponential kernel (copies;
+        D zero when not given), None for another kernel."""
+        if self.kernel_kind != "exp":
+            return None
+        a, b, C, D = self._keep["kernel"].keep
+        return a.copy(), b.copy(), C.copy(), (np.zeros_like(C) if D is None else D.copy())
+
+    @property
+    def kernel_near_delta(self) -> float:
+        """delta of :meth:`set_kernel_near` (time units); 0.0 without near cells."""
+        return self._near_delta
+
+    @property
+    def kernel_fit(self) -> tuple[Any, tuple[int, int] | None] | None:
+        """(fit, entry) of :meth:`set_kernel_fit` (the :class:`dmi.kernels.KernelFit` as given,
+        entry (i, j) of a scalar fit, None for an n x n fit), None when the kernel was set otherwise."""
+        return self._fit
+
+    @property
+    def convolution(self) -> str:
+        """The method asked of :meth:`set_convolution` (``"auto"`` unless set)."""
+        return self._choices["convolution"]
+
+    @property
+    def quadrature(self) -> str:
+        """The rule of :meth:`set_quadrature` (``"left"`` unless set)."""
+        return self._choices["quadrature"]
+
+    def has(self, part: str) -> bool:
+        """Whether the model has a part other than its default (zero).
+
+        Parameters
+        ----------
+        part : str
+            ``"rhs"``, ``"resolvent"`` (any A), ``"kernel"``, ``"kernel_near"`` or ``"history"``.
+
+        Returns
+        -------
+        bool
+            False where that part is the default, zero.
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: another part.
+        """
+        if part == "resolvent":
+            return self.resolvent_kind != ""
+        if part == "kernel":
+            return self.kernel_kind != ""
+        if part not in ("rhs", "kernel_near", "history"):
+            raise InvalidArgument(_lib.EINVAL, f"has: part {part!r} is not one of 'rhs', "
+                                  "'resolvent', 'kernel', 'kernel_near', 'history'")
+        bound = self._keep.get(part)
+        return bound is not None and bound.address is not None
+
+    def _call_slot(self, slot: str, fn_type: Any, args: tuple, size: int, what: str) -> np.ndarray:
+        """Calls the C-level function of ``slot`` (libdmi's signature) with args and an output of
+        ``size`` doubles: a Python callback's exception is raised as it is, with a note."""
+        out = np.zeros(size)
+        bound = self._keep[slot]
+        rc = fn_type(bound.address)(*args, out.ctypes.data, bound.user)
+        failure, self._failure[0] = self._failure[0], None
+        if failure is not None:
+            failure.add_note(f"raised by the model's {what}")
+            raise failure
+        if rc != 0:
+            raise Error(_lib.ECALLBACK, f"the model's {what} returned {rc}")
+        return out
+
+    def eval_rhs(self, t: float, u: Any) -> np.ndarray:
+        """f(t, u) of :meth:`set_rhs` (zero without one), through the same function the
+        scheme calls (Python, ``jit=True`` or C).
+
+        Parameters
+        ----------
+        t : float
+            Time (time units).
+        u : array_like, shape (n,)
+            State (state units).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n,)
+            f(t, u).
+
+        Raises
+        ------
+        Exception
+            A Python callback's own exception; :class:`dmi.Error` (code ``dmi.ECALLBACK``) for a
+            nonzero return.  Non-finite values are returned as they are.
+        """
+        x = np.ascontiguousarray(np.asarray(u, dtype=float).reshape(self._n))
+        if not self.has("rhs"):
+            return np.zeros(self._n)
+        return self._call_slot("rhs", _lib.RhsFn, (float(t), x.ctypes.data), self._n,
+                               f"rhs at t = {float(t)!r}, u = {x!r}")
+
+    def eval_resolvent(self, lam: float, x: Any) -> np.ndarray:
+        """(I + lam A)^-1 x (n,): the built-in friction (soft threshold by lam alpha), box (a
+        clip), a callback of :meth:`set_resolvent`, or x itself for A = 0.
+
+        Parameters
+        ----------
+        lam : float
+            lam = h in the scheme (time units).
+        x : array_like, shape (n,)
+            The resolvent's argument (state units).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n,)
+            (I + lam A)^-1 x.
+
+        Raises
+        ------
+        Exception
+            As :meth:`eval_rhs`.
+        """
+        x = np.ascontiguousarray(np.asarray(x, dtype=float).reshape(self._n))
+        kind = self.resolvent_kind
+        if kind == "friction":
+            lam_a = float(lam) * self._resolvent[1]
+            return np.sign(x) * np.maximum(np.abs(x) - lam_a, 0.0)
+        if kind == "box":
+            return np.clip(x, self._resolvent[1], self._resolvent[2])
+        if kind == "callback":
+            return self._call_slot("resolvent", _lib.ResolventFn, (float(lam), x.ctypes.data),
+                                   self._n, f"resolvent at lam = {float(lam)!r}, x = {x!r}")
+        return x.copy()
+
+    def eval_kernel(self, s: float) -> np.ndarray:
+        """H(s) (n, n): the exponential sum or the callback of the kernel (zero without one);
+        the near kernel of :meth:`set_kernel_near` is :meth:`eval_kernel_near`.
+
+        Parameters
+        ----------
+        s : float
+            Lag (time units).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n, n)
+            H(s).
+
+        Raises
+        ------
+        Exception
+            As :meth:`eval_rhs`.
+        """
+        n = self._n
+        kind = self.kernel_kind
+        if kind == "exp":
+            a, b, C, D = self.kernel_terms  # type: ignore[misc]
+            s = float(s)
+            e = np.exp(a * s)
+            return np.tensordot(e * np.cos(b * s), C, axes=1) + np.tensordot(e * np.sin(b * s), D,
+                                                                              axes=1)
+        if kind == "callback":
+            return self._call_slot("kernel", _lib.KernelFn, (float(s),), n * n,
+                                   f"kernel at s = {float(s)!r}").reshape(n, n)
+        return np.zeros((n, n))
+
+    def eval_kernel_near(self, s: float) -> np.ndarray:
+        """The near kernel of :meth:`set_kernel_near` at s (zero without one).
+
+        Parameters
+        ----------
+        s : float
+            Lag (time units).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n, n)
+            The near kernel at s.
+
+        Raises
+        ------
+        Exception
+            As :meth:`eval_rhs`.
+        """
+        n = self._n
+        if not self.has("kernel_near"):
+            return np.zeros((n, n))
+        return self._call_slot("kernel_near", _lib.KernelFn, (float(s),), n * n,
+                               f"near kernel at s = {float(s)!r}").reshape(n, n)
+
+    def eval_history(self, t: float) -> np.ndarray:
+        """z(t) of :meth:`set_history` (zero without one).
+
+        Parameters
+        ----------
+        t : float
+            Time, -tau <= t <= 0 (time units).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n,)
+            z(t).
+
+        Raises
+        ------
+        Exception
+            As :meth:`eval_rhs`.
+        """
+        if not self.has("history"):
+            return np.zeros(self._n)
+        return self._call_slot("history", _lib.HistoryFn, (float(t),), self._n,
+                               f"history at t = {float(t)!r}")
 
     def __repr__(self) -> str:
         if self._h_given is not None:

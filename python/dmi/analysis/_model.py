@@ -84,35 +84,35 @@ class _Matrix:
         self.c.m[:] = [float(x) for x in np.ravel(M)]
 
 
-def _call(fn_type: Any, bound: Any, solver: Solver, first: float, x: np.ndarray,
-          what: str) -> np.ndarray:
-    """Calls the model's C-level callback (libdmi's signature) at (first, x): out (n,)."""
-    out = np.zeros(solver.n)
-    x = np.ascontiguousarray(x, dtype=float)
-    rc = fn_type(bound.address)(first, x.ctypes.data, out.ctypes.data, bound.user)
-    failure, solver._failure[0] = solver._failure[0], None
-    if failure is not None:
-        failure.add_note(f"dmi.analysis: raised by the model's {what} at {x!r}")
-        raise failure
-    if rc != 0:
-        raise ValueError(f"dmi.analysis: the model's {what} returned {rc} at {x!r}")
-    if not np.all(np.isfinite(out)):
-        raise ValueError(f"dmi.analysis: the model's {what} is not finite at {x!r}: {out!r}")
-    return out
+def _checked(values: np.ndarray, what: str, x: Any) -> np.ndarray:
+    """values, or ValueError when one is not finite."""
+    if not np.all(np.isfinite(values)):
+        raise ValueError(f"dmi.analysis: the model's {what} is not finite at {x!r}: {values!r}")
+    return values
 
 
-def _call_kernel(bound: Any, solver: Solver, s: float) -> np.ndarray:
-    """The model's C-level kernel callback (libdmi's signature) at s: H(s) (n, n)."""
-    n = solver.n
-    out = np.zeros(n * n)
-    rc = _lib.KernelFn(bound.address)(s, out.ctypes.data, bound.user)
-    failure, solver._failure[0] = solver._failure[0], None
-    if failure is not None:
-        failure.add_note(f"dmi.analysis: raised by the model's kernel at s = {s!r}")
-        raise failure
-    if rc != 0 or not np.all(np.isfinite(out)):
-        raise ValueError(f"dmi.analysis: the model's kernel returned {rc} at s = {s!r}: {out!r}")
-    return out.reshape(n, n)
+def _call(solver: Solver, what: str, first: float, x: np.ndarray) -> np.ndarray:
+    """The model's rhs f(first, x) or resolvent (first = lam) at x, through the solver's own
+    callback: out (n,), finite."""
+    try:
+        if what == "rhs":
+            out = solver.eval_rhs(first, x)
+        else:
+            out = solver.eval_resolvent(first, x)
+    except BaseException as e:
+        e.add_note(f"dmi.analysis: raised by the model's {what} at {x!r}")
+        raise
+    return _checked(out, what, x)
+
+
+def _call_kernel(solver: Solver, s: float) -> np.ndarray:
+    """The model's kernel H(s) (n, n), finite."""
+    try:
+        out = solver.eval_kernel(s)
+    except BaseException as e:
+        e.add_note(f"dmi.analysis: raised by the model's kernel at s = {s!r}")
+        raise
+    return _checked(out, "kernel", s)
 
 
 def _central(g: Callable[[np.ndarray], np.ndarray], x: np.ndarray, scale: float,
@@ -139,9 +139,9 @@ def _central(g: Callable[[np.ndarray], np.ndarray], x: np.ndarray, scale: float,
 def _resolvent_derivative(s: Solver, X: np.ndarray, h: float, scale: float) -> np.ndarray:
     """D = R'(X): exact for the built-in friction and box, central differences for a callback."""
     n = s.n
-    kind = getattr(s, "_resolvent", ())
-    if kind and kind[0] == "friction":
-        alpha = kind[1]
+    kind = s.resolvent_kind
+    if kind == "friction":
+        alpha = s.friction
         d = np.ones(n)
         for i in range(n):
             lam = h * alpha[i]
@@ -153,8 +153,8 @@ def _resolvent_derivative(s: Solver, X: np.ndarray, h: float, scale: float) -> n
                                 "the resolvent, no linearisation there")
             d[i] = 1.0 if abs(X[i]) > lam else 0.0
         return np.diag(d)
-    if kind and kind[0] == "box":
-        lo, hi = kind[1], kind[2]
+    if kind == "box":
+        lo, hi = s.box
         d = np.ones(n)
         for i in range(n):
             for b in (lo[i], hi[i]):
@@ -164,47 +164,36 @@ def _resolvent_derivative(s: Solver, X: np.ndarray, h: float, scale: float) -> n
                                     "there")
             d[i] = 1.0 if lo[i] < X[i] < hi[i] else 0.0
         return np.diag(d)
-    bound = s._keep.get("resolvent")
-    if bound is None or bound.address is None:
+    if kind != "callback":
         return np.eye(n)
-    return _central(lambda x: _call(_lib.ResolventFn, bound, s, h, x, "resolvent"), X, scale,
-                    "resolvent")
+    return _central(lambda x: _call(s, "resolvent", h, x), X, scale, "resolvent")
 
 
 def resolvent_of(s: Solver) -> Callable[[np.ndarray], np.ndarray]:
     """The model's resolvent (I + h A)^-1 as a function of X: the built-in friction (a soft
     threshold by h alpha) or box (a clip), a callback, or the identity."""
     h = s.h
-    kind = getattr(s, "_resolvent", ())
-    if kind and kind[0] == "friction":
-        lam = h * kind[1]
-        return lambda X: np.sign(X) * np.maximum(np.abs(X) - lam, 0.0)
-    if kind and kind[0] == "box":
-        lo, hi = kind[1], kind[2]
-        return lambda X: np.clip(X, lo, hi)
-    bound = s._keep.get("resolvent")
-    if bound is None or bound.address is None:
-        return lambda X: X
-    return lambda X: _call(_lib.ResolventFn, bound, s, h, X, "resolvent")
+    if s.resolvent_kind in ("friction", "box", ""):
+        return lambda X: s.eval_resolvent(h, X)
+    return lambda X: _call(s, "resolvent", h, X)
 
 
 def rhs_of(s: Solver, t: float = 0.0) -> Callable[[np.ndarray], np.ndarray]:
     """The model's f(t, u) as a function of u (0 without a right-hand side)."""
-    bound = s._keep.get("rhs")
-    if bound is None or bound.address is None:
+    if not s.has("rhs"):
         return lambda u: np.zeros(s.n)
-    return lambda u: _call(_lib.RhsFn, bound, s, t, u, "rhs")
+    return lambda u: _call(s, "rhs", t, u)
 
 
 def kernel_of(s: Solver) -> tuple[tuple | None, Callable[[float], np.ndarray] | None]:
     """The model's kernel: (the exponential-sum terms (a, b, C, D) of ``set_kernel_exp``, None)
     or (None, H(s) -> (n, n) of a callback), (None, None) without a kernel."""
-    kernel = s._keep.get("kernel")
-    if kernel is None:
-        return None, None
-    if kernel.address is None:
-        return (kernel.keep or None), None
-    return None, (lambda x: _call_kernel(kernel, s, x))
+    kind = s.kernel_kind
+    if kind == "exp":
+        return s.kernel_terms, None
+    if kind == "callback":
+        return None, (lambda x: _call_kernel(s, x))
+    return None, None
 
 
 def kernel_panels(call: Callable[[float], np.ndarray], tau: float, reach: float
@@ -274,7 +263,7 @@ class Linearisation:
         self.tangent = t
         self._window = np.zeros((self.N + 1, self.n))
         # what the equation's characteristic matrix needs (dmi.analysis.equation)
-        self.resolvent_kind = s._resolvent[0] if s._resolvent else ""
+        self.resolvent_kind = s.resolvent_kind if s.resolvent_kind != "callback" else ""
         self.kernel_terms, self.kernel = kernel_of(t)
 
     def _linearise(self, s: Solver, u_eq: Any, args: tuple, tol: float, of: str) -> None:
@@ -303,12 +292,10 @@ class Linearisation:
                              f"{scale:.3g}; tolerance {tol:g}): correct it with "
                              "dmi.analysis.equilibrium")
         scale_u = max(np.max(np.abs(u)), np.max(np.abs(X))) or 1.0
-        bound = s._keep.get("rhs")
-        if bound is None or bound.address is None:
+        if not s.has("rhs"):
             J = np.zeros((n, n))
         else:
-            J = _central(lambda x: _call(_lib.RhsFn, bound, s, t0, x, "rhs"), u,
-                         np.max(np.abs(u)) or 1.0, None)
+            J = _central(lambda x: _call(s, "rhs", t0, x), u, np.max(np.abs(u)) or 1.0, None)
         self.D = _resolvent_derivative(s, X, h, scale_u)
         self.J, self.u_eq, self.X = J, u, X
         self.n, self.N, self.h, self.tau = n, N, h, s.tau
