@@ -731,9 +731,11 @@ class Solver:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def __del__(self) -> None:
+    def __del__(self, _free: Any = _L.dmi_free, _byref: Any = ctypes.byref) -> None:
+        # dmi_free and byref bound at definition: during interpreter shutdown the module's globals
+        # (_L, ctypes) may already be None when a solver left alive is collected
         if getattr(self, "_handle", None) is not None:
-            _L.dmi_free(ctypes.byref(self._handle))
+            _free(_byref(self._handle))
             self._handle = None
 
     def set_quadrature(self, rule: str) -> None:
