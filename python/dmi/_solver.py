@@ -7,6 +7,7 @@ import ctypes
 import math
 import operator
 import threading
+import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
@@ -753,9 +754,14 @@ class Solver:
         Raises
         ------
         dmi.InvalidArgument
-            Code ``dmi.EINVAL``: another rule; code ``dmi.ESTATE``: after :meth:`init`.
+            Code ``dmi.EINVAL``: another rule, or ``"left"`` with near cells
+            (:meth:`set_kernel_near`); code ``dmi.ESTATE``: after :meth:`init`.
         """
         code = _choice(_lib.QUAD, rule, "set_quadrature: rule")
+        if rule == "left" and self._near_delta > 0:
+            raise InvalidArgument(_lib.EINVAL, "set_quadrature('left'): the near cells of "
+                                  "set_kernel_fit or set_kernel_near need the cell rule (remove "
+                                  "them first: set_kernel_near(None, 0))")
         with self._using() as s:
             self._check(_L.dmi_set_quadrature(s, code))
         self._choices["quadrature"] = rule
@@ -764,7 +770,9 @@ class Solver:
         """Sets the exact kernel of the cells below ``delta``, whose weights become H's exact cell
         integrals, while the kernel of :meth:`set_kernel_exp` (a fit on [delta, tau]) gives the
         other cells: a kernel singular at 0 in O(1) per step (``dmi_set_kernel_near``).  Before
-        :meth:`init`, which checks the combination.
+        :meth:`init`, which checks the combination.  Near cells need the cell rule
+        (:meth:`set_quadrature` ``("cell")``): under the left rule the quadrature is switched to
+        the cell rule, with a ``UserWarning`` that says so.
 
         Parameters
         ----------
@@ -788,6 +796,13 @@ class Solver:
             return _L.dmi_set_kernel_near(s, address, u, float(delta))
         self._set_callback("kernel_near", cb.KERNEL, setter, H, user, False)
         self._near_delta = float(delta) if H is not None else 0.0
+        if self._near_delta > 0 and self._choices["quadrature"] == "left":
+            # the left rule would sample the fit at l h while the near cells are exact integrals
+            self.set_quadrature("cell")
+            warnings.warn("near cells (delta > 0, of set_kernel_fit or set_kernel_near) need the "
+                          "cell rule; the quadrature is now the cell rule (call "
+                          "set_quadrature('cell') first to make this explicit)", UserWarning,
+                          stacklevel=2)
 
     def set_kernel_fit(self, fit: Any, entry: tuple[int, int] | None = None, near: Callback | None = None,
                        ) -> None:
@@ -810,11 +825,18 @@ class Solver:
         Raises
         ------
         dmi.InvalidArgument
-            Code ``dmi.EINVAL``: a matrix fit of another size or with ``entry``, a scalar fit
-            without ``entry`` for n > 1 or with an entry outside n x n, a fit with ``delta > 0``
-            and no exact kernel, or as :meth:`set_kernel_exp` and :meth:`set_kernel_near`; code
-            ``dmi.ESTATE``: after :meth:`init`.
+            Code ``dmi.EINVAL``: fit not a KernelFit (None included: to remove the kernel,
+            :meth:`set_kernel` ``(None)`` and :meth:`set_kernel_near` ``(None, 0)``), a matrix fit
+            of another size or with ``entry``, a scalar fit without ``entry`` for n > 1 or with an
+            entry outside n x n, a fit with ``delta > 0`` and no exact kernel, or as
+            :meth:`set_kernel_exp` and :meth:`set_kernel_near`; code ``dmi.ESTATE``: after
+            :meth:`init`.  From :meth:`init`: code ``dmi.ECALLBACK`` when the near kernel of a
+            scalar fit does not return a scalar.
         """
+        if not all(hasattr(fit, k) for k in ("a", "b", "C", "D", "delta")):
+            raise InvalidArgument(_lib.EINVAL, f"set_kernel_fit: fit is {type(fit).__name__}; "
+                                  "expected a dmi.kernels.KernelFit (to remove the kernel: "
+                                  "set_kernel(None) and set_kernel_near(None, 0))")
         n = self._n
         C, D = np.asarray(fit.C, float), np.asarray(fit.D, float)
         K = len(fit.a)
@@ -848,8 +870,14 @@ class Solver:
                 scalar = exact   # a Python scalar kernel: as an n x n one
 
                 def exact(s: float, _i: int = i, _j: int = j) -> np.ndarray:
+                    v = np.asarray(scalar(s))
+                    if v.size != 1:
+                        raise InvalidArgument(_lib.ECALLBACK, "set_kernel_fit: the near kernel of "
+                                              f"a scalar fit must return a scalar; at s = {s!r} it "
+                                              f"returned shape {v.shape} (an n x n near kernel "
+                                              "goes with an n x n fit)")
                     out = np.zeros((n, n))
-                    out[_i, _j] = scalar(s)
+                    out[_i, _j] = v.item()
                     return out
             self.set_kernel_near(exact, fit.delta)
         else:
