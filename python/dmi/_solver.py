@@ -172,12 +172,22 @@ class Solver:
             return
         if failure is not None:
             raise failure
+        self._raise_jit(rc)
         message = _L.dmi_last_error(self._handle).decode()
         if rc == _lib.ECALLBACK and "callback returned 2 " in message and \
                 self._jit_slots:
             message += (" (a jit=True callback returns 2 when its result does not have libdmi's "
                         "shape: (n,), or (n, n) for the kernel)")
         raise from_code(rc, message)
+
+    def _raise_jit(self, rc: int) -> None:
+        """Raises the exception of a jit=True callback whose compiled code failed (rc
+        DMI_ECALLBACK): the Python function's own, called again where the compiled one failed."""
+        if rc == _lib.ECALLBACK and self._jit_slots:
+            from . import _jit
+            exc = _jit.raised([self._keep[k] for k in self._jit_slots])
+            if exc is not None:
+                raise exc
 
     def _set_callback(self, slot: str, kind: cb.Kind, setter: Any, f: Any, user: Any,
                       jit: bool = False) -> None:
@@ -424,12 +434,17 @@ class Solver:
         """Samples the kernel and the history and sets t = 0 (p = 0, ``dmi_init``); again: restarts
         from t = 0.
 
+        A ``jit=True`` callback computes with its closure's and globals' values as they are now
+        (docs/python.md, "jit=True").
+
         Raises
         ------
         Exception
             The exception a Python kernel or history callback raised, as it is.
         dmi.InvalidArgument
-            Code ``dmi.ECALLBACK``: a Python callback returned a result of another shape or type;
+            Code ``dmi.EINVAL``: a value a ``jit=True`` callback reads changed its type since its
+            ``set_*`` call (set it again);
+            code ``dmi.ECALLBACK``: a Python callback returned a result of another shape or type;
             code ``dmi.EINVAL``: near cells of :meth:`set_kernel_near` without a kernel of
             :meth:`set_kernel_exp` or with ceil(delta / h) + 1 > N, or ``"recursive"`` for a
             kernel it refuses (see :meth:`set_convolution`).
@@ -438,6 +453,10 @@ class Solver:
             infinite sample) or ``dmi.ENOMEM``.  The solver is then unchanged.
         """
         with self._using() as s:
+            if self._jit_slots:   # (the values jit=True callbacks read: as they are now)
+                from . import _jit
+                for slot in sorted(self._jit_slots):
+                    _jit.refresh(self._keep[slot], "init")
             self._check(_L.dmi_init(s))
 
     def step(self) -> None:
@@ -982,6 +1001,7 @@ class Solver:
         if failure is not None:
             failure.add_note(f"raised by the model's {what}")
             raise failure
+        self._raise_jit(_lib.ECALLBACK if rc != 0 else rc)
         if rc != 0:
             raise Error(_lib.ECALLBACK, f"the model's {what} returned {rc}")
         return out
