@@ -111,7 +111,7 @@ def _parameters(f: types.FunctionType, what: str) -> tuple[list[str], list[Any],
         names.append(g)
         values.append(f.__globals__[g])
         keys.append(_global_type(values[-1]))
-    for g in {g for c in _nested_codes(code) for g in _global_names(c, f)} - set(names):
+    for g in sorted({g for c in _nested_codes(code) for g in _global_names(c, f)} - set(names)):
         names.append(g)   # read inside a comprehension or nested function: a constant, keyed
         values.append(f.__globals__[g])
         keys.append(("k", id(values[-1])))

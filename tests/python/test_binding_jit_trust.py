@@ -47,6 +47,21 @@ def test_raise_fails_the_step_with_the_exception():
         assert s.eval_rhs(0.0, [2.0])[0] == 2.0
 
 
+def history_raising(t):
+    if t < -0.5:
+        raise KeyError("no record before -0.5")
+    return np.array([1.0])
+
+
+def test_history_raising_fails_init_with_its_exception():
+    for jit in (False, True):
+        s = dmi.Solver(1, 1.0, 10)
+        s.set_history(history_raising, jit=jit)
+        with pytest.raises(KeyError) as e:
+            s.init()
+        assert e.value.args == ("no record before -0.5",)
+
+
 def test_division_by_zero_is_the_plain_callbacks_nonfinite_error():
     errors = []
     for jit in (False, True):
