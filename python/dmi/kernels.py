@@ -561,14 +561,17 @@ def fit(H: Callable[[float], Any] | None, tau: float, *, tol: float = 1e-8, rela
     -------
     KernelFit
         The fit with the fewest terms that meets ``tol`` (at most ``max_terms``); when none does,
-        the best found, with a ``UserWarning`` (for a callable H).
+        the best found, with a ``UserWarning`` that says why when it can: a growing kernel (fits
+        allow only decaying terms), or for uniform samples their noise, estimated from their 4th
+        differences, and the tol it allows.
 
     Raises
     ------
     ValueError
         tau, tol, max_terms or delta out of range; both or neither of H and samples; samples of
         other shapes, not finite or not increasing, or on a non-uniform grid and not positive and
-        decreasing.
+        decreasing; complex values of H or the samples; a callable H whose integral of ||H|| over
+        [0, tau] does not converge (not integrable at 0, as 1/s).
     """
     if not (tau > 0 and math.isfinite(tau)):
         raise ValueError(f"fit: tau = {tau}; expected a finite tau > 0")
