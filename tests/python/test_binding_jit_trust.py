@@ -1,6 +1,6 @@
 # jit=True fails where the Python callback fails and computes with the same values: a raise, a
 # division by zero and an index out of range give the plain callback's exception or libdmi error
-# (the solver unchanged); a function whose file was edited after import is refused, not compiled
+# (the solver unchanged); a function writing into u changes only its copy; a function whose file was edited after import is refused, not compiled
 # from the edited file; globals and closure values are those at init(), also after set_rhs is
 # called again; a kernel returning a vector is told it must return an n x n array.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -88,6 +88,21 @@ def test_kernel_returning_a_vector_is_told_the_shape():
     s = dmi.Solver(2, 1.0, 10)
     with pytest.raises(dmi.InvalidArgument, match="the kernel must return an n x n array"):
         s.set_kernel(lambda x: np.array([np.exp(-x), 0.0]), jit=True)
+
+
+def overwriting(t, u):
+    v = u[0]
+    u[0] = 0.0            # writes into its argument: the Python callback's is a copy
+    return np.array([0.1 * v])
+
+
+def test_writing_into_u_changes_nothing_else():
+    runs = []
+    for jit in (False, True):
+        s = decay(overwriting, jit)
+        s.advance(5)
+        runs.append(s.state[0])
+    assert runs[0] == pytest.approx(0.999 ** 5, rel=1e-14) and runs[1] == runs[0]
 
 
 # ---- the function object, not the file ----------------------------------------------------------
