@@ -627,7 +627,7 @@ def _why_missed(seen: dict, length: float, sampled: bool, relative: bool) -> str
     """What keeps the fits from tol: a growing kernel, or the noise of uniform samples
     (seen["samples"])."""
     rate = seen.get("rate", 0.0)
-    if rate * length > 0.1:   # the leading exponential grows by > 10 % over [delta, tau]
+    if rate * length > 0.1 and seen.get("larger_at_tau"):   # the leading term grows by > 10 %
         return (f". The kernel grows (its leading rate is +{rate:.3g} per time unit): fits allow "
                 "only decaying or constant terms (a_k <= 0), and more terms do not help; a growing "
                 "memory kernel makes the scheme's sum grow with tau")
@@ -686,6 +686,8 @@ def _fit_esprit(s, V, tau, lo, tol, relative, max_terms, noisy, check, seen):
         rw = 1 / np.maximum(np.abs(Vf).max(axis=1), np.finfo(float).tiny)
     best = None
     errors = []
+    tenth = max(1, len(s) // 10)   # |H| larger on the last tenth than on the first: it grows
+    seen["larger_at_tau"] = bool(np.abs(Vf[-tenth:]).max() > np.abs(Vf[:tenth]).max())
     for r, a, b in _esprit_candidates(s, Vf, 2 * max_terms, noisy, seen):
         if len(a) > max_terms:
             continue
