@@ -1,6 +1,7 @@
-# Floquet multipliers of periodic orbits that carry the stick/slip switching.
+# Floquet multipliers of periodic orbits that carry the stick/slip switching, verified.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
-"""Floquet multipliers of a periodic orbit of the scheme, right at stick/slip transitions.
+"""Floquet multipliers of a periodic orbit of the scheme, right at stick/slip transitions, and
+verified before they are reported.
 
 The exact derivative of the step map is piecewise: a perturbation too small to move a switch
 (a velocity reversal, the start or end of a stick) by one step sees the switch frozen at its
@@ -16,13 +17,38 @@ them, error O(h^(2/3)) (0.2 % at M = 2e4 against Den Hartog's saltation oracle, 
 tests/python/test_analysis_orbit_oracles.py).  Multipliers of a stuck phase come out exactly
 0: a perturbation that keeps the stick is wiped out.
 
-The leading multipliers are the eigenvalues of largest modulus of that operator (a
-``scipy.sparse.linalg.LinearOperator``): Rayleigh-Ritz on a block Krylov space of two blocks (a
-dense matrix for small states), see :func:`floquet_multipliers`.
+The leading multipliers (:func:`floquet`, :func:`floquet_multipliers`) are the eigenvalues of
+largest modulus of that operator (a ``scipy.sparse.linalg.LinearOperator``) by ARPACK
+(``scipy.sparse.linalg.eigs``, implicitly restarted Arnoldi) on a Krylov space wide enough for a
+ring of multipliers of nearly equal modulus (a long memory), the whole matrix for states of at
+most 64 values.  Each Ritz pair (mu, v) is then *verified* by fresh products: its residual
+r = |A v - mu v|_2 (|v|_2 = 1), and the operator's own noise on v, eta = |A_eps v -
+A_(eps/2) v|_2 (the same product at half the difference step: the switches' rounding and the
+curvature change, the linear part does not).  Its error bound is r + eta (the pair's backward
+error plus the noise; the eigenvalue's own condition number is not included); nan where that
+exceeds 0.5.  ARPACK's restarts combine products of many directions, which a nonlinear
+difference operator does not add up exactly: the fresh residual, not ARPACK's estimate, is the
+pair's accuracy (2e-4 on the Bagley-Torvik example's ring, against 1e-6 asked of ARPACK).
+
+The verdict ``stable``: False when a verified multiplier other than the trivial one has
+|mu| - 1 above its error; True when the Krylov iteration converged, all pairs are verified and
+the largest nontrivial |mu| + error < 1; where the largest nontrivial |mu| - 1 lies inside its
+error, or the pairs are not all verified, a *plain run* decides: the orbit perturbed along the
+leading Ritz vector, run ``Verify.periods`` periods, its period-to-period change
+e_k = max |U(t + k P) - U(t + (k - 1) P)| over period k (a shift along an autonomous orbit, the
+trivial direction, cancels), the growth rate fitted to log e_k over the later periods.  A rate
+above 1 beyond three standard errors: False; below 1 beyond them (and the pair verified): True.
+Otherwise ``None``, with a :class:`StabilityWarning` saying why: never True unverified.
+
+The trivial multiplier of an autonomous orbit (a shift along the orbit) is the Ritz pair whose
+vector is most nearly parallel to the orbit's velocity (the window of U'), not the multiplier
+nearest 1.
 """
 from __future__ import annotations
 
 import math
+import warnings
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg as sl
@@ -97,18 +123,322 @@ def monodromy_operator(F: StepMap, x: np.ndarray, eps: float | None = None,
     return sla.LinearOperator((x.size, x.size), matvec=mv, dtype=float)
 
 
+class StabilityWarning(RuntimeWarning):
+    """A stability verdict left undecided (``stable`` None), or a multiplier left unverified: the
+    message says which and why."""
+
+
+@dataclass(frozen=True)
+class Verify:
+    """How :func:`floquet` verifies the leading multipliers (also ``verify=`` of
+    :func:`floquet_multipliers`, :func:`dmi.analysis.periodic_orbit` and
+    :func:`dmi.analysis.hopf_orbit`).
+
+    Attributes
+    ----------
+    fixed_point_tol : float
+        The state must be a fixed point: |F(x) - x|_inf <= fixed_point_tol max(1, |x|_inf),
+        else ValueError (multipliers of a point that is no orbit mean nothing).
+    krylov : int or None
+        ARPACK's Krylov space (``ncv``); default min(dim, max(2 k + 1, 60)), k the pairs sought.
+    products : int
+        ARPACK's budget of operator products (each 2 runs of a period, central differences).
+    tol : float
+        ARPACK's relative tolerance on the Ritz pairs.
+    periods : int
+        The plain run's length (periods) where the verdict is left to it; 0: no plain run.
+    kick : float
+        The plain run's perturbation, kick A along the Ritz vector (|v|_inf = 1), A the orbit's
+        largest half range (or max(1, |x|) for a constant orbit).
+    """
+    fixed_point_tol: float = 1e-6
+    krylov: int | None = None
+    products: int = 3000
+    tol: float = 1e-6
+    periods: int = 200
+    kick: float = 1e-3
+
+    def __post_init__(self) -> None:
+        for name in ("fixed_point_tol", "tol", "kick"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise ValueError(f"Verify: {name} = {v!r}; expected a finite number > 0")
+        for name, least in (("products", 1), ("periods", 0)):
+            v = getattr(self, name)
+            if not (isinstance(v, int) and v >= least):
+                raise ValueError(f"Verify: {name} = {v!r}; expected a whole number >= {least}")
+        if self.krylov is not None and not (isinstance(self.krylov, int) and self.krylov >= 3):
+            raise ValueError(f"Verify: krylov = {self.krylov!r}; expected None or a whole "
+                             "number >= 3")
+
+
+@dataclass
+class Floquet:
+    """The leading Floquet multipliers of a periodic orbit and the stability verdict, verified.
+
+    Attributes
+    ----------
+    multipliers : numpy.ndarray of complex
+        Largest |mu| first (dimensionless); below 1e-12 in modulus: 0 (a stuck phase's).
+    errors : numpy.ndarray of float
+        Each multiplier's error bound (its residual plus the operator's noise); nan: not
+        verified.
+    vectors : numpy.ndarray of complex
+        Shape (dim, count): the Ritz vectors, |v|_2 = 1.
+    trivial : int or None
+        An autonomous orbit: the index of its trivial multiplier (the vector along the orbit's
+        velocity); None for a forced orbit, or when none of the pairs lies along the velocity.
+    stable : bool or None
+        True: verified stable; False: verified unstable; None: not decided (see ``reason``).
+    reason : str
+        How the verdict was reached, or why there is none.
+    rate : float or nan
+        The plain run's growth per period, when one was run (else nan).
+    products : int
+        Operator products spent (each 2 runs of a period, central differences).
+    """
+    multipliers: np.ndarray
+    errors: np.ndarray
+    vectors: np.ndarray = field(repr=False)
+    trivial: int | None
+    stable: bool | None
+    reason: str
+    rate: float = math.nan
+    products: int = 0
+
+    def nontrivial(self) -> np.ndarray:
+        """The multipliers without the trivial one (all of them for a forced orbit)."""
+        if self.trivial is None:
+            return self.multipliers
+        return np.delete(self.multipliers, self.trivial)
+
+
+def check_fixed_point(F: StepMap, x: np.ndarray, tol: float) -> None:
+    """ValueError when x is not a fixed point of F to tol max(1, |x|_inf) (the residual given)."""
+    r = float(np.max(np.abs(F(x) - x)))
+    scale = max(1.0, float(np.max(np.abs(x))))
+    if not r <= tol * scale:
+        raise ValueError(f"the state is not a fixed point of the {F.M}-step map at p = {F.p!r}: "
+                         f"|F(x) - x|_inf = {r:.3g} ({r / scale:.3g} relative; tolerance "
+                         f"{tol:g}, Verify.fixed_point_tol): the multipliers of a point that is "
+                         "no orbit mean nothing; converge it first (periodic_orbit, "
+                         "refine_orbit)")
+
+
+def window_velocity(F: StepMap, U: np.ndarray) -> np.ndarray:
+    """The velocity of the window along an M-periodic orbit: row i of the L rows (time
+    (i - L + 1) h) is (U^(k+1) - U^(k-1)) / (2 h), k its step, U one period (M + 1 rows) read
+    periodically; flattened (L n values)."""
+    M = F.M
+    k = np.arange(F.L) - (F.L - 1)
+    P = np.asarray(U)[:M]
+    return ((P[(k + 1) % M] - P[(k - 1) % M]) / (2 * F.h)).ravel()
+
+
+def _pairs(A: sla.LinearOperator, k: int, opts: Verify, dim: int
+           ) -> tuple[np.ndarray, np.ndarray, bool, str]:
+    """(mu, V, converged, note): k Ritz pairs of largest modulus by ARPACK (the whole matrix
+    for dim <= 64), |V[:, j]|_2 = 1."""
+    if dim <= 64:
+        mu, V = np.linalg.eig(A.matmat(np.eye(dim)))
+        return mu, V, True, ""
+    ncv = opts.krylov if opts.krylov is not None else max(2 * k + 1, 60)
+    ncv = min(dim, max(ncv, k + 2))
+    restarts = max(1, opts.products // max(1, ncv - k))
+    v0 = np.random.default_rng(0).standard_normal(dim)
+    try:
+        mu, V = sla.eigs(A, k=k, ncv=ncv, which="LM", tol=opts.tol, maxiter=restarts, v0=v0)
+        return mu, V, True, ""
+    except sla.ArpackNoConvergence as e:
+        note = (f"ARPACK converged {len(e.eigenvalues)} of {k} pairs in {opts.products} "
+                f"products (Krylov space {ncv})")
+        return e.eigenvalues, e.eigenvectors, False, note
+
+
+def _verify_pairs(A: sla.LinearOperator, half: sla.LinearOperator, mu: np.ndarray,
+                  V: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(errors, residuals, noises) of the pairs: the residual r = |A v - mu v|_2 by a fresh
+    product, the operator's noise eta = |A v - half v|_2 (half: A at half the difference
+    step), the error r + eta; nan where it exceeds 0.5 (no multiplier to speak of)."""
+    err, res, noise = (np.full(mu.size, np.nan) for _ in range(3))
+    for j in range(mu.size):
+        if j and mu[j].imag and abs(mu[j] - np.conj(mu[j - 1])) <= 1e-12 * abs(mu[j]):
+            err[j], res[j], noise[j] = err[j - 1], res[j - 1], noise[j - 1]   # a conjugate pair
+            continue
+        v = V[:, j] / np.linalg.norm(V[:, j])
+        Av = A.matvec(v)
+        res[j] = float(np.linalg.norm(Av - mu[j] * v))
+        noise[j] = float(np.linalg.norm(Av - half.matvec(v)))
+        if res[j] + noise[j] <= 0.5:
+            err[j] = res[j] + noise[j]
+    return err, res, noise
+
+
+def growth_rate(F: StepMap, x: np.ndarray, v: np.ndarray, kick: float, periods: int
+                ) -> tuple[float, float]:
+    """(rate, standard error of its log) of a plain run from x + kick A Re(v) / |Re v|_inf (A
+    the orbit's largest half range, max(1, |x|) for a constant orbit): e_k = max |U over period
+    k - U over period k - 1| (a shift along an autonomous orbit cancels), the rate exp(slope)
+    of a least-squares line through log e_k over the periods where e_k lies between the floor
+    (100 times the fixed point's residual |F(x) - x|, plus rounding) and 0.1 A (beyond: not
+    linear), from the first period on, the first third of those left out (the other modes
+    fade); (nan, nan) with fewer than 5 such periods."""
+    U = F.trajectory(x)
+    A = float(np.max(0.5 * (U.max(axis=0) - U.min(axis=0))))
+    scale = max(1.0, float(np.max(np.abs(x))))
+    if not A > 0:
+        A = scale
+    w = np.real(v) if np.max(np.abs(np.real(v))) >= np.max(np.abs(np.imag(v))) else np.imag(v)
+    w = w / np.max(np.abs(w))
+    floor = 100 * float(np.max(np.abs(F(x) - x))) + 1e-13 * scale
+    M = F.M
+    R = F.run_from(x + kick * A * w, periods * M)
+    e = np.array([np.max(np.abs(R[k * M + 1:(k + 1) * M + 1] - R[(k - 1) * M + 1:k * M + 1]))
+                  for k in range(1, periods)])
+    inside = (e > floor) & (e < 0.1 * A)
+    last = int(np.argmin(inside)) if not inside.all() else inside.size   # the first period out
+    first = last // 3
+    if last - first < 5:
+        return math.nan, math.nan
+    k = np.arange(first, last, dtype=float)
+    y = np.log(e[first:last])
+    X = np.column_stack([np.ones_like(k), k])
+    coef, *_ = np.linalg.lstsq(X, y, rcond=None)
+    resid = y - X @ coef
+    se = math.sqrt(float(resid @ resid) / max(1, k.size - 2) / float(np.sum((k - k.mean()) ** 2)))
+    return math.exp(float(coef[1])), se
+
+
+def floquet(F: StepMap, x: np.ndarray, count: int = 10, *, autonomous: bool = False,
+            eps: float | None = None, central: bool = True, verify: Verify | None = None
+            ) -> Floquet:
+    """The leading Floquet multipliers of a periodic orbit, verified, and its stability verdict.
+
+    See the module: ARPACK on the difference operator, each Ritz pair's residual judged against
+    the operator's noise, a plain run where the verdict lies inside the errors.
+
+    Parameters
+    ----------
+    F : StepMap
+        The M-step map, e.g. ``StepMap(orbit.make, orbit.p, orbit.steps, orbit.rows)``.
+    x : numpy.ndarray
+        Its fixed point, e.g. ``orbit.state``.
+    count : int
+        How many multipliers (>= 1).
+    autonomous : bool
+        An orbit of free period: its trivial multiplier (along the velocity) is found and left
+        out of the verdict.
+    eps : float, optional
+        The difference step (state units), instead of :func:`fd_step`'s.
+    central : bool
+        Central differences (2 evaluations a product), else forward (1).
+    verify : Verify, optional
+        The verification's tolerances and budgets (default ``Verify()``).
+
+    Returns
+    -------
+    Floquet
+        Multipliers, their errors, the trivial one's index, the verdict and its reason.
+
+    Raises
+    ------
+    ValueError
+        x is not a fixed point of F (the residual is given), count < 1, verify not a Verify.
+    """
+    opts = Verify() if verify is None else verify
+    if not isinstance(opts, Verify):
+        raise ValueError(f"verify = {verify!r}: give a dmi.analysis.Verify (or None)")
+    if int(count) != count or count < 1:
+        raise ValueError(f"count = {count!r}: give a whole number of multipliers >= 1")
+    x = np.asarray(x, dtype=float).ravel()
+    if x.size != F.dim:
+        raise ValueError(f"the state has {x.size} values; the map's is L n = {F.dim}")
+    check_fixed_point(F, x, opts.fixed_point_tol)
+    U, X = F.trajectory_terms(x)
+    e = fd_step(F, x, U, X) if eps is None else float(eps)
+    A = monodromy_operator(F, x, e, central)
+    half = monodromy_operator(F, x, e / 2, central)
+    dim = x.size
+    want = min(int(count) + (1 if autonomous else 0), dim)
+    k = min(want + 1, dim - 2) if dim > 64 else dim
+    start = F.evaluations
+    mu, V, converged, note = _pairs(A, k, opts, dim)
+    order = np.argsort(-np.abs(mu), kind="stable")[:want]
+    mu, V = np.asarray(mu, complex)[order], np.asarray(V, complex)[:, order]
+    V = V / np.linalg.norm(V, axis=0)
+    err, res, noise = _verify_pairs(A, half, mu, V)
+    trivial = None
+    why: list[str] = [note] if note else []
+    if autonomous and mu.size:
+        w = window_velocity(F, U)
+        align = np.abs(V.conj().T @ w) / max(float(np.linalg.norm(w)), 1e-300)
+        j = int(np.argmax(align))
+        if align[j] >= 0.9:
+            trivial = j
+        else:
+            why.append(f"no Ritz vector lies along the orbit's velocity (best alignment "
+                       f"{align[j]:.2f}): the trivial multiplier is not among those found")
+    mu[np.abs(mu) < 1e-12] = 0.0
+    rest = [j for j in range(mu.size) if j != trivial]
+    stable: bool | None = None
+    rate = math.nan
+    unver = [j for j in rest if not np.isfinite(err[j])]
+    if unver:
+        why.append(f"{len(unver)} of {len(rest)} multipliers not verified (residual "
+                   f"{res[unver[0]]:.2g} at |mu| = {abs(mu[unver[0]]):.4g})")
+    out = [j for j in rest if np.isfinite(err[j]) and abs(mu[j]) - 1 > err[j]]
+    if out:
+        stable = False
+        j = out[0]
+        reason = (f"unstable: |mu| = {abs(mu[j]):.6g} > 1 beyond its error {err[j]:.2g} "
+                  "(verified)")
+    elif not rest:
+        reason = "no multiplier besides the trivial one: no verdict"
+    else:
+        lead = rest[0]
+        inside = np.isfinite(err[lead]) and abs(mu[lead]) + err[lead] >= 1
+        if not inside and converged and not unver:
+            stable = True
+            reason = (f"stable: the largest |mu| = {abs(mu[lead]):.6g} plus its error "
+                      f"{err[lead]:.2g} is below 1 (verified)")
+        else:
+            if inside:
+                why.append(f"|mu| = {abs(mu[lead]):.6g} is within its error {err[lead]:.2g} of 1")
+            reason = "; ".join(why)
+            if opts.periods > 0:
+                rate, se = growth_rate(F, x, V[:, lead], opts.kick, opts.periods)
+                if math.isfinite(rate) and math.log(rate) > 3 * se:
+                    stable = False
+                    reason = (f"unstable: a plain run from the orbit along the leading Ritz "
+                              f"vector grows by {rate:.6g} a period ({opts.periods} periods; "
+                              f"{reason})")
+                elif math.isfinite(rate) and math.log(rate) < -3 * se and converged \
+                        and np.isfinite(err[lead]):
+                    stable = True
+                    reason = (f"stable: a plain run from the orbit along the leading Ritz "
+                              f"vector decays by {rate:.6g} a period ({opts.periods} periods; "
+                              f"{reason})")
+                else:
+                    reason = (f"undecided: {reason}; a plain run of {opts.periods} periods "
+                              f"changes by {rate:.6g} a period, not decisive")
+            else:
+                reason = f"undecided: {reason}"
+    products = (F.evaluations - start) // (2 if central else 1)
+    return Floquet(mu, err, V, trivial, stable, reason, rate, products)
+
+
 def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
-                        eps: float | None = None, blocks: int = 2,
-                        central: bool = True) -> np.ndarray:
-    """The leading Floquet multipliers of a periodic orbit, right at stick/slip transitions.
+                        eps: float | None = None, central: bool = True,
+                        autonomous: bool = False, verify: Verify | None = None) -> np.ndarray:
+    """The leading Floquet multipliers of a periodic orbit, right at stick/slip transitions,
+    verified (:func:`floquet`, which also gives their errors and the stability verdict).
 
     The monodromy operator by central differences with a step that moves the switches by many
     steps (:func:`fd_step`; the smooth step on an orbit with no switch to carry); its eigenvalues
-    of largest modulus by Rayleigh-Ritz on ``blocks`` blocks of a block Krylov space of b =
-    count + 2 vectors (states of at most 64 values: the dense matrix).  Not ARPACK's eigs: the
-    difference operator is linear only up to the switches' rounding to a step (O(h / eps)), and a
-    long Krylov recurrence with restarts amplifies that, while a Ritz matrix of independently
-    differenced columns, few blocks deep, carries it once.
+    of largest modulus by ARPACK (the whole matrix for states of at most 64 values), each pair's
+    error bound from a fresh residual and the operator's noise (:func:`floquet`'s ``errors``).
+    A multiplier without a bound (residual + noise above 0.5) is still returned, with a
+    :class:`StabilityWarning` naming it.
 
     Parameters
     ----------
@@ -120,10 +450,14 @@ def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
         How many multipliers.
     eps : float, optional
         The difference step (state units), instead of :func:`fd_step`'s.
-    blocks : int
-        Krylov blocks (>= 2).
     central : bool
         Central differences (2 evaluations a product), else forward (1).
+    autonomous : bool
+        An autonomous orbit (its trivial multiplier is found by its vector; it stays in the
+        list).
+    verify : Verify, optional
+        Tolerances and budgets of the verification (default ``Verify(periods=0)``: no plain
+        run, which only the verdict needs).
 
     Returns
     -------
@@ -133,9 +467,17 @@ def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
     Raises
     ------
     ValueError
-        blocks < 2.
+        x is not a fixed point of F (the residual is given), count < 1.
     """
-    return ritz(F, x, count, blocks=blocks, eps=eps, central=central)[0]
+    opts = Verify(periods=0) if verify is None else verify
+    fl = floquet(F, x, count, autonomous=autonomous, eps=eps, central=central, verify=opts)
+    bad = np.flatnonzero(~np.isfinite(fl.errors[:count]))
+    if bad.size:
+        warnings.warn(f"floquet_multipliers: {bad.size} of {min(count, fl.multipliers.size)} "
+                      f"multipliers have a residual above 0.5 (no error bound): "
+                      f"{np.array2string(fl.multipliers[bad], precision=4)}", StabilityWarning,
+                      stacklevel=2)
+    return fl.multipliers[:count]
 
 
 def ritz(F: StepMap, x: np.ndarray, count: int, *, blocks: int = 2,
