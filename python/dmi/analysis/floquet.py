@@ -309,6 +309,54 @@ def growth_rate(F: StepMap, x: np.ndarray, v: np.ndarray, kick: float, periods: 
     return math.exp(float(coef[1])), se
 
 
+#: An autonomous orbit's trivial pair with an error above this may hide a second multiplier
+#: beside 1 (a noisy operator merges close eigenvalues: 1.012 hidden in 1.0005 +- 0.009 on a
+#: stick-slip orbit): a True verdict then needs a plain run.
+TRIVIAL_TOL = 1e-6
+
+
+def _verdict(F: StepMap, x: np.ndarray, mu: np.ndarray, V: np.ndarray, err: np.ndarray,
+             res: np.ndarray, trivial: int | None, converged: bool, why: list[str],
+             opts: Verify) -> tuple[bool | None, str, float]:
+    """(stable, reason, plain run's rate) from the verified pairs (see the module)."""
+    rest = [j for j in range(mu.size) if j != trivial]
+    unver = [j for j in rest if not np.isfinite(err[j])]
+    if unver:
+        why.append(f"{len(unver)} of {len(rest)} multipliers without an error bound (residual "
+                   f"{res[unver[0]]:.2g} at |mu| = {abs(mu[unver[0]]):.4g})")
+    out = [j for j in rest if np.isfinite(err[j]) and abs(mu[j]) - 1 > err[j]]
+    if out:
+        j = out[0]
+        return False, (f"unstable: |mu| = {abs(mu[j]):.6g} > 1 beyond its error {err[j]:.2g} "
+                       "(verified)"), math.nan
+    if not rest:
+        return None, "no multiplier besides the trivial one: no verdict", math.nan
+    lead = rest[0]
+    inside = np.isfinite(err[lead]) and abs(mu[lead]) + err[lead] >= 1
+    if inside:
+        why.append(f"|mu| = {abs(mu[lead]):.6g} is within its error {err[lead]:.2g} of 1")
+    if trivial is not None and err[trivial] > TRIVIAL_TOL:
+        why.append(f"the trivial multiplier {mu[trivial]:.6g} has an error {err[trivial]:.2g} "
+                   "that may hide a second multiplier beside 1")
+    if not why and converged:
+        return True, (f"stable: the largest |mu| = {abs(mu[lead]):.6g} plus its error "
+                      f"{err[lead]:.2g} is below 1 (verified)"), math.nan
+    reason = "; ".join(why) if why else "ARPACK did not converge"
+    if opts.periods == 0:
+        return None, f"undecided: {reason}", math.nan
+    # a plain run from the orbit perturbed along every pair found (a multiplier hidden beside
+    # one of them is excited too; the shift along the orbit cancels in e_k)
+    w = sum(V[:, j] / np.max(np.abs(V[:, j])) for j in range(mu.size))
+    rate, se = growth_rate(F, x, w, opts.kick, opts.periods)
+    what = f"a plain run of {opts.periods} periods from the orbit perturbed along the Ritz vectors"
+    if math.isfinite(rate) and math.log(rate) > 3 * se:
+        return False, f"unstable: {what} grows by {rate:.6g} a period ({reason})", rate
+    if math.isfinite(rate) and math.log(rate) < -3 * se and converged and not unver:
+        return True, f"stable: {what} decays by {rate:.6g} a period ({reason})", rate
+    return None, (f"undecided: {reason}; {what} changes by {rate:.6g} a period, not "
+                  "decisively (Verify.periods, Verify.kick)"), rate
+
+
 def floquet(F: StepMap, x: np.ndarray, count: int = 10, *, autonomous: bool = False,
             eps: float | None = None, central: bool = True, verify: Verify | None = None
             ) -> Floquet:
@@ -379,50 +427,7 @@ def floquet(F: StepMap, x: np.ndarray, count: int = 10, *, autonomous: bool = Fa
             why.append(f"no Ritz vector lies along the orbit's velocity (best alignment "
                        f"{align[j]:.2f}): the trivial multiplier is not among those found")
     mu[np.abs(mu) < 1e-12] = 0.0
-    rest = [j for j in range(mu.size) if j != trivial]
-    stable: bool | None = None
-    rate = math.nan
-    unver = [j for j in rest if not np.isfinite(err[j])]
-    if unver:
-        why.append(f"{len(unver)} of {len(rest)} multipliers not verified (residual "
-                   f"{res[unver[0]]:.2g} at |mu| = {abs(mu[unver[0]]):.4g})")
-    out = [j for j in rest if np.isfinite(err[j]) and abs(mu[j]) - 1 > err[j]]
-    if out:
-        stable = False
-        j = out[0]
-        reason = (f"unstable: |mu| = {abs(mu[j]):.6g} > 1 beyond its error {err[j]:.2g} "
-                  "(verified)")
-    elif not rest:
-        reason = "no multiplier besides the trivial one: no verdict"
-    else:
-        lead = rest[0]
-        inside = np.isfinite(err[lead]) and abs(mu[lead]) + err[lead] >= 1
-        if not inside and converged and not unver:
-            stable = True
-            reason = (f"stable: the largest |mu| = {abs(mu[lead]):.6g} plus its error "
-                      f"{err[lead]:.2g} is below 1 (verified)")
-        else:
-            if inside:
-                why.append(f"|mu| = {abs(mu[lead]):.6g} is within its error {err[lead]:.2g} of 1")
-            reason = "; ".join(why)
-            if opts.periods > 0:
-                rate, se = growth_rate(F, x, V[:, lead], opts.kick, opts.periods)
-                if math.isfinite(rate) and math.log(rate) > 3 * se:
-                    stable = False
-                    reason = (f"unstable: a plain run from the orbit along the leading Ritz "
-                              f"vector grows by {rate:.6g} a period ({opts.periods} periods; "
-                              f"{reason})")
-                elif math.isfinite(rate) and math.log(rate) < -3 * se and converged \
-                        and np.isfinite(err[lead]):
-                    stable = True
-                    reason = (f"stable: a plain run from the orbit along the leading Ritz "
-                              f"vector decays by {rate:.6g} a period ({opts.periods} periods; "
-                              f"{reason})")
-                else:
-                    reason = (f"undecided: {reason}; a plain run of {opts.periods} periods "
-                              f"changes by {rate:.6g} a period, not decisive")
-            else:
-                reason = f"undecided: {reason}"
+    stable, reason, rate = _verdict(F, x, mu, V, err, res, trivial, converged, why, opts)
     products = (F.evaluations - start) // (2 if central else 1)
     return Floquet(mu, err, V, trivial, stable, reason, rate, products)
 
