@@ -22,6 +22,7 @@ form a ring of nearly equal modulus."""
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numba
 import numpy as np
@@ -35,12 +36,7 @@ LIPSCHITZ = (MU_S - MU_D) / V_S     # of the continuous part g
 P0 = 2 * math.pi                    # the free period
 TAU = 8 * P0                        # the memory: 8 periods
 M = 200                             # steps a period
-H0 = P0 / M
 W = 2 * math.sqrt(TAU / math.pi)    # int_0^tau s^-1/2 / Gamma(1/2) ds
-FIT = kernels.fit(kernels.PowerKernel(0.5, C / math.sqrt(math.pi)), TAU, tol=1e-8, relative=True,
-                  delta=H0)
-
-
 def stribeck(v: float) -> float:
     """F(v) for v != 0 (at v = 0 the interval [-mu_s, mu_s])."""
     return math.copysign(MU_D + (MU_S - MU_D) * math.exp(-abs(v) / V_S), v)
@@ -52,17 +48,28 @@ def weakening(v: float) -> float:
     return -math.copysign((MU_S - MU_D) * -math.expm1(-abs(v) / V_S), v)
 
 
-def make(vb: float, h: float = H0) -> dmi.Solver:
-    """The belt at the speed vb with the step h (an autonomous orbit's period sets h): the
-    right-hand side compiled by numba (jit=True), the sign graph at mu_s in A, the fitted
-    fractional kernel with its first cell exact (the cell rule)."""
-    s = dmi.Solver(2, TAU, h=h)
-    s.set_rhs(lambda t, u: np.array([-(u[1] + vb), K * u[0] + weakening(u[1]) + C * W * vb]),
-              jit=True)
-    s.set_friction([0.0, MU_S])
-    s.set_quadrature("cell")
-    s.set_kernel_fit(FIT, entry=(1, 1))
-    return s
+def model(steps: int = M) -> Callable[..., dmi.Solver]:
+    """The model make(vb, h=...) at ``steps`` steps a free period: the fractional kernel fitted
+    on [h, tau] (relative error 1e-8) with its first cell exact."""
+    h0 = P0 / steps
+    fit = kernels.fit(kernels.PowerKernel(0.5, C / math.sqrt(math.pi)), TAU, tol=1e-8,
+                      relative=True, delta=h0)
+
+    def make(vb: float, h: float = h0) -> dmi.Solver:
+        """The belt at the speed vb with the step h (an autonomous orbit's period sets h): the
+        right-hand side compiled by numba (jit=True), the sign graph at mu_s in A, the fitted
+        fractional kernel with its first cell exact (the cell rule)."""
+        s = dmi.Solver(2, TAU, h=h)
+        s.set_rhs(lambda t, u: np.array([-(u[1] + vb), K * u[0] + weakening(u[1]) + C * W * vb]),
+                  jit=True)
+        s.set_friction([0.0, MU_S])
+        s.set_quadrature("cell")
+        s.set_kernel_fit(fit, entry=(1, 1))
+        return s
+    return make
+
+
+make = model(M)
 
 
 def period_changes(make_p, p: float, state: np.ndarray, steps: int, periods: int,

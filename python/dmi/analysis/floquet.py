@@ -37,7 +37,8 @@ error, or the pairs are not all verified, a *plain run* decides: the orbit pertu
 leading Ritz vector, run ``Verify.periods`` periods, its period-to-period change
 e_k = max |U(t + k P) - U(t + (k - 1) P)| over period k (a shift along an autonomous orbit, the
 trivial direction, cancels), the growth rate fitted to log e_k over the later periods.  A rate
-above 1 beyond three standard errors: False; below 1 beyond them (and the pair verified): True.
+above 1 beyond three standard errors and by 5 % or more over the periods fitted: False; below 1
+so (and the pairs verified): True.
 Otherwise ``None``, with a :class:`StabilityWarning` saying why: never True unverified.
 
 The trivial multiplier of an autonomous orbit (a shift along the orbit) is the Ritz pair whose
@@ -275,14 +276,14 @@ def _verify_pairs(A: sla.LinearOperator, half: sla.LinearOperator, mu: np.ndarra
 
 
 def growth_rate(F: StepMap, x: np.ndarray, v: np.ndarray, kick: float, periods: int
-                ) -> tuple[float, float]:
-    """(rate, standard error of its log) of a plain run from x + kick A Re(v) / |Re v|_inf (A
+                ) -> tuple[float, float, int]:
+    """(rate, standard error of its log, periods fitted) of a plain run from x + kick A Re(v) / |Re v|_inf (A
     the orbit's largest half range, max(1, |x|) for a constant orbit): e_k = max |U over period
     k - U over period k - 1| (a shift along an autonomous orbit cancels), the rate exp(slope)
     of a least-squares line through log e_k over the periods where e_k lies between the floor
     (100 times the fixed point's residual |F(x) - x|, plus rounding) and 0.1 A (beyond: not
     linear), from the first period on, the first third of those left out (the other modes
-    fade); (nan, nan) with fewer than 5 such periods."""
+    fade); (nan, nan, 0) with fewer than 5 such periods."""
     U = F.trajectory(x)
     A = float(np.max(0.5 * (U.max(axis=0) - U.min(axis=0))))
     scale = max(1.0, float(np.max(np.abs(x))))
@@ -299,14 +300,14 @@ def growth_rate(F: StepMap, x: np.ndarray, v: np.ndarray, kick: float, periods: 
     last = int(np.argmin(inside)) if not inside.all() else inside.size   # the first period out
     first = last // 3
     if last - first < 5:
-        return math.nan, math.nan
+        return math.nan, math.nan, 0
     k = np.arange(first, last, dtype=float)
     y = np.log(e[first:last])
     X = np.column_stack([np.ones_like(k), k])
     coef, *_ = np.linalg.lstsq(X, y, rcond=None)
     resid = y - X @ coef
     se = math.sqrt(float(resid @ resid) / max(1, k.size - 2) / float(np.sum((k - k.mean()) ** 2)))
-    return math.exp(float(coef[1])), se
+    return math.exp(float(coef[1])), se, last - first
 
 
 #: An autonomous orbit's trivial pair with an error above this may hide a second multiplier
@@ -329,16 +330,16 @@ def _verdict(F: StepMap, x: np.ndarray, mu: np.ndarray, V: np.ndarray, err: np.n
         j = out[0]
         return False, (f"unstable: |mu| = {abs(mu[j]):.6g} > 1 beyond its error {err[j]:.2g} "
                        "(verified)"), math.nan
-    if not rest:
-        return None, "no multiplier besides the trivial one: no verdict", math.nan
-    lead = rest[0]
-    inside = np.isfinite(err[lead]) and abs(mu[lead]) + err[lead] >= 1
-    if inside:
+    lead = rest[0] if rest else None
+    inside = lead is not None and np.isfinite(err[lead]) and abs(mu[lead]) + err[lead] >= 1
+    if lead is None:
+        why.append("no multiplier besides the trivial one was found")
+    elif inside:
         why.append(f"|mu| = {abs(mu[lead]):.6g} is within its error {err[lead]:.2g} of 1")
     if trivial is not None and err[trivial] > TRIVIAL_TOL:
         why.append(f"the trivial multiplier {mu[trivial]:.6g} has an error {err[trivial]:.2g} "
                    "that may hide a second multiplier beside 1")
-    if not why and converged:
+    if not why and converged and lead is not None:
         return True, (f"stable: the largest |mu| = {abs(mu[lead]):.6g} plus its error "
                       f"{err[lead]:.2g} is below 1 (verified)"), math.nan
     reason = "; ".join(why) if why else "ARPACK did not converge"
@@ -346,12 +347,16 @@ def _verdict(F: StepMap, x: np.ndarray, mu: np.ndarray, V: np.ndarray, err: np.n
         return None, f"undecided: {reason}", math.nan
     # a plain run from the orbit perturbed along every pair found (a multiplier hidden beside
     # one of them is excited too; the shift along the orbit cancels in e_k)
-    w = sum(V[:, j] / np.max(np.abs(V[:, j])) for j in range(mu.size))
-    rate, se = growth_rate(F, x, w, opts.kick, opts.periods)
+    w = sum((V[:, j] / np.max(np.abs(V[:, j])) for j in range(mu.size)),
+            np.random.default_rng(1).standard_normal(x.size) if lead is None else 0.0)
+    rate, se, span = growth_rate(F, x, w, opts.kick, opts.periods)
     what = f"a plain run of {opts.periods} periods from the orbit perturbed along the Ritz vectors"
-    if math.isfinite(rate) and math.log(rate) > 3 * se:
+    # decisive: beyond three standard errors, and a change by 5 % or more over the fit's periods
+    g = math.log(rate) if math.isfinite(rate) else 0.0
+    decisive = abs(g) > 3 * se and abs(g) * span >= 0.05
+    if decisive and g > 0:
         return False, f"unstable: {what} grows by {rate:.6g} a period ({reason})", rate
-    if math.isfinite(rate) and math.log(rate) < -3 * se and converged and not unver:
+    if decisive and g < 0 and converged and not unver and lead is not None:
         return True, f"stable: {what} decays by {rate:.6g} a period ({reason})", rate
     return None, (f"undecided: {reason}; {what} changes by {rate:.6g} a period, not "
                   "decisively (Verify.periods, Verify.kick)"), rate
@@ -372,7 +377,7 @@ def floquet(F: StepMap, x: np.ndarray, count: int = 10, *, autonomous: bool = Fa
     x : numpy.ndarray
         Its fixed point, e.g. ``orbit.state``.
     count : int
-        How many multipliers (>= 1).
+        How many multipliers (>= 1); an autonomous orbit gets one more, its trivial one.
     autonomous : bool
         An orbit of free period: its trivial multiplier (along the velocity) is found and left
         out of the verdict.

@@ -113,7 +113,7 @@ def make_orbit(F: StepMap, x: np.ndarray, res: list[float], multipliers: int,
         if fl.stable is None:
             warnings.warn(f"periodic orbit at p = {F.p!r}: stability not decided: {fl.reason}",
                           StabilityWarning, stacklevel=3)
-    mu = fl.multipliers[:multipliers + (1 if autonomous else 0)] if fl else np.empty(0, complex)
+    mu = fl.multipliers[:multipliers] if fl else np.empty(0, complex)
     return Orbit(p=F.p, period=F.M * F.h, steps=F.M, h=F.h, t=np.arange(F.M + 1) * F.h, u=U,
                  state=x, multipliers=mu, stable=fl.stable if fl else None,
                  stick_fraction=stick_fraction(U), iterations=len(res) - 1, residual=res[-1],

@@ -19,7 +19,8 @@ from .stepmap import Model, StepMap, build, state_of, steps_per_period
 def periodic_orbit(make: Model, p: float, period: float | None = None, guess: Any = None, *,
                    guess_period: float | None = None, steps: int | None = None,
                    tol: float = 1e-10, max_iter: int = 30, multipliers: int = 10,
-                   rows: int | None = None, verify: Verify | None = None) -> Orbit:
+                   rows: int | None = None, verify: Verify | None = None,
+                   constant: bool = False) -> Orbit:
     """The periodic orbit of the model near a guess, by shooting.
 
     Newton with GMRES on the matrix-free Jacobian of the M-step map (:mod:`dmi.analysis.stepmap`)
@@ -56,6 +57,10 @@ def periodic_orbit(make: Model, p: float, period: float | None = None, guess: An
         L, the rows of the state (default N + 1).
     verify : dmi.analysis.Verify, optional
         Tolerances and budgets of the multipliers' verification (default ``Verify()``).
+    constant : bool
+        Accept a constant orbit of an autonomous model at a fixed ``period`` (the scheme's
+        equilibrium as a fixed point of its M-step map, e.g. to continue the map's fixed points
+        with :func:`dmi.analysis.continue_orbit`); by default it is refused (ShootingError).
 
     Returns
     -------
@@ -106,7 +111,8 @@ def periodic_orbit(make: Model, p: float, period: float | None = None, guess: An
     x, res = newton(F, x0, tol=tol, max_iter=max_iter,
                     what=f"periodic orbit at p = {p!r}, period {period!r} = {M} steps")
     period_of_model(F, x, period)
-    constant_of_autonomous(F, x, tol, f"periodic orbit at p = {p!r}, period {period!r}")
+    if not constant:
+        constant_of_autonomous(F, x, tol, f"periodic orbit at p = {p!r}, period {period!r}")
     return make_orbit(F, x, res, multipliers, verify=verify)
 
 
@@ -131,7 +137,8 @@ def constant_of_autonomous(F: StepMap, x: np.ndarray, tol: float, what: str) -> 
                         "on t there): a constant state is periodic with any period; for the "
                         "model's own orbits use period=None with guess_period (an autonomous "
                         "orbit) from a guess that moves, or hopf_orbit from a Hopf point; for "
-                        "the equilibrium's stability dmi.analysis.equilibrium", [])
+                        "the equilibrium's stability dmi.analysis.equilibrium (constant=True "
+                        "accepts it as a fixed point of the M-step map)", [])
 
 
 def period_of_model(F: StepMap, x: np.ndarray, period: float) -> None:
