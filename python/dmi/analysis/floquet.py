@@ -208,7 +208,14 @@ class Floquet:
     products: int = 0
 
     def nontrivial(self) -> np.ndarray:
-        """The multipliers without the trivial one (all of them for a forced orbit)."""
+        """The multipliers without the trivial one.
+
+        Returns
+        -------
+        numpy.ndarray of complex
+            ``multipliers`` less the trivial one (all of them for a forced orbit), largest
+            |mu| first.
+        """
         if self.trivial is None:
             return self.multipliers
         return np.delete(self.multipliers, self.trivial)

@@ -117,10 +117,11 @@ def periodic_orbit(make: Model, p: float, period: float | None = None, guess: An
 
 
 def constant_of_autonomous(F: StepMap, x: np.ndarray, tol: float, what: str) -> None:
-    """ShootingError when the fixed point x of F is a constant state (its rows differ by at most
-    1e3 tol max(1, |x|)) and the model's rhs does not depend on t there (at 8 times over the
-    period): an equilibrium of an autonomous model, periodic with any period, no orbit.  (A
-    forced model's constant orbit, a mass stuck throughout under a weak forcing, is kept.)"""
+    """ShootingError when the fixed point x of F is a constant state u (its rows differ by at
+    most 1e3 tol max(1, |x|)) and the model's rhs does not depend on t at u nor at u + 1e-3
+    max(1, |x|) e_i (at 8 times over the period): an equilibrium of an autonomous model,
+    periodic with any period, no orbit.  (A forced model's constant orbit, a mass stuck
+    throughout under a weak forcing, the rest of a parametric forcing, is kept.)"""
     X = np.asarray(x).reshape(F.L, F.n)
     spread = float(np.max(X.max(axis=0) - X.min(axis=0)))
     scale = max(1.0, float(np.max(np.abs(X))))
@@ -128,10 +129,13 @@ def constant_of_autonomous(F: StepMap, x: np.ndarray, tol: float, what: str) -> 
         return
     s, u = F.solver, X[-1]
     if s.has("rhs"):
-        f0 = s.eval_rhs(0.0, u)
-        for t in np.linspace(0.0, F.M * F.h, 9)[1:]:
-            if not np.array_equal(s.eval_rhs(float(t), u), f0):
-                return            # forced: a constant orbit under a forcing is an orbit
+        # at u and beside it (a parametric forcing b cos(w t) x vanishes at x = 0 only)
+        d = 1e-3 * scale
+        for w in [u] + [u + d * e for e in np.eye(F.n)]:
+            f0 = s.eval_rhs(0.0, w)
+            for t in np.linspace(0.0, F.M * F.h, 9)[1:]:
+                if not np.array_equal(s.eval_rhs(float(t), w), f0):
+                    return        # forced: a constant orbit under a forcing is an orbit
     raise ShootingError(f"{what}: converged to an equilibrium of an autonomous model, {u!r}, "
                         f"not an orbit (its rows differ by {spread:.3g}; the rhs does not depend "
                         "on t there): a constant state is periodic with any period; for the "
