@@ -87,3 +87,19 @@ def period_changes(make_p, p: float, state: np.ndarray, steps: int, periods: int
     return np.array([np.max(np.abs(U[k * steps + 1:(k + 1) * steps + 1]
                                    - U[(k - 1) * steps + 1:k * steps + 1]))
                      for k in range(1, periods)])
+
+
+def amplitude_deviation(make_p, p: float, state: np.ndarray, steps: int, periods: int,
+                        kick: float, amplitude: np.ndarray) -> np.ndarray:
+    """max_i |A_i(k) - amplitude_i| for each period k of a plain run from the orbit's state with
+    kick added to its last row's y, A_i(k) the half range of u_i over period k: how far the run
+    is from the orbit across it (a shift along the orbit leaves the amplitude alone)."""
+    s = make_p(p)
+    X = np.array(np.asarray(state).reshape(-1, 2)[-(s.N + 1):])
+    X[-1, 1] += kick
+    s.init()
+    s.set_window(X)
+    U = s.run(periods * steps)[1]
+    s.close()
+    B = U[1:].reshape(periods, steps, 2)
+    return np.max(np.abs(0.5 * (B.max(axis=1) - B.min(axis=1)) - amplitude), axis=1)

@@ -37,8 +37,10 @@ error, or the pairs are not all verified, a *plain run* decides: the orbit pertu
 leading Ritz vector, run ``Verify.periods`` periods, its period-to-period change
 e_k = max |U(t + k P) - U(t + (k - 1) P)| over period k (a shift along an autonomous orbit, the
 trivial direction, cancels), the growth rate fitted to log e_k over the later periods.  A rate
-above 1 beyond three standard errors and by 5 % or more over the periods fitted: False; below 1
-so (and the pairs verified): True.
+above 1 beyond three standard errors and by 5 % or more over the periods fitted, the run's last
+period at least twice as far from the orbit as its first (across the orbit, for an autonomous
+one: a scheme's orbit can drift along itself for hundreds of periods and lock on again): False;
+below 1 so, the last period at most half as far (and the pairs verified): True.
 Otherwise ``None``, with a :class:`StabilityWarning` saying why: never True unverified.
 
 The trivial multiplier of an autonomous orbit (a shift along the orbit) is the Ritz pair whose
@@ -149,8 +151,10 @@ class Verify:
     periods : int
         The plain run's length (periods) where the verdict is left to it; 0: no plain run.
     kick : float
-        The plain run's perturbation, kick A along the Ritz vector (|v|_inf = 1), A the orbit's
-        largest half range (or max(1, |x|) for a constant orbit).
+        The plain run's perturbation, kick A along the Ritz vectors (|v|_inf = 1), A the
+        orbit's largest half range (or max(1, |x|) for a constant orbit), and at least the
+        difference step (on an orbit with switches: smaller kicks see the scheme's switches
+        frozen at their steps, where an orbit can drift along itself and lock on again).
     """
     fixed_point_tol: float = 1e-6
     krylov: int | None = None
@@ -282,15 +286,42 @@ def _verify_pairs(A: sla.LinearOperator, half: sla.LinearOperator, mu: np.ndarra
     return err, res, noise
 
 
-def growth_rate(F: StepMap, x: np.ndarray, v: np.ndarray, kick: float, periods: int
-                ) -> tuple[float, float, int]:
-    """(rate, standard error of its log, periods fitted) of a plain run from x + kick A Re(v) / |Re v|_inf (A
-    the orbit's largest half range, max(1, |x|) for a constant orbit): e_k = max |U over period
-    k - U over period k - 1| (a shift along an autonomous orbit cancels), the rate exp(slope)
-    of a least-squares line through log e_k over the periods where e_k lies between the floor
-    (100 times the fixed point's residual |F(x) - x|, plus rounding) and 0.1 A (beyond: not
-    linear), from the first period on, the first third of those left out (the other modes
-    fade); (nan, nan, 0) with fewer than 5 such periods."""
+def off_orbit(B: np.ndarray, P: np.ndarray, h: float, autonomous: bool) -> float:
+    """How far one period B (M rows) of a run lies from the orbit's period P (M rows, the same
+    steps of the orbit, read periodically): the median over the steps of |B - P|_2; on an
+    autonomous orbit across the orbit only, after the best shift by whole steps and by the
+    fraction delta of a step along the velocity P' (least squares), so that a run that only
+    drifts along the orbit comes out near 0 (the median passes over the few steps at a switch,
+    where a shift by a fraction of a step is no multiple of P')."""
+    P = np.asarray(P)
+    if not autonomous:
+        return float(np.median(np.linalg.norm(B - P, axis=1)))
+    M = P.shape[0]
+    # B[i] against P[(i + j) mod M] for every shift j: the best j
+    idx = (np.arange(M)[None, :] + np.arange(M)[:, None]) % M       # [j, i]
+    j = int(np.argmin(np.sum((B[None, :, :] - P[idx]) ** 2, axis=(1, 2))))
+    Pj = P[idx[j]]
+    V = (P[(idx[j] + 1) % M] - P[(idx[j] - 1) % M]) / (2 * h)
+    vv = float(np.sum(V * V))
+    d = float(np.sum((B - Pj) * V)) / vv if vv > 0 else 0.0
+    return float(np.median(np.linalg.norm(B - Pj - d * V, axis=1)))
+
+
+def growth_rate(F: StepMap, x: np.ndarray, v: np.ndarray, kick: float, periods: int,
+                autonomous: bool = False, least: float = 0.0
+                ) -> tuple[float, float, int, float]:
+    """(rate, standard error of its log, periods fitted, moved) of a plain run from
+    x + max(kick A, least) Re(v) / |Re v|_inf (A the orbit's largest half range, max(1, |x|)
+    for a constant orbit; ``least``: the difference step, so that the run sees the scale the
+    multipliers describe, where a switch moves by many steps): e_k = max |U over period k - U over period k - 1| (a shift along an autonomous orbit
+    cancels), the rate exp(slope) of a least-squares line through log e_k over the periods where
+    e_k lies between the floor (100 times the fixed point's residual |F(x) - x|, plus rounding)
+    and 0.1 A (beyond: not linear), from the first period on, the first third of those left out
+    (the other modes fade); a run that falls to the floor and stays there: the bound
+    (floor / e_1)^(1 / k) over the k periods it took (standard error 0); (nan, nan, 0) with
+    fewer than 5 such periods.  ``moved``: :func:`off_orbit` of the last period over the
+    first's (an autonomous scheme's orbit can drift along itself for hundreds of periods, which
+    e_k sees as growth, and then lock onto it again)."""
     U = F.trajectory(x)
     A = float(np.max(0.5 * (U.max(axis=0) - U.min(axis=0))))
     scale = max(1.0, float(np.max(np.abs(x))))
@@ -300,21 +331,28 @@ def growth_rate(F: StepMap, x: np.ndarray, v: np.ndarray, kick: float, periods: 
     w = w / np.max(np.abs(w))
     floor = 100 * float(np.max(np.abs(F(x) - x))) + 1e-13 * scale
     M = F.M
-    R = F.run_from(x + kick * A * w, periods * M)
+    R = F.run_from(x + max(kick * A, least) * w, periods * M)
+    first_off = off_orbit(R[1:M + 1], U[1:], F.h, autonomous)
+    last_off = off_orbit(R[(periods - 1) * M + 1:], U[1:], F.h, autonomous)
+    moved = last_off / first_off if first_off > 0 else math.nan
     e = np.array([np.max(np.abs(R[k * M + 1:(k + 1) * M + 1] - R[(k - 1) * M + 1:k * M + 1]))
                   for k in range(1, periods)])
     inside = (e > floor) & (e < 0.1 * A)
     last = int(np.argmin(inside)) if not inside.all() else inside.size   # the first period out
+    if last < inside.size and e[last] <= floor and np.all(e[last:] <= floor) and e[0] > floor:
+        # down to the floor and staying there (a stuck phase wipes a perturbation out): a
+        # decay by floor / e_1 at least over those periods, no fit
+        return (floor / e[0]) ** (1 / max(1, last)), 0.0, max(1, last), moved
     first = last // 3
     if last - first < 5:
-        return math.nan, math.nan, 0
+        return math.nan, math.nan, 0, moved
     k = np.arange(first, last, dtype=float)
     y = np.log(e[first:last])
     X = np.column_stack([np.ones_like(k), k])
     coef, *_ = np.linalg.lstsq(X, y, rcond=None)
     resid = y - X @ coef
     se = math.sqrt(float(resid @ resid) / max(1, k.size - 2) / float(np.sum((k - k.mean()) ** 2)))
-    return math.exp(float(coef[1])), se, last - first
+    return math.exp(float(coef[1])), se, last - first, moved
 
 
 #: An autonomous orbit's trivial pair with an error above this may hide a second multiplier
@@ -325,7 +363,7 @@ TRIVIAL_TOL = 1e-6
 
 def _verdict(F: StepMap, x: np.ndarray, mu: np.ndarray, V: np.ndarray, err: np.ndarray,
              res: np.ndarray, trivial: int | None, converged: bool, why: list[str],
-             opts: Verify) -> tuple[bool | None, str, float]:
+             opts: Verify, eps: float) -> tuple[bool | None, str, float]:
     """(stable, reason, plain run's rate) from the verified pairs (see the module)."""
     rest = [j for j in range(mu.size) if j != trivial]
     unver = [j for j in rest if not np.isfinite(err[j])]
@@ -356,17 +394,21 @@ def _verdict(F: StepMap, x: np.ndarray, mu: np.ndarray, V: np.ndarray, err: np.n
     # one of them is excited too; the shift along the orbit cancels in e_k)
     w = sum((V[:, j] / np.max(np.abs(V[:, j])) for j in range(mu.size)),
             np.random.default_rng(1).standard_normal(x.size) if lead is None else 0.0)
-    rate, se, span = growth_rate(F, x, w, opts.kick, opts.periods)
+    rate, se, span, moved = growth_rate(F, x, w, opts.kick, opts.periods, trivial is not None,
+                                        eps)
     what = f"a plain run of {opts.periods} periods from the orbit perturbed along the Ritz vectors"
-    # decisive: beyond three standard errors, and a change by 5 % or more over the fit's periods
+    # decisive: beyond three standard errors, by 5 % or more over the fit's periods, and the
+    # run's last period as far again from the orbit (across it) as its first (or half as far)
     g = math.log(rate) if math.isfinite(rate) else 0.0
     decisive = abs(g) > 3 * se and abs(g) * span >= 0.05
-    if decisive and g > 0:
-        return False, f"unstable: {what} grows by {rate:.6g} a period ({reason})", rate
-    if decisive and g < 0 and converged and not unver and lead is not None:
+    if decisive and g > 0 and moved >= 2:
+        return False, (f"unstable: {what} grows by {rate:.6g} a period, {moved:.3g} times as "
+                       f"far from the orbit at its end ({reason})"), rate
+    if decisive and g < 0 and moved <= 0.5 and converged and not unver and lead is not None:
         return True, f"stable: {what} decays by {rate:.6g} a period ({reason})", rate
-    return None, (f"undecided: {reason}; {what} changes by {rate:.6g} a period, not "
-                  "decisively (Verify.periods, Verify.kick)"), rate
+    return None, (f"undecided: {reason}; {what} changes by {rate:.6g} a period and ends "
+                  f"{moved:.3g} times as far from the orbit as it began, not decisive "
+                  "(Verify.periods, Verify.kick)"), rate
 
 
 def floquet(F: StepMap, x: np.ndarray, count: int = 10, *, autonomous: bool = False,
@@ -439,7 +481,7 @@ def floquet(F: StepMap, x: np.ndarray, count: int = 10, *, autonomous: bool = Fa
             why.append(f"no Ritz vector lies along the orbit's velocity (best alignment "
                        f"{align[j]:.2f}): the trivial multiplier is not among those found")
     mu[np.abs(mu) < 1e-12] = 0.0
-    stable, reason, rate = _verdict(F, x, mu, V, err, res, trivial, converged, why, opts)
+    stable, reason, rate = _verdict(F, x, mu, V, err, res, trivial, converged, why, opts, e)
     products = (F.evaluations - start) // (2 if central else 1)
     return Floquet(mu, err, V, trivial, stable, reason, rate, products)
 
