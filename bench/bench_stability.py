@@ -159,7 +159,7 @@ def bench_chart(P: int, Q: int, N: int, workers: int, dask: bool, rounds: int) -
 
 def bench_verdict(Ms: list[int]) -> None:
     """The verdict of the belt's orbits (amplitudes 0.05 and 0.8) at each M: wall-clock time of
-    floquet() at the orbit found by hopf_orbit (without multipliers), against one period."""
+    floquet_verdict() at the orbit found by hopf_orbit (without multipliers), against one period."""
     import stribeck_belt as belt
     for M in Ms:
         make = belt.model(M)
@@ -174,7 +174,7 @@ def bench_verdict(Ms: list[int]) -> None:
             F.trajectory(o.state)
             one = time.perf_counter() - t0
             t0 = time.perf_counter()
-            fl = analysis.floquet(F, o.state, 10, autonomous=True)
+            fl = analysis.floquet_verdict(F, o.state, 10, autonomous=True)
             took = time.perf_counter() - t0
             print(f"M = {M} (N = {F.N}, state {F.dim} values), amplitude {amplitude}: verdict "
                   f"{fl.stable} in {took:.1f} s ({took / one:.0f} periods' time; one period "

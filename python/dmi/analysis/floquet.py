@@ -17,7 +17,7 @@ them, error O(h^(2/3)) (0.2 % at M = 2e4 against Den Hartog's saltation oracle, 
 tests/python/test_analysis_orbit_oracles.py).  Multipliers of a stuck phase come out exactly
 0: a perturbation that keeps the stick is wiped out.
 
-The leading multipliers (:func:`floquet`, :func:`floquet_multipliers`) are the eigenvalues of
+The leading multipliers (:func:`floquet_verdict`, :func:`floquet_multipliers`) are the eigenvalues of
 largest modulus of that operator (a ``scipy.sparse.linalg.LinearOperator``) by ARPACK
 (``scipy.sparse.linalg.eigs``, implicitly restarted Arnoldi) on a Krylov space wide enough for a
 ring of multipliers of nearly equal modulus (a long memory), the whole matrix for states of at
@@ -33,14 +33,14 @@ pair's accuracy (2e-4 on the Bagley-Torvik example's ring, against 1e-6 asked of
 The verdict ``stable``: False when a verified multiplier other than the trivial one has
 |mu| - 1 above its error; True when the Krylov iteration converged, all pairs are verified and
 the largest nontrivial |mu| + error < 1; where the largest nontrivial |mu| - 1 lies inside its
-error, or the pairs are not all verified, a *plain run* decides: the orbit perturbed along the
-leading Ritz vector, run ``Verify.periods`` periods, its period-to-period change
-e_k = max |U(t + k P) - U(t + (k - 1) P)| over period k (a shift along an autonomous orbit, the
-trivial direction, cancels), the growth rate fitted to log e_k over the later periods.  A rate
-above 1 beyond three standard errors and by 5 % or more over the periods fitted, the run's last
-period at least twice as far from the orbit as its first (across the orbit, for an autonomous
-one: a scheme's orbit can drift along itself for hundreds of periods and lock on again): False;
-below 1 so, the last period at most half as far (and the pairs verified): True.
+error, or the pairs are not all verified (or, on an autonomous orbit, the trivial pair's error
+leaves room for a second multiplier beside 1), a *plain run* decides: the orbit perturbed
+along the Ritz vectors (by ``Verify.kick`` of its amplitude, and at least the difference step),
+run ``Verify.periods`` periods; its distance from the orbit period by period (across the orbit,
+for an autonomous one: a scheme's stick-slip orbit kicked by less than a step's worth of switch
+motion drifts along itself by fractions of a step for hundreds of periods and locks on again),
+the growth rate fitted to its log.  Growth beyond three standard errors and by 5 % or more over
+the periods fitted: False; decay so (and the pairs verified): True.
 Otherwise ``None``, with a :class:`StabilityWarning` saying why: never True unverified.
 
 The trivial multiplier of an autonomous orbit (a shift along the orbit) is the Ritz pair whose
@@ -133,7 +133,7 @@ class StabilityWarning(RuntimeWarning):
 
 @dataclass(frozen=True)
 class Verify:
-    """How :func:`floquet` verifies the leading multipliers (also ``verify=`` of
+    """How :func:`floquet_verdict` verifies the leading multipliers (also ``verify=`` of
     :func:`floquet_multipliers`, :func:`dmi.analysis.periodic_orbit` and
     :func:`dmi.analysis.hopf_orbit`).
 
@@ -289,70 +289,82 @@ def _verify_pairs(A: sla.LinearOperator, half: sla.LinearOperator, mu: np.ndarra
 def off_orbit(B: np.ndarray, P: np.ndarray, h: float, autonomous: bool) -> float:
     """How far one period B (M rows) of a run lies from the orbit's period P (M rows, the same
     steps of the orbit, read periodically): the median over the steps of |B - P|_2; on an
-    autonomous orbit across the orbit only, after the best shift by whole steps and by the
-    fraction delta of a step along the velocity P' (least squares), so that a run that only
-    drifts along the orbit comes out near 0 (the median passes over the few steps at a switch,
-    where a shift by a fraction of a step is no multiple of P')."""
+    autonomous orbit across the orbit only, after the best shift by whole steps (B's first row
+    against every row of P, then the whole period within 8 steps of that) and by the fraction
+    delta of a step along the velocity P' (least squares), so that a run that only drifts along
+    the orbit comes out near 0 (the median passes over the few steps at a switch, where a shift
+    by a fraction of a step is no multiple of P')."""
     P = np.asarray(P)
     if not autonomous:
         return float(np.median(np.linalg.norm(B - P, axis=1)))
     M = P.shape[0]
-    # B[i] against P[(i + j) mod M] for every shift j: the best j
-    idx = (np.arange(M)[None, :] + np.arange(M)[:, None]) % M       # [j, i]
-    j = int(np.argmin(np.sum((B[None, :, :] - P[idx]) ** 2, axis=(1, 2))))
-    Pj = P[idx[j]]
-    V = (P[(idx[j] + 1) % M] - P[(idx[j] - 1) % M]) / (2 * h)
+    j0 = int(np.argmin(np.sum((P - B[0]) ** 2, axis=1)))
+    rows = np.arange(M)
+    best = None
+    for j in range(j0 - 8, j0 + 9):
+        r = float(np.sum((B - P[(rows + j) % M]) ** 2))
+        if best is None or r < best[0]:
+            best = (r, j)
+    idx = (rows + best[1]) % M
+    Pj = P[idx]
+    V = (P[(idx + 1) % M] - P[(idx - 1) % M]) / (2 * h)
     vv = float(np.sum(V * V))
     d = float(np.sum((B - Pj) * V)) / vv if vv > 0 else 0.0
     return float(np.median(np.linalg.norm(B - Pj - d * V, axis=1)))
 
 
 def growth_rate(F: StepMap, x: np.ndarray, v: np.ndarray, kick: float, periods: int,
-                autonomous: bool = False, least: float = 0.0
-                ) -> tuple[float, float, int, float]:
-    """(rate, standard error of its log, periods fitted, moved) of a plain run from
-    x + max(kick A, least) Re(v) / |Re v|_inf (A the orbit's largest half range, max(1, |x|)
-    for a constant orbit; ``least``: the difference step, so that the run sees the scale the
-    multipliers describe, where a switch moves by many steps): e_k = max |U over period k - U over period k - 1| (a shift along an autonomous orbit
-    cancels), the rate exp(slope) of a least-squares line through log e_k over the periods where
-    e_k lies between the floor (100 times the fixed point's residual |F(x) - x|, plus rounding)
-    and 0.1 A (beyond: not linear), from the first period on, the first third of those left out
-    (the other modes fade); a run that falls to the floor and stays there: the bound
-    (floor / e_1)^(1 / k) over the k periods it took (standard error 0); (nan, nan, 0) with
-    fewer than 5 such periods.  ``moved``: :func:`off_orbit` of the last period over the
-    first's (an autonomous scheme's orbit can drift along itself for hundreds of periods, which
-    e_k sees as growth, and then lock onto it again)."""
+                autonomous: bool = False, least: float = 0.0) -> tuple[float, float, int]:
+    """(rate, standard error of its log, periods fitted) of a plain run from
+    x + max(kick A, least) Re(v) / |Re v_0|_inf (v_0: v's last row, the state at t = 0; A the
+    orbit's largest half range, max(1, |x|) for a constant orbit; ``least``: the difference
+    step, so that the run sees the scale the multipliers describe, where a switch moves by
+    many steps).
+
+    d_k = :func:`off_orbit` of period k (across the orbit, for an autonomous one: a scheme's
+    orbit can drift along itself by fractions of a step for hundreds of periods and lock on
+    again), the rate exp(slope) of a least-squares line through log d_k over the periods where
+    d_k lies between the floor (100 times the fixed point's residual |F(x) - x|, the shift's
+    interpolation error h^2 |U''| / 8 (a median over the period), rounding) and 0.1 A (beyond:
+    not linear), the first third of those left out (the other modes fade); a run that falls
+    to the floor and never comes back to a tenth of d_0: the bound (floor / d_0)^(1 / k) over
+    the k periods it took (standard error 0); (nan, nan, 0) with fewer than 5 such periods."""
     U = F.trajectory(x)
     A = float(np.max(0.5 * (U.max(axis=0) - U.min(axis=0))))
     scale = max(1.0, float(np.max(np.abs(x))))
     if not A > 0:
         A = scale
     w = np.real(v) if np.max(np.abs(np.real(v))) >= np.max(np.abs(np.imag(v))) else np.imag(v)
-    w = w / np.max(np.abs(w))
-    floor = 100 * float(np.max(np.abs(F(x) - x))) + 1e-13 * scale
+    now = float(np.max(np.abs(w[-F.n:])))     # the kick's size is that of the state at t = 0
+    w = w / (now if now > 1e-3 * np.max(np.abs(w)) else np.max(np.abs(w)))
+    P = U[1:]
+    curv = 0.0
+    if autonomous:
+        Q = np.concatenate([P[-1:], P, P[:1]])
+        curv = float(np.median(np.linalg.norm(Q[2:] - 2 * Q[1:-1] + Q[:-2], axis=1))) / 8
+    floor = 100 * float(np.max(np.abs(F(x) - x))) + curv + 1e-13 * scale
     M = F.M
     R = F.run_from(x + max(kick * A, least) * w, periods * M)
-    first_off = off_orbit(R[1:M + 1], U[1:], F.h, autonomous)
-    last_off = off_orbit(R[(periods - 1) * M + 1:], U[1:], F.h, autonomous)
-    moved = last_off / first_off if first_off > 0 else math.nan
-    e = np.array([np.max(np.abs(R[k * M + 1:(k + 1) * M + 1] - R[(k - 1) * M + 1:k * M + 1]))
-                  for k in range(1, periods)])
-    inside = (e > floor) & (e < 0.1 * A)
+    d = np.array([off_orbit(R[k * M + 1:(k + 1) * M + 1], P, F.h, autonomous)
+                  for k in range(periods)])
+    inside = (d > floor) & (d < 0.1 * A)
     last = int(np.argmin(inside)) if not inside.all() else inside.size   # the first period out
-    if last < inside.size and e[last] <= floor and np.all(e[last:] <= floor) and e[0] > floor:
-        # down to the floor and staying there (a stuck phase wipes a perturbation out): a
-        # decay by floor / e_1 at least over those periods, no fit
-        return (floor / e[0]) ** (1 / max(1, last)), 0.0, max(1, last), moved
+    if last < inside.size and d[last] <= floor and d[0] > floor \
+            and np.max(d[last:]) <= max(floor, 0.1 * d[0]):
+        # down to the floor, never back to a tenth of the kick (a stuck phase wipes a
+        # perturbation out; what stays is the shift's interpolation as the run drifts along
+        # the orbit): a decay by floor / d_0 at least over those periods, no fit
+        return (floor / d[0]) ** (1 / max(1, last)), 0.0, max(1, last)
     first = last // 3
     if last - first < 5:
-        return math.nan, math.nan, 0, moved
+        return math.nan, math.nan, 0
     k = np.arange(first, last, dtype=float)
-    y = np.log(e[first:last])
+    y = np.log(d[first:last])
     X = np.column_stack([np.ones_like(k), k])
     coef, *_ = np.linalg.lstsq(X, y, rcond=None)
     resid = y - X @ coef
     se = math.sqrt(float(resid @ resid) / max(1, k.size - 2) / float(np.sum((k - k.mean()) ** 2)))
-    return math.exp(float(coef[1])), se, last - first, moved
+    return math.exp(float(coef[1])), se, last - first
 
 
 #: An autonomous orbit's trivial pair with an error above this may hide a second multiplier
@@ -394,24 +406,21 @@ def _verdict(F: StepMap, x: np.ndarray, mu: np.ndarray, V: np.ndarray, err: np.n
     # one of them is excited too; the shift along the orbit cancels in e_k)
     w = sum((V[:, j] / np.max(np.abs(V[:, j])) for j in range(mu.size)),
             np.random.default_rng(1).standard_normal(x.size) if lead is None else 0.0)
-    rate, se, span, moved = growth_rate(F, x, w, opts.kick, opts.periods, trivial is not None,
-                                        eps)
-    what = f"a plain run of {opts.periods} periods from the orbit perturbed along the Ritz vectors"
-    # decisive: beyond three standard errors, by 5 % or more over the fit's periods, and the
-    # run's last period as far again from the orbit (across it) as its first (or half as far)
+    rate, se, span = growth_rate(F, x, w, opts.kick, opts.periods, trivial is not None, eps)
+    what = (f"a plain run of {opts.periods} periods from the orbit perturbed along the Ritz "
+            "vectors, its distance from the orbit")
+    # decisive: beyond three standard errors, and by 5 % or more over the fit's periods
     g = math.log(rate) if math.isfinite(rate) else 0.0
     decisive = abs(g) > 3 * se and abs(g) * span >= 0.05
-    if decisive and g > 0 and moved >= 2:
-        return False, (f"unstable: {what} grows by {rate:.6g} a period, {moved:.3g} times as "
-                       f"far from the orbit at its end ({reason})"), rate
-    if decisive and g < 0 and moved <= 0.5 and converged and not unver and lead is not None:
+    if decisive and g > 0:
+        return False, f"unstable: {what} grows by {rate:.6g} a period ({reason})", rate
+    if decisive and g < 0 and converged and not unver and lead is not None:
         return True, f"stable: {what} decays by {rate:.6g} a period ({reason})", rate
-    return None, (f"undecided: {reason}; {what} changes by {rate:.6g} a period and ends "
-                  f"{moved:.3g} times as far from the orbit as it began, not decisive "
-                  "(Verify.periods, Verify.kick)"), rate
+    return None, (f"undecided: {reason}; {what} changes by {rate:.6g} a period, not "
+                  "decisively (Verify.periods, Verify.kick)"), rate
 
 
-def floquet(F: StepMap, x: np.ndarray, count: int = 10, *, autonomous: bool = False,
+def floquet_verdict(F: StepMap, x: np.ndarray, count: int = 10, *, autonomous: bool = False,
             eps: float | None = None, central: bool = True, verify: Verify | None = None
             ) -> Floquet:
     """The leading Floquet multipliers of a periodic orbit, verified, and its stability verdict.
@@ -490,12 +499,12 @@ def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
                         eps: float | None = None, central: bool = True,
                         autonomous: bool = False, verify: Verify | None = None) -> np.ndarray:
     """The leading Floquet multipliers of a periodic orbit, right at stick/slip transitions,
-    verified (:func:`floquet`, which also gives their errors and the stability verdict).
+    verified (:func:`floquet_verdict`, which also gives their errors and the stability verdict).
 
     The monodromy operator by central differences with a step that moves the switches by many
     steps (:func:`fd_step`; the smooth step on an orbit with no switch to carry); its eigenvalues
     of largest modulus by ARPACK (the whole matrix for states of at most 64 values), each pair's
-    error bound from a fresh residual and the operator's noise (:func:`floquet`'s ``errors``).
+    error bound from a fresh residual and the operator's noise (:func:`floquet_verdict`'s ``errors``).
     A multiplier without a bound (residual + noise above 0.5) is still returned, with a
     :class:`StabilityWarning` naming it.
 
@@ -529,7 +538,7 @@ def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
         x is not a fixed point of F (the residual is given), count < 1.
     """
     opts = Verify(periods=0) if verify is None else verify
-    fl = floquet(F, x, count, autonomous=autonomous, eps=eps, central=central, verify=opts)
+    fl = floquet_verdict(F, x, count, autonomous=autonomous, eps=eps, central=central, verify=opts)
     bad = np.flatnonzero(~np.isfinite(fl.errors[:count]))
     if bad.size:
         warnings.warn(f"floquet_multipliers: {bad.size} of {min(count, fl.multipliers.size)} "

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .floquet import Floquet, StabilityWarning, Verify, floquet
+from .floquet import Floquet, StabilityWarning, Verify, floquet_verdict
 from .stepmap import Model, StepMap
 
 @dataclass
@@ -33,7 +33,7 @@ class Orbit:
     state : numpy.ndarray
         The shooting state: L n values, rows oldest first, the last at t = 0.
     multipliers : numpy.ndarray of complex
-        The leading Floquet multipliers, largest |mu| first (verified: ``floquet.errors``).
+        The leading Floquet multipliers, largest |mu| first (verified: ``floquet.errors``, the Orbit's Floquet record).
     stable : bool or None
         True: verified stable, all |mu| < 1 beyond their errors (an autonomous orbit: all but
         its trivial multiplier, found by its vector along the velocity); False: verified
@@ -55,7 +55,7 @@ class Orbit:
         True for an orbit of free period (its phase's multiplier is 1).
     floquet : Floquet or None
         The multipliers' errors, vectors, the trivial one's index and the verdict's reason
-        (:func:`dmi.analysis.floquet.floquet`); None without multipliers.
+        (:func:`dmi.analysis.floquet_verdict`); None without multipliers.
     """
     p: float
     period: float
@@ -103,13 +103,13 @@ def stick_fraction(u: np.ndarray) -> np.ndarray:
 def make_orbit(F: StepMap, x: np.ndarray, res: list[float], multipliers: int,
                autonomous: bool = False, verify: Verify | None = None) -> Orbit:
     """The Orbit at the fixed point x of F (one more run for t, u; the multipliers, verified by
-    :func:`dmi.analysis.floquet.floquet` with ``verify``).  An ``autonomous`` orbit's ``stable``
+    :func:`dmi.analysis.floquet_verdict` with ``verify``).  An ``autonomous`` orbit's ``stable``
     leaves out its trivial multiplier; ``stable`` None (with a StabilityWarning) when nothing
     decided, or without multipliers."""
     U = F.trajectory(x)
     fl = None
     if multipliers > 0:
-        fl = floquet(F, x, multipliers, autonomous=autonomous, verify=verify)
+        fl = floquet_verdict(F, x, multipliers, autonomous=autonomous, verify=verify)
         if fl.stable is None:
             warnings.warn(f"periodic orbit at p = {F.p!r}: stability not decided: {fl.reason}",
                           StabilityWarning, stacklevel=3)
