@@ -212,7 +212,8 @@ def kernel_panels(call: Callable[[float], np.ndarray], tau: float, reach: float
 
 def kernel_integral(s: Solver) -> np.ndarray:
     """int_0^tau H(s) ds (n x n) of the model's kernel: Hhat(0) in closed form for an
-    exponential sum (with a fitted singular kernel's exact near part), by the panels' quadrature for a callback, 0 without a kernel."""
+    exponential sum (with a fitted singular kernel's exact near part), by the panels'
+    quadrature for a callback, 0 without a kernel."""
     terms, kernel = kernel_of(s)
     if terms is not None:
         near = near_shift(s)      # a fitted singular kernel: exact on [0, delta]

@@ -17,8 +17,8 @@ them, error O(h^(2/3)) (0.2 % at M = 2e4 against Den Hartog's saltation oracle, 
 tests/python/test_analysis_orbit_oracles.py).  Multipliers of a stuck phase come out exactly
 0: a perturbation that keeps the stick is wiped out.
 
-The leading multipliers (:func:`floquet_verdict`, :func:`floquet_multipliers`) are the eigenvalues of
-largest modulus of that operator (a ``scipy.sparse.linalg.LinearOperator``) by ARPACK
+The leading multipliers (:func:`floquet_verdict`, :func:`floquet_multipliers`) are the
+eigenvalues of largest modulus of that operator (a ``scipy.sparse.linalg.LinearOperator``) by ARPACK
 (``scipy.sparse.linalg.eigs``, implicitly restarted Arnoldi) on a Krylov space wide enough for a
 ring of multipliers of nearly equal modulus (a long memory), the whole matrix for states of at
 most 64 values.  Each Ritz pair (mu, v) is then *verified* by fresh products: its residual
@@ -504,7 +504,8 @@ def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
     The monodromy operator by central differences with a step that moves the switches by many
     steps (:func:`fd_step`; the smooth step on an orbit with no switch to carry); its eigenvalues
     of largest modulus by ARPACK (the whole matrix for states of at most 64 values), each pair's
-    error bound from a fresh residual and the operator's noise (:func:`floquet_verdict`'s ``errors``).
+    error bound from a fresh residual and the operator's noise (``errors`` of
+    :func:`floquet_verdict`).
     A multiplier without a bound (residual + noise above 0.5) is still returned, with a
     :class:`StabilityWarning` naming it.
 

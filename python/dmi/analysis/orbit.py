@@ -33,7 +33,8 @@ class Orbit:
     state : numpy.ndarray
         The shooting state: L n values, rows oldest first, the last at t = 0.
     multipliers : numpy.ndarray of complex
-        The leading Floquet multipliers, largest |mu| first (verified: ``floquet.errors``, the Orbit's Floquet record).
+        The leading Floquet multipliers, largest |mu| first (their error bounds:
+        ``floquet.errors``).
     stable : bool or None
         True: verified stable, all |mu| < 1 beyond their errors (an autonomous orbit: all but
         its trivial multiplier, found by its vector along the velocity); False: verified

@@ -11,8 +11,8 @@ import numpy as np
 
 from .._solver import Solver
 from .autonomous import autonomous_orbit
-from .newton import ShootingError, newton
 from .floquet import Verify
+from .newton import ShootingError, newton
 from .orbit import Orbit, make_orbit
 from .stepmap import Model, StepMap, build, state_of, steps_per_period
 
