@@ -238,3 +238,13 @@ def test_stribeck_stick_slip_orbit_is_stable_as_plain_runs_come_back(belt_hopf):
     dev = belt.amplitude_deviation(o.make, o.p, o.state, belt.M, 100, 0.016, o.amplitude)
     assert dev[10] < 0.2 * dev[0] and np.max(dev[10:]) < 0.5 * dev[0], dev
     assert o.stable is True, o.floquet.reason
+
+
+def test_hopf_orbit_takes_the_verification_options(belt_hopf):
+    """verify= reaches the verdict: without a plain run (periods=0) the stick-slip orbit, whose
+    trivial pair leaves room for a second multiplier beside 1, is left undecided, with a
+    warning that says why."""
+    with pytest.warns(analysis.StabilityWarning, match="may hide a second multiplier"):
+        o = analysis.hopf_orbit(belt.make, belt_hopf.hopf, belt_hopf.u, amplitude=0.8,
+                                steps=belt.M, verify=analysis.Verify(periods=0))
+    assert o.stable is None and "undecided" in o.floquet.reason
