@@ -552,7 +552,9 @@ def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
 def ritz(F: StepMap, x: np.ndarray, count: int, *, blocks: int = 2,
          start: np.ndarray | None = None, eps: float | None = None, central: bool = True
          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(multipliers, Q, Z) of :func:`floquet_multipliers`: Q (dim, k) an orthonormal basis of the
+    """(multipliers, Q, Z) of Rayleigh-Ritz on ``blocks`` blocks of a block Krylov space of b =
+    count + 2 vectors (the continuation's multipliers along a branch, unverified; an orbit's
+    own are :func:`floquet_verdict`'s): Q (dim, k) an orthonormal basis of the
     dominant invariant subspace of the Ritz matrix (its k >= count + 2 eigenvalues of largest
     modulus; k = b, or b + 1 when a complex pair straddles the cut) and Z = A Q, so that Q' Z is
     the Ritz matrix there and Z Q' the operator's rank-k approximation on that subspace (the
