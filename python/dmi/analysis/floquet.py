@@ -151,10 +151,11 @@ class Verify:
     periods : int
         The plain run's length (periods) where the verdict is left to it; 0: no plain run.
     kick : float
-        The plain run's perturbation, kick A along the Ritz vectors (|v|_inf = 1), A the
-        orbit's largest half range (or max(1, |x|) for a constant orbit), and at least the
-        difference step (on an orbit with switches: smaller kicks see the scheme's switches
-        frozen at their steps, where an orbit can drift along itself and lock on again).
+        The plain run's perturbation along the Ritz vectors: the state at t = 0 moved by kick A
+        (A the orbit's largest half range, or max(1, |x|) for a constant orbit), and at least
+        by the difference step (on an orbit with switches: smaller kicks see the scheme's
+        switches frozen at their steps, where an orbit can drift along itself and lock on
+        again).
     """
     fixed_point_tol: float = 1e-6
     krylov: int | None = None
@@ -186,10 +187,10 @@ class Floquet:
     multipliers : numpy.ndarray of complex
         Largest |mu| first (dimensionless); below 1e-12 in modulus: 0 (a stuck phase's).
     errors : numpy.ndarray of float
-        Each multiplier's error bound (its residual plus the operator's noise); nan: not
-        verified.
+        Each multiplier's error bound (its residual plus the operator's noise); nan where
+        that exceeds 0.5 (no bound).
     vectors : numpy.ndarray of complex
-        Shape (dim, count): the Ritz vectors, |v|_2 = 1.
+        Shape (dim, k): the Ritz vectors, |v|_2 = 1, one for each multiplier.
     trivial : int or None
         An autonomous orbit: the index of its trivial multiplier (the vector along the orbit's
         velocity); None for a forced orbit, or when none of the pairs lies along the velocity.
