@@ -216,7 +216,8 @@ def near_shift(solver: Any) -> Callable[[Any], np.ndarray] | None:
     (its near cells) and the fit's exponential sum on [delta, tau]; the closed form
     :func:`laplace` of the sum over [0, tau] therefore needs ``int_0^delta (H(s) - sum(s))
     e^{-lambda s} ds`` added.  H is the fit's :class:`dmi.kernels.PowerKernel` (exact:
-    :func:`power_laplace`); another near kernel is refused.
+    :func:`power_laplace`); another near kernel (another fit's, or one given as ``near=``,
+    which the near cells' samples at 3 points tell) is refused.
 
     Parameters
     ----------
@@ -232,8 +233,8 @@ def near_shift(solver: Any) -> Callable[[Any], np.ndarray] | None:
     Raises
     ------
     ValueError
-        Near cells whose exact kernel is not a PowerKernel (its transform on [0, delta] is not
-        known here).
+        Near cells whose kernel is not the fit's PowerKernel (its transform on [0, delta] is
+        not known here).
     """
     delta = float(solver.kernel_near_delta)
     fitted = solver.kernel_fit
@@ -248,8 +249,18 @@ def near_shift(solver: Any) -> Callable[[Any], np.ndarray] | None:
                          "use the scheme's answers (of=\"scheme\")")
     a, b, C, D = solver.kernel_terms
     n = int(solver.n)
-    i, j = (0, 0) if entry is None else entry
+    i, j = entry
     beta, c = float(exact.beta), float(exact.c)
+    # the near cells run the fit's own kernel, not another one given as near=
+    for q in (0.1, 0.5, 1.0):
+        s = q * delta
+        ran = float(solver.eval_kernel_near(s)[i, j])
+        if not abs(ran - c * s ** -beta) <= 1e-12 * abs(c * s ** -beta):
+            raise ValueError(f"the near cells (delta = {delta!r}) run a kernel other than the "
+                             f"fit's PowerKernel (at s = {s!r}: {ran!r}, the fit's kernel "
+                             f"{c * s ** -beta!r}): dmi.analysis does not know its transform on "
+                             "[0, delta] (the equation's answers need it): set the fit without "
+                             "near=, or use the scheme's answers (of=\"scheme\")")
 
     def shift(lam: Any) -> np.ndarray:
         lam = np.asarray(lam, dtype=np.complex128)

@@ -110,3 +110,14 @@ def test_near_cells_of_another_kernel_are_refused_for_the_equation():
         return s
     with pytest.raises(ValueError, match="PowerKernel"):
         analysis.equilibrium(make, 0.0, [0.5], of="equation")
+
+
+def test_near_kernel_other_than_the_fits_power_kernel_is_refused_for_the_equation():
+    """A PowerKernel fit whose near cells run another kernel (near=): its transform on
+    [0, delta] is not the power kernel's, refused (before: the power kernel's would be taken)."""
+    def make(p):
+        s = make_scalar(p, 200)
+        s.set_kernel_fit(FIT, near=lambda s: 2 * CF * s ** -BETA)
+        return s
+    with pytest.raises(ValueError, match="other than the fit's PowerKernel"):
+        analysis.equilibrium(make, 0.0, [0.5], of="equation")
