@@ -8,8 +8,13 @@
 #    both).  Rounds interleave the cases; the fastest round of each counts; CPU time (the process).
 # 2. A stability chart of the oscillator over (a, tau) on the local processes (--workers), and the
 #    same chart through a Dask LocalCluster of as many workers, interleaved; wall-clock time.
+# 3. The verified stability verdict (dmi.analysis.floquet) of the Stribeck belt's orbits born at
+#    its Hopf point (examples/python/stribeck_belt.py: fractional damping fitted, a memory of 8
+#    periods, velocity-weakening friction), at M steps a period (M = 1250: h = 0.005, N = 1e4):
+#    the verdict's wall-clock time, its operator products and plain-run periods, against one
+#    period's simulation.
 # Usage: bench/bench_stability.py [--N 1000 10000 100000] [--rounds R] [--chart P Q] [--chart-N N]
-#        [--workers W] [--no-dask] [--chart-rounds R]
+#        [--workers W] [--no-dask] [--chart-rounds R] [--verdict-M 200 1250]
 #        (needs dmi importable: PYTHONPATH=<build>/python; numba)
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
@@ -152,11 +157,36 @@ def bench_chart(P: int, Q: int, N: int, workers: int, dask: bool, rounds: int) -
         print("the same grid bitwise:", np.array_equal(charts["processes"].re, charts["dask"].re))
 
 
+def bench_verdict(Ms: list[int]) -> None:
+    """The verdict of the belt's orbits (amplitudes 0.05 and 0.8) at each M: wall-clock time of
+    floquet_verdict() at the orbit found by hopf_orbit (without multipliers), against one period."""
+    import stribeck_belt as belt
+    for M in Ms:
+        make = belt.model(M)
+        eq = analysis.equilibrium(make, 1.0, [0.3, -1.0])
+        (hp,) = [e for e in analysis.continue_equilibrium(eq, 0.3, step=0.05).events
+                 if e.kind == "hopf"]
+        for amplitude in (0.05, 0.8):
+            o = analysis.hopf_orbit(make, hp.hopf, hp.u, amplitude=amplitude, steps=M,
+                                    multipliers=0)
+            F = analysis.StepMap(o.make, o.p, o.steps, o.rows)
+            t0 = time.perf_counter()
+            F.trajectory(o.state)
+            one = time.perf_counter() - t0
+            t0 = time.perf_counter()
+            fl = analysis.floquet_verdict(F, o.state, 10, autonomous=True)
+            took = time.perf_counter() - t0
+            print(f"M = {M} (N = {F.N}, state {F.dim} values), amplitude {amplitude}: verdict "
+                  f"{fl.stable} in {took:.1f} s ({took / one:.0f} periods' time; one period "
+                  f"{one * 1e3:.1f} ms), {fl.products} products, {fl.reason}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(
         description="Prints the cost of roots(count = 10) of the distributed-delay oscillator "
-                    "against simulating one delay tau, and the time of a stability chart on local "
-                    "processes and on a Dask LocalCluster.",
+                    "against simulating one delay tau, the time of a stability chart on local "
+                    "processes and on a Dask LocalCluster, and of the verified verdict of the "
+                    "Stribeck belt's orbits.",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     ap.add_argument("--N", type=int, nargs="+", default=[1000, 10000, 100000],
                     help="steps per delay of the roots cases")
@@ -167,10 +197,14 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2, help="processes, and Dask workers, of the chart")
     ap.add_argument("--no-dask", action="store_true", help="time the chart on processes only")
     ap.add_argument("--chart-rounds", type=int, default=2, help="interleaved rounds of the chart")
+    ap.add_argument("--verdict-M", type=int, nargs="*", default=[200, 1250],
+                    help="steps a period of the belt's verdicts (none: skip)")
     a = ap.parse_args()
     bench_roots(a.N, a.rounds)
     if a.chart[0] > 0:
         bench_chart(a.chart[0], a.chart[1], a.chart_N, a.workers, not a.no_dask, a.chart_rounds)
+    if a.verdict_M:
+        bench_verdict(a.verdict_M)
 
 
 if __name__ == "__main__":

@@ -84,6 +84,10 @@ stage "dmi.analysis: the forced Bagley-Torvik oscillator with dry friction (fitt
 PYTHONPATH="$build/python" MPLBACKEND=Agg DMI_FIGURE="$out/bagley_torvik.png" "$py" \
   examples/python/plot_bagley_torvik.py | tee "$out/bagley_torvik.txt"
 
+stage "dmi.analysis: Stribeck friction split at the static level, verified stability of the belt's orbits"
+PYTHONPATH="$build/python:examples/python" MPLBACKEND=Agg DMI_FIGURE="$out/stribeck_belt.png" "$py" \
+  examples/python/plot_stribeck_belt.py | tee "$out/stribeck_belt.txt"
+
 stage "figures and comparison with the paper and ../shared/reference"
 refarg=()
 if [[ -d $ref ]]; then

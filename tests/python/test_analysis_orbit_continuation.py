@@ -15,7 +15,7 @@ from orbit_models import DenHartog, Fold, Logistic
 
 def test_fold_and_unstable_side():
     m = Fold()
-    o = periodic_orbit(m.make, 1.0, m.M * m.h, [0.9], multipliers=2)
+    o = periodic_orbit(m.make, 1.0, m.M * m.h, [0.9], multipliers=2, constant=True)
     b = continue_orbit(o, -1.0, step=0.1, multipliers=2)
     folds = [e for e in b.events if e.kind == "fold"]
     assert len(folds) == 1 and abs(folds[0].p) < 0.02, b.events
@@ -30,7 +30,7 @@ def test_fold_and_unstable_side():
 
 def test_period_doubling_and_doubled_branch():
     m = Logistic()
-    o = periodic_orbit(m.make, 1.5, 1.0, [0.9], multipliers=2)
+    o = periodic_orbit(m.make, 1.5, 1.0, [0.9], multipliers=2, constant=True)
     b = continue_orbit(o, 2.5, step=0.1, multipliers=2)
     pds = [e for e in b.events if e.kind == "period-doubling"]
     assert len(pds) == 1 and pds[0].p == pytest.approx(2.0, abs=1e-6), b.events
@@ -115,7 +115,7 @@ def test_torus_where_a_complex_pair_leaves_the_unit_circle():
         s = dmi.Solver(2, h, h=h)
         s.set_rhs(lambda t, u: np.array([-p * u[0] + u[1], -u[0] - p * u[1]]))
         return s
-    o = periodic_orbit(make, -0.3, M * h, [0.0, 0.0], multipliers=2)
+    o = periodic_orbit(make, -0.3, M * h, [0.0, 0.0], multipliers=2, constant=True)
     b = continue_orbit(o, 0.3, step=0.05, multipliers=2)
     tori = [e for e in b.events if e.kind == "torus"]
     pstar = (np.sqrt(1 - h * h) - 1) / h

@@ -21,7 +21,7 @@ from .branch import Branch, BranchPoint, Event
 from .chart import HopfCurve, StabilityChart, plot_stability_chart, stability_chart
 from .continuation import continue_orbit, period_doubled_orbit
 from .equilibria import Equilibrium, EquilibriumPoint, continue_equilibrium, equilibrium
-from .floquet import floquet_multipliers
+from .floquet import Floquet, StabilityWarning, Verify, floquet_multipliers, floquet_verdict
 from .newton import ShootingError
 from .orbit import Orbit
 from .orbit_plot import plot_branch
@@ -39,4 +39,6 @@ __all__ = [
     "periodic_orbit", "hopf_orbit", "Orbit", "ShootingError", "StepMap", "floquet_multipliers",
     "continue_orbit", "period_doubled_orbit", "Branch", "BranchPoint", "Event", "plot_branch",
     "refine_orbit", "Refined",
+    # verified Floquet multipliers and stability verdicts (docs/orbits.md)
+    "floquet_verdict", "Floquet", "Verify", "StabilityWarning",
 ]

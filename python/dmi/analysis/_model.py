@@ -26,7 +26,7 @@ import numpy as np
 
 from .. import _lib
 from .._solver import Solver
-from .._transform import laplace
+from .._transform import laplace, near_shift
 
 #: Relative step of the central differences of f and of a user resolvent: about eps^(1/3).
 FD_STEP = 2.0 ** -17
@@ -212,10 +212,12 @@ def kernel_panels(call: Callable[[float], np.ndarray], tau: float, reach: float
 
 def kernel_integral(s: Solver) -> np.ndarray:
     """int_0^tau H(s) ds (n x n) of the model's kernel: Hhat(0) in closed form for an
-    exponential sum, by the panels' quadrature for a callback, 0 without a kernel."""
+    exponential sum (with a fitted singular kernel's exact near part), by the panels'
+    quadrature for a callback, 0 without a kernel."""
     terms, kernel = kernel_of(s)
     if terms is not None:
-        return np.real(laplace(0.0, *terms, tau=s.tau))
+        near = near_shift(s)      # a fitted singular kernel: exact on [0, delta]
+        return np.real(laplace(0.0, *terms, tau=s.tau) + (near(0.0) if near else 0.0))
     if kernel is not None:
         _, w, H = kernel_panels(kernel, s.tau, 1.0)
         return np.tensordot(w, H, axes=(0, 0))

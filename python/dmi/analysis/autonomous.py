@@ -28,6 +28,7 @@ import numpy as np
 from .._solver import Solver
 from ._model import Linearisation
 from .equilibria import equilibrium
+from .floquet import Verify
 from .newton import ShootingError, bordered_newton
 from .orbit import Orbit, loops, make_orbit
 from .stability import HopfPoint
@@ -105,7 +106,7 @@ def no_equilibrium(o: Orbit, tol: float, what: str) -> Orbit:
 
 def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
                      steps: int | None = None, tol: float = 1e-10, max_iter: int = 30,
-                     multipliers: int = 10) -> Orbit:
+                     multipliers: int = 10, verify: Verify | None = None) -> Orbit:
     """See :func:`dmi.analysis.periodic_orbit` with ``period=None``.  ``steps``: M (default
     round(guess_period / h) with the h of ``make(p)``).  ``guess``: a state (N + 1 rows of the
     solver ``make(p, h=guess_period / M)``, or n values) or such a solver run near the orbit (its
@@ -159,7 +160,7 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
                                 "the orbit, or from a Hopf point with hopf_orbit",
                                 e.residuals) from e
         raise
-    o = make_orbit(maps(z[-1], p), z[:-1], res, multipliers, autonomous=True)
+    o = make_orbit(maps(z[-1], p), z[:-1], res, multipliers, autonomous=True, verify=verify)
     no_equilibrium(o, tol, what)
     k = loops(o.u)
     if k > 1:
@@ -184,7 +185,7 @@ def critical_vector(lin: Linearisation, lam: complex) -> np.ndarray:
 
 def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: float, steps: int,
                component: int | None = None, multipliers: int = 10, tol: float = 1e-10,
-               max_iter: int = 30) -> Orbit:
+               max_iter: int = 30, verify: Verify | None = None) -> Orbit:
     """The autonomous orbit born at a Hopf point, of a given amplitude, its parameter free.
 
     An amplitude condition replaces the parameter: the unknowns are the state, the step h (the
@@ -217,6 +218,8 @@ def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: floa
         Newton's tolerance.
     max_iter : int
         Newton iterations at most.
+    verify : dmi.analysis.Verify, optional
+        Tolerances and budgets of the multipliers' verification (default ``Verify()``).
 
     Returns
     -------
@@ -284,5 +287,6 @@ def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: floa
     z, res = bordered_newton(lambda q: maps(q[0], q[1]), np.concatenate([x0, [h0, p]]), 2,
                              conditions, tol=tol, max_iter=max_iter, what=what,
                              steps=np.array([1e-7 * h0, 1e-7 * max(1.0, abs(p))]))
-    o = make_orbit(maps(z[-2], z[-1]), z[:dim], res, multipliers, autonomous=True)
+    o = make_orbit(maps(z[-2], z[-1]), z[:dim], res, multipliers, autonomous=True,
+                   verify=verify)
     return no_equilibrium(o, tol, what)

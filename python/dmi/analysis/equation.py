@@ -13,7 +13,9 @@ its roots the lambda with det Delta(lambda) = 0.  A' is 0 for dry friction and t
 their thresholds; a component their resolvent holds (a stuck velocity, a face in contact) has no
 dynamics and is removed; for a smooth user resolvent J (its derivative DJ at the scheme's X*)
 A' = ((DJ)^-1 - I) / h, the generator whose resolvent (I + h A')^-1 is DJ.  Hhat is the closed
-form of :func:`dmi._transform.laplace` for an exponential-sum kernel (``set_kernel_exp``), and
+form of :func:`dmi._transform.laplace` for an exponential-sum kernel (``set_kernel_exp``; a fit
+of a singular :class:`dmi.kernels.PowerKernel` with near cells has its exact transform on
+[0, delta] instead of the sum's there, :func:`dmi._transform.near_shift`), and
 Gauss-Legendre quadrature on panels sampled once for a callback kernel (panels of at most
 1 / |lambda|_max, 16 nodes each, lambda_max the largest root asked for).
 
@@ -29,7 +31,7 @@ import warnings
 
 import numpy as np
 
-from .._transform import laplace
+from .._transform import laplace, near_shift
 from ._model import Linearisation, kernel_panels
 
 #: Relative tolerance of a refined root: |dlambda| <= ROOT_TOL max(1, |lambda|).
@@ -63,6 +65,8 @@ class Characteristic:
         self.m = len(free)
         self.tau = lin.tau
         self._terms = lin.kernel_terms
+        # a fitted singular kernel's near cells: the exact kernel on [0, delta], not the sum
+        self._near = near_shift(lin.tangent) if self._terms is not None else None
         self._panel: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         if self._terms is None and lin.kernel is not None:
             s, w, H = kernel_panels(lin.kernel, lin.tau, max(1.0, float(reach)))
@@ -74,6 +78,8 @@ class Characteristic:
         if self._terms is not None:
             a, b, C, D = self._terms
             H = laplace(lam, a, b, C, D, tau=self.tau)
+            if self._near is not None:
+                H = H + self._near(lam)
             return H[..., self.free[:, None], self.free[None, :]]
         if self._panel is not None:
             s, w, H = self._panel

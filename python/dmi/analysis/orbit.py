@@ -4,11 +4,12 @@
 period's states: where a friction component sticks, and how many times the period loops."""
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .floquet import floquet_multipliers, phase_free
+from .floquet import Floquet, StabilityWarning, Verify, floquet_verdict
 from .stepmap import Model, StepMap
 
 @dataclass
@@ -32,9 +33,14 @@ class Orbit:
     state : numpy.ndarray
         The shooting state: L n values, rows oldest first, the last at t = 0.
     multipliers : numpy.ndarray of complex
-        The leading Floquet multipliers, largest |mu| first.
-    stable : bool
-        All |mu| < 1 (an autonomous orbit: all but its phase's multiplier 1).
+        The leading Floquet multipliers, largest |mu| first (their error bounds:
+        ``floquet.errors``).
+    stable : bool or None
+        True: verified stable, all |mu| < 1 beyond their errors (an autonomous orbit: all but
+        its trivial multiplier, found by its vector along the velocity); False: verified
+        unstable; None: not decided (no multipliers computed, or neither the multipliers nor
+        a plain run decided: ``floquet.reason`` says why, and a :class:`StabilityWarning` was
+        issued).  Test it with ``is True`` / ``is False``: None is falsy.
     stick_fraction : numpy.ndarray
         Shape (n,): the fraction of the M steps where component i is stuck (:func:`stuck_mask`: U_i
         == 0 exactly after the friction resolvent, for 2 steps or more).
@@ -48,6 +54,9 @@ class Orbit:
         L, the rows of the shooting state.
     autonomous : bool
         True for an orbit of free period (its phase's multiplier is 1).
+    floquet : Floquet or None
+        The multipliers' errors, vectors, the trivial one's index and the verdict's reason
+        (:func:`dmi.analysis.floquet_verdict`); None without multipliers.
     """
     p: float
     period: float
@@ -57,13 +66,14 @@ class Orbit:
     u: np.ndarray
     state: np.ndarray
     multipliers: np.ndarray
-    stable: bool
+    stable: bool | None
     stick_fraction: np.ndarray
     iterations: int
     residual: float
     make: Model = field(repr=False)
     rows: int = 0
     autonomous: bool = False
+    floquet: Floquet | None = field(default=None, repr=False)
 
     @property
     def amplitude(self) -> np.ndarray:
@@ -92,16 +102,23 @@ def stick_fraction(u: np.ndarray) -> np.ndarray:
 
 
 def make_orbit(F: StepMap, x: np.ndarray, res: list[float], multipliers: int,
-               autonomous: bool = False) -> Orbit:
-    """The Orbit at the fixed point x of F (one more run for t, u; the multipliers).  An
-    ``autonomous`` orbit's ``stable`` leaves out its phase multiplier (:func:`phase_free`)."""
+               autonomous: bool = False, verify: Verify | None = None) -> Orbit:
+    """The Orbit at the fixed point x of F (one more run for t, u; the multipliers, verified by
+    :func:`dmi.analysis.floquet_verdict` with ``verify``).  An ``autonomous`` orbit's ``stable``
+    leaves out its trivial multiplier; ``stable`` None (with a StabilityWarning) when nothing
+    decided, or without multipliers."""
     U = F.trajectory(x)
-    mu = floquet_multipliers(F, x, multipliers) if multipliers > 0 else np.empty(0, complex)
-    rest = phase_free(mu) if autonomous else mu
+    fl = None
+    if multipliers > 0:
+        fl = floquet_verdict(F, x, multipliers, autonomous=autonomous, verify=verify)
+        if fl.stable is None:
+            warnings.warn(f"periodic orbit at p = {F.p!r}: stability not decided: {fl.reason}",
+                          StabilityWarning, stacklevel=3)
+    mu = fl.multipliers[:multipliers] if fl else np.empty(0, complex)
     return Orbit(p=F.p, period=F.M * F.h, steps=F.M, h=F.h, t=np.arange(F.M + 1) * F.h, u=U,
-                 state=x, multipliers=mu, stable=bool(rest.size and np.all(np.abs(rest) < 1)),
+                 state=x, multipliers=mu, stable=fl.stable if fl else None,
                  stick_fraction=stick_fraction(U), iterations=len(res) - 1, residual=res[-1],
-                 make=F.make, rows=F.L, autonomous=autonomous)
+                 make=F.make, rows=F.L, autonomous=autonomous, floquet=fl)
 
 
 def loops(u: np.ndarray, most: int = 64) -> int:

@@ -11,14 +11,16 @@ import numpy as np
 
 from .._solver import Solver
 from .autonomous import autonomous_orbit
-from .newton import newton
+from .floquet import Verify
+from .newton import ShootingError, newton
 from .orbit import Orbit, make_orbit
 from .stepmap import Model, StepMap, build, state_of, steps_per_period
 
 def periodic_orbit(make: Model, p: float, period: float | None = None, guess: Any = None, *,
                    guess_period: float | None = None, steps: int | None = None,
                    tol: float = 1e-10, max_iter: int = 30, multipliers: int = 10,
-                   rows: int | None = None) -> Orbit:
+                   rows: int | None = None, verify: Verify | None = None,
+                   constant: bool = False) -> Orbit:
     """The periodic orbit of the model near a guess, by shooting.
 
     Newton with GMRES on the matrix-free Jacobian of the M-step map (:mod:`dmi.analysis.stepmap`)
@@ -50,15 +52,22 @@ def periodic_orbit(make: Model, p: float, period: float | None = None, guess: An
     max_iter : int
         Newton iterations at most.
     multipliers : int
-        Leading Floquet multipliers to compute (0: none; ``stable`` is then False).
+        Leading Floquet multipliers to compute (0: none; ``stable`` is then None).
     rows : int, optional
         L, the rows of the state (default N + 1).
+    verify : dmi.analysis.Verify, optional
+        Tolerances and budgets of the multipliers' verification (default ``Verify()``).
+    constant : bool
+        Accept a constant orbit of an autonomous model at a fixed ``period`` (the scheme's
+        equilibrium as a fixed point of its M-step map, e.g. to continue the map's fixed points
+        with :func:`dmi.analysis.continue_orbit`); by default it is refused (ShootingError).
 
     Returns
     -------
     Orbit
-        The orbit: one period ``t``, ``u``, its ``state``, ``multipliers``, ``stable`` (an
-        autonomous orbit's leaves out its phase multiplier), ``stick_fraction``.
+        The orbit: one period ``t``, ``u``, its ``state``, ``multipliers``, ``stable`` (True,
+        False, or None when not decided, with a StabilityWarning; an autonomous orbit's leaves
+        out its trivial multiplier), ``stick_fraction``.
 
     Raises
     ------
@@ -69,7 +78,8 @@ def periodic_orbit(make: Model, p: float, period: float | None = None, guess: An
     ShootingError
         Newton fails, with every residual tried: no new least residual in 3 iterations, a
         singular Jacobian, max_iter reached, the map failing (a NaN from the rhs names the call
-        and p), an autonomous orbit converging to an equilibrium or a guess period too long.
+        and p), an orbit converging to an equilibrium of an autonomous model (a constant state
+        is periodic with any period) or a guess period too long.
     Exception
         The model's own, when ``make(p)`` fails (a note names the call).
     """
@@ -79,7 +89,7 @@ def periodic_orbit(make: Model, p: float, period: float | None = None, guess: An
         if guess_period is None:
             raise ValueError("period=None (an autonomous orbit) needs guess_period")
         return autonomous_orbit(make, p, guess, guess_period, steps=steps, tol=tol,
-                                max_iter=max_iter, multipliers=multipliers)
+                                max_iter=max_iter, multipliers=multipliers, verify=verify)
     probe = build(make, p)
     M = steps_per_period(probe.h, period)
     F = StepMap(make, p, M, rows, solver=probe)
@@ -101,7 +111,38 @@ def periodic_orbit(make: Model, p: float, period: float | None = None, guess: An
     x, res = newton(F, x0, tol=tol, max_iter=max_iter,
                     what=f"periodic orbit at p = {p!r}, period {period!r} = {M} steps")
     period_of_model(F, x, period)
-    return make_orbit(F, x, res, multipliers)
+    if not constant:
+        constant_of_autonomous(F, x, tol, f"periodic orbit at p = {p!r}, period {period!r}")
+    return make_orbit(F, x, res, multipliers, verify=verify)
+
+
+def constant_of_autonomous(F: StepMap, x: np.ndarray, tol: float, what: str) -> None:
+    """ShootingError when the fixed point x of F is a constant state u (its rows differ by at
+    most 1e3 tol max(1, |x|)) and the model's rhs does not depend on t at u nor at u + 1e-3
+    max(1, |x|) e_i (at 8 times over the period): an equilibrium of an autonomous model,
+    periodic with any period, no orbit.  (A forced model's constant orbit, a mass stuck
+    throughout under a weak forcing, the rest of a parametric forcing, is kept.)"""
+    X = np.asarray(x).reshape(F.L, F.n)
+    spread = float(np.max(X.max(axis=0) - X.min(axis=0)))
+    scale = max(1.0, float(np.max(np.abs(X))))
+    if spread > 1e3 * tol * scale:
+        return
+    s, u = F.solver, X[-1]
+    if s.has("rhs"):
+        # at u and beside it (a parametric forcing b cos(w t) x vanishes at x = 0 only)
+        d = 1e-3 * scale
+        for w in [u] + [u + d * e for e in np.eye(F.n)]:
+            f0 = s.eval_rhs(0.0, w)
+            for t in np.linspace(0.0, F.M * F.h, 9)[1:]:
+                if not np.array_equal(s.eval_rhs(float(t), w), f0):
+                    return        # forced: a constant orbit under a forcing is an orbit
+    raise ShootingError(f"{what}: converged to an equilibrium of an autonomous model, {u!r}, "
+                        f"not an orbit (its rows differ by {spread:.3g}; the rhs does not depend "
+                        "on t there): a constant state is periodic with any period; for the "
+                        "model's own orbits use period=None with guess_period (an autonomous "
+                        "orbit) from a guess that moves, or hopf_orbit from a Hopf point; for "
+                        "the equilibrium's stability dmi.analysis.equilibrium (constant=True "
+                        "accepts it as a fixed point of the M-step map)", [])
 
 
 def period_of_model(F: StepMap, x: np.ndarray, period: float) -> None:
