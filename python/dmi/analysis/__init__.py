@@ -40,3 +40,7 @@ __all__ = [
     "continue_orbit", "period_doubled_orbit", "Branch", "BranchPoint", "Event", "plot_branch",
     "refine_orbit", "Refined",
 ]
+from .collocation import collocate  # noqa: E402
+from .equation_orbit import EquationOrbit  # noqa: E402
+
+__all__ += ["collocate", "EquationOrbit"]

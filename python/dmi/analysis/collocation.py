@@ -1,0 +1,389 @@
+# Periodic orbits of the equation (not of the scheme) by orthogonal collocation, from an orbit of
+# the scheme: smooth orbits and the multi-segment orbits of dry friction and boxes.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""collocate: the equation's periodic orbit from the scheme's.
+
+The orbit of u' + A(u) + f(t, u) + int_0^tau H(s) u(t - s) ds ∋ 0 is a continuous periodic
+piecewise polynomial of degree m, collocated at the m Gauss-Legendre points of each mesh interval
+(:mod:`dmi.analysis.collocation_system`); the delay integral is taken on the polynomial itself,
+wrapping as many periods as tau / T needs (:mod:`dmi.analysis.collocation_mesh`).  With the
+built-in friction or box the period is cut into segments whose modes (slip +-, stuck, on a face,
+free) are read from the scheme's orbit, the segments' ends unknowns with their switching
+conditions (:mod:`dmi.analysis.collocation_signature`); every inequality is checked on a fine grid
+of the result, and an orbit that breaks one is not returned.  Multipliers: the discretised
+monodromy operator with the saltation at the switches (:mod:`dmi.analysis.collocation_floquet`).
+
+Errors: the orbit is solved on a mesh and on the same mesh with every interval halved; the
+difference of their period, amplitudes, multipliers and u is the error estimate of the finer one
+(which is returned): an upper estimate while the convergence is in its asymptotic range (the
+finer one's error is that difference over 2^p - 1, p >= m the order).  With ``intervals=None``
+the mesh is equidistributed (AUTO, COLSYS: equal integrals of |u^(m+1)|^(1 / (m + 1)),
+estimated from the jumps of u^(m) between intervals) and refined until the estimate of the
+period and amplitudes is below ``tol``.
+
+Limits: a kernel with a jump inside (0, tau) at a lag not known to collocation caps the order at
+1 (the exponential sums and the truncation at tau are handled exactly); a user resolvent
+(``set_resolvent``) has no A to collocate (use ``refine_orbit``); near cells of fitted kernels
+(``set_kernel_near``) are not collocated here.
+"""
+from __future__ import annotations
+
+import math
+import warnings
+from typing import Any
+
+import numpy as np
+
+from .collocation_floquet import multipliers as floquet
+from .collocation_mesh import equidistribute
+from .collocation_signature import Signature, read_signature, violations
+from .collocation_system import Layout, Terms, assemble, solve
+from .equation_orbit import EquationOrbit
+from .orbit import Orbit
+from .stepmap import build
+
+#: Points a mesh interval of the grid on which the inequalities are checked.
+CHECK_POINTS = 8
+#: Mesh refinement rounds at most (intervals=None).
+MAX_ROUNDS = 6
+#: Intervals at most.
+MAX_INTERVALS = 4000
+
+
+class CollocationWarning(RuntimeWarning):
+    """A collocated orbit's verdict that could not be verified (its stability)."""
+
+
+def _counts(lengths: np.ndarray, L: int) -> np.ndarray:
+    """L intervals shared by pieces of these lengths (or weights), at least 1 each."""
+    w = np.asarray(lengths, dtype=float)
+    c = np.maximum(1, np.round(L * w / w.sum()).astype(int))
+    return c
+
+
+def uniform_fractions(bounds: np.ndarray, L: int) -> list[np.ndarray]:
+    """Each piece of [0, T] (ends ``bounds``) cut into equal intervals, L in all (about)."""
+    return [np.linspace(0.0, 1.0, c + 1) for c in _counts(np.diff(bounds), L)]
+
+
+def halved(fractions: list[np.ndarray]) -> list[np.ndarray]:
+    """Every interval cut in two."""
+    out = []
+    for f in fractions:
+        mid = 0.5 * (f[:-1] + f[1:])
+        out.append(np.sort(np.concatenate([f, mid])))
+    return out
+
+
+def evaluate(lay: Layout, x: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """u(t) (len(t), n) of the collocated orbit x (t any reals)."""
+    from .collocation_mesh import periodic_locator
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    _, z, cols = periodic_locator(mesh, lay.m)(np.asarray(t, dtype=float))
+    return np.einsum("pk,pkn->pn", lay.basis.values(z), V[cols])
+
+
+def node_times(lay: Layout, b: np.ndarray, T: float) -> np.ndarray:
+    """The times of the L m node rows."""
+    mesh = lay.mesh(b, T)
+    z = lay.basis.nodes[:-1]
+    return (mesh[:-1, None] + np.diff(mesh)[:, None] * z[None, :]).ravel()
+
+
+def transfer(lay: Layout, x: np.ndarray, new: Layout) -> np.ndarray:
+    """x's orbit on the layout ``new`` (same signature, b's and T)."""
+    _, b, T = lay.split(x)
+    V = evaluate(lay, x, node_times(new, b, T))
+    return np.concatenate([V.ravel(), x[lay.rows * lay.n:]])
+
+
+def indicator(lay: Layout, x: np.ndarray) -> np.ndarray:
+    """(L,): |u^(m+1)|^(1/(m+1)) estimated on each interval from the jumps of the piecewise
+    constant u^(m) to its neighbours in the same piece (AUTO's indicator)."""
+    m = lay.m
+    V, b, T = lay.split(x)
+    h = np.diff(lay.mesh(b, T))
+    k = np.arange(m + 1)
+    cols = (np.arange(lay.L)[:, None] * m + k[None, :]) % lay.rows
+    top = np.einsum("k,lkn->ln", lay.basis.top, V[cols]) / h[:, None] ** m   # u^(m) (L, n)
+    piece = lay.piece_of_interval()
+    jump = np.zeros(lay.L)
+    same = piece[1:] == piece[:-1]
+    if lay.signature.switches == 0:                        # one piece: around the circle
+        d = np.linalg.norm(np.roll(top, -1, axis=0) - top, axis=1)
+        dist = 0.5 * (h + np.roll(h, -1))
+        g = d / dist
+        jump = np.maximum(g, np.roll(g, 1))
+    else:
+        d = np.linalg.norm(top[1:] - top[:-1], axis=1) / (0.5 * (h[1:] + h[:-1]))
+        d = np.where(same, d, 0.0)
+        jump[:-1] = np.maximum(jump[:-1], d)
+        jump[1:] = np.maximum(jump[1:], d)
+    return jump ** (1.0 / (m + 1))
+
+
+def adapted(lay: Layout, x: np.ndarray, L: int) -> list[np.ndarray]:
+    """Fractions of L intervals (about) equidistributing :func:`indicator` piece by piece."""
+    rho = indicator(lay, x)
+    _, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    e = lay.bounds(b, T)
+    piece = lay.piece_of_interval()
+    h = np.diff(mesh)
+    weight = np.array([np.sum((rho * h)[piece == j]) for j in range(len(lay.fractions))])
+    weight = np.maximum(weight, 1e-3 * max(weight.max(), 1e-300))
+    counts = _counts(weight, L)
+    out = []
+    for j, c in enumerate(counts):
+        sel = piece == j
+        pm = np.concatenate([mesh[:-1][sel], [mesh[1:][sel][-1]]])
+        new = equidistribute(pm, rho[sel], int(c))
+        out.append((new - e[j]) / (e[j + 1] - e[j]))
+        out[-1][0], out[-1][-1] = 0.0, 1.0
+    return out
+
+
+def extrema(lay: Layout, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(max (n,), min (n,)) of each component on the piecewise polynomial: the derivative's
+    roots in the intervals next to the largest and smallest nodes."""
+    m, n = lay.m, lay.n
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    k = np.arange(m + 1)
+    y = 2 * lay.basis.nodes - 1
+    hi, lo = V.max(axis=0).copy(), V.min(axis=0).copy()
+    for i in range(n):
+        for sign, best in ((1.0, hi), (-1.0, lo)):
+            node = int(np.argmax(sign * V[:, i]))
+            iv = node // m
+            for j in {(iv - 1) % lay.L, iv, (iv + 1) % lay.L}:
+                vals = V[(j * m + k) % lay.rows, i]
+                c = np.polynomial.polynomial.polyfit(y, vals, m)
+                r = np.polynomial.polynomial.polyroots(np.polynomial.polynomial.polyder(c))
+                r = r.real[(np.abs(r.imag) < 1e-9) & (np.abs(r.real) <= 1)]
+                if r.size:
+                    v = np.polynomial.polynomial.polyval(r, c)
+                    best[i] = max(best[i], v.max()) if sign > 0 else min(best[i], v.min())
+    del mesh
+    return hi, lo
+
+
+def check_inequalities(lay: Layout, terms: Terms, x: np.ndarray, tol: float) -> list[str]:
+    """The inequalities the result breaks on a fine grid (CHECK_POINTS a mesh interval)."""
+    if lay.signature.switches == 0 and not (np.any(terms.alpha > 0)
+                                            or np.any(np.isfinite(terms.lo))
+                                            or np.any(np.isfinite(terms.hi))):
+        return []
+    from .collocation_mesh import delay_matrix, periodic_locator
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    e = lay.bounds(b, T)
+    grid, us, forces = [], [], []
+    loc = periodic_locator(mesh, lay.m)
+    for j in range(len(e) - 1):
+        count = (len(lay.fractions[j]) - 1) * CHECK_POINTS + 1
+        t = np.linspace(e[j], e[j + 1], count)
+        u = evaluate(lay, x, t)
+        F = -terms.f(t, u)
+        if terms.has_kernel:
+            G = delay_matrix(t, terms.tau, mesh, T, terms.H, loc, lay.basis, lay.n, lay.rows,
+                             pattern=terms.pattern)[0]
+            F = F - (G @ V.ravel()).reshape(-1, lay.n)
+        grid.append(t)
+        us.append(u)
+        forces.append(F)
+    return violations(lay.signature.pieces(), grid, us, forces, terms.alpha, terms.lo, terms.hi,
+                      tol)
+
+
+def _match(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """|a_j - (the nearest b)| for each a_j."""
+    if b.size == 0:
+        return np.full(a.shape, np.inf)
+    return np.min(np.abs(a[:, None] - b[None, :]), axis=1)
+
+
+class Solved:
+    """A solution on one layout, with its derived quantities."""
+
+    def __init__(self, lay: Layout, terms: Terms, x: np.ndarray, count: int):
+        self.lay, self.x = lay, x
+        _, self.b, self.T = lay.split(x)
+        hi, lo = extrema(lay, x)
+        self.amplitude = 0.5 * (hi - lo)
+        self.mu = floquet(lay, terms, x, count) if count > 0 else np.empty(0, complex)
+
+
+def _refine(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, count: int, what: str
+            ) -> tuple[Solved, Solved]:
+    """The orbit on ``lay`` (from x on another layout) and on ``lay`` halved."""
+    xc, _ = solve(lay, terms, x, ref, what=what)
+    fine = lay.with_fractions(halved(lay.fractions))
+    xf, _ = solve(fine, terms, transfer(lay, xc, fine), ref, what=what)
+    return Solved(lay, terms, xc, 0), Solved(fine, terms, xf, 0)
+
+
+def _errors(c: Solved, f: Solved) -> dict[str, Any]:
+    """The differences of the two levels: the finer's error estimate."""
+    t = np.linspace(0.0, f.T, 40 * f.lay.L, endpoint=False)
+    du = float(np.max(np.abs(evaluate(c.lay, c.x, t * c.T / f.T) - evaluate(f.lay, f.x, t))))
+    return {"period": abs(c.T - f.T), "amplitude": np.abs(c.amplitude - f.amplitude),
+            "multipliers": _match(f.mu, c.mu), "u": du}
+
+
+def _stable(mu: np.ndarray, err: np.ndarray, autonomous: bool) -> bool | None:
+    """All |mu| < 1 but the trivial one (autonomous), verified against the errors; None (with a
+    CollocationWarning) when a multiplier's |mu| is within its error of 1."""
+    if mu.size == 0:
+        return None
+    keep = np.ones(mu.size, bool)
+    if autonomous:
+        keep[int(np.argmin(np.abs(mu - 1)))] = False
+    a, e = np.abs(mu[keep]), err[keep]
+    if np.any(a > 1 + e):
+        return False
+    if np.all(a < 1 - e):
+        return True
+    warnings.warn(f"collocate: a multiplier's modulus is within its estimated error of 1 "
+                  f"({a[np.argmin(np.abs(a - 1))]:.12g}): stability not verified (None)",
+                  CollocationWarning, stacklevel=3)
+    return None
+
+
+def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
+              tol: float = 1e-10, multipliers: int = 10) -> EquationOrbit:
+    """The equation's periodic orbit near an orbit of the scheme, by orthogonal collocation.
+
+    Piecewise polynomials of degree m on L mesh intervals of one period, collocated at the
+    Gauss-Legendre points; the delay integral on the periodic polynomial; for an autonomous orbit
+    the period is an unknown with an integral phase condition; with the built-in friction or box
+    the period's segments (slip +-, stuck, on a face) are read from the scheme's orbit and their
+    ends are unknowns fixed by switching conditions (module docstring: method, errors, limits).
+
+    Parameters
+    ----------
+    orbit : Orbit
+        An orbit of the scheme (:func:`dmi.analysis.periodic_orbit`, :func:`hopf_orbit`, a
+        branch's point), forced or autonomous.
+    degree : int
+        m, the polynomials' degree (2 to 8).
+    intervals : int, optional
+        L, the mesh's intervals (then the mesh is uniform in each segment and not adapted); None:
+        adapted until the estimated error of the period and amplitudes is below ``tol``.
+    tol : float
+        The error asked (time and state units), > 0.
+    multipliers : int
+        Leading Floquet multipliers (0: none; ``stable`` is then None).
+
+    Returns
+    -------
+    EquationOrbit
+        The orbit with its period, amplitude, multipliers, stability, mesh, signature and
+        estimated errors (those of the returned, finer level).
+
+    Raises
+    ------
+    TypeError
+        ``orbit`` is not an Orbit of the scheme.
+    ValueError
+        Bad degree, intervals or tol; a model with a user resolvent (use ``refine_orbit``) or
+        with near cells; a result that breaks an inequality of its signature (the message names
+        it: the signature read from the scheme is wrong; refine the scheme's orbit); the
+        estimated error still above ``tol`` at the largest mesh.
+    ShootingError
+        Newton fails.
+    """
+    if not isinstance(orbit, Orbit):
+        raise TypeError(f"collocate: give an Orbit of the scheme (periodic_orbit, hopf_orbit), "
+                        f"not {type(orbit).__name__}")
+    m = int(degree)
+    if m != degree or not 2 <= m <= 8:
+        raise ValueError(f"collocate: degree = {degree!r}: give a whole number in 2..8")
+    if intervals is not None and (int(intervals) != intervals or intervals < 4):
+        raise ValueError(f"collocate: intervals = {intervals!r}: give a whole number >= 4, or "
+                         "None to adapt")
+    if not (tol > 0 and math.isfinite(tol)):
+        raise ValueError(f"collocate: tol = {tol!r}: give a finite tol > 0")
+    terms = Terms(build(orbit.make, orbit.p))
+    sig, b0 = read_signature(orbit.u, orbit.h, terms.alpha, terms.lo, terms.hi)
+    T0 = float(orbit.period)
+    bounds = np.concatenate([[0.0], b0, [T0]])
+    L0 = int(intervals) if intervals is not None else max(16, 4 * len(sig.pieces()))
+    lay = Layout(m, terms.n, sig, uniform_fractions(bounds, L0), bool(orbit.autonomous), T0)
+    t_s = np.asarray(orbit.t, dtype=float)
+
+    def scheme(t: np.ndarray) -> np.ndarray:
+        tt = np.mod(t, T0)
+        return np.column_stack([np.interp(tt, t_s, orbit.u[:, i]) for i in range(terms.n)])
+    x0 = np.concatenate([scheme(node_times(lay, b0, T0)).ravel(), b0,
+                         [T0] if orbit.autonomous else []])
+    ref0 = _reference(lay, x0) if orbit.autonomous else None
+    what = f"collocation of the orbit at p = {orbit.p!r}"
+    x1, _ = solve(lay, terms, x0, ref0, what=what)
+    lay1 = lay
+    ref = _reference(lay1, x1) if orbit.autonomous else None
+    count = int(multipliers)
+    if intervals is not None:
+        c, f = _refine(lay1, terms, x1, ref, count, what)
+        return _result(orbit, terms, c, f, count)
+    L = L0
+    last = None
+    for _ in range(MAX_ROUNDS):
+        lay2 = lay1.with_fractions(adapted(lay1, x1, L))
+        c, f = _refine(lay2, terms, transfer(lay1, x1, lay2), ref, count, what)
+        d = max(abs(c.T - f.T), float(np.max(np.abs(c.amplitude - f.amplitude))))
+        if d <= tol:
+            return _result(orbit, terms, c, f, count)
+        grow = (d / tol) ** (1.0 / (m + 1)) * 1.2
+        if last is not None and last[1] > d > 0:               # the observed order
+            q = math.log(last[1] / d) / math.log(L / last[0])
+            if q > m:
+                grow = (d / tol) ** (1.0 / q) * 1.1
+        last = (L, d)
+        L = min(MAX_INTERVALS, max(L + 2, math.ceil(L * min(grow, 8.0))))
+        lay1, x1 = f.lay, f.x
+        if f.lay.L >= MAX_INTERVALS:
+            break
+    raise ValueError(f"collocate: the estimated error {d:.3g} is still above tol = {tol!r} at "
+                     f"{f.lay.L} intervals: ask a larger tol or a higher degree")
+
+
+def _reference(lay: Layout, x: np.ndarray) -> Any:
+    """theta -> r'(theta) (P, n): the derivative in theta = t / T of the orbit x (the phase
+    condition's reference), by its polynomial."""
+    from .collocation_mesh import periodic_locator
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T) / T
+    loc = periodic_locator(mesh, lay.m)
+    basis = lay.basis
+
+    def r(theta: np.ndarray) -> np.ndarray:
+        i, z, cols = loc(np.asarray(theta, dtype=float))
+        B = basis.derivatives(z) / np.diff(mesh)[i][:, None]
+        return np.einsum("pk,pkn->pn", B, V[cols])
+    return r
+
+
+def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int) -> EquationOrbit:
+    """The EquationOrbit of the finer level f (its multipliers and the coarser's), checked
+    against its signature's inequalities."""
+    if count > 0:
+        c.mu = floquet(c.lay, terms, c.x, count)
+        f.mu = floquet(f.lay, terms, f.x, count)
+    errors = _errors(c, f)
+    bad = check_inequalities(f.lay, terms, f.x, 1e-9 * max(1.0, float(np.max(np.abs(f.x)))))
+    if bad:
+        raise ValueError("collocate: the collocated orbit breaks its signature's inequalities "
+                         f"({'; '.join(bad[:4])}): the signature read from the scheme "
+                         f"({', '.join(f.lay.signature.describe())}) is wrong; refine the "
+                         "scheme's orbit (a smaller h) and collocate again")
+    V, b, T = f.lay.split(f.x)
+    return EquationOrbit(p=float(orbit.p), period=T, amplitude=f.amplitude, multipliers=f.mu,
+                         stable=_stable(f.mu, errors["multipliers"], bool(orbit.autonomous)),
+                         mesh=f.lay.mesh(b, T), signature=f.lay.signature, switches=b.copy(),
+                         make=orbit.make, autonomous=bool(orbit.autonomous), errors=errors,
+                         degree=f.lay.m, nodes=V.copy())
+
+
+__all__ = ["collocate", "CollocationWarning", "Signature", "assemble"]
