@@ -19,7 +19,8 @@ difference of their period, amplitudes, multipliers and u is the error estimate 
 finer one's error is that difference over 2^p - 1, p >= m the order).  With ``intervals=None``
 the mesh is equidistributed (AUTO, COLSYS: equal integrals of |u^(m+1)|^(1 / (m + 1)),
 estimated from the jumps of u^(m) between intervals) and refined until the estimate of the
-period and amplitudes is below ``tol``.
+period (an autonomous orbit; it converges as h^(2m) on smooth orbits) or of the amplitudes (a
+forced orbit; h^(m+1): an extremum is inside an interval) is below ``tol``.
 
 Limits: a kernel with a jump inside (0, tau) at a lag not known to collocation caps the order at
 1 (the exponential sums and the truncation at tau are handled exactly); a user resolvent
@@ -269,8 +270,10 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     degree : int
         m, the polynomials' degree (2 to 8).
     intervals : int, optional
-        L, the mesh's intervals (then the mesh is uniform in each segment and not adapted); None:
-        adapted until the estimated error of the period and amplitudes is below ``tol``.
+        L, the mesh's intervals (equidistributed once, not refined; the orbit returned has 2 L,
+        the estimate's finer level); None: refined until the estimated error of the period (an
+        autonomous orbit) or of the amplitudes (a forced one) is below ``tol``; the other
+        estimates are in ``errors``.
     tol : float
         The error asked (time and state units), > 0.
     multipliers : int
@@ -324,15 +327,17 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     lay1 = lay
     ref = _reference(lay1, x1) if orbit.autonomous else None
     count = int(multipliers)
-    if intervals is not None:
-        c, f = _refine(lay1, terms, x1, ref, count, what)
+    if intervals is not None:               # once equidistributed, then halved for the estimate
+        lay2 = lay1.with_fractions(adapted(lay1, x1, L0))
+        c, f = _refine(lay2, terms, transfer(lay1, x1, lay2), ref, count, what)
         return _result(orbit, terms, c, f, count)
     L = L0
     last = None
     for _ in range(MAX_ROUNDS):
         lay2 = lay1.with_fractions(adapted(lay1, x1, L))
         c, f = _refine(lay2, terms, transfer(lay1, x1, lay2), ref, count, what)
-        d = max(abs(c.T - f.T), float(np.max(np.abs(c.amplitude - f.amplitude))))
+        d = (abs(c.T - f.T) if orbit.autonomous
+             else float(np.max(np.abs(c.amplitude - f.amplitude))))
         if d <= tol:
             return _result(orbit, terms, c, f, count)
         grow = (d / tol) ** (1.0 / (m + 1)) * 1.2

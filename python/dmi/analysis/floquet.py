@@ -134,7 +134,12 @@ def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
     ------
     ValueError
         blocks < 2.
+    TypeError
+        An EquationOrbit (it carries its multipliers).
     """
+    if getattr(F, "of", "scheme") == "equation":
+        raise TypeError("floquet_multipliers: an EquationOrbit (collocate) carries its own "
+                        ".multipliers; this takes a StepMap of the scheme")
     return ritz(F, x, count, blocks=blocks, eps=eps, central=central)[0]
 
 
