@@ -383,12 +383,20 @@ def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int) -> Equ
                          f"({'; '.join(bad[:4])}): the signature read from the scheme "
                          f"({', '.join(f.lay.signature.describe())}) is wrong; refine the "
                          "scheme's orbit (a smaller h) and collocate again")
+    return equation_orbit(f, float(orbit.p), orbit.make, errors)
+
+
+def equation_orbit(f: Solved, p: float, make: Any, errors: dict[str, Any]) -> EquationOrbit:
+    """The EquationOrbit of a solution (its stability verified against ``errors``)."""
     V, b, T = f.lay.split(f.x)
-    return EquationOrbit(p=float(orbit.p), period=T, amplitude=f.amplitude, multipliers=f.mu,
-                         stable=_stable(f.mu, errors["multipliers"], bool(orbit.autonomous)),
+    return EquationOrbit(p=p, period=T, amplitude=f.amplitude, multipliers=f.mu,
+                         stable=_stable(f.mu, errors.get("multipliers", np.full(f.mu.shape,
+                                                                                np.inf)),
+                                        f.lay.autonomous),
                          mesh=f.lay.mesh(b, T), signature=f.lay.signature, switches=b.copy(),
-                         make=orbit.make, autonomous=bool(orbit.autonomous), errors=errors,
-                         degree=f.lay.m, nodes=V.copy())
+                         make=make, autonomous=f.lay.autonomous, errors=errors,
+                         degree=f.lay.m, nodes=V.copy(),
+                         fractions=[fr.copy() for fr in f.lay.fractions])
 
 
 __all__ = ["collocate", "CollocationWarning", "Signature", "assemble"]

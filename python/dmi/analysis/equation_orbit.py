@@ -50,6 +50,9 @@ class EquationOrbit:
         m, the polynomials' degree.
     nodes : numpy.ndarray
         Shape (L m, n): the values at the nodes t_i + k h_i / m, k = 0..m-1 of each interval.
+    fractions : list of numpy.ndarray
+        Each piece's mesh as fractions of the piece (the pieces: the signature's segments in
+        order over [0, period]).
     """
     p: float
     period: float
@@ -64,6 +67,7 @@ class EquationOrbit:
     errors: dict[str, Any] = field(default_factory=dict)
     degree: int = 4
     nodes: np.ndarray = field(default_factory=lambda: np.empty((0, 0)), repr=False)
+    fractions: list = field(default_factory=list, repr=False)
 
     #: What the orbit is of: ``refine_orbit`` and ``floquet_multipliers`` refuse it by this.
     of = "equation"
