@@ -312,7 +312,8 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     sig, b0 = read_signature(orbit.u, orbit.h, terms.alpha, terms.lo, terms.hi)
     T0 = float(orbit.period)
     bounds = np.concatenate([[0.0], b0, [T0]])
-    L0 = int(intervals) if intervals is not None else max(16, 4 * len(sig.pieces()))
+    L = int(intervals) if intervals is not None else max(16, 4 * len(sig.pieces()))
+    L0 = max(8, 2 * len(sig.pieces()), L // 2)        # a first solve: the indicator, the phase
     lay = Layout(m, terms.n, sig, uniform_fractions(bounds, L0), bool(orbit.autonomous), T0)
     t_s = np.asarray(orbit.t, dtype=float)
 
@@ -328,10 +329,9 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     ref = _reference(lay1, x1) if orbit.autonomous else None
     count = int(multipliers)
     if intervals is not None:               # once equidistributed, then halved for the estimate
-        lay2 = lay1.with_fractions(adapted(lay1, x1, L0))
+        lay2 = lay1.with_fractions(adapted(lay1, x1, L))
         c, f = _refine(lay2, terms, transfer(lay1, x1, lay2), ref, count, what)
         return _result(orbit, terms, c, f, count)
-    L = L0
     last = None
     for _ in range(MAX_ROUNDS):
         lay2 = lay1.with_fractions(adapted(lay1, x1, L))

@@ -26,6 +26,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from .collocation_system import History, Layout, Terms, full_jacobian
+from .stability import _one_blas_thread
 
 
 def monodromy(lay: Layout, terms: Terms, x: np.ndarray) -> np.ndarray:
@@ -85,6 +86,7 @@ def monodromy(lay: Layout, terms: Terms, x: np.ndarray) -> np.ndarray:
 
 def multipliers(lay: Layout, terms: Terms, x: np.ndarray, count: int = 10) -> np.ndarray:
     """The ``count`` multipliers of largest modulus (largest first; below 1e-12: 0)."""
-    mu = sl.eigvals(monodromy(lay, terms, x))
+    with _one_blas_thread():          # a small dense problem: BLAS threads only contend
+        mu = sl.eigvals(monodromy(lay, terms, x))
     mu = mu[np.argsort(-np.abs(mu), kind="stable")][:count]
     return np.where(np.abs(mu) < 1e-12, 0.0, mu)

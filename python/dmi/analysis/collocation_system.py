@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -373,39 +374,56 @@ def full_jacobian(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None
 def solve(lay: Layout, terms: Terms, x0: np.ndarray, ref: Callable | None, *,
           tol: float = 1e-12, max_iter: int = 25, what: str = "collocation"
           ) -> tuple[np.ndarray, list[float]]:
-    """Newton's method on the collocation system (sparse LU, a halving line search on |r|):
-    converged when the correction is below tol max(1, |x|_inf) (then one more step).
+    """Newton's method on the collocation system with sparse LU: the factored Jacobian is kept
+    while the residual falls by 10 or more a step (chord steps cost a residual), refreshed
+    otherwise, and a fresh step is halved until the residual falls; converged when the
+    correction is below tol max(1, |x|_inf) (that correction applied).
 
     Raises
     ------
     ShootingError
         No convergence in max_iter, a singular Jacobian, a non-finite residual, a segment that
-        vanishes (:class:`Degenerate` is a ValueError: the signature changed).
+        vanishes on a fresh step (the signature changed).
     """
     x = np.array(x0, dtype=float)
     res: list[float] = []
+    r = assemble(lay, terms, x, ref, jacobian=False)[0]
+    lu, age = None, 0
     for _ in range(max_iter):
-        r, J = full_jacobian(lay, terms, x, ref)
         rn = float(np.max(np.abs(r)))
         res.append(rn)
         if not math.isfinite(rn):
             raise ShootingError(f"{what}: non-finite residual", res)
-        try:
-            dx = sla.splu(J).solve(-r)
-        except RuntimeError as err:
-            raise ShootingError(f"{what}: singular Jacobian ({err})", res) from None
+        if lu is None or (len(res) > 1 and rn > 0.1 * res[-2]):
+            lu, age = _factor(lay, terms, x, ref, what, res), 0
+        dx = lu.solve(-r)
+        age += 1
         if np.max(np.abs(dx)) <= tol * max(1.0, float(np.max(np.abs(x)))):
-            x = x + dx                           # converged: the last, full step
-            res.append(float(np.max(np.abs(assemble(lay, terms, x, ref, jacobian=False)[0]))))
-            return x, res
+            return x + dx, res
         lam = 1.0
-        for _ in range(6):                       # a halving line search on the residual
+        while True:
             try:
                 r1 = assemble(lay, terms, x + lam * dx, ref, jacobian=False)[0]
                 if np.max(np.abs(r1)) < rn or lam < 0.05:
                     break
             except Degenerate:
-                pass
+                if lam < 0.05:
+                    raise ShootingError(f"{what}: a segment vanishes (the signature "
+                                        "changed)", res) from None
+            if age > 1:                          # a stale Jacobian: refresh it, not the step
+                lu, age = _factor(lay, terms, x, ref, what, res), 1
+                dx, lam = lu.solve(-r), 1.0
+                continue
             lam *= 0.5
-        x = x + lam * dx
+        x, r = x + lam * dx, r1
     raise ShootingError(f"{what}: no convergence in {max_iter} Newton iterations", res)
+
+
+def _factor(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None, what: str,
+            res: list[float]) -> Any:
+    """The sparse LU of the Jacobian at x (ShootingError when singular)."""
+    _, J = full_jacobian(lay, terms, x, ref)
+    try:
+        return sla.splu(J)
+    except RuntimeError as err:
+        raise ShootingError(f"{what}: singular Jacobian ({err})", res) from None
