@@ -83,8 +83,8 @@ def main(argv: list[str] | None = None) -> int:
     ref = da.collocate(o, intervals=320, multipliers=4)
     e = da.collocate(o, intervals=40)
     disc, x = da.CollocationDiscretisation.of(e)
-    ref2 = da.collocate(scheme_orbit(vdp, 0.55, np.array([2.0, 0.0]), 6.0, 600), intervals=320,
-                        multipliers=4)
+    dref, xref = da.CollocationDiscretisation.of(ref, estimate=False)
+    ref2 = point(dref, xref, 0.55)
     ob = scheme_orbit(belt, 1.0, np.array([1.0, 0.0]), 6.46, 1000)
     refb = da.collocate(ob, intervals=320, multipliers=0)
     cases = {
