@@ -49,6 +49,8 @@ CHECK_POINTS = 8
 MAX_ROUNDS = 6
 #: Intervals at most.
 MAX_INTERVALS = 4000
+#: The errors' floor, relative to their quantities (Newton's 1e-12 and the conditioning).
+FLOOR = 1e-11
 
 
 class CollocationWarning(RuntimeWarning):
@@ -229,8 +231,21 @@ def _errors(c: Solved, f: Solved) -> dict[str, Any]:
     """The differences of the two levels: the finer's error estimate."""
     t = np.linspace(0.0, f.T, 40 * f.lay.L, endpoint=False)
     du = float(np.max(np.abs(evaluate(c.lay, c.x, t * c.T / f.T) - evaluate(f.lay, f.x, t))))
-    return {"period": abs(c.T - f.T), "amplitude": np.abs(c.amplitude - f.amplitude),
-            "multipliers": _match(f.mu, c.mu), "u": du}
+    return with_floor({"period": abs(c.T - f.T), "amplitude": np.abs(c.amplitude - f.amplitude),
+                       "multipliers": _match(f.mu, c.mu), "u": du},
+                      f.T, f.amplitude, f.mu, float(np.max(np.abs(f.x[:f.lay.rows * f.lay.n]))))
+
+
+def with_floor(errors: dict[str, Any], T: float, amplitude: np.ndarray, mu: np.ndarray,
+               u: float) -> dict[str, Any]:
+    """The errors, each at least FLOOR times its quantity's size (at least 1): Newton stops at
+    a correction of 1e-12 relative, and the conditioning adds a few digits."""
+    errors["period"] = max(errors["period"], FLOOR * max(1.0, T))
+    errors["amplitude"] = np.maximum(errors["amplitude"], FLOOR * np.maximum(1.0, amplitude))
+    errors["multipliers"] = np.maximum(errors["multipliers"], FLOOR * np.maximum(1.0,
+                                                                                   np.abs(mu)))
+    errors["u"] = max(errors["u"], FLOOR * max(1.0, u))
+    return errors
 
 
 def _stable(mu: np.ndarray, err: np.ndarray, autonomous: bool) -> bool | None:

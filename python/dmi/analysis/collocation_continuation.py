@@ -5,8 +5,8 @@
 
 The driver's contract: ``residual(x, p)`` (len(x) equations), ``jacobian(x, p) -> (J_x, J_p)``
 (J_x a scipy.sparse matrix, J_p by a central difference in p), ``point(x, p)`` (the
-:class:`EquationOrbit` the user sees, with its multipliers, their error estimate from the mesh
-with every interval halved, and its verified stability; None when the orbit breaks an inequality
+:class:`EquationOrbit` the user sees, with its multipliers, their error estimates (twice the
+difference to the solve on the mesh with every interval halved), and its verified stability; None when the orbit breaks an inequality
 of its signature), ``event_functions(x, p, point)`` (a sign change is an event) and ``adapt(x, p)``
 (between steps: a segment shorter than ``VANISH`` of the period is removed, a slip or stuck
 segment whose inequality breaks is split around the breach, the mesh is equidistributed again and
@@ -31,7 +31,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from .collocation import (CollocationWarning, Solved, _reference, adapted, check_inequalities,
-                          equation_orbit, evaluate, halved, transfer, uniform_fractions)
+                          _errors, equation_orbit, evaluate, halved, transfer,
+                          uniform_fractions)
 from .collocation_signature import SLIP_NEG, SLIP_POS, STUCK, Signature
 from .collocation_system import Layout, Terms, assemble, full_jacobian, solve
 from .equation_orbit import EquationOrbit
@@ -181,9 +182,8 @@ class CollocationDiscretisation:
                               CollocationWarning, stacklevel=2)
                 return None
             f = Solved(fine, terms, xf, self.count)
-            errors = {"period": abs(f.T - here.T),
-                      "amplitude": np.abs(f.amplitude - here.amplitude),
-                      "multipliers": _nearest(here.mu, f.mu)}
+            # the coarser level's error is about d 2^q / (2^q - 1) <= 2 d, d the difference
+            errors = {k: 2 * v for k, v in _errors(here, f).items()}
         return equation_orbit(here, float(p), self.make, errors)
 
     def event_functions(self, x: np.ndarray, p: float, point: EquationOrbit | None
@@ -269,13 +269,6 @@ class CollocationDiscretisation:
         return x
 
 
-def _nearest(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """|a_j - the nearest b|."""
-    if b.size == 0:
-        return np.full(a.shape, np.inf)
-    return np.min(np.abs(a[:, None] - b[None, :]), axis=1)
-
-
 def _circle(lay: Layout, x: np.ndarray) -> tuple[list[tuple[np.ndarray, float]], float]:
     """The segments around the circle as (modes, start), segment 0 holding t = 0."""
     _, b, T = lay.split(x)
@@ -322,11 +315,18 @@ def _breaches(lay: Layout, terms: Terms, x: np.ndarray, segs: list, T: float) ->
                 continue
             if np.any(bad):
                 k = np.flatnonzero(bad)
-                t0, t1 = t[k[0]], t[k[-1]]
                 inner = mode.copy()
                 inner[i] = new
-                cut = [(inner, float(t0)), (mode, float(t1))]
-                return sorted([s for s in segs] + cut, key=lambda s: s[1] % T)
+                # the breach from the piece's start (a switch that should have been another):
+                # the new mode takes the piece's start over, no sliver of the old mode before it
+                at_start = k[0] == 0 and j > 0
+                out = [sg for sg in segs
+                       if not (at_start and abs((sg[1] - e[j] + 0.5 * T) % T - 0.5 * T)
+                               <= 1e-12 * T)]
+                out.append((inner, float(e[j] if at_start else t[k[0]])))
+                if k[-1] < t.size - 1:
+                    out.append((mode, float(t[k[-1]])))
+                return sorted(out, key=lambda s: s[1] % T)
     return None
 
 
@@ -345,12 +345,9 @@ def _memory(lay: Layout, terms: Terms, x: np.ndarray, t: np.ndarray) -> np.ndarr
 def _relaid(lay: Layout, x: np.ndarray, segs: list, T: float) -> tuple[Layout, np.ndarray]:
     """The layout of the segments ``segs`` (same L, uniform in each piece) and x on it."""
     segs = sorted(segs, key=lambda s: s[1] % T)
-    starts = np.array([s[1] % T for s in segs])
-    first = int(np.argmax(starts)) if starts.min() > 0 else int(np.argmin(starts))
-    # segment 0 holds t = 0: the last to start before T (mod T), unless one starts at 0
-    order = [(first + k) % len(segs) for k in range(len(segs))]
-    modes = np.array([segs[k][0] for k in order])
-    b = np.sort(starts[order[1:]]) if len(segs) > 1 else np.empty(0)
+    # segment 0 holds t = 0: the last to start (mod T); b: every start, ascending
+    modes = np.array([segs[-1][0]] + [s[0] for s in segs[:-1]])
+    b = np.array([s[1] % T for s in segs]) if len(segs) > 1 else np.empty(0)
     sig = Signature(modes if len(segs) > 1 else modes[:1])
     for k in range(1, sig.switches + 1):
         i = np.flatnonzero(sig.modes[k - 1] != sig.modes[k % len(sig.modes)])
