@@ -189,9 +189,9 @@ def test_convergence_order_at_least_degree(vdp_case):
     assert math.log2(err[0] / err[1]) >= 4
 
 
-# ---- circles of a rotating system with a damped-cosine memory -------------------------------------
-# u' = (mu - |u|^2) u + w0 J u - int_0^tau g e^{-s / th} cos(beta s) u(t - s) ds in R^2: z = x + i y,
-# z = r e^{i Om t} with i Om = mu - r^2 + i w0 - K(i Om), K(q) = int_0^tau g e^{-s/th} cos(beta s)
+# ---- circles of a rotating system with a damped-cosine memory ---------------------------------
+# u' = (mu - |u|^2) u + w0 J u - int_0^tau g e^{-s / th} cos(beta s) u(t - s) ds in R^2:
+# z = x + i y, z = r e^{i Om t} with i Om = mu - r^2 + i w0 - K(i Om), K(q) = int_0^tau g e^{-s/th} cos(beta s)
 # e^{-q s} ds in closed form.
 MU, W0, G, TH, BETA, TAU_C = 1.0, 1.0, 0.5, 1.0, 2.0, 2.0
 

@@ -92,7 +92,8 @@ def test_vdp_branch_against_fourier():
 
 def test_den_hartog_branch_signature_changes_to_stick_slip():
     # p scales the forcing: at p = 1 the orbit reverses without sticking (two segments); lowering
-    # the forcing makes it stick at the reversals (from p = 0.45 on); adapt mends the signature between steps
+    # the forcing makes it stick at the reversals (from p = 0.45 on); adapt mends the signature
+    # between steps
     d = DenHartog()
     M = 2000
     make = d.make_for(M)

@@ -1,9 +1,9 @@
 # dmi.analysis.collocate on a stick-slip orbit with memory, u' + sigma(u) + int_0^tau g e^{-s}
 # u(t - s) ds ∋ c sin t, against an event-driven integration written here: the memory as
-# z' = g u(t) - z - g e^{-tau} u(t - tau), DOP853 between events and on pieces at most tau long (a slip reaching 0: a stick or a
+# z' = g u(t) - z - g e^{-tau} u(t - tau), DOP853 between events (a slip reaching 0: a stick or a
 # reversal by the net force; a stick's net force reaching +-1) and the breakpoints the delay carries
-# (every switch + tau), u(t - tau) from the dense outputs of the earlier pieces; run from rest until
-# two periods agree.
+# (every switch + tau), on pieces at most tau long, u(t - tau) from the dense outputs of the earlier
+# pieces; run from rest until two periods agree.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 

@@ -36,9 +36,9 @@ from typing import Any
 import numpy as np
 
 from .collocation_floquet import multipliers as floquet
-from .collocation_mesh import equidistribute
-from .collocation_signature import Signature, read_signature, violations
-from .collocation_system import Layout, Terms, assemble, solve
+from .collocation_mesh import delay_matrix, equidistribute, periodic_locator
+from .collocation_signature import read_signature, violations
+from .collocation_system import Layout, Terms, solve
 from .equation_orbit import EquationOrbit
 from .orbit import Orbit
 from .stepmap import build
@@ -80,7 +80,6 @@ def halved(fractions: list[np.ndarray]) -> list[np.ndarray]:
 
 def evaluate(lay: Layout, x: np.ndarray, t: np.ndarray) -> np.ndarray:
     """u(t) (len(t), n) of the collocated orbit x (t any reals)."""
-    from .collocation_mesh import periodic_locator
     V, b, T = lay.split(x)
     mesh = lay.mesh(b, T)
     _, z, cols = periodic_locator(mesh, lay.m)(np.asarray(t, dtype=float))
@@ -151,8 +150,7 @@ def extrema(lay: Layout, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(max (n,), min (n,)) of each component on the piecewise polynomial: the derivative's
     roots in the intervals next to the largest and smallest nodes."""
     m, n = lay.m, lay.n
-    V, b, T = lay.split(x)
-    mesh = lay.mesh(b, T)
+    V = lay.split(x)[0]
     k = np.arange(m + 1)
     y = 2 * lay.basis.nodes - 1
     hi, lo = V.max(axis=0).copy(), V.min(axis=0).copy()
@@ -168,7 +166,6 @@ def extrema(lay: Layout, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
                 if r.size:
                     v = np.polynomial.polynomial.polyval(r, c)
                     best[i] = max(best[i], v.max()) if sign > 0 else min(best[i], v.min())
-    del mesh
     return hi, lo
 
 
@@ -178,7 +175,6 @@ def check_inequalities(lay: Layout, terms: Terms, x: np.ndarray, tol: float) -> 
                                             or np.any(np.isfinite(terms.lo))
                                             or np.any(np.isfinite(terms.hi))):
         return []
-    from .collocation_mesh import delay_matrix, periodic_locator
     V, b, T = lay.split(x)
     mesh = lay.mesh(b, T)
     e = lay.bounds(b, T)
@@ -372,7 +368,6 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
 def _reference(lay: Layout, x: np.ndarray) -> Any:
     """theta -> r'(theta) (P, n): the derivative in theta = t / T of the orbit x (the phase
     condition's reference), by its polynomial."""
-    from .collocation_mesh import periodic_locator
     V, b, T = lay.split(x)
     mesh = lay.mesh(b, T) / T
     loc = periodic_locator(mesh, lay.m)
@@ -414,4 +409,4 @@ def equation_orbit(f: Solved, p: float, make: Any, errors: dict[str, Any]) -> Eq
                          fractions=[fr.copy() for fr in f.lay.fractions])
 
 
-__all__ = ["collocate", "CollocationWarning", "Signature", "assemble"]
+__all__ = ["collocate", "CollocationWarning"]

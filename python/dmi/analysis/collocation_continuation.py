@@ -6,8 +6,8 @@
 The driver's contract: ``residual(x, p)`` (len(x) equations), ``jacobian(x, p) -> (J_x, J_p)``
 (J_x a scipy.sparse matrix, J_p by a central difference in p), ``point(x, p)`` (the
 :class:`EquationOrbit` the user sees, with its multipliers, their error estimates (twice the
-difference to the solve on the mesh with every interval halved), and its verified stability; None when the orbit breaks an inequality
-of its signature), ``event_functions(x, p, point)`` (a sign change is an event) and ``adapt(x, p)``
+difference to the solve on the mesh with every interval halved), and its verified stability; None
+when the orbit breaks an inequality of its signature), ``event_functions(x, p, point)`` (a sign change is an event) and ``adapt(x, p)``
 (between steps: a segment shorter than ``VANISH`` of the period is removed, a slip or stuck
 segment whose inequality breaks is split around the breach, the mesh is equidistributed again and
 the phase condition's reference moves to x; x changes its length when the signature changes, and
@@ -30,9 +30,10 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
-from .collocation import (CollocationWarning, Solved, _reference, adapted, check_inequalities,
-                          _errors, equation_orbit, evaluate, halved, transfer,
-                          uniform_fractions)
+from .collocation import (CollocationWarning, Solved, _errors, _reference, adapted,
+                          check_inequalities, equation_orbit, evaluate, halved, node_times,
+                          transfer, uniform_fractions)
+from .collocation_mesh import delay_matrix, periodic_locator, point_matrix
 from .collocation_signature import SLIP_NEG, SLIP_POS, STUCK, Signature
 from .collocation_system import Layout, Terms, assemble, full_jacobian, solve
 from .equation_orbit import EquationOrbit
@@ -100,7 +101,18 @@ class CollocationDiscretisation:
         return cls(orbit.make, lay, x, **kw), x
 
     def terms(self, p: float) -> Terms:
-        """The model's terms at p (the last few cached)."""
+        """The model's terms at p (the last few cached).
+
+        Parameters
+        ----------
+        p : float
+            The parameter.
+
+        Returns
+        -------
+        Terms
+            f, its derivative, the kernel, A's coefficients of ``make(p)``.
+        """
         key = float(p)
         t = self._terms.get(key)
         if t is None:
@@ -334,7 +346,6 @@ def _memory(lay: Layout, terms: Terms, x: np.ndarray, t: np.ndarray) -> np.ndarr
     """int_0^tau H(s) u(t - s) ds at the times t (len(t), n) of the orbit x."""
     if not terms.has_kernel:
         return np.zeros((t.size, lay.n))
-    from .collocation_mesh import delay_matrix, periodic_locator
     V, b, T = lay.split(x)
     mesh = lay.mesh(b, T)
     G = delay_matrix(t, terms.tau, mesh, T, terms.H, periodic_locator(mesh, lay.m), lay.basis,
@@ -356,7 +367,6 @@ def _relaid(lay: Layout, x: np.ndarray, segs: list, T: float) -> tuple[Layout, n
                              f"t = {b[k - 1]:.6g}: not continued")
     bounds = np.concatenate([[0.0], b, [T]])
     new = Layout(lay.m, lay.n, sig, uniform_fractions(bounds, lay.L), lay.autonomous, lay.period)
-    from .collocation import node_times
     V = evaluate(lay, x, node_times(new, b, T))
     return new, np.concatenate([V.ravel(), b, [T] if lay.autonomous else []])
 
@@ -433,7 +443,6 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     T = 2 * math.pi / om
     lay = Layout(int(degree), n, Signature(np.zeros((1, n), dtype=int)),
                  [np.linspace(0.0, 1.0, int(intervals) + 1)], True, T)
-    from .collocation import node_times
     t = node_times(lay, np.empty(0), T)
     V = ue + a * np.real(np.outer(np.exp(1j * om * t), v))
     x = np.concatenate([V.ravel(), [T]])
@@ -462,7 +471,6 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
 def _amplitude_condition(lay: Layout, x: np.ndarray, ue: np.ndarray, c: int, a: float,
                          gz: np.ndarray, gw: np.ndarray) -> tuple[float, np.ndarray]:
     """int_0^1 (u_c - u_eq,c)^2 d theta - a^2 / 2 and its row in (x, p) (Gauss points)."""
-    from .collocation_mesh import periodic_locator, point_matrix
     V, b, T = lay.split(x)
     mesh = lay.mesh(b, T)
     h = np.diff(mesh)

@@ -1,5 +1,5 @@
-# Piecewise polynomials on a mesh of one period: the Lagrange basis, evaluation, the delay integral's
-# quadrature matrix and the equidistribution of the mesh.
+# Piecewise polynomials on a mesh of one period: the Lagrange basis, evaluation, the delay
+# integral's quadrature matrix and the equidistribution of the mesh.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """The mesh machinery of :mod:`dmi.analysis.collocation`; private to the package.
 
