@@ -123,9 +123,11 @@ def hill_multiplier(T: float, w: np.ndarray, v: np.ndarray, guess: float) -> flo
         return np.concatenate([r1, r2, [pw[0] - 1]])
 
     lam0 = math.log(guess) / T
-    # a start: the eigenvector of the frozen problem is unknown, so start from a smooth vector and
-    # let root find the pair
-    z0 = np.concatenate([np.ones(N), np.zeros(N), [lam0]])
+    # the start: the right singular vector of the smallest singular value of the (linear) map
+    # p -> residual at lam0, scaled to p_w(0) = 1
+    A = np.column_stack([res(np.concatenate([e, [lam0]]))[:2 * N] for e in np.eye(2 * N)])
+    p0 = sl.svd(A)[2][-1]
+    z0 = np.concatenate([p0 / p0[0], [lam0]])
     z = newton_fd(res, z0)
     assert np.max(np.abs(res(z))) < 1e-10
     return math.exp(z[-1] * T)

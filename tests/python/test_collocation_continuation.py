@@ -62,7 +62,7 @@ def test_hopf_orbit_and_circle_branch_closed_form():
     assert abs(e.p - (muH + 0.01)) < 1e-10 and abs(e.period - T) < 1e-10
     assert np.all(np.abs(e.amplitude - 0.1) < 1e-10)
     disc, x = da.CollocationDiscretisation.of(e)
-    ps = [muH + 0.05, muH + 0.2, 0.6, 1.0]
+    ps = [muH + 0.02, muH + 0.05, muH + 0.1, muH + 0.2, 0.6, 1.0]
     pts = branch(disc, x, ps)
     for p, pt in zip(ps, pts):
         assert pt is not None and pt.p == p                 # lands on each p asked

@@ -18,6 +18,7 @@ unknown lag inside (0, tau) caps the order at 1 there: the pieces do not see it.
 """
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -55,13 +56,15 @@ class Basis:
         return 0.5 * (g + 1.0), 0.5 * w
 
     def values(self, z: np.ndarray) -> np.ndarray:
-        """(len(z), m + 1): the basis polynomials at the local coordinates z."""
-        z = np.asarray(z, dtype=float)
-        d = z[:, None] - self.nodes[None, :]
-        ones = np.ones((z.size, 1))
-        before = np.cumprod(np.concatenate([ones, d[:, :-1]], axis=1), axis=1)
-        after = np.cumprod(np.concatenate([ones, d[:, :0:-1]], axis=1), axis=1)[:, ::-1]
-        return self.weights * before * after
+        """(len(z), m + 1): the basis polynomials at the local coordinates z (their monomial
+        coefficients in y = 2 z - 1, by Horner's scheme)."""
+        y = 2.0 * np.asarray(z, dtype=float) - 1.0
+        C = _monomials(self.m)
+        out = np.broadcast_to(C[self.m], (y.size, self.m + 1)).copy()
+        for j in range(self.m - 1, -1, -1):
+            out *= y[:, None]
+            out += C[j]
+        return out
 
     def derivatives(self, z: np.ndarray) -> np.ndarray:
         """(len(z), m + 1): the basis polynomials' first derivatives at z (d/dz, z in [0, 1])."""
@@ -81,6 +84,14 @@ class Basis:
     def top(self) -> np.ndarray:
         """(m + 1,): the m-th derivative (d/dz) of each basis polynomial, a constant."""
         return self.weights * math.factorial(self.m)
+
+
+@functools.lru_cache(maxsize=16)
+def _monomials(m: int) -> np.ndarray:
+    """(m + 1, m + 1): row j holds the y^j coefficients of the m + 1 Lagrange polynomials on the
+    equispaced nodes of [-1, 1] (y = 2 z - 1; well conditioned for m <= 8)."""
+    y = np.linspace(-1.0, 1.0, m + 1)
+    return np.linalg.inv(np.vander(y, m + 1, increasing=True))
 
 
 def interval_of(mesh: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

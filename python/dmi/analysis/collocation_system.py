@@ -33,8 +33,10 @@ from .collocation_mesh import (Basis, Locator, delay_matrix, history_locator, hi
 from .collocation_signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
 from .newton import ShootingError
 
-#: Quadrature nodes a piece of the delay integral: m + QUAD_EXTRA.
-QUAD_EXTRA = 3
+#: Quadrature nodes a piece of the delay integral: m + QUAD_EXTRA (exact for H u with u of
+#: degree m and H of degree m + 2 QUAD_EXTRA - 1 on the piece; the error h^(2m + 2 QUAD_EXTRA + 1)
+#: a piece stays below the collocation's h^(2m) at the mesh points).
+QUAD_EXTRA = 1
 
 
 class Terms:
