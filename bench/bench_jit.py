@@ -9,7 +9,10 @@
 # u = (x, y), y = x' - v (friction on y), p = a; the orbit has the forcing's period, M steps.
 # Rounds interleave the variants; the fastest round of each counts; CPU times of the process
 # (the machine may be shared); one BLAS thread.  jit=True compiles once per process, before the
-# rounds (the compilation time is printed apart).
+# rounds (the compilation time is printed apart).  Also the cost of a step (advance over --steps
+# steps) with jit=True against the same rhs written by hand as a numba cfunc (its parameter in
+# the user pointer): what jit=True's index checks, error model, copy of u and exception capture
+# cost.
 # Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_jit.py [--rounds 2] [--M 400]
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
@@ -49,6 +52,37 @@ def belt(M: int, jit: bool):
     return make
 
 
+def belt_cfunc(M: int):
+    """make(p) of belt() with the rhs written by hand as a numba cfunc, p in its user data."""
+    import numba
+    h = 2 * math.pi / (W * M)
+
+    @numba.cfunc(dmi.RHS_SIGNATURE)
+    def rhs(t, u, out, user):
+        a = numba.carray(user, (1,), numba.float64)[0]
+        out[0] = -(u[1] + V)
+        out[1] = u[0] + C * (u[1] + V) - a * math.cos(W * t)
+        return 0
+
+    def make(a: float) -> dmi.Solver:
+        s = dmi.Solver(2, TAU, h=h)
+        p = np.array([a])
+        s.set_rhs(rhs, p)
+        s.p = p   # (kept alive with the solver)
+        s.set_friction([0.0, ALPHA])
+        s.set_kernel_exp([-1.0 / THETA], [0.0], [[[0.0, 0.0], [G, 0.0]]])
+        return s
+    return make
+
+
+def per_step(make, steps: int) -> tuple[float, np.ndarray]:
+    """ns of CPU time per step over steps steps from t = 0, and the final state."""
+    s = make(A)
+    s.init()
+    t = cpu(lambda: s.advance(steps))
+    return 1e9 * t / steps, s.state
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(
         description="Times a shooting solve and a continuation step of a forced belt model with "
@@ -57,13 +91,20 @@ def main(argv: list[str] | None = None) -> int:
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     ap.add_argument("--rounds", type=int, default=2, help="interleaved rounds")
     ap.add_argument("--M", type=int, default=400, help="steps a forcing period")
+    ap.add_argument("--steps", type=int, default=2_000_000,
+                    help="steps of the per-step comparison with a hand-written cfunc")
     a = ap.parse_args(argv)
-    if a.rounds < 1 or a.M < 10:
-        ap.error("--rounds must be >= 1 and --M >= 10")
+    if a.rounds < 1 or a.M < 10 or a.steps < 1:
+        ap.error("--rounds and --steps must be >= 1 and --M >= 10")
     P = 2 * math.pi / W
     compile_s = cpu(lambda: belt(a.M, True)(A))
     best = {(k, jit): math.inf for k in ("solve", "step", "period") for jit in (False, True)}
+    ns = {"jit": math.inf, "cfunc": math.inf}
+    states = {}
     for _ in range(a.rounds):
+        for name, make in (("jit", belt(a.M, True)), ("cfunc", belt_cfunc(a.M))):
+            t, states[name] = per_step(make, a.steps)
+            ns[name] = min(ns[name], t)
         for jit in (False, True):
             make = belt(a.M, jit)
             s = make(A)
@@ -84,6 +125,9 @@ def main(argv: list[str] | None = None) -> int:
     print(f"forced belt, M = {a.M} steps a period, N = {dmi.Solver(2, TAU, h=P / a.M).N} delay "
           f"cells; fastest of {a.rounds} interleaved rounds, CPU seconds; jit=True compiled once "
           f"in {compile_s:.2f} s")
+    print(f"per step over {a.steps} steps: jit=True {ns['jit']:.1f} ns, hand-written cfunc "
+          f"{ns['cfunc']:.1f} ns, ratio {ns['jit'] / ns['cfunc']:.3f} (final states differ by "
+          f"{np.max(np.abs(states['jit'] - states['cfunc'])):.1e})")
     print(f"{'':<22} {'Python rhs':>11} {'jit=True':>9} {'Python / jit':>13}")
     for k, label in (("period", "one period (advance)"), ("solve", "shooting solve"),
                      ("step", "continuation step")):

@@ -1,13 +1,19 @@
 # jit=True of the Solver's set_rhs, set_resolvent, set_kernel and set_history: a plain Python
 # function with the Python callback's signature, compiled by numba into the C callback libdmi
-# calls.  The function's source is recompiled with its closure variables as extra arguments, so
-# that their values travel at run time in the callback's user data (numbers by value, NumPy
-# arrays by address) instead of being frozen into the machine code; the compiled code is cached
-# per process, keyed on the function's code and the closure values' types.
+# calls.  The function's source (checked against its code object: an edited file is refused) is
+# recompiled with its closure variables and the numbers and arrays among its globals as extra
+# arguments, so that their values travel at run time in the callback's user data (numbers by
+# value, NumPy arrays by address), written at set_* and again at every init(); the compiled code
+# is cached per process, keyed on the function's code, those values' types and the identity of the
+# other globals and closure values it reads (modules, functions: constants of the machine code).
+# Errors as the Python function's: numba's NumPy error model (1/0 = inf), index checks, and an
+# exception in the compiled code fails the call (returns 3) with its arguments kept in the user
+# data, where raised() calls the Python function again to raise its exception.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """numba compilation of plain Python callbacks (``jit=True``); private to the package."""
 from __future__ import annotations
 
+import __future__
 import ast
 import copy
 import inspect
@@ -22,7 +28,7 @@ import numpy as np
 
 from . import _lib
 from ._callbacks import KERNEL, Bound, Kind
-from ._errors import InvalidArgument
+from ._errors import Error, InvalidArgument
 
 # Array dtypes a closure may hold, by NumPy's dtype.str.
 _DTYPES = {"<f8": "float64", "<f4": "float32", "<i8": "int64", "<i4": "int32"}
@@ -65,11 +71,64 @@ def _param_type(name: str, value: Any, what: str) -> tuple:
                           "modules and functions as they are at compile time)")
 
 
-def _user_data(n: int, values: list[Any], keys: list[tuple]) -> tuple[np.ndarray, list]:
-    """The callback's user data: int64 slots, n first, then each value (a number's bits, or an
-    array's address and shape); and the arrays to keep alive."""
-    slots: list[Any] = [n]
-    keep = []
+def _global_type(value: Any) -> tuple:
+    """The key of a global the function reads: a passed value's type key (as a closure's), or
+    ("k", id) for any other value (a constant of the compiled code, as numba freezes globals)."""
+    try:
+        return _param_type("", value, "")
+    except InvalidArgument:
+        return ("k", id(value))
+
+
+def _global_names(code: types.CodeType, f: types.FunctionType) -> list[str]:
+    """The names code reads from f's globals (LOAD_GLOBAL; not builtins), in order of first use."""
+    import dis
+    names = []
+    for ins in dis.get_instructions(code):
+        if ins.opname in ("LOAD_GLOBAL", "LOAD_NAME") and ins.argval in f.__globals__ \
+                and ins.argval not in names:
+            names.append(ins.argval)
+    return names
+
+
+def _nested_codes(code: types.CodeType) -> list[types.CodeType]:
+    """The code objects inside code (comprehensions, nested functions), at any depth."""
+    out = []
+    for c in code.co_consts:
+        if isinstance(c, types.CodeType):
+            out += [c, *_nested_codes(c)]
+    return out
+
+
+def _parameters(f: types.FunctionType, what: str) -> tuple[list[str], list[Any], list[tuple]]:
+    """The names, current values and keys of what the compiled code reads besides its arguments:
+    the closure's cells, then the globals."""
+    code = f.__code__
+    names = list(code.co_freevars)
+    values = [c.cell_contents for c in (f.__closure__ or ())]
+    keys = [_param_type(name, v, what) for name, v in zip(names, values)]
+    for g in _global_names(code, f):
+        names.append(g)
+        values.append(f.__globals__[g])
+        keys.append(_global_type(values[-1]))
+    for g in sorted({g for c in _nested_codes(code) for g in _global_names(c, f)} - set(names)):
+        names.append(g)   # read inside a comprehension or nested function: a constant, keyed
+        values.append(f.__globals__[g])
+        keys.append(("k", id(values[-1])))
+    return names, values, keys
+
+
+_HEAD = 4  # user data slots before the values: n, failed, the failing t, the scratch's address
+
+
+def _user_data(kind: Kind, n: int, values: list[Any], keys: list[tuple]) -> tuple[np.ndarray, list]:
+    """The callback's user data: int64 slots, the head (n; 0, the failure flag; the failing t
+    (or s, lam); the address of a scratch of 2 n doubles, the failing u and the copy of u the
+    function gets, for f(t, u) and r(lam, x)) and each value (a number's bits, or an array's
+    address and shape); and the arrays to keep alive (the scratch first)."""
+    scratch = np.zeros(2 * n if kind.args == "dppp" else 0)
+    slots: list[Any] = [n, 0, 0, scratch.ctypes.data]
+    keep = [scratch]
     for v, k in zip(values, keys):
         if k[0] == "k":
             continue
@@ -104,6 +163,9 @@ def _source_tree(f: types.FunctionType, what: str) -> tuple[list[ast.arg], list[
         body = ast.parse("(" + text[c0:end].decode() + "\n)", mode="eval").body
         ast.increment_lineno(body, l0 - 1)
         args = [ast.arg(arg=a) for a in code.co_varnames[:code.co_argcount]]
+        _check_source(f, what, ast.Lambda(args=ast.arguments(
+            posonlyargs=[], args=copy.deepcopy(args), vararg=None, kwonlyargs=[], kw_defaults=[],
+            kwarg=None, defaults=[]), body=copy.deepcopy(body)), l0)
         ret = ast.Return(value=body, lineno=body.lineno, end_lineno=body.end_lineno,
                          col_offset=0, end_col_offset=0)
         return args, [ret]
@@ -117,7 +179,78 @@ def _source_tree(f: types.FunctionType, what: str) -> tuple[list[ast.arg], list[
     if not isinstance(node, ast.FunctionDef):
         raise InvalidArgument(_lib.EINVAL, f"{what}: jit=True takes a def or a lambda")
     ast.increment_lineno(node, code.co_firstlineno - 1)
+    _check_source(f, what, node, code.co_firstlineno)
     return node.args.args, node.body
+
+
+def _check_source(f: types.FunctionType, what: str, node: ast.FunctionDef | ast.Lambda,
+                  line: int) -> None:
+    """Refuses source that no longer compiles to f's code object (the file edited after f was
+    made): the source is compiled inside a function that makes f's free variables cells, as
+    f's own enclosing function did, after imports of the names its file imports at module level
+    (Python compiles a method call on an imported module otherwise), and the code objects are
+    compared."""
+    code = f.__code__
+    if isinstance(node, ast.Lambda):
+        inner: ast.stmt = ast.Assign(targets=[ast.Name(id="__dmi_f", ctx=ast.Store())], value=node)
+    else:
+        inner = copy.deepcopy(node)
+        inner.decorator_list = []
+    body: list[ast.stmt] = []
+    if code.co_freevars:
+        body.append(ast.Assign(targets=[ast.Name(id=v, ctx=ast.Store()) for v in code.co_freevars],
+                               value=ast.Constant(value=None)))
+    outer = ast.FunctionDef(name="__dmi_outer", args=ast.arguments(
+        posonlyargs=[], args=[], vararg=None, kwonlyargs=[], kw_defaults=[], kwarg=None,
+        defaults=[]), body=body + [inner], decorator_list=[], returns=None)
+    imports = [ast.Import(names=[ast.alias(name="_", asname=nm)]) for nm in _imported(code.co_filename)]
+    module = ast.fix_missing_locations(ast.Module(body=imports + [outer], type_ignores=[]))
+    try:
+        compiled = compile(module, code.co_filename, "exec", dont_inherit=True,
+                           flags=code.co_flags & __future__.annotations.compiler_flag)
+        made = next(c for c in _nested_codes(compiled) if c.co_name == code.co_name)
+    except (SyntaxError, StopIteration):
+        made = None
+    if made is None or not _same_code(made, code):
+        raise InvalidArgument(_lib.EINVAL, f"{what}: jit=True compiles the source of "
+                              f"{f.__qualname__} ({code.co_filename}, line {line}), which no "
+                              "longer matches the function object (its file was edited after "
+                              "the function was made): reload the module, make the function "
+                              "again and set it again")
+
+
+def _imported(filename: str) -> list[str]:
+    """The names the file's module scope binds by import statements (none if it cannot be read)."""
+    try:
+        tree = ast.parse("".join(linecache.getlines(filename)))
+    except (SyntaxError, ValueError):
+        return []
+    names: set[str] = set()
+    todo: list[ast.AST] = list(tree.body)
+    while todo:
+        node = todo.pop()
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef, ast.Lambda)):
+            continue  # (their own scopes)
+        if isinstance(node, (ast.Import, ast.ImportFrom)):
+            names.update((a.asname or a.name).split(".")[0] for a in node.names if a.name != "*")
+        todo.extend(ast.iter_child_nodes(node))
+    return sorted(names)
+
+
+def _same_code(a: types.CodeType, b: types.CodeType) -> bool:
+    """Whether two code objects have the same bytecode, names and constants (nested code too;
+    line numbers and positions not compared)."""
+    fields = ("co_code", "co_names", "co_varnames", "co_freevars", "co_cellvars", "co_argcount",
+              "co_posonlyargcount", "co_kwonlyargcount")
+    if any(getattr(a, k) != getattr(b, k) for k in fields) or len(a.co_consts) != len(b.co_consts):
+        return False
+    for x, y in zip(a.co_consts, b.co_consts):
+        if isinstance(x, types.CodeType) and isinstance(y, types.CodeType):
+            if not _same_code(x, y):
+                return False
+        elif (type(x), repr(x)) != (type(y), repr(y)):
+            return False
+    return True
 
 
 def _array_literal(node: ast.expr, np_names: set[str]) -> list[ast.expr] | None:
@@ -157,16 +290,15 @@ class _Returns(ast.NodeTransformer):
         return node
 
 
-def _recompiled(f: types.FunctionType, args: list[ast.arg], body: list[ast.stmt],
-                keys: list[tuple], literal: bool) -> types.FunctionType:
-    """f as a module-level function of its arguments and then its closure's values, in f's globals
-    with the closure's modules and functions (compiled with f's file name and lines, so that
-    numba's messages point at them)."""
-    names = f.__code__.co_freevars
-    cells = [c.cell_contents for c in (f.__closure__ or ())]
+def _recompiled(f: types.FunctionType, args: list[ast.arg], body: list[ast.stmt], names: list[str],
+                values: list[Any], keys: list[tuple], literal: bool) -> types.FunctionType:
+    """f as a module-level function of its arguments and then the values passed at run time (its
+    closure's and globals' numbers and arrays), in f's globals with the closure's other values
+    (compiled with f's file name and lines, so that numba's messages point at them)."""
     free = [v for v, k in zip(names, keys) if k[0] != "k"]
     scope = dict(f.__globals__)
-    scope.update((v, c) for v, c, k in zip(names, cells, keys) if k[0] == "k")
+    scope.update((v, c) for v, c, k in zip(names[:len(f.__code__.co_freevars)], values, keys)
+                 if k[0] == "k")
     body = copy.deepcopy(body)  # the same nodes serve both attempts of _compile
     line, last = body[0].lineno, max(getattr(b, "end_lineno", b.lineno) for b in body)
     at = dict(lineno=line, end_lineno=line, col_offset=0, end_col_offset=0)
@@ -260,39 +392,53 @@ def _numba_helpers() -> dict[str, Any]:
 
 
 def _adapter_source(kind: Kind, keys: list[tuple]) -> str:
-    """The cfunc's source: unpacks the user data into the closure's values, calls the function,
-    stores its result."""
+    """The cfunc's source: unpacks the user data into the values passed, copies u into the
+    scratch (the function may write into its argument, as into the Python callback's copy),
+    calls the function and stores its result; an exception in the function (numba catches, it
+    cannot bind) keeps the arguments in the user data and returns 3."""
     vector = kind.args == "dppp"
     head = "x, u_, out_, user" if vector else "x, out_, user"
+    count = sum(1 + k[2] if k[0] == "a" else k[0] != "k" for k in keys)
     lines = [f"def adapter({head}):",
-             f"    m = carray(user, ({1 + sum(1 + k[2] if k[0] == 'a' else k[0] != 'k' for k in keys)},), "
-             "int64)",
+             f"    m = carray(user, ({_HEAD + count},), int64)",
              "    mf = carray(user, (m.shape[0],), float64)",
              "    n = m[0]"]
     if vector:
-        lines.append("    u = carray(u_, (n,))")
+        lines += ["    src = carray(u_, (n,))",
+                  "    failed_u = carray(address(m[3]), (n,), float64)",
+                  "    u = carray(address(m[3] + 8 * n), (n,), float64)",
+                  "    for i in range(n):",
+                  "        u[i] = src[i]"]
     size = "n * n" if kind is KERNEL else "n"
     lines.append(f"    out = carray(out_, ({size},))")
-    j, names = 1, []
+    at, names = _HEAD, []
     for k, key in enumerate(keys):
         if key[0] == "k":
             continue
         v = f"c{k}"
         names.append(v)
         if key[0] == "f":
-            lines.append(f"    {v} = mf[{j}]")
+            lines.append(f"    {v} = mf[{at}]")
         elif key[0] == "i":
-            lines.append(f"    {v} = m[{j}]")
+            lines.append(f"    {v} = m[{at}]")
         elif key[0] == "b":
-            lines.append(f"    {v} = m[{j}] != 0")
+            lines.append(f"    {v} = m[{at}] != 0")
         else:
-            shape = ", ".join(f"m[{j + 1 + d}]" for d in range(key[2]))
-            lines.append(f"    {v} = carray(address(m[{j}]), ({shape},), {_DTYPES[key[1]]})")
-            j += key[2]
-        j += 1
+            shape = ", ".join(f"m[{at + 1 + d}]" for d in range(key[2]))
+            lines.append(f"    {v} = carray(address(m[{at}]), ({shape},), {_DTYPES[key[1]]})")
+            at += key[2]
+        at += 1
     call = ", ".join(["x", "u"] if vector else ["x"]) + "".join(f", {v}" for v in names)
-    lines.append(f"    r = inner({call})")
-    lines.append(f"    return {'put_mat' if kind is KERNEL else 'put_vec'}(r, out, n)")
+    lines += ["    try:",
+              f"        r = inner({call})",
+              "    except Exception:",
+              "        m[1] = 1",
+              "        mf[2] = x"]
+    if vector:
+        lines += ["        for i in range(n):",
+                  "            failed_u[i] = src[i]"]
+    lines += ["        return 3",
+              f"    return {'put_mat' if kind is KERNEL else 'put_vec'}(r, out, n)"]
     return "\n".join(lines) + "\n"
 
 
@@ -326,25 +472,53 @@ def _signature(kind: Kind, keys: list[tuple]) -> tuple:
     return tuple(args)
 
 
-def _compile(kind: Kind, f: types.FunctionType, keys: list[tuple], what: str) -> Any:
+_FORM = {"rhs": "f(t, u)", "resolvent": "r(lam, x)", "kernel": "H(s)", "history": "z(t)"}
+
+
+def _result_refused(kind: Kind, f: types.FunctionType, result: Any) -> str | None:
+    """Why numba's type of f's result cannot be libdmi's output, or None when it can."""
+    from numba import types as nt
+    if kind is KERNEL:
+        if isinstance(result, nt.Array) and result.ndim == 2:
+            return None
+        return (f"the kernel must return an n x n array; {f.__qualname__} returns {result} "
+                "(for n = 1 too: np.array([[value]]))")
+    if (isinstance(result, nt.Array) and result.ndim == 1) or isinstance(result, nt.BaseTuple):
+        return None
+    return (f"the {kind.name} {_FORM[kind.name]} must return an array of shape (n,) (or a tuple of "
+            f"n numbers); {f.__qualname__} returns {result}")
+
+
+def _compile(kind: Kind, f: types.FunctionType, names: list[str], values: list[Any],
+             keys: list[tuple], what: str) -> Any:
     h = _numba_helpers()
     numba = h["numba"]
-    args, body = _source_tree(f, what)
     want = 2 if kind.args == "dppp" else 1
-    if len(args) != want or f.__code__.co_flags & (inspect.CO_VARARGS | inspect.CO_VARKEYWORDS):
-        form = {"rhs": "f(t, u)", "resolvent": "r(lam, x)", "kernel": "H(s)", "history": "z(t)"}
+    if f.__code__.co_argcount != want or f.__code__.co_kwonlyargcount or \
+            f.__code__.co_flags & (inspect.CO_VARARGS | inspect.CO_VARKEYWORDS):
         raise InvalidArgument(_lib.EINVAL, f"{what}: jit=True takes a function of {want} "
-                              f"argument(s), as the Python callback {form[kind.name]}")
+                              f"argument(s), as the Python callback {_FORM[kind.name]}")
+    args, body = _source_tree(f, what)
     from numba import carray, float64, int64
     for literal in ((True, False) if kind is not KERNEL else (False,)):
         try:
-            inner = numba.njit(_recompiled(f, args, body, keys, literal))
-            inner.compile(_signature(kind, keys))  # the function's own errors first
+            # numba's NumPy error model (x / 0 = inf, as NumPy's floats give) and index checks
+            inner = numba.njit(_recompiled(f, args, body, names, values, keys, literal),
+                               error_model="numpy", boundscheck=True)
+            sig = _signature(kind, keys)
+            inner.compile(sig)  # the function's own errors first
+            why = _result_refused(kind, f, inner.overloads[sig].signature.return_type)
+            if why is not None:
+                if literal:
+                    continue
+                raise InvalidArgument(_lib.EINVAL, f"{what}(jit=True): {why}")
             ns = {"carray": carray, "float64": float64, "int64": int64, "float32": numba.float32,
                   "int32": numba.int32, "inner": inner, "address": h["address"],
                   "put_vec": h["put_vec"], "put_mat": h["put_mat"]}
             exec(_adapter_source(kind, keys), ns)
             return numba.cfunc(kind.numba)(ns["adapter"])
+        except InvalidArgument:
+            raise
         except Exception as e:  # numba's errors, and Python's raised while numba reads the code
             if literal:
                 continue  # try the function as written
@@ -356,9 +530,18 @@ def _compile(kind: Kind, f: types.FunctionType, keys: list[tuple], what: str) ->
     raise AssertionError("unreachable")
 
 
+class JitBound(Bound):
+    """A jit=True callback as handed to libdmi, with what raised() and refresh() need."""
+
+    def __init__(self, kind: Kind, f: types.FunctionType, n: int, keys: list[tuple], cfunc: Any,
+                 data: np.ndarray, arrays: list):
+        super().__init__(int(cfunc.address), int(data.ctypes.data), (cfunc, data, arrays, f))
+        self.kind, self.f, self.n, self.keys, self.data = kind, f, n, keys, data
+
+
 def bind(kind: Kind, f: Any, user: Any, n: int) -> Bound:
     """What set_<kind>(f, jit=True) hands to libdmi: the compiled callback (cached) and its user
-    data holding the closure's current values."""
+    data holding the current values of the closure and of the globals passed."""
     what = f"set_{kind.name}"
     if user is not None:
         raise InvalidArgument(_lib.EINVAL, f"{what}: jit=True takes no user pointer (the closure's "
@@ -366,15 +549,61 @@ def bind(kind: Kind, f: Any, user: Any, n: int) -> Bound:
     if not isinstance(f, types.FunctionType):
         raise InvalidArgument(_lib.EINVAL, f"{what}: jit=True compiles a Python function (def or "
                               f"lambda), not {type(f).__name__}")
-    code = f.__code__
-    values = [c.cell_contents for c in (f.__closure__ or ())]
-    keys = [_param_type(name, v, what) for name, v in zip(code.co_freevars, values)]
-    key = (code, id(f.__globals__), kind.name, tuple(keys))
+    names, values, keys = _parameters(f, what)
+    key = (f.__code__, id(f.__globals__), kind.name, tuple(names), tuple(keys))
     with _lock:
         c = _cache.get(key)
         if c is None:
-            c = _compile(kind, f, keys, what)
+            c = _compile(kind, f, names, values, keys, what)
             _cache[key] = c
             _compilations[0] += 1
-    data, arrays = _user_data(n, values, keys)
-    return Bound(int(c.address), int(data.ctypes.data), (c, data, arrays, f))
+    data, arrays = _user_data(kind, n, values, keys)
+    return JitBound(kind, f, n, keys, c, data, arrays)
+
+
+def refresh(bound: JitBound, what: str) -> None:
+    """Writes the current values of the function's closure and globals into the user data libdmi
+    holds (init(): the compiled callback then computes with them, as the Python function would).
+
+    Raises
+    ------
+    dmi.InvalidArgument
+        A value changed its type, or a module or function it reads was rebound, since set_*:
+        the compiled code no longer fits (set the callback again).
+    """
+    names, values, keys = _parameters(bound.f, what)
+    if keys != bound.keys:
+        changed = next((nm for nm, k, old in zip(names, keys, bound.keys) if k != old), names[-1])
+        raise InvalidArgument(_lib.EINVAL, f"{what}: the jit=True {bound.kind.name} callback's "
+                              f"{changed!r} changed its type or was rebound since set_"
+                              f"{bound.kind.name}; its compiled code no longer fits: call "
+                              f"set_{bound.kind.name}(..., jit=True) again")
+    data, arrays = _user_data(bound.kind, bound.n, values, keys)
+    bound.data[_HEAD:] = data[_HEAD:]    # (the head stays: the scratch's address)
+    bound.keep = (bound.keep[0], bound.data, [bound.keep[2][0]] + arrays[1:], bound.f)
+
+
+def raised(bounds: list[Bound]) -> BaseException | None:
+    """The exception of a jit=True callback whose compiled code failed (returned 3): the Python
+    function called again at the arguments it failed at, which raises the same exception (with a
+    note); an Error when the Python function does not raise there; None if none failed."""
+    for b in bounds:
+        if not isinstance(b, JitBound) or b.data[1] == 0:
+            continue
+        b.data[1] = 0
+        x = float(b.data[2:3].view(np.float64)[0])
+        args: tuple = (x,)
+        if b.kind.args == "dppp":
+            args += (b.keep[2][0][:b.n].copy(),)
+        where = f"{_FORM[b.kind.name].split('(')[1][:-1]} = " + ", ".join(repr(a) for a in args)
+        try:
+            b.f(*args)
+        except Exception as e:  # noqa: BLE001 - the user's own exception, raised as it is
+            e.add_note(f"raised by the jit=True {b.kind.name} callback {b.f.__qualname__} at "
+                       f"{where} (its compiled code failed there; this is the Python function's "
+                       "exception at the same arguments)")
+            return e
+        return Error(_lib.ECALLBACK, f"the jit=True {b.kind.name} callback {b.f.__qualname__} "
+                     f"failed in its compiled code at {where} (an exception, or an index out of "
+                     "range), but the Python function does not raise there")
+    return None

@@ -7,6 +7,7 @@ import ctypes
 import math
 import operator
 import threading
+import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
@@ -171,12 +172,22 @@ class Solver:
             return
         if failure is not None:
             raise failure
+        self._raise_jit(rc)
         message = _L.dmi_last_error(self._handle).decode()
         if rc == _lib.ECALLBACK and "callback returned 2 " in message and \
                 self._jit_slots:
             message += (" (a jit=True callback returns 2 when its result does not have libdmi's "
                         "shape: (n,), or (n, n) for the kernel)")
         raise from_code(rc, message)
+
+    def _raise_jit(self, rc: int) -> None:
+        """Raises the exception of a jit=True callback whose compiled code failed (rc
+        DMI_ECALLBACK): the Python function's own, called again where the compiled one failed."""
+        if rc == _lib.ECALLBACK and self._jit_slots:
+            from . import _jit
+            exc = _jit.raised([self._keep[k] for k in self._jit_slots])
+            if exc is not None:
+                raise exc
 
     def _set_callback(self, slot: str, kind: cb.Kind, setter: Any, f: Any, user: Any,
                       jit: bool = False) -> None:
@@ -423,12 +434,17 @@ class Solver:
         """Samples the kernel and the history and sets t = 0 (p = 0, ``dmi_init``); again: restarts
         from t = 0.
 
+        A ``jit=True`` callback computes with its closure's and globals' values as they are now
+        (docs/python.md, "jit=True").
+
         Raises
         ------
         Exception
             The exception a Python kernel or history callback raised, as it is.
         dmi.InvalidArgument
-            Code ``dmi.ECALLBACK``: a Python callback returned a result of another shape or type;
+            Code ``dmi.EINVAL``: a value a ``jit=True`` callback reads changed its type since its
+            ``set_*`` call (set it again);
+            code ``dmi.ECALLBACK``: a Python callback returned a result of another shape or type;
             code ``dmi.EINVAL``: near cells of :meth:`set_kernel_near` without a kernel of
             :meth:`set_kernel_exp` or with ceil(delta / h) + 1 > N, or ``"recursive"`` for a
             kernel it refuses (see :meth:`set_convolution`).
@@ -437,6 +453,10 @@ class Solver:
             infinite sample) or ``dmi.ENOMEM``.  The solver is then unchanged.
         """
         with self._using() as s:
+            if self._jit_slots:   # (the values jit=True callbacks read: as they are now)
+                from . import _jit
+                for slot in sorted(self._jit_slots):
+                    _jit.refresh(self._keep[slot], "init")
             self._check(_L.dmi_init(s))
 
     def step(self) -> None:
@@ -731,9 +751,11 @@ class Solver:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def __del__(self) -> None:
+    def __del__(self, _free: Any = _L.dmi_free, _byref: Any = ctypes.byref) -> None:
+        # dmi_free and byref bound at definition: during interpreter shutdown the module's globals
+        # (_L, ctypes) may already be None when a solver left alive is collected
         if getattr(self, "_handle", None) is not None:
-            _L.dmi_free(ctypes.byref(self._handle))
+            _free(_byref(self._handle))
             self._handle = None
 
     def set_quadrature(self, rule: str) -> None:
@@ -751,9 +773,14 @@ class Solver:
         Raises
         ------
         dmi.InvalidArgument
-            Code ``dmi.EINVAL``: another rule; code ``dmi.ESTATE``: after :meth:`init`.
+            Code ``dmi.EINVAL``: another rule, or ``"left"`` with near cells
+            (:meth:`set_kernel_near`); code ``dmi.ESTATE``: after :meth:`init`.
         """
         code = _choice(_lib.QUAD, rule, "set_quadrature: rule")
+        if rule == "left" and self._near_delta > 0:
+            raise InvalidArgument(_lib.EINVAL, "set_quadrature('left'): the near cells of "
+                                  "set_kernel_fit or set_kernel_near need the cell rule (remove "
+                                  "them first: set_kernel_near(None, 0))")
         with self._using() as s:
             self._check(_L.dmi_set_quadrature(s, code))
         self._choices["quadrature"] = rule
@@ -762,7 +789,9 @@ class Solver:
         """Sets the exact kernel of the cells below ``delta``, whose weights become H's exact cell
         integrals, while the kernel of :meth:`set_kernel_exp` (a fit on [delta, tau]) gives the
         other cells: a kernel singular at 0 in O(1) per step (``dmi_set_kernel_near``).  Before
-        :meth:`init`, which checks the combination.
+        :meth:`init`, which checks the combination.  Near cells need the cell rule
+        (:meth:`set_quadrature` ``("cell")``): under the left rule the quadrature is switched to
+        the cell rule, with a ``UserWarning`` that says so.
 
         Parameters
         ----------
@@ -786,6 +815,13 @@ class Solver:
             return _L.dmi_set_kernel_near(s, address, u, float(delta))
         self._set_callback("kernel_near", cb.KERNEL, setter, H, user, False)
         self._near_delta = float(delta) if H is not None else 0.0
+        if self._near_delta > 0 and self._choices["quadrature"] == "left":
+            # the left rule would sample the fit at l h while the near cells are exact integrals
+            self.set_quadrature("cell")
+            warnings.warn("near cells (delta > 0, of set_kernel_fit or set_kernel_near) need the "
+                          "cell rule; the quadrature is now the cell rule (call "
+                          "set_quadrature('cell') first to make this explicit)", UserWarning,
+                          stacklevel=2)
 
     def set_kernel_fit(self, fit: Any, entry: tuple[int, int] | None = None, near: Callback | None = None,
                        ) -> None:
@@ -808,11 +844,18 @@ class Solver:
         Raises
         ------
         dmi.InvalidArgument
-            Code ``dmi.EINVAL``: a matrix fit of another size or with ``entry``, a scalar fit
-            without ``entry`` for n > 1 or with an entry outside n x n, a fit with ``delta > 0``
-            and no exact kernel, or as :meth:`set_kernel_exp` and :meth:`set_kernel_near`; code
-            ``dmi.ESTATE``: after :meth:`init`.
+            Code ``dmi.EINVAL``: fit not a KernelFit (None included: to remove the kernel,
+            :meth:`set_kernel` ``(None)`` and :meth:`set_kernel_near` ``(None, 0)``), a matrix fit
+            of another size or with ``entry``, a scalar fit without ``entry`` for n > 1 or with an
+            entry outside n x n, a fit with ``delta > 0`` and no exact kernel, or as
+            :meth:`set_kernel_exp` and :meth:`set_kernel_near`; code ``dmi.ESTATE``: after
+            :meth:`init`.  From :meth:`init`: code ``dmi.ECALLBACK`` when the near kernel of a
+            scalar fit does not return a scalar.
         """
+        if not all(hasattr(fit, k) for k in ("a", "b", "C", "D", "delta")):
+            raise InvalidArgument(_lib.EINVAL, f"set_kernel_fit: fit is {type(fit).__name__}; "
+                                  "expected a dmi.kernels.KernelFit (to remove the kernel: "
+                                  "set_kernel(None) and set_kernel_near(None, 0))")
         n = self._n
         C, D = np.asarray(fit.C, float), np.asarray(fit.D, float)
         K = len(fit.a)
@@ -846,8 +889,14 @@ class Solver:
                 scalar = exact   # a Python scalar kernel: as an n x n one
 
                 def exact(s: float, _i: int = i, _j: int = j) -> np.ndarray:
+                    v = np.asarray(scalar(s))
+                    if v.size != 1:
+                        raise InvalidArgument(_lib.ECALLBACK, "set_kernel_fit: the near kernel of "
+                                              f"a scalar fit must return a scalar; at s = {s!r} it "
+                                              f"returned shape {v.shape} (an n x n near kernel "
+                                              "goes with an n x n fit)")
                     out = np.zeros((n, n))
-                    out[_i, _j] = scalar(s)
+                    out[_i, _j] = v.item()
                     return out
             self.set_kernel_near(exact, fit.delta)
         else:
@@ -952,6 +1001,7 @@ class Solver:
         if failure is not None:
             failure.add_note(f"raised by the model's {what}")
             raise failure
+        self._raise_jit(_lib.ECALLBACK if rc != 0 else rc)
         if rc != 0:
             raise Error(_lib.ECALLBACK, f"the model's {what} returned {rc}")
         return out

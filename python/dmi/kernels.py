@@ -29,6 +29,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
 import sys
 import warnings
 from dataclasses import dataclass, field
@@ -43,7 +44,7 @@ __all__ = ["KernelFit", "PowerKernel", "fit", "main"]
 
 @dataclass(frozen=True)
 class PowerKernel:
-    """The power kernel ``c s^{-beta}``, ``beta > 0``, singular at 0 (integrable for ``beta < 1``: with
+    """The power kernel ``c s^{-beta}``, ``0 < beta < 1``, singular at 0 and integrable (with
     ``c = 1 / Gamma(beta)`` it is the kernel of the Caputo derivative of order ``1 - beta``).
 
     A callable ``s -> c s^{-beta}`` that also carries its Laplace measure, ``s^{-beta} = 1/Gamma(beta)
@@ -53,7 +54,8 @@ class PowerKernel:
     Attributes
     ----------
     beta : float
-        The exponent, finite and > 0.
+        The exponent, 0 < beta < 1 (for beta >= 1 the kernel is not integrable at 0: no memory
+        kernel).
     c : float
         The factor, finite and nonzero.
 
@@ -66,8 +68,9 @@ class PowerKernel:
     c: float = 1.0
 
     def __post_init__(self) -> None:
-        if not (self.beta > 0 and math.isfinite(self.beta)):
-            raise ValueError(f"PowerKernel: beta = {self.beta}; expected a finite beta > 0")
+        if not 0 < self.beta < 1:
+            raise ValueError(f"PowerKernel: beta = {self.beta}; expected 0 < beta < 1 (s^-beta is "
+                             "integrable at 0 only for beta < 1)")
         if not math.isfinite(self.c) or self.c == 0:
             raise ValueError(f"PowerKernel: c = {self.c}; expected a finite nonzero c")
 
@@ -115,11 +118,16 @@ class KernelFit:
     relative : bool
         Whether ``max_error`` is relative to max |H(s)| at each s.
     certified : bool
-        The error bound holds between the grid points too (a derivative bound, docs/kernels.md).
+        ``max_error`` bounds the error everywhere on ``[delta, tau]``, between the check grid's
+        points too (a derivative bound, docs/kernels.md; only for a :class:`PowerKernel`).  It
+        covers the fit on ``[delta, tau]`` and nothing else: not the near cells below ``delta``,
+        whose weights libdmi computes by its own quadrature of the exact kernel
+        (``Solver.set_kernel_near``), nor the scheme's error.
     l1_error : float
         int_delta^tau ||H - H~|| ds.
     kernel_l1 : float
-        int_0^tau ||H|| ds.
+        int_0^tau ||H|| ds, >= 0 (the kernel must be integrable: :func:`fit` refuses one that
+        is not).
     method : str
         The method of the fit returned: ``"esprit"`` or ``"laplace"``.
     grid_points : int
@@ -246,14 +254,20 @@ class KernelFit:
         Parameters
         ----------
         name : str, optional
-            The prefix of the names.
+            The prefix of the names: a C identifier (letters, digits and _, not a digit first).
 
         Returns
         -------
         str
             A comment with the call, the constant ``<name>_K`` and the ``static const double``
             arrays ``<name>_a``, ``<name>_b``, ``<name>_C``, ``<name>_D``.
+
+        Raises
+        ------
+        ValueError
+            name is not a C identifier.
         """
+        _check_name(name, "c")
         def arr(tag: str, x: np.ndarray) -> str:
             vals = ", ".join(repr(float(v)) for v in x.ravel())
             return f"static const double {name}_{tag}[{x.size}] = {{{vals}}};"
@@ -269,7 +283,8 @@ class KernelFit:
         Parameters
         ----------
         name : str, optional
-            The prefix of the names.
+            The prefix of the names: a Fortran name (a letter, then letters, digits and _; at
+            most 61 characters).
 
         Returns
         -------
@@ -277,7 +292,13 @@ class KernelFit:
             The parameter ``<name>_K`` and ``real(c_double)`` arrays with ``data`` statements;
             C and D flat in the C layout (row-major per term), as ``dmi_set_kernel_exp`` reads
             them.
+
+        Raises
+        ------
+        ValueError
+            name is not a Fortran name.
         """
+        _check_name(name, "fortran")
         def arr(tag: str, x: np.ndarray) -> list[str]:
             # C, D: the C layout (row-major per term) as one flat array, as dmi_set_kernel_exp reads it
             vals = [repr(float(v)).replace("e", "d") if "e" in repr(float(v)) else repr(float(v)) + "d0"
@@ -297,15 +318,45 @@ class KernelFit:
 
 # ---- helpers ---------------------------------------------------------------------------------------
 
+# The names to_c and to_fortran print: <name>_K, <name>_a, ... (Fortran: 63 characters at most).
+_NAMES = {"c": (r"[A-Za-z_][A-Za-z0-9_]*", "a C identifier: letters, digits and _, not a digit first"),
+          "fortran": (r"[A-Za-z][A-Za-z0-9_]{0,60}", "a Fortran name: a letter, then letters, digits "
+                      "and _, at most 61 characters")}
+
+
+def _check_name(name: Any, language: str) -> None:
+    """ValueError unless name makes valid names <name>_K, <name>_a, ... in the language."""
+    pattern, rule = _NAMES[language]
+    if not (isinstance(name, str) and re.fullmatch(pattern, name)):
+        raise ValueError(f"name {name!r} is not {rule}")
+
+
+_COMPLEX = ("fit: H returns complex values; libdmi's kernels are real (a complex exponential "
+            "exp((a + ib) s) is the real pair exp(a s) cos(b s), exp(a s) sin(b s): fit the real "
+            "kernel)")
+
+
+def _real(v: Any) -> np.ndarray:
+    """v as a float64 array; ValueError for complex values (their imaginary part would be lost)."""
+    v = np.asarray(v)
+    if np.iscomplexobj(v):
+        raise ValueError(_COMPLEX)
+    return np.asarray(v, dtype=np.float64)
+
+
 def _values(H: Callable[[float], Any], s: np.ndarray) -> np.ndarray:
     """H at the points s: (M,) or (M, n, n), vectorised when H takes arrays, else point by point."""
+    complex_values = False
     try:
-        v = np.asarray(H(s), dtype=np.float64)
-        if v.shape[:1] == s.shape:
-            return v
+        v = np.asarray(H(s))
+        complex_values = np.iscomplexobj(v)
+        if v.shape[:1] == s.shape and not complex_values:
+            return np.asarray(v, dtype=np.float64)
     except Exception:  # noqa: BLE001 - a scalar-only callable: evaluate point by point below
         pass
-    return np.array([np.asarray(H(float(x)), dtype=np.float64) for x in s])
+    if complex_values:
+        raise ValueError(_COMPLEX)
+    return np.array([_real(H(float(x))) for x in s])
 
 
 def _err(ref: np.ndarray, got: np.ndarray, relative: bool) -> np.ndarray:
@@ -348,8 +399,9 @@ def _coefficients(s: np.ndarray, V: np.ndarray, a: np.ndarray, b: np.ndarray,
 
 # ---- ESPRIT ------------------------------------------------------------------------------------------
 
-def _esprit_candidates(s: np.ndarray, V: np.ndarray, max_rank: int, noisy: bool):
-    """Yields (a, b) for ranks 1, 2, ... of the block-Hankel matrix of the uniform samples V (M, E)."""
+def _esprit_candidates(s: np.ndarray, V: np.ndarray, max_rank: int, noisy: bool, seen: dict):
+    """Yields (a, b) for ranks 1, 2, ... of the block-Hankel matrix of the uniform samples V (M, E);
+    seen["rate"] becomes the rank-1 rate before it is bounded to <= 0 (> 0: the kernel grows)."""
     M, E = V.shape
     ds = s[1] - s[0]
     L = M // 2
@@ -366,6 +418,8 @@ def _esprit_candidates(s: np.ndarray, V: np.ndarray, max_rank: int, noisy: bool)
         z = np.linalg.eigvals(Phi)
         z = z[np.abs(z) > 1e-300]
         mu = np.log(z.astype(np.complex128)) / ds
+        if r == 1 and len(mu):
+            seen["rate"] = float(mu.real.max())
         a = np.minimum(mu.real, 0.0)  # a decaying or constant term: the recursion refuses growth
         b = np.abs(mu.imag)
         # conjugate pairs (real data) give one (a, b) term: merge equal (a, |b|)
@@ -507,14 +561,17 @@ def fit(H: Callable[[float], Any] | None, tau: float, *, tol: float = 1e-8, rela
     -------
     KernelFit
         The fit with the fewest terms that meets ``tol`` (at most ``max_terms``); when none does,
-        the best found, with a ``UserWarning`` (for a callable H).
+        the best found, with a ``UserWarning`` that says why when it can: a growing kernel (fits
+        allow only decaying terms), or for uniform samples their noise, estimated from their 4th
+        differences, and the tol it allows.
 
     Raises
     ------
     ValueError
         tau, tol, max_terms or delta out of range; both or neither of H and samples; samples of
         other shapes, not finite or not increasing, or on a non-uniform grid and not positive and
-        decreasing.
+        decreasing; complex values of H or the samples; a callable H whose integral of ||H|| over
+        [0, tau] does not converge (not integrable at 0, as 1/s).
     """
     if not (tau > 0 and math.isfinite(tau)):
         raise ValueError(f"fit: tau = {tau}; expected a finite tau > 0")
@@ -528,9 +585,10 @@ def fit(H: Callable[[float], Any] | None, tau: float, *, tol: float = 1e-8, rela
     if (H is None) == (samples is None):
         raise ValueError("fit: give H, or H = None and samples = (s, values)")
     candidates: list[KernelFit] = []
+    seen: dict[str, Any] = {}   # what the fits saw that the warning reports
     if samples is not None:
-        s = np.asarray(samples[0], dtype=np.float64)
-        V = np.asarray(samples[1], dtype=np.float64)
+        s = _real(samples[0])
+        V = _real(samples[1])
         if s.ndim != 1 or len(s) < 8 or V.shape[:1] != s.shape or V.ndim not in (1, 3):
             raise ValueError(f"fit: samples of shapes {s.shape}, {V.shape}; expected (M,), (M,) or (M, n, n)"
                              ", M >= 8")
@@ -541,23 +599,52 @@ def fit(H: Callable[[float], Any] | None, tau: float, *, tol: float = 1e-8, rela
         ds = np.diff(s)
         if np.ptp(ds) > 1e-6 * ds.mean():
             fn = _interpolated(s, V)
-            candidates += _fit_callable(fn, tau, lo, tol, relative, max_terms, noisy=True, esprit=False)
+            candidates += _fit_callable(fn, tau, lo, tol, relative, max_terms, noisy=True, esprit=False,
+                                        seen=seen)
             if not candidates:
                 raise ValueError("fit: samples on a non-uniform grid are fitted only when positive and "
                                  "decreasing (a completely monotone kernel); resample them uniformly")
         else:
-            candidates += _fit_esprit(s, V, tau, lo, tol, relative, max_terms, noisy=True, check=(s, V))
+            seen["samples"] = V
+            candidates += _fit_esprit(s, V, tau, lo, tol, relative, max_terms, noisy=True, check=(s, V),
+                                      seen=seen)
     else:
-        candidates += _fit_callable(H, tau, lo, tol, relative, max_terms, noisy=False, esprit=True)
+        candidates += _fit_callable(H, tau, lo, tol, relative, max_terms, noisy=False, esprit=True,
+                                    seen=seen)
     good = [c for c in candidates if c.max_error <= tol]
     if good:
         best = min(good, key=lambda c: (c.terms, c.max_error))
     else:
         best = min(candidates, key=lambda c: c.max_error)
-        if samples is None:
-            warnings.warn(f"fit: no fit of at most {max_terms} terms meets tol = {tol:g}; the best has "
-                          f"{best.terms} terms and error {best.max_error:.3g}", stacklevel=2)
+        warnings.warn(f"fit: no fit of at most {max_terms} terms meets tol = {tol:g}; the best has "
+                      f"{best.terms} terms and error {best.max_error:.3g}"
+                      + _why_missed(seen, tau - lo, samples is not None, relative),
+                      stacklevel=2)
     return _with_l1(best, H, samples)
+
+
+def _why_missed(seen: dict, length: float, sampled: bool, relative: bool) -> str:
+    """What keeps the fits from tol: a growing kernel, or the noise of uniform samples
+    (seen["samples"])."""
+    rate = seen.get("rate", 0.0)
+    if rate * length > 0.1 and seen.get("larger_at_tau"):   # the leading term grows by > 10 %
+        return (f". The kernel grows (its leading rate is +{rate:.3g} per time unit): fits allow "
+                "only decaying or constant terms (a_k <= 0), and more terms do not help; a growing "
+                "memory kernel makes the scheme's sum grow with tau")
+    V = seen.get("samples")
+    if V is None:
+        return (": the samples are on a non-uniform grid (their noise is not estimated); more "
+                "or smoother samples, or a larger tol" if sampled else
+                ": more terms (max_terms) or a larger tol")
+    d4 = np.diff(V.reshape(len(V), -1), 4, axis=0)   # white noise: var(d4) = 70 sigma^2
+    sigma = float(1.4826 * np.median(np.abs(d4)) / math.sqrt(70)) if len(d4) else 0.0
+    scale = float(np.max(np.abs(V))) if relative else 1.0
+    largest = sigma * math.sqrt(2 * math.log(max(len(V), 2)))  # the largest of M Gaussian deviations
+    return (f". The samples' noise, estimated from their 4th differences, is about "
+            f"{sigma / scale:.2g}{' relative to max |H|' if relative else ''}: no fit can follow "
+            f"them closer than that; the error is measured at the {len(V)} samples, whose largest "
+            f"noise is about {largest / scale:.2g}, so a tol of about {largest / scale:.2g} or more "
+            "is what the noise allows (or give smoother samples)")
 
 
 def _with_l1(f: KernelFit, H, samples) -> KernelFit:
@@ -566,11 +653,20 @@ def _with_l1(f: KernelFit, H, samples) -> KernelFit:
         s = np.asarray(samples[0], float)
         v = _frob(np.asarray(samples[1], float))
         l1 = _trapezoid(v, s) + float(v[0] * s[0]) if s[0] > 0 else _trapezoid(v, s)
-    elif isinstance(H, PowerKernel) and H.beta < 1:
+    elif isinstance(H, PowerKernel):   # (0 < beta < 1)
         l1 = abs(H.c) * f.tau ** (1 - H.beta) / (1 - H.beta)
     else:
-        from scipy.integrate import quad
-        l1 = quad(lambda x: float(_frob(_values(H, np.array([x])))[0]), 0, f.tau, limit=200)[0]
+        from scipy.integrate import IntegrationWarning, quad
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", IntegrationWarning)
+            try:
+                l1, err = quad(lambda x: float(_frob(_values(H, np.array([x])))[0]), 0, f.tau, limit=200)
+            except IntegrationWarning:
+                l1, err = math.inf, math.inf
+        if not (math.isfinite(l1) and err <= 1e-6 * l1):
+            raise ValueError(f"fit: int_0^tau ||H(s)|| ds does not converge (scipy's quad: {l1:.6g}, "
+                             f"error {err:.3g}): H looks not integrable on [0, {f.tau!r}] (1/s is "
+                             "not, s^-beta is for beta < 1), and a memory kernel must be")
     exact = H if isinstance(H, PowerKernel) else None  # (picklable: kept for the near cells)
     return KernelFit(**{**f.__dict__, "kernel_l1": float(l1), "kernel": exact})
 
@@ -581,7 +677,7 @@ def _interpolated(s: np.ndarray, V: np.ndarray) -> Callable[[np.ndarray], np.nda
     return fn
 
 
-def _fit_esprit(s, V, tau, lo, tol, relative, max_terms, noisy, check, certified_fn=None):
+def _fit_esprit(s, V, tau, lo, tol, relative, max_terms, noisy, check, seen):
     shape = V.shape[1:]
     Vf = V.reshape(len(s), -1)
     cs, cv = check
@@ -590,11 +686,13 @@ def _fit_esprit(s, V, tau, lo, tol, relative, max_terms, noisy, check, certified
         rw = 1 / np.maximum(np.abs(Vf).max(axis=1), np.finfo(float).tiny)
     best = None
     errors = []
-    for r, a, b in _esprit_candidates(s, Vf, 2 * max_terms, noisy):
+    tenth = max(1, len(s) // 10)   # |H| larger on the last tenth than on the first: it grows
+    seen["larger_at_tau"] = bool(np.abs(Vf[-tenth:]).max() > np.abs(Vf[:tenth]).max())
+    for r, a, b in _esprit_candidates(s, Vf, 2 * max_terms, noisy, seen):
         if len(a) > max_terms:
             continue
         C, D = _coefficients(s, Vf, a, b, rw)
-        f = _build(a, b, C, D, shape, tau, lo, relative, "esprit", cs, cv, certified_fn, cs, cv)
+        f = _build(a, b, C, D, shape, tau, lo, relative, "esprit", cs, cv, None, cs, cv)
         errors.append((f.max_error, f))
         if best is None or f.max_error < best.max_error:
             best = f
@@ -608,7 +706,7 @@ def _fit_esprit(s, V, tau, lo, tol, relative, max_terms, noisy, check, certified
     return [best]
 
 
-def _fit_callable(H, tau, lo, tol, relative, max_terms, noisy, esprit):
+def _fit_callable(H, tau, lo, tol, relative, max_terms, noisy, esprit, seen):
     out = []
     m = 1000
     check_u = np.linspace(lo, tau, 10 * m + 1)
@@ -632,7 +730,8 @@ def _fit_callable(H, tau, lo, tol, relative, max_terms, noisy, esprit):
                 fewest = out[-1].terms - 1  # ESPRIT is of use only with fewer terms
     if esprit and not isinstance(H, PowerKernel) and fewest >= 1:
         s = np.linspace(lo, tau, m)
-        out += _fit_esprit(s, _values(H, s), tau, lo, tol, relative, fewest, noisy, (check_s, check_v))
+        out += _fit_esprit(s, _values(H, s), tau, lo, tol, relative, fewest, noisy, (check_s, check_v),
+                           seen)
     return out
 
 
@@ -680,24 +779,64 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--name", default="kernel", help="prefix of the printed names (default kernel)")
     args = p.parse_args(argv)
     try:
+        if args.format != "json":
+            try:
+                _check_name(args.name, args.format)
+            except ValueError as e:
+                raise ValueError(f"--name: {e} (--format {args.format})") from None
+        samples = None
         if args.power is not None:
-            H: Any = PowerKernel(args.power, args.scale)
-            samples = None
+            try:
+                H: Any = PowerKernel(args.power, args.scale)
+            except ValueError as e:
+                raise ValueError(f"--power/--scale: {e}") from None
         elif args.expr is not None:
-            expr = compile(args.expr, "<expr>", "eval")
-            H = lambda s: eval(expr, {"np": np, "__builtins__": {}}, {"s": s})  # noqa: E731,S307
-            samples = None
+            H = _expression(args.expr, args.tau)
         else:
-            data = np.loadtxt(args.samples)
-            H, samples = None, (data[:, 0], data[:, 1])
+            H, samples = None, _sample_file(args.samples)
         f = fit(H, args.tau, tol=args.tol, relative=args.relative, max_terms=args.max_terms,
                 delta=args.delta, samples=samples)
-    except (ValueError, OSError, SyntaxError, NameError, IndexError) as e:
+    except (ValueError, OSError) as e:
         print(f"dmi-kernel-fit: {e}", file=sys.stderr)
         return 2
     out = {"c": f.to_c, "fortran": f.to_fortran}.get(args.format)
     sys.stdout.write(out(args.name) if out else f.to_json() + "\n")
     return 0
+
+
+def _expression(text: str, tau: float) -> Callable[[Any], np.ndarray]:
+    """H(s) of --expr: the expression evaluated with s and np; ValueError naming --expr when it
+    does not compile, raises, or gives no real numbers (tried at s = tau first)."""
+    try:
+        code = compile(text, "<expr>", "eval")
+    except SyntaxError as e:
+        raise ValueError(f"--expr {text!r} is not a Python expression: {e.msg}") from None
+
+    def H(s: Any) -> np.ndarray:
+        try:
+            return _real(eval(code, {"np": np, "__builtins__": {}}, {"s": s}))  # noqa: S307
+        except Exception as e:  # noqa: BLE001 - any failure of the user's expression, named
+            raise ValueError(f"--expr {text!r} fails at s = {s!r}: {type(e).__name__}: {e} "
+                             "(an expression in s, a float or an array, and np)") from None
+    if tau > 0 and math.isfinite(tau):   # (a bad tau: fit says so)
+        H(float(tau))
+    return H
+
+
+def _sample_file(path: str) -> tuple[np.ndarray, np.ndarray]:
+    """(s, H(s)) of --samples: a text file of two whitespace-separated columns."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)   # (loadtxt's "no data": said below)
+            data = np.loadtxt(path, ndmin=2)
+    except (ValueError, UnicodeDecodeError) as e:
+        raise ValueError(f"--samples {path}: not a text file of two columns s, H(s): {e}") from None
+    except OSError as e:
+        raise ValueError(f"--samples {path}: {e.strerror or e}") from None
+    if data.size == 0 or data.shape[1] != 2:
+        got = "no data" if data.size == 0 else f"{data.shape[1]} column(s)"
+        raise ValueError(f"--samples {path}: {got}; expected two whitespace-separated columns s, H(s)")
+    return data[:, 0], data[:, 1]
 
 
 if __name__ == "__main__":

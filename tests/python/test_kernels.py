@@ -70,7 +70,8 @@ def test_noisy_samples_saturate():
     for M, tol in ((2001, 1e-8), (4001, 1e-10), (2001, 1e-12)):
         s = np.linspace(0, 5, M)
         v = true(s) + 1e-6 * rng.standard_normal(M)
-        f = kernels.fit(None, 5.0, tol=tol, samples=(s, v))
+        with pytest.warns(UserWarning, match="noise"):  # tol is below the noise
+            f = kernels.fit(None, 5.0, tol=tol, samples=(s, v))
         counts.append(f.terms)
         assert np.all(f.a <= 0)
         assert f.max_error <= 1e-5  # measured against the samples: near the noise
