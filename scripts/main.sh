@@ -84,6 +84,10 @@ stage "dmi.analysis: the forced Bagley-Torvik oscillator with dry friction (fitt
 PYTHONPATH="$build/python" MPLBACKEND=Agg DMI_FIGURE="$out/bagley_torvik.png" "$py" \
   examples/python/plot_bagley_torvik.py | tee "$out/bagley_torvik.txt"
 
+stage "dmi.analysis: a stick-slip orbit of the equation with memory by collocation"
+PYTHONPATH="$build/python" MPLBACKEND=Agg DMI_FIGURE="$out/collocation_stickslip.png" "$py" \
+  examples/python/plot_collocation_stickslip.py | tee "$out/collocation_stickslip.txt"
+
 stage "figures and comparison with the paper and ../shared/reference"
 refarg=()
 if [[ -d $ref ]]; then

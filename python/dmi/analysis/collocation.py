@@ -351,7 +351,8 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
              else float(np.max(np.abs(c.amplitude - f.amplitude))))
         if d <= tol:
             return _result(orbit, terms, c, f, count)
-        grow = (d / tol) ** (1.0 / (m + 1)) * 1.2
+        # the expected order: the period's h^(2m) (superconvergent), an extremum's h^(m+1)
+        grow = (d / tol) ** (1.0 / (2 * m if orbit.autonomous else m + 1)) * 1.2
         if last is not None and last[1] > d > 0:               # the observed order
             q = math.log(last[1] / d) / math.log(L / last[0])
             if q > m:
