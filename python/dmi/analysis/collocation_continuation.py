@@ -4,7 +4,7 @@
 """The collocation discretisation of :mod:`dmi.analysis.collocation` for a continuation driver.
 
 The driver's contract: ``residual(x, p)`` (len(x) equations), ``jacobian(x, p) -> (J_x, J_p)``
-(J_x a scipy.sparse matrix, J_p by a central difference in p), ``point(x, p)`` (the
+(J_x a scipy.sparse matrix, J_p by a forward difference in p), ``point(x, p)`` (the
 :class:`EquationOrbit` the user sees, with its multipliers, their error estimates (twice the
 difference to the solve on the mesh with every interval halved), and its verified stability; None
 when the orbit breaks an inequality of its signature), ``event_functions(x, p, point)`` (a sign change is an event) and ``adapt(x, p)``
@@ -141,7 +141,8 @@ class CollocationDiscretisation:
 
     def jacobian(self, x: np.ndarray, p: float) -> tuple[sp.csc_matrix, np.ndarray]:
         """(J_x, J_p): J_x sparse (exact in the node values, central differences in the
-        switching times), J_p by a central difference (step 1e-6 max(1, |p|)).
+        switching times), J_p by a forward difference (step 1e-7 max(1, |p|): a tangent's
+        accuracy, not the orbit's).
 
         Parameters
         ----------
@@ -155,9 +156,9 @@ class CollocationDiscretisation:
         tuple
             (scipy.sparse.csc_matrix (len(x), len(x)), numpy.ndarray (len(x),)).
         """
-        _, J = full_jacobian(self.lay, self.terms(p), x, self.ref)
-        d = 1e-6 * max(1.0, abs(p))
-        Jp = (self.residual(x, p + d) - self.residual(x, p - d)) / (2 * d)
+        r, J = full_jacobian(self.lay, self.terms(p), x, self.ref)
+        d = 1e-7 * max(1.0, abs(p))
+        Jp = (self.residual(x, p + d) - r) / d
         return J, Jp
 
     def point(self, x: np.ndarray, p: float) -> EquationOrbit | None:
