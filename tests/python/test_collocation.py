@@ -236,22 +236,30 @@ def test_circle_radius_and_period_closed_form():
 
 
 # ---- Den Hartog's dry-friction oscillator: a two-segment orbit ---------------------------------
+def forced_orbit(model, M: int, periods: int, p: float = 1.0) -> da.Orbit:
+    """The scheme's orbit of a forced model of orbit_models.py at M steps a period, from rest
+    run ``periods`` periods."""
+    make = model.make_for(M)
+    s = make(p)
+    s.init()
+    s.advance(periods * M)
+    return da.periodic_orbit(make, p, model.T, s, multipliers=0)
+
+
 def test_den_hartog_amplitude_and_multipliers_closed_form():
     d = DenHartog()
-    M = 2000
-    make = d.make_for(M)
-    s = make(1.0)
-    s.init()
-    s.advance(20 * M)
-    o = da.periodic_orbit(make, 1.0, d.T, s, multipliers=0)
-    e = da.collocate(o, intervals=24)
+    e = da.collocate(forced_orbit(d, 2000, 20), intervals=24)
     assert e.signature.switches == 2 and not e.autonomous
     assert abs(e.amplitude[0] - d.a) < 1e-10
     mu = np.sort_complex(e.multipliers[:2])
     ref = np.sort_complex(d.multipliers)
     assert np.max(np.abs(mu - ref)) < 1e-8
-    # the issue's form: mu = nu^2, nu^2 - (1 + r) cos(pi / w) nu + r = 0, r = (X w^2 - F0) / (X
-    # w^2 + F0), X = the amplitude of the free oscillation's part, here a (w = 0.7, F0 = 0.3)
+    # Den Hartog's form: mu = nu^2, nu^2 - (1 + r) cos(pi / w) nu + r = 0, r = (X w^2 - F0) /
+    # (X w^2 + F0), X the amplitude
+    X, w = d.a, d.w
+    r = (X * w * w - d.F0) / (X * w * w + d.F0)
+    nu = np.roots([1.0, -(1 + r) * np.cos(np.pi / w), r])
+    assert np.max(np.abs(mu - np.sort_complex(nu ** 2))) < 1e-8
     assert np.all(np.abs(mu) < 1) and e.stable is True
     # the reversals: v = 0 at the switching times, half a period apart
     assert abs(e.switches[1] - e.switches[0] - d.T / 2) < 1e-10
@@ -261,13 +269,7 @@ def test_den_hartog_amplitude_and_multipliers_closed_form():
 # ---- stick-slip: u' + sigma(u) ∋ c sin t ------------------------------------------------------
 def test_stick_slip_closed_form():
     d = StickSlip1()
-    M = 2000
-    make = d.make_for(M)
-    s = make(1.0)
-    s.init()
-    s.advance(5 * M)
-    o = da.periodic_orbit(make, 1.0, d.T, s, multipliers=0)
-    e = da.collocate(o, intervals=48)
+    e = da.collocate(forced_orbit(d, 2000, 5), intervals=48)
     assert e.signature.describe() == ["(slip -)", "(stuck)", "(slip +)", "(stuck)"]
     ref = np.array([d.t2 - np.pi, d.t1, d.t2, np.pi + d.t1])
     assert np.max(np.abs(e.switches - ref)) < 1e-10
@@ -294,12 +296,7 @@ def test_user_resolvent_refused_naming_refine_orbit():
 
 
 def test_equation_orbit_refused_by_refine_and_floquet():
-    d = StickSlip1()
-    make = d.make_for(400)
-    s = make(1.0)
-    s.init()
-    s.advance(2000)
-    o = da.periodic_orbit(make, 1.0, d.T, s, multipliers=0)
+    o = forced_orbit(StickSlip1(), 400, 5)
     e = da.collocate(o, intervals=8, multipliers=0)
     with pytest.raises(TypeError, match="Orbit of the scheme"):
         da.refine_orbit(e)

@@ -95,13 +95,7 @@ def test_den_hartog_branch_signature_changes_to_stick_slip():
     # the forcing makes it stick at the reversals (from p = 0.45 on); adapt mends the signature
     # between steps
     d = DenHartog()
-    M = 2000
-    make = d.make_for(M)
-    s = make(1.0)
-    s.init()
-    s.advance(20 * M)
-    o = da.periodic_orbit(make, 1.0, d.T, s, multipliers=0)
-    e = da.collocate(o, intervals=24, multipliers=2)
+    e = da.collocate(tc.forced_orbit(d, 2000, 20), intervals=24, multipliers=2)
     assert e.signature.switches == 2
     disc, x = da.CollocationDiscretisation.of(e, multipliers=2)
     p, pt = 1.0, e
@@ -120,11 +114,7 @@ def test_den_hartog_branch_signature_changes_to_stick_slip():
     # the scheme's orbit at p approaches the collocated one as h shrinks (O(h))
     gaps = []
     for Ms in (1000, 4000):
-        mk = d.make_for(Ms)
-        s = mk(p)
-        s.init()
-        s.advance(20 * Ms)
-        os_ = da.periodic_orbit(mk, p, d.T, s, multipliers=0)
+        os_ = tc.forced_orbit(d, Ms, 20, p)
         gaps.append(np.max(np.abs(os_.u - pt.u_at(os_.t))))
     assert gaps[1] < 0.4 * gaps[0]
 
