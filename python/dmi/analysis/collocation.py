@@ -102,7 +102,8 @@ def transfer(lay: Layout, x: np.ndarray, new: Layout) -> np.ndarray:
 
 def indicator(lay: Layout, x: np.ndarray) -> np.ndarray:
     """(L,): |u^(m+1)|^(1/(m+1)) estimated on each interval from the jumps of the piecewise
-    constant u^(m) to its neighbours in the same piece (AUTO's indicator)."""
+    constant u^(m) to its neighbours in the same piece (AUTO's indicator); an interval alone in
+    its piece takes |u^(m)| / h (no neighbour to difference with)."""
     m = lay.m
     V, b, T = lay.split(x)
     h = np.diff(lay.mesh(b, T))
@@ -122,6 +123,10 @@ def indicator(lay: Layout, x: np.ndarray) -> np.ndarray:
         d = np.where(same, d, 0.0)
         jump[:-1] = np.maximum(jump[:-1], d)
         jump[1:] = np.maximum(jump[1:], d)
+        alone = np.ones(lay.L, bool)
+        alone[:-1] &= ~same
+        alone[1:] &= ~same
+        jump = np.where(alone, np.linalg.norm(top, axis=1) / h, jump)
     return jump ** (1.0 / (m + 1))
 
 
@@ -134,7 +139,8 @@ def adapted(lay: Layout, x: np.ndarray, L: int) -> list[np.ndarray]:
     piece = lay.piece_of_interval()
     h = np.diff(mesh)
     weight = np.array([np.sum((rho * h)[piece == j]) for j in range(len(lay.fractions))])
-    weight = np.maximum(weight, 1e-3 * max(weight.max(), 1e-300))
+    # a floor: a quarter of the share of the piece's length (a quiet piece stays meshed)
+    weight = np.maximum(weight, 0.25 * np.diff(e) / T * weight.sum())
     counts = _counts(weight, L)
     out = []
     for j, c in enumerate(counts):
@@ -192,7 +198,7 @@ def check_inequalities(lay: Layout, terms: Terms, x: np.ndarray, tol: float) -> 
         grid.append(t)
         us.append(u)
         forces.append(F)
-    return violations(lay.signature.pieces(), grid, us, forces, terms.alpha, terms.lo, terms.hi,
+    return violations(lay.piece_modes(b, T), grid, us, forces, terms.alpha, terms.lo, terms.hi,
                       tol)
 
 
@@ -322,10 +328,11 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     terms = Terms(build(orbit.make, orbit.p))
     sig, b0 = read_signature(orbit.u, orbit.h, terms.alpha, terms.lo, terms.hi)
     T0 = float(orbit.period)
-    bounds = np.concatenate([[0.0], b0, [T0]])
-    L = int(intervals) if intervals is not None else max(16, 4 * len(sig.pieces()))
-    L0 = max(8, 2 * len(sig.pieces()), L // 2)        # a first solve: the indicator, the phase
-    lay = Layout(m, terms.n, sig, uniform_fractions(bounds, L0), bool(orbit.autonomous), T0)
+    lay = Layout(m, terms.n, sig, [], bool(orbit.autonomous), T0, carried(terms, sig))
+    bounds = lay.bounds(b0, T0)
+    L = int(intervals) if intervals is not None else max(16, 4 * (bounds.size - 1))
+    L0 = max(8, 2 * (bounds.size - 1), L // 2)        # a first solve: the indicator, the phase
+    lay = lay.with_fractions(uniform_fractions(bounds, L0))
     t_s = np.asarray(orbit.t, dtype=float)
 
     def scheme(t: np.ndarray) -> np.ndarray:
@@ -364,6 +371,14 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
             break
     raise ValueError(f"collocate: the estimated error {d:.3g} is still above tol = {tol!r} at "
                      f"{f.lay.L} intervals: ask a larger tol or a higher degree")
+
+
+def carried(terms: Terms, sig: Any) -> tuple[float, ...]:
+    """The lags at which the memory carries a switch forward: (tau,) where H(tau) != 0 on an
+    orbit with switches (the delay integral's derivative jumps at b_k + tau), else ()."""
+    if sig.switches == 0 or not terms.has_kernel:
+        return ()
+    return (terms.tau,) if np.any(terms.H(np.array([terms.tau])) != 0) else ()
 
 
 def _reference(lay: Layout, x: np.ndarray) -> Any:
@@ -407,7 +422,7 @@ def equation_orbit(f: Solved, p: float, make: Any, errors: dict[str, Any]) -> Eq
                          mesh=f.lay.mesh(b, T), signature=f.lay.signature, switches=b.copy(),
                          make=make, autonomous=f.lay.autonomous, errors=errors,
                          degree=f.lay.m, nodes=V.copy(),
-                         fractions=[fr.copy() for fr in f.lay.fractions])
+                         fractions=[fr.copy() for fr in f.lay.fractions], carried=f.lay.carried)
 
 
 __all__ = ["collocate", "CollocationWarning"]

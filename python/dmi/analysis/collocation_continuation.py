@@ -30,7 +30,7 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
-from .collocation import (CollocationWarning, Solved, _errors, _reference, adapted,
+from .collocation import (CollocationWarning, Solved, _errors, _reference, adapted, carried,
                           check_inequalities, equation_orbit, evaluate, halved, node_times,
                           transfer, uniform_fractions)
 from .collocation_mesh import delay_matrix, periodic_locator, point_matrix
@@ -95,7 +95,7 @@ class CollocationDiscretisation:
             raise TypeError(f"give an EquationOrbit (collocate), not {type(orbit).__name__}")
         n = orbit.nodes.shape[1]
         lay = Layout(orbit.degree, n, orbit.signature, [f.copy() for f in orbit.fractions],
-                     orbit.autonomous, orbit.period)
+                     orbit.autonomous, orbit.period, tuple(orbit.carried))
         x = np.concatenate([orbit.nodes.ravel(), orbit.switches,
                             [orbit.period] if orbit.autonomous else []])
         return cls(orbit.make, lay, x, **kw), x
@@ -223,7 +223,7 @@ class CollocationDiscretisation:
         """
         out: dict[str, float] = {}
         _, b, T = self.lay.split(x)
-        e = self.lay.bounds(b, T)
+        e = np.concatenate([[0.0], b, [T]])                 # the segments' ends
         if self.lay.S:
             lengths = np.diff(e)
             out["segment"] = float(min(lengths[0] + lengths[-1], *lengths[1:-1])
@@ -272,7 +272,7 @@ class CollocationDiscretisation:
             if grown is not None:
                 segs, changed = grown, True
         if changed:
-            new_lay, x = _relaid(lay, x, segs, T)
+            new_lay, x = _relaid(lay, terms, x, segs, T)
         else:
             new_lay = lay.with_fractions(adapted(lay, x, lay.L))
             x = transfer(lay, x, new_lay)
@@ -310,8 +310,8 @@ def _breaches(lay: Layout, terms: Terms, x: np.ndarray, segs: list, T: float) ->
     """The segments with the first breached stretch (a slip component of the wrong sign, a
     stuck one whose force exceeds alpha) made a segment of its own (stuck, or slipping with the
     force's sign), or None when nothing is breached."""
-    pieces = lay.signature.pieces()
     _, b, _ = lay.split(x)
+    pieces = lay.piece_modes(b, T)
     e = lay.bounds(b, T)
     for j, mode in enumerate(pieces):
         t = np.linspace(e[j], e[j + 1], 64 * (len(lay.fractions[j]) - 1) + 1)[1:-1]
@@ -354,7 +354,8 @@ def _memory(lay: Layout, terms: Terms, x: np.ndarray, t: np.ndarray) -> np.ndarr
     return (G @ V.ravel()).reshape(-1, lay.n)
 
 
-def _relaid(lay: Layout, x: np.ndarray, segs: list, T: float) -> tuple[Layout, np.ndarray]:
+def _relaid(lay: Layout, terms: Terms, x: np.ndarray, segs: list, T: float
+            ) -> tuple[Layout, np.ndarray]:
     """The layout of the segments ``segs`` (same L, uniform in each piece) and x on it."""
     segs = sorted(segs, key=lambda s: s[1] % T)
     # segment 0 holds t = 0: the last to start (mod T); b: every start, ascending
@@ -366,8 +367,8 @@ def _relaid(lay: Layout, x: np.ndarray, segs: list, T: float) -> tuple[Layout, n
         if i.size != 1:
             raise ValueError(f"the mended signature changes {i.size} components at once at "
                              f"t = {b[k - 1]:.6g}: not continued")
-    bounds = np.concatenate([[0.0], b, [T]])
-    new = Layout(lay.m, lay.n, sig, uniform_fractions(bounds, lay.L), lay.autonomous, lay.period)
+    new = Layout(lay.m, lay.n, sig, [], lay.autonomous, lay.period, carried(terms, sig))
+    new = new.with_fractions(uniform_fractions(new.bounds(b, T), lay.L))
     V = evaluate(lay, x, node_times(new, b, T))
     return new, np.concatenate([V.ravel(), b, [T] if lay.autonomous else []])
 

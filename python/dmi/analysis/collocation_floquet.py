@@ -61,6 +61,7 @@ def monodromy(lay: Layout, terms: Terms, x: np.ndarray) -> np.ndarray:
     dz = lay.basis.derivatives(lay.basis.nodes)             # (m + 1 nodes, m + 1 basis)
     left, right = lay.node_motion()
     piece = lay.piece_of_interval()
+    who = lay.ends(b, T)[1]                                 # the switch each piece end moves with
     where = {int(gg): j for j, gg in enumerate(state)}
     dim = scol.size
     M = np.zeros((dim, dim))
@@ -76,10 +77,10 @@ def monodromy(lay: Layout, terms: Terms, x: np.ndarray) -> np.ndarray:
         slope = dz @ one[iv] / h[iv]                        # u*' inside interval iv at its nodes
         move = np.zeros((m + 1, dim))                       # d t_node / d state
         pc = piece[iv]
-        if pc >= 1:
-            move += left[iv][:, None] * db[pc - 1][None, :]
-        if pc + 1 <= lay.S:
-            move += right[iv][:, None] * db[pc][None, :]
+        if who[pc] >= 0:
+            move += left[iv][:, None] * db[who[pc]][None, :]
+        if who[pc + 1] >= 0:
+            move += right[iv][:, None] * db[who[pc + 1]][None, :]
         M[out] = (rows - slope[:, :, None] * move[:, None, :]).reshape((m + 1) * n, dim)
     return M
 

@@ -146,6 +146,10 @@ class Layout:
         The period is an unknown.
     period : float
         The period of a forced orbit (unused when autonomous).
+    carried : tuple of float
+        Lags c at which the memory carries each switch forward: the pieces are also cut at
+        (b_k + c) mod T (c = tau where H(tau) != 0: the delay integral's derivative jumps there),
+        so that no interval holds a jump of a derivative of u.
     """
     m: int
     n: int
@@ -153,6 +157,7 @@ class Layout:
     fractions: list[np.ndarray]
     autonomous: bool
     period: float
+    carried: tuple[float, ...] = ()
     basis: Basis = field(init=False)
 
     def __post_init__(self) -> None:
@@ -184,15 +189,39 @@ class Layout:
         T = float(x[-1]) if self.autonomous else self.period
         return x[:k].reshape(self.rows, self.n), x[k:k + self.S], T
 
+    def ends(self, b: np.ndarray, T: float) -> tuple[np.ndarray, np.ndarray]:
+        """The pieces' ends in order (0, the b_k, the carried (b_k + c) mod T, T) and the switch
+        each moves with (k - 1 for b_k and its carried points, -1 for 0 and T)."""
+        S = self.S
+        t = [0.0, T] + list(b) + [float((b[k] + c) % T) for k in range(S) for c in self.carried]
+        who = [-1, -1] + list(range(S)) + [k for k in range(S) for _ in self.carried]
+        order = np.argsort(t, kind="stable")
+        t, who = np.asarray(t)[order], np.asarray(who)[order]
+        if t[0] != 0.0 or t[-1] != T:          # a carried point at 0 or T: keep 0 and T outside
+            inner = (t > 0) & (t < T)
+            t = np.concatenate([[0.0], t[inner], [T]])
+            who = np.concatenate([[-1], who[inner], [-1]])
+        return t, who
+
     def bounds(self, b: np.ndarray, T: float) -> np.ndarray:
-        """The pieces' ends 0, b_1, ..., b_S, T."""
-        return np.concatenate([[0.0], b, [T]])
+        """The pieces' ends (:meth:`ends`)."""
+        return self.ends(b, T)[0]
 
     def mesh(self, b: np.ndarray, T: float) -> np.ndarray:
         """The L + 1 mesh points."""
         e = self.bounds(b, T)
+        if e.size != len(self.fractions) + 1:
+            raise Degenerate(f"a carried breakpoint left (0, T): {e.size - 1} pieces for "
+                             f"{len(self.fractions)} meshes")
         parts = [e[j] + (e[j + 1] - e[j]) * f[:-1] for j, f in enumerate(self.fractions)]
         return np.concatenate(parts + [[T]])
+
+    def piece_modes(self, b: np.ndarray, T: float) -> list[np.ndarray]:
+        """The modes of the pieces: those of the segment holding each piece."""
+        e = self.bounds(b, T)
+        seg = np.searchsorted(b, 0.5 * (e[:-1] + e[1:]))
+        pieces = self.signature.pieces()
+        return [pieces[int(k)] for k in seg]
 
     def piece_of_interval(self) -> np.ndarray:
         """(L,): the piece of each interval."""
@@ -211,7 +240,8 @@ class Layout:
 
     def with_fractions(self, fractions: list[np.ndarray]) -> Layout:
         """The same layout on other meshes of its pieces."""
-        return Layout(self.m, self.n, self.signature, fractions, self.autonomous, self.period)
+        return Layout(self.m, self.n, self.signature, fractions, self.autonomous, self.period,
+                      self.carried)
 
 
 class Degenerate(ValueError):
@@ -247,9 +277,9 @@ def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray
     m, n, basis = lay.m, lay.n, lay.basis
     V, b, T = lay.split(x)
     e = lay.bounds(b, T)
-    if np.any(np.diff(e) <= 0) or not np.isfinite(T):
-        raise Degenerate(f"a segment's length went to {np.min(np.diff(e)):.3g}: the switching "
-                         f"times {b!r} are out of order in (0, {T!r})")
+    if np.any(np.diff(e) <= 0) or not np.isfinite(T) or e.size != len(lay.fractions) + 1:
+        raise Degenerate(f"a piece's length went to {np.min(np.diff(e)):.3g}: the switching "
+                         f"times {b!r} (and their carried points) are out of order in (0, {T!r})")
     mesh = lay.mesh(b, T)
     h = np.diff(mesh)
     gz, gw = basis.gauss()
@@ -273,8 +303,7 @@ def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray
     r = du + terms.f(tc, Uc)
     if G is not None:
         r += (G @ u).reshape(-1, n)
-    pieces = lay.signature.pieces()
-    mode = np.repeat(np.array(pieces)[lay.piece_of_interval()], m, axis=0)
+    mode = np.repeat(np.array(lay.piece_modes(b, T))[lay.piece_of_interval()], m, axis=0)
     r += terms.alpha * ((mode == SLIP_POS).astype(float) - (mode == SLIP_NEG))
     held, value = _held(mode, terms)
     r = np.where(held, Uc - value, r)
@@ -301,7 +330,7 @@ def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray
                                            np.r_[np.arange(n), last * n + np.arange(n)])),
                                          shape=(n, rows * n)))
     for k in range(1, lay.S + 1):
-        g, row = _switch_condition(lay, terms, k, e[k], mesh, T, loc, rows, u, jacobian)
+        g, row = _switch_condition(lay, terms, k, b[k - 1], mesh, T, loc, rows, u, jacobian)
         extra_r.append(np.array([g]))
         if jacobian:
             extra_J.append(row)

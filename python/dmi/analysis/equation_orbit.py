@@ -52,7 +52,10 @@ class EquationOrbit:
         Shape (L m, n): the values at the nodes t_i + k h_i / m, k = 0..m-1 of each interval.
     fractions : list of numpy.ndarray
         Each piece's mesh as fractions of the piece (the pieces: the signature's segments in
-        order over [0, period]).
+        order over [0, period], cut again at the carried breakpoints).
+    carried : tuple of float
+        The lags c at which the memory carries each switch: the mesh has points at
+        (switch + c) mod period.
     """
     p: float
     period: float
@@ -68,6 +71,7 @@ class EquationOrbit:
     degree: int = 4
     nodes: np.ndarray = field(default_factory=lambda: np.empty((0, 0)), repr=False)
     fractions: list = field(default_factory=list, repr=False)
+    carried: tuple = ()
 
     #: What the orbit is of: ``refine_orbit`` and ``floquet_multipliers`` refuse it by this.
     of = "equation"
