@@ -5,7 +5,8 @@
 # 40 intervals of degree 4, 0.69 s a branch point with its stability at 5e-9): collocate from a
 # scheme orbit (the shooting not counted) with 40 intervals (the orbit returned has 80: the error
 # estimate's finer level) and with tol = 1e-10; one continuation point (a = 0.5 -> 0.55: Newton,
-# the multipliers and the error estimate on the halved mesh); and a stick-slip orbit of a belt
+# the multipliers and the error estimate on the halved mesh, and without the estimate, as
+# DDE-BIFTOOL's points come); and a stick-slip orbit of a belt
 # oscillator with a truncated exponential memory (autonomous, its stick segment read from the
 # scheme).  Errors against a reference collocation at 320 intervals.  Rounds interleave the cases;
 # the fastest of each counts; CPU times; one BLAS thread.
@@ -83,6 +84,7 @@ def main(argv: list[str] | None = None) -> int:
     ref = da.collocate(o, intervals=320, multipliers=4)
     e = da.collocate(o, intervals=40)
     disc, x = da.CollocationDiscretisation.of(e)
+    bare, _ = da.CollocationDiscretisation.of(e, estimate=False)
     dref, xref = da.CollocationDiscretisation.of(ref, estimate=False)
     ref2 = point(dref, xref, 0.55)
     ob = scheme_orbit(belt, 1.0, np.array([1.0, 0.0]), 6.46, 1000)
@@ -91,9 +93,11 @@ def main(argv: list[str] | None = None) -> int:
         "vdp, 40 intervals": lambda: da.collocate(o, intervals=40),
         "vdp, tol 1e-10": lambda: da.collocate(o, tol=1e-10),
         "vdp, branch point": lambda: point(disc, x.copy(), 0.55),
+        "point, no estimate": lambda: point(bare, x.copy(), 0.55),
         "belt stick-slip": lambda: da.collocate(ob, tol=1e-9),
     }
     refs = {"vdp, 40 intervals": ref, "vdp, tol 1e-10": ref, "vdp, branch point": ref2,
+            "point, no estimate": ref2,
             "belt stick-slip": refb}
     best = {k: np.inf for k in cases}
     out = {}
@@ -102,7 +106,7 @@ def main(argv: list[str] | None = None) -> int:
             res = []
             best[k] = min(best[k], cpu(lambda: res.append(f())))
             out[k] = res[0]
-    print(f"{'case':>20} {'CPU s':>7} {'intervals':>9} {'period error':>12} {'estimate':>9} "
+    print(f"{"case":>20} {'CPU s':>7} {'intervals':>9} {'period error':>12} {'estimate':>9} "
           f"{'mu2 error':>9} {'signature'}")
     for k in cases:
         r, R = out[k], refs[k]

@@ -59,8 +59,8 @@ class CollocationDiscretisation:
     multipliers : int
         Leading multipliers a point carries.
     estimate : bool
-        A point's errors from the solve on the halved mesh (False: no estimate; ``stable`` is
-        then None unless the margin exceeds 1e-6).
+        A point's errors from the solve on the halved mesh (False: none, ``errors`` empty and
+        ``stable`` None: a verdict needs the multipliers' errors).
     """
 
     def __init__(self, make: Model, layout: Layout, x: np.ndarray, *, multipliers: int = 10,
