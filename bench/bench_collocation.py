@@ -106,7 +106,7 @@ def main(argv: list[str] | None = None) -> int:
             res = []
             best[k] = min(best[k], cpu(lambda: res.append(f())))
             out[k] = res[0]
-    print(f"{"case":>20} {'CPU s':>7} {'intervals':>9} {'period error':>12} {'estimate':>9} "
+    print(f"{'case':>20} {'CPU s':>7} {'intervals':>9} {'period error':>12} {'estimate':>9} "
           f"{'mu2 error':>9} {'signature'}")
     for k in cases:
         r, R = out[k], refs[k]

@@ -10,7 +10,9 @@ wrapping as many periods as tau / T needs (:mod:`dmi.analysis.collocation_mesh`)
 built-in friction or box the period is cut into segments whose modes (slip +-, stuck, on a face,
 free) are read from the scheme's orbit, the segments' ends unknowns with their switching
 conditions (:mod:`dmi.analysis.collocation_signature`); every inequality is checked on a fine grid
-of the result, and an orbit that breaks one is not returned.  Multipliers: the discretised
+of the result: a breach splits a segment, a vanishing segment is removed
+(:mod:`dmi.analysis.collocation_mend`) and the orbit is solved again; an orbit that breaks one is
+never returned.  Multipliers: the discretised
 monodromy operator with the saltation at the switches (:mod:`dmi.analysis.collocation_floquet`).
 
 Errors: the orbit is solved on a mesh and on the same mesh with every interval halved; the
@@ -38,7 +40,9 @@ import numpy as np
 from .collocation_floquet import multipliers as floquet
 from .collocation_mesh import delay_matrix, equidistribute, periodic_locator
 from .collocation_signature import read_signature, violations
-from .collocation_system import Layout, Terms, solve
+from .collocation_system import (Layout, Terms, carried, evaluate, interval_counts, node_times,
+                                 solve, uniform_fractions)
+from .collocation_mend import mend
 from .equation_orbit import EquationOrbit
 from .orbit import Orbit
 from .stepmap import build
@@ -47,6 +51,8 @@ from .stepmap import build
 CHECK_POINTS = 8
 #: Mesh refinement rounds at most (intervals=None).
 MAX_ROUNDS = 6
+#: Signature mends at most (a segment split or removed where an inequality breaks).
+MENDS = 4
 #: Intervals at most.
 MAX_INTERVALS = 4000
 #: The errors' floor, relative to their quantities (Newton's 1e-12 and the conditioning).
@@ -57,18 +63,6 @@ class CollocationWarning(RuntimeWarning):
     """A collocated orbit's verdict that could not be verified (its stability)."""
 
 
-def _counts(lengths: np.ndarray, L: int) -> np.ndarray:
-    """L intervals shared by pieces of these lengths (or weights), at least 1 each."""
-    w = np.asarray(lengths, dtype=float)
-    c = np.maximum(1, np.round(L * w / w.sum()).astype(int))
-    return c
-
-
-def uniform_fractions(bounds: np.ndarray, L: int) -> list[np.ndarray]:
-    """Each piece of [0, T] (ends ``bounds``) cut into equal intervals, L in all (about)."""
-    return [np.linspace(0.0, 1.0, c + 1) for c in _counts(np.diff(bounds), L)]
-
-
 def halved(fractions: list[np.ndarray]) -> list[np.ndarray]:
     """Every interval cut in two."""
     out = []
@@ -76,21 +70,6 @@ def halved(fractions: list[np.ndarray]) -> list[np.ndarray]:
         mid = 0.5 * (f[:-1] + f[1:])
         out.append(np.sort(np.concatenate([f, mid])))
     return out
-
-
-def evaluate(lay: Layout, x: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """u(t) (len(t), n) of the collocated orbit x (t any reals)."""
-    V, b, T = lay.split(x)
-    mesh = lay.mesh(b, T)
-    _, z, cols = periodic_locator(mesh, lay.m)(np.asarray(t, dtype=float))
-    return np.einsum("pk,pkn->pn", lay.basis.values(z), V[cols])
-
-
-def node_times(lay: Layout, b: np.ndarray, T: float) -> np.ndarray:
-    """The times of the L m node rows."""
-    mesh = lay.mesh(b, T)
-    z = lay.basis.nodes[:-1]
-    return (mesh[:-1, None] + np.diff(mesh)[:, None] * z[None, :]).ravel()
 
 
 def transfer(lay: Layout, x: np.ndarray, new: Layout) -> np.ndarray:
@@ -141,7 +120,7 @@ def adapted(lay: Layout, x: np.ndarray, L: int) -> list[np.ndarray]:
     weight = np.array([np.sum((rho * h)[piece == j]) for j in range(len(lay.fractions))])
     # a floor: a quarter of the share of the piece's length (a quiet piece stays meshed)
     weight = np.maximum(weight, 0.25 * np.diff(e) / T * weight.sum())
-    counts = _counts(weight, L)
+    counts = interval_counts(weight, L)
     out = []
     for j, c in enumerate(counts):
         sel = piece == j
@@ -308,9 +287,9 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
         ``orbit`` is not an Orbit of the scheme.
     ValueError
         Bad degree, intervals or tol; a model with a user resolvent (use ``refine_orbit``) or
-        with near cells; a result that breaks an inequality of its signature (the message names
-        it: the signature read from the scheme is wrong; refine the scheme's orbit); the
-        estimated error still above ``tol`` at the largest mesh.
+        with near cells; a result that still breaks an inequality of its signature after
+        MENDS mends (the message names it; refine the scheme's orbit); the estimated error
+        still above ``tol`` at the largest mesh.
     ShootingError
         Newton fails.
     """
@@ -343,42 +322,51 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     ref0 = _reference(lay, x0) if orbit.autonomous else None
     what = f"collocation of the orbit at p = {orbit.p!r}"
     x1, _ = solve(lay, terms, x0, ref0, what=what)
-    lay1 = lay
-    ref = _reference(lay1, x1) if orbit.autonomous else None
+    ref = _reference(lay, x1) if orbit.autonomous else None
     count = int(multipliers)
-    if intervals is not None:               # once equidistributed, then halved for the estimate
-        lay2 = lay1.with_fractions(adapted(lay1, x1, L))
-        c, f = _refine(lay2, terms, transfer(lay1, x1, lay2), ref, count, what)
-        return _result(orbit, terms, c, f, count)
+    for attempt in range(MENDS + 1):
+        c, f = _levels(lay, terms, x1, ref, L, intervals is not None, tol, count, what)
+        bad = check_inequalities(f.lay, terms, f.x, 1e-9 * max(1.0, float(np.max(np.abs(f.x)))))
+        if not bad:
+            return _result(orbit, terms, c, f, count)
+        mended = mend(f.lay, terms, f.x) if attempt < MENDS else None
+        if mended is None:
+            break
+        lay, x1 = mended                      # a segment split or removed: solve again
+        x1, _ = solve(lay, terms, x1, ref, what=what)
+    raise ValueError("collocate: the collocated orbit breaks its signature's inequalities "
+                     f"({'; '.join(bad[:4])}) after {attempt} mends of the signature read from "
+                     f"the scheme ({', '.join(f.lay.signature.describe())}); refine the scheme's "
+                     "orbit (a smaller h) and collocate again")
+
+
+def _levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bool,
+            tol: float, count: int, what: str) -> tuple[Solved, Solved]:
+    """The orbit on L intervals equidistributed (``fixed``) or refined until the estimate is
+    below tol, and on that mesh halved: (coarser, finer)."""
     last = None
     for _ in range(MAX_ROUNDS):
-        lay2 = lay1.with_fractions(adapted(lay1, x1, L))
-        c, f = _refine(lay2, terms, transfer(lay1, x1, lay2), ref, count, what)
-        d = (abs(c.T - f.T) if orbit.autonomous
+        lay2 = lay.with_fractions(adapted(lay, x, L))
+        c, f = _refine(lay2, terms, transfer(lay, x, lay2), ref, count, what)
+        if fixed:
+            return c, f
+        d = (abs(c.T - f.T) if lay.autonomous
              else float(np.max(np.abs(c.amplitude - f.amplitude))))
         if d <= tol:
-            return _result(orbit, terms, c, f, count)
+            return c, f
         # the expected order: the period's h^(2m) (superconvergent), an extremum's h^(m+1)
-        grow = (d / tol) ** (1.0 / (2 * m if orbit.autonomous else m + 1)) * 1.2
+        grow = (d / tol) ** (1.0 / (2 * lay.m if lay.autonomous else lay.m + 1)) * 1.2
         if last is not None and last[1] > d > 0:               # the observed order
             q = math.log(last[1] / d) / math.log(L / last[0])
-            if q > m:
+            if q > lay.m:
                 grow = (d / tol) ** (1.0 / q) * 1.1
         last = (L, d)
         L = min(MAX_INTERVALS, max(L + 2, math.ceil(L * min(grow, 8.0))))
-        lay1, x1 = f.lay, f.x
+        lay, x = f.lay, f.x
         if f.lay.L >= MAX_INTERVALS:
             break
     raise ValueError(f"collocate: the estimated error {d:.3g} is still above tol = {tol!r} at "
                      f"{f.lay.L} intervals: ask a larger tol or a higher degree")
-
-
-def carried(terms: Terms, sig: Any) -> tuple[float, ...]:
-    """The lags at which the memory carries a switch forward: (tau,) where H(tau) != 0 on an
-    orbit with switches (the delay integral's derivative jumps at b_k + tau), else ()."""
-    if sig.switches == 0 or not terms.has_kernel:
-        return ()
-    return (terms.tau,) if np.any(terms.H(np.array([terms.tau])) != 0) else ()
 
 
 def _reference(lay: Layout, x: np.ndarray) -> Any:
@@ -397,19 +385,11 @@ def _reference(lay: Layout, x: np.ndarray) -> Any:
 
 
 def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int) -> EquationOrbit:
-    """The EquationOrbit of the finer level f (its multipliers and the coarser's), checked
-    against its signature's inequalities."""
+    """The EquationOrbit of the finer level f, with its multipliers and the coarser's."""
     if count > 0:
         c.mu = floquet(c.lay, terms, c.x, count)
         f.mu = floquet(f.lay, terms, f.x, count)
-    errors = _errors(c, f)
-    bad = check_inequalities(f.lay, terms, f.x, 1e-9 * max(1.0, float(np.max(np.abs(f.x)))))
-    if bad:
-        raise ValueError("collocate: the collocated orbit breaks its signature's inequalities "
-                         f"({'; '.join(bad[:4])}): the signature read from the scheme "
-                         f"({', '.join(f.lay.signature.describe())}) is wrong; refine the "
-                         "scheme's orbit (a smaller h) and collocate again")
-    return equation_orbit(f, float(orbit.p), orbit.make, errors)
+    return equation_orbit(f, float(orbit.p), orbit.make, _errors(c, f))
 
 
 def equation_orbit(f: Solved, p: float, make: Any, errors: dict[str, Any]) -> EquationOrbit:

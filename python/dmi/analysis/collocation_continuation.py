@@ -8,7 +8,7 @@ The driver's contract: ``residual(x, p)`` (len(x) equations), ``jacobian(x, p) -
 :class:`EquationOrbit` the user sees, with its multipliers, their error estimates (twice the
 difference to the solve on the mesh with every interval halved), and its verified stability; None
 when the orbit breaks an inequality of its signature), ``event_functions(x, p, point)`` (a sign change is an event) and ``adapt(x, p)``
-(between steps: a segment shorter than ``VANISH`` of the period is removed, a slip or stuck
+(between steps: a segment shorter than 1e-7 of the period is removed, a slip or stuck
 segment whose inequality breaks is split around the breach, the mesh is equidistributed again and
 the phase condition's reference moves to x; x changes its length when the signature changes, and
 the driver restarts its tangent).
@@ -30,19 +30,17 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
-from .collocation import (CollocationWarning, Solved, _errors, _reference, adapted, carried,
-                          check_inequalities, equation_orbit, evaluate, halved, node_times,
-                          transfer, uniform_fractions)
-from .collocation_mesh import delay_matrix, periodic_locator, point_matrix
-from .collocation_signature import SLIP_NEG, SLIP_POS, STUCK, Signature
-from .collocation_system import Layout, Terms, assemble, full_jacobian, solve
+from .collocation import (CollocationWarning, Solved, _errors, _reference, adapted,
+                          check_inequalities, equation_orbit, halved, transfer)
+from .collocation_mend import mend
+from .collocation_mesh import periodic_locator, point_matrix
+from .collocation_signature import Signature
+from .collocation_system import Layout, Terms, assemble, full_jacobian, node_times, solve
 from .equation_orbit import EquationOrbit
 from .newton import ShootingError
 from .stability import HopfPoint
 from .stepmap import Model, build
 
-#: A segment shorter than this fraction of the period is removed by ``adapt``.
-VANISH = 1e-7
 
 
 class CollocationDiscretisation:
@@ -261,18 +259,9 @@ class CollocationDiscretisation:
             x on the new layout (another length when the signature changed).
         """
         lay, terms = self.lay, self.terms(p)
-        segs, T = _circle(lay, x)
-        changed = False
-        lengths = [(segs[(j + 1) % len(segs)][1] - s[1]) % T for j, s in enumerate(segs)]
-        if len(segs) > 1 and min(lengths) < VANISH * T:
-            segs = _removed(segs, int(np.argmin(lengths)), T)
-            changed = True
-        else:
-            grown = _breaches(lay, terms, x, segs, T)
-            if grown is not None:
-                segs, changed = grown, True
-        if changed:
-            new_lay, x = _relaid(lay, terms, x, segs, T)
+        mended = mend(lay, terms, x)
+        if mended is not None:
+            new_lay, x = mended
         else:
             new_lay = lay.with_fractions(adapted(lay, x, lay.L))
             x = transfer(lay, x, new_lay)
@@ -280,97 +269,6 @@ class CollocationDiscretisation:
         if lay.autonomous:
             self.ref = _reference(new_lay, x)
         return x
-
-
-def _circle(lay: Layout, x: np.ndarray) -> tuple[list[tuple[np.ndarray, float]], float]:
-    """The segments around the circle as (modes, start), segment 0 holding t = 0."""
-    _, b, T = lay.split(x)
-    modes = lay.signature.modes
-    if lay.S == 0:
-        return [(modes[0], 0.0)], T
-    return [(modes[0], float(b[-1] - T))] + [(modes[k], float(b[k - 1]))
-                                             for k in range(1, lay.S)], T
-
-
-def _removed(segs: list, j: int, T: float) -> list:
-    """Segment j removed: its neighbours meet at its middle, or merge when their modes agree."""
-    S = len(segs)
-    start = segs[j][1]
-    end = segs[(j + 1) % S][1] + (T if j == S - 1 else 0.0)
-    prev, nxt = segs[(j - 1) % S], segs[(j + 1) % S]
-    rest = [s for k, s in enumerate(segs) if k not in (j, (j + 1) % S)]
-    if np.array_equal(prev[0], nxt[0]):
-        out = rest
-    else:
-        out = rest + [(nxt[0], 0.5 * (start + end))]
-    return sorted(out, key=lambda s: s[1] % T)
-
-
-def _breaches(lay: Layout, terms: Terms, x: np.ndarray, segs: list, T: float) -> list | None:
-    """The segments with the first breached stretch (a slip component of the wrong sign, a
-    stuck one whose force exceeds alpha) made a segment of its own (stuck, or slipping with the
-    force's sign), or None when nothing is breached."""
-    _, b, _ = lay.split(x)
-    pieces = lay.piece_modes(b, T)
-    e = lay.bounds(b, T)
-    for j, mode in enumerate(pieces):
-        t = np.linspace(e[j], e[j + 1], 64 * (len(lay.fractions[j]) - 1) + 1)[1:-1]
-        u = evaluate(lay, x, t)
-        for i, c in enumerate(mode):
-            if c in (SLIP_POS, SLIP_NEG):
-                bad, new = c * u[:, i] < 0, STUCK
-            elif c == STUCK:
-                force = -terms.f(t, u)[:, i] - _memory(lay, terms, x, t)[:, i]
-                over = np.abs(force) > terms.alpha[i]
-                bad = over
-                new = SLIP_POS if np.any(force[over] > 0) else SLIP_NEG
-            else:
-                continue
-            if np.any(bad):
-                k = np.flatnonzero(bad)
-                inner = mode.copy()
-                inner[i] = new
-                # the breach from the piece's start (a switch that should have been another):
-                # the new mode takes the piece's start over, no sliver of the old mode before it
-                at_start = k[0] == 0 and j > 0
-                out = [sg for sg in segs
-                       if not (at_start and abs((sg[1] - e[j] + 0.5 * T) % T - 0.5 * T)
-                               <= 1e-12 * T)]
-                out.append((inner, float(e[j] if at_start else t[k[0]])))
-                if k[-1] < t.size - 1:
-                    out.append((mode, float(t[k[-1]])))
-                return sorted(out, key=lambda s: s[1] % T)
-    return None
-
-
-def _memory(lay: Layout, terms: Terms, x: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """int_0^tau H(s) u(t - s) ds at the times t (len(t), n) of the orbit x."""
-    if not terms.has_kernel:
-        return np.zeros((t.size, lay.n))
-    V, b, T = lay.split(x)
-    mesh = lay.mesh(b, T)
-    G = delay_matrix(t, terms.tau, mesh, T, terms.H, periodic_locator(mesh, lay.m), lay.basis,
-                     lay.n, lay.rows, pattern=terms.pattern)[0]
-    return (G @ V.ravel()).reshape(-1, lay.n)
-
-
-def _relaid(lay: Layout, terms: Terms, x: np.ndarray, segs: list, T: float
-            ) -> tuple[Layout, np.ndarray]:
-    """The layout of the segments ``segs`` (same L, uniform in each piece) and x on it."""
-    segs = sorted(segs, key=lambda s: s[1] % T)
-    # segment 0 holds t = 0: the last to start (mod T); b: every start, ascending
-    modes = np.array([segs[-1][0]] + [s[0] for s in segs[:-1]])
-    b = np.array([s[1] % T for s in segs]) if len(segs) > 1 else np.empty(0)
-    sig = Signature(modes if len(segs) > 1 else modes[:1])
-    for k in range(1, sig.switches + 1):
-        i = np.flatnonzero(sig.modes[k - 1] != sig.modes[k % len(sig.modes)])
-        if i.size != 1:
-            raise ValueError(f"the mended signature changes {i.size} components at once at "
-                             f"t = {b[k - 1]:.6g}: not continued")
-    new = Layout(lay.m, lay.n, sig, [], lay.autonomous, lay.period, carried(terms, sig))
-    new = new.with_fractions(uniform_fractions(new.bounds(b, T), lay.L))
-    V = evaluate(lay, x, node_times(new, b, T))
-    return new, np.concatenate([V.ravel(), b, [T] if lay.autonomous else []])
 
 
 def _hhat(terms: Terms, lam: complex) -> np.ndarray:

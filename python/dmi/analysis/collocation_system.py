@@ -458,3 +458,37 @@ def _factor(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None, what
         return sla.splu(J)
     except RuntimeError as err:
         raise ShootingError(f"{what}: singular Jacobian ({err})", res) from None
+
+def interval_counts(lengths: np.ndarray, L: int) -> np.ndarray:
+    """L intervals shared by pieces of these lengths (or weights), at least 1 each."""
+    w = np.asarray(lengths, dtype=float)
+    c = np.maximum(1, np.round(L * w / w.sum()).astype(int))
+    return c
+
+
+def uniform_fractions(bounds: np.ndarray, L: int) -> list[np.ndarray]:
+    """Each piece of [0, T] (ends ``bounds``) cut into equal intervals, L in all (about)."""
+    return [np.linspace(0.0, 1.0, c + 1) for c in interval_counts(np.diff(bounds), L)]
+
+
+def evaluate(lay: Layout, x: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """u(t) (len(t), n) of the collocated orbit x (t any reals)."""
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    _, z, cols = periodic_locator(mesh, lay.m)(np.asarray(t, dtype=float))
+    return np.einsum("pk,pkn->pn", lay.basis.values(z), V[cols])
+
+
+def node_times(lay: Layout, b: np.ndarray, T: float) -> np.ndarray:
+    """The times of the L m node rows."""
+    mesh = lay.mesh(b, T)
+    z = lay.basis.nodes[:-1]
+    return (mesh[:-1, None] + np.diff(mesh)[:, None] * z[None, :]).ravel()
+
+
+def carried(terms: Terms, sig: Any) -> tuple[float, ...]:
+    """The lags at which the memory carries a switch forward: (tau,) where H(tau) != 0 on an
+    orbit with switches (the delay integral's derivative jumps at b_k + tau), else ()."""
+    if sig.switches == 0 or not terms.has_kernel:
+        return ()
+    return (terms.tau,) if np.any(terms.H(np.array([terms.tau])) != 0) else ()
