@@ -72,6 +72,15 @@ def halved(fractions: list[np.ndarray]) -> list[np.ndarray]:
     return out
 
 
+def merged(fractions: list[np.ndarray]) -> list[np.ndarray]:
+    """Every pair of intervals made one (a piece of an odd count keeps its last interval)."""
+    out = []
+    for f in fractions:
+        g = f[::2]
+        out.append(g if g[-1] == f[-1] else np.append(g, f[-1]))
+    return out
+
+
 def transfer(lay: Layout, x: np.ndarray, new: Layout) -> np.ndarray:
     """x's orbit on the layout ``new`` (same signature, b's and T)."""
     _, b, T = lay.split(x)

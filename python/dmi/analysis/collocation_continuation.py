@@ -5,8 +5,9 @@
 
 The driver's contract: ``residual(x, p)`` (len(x) equations), ``jacobian(x, p) -> (J_x, J_p)``
 (J_x a scipy.sparse matrix, J_p by a forward difference in p), ``point(x, p)`` (the
-:class:`EquationOrbit` the user sees, with its multipliers, their error estimates (twice the
-difference to the solve on the mesh with every interval halved), and its verified stability; None
+:class:`EquationOrbit` the user sees, with its multipliers, their error estimates (the
+difference to the solve on the mesh with every pair of intervals merged: an upper estimate), and
+its verified stability; None
 when the orbit breaks an inequality of its signature), ``event_functions(x, p, point)`` (a sign change is an event) and ``adapt(x, p)``
 (between steps: a segment shorter than 1e-7 of the period is removed, a slip or stuck
 segment whose inequality breaks is split around the breach, the mesh is equidistributed again and
@@ -31,7 +32,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from .collocation import (CollocationWarning, Solved, _errors, _reference, adapted,
-                          check_inequalities, equation_orbit, halved, transfer)
+                          check_inequalities, equation_orbit, merged, transfer)
 from .collocation_mend import mend
 from .collocation_mesh import periodic_locator, point_matrix
 from .collocation_signature import Signature
@@ -57,8 +58,8 @@ class CollocationDiscretisation:
     multipliers : int
         Leading multipliers a point carries.
     estimate : bool
-        A point's errors from the solve on the halved mesh (False: none, ``errors`` empty and
-        ``stable`` None: a verdict needs the multipliers' errors).
+        A point's errors from the solve on the mesh with every pair of intervals merged (False:
+        none, ``errors`` empty and ``stable`` None: a verdict needs the multipliers' errors).
     """
 
     def __init__(self, make: Model, layout: Layout, x: np.ndarray, *, multipliers: int = 10,
@@ -161,7 +162,7 @@ class CollocationDiscretisation:
 
     def point(self, x: np.ndarray, p: float) -> EquationOrbit | None:
         """The orbit at (x, p) with its multipliers and error estimates; None (with a
-        CollocationWarning) when it breaks an inequality of its signature or the halved mesh's
+        CollocationWarning) when it breaks an inequality of its signature or the merged mesh's
         solve fails.
 
         Parameters
@@ -185,16 +186,15 @@ class CollocationDiscretisation:
         here = Solved(self.lay, terms, x, self.count)
         errors: dict[str, Any] = {}
         if self.estimate:
-            fine = self.lay.with_fractions(halved(self.lay.fractions))
+            coarse = self.lay.with_fractions(merged(self.lay.fractions))
             try:
-                xf, _ = solve(fine, terms, transfer(self.lay, x, fine), self.ref)
+                xc, _ = solve(coarse, terms, transfer(self.lay, x, coarse), self.ref)
             except (ShootingError, ValueError) as e:
-                warnings.warn(f"p = {p!r}: the halved mesh's solve failed ({e}): no point",
+                warnings.warn(f"p = {p!r}: the merged mesh's solve failed ({e}): no point",
                               CollocationWarning, stacklevel=2)
                 return None
-            f = Solved(fine, terms, xf, self.count)
-            # the coarser level's error is about d 2^q / (2^q - 1) <= 2 d, d the difference
-            errors = {k: 2 * v for k, v in _errors(here, f).items()}
+            # the difference to the mesh of merged pairs is about 2^q - 1 >= 1 times the error
+            errors = _errors(Solved(coarse, terms, xc, self.count), here)
         return equation_orbit(here, float(p), self.make, errors)
 
     def event_functions(self, x: np.ndarray, p: float, point: EquationOrbit | None
@@ -313,7 +313,7 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     Returns
     -------
     EquationOrbit
-        Autonomous, at the p found (errors from the halved mesh).
+        Autonomous, at the p found (errors from the mesh of merged pairs).
 
     Raises
     ------
