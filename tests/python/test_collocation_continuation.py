@@ -98,6 +98,11 @@ def test_den_hartog_branch_signature_changes_to_stick_slip():
     e = da.collocate(tc.forced_orbit(d, 2000, 20), intervals=24, multipliers=2)
     assert e.signature.switches == 2
     disc, x = da.CollocationDiscretisation.of(e, multipliers=2)
+    # the events at p = 1: a complex pair (Den Hartog's closed form) inside the unit circle
+    ev = disc.event_functions(x, 1.0, disc.point(x, 1.0))
+    assert abs(ev["torus"] - (np.max(np.abs(d.multipliers)) - 1)) < 1e-8
+    assert "fold" not in ev and "period_doubling" not in ev
+    assert abs(ev["segment"] - 0.5) < 1e-10                 # two half periods
     p, pt = 1.0, e
     while p > 0.41:
         p = round(p - 0.05, 10)
@@ -111,6 +116,9 @@ def test_den_hartog_branch_signature_changes_to_stick_slip():
         x = disc.adapt(x, p)
     stuck = [row for row in pt.signature.describe() if "stuck" in row]
     assert len(stuck) == 2
+    ev = disc.event_functions(x, p, pt)
+    lengths = np.diff(np.concatenate([pt.switches, [pt.switches[0] + pt.period]]))
+    assert abs(ev["segment"] - lengths.min() / pt.period) < 1e-12
     # the scheme's orbit at p approaches the collocated one as h shrinks (O(h))
     gaps = []
     for Ms in (1000, 4000):
