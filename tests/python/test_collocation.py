@@ -3,8 +3,8 @@
 # integral exact on each Fourier mode) and its second multiplier by Hill's method on the same
 # Fourier basis; the circles of a rotating system with a damped-cosine memory in closed form (from
 # the kernel's transform at the circle's frequency); Den Hartog's dry-friction oscillator in closed
-# form (tests/python/orbit_models.py) and the stick-slip orbit of u' + sigma(u) ∋ c sin t in closed
-# form; the convergence order under mesh refinement; the refusals.
+# form (tests/python/orbit_models.py), the stick-slip orbit of u' + sigma(u) ∋ c sin t and a box's
+# faces in closed form; the convergence order under mesh refinement; the refusals.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -322,3 +322,30 @@ def test_eval_rhs_many_is_eval_rhs_at_each_point():
     with pytest.raises(ZeroDivisionError) as info:
         s.eval_rhs_many(t, U)
     assert "rhs at t = " in " ".join(info.value.__notes__)
+
+
+# ---- a box: u' + N_[-1, 1](u) ∋ c sin(t + phi) ------------------------------------------------
+def test_box_faces_closed_form():
+    # free: u' = c sin(t + phi); held on a face while the force pushes into it.  With s = t + phi:
+    # on hi from its arrival until sin s = 0 (s = pi), then u = 1 - c (1 + cos s) down to -1 at
+    # cos s = (2 - c) / c, on lo until s = 2 pi, then u = -1 + c (1 - cos s) up to 1 at
+    # cos s = (c - 2) / c
+    c, phi, M = 1.5, 1.0, 2000
+    T = 2 * math.pi
+
+    def make(p: float) -> dmi.Solver:
+        s = dmi.Solver(1, T / M, 1)
+        s.set_rhs(lambda t, u: np.array([-c * math.sin(t + phi)]))
+        s.set_box([-1.0], [1.0])
+        return s
+    s = make(1.0)
+    s.init()
+    s.advance(5 * M)
+    o = da.periodic_orbit(make, 1.0, T, s, multipliers=0)
+    e = da.collocate(o, intervals=24, multipliers=2)
+    s_ref = np.array([math.acos((c - 2) / c), math.pi, 2 * math.pi - math.acos((2 - c) / c),
+                      2 * math.pi])
+    ref = np.sort(np.mod(s_ref - phi, T))
+    assert np.max(np.abs(np.sort(e.switches) - ref)) < 1e-10
+    assert sorted(e.signature.describe()) == sorted(["(free)", "(on hi)", "(free)", "(on lo)"])
+    assert np.all(e.multipliers == 0)               # a face wipes a perturbation out

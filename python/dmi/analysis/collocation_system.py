@@ -6,14 +6,16 @@
 The equation is u' + A(u) + f(t, u) + int_0^tau H(s) u(t - s) ds ∋ 0.  The unknowns are the node
 values of the periodic piecewise polynomial (:mod:`dmi.analysis.collocation_mesh`), the switching
 times b_1 < ... < b_S of the signature (:mod:`dmi.analysis.collocation_signature`) and, for an
-autonomous orbit, the period T.  The mesh of each piece [b_j, b_{j+1}] is a fixed set of fractions
-of it, so the mesh moves with the b's and T.  The equations: at the m Gauss points of each interval
+autonomous orbit, the period T.  The period is cut into pieces at 0, the b's, the points (b_k + c)
+mod T the memory carries them to, and T; the mesh of each piece is a fixed set of fractions of it,
+so the mesh moves with the b's and T.  The equations: at the m Gauss points of each interval
 u' + f + int H u + (alpha_i sign on slip components) = 0, a held component (stuck, on a face) held
 at its value instead; one switching condition at each b_k; for an autonomous orbit the integral
 phase condition int_0^1 <u(theta T), r'(theta)> d theta = 0 against a reference orbit r.
 
 The Jacobian's columns of the node values are exact (f_u by central differences of the model's
-rhs); the few columns of the b's, T and p by central differences of the residual.
+rhs), T's exact for a smooth autonomous orbit; the few columns of the b's (and T with switches) by
+central differences of the residual.
 """
 from __future__ import annotations
 
