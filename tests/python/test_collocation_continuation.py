@@ -126,3 +126,32 @@ def test_den_hartog_branch_signature_changes_to_stick_slip():
         gaps.append(np.max(np.abs(os_.u - pt.u_at(os_.t))))
     assert gaps[1] < 0.4 * gaps[0]
 
+
+
+def test_belt_hopf_orbit_vertical_branch():
+    # a belt that slips (y = x' - V < 0) is linear: x'' + x - p x' + g int_0^tau e^{-s} x(t - s) ds
+    # = alpha; its Hopf point from lambda^2 - p lambda + 1 + g K(lambda) = 0, K(lambda) = (1 -
+    # e^{-(1 + lambda) tau}) / (1 + lambda), at lambda = i omega (brentq here); every amplitude
+    # below grazing is an orbit at p_H of period 2 pi / omega (a vertical branch)
+    import dmi
+    V, ALPHA, G, TAU = 0.5, 0.4, 0.3, 2.0
+
+    def belt(p: float, h: float | None = None) -> dmi.Solver:
+        s = dmi.Solver(2, TAU, h=0.01 if h is None else h)
+        s.set_rhs(lambda t, u: np.array([-(u[1] + V), u[0] - p * (u[1] + V)]))
+        s.set_friction([0.0, ALPHA])
+        s.set_kernel_exp([-1.0], [0.0], [[[0.0, 0.0], [G, 0.0]]])
+        return s
+
+    def K(lam):
+        return (1 - np.exp(-(1 + lam) * TAU)) / (1 + lam)
+    import scipy.optimize as so
+    om = so.brentq(lambda w: 1 - w * w + G * K(1j * w).real, 0.3, 3.0, xtol=1e-15)
+    pH = G * K(1j * om).imag / om
+    xe = ALPHA / (1 + G * (1 - math.exp(-TAU)))
+    for a in (0.1, 0.3):
+        e = da.equation_hopf_orbit(belt, da.HopfPoint(p=pH, omega=om, root=1j * om), [xe, -V], a)
+        assert e.signature.describe() == ["(free, slip -)"]
+        assert abs(e.p - pH) < 1e-10 and abs(e.period - 2 * math.pi / om) < 1e-10
+        assert abs(e.amplitude[1] - a) < 1e-10          # y moves most: a sine of amplitude a
+        assert e.stable is None                          # not isolated at fixed p: no verdict

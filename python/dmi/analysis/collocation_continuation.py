@@ -35,7 +35,7 @@ from .collocation import (CollocationWarning, Solved, _errors, _reference, adapt
                           check_inequalities, equation_orbit, merged, transfer)
 from .collocation_mend import mend
 from .collocation_mesh import periodic_locator, point_matrix
-from .collocation_signature import Signature
+from .collocation_signature import SLIP_NEG, SLIP_POS, Signature
 from .collocation_system import Layout, Terms, assemble, full_jacobian, node_times, solve
 from .equation_orbit import EquationOrbit
 from .newton import ShootingError
@@ -313,7 +313,8 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     Returns
     -------
     EquationOrbit
-        Autonomous, at the p found (errors from the mesh of merged pairs).
+        Autonomous, at the p found (errors from the mesh of merged pairs; none, and ``stable``
+        None, where the orbit is not isolated at fixed p: a vertical branch).
 
     Raises
     ------
@@ -341,7 +342,7 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     c = int(np.argmax(np.abs(v)))
     v = v / v[c]
     T = 2 * math.pi / om
-    lay = Layout(int(degree), n, Signature(np.zeros((1, n), dtype=int)),
+    lay = Layout(int(degree), n, Signature(_slipping(terms, ue)[None, :]),
                  [np.linspace(0.0, 1.0, int(intervals) + 1)], True, T)
     t = node_times(lay, np.empty(0), T)
     V = ue + a * np.real(np.outer(np.exp(1j * om * t), v))
@@ -361,11 +362,34 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
         z = z + dz
         if np.max(np.abs(dz)) <= tol * max(1.0, float(np.max(np.abs(z)))):
             pt = disc.point(z[:-1], z[-1])
+            if pt is None:            # no estimate at fixed p (a vertical branch): none given
+                disc.estimate = False
+                pt = disc.point(z[:-1], z[-1])
             if pt is None:
                 raise ShootingError("the orbit from the Hopf point breaks its signature", [])
             return pt
     raise ShootingError(f"the orbit from the Hopf point at p = {p0!r}: no convergence in "
                         f"{max_iter} Newton iterations", [])
+
+
+def _slipping(terms: Terms, ue: np.ndarray) -> np.ndarray:
+    """The modes (n,) at an equilibrium: a friction component slips with the sign of u_eq, the
+    others are free.
+
+    Raises
+    ------
+    ValueError
+        A friction component at 0 (stuck) or a box component on a face: no Hopf point there.
+    """
+    modes = np.zeros(terms.n, dtype=int)
+    for i in range(terms.n):
+        if terms.alpha[i] > 0:
+            if ue[i] == 0:
+                raise ValueError(f"u_eq[{i}] = 0 sticks (friction): no Hopf orbit there")
+            modes[i] = SLIP_POS if ue[i] > 0 else SLIP_NEG
+        elif ue[i] <= terms.lo[i] or ue[i] >= terms.hi[i]:
+            raise ValueError(f"u_eq[{i}] = {ue[i]!r} is on the box's face: no Hopf orbit there")
+    return modes
 
 
 def _amplitude_condition(lay: Layout, x: np.ndarray, ue: np.ndarray, c: int, a: float,

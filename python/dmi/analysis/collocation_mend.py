@@ -113,7 +113,16 @@ def memory(lay: Layout, terms: Terms, x: np.ndarray, t: np.ndarray) -> np.ndarra
 
 def relaid(lay: Layout, terms: Terms, x: np.ndarray, segs: list, T: float
             ) -> tuple[Layout, np.ndarray]:
-    """The layout of the segments ``segs`` (same L, uniform in each piece) and x on it."""
+    """The layout of the segments ``segs`` (same L, uniform in each piece) and x on it; an
+    autonomous orbit's time origin moved to the middle of its longest segment (no switch at 0)."""
+    shift = 0.0
+    if lay.autonomous and len(segs) > 1:
+        segs = sorted(segs, key=lambda s: s[1] % T)
+        starts = np.array([s[1] % T for s in segs])
+        lengths = np.diff(np.append(starts, starts[0] + T))
+        j = int(np.argmax(lengths))
+        shift = float(starts[j] + 0.5 * lengths[j])
+        segs = [(md, (st - shift) % T) for md, st in segs]
     segs = sorted(segs, key=lambda s: s[1] % T)
     # segment 0 holds t = 0: the last to start (mod T); b: every start, ascending
     modes = np.array([segs[-1][0]] + [s[0] for s in segs[:-1]])
@@ -126,5 +135,5 @@ def relaid(lay: Layout, terms: Terms, x: np.ndarray, segs: list, T: float
                              f"t = {b[k - 1]:.6g}: not continued")
     new = Layout(lay.m, lay.n, sig, [], lay.autonomous, lay.period, carried(terms, sig))
     new = new.with_fractions(uniform_fractions(new.bounds(b, T), lay.L))
-    V = evaluate(lay, x, node_times(new, b, T))
+    V = evaluate(lay, x, node_times(new, b, T) + shift)
     return new, np.concatenate([V.ravel(), b, [T] if lay.autonomous else []])
