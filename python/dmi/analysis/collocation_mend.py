@@ -57,7 +57,7 @@ def removed(segs: list, j: int, T: float) -> list:
     prev, nxt = segs[(j - 1) % S], segs[(j + 1) % S]
     rest = [s for k, s in enumerate(segs) if k not in (j, (j + 1) % S)]
     if np.array_equal(prev[0], nxt[0]):
-        out = rest
+        out = rest or [prev]                  # two segments: the other one is all that is left
     else:
         out = rest + [(nxt[0], 0.5 * (start + end))]
     return sorted(out, key=lambda s: s[1] % T)
