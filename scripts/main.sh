@@ -88,6 +88,10 @@ stage "dmi.analysis: Stribeck friction split at the static level, verified stabi
 PYTHONPATH="$build/python:examples/python" MPLBACKEND=Agg DMI_FIGURE="$out/stribeck_belt.png" "$py" \
   examples/python/plot_stribeck_belt.py | tee "$out/stribeck_belt.txt"
 
+stage "dmi.analysis: a stick-slip orbit of the equation with memory by collocation"
+PYTHONPATH="$build/python" MPLBACKEND=Agg DMI_FIGURE="$out/collocation_stickslip.png" "$py" \
+  examples/python/plot_collocation_stickslip.py | tee "$out/collocation_stickslip.txt"
+
 stage "figures and comparison with the paper and ../shared/reference"
 refarg=()
 if [[ -d $ref ]]; then

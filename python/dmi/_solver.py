@@ -1146,6 +1146,54 @@ class Solver:
         return self._call_slot("history", _lib.HistoryFn, (float(t),), self._n,
                                f"history at t = {float(t)!r}")
 
+    def eval_rhs_many(self, t: Any, U: Any) -> np.ndarray:
+        """f(t_c, U_c) of :meth:`set_rhs` at many points (zero without one), through the same
+        function the scheme calls, without :meth:`eval_rhs`'s per-call bookkeeping (a failing
+        call is named by its point).
+
+        Parameters
+        ----------
+        t : array_like, shape (P,)
+            Times (time units).
+        U : array_like, shape (P, n)
+            States (state units).
+
+        Returns
+        -------
+        numpy.ndarray, shape (P, n)
+            f(t_c, U_c), row c.
+
+        Raises
+        ------
+        ValueError
+            t and U of other shapes.
+        Exception
+            As :meth:`eval_rhs`.
+        """
+        n = self._n
+        tt = np.ascontiguousarray(np.asarray(t, dtype=float).ravel())
+        X = np.ascontiguousarray(np.asarray(U, dtype=float))
+        if X.shape != (tt.size, n):
+            raise ValueError(f"eval_rhs_many: U has shape {X.shape}; expected ({tt.size}, {n}) "
+                             "(one state a time)")
+        out = np.zeros((tt.size, n))
+        if not self.has("rhs") or tt.size == 0:
+            return out
+        bound = self._keep["rhs"]
+        fn = _lib.RhsFn(bound.address)
+        x0, o0 = X.ctypes.data, out.ctypes.data
+        step = 8 * n
+        for c in range(tt.size):
+            rc = fn(float(tt[c]), x0 + c * step, o0 + c * step, bound.user)
+            failure, self._failure[0] = self._failure[0], None
+            if failure is not None:
+                failure.add_note(f"raised by the model's rhs at t = {tt[c]!r}, u = {X[c]!r}")
+                raise failure
+            if rc != 0:
+                raise Error(_lib.ECALLBACK, f"the model's rhs at t = {tt[c]!r}, u = {X[c]!r} "
+                            f"returned {rc}")
+        return out
+
     def __repr__(self) -> str:
         if self._h_given is not None:
             return f"dmi.Solver(n={self._n}, tau={self._tau!r}, h={self._h_given!r})"

@@ -42,3 +42,11 @@ __all__ = [
     # verified Floquet multipliers and stability verdicts (docs/orbits.md)
     "floquet_verdict", "Floquet", "Verify", "StabilityWarning",
 ]
+from .collocation import collocate  # noqa: E402
+from .equation_orbit import EquationOrbit  # noqa: E402
+
+__all__ += ["collocate", "EquationOrbit"]
+from .collocation_continuation import (CollocationDiscretisation,  # noqa: E402
+                                       equation_hopf_orbit)
+
+__all__ += ["CollocationDiscretisation", "equation_hopf_orbit"]

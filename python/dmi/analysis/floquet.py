@@ -538,7 +538,12 @@ def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
     ------
     ValueError
         x is not a fixed point of F (the residual is given), count < 1.
+    TypeError
+        An EquationOrbit (it carries its multipliers).
     """
+    if getattr(F, "of", "scheme") == "equation":
+        raise TypeError("floquet_multipliers: an EquationOrbit (collocate) carries its own "
+                        ".multipliers; this takes a StepMap of the scheme")
     opts = Verify(periods=0) if verify is None else verify
     fl = floquet_verdict(F, x, count, autonomous=autonomous, eps=eps, central=central, verify=opts)
     bad = np.flatnonzero(~np.isfinite(fl.errors[:count]))

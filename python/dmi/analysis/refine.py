@@ -152,9 +152,14 @@ def refine_orbit(orbit: Orbit, *, levels: int = 3, tol: float = 1e-10) -> Refine
     ------
     ValueError
         levels < 3, or a model that does not take h.
+    TypeError
+        An EquationOrbit (it is the equation's already).
     ShootingError
         A level's shooting fails.
     """
+    if getattr(orbit, "of", "scheme") == "equation":
+        raise TypeError("refine_orbit: an EquationOrbit (collocate) is the equation's "
+                        "already; refine_orbit takes an Orbit of the scheme")
     if int(levels) != levels or levels < 3:
         raise ValueError(f"levels = {levels!r}: give 3 or more (M, 2 M, 4 M, ...)")
     count = int(orbit.multipliers.size)

@@ -1,0 +1,417 @@
+# Periodic orbits of the equation (not of the scheme) by orthogonal collocation, from an orbit of
+# the scheme: smooth orbits and the multi-segment orbits of dry friction and boxes.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""collocate: the equation's periodic orbit from the scheme's.
+
+The orbit of u' + A(u) + f(t, u) + int_0^tau H(s) u(t - s) ds ∋ 0 is a continuous periodic
+piecewise polynomial of degree m, collocated at the m Gauss-Legendre points of each mesh interval
+(:mod:`dmi.analysis.collocation_system`); the delay integral is taken on the polynomial itself,
+wrapping as many periods as tau / T needs (:mod:`dmi.analysis.collocation_mesh`).  With the
+built-in friction or box the period is cut into segments whose modes (slip +-, stuck, on a face,
+free) are read from the scheme's orbit, the segments' ends unknowns with their switching
+conditions (:mod:`dmi.analysis.collocation_signature`); every inequality is checked on a fine grid
+of the result: a breach splits a segment, a vanishing segment is removed
+(:mod:`dmi.analysis.collocation_mend`) and the orbit is solved again; an orbit that breaks one is
+never returned.  Multipliers: the discretised
+monodromy operator with the saltation at the switches (:mod:`dmi.analysis.collocation_floquet`).
+
+Errors: the orbit is solved on a mesh and on the same mesh with every interval halved; the
+difference of their period, amplitudes, multipliers and u is the error estimate of the finer one
+(which is returned): an upper estimate while the convergence is in its asymptotic range (the
+finer one's error is that difference over 2^p - 1, p >= m the order).  With ``intervals=None``
+the mesh is equidistributed (AUTO, COLSYS: equal integrals of |u^(m+1)|^(1 / (m + 1)),
+estimated from the jumps of u^(m) between intervals) and refined until the estimate of the
+period (an autonomous orbit; it converges as h^(2m) on smooth orbits) or of the amplitudes (a
+forced orbit; h^(m+1): an extremum is inside an interval) is below ``tol``.
+
+Limits: a kernel with a jump inside (0, tau) at a lag not known to collocation caps the order at
+1 (the exponential sums and the truncation at tau are handled exactly); a user resolvent
+(``set_resolvent``) has no A to collocate (use ``refine_orbit``); near cells of fitted kernels
+(``set_kernel_near``) are not collocated here.
+"""
+from __future__ import annotations
+
+import math
+import warnings
+from typing import Any
+
+import numpy as np
+
+from .collocation_floquet import multipliers as floquet
+from .collocation_mesh import delay_matrix, equidistribute, periodic_locator
+from .collocation_signature import read_signature, violations
+from .collocation_system import (Layout, Terms, carried, evaluate, interval_counts, node_times,
+                                 solve, uniform_fractions)
+from .collocation_mend import mend
+from .equation_orbit import EquationOrbit
+from .orbit import Orbit
+from .stepmap import build
+
+#: Points a mesh interval of the grid on which the inequalities are checked.
+CHECK_POINTS = 8
+#: Mesh refinement rounds at most (intervals=None).
+MAX_ROUNDS = 6
+#: Signature mends at most (a segment split or removed where an inequality breaks).
+MENDS = 4
+#: Intervals at most.
+MAX_INTERVALS = 4000
+#: The errors' floor, relative to their quantities (Newton's 1e-12 and the conditioning).
+FLOOR = 1e-11
+
+
+class CollocationWarning(RuntimeWarning):
+    """A collocated orbit's verdict that could not be verified (its stability)."""
+
+
+def halved(fractions: list[np.ndarray]) -> list[np.ndarray]:
+    """Every interval cut in two."""
+    out = []
+    for f in fractions:
+        mid = 0.5 * (f[:-1] + f[1:])
+        out.append(np.sort(np.concatenate([f, mid])))
+    return out
+
+
+def merged(fractions: list[np.ndarray]) -> list[np.ndarray]:
+    """Every pair of intervals made one (a piece of an odd count keeps its last interval)."""
+    out = []
+    for f in fractions:
+        g = f[::2]
+        out.append(g if g[-1] == f[-1] else np.append(g, f[-1]))
+    return out
+
+
+def transfer(lay: Layout, x: np.ndarray, new: Layout) -> np.ndarray:
+    """x's orbit on the layout ``new`` (same signature, b's and T)."""
+    _, b, T = lay.split(x)
+    V = evaluate(lay, x, node_times(new, b, T))
+    return np.concatenate([V.ravel(), x[lay.rows * lay.n:]])
+
+
+def indicator(lay: Layout, x: np.ndarray) -> np.ndarray:
+    """(L,): |u^(m+1)|^(1/(m+1)) estimated on each interval from the jumps of the piecewise
+    constant u^(m) to its neighbours in the same piece (AUTO's indicator); an interval alone in
+    its piece takes |u^(m)| / h (no neighbour to difference with)."""
+    m = lay.m
+    V, b, T = lay.split(x)
+    h = np.diff(lay.mesh(b, T))
+    k = np.arange(m + 1)
+    cols = (np.arange(lay.L)[:, None] * m + k[None, :]) % lay.rows
+    top = np.einsum("k,lkn->ln", lay.basis.top, V[cols]) / h[:, None] ** m   # u^(m) (L, n)
+    piece = lay.piece_of_interval()
+    jump = np.zeros(lay.L)
+    same = piece[1:] == piece[:-1]
+    if lay.signature.switches == 0:                        # one piece: around the circle
+        d = np.linalg.norm(np.roll(top, -1, axis=0) - top, axis=1)
+        dist = 0.5 * (h + np.roll(h, -1))
+        g = d / dist
+        jump = np.maximum(g, np.roll(g, 1))
+    else:
+        d = np.linalg.norm(top[1:] - top[:-1], axis=1) / (0.5 * (h[1:] + h[:-1]))
+        d = np.where(same, d, 0.0)
+        jump[:-1] = np.maximum(jump[:-1], d)
+        jump[1:] = np.maximum(jump[1:], d)
+        alone = np.ones(lay.L, bool)
+        alone[:-1] &= ~same
+        alone[1:] &= ~same
+        jump = np.where(alone, np.linalg.norm(top, axis=1) / h, jump)
+    return jump ** (1.0 / (m + 1))
+
+
+def adapted(lay: Layout, x: np.ndarray, L: int) -> list[np.ndarray]:
+    """Fractions of L intervals (about) equidistributing :func:`indicator` piece by piece."""
+    rho = indicator(lay, x)
+    _, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    e = lay.bounds(b, T)
+    piece = lay.piece_of_interval()
+    h = np.diff(mesh)
+    weight = np.array([np.sum((rho * h)[piece == j]) for j in range(len(lay.fractions))])
+    # a floor: a quarter of the share of the piece's length (a quiet piece stays meshed)
+    weight = np.maximum(weight, 0.25 * np.diff(e) / T * weight.sum())
+    counts = interval_counts(weight, L)
+    out = []
+    for j, c in enumerate(counts):
+        sel = piece == j
+        pm = np.concatenate([mesh[:-1][sel], [mesh[1:][sel][-1]]])
+        new = equidistribute(pm, rho[sel], int(c))
+        out.append((new - e[j]) / (e[j + 1] - e[j]))
+        out[-1][0], out[-1][-1] = 0.0, 1.0
+    return out
+
+
+def extrema(lay: Layout, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(max (n,), min (n,)) of each component on the piecewise polynomial: the derivative's
+    roots in the intervals next to the largest and smallest nodes."""
+    m, n = lay.m, lay.n
+    V = lay.split(x)[0]
+    k = np.arange(m + 1)
+    y = 2 * lay.basis.nodes - 1
+    hi, lo = V.max(axis=0).copy(), V.min(axis=0).copy()
+    for i in range(n):
+        for sign, best in ((1.0, hi), (-1.0, lo)):
+            node = int(np.argmax(sign * V[:, i]))
+            iv = node // m
+            for j in {(iv - 1) % lay.L, iv, (iv + 1) % lay.L}:
+                vals = V[(j * m + k) % lay.rows, i]
+                c = np.polynomial.polynomial.polyfit(y, vals, m)
+                r = np.polynomial.polynomial.polyroots(np.polynomial.polynomial.polyder(c))
+                r = r.real[(np.abs(r.imag) < 1e-9) & (np.abs(r.real) <= 1)]
+                if r.size:
+                    v = np.polynomial.polynomial.polyval(r, c)
+                    best[i] = max(best[i], v.max()) if sign > 0 else min(best[i], v.min())
+    return hi, lo
+
+
+def check_inequalities(lay: Layout, terms: Terms, x: np.ndarray, tol: float) -> list[str]:
+    """The inequalities the result breaks on a fine grid (CHECK_POINTS a mesh interval)."""
+    if lay.signature.switches == 0 and not (np.any(terms.alpha > 0)
+                                            or np.any(np.isfinite(terms.lo))
+                                            or np.any(np.isfinite(terms.hi))):
+        return []
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    e = lay.bounds(b, T)
+    grid, us, forces = [], [], []
+    loc = periodic_locator(mesh, lay.m)
+    for j in range(len(e) - 1):
+        count = (len(lay.fractions[j]) - 1) * CHECK_POINTS + 1
+        t = np.linspace(e[j], e[j + 1], count)
+        u = evaluate(lay, x, t)
+        F = -terms.f(t, u)
+        if terms.has_kernel:
+            G = delay_matrix(t, terms.tau, mesh, T, terms.H, loc, lay.basis, lay.n, lay.rows,
+                             pattern=terms.pattern)[0]
+            F = F - (G @ V.ravel()).reshape(-1, lay.n)
+        grid.append(t)
+        us.append(u)
+        forces.append(F)
+    return violations(lay.piece_modes(b, T), grid, us, forces, terms.alpha, terms.lo, terms.hi,
+                      tol)
+
+
+def _match(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """|a_j - (the nearest b)| for each a_j."""
+    if b.size == 0:
+        return np.full(a.shape, np.inf)
+    return np.min(np.abs(a[:, None] - b[None, :]), axis=1)
+
+
+class Solved:
+    """A solution on one layout, with its derived quantities."""
+
+    def __init__(self, lay: Layout, terms: Terms, x: np.ndarray, count: int):
+        self.lay, self.x = lay, x
+        _, self.b, self.T = lay.split(x)
+        hi, lo = extrema(lay, x)
+        self.amplitude = 0.5 * (hi - lo)
+        self.mu = floquet(lay, terms, x, count) if count > 0 else np.empty(0, complex)
+
+
+def _refine(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, count: int, what: str
+            ) -> tuple[Solved, Solved]:
+    """The orbit on ``lay`` (from x on another layout) and on ``lay`` halved."""
+    xc, _ = solve(lay, terms, x, ref, what=what)
+    fine = lay.with_fractions(halved(lay.fractions))
+    xf, _ = solve(fine, terms, transfer(lay, xc, fine), ref, what=what)
+    return Solved(lay, terms, xc, 0), Solved(fine, terms, xf, 0)
+
+
+def _errors(c: Solved, f: Solved) -> dict[str, Any]:
+    """The differences of the two levels: the finer's error estimate."""
+    t = np.linspace(0.0, f.T, 40 * f.lay.L, endpoint=False)
+    du = float(np.max(np.abs(evaluate(c.lay, c.x, t * c.T / f.T) - evaluate(f.lay, f.x, t))))
+    return with_floor({"period": abs(c.T - f.T), "amplitude": np.abs(c.amplitude - f.amplitude),
+                       "multipliers": _match(f.mu, c.mu), "u": du},
+                      f.T, f.amplitude, f.mu, float(np.max(np.abs(f.x[:f.lay.rows * f.lay.n]))))
+
+
+def with_floor(errors: dict[str, Any], T: float, amplitude: np.ndarray, mu: np.ndarray,
+               u: float) -> dict[str, Any]:
+    """The errors, each at least FLOOR times its quantity's size (at least 1): Newton stops at
+    a correction of 1e-12 relative, and the conditioning adds a few digits."""
+    errors["period"] = max(errors["period"], FLOOR * max(1.0, T))
+    errors["amplitude"] = np.maximum(errors["amplitude"], FLOOR * np.maximum(1.0, amplitude))
+    errors["multipliers"] = np.maximum(errors["multipliers"], FLOOR * np.maximum(1.0,
+                                                                                   np.abs(mu)))
+    errors["u"] = max(errors["u"], FLOOR * max(1.0, u))
+    return errors
+
+
+def _stable(mu: np.ndarray, err: np.ndarray, autonomous: bool) -> bool | None:
+    """All |mu| < 1 but the trivial one (autonomous), verified against the errors; None (with a
+    CollocationWarning) when a multiplier's |mu| is within its error of 1."""
+    if mu.size == 0:
+        return None
+    keep = np.ones(mu.size, bool)
+    if autonomous:
+        keep[int(np.argmin(np.abs(mu - 1)))] = False
+    a, e = np.abs(mu[keep]), err[keep]
+    if np.any(a > 1 + e):
+        return False
+    if np.all(a < 1 - e):
+        return True
+    warnings.warn(f"collocate: a multiplier's modulus is within its estimated error of 1 "
+                  f"({a[np.argmin(np.abs(a - 1))]:.12g}): stability not verified (None)",
+                  CollocationWarning, stacklevel=3)
+    return None
+
+
+def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
+              tol: float = 1e-10, multipliers: int = 10) -> EquationOrbit:
+    """The equation's periodic orbit near an orbit of the scheme, by orthogonal collocation.
+
+    Piecewise polynomials of degree m on L mesh intervals of one period, collocated at the
+    Gauss-Legendre points; the delay integral on the periodic polynomial; for an autonomous orbit
+    the period is an unknown with an integral phase condition; with the built-in friction or box
+    the period's segments (slip +-, stuck, on a face) are read from the scheme's orbit and their
+    ends are unknowns fixed by switching conditions (module docstring: method, errors, limits).
+
+    Parameters
+    ----------
+    orbit : Orbit
+        An orbit of the scheme (:func:`dmi.analysis.periodic_orbit`, :func:`hopf_orbit`, a
+        branch's point), forced or autonomous.
+    degree : int
+        m, the polynomials' degree (2 to 8).
+    intervals : int, optional
+        L, the mesh's intervals (equidistributed once, not refined; the orbit returned has 2 L,
+        the estimate's finer level); None: refined until the estimated error of the period (an
+        autonomous orbit) or of the amplitudes (a forced one) is below ``tol``; the other
+        estimates are in ``errors``.
+    tol : float
+        The error asked (time and state units), > 0.
+    multipliers : int
+        Leading Floquet multipliers (0: none; ``stable`` is then None).
+
+    Returns
+    -------
+    EquationOrbit
+        The orbit with its period, amplitude, multipliers, stability, mesh, signature and
+        estimated errors (those of the returned, finer level).
+
+    Raises
+    ------
+    TypeError
+        ``orbit`` is not an Orbit of the scheme.
+    ValueError
+        Bad degree, intervals or tol; a model with a user resolvent (use ``refine_orbit``) or
+        with near cells; a result that still breaks an inequality of its signature after
+        MENDS mends (the message names it; refine the scheme's orbit); the estimated error
+        still above ``tol`` at the largest mesh.
+    ShootingError
+        Newton fails.
+    """
+    if not isinstance(orbit, Orbit):
+        raise TypeError(f"collocate: give an Orbit of the scheme (periodic_orbit, hopf_orbit), "
+                        f"not {type(orbit).__name__}")
+    m = int(degree)
+    if m != degree or not 2 <= m <= 8:
+        raise ValueError(f"collocate: degree = {degree!r}: give a whole number in 2..8")
+    if intervals is not None and (int(intervals) != intervals or intervals < 4):
+        raise ValueError(f"collocate: intervals = {intervals!r}: give a whole number >= 4, or "
+                         "None to adapt")
+    if not (tol > 0 and math.isfinite(tol)):
+        raise ValueError(f"collocate: tol = {tol!r}: give a finite tol > 0")
+    terms = Terms(build(orbit.make, orbit.p))
+    sig, b0 = read_signature(orbit.u, orbit.h, terms.alpha, terms.lo, terms.hi)
+    T0 = float(orbit.period)
+    lay = Layout(m, terms.n, sig, [], bool(orbit.autonomous), T0, carried(terms, sig))
+    bounds = lay.bounds(b0, T0)
+    L = int(intervals) if intervals is not None else max(16, 4 * (bounds.size - 1))
+    L0 = max(8, 2 * (bounds.size - 1), L // 2)        # a first solve: the indicator, the phase
+    lay = lay.with_fractions(uniform_fractions(bounds, L0))
+    t_s = np.asarray(orbit.t, dtype=float)
+
+    def scheme(t: np.ndarray) -> np.ndarray:
+        tt = np.mod(t, T0)
+        return np.column_stack([np.interp(tt, t_s, orbit.u[:, i]) for i in range(terms.n)])
+    x0 = np.concatenate([scheme(node_times(lay, b0, T0)).ravel(), b0,
+                         [T0] if orbit.autonomous else []])
+    ref0 = _reference(lay, x0) if orbit.autonomous else None
+    what = f"collocation of the orbit at p = {orbit.p!r}"
+    x1, _ = solve(lay, terms, x0, ref0, what=what)
+    ref = _reference(lay, x1) if orbit.autonomous else None
+    count = int(multipliers)
+    for attempt in range(MENDS + 1):
+        c, f = _levels(lay, terms, x1, ref, L, intervals is not None, tol, count, what)
+        bad = check_inequalities(f.lay, terms, f.x, 1e-9 * max(1.0, float(np.max(np.abs(f.x)))))
+        if not bad:
+            return _result(orbit, terms, c, f, count)
+        mended = mend(f.lay, terms, f.x) if attempt < MENDS else None
+        if mended is None:
+            break
+        lay, x1 = mended                      # a segment split or removed: solve again
+        x1, _ = solve(lay, terms, x1, ref, what=what)
+    raise ValueError("collocate: the collocated orbit breaks its signature's inequalities "
+                     f"({'; '.join(bad[:4])}) after {attempt} mends of the signature read from "
+                     f"the scheme ({', '.join(f.lay.signature.describe())}); refine the scheme's "
+                     "orbit (a smaller h) and collocate again")
+
+
+def _levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bool,
+            tol: float, count: int, what: str) -> tuple[Solved, Solved]:
+    """The orbit on L intervals equidistributed (``fixed``) or refined until the estimate is
+    below tol, and on that mesh halved: (coarser, finer)."""
+    last = None
+    for _ in range(MAX_ROUNDS):
+        lay2 = lay.with_fractions(adapted(lay, x, L))
+        c, f = _refine(lay2, terms, transfer(lay, x, lay2), ref, count, what)
+        if fixed:
+            return c, f
+        d = (abs(c.T - f.T) if lay.autonomous
+             else float(np.max(np.abs(c.amplitude - f.amplitude))))
+        if d <= tol:
+            return c, f
+        # the expected order: the period's h^(2m) (superconvergent), an extremum's h^(m+1)
+        grow = (d / tol) ** (1.0 / (2 * lay.m if lay.autonomous else lay.m + 1)) * 1.2
+        if last is not None and last[1] > d > 0:               # the observed order
+            q = math.log(last[1] / d) / math.log(L / last[0])
+            if q > lay.m:
+                grow = (d / tol) ** (1.0 / q) * 1.1
+        last = (L, d)
+        L = min(MAX_INTERVALS, max(L + 2, math.ceil(L * min(grow, 8.0))))
+        lay, x = f.lay, f.x
+        if f.lay.L >= MAX_INTERVALS:
+            break
+    raise ValueError(f"collocate: the estimated error {d:.3g} is still above tol = {tol!r} at "
+                     f"{f.lay.L} intervals: ask a larger tol or a higher degree")
+
+
+def _reference(lay: Layout, x: np.ndarray) -> Any:
+    """theta -> r'(theta) (P, n): the derivative in theta = t / T of the orbit x (the phase
+    condition's reference), by its polynomial."""
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T) / T
+    loc = periodic_locator(mesh, lay.m)
+    basis = lay.basis
+
+    def r(theta: np.ndarray) -> np.ndarray:
+        i, z, cols = loc(np.asarray(theta, dtype=float))
+        B = basis.derivatives(z) / np.diff(mesh)[i][:, None]
+        return np.einsum("pk,pkn->pn", B, V[cols])
+    return r
+
+
+def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int) -> EquationOrbit:
+    """The EquationOrbit of the finer level f, with its multipliers and the coarser's."""
+    if count > 0:
+        c.mu = floquet(c.lay, terms, c.x, count)
+        f.mu = floquet(f.lay, terms, f.x, count)
+    return equation_orbit(f, float(orbit.p), orbit.make, _errors(c, f))
+
+
+def equation_orbit(f: Solved, p: float, make: Any, errors: dict[str, Any]) -> EquationOrbit:
+    """The EquationOrbit of a solution (its stability verified against ``errors``)."""
+    V, b, T = f.lay.split(f.x)
+    return EquationOrbit(p=p, period=T, amplitude=f.amplitude, multipliers=f.mu,
+                         stable=_stable(f.mu, errors.get("multipliers", np.full(f.mu.shape,
+                                                                                np.inf)),
+                                        f.lay.autonomous),
+                         mesh=f.lay.mesh(b, T), signature=f.lay.signature, switches=b.copy(),
+                         make=make, autonomous=f.lay.autonomous, errors=errors,
+                         degree=f.lay.m, nodes=V.copy(),
+                         fractions=[fr.copy() for fr in f.lay.fractions], carried=f.lay.carried)
+
+
+__all__ = ["collocate", "CollocationWarning"]

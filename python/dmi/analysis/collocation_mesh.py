@@ -1,0 +1,263 @@
+# Piecewise polynomials on a mesh of one period: the Lagrange basis, evaluation, the delay
+# integral's quadrature matrix and the equidistribution of the mesh.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""The mesh machinery of :mod:`dmi.analysis.collocation`; private to the package.
+
+A function on one period [0, T] is a continuous piecewise polynomial of degree m on a mesh
+0 = t_0 < t_1 < ... < t_L = T: on interval i it interpolates m + 1 equispaced nodes t_i + k h_i / m
+(k = 0..m), the last node of an interval being the first of the next.  A *locator* maps times
+(any real numbers) to (interval, local coordinate in [0, 1], the columns of that interval's m + 1
+nodes in the unknowns): the periodic one wraps times mod T (the orbit), the history one sends
+negative times to a separate, discontinuous copy of the mesh (the monodromy operator).
+
+The delay integral I(t) = int_0^tau H(s) u(t - s) ds is exact for the piecewise polynomial up to
+the kernel's own smoothness: [0, tau] is cut at every lag s where t - s crosses a mesh point (all
+shifted periods) and at the kernel's own breakpoints, and each piece takes ``q`` Gauss-Legendre
+nodes (exact for H polynomial of degree 2 q - 1 - m on the piece).  A kernel with a jump at an
+unknown lag inside (0, tau) caps the order at 1 there: the pieces do not see it.
+"""
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+#: Locator: times -> (interval (k,), local coordinate (k,), columns (k, m + 1) of node rows).
+Locator = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]
+
+
+@dataclass(frozen=True)
+class Basis:
+    """The Lagrange basis of degree m on the equispaced nodes k / m of [0, 1], with the m Gauss
+    points (collocation) and the Gauss-Legendre rule of q nodes (quadrature) on [0, 1]."""
+    m: int
+    q: int
+
+    @property
+    def nodes(self) -> np.ndarray:
+        """The m + 1 interpolation nodes k / m."""
+        return np.linspace(0.0, 1.0, self.m + 1)
+
+    @property
+    def weights(self) -> np.ndarray:
+        """Barycentric weights 1 / prod_{j != k} (x_k - x_j)."""
+        x = self.nodes
+        d = x[:, None] - x[None, :]
+        np.fill_diagonal(d, 1.0)
+        return 1.0 / np.prod(d, axis=1)
+
+    def gauss(self, count: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Gauss-Legendre nodes and weights on [0, 1] (``count`` nodes, default m)."""
+        g, w = np.polynomial.legendre.leggauss(self.m if count is None else count)
+        return 0.5 * (g + 1.0), 0.5 * w
+
+    def values(self, z: np.ndarray) -> np.ndarray:
+        """(len(z), m + 1): the basis polynomials at the local coordinates z (their monomial
+        coefficients in y = 2 z - 1, by Horner's scheme)."""
+        y = 2.0 * np.asarray(z, dtype=float) - 1.0
+        C = _monomials(self.m)
+        out = np.broadcast_to(C[self.m], (y.size, self.m + 1)).copy()
+        for j in range(self.m - 1, -1, -1):
+            out *= y[:, None]
+            out += C[j]
+        return out
+
+    def derivatives(self, z: np.ndarray) -> np.ndarray:
+        """(len(z), m + 1): the basis polynomials' first derivatives at z (d/dz, z in [0, 1])."""
+        z = np.asarray(z, dtype=float)
+        x, w = self.nodes, self.weights
+        d = z[:, None] - x[None, :]
+        out = np.zeros((z.size, self.m + 1))
+        for k in range(self.m + 1):
+            others = [j for j in range(self.m + 1) if j != k]
+            for i in others:
+                rest = [j for j in others if j != i]
+                out[:, k] += np.prod(d[:, rest], axis=1)
+            out[:, k] *= w[k]
+        return out
+
+    @property
+    def top(self) -> np.ndarray:
+        """(m + 1,): the m-th derivative (d/dz) of each basis polynomial, a constant."""
+        return self.weights * math.factorial(self.m)
+
+
+@functools.lru_cache(maxsize=16)
+def _monomials(m: int) -> np.ndarray:
+    """(m + 1, m + 1): row j holds the y^j coefficients of the m + 1 Lagrange polynomials on the
+    equispaced nodes of [-1, 1] (y = 2 z - 1; well conditioned for m <= 8)."""
+    y = np.linspace(-1.0, 1.0, m + 1)
+    return np.linalg.inv(np.vander(y, m + 1, increasing=True))
+
+
+def interval_of(mesh: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For times t in [mesh[0], mesh[-1]]: the interval index and the local coordinate in [0, 1]."""
+    L = mesh.size - 1
+    i = np.clip(np.searchsorted(mesh, t, side="right") - 1, 0, L - 1)
+    z = (t - mesh[i]) / (mesh[i + 1] - mesh[i])
+    return i, z
+
+
+def periodic_locator(mesh: np.ndarray, m: int) -> Locator:
+    """The locator of the periodic continuous piecewise polynomial: L m node rows, times mod T."""
+    T = float(mesh[-1])
+    L = mesh.size - 1
+    k = np.arange(m + 1)
+
+    def locate(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        i, z = interval_of(mesh, np.mod(t, T))
+        return i, z, (i[:, None] * m + k[None, :]) % (L * m)
+    return locate
+
+
+def history_locator(mesh: np.ndarray, hist: np.ndarray, m: int, periods: int) -> Locator:
+    """The locator of one period forward from a history: times t >= 0 on ``mesh`` (L m + 1
+    continuous node rows, node 0 at t = 0), times t < 0 on ``periods`` copies of ``hist`` shifted
+    back by whole periods, each interval with its own m + 1 rows (a discontinuous piecewise
+    polynomial: a perturbation may jump at a switch), after the L m + 1 rows of the period."""
+    T = float(hist[-1])
+    L = mesh.size - 1
+    k = np.arange(m + 1)
+    base = L * m + 1
+
+    def locate(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        t = np.asarray(t, dtype=float)
+        i, z = interval_of(mesh, np.clip(t, 0.0, mesh[-1]))
+        cols = i[:, None] * m + k[None, :]
+        back = t < 0
+        if np.any(back):
+            per = np.ceil(-t[back] / T).astype(int)            # 1 .. periods
+            ih, zh = interval_of(hist, t[back] + per * T)
+            i[back], z[back] = ih, zh
+            g = (periods - per) * L + ih                        # history interval, oldest first
+            cols[back] = base + g[:, None] * (m + 1) + k[None, :]
+        return i, z, cols
+    return locate
+
+
+def history_rows(L: int, m: int, periods: int) -> int:
+    """The node rows of :func:`history_locator`: L m + 1 for the period, L (m + 1) a past period."""
+    return L * m + 1 + periods * L * (m + 1)
+
+
+def delay_matrix(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: float,
+                 kernel: Callable[[np.ndarray], np.ndarray], locate: Locator, basis: Basis,
+                 n: int, rows: int, breaks: np.ndarray | None = None,
+                 pattern: np.ndarray | None = None, slope_of: np.ndarray | None = None
+                 ) -> tuple[sp.csr_matrix, np.ndarray | None]:
+    """The sparse matrix G (len(times) n, rows n) with G u = (int_0^tau H(s) u(t_c - s) ds)_c.
+
+    Parameters
+    ----------
+    times : numpy.ndarray
+        The times t_c.
+    tau : float
+        The memory's length.
+    mesh_points : numpy.ndarray
+        The mesh points of one period (where u's pieces join), repeated every T.
+    T : float
+        The period.
+    kernel : callable
+        s (k,) -> H(s) (k, n, n).
+    locate : callable
+        The locator of u's node rows.
+    basis : Basis
+        The basis (degree m, q quadrature nodes a piece).
+    n : int
+        The state's dimension.
+    rows : int
+        The node rows of u.
+    breaks : numpy.ndarray, optional
+        The kernel's own breakpoints in (0, tau).
+    pattern : numpy.ndarray of bool, optional
+        (n, n): the entries of H that may be nonzero (default all).
+    slope_of : numpy.ndarray, optional
+        Node rows (rows, n) of u: then also (1 / T) int_0^tau s H(s) u'(t_c - s) ds (len(times),
+        n), the derivative of G u in T when the mesh scales with T (an autonomous orbit).
+
+    Returns
+    -------
+    tuple
+        G (scipy.sparse.csr_matrix; row c n + a, column (node row) n + b) and the T derivative
+        (or None).
+    """
+    gz, gw = basis.gauss(basis.q)
+    pts = np.asarray(mesh_points[:-1], dtype=float)
+    times = np.asarray(times, dtype=float)
+    lo = math.floor((times.min() - tau - pts[-1]) / T) - 1
+    hi = math.floor((times.max() - pts[0]) / T) + 1
+    ext = (pts[None, :] + T * np.arange(lo, hi + 1)[:, None]).ravel()   # sorted
+    j0 = np.searchsorted(ext, times - tau, side="right")
+    j1 = np.searchsorted(ext, times, side="left")
+    K = int(np.max(j1 - j0)) if times.size else 0
+    idx = j0[:, None] + np.arange(K)[None, :]
+    inside = idx < j1[:, None]
+    cut = np.where(inside, times[:, None] - ext[np.minimum(idx, ext.size - 1)], 0.0)
+    extra = [np.zeros((times.size, 1)), np.full((times.size, 1), tau)]
+    if breaks is not None and breaks.size:
+        extra.append(np.broadcast_to(breaks, (times.size, breaks.size)))
+    s = np.sort(np.concatenate([cut] + extra, axis=1), axis=1)
+    a, d = s[:, :-1], np.diff(s, axis=1)
+    keep = d > 1e-14 * max(tau, 1.0)
+    C = np.nonzero(keep)[0]
+    a, d = a[keep], d[keep]                                      # the pieces (k,)
+    S = a[:, None] + d[:, None] * gz[None, :]                    # (k, q)
+    W = d[:, None] * gw[None, :]
+    H = kernel(S.ravel()).reshape(S.shape + (n, n))              # (k, q, n, n)
+    mid = times[C] - (a + 0.5 * d)
+    i, _, cols = locate(mid)                                     # each piece in one interval
+    i2, z, _ = locate((times[C][:, None] - S).ravel())
+    B = basis.values(z).reshape(S.shape + (basis.m + 1,))        # (k, q, m + 1)
+    if pattern is None:
+        pattern = np.ones((n, n), bool)
+    ia, ib = np.nonzero(pattern)
+    val = np.einsum("kq,kqe,kqj->kej", W, H[:, :, ia, ib], B)   # (k, entries, m + 1)
+    r = np.broadcast_to((C[:, None] * n + ia[None, :])[:, :, None], val.shape)
+    cc = cols[:, None, :] * n + ib[None, :, None]
+    G = sp.csr_matrix((val.ravel(), (r.ravel(), np.broadcast_to(cc, val.shape).ravel())),
+                      shape=(times.size * n, rows * n))
+    dT = None
+    if slope_of is not None:
+        mesh = np.asarray(mesh_points, dtype=float)
+        Bd = basis.derivatives(z).reshape(S.shape + (basis.m + 1,))
+        h = np.diff(mesh)[i2 % (mesh.size - 1)].reshape(S.shape)
+        Ud = np.einsum("kqj,kjb->kqb", Bd / h[:, :, None], slope_of[cols])   # u'(t - s)
+        contrib = np.einsum("kq,kqab,kqb->ka", W * S, H, Ud) / T
+        dT = np.zeros((times.size, n))
+        np.add.at(dT, C, contrib)
+    del i
+    return G, dT
+
+
+def point_matrix(times: np.ndarray, locate: Locator, basis: Basis, mesh: np.ndarray, n: int,
+                 rows: int, derivative: bool = False) -> sp.csr_matrix:
+    """The sparse matrix E (len(times) n, rows n) of u(t_c) (or u'(t_c), d/dt, with
+    ``derivative``) from the node rows."""
+    i, z, cols = locate(np.asarray(times, dtype=float))
+    if derivative:
+        B = basis.derivatives(z) / (mesh[i + 1] - mesh[i])[:, None]
+    else:
+        B = basis.values(z)
+    P = len(times)
+    val = np.broadcast_to(B[:, None, :], (P, n, basis.m + 1))
+    r = np.broadcast_to((np.arange(P)[:, None, None] * n + np.arange(n)[None, :, None]),
+                        val.shape)
+    cc = cols[:, None, :] * n + np.arange(n)[None, :, None]
+    return sp.csr_matrix((val.ravel(), (r.ravel(), cc.ravel())), shape=(P * n, rows * n))
+
+
+def equidistribute(mesh: np.ndarray, indicator: np.ndarray, L: int) -> np.ndarray:
+    """A mesh of L intervals over [mesh[0], mesh[-1]] on which the piecewise constant density
+    ``indicator`` (per interval of ``mesh``, >= 0) has equal integrals (as AUTO and COLSYS), a
+    floor of 1 % of its mean keeping quiet stretches meshed."""
+    h = np.diff(mesh)
+    d = np.maximum(indicator, 1e-2 * max(float(np.sum(indicator * h) / np.sum(h)), 1e-300))
+    cum = np.concatenate([[0.0], np.cumsum(d * h)])
+    target = np.linspace(0.0, cum[-1], L + 1)
+    new = np.interp(target, cum, mesh)
+    new[0], new[-1] = mesh[0], mesh[-1]
+    return new
