@@ -730,7 +730,7 @@ class Solver:
             _L.dmi_free(ctypes.byref(self._handle))
             self._handle = None
 
-    def set_quadrature(self, rule: str) -> None:
+    def set_quadrature(self, rule: str, singularity: float | None = None) -> None:
         """Sets the quadrature rule of the delay integral, before :meth:`init`
         (``dmi_set_quadrature``).  Every convolution method computes the same sum.
 
@@ -741,15 +741,23 @@ class Solver:
             cell weights, the integral of H over each cell (closed form for
             :meth:`set_kernel_exp`, tanh-sinh quadrature for a callback, which is then called
             inside the cells, never at s = 0: kernels singular at 0 such as s^-1/2 run).
+        singularity : float, optional
+            The exponent alpha, 0 <= alpha < 1, of the kernel's singularity H ~ s^-alpha g(s) at
+            0 (of a callback kernel's first cell, and of the near kernel of
+            :meth:`set_kernel_near`); None (default): estimated from H close to 0
+            (``dmi_set_kernel_singularity``).
 
         Raises
         ------
         dmi.InvalidArgument
-            Code ``dmi.EINVAL``: another rule; code ``dmi.ESTATE``: after :meth:`init`.
+            Code ``dmi.EINVAL``: another rule, or ``singularity`` outside [0, 1); code
+            ``dmi.ESTATE``: after :meth:`init`.
         """
         code = _choice(_lib.QUAD, rule, "set_quadrature: rule")
+        alpha = math.nan if singularity is None else float(singularity)
         with self._using() as s:
             self._check(_L.dmi_set_quadrature(s, code))
+            self._check(_L.dmi_set_kernel_singularity(s, alpha))
 
     def set_kernel_near(self, H: Callback | None, delta: float, user: Any = None) -> None:
         """Sets the exact kernel of the cells below ``delta``, whose weights become H's exact cell
