@@ -53,7 +53,7 @@ static int quad_fail(const dmi_solver *s, const dmi_quad_report *r, int near, si
     case DMI_QUAD_ENOTPOWER:
         return dmi_fail(s, DMI_EINVAL, "dmi_init: cell %zu = [0, %.17g]: %s entry (%zu, %zu) is "
                                        "not s^-alpha g(s) with g smooth, g(0) != 0 near s = 0: "
-                                       "its local exponent runs from %.9g to %.9g between s = "
+                                       "its local exponent runs from %.12g to %.12g between s = "
                                        "%.3g and %.3g, so the part below them is unknown "
                                        "(estimate %.17g, error %.3g); 1/(s ln^2 s) looks so "
                                        "and no sampling tells it from 1/s; if H is a power law, "

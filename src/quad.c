@@ -52,7 +52,7 @@
 #define MAX_DEPTH 60     /* halvings of a piece */
 #define MAX_CALLS 200000 /* calls of f in one integration */
 #define SLOPE_TOL 1e-10  /* local exponents of a power law agree to this */
-#define SCALE_STEP 60    /* a value beyond 2^60 in scaled units rescales its sums */
+#define TAIL_TOL 1e-11   /* the part below s_min known to this share of the integral of |f| */
 
 /* ---- exponential kernels ------------------------------------------------- */
 
@@ -180,11 +180,11 @@ static double *blk(const ctx *c, int k)
 }
 
 /* v (finite, not 0) in q's scaled units; the sums of q rescaled first when
- * it would be beyond 2^SCALE_STEP there. */
+ * it would be beyond 2^60 there. */
 static double scaled(ctx *c, size_t q, double v)
 {
     double y = v * c->mul[q];
-    if (fabs(y) > 0x1p60) {
+    if (fabs(y) > 0x1p60) { /* (a bound far from overflow, far above every weight) */
         const int e = ilogb(v);
         const double factor = ldexp(1.0, (int)c->ex[q] - e);
         for (int k = 0; k < S_COUNT; k++)
@@ -469,7 +469,7 @@ int dmi_quad_integrate(const dmi_quad_nodes *t, dmi_quad_fn f, void *user, size_
         }
     }
     for (size_t q = 0; q < nn; q++) {
-        if (unc[q] > DMI_QUAD_REL_TOL * (tabs[q] + fabs(tot[q]))) {
+        if (unc[q] > TAIL_TOL * (tabs[q] + fabs(tot[q]))) {
             rep->entry = q;
             rep->alpha_lo = c.sig[q];
             rep->alpha_hi = c.sig[nn + q];

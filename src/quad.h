@@ -95,7 +95,8 @@ size_t dmi_quad_scratch(size_t nn);
  * the variable x with s = hi x^{1/(1 - alpha)} (smooth in x), and the part
  * below s_min added as s_min f(s_min) / (1 - alpha).  An entry whose
  * exponent is >= DMI_QUAD_ALPHA_MAX is refused (ENOTINTEGRABLE), one whose
- * local exponents disagree (1 / (s ln^2 s), which no sampling tells from
+ * local exponents disagree so that the part below s_min is not known to
+ * 1e-11 of the integral of |f| (1 / (s ln^2 s), which no sampling tells from
  * 1 / s) too (ENOTPOWER).
  *
  * scratch: dmi_quad_scratch(nn) doubles.  Returns rep->status; rep filled.
