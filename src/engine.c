@@ -187,7 +187,7 @@ static const double *sum_full(const dmi_solver *s, double *W)
 
 /* Every method: its full sum, then the last cell's change (theta = 1
  * leaves the full sum's bits alone). */
-const double *dmi_engine_sum(const dmi_solver *s, double *W)
+const double *dmi_engine_sum_other(const dmi_solver *s, double *W)
 {
     const double *full = sum_full(s, W);
     if (s->theta == 1)
@@ -201,12 +201,9 @@ const double *dmi_engine_sum(const dmi_solver *s, double *W)
     return W;
 }
 
-void dmi_engine_advance(dmi_solver *s)
+void dmi_engine_advance_fft(dmi_solver *s)
 {
-    if (s->conv)
-        fft_advance(s->conv, &s->kernel, &s->ring, s->p);
-    if (s->rec)
-        dmi_exp_advance(s->rec, &s->ring, s->p);
+    fft_advance(s->conv, &s->kernel, &s->ring, s->p);
 }
 
 /* ---- memory (core.h) ---------------------------------------------------------- */

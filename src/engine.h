@@ -32,11 +32,30 @@ void dmi_engine_free(dmi_conv *conv, dmi_exp *rec);
 /* Recomputes the engines (either may be NULL) for s's step p from the ring. */
 void dmi_engine_rebuild(const dmi_solver *s, dmi_conv *conv, dmi_exp *rec);
 
+/* dmi_engine_sum but for the recursion alone (full cells, no near cells). */
+const double *dmi_engine_sum_other(const dmi_solver *s, double *W);
+
 /* W^p of s's engines, the last cell weighted theta h: the recursion's own
- * array (valid until the engine moves on), or W (n values) filled. */
-const double *dmi_engine_sum(const dmi_solver *s, double *W);
+ * array (valid until the engine moves on), or W (n values) filled.  (The
+ * recursion alone inline: the step's common case pays no call for the
+ * dispatch.) */
+static inline const double *dmi_engine_sum(const dmi_solver *s, double *W)
+{
+    if (s->rec && !s->near.nnz && s->theta == 1)
+        return dmi_exp_sum(s->rec);
+    return dmi_engine_sum_other(s, W);
+}
+
+/* The FFT engine's part of dmi_engine_advance. */
+void dmi_engine_advance_fft(dmi_solver *s);
 
 /* After a step was committed (U^p pushed, p counted). */
-void dmi_engine_advance(dmi_solver *s);
+static inline void dmi_engine_advance(dmi_solver *s)
+{
+    if (s->rec)
+        dmi_exp_advance(s->rec, &s->ring, s->p);
+    else if (s->conv)
+        dmi_engine_advance_fft(s);
+}
 
 #endif
