@@ -380,7 +380,7 @@ static int singular_start(ctx *c, double hint, double *x0, double *x1)
     }
     c->rep->alpha = top;
     c->a = a;
-    if (top > 0) {
+    if (top > 0 && 1 / (1 - top) != 1) { /* (an exponent within rounding of 0: s itself) */
         c->p = 1 / (1 - top);
         *x0 = exp2(-(double)E0 / c->p);
         *x1 = 1;

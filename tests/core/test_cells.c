@@ -3,7 +3,7 @@
  * promise for hard kernels, against closed forms written here:
  * - H = s^-alpha (1 + s), alpha up to 0.99 (tau = 1, N = 8): the cells'
  *   weights within 1e-10 of int = [s^{1-a}/(1-a) + s^{2-a}/(2-a)] (relative),
- *   and as the near kernel of an exponential sum;
+ *   and as the near kernel of an exponential sum; alpha = 1e-17 too;
  * - 1/s, s^-1.5 and 1/(s ln^2 s) refused by dmi_init (DMI_EINVAL) with a
  *   message naming cell 0, for both; the solver unchanged;
  * - a jump inside a cell (H = 1 on [0, 0.3)): W = 0.3 within 1e-10;
@@ -103,6 +103,17 @@ static void test_power_cells(void)
         snprintf(what, sizeof what, "W^0 of s^-%g (1 + s), exponent given", alpha);
         CU_ASSERT(core_close_rel(what, W, power_integral(alpha, 1.0), 1e-10));
     }
+}
+
+/* An exponent within rounding of 0 (s^-1e-17: its local exponents are 1e-17
+ * give or take 4e-18): integrated as a bounded kernel. */
+static void test_exponent_near_zero(void)
+{
+    double alpha = 1e-17;
+    int rc;
+    double W = first_W(power_kernel, &alpha, one, 1.0, 8, NAN, &rc, NULL);
+    CU_ASSERT_EQUAL(rc, DMI_OK);
+    CU_ASSERT(core_close_rel("W^0 of s^-1e-17 (1 + s)", W, 1.5, 1e-12));
 }
 
 /* e^{-s} as a sum; near cells below delta = 0.2 (2 of 8 cells) with the
@@ -347,6 +358,7 @@ int main(int argc, char **argv)
     static const core_test tests[] = {
         {"s^-alpha (1 + s) to 1e-10, alpha up to 0.99", test_power_cells},
         {"near cells of s^-alpha (1 + s) to 1e-10", test_power_near_cells},
+        {"an exponent within rounding of 0", test_exponent_near_zero},
         {"1/s, s^-1.5, 1/(s ln^2 s) refused naming cell 0", test_not_integrable_refused},
         {"a refused kernel leaves the solver as it was", test_refusal_leaves_solver},
         {"a jump inside a cell to 1e-10", test_jump_in_cell},
