@@ -32,7 +32,7 @@
 #include "fmi3FunctionTypes.h"
 #include "fmu_loader.h"
 #include "model.h"  /* VR_N, VR_tau */
-#include "solver.h" /* libdmi's core: dmi_advance_watch, the FMU's count of its indicators */
+#include "core.h" /* libdmi's core: dmi_advance_watch, the FMU's count of its indicators */
 
 #ifndef DMI_FMU_BINARY
 #define DMI_FMU_BINARY "DelayFrictionOscillator.so"

@@ -5,7 +5,7 @@
 #include "framework.h"
 
 #include "bytes.h"  /* libdmi's: FNV-1a, values at a byte offset */
-#include "solver.h" /* libdmi's: dmi_watch, the resolvent's hold step by step */
+#include "core.h"   /* libdmi's: dmi_watch (the resolvent's hold step by step), dmi_core_bytes */
 
 #include <math.h>
 #include <stdarg.h>
@@ -188,15 +188,33 @@ static size_t steps_per_tau(const dmi_fmu_values *v)
     return (size_t)v->value[MODEL->N];
 }
 
-/* The bytes the solver of N cells allocates: the model's figures, or the
- * bound of a dense kernel (the history ring, 2 (N + 1) n doubles; n^2 N
- * kernel samples kept, the same again while sampling). */
-static void solver_bytes(const dmi_fmu_values *v, size_t N_cells, double *peak, double *kept)
+/* The bytes the solver of N cells of h allocates: the model's figures, or
+ * libdmi's (dmi_core_bytes) for the solver s as configured; without one (its
+ * history did not fit), for a solver of one cell configured alike; failing
+ * that, the bound of a dense kernel (the history ring, 2 (N + 1) n doubles;
+ * n^2 N kernel samples kept, the same again while sampling). */
+static void solver_bytes(const dmi_fmu_values *v, const dmi_solver *s, size_t N_cells, double h,
+                         double *peak, double *kept)
 {
     if (MODEL->bytes) {
         MODEL->bytes(v, peak, kept);
         return;
     }
+    const double tau = v->value[MODEL->tau];
+    if (!(h > 0))
+        h = tau / (double)N_cells;
+    if (s) {
+        dmi_core_bytes(s, N_cells, h, peak, kept);
+        return;
+    }
+    dmi_solver *one = NULL;
+    char msg[FMU_ERRLEN] = "";
+    if (dmi_create(&one, MODEL->n, tau, 1) == DMI_OK && MODEL->configure(v, one, msg) == 0) {
+        dmi_core_bytes(one, N_cells, h, peak, kept);
+        dmi_free(&one);
+        return;
+    }
+    dmi_free(&one);
     const double n = (double)MODEL->n, N = (double)N_cells, d = sizeof(double);
     const double ring = 2 * (N + 1) * n * d, samples = n * n * N * d;
     *kept = ring + samples;
@@ -215,10 +233,11 @@ static void name_N(size_t N, double h, char *out, size_t size)
 
 /* "N = .. steps per tau: <bytes> while initialising, <bytes> after" into out
  * (size bytes; cut to fit) for the solver's N and h (name_N). */
-static void describe_bytes(const dmi_fmu_values *v, size_t N, double h, char *out, size_t size)
+static void describe_bytes(const dmi_fmu_values *v, const dmi_solver *s, size_t N, double h,
+                           char *out, size_t size)
 {
     double kept, peak;
-    solver_bytes(v, N, &peak, &kept);
+    solver_bytes(v, s, N, h, &peak, &kept);
     char what[96];
     name_N(N, h, what, sizeof what);
     snprintf(out, size, "%s %s: the solver allocates %.0f bytes (%.3g GB) "
@@ -229,11 +248,12 @@ static void describe_bytes(const dmi_fmu_values *v, size_t N, double h, char *ou
 
 /* Out of memory in a solver of N cells of h (describe_bytes): the error
  * names N and the bytes needed. */
-static int memory_fail(char *err, const char *what, const dmi_fmu_values *v, size_t N, double h)
+static int memory_fail(char *err, const char *what, const dmi_fmu_values *v, const dmi_solver *s,
+                       size_t N, double h)
 {
     int len = snprintf(err, FMU_ERRLEN, "%s: out of memory: ", what);
     if (len >= 0 && len < FMU_ERRLEN)
-        describe_bytes(v, N, h, err + len, (size_t)(FMU_ERRLEN - len));
+        describe_bytes(v, s, N, h, err + len, (size_t)(FMU_ERRLEN - len));
     return -1;
 }
 
@@ -267,14 +287,15 @@ static int solver_create(const dmi_fmu_values *v, dmi_solver **out, char *err)
     } else {
         rc = dmi_create(out, MODEL->n, tau, steps_per_tau(v));
         if (rc == DMI_ENOMEM) /* N is the parameter: no solver to ask */
-            return memory_fail(err, "creating the solver", v, steps_per_tau(v), 0.0);
+            return memory_fail(err, "creating the solver", v, NULL, steps_per_tau(v), 0.0);
         if (rc != DMI_OK)
             return solver_fail(err, "creating the solver (tau, N)", NULL, rc);
     }
     char msg[FMU_ERRLEN] = "";
     if ((rc = MODEL->configure(v, *out, msg)) != 0) {
         if (rc == DMI_ENOMEM)
-            memory_fail(err, "configuring the solver", v, dmi_get_N(*out), dmi_get_h(*out));
+            memory_fail(err, "configuring the solver", v, *out, dmi_get_N(*out),
+                        dmi_get_h(*out));
         else { /* the model's message after the prefix, cut to fit */
             const char *why = msg[0] ? msg : dmi_last_error(*out);
             size_t len = strlen(strcpy(err, "configuring the solver: "));
@@ -293,7 +314,7 @@ static int solver_init(const dmi_fmu_values *v, dmi_solver *s, char *err)
 {
     int rc = dmi_init(s);
     if (rc == DMI_ENOMEM)
-        return memory_fail(err, "initialising the solver", v, dmi_get_N(s), dmi_get_h(s));
+        return memory_fail(err, "initialising the solver", v, s, dmi_get_N(s), dmi_get_h(s));
     return rc == DMI_OK ? 0 : solver_fail(err, "initialising the solver", s, rc);
 }
 
@@ -371,9 +392,9 @@ int fmu_model_start(fmu_model *m, double t_start, char *err, char *note)
     if (solver_create(m->v, &s, err) != 0) /* allocates the ring only */
         return -1;
     double kept, peak; /* for libdmi's N, before dmi_init allocates the rest */
-    solver_bytes(m->v, dmi_get_N(s), &peak, &kept);
+    solver_bytes(m->v, s, dmi_get_N(s), dmi_get_h(s), &peak, &kept);
     if (peak > FMU_NOTE_BYTES)
-        describe_bytes(m->v, dmi_get_N(s), dmi_get_h(s), note, FMU_ERRLEN);
+        describe_bytes(m->v, s, dmi_get_N(s), dmi_get_h(s), note, FMU_ERRLEN);
     if (solver_init(m->v, s, err) != 0) {
         dmi_free(&s);
         return -1;

@@ -155,43 +155,6 @@ static int check_coarse_step(const dmi_fmu_values *m, double T, char *msg)
     return 1;
 }
 
-/* Whether libdmi's default method for the kernel is the recursion
- * (dmi_set_convolution: no growing term, every |b_k| h <= pi). */
-static int recursion(const dmi_fmu_values *m)
-{
-    const double *r = m->value, h = r[VR_tau] / r[VR_N];
-    const double freq[5] = {0.0, 0.0, r[VR_H_omega1], r[VR_H_omega2], r[VR_H_omega3]};
-    int used = 0;
-    for (size_t k = 0; k < 5; k++)
-        if (r[KERNEL_COEF[k]] != 0) {
-            used = 1;
-            if ((k == 1 && r[VR_H_lambda] < 0) || fabs(freq[k]) * h > 3.14159265358979323846)
-                return 0;
-        }
-    return used;
-}
-
-/* The bytes libdmi allocates for the model's solver, from its layout
- * (src/delay.h, src/exp.h, dmi_create and dmi_init in src/dmi.c): n = 2
- * components, N steps per tau, nnz nonzero kernel entries (H(s) acts on w
- * in the v equation: 1, or 0 without a kernel), K exponential terms.
- * After initialisation (kept): the history ring, 2 (N + 1) n doubles (the
- * series and its mirror), the kernel samples, nnz N doubles, except under
- * the recursion, which takes none, and the recursion's sums, one complex
- * sum per term and column used: 2 K doubles.  While dmi_init runs (peak):
- * dmi_create's ring and dmi_init's new ring, and when it samples the
- * kernel the dense samples, N n^2 doubles, and the kept samples. */
-static void solver_bytes(const dmi_fmu_values *m, double *peak, double *kept)
-{
-    const double n = 2, N = m->value[VR_N], d = sizeof(double);
-    double K = 0;
-    for (size_t k = 0; k < 5; k++)
-        K += m->value[KERNEL_COEF[k]] != 0;
-    const double nnz = K > 0 && !recursion(m), ring = 2 * (N + 1) * n * d, samples = nnz * N * d;
-    *kept = ring + samples + 2 * K * d;
-    *peak = 2 * ring + nnz * N * n * n * d + samples;
-}
-
 const dmi_fmu_model DMI_FMU_MODEL = {
     .description = "w'' + b w + int_0^tau H(s) w(t-s) ds + alpha sigma(w') + g(t) contains 0, "
                    "implicit Euler scheme with h = tau/N",
@@ -206,7 +169,6 @@ const dmi_fmu_model DMI_FMU_MODEL = {
     .outputs = outputs,
     .accept = accept,
     .check = check_coarse_step,
-    .bytes = solver_bytes,
     .author = "the dmi authors",
     .nindicators = 1,
     .held = HELD,

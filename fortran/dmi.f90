@@ -29,7 +29,7 @@ module dmi
 
   ! Version of this binding (the same as the C header it mirrors).
   integer(c_int), parameter, public :: DMI_VERSION_MAJOR = 1
-  integer(c_int), parameter, public :: DMI_VERSION_MINOR = 3
+  integer(c_int), parameter, public :: DMI_VERSION_MINOR = 4
   integer(c_int), parameter, public :: DMI_VERSION_PATCH = 0
 
   ! Error codes.
@@ -53,7 +53,7 @@ module dmi
   public :: dmi_version, dmi_create, dmi_create_h, dmi_free
   public :: dmi_set_rhs, dmi_set_resolvent, dmi_set_friction, dmi_set_box
   public :: dmi_set_kernel, dmi_set_kernel_exp, dmi_set_history, dmi_set_convolution
-  public :: dmi_set_quadrature, dmi_set_kernel_near
+  public :: dmi_set_quadrature, dmi_set_kernel_near, dmi_set_kernel_singularity
   public :: dmi_init, dmi_step, dmi_advance
   public :: dmi_time, dmi_get_step_index, dmi_get_h, dmi_get_N, dmi_get_state, dmi_get_past
   public :: dmi_get_step_terms, dmi_get_window, dmi_set_window
@@ -202,6 +202,16 @@ module dmi
       real(c_double), value :: delta
       integer(c_int) :: rc
     end function dmi_set_kernel_near
+    ! (since 1.4) the exponent alpha (0 <= alpha < 1) of the kernel's singularity
+    ! s^-alpha at 0 for the cell rule and the near cells, or NaN (the default) to
+    ! estimate it; before dmi_init.
+    function dmi_set_kernel_singularity(s, alpha) result(rc) &
+        bind(C, name='dmi_set_kernel_singularity')
+      import :: c_int, c_ptr, c_double
+      type(c_ptr), value :: s
+      real(c_double), value :: alpha
+      integer(c_int) :: rc
+    end function dmi_set_kernel_singularity
     function dmi_set_convolution(s, method) result(rc) bind(C, name='dmi_set_convolution')
       import :: c_int, c_ptr
       type(c_ptr), value :: s

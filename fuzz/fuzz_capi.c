@@ -1,7 +1,10 @@
 /*
  * libFuzzer target: the C API's create / set / init / step / save / load
  * sequence driven by the fuzzer's bytes (kernels as callbacks or as
- * exponential terms, dmi_set_kernel_exp, every method).  The sizes, tau, every setter's
+ * exponential terms, dmi_set_kernel_exp, every method; the cell rule, near
+ * cells and the exponent of dmi_set_kernel_singularity with extreme kernels:
+ * powers s^-alpha up to and beyond 1, jumps inside cells, huge, infinite or
+ * NaN scales, 1/(s ln^2 s), failures close to 0).  The sizes, tau, every setter's
  * arguments (raw doubles included: NaN, Inf, subnormals), the callbacks'
  * misbehaviour (fail, NaN, +-Inf, huge values) and the order of calls come
  * from the input.  Besides the sanitizers, it aborts on a broken contract:
@@ -51,6 +54,40 @@ static double value(input *in)
     if (k < 200)
         return tame[k % (sizeof tame / sizeof tame[0])];
     return raw_double(in);
+}
+
+/* An extreme kernel (every entry alike): c s^-alpha, c on [0, jump) and 0
+ * beyond, c / (s ln^2 s), or c s^-alpha failing below s = 1e-30. */
+typedef struct {
+    size_t nn;
+    int kind;
+    double c, alpha, jump;
+} extreme;
+
+static int extreme_kernel(double s, double *out, void *user)
+{
+    const extreme *e = user;
+    double v;
+    switch (e->kind) {
+    case 0:
+        v = e->c * pow(s, -e->alpha);
+        break;
+    case 1:
+        v = s < e->jump ? e->c : 0.0;
+        break;
+    case 2: {
+        const double l = log(s);
+        v = e->c / (s * l * l);
+        break;
+    }
+    default:
+        if (s < 1e-30)
+            return 5;
+        v = e->c * pow(s, -e->alpha);
+    }
+    for (size_t q = 0; q < e->nn; q++)
+        out[q] = v;
+    return 0;
 }
 
 static void must(int ok)
@@ -112,13 +149,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     N = dmi_get_N(s);
     double *u = calloc(2 * n, sizeof *u);
     must(u != NULL);
+    extreme ek = {n * n, 0, 1.0, 0.5, 0.3};
     for (int ops = 0; ops < 64 && in.left; ops++) {
         uint8_t op = byte(&in);
         size_t ssize;
         uint64_t p;
         unsigned char *before = snapshot(s, &ssize, &p);
         int stateful = 0; /* whether a failure must leave the state unchanged */
-        switch (op % 16) {
+        switch (op % 20) {
         case 0:
             rc = dmi_set_rhs(s, n == MODEL_n && byte(&in) % 4 ? model_rhs : NULL, &m);
             break;
@@ -229,6 +267,28 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             rc = DMI_OK;
             break;
         }
+        case 16: /* (libdmi 1.3) the rule: left, cell, or unknown */
+            rc = dmi_set_quadrature(s, (int)(byte(&in) % 4) - 1);
+            break;
+        case 17: /* an extreme kernel (its parameters also seen by near cells) */
+        case 18: {
+            ek.kind = byte(&in) % 4;
+            const uint8_t scale = byte(&in);
+            ek.c = scale < 128 ? 1.0 : scale < 192 ? 1e307 : value(&in);
+            ek.alpha = byte(&in) / 200.0; /* 0 .. 1.275: integrable or not */
+            ek.jump = tau * byte(&in) / 255.0;
+            if (op % 20 == 17)
+                rc = dmi_set_kernel(s, byte(&in) % 8 ? extreme_kernel : NULL, &ek);
+            else /* (libdmi 1.3) near cells below delta */
+                rc = dmi_set_kernel_near(s, byte(&in) % 8 ? extreme_kernel : NULL, &ek,
+                                         byte(&in) < 200 ? tau * byte(&in) / 255.0 : value(&in));
+            break;
+        }
+        case 19: /* (libdmi 1.4) the exponent at 0: in [0, 1), NaN, or anything */
+            rc = dmi_set_kernel_singularity(s, byte(&in) < 128 ? byte(&in) / 256.0
+                                                                : byte(&in) < 64 ? NAN
+                                                                                 : value(&in));
+            break;
         }
         check_code(s, rc);
         if (stateful && rc != DMI_OK)

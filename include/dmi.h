@@ -50,7 +50,7 @@ extern "C" {
 /** Major version of this header; dmi_version() gives the version of the library. */
 #define DMI_VERSION_MAJOR 1
 /** Minor version of this header. */
-#define DMI_VERSION_MINOR 3
+#define DMI_VERSION_MINOR 4
 /** Patch version of this header. */
 #define DMI_VERSION_PATCH 0
 
@@ -257,11 +257,29 @@ DMI_API int dmi_set_kernel_exp(dmi_solver *s, size_t K, const double *a, const d
  *                  h Re((C - i D) phi1(mu h) e^{mu l h}), phi1(z) = (e^z - 1)/z
  *                  (the partial last cell: theta h and phi1(mu theta h)); the
  *                  recursion runs the same weights at the same cost.  Callback
- *                  kernels by tanh-sinh quadrature on each cell (the step
- *                  halved until two levels agree to 1e-14 of the cell's
- *                  integral of |H|, at most 8193 calls a cell; typically 30 to
- *                  70 calls for a smooth kernel), by dmi_init, which then calls
- *                  H at points inside the cells (0 < s < tau), not at l h.
+ *                  kernels by tanh-sinh quadrature on each cell (since 1.4:
+ *                  the nodes computed once per dmi_init; the step halved
+ *                  until two levels agree, with the rule's truncation, to
+ *                  1e-13 of the cell's integral of |H|, else the cell
+ *                  bisected, a jump so located; typically 30 to 130 calls for
+ *                  a smooth kernel), by dmi_init, which then calls H only
+ *                  strictly inside the cells: 0 < s < tau, never at l h.
+ *                  (Since 1.4.)  What is promised: each cell's weight within
+ *                  1e-10 of its integral (relative), for H smooth within
+ *                  cells or with jumps, and in the first cell for
+ *                  H(s) = s^-alpha g(s) with alpha < 1, g smooth and
+ *                  g(0) != 0, entry by entry: alpha is given by
+ *                  dmi_set_kernel_singularity or estimated from H at
+ *                  s = h 2^-960 .. h 2^-720 (where H must be computable),
+ *                  and the part below those points is added in closed form.
+ *                  What is refused, by dmi_init with DMI_EINVAL and a message
+ *                  naming the cell and entry: an exponent >= 1 (1/s is not
+ *                  integrable); a singularity that is no such power law
+ *                  (1/(s ln^2 s): no sampling tells it from 1/s); a cell whose
+ *                  integral does not converge (the estimate reached is in the
+ *                  message).  A cell integral beyond the largest double:
+ *                  DMI_ENONFINITE.  The sums are scaled, so kernels up to the
+ *                  largest double are integrated.
  *                  Every method (DIRECT, FFT, RECURSIVE) computes this same
  *                  sum (up to rounding).  The error of the rule is that of the
  *                  product U(t - s) ~ U^{p-l} on the cell, order 1 in h, as the
@@ -289,10 +307,31 @@ DMI_API int dmi_set_quadrature(dmi_solver *s, int rule);
  * Errors: DMI_EINVAL for s NULL or delta negative or not finite; from
  * dmi_init, DMI_EINVAL when the kernel is not one of dmi_set_kernel_exp or
  * when m + 1 > N (the last cell must be the sum's), and the kernel
- * callback's errors (DMI_ECALLBACK, DMI_ENONFINITE); DMI_ESTATE after
- * dmi_init.
+ * callback's errors (DMI_ECALLBACK, DMI_ENONFINITE) and the refusals of
+ * DMI_QUAD_CELL (an exponent at 0 >= 1, a singularity that is no power law,
+ * a cell that does not converge: DMI_EINVAL with the cell in the message);
+ * DMI_ESTATE after dmi_init.  (Since 1.4: H's singularity at 0 is handled
+ * as for DMI_QUAD_CELL, its exponent given by dmi_set_kernel_singularity or
+ * estimated.)
  */
 DMI_API int dmi_set_kernel_near(dmi_solver *s, dmi_kernel_fn H, void *user, double delta);
+
+/**
+ * (Since 1.4.)  The exponent alpha of the kernel's singularity at 0,
+ * H(s) = s^-alpha g(s) near s = 0 with g smooth and g(0) != 0 (alpha
+ * dimensionless, 0 <= alpha < 1), for the first cell's integral under
+ * DMI_QUAD_CELL (of the kernel of dmi_set_kernel) and of the near kernel
+ * (dmi_set_kernel_near).  Without it (alpha = NAN, the default) dmi_init
+ * estimates alpha entry by entry from H at s = h 2^-960 .. h 2^-720 and
+ * refuses a kernel whose local exponents there disagree; with it, the
+ * exponent is taken as given for every entry (an entry that is not singular
+ * loses nothing: the part below h 2^-960 is below 1e-280 of its integral)
+ * and no consistency is checked: a wrong alpha gives a wrong first cell.
+ * Not part of the saved state.  Errors: DMI_EINVAL for s NULL or alpha
+ * outside [0, 1) and not NAN (the message says why); DMI_ESTATE after
+ * dmi_init.
+ */
+DMI_API int dmi_set_kernel_singularity(dmi_solver *s, double alpha);
 
 /** History z(t) on [-tau, 0]; z = NULL restores z = 0.  Sampled at t = p h,
  * p = -(N-1)..0, and at t = -tau for U^{-N} (= -N h for dmi_create, not for
@@ -371,6 +410,7 @@ DMI_API int dmi_set_convolution(dmi_solver *s, int method);
  * and a later dmi_set_convolution to another method samples it then; a
  * restart keeps the recursion's engine.
  * Errors: DMI_ECALLBACK / DMI_ENONFINITE (kernel or history callback),
+ * DMI_EINVAL (a kernel the cell rule refuses, see dmi_set_quadrature),
  * DMI_ENOMEM; the solver is then unchanged (still uninitialised, or still at
  * its former t_p if it had been initialised).
  */

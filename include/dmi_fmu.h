@@ -172,9 +172,11 @@ typedef int (*dmi_fmu_check_fn)(const dmi_fmu_values *v, double T, char *msg);
 
 /** Optional: the bytes the solver allocates while initialising (peak) and
  * keeps (kept), for the memory messages (logMemory when peak > 100 MB, and
- * the out-of-memory error).  Without it the framework uses the figures of a
- * dense kernel (every entry of H sampled): 2 (N + 1) n doubles of history
- * and n^2 N samples kept, twice that while initialising. */
+ * the out-of-memory error).  Without it the framework asks libdmi for the
+ * solver as the model configured it (its kernel, rule and method: the
+ * history ring, 2 (N + 1) n doubles, and the kernel's weights per cell
+ * unless the recursion runs alone, a callback kernel's counted for every
+ * entry); a model need not restate libdmi's layout. */
 typedef void (*dmi_fmu_bytes_fn)(const dmi_fmu_values *v, double *peak, double *kept);
 
 /**
@@ -243,8 +245,8 @@ typedef double (*dmi_fmu_step_fn)(const dmi_fmu_values *v);
  * tau and N (the value references of the delay, a Float64 parameter, and of
  * the steps per tau, an Int32 parameter); stop_time and step_size (the
  * default experiment, which starts at 0); configure and outputs (required);
- * accept, check and bytes (optional: NULL for none; without bytes, the
- * figures of a dense kernel); author (the model descriptions' author, NULL
+ * accept, check and bytes (optional: NULL for none; without bytes,
+ * libdmi's figures for the configured solver); author (the model descriptions' author, NULL
  * for none); nindicators and indicators (optional: 0 and NULL for none; see
  * dmi_fmu_indicators_fn); step (optional: NULL for h = tau / N; see
  * dmi_fmu_step_fn); held (optional, the last field: the built-in indicators

@@ -1,17 +1,20 @@
 /*
  * libdmi — the implicit Euler scheme (3.12)-(3.13) with a Volterra delay term:
- * the solver's life cycle and its step.  Its saved state is in state.c.
+ * the solver's life cycle, its setters and its step.  Its saved state is in
+ * state.c, the delay sum's engines in engine.c, the cell rule in cells.c
+ * (with quad.c's integration), the errors in errors.c.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include "solver.h"
 
-#include "quad.h"
+#include "cells.h"
+#include "core.h"
+#include "engine.h"
+#include "errors.h"
 
 #include "bytes.h"
 
 #include <math.h>
-#include <stdarg.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -20,223 +23,9 @@
 
 enum { A_NONE, A_CALLBACK, A_FRICTION, A_BOX }; /* s->a_kind */
 
-/* The message buffer is not part of the numerical state: const functions may
- * write it (every solver is allocated by dmi_create, never const-defined). */
-int dmi_fail(const dmi_solver *cs, int code, const char *fmt, ...)
-{
-    dmi_solver *s = (dmi_solver *)cs;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(s->err, sizeof s->err, fmt, ap);
-    va_end(ap);
-    return code;
-}
-
-size_t dmi_first_nonfinite(const double *x, size_t n)
-{
-    size_t i = 0;
-    while (i < n && isfinite(x[i]))
-        i++;
-    return i;
-}
-
-/* dmi_first_nonfinite for long arrays: blocks of 8 without a branch per
- * value (x * 0 is 0 for a finite x, NaN otherwise), the block with one then
- * searched value by value. */
-static size_t first_nonfinite_long(const double *x, size_t n)
-{
-    size_t i = 0;
-    for (; i + 8 <= n; i += 8) {
-        double z[2] = {0, 0};
-        for (size_t k = 0; k < 8; k += 2)
-            for (int c = 0; c < 2; c++)
-                z[c] += x[i + k + (size_t)c] * 0.0;
-        if (!(z[0] == 0 && z[1] == 0))
-            break;
-    }
-    return i + dmi_first_nonfinite(x + i, n - i);
-}
-
-/* ---- the delay sum's engine ------------------------------------------------
- * s->conv is the FFT engine, s->rec the recursion's; both NULL when the
- * direct sum is in use.  The FFT engine exists only when built with
- * DMI_HAVE_FFT (conv.c and GSL, as libdmi is); without it (the core alone:
- * the FMU's sources) the FFT method is refused. */
-
-/* The recursion's limit on |b_k| h: beyond pi the samples cos(b_k l h)
- * alias a frequency below pi / h, and r = exp(i b h) and the samples lose
- * accuracy as |b| h grows (measured: 1.8e-7 apart at b h = 1e9). */
-#define REC_MAX_BH 3.14159265358979323846
-
-/* Index of the first term of the exponential kernel that the recursion
- * refuses (C_k or D_k not zero, and growing, a_k > 0, or |b_k| h > pi), or
- * K; *aliased tells which. */
-static size_t first_unfit(const dmi_solver *s, int *aliased)
-{
-    const dmi_expk *x = &s->expk;
-    for (size_t k = 0; k < x->K; k++) {
-        *aliased = !(x->a[k] > 0);
-        if ((x->a[k] > 0 || fabs(x->b[k]) * s->h > REC_MAX_BH) && dmi_expk_term_used(x, k))
-            return k;
-    }
-    return x->K;
-}
-
-/* Whether method is allowed with s's kernel (DMI_EINVAL and a message if not). */
-static int check_method(const dmi_solver *s, int method, const char *fn)
-{
-    if (method != DMI_CONV_AUTO && method != DMI_CONV_DIRECT && method != DMI_CONV_FFT &&
-        method != DMI_CONV_RECURSIVE)
-        return dmi_fail(s, DMI_EINVAL, "%s: unknown method %d", fn, method);
-#ifndef DMI_HAVE_FFT
-    if (method == DMI_CONV_FFT)
-        return dmi_fail(s, DMI_EINVAL, "%s: DMI_CONV_FFT is not available, this libdmi was built "
-                                       "without the FFT (no DMI_HAVE_FFT)", fn);
-#endif
-    if (method != DMI_CONV_RECURSIVE)
-        return DMI_OK;
-    if (s->H && !dmi_has_expk(s))
-        return dmi_fail(s, DMI_EINVAL, "%s: method %d (DMI_CONV_RECURSIVE) needs a kernel given by "
-                                       "dmi_set_kernel_exp, not a callback", fn, method);
-    int aliased = 0;
-    size_t k = first_unfit(s, &aliased);
-    if (k == s->expk.K)
-        return DMI_OK;
-    if (aliased)
-        return dmi_fail(s, DMI_EINVAL, "%s: method %d (DMI_CONV_RECURSIVE) refuses the term "
-                                       "b[%zu] = %g: b h = %g is beyond [-pi, pi], where its "
-                                       "samples alias a frequency below pi / h and r = exp(i b h) "
-                                       "loses accuracy (use DIRECT or FFT, or a smaller h)",
-                        fn, method, k, s->expk.b[k], s->expk.b[k] * s->h);
-    return dmi_fail(s, DMI_EINVAL, "%s: method %d (DMI_CONV_RECURSIVE) refuses the growing "
-                                   "term a[%zu] = %g > 0: the recursion would multiply its "
-                                   "rounding errors by exp(a h) > 1 every step (use DIRECT or "
-                                   "FFT)", fn, method, k, s->expk.a[k]);
-}
-
-/* Whether method is the recursion (AUTO: for an exponential kernel it
- * takes, see first_unfit), which needs no kernel samples. */
-static int is_recursion(const dmi_solver *s, int method)
-{
-    int aliased;
-    return method == DMI_CONV_RECURSIVE ||
-           (method == DMI_CONV_AUTO && dmi_has_expk(s) && first_unfit(s, &aliased) == s->expk.K);
-}
-
-/* The engines that method asks for with kernel samples k (AUTO: the
- * recursion for an exponential kernel it takes). */
-static int engine_make(const dmi_solver *s, const dmi_kernel *k, int method, dmi_conv **conv,
-                       dmi_exp **rec, const char *fn)
-{
-    *conv = NULL;
-    *rec = NULL;
-    if (is_recursion(s, method)) {
-        const dmi_expk *x = s->quad == DMI_QUAD_CELL ? &s->cell_expk : &s->expk;
-        if (dmi_has_expk(s) && dmi_exp_create(rec, x, s->N, s->h) != 0)
-            return dmi_fail(s, DMI_ENOMEM, "%s: out of memory for the recursion's sums", fn);
-        return DMI_OK;
-    }
-#ifdef DMI_HAVE_FFT
-    if (dmi_conv_create(conv, k, s->n, s->N, method) != 0)
-        return dmi_fail(s, DMI_ENOMEM, "%s: out of memory for the FFT engine", fn);
-#else
-    (void)k;
-#endif
-    return DMI_OK;
-}
-
-static void engine_free(dmi_conv *conv, dmi_exp *rec)
-{
-#ifdef DMI_HAVE_FFT
-    dmi_conv_free(conv);
-#else
-    (void)conv;
-#endif
-    dmi_exp_free(rec);
-}
-
-/* Recomputes the engines for s's step p from the ring. */
-void dmi_engine_rebuild(const dmi_solver *s, dmi_conv *conv, dmi_exp *rec)
-{
-#ifdef DMI_HAVE_FFT
-    if (conv)
-        dmi_conv_rebuild(conv, &s->kernel, &s->ring, s->p);
-#else
-    (void)conv;
-#endif
-    if (rec)
-        dmi_exp_anchor(rec, &s->ring, s->p);
-}
-
-/* W^p with every cell's weight h: the recursion's own array (valid until
- * the engine moves on), or W filled. */
-static const double *delay_sum_full(const dmi_solver *s, double *W)
-{
-    if (s->rec && s->near.nnz) { /* the near cells' exact weights less the sum's */
-        memcpy(W, dmi_exp_sum(s->rec), s->n * sizeof *W);
-        dmi_quad_near_add(&s->near, &s->ring, s->h, W);
-        return W;
-    }
-    if (s->rec)
-        return dmi_exp_sum(s->rec);
-#ifdef DMI_HAVE_FFT
-    if (s->conv) {
-        dmi_conv_sum(s->conv, &s->kernel, &s->ring, s->p, s->h, W);
-        return W;
-    }
-#endif
-    dmi_delay_sum(&s->kernel, &s->ring, s->h, W);
-    return W;
-}
-
-/* W^p, the last cell weighted theta h (every method: its full sum, then the
- * last cell's change; theta = 1 leaves the full sum's bits alone). */
-static const double *delay_sum(const dmi_solver *s, double *W)
-{
-    const double *full = delay_sum_full(s, W);
-    if (s->theta == 1)
-        return full;
-    if (full != W)
-        memcpy(W, full, s->n * sizeof *W);
-    if (s->quad == DMI_QUAD_CELL)
-        dmi_quad_last(&s->kernel, &s->ring, s->cell_last, W);
-    else
-        dmi_delay_last(&s->kernel, &s->ring, (s->theta - 1) * s->h, W);
-    return W;
-}
-
-/* After a step was committed (U^p pushed, p counted). */
-static void engine_advance(dmi_solver *s)
-{
-#ifdef DMI_HAVE_FFT
-    if (s->conv)
-        dmi_conv_advance(s->conv, &s->kernel, &s->ring, s->p);
-#endif
-    if (s->rec)
-        dmi_exp_advance(s->rec, &s->ring, s->p);
-}
-
 const char *dmi_version(void)
 {
     return STR(DMI_VERSION_MAJOR) "." STR(DMI_VERSION_MINOR) "." STR(DMI_VERSION_PATCH);
-}
-
-const char *dmi_strerror(int code)
-{
-    switch (code) {
-    case DMI_OK: return "success";
-    case DMI_EINVAL: return "invalid argument";
-    case DMI_ENOMEM: return "out of memory";
-    case DMI_ECALLBACK: return "a callback reported failure";
-    case DMI_ENONFINITE: return "a non-finite value (NaN or infinity) appeared";
-    case DMI_ESTATE: return "call not allowed in the solver's current state";
-    default: return "unknown error code";
-    }
-}
-
-const char *dmi_last_error(const dmi_solver *s)
-{
-    return s ? s->err : "no solver (NULL handle)";
 }
 
 /* ---- life cycle ---------------------------------------------------------- */
@@ -259,6 +48,7 @@ static int create(dmi_solver **out, size_t n, double tau, size_t N, double h, do
     s->theta = theta;
     s->a_kind = A_NONE;
     s->conv_method = DMI_CONV_AUTO;
+    s->alpha = NAN;
     s->work = malloc(5 * n * sizeof(double));
     s->last_W = calloc(n, sizeof(double));
     s->last_X = calloc(n, sizeof(double));
@@ -318,7 +108,7 @@ void dmi_free(dmi_solver **ps)
     dmi_expk_release(&s->cell_expk);
     free(s->cell_last);
     dmi_kernel_release(&s->near);
-    engine_free(s->conv, s->rec);
+    dmi_engine_free(s->conv, s->rec);
     free(s->last_W);
     free(s->last_X);
     free(s->work);
@@ -487,6 +277,21 @@ int dmi_set_kernel_near(dmi_solver *s, dmi_kernel_fn H, void *user, double delta
     return DMI_OK;
 }
 
+int dmi_set_kernel_singularity(dmi_solver *s, double alpha)
+{
+    if (!s)
+        return DMI_EINVAL;
+    if (s->initialized)
+        return dmi_fail(s, DMI_ESTATE, "dmi_set_kernel_singularity: the kernel's weights are "
+                                       "computed by dmi_init and cannot change afterwards");
+    if (!isnan(alpha) && !(alpha >= 0 && alpha < 1))
+        return dmi_fail(s, DMI_EINVAL, "dmi_set_kernel_singularity: alpha = %g; expected 0 <= "
+                                       "alpha < 1 (s^-alpha is not integrable at 0 for alpha >= "
+                                       "1), or NAN to estimate it from the kernel", alpha);
+    s->alpha = alpha;
+    return DMI_OK;
+}
+
 int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user)
 {
     if (!s)
@@ -501,18 +306,11 @@ int dmi_set_history(dmi_solver *s, dmi_history_fn z, void *user)
 
 static int sample_kernel(dmi_solver *s, dmi_kernel *k, const char *fn);
 
-/* Whether method's engine needs the kernel's weights per cell: all but the recursion with full
- * cells, the paper's rule and no near cells (which runs on the exponential terms alone). */
-static int needs_samples(const dmi_solver *s, int method)
-{
-    return s->theta != 1 || !is_recursion(s, method) || s->quad == DMI_QUAD_CELL || s->near_H;
-}
-
 int dmi_set_convolution(dmi_solver *s, int method)
 {
     if (!s)
         return DMI_EINVAL;
-    int rc = check_method(s, method, "dmi_set_convolution");
+    int rc = dmi_engine_check_method(s, method, "dmi_set_convolution");
     if (rc != DMI_OK)
         return rc;
     if (s->initialized) { /* the engine follows the method from the next step on */
@@ -521,10 +319,10 @@ int dmi_set_convolution(dmi_solver *s, int method)
         dmi_kernel k = {0};
         /* dmi_init went without samples only under the paper's rule with full cells and no
          * near cells (needs_samples): the plain samples are then the weights */
-        const int sample = !s->kernel_sampled && needs_samples(s, method);
+        const int sample = !s->kernel_sampled && dmi_engine_needs_samples(s, method);
         if (sample && (rc = sample_kernel(s, &k, "dmi_set_convolution")) != DMI_OK)
             return rc;
-        rc = engine_make(s, sample ? &k : &s->kernel, method, &c, &e, "dmi_set_convolution");
+        rc = dmi_engine_make(s, sample ? &k : &s->kernel, method, &c, &e, "dmi_set_convolution");
         if (rc != DMI_OK) {
             dmi_kernel_release(&k);
             return rc;
@@ -535,7 +333,7 @@ int dmi_set_convolution(dmi_solver *s, int method)
             s->kernel_sampled = 1;
         }
         dmi_engine_rebuild(s, c, e);
-        engine_free(s->conv, s->rec);
+        dmi_engine_free(s->conv, s->rec);
         s->conv = c;
         s->rec = e;
     }
@@ -621,10 +419,10 @@ static int sample_history(dmi_solver *s, dmi_history *ring)
 }
 
 /* The cell rule's samples into k and its last-cell change into *last
- * (quad.c), and s->cell_expk, the kernel the recursion runs: a function of
+ * (cells.c), and s->cell_expk, the kernel the recursion runs: a function of
  * the exponential terms and h alone, so that setting it before dmi_init can
  * still fail changes no result. */
-static int quad_prepare(dmi_solver *s, dmi_kernel *k, double **last)
+static int quad_prepare(dmi_solver *s, dmi_quad_nodes *nodes, dmi_kernel *k, double **last)
 {
     if (dmi_has_expk(s)) { /* (an initialised solver gets the same values again) */
         dmi_expk x;
@@ -633,14 +431,14 @@ static int quad_prepare(dmi_solver *s, dmi_kernel *k, double **last)
         dmi_expk_release(&s->cell_expk);
         s->cell_expk = x;
     }
-    return dmi_quad_sample(s, k, last);
+    return dmi_cells_sample(s, nodes, k, last);
 }
 
 int dmi_init(dmi_solver *s)
 {
     if (!s)
         return DMI_EINVAL;
-    int rc = check_method(s, s->conv_method, "dmi_init"); /* the kernel may have changed */
+    int rc = dmi_engine_check_method(s, s->conv_method, "dmi_init"); /* the kernel may have changed */
     if (rc != DMI_OK)
         return rc;
     dmi_kernel k = {0};
@@ -651,28 +449,30 @@ int dmi_init(dmi_solver *s)
     dmi_exp *e = NULL;
     double *last = NULL;
     dmi_kernel near = {0};
+    dmi_quad_nodes nodes = {0}; /* the quadrature's, made once when a callback is integrated */
     if (s->near_H && !dmi_has_expk(s))
         rc = dmi_fail(s, DMI_EINVAL, "dmi_init: the near cells of dmi_set_kernel_near need a kernel "
                                      "given by dmi_set_kernel_exp");
     /* without samples where the method needs none: taken if another method is chosen later
      * (dmi_set_convolution) */
-    const int sample = needs_samples(s, s->conv_method);
+    const int sample = dmi_engine_needs_samples(s, s->conv_method);
     if (rc == DMI_OK && !sample)
         dmi_kernel_alloc(&k, s->n, s->N, NULL); /* none (allocates nothing) */
     else if (rc == DMI_OK)
-        rc = s->quad == DMI_QUAD_CELL ? quad_prepare(s, &k, &last)
+        rc = s->quad == DMI_QUAD_CELL ? quad_prepare(s, &nodes, &k, &last)
                                       : sample_kernel(s, &k, "dmi_init");
     if (rc == DMI_OK && s->near_H)
-        rc = dmi_quad_near(s, &k, &last, &near);
+        rc = dmi_cells_near(s, &nodes, &k, &last, &near);
+    dmi_quad_nodes_free(&nodes);
     if (rc == DMI_OK)
         rc = sample_history(s, &ring);
     /* a restart keeps the recursion's engine: it depends on the kernel, N and
      * h only, which cannot change after dmi_init, and is anchored below */
-    const int keep_rec = s->initialized && s->rec && is_recursion(s, s->conv_method);
+    const int keep_rec = s->initialized && s->rec && dmi_engine_is_recursion(s, s->conv_method);
     if (rc == DMI_OK && keep_rec)
         e = s->rec;
     else if (rc == DMI_OK)
-        rc = engine_make(s, &k, s->conv_method, &c, &e, "dmi_init");
+        rc = dmi_engine_make(s, &k, s->conv_method, &c, &e, "dmi_init");
     if (rc != DMI_OK) {
         dmi_kernel_release(&k);
         dmi_history_release(&ring);
@@ -690,7 +490,7 @@ int dmi_init(dmi_solver *s)
     s->kernel_sampled = sample;
     s->ring = ring;
     if (!keep_rec)
-        engine_free(s->conv, s->rec);
+        dmi_engine_free(s->conv, s->rec);
     s->conv = c;
     s->rec = e;
     s->p = 0;
@@ -702,6 +502,21 @@ int dmi_init(dmi_solver *s)
 }
 
 /* ---- stepping -------------------------------------------------------------- */
+
+/* The holds of the built-in operators, for the step and for the watch:
+ * friction's resolvent holds U_i at 0 when |x| <= lam = h alpha_i (side 0),
+ * else it moves x by lam towards 0 (side +1 above lam, -1 below -lam); the
+ * box's projection holds U_i at lo_i when x <= lo_i (side -1), at hi_i when
+ * x >= hi_i (+1), else U_i = x (0). */
+static inline int friction_side(double x, double lam)
+{
+    return x > lam ? 1 : x < -lam ? -1 : 0;
+}
+
+static inline int box_side(double x, double lo, double hi)
+{
+    return x <= lo ? -1 : x >= hi ? 1 : 0;
+}
 
 static int apply_resolvent(dmi_solver *s, const double *x, double *out)
 {
@@ -718,13 +533,16 @@ static int apply_resolvent(dmi_solver *s, const double *x, double *out)
     }
     case A_FRICTION:
         for (size_t i = 0; i < n; i++) {
-            double lam = h * s->a_lo[i];
-            out[i] = x[i] > lam ? x[i] - lam : x[i] < -lam ? x[i] + lam : 0.0;
+            const double lam = h * s->a_lo[i];
+            const int side = friction_side(x[i], lam);
+            out[i] = side > 0 ? x[i] - lam : side < 0 ? x[i] + lam : 0.0;
         }
         break;
     case A_BOX:
-        for (size_t i = 0; i < n; i++)
-            out[i] = x[i] < s->a_lo[i] ? s->a_lo[i] : x[i] > s->a_hi[i] ? s->a_hi[i] : x[i];
+        for (size_t i = 0; i < n; i++) {
+            const int side = box_side(x[i], s->a_lo[i], s->a_hi[i]);
+            out[i] = side < 0 ? s->a_lo[i] : side > 0 ? s->a_hi[i] : x[i];
+        }
         break;
     default:
         memcpy(out, x, n * sizeof *out);
@@ -751,7 +569,7 @@ int dmi_step(dmi_solver *s)
             return dmi_fail(s, DMI_ECALLBACK, "dmi_step: rhs callback returned %d at t = %.17g", rc,
                             t);
     }
-    const double *W = delay_sum(s, Wbuf);
+    const double *W = dmi_engine_sum(s, Wbuf);
     for (size_t i = 0; i < n; i++)
         X[i] = U[i] - h * fv[i] - h * W[i];
     /* A non-finite f or W makes X non-finite (U^p and h are finite), so one
@@ -782,7 +600,7 @@ int dmi_step(dmi_solver *s)
         s->last_X[i] = X[i];
     }
     s->p++;
-    engine_advance(s);
+    dmi_engine_advance(s);
     return DMI_OK;
 }
 
@@ -801,11 +619,9 @@ int dmi_advance(dmi_solver *s, size_t steps)
 /* The hold of component i for the resolvent's argument x (see dmi_watch). */
 static int held_of(const dmi_solver *s, size_t i, double x)
 {
-    if (s->a_kind == A_FRICTION) {
-        const double lam = s->h * s->a_lo[i];
-        return !(x > lam) && !(x < -lam);
-    }
-    return x <= s->a_lo[i] ? -1 : x >= s->a_hi[i] ? 1 : 0;
+    if (s->a_kind == A_FRICTION)
+        return friction_side(x, s->h * s->a_lo[i]) == 0;
+    return box_side(x, s->a_lo[i], s->a_hi[i]);
 }
 
 int dmi_watch_start(dmi_solver *s, dmi_watch *w)
@@ -874,17 +690,6 @@ size_t dmi_get_N(const dmi_solver *s)
     return s ? s->N : 0;
 }
 
-int dmi_check_query(const dmi_solver *s, const void *out, const char *fn)
-{
-    if (!s)
-        return DMI_EINVAL;
-    if (!out)
-        return dmi_fail(s, DMI_EINVAL, "%s: output pointer is NULL", fn);
-    if (!s->initialized)
-        return dmi_fail(s, DMI_ESTATE, "%s: call dmi_init first", fn);
-    return DMI_OK;
-}
-
 int dmi_get_step_index(const dmi_solver *s, uint64_t *p)
 {
     int rc = dmi_check_query(s, p, "dmi_get_step_index");
@@ -927,7 +732,7 @@ int dmi_set_window(dmi_solver *s, const double *U)
     int rc = dmi_check_query(s, U, "dmi_set_window");
     if (rc != DMI_OK)
         return rc;
-    const size_t n = s->n, N = s->N, bad = first_nonfinite_long(U, (N + 1) * n);
+    const size_t n = s->n, N = s->N, bad = dmi_first_nonfinite_long(U, (N + 1) * n);
     if (bad < (N + 1) * n)
         return dmi_fail(s, DMI_EINVAL, "dmi_set_window: U[%zu] (row %zu = U^{p-%zu}, component "
                         "%zu) is not finite", bad, bad / n, N - bad / n, bad % n);

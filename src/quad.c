@@ -1,14 +1,7 @@
 /*
- * The exact cell rule of the delay sum (dmi_set_quadrature, DMI_QUAD_CELL):
- * each cell's weight is the integral of H over the cell instead of h H(l h).
+ * Numerical integration for the exact cell rule (dmi_set_quadrature,
+ * DMI_QUAD_CELL; dmi_set_kernel_near): see quad.h.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
- *
- * Every engine sums h * samples[l] U^{p-l} (l < N) and then adds a last-cell
- * change; so the cell rule stores as samples the cells' means,
- *     samples[l] = (1/h) int_{l h}^{(l+1) h} H,
- * and as the change per kernel entry, last[e], what turns the last full
- * cell's h samples[N-1] into the integral over the partial last cell
- * [(N-1) h, tau] (0 when theta = 1).
  *
  * Exponential kernels in closed form: per term mu = a + i b, G = C - i D,
  *     int_{l h}^{(l+1) h} Re(G e^{mu s}) ds = h Re(G phi1(mu h) e^{mu l h}),
@@ -17,32 +10,49 @@
  * (dmi_quad_expk), which the recursion then runs as it is.  The partial last
  * cell is theta h Re(G phi1(mu theta h) e^{mu (N-1) h}).
  *
- * Callback kernels by tanh-sinh quadrature (the double-exponential rule of
+ * Other integrands by tanh-sinh quadrature (the double-exponential rule of
  * Takahasi and Mori), written from its formulas: on [lo, hi], c = (lo + hi)/2,
  * d = (hi - lo)/2, u(t) = (pi/2) sinh t,
- *     int f = d sum_j w h f(c + d tanh u(t_j)),  t_j = j w,
- *     weight (pi/2) cosh t / cosh^2 u,
- * the nodes near an end placed by their distance to it, d 2 / (e^{2|u|} + 1),
- * so an integrable singularity at s = 0 (s^-alpha) is never evaluated at and
- * converges as fast as a smooth integrand.  The step w halves (new nodes
- * only) until two levels agree to REL_TOL of the cell's integral of |H|, or
- * MAX_LEVEL is reached.  One rule in every build: libdmi and the GSL-free
- * core inside FMUs give the same weights (GSL's QAGS would report a
- * round-off failure through GSL's error handler, which aborts unless it is
- * turned off process-wide: global state a library must not touch).
+ *     int f = d sum_j w f(c + d tanh u(t_j)) wt_j,  t_j = j w,
+ *     wt = (pi/2) cosh t / cosh^2 u,
+ * the nodes near an end placed by their distance to it, d 2 / (e^{2|u|} + 1)
+ * (from the table of dmi_quad_nodes_make), and never at an end: a node that
+ * rounds onto an end is left out (its weight is below 1e-30 of the middle's).
+ * The step w halves (new nodes only) until two levels agree to
+ * DMI_QUAD_REL_TOL of the integral of |f|, the terms at |t| = T_MAX (the
+ * truncation) included in the error; where that fails by LEVEL_WHOLE, the
+ * interval is bisected, depth first, each piece accepted once it converges
+ * by LEVEL_PIECE, within MAX_DEPTH halvings and MAX_CALLS calls.
+ *
+ * Sums are kept per value q scaled by 2^-e_q, e_q following the largest |f_q|
+ * seen, so that a kernel near the largest double does not overflow them.
+ *
+ * A power singularity at 0, f = s^-alpha g(s): the exponent is read from f
+ * at s = hi 2^-E0, .., hi 2^-(E0-4 gap) (five probes 2^gap apart, gap = 60
+ * for E0 >= 300: the local exponents log2(|f(s_k)| / |f(s_k+1)|) / gap are
+ * alpha there, whatever g's value, to rounding); then s = hi x^p, p = 1 / (1 - alpha), turns
+ * int_{s_min}^{hi} f ds into int_{x_min}^1 f(hi x^p) hi p x^{p-1} dx, whose
+ * integrand is g(hi x^p) hi p: smooth and bounded; the part below
+ * s_min = hi 2^-E0 is s_min^{1-alpha} g(0) / (1 - alpha) = s_min f(s_min) /
+ * (1 - alpha), to a relative error g's change over [0, s_min] (nothing) and
+ * alpha's error over 1 - alpha.
  */
 #include "quad.h"
-
-#include "bytes.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #define PI_2 1.57079632679489661923
-#define T_MAX 4.0     /* |t| <= T_MAX: the weights beyond are below 1e-36 of the middle's */
-#define MAX_LEVEL 9   /* steps 1/2 .. 1/1024: at most 8193 nodes a cell */
-#define REL_TOL 1e-14
+#define T_MAX 4.0        /* |t| <= T_MAX: the weights beyond are below 1e-35 of the middle's */
+#define L_FINE 10        /* the table's step 2^-10 */
+#define LEVEL_MIN 3      /* a converged estimate compares at least steps 1/4 and 1/8 */
+#define LEVEL_WHOLE 7    /* steps down to 1/128 on the whole interval (1025 nodes) */
+#define LEVEL_PIECE 5    /* and to 1/32 on each piece of a bisection (257 nodes) */
+#define MAX_DEPTH 60     /* halvings of a piece */
+#define MAX_CALLS 200000 /* calls of f in one integration */
+#define SLOPE_TOL 1e-10  /* local exponents of a power law agree to this */
+#define TAIL_TOL 1e-11   /* the part below s_min known to this share of the integral of |f| */
 
 /* ---- exponential kernels ------------------------------------------------- */
 
@@ -84,7 +94,7 @@ int dmi_quad_expk(const dmi_expk *k, double h, dmi_expk *out)
 }
 
 /* The integral over [(N-1) h, (N-1+theta) h] of entry q of k. */
-static double expk_last(const dmi_expk *k, size_t q, size_t N, double h, double theta)
+double dmi_quad_expk_last(const dmi_expk *k, size_t q, size_t N, double h, double theta)
 {
     const size_t nn = k->n * k->n;
     const double s0 = (double)(N - 1) * h, w = theta * h;
@@ -102,234 +112,381 @@ static double expk_last(const dmi_expk *k, size_t q, size_t N, double h, double 
     return sum;
 }
 
-/* ---- callback kernels ---------------------------------------------------- */
+/* ---- the node table ------------------------------------------------------ */
+
+int dmi_quad_nodes_make(dmi_quad_nodes *t)
+{
+    const size_t J = (size_t)T_MAX << L_FINE;
+    t->J = 0;
+    t->wt = malloc((J + 1) * sizeof *t->wt);
+    t->dist = malloc((J + 1) * sizeof *t->dist);
+    if (!t->wt || !t->dist) {
+        dmi_quad_nodes_free(t);
+        return -1;
+    }
+    for (size_t j = 0; j <= J; j++) {
+        const double tj = ldexp((double)j, -L_FINE), u = PI_2 * sinh(tj), ch = cosh(u);
+        t->wt[j] = PI_2 * cosh(tj) / (ch * ch);
+        t->dist[j] = 2 / (exp(2 * u) + 1);
+    }
+    t->J = J;
+    return 0;
+}
+
+void dmi_quad_nodes_free(dmi_quad_nodes *t)
+{
+    free(t->wt);
+    free(t->dist);
+    t->wt = t->dist = NULL;
+    t->J = 0;
+}
+
+/* ---- one integration ----------------------------------------------------- */
+
+/* The scaled sums, nn values each (block k at sc + k nn), in units of 2^e_q:
+ * the current level's sum of wt f and of wt |f|, the previous level's
+ * integral, the truncation terms (|t| = T_MAX), a piece's integral and error
+ * estimate, the accepted total, its |f| integral and error, the tolerance of
+ * a piece, the uncertainty of the part below s_min. */
+enum { S_SUM, S_ABS, S_PREV, S_EDGE, S_VAL, S_ERR, S_TOT, S_TABS, S_TERR, S_TOL, S_UNC, S_COUNT };
+
+#define PROBES 5
+#define PROBE_GAP 60 /* binary orders between probes */
+
+size_t dmi_quad_scratch(size_t nn)
+{
+    const size_t per = 3 + S_COUNT + PROBES + 2;
+    return nn && nn <= (size_t)-1 / per / sizeof(double) ? per * nn : 0;
+}
 
 typedef struct {
-    dmi_solver *s;
-    dmi_kernel_fn H;
+    const dmi_quad_nodes *t;
+    dmi_quad_fn f;
     void *user;
     size_t nn;
-    double *val; /* nn: H at the node */
-} integrand;
+    double s_lo, s_hi; /* f is called in the open (s_lo, s_hi) only */
+    double a, p;       /* p == 1: s = x; else s = a x^p */
+    double *val;       /* nn: f at the node */
+    double *ex, *mul;  /* nn each: e_q (an integer) and 2^-e_q */
+    double *sc;        /* S_COUNT nn */
+    double *probe;     /* PROBES nn: f at the probes */
+    double *sig;       /* 2 nn: the least and largest local exponent near 0 */
+    dmi_quad_report *rep;
+} ctx;
 
-/* acc += wt H(x); a failing or non-finite callback is an error (message set). */
-static int add_node(integrand *g, double x, double wt, double *acc, double *absacc)
+static double *blk(const ctx *c, int k)
 {
-    memset(g->val, 0, g->nn * sizeof *g->val);
-    int rc = g->H(x, g->val, g->user);
-    if (rc != 0)
-        return dmi_fail(g->s, DMI_ECALLBACK, "dmi_init: kernel callback returned %d at s = %.17g",
-                        rc, x);
-    size_t bad = dmi_first_nonfinite(g->val, g->nn);
-    if (bad < g->nn)
-        return dmi_fail(g->s, DMI_ENONFINITE, "dmi_init: kernel H(%.17g)[%zu][%zu] = %g", x,
-                        bad / g->s->n, bad % g->s->n, g->val[bad]);
-    for (size_t q = 0; q < g->nn; q++) {
-        acc[q] += wt * g->val[q];
-        absacc[q] += wt * fabs(g->val[q]);
-    }
-    return DMI_OK;
+    return c->sc + (size_t)k * c->nn;
 }
 
-/* The nodes t = j w, j odd (all j at level 0), of the rule on [lo, hi]
- * added into acc (nn sums of weight * H, without the factor w d). */
-static int add_level(integrand *g, double lo, double hi, double w, int first, double *acc,
-                     double *absacc)
+/* v (finite, not 0) in q's scaled units; the sums of q rescaled first when
+ * it would be beyond 2^60 there. */
+static double scaled(ctx *c, size_t q, double v)
 {
-    const double d = (hi - lo) / 2, c = lo + d;
-    for (long j = first ? 0 : 1; (double)j * w <= T_MAX; j += first ? 1 : 2) {
-        const double t = (double)j * w, u = PI_2 * sinh(t), ch = cosh(u);
-        const double wt = PI_2 * cosh(t) / (ch * ch);
-        if (j == 0) {
-            int rc = add_node(g, c, wt, acc, absacc);
-            if (rc != DMI_OK)
-                return rc;
-            continue;
-        }
-        const double off = d * 2 / (exp(2 * u) + 1); /* distance of the node to the end */
-        if (!(off > 0))
-            break;
-        int rc = add_node(g, lo + off, wt, acc, absacc);
-        if (rc == DMI_OK)
-            rc = add_node(g, hi - off, wt, acc, absacc);
-        if (rc != DMI_OK)
-            return rc;
+    double y = v * c->mul[q];
+    if (fabs(y) > 0x1p60) { /* (a bound far from overflow, far above every weight) */
+        const int e = ilogb(v);
+        const double factor = ldexp(1.0, (int)c->ex[q] - e);
+        for (int k = 0; k < S_COUNT; k++)
+            blk(c, k)[q] *= factor;
+        c->ex[q] = e;
+        c->mul[q] = ldexp(1.0, -e);
+        y = v * c->mul[q];
     }
-    return DMI_OK;
+    return y;
 }
 
-/* out[q] = int_lo^hi H_q (nn values); scratch: 4 nn doubles. */
-static int integrate(integrand *g, double lo, double hi, double *out, double *scratch)
+/* f at s into c->val: DMI_QUAD_OK, or the failure (reported). */
+static int call(ctx *c, double s)
 {
-    const size_t nn = g->nn;
-    double *acc = scratch, *absacc = acc + nn, *prev = absacc + nn;
-    memset(acc, 0, 2 * nn * sizeof *acc);
-    double w = 0.5;
-    const double d = (hi - lo) / 2;
-    int rc = add_level(g, lo, hi, w, 1, acc, absacc);
-    for (int level = 1; rc == DMI_OK; level++) {
-        for (size_t q = 0; q < nn; q++)
-            prev[q] = acc[q] * w * d;
-        w /= 2;
-        rc = add_level(g, lo, hi, w, 0, acc, absacc);
-        if (rc != DMI_OK)
-            break;
-        double change = 0, size = 0;
-        for (size_t q = 0; q < nn; q++) {
-            change = fmax(change, fabs(acc[q] * w * d - prev[q]));
-            size = fmax(size, absacc[q] * w * d);
-        }
-        if (change <= REL_TOL * size || level == MAX_LEVEL)
-            break;
+    memset(c->val, 0, c->nn * sizeof *c->val);
+    c->rep->calls++;
+    const int rc = c->f(s, c->val, c->user);
+    if (rc != 0) {
+        c->rep->rc = rc;
+        c->rep->at = s;
+        return c->rep->status = DMI_QUAD_ECALL;
     }
-    for (size_t q = 0; q < nn; q++)
-        out[q] = acc[q] * w * d;
-    return rc;
+    for (size_t q = 0; q < c->nn; q++)
+        if (!isfinite(c->val[q])) {
+            c->rep->entry = q;
+            c->rep->at = s;
+            c->rep->value = c->val[q];
+            return c->rep->status = DMI_QUAD_ENONFINITE;
+        }
+    return DMI_QUAD_OK;
 }
 
-/* ---- the cells ------------------------------------------------------------ */
-
-int dmi_quad_sample(dmi_solver *s, dmi_kernel *k, double **last)
+/* Adds wt f(s(x)) jac(x) to the level's sums (and to the truncation terms
+ * when edge); a node whose s is not strictly inside the interval is left out. */
+static int node(ctx *c, double x, double wt, int edge)
 {
-    const size_t n = s->n, N = s->N, nn = n * n;
-    const double h = s->h, theta = s->theta;
-    *last = NULL;
-    dmi_kernel_alloc(k, n, N, NULL);
-    if (!s->H)
-        return DMI_OK;
-    if (dmi_has_expk(s)) {
-        int rc = dmi_expk_sample(&s->cell_expk, N, h, k);
-        if (rc < 0)
-            return dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for the cell weights");
-        if (rc > 0)
-            return dmi_fail(s, DMI_ENONFINITE, "dmi_init: a cell weight of the exponential kernel "
-                                               "is not finite (a h or b h out of range)");
-        *last = calloc(k->nnz ? k->nnz : 1, sizeof **last);
-        if (!*last) {
-            dmi_kernel_release(k);
-            return dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for the cell weights");
-        }
-        if (theta != 1)
-            for (size_t e = 0; e < k->nnz; e++) /* the partial cell's integral less h mean */
-                (*last)[e] = expk_last(&s->expk, k->row[e] * n + k->col[e], N, h, theta) -
-                             h * k->samples[e * N + N - 1];
-        return DMI_OK;
+    double s = x, jac = 1;
+    if (c->p != 1) {
+        const double xp = pow(x, c->p - 1);
+        s = c->a * (xp * x);
+        jac = c->a * c->p * xp;
     }
-    size_t bytes = dmi_mul_size(n, n, 1) ? dmi_mul_size(N, nn, sizeof(double)) : 0;
-    size_t sbytes = dmi_mul_size(5, nn, sizeof(double));
-    double *dense = bytes ? malloc(bytes) : NULL, *scratch = sbytes ? malloc(sbytes) : NULL;
-    if (!dense || !scratch) {
-        free(dense);
-        free(scratch);
-        return dmi_fail(s, DMI_ENOMEM, "dmi_init: cannot allocate %zu x %zu x %zu cell weights", N,
-                        n, n);
-    }
-    integrand g = {s, s->H, s->H_user, nn, scratch + 4 * nn};
-    int rc = DMI_OK;
-    for (size_t l = 0; l < N && rc == DMI_OK; l++) {
-        const double lo = (double)l * h, hi = l + 1 == N ? s->tau : (double)(l + 1) * h;
-        const double width = l + 1 == N ? theta * h : h; /* the mean over the cell */
-        rc = integrate(&g, lo, hi, dense + l * nn, scratch);
-        for (size_t q = 0; q < nn && rc == DMI_OK; q++)
-            dense[l * nn + q] /= width;
-    }
-    free(scratch);
-    if (rc == DMI_OK && dmi_kernel_alloc(k, n, N, dense) != 0)
-        rc = dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for the cell weights");
-    free(dense);
-    if (rc == DMI_OK) {
-        *last = calloc(k->nnz ? k->nnz : 1, sizeof **last);
-        if (!*last) {
-            dmi_kernel_release(k);
-            rc = dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for the cell weights");
-        }
-    }
-    if (rc == DMI_OK) /* the last mean is the partial cell's: weight theta h, not h */
-        for (size_t e = 0; e < k->nnz; e++)
-            (*last)[e] = (theta - 1) * h * k->samples[e * N + N - 1];
-    return rc;
-}
-
-void dmi_quad_last(const dmi_kernel *k, const dmi_history *r, const double *last, double *W)
-{
-    const size_t lag = k->N - 1;
-    for (size_t e = 0; e < k->nnz; e++)
-        W[k->row[e]] += last[e] * dmi_history_series(r, k->col[e])[lag];
-}
-
-/* ---- the near cells of a fitted kernel ---------------------------------- */
-
-int dmi_quad_near(dmi_solver *s, dmi_kernel *k, double **last, dmi_kernel *near)
-{
-    const size_t n = s->n, N = s->N, nn = n * n;
-    const double h = s->h;
-    dmi_kernel_alloc(near, n, 0, NULL);
-    const double q = s->near_delta / h;
-    const size_t m = q >= (double)N ? N : (size_t)ceil(q); /* the cells with l h < delta */
-    if (m == 0)
-        return DMI_OK;
-    if (m + 1 > N)
-        return dmi_fail(s, DMI_EINVAL, "dmi_init: the near cells (delta = %g, %zu cells of h = %g) "
-                                       "must leave at least the last of the N = %zu cells to the "
-                                       "exponential sum", s->near_delta, m, h, N);
-    /* (m < N <= the ring's rows: m n n doubles fit) */
-    size_t bytes = dmi_mul_size(N, nn, sizeof(double)), sbytes = dmi_mul_size(5, nn, sizeof(double));
-    double *dense = bytes ? calloc(N * nn, sizeof *dense) : NULL;
-    double *diff = calloc(m * nn, sizeof *diff), *scratch = sbytes ? malloc(sbytes) : NULL;
-    double *last2 = calloc(nn, sizeof *last2); /* by entry, then by the new kernel's entries */
-    dmi_kernel k2 = {0};
-    int rc = dense && diff && scratch && last2 ? DMI_OK
-                                               : dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory "
-                                                          "for the near cells");
-    for (size_t e = 0; rc == DMI_OK && e < k->nnz; e++) { /* the sum's means, dense */
-        const size_t qe = k->row[e] * n + k->col[e];
-        for (size_t l = 0; l < N; l++)
-            dense[l * nn + qe] = k->samples[e * N + l];
-        if (*last)
-            last2[qe] = (*last)[e];
-    }
-    integrand g = {s, s->near_H, s->near_user, nn, scratch ? scratch + 4 * nn : NULL};
-    for (size_t l = 0; l < m && rc == DMI_OK; l++) { /* the exact means of the near cells */
-        double *row = dense + l * nn;
-        rc = integrate(&g, (double)l * h, (double)(l + 1) * h, diff + l * nn, scratch);
-        for (size_t qe = 0; qe < nn && rc == DMI_OK; qe++) {
-            const double exact = diff[l * nn + qe] / h;
-            diff[l * nn + qe] = exact - row[qe]; /* what the recursion's sum lacks */
-            row[qe] = exact;
-        }
-    }
-    if (rc == DMI_OK && (dmi_kernel_alloc(&k2, n, N, dense) != 0 ||
-                         dmi_kernel_alloc(near, n, m, diff) != 0))
-        rc = dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for the near cells");
-    double *l2 = NULL;
-    if (rc == DMI_OK && *last) {
-        l2 = calloc(k2.nnz ? k2.nnz : 1, sizeof *l2);
-        if (!l2)
-            rc = dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for the near cells");
-        for (size_t e = 0; l2 && e < k2.nnz; e++)
-            l2[e] = last2[k2.row[e] * n + k2.col[e]];
-    }
-    free(dense);
-    free(diff);
-    free(scratch);
-    free(last2);
-    if (rc != DMI_OK) {
-        dmi_kernel_release(&k2);
-        dmi_kernel_release(near);
+    if (!(s > c->s_lo && s < c->s_hi))
+        return DMI_QUAD_OK;
+    const int rc = call(c, s);
+    if (rc != DMI_QUAD_OK)
         return rc;
+    double *sum = blk(c, S_SUM), *abs_ = blk(c, S_ABS), *e = blk(c, S_EDGE);
+    for (size_t q = 0; q < c->nn; q++) {
+        if (c->val[q] == 0)
+            continue;
+        const double y = scaled(c, q, c->val[q]) * jac * wt;
+        sum[q] += y;
+        abs_[q] += fabs(y);
+        if (edge)
+            e[q] += fabs(y);
     }
-    dmi_kernel_release(k);
-    *k = k2;
-    if (*last) {
-        free(*last);
-        *last = l2;
-    }
-    return DMI_OK;
+    return DMI_QUAD_OK;
 }
 
-void dmi_quad_near_add(const dmi_kernel *near, const dmi_history *r, double h, double *W)
+/* The nodes of level k of the rule on [x0, x1] not in a coarser level (all of
+ * them at k = 1): t = j 2^-k, j odd. */
+static int level(ctx *c, double x0, double x1, int k)
 {
-    for (size_t e = 0; e < near->nnz; e++)
-        W[near->row[e]] += h * dmi_dot(near->samples + e * near->N,
-                                       dmi_history_series(r, near->col[e]), near->N);
+    const double d = (x1 - x0) / 2;
+    const size_t step = (size_t)1 << (L_FINE - k), J = c->t->J;
+    int rc = k == 1 ? node(c, x0 + d, c->t->wt[0], 0) : DMI_QUAD_OK;
+    for (size_t j = step; j <= J && rc == DMI_QUAD_OK; j += k == 1 ? step : 2 * step) {
+        const double off = d * c->t->dist[j], wt = c->t->wt[j];
+        rc = node(c, x0 + off, wt, j == J);
+        if (rc == DMI_QUAD_OK)
+            rc = node(c, x1 - off, wt, j == J);
+    }
+    return rc;
+}
+
+/* The rule on [x0, x1], levels 1 .. max_level: S_VAL, S_ERR (level change
+ * plus truncation terms) and S_ABS (the integral of |f|) of the last level;
+ * *conv = whether every error is within its tolerance: S_TOL, or with
+ * own_tol DMI_QUAD_REL_TOL of (S_ABS + |S_TOT|). */
+static int piece(ctx *c, double x0, double x1, int max_level, int own_tol, int *conv)
+{
+    const size_t nn = c->nn;
+    const double d = (x1 - x0) / 2;
+    double *sum = blk(c, S_SUM), *abs_ = blk(c, S_ABS), *prev = blk(c, S_PREV);
+    double *e = blk(c, S_EDGE), *val = blk(c, S_VAL), *err = blk(c, S_ERR);
+    double *tot = blk(c, S_TOT), *tol = blk(c, S_TOL);
+    for (int k = S_SUM; k <= S_ERR; k++)
+        memset(blk(c, k), 0, nn * sizeof *sum);
+    *conv = 0;
+    for (int k = 1; k <= max_level && !*conv; k++) {
+        for (size_t q = 0; q < nn; q++)
+            prev[q] = ldexp(sum[q], 1 - k) * d;
+        const int rc = level(c, x0, x1, k);
+        if (rc != DMI_QUAD_OK)
+            return rc;
+        int ok = k >= LEVEL_MIN;
+        for (size_t q = 0; q < nn; q++) {
+            val[q] = ldexp(sum[q], -k) * d;
+            err[q] = fabs(val[q] - prev[q]) + e[q] * d;
+            const double t = own_tol ? DMI_QUAD_REL_TOL * (ldexp(abs_[q], -k) * d + fabs(tot[q]))
+                                     : tol[q];
+            ok = ok && err[q] <= t;
+        }
+        *conv = ok;
+        if (*conv || k == max_level)
+            for (size_t q = 0; q < nn; q++)
+                abs_[q] = ldexp(abs_[q], -k) * d;
+    }
+    return DMI_QUAD_OK;
+}
+
+/* Adds the piece just integrated to the accepted total. */
+static void accept_piece(ctx *c)
+{
+    const double *val = blk(c, S_VAL), *err = blk(c, S_ERR), *abs_ = blk(c, S_ABS);
+    double *tot = blk(c, S_TOT), *tabs = blk(c, S_TABS), *terr = blk(c, S_TERR);
+    for (size_t q = 0; q < c->nn; q++) {
+        tot[q] += val[q];
+        tabs[q] += abs_[q];
+        terr[q] += err[q];
+    }
+}
+
+/* The exponent at 0 from the probes (or the hint) and the part below the
+ * smallest probe into S_TOT (its uncertainty in S_UNC); the variable of the
+ * rest: [*x0, *x1] with c->a, c->p. */
+static int singular_start(ctx *c, double hint, double *x0, double *x1)
+{
+    const size_t nn = c->nn;
+    const double a = c->s_hi;
+    /* without a hint five probes from s_min = hi 2^-E0 up to hi 2^-(E0-4 gap),
+     * gap = 60 (less once E0 < 300: the probes stay below hi 2^-60); with one
+     * only s_min; E0 = 960, 900, .., 120 (60 with a hint) until f is finite
+     * at every probe */
+    const int given = !isnan(hint), probes = given ? 1 : PROBES;
+    int E0 = 960, gap = PROBE_GAP, rc = DMI_QUAD_OK;
+    if (E0 > ilogb(a) + 1021) /* s_min stays a normal number */
+        E0 = ilogb(a) + 1021;
+    for (;; E0 -= PROBE_GAP) {
+        gap = E0 - 60 < PROBE_GAP * (PROBES - 1) ? (E0 - 60) / (PROBES - 1) : PROBE_GAP;
+        for (int j = 0; j < probes && rc == DMI_QUAD_OK; j++) {
+            rc = call(c, ldexp(a, -E0 + gap * j));
+            if (rc == DMI_QUAD_OK)
+                memcpy(c->probe + (size_t)j * nn, c->val, nn * sizeof *c->val);
+        }
+        if (rc == DMI_QUAD_OK || E0 - PROBE_GAP < (given ? 60 : 120))
+            break;
+        rc = c->rep->status = DMI_QUAD_OK; /* not finite or refused this close to 0: move up */
+    }
+    if (rc != DMI_QUAD_OK)
+        return rc;
+    const double s_min = ldexp(a, -E0);
+    c->rep->probe_lo = s_min;
+    c->rep->probe_hi = ldexp(a, -E0 + gap * (probes - 1));
+    double top = 0; /* the largest exponent */
+    double *tot = blk(c, S_TOT), *unc = blk(c, S_UNC);
+    for (size_t q = 0; q < nn; q++) {
+        const double *y = c->probe + q;
+        double alpha = 0, lo = 0, hi = 0, big = 0;
+        int power = 1;
+        for (int k = 0; k < probes; k++) {
+            big = fmax(big, fabs(y[k * nn]));
+            power = power && y[k * nn] != 0 && (y[k * nn] > 0) == (y[0] > 0);
+        }
+        if (given) {
+            alpha = lo = hi = hint;
+        } else if (power) {
+            for (int k = 0; k + 1 < PROBES; k++) {
+                const double sig = (log2(fabs(y[k * nn])) - log2(fabs(y[(k + 1) * nn]))) / gap;
+                lo = k ? fmin(lo, sig) : sig;
+                hi = k ? fmax(hi, sig) : sig;
+                if (k == 0)
+                    alpha = sig;
+            }
+            if (alpha >= DMI_QUAD_ALPHA_MAX) {
+                c->rep->entry = q;
+                c->rep->alpha = alpha;
+                return c->rep->status = DMI_QUAD_ENOTINTEGRABLE;
+            }
+        }
+        c->sig[q] = lo;
+        c->sig[nn + q] = hi;
+        if (y[0] != 0) {
+            /* below s_min: s_min f(s_min) / (1 - alpha); a non-power, bounded f: s_min f */
+            const double tail = s_min * y[0] / (power ? 1 - alpha : 1);
+            tot[q] = scaled(c, q, tail);
+            unc[q] = power ? fabs(tot[q]) * ((hi - lo) / (1 - alpha) + 1e-15)
+                           : scaled(c, q, 2 * s_min * big);
+        }
+        if (power && alpha > top)
+            top = alpha;
+    }
+    c->rep->alpha = top;
+    c->a = a;
+    if (top > 0 && 1 / (1 - top) != 1) { /* (an exponent within rounding of 0: s itself) */
+        c->p = 1 / (1 - top);
+        *x0 = exp2(-(double)E0 / c->p);
+        *x1 = 1;
+    } else {
+        *x0 = s_min;
+        *x1 = a;
+    }
+    return DMI_QUAD_OK;
+}
+
+/* The entry q whose error is the largest against its tolerance. */
+static size_t worst(const ctx *c, const double *err, const double *tol)
+{
+    size_t w = 0;
+    double r = -1;
+    for (size_t q = 0; q < c->nn; q++) {
+        const double x = tol[q] > 0 ? err[q] / tol[q] : err[q] > 0 ? INFINITY : 0;
+        if (x > r) {
+            r = x;
+            w = q;
+        }
+    }
+    return w;
+}
+
+int dmi_quad_integrate(const dmi_quad_nodes *t, dmi_quad_fn f, void *user, size_t nn, double lo,
+                       double hi, int singular_lo, double alpha_hint, double *out,
+                       double *scratch, dmi_quad_report *rep)
+{
+    memset(rep, 0, sizeof *rep);
+    ctx c = {t, f, user, nn, lo, hi, hi, 1, scratch, scratch + nn, scratch + 2 * nn,
+             scratch + 3 * nn, scratch + (3 + S_COUNT) * nn,
+             scratch + (3 + S_COUNT + PROBES) * nn, rep};
+    for (size_t q = 0; q < nn; q++) {
+        c.ex[q] = 0;
+        c.mul[q] = 1;
+    }
+    memset(c.sc, 0, S_COUNT * nn * sizeof *c.sc);
+    double x0 = lo, x1 = hi;
+    int rc = singular_lo ? singular_start(&c, alpha_hint, &x0, &x1) : DMI_QUAD_OK;
+    int conv = 0;
+    if (rc == DMI_QUAD_OK)
+        rc = piece(&c, x0, x1, LEVEL_WHOLE, 1, &conv);
+    if (rc != DMI_QUAD_OK)
+        return rc;
+    double *tol = blk(&c, S_TOL), *tot = blk(&c, S_TOT), *terr = blk(&c, S_TERR);
+    double *unc = blk(&c, S_UNC), *tabs = blk(&c, S_TABS);
+    for (size_t q = 0; q < nn; q++) /* the pieces' share of the whole's tolerance */
+        tol[q] = DMI_QUAD_REL_TOL / 4 * (blk(&c, S_ABS)[q] + fabs(tot[q]));
+    if (conv) {
+        accept_piece(&c);
+    } else { /* bisected, depth first, the left piece first */
+        const size_t q = worst(&c, blk(&c, S_ERR), tol);
+        rep->entry = q;
+        rep->estimate = ldexp(tot[q] + blk(&c, S_VAL)[q], (int)c.ex[q]);
+        rep->error = ldexp(blk(&c, S_ERR)[q], (int)c.ex[q]);
+        struct { double x0, x1; int depth; } stack[MAX_DEPTH + 2];
+        size_t top = 0;
+        stack[top].x0 = x0 + (x1 - x0) / 2;
+        stack[top].x1 = x1;
+        stack[top++].depth = 1;
+        stack[top].x0 = x0;
+        stack[top].x1 = x0 + (x1 - x0) / 2;
+        stack[top++].depth = 1;
+        while (top > 0) {
+            const double a = stack[top - 1].x0, b = stack[top - 1].x1;
+            const int depth = stack[--top].depth;
+            rc = piece(&c, a, b, LEVEL_PIECE, 0, &conv);
+            if (rc != DMI_QUAD_OK)
+                return rc;
+            const double m = a + (b - a) / 2;
+            if (conv) {
+                accept_piece(&c);
+                continue;
+            }
+            if (depth >= MAX_DEPTH || rep->calls > MAX_CALLS || !(m > a && m < b)) {
+                /* the estimate reached: the whole rule's (rep->estimate, error) */
+                return rep->status = DMI_QUAD_ECONVERGE;
+            }
+            stack[top].x0 = m;
+            stack[top].x1 = b;
+            stack[top++].depth = depth + 1;
+            stack[top].x0 = a;
+            stack[top].x1 = m;
+            stack[top++].depth = depth + 1;
+        }
+    }
+    for (size_t q = 0; q < nn; q++) {
+        if (unc[q] > TAIL_TOL * (tabs[q] + fabs(tot[q]))) {
+            rep->entry = q;
+            rep->alpha_lo = c.sig[q];
+            rep->alpha_hi = c.sig[nn + q];
+            rep->estimate = ldexp(tot[q], (int)c.ex[q]);
+            rep->error = ldexp(unc[q] + terr[q], (int)c.ex[q]);
+            return rep->status = DMI_QUAD_ENOTPOWER;
+        }
+        out[q] = ldexp(tot[q], (int)c.ex[q]);
+        if (!isfinite(out[q])) {
+            rep->entry = q;
+            return rep->status = DMI_QUAD_EOVERFLOW;
+        }
+        const double e = ldexp(terr[q] + unc[q], (int)c.ex[q]);
+        if (e > rep->error) {
+            rep->error = e;
+            rep->estimate = out[q];
+        }
+    }
+    return rep->status = DMI_QUAD_OK;
 }

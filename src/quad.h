@@ -1,13 +1,18 @@
 /*
- * The exact cell rule of the delay sum (quad.c): cells' means as the kernel
- * samples, the change of the partial last cell, and the exponential kernel
- * whose samples are its cells' means (what the recursion runs).
+ * Numerical integration for the exact cell rule (quad.c): integrals of a
+ * vector-valued function over an interval by tanh-sinh quadrature (an
+ * integrable power singularity at s = 0 handled exactly), and the closed
+ * forms of exponential kernels over cells.  A numerical module: it knows
+ * nothing of the solver; it returns a status and a report, and the caller
+ * writes the message.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #ifndef DMI_QUAD_H
 #define DMI_QUAD_H
 
-#include "solver.h"
+#include <stddef.h>
+
+#include "exp.h"
 
 /* out = the exponential kernel with k's (a, b) whose samples at l h are
  * k's cells' means (1/h) int_{l h}^{(l+1) h} H: C' - i D' = (C - i D)
@@ -15,28 +20,89 @@
  * recursion has the same sums).  0, or -1 when out of memory. */
 int dmi_quad_expk(const dmi_expk *k, double h, dmi_expk *out);
 
-/* The cell rule's samples of s's kernel into k (the means over the N cells,
- * the last one over [(N-1) h, tau]) and *last = nnz values (malloc'd, NULL
- * for no kernel) to be added times U^{p-N+1} by dmi_quad_last: with them
- * every engine's sum is sum_l int_{cell l} H U^{p-l}.  Callback kernels by
- * tanh-sinh quadrature, exponential ones in closed form (from
- * s->cell_expk, dmi_quad_expk of s->expk).  DMI_OK or an error (message
- * set; k and *last empty). */
-int dmi_quad_sample(dmi_solver *s, dmi_kernel *k, double **last);
+/* The integral over [(N-1) h, (N-1+theta) h] of entry q (row-major) of k. */
+double dmi_quad_expk_last(const dmi_expk *k, size_t q, size_t N, double h, double theta);
 
-/* W += last[e] U_{col e}^{p-N+1} for each stored kernel entry e. */
-void dmi_quad_last(const dmi_kernel *k, const dmi_history *r, const double *last, double *W);
+/* The integrand: f(s, out, user) writes nn values at s (0 < s, strictly
+ * inside the interval integrated), 0 on success. */
+typedef int (*dmi_quad_fn)(double s, double *out, void *user);
 
-/* The near cells of a kernel given as an exponential sum (the far part, in k
- * and *last as sampled for s's rule) and an exact callback below delta
- * (dmi_set_kernel_near): k's first m = ceil(delta / h) cells become the
- * callback's exact cell means (tanh-sinh), *last is re-indexed to the new
- * entries, and near = the m cells' exact means less the sum's, which the
- * recursion adds (dmi_quad_near_add).  m = 0: nothing changes, near empty.
- * DMI_OK or an error (message set; k, *last unchanged, near empty). */
-int dmi_quad_near(dmi_solver *s, dmi_kernel *k, double **last, dmi_kernel *near);
+/* The tanh-sinh nodes, computed once (dmi_quad_nodes_make) and used for
+ * every interval: at t_j = j 2^-L (0 <= j <= J), the weight
+ * (pi/2) cosh t / cosh^2((pi/2) sinh t) and the node's distance to the
+ * nearer end as a fraction of the half width, 2 / (e^{2u} + 1), so that
+ * nodes near an end are placed by their distance to it. */
+typedef struct {
+    size_t J;
+    double *wt, *dist; /* J + 1 each (malloc'd) */
+} dmi_quad_nodes;
 
-/* W += h sum_{l<m} near_l U^{p-l}. */
-void dmi_quad_near_add(const dmi_kernel *near, const dmi_history *r, double h, double *W);
+/* 0, or -1 when out of memory (t then empty).  Made once, read by any
+ * number of integrations (they do not write it). */
+int dmi_quad_nodes_make(dmi_quad_nodes *t);
+void dmi_quad_nodes_free(dmi_quad_nodes *t);
+
+/* What an integration reached (the caller's message says it). */
+enum {
+    DMI_QUAD_OK,
+    DMI_QUAD_ECALL,          /* f returned rc at s = at */
+    DMI_QUAD_ENONFINITE,     /* f's value[entry] at s = at is value (not finite) */
+    DMI_QUAD_ENOTINTEGRABLE, /* |f[entry]| grows like s^-alpha, alpha >= 1, near s = 0 */
+    DMI_QUAD_ENOTPOWER,      /* f[entry] is not s^-alpha g(s), g smooth, near 0: its local
+                              * exponents between s = probe_lo and probe_hi span
+                              * [alpha_lo, alpha_hi] */
+    DMI_QUAD_ECONVERGE,      /* no estimate of f[entry] within the tolerance after calls calls:
+                              * estimate, error */
+    DMI_QUAD_EOVERFLOW,      /* the integral of f[entry] is beyond the largest double */
+    DMI_QUAD_ENOMEM
+};
+
+typedef struct {
+    int status;
+    int rc;
+    size_t entry;
+    double at, value;
+    double alpha;              /* the exponent at s = 0 used (0: none) */
+    double alpha_lo, alpha_hi; /* local exponents near 0 (ENOTPOWER) */
+    double probe_lo, probe_hi; /* where they were measured */
+    double estimate, error;    /* the integral and its error estimate reached */
+    size_t calls;              /* calls of f */
+} dmi_quad_report;
+
+/* The doubles of scratch that dmi_quad_integrate needs for nn values (0 when
+ * that overflows). */
+size_t dmi_quad_scratch(size_t nn);
+
+/* The relative accuracy asked of each integral (of the integral of |f|). */
+#define DMI_QUAD_REL_TOL 1e-13
+
+/* Exponents alpha of s^-alpha at or beyond this are taken as not integrable. */
+#define DMI_QUAD_ALPHA_MAX (1 - 1e-6)
+
+/*
+ * out[q] = int_lo^hi f_q(s) ds, q < nn, each within DMI_QUAD_REL_TOL of
+ * int |f_q| (error estimates that include the truncation of the rule), f
+ * called only strictly inside (lo, hi).  Where the rule does not converge
+ * the interval is bisected (a jump is located that way), within a budget of
+ * calls; reaching it is an error (ECONVERGE), never a result.
+ *
+ * singular_lo (lo must then be 0): f may be s^-alpha g(s) near 0 with g
+ * smooth, g(0) != 0 and alpha < 1 (entry by entry).  alpha is estimated
+ * from f at five probes s = hi 2^-E0 (s_min) .. hi 2^-(E0 - 240), E0 = 960
+ * (or 900, .., 120 when f fails or is not finite at one of them: the probes
+ * move up, staying below hi 2^-60), or given (alpha_hint in [0, 1), not
+ * NAN): f is then called at s_min only, E0 down to 60.  The integral from the smallest probe s_min to hi is then taken in
+ * the variable x with s = hi x^{1/(1 - alpha)} (smooth in x), and the part
+ * below s_min added as s_min f(s_min) / (1 - alpha).  An entry whose
+ * exponent is >= DMI_QUAD_ALPHA_MAX is refused (ENOTINTEGRABLE), one whose
+ * local exponents disagree so that the part below s_min is not known to
+ * 1e-11 of the integral of |f| (1 / (s ln^2 s), which no sampling tells from
+ * 1 / s) too (ENOTPOWER).
+ *
+ * scratch: dmi_quad_scratch(nn) doubles.  Returns rep->status; rep filled.
+ */
+int dmi_quad_integrate(const dmi_quad_nodes *t, dmi_quad_fn f, void *user, size_t nn, double lo,
+                       double hi, int singular_lo, double alpha_hint, double *out,
+                       double *scratch, dmi_quad_report *rep);
 
 #endif

@@ -1,5 +1,6 @@
 /*
  * The solver of libdmi (dmi.c), for the files that handle its innards: the
+ * engine (engine.c), the cell rule (cells.c), the errors (errors.c) and the
  * saved state (state.c).
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
@@ -51,6 +52,9 @@ struct dmi_solver {
     int quad;
     double *cell_last;
     dmi_expk cell_expk;
+    /* (since 1.4) the exponent alpha of the kernel's singularity s^-alpha at
+     * s = 0 (dmi_set_kernel_singularity; NAN: estimated from samples) */
+    double alpha;
     /* (since 1.3) the exact kernel of the cells below near_delta
      * (dmi_set_kernel_near; NULL: none) and what those cells add to the
      * recursion's sum (nonzero entries over the m near cells) */
@@ -59,16 +63,6 @@ struct dmi_solver {
     double near_delta;
     dmi_kernel near;
 };
-
-/* Writes the message (printf format) for dmi_last_error; returns code. */
-int dmi_fail(const dmi_solver *s, int code, const char *fmt, ...);
-
-/* The index of the first non-finite x[i], or n. */
-size_t dmi_first_nonfinite(const double *x, size_t n);
-
-/* The checks of a query fn writing to out: s not NULL (else DMI_EINVAL),
- * out not NULL, s initialized.  DMI_OK or the error. */
-int dmi_check_query(const dmi_solver *s, const void *out, const char *fn);
 
 /* Whether s's kernel is the exponential one of dmi_set_kernel_exp. */
 static inline int dmi_has_expk(const dmi_solver *s)
@@ -82,35 +76,5 @@ static inline int dmi_h_is_tau_over_N(const dmi_solver *s)
 {
     return s->h == s->tau / (double)s->N;
 }
-
-/* Recomputes the engines (either may be NULL) for s's step p from the ring. */
-void dmi_engine_rebuild(const dmi_solver *s, dmi_conv *conv, dmi_exp *rec);
-
-/*
- * The resolvent's hold of some components, watched step by step (not part of
- * the public API: the FMU framework, which compiles libdmi's core, counts its
- * built-in event indicators with it).  The hold of component i at step p,
- * from the resolvent's argument X^p (U^0 at p = 0): with dmi_set_friction,
- * 1 when |X_i| <= h alpha_i (the resolvent held U_i at 0), else 0; with
- * dmi_set_box, -1 when X_i <= lo_i, +1 when X_i >= hi_i, else 0.
- */
-typedef struct {
-    size_t m;           /* the watched components comp[0..m-1], each < n */
-    const size_t *comp;
-    int *held;          /* their holds at the solver's step (m values, the caller's) */
-    uint64_t changes;   /* steps at which a hold changed: counted on */
-    uint64_t last_p;    /* the last of them (set when one is counted) */
-} dmi_watch;
-
-/* Fills w->held for s's current step: DMI_OK; DMI_ESTATE before dmi_init;
- * DMI_EINVAL when its operator is neither friction nor a box or a
- * component is not below n (with a message). */
-int dmi_watch_start(dmi_solver *s, dmi_watch *w);
-
-/* dmi_advance of up to steps steps that updates w (started) after each
- * step; with stop nonzero it returns after the first step at which a hold
- * changed.  *taken: the steps taken (also on an error, which leaves the
- * failed step untaken, as dmi_advance). */
-int dmi_advance_watch(dmi_solver *s, size_t steps, dmi_watch *w, int stop, size_t *taken);
 
 #endif

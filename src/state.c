@@ -5,6 +5,9 @@
  */
 #include "solver.h"
 
+#include "engine.h"
+#include "errors.h"
+
 #include "bytes.h"
 
 #include <stdlib.h>

@@ -54,6 +54,7 @@ _PROTOTYPES = {
     "dmi_set_convolution": (c_int, [_solver_p, c_int]),
     "dmi_set_quadrature": (c_int, [_solver_p, c_int]),
     "dmi_set_kernel_near": (c_int, [_solver_p, c_void_p, c_void_p, c_double]),
+    "dmi_set_kernel_singularity": (c_int, [_solver_p, c_double]),
     "dmi_init": (c_int, [_solver_p]),
     "dmi_step": (c_int, [_solver_p]),
     "dmi_advance": (c_int, [_solver_p, c_size_t]),

@@ -758,7 +758,7 @@ class Solver:
             _free(_byref(self._handle))
             self._handle = None
 
-    def set_quadrature(self, rule: str) -> None:
+    def set_quadrature(self, rule: str, singularity: float | None = None) -> None:
         """Sets the quadrature rule of the delay integral, before :meth:`init`
         (``dmi_set_quadrature``).  Every convolution method computes the same sum.
 
@@ -769,19 +769,28 @@ class Solver:
             cell weights, the integral of H over each cell (closed form for
             :meth:`set_kernel_exp`, tanh-sinh quadrature for a callback, which is then called
             inside the cells, never at s = 0: kernels singular at 0 such as s^-1/2 run).
+        singularity : float, optional
+            The exponent alpha, 0 <= alpha < 1, of the kernel's singularity H ~ s^-alpha g(s) at
+            0 (of a callback kernel's first cell, and of the near kernel of
+            :meth:`set_kernel_near`); None (default): estimated from H close to 0
+            (``dmi_set_kernel_singularity``).
 
         Raises
         ------
         dmi.InvalidArgument
-            Code ``dmi.EINVAL``: another rule, or ``"left"`` with near cells
-            (:meth:`set_kernel_near`); code ``dmi.ESTATE``: after :meth:`init`.
+            Code ``dmi.EINVAL``: another rule, ``"left"`` with near cells
+            (:meth:`set_kernel_near`), or ``singularity`` outside [0, 1); code ``dmi.ESTATE``:
+            after :meth:`init`.
         """
         code = _choice(_lib.QUAD, rule, "set_quadrature: rule")
         if rule == "left" and self._near_delta > 0:
             raise InvalidArgument(_lib.EINVAL, "set_quadrature('left'): the near cells of "
                                   "set_kernel_fit or set_kernel_near need the cell rule (remove "
                                   "them first: set_kernel_near(None, 0))")
+        alpha = math.nan if singularity is None else float(singularity)
         with self._using() as s:
+            # the exponent first: a refused one leaves the rule as it was
+            self._check(_L.dmi_set_kernel_singularity(s, alpha))
             self._check(_L.dmi_set_quadrature(s, code))
         self._choices["quadrature"] = rule
 

@@ -1,5 +1,5 @@
 /*
- * The resolvent's hold watched step by step (src/solver.h: dmi_watch, the
+ * The resolvent's hold watched step by step (src/core.h: dmi_watch, the
  * FMU framework's built-in indicators), on libdmi's GSL-free core: the holds
  * and their changes counted by dmi_advance_watch are those computed here from
  * each step's resolvent argument X^p (dmi_get_step_terms) with the formulas of
@@ -19,7 +19,7 @@
 #include <CUnit/Basic.h>
 
 #include "forced_oscillator.h"
-#include "solver.h"
+#include "core.h"
 
 enum { n = 2, N = 200, STEPS = 2000 };
 static const double ALPHA[n] = {0.0, 1.0};

@@ -1,0 +1,370 @@
+/*
+ * What the cell rule (DMI_QUAD_CELL) and the near cells (dmi_set_kernel_near)
+ * promise for hard kernels, against closed forms written here:
+ * - H = s^-alpha (1 + s), alpha up to 0.99 (tau = 1, N = 8): the cells'
+ *   weights within 1e-10 of int = [s^{1-a}/(1-a) + s^{2-a}/(2-a)] (relative),
+ *   and as the near kernel of an exponential sum; alpha = 1e-17 too;
+ * - 1/s, s^-1.5 and 1/(s ln^2 s) refused by dmi_init (DMI_EINVAL) with a
+ *   message naming cell 0, for both; the solver unchanged;
+ * - a jump inside a cell (H = 1 on [0, 0.3)): W = 0.3 within 1e-10;
+ * - every call of the kernel strictly inside a cell: 0 < s < tau and never
+ *   at l h;
+ * - a kernel of 1e307, and 1e280 s^-1/2 (not finite in double below
+ *   s = 1e-55): the step's W is right (no overflow);
+ * - dmi_set_kernel_singularity: its checks, and a kernel that cannot be
+ *   evaluated below s = 1e-30 integrated to 1e-10 with the exponent given.
+ * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core_test.h"
+
+/* s^-alpha (1 + s), alpha = *user. */
+static int power_kernel(double s, double *out, void *user)
+{
+    const double alpha = *(const double *)user;
+    out[0] = pow(s, -alpha) * (1 + s);
+    return s > 0 ? 0 : 1;
+}
+
+/* int_0^x s^-alpha (1 + s) ds */
+static double power_integral(double alpha, double x)
+{
+    return pow(x, 1 - alpha) / (1 - alpha) + pow(x, 2 - alpha) / (2 - alpha);
+}
+
+static int one(double t, double *out, void *user)
+{
+    (void)t;
+    (void)user;
+    out[0] = 1;
+    return 0;
+}
+
+/* z(t) = cos(5 t): W^0 = sum_l w_l cos(5 l h) tells each cell's weight apart. */
+static int wave(double t, double *out, void *user)
+{
+    (void)user;
+    out[0] = cos(5 * t);
+    return 0;
+}
+
+/* W^0 of a new solver for u' + W = 0 (n = 1, tau, N cells) with the kernel
+ * callback H (user), history z, the cell rule, exponent hint alpha (NAN:
+ * none): *rc = dmi_init's code, the message into msg (if not NULL). */
+static double first_W(dmi_kernel_fn H, void *user, dmi_history_fn z, double tau, size_t N,
+                      double alpha, int *rc, char *msg)
+{
+    dmi_solver *s = NULL;
+    double W = NAN;
+    CU_ASSERT_FATAL(dmi_create(&s, 1, tau, N) == DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_kernel(s, H, user), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_history(s, z, NULL), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_quadrature(s, DMI_QUAD_CELL), DMI_OK);
+    if (!isnan(alpha))
+        CU_ASSERT_EQUAL(dmi_set_kernel_singularity(s, alpha), DMI_OK);
+    *rc = dmi_init(s);
+    if (msg)
+        snprintf(msg, 512, "%s", dmi_last_error(s));
+    if (*rc == DMI_OK && dmi_step(s) == DMI_OK)
+        dmi_get_step_terms(s, &W, NULL);
+    dmi_free(&s);
+    return W;
+}
+
+static void test_power_cells(void)
+{
+    const double alphas[5] = {0.5, 0.8, 0.9, 0.95, 0.99};
+    for (int i = 0; i < 5; i++) {
+        double alpha = alphas[i];
+        const double tau = 1.0, h = 0.125;
+        /* z = 1: W^0 = int_0^1 H */
+        int rc;
+        char what[96];
+        double W = first_W(power_kernel, &alpha, one, tau, 8, NAN, &rc, NULL);
+        CU_ASSERT_EQUAL(rc, DMI_OK);
+        snprintf(what, sizeof what, "W^0 of s^-%g (1 + s), z = 1", alpha);
+        CU_ASSERT(core_close_rel(what, W, power_integral(alpha, 1.0), 1e-10));
+        /* z = cos 5t: each cell's weight */
+        double ref = 0;
+        for (int l = 0; l < 8; l++)
+            ref += (power_integral(alpha, (l + 1) * h) - power_integral(alpha, l * h)) *
+                   cos(5 * l * h);
+        W = first_W(power_kernel, &alpha, wave, tau, 8, NAN, &rc, NULL);
+        CU_ASSERT_EQUAL(rc, DMI_OK);
+        snprintf(what, sizeof what, "W^0 of s^-%g (1 + s), z = cos 5t", alpha);
+        CU_ASSERT(core_close_rel(what, W, ref, 1e-10));
+        /* the exponent given: the same */
+        W = first_W(power_kernel, &alpha, one, tau, 8, alpha, &rc, NULL);
+        CU_ASSERT_EQUAL(rc, DMI_OK);
+        snprintf(what, sizeof what, "W^0 of s^-%g (1 + s), exponent given", alpha);
+        CU_ASSERT(core_close_rel(what, W, power_integral(alpha, 1.0), 1e-10));
+    }
+}
+
+/* An exponent within rounding of 0 (s^-1e-17: its local exponents are 1e-17
+ * give or take 4e-18): integrated as a bounded kernel. */
+static void test_exponent_near_zero(void)
+{
+    double alpha = 1e-17;
+    int rc;
+    double W = first_W(power_kernel, &alpha, one, 1.0, 8, NAN, &rc, NULL);
+    CU_ASSERT_EQUAL(rc, DMI_OK);
+    CU_ASSERT(core_close_rel("W^0 of s^-1e-17 (1 + s)", W, 1.5, 1e-12));
+}
+
+/* e^{-s} as a sum; near cells below delta = 0.2 (2 of 8 cells) with the
+ * callback H: W^0 (z = 1) into *W, dmi_init's code returned, message in msg. */
+static const double NA[1] = {-1}, NB[1] = {0}, NC[1] = {1};
+
+static int near_W(dmi_kernel_fn H, void *user, double *W, char *msg)
+{
+    dmi_solver *s = NULL;
+    *W = NAN;
+    CU_ASSERT_FATAL(dmi_create(&s, 1, 1.0, 8) == DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_kernel_exp(s, 1, NA, NB, NC, NULL), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_kernel_near(s, H, user, 0.2), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_history(s, one, NULL), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_quadrature(s, DMI_QUAD_CELL), DMI_OK);
+    int rc = dmi_init(s);
+    if (msg)
+        snprintf(msg, 512, "%s", dmi_last_error(s));
+    if (rc == DMI_OK && dmi_step(s) == DMI_OK)
+        dmi_get_step_terms(s, W, NULL);
+    dmi_free(&s);
+    return rc;
+}
+
+static void test_power_near_cells(void)
+{
+    const double alphas[5] = {0.5, 0.8, 0.9, 0.95, 0.99};
+    for (int i = 0; i < 5; i++) {
+        double alpha = alphas[i], W;
+        CU_ASSERT_EQUAL(near_W(power_kernel, &alpha, &W, NULL), DMI_OK);
+        /* int_0^{0.25} s^-a (1 + s) + int_{0.25}^1 e^{-s} */
+        const double ref = power_integral(alpha, 0.25) + exp(-0.25) - exp(-1.0);
+        char what[64];
+        snprintf(what, sizeof what, "near cells of s^-%g (1 + s)", alpha);
+        CU_ASSERT(core_close_rel(what, W, ref, 1e-10));
+    }
+}
+
+static int inverse(double s, double *out, void *user)
+{
+    (void)user;
+    out[0] = 1 / s;
+    return 0;
+}
+
+static int inverse_three_halves(double s, double *out, void *user)
+{
+    (void)user;
+    out[0] = pow(s, -1.5);
+    return 0;
+}
+
+/* 1/(s ln^2 s) on (0, 1/2]: integrable (int_0^x = -1/ln x), yet no sample
+ * tells it from 1/s. */
+static int log_squared(double s, double *out, void *user)
+{
+    (void)user;
+    const double l = log(s);
+    out[0] = 1 / (s * l * l);
+    return 0;
+}
+
+static void test_not_integrable_refused(void)
+{
+    dmi_kernel_fn kernels[3] = {inverse, inverse_three_halves, log_squared};
+    const char *names[3] = {"1/s", "s^-1.5", "1/(s ln^2 s)"};
+    for (int i = 0; i < 3; i++) {
+        char msg[512];
+        int rc;
+        double W = first_W(kernels[i], NULL, one, 0.5, 8, NAN, &rc, msg);
+        if (rc != DMI_EINVAL || !strstr(msg, "cell 0"))
+            printf("\n  %s under the cell rule: rc %d, W %.17g, \"%s\"\n", names[i], rc, W, msg);
+        CU_ASSERT_EQUAL(rc, DMI_EINVAL);
+        CU_ASSERT(strstr(msg, "cell 0 = [0, ") != NULL);
+        CU_ASSERT(i == 2 ? strstr(msg, "not s^-alpha g(s)") != NULL
+                         : strstr(msg, "not integrable") != NULL);
+        rc = near_W(kernels[i], NULL, &W, msg);
+        if (rc != DMI_EINVAL || !strstr(msg, "cell 0"))
+            printf("\n  %s as near kernel: rc %d, W %.17g, \"%s\"\n", names[i], rc, W, msg);
+        CU_ASSERT_EQUAL(rc, DMI_EINVAL);
+        CU_ASSERT(strstr(msg, "cell 0 = [0, ") != NULL && strstr(msg, "near kernel") != NULL);
+    }
+}
+
+/* A refused kernel leaves an initialised solver as it was: its run goes on
+ * bitwise as one never restarted. */
+static int switchable(double s, double *out, void *user)
+{
+    const int *bad = user;
+    out[0] = *bad ? 1 / s : exp(-s);
+    return 0;
+}
+
+static void test_refusal_leaves_solver(void)
+{
+    int bad = 0;
+    dmi_solver *s = NULL, *ref = NULL;
+    for (int k = 0; k < 2; k++) {
+        dmi_solver **x = k ? &ref : &s;
+        CU_ASSERT_FATAL(dmi_create(x, 1, 1.0, 16) == DMI_OK);
+        CU_ASSERT_EQUAL(dmi_set_kernel(*x, switchable, &bad), DMI_OK);
+        CU_ASSERT_EQUAL(dmi_set_history(*x, wave, NULL), DMI_OK);
+        CU_ASSERT_EQUAL(dmi_set_quadrature(*x, DMI_QUAD_CELL), DMI_OK);
+        CU_ASSERT_FATAL(dmi_init(*x) == DMI_OK);
+        CU_ASSERT_EQUAL(dmi_advance(*x, 20), DMI_OK);
+    }
+    bad = 1;
+    CU_ASSERT_EQUAL(dmi_init(s), DMI_EINVAL);
+    CU_ASSERT(strstr(dmi_last_error(s), "not integrable") != NULL);
+    bad = 0;
+    CU_ASSERT(core_same_state(s, ref));
+    CU_ASSERT_EQUAL(dmi_advance(s, 20), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_advance(ref, 20), DMI_OK);
+    CU_ASSERT(core_same_state(s, ref));
+    dmi_free(&s);
+    dmi_free(&ref);
+}
+
+/* H = 1 on [0, 0.3), 0 beyond: a jump inside cell 2 of N = 8. */
+static int step_kernel(double s, double *out, void *user)
+{
+    (void)user;
+    out[0] = s < 0.3 ? 1.0 : 0.0;
+    return 0;
+}
+
+static void test_jump_in_cell(void)
+{
+    int rc;
+    double W = first_W(step_kernel, NULL, one, 1.0, 8, NAN, &rc, NULL);
+    CU_ASSERT_EQUAL(rc, DMI_OK);
+    CU_ASSERT(core_close_rel("W^0 of H = 1 on [0, 0.3)", W, 0.3, 1e-10));
+    /* the cell's own weight: z = cos 5t tells it from its neighbours */
+    const double ref = 0.125 * (1 + cos(5 * 0.125)) + 0.05 * cos(5 * 0.25);
+    W = first_W(step_kernel, NULL, wave, 1.0, 8, NAN, &rc, NULL);
+    CU_ASSERT(core_close_rel("W^0 of the jump, z = cos 5t", W, ref, 1e-10));
+}
+
+/* s^-1/2 recording where it is called: outside (0, tau), or at some l h. */
+typedef struct {
+    double tau, h;
+    size_t N, calls, outside, at_ends;
+} recorder;
+
+static int recording(double s, double *out, void *user)
+{
+    recorder *r = user;
+    r->calls++;
+    if (!(s > 0 && s < r->tau))
+        r->outside++;
+    for (size_t l = 1; l < r->N; l++)
+        if (s == (double)l * r->h)
+            r->at_ends++;
+    out[0] = 1 / sqrt(s);
+    return 0;
+}
+
+static void test_calls_inside_cells(void)
+{
+    const size_t Ns[3] = {8, 10, 1000};
+    for (int i = 0; i < 3; i++) {
+        recorder r = {1.0, 1.0 / (double)Ns[i], Ns[i], 0, 0, 0};
+        int rc;
+        first_W(recording, &r, one, 1.0, Ns[i], NAN, &rc, NULL);
+        CU_ASSERT_EQUAL(rc, DMI_OK);
+        if (r.outside || r.at_ends)
+            printf("\n  N = %zu: %zu of %zu calls outside (0, tau), %zu at l h\n", Ns[i],
+                   r.outside, r.calls, r.at_ends);
+        CU_ASSERT(r.calls > 0 && r.outside == 0 && r.at_ends == 0);
+    }
+    /* the near cells: inside (0, m h) and never at l h either */
+    recorder r = {0.25, 0.125, 8, 0, 0, 0};
+    double W;
+    CU_ASSERT_EQUAL(near_W(recording, &r, &W, NULL), DMI_OK);
+    CU_ASSERT(r.calls > 0 && r.outside == 0 && r.at_ends == 0);
+}
+
+static int huge(double s, double *out, void *user)
+{
+    (void)s;
+    (void)user;
+    out[0] = 1e307;
+    return 0;
+}
+
+static int huge_power(double s, double *out, void *user)
+{
+    (void)user;
+    out[0] = 1e280 / sqrt(s);
+    return 0;
+}
+
+static void test_huge_kernel(void)
+{
+    int rc;
+    double W = first_W(huge, NULL, one, 1.0, 8, NAN, &rc, NULL);
+    CU_ASSERT_EQUAL(rc, DMI_OK);
+    CU_ASSERT(core_close_rel("W^0 of H = 1e307", W, 1e307, 1e-12));
+    /* 1e280 s^-1/2: beyond the largest double below s = 1e-55, integrable */
+    W = first_W(huge_power, NULL, one, 1.0, 8, NAN, &rc, NULL);
+    CU_ASSERT_EQUAL(rc, DMI_OK);
+    CU_ASSERT(core_close_rel("W^0 of H = 1e280 s^-1/2", W, 2e280, 1e-10));
+}
+
+/* s^-0.99 that refuses s < 1e-30 (a kernel not computable close to 0). */
+static int coarse_power(double s, double *out, void *user)
+{
+    (void)user;
+    out[0] = pow(s, -0.99);
+    return s < 1e-30 ? 3 : 0;
+}
+
+static void test_singularity_hint(void)
+{
+    dmi_solver *s = NULL;
+    CU_ASSERT_EQUAL(dmi_set_kernel_singularity(NULL, 0.5), DMI_EINVAL);
+    CU_ASSERT_FATAL(dmi_create(&s, 1, 1.0, 8) == DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_kernel_singularity(s, 1.0), DMI_EINVAL);
+    CU_ASSERT(strstr(dmi_last_error(s), "alpha = 1") != NULL);
+    CU_ASSERT_EQUAL(dmi_set_kernel_singularity(s, -0.1), DMI_EINVAL);
+    CU_ASSERT_EQUAL(dmi_set_kernel_singularity(s, INFINITY), DMI_EINVAL);
+    CU_ASSERT_EQUAL(dmi_set_kernel_singularity(s, 0.0), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_kernel_singularity(s, NAN), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_init(s), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_kernel_singularity(s, 0.5), DMI_ESTATE);
+    dmi_free(&s);
+    /* not computable close to 0: refused with a message that says why, unless
+     * the exponent is given */
+    int rc;
+    char msg[512];
+    double W = first_W(coarse_power, NULL, one, 1.0, 8, NAN, &rc, msg);
+    CU_ASSERT_EQUAL(rc, DMI_ECALLBACK);
+    CU_ASSERT(strstr(msg, "dmi_set_kernel_singularity") != NULL);
+    W = first_W(coarse_power, NULL, one, 1.0, 8, 0.99, &rc, msg);
+    CU_ASSERT_EQUAL(rc, DMI_OK);
+    CU_ASSERT(core_close_rel("W^0 of s^-0.99 not computable below 1e-30, exponent given", W,
+                             100.0, 1e-10));
+}
+
+int main(int argc, char **argv)
+{
+    static const core_test tests[] = {
+        {"s^-alpha (1 + s) to 1e-10, alpha up to 0.99", test_power_cells},
+        {"near cells of s^-alpha (1 + s) to 1e-10", test_power_near_cells},
+        {"an exponent within rounding of 0", test_exponent_near_zero},
+        {"1/s, s^-1.5, 1/(s ln^2 s) refused naming cell 0", test_not_integrable_refused},
+        {"a refused kernel leaves the solver as it was", test_refusal_leaves_solver},
+        {"a jump inside a cell to 1e-10", test_jump_in_cell},
+        {"the kernel called strictly inside the cells", test_calls_inside_cells},
+        {"a kernel near the largest double", test_huge_kernel},
+        {"the exponent given by dmi_set_kernel_singularity", test_singularity_hint},
+        {NULL, NULL}};
+    return core_main(argc, argv, "cells", tests);
+}
