@@ -11,7 +11,7 @@ to one or more :class:`Record` with SciPy's trust-region ``least_squares`` and r
 """
 from __future__ import annotations
 
-from .estimate import Estimate, Record, estimate
+from .fitting import Estimate, Record, estimate
 from .profile import Profile, profile_likelihood
 from .sensitivity import Sensitivities, sensitivities
 

@@ -10,7 +10,7 @@ import math
 import numpy as np
 from scipy import optimize, stats
 
-from .estimate import Estimate, _index, _Problem
+from .fitting import Estimate, _index, _Problem
 
 
 @dataclasses.dataclass

@@ -424,8 +424,8 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
     outside = np.flatnonzero((p0 < lo) | (p0 > hi))
     if len(outside):
         j = outside[0]
-        raise ValueError(f"bounds exclude p0: {names[j]} = {p0[j]!r} is outside [{lo[j]!r}, "
-                         f"{hi[j]!r}]; move p0 or widen the bounds")
+        raise ValueError(f"bounds exclude p0: {names[j]} = {float(p0[j])!r} is outside "
+                         f"[{float(lo[j])!r}, {float(hi[j])!r}]; move p0 or widen the bounds")
     data = []
     for k, (r, mk) in enumerate(zip(records, makes)):
         try:
@@ -579,8 +579,9 @@ def _summarise(problem: _Problem, names: list, x: np.ndarray, cost: float, messa
         cov[idx[b], idx[b]] = np.inf
         stderr[idx[b]] = np.inf
     with np.errstate(invalid="ignore", divide="ignore"):
-        corr = cov / np.outer(stderr, stderr)
-    corr[~np.isfinite(corr) | (np.outer(stderr, stderr) == 0)] = np.nan
+        outer = np.outer(stderr, stderr)
+        corr = cov / outer
+    corr[~np.isfinite(corr) | (outer == 0) | ~np.isfinite(outer)] = np.nan
     rss = 2.0 * cost
     if known:
         aic, bic = rss + 2 * F, rss + F * math.log(M)
