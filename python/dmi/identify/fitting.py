@@ -247,6 +247,7 @@ class _Problem:
         self.makes, self.p0, self.free, self.data, self.rhs = makes, p0, free, data, rhs
         self.nfev = self.njev = 0
         self.jumps = True
+        self.bounds = (np.full(len(p0), -np.inf), np.full(len(p0), np.inf))
         self.best: tuple[float, np.ndarray] | None = None
         self._cache: tuple[bytes, np.ndarray, np.ndarray] | None = None
 
@@ -436,6 +437,7 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
             raise TypeError(f"make(p0) returned {type(s).__name__}; expected a dmi.Solver")
         data.append(_check_record(r, k, s.n))
     problem = _Problem(makes, p0, mask, data, rhs)
+    problem.bounds = (lo, hi)
     starts = _starts(multistart, p0, lo, hi, seed)
     fits = []
     for x_start in starts:

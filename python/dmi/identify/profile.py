@@ -32,7 +32,7 @@ class Profile:
         cost * F(level; 1, dof) / dof.
     interval : tuple of float
         The likelihood-ratio interval (low, high); an end the profile did not reach within
-        ``max_steps`` is -inf or inf.
+        ``max_steps`` or within the fit's bounds is -inf or inf.
     wald : tuple of float
         The covariance (Wald) interval.
     level : float
@@ -111,9 +111,10 @@ def profile_likelihood(estimate: Estimate, index: int | str, *, level: float = 0
         q = start.copy()
         q[i] = v
         sub = _Problem(base.makes, q, free, base.data, base.rhs)
+        lo, hi = base.bounds
         if free.any():
             res = optimize.least_squares(sub.residuals, q[free], jac=sub.jacobian, method="trf",
-                                         x_scale="jac")
+                                         x_scale="jac", bounds=(lo[free], hi[free]))
             out = (float(res.cost), sub.full(res.x))
         else:
             r = sub.residuals(np.empty(0))
@@ -128,6 +129,8 @@ def profile_likelihood(estimate: Estimate, index: int | str, *, level: float = 0
         end = sign * math.inf
         for k in range(1, max_steps + 1):
             v = float(p_hat[i] + sign * k * step)
+            if not base.bounds[0][i] <= v <= base.bounds[1][i]:
+                break                    # the fit's bounds: the end is not reached within them
             cur = prof(v, prev[1])
             if cur[0] - c_hat > thr:
                 def excess(x: float, _start: np.ndarray = prev[1]) -> float:

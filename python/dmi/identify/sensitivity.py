@@ -21,6 +21,7 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+from scipy.signal import fftconvolve
 
 from .._solver import Solver
 
@@ -207,7 +208,6 @@ class _Memory:
             self.G = None
             return
         # the kernel's part for all steps at once: dWU[p, :, j] = sum_l dG_j[l] U^{p-l}
-        from scipy.signal import fftconvolve
         conv = fftconvolve(dG.transpose(1, 0, 2, 3), Uext[:, None, None, :], axes=0)
         conv = conv.sum(axis=3)                       # (N + L - 1, P, n)
         self.dWU = conv[N - 1:N - 1 + len(Uext) - N].transpose(0, 2, 1)   # (steps + 1, n, P)
