@@ -208,9 +208,12 @@ class _Memory:
             self.G = None
             return
         # the kernel's part for all steps at once: dWU[p, :, j] = sum_l dG_j[l] U^{p-l}
-        conv = fftconvolve(dG.transpose(1, 0, 2, 3), Uext[:, None, None, :], axes=0)
-        conv = conv.sum(axis=3)                       # (N + L - 1, P, n)
-        self.dWU = conv[N - 1:N - 1 + len(Uext) - N].transpose(0, 2, 1)   # (steps + 1, n, P)
+        # (one FFT convolution per parameter: memory O((N + steps) n^2), not times P)
+        steps = len(Uext) - N
+        self.dWU = np.empty((steps, n, P))
+        for j in range(P):
+            conv = fftconvolve(dG[j], Uext[:, None, :], axes=0).sum(axis=2)   # (N + L - 1, n)
+            self.dWU[:, :, j] = conv[N - 1:N - 1 + steps]
         self.Z = None
 
     def _recompute(self, Sall: np.ndarray, p: int) -> None:
