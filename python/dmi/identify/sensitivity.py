@@ -296,12 +296,15 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     # S of the history: dz(t_q)/dp for q = -N, ..., 0
     Sall = np.zeros((N + steps + 1, n, P))
     if s.has("history") or any(o.has("history") for o in mod.others):
-        times = -np.arange(N, -1, -1) * h
-        times[0] = -s.tau
+        # without a kernel the scheme reads the history at t = 0 only
+        first = 0 if s.kernel_kind else N
+        times = -np.arange(N - first, -1, -1) * h
+        if first == 0:
+            times[0] = -s.tau
         z0 = np.array([s.eval_history(x) for x in times])
         for j, other in enumerate(mod.others):
             zj = np.array([other.eval_history(x) for x in times])
-            Sall[:N + 1, :, j] = (zj - z0) / mod.delta[j]
+            Sall[first:N + 1, :, j] = (zj - z0) / mod.delta[j]
     Uext = np.concatenate([window[1:], U[1:]])                       # U^{-N+1}, ..., U^steps
     memory = _Memory(mod, Uext, P)
     # the resolvent's derivatives in p, as they do not depend on the step
@@ -310,6 +313,9 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     dalpha = dlo = dhi = None
     if kind == "friction":
         dalpha = np.stack([(o.friction - alpha) / d for o, d in zip(mod.others, mod.delta)], axis=1)
+        # R' (1 slipping, 0 stuck) and dR/dp = -h sign(X) dalpha where slipping, for every step
+        slipping = (U[1:] != 0.0).astype(float)
+        dR = (-h * np.sign(X) * slipping)[:, :, None] * dalpha[None]
     elif kind == "box":
         lo, hi = s.box
         dlo = np.stack([_bound_diff(o.box[0], lo) / d for o, d in zip(mod.others, mod.delta)], axis=1)
@@ -335,8 +341,8 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
         dX[q] = T
         Snew = Sall[q + 1 + N]
         if kind == "friction":
-            slip = U[q + 1] != 0.0
-            Snew[:] = np.where(slip[:, None], T - h * np.sign(X[q])[:, None] * dalpha, 0.0)
+            np.multiply(T, slipping[q][:, None], out=Snew)
+            Snew += dR[q]
             if jumps:
                 _reversals(q, U, phi, alpha, dalpha, T, Snew, h, switches)
         elif kind == "box":
