@@ -86,6 +86,24 @@ def test_fixed_parameters_and_bounds():
     assert est.jacobian.shape[1] == 2
 
 
+def test_friction_force_and_complex_step_in_a_fit():
+    """Records of the friction force (X - U)/h through observe, with rhs by complex step."""
+    make = memory_oscillator(h=0.02)
+    s = make(TRUE)
+    s.init()
+    t, U, X = s.run_terms(300)
+    force = (X[:, 1] - U[1:, 1]) / s.h
+    assert np.any(np.abs(force) < TRUE[0] - 1e-9) and np.any(np.abs(np.abs(force) - TRUE[0]) < 1e-12)
+
+    def rhs(t, u, p):
+        return np.array([-u[1], p[1] * u[0] + 2.0 * np.cos(0.8 * t)])
+    recs = [Record(t[1:], force, observe=lambda t, u, a: a[1]), Record(t[::3], U[::3, 0])]
+    p0 = TRUE.copy()
+    p0[:2] *= 1.2
+    est = estimate([make, make], p0, recs, names=NAMES, free=["mu", "k"], rhs=rhs)
+    assert est.success and np.abs(est.p[:2] / TRUE[:2] - 1).max() < 1e-8, (est.p, est.message)
+
+
 def coulomb_oscillator(h=0.02):
     def make(p):
         mu, k = p

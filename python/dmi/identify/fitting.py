@@ -312,11 +312,17 @@ class _Problem:
         p = self.full(x)
         idx = np.flatnonzero(self.free)
         rows, res = [], []
+        rhs = None
+        if self.rhs is not None:
+            def rhs(t: float, u: np.ndarray, q: np.ndarray) -> Any:
+                pc = self.p0.astype(complex)
+                pc[self.free] = q
+                return self.rhs(t, u, pc)
         for make, d in zip(self.makes, self.data):
             def make_free(q: np.ndarray, _make: Callable = make) -> Solver:
                 return _make(self.full(q))
             s0 = make(p.copy())
-            sens: Sensitivities = sensitivities(make_free, p[idx], self._steps(s0, d), rhs=self.rhs,
+            sens: Sensitivities = sensitivities(make_free, p[idx], self._steps(s0, d), rhs=rhs,
                                                  jumps=self.jumps)
             val, der = self._predict(d, sens.t, sens.h, sens.u, sens.x, sens.S, sens.dx)
             res.append(((val - d.y) * d.w).ravel())
@@ -328,10 +334,6 @@ class _Problem:
 
 
 # ---- the fit --------------------------------------------------------------------------------------
-
-class _Stop(Exception):
-    """Raised by the progress callback to end the fit at the current point."""
-
 
 def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarray], Solver]],
              p0: Any, records: Record | Sequence[Record], *, names: Sequence[str] | None = None,
