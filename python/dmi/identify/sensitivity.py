@@ -296,15 +296,10 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     # S of the history: dz(t_q)/dp for q = -N, ..., 0
     Sall = np.zeros((N + steps + 1, n, P))
     if s.has("history") or any(o.has("history") for o in mod.others):
-        # without a kernel the scheme reads the history at t = 0 only
-        first = 0 if s.kernel_kind else N
-        times = -np.arange(N - first, -1, -1) * h
-        if first == 0:
-            times[0] = -s.tau
-        z0 = np.array([s.eval_history(x) for x in times])
+        # each perturbed model samples its own history in init, as the scheme does
         for j, other in enumerate(mod.others):
-            zj = np.array([other.eval_history(x) for x in times])
-            Sall[first:N + 1, :, j] = (zj - z0) / mod.delta[j]
+            other.init()
+            Sall[:N + 1, :, j] = (other.get_window() - window) / mod.delta[j]
     Uext = np.concatenate([window[1:], U[1:]])                       # U^{-N+1}, ..., U^steps
     memory = _Memory(mod, Uext, P)
     # the resolvent's derivatives in p, as they do not depend on the step
