@@ -311,6 +311,8 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
         # R' (1 slipping, 0 stuck) and dR/dp = -h sign(X) dalpha where slipping, for every step
         slipping = (U[1:] != 0.0).astype(float)
         dR = (-h * np.sign(X) * slipping)[:, :, None] * dalpha[None]
+        # the steps where a slipping friction component meets zero or changes sign
+        meets = np.any((U[:-1] != 0.0) & (U[:-1] * U[1:] <= 0.0) & (alpha > 0.0), axis=1)
     elif kind == "box":
         lo, hi = s.box
         dlo = np.stack([_bound_diff(o.box[0], lo) / d for o, d in zip(mod.others, mod.delta)], axis=1)
@@ -338,7 +340,7 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
         if kind == "friction":
             np.multiply(T, slipping[q][:, None], out=Snew)
             Snew += dR[q]
-            if jumps:
+            if jumps and meets[q]:
                 _reversals(q, U, phi, alpha, dalpha, T, Snew, h, switches)
         elif kind == "box":
             below, above = X[q] < lo, X[q] > hi
