@@ -134,7 +134,7 @@ def test_box_and_resolvent_callback_against_central_differences():
 
 def test_complex_step_rhs_matches_differences():
     make = smooth_model()
-    k, c = P_SMOOTH[0], P_SMOOTH[1]
+    k = P_SMOOTH[0]
 
     def rhs(t, u, p):
         return np.array([-u[1], p[0] * np.sin(u[0]) + p[1] * u[1] * np.sqrt(u[1] * u[1]) + np.cos(t),
@@ -147,7 +147,6 @@ def test_complex_step_rhs_matches_differences():
     with pytest.raises(ValueError, match="disagrees"):
         sensitivities(make, P_SMOOTH, 10,
                       rhs=lambda t, u, p: rhs(t, u, p) + np.array([0, 0, 1e-3 * (p[0] - k)]))
-    assert c == P_SMOOTH[1]
 
 
 # ---- through switches: an event-driven integration of the equation ---------------------------------
@@ -227,7 +226,7 @@ def oscillator(h, mu, k=1.0, g=2.0, om=0.8, w0=0.3, c=0.0, a=-5.0, tau=1.0):
     return make
 
 
-def test_event_driven_reference_is_the_issue_value_and_its_own_differences():
+def test_event_driven_reference_is_the_measured_value_and_its_own_differences():
     _, S = event_driven(6.0, 0.5)
     assert abs(S[0, 0] + 2.967) < 1.5e-3 and abs(S[1, 0] - 2.359) < 1.5e-3
     d = 1e-6

@@ -169,7 +169,6 @@ class _Memory:
         self.N, n = s.N, s.n
         N = self.N
         kind = s.kernel_kind
-        self.kind = kind
         self.recursive = False
         if kind == "exp":
             a, b, C, D = s.kernel_terms
@@ -187,7 +186,7 @@ class _Memory:
             # the recursion: Z_k^p = sum_l r_k^l S^{p-l} (all N cells), then the last cell mended
             self.recursive = bool(np.all(a <= 0.0) and np.all(np.abs(b) * s.h <= math.pi))
             if self.recursive:
-                self.lam, self.E = lam, E * c[:, None, None]
+                self.E = E * c[:, None, None]
                 self.r = np.exp(lam * s.h)
                 self.rN = np.exp(lam * s.h * N)
                 self.powers = np.exp(np.outer(lam, np.arange(N) * s.h))          # (K, N)
