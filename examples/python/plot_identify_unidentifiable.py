@@ -67,7 +67,7 @@ def measure(mk, p, comps, steps, rng):
 rng = np.random.default_rng(7)
 t, y = measure(make, [1.0, 0.2, 1.0], [0, 2], 500, rng)
 est = identify.estimate(make, [0.8, 0.3, 0.5], identify.Record(t, y, components=[0, 2], sigma=SIGMA),
-                        names=["k", "c", "mu"], bounds=([0, 0, 0.31], [5, 5, 10]))
+                        names=["k", "c", "mu"], bounds=([0, 0, 0], [5, 5, 10]))
 print(f"fit: {est.message}")
 for name, pv, se in zip(est.names, est.p, est.stderr):
     print(f"  {name:3} {pv:9.5f} +- {se:.5f}")
@@ -96,7 +96,8 @@ ax[1].plot(prof.values, prof.cost - est.cost, "o-")
 ax[1].axhline(prof.threshold, color="r", lw=0.8, label="95 % threshold")
 ax[1].set_xlabel("mu")
 ax[1].set_ylabel("cost - least cost")
-ax[1].set_title("profile of the friction level: flat")
+ax[1].set_yscale("symlog")
+ax[1].set_title("profile of the friction level: flat above 0.3")
 ax[1].legend()
 fig.tight_layout()
 if os.environ.get("DMI_FIGURE"):
