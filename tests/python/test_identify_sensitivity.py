@@ -363,3 +363,18 @@ def test_parameters_that_change_the_structure_are_refused():
         sensitivities(make, [float("nan")], 10)
     with pytest.raises(ValueError, match="steps"):
         sensitivities(make_conv, [1.0], 0)
+
+
+def test_a_failing_callback_of_a_perturbed_model_names_the_call():
+    def make(p):
+        s = dmi.Solver(1, 1.0, 10)
+
+        def f(t, u):
+            if p[0] != 1.0 and t > 0.35:     # only the perturbed model fails, through eval_rhs
+                raise RuntimeError("f fails")
+            return np.array([p[0]])
+        s.set_rhs(f)
+        return s
+    with pytest.raises(RuntimeError, match="f fails") as e:
+        sensitivities(make, [1.0], 10)
+    assert any("raised by the model's rhs at t = 0.4" in note for note in e.value.__notes__)
