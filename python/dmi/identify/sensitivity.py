@@ -168,6 +168,7 @@ class _Memory:
         s = mod.base
         self.N, n = s.N, s.n
         N = self.N
+        self._flat: np.ndarray | None = None
         kind = s.kernel_kind
         self.recursive = False
         if kind == "exp":
@@ -187,8 +188,8 @@ class _Memory:
             self.recursive = bool(np.all(a <= 0.0) and np.all(np.abs(b) * s.h <= math.pi))
             if self.recursive:
                 self.E = E * c[:, None, None]
-                self.r = np.exp(lam * s.h)
-                self.rN = np.exp(lam * s.h * N)
+                self.r = np.exp(lam * s.h)[:, None, None]
+                self.rN = np.exp(lam * s.h * N)[:, None, None]
                 self.powers = np.exp(np.outer(lam, np.arange(N) * s.h))          # (K, N)
                 full_last = np.einsum("k,kij->ij", self.powers[:, N - 1], self.E).real
                 self.last = self.G[N - 1] - full_last
@@ -228,14 +229,17 @@ class _Memory:
                 self._recompute(Sall, p)
             out = np.einsum("kij,kjq->iq", self.E, self.Z).real
             return out + self.last @ Sall[p + 1]
-        window = Sall[p + 1:p + N + 1][::-1]
-        return np.einsum("lij,ljq->iq", self.G, window)
+        # sum_l G_l S^{p-l} = sum_m G_{N-1-m} S^{p-N+1+m}: one matrix product on the stored rows
+        if self._flat is None:
+            n = self.G.shape[1]
+            self._flat = np.ascontiguousarray(self.G[::-1].transpose(1, 0, 2).reshape(n, N * n))
+        rows = Sall[p + 1:p + N + 1]
+        return self._flat @ rows.reshape(N * rows.shape[1], rows.shape[2])
 
     def push(self, Sall: np.ndarray, p: int) -> None:
         """Advances Z from step p to p + 1 once S^{p+1} is in Sall."""
         if self.recursive and self.Z is not None:
-            self.Z = (self.r[:, None, None] * self.Z + Sall[p + 1 + self.N][None]
-                      - self.rN[:, None, None] * Sall[p + 1][None])
+            self.Z = self.r * self.Z + (Sall[p + 1 + self.N] - self.rN * Sall[p + 1])
             self.since += 1
 
 
@@ -329,8 +333,9 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
             Fd = _complex_directions(rhs, t[q], U[q], p, Sq)
         elif has_f:
             f0 = s.eval_rhs(t[q], U[q])
-            for j, other in enumerate(mod.others):
-                Fd[:, j] = (other.eval_rhs(t[q], U[q] + mod.delta[j] * Sq[:, j]) - f0) / mod.delta[j]
+            moved = U[q] + mod.delta[:, None] * Sq.T                  # (P, n): U + delta_j S_j
+            Fd = (np.array([o.eval_rhs(t[q], m) for o, m in zip(mod.others, moved)]).T
+                  - f0[:, None]) / mod.delta
         T = Sq - h * Fd
         if memory.G is not None:
             T -= h * (memory.sum_S(Sall, q) + memory.dWU[q])
