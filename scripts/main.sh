@@ -92,6 +92,14 @@ stage "dmi.analysis: a stick-slip orbit of the equation with memory by collocati
 PYTHONPATH="$build/python" MPLBACKEND=Agg DMI_FIGURE="$out/collocation_stickslip.png" "$py" \
   examples/python/plot_collocation_stickslip.py | tee "$out/collocation_stickslip.txt"
 
+stage "dmi.identify: a friction oscillator with a viscoelastic memory identified from noisy data"
+PYTHONPATH="$build/python" MPLBACKEND=Agg DMI_FIGURE="$out/identify_friction_memory.png" "$py" \
+  examples/python/plot_identify_friction_memory.py | tee "$out/identify_friction_memory.txt"
+
+stage "dmi.identify: data that leave the friction level undetermined, and the fit saying so"
+PYTHONPATH="$build/python" MPLBACKEND=Agg DMI_FIGURE="$out/identify_unidentifiable.png" "$py" \
+  examples/python/plot_identify_unidentifiable.py | tee "$out/identify_unidentifiable.txt"
+
 stage "figures and comparison with the paper and ../shared/reference"
 refarg=()
 if [[ -d $ref ]]; then

@@ -8,7 +8,7 @@ import math
 import operator
 import threading
 import warnings
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any
 
@@ -1000,19 +1000,21 @@ class Solver:
         bound = self._keep.get(part)
         return bound is not None and bound.address is not None
 
-    def _call_slot(self, slot: str, fn_type: Any, args: tuple, size: int, what: str) -> np.ndarray:
+    def _call_slot(self, slot: str, fn_type: Any, args: tuple, size: int,
+                   what: Callable[[], str]) -> np.ndarray:
         """Calls the C-level function of ``slot`` (libdmi's signature) with args and an output of
-        ``size`` doubles: a Python callback's exception is raised as it is, with a note."""
+        ``size`` doubles: a Python callback's exception is raised as it is, with a note; ``what()``
+        names the call in that note (built only on failure: a repr of u costs more than a call)."""
         out = np.zeros(size)
         bound = self._keep[slot]
         rc = fn_type(bound.address)(*args, out.ctypes.data, bound.user)
         failure, self._failure[0] = self._failure[0], None
         if failure is not None:
-            failure.add_note(f"raised by the model's {what}")
+            failure.add_note(f"raised by the model's {what()}")
             raise failure
         self._raise_jit(_lib.ECALLBACK if rc != 0 else rc)
         if rc != 0:
-            raise Error(_lib.ECALLBACK, f"the model's {what} returned {rc}")
+            raise Error(_lib.ECALLBACK, f"the model's {what()} returned {rc}")
         return out
 
     def eval_rhs(self, t: float, u: Any) -> np.ndarray:
@@ -1041,7 +1043,7 @@ class Solver:
         if not self.has("rhs"):
             return np.zeros(self._n)
         return self._call_slot("rhs", _lib.RhsFn, (float(t), x.ctypes.data), self._n,
-                               f"rhs at t = {float(t)!r}, u = {x!r}")
+                               lambda: f"rhs at t = {float(t)!r}, u = {x!r}")
 
     def eval_resolvent(self, lam: float, x: Any) -> np.ndarray:
         """(I + lam A)^-1 x (n,): the built-in friction (soft threshold by lam alpha), box (a
@@ -1073,7 +1075,7 @@ class Solver:
             return np.clip(x, self._resolvent[1], self._resolvent[2])
         if kind == "callback":
             return self._call_slot("resolvent", _lib.ResolventFn, (float(lam), x.ctypes.data),
-                                   self._n, f"resolvent at lam = {float(lam)!r}, x = {x!r}")
+                                   self._n, lambda: f"resolvent at lam = {float(lam)!r}, x = {x!r}")
         return x.copy()
 
     def eval_kernel(self, s: float) -> np.ndarray:
@@ -1105,7 +1107,7 @@ class Solver:
                                                                               axes=1)
         if kind == "callback":
             return self._call_slot("kernel", _lib.KernelFn, (float(s),), n * n,
-                                   f"kernel at s = {float(s)!r}").reshape(n, n)
+                                   lambda: f"kernel at s = {float(s)!r}").reshape(n, n)
         return np.zeros((n, n))
 
     def eval_kernel_near(self, s: float) -> np.ndarray:
@@ -1130,7 +1132,7 @@ class Solver:
         if not self.has("kernel_near"):
             return np.zeros((n, n))
         return self._call_slot("kernel_near", _lib.KernelFn, (float(s),), n * n,
-                               f"near kernel at s = {float(s)!r}").reshape(n, n)
+                               lambda: f"near kernel at s = {float(s)!r}").reshape(n, n)
 
     def eval_history(self, t: float) -> np.ndarray:
         """z(t) of :meth:`set_history` (zero without one).
@@ -1153,7 +1155,7 @@ class Solver:
         if not self.has("history"):
             return np.zeros(self._n)
         return self._call_slot("history", _lib.HistoryFn, (float(t),), self._n,
-                               f"history at t = {float(t)!r}")
+                               lambda: f"history at t = {float(t)!r}")
 
     def eval_rhs_many(self, t: Any, U: Any) -> np.ndarray:
         """f(t_c, U_c) of :meth:`set_rhs` at many points (zero without one), through the same

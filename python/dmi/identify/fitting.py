@@ -1,0 +1,631 @@
+# dmi.identify.estimate: least-squares fits of a model's parameters to measured records.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""Records, the weighted residuals and their Jacobian from :func:`sensitivities`, SciPy's
+trust-region ``least_squares``, and the :class:`Estimate` with its covariance and the parameter
+combinations the data cannot determine."""
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+from scipy import optimize, stats
+
+from .._solver import Solver
+from .sensitivity import Sensitivities, sensitivities
+
+#: Singular values of the column-normalised Jacobian below this fraction of the largest one mark
+#: a parameter combination as not determined by the data.
+RCOND = 1e-6
+
+
+@dataclasses.dataclass
+class Record:
+    """One measured record.
+
+    Attributes
+    ----------
+    t : array_like, shape (m,)
+        Measurement times, increasing, >= 0 (time units; anywhere in the run: the model's U and S
+        are interpolated linearly between steps).
+    y : array_like, shape (m,) or (m, k)
+        The measurements: one observed quantity, or k of them.
+    components : sequence of int, optional
+        The state components observed (k of them); default: component 0 for a 1-D y, else the
+        first k.  Ignored with ``observe``.
+    observe : callable, optional
+        ``observe(t, u, a) -> (k,)``: the observed quantities as a function of the time, the state
+        u and the element a = (X - U)/h of A(u) the scheme selects (the friction force, the
+        contact force); differentiated by directional differences.
+    sigma : float or array_like, optional
+        Noise level(s) (units of y): a number, (k,) per quantity or (m, k) per value.  Given, the
+        covariance is the inverse of J^T J; not given, it is scaled by the residual variance.
+    """
+
+    t: Any
+    y: Any
+    components: Sequence[int] | None = None
+    observe: Callable[[float, np.ndarray, np.ndarray], Any] | None = None
+    sigma: Any = None
+
+
+@dataclasses.dataclass
+class Estimate:
+    """The result of :func:`estimate`.
+
+    Attributes
+    ----------
+    p : numpy.ndarray, shape (P,)
+        All parameters, the fixed ones as given.
+    names : list of str
+        Their names.
+    free : numpy.ndarray of bool, shape (P,)
+        Which were fitted.
+    cov : numpy.ndarray, shape (P, P)
+        Covariance of the fitted parameters (zero rows for fixed ones; inf on the diagonal of a
+        parameter in an undetermined combination).
+    stderr : numpy.ndarray, shape (P,)
+        Standard errors, sqrt of cov's diagonal (0 for a fixed parameter, inf for an undetermined
+        one).
+    corr : numpy.ndarray, shape (P, P)
+        Correlations (NaN where a standard error is 0 or inf).
+    residuals : numpy.ndarray, shape (M,)
+        Weighted residuals (model - data) / sigma of all records, in order.
+    jacobian : numpy.ndarray, shape (M, F)
+        Jacobian of the weighted residuals in the F free parameters.
+    cost : float
+        0.5 * sum(residuals**2), SciPy's cost.
+    aic, bic : float
+        Akaike's and Schwarz's criteria (with sigma given: 2 cost + 2F and 2 cost + F log M;
+        without: M log(2 cost / M) + 2F and M log(2 cost / M) + F log M).
+    success : bool
+        Whether the fit converged and decreased the cost (or started at a zero cost).
+    message : str
+        SciPy's message, or why the fit failed or stopped, with the last cost.
+    unidentifiable : list of str
+        The parameter combinations the data do not determine, named (e.g. ``"1.00*mu"``, or
+        ``"0.71*C0 - 0.71*C1"`` in relative units: coefficient times parameter / |parameter|).
+    nfev, njev : int
+        Model runs for residuals, and sensitivity runs (iterations).
+    dof : int
+        Degrees of freedom M - F.
+    sigma_known : bool
+        Whether every record gave sigma.
+    starts : list of tuple
+        (p0, cost) of each start of ``multistart``.
+    """
+
+    p: np.ndarray
+    names: list
+    free: np.ndarray
+    cov: np.ndarray
+    stderr: np.ndarray
+    corr: np.ndarray
+    residuals: np.ndarray
+    jacobian: np.ndarray
+    cost: float
+    aic: float
+    bic: float
+    success: bool
+    message: str
+    unidentifiable: list
+    nfev: int
+    njev: int
+    dof: int
+    sigma_known: bool
+    starts: list
+    _problem: Any = dataclasses.field(default=None, repr=False)
+
+    def wald_interval(self, index: int | str, level: float = 0.95) -> tuple[float, float]:
+        """The Wald (covariance) interval of one parameter.
+
+        Parameters
+        ----------
+        index : int or str
+            The parameter, by position or name.
+        level : float, optional
+            Confidence level in (0, 1).
+
+        Returns
+        -------
+        tuple of float
+            (low, high): p +- q stderr, q the normal quantile with sigma known, else Student's
+            with dof degrees of freedom.
+
+        Raises
+        ------
+        ValueError
+            An unknown parameter or a level outside (0, 1).
+        """
+        i = _index(index, self.names)
+        if not 0.0 < level < 1.0:
+            raise ValueError(f"level = {level!r}: expected a number in (0, 1)")
+        q = _quantile(level, self.dof, self.sigma_known)
+        return self.p[i] - q * self.stderr[i], self.p[i] + q * self.stderr[i]
+
+
+def _quantile(level: float, dof: int, known: bool) -> float:
+    if known:
+        return float(stats.norm.ppf(0.5 + level / 2))
+    return float(stats.t.ppf(0.5 + level / 2, max(dof, 1)))
+
+
+def _index(index: int | str, names: list) -> int:
+    if isinstance(index, str):
+        if index not in names:
+            raise ValueError(f"parameter {index!r} is not one of {names}")
+        return names.index(index)
+    i = int(index)
+    if not 0 <= i < len(names):
+        raise ValueError(f"parameter index {index!r} outside 0 .. {len(names) - 1}")
+    return i
+
+
+# ---- the records --------------------------------------------------------------------------------
+
+@dataclasses.dataclass
+class _Data:
+    """A checked record: times, data (m, k), weights 1/sigma (m, k), what is observed."""
+
+    t: np.ndarray
+    y: np.ndarray
+    w: np.ndarray
+    components: list | None
+    observe: Callable | None
+    sigma_known: bool
+
+
+def _check_record(r: Any, k_index: int, n: int) -> _Data:
+    if not isinstance(r, Record):
+        raise TypeError(f"records[{k_index}] is a {type(r).__name__}; expected a dmi.identify.Record")
+    where = f"records[{k_index}]"
+    t = np.asarray(r.t, dtype=float)
+    if t.ndim != 1 or len(t) == 0:
+        raise ValueError(f"{where}.t has shape {t.shape}; expected (m,), m >= 1 times")
+    if not np.all(np.isfinite(t)):
+        raise ValueError(f"{where}.t has NaN or infinite times")
+    if t[0] < 0.0:
+        raise ValueError(f"{where}.t starts at {t[0]!r} < 0: times outside the run (it starts at "
+                         "t = 0; the history is not measured)")
+    if np.any(np.diff(t) < 0):
+        raise ValueError(f"{where}.t is not increasing")
+    y = np.asarray(r.y, dtype=float)
+    if y.ndim == 1:
+        y = y[:, None]
+    if y.ndim != 2 or y.shape[0] != len(t):
+        raise ValueError(f"{where}.y has shape {np.shape(r.y)}; expected ({len(t)},) or ({len(t)}, k)")
+    if not np.all(np.isfinite(y)):
+        bad = np.argwhere(~np.isfinite(y))[0]
+        raise ValueError(f"{where}.y has NaN or infinite values (first at row {bad[0]}, column "
+                         f"{bad[1]}); drop those rows")
+    k = y.shape[1]
+    comps = None
+    if r.observe is None:
+        comps = list(range(k)) if r.components is None else [int(c) for c in r.components]
+        if len(comps) != k:
+            raise ValueError(f"{where}: {len(comps)} components {comps} for y of {k} columns")
+        if any(not 0 <= c < n for c in comps):
+            raise ValueError(f"{where}.components {comps}: the state has components 0 .. {n - 1}")
+    if r.sigma is None:
+        w = np.ones_like(y)
+    else:
+        sig = np.asarray(r.sigma, dtype=float)
+        try:
+            sig = np.broadcast_to(sig, y.shape)
+        except ValueError:
+            raise ValueError(f"{where}.sigma has shape {sig.shape}; expected a number, ({k},) or "
+                             f"{y.shape}") from None
+        if not np.all(np.isfinite(sig) & (sig > 0)):
+            raise ValueError(f"{where}.sigma: noise levels must be finite and > 0")
+        w = 1.0 / sig
+    return _Data(t, y, w, comps, r.observe, r.sigma is not None)
+
+
+def _interp(grid_t: np.ndarray, h: float, t: np.ndarray, V: np.ndarray) -> np.ndarray:
+    """V (steps + 1, ...) at the times t, linearly between steps."""
+    x = t / h
+    i = np.minimum(np.floor(x).astype(int), len(grid_t) - 2)
+    i = np.maximum(i, 0)
+    f = (x - i).reshape((-1,) + (1,) * (V.ndim - 1))
+    return (1.0 - f) * V[i] + f * V[i + 1]
+
+
+def _forces(U: np.ndarray, X: np.ndarray, h: float) -> np.ndarray:
+    """a^p = (X^{p-1} - U^p) / h at each step, a^0 = a^1."""
+    a = np.empty_like(U)
+    a[1:] = (X - U[1:]) / h
+    a[0] = a[1]
+    return a
+
+
+class _Problem:
+    """The residuals of all records as a function of the free parameters."""
+
+    def __init__(self, makes: list, p0: np.ndarray, free: np.ndarray, data: list, rhs: Any):
+        self.makes, self.p0, self.free, self.data, self.rhs = makes, p0, free, data, rhs
+        self.nfev = self.njev = 0
+        self.jumps = True
+        self.bounds = (np.full(len(p0), -np.inf), np.full(len(p0), np.inf))
+        self.best: tuple[float, np.ndarray] | None = None
+        self._cache: tuple[bytes, np.ndarray, np.ndarray] | None = None
+
+    def full(self, x: np.ndarray) -> np.ndarray:
+        p = self.p0.copy()
+        p[self.free] = x
+        return p
+
+    def _steps(self, s: Solver, d: _Data) -> int:
+        return max(1, math.ceil(d.t[-1] / s.h - 1e-9))
+
+    def _predict(self, d: _Data, t_grid: np.ndarray, h: float, U: np.ndarray, X: np.ndarray,
+                 S: np.ndarray | None, dX: np.ndarray | None) -> tuple[np.ndarray, np.ndarray | None]:
+        """The model's values (m, k) at the record's times and their derivatives (m, k, F)."""
+        if d.observe is None:
+            val = _interp(t_grid, h, d.t, U[:, d.components])
+            der = None if S is None else _interp(t_grid, h, d.t, S[:, d.components, :])
+            return val, der
+        a = _forces(U, X, h)
+        ui, ai = _interp(t_grid, h, d.t, U), _interp(t_grid, h, d.t, a)
+        val = np.array([np.asarray(d.observe(tt, uu, aa), dtype=float).reshape(-1)
+                        for tt, uu, aa in zip(d.t, ui, ai)])
+        if val.shape != d.y.shape:
+            raise ValueError(f"observe returned {val.shape[1:]} values per time; the record has "
+                             f"{d.y.shape[1]}")
+        if S is None:
+            return val, None
+        dA = np.empty_like(S)
+        dA[1:] = (dX - S[1:]) / h
+        dA[0] = dA[1]
+        Si, dAi = _interp(t_grid, h, d.t, S), _interp(t_grid, h, d.t, dA)
+        der = np.empty(val.shape + (S.shape[2],))
+        for m in range(len(d.t)):
+            scale = max(1.0, float(np.abs(ui[m]).max()), float(np.abs(ai[m]).max()))
+            for j in range(S.shape[2]):
+                norm = max(1.0, float(np.abs(Si[m, :, j]).max()), float(np.abs(dAi[m, :, j]).max()))
+                eps = 2.0 ** -26 * scale / norm
+                up = d.observe(d.t[m], ui[m] + eps * Si[m, :, j], ai[m] + eps * dAi[m, :, j])
+                der[m, :, j] = (np.asarray(up, dtype=float).reshape(-1) - val[m]) / eps
+        return val, der
+
+    def residuals(self, x: np.ndarray) -> np.ndarray:
+        p = self.full(x)
+        out = []
+        for make, d in zip(self.makes, self.data):
+            s = make(p.copy())
+            s.init()
+            t_grid, U, X = s.run_terms(self._steps(s, d))
+            val, _ = self._predict(d, t_grid, s.h, U, X, None, None)
+            out.append(((val - d.y) * d.w).ravel())
+        r = np.concatenate(out)
+        self.nfev += 1
+        cost = 0.5 * float(r @ r)
+        if np.isfinite(cost) and (self.best is None or cost < self.best[0]):
+            self.best = (cost, x.copy())
+        return r
+
+    def jacobian(self, x: np.ndarray) -> np.ndarray:
+        key = x.tobytes() + bytes([self.jumps])
+        if self._cache is not None and self._cache[0] == key:
+            return self._cache[2]
+        p = self.full(x)
+        idx = np.flatnonzero(self.free)
+        rows, res = [], []
+        rhs = None
+        if self.rhs is not None:
+            def rhs(t: float, u: np.ndarray, q: np.ndarray) -> Any:
+                pc = self.p0.astype(complex)
+                pc[self.free] = q
+                return self.rhs(t, u, pc)
+        for make, d in zip(self.makes, self.data):
+            def make_free(q: np.ndarray, _make: Callable = make) -> Solver:
+                return _make(self.full(q))
+            s0 = make(p.copy())
+            sens: Sensitivities = sensitivities(make_free, p[idx], self._steps(s0, d), rhs=rhs,
+                                                 jumps=self.jumps)
+            val, der = self._predict(d, sens.t, sens.h, sens.u, sens.x, sens.S, sens.dx)
+            res.append(((val - d.y) * d.w).ravel())
+            rows.append((der * d.w[:, :, None]).reshape(-1, len(idx)))
+        J = np.concatenate(rows)
+        self.njev += 1
+        self._cache = (key, np.concatenate(res), J)
+        return J
+
+
+# ---- the fit --------------------------------------------------------------------------------------
+
+def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarray], Solver]],
+             p0: Any, records: Record | Sequence[Record], *, names: Sequence[str] | None = None,
+             free: Any = None, bounds: tuple[Any, Any] | None = None, x_scale: Any = "jac",
+             loss: str = "linear", multistart: int | Sequence[Any] | None = None, seed: int = 0,
+             max_nfev: int | None = None, callback: Callable[[dict], Any] | None = None,
+             verbose: bool = False, polish: bool = True,
+             rhs: Callable[[float, np.ndarray, np.ndarray], np.ndarray] | None = None) -> Estimate:
+    """Fits the parameters of ``make(p) -> dmi.Solver`` to measured records by SciPy's
+    trust-region ``least_squares`` with the Jacobian of :func:`sensitivities`.
+
+    Parameters
+    ----------
+    make : callable or sequence of callables
+        ``make(p) -> dmi.Solver`` for the full parameter vector p; a sequence: one model per record
+        (several experiments: each takes the full p and uses its shared and its own parameters,
+        e.g. its own initial condition through the history).
+    p0 : array_like, shape (P,)
+        The starting point (and the values of the fixed parameters).
+    records : Record or sequence of Record
+        The measurements; times from t = 0, the start of the model's run.
+    names : sequence of str, optional
+        The parameters' names (default ``p0``, ``p1``, ...).
+    free : array_like, optional
+        Which parameters are fitted: a boolean mask (P,) or the indices or names of the free ones
+        (default: all).
+    bounds : tuple of array_like, optional
+        (lower, upper), each a number or (P,) (for all parameters; infinite allowed); p0 must lie
+        inside.
+    x_scale : array_like or "jac", optional
+        SciPy's ``x_scale`` for the free parameters (default ``"jac"``).
+    loss : str, optional
+        SciPy's loss (``"linear"`` default; ``"soft_l1"``, ``"huber"``, ``"cauchy"``,
+        ``"arctan"``): the covariance is then that of the linear loss at the solution.
+    multistart : int or sequence of array_like, optional
+        More starting points: a number M of starts (p0 and M - 1 drawn uniformly within finite
+        bounds, or within p0 * (1 +- 0.5) otherwise, with ``seed``), or the starts themselves
+        (P each); the lowest cost wins.
+    seed : int, optional
+        Seed of the drawn starts.
+    max_nfev : int, optional
+        Most model runs per start (SciPy's default otherwise).
+    callback : callable, optional
+        ``callback(info)`` after each iteration with ``info = {"iteration", "cost", "p"}``;
+        returning True stops the fit at the best point so far (success False).  Ctrl-C
+        (KeyboardInterrupt) also stops it there.
+    verbose : bool, optional
+        Prints the cost per iteration.
+    polish : bool, optional
+        True (default): after the fit with the equation's sensitivities, a few iterations with the
+        scheme's own tangent (jumps=False in :func:`sensitivities`), the exact derivative of the
+        scheme's residuals where nothing switches: quadratic convergence to the scheme's least
+        squares.  The covariance is that of the equation's sensitivities either way.
+    rhs : callable, optional
+        ``rhs(t, u, p)``: f as a Python function of complex u and the full p, for complex-step
+        derivatives (see :func:`sensitivities`).
+
+    Returns
+    -------
+    Estimate
+        The fit, its uncertainty and what the data leave undetermined.
+
+    Raises
+    ------
+    ValueError
+        Records of the wrong shape, NaN in the data, times before 0, sigma not positive, p0 not
+        finite or of another length than names, bounds that exclude p0, no free parameter, make
+        raising at p0, or a parameter that changes the model's structure (see
+        :func:`sensitivities`).
+    TypeError
+        A record that is not a :class:`Record`, or make not returning a dmi.Solver.
+    """
+    p0 = np.array(p0, dtype=float).reshape(-1)
+    P = len(p0)
+    if P == 0 or not np.all(np.isfinite(p0)):
+        raise ValueError("p0: expected a nonempty vector of finite numbers")
+    names = [f"p{j}" for j in range(P)] if names is None else [str(n) for n in names]
+    if len(names) != P or len(set(names)) != P:
+        raise ValueError(f"names {names}: expected {P} distinct names, one per parameter")
+    records = [records] if isinstance(records, Record) else list(records)
+    if not records:
+        raise ValueError("records: expected at least one Record")
+    makes = list(make) if isinstance(make, (list, tuple)) else [make] * len(records)
+    if len(makes) != len(records):
+        raise ValueError(f"{len(makes)} models for {len(records)} records: give one make, or one per "
+                         "record")
+    mask = _free_mask(free, names)
+    if not mask.any():
+        raise ValueError("free: no parameter left to fit")
+    lo, hi = _bounds(bounds, P)
+    outside = np.flatnonzero((p0 < lo) | (p0 > hi))
+    if len(outside):
+        j = outside[0]
+        raise ValueError(f"bounds exclude p0: {names[j]} = {float(p0[j])!r} is outside "
+                         f"[{float(lo[j])!r}, {float(hi[j])!r}]; move p0 or widen the bounds")
+    data = []
+    for k, (r, mk) in enumerate(zip(records, makes)):
+        try:
+            s = mk(p0.copy())
+        except Exception as e:
+            raise ValueError(f"make(p0) for records[{k}] raised {type(e).__name__}: {e}") from e
+        if not isinstance(s, Solver):
+            raise TypeError(f"make(p0) returned {type(s).__name__}; expected a dmi.Solver")
+        data.append(_check_record(r, k, s.n))
+    problem = _Problem(makes, p0, mask, data, rhs)
+    problem.bounds = (lo, hi)
+    starts = _starts(multistart, p0, lo, hi, seed)
+    fits = []
+    for x_start in starts:
+        fits.append(_fit(problem, x_start, lo, hi, x_scale, loss, max_nfev, callback, verbose,
+                         polish))
+        if fits[-1][3]:                                   # stopped by the user: no more starts
+            break
+    best = min(fits, key=lambda f: f[1])
+    est = _summarise(problem, names, *best)
+    est.starts = [(s.copy(), f[1]) for s, f in zip(starts, fits)]
+    return est
+
+
+def _free_mask(free: Any, names: list) -> np.ndarray:
+    P = len(names)
+    if free is None:
+        return np.ones(P, bool)
+    f = np.asarray(free)
+    if f.dtype == bool:
+        if f.shape != (P,):
+            raise ValueError(f"free: a mask of shape {f.shape}; expected ({P},)")
+        return f.copy()
+    mask = np.zeros(P, bool)
+    for item in np.atleast_1d(f).tolist():
+        mask[_index(item, names)] = True
+    return mask
+
+
+def _bounds(bounds: Any, P: int) -> tuple[np.ndarray, np.ndarray]:
+    if bounds is None:
+        return np.full(P, -np.inf), np.full(P, np.inf)
+    try:
+        lo, hi = bounds
+        lo = np.broadcast_to(np.asarray(lo, dtype=float), (P,)).copy()
+        hi = np.broadcast_to(np.asarray(hi, dtype=float), (P,)).copy()
+    except (TypeError, ValueError):
+        raise ValueError(f"bounds: expected (lower, upper), each a number or {P} numbers") from None
+    if np.any(np.isnan(lo) | np.isnan(hi)) or np.any(lo >= hi):
+        raise ValueError("bounds: need lower < upper for every parameter, no NaN")
+    return lo, hi
+
+
+def _starts(multistart: Any, p0: np.ndarray, lo: np.ndarray, hi: np.ndarray, seed: int) -> list:
+    if multistart is None:
+        return [p0.copy()]
+    if isinstance(multistart, (int, np.integer)):
+        if multistart < 1:
+            raise ValueError(f"multistart = {multistart}: expected a number of starts >= 1")
+        rng = np.random.default_rng(seed)
+        out = [p0.copy()]
+        for _ in range(int(multistart) - 1):
+            a = np.where(np.isfinite(lo), lo, p0 - 0.5 * np.abs(p0))
+            b = np.where(np.isfinite(hi), hi, p0 + 0.5 * np.abs(p0))
+            a, b = np.maximum(a, lo), np.minimum(b, hi)
+            out.append(rng.uniform(a, b))
+        return out
+    out = [p0.copy()]
+    for s in multistart:
+        q = np.array(s, dtype=float).reshape(-1)
+        if q.shape != p0.shape or not np.all(np.isfinite(q)) or np.any((q < lo) | (q > hi)):
+            raise ValueError(f"multistart: a start {q.tolist()} is not {len(p0)} finite numbers "
+                             "within the bounds")
+        out.append(q)
+    return out
+
+
+def _fit(problem: _Problem, start: np.ndarray, lo: np.ndarray, hi: np.ndarray, x_scale: Any,
+         loss: str, max_nfev: int | None, callback: Callable | None, verbose: bool, polish: bool
+         ) -> tuple[np.ndarray, float, str, bool, bool]:
+    """One least_squares run: (x, cost, message, stopped, converged)."""
+    free = problem.free
+    x0 = start[free].copy()
+    problem.best = None
+    iteration = [0]
+
+    def progress(intermediate_result: Any) -> None:
+        iteration[0] += 1
+        cost = float(intermediate_result.cost)
+        if verbose:
+            print(f"iteration {iteration[0]}: cost {cost:.10g}")
+        if callback is not None and callback({"iteration": iteration[0], "cost": cost,
+                                              "p": problem.full(intermediate_result.x)}):
+            raise StopIteration
+    xs = x_scale if isinstance(x_scale, str) else np.broadcast_to(np.asarray(x_scale, float),
+                                                                  (free.sum(),))
+    r0 = problem.residuals(x0)
+    cost0 = 0.5 * float(r0 @ r0)
+    def solve(x_start: np.ndarray, jumps: bool, tol: float) -> Any:
+        problem.jumps = jumps
+        try:
+            return optimize.least_squares(problem.residuals, x_start, jac=problem.jacobian,
+                                          bounds=(lo[free], hi[free]), method="trf", x_scale=xs,
+                                          loss=loss, max_nfev=max_nfev, callback=progress,
+                                          ftol=tol, xtol=tol)
+        finally:
+            problem.jumps = True
+    try:
+        res = solve(x0, True, 1e-5 if polish else 1e-8)
+        if res.status > 0 and polish:
+            # the scheme's own tangent, exact where nothing switches: quadratic convergence to
+            # the scheme's least squares from a point the equation's sensitivities found
+            fine = solve(res.x, False, 1e-8)
+            if fine.status > 0 and fine.cost <= res.cost:
+                res = fine
+    except KeyboardInterrupt:
+        cost, x = problem.best
+        return x, cost, f"stopped (KeyboardInterrupt) at the best point so far, cost {cost:.10g}", \
+            True, False
+    if res.status == -2:
+        return res.x, float(res.cost), f"stopped by the callback at cost {res.cost:.10g}", True, False
+    x = res.x
+    cost = 0.5 * float(res.fun @ res.fun)
+    converged = bool(res.success) and res.status > 0
+    if cost >= cost0 and cost0 > 0.0:
+        J = problem.jacobian(x)
+        rank = np.linalg.matrix_rank(J) if J.size else 0
+        if rank < J.shape[1] or not np.any(J):
+            return x, cost, (f"the fit cannot decrease the cost (the Jacobian has rank {rank} of "
+                             f"{J.shape[1]}): last cost {cost:.10g}"), False, False
+    msg = f"{res.message} (cost {cost:.10g} after {problem.njev} iterations)"
+    return x, cost, msg, False, converged
+
+
+def _summarise(problem: _Problem, names: list, x: np.ndarray, cost: float, message: str,
+               stopped: bool, converged: bool) -> Estimate:
+    free = problem.free
+    p = problem.full(x)
+    J = problem.jacobian(x)
+    r = problem._cache[1]
+    M, F = J.shape
+    P = len(p)
+    dof = M - F
+    known = all(d.sigma_known for d in problem.data)
+    s2 = 1.0 if known else (2.0 * cost / dof if dof > 0 else np.inf)
+    covf, bad, combos = _covariance(J, x, [names[j] for j in np.flatnonzero(free)])
+    cov = np.zeros((P, P))
+    idx = np.flatnonzero(free)
+    cov[np.ix_(idx, idx)] = covf * s2
+    stderr = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    for b in bad:
+        cov[idx[b], idx[b]] = np.inf
+        stderr[idx[b]] = np.inf
+    with np.errstate(invalid="ignore", divide="ignore"):
+        outer = np.outer(stderr, stderr)
+        corr = cov / outer
+    corr[~np.isfinite(corr) | (outer == 0) | ~np.isfinite(outer)] = np.nan
+    rss = 2.0 * cost
+    if known:
+        aic, bic = rss + 2 * F, rss + F * math.log(M)
+    else:
+        base = M * math.log(rss / M) if rss > 0 else -np.inf
+        aic, bic = base + 2 * F, base + F * math.log(M)
+    return Estimate(p=p, names=list(names), free=free.copy(), cov=cov, stderr=stderr, corr=corr,
+                    residuals=r, jacobian=J, cost=cost, aic=aic, bic=bic,
+                    success=converged and not stopped, message=message, unidentifiable=combos,
+                    nfev=problem.nfev, njev=problem.njev, dof=dof, sigma_known=known, starts=[],
+                    _problem=problem)
+
+
+def _covariance(J: np.ndarray, x: np.ndarray, names: list) -> tuple[np.ndarray, list, list]:
+    """(J^T J)^-1 on the determined subspace, the parameters in undetermined combinations, and
+    those combinations named, from the SVD of J with columns scaled by |x| (1 where x = 0) and
+    then normalised."""
+    F = J.shape[1]
+    d = np.where(x != 0.0, np.abs(x), 1.0)
+    Js = J * d
+    norms = np.linalg.norm(Js, axis=0)
+    safe = np.where(norms > 0, norms, 1.0)
+    Jn = Js / safe
+    _, sv, Vt = np.linalg.svd(Jn, full_matrices=True)
+    sv = np.concatenate([sv, np.zeros(F - len(sv))])
+    top = sv.max() if sv.size and sv.max() > 0 else 1.0
+    weak = sv <= RCOND * top
+    combos, bad = [], set()
+    for k in np.flatnonzero(weak):
+        v = Vt[k].copy()
+        v /= np.abs(v).max()
+        v = np.where(np.abs(v) >= 0.05, v, 0.0)
+        v /= np.linalg.norm(v)
+        terms = [f"{'-' if c < 0 else '+'} {abs(c):.2f}*{names[j]}" for j, c in enumerate(v) if c != 0]
+        text = " ".join(terms)
+        combos.append(text[2:] if text.startswith("+ ") else "-" + text[2:])
+        bad.update(np.flatnonzero(v != 0).tolist())
+    keep = ~weak
+    V = Vt.T
+    inv = (V[:, keep] / sv[keep] ** 2) @ V[:, keep].T           # (Jn^T Jn)^+ on the kept subspace
+    scale = d / safe
+    cov = inv * np.outer(scale, scale)
+    return cov, sorted(bad), combos

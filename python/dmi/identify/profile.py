@@ -1,0 +1,159 @@
+# dmi.identify.profile: the profile likelihood of one parameter and its likelihood-ratio interval.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""The profile of one parameter of an :class:`Estimate`: the least cost with that parameter fixed
+and the others refitted, its likelihood-ratio interval, and the Wald interval beside it."""
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+from scipy import optimize, stats
+
+from .fitting import Estimate, _index, _Problem
+
+
+@dataclasses.dataclass
+class Profile:
+    """The profile of one parameter.
+
+    Attributes
+    ----------
+    name : str
+        The parameter.
+    values : numpy.ndarray, shape (k,)
+        The values at which it was fixed, increasing (the estimate's among them).
+    cost : numpy.ndarray, shape (k,)
+        The least cost there (the other free parameters refitted).
+    p : numpy.ndarray, shape (k, P)
+        The refitted parameters there.
+    threshold : float
+        The cost increase that bounds the interval: chi2(level, 1) / 2 with sigma known, else
+        cost * F(level; 1, dof) / dof.
+    interval : tuple of float
+        The likelihood-ratio interval (low, high); an end the profile did not reach within
+        ``max_steps`` or within the fit's bounds is -inf or inf.
+    wald : tuple of float
+        The covariance (Wald) interval.
+    level : float
+        The confidence level.
+    quadratic : bool
+        Whether the two intervals agree to 10 % of the Wald half-width at both ends (the cost is
+        then close to quadratic there).
+    message : str
+        What the comparison says.
+    """
+
+    name: str
+    values: np.ndarray
+    cost: np.ndarray
+    p: np.ndarray
+    threshold: float
+    interval: tuple
+    wald: tuple
+    level: float
+    quadratic: bool
+    message: str
+
+
+def profile_likelihood(estimate: Estimate, index: int | str, *, level: float = 0.95,
+                       step: float | None = None, max_steps: int = 12) -> Profile:
+    """The profile likelihood of one fitted parameter and its likelihood-ratio interval.
+
+    Parameters
+    ----------
+    estimate : Estimate
+        A result of :func:`estimate`.
+    index : int or str
+        The parameter, by position or name; it must have been fitted.
+    level : float, optional
+        Confidence level in (0, 1).
+    step : float, optional
+        Spacing of the profile's points (default: half the standard error, or 5 % of the value
+        when the standard error is not finite).
+    max_steps : int, optional
+        Most points on each side before the interval's end is declared not reached.
+
+    Returns
+    -------
+    Profile
+        The profile, the likelihood-ratio and Wald intervals, and whether they agree.
+
+    Raises
+    ------
+    ValueError
+        A parameter that was not fitted, an unknown one, a level outside (0, 1), or an estimate
+        without its problem (not made by :func:`estimate`).
+    """
+    if not isinstance(estimate, Estimate) or estimate._problem is None:
+        raise ValueError("profile_likelihood: expected an Estimate returned by dmi.identify.estimate")
+    i = _index(index, estimate.names)
+    if not estimate.free[i]:
+        raise ValueError(f"parameter {estimate.names[i]!r} was fixed in the fit; profile a fitted one")
+    if not 0.0 < level < 1.0:
+        raise ValueError(f"level = {level!r}: expected a number in (0, 1)")
+    base: _Problem = estimate._problem
+    p_hat, c_hat = estimate.p.copy(), estimate.cost
+    if estimate.sigma_known:
+        thr = float(stats.chi2.ppf(level, 1)) / 2.0
+    else:
+        thr = c_hat * float(stats.f.ppf(level, 1, max(estimate.dof, 1))) / max(estimate.dof, 1)
+    se = estimate.stderr[i]
+    if step is None:
+        step = 0.5 * se if np.isfinite(se) and se > 0 else 0.05 * max(abs(p_hat[i]), 1e-12)
+    free = base.free.copy()
+    free[i] = False
+    cache: dict[float, tuple[float, np.ndarray]] = {}
+
+    def prof(v: float, start: np.ndarray) -> tuple[float, np.ndarray]:
+        if v in cache:
+            return cache[v]
+        q = start.copy()
+        q[i] = v
+        sub = _Problem(base.makes, q, free, base.data, base.rhs)
+        lo, hi = base.bounds
+        if free.any():
+            res = optimize.least_squares(sub.residuals, q[free], jac=sub.jacobian, method="trf",
+                                         x_scale="jac", bounds=(lo[free], hi[free]))
+            out = (float(res.cost), sub.full(res.x))
+        else:
+            r = sub.residuals(np.empty(0))
+            out = (0.5 * float(r @ r), q)
+        cache[v] = out
+        return out
+
+    cache[float(p_hat[i])] = (c_hat, p_hat)
+    ends = []
+    for sign in (-1.0, 1.0):
+        prev_v, prev = float(p_hat[i]), (c_hat, p_hat)
+        end = sign * math.inf
+        for k in range(1, max_steps + 1):
+            v = float(p_hat[i] + sign * k * step)
+            if not base.bounds[0][i] <= v <= base.bounds[1][i]:
+                break                    # the fit's bounds: the end is not reached within them
+            cur = prof(v, prev[1])
+            if cur[0] - c_hat > thr:
+                def excess(x: float, _start: np.ndarray = prev[1]) -> float:
+                    return prof(float(x), _start)[0] - c_hat - thr
+                a, b = sorted((prev_v, v))
+                end = optimize.brentq(excess, a, b, xtol=1e-3 * step)
+                break
+            prev_v, prev = v, cur
+        ends.append(end)
+    values = np.array(sorted(cache))
+    wald = estimate.wald_interval(i, level)
+    half = 0.5 * (wald[1] - wald[0])
+    quadratic = bool(np.isfinite(half) and all(np.isfinite(ends))
+                     and abs(ends[0] - wald[0]) <= 0.1 * half and abs(ends[1] - wald[1]) <= 0.1 * half)
+    if quadratic:
+        message = "the likelihood-ratio and Wald intervals agree: the cost is close to quadratic"
+    elif not all(np.isfinite(ends)):
+        message = (f"the profile stays below the threshold within {max_steps} steps on one side: "
+                   "the parameter is not bounded there by the data")
+    else:
+        message = ("the likelihood-ratio interval differs from the Wald interval: the cost is not "
+                   "quadratic there; trust the likelihood-ratio interval")
+    return Profile(name=estimate.names[i], values=values, cost=np.array([cache[v][0] for v in values]),
+                   p=np.array([cache[v][1] for v in values]), threshold=thr,
+                   interval=(ends[0], ends[1]), wald=wald, level=level, quadratic=quadratic,
+                   message=message)

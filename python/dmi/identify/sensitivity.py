@@ -1,0 +1,430 @@
+# dmi.identify.sensitivity: dU/dp of the scheme, with the saltation jump at velocity reversals.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""Sensitivities dU^p/dp of the implicit Euler scheme (3.12)-(3.13) for a model ``make(p)``.
+
+Where nothing switches, S^p = dU^p/dp is the exact tangent of the scheme,
+
+    T^p = S^p - h (f_u S^p + f_p) - h dW^p,      S^{p+1} = R'(X^p) T^p + dR/dp,
+
+with X^p = U^p - h f(t_p, U^p) - h W^p the resolvent's argument.  Where a friction component
+reverses inside a step (directly, or through one step in the dead zone), S of that component is
+multiplied by the saltation factor F+ / F- of the equation (F = u' just before and after the
+reversal), which the plain tangent misses by O(1) however small h is; sticks, slip onsets and box
+contacts need no correction (the tangent gives S = 0 while stuck, and F is continuous at a slip
+onset).  S then converges at O(h) to the equation's sensitivity.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from scipy.signal import fftconvolve
+
+from .._solver import Solver
+
+#: Relative step of the directional differences (about the square root of the unit roundoff).
+REL_STEP = 2.0 ** -26
+
+
+@dataclasses.dataclass
+class Sensitivities:
+    """States and sensitivities of one run of the scheme.
+
+    Attributes
+    ----------
+    t : numpy.ndarray, shape (steps + 1,)
+        Times t_p = p h (time units).
+    u : numpy.ndarray, shape (steps + 1, n)
+        States U^p (state units).
+    S : numpy.ndarray, shape (steps + 1, n, P)
+        dU^p/dp_j (state units per unit of p_j).
+    x : numpy.ndarray, shape (steps, n)
+        Resolvent arguments X^p of the step into U^{p+1}; (X^p - U^{p+1}) / h is the element of
+        A(U^{p+1}) selected (the friction force).
+    dx : numpy.ndarray, shape (steps, n, P)
+        dX^p/dp_j.
+    h : float
+        The step (time units).
+    switches : list of tuple
+        (p, i, kind): friction component i reverses in step p (``"reversal"``, S_i multiplied by
+        the saltation factor there) or starts to stick (``"stick"``).
+    """
+
+    t: np.ndarray
+    u: np.ndarray
+    S: np.ndarray
+    x: np.ndarray
+    dx: np.ndarray
+    h: float
+    switches: list
+
+
+@dataclasses.dataclass
+class _Perturbed:
+    """The model at p and at p + delta_j e_j, and what differs between them."""
+
+    base: Solver
+    others: list        # the solvers at p + delta_j e_j
+    delta: np.ndarray   # delta_j as applied: fl(p_j + step) - p_j
+
+
+def _build(make: Callable[[np.ndarray], Solver], p: np.ndarray) -> _Perturbed:
+    """The solvers at p and p + delta_j e_j, after checking that the parameters change nothing
+    the sensitivities cannot follow."""
+    base = _call_make(make, p, "p")
+    others, delta = [], np.empty(len(p))
+    for j in range(len(p)):
+        step = REL_STEP * max(1.0, abs(p[j]))
+        q = p.copy()
+        q[j] = p[j] + step
+        delta[j] = q[j] - p[j]          # the step actually applied
+        other = _call_make(make, q, f"p + delta e_{j}")
+        _same_structure(base, other, j)
+        others.append(other)
+    return _Perturbed(base, others, delta)
+
+
+def _call_make(make: Callable[[np.ndarray], Solver], q: np.ndarray, what: str) -> Solver:
+    try:
+        s = make(q.copy())
+    except Exception as e:
+        raise ValueError(f"make({what} = {q.tolist()}) raised {type(e).__name__}: {e}; "
+                         "sensitivities need make to accept parameters near p") from e
+    if not isinstance(s, Solver):
+        raise TypeError(f"make({what}) returned {type(s).__name__}; expected a dmi.Solver")
+    return s
+
+
+def _same_structure(a: Solver, b: Solver, j: int) -> None:
+    """ValueError naming what parameter j changes among the things a sensitivity cannot follow."""
+    checks = [("n", a.n, b.n), ("N", a.N, b.N), ("h", a.h, b.h), ("tau", a.tau, b.tau),
+              ("the kind of A", a.resolvent_kind, b.resolvent_kind),
+              ("the kind of kernel", a.kernel_kind, b.kernel_kind),
+              ("the convolution method", a.convolution, b.convolution),
+              ("the quadrature rule", a.quadrature, b.quadrature),
+              ("the near kernel's delta", a.kernel_near_delta, b.kernel_near_delta)]
+    ta, tb = a.kernel_terms, b.kernel_terms
+    if ta is not None and tb is not None:
+        checks.append(("the number of kernel terms", len(ta[0]), len(tb[0])))
+    for name, x, y in checks:
+        if x != y:
+            raise ValueError(f"parameter {j} changes {name} ({x!r} -> {y!r}); a parameter may change "
+                             "values of the model, not its structure: keep n, N, h, tau, the kinds of A "
+                             "and kernel, the number of kernel terms, the convolution method and the "
+                             "quadrature fixed in make")
+    if a.has("kernel_near"):
+        raise ValueError("a near kernel (set_kernel_near, a fit with delta > 0) is not supported by "
+                         "sensitivities; fit the kernel with delta = 0")
+    if a.kernel_kind == "callback" and a.quadrature == "cell":
+        raise ValueError("a callback kernel under the cell rule is not supported by sensitivities "
+                         "(its weights are tanh-sinh integrals); use the left rule or set_kernel_exp")
+
+
+def _theta(s: Solver) -> float:
+    """Weight of the last delay cell relative to h (1 when h = tau / N, as libdmi decides it)."""
+    N, h, tau = s.N, s.h, s.tau
+    M = round(tau / h)
+    if M >= 1 and tau / M == h:
+        return 1.0
+    return tau / h - (N - 1)
+
+
+# ---- the kernel's weights and their derivatives --------------------------------------------------
+
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(12)
+
+
+def _exp_weights(s: Solver, lam: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per term k and cell l: w[k, l], the complex weight of e^{lam_k s} over cell l, and ws[k, l],
+    that of s e^{lam_k s} (its derivative in lam_k); c[k], the factor of r_k^l in the full cells
+    (w[k, l] = c_k r_k^l for l < N - 1)."""
+    N, h = s.N, s.h
+    theta = _theta(s)
+    lags = np.arange(N) * h
+    if s.quadrature == "left":
+        cell = np.full(N, h)
+        cell[-1] = theta * h
+        e = np.exp(np.outer(lam, lags))
+        return cell * e, cell * lags * e, np.full(len(lam), h, dtype=complex)
+    # the cell rule: the integrals over each cell, by Gauss-Legendre (the integrands are smooth)
+    length = np.full(N, h)
+    length[-1] = theta * h
+    nodes = lags[:, None] + 0.5 * length[:, None] * (1.0 + _GL_X[None, :])     # (N, G)
+    wts = 0.5 * length[:, None] * _GL_W[None, :]
+    e = np.exp(lam[:, None, None] * nodes[None])                                  # (K, N, G)
+    w = np.sum(e * wts[None], axis=2)
+    ws = np.sum(e * (nodes * wts)[None], axis=2)
+    c = np.sum(np.exp(lam[:, None] * (0.5 * h * (1.0 + _GL_X))[None]) * (0.5 * h * _GL_W)[None], axis=1)
+    return w, ws, c
+
+
+class _Memory:
+    """The delay sum of the tangent, sum_l G_l S^{p-l}, and the kernel's part dG_l U^{p-l}."""
+
+    def __init__(self, mod: _Perturbed, Uext: np.ndarray, P: int):
+        s = mod.base
+        self.N, n = s.N, s.n
+        N = self.N
+        self._flat: np.ndarray | None = None
+        kind = s.kernel_kind
+        self.recursive = False
+        if kind == "exp":
+            a, b, C, D = s.kernel_terms
+            lam = a + 1j * b
+            w, ws, c = _exp_weights(s, lam)
+            E = C - 1j * D                                                     # (K, n, n)
+            self.G = np.einsum("kl,kij->lij", w, E).real                         # (N, n, n)
+            dG = np.zeros((P, N, n, n))
+            for j, other in enumerate(mod.others):
+                a2, b2, C2, D2 = other.kernel_terms
+                dl = ((a2 - a) + 1j * (b2 - b)) / mod.delta[j]
+                dE = ((C2 - C) - 1j * (D2 - D)) / mod.delta[j]
+                dG[j] = (np.einsum("kl,kij->lij", w, dE)
+                         + np.einsum("kl,k,kij->lij", ws, dl, E)).real
+            # the recursion: Z_k^p = sum_l r_k^l S^{p-l} (all N cells), then the last cell mended
+            self.recursive = bool(np.all(a <= 0.0) and np.all(np.abs(b) * s.h <= math.pi))
+            if self.recursive:
+                self.E = E * c[:, None, None]
+                self.r = np.exp(lam * s.h)[:, None, None]
+                self.rN = np.exp(lam * s.h * N)[:, None, None]
+                self.powers = np.exp(np.outer(lam, np.arange(N) * s.h))          # (K, N)
+                full_last = np.einsum("k,kij->ij", self.powers[:, N - 1], self.E).real
+                self.last = self.G[N - 1] - full_last
+        elif kind == "callback":
+            theta = _theta(s)
+            cell = np.full(N, s.h)
+            cell[-1] = theta * s.h
+            lags = np.arange(N) * s.h
+            H0 = np.array([s.eval_kernel(x) for x in lags])
+            self.G = cell[:, None, None] * H0
+            dG = np.empty((P, N, n, n))
+            for j, other in enumerate(mod.others):
+                Hj = np.array([other.eval_kernel(x) for x in lags])
+                dG[j] = cell[:, None, None] * (Hj - H0) / mod.delta[j]
+        else:
+            self.G = None
+            return
+        # the kernel's part for all steps at once: dWU[p, :, j] = sum_l dG_j[l] U^{p-l}
+        # (one FFT convolution per parameter: memory O((N + steps) n^2), not times P)
+        steps = len(Uext) - N
+        self.dWU = np.empty((steps, n, P))
+        for j in range(P):
+            conv = fftconvolve(dG[j], Uext[:, None, :], axes=0).sum(axis=2)   # (N + L - 1, n)
+            self.dWU[:, :, j] = conv[N - 1:N - 1 + steps]
+        self.Z = None
+
+    def _recompute(self, Sall: np.ndarray, p: int) -> None:
+        window = Sall[p + 1:p + self.N + 1][::-1]                                # S^{p-l}
+        self.Z = np.einsum("kl,lnq->knq", self.powers, window)
+        self.since = 0
+
+    def sum_S(self, Sall: np.ndarray, p: int) -> np.ndarray:
+        """sum_l G_l S^{p-l}, (n, P); Sall[q + N] = S^q."""
+        N = self.N
+        if self.recursive:
+            if self.Z is None or self.since >= 4 * N:
+                self._recompute(Sall, p)
+            out = np.einsum("kij,kjq->iq", self.E, self.Z).real
+            return out + self.last @ Sall[p + 1]
+        # sum_l G_l S^{p-l} = sum_m G_{N-1-m} S^{p-N+1+m}: one matrix product on the stored rows
+        if self._flat is None:
+            n = self.G.shape[1]
+            self._flat = np.ascontiguousarray(self.G[::-1].transpose(1, 0, 2).reshape(n, N * n))
+        rows = Sall[p + 1:p + N + 1]
+        return self._flat @ rows.reshape(N * rows.shape[1], rows.shape[2])
+
+    def push(self, Sall: np.ndarray, p: int) -> None:
+        """Advances Z from step p to p + 1 once S^{p+1} is in Sall."""
+        if self.recursive and self.Z is not None:
+            self.Z = self.r * self.Z + (Sall[p + 1 + self.N] - self.rN * Sall[p + 1])
+            self.since += 1
+
+
+# ---- the run --------------------------------------------------------------------------------------
+
+def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
+                  rhs: Callable[[float, np.ndarray, np.ndarray], np.ndarray] | None = None,
+                  jumps: bool = True) -> Sensitivities:
+    """The states U^p and their sensitivities dU^p/dp of the model ``make(p)`` over ``steps``
+    steps from t = 0.
+
+    Parameters
+    ----------
+    make : callable
+        ``make(p) -> dmi.Solver``, the model at the parameter vector p (a new solver, set but
+        not necessarily initialised; it is initialised here).  p may enter f, the friction
+        coefficients, the box, the kernel (its exponential terms a, b, C, D, or a kernel
+        callback) and the history; it may not change n, N, h, tau, the kinds of A and kernel,
+        the number of kernel terms, the convolution method or the quadrature rule.
+    p : array_like, shape (P,)
+        The parameters.
+    steps : int
+        Number of steps, >= 1.
+    rhs : callable, optional
+        ``rhs(t, u, p) -> (n,)``, the model's f as a Python function of complex u and p: f_u S +
+        f_p by complex step (checked once against a directional difference) instead of
+        directional differences of the solver's f.
+    jumps : bool, optional
+        True (default): the saltation factor at reversals (S converges to the equation's
+        sensitivity); False: the plain tangent of the scheme everywhere.
+
+    Returns
+    -------
+    Sensitivities
+        t, u, S (dU/dp), the resolvent arguments x and dx, h, and the reversals and sticks met.
+
+    Raises
+    ------
+    ValueError
+        p not a finite vector, steps < 1, make raising at p or near it, a parameter changing the
+        model's structure, a near kernel, a callback kernel under the cell rule, or ``rhs``
+        disagreeing with the solver's f.
+    TypeError
+        make not returning a dmi.Solver.
+    """
+    p = np.array(p, dtype=float).reshape(-1) if np.ndim(p) <= 1 else None
+    if p is None or len(p) == 0 or not np.all(np.isfinite(p)):
+        raise ValueError("p: expected a nonempty vector of finite numbers")
+    if not isinstance(steps, (int, np.integer)) or steps < 1:
+        raise ValueError(f"steps = {steps!r}: expected an integer >= 1")
+    mod = _build(make, p)
+    s = mod.base
+    n, N, h, P = s.n, s.N, s.h, len(p)
+    s.init()
+    window = s.get_window()                                          # U^{-N}, ..., U^0
+    t, U, X = s.run_terms(steps)
+    # S of the history: dz(t_q)/dp for q = -N, ..., 0
+    Sall = np.zeros((N + steps + 1, n, P))
+    if s.has("history") or any(o.has("history") for o in mod.others):
+        # each perturbed model samples its own history in init, as the scheme does
+        for j, other in enumerate(mod.others):
+            other.init()
+            Sall[:N + 1, :, j] = (other.get_window() - window) / mod.delta[j]
+    Uext = np.concatenate([window[1:], U[1:]])                       # U^{-N+1}, ..., U^steps
+    memory = _Memory(mod, Uext, P)
+    # the resolvent's derivatives in p, as they do not depend on the step
+    kind = s.resolvent_kind
+    alpha = s.friction
+    dalpha = dlo = dhi = None
+    if kind == "friction":
+        dalpha = np.stack([(o.friction - alpha) / d for o, d in zip(mod.others, mod.delta)], axis=1)
+        # R' (1 slipping, 0 stuck) and dR/dp = -h sign(X) dalpha where slipping, for every step
+        slipping = (U[1:] != 0.0).astype(float)
+        dR = (-h * np.sign(X) * slipping)[:, :, None] * dalpha[None]
+        # the steps where a slipping friction component meets zero or changes sign
+        meets = np.any((U[:-1] != 0.0) & (U[:-1] * U[1:] <= 0.0) & (alpha > 0.0), axis=1)
+    elif kind == "box":
+        lo, hi = s.box
+        dlo = np.stack([_bound_diff(o.box[0], lo) / d for o, d in zip(mod.others, mod.delta)], axis=1)
+        dhi = np.stack([_bound_diff(o.box[1], hi) / d for o, d in zip(mod.others, mod.delta)], axis=1)
+    has_f = s.has("rhs") or any(o.has("rhs") for o in mod.others)
+    if rhs is not None:
+        _check_complex_rhs(rhs, mod, p, t[0], U[0], Sall[N])
+    phi = (U[:-1] - X) / h                                            # f + W at each step
+    dX = np.empty((steps, n, P))
+    switches: list = []
+    Fd = np.zeros((n, P))
+    for q in range(steps):
+        Sq = Sall[q + N]
+        if rhs is not None:
+            Fd = _complex_directions(rhs, t[q], U[q], p, Sq)
+        elif has_f:
+            f0 = s.eval_rhs(t[q], U[q])
+            moved = U[q] + mod.delta[:, None] * Sq.T                  # (P, n): U + delta_j S_j
+            Fd = (np.array([o.eval_rhs(t[q], m) for o, m in zip(mod.others, moved)]).T
+                  - f0[:, None]) / mod.delta
+        T = Sq - h * Fd
+        if memory.G is not None:
+            T -= h * (memory.sum_S(Sall, q) + memory.dWU[q])
+        dX[q] = T
+        Snew = Sall[q + 1 + N]
+        if kind == "friction":
+            np.multiply(T, slipping[q][:, None], out=Snew)
+            Snew += dR[q]
+            if jumps and meets[q]:
+                _reversals(q, U, phi, alpha, dalpha, T, Snew, h, switches)
+        elif kind == "box":
+            below, above = X[q] < lo, X[q] > hi
+            Snew[:] = np.where(below[:, None], dlo, np.where(above[:, None], dhi, T))
+        elif kind == "callback":
+            for j, other in enumerate(mod.others):
+                Snew[:, j] = (other.eval_resolvent(h, X[q] + mod.delta[j] * T[:, j])
+                              - U[q + 1]) / mod.delta[j]
+        else:
+            Snew[:] = T
+        memory.push(Sall, q)
+    return Sensitivities(t, U, Sall[N:].copy(), X, dX, h, switches)
+
+
+def _bound_diff(b2: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """b2 - b, 0 where both bounds are the same infinity."""
+    with np.errstate(invalid="ignore"):
+        d = b2 - b
+    return np.where(b2 == b, 0.0, d)
+
+
+def _reversals(q: int, U: np.ndarray, phi: np.ndarray, alpha: np.ndarray, dalpha: np.ndarray,
+               T: np.ndarray, Snew: np.ndarray, h: float, switches: list) -> None:
+    """At step q, for each friction component that slips at U^q and reverses during the step (to
+    the other sign at once, or through one step in the dead zone), S_i^{q+1} = rho (T_i - h s
+    dalpha_i), rho = F+ / F- the ratio of the velocities just after and before the reversal
+    (the saltation of the equation); a component that lands in the dead zone and stays is
+    recorded as a stick."""
+    steps = len(U) - 1
+    for i in np.flatnonzero((U[q] != 0.0) & (alpha > 0.0)):
+        sm = math.copysign(1.0, U[q, i])
+        nxt = U[q + 1, i]
+        if nxt * sm > 0.0:
+            continue
+        if nxt == 0.0 and not (q + 2 <= steps and U[q + 2, i] * sm < 0.0):
+            switches.append((q, int(i), "stick"))
+            continue
+        # where the reversal falls: linear interpolation of u_i across the step
+        frac = U[q, i] / (U[q, i] - nxt)
+        ph = phi[q, i] if q + 1 >= len(phi) else (1.0 - frac) * phi[q, i] + frac * phi[q + 1, i]
+        before = sm * ph + alpha[i]        # -s F-: the speed towards 0 before the reversal
+        after = sm * ph - alpha[i]         # s F+: the speed away from 0 after it
+        if before <= 0.0 or after <= 0.0:
+            continue
+        Snew[i] = (after / before) * (T[i] - h * sm * dalpha[i])
+        switches.append((q, int(i), "reversal"))
+
+
+def _complex_directions(rhs: Callable, t: float, u: np.ndarray, p: np.ndarray,
+                        S: np.ndarray) -> np.ndarray:
+    """f_u S_j + f_p_j for each j by complex step."""
+    eps = 1e-30
+    out = np.empty(S.shape)
+    for j in range(len(p)):
+        pc = p.astype(complex)
+        pc[j] += 1j * eps
+        out[:, j] = np.imag(np.asarray(rhs(t, u + 1j * eps * S[:, j], pc))) / eps
+    return out
+
+
+def _check_complex_rhs(rhs: Callable, mod: _Perturbed, p: np.ndarray, t: float, u: np.ndarray,
+                       S: np.ndarray) -> None:
+    """ValueError unless rhs(t, u, p) is the solver's f and its complex-step directions agree with
+    the directional differences at the first step (to 1e-5 relative)."""
+    s = mod.base
+    try:
+        f = np.asarray(rhs(t, u.astype(complex), p.astype(complex)))
+    except Exception as e:
+        raise ValueError(f"rhs(t, u, p) raised {type(e).__name__} on complex arguments: {e}") from e
+    f0 = s.eval_rhs(t, u)
+    if f.shape != (s.n,) or not np.allclose(f.real, f0, rtol=1e-12, atol=1e-12 * (1 + np.abs(f0).max())):
+        raise ValueError(f"rhs(t, u, p) = {f!r} at t = {t}, u = {u!r} is not the solver's f = {f0!r}")
+    # a direction with a state part too, so that f_u is checked as well as f_p
+    S1 = S + 1.0
+    cs = _complex_directions(rhs, t, u, p, S1)
+    for j, other in enumerate(mod.others):
+        d = mod.delta[j]
+        fd = (other.eval_rhs(t, u + d * S1[:, j]) - f0) / d
+        scale = max(1.0, float(np.abs(cs[:, j]).max()), float(np.abs(fd).max()))
+        if np.abs(cs[:, j] - fd).max() > 1e-5 * scale:
+            raise ValueError(f"rhs: its complex-step derivative in direction {j} ({cs[:, j]!r}) "
+                             f"disagrees with a difference of the solver's f ({fd!r}); rhs must "
+                             "be the model's f(t, u, p), analytic in u and p")
