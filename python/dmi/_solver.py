@@ -142,6 +142,7 @@ class Solver:
         self._h_given = h  # (for repr)
         self._keep: dict[str, cb.Bound] = {}   # callbacks and data libdmi points to
         self._jit_slots: set[str] = set()
+        self._python_slots: set[str] = set()   # slots holding a Python function's trampoline
         self._resolvent: tuple = ()             # the built-in resolvent and its data
         self._choices = {"convolution": "auto", "quadrature": "left"}
         self._near_delta = 0.0                  # delta of set_kernel_near (0: no near cells)
@@ -199,6 +200,11 @@ class Solver:
         with self._using() as s:
             self._check(setter(s, bound.address, bound.user))
         self._keep[slot] = bound  # only now: a refused call keeps the former callback alive
+        # a Python function is bound through a trampoline (bound.keep[0]); a C function is kept as given
+        if f is not None and not jit and bound.keep[0] is not f:
+            self._python_slots.add(slot)
+        else:
+            self._python_slots.discard(slot)
         if jit and f is not None:   # (the slots a jit=True callback fills: their error hint)
             self._jit_slots.add(slot)
         else:
@@ -1204,6 +1210,38 @@ class Solver:
                 raise Error(_lib.ECALLBACK, f"the model's rhs at t = {tt[c]!r}, u = {X[c]!r} "
                             f"returned {rc}")
         return out
+
+    def c_callback(self, part: str) -> tuple[int, int] | None:
+        """The C function libdmi calls for a part of the model, for code that calls it directly
+        (compiled code: no Python in between).
+
+        Parameters
+        ----------
+        part : str
+            ``"rhs"``, ``"resolvent"``, ``"kernel"``, ``"kernel_near"`` or ``"history"``.
+
+        Returns
+        -------
+        tuple of int or None
+            (address, user): the function's address, with libdmi's signature for that part
+            (``dmi.RHS_SIGNATURE`` and the others of include/dmi.h), and its user pointer (0 for
+            NULL), valid while the solver keeps that callback; None where the part is not a
+            callback (absent, built-in friction or box, an exponential kernel) or is a Python
+            function (called through a Python trampoline; use the ``eval_*`` methods).  A
+            ``jit=True`` callback reads the closure values written at :meth:`init`.
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: another part.
+        """
+        if part not in ("rhs", "resolvent", "kernel", "kernel_near", "history"):
+            raise InvalidArgument(_lib.EINVAL, f"c_callback: part {part!r} is not one of 'rhs', "
+                                  "'resolvent', 'kernel', 'kernel_near', 'history'")
+        bound = self._keep.get(part)
+        if bound is None or bound.address is None or part in self._python_slots:
+            return None
+        return int(bound.address), int(bound.user or 0)
 
     def __repr__(self) -> str:
         if self._h_given is not None:

@@ -16,6 +16,7 @@ onset).  S then converges at O(h) to the equation's sensitivity.
 from __future__ import annotations
 
 import dataclasses
+import importlib.util
 import math
 from collections.abc import Callable
 from typing import Any
@@ -51,6 +52,9 @@ class Sensitivities:
     switches : list of tuple
         (p, i, kind): friction component i reverses in step p (``"reversal"``, S_i multiplied by
         the saltation factor there) or starts to stick (``"stick"``).
+    engine : str
+        The loop over the steps that computed S: ``"compiled"`` (numba, f called through its C
+        function) or ``"python"``.
     """
 
     t: np.ndarray
@@ -60,6 +64,7 @@ class Sensitivities:
     dx: np.ndarray
     h: float
     switches: list
+    engine: str = "python"
 
 
 @dataclasses.dataclass
@@ -247,7 +252,7 @@ class _Memory:
 
 def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
                   rhs: Callable[[float, np.ndarray, np.ndarray], np.ndarray] | None = None,
-                  jumps: bool = True) -> Sensitivities:
+                  jumps: bool = True, engine: str = "auto") -> Sensitivities:
     """The states U^p and their sensitivities dU^p/dp of the model ``make(p)`` over ``steps``
     steps from t = 0.
 
@@ -270,6 +275,12 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     jumps : bool, optional
         True (default): the saltation factor at reversals (S converges to the equation's
         sensitivity); False: the plain tangent of the scheme everywhere.
+    engine : str, optional
+        The loop over the steps: ``"auto"`` (default) the compiled one where it applies, else
+        the Python one; ``"compiled"`` (numba; f a C function in every model (``jit=True``, a
+        cfunc, a ctypes function) or no f, A zero, friction or a box, no ``rhs``): an error
+        where it does not apply; ``"python"``: one step at a time in Python, calling f through
+        :meth:`dmi.Solver.eval_rhs`.  Both give the same S to rounding.
 
     Returns
     -------
@@ -280,8 +291,9 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     ------
     ValueError
         p not a finite vector, steps < 1, make raising at p or near it, a parameter changing the
-        model's structure, a near kernel, a callback kernel under the cell rule, or ``rhs``
-        disagreeing with the solver's f.
+        model's structure, a near kernel, a callback kernel under the cell rule, ``rhs``
+        disagreeing with the solver's f, an unknown ``engine``, or ``engine="compiled"`` where
+        it does not apply (the message says why).
     TypeError
         make not returning a dmi.Solver.
     """
@@ -290,6 +302,8 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
         raise ValueError("p: expected a nonempty vector of finite numbers")
     if not isinstance(steps, (int, np.integer)) or steps < 1:
         raise ValueError(f"steps = {steps!r}: expected an integer >= 1")
+    if engine not in ("auto", "compiled", "python"):
+        raise ValueError(f"engine = {engine!r}: expected 'auto', 'compiled' or 'python'")
     mod = _build(make, p)
     s = mod.base
     n, N, h, P = s.n, s.N, s.h, len(p)
@@ -324,6 +338,20 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     if rhs is not None:
         _check_complex_rhs(rhs, mod, p, t[0], U[0], Sall[N])
     phi = (U[:-1] - X) / h                                            # f + W at each step
+    why = _not_compiled(mod, has_f, rhs) if engine != "python" else "engine='python'"
+    if why and engine == "compiled":
+        raise ValueError(f"engine='compiled' does not apply: {why}; use engine='auto' or 'python'")
+    if not why:
+        from . import _compiled
+        callbacks = ([m.c_callback("rhs") for m in [s, *mod.others]] if has_f else None)
+        friction = (slipping, dR, meets, alpha, dalpha) if kind == "friction" else None
+        box = (lo, hi, dlo, dhi) if kind == "box" else None
+        dX, switches, failed = _compiled.run(steps, N, h, t, U, X, phi, Sall, mod.delta, callbacks,
+                                             memory, kind, friction, box, jumps)
+        if failed < 0:
+            return Sensitivities(t, U, Sall[N:].copy(), X, dX, h, switches, "compiled")
+        # a call of f failed: the Python loop below (which rewrites each S^{q+1} of Sall from
+        # the history's S on) raises the callback's own error
     dX = np.empty((steps, n, P))
     switches: list = []
     Fd = np.zeros((n, P))
@@ -356,7 +384,25 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
         else:
             Snew[:] = T
         memory.push(Sall, q)
-    return Sensitivities(t, U, Sall[N:].copy(), X, dX, h, switches)
+    return Sensitivities(t, U, Sall[N:].copy(), X, dX, h, switches, "python")
+
+
+def _not_compiled(mod: _Perturbed, has_f: bool, rhs: Callable | None) -> str:
+    """Why the compiled loop does not apply ("" where it does)."""
+    if rhs is not None:
+        return "rhs= (complex step) calls a Python function"
+    kind = mod.base.resolvent_kind
+    if kind not in ("", "friction", "box"):
+        return f"A is a {kind} (its resolvent is called from Python)"
+    if has_f:
+        for j, m in enumerate([mod.base, *mod.others]):
+            if m.c_callback("rhs") is None:
+                where = "p" if j == 0 else f"p + delta e_{j - 1}"
+                return (f"f of the model at {where} is a Python function (set_rhs(f, jit=True) or a "
+                        "C function makes it compiled)")
+    if importlib.util.find_spec("numba") is None:
+        return "numba is not installed"
+    return ""
 
 
 def _bound_diff(b2: np.ndarray, b: np.ndarray) -> np.ndarray:

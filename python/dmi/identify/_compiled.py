@@ -1,0 +1,213 @@
+# dmi.identify._compiled: the per-step loop of the sensitivities, compiled by numba (nopython).
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""The tangent loop of :func:`dmi.identify.sensitivities` compiled by numba, for models whose f is a
+C function (a ``jit=True`` callback, a numba cfunc, a ctypes function): f is called through its
+address, with no Python in between.  It does step by step what the Python loop of sensitivity.py
+does, on the same precomputed arrays (the memory's weights, the kernel's part, the resolvent's
+derivatives), so the two agree to rounding.  This module imports numba (sensitivity.py imports
+it only where numba is installed); the loop is compiled on first call and cached on disk."""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numba
+import numpy as np
+from llvmlite import ir
+from numba import types as nt
+from numba.extending import intrinsic
+
+# codes of the memory and of the resolvent (arguments of the loop)
+MEMORY_NONE, MEMORY_RECURSIVE, MEMORY_DIRECT = 0, 1, 2
+RESOLVENT_NONE, RESOLVENT_FRICTION, RESOLVENT_BOX = 0, 1, 2
+#: codes of the switches the loop records
+STICK, REVERSAL = 0, 1
+
+
+@intrinsic
+def call_rhs(typingctx, address, t, u, out, user):
+    """int f(double t, const double *u, double *out, void *user) at address."""
+    sig = nt.int32(nt.int64, nt.float64, u, out, nt.int64)
+
+    def codegen(context, builder, signature, args):
+        addr, tt, ua, oa, us = args
+        dbl = ir.DoubleType()
+        fnty = ir.FunctionType(ir.IntType(32), [dbl, dbl.as_pointer(), dbl.as_pointer(),
+                                                ir.IntType(8).as_pointer()])
+        fn = builder.inttoptr(addr, fnty.as_pointer())
+        up = context.make_array(signature.args[2])(context, builder, ua).data
+        op = context.make_array(signature.args[3])(context, builder, oa).data
+        return builder.call(fn, [tt, up, op, builder.inttoptr(us, ir.IntType(8).as_pointer())])
+    return sig, codegen
+
+
+@numba.njit(cache=True, nogil=False)
+def loop(steps, N, h, t, U, X, phi, Sall, dX, delta, has_f, addrs, users,
+         memory, E, r, rN, powers, last, flat, dWU,
+         kind, slipping, dR, meets, alpha, dalpha, jumps, lo, hi, dlo, dhi,
+         sw_q, sw_i, sw_kind):
+    n = U.shape[1]
+    P = delta.shape[0]
+    K = r.shape[0]
+    Fd = np.zeros((n, P))
+    T = np.empty((n, P))
+    f0 = np.empty(n)
+    fj = np.empty(n)
+    moved = np.empty(n)
+    Z = np.zeros((K, n, P), dtype=np.complex128)
+    since = 4 * N                       # Z is computed at the first step
+    count = 0
+    Sflat = Sall.reshape(Sall.shape[0] * n, P)
+    for q in range(steps):
+        Sq = Sall[q + N]
+        # f_u S_j + f_p_j: one call of f at p and one of f at p + delta_j e_j per parameter
+        if has_f:
+            if call_rhs(addrs[0], t[q], U[q], f0, users[0]) != 0:
+                return count, q
+            for j in range(P):
+                for i in range(n):
+                    moved[i] = U[q, i] + delta[j] * Sq[i, j]
+                if call_rhs(addrs[j + 1], t[q], moved, fj, users[j + 1]) != 0:
+                    return count, q
+                for i in range(n):
+                    Fd[i, j] = (fj[i] - f0[i]) / delta[j]
+        for i in range(n):
+            for j in range(P):
+                T[i, j] = Sq[i, j] - h * Fd[i, j]
+        # the delay sum sum_l G_l S^{q-l} and the kernel's part dWU
+        if memory == MEMORY_RECURSIVE:
+            if since >= 4 * N:          # Z_k = sum_l r_k^l S^{q-l}, afresh
+                for k in range(K):
+                    for i in range(n):
+                        for j in range(P):
+                            acc = 0j
+                            for l in range(N):
+                                acc += powers[k, l] * Sall[q + N - l, i, j]
+                            Z[k, i, j] = acc
+                since = 0
+            for i in range(n):
+                for j in range(P):
+                    acc = 0.0
+                    for k in range(K):
+                        for m in range(n):
+                            acc += (E[k, i, m] * Z[k, m, j]).real
+                    for m in range(n):
+                        acc += last[i, m] * Sall[q + 1, m, j]
+                    T[i, j] -= h * (acc + dWU[q, i, j])
+        elif memory == MEMORY_DIRECT:
+            rows = Sflat[(q + 1) * n:(q + N + 1) * n]
+            W = flat @ rows
+            for i in range(n):
+                for j in range(P):
+                    T[i, j] -= h * (W[i, j] + dWU[q, i, j])
+        dX[q] = T
+        Snew = Sall[q + 1 + N]
+        if kind == RESOLVENT_FRICTION:
+            for i in range(n):
+                for j in range(P):
+                    Snew[i, j] = T[i, j] * slipping[q, i] + dR[q, i, j]
+            if jumps and meets[q]:
+                # the reversals of the step: S_i multiplied by the saltation factor F+ / F-
+                for i in range(n):
+                    if U[q, i] == 0.0 or not alpha[i] > 0.0:
+                        continue
+                    sm = math.copysign(1.0, U[q, i])
+                    nxt = U[q + 1, i]
+                    if nxt * sm > 0.0:
+                        continue
+                    if nxt == 0.0 and not (q + 2 <= steps and U[q + 2, i] * sm < 0.0):
+                        sw_q[count], sw_i[count], sw_kind[count] = q, i, STICK
+                        count += 1
+                        continue
+                    frac = U[q, i] / (U[q, i] - nxt)
+                    if q + 1 >= steps:
+                        ph = phi[q, i]
+                    else:
+                        ph = (1.0 - frac) * phi[q, i] + frac * phi[q + 1, i]
+                    before = sm * ph + alpha[i]
+                    after = sm * ph - alpha[i]
+                    if before <= 0.0 or after <= 0.0:
+                        continue
+                    for j in range(P):
+                        Snew[i, j] = (after / before) * (T[i, j] - h * sm * dalpha[i, j])
+                    sw_q[count], sw_i[count], sw_kind[count] = q, i, REVERSAL
+                    count += 1
+        elif kind == RESOLVENT_BOX:
+            for i in range(n):
+                for j in range(P):
+                    if X[q, i] < lo[i]:
+                        Snew[i, j] = dlo[i, j]
+                    elif X[q, i] > hi[i]:
+                        Snew[i, j] = dhi[i, j]
+                    else:
+                        Snew[i, j] = T[i, j]
+        else:
+            for i in range(n):
+                for j in range(P):
+                    Snew[i, j] = T[i, j]
+        if memory == MEMORY_RECURSIVE:      # Z from step q to q + 1
+            for k in range(K):
+                for i in range(n):
+                    for j in range(P):
+                        Z[k, i, j] = r[k] * Z[k, i, j] + (Sall[q + 1 + N, i, j]
+                                                          - rN[k] * Sall[q + 1, i, j])
+            since += 1
+    return count, -1
+
+
+
+def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarray, phi: np.ndarray,
+        Sall: np.ndarray, delta: np.ndarray, rhs: list | None, memory: Any, kind: str,
+        friction: tuple | None, box: tuple | None, jumps: bool
+        ) -> tuple[np.ndarray, list, int]:
+    """The loop over the steps: fills Sall[N + 1:] and returns dX, the switches (p, i, kind) and
+    the step whose f call failed (-1: none; the caller then takes the Python loop, which raises
+    the callback's own error).
+
+    ``rhs``: [(address, user)] of f at p and at p + delta_j e_j, or None without f; ``memory``:
+    the _Memory of sensitivity.py; ``friction``: (slipping, dR, meets, alpha, dalpha);
+    ``box``: (lo, hi, dlo, dhi)."""
+    n, P = U.shape[1], len(delta)
+    f64 = np.float64
+    c = np.ascontiguousarray
+    t, U, X, phi = c(t, f64), c(U, f64), c(X, f64), c(phi, f64)
+    if rhs is None:
+        addrs, users = np.zeros(1, np.int64), np.zeros(1, np.int64)
+    else:
+        addrs = np.array([a for a, _ in rhs], np.int64)
+        users = np.array([u for _, u in rhs], np.int64)
+    none2, none3 = np.zeros((0, 0), f64), np.zeros((0, 0, 0), f64)
+    E, r, rN = np.zeros((0, n, n), complex), np.zeros(0, complex), np.zeros(0, complex)
+    powers, last, flat, dWU = np.zeros((0, 0), complex), none2, none2, none3
+    code = MEMORY_NONE
+    if memory.G is not None:
+        dWU = memory.dWU
+        if memory.recursive:
+            code = MEMORY_RECURSIVE
+            E = np.ascontiguousarray(memory.E)
+            r, rN = memory.r[:, 0, 0].copy(), memory.rN[:, 0, 0].copy()
+            powers, last = memory.powers, np.ascontiguousarray(memory.last)
+        else:
+            code = MEMORY_DIRECT
+            flat = np.ascontiguousarray(memory.G[::-1].transpose(1, 0, 2).reshape(n, N * n))
+    kcode = RESOLVENT_NONE
+    slipping, dR, meets = none2, none3, np.zeros(0, np.bool_)
+    alpha, dalpha = np.zeros(0), none2
+    lo, hi, dlo, dhi = np.zeros(0), np.zeros(0), none2, none2
+    if kind == "friction":
+        kcode = RESOLVENT_FRICTION
+        slipping, dR, meets, alpha, dalpha = (c(a) for a in friction)
+    elif kind == "box":
+        kcode = RESOLVENT_BOX
+        lo, hi, dlo, dhi = (c(a, f64) for a in box)
+    dX = np.empty((steps, n, P))
+    cap = steps * n if kind == "friction" else 0
+    sw_q, sw_i, sw_kind = np.empty(cap, np.int64), np.empty(cap, np.int64), np.empty(cap, np.int64)
+    count, failed = loop(steps, N, float(h), t, U, X, phi, Sall, dX, delta, rhs is not None,
+                         addrs, users, code, E, r, rN, powers, last, flat, dWU,
+                         kcode, slipping, dR, meets, alpha, dalpha, bool(jumps),
+                         lo, hi, dlo, dhi, sw_q, sw_i, sw_kind)
+    names = {STICK: "stick", REVERSAL: "reversal"}
+    switches = [(q, i, names[k]) for q, i, k in zip(sw_q[:count].tolist(), sw_i[:count].tolist(),
+                                                    sw_kind[:count].tolist())]
+    return dX, switches, int(failed)
