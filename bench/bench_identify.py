@@ -4,8 +4,10 @@
 # The model: a friction oscillator with a viscoelastic memory of two Prony terms on the velocity,
 #   w'' + k w + mu sigma(w') + int_0^tau (c1 e^{a1 s} + c2 e^{a2 s}) w'(t - s) ds + g cos 0.8 t ∋ 0,
 # w = w0 on t <= 0, P = 8 parameters (k, g: f; mu: friction; w0: history; c1, a1, c2, a2: kernel),
-# tau = N h, N = steps.  Variants: f with jit=True (compiled) or a Python function; the kernel as
-# exponentials (RECURSIVE) or as a Python callback (DIRECT, FFT; shorter runs).  Then one
+# tau = N h, N = steps.  Variants: f with jit=True (compiled: the sensitivities' compiled loop) or a
+# Python function (their Python loop); the history a Python function, or jit=True as well ("all
+# jit"); the kernel as exponentials (RECURSIVE) or as a Python callback (DIRECT, FFT; shorter
+# runs); "f jit, Python loop" times the Python loop on the compiled model.  Then one
 # Gauss-Newton iteration of the gallery's fit (plot_identify_friction_memory.py: one sensitivity
 # run and one residual run) against the P + 1 runs it needs.
 # Rounds interleave the variants; the fastest round of each counts; CPU times of the process (the
@@ -34,8 +36,9 @@ P0 = np.array([1.0, 2.0, 0.5, 1.0, 1.0, -0.3, 3.0, -3.0])   # k, g, mu, w0, c1, 
 H = 0.01
 
 
-def model(steps: int, jit: bool, kernel: str):
-    """make(p) at N = steps, f compiled or not, the kernel as exponentials or a callback."""
+def model(steps: int, jit: bool, kernel: str, history_jit: bool = False):
+    """make(p) at N = steps, f (and the history) compiled or not, the kernel as exponentials or a
+    callback."""
     def make(p):
         k, g, mu, w0, c1, a1, c2, a2 = p
 
@@ -53,7 +56,7 @@ def model(steps: int, jit: bool, kernel: str):
                 return np.array([[0.0, 0.0], [0.0, c1 * math.exp(a1 * x) + c2 * math.exp(a2 * x)]])
             s.set_kernel(H_)
             s.set_convolution(kernel)
-        s.set_history(lambda t: np.array([w0, 0.0]))
+        s.set_history(lambda t: np.array([w0, 0.0]), jit=history_jit)
         return s
     return make
 
@@ -82,19 +85,24 @@ def main() -> None:
     P = len(P0)
     cases = []
     for steps in args.steps:
-        for jit in (True, False):
-            cases.append((f"exp, f {'jit' if jit else 'Python'}, steps = N = {steps}",
-                          model(steps, jit, "exp"), steps))
+        cases.append((f"exp, all jit, steps = N = {steps}", model(steps, True, "exp", True), steps,
+                      "auto"))
+        cases.append((f"exp, f jit, steps = N = {steps}", model(steps, True, "exp"), steps, "auto"))
+        cases.append((f"exp, f jit, Python loop, N = {steps}", model(steps, True, "exp"), steps,
+                      "python"))
+        cases.append((f"exp, f Python, steps = N = {steps}", model(steps, False, "exp"), steps,
+                      "auto"))
     for kernel in ("direct", "fft"):
-        cases.append((f"{kernel} kernel callback, f jit, steps = N = {args.callback_steps}",
-                      model(args.callback_steps, True, kernel), args.callback_steps))
-    for _, make, steps in cases:        # compile the jit=True callbacks before timing
+        cases.append((f"{kernel} kernel callback, f jit, N = {args.callback_steps}",
+                      model(args.callback_steps, True, kernel), args.callback_steps, "auto"))
+    for _, make, steps, engine in cases:   # compile the jit=True callbacks and the loop first
         plain(make, P0, 2)
+        sensitivities(make, P0, 2, engine=engine)
     best: dict = {}
     for _ in range(args.rounds):
-        for name, make, steps in cases:
+        for name, make, steps, engine in cases:
             times = {"run": cpu(lambda: plain(make, P0, steps)),
-                     "sens": cpu(lambda: sensitivities(make, P0, steps)),
+                     "sens": cpu(lambda: sensitivities(make, P0, steps, engine=engine)),
                      "fwd": cpu(lambda: differences(make, P0, steps, False)),
                      "central": cpu(lambda: differences(make, P0, steps, True))}
             old = best.get(name, {})

@@ -44,6 +44,7 @@ def call_rhs(typingctx, address, t, u, out, user):
 @numba.njit(cache=True, nogil=False)
 def loop(steps, N, h, t, U, X, phi, Sall, dX, delta, has_f, addrs, users,
          memory, E, r, rN, powers, last, flat, dWU,
+         Uext, E0, cw, c1, wlast, wslast, dE, dl,
          kind, slipping, dR, meets, alpha, dalpha, jumps, lo, hi, dlo, dhi,
          sw_q, sw_i, sw_kind):
     n = U.shape[1]
@@ -55,6 +56,12 @@ def loop(steps, N, h, t, U, X, phi, Sall, dX, delta, has_f, addrs, users,
     fj = np.empty(n)
     moved = np.empty(n)
     Z = np.zeros((K, n, P), dtype=np.complex128)
+    # the kernel's part by recursion: Y_k = sum_l r_k^l U^{q-l}, Y1_k = sum_l l r_k^l U^{q-l}
+    Y = np.zeros((K, n), dtype=np.complex128)
+    Y1 = np.zeros((K, n), dtype=np.complex128)
+    A = np.zeros((K, n), dtype=np.complex128)
+    EB = np.zeros((K, n), dtype=np.complex128)
+    B = np.zeros(n, dtype=np.complex128)
     since = 4 * N                       # Z is computed at the first step
     count = 0
     Sflat = Sall.reshape(Sall.shape[0] * n, P)
@@ -76,7 +83,7 @@ def loop(steps, N, h, t, U, X, phi, Sall, dX, delta, has_f, addrs, users,
                 T[i, j] = Sq[i, j] - h * Fd[i, j]
         # the delay sum sum_l G_l S^{q-l} and the kernel's part dWU
         if memory == MEMORY_RECURSIVE:
-            if since >= 4 * N:          # Z_k = sum_l r_k^l S^{q-l}, afresh
+            if since >= 4 * N:          # Z_k = sum_l r_k^l S^{q-l}, Y_k and Y1_k afresh
                 for k in range(K):
                     for i in range(n):
                         for j in range(P):
@@ -84,7 +91,29 @@ def loop(steps, N, h, t, U, X, phi, Sall, dX, delta, has_f, addrs, users,
                             for l in range(N):
                                 acc += powers[k, l] * Sall[q + N - l, i, j]
                             Z[k, i, j] = acc
+                        acc = 0j
+                        acc1 = 0j
+                        for l in range(N):
+                            v = powers[k, l] * Uext[q + N - 1 - l, i]
+                            acc += v
+                            acc1 += l * v
+                        Y[k, i] = acc
+                        Y1[k, i] = acc1
                 since = 0
+            # sum_l w_kl U^{q-l} (A_k) and E_k sum_l ws_kl U^{q-l} (EB_k): the full cells from
+            # Y and Y1, the last one (U^{q-N+1}, weights w_k,N-1, ws_k,N-1) mended
+            for k in range(K):
+                rl = powers[k, N - 1]
+                fa = wlast[k] - cw[k] * rl
+                fb = wslast[k] - rl * ((N - 1) * h * cw[k] + c1[k])
+                for i in range(n):
+                    A[k, i] = cw[k] * Y[k, i] + fa * Uext[q, i]
+                    B[i] = h * cw[k] * Y1[k, i] + c1[k] * Y[k, i] + fb * Uext[q, i]
+                for i in range(n):
+                    acc = 0j
+                    for m in range(n):
+                        acc += E0[k, i, m] * B[m]
+                    EB[k, i] = acc
             for i in range(n):
                 for j in range(P):
                     acc = 0.0
@@ -93,7 +122,14 @@ def loop(steps, N, h, t, U, X, phi, Sall, dX, delta, has_f, addrs, users,
                             acc += (E[k, i, m] * Z[k, m, j]).real
                     for m in range(n):
                         acc += last[i, m] * Sall[q + 1, m, j]
-                    T[i, j] -= h * (acc + dWU[q, i, j])
+                    # the kernel's part: sum_k dE_jk A_k + dl_jk EB_k
+                    part = 0.0
+                    for k in range(K):
+                        z = dl[j, k] * EB[k, i]
+                        for m in range(n):
+                            z += dE[j, k, i, m] * A[k, m]
+                        part += z.real
+                    T[i, j] -= h * (acc + part)
         elif memory == MEMORY_DIRECT:
             rows = Sflat[(q + 1) * n:(q + N + 1) * n]
             W = flat @ rows
@@ -151,6 +187,9 @@ def loop(steps, N, h, t, U, X, phi, Sall, dX, delta, has_f, addrs, users,
                     for j in range(P):
                         Z[k, i, j] = r[k] * Z[k, i, j] + (Sall[q + 1 + N, i, j]
                                                           - rN[k] * Sall[q + 1, i, j])
+                    # U^{q+1} = Uext[q + N], U^{q+1-N} = Uext[q]
+                    Y1[k, i] = r[k] * (Y1[k, i] + Y[k, i]) - N * rN[k] * Uext[q, i]
+                    Y[k, i] = r[k] * Y[k, i] + Uext[q + N, i] - rN[k] * Uext[q, i]
             since += 1
     return count, -1
 
@@ -179,16 +218,23 @@ def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarra
     none2, none3 = np.zeros((0, 0), f64), np.zeros((0, 0, 0), f64)
     E, r, rN = np.zeros((0, n, n), complex), np.zeros(0, complex), np.zeros(0, complex)
     powers, last, flat, dWU = np.zeros((0, 0), complex), none2, none2, none3
+    cplx = np.complex128
+    Uext, E0, cw, c1 = none2, np.zeros((0, n, n), cplx), np.zeros(0, cplx), np.zeros(0, cplx)
+    wlast, wslast = np.zeros(0, cplx), np.zeros(0, cplx)
+    dE, dl = np.zeros((0, 0, n, n), cplx), np.zeros((0, 0), cplx)
     code = MEMORY_NONE
     if memory.G is not None:
-        dWU = memory.dWU
         if memory.recursive:
             code = MEMORY_RECURSIVE
-            E = np.ascontiguousarray(memory.E)
+            E = c(memory.E, cplx)
             r, rN = memory.r[:, 0, 0].copy(), memory.rN[:, 0, 0].copy()
-            powers, last = memory.powers, np.ascontiguousarray(memory.last)
+            powers, last = c(memory.powers, cplx), c(memory.last, f64)
+            Uext, E0, cw, c1 = c(memory.Uext, f64), c(memory.E0, cplx), c(memory.c, cplx), c(memory.c1, cplx)
+            wlast, wslast = c(memory.w[:, -1], cplx), c(memory.ws[:, -1], cplx)
+            dE, dl = c(memory.dE, cplx), c(memory.dl, cplx)
         else:
             code = MEMORY_DIRECT
+            dWU = memory.kernel_part()
             flat = np.ascontiguousarray(memory.G[::-1].transpose(1, 0, 2).reshape(n, N * n))
     kcode = RESOLVENT_NONE
     slipping, dR, meets = none2, none3, np.zeros(0, np.bool_)
@@ -205,6 +251,7 @@ def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarra
     sw_q, sw_i, sw_kind = np.empty(cap, np.int64), np.empty(cap, np.int64), np.empty(cap, np.int64)
     count, failed = loop(steps, N, float(h), t, U, X, phi, Sall, dX, delta, rhs is not None,
                          addrs, users, code, E, r, rN, powers, last, flat, dWU,
+                         Uext, E0, cw, c1, wlast, wslast, dE, dl,
                          kcode, slipping, dR, meets, alpha, dalpha, bool(jumps),
                          lo, hi, dlo, dhi, sw_q, sw_i, sw_kind)
     names = {STICK: "stick", REVERSAL: "reversal"}

@@ -22,7 +22,7 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from scipy.signal import fftconvolve
+from scipy import fft as sp_fft
 
 from .._solver import Solver
 
@@ -142,10 +142,11 @@ def _theta(s: Solver) -> float:
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(12)
 
 
-def _exp_weights(s: Solver, lam: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _exp_weights(s: Solver, lam: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Per term k and cell l: w[k, l], the complex weight of e^{lam_k s} over cell l, and ws[k, l],
-    that of s e^{lam_k s} (its derivative in lam_k); c[k], the factor of r_k^l in the full cells
-    (w[k, l] = c_k r_k^l for l < N - 1)."""
+    that of s e^{lam_k s} (its derivative in lam_k); c[k] and c1[k], the factors of the full cells
+    (w[k, l] = c_k r_k^l and ws[k, l] = r_k^l (l h c_k + c1_k) for l < N - 1, r_k = e^{lam_k h})."""
     N, h = s.N, s.h
     theta = _theta(s)
     lags = np.arange(N) * h
@@ -153,7 +154,8 @@ def _exp_weights(s: Solver, lam: np.ndarray) -> tuple[np.ndarray, np.ndarray, np
         cell = np.full(N, h)
         cell[-1] = theta * h
         e = np.exp(np.outer(lam, lags))
-        return cell * e, cell * lags * e, np.full(len(lam), h, dtype=complex)
+        return (cell * e, cell * lags * e, np.full(len(lam), h, dtype=complex),
+                np.zeros(len(lam), dtype=complex))
     # the cell rule: the integrals over each cell, by Gauss-Legendre (the integrands are smooth)
     length = np.full(N, h)
     length[-1] = theta * h
@@ -162,33 +164,41 @@ def _exp_weights(s: Solver, lam: np.ndarray) -> tuple[np.ndarray, np.ndarray, np
     e = np.exp(lam[:, None, None] * nodes[None])                                  # (K, N, G)
     w = np.sum(e * wts[None], axis=2)
     ws = np.sum(e * (nodes * wts)[None], axis=2)
-    c = np.sum(np.exp(lam[:, None] * (0.5 * h * (1.0 + _GL_X))[None]) * (0.5 * h * _GL_W)[None], axis=1)
-    return w, ws, c
+    x = 0.5 * h * (1.0 + _GL_X)
+    e1 = np.exp(lam[:, None] * x[None]) * (0.5 * h * _GL_W)[None]
+    return w, ws, np.sum(e1, axis=1), np.sum(e1 * x[None], axis=1)
 
 
 class _Memory:
-    """The delay sum of the tangent, sum_l G_l S^{p-l}, and the kernel's part dG_l U^{p-l}."""
+    """The delay sum of the tangent, sum_l G_l S^{p-l}, and the kernel's part dG_l U^{p-l}
+    (:meth:`kernel_part`)."""
 
     def __init__(self, mod: _Perturbed, Uext: np.ndarray, P: int):
         s = mod.base
         self.N, n = s.N, s.n
         N = self.N
+        self.Uext, self.P = Uext, P
         self._flat: np.ndarray | None = None
+        self._dWU: np.ndarray | None = None
         kind = s.kernel_kind
+        self.kind = kind
         self.recursive = False
         if kind == "exp":
             a, b, C, D = s.kernel_terms
             lam = a + 1j * b
-            w, ws, c = _exp_weights(s, lam)
+            w, ws, c, c1 = _exp_weights(s, lam)
             E = C - 1j * D                                                     # (K, n, n)
-            self.G = np.einsum("kl,kij->lij", w, E).real                         # (N, n, n)
-            dG = np.zeros((P, N, n, n))
+            K = len(a)
+            # sum_k w[k, l] E_k as one matrix product (N, K) @ (K, n n)
+            self.G = (w.T @ E.reshape(K, n * n)).real.reshape(N, n, n)
+            # the terms' derivatives: dE[j, k] of C - iD and dl[j, k] of lam_k in p_j
+            self.dE = np.empty((P, K, n, n), dtype=complex)
+            self.dl = np.empty((P, K), dtype=complex)
             for j, other in enumerate(mod.others):
                 a2, b2, C2, D2 = other.kernel_terms
-                dl = ((a2 - a) + 1j * (b2 - b)) / mod.delta[j]
-                dE = ((C2 - C) - 1j * (D2 - D)) / mod.delta[j]
-                dG[j] = (np.einsum("kl,kij->lij", w, dE)
-                         + np.einsum("kl,k,kij->lij", ws, dl, E)).real
+                self.dl[j] = ((a2 - a) + 1j * (b2 - b)) / mod.delta[j]
+                self.dE[j] = ((C2 - C) - 1j * (D2 - D)) / mod.delta[j]
+            self.w, self.ws, self.c, self.c1, self.E0 = w, ws, c, c1, E
             # the recursion: Z_k^p = sum_l r_k^l S^{p-l} (all N cells), then the last cell mended
             self.recursive = bool(np.all(a <= 0.0) and np.all(np.abs(b) * s.h <= math.pi))
             if self.recursive:
@@ -205,21 +215,37 @@ class _Memory:
             lags = np.arange(N) * s.h
             H0 = np.array([s.eval_kernel(x) for x in lags])
             self.G = cell[:, None, None] * H0
-            dG = np.empty((P, N, n, n))
+            self.dG = np.empty((P, N, n, n))
             for j, other in enumerate(mod.others):
                 Hj = np.array([other.eval_kernel(x) for x in lags])
-                dG[j] = cell[:, None, None] * (Hj - H0) / mod.delta[j]
+                self.dG[j] = cell[:, None, None] * (Hj - H0) / mod.delta[j]
         else:
             self.G = None
-            return
-        # the kernel's part for all steps at once: dWU[p, :, j] = sum_l dG_j[l] U^{p-l}
-        # (one FFT convolution per parameter: memory O((N + steps) n^2), not times P)
-        steps = len(Uext) - N
-        self.dWU = np.empty((steps, n, P))
-        for j in range(P):
-            conv = fftconvolve(dG[j], Uext[:, None, :], axes=0).sum(axis=2)   # (N + L - 1, n)
-            self.dWU[:, :, j] = conv[N - 1:N - 1 + steps]
         self.Z = None
+
+    def kernel_part(self) -> np.ndarray:
+        """dWU[p, :, j] = sum_l dG_j[l] U^{p-l} for all steps at once (steps, n, P): one FFT
+        convolution per parameter, U transformed once (memory O((N + steps) n^2), not times P)."""
+        if self._dWU is not None:
+            return self._dWU
+        N, P, Uext = self.N, self.P, self.Uext
+        n = Uext.shape[1]
+        if self.kind == "exp":
+            K = len(self.c)
+            Ef = self.E0.reshape(K, n * n)
+            wT = self.w.T
+            dG = [(wT @ self.dE[j].reshape(K, n * n)
+                   + (self.ws * self.dl[j][:, None]).T @ Ef).real.reshape(N, n, n) for j in range(P)]
+        else:
+            dG = self.dG
+        steps = len(Uext) - N
+        size = sp_fft.next_fast_len(N + len(Uext) - 1, real=True)
+        FU = sp_fft.rfft(Uext, size, axis=0)[:, :, None]                       # (F, n, 1)
+        self._dWU = np.empty((steps, n, P))
+        for j in range(P):
+            conv = sp_fft.irfft((sp_fft.rfft(dG[j], size, axis=0) @ FU)[:, :, 0], size, axis=0)
+            self._dWU[:, :, j] = conv[N - 1:N - 1 + steps]
+        return self._dWU
 
     def _recompute(self, Sall: np.ndarray, p: int) -> None:
         window = Sall[p + 1:p + self.N + 1][::-1]                                # S^{p-l}
@@ -355,6 +381,7 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     dX = np.empty((steps, n, P))
     switches: list = []
     Fd = np.zeros((n, P))
+    dWU = memory.kernel_part() if memory.G is not None else None
     for q in range(steps):
         Sq = Sall[q + N]
         if rhs is not None:
@@ -366,7 +393,7 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
                   - f0[:, None]) / mod.delta
         T = Sq - h * Fd
         if memory.G is not None:
-            T -= h * (memory.sum_S(Sall, q) + memory.dWU[q])
+            T -= h * (memory.sum_S(Sall, q) + dWU[q])
         dX[q] = T
         Snew = Sall[q + 1 + N]
         if kind == "friction":
