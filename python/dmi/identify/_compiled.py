@@ -41,7 +41,7 @@ def call_rhs(typingctx, address, t, u, out, user):
     return sig, codegen
 
 
-@numba.njit(cache=True, nogil=False)
+@numba.njit(cache=True)
 def loop(steps, N, h, t, U, X, phi, Sall, dX, delta, has_f, addrs, users,
          memory, E, r, rN, powers, last, flat, dWU,
          Uext, E0, cw, c1, wlast, wslast, dE, dl,
@@ -119,16 +119,18 @@ def loop(steps, N, h, t, U, X, phi, Sall, dX, delta, has_f, addrs, users,
                     acc = 0.0
                     for k in range(K):
                         for m in range(n):
-                            acc += (E[k, i, m] * Z[k, m, j]).real
+                            e, z = E[k, i, m], Z[k, m, j]     # the real part only
+                            acc += e.real * z.real - e.imag * z.imag
                     for m in range(n):
                         acc += last[i, m] * Sall[q + 1, m, j]
                     # the kernel's part: sum_k dE_jk A_k + dl_jk EB_k
                     part = 0.0
                     for k in range(K):
-                        z = dl[j, k] * EB[k, i]
+                        d, v = dl[j, k], EB[k, i]
+                        part += d.real * v.real - d.imag * v.imag
                         for m in range(n):
-                            z += dE[j, k, i, m] * A[k, m]
-                        part += z.real
+                            d, v = dE[j, k, i, m], A[k, m]
+                            part += d.real * v.real - d.imag * v.imag
                     T[i, j] -= h * (acc + part)
         elif memory == MEMORY_DIRECT:
             rows = Sflat[(q + 1) * n:(q + N + 1) * n]
