@@ -3,8 +3,9 @@
 """The tangent loop of :func:`dmi.identify.sensitivities` compiled by numba, for models whose f is a
 C function (a ``jit=True`` callback, a numba cfunc, a ctypes function): f is called through its
 address, with no Python in between.  It does step by step what the Python loop of sensitivity.py
-does, on the same precomputed arrays (the memory's weights, the kernel's part, the resolvent's
-derivatives), so the two agree to rounding.  This module imports numba (sensitivity.py imports
+does, on the same precomputed arrays (the memory's weights and the kernel terms' derivatives, the
+resolvent's derivatives along the run), so the two agree to rounding; the exponential kernel's part
+dG_l U^{p-l}, which the Python loop takes from FFT convolutions, runs here by its recursions.  This module imports numba (sensitivity.py imports
 it only where numba is installed); the loop is compiled on first call and cached on disk."""
 from __future__ import annotations
 
@@ -196,7 +197,6 @@ def loop(steps, N, h, t, U, X, phi, Sall, dX, delta, has_f, addrs, users,
     return count, -1
 
 
-
 def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarray, phi: np.ndarray,
         Sall: np.ndarray, delta: np.ndarray, rhs: list | None, memory: Any, kind: str,
         friction: tuple | None, box: tuple | None, jumps: bool
@@ -231,7 +231,8 @@ def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarra
             E = c(memory.E, cplx)
             r, rN = memory.r[:, 0, 0].copy(), memory.rN[:, 0, 0].copy()
             powers, last = c(memory.powers, cplx), c(memory.last, f64)
-            Uext, E0, cw, c1 = c(memory.Uext, f64), c(memory.E0, cplx), c(memory.c, cplx), c(memory.c1, cplx)
+            Uext, E0 = c(memory.Uext, f64), c(memory.E0, cplx)
+            cw, c1 = c(memory.c, cplx), c(memory.c1, cplx)
             wlast, wslast = c(memory.w[:, -1], cplx), c(memory.ws[:, -1], cplx)
             dE, dl = c(memory.dE, cplx), c(memory.dl, cplx)
         else:
