@@ -30,6 +30,7 @@ from ._model import Linearisation
 from .equilibria import equilibrium
 from .newton import ShootingError, bordered_newton
 from .orbit import Orbit, loops, make_orbit
+from .branch import Event
 from .stability import HopfPoint
 from .stepmap import Model, StepMap, build, fixed_step, positive_time
 
@@ -182,6 +183,44 @@ def critical_vector(lin: Linearisation, lam: complex) -> np.ndarray:
     return Vh[-1].conj()
 
 
+def _hopf_of(hopf_point: Any) -> HopfPoint:
+    """The HopfPoint of a ``hopf`` Event or a HopfPoint, checked: omega > 0 and its root on the
+    imaginary axis; ValueError saying why otherwise."""
+    if isinstance(hopf_point, Event):
+        if hopf_point.kind != "hopf" or hopf_point.hopf is None:
+            raise ValueError(f"hopf_point: an event of kind {hopf_point.kind!r} at p = "
+                             f"{hopf_point.p!r} is not a Hopf point ({hopf_point.detail}); "
+                             "hopf_orbit starts at a 'hopf' event, where a pair of non-real "
+                             "roots crosses the imaginary axis")
+        hopf_point = hopf_point.hopf
+    if not isinstance(hopf_point, HopfPoint):
+        raise ValueError(f"hopf_point = {hopf_point!r}: give a dmi.analysis.HopfPoint (from "
+                         "dmi.analysis.hopf or a 'hopf' event's Event.hopf)")
+    if not (hopf_point.omega > 0 and math.isfinite(hopf_point.omega)):
+        raise ValueError(f"hopf_point.omega = {hopf_point.omega!r}: a Hopf point has omega > 0 "
+                         "(omega = 0 is a fold or a branch point)")
+    root = complex(hopf_point.root)
+    if not abs(root.real) <= 1e-6 * max(1.0, abs(root)):
+        raise ValueError(f"hopf_point: its root {root!r} is not on the imaginary axis (Re = "
+                         f"{root.real:.3g}): not a Hopf point (a pair that meets on the real "
+                         "axis, or a point not located on the branch); locate it with "
+                         "dmi.analysis.hopf or continue_equilibrium")
+    return hopf_point
+
+
+def positive_amplitude(value: Any) -> float:
+    """The amplitude of hopf_orbit as a float, finite and > 0; ValueError naming it (a half
+    range of a state component, state units) otherwise."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"amplitude = {value!r} is not a number") from None
+    if not (math.isfinite(v) and v > 0):
+        raise ValueError(f"amplitude = {v}: must be finite and > 0 (the half range (max - min) "
+                         "/ 2 of a state component over the period, state units)")
+    return v
+
+
 def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: float, steps: int,
                component: int | None = None, multipliers: int = 10, tol: float = 1e-10,
                max_iter: int = 30) -> Orbit:
@@ -198,9 +237,9 @@ def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: floa
     ----------
     make : callable
         The model ``make(p, h=...) -> dmi.Solver``: it must take the step.
-    hopf_point : HopfPoint
-        From :func:`dmi.analysis.hopf` or a ``hopf`` event of
-        :func:`dmi.analysis.continue_equilibrium` (``Event.hopf``).
+    hopf_point : HopfPoint or Event
+        From :func:`dmi.analysis.hopf`, or a ``hopf`` event of
+        :func:`dmi.analysis.continue_equilibrium` (the Event or its ``Event.hopf``).
     u_eq : array_like
         Shape (n,): the equilibrium at the Hopf point (``Event.u``), corrected by Newton at the
         orbit's step.
@@ -227,17 +266,14 @@ def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: floa
     Raises
     ------
     ValueError
-        Bad input: not a HopfPoint, omega <= 0 (a fold), amplitude <= 0, steps < 8, a component
+        Bad input: not a HopfPoint (an event of another kind: said so), omega <= 0 (a fold),
+        a root off the imaginary axis, amplitude <= 0, steps < 8, a component
         out of range or not moving in the critical mode, a model that does not take h.
     ShootingError
         Newton fails (every residual listed).
     """
-    if not isinstance(hopf_point, HopfPoint):
-        raise ValueError(f"hopf_point = {hopf_point!r}: give a dmi.analysis.HopfPoint")
-    if not (hopf_point.omega > 0 and math.isfinite(hopf_point.omega)):
-        raise ValueError(f"hopf_point.omega = {hopf_point.omega!r}: a Hopf point has omega > 0 "
-                         "(omega = 0 is a fold)")
-    a = positive_time("amplitude", amplitude)
+    hopf_point = _hopf_of(hopf_point)
+    a = positive_amplitude(amplitude)
     M = int(steps)
     if M != steps or M < 8:
         raise ValueError(f"steps = {steps!r}: give a whole number of steps a period, >= 8")

@@ -79,7 +79,7 @@ from .newton import ShootingError, fmt_residuals, judge
 VERTICAL = 1e-6
 
 
-class _Curve:
+class Curve:
     """The discretisation with the driver's inner product: z = (x, p), weights w."""
 
     def __init__(self, disc: Any, size: int):
@@ -202,7 +202,7 @@ def _parity(perm: np.ndarray) -> float:
     return sign
 
 
-def tangent(curve: _Curve, z: np.ndarray, prev: np.ndarray) -> tuple[np.ndarray, Any, np.ndarray]:
+def tangent(curve: Curve, z: np.ndarray, prev: np.ndarray) -> tuple[np.ndarray, Any, np.ndarray]:
     """The unit tangent (weighted norm) at z oriented along prev (<w t, prev> > 0), and the
     Jacobian (J_x, J_p) it came from."""
     Jx, Jp = curve.jacobian(z)
@@ -221,13 +221,13 @@ def tangent(curve: _Curve, z: np.ndarray, prev: np.ndarray) -> tuple[np.ndarray,
     return (t if float(np.dot(w * t, prev)) >= 0 else -t), Jx, Jp
 
 
-def newton_corrector(curve: _Curve, zp: np.ndarray, row: np.ndarray, target: float, *,
+def newton_corrector(curve: Curve, zp: np.ndarray, row: np.ndarray, target: float, *,
                      tol: float, max_iter: int, far: float, what: str) -> tuple[np.ndarray, int]:
     """Newton on (residual(z), row . z - target) = 0 from zp with the bordered Jacobian.
 
     Parameters
     ----------
-    curve : _Curve
+    curve : Curve
         The discretisation.
     zp : numpy.ndarray
         The predictor (x, p).
@@ -286,7 +286,7 @@ class _Run:
     """One continuation: the curve, the corrector's settings and the points found."""
 
     def __init__(self, disc: Any, size: int, tol: float, max_iter: int):
-        self.curve = _Curve(disc, size)
+        self.curve = Curve(disc, size)
         self.disc = disc
         self.tol, self.max_iter = tol, max_iter
 
@@ -647,7 +647,7 @@ def _events(run: _Run, za: np.ndarray, ta: np.ndarray, fa: dict[str, float],
         events.append(Event(kind, p, 0, **fields))
 
 
-def _parabola(curve: _Curve, zs: list[np.ndarray]) -> float:
+def _parabola(curve: Curve, zs: list[np.ndarray]) -> float:
     """The fold's p: the vertex of the parabola p(s) through the last three points (s their
     arclength), or the middle of the last two where it has none between them."""
     zs = [z for z in zs if z.size == zs[-1].size][-3:]

@@ -27,16 +27,48 @@ from ._model import call_make
 Model = Callable[..., Solver]
 
 
-def fixed_step(make: Model, h: float) -> Model:
-    """make at the step h: ``made(p)`` is ``make(p, h=h)``, and ``made(p, h=other)`` another
-    step (an autonomous Orbit's ``make``: StepMap(orbit.make, ...) runs at the orbit's step and
-    continuation changes it)."""
-    base = getattr(make, "base", make)     # the user's model, not a made of a made
+class FixedStep:
+    """A model at a fixed step: ``FixedStep(make, h)(p)`` is ``make(p, h=h)``, and
+    ``(p, h=other)`` another step (an autonomous Orbit's ``make``).  A class, not a closure, so
+    that the branches and orbits holding it pickle (when ``make`` does).
 
-    def made(p: float, h: float = h) -> Solver:
-        return base(p, h=h)  # type: ignore[call-arg]
-    made.base = base  # type: ignore[attr-defined]
-    return made
+    Parameters
+    ----------
+    make : callable
+        The model ``make(p, h=...) -> dmi.Solver`` (a FixedStep's own model is taken).
+    h : float
+        The step.
+    """
+
+    def __init__(self, make: Model, h: float):
+        self.base = getattr(make, "base", make)   # the user's model, not a FixedStep of one
+        self.h = float(h)
+
+    def __call__(self, p: float, h: float | None = None) -> Solver:
+        """make(p, h=h).
+
+        Parameters
+        ----------
+        p : float
+            The parameter.
+        h : float, optional
+            The step (default the fixed one).
+
+        Returns
+        -------
+        dmi.Solver
+            The model's solver.
+        """
+        return self.base(p, h=self.h if h is None else h)
+
+    def __repr__(self) -> str:
+        return f"FixedStep({self.base!r}, h={self.h!r})"
+
+
+def fixed_step(make: Model, h: float) -> Model:
+    """make at the step h: a :class:`FixedStep` (``made(p)`` is ``make(p, h=h)``, and
+    ``made(p, h=other)`` another step)."""
+    return FixedStep(make, h)
 
 
 def build(make: Model, p: float, **kw: Any) -> Solver:
