@@ -21,17 +21,26 @@ are fixed; a second discretisation, e.g. collocation of the equation's orbits, i
   computable there (no event of that kind between the two points).
 - optional ``disc.describe(kind, x, p, point) -> dict | None``: the located event checked and
   described: the fields of :class:`dmi.analysis.Event` to set (``detail``, ``u``, ``hopf``,
-  ``component``), or None when the check refutes it (the event is then dropped with a
-  ``RuntimeWarning`` that says why, from ``disc.why`` when the object sets it).
+  ``component``), or None when the check refutes it (the event is then dropped, with a
+  ``RuntimeWarning`` that says why when the object sets ``disc.why``; an empty ``why``: a
+  known false zero of the test function, dropped silently).
 - optional ``disc.adapt(x, p) -> x``: a change of mesh (or of the unknowns) between steps; the
   driver then restarts its tangent from the new x.
 - optional ``disc.correct(x, p, row, target, far) -> tuple[x, p, iterations]``: the
   discretisation's own corrector on residual(x, p) = 0, row . (x, p) = target (e.g.
   Newton-Picard for shooting); it raises to refuse the step (the driver halves it), ``far`` the
   largest distance (weighted norm) from the predictor it may stray.
-- optional ``disc.weight``: a float, the weight of x in the arclength's inner product
-  <a, b> = weight a_x . b_x + a_p b_p (default 1 / len(x): x's RMS, so that a step is in "p or
-  RMS state units").
+- optional ``disc.weight``: a float or an array of len(x), the weight of x in the arclength's
+  inner product <a, b> = sum weight a_x b_x + a_p b_p (default 1 / len(x): x's RMS, so that a
+  step is in "p or RMS state units").
+- optional ``disc.start_tangent(x, p, direction) -> np.ndarray | None``: with the secant
+  predictor, the first tangent (len(x) + 1, unit in the weighted norm); None or absent: the
+  first step is a natural one in p (the hyperplane p = p0 + step).
+- optional ``disc.between(za, a, zb, b, middle) -> list[Event]``: events decided by the
+  discretisation from two consecutive points (changes of a count, as a stick pattern's);
+  ``middle(z0, z1)`` is the branch's point z on the hyperplane through the middle of z0 and z1
+  across their chord (a bisection along the branch, also where it turns at the event); the
+  driver sets the events' indices.
 
 The driver: ``continuation(disc, x0, p0, p_end, *, step, min_step, max_step, max_points,
 at=(), ...) -> Branch``.
@@ -85,13 +94,14 @@ class Curve:
     def __init__(self, disc: Any, size: int):
         self.disc = disc
         self.size = size   # len(x)
-        weight = getattr(disc, "weight", None)
-        self.weight = 1.0 / size if weight is None else float(weight)
 
     def w(self, n: int | None = None) -> np.ndarray:
         """The inner product's weights on z (len(x) + 1)."""
         m = self.size if n is None else n
-        v = np.full(m + 1, self.weight)
+        weight = getattr(self.disc, "weight", None)
+        if weight is not None and np.ndim(weight) == 1:
+            return np.concatenate([np.asarray(weight, dtype=float), [1.0]])
+        v = np.full(m + 1, 1.0 / m if weight is None else float(weight))
         v[-1] = 1.0
         return v
 
@@ -314,6 +324,11 @@ class _Run:
         wc = self.curve.w(za.size - 1) * c
         return self.correct(za + s * c, wc, float(wc @ za) + s, math.inf)[0]
 
+    def middle(self, z0: np.ndarray, z1: np.ndarray) -> np.ndarray:
+        """The point on the hyperplane through the middle of z0 and z1, across their chord."""
+        L = self.curve.norm(z1 - z0)
+        return self.across(z0, (z1 - z0) / L, 0.5 * L)
+
     def land(self, za: np.ndarray, zb: np.ndarray, p: float) -> np.ndarray:
         """The point at exactly the parameter p between za and zb (p between their p's): from
         the chord's interpolation; where that fails, Brent on p along the chord first."""
@@ -342,6 +357,7 @@ def continuation(disc: Any, x0: np.ndarray, p0: float, p_end: float, *, step: fl
                  min_step: float | None = None, max_step: float | None = None,
                  max_points: int = 200, at: Iterable[float] = (), tol: float = 1e-10,
                  max_iter: int = 8, predictor: str = "tangent", easy: int = 3,
+                 grow_first: bool = True,
                  make: Callable[..., Any] | None = None, kind: str = "points",
                  branch: dict[str, Any] | None = None) -> Branch:
     """Continues residual(x, p) = 0 from (x0, p0) to p_end by pseudo-arclength (see the module).
@@ -375,6 +391,9 @@ def continuation(disc: Any, x0: np.ndarray, p0: float, p_end: float, *, step: fl
         The tangent at every point, or the secant (the tangent at the start only).
     easy : int
         A corrector of at most this many iterations lets the step grow.
+    grow_first : bool
+        The step may grow after the first step too (False: the second step is ``step`` again;
+        a first step in p alone says little of the arclength's scale).
     make : callable, optional
         The model, stored in the Branch.
     kind : str
@@ -424,9 +443,19 @@ def continuation(disc: Any, x0: np.ndarray, p0: float, p_end: float, *, step: fl
         z = run.at_p(z, p0)
     e_p = np.zeros(z.size)
     e_p[-1] = direction
-    t, Jx, Jp = tangent(curve, z, e_p)
-    if abs(t[-1]) > VERTICAL and t[-1] * direction < 0:
-        t = -t
+    natural = False   # the first step on the hyperplane p = p0 + step
+    Jx = Jp = None
+    if predictor == "tangent":
+        t, Jx, Jp = tangent(curve, z, e_p)
+        if abs(t[-1]) > VERTICAL and t[-1] * direction < 0:
+            t = -t
+    else:
+        start = getattr(disc, "start_tangent", None)
+        t = None if start is None else start(z[:-1].copy(), p0, direction)
+        if t is None:
+            t, natural = e_p, True
+        t = np.asarray(t, dtype=float)
+    between = getattr(disc, "between", None)
     has_events = hasattr(disc, "event_functions")
     describe = getattr(disc, "describe", None)
 
@@ -444,19 +473,19 @@ def continuation(disc: Any, x0: np.ndarray, p0: float, p_end: float, *, step: fl
 
     pts = [record(z, float(t[-1]))]
     zs, ts = [z], [t]
-    fs = [tests(z, pts[0], t, (Jx, Jp) if predictor == "tangent" else None)]
+    fs = [tests(z, pts[0], t, (Jx, Jp) if Jx is not None else None)]
     events: list[Event] = []
     status = "max_points reached"
     ds = step
-    cornered = False
     while len(pts) < max_points:
         # the predictor and the corrector, the step halved after a failure
         zn = None
+        cornered = False
         while zn is None:
             zp = z + ds * t
             row = curve.w(z.size - 1) * t
             try:
-                zn, its = run.correct(zp, row, float(row @ zp), ds)
+                zn, its = run.correct(zp, row, float(row @ zp), math.inf if natural else ds)
             except Exception as e:   # the model's or the corrector's failure: a shorter step
                 ds /= 2
                 if ds < step / 8 and not cornered:
@@ -472,6 +501,8 @@ def continuation(disc: Any, x0: np.ndarray, p0: float, p_end: float, *, step: fl
                     break
         if zn is None:
             break
+        grow = grow_first or len(pts) > 1   # else the second step is the user's step again
+        natural = False
         adapt = getattr(disc, "adapt", None)
         restarted = False
         if adapt is not None:
@@ -494,6 +525,8 @@ def continuation(disc: Any, x0: np.ndarray, p0: float, p_end: float, *, step: fl
         found: list[Event] = []
         _events(run, z, t, fs[-1], zn, tn, f, found, describe, predictor == "tangent",
                 zs[-2:])
+        if between is not None and z.size == zn.size:
+            found += between(z, pts[-1], zn, pt, run.middle)
         # p_end crossed by the new point, or twice inside the step (a located fold beyond it):
         # the last point lands on it exactly, at its first crossing
         past = [e for e in found if e.kind == "fold" and e.u is not None
@@ -537,11 +570,12 @@ def continuation(disc: Any, x0: np.ndarray, p0: float, p_end: float, *, step: fl
         z, t = zn, tn
         if done:
             break
-        if float(z[-1]) < lo - 1e-12 * max(1, abs(lo)) or float(z[-1]) > hi + 1e-12 * max(
+        # out of the range by more than 1e-7 (relative): a vertical branch's p moves by rounding
+        if float(z[-1]) < lo - 1e-7 * max(1, abs(lo)) or float(z[-1]) > hi + 1e-7 * max(
                 1, abs(hi)):
             status = f"left the range [{lo!r}, {hi!r}] after a fold"
             break
-        if its <= easy:
+        if its <= easy and grow:
             ds = min(max_step, ds * 1.5)
     events.sort(key=lambda e: (e.index, 0 if e.kind != "user" else 1))
     return Branch(pts, events, status, make, kind=kind, **(branch or {}))
@@ -639,9 +673,10 @@ def _events(run: _Run, za: np.ndarray, ta: np.ndarray, fa: dict[str, float],
             got = describe(kind, x, p, run.disc.point(x, p))
             if got is None:
                 why = getattr(run.disc, "why", "")
-                warnings.warn(f"a {kind} test function changes sign at p = {p!r} but the "
-                              f"check refutes the event{': ' + why if why else ''}: no event "
-                              "reported", RuntimeWarning, stacklevel=3)
+                if why:
+                    warnings.warn(f"a {kind} test function changes sign at p = {p!r} but the "
+                                  f"check refutes the event: {why}: no event reported",
+                                  RuntimeWarning, stacklevel=3)
                 continue
             fields.update(got)
         events.append(Event(kind, p, 0, **fields))

@@ -36,11 +36,11 @@ import numpy as np
 
 from .._errors import Error
 from ._model import KinkError, equation_step
-from .branch import Branch
+from .branch import Branch, HopfPoint
 from .driver import Curve, continuation, newton_corrector
 from .newton import ShootingError
 from .problem import Problem
-from .stability import HopfPoint, check_of, roots
+from .stability import check_of, roots
 from .stepmap import Model
 
 #: Roots computed at each point of a branch (the Hopf test function reads them).
@@ -254,7 +254,7 @@ class Equilibria:
         """The located event checked: a Hopf point has a non-real pair on the imaginary axis
         (to ON_AXIS); a branch point a two-dimensional null space of [G_u, G_p] (its smallest
         singular value below 1e-5 of the largest, the forward differences' reach).  None
-        (``why`` says why) when the check refutes it."""
+        when the check refutes it (``why`` says why, empty for a neutral saddle)."""
         if kind == "hopf":
             lam = point.roots
             c = lam[np.isfinite(lam) & (lam.imag > REAL * np.maximum(1.0, np.abs(lam)))]
@@ -264,10 +264,14 @@ class Equilibria:
                     hp = HopfPoint(p=p, omega=root.imag, root=root)
                     return {"hopf": hp, "u": x, "detail": "a pair of roots crosses the "
                             f"imaginary axis at omega = {hp.omega:.8g}"}
-            self.why = (f"no pair of non-real roots on the imaginary axis there (the rightmost "
-                        f"roots {np.round(lam[:4], 6)!r}): two real roots of opposite signs "
-                        "(lambda_i + lambda_j = 0, a neutral saddle), or a change of the set of "
-                        "roots computed, changed the test function's sign")
+            r = lam[np.isfinite(lam) & ~(lam.imag > REAL * np.maximum(1.0, np.abs(lam)))].real
+            saddle = any(abs(a + b) <= ON_AXIS * max(1.0, abs(a)) for i, a in enumerate(r)
+                         for b in r[i + 1:])
+            # a neutral saddle (two real roots lambda_i + lambda_j = 0) zeroes the test function
+            # too: no event, and nothing to warn of; anything else is said
+            self.why = "" if saddle else (
+                f"no pair of non-real roots on the imaginary axis there (the rightmost roots "
+                f"{np.round(lam[:4], 6)!r}): the set of roots computed changed")
             return None
         if kind == "branch-point":
             Gu, Gp = self.jacobian(x, p)

@@ -5,9 +5,12 @@
 A :class:`Problem` holds the model, its step policy (the model keeps its own step h, or gets
 h through ``make(p, h=...)``), one cache of the recent objects built from it (step maps,
 one-step maps of equilibria: each built once per key), and the probe solvers read for h, tau
-and N through Solver's public accessors (built once per (p, h), never run).  The memory a
+and N through Solver's public accessors (built once per (p, h), never run; the map at (p, h)
+takes the probe over, :meth:`Problem.take`).  The memory a
 step h needs, N = ceil(tau / h) steps, is asked of the probe (:meth:`Problem.memory`): one
-place for the rule.
+place for the rule.  The step maps of a model whose step h is free (autonomous orbits) by (h,
+p): :class:`AutonomousMaps`, in the same cache; the phase condition through a point of an
+autonomous orbit: :func:`phase_row` with :func:`velocity`.
 """
 from __future__ import annotations
 
@@ -15,8 +18,11 @@ from collections import OrderedDict
 from collections.abc import Callable
 from typing import Any
 
+import numpy as np
+
 from .._solver import Solver
-from .stepmap import Model, build
+from .newton import ShootingError
+from .stepmap import Model, StepMap, build, fixed_step
 
 #: Objects the cache keeps (the least recently used goes first).
 KEEP = 8
@@ -106,6 +112,25 @@ class Problem:
         """
         return self.cached(("probe", float(p), h), lambda: self.solver(p, h))
 
+    def take(self, p: float, h: float | None = None) -> Solver:
+        """The probe solver at (p, h), taken out of the cache (the caller owns it and may
+        initialise it: a solver read for N is not built twice), or a new one.
+
+        Parameters
+        ----------
+        p : float
+            The parameter.
+        h : float, optional
+            The step.
+
+        Returns
+        -------
+        dmi.Solver
+            Configured, not initialised.
+        """
+        got = self._cache.pop(("probe", float(p), h), None)
+        return got if got is not None else self.solver(p, h)
+
     def memory(self, p: float, h: float | None = None) -> int:
         """N, the steps of memory of the model at (p, h): the probe's ``N`` (ceil(tau / h)).
 
@@ -122,3 +147,57 @@ class Problem:
             N.
         """
         return int(self.probe(p, h).N)
+
+
+def step_model(make: Model, p: float, h: float) -> Solver:
+    """make(p, h=h), with a model that does not take the step named."""
+    try:
+        return build(make, p, h=h)
+    except TypeError as e:
+        if "h" in str(e) or "argument" in str(e):
+            raise ValueError(f"an autonomous orbit needs a model make(p, h=...) that takes the "
+                             f"step ({e})") from e
+        raise
+
+
+class AutonomousMaps:
+    """The StepMaps of make(p, h=h) by (h, p) on states of ``rows`` rows, in the cache of a
+    :class:`dmi.analysis.problem.Problem`; a step h <= h_min, or an N + 1 above ``rows``, is
+    refused (ShootingError)."""
+
+    def __init__(self, make: Model, M: int, rows: int, h_min: float,
+                 problem: Problem | None = None):
+        self.make, self.M, self.rows, self.h_min = make, int(M), int(rows), float(h_min)
+        self.problem = Problem(make) if problem is None else problem
+
+    def __call__(self, h: float, p: float) -> StepMap:
+        return self.problem.cached(("map", float(p), float(h), self.M, self.rows),
+                                   lambda: self._new(float(h), float(p)))
+
+    def _new(self, h: float, p: float) -> StepMap:
+        if not h > self.h_min:
+            raise ShootingError(f"the period M h went to {self.M * h:.6g} (h = {h:.6g}), "
+                                f"below the least the state holds, {self.M * self.h_min:.6g}: "
+                                f"the guess period is too long for the orbit (a period near "
+                                f"the orbit's?), or there is no orbit near the guess", [])
+        s = step_model(self.make, p, h)
+        if s.N + 1 > self.rows:
+            raise ShootingError(f"the period M h went to {self.M * h:.6g}: its N + 1 = "
+                                f"{s.N + 1} steps of memory exceed the {self.rows} rows the "
+                                "state holds (the guess period is too long for the orbit?)", [])
+        return StepMap(fixed_step(self.make, h), p, self.M, self.rows, solver=s)
+
+
+def velocity(U: np.ndarray, h: float) -> np.ndarray:
+    """The velocity at t = 0 of one period U (M + 1 rows), by a central difference across it."""
+    M = U.shape[0] - 1
+    return (U[1] - U[M - 1]) / (2 * h) if M > 1 else (U[1] - U[0]) / h
+
+
+def phase_row(x: np.ndarray, xdot: np.ndarray, ref: np.ndarray, k: int
+              ) -> tuple[float, np.ndarray]:
+    """The phase condition <xdot, x_0 - ref> (x_0 the last row of x) and its row over (x, q)."""
+    n = xdot.size
+    row = np.zeros(x.size + k)
+    row[x.size - n:x.size] = xdot
+    return float(np.dot(xdot, x[-n:] - ref)), row

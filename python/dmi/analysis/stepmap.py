@@ -255,6 +255,51 @@ class StepMap:
         return W.ravel()
 
 
+def guess_rows(guess: Any, n: int, N: int, most: int | None = None) -> np.ndarray:
+    """A guess given as values: n values (a constant window of ``most`` or N + 1 rows) or k rows
+    of n, N + 1 <= k (<= most when given), flattened; the shooting of forced and autonomous
+    orbits both read their guesses here.
+
+    Parameters
+    ----------
+    guess : array_like
+        The values.
+    n : int
+        The model's n.
+    N : int
+        Its memory: the map reads N + 1 rows.
+    most : int, optional
+        The most rows the state holds (L).
+
+    Returns
+    -------
+    numpy.ndarray
+        k n values.
+
+    Raises
+    ------
+    ValueError
+        A value that is not finite (its index named), or a shape that is none of these.
+    """
+    x0 = np.asarray(guess, dtype=float).ravel()
+    bad = np.flatnonzero(~np.isfinite(x0))
+    if bad.size:
+        where = ", ".join(f"row {i // n} component {i % n} = {float(x0[i])!r}"
+                          for i in bad[:4])
+        raise ValueError(f"guess has {bad.size} non-finite value(s) ({where}"
+                         f"{', ...' if bad.size > 4 else ''}): give finite values")
+    if x0.size == n:
+        x0 = np.tile(x0, most if most is not None else N + 1)   # a constant window
+    k = x0.size // n
+    if x0.size % n or k < N + 1 or (most is not None and k > most):
+        upper = f" <= k <= L = {most}" if most is not None else " <= k"
+        raise ValueError(f"guess has {x0.size} values (shape {np.shape(guess)}); the model has "
+                         f"n = {n}: give n = {n} values (a constant window), or k rows of n, "
+                         f"N + 1 = {N + 1}{upper} (an (k, {n}) array or k {n} values), the "
+                         "last at t = 0, or a dmi.Solver run onto the orbit")
+    return x0
+
+
 def state_of(solver: Solver, M: int) -> np.ndarray:
     """The window (N + 1 rows, flattened) of a solver run onto an orbit of M steps, at the next
     step index that is a multiple of M (the orbit's phase 0): the solver is advanced there and
