@@ -5,7 +5,6 @@
 from __future__ import annotations
 
 import math
-import pickle
 
 import numpy as np
 import pytest
@@ -86,10 +85,3 @@ def test_hopf_orbit_amplitude_message_is_in_state_units():
 def test_equilibrium_at_a_nan_parameter_names_p_and_the_call():
     with pytest.raises(ValueError, match=r"equilibrium\(make, p = nan"):
         da.equilibrium(vdp, math.nan, [0.0, 0.0])
-
-
-def test_an_equilibrium_branch_pickles():
-    e = da.equilibrium(vdp, 0.5, [0.0, 0.0])
-    br = da.continue_equilibrium(e, 0.3, step=0.1)
-    back = pickle.loads(pickle.dumps(br))
-    assert np.array_equal(back.p, br.p) and back.status == br.status

@@ -14,20 +14,10 @@ import pytest
 
 import dmi
 import dmi.analysis as da
+from test_analysis_events import vdp
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-
-TAU = 1.0
-
-
-def vdp(a: float, h: float | None = None) -> dmi.Solver:
-    # w'' + (w^2 - 1) w' + w + (a / tau) int_0^tau w(t - s) ds = 0, u = (w, v)
-    s = dmi.Solver(2, TAU, h=0.02 if h is None else h)
-    s.set_rhs(lambda t, u: np.array([-u[1], (u[0] ** 2 - 1) * u[1] + u[0]]))
-    s.set_kernel_exp([0.0], [0.0], [[[0.0, 0.0], [a / TAU, 0.0]]])
-    return s
-
 
 @pytest.fixture(scope="module")
 def vdp_branch():
@@ -101,6 +91,6 @@ def test_refine_of_an_orbit_on_a_vertical_branch_says_it_is_not_isolated():
     eq = da.equilibrium(belt, 1.0, [0.2, -0.2])
     br = da.continue_equilibrium(eq, -0.5, step=0.2)
     hopf = [e for e in br.events if e.kind == "hopf"][0]
-    o = da.hopf_orbit(belt, hopf, hopf.u, amplitude=0.1, steps=200)
+    o = da.hopf_orbit(belt, hopf.hopf, hopf.u, amplitude=0.1, steps=200)
     with pytest.raises(da.ShootingError, match="not isolated at fixed p"):
         da.refine_orbit(o)

@@ -23,8 +23,8 @@ import numpy as np
 from .._solver import Solver
 from .newton import ShootingError, bordered_newton
 from .orbit import Orbit, loops, make_orbit
-from .problem import AutonomousMaps, phase_row, step_model, velocity
-from .stepmap import Model, build, guess_rows, positive_time
+from .problem import AutonomousMaps, Problem, phase_row, step_model, velocity
+from .stepmap import Model, guess_rows, positive_time
 
 
 def no_equilibrium(o: Orbit, tol: float, what: str) -> Orbit:
@@ -47,13 +47,14 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
     solver ``make(p, h=guess_period / M)``, or n values) or such a solver run near the orbit (its
     window is taken as it is: any phase)."""
     P0 = positive_time("guess_period", guess_period)
-    M = int(steps) if steps is not None else max(1, round(P0 / build(make, p).h))
+    problem = Problem(make)
+    M = int(steps) if steps is not None else max(1, round(P0 / problem.probe(p).h))
     if M < 1:
         raise ValueError(f"steps = {steps}: must be >= 1")
     h0 = P0 / M
-    s0 = step_model(make, p, h0)
+    s0 = step_model(problem, p, h0)      # read for N and tau; the map at h0 takes it over
     rows = max(s0.N + 1, math.ceil(s0.tau / (0.8 * h0)) + 1)
-    maps = AutonomousMaps(make, M, rows, 0.8 * h0)
+    maps = AutonomousMaps(make, M, rows, 0.8 * h0, problem)
     F0 = maps(h0, p)
     n = F0.n
     if isinstance(guess, Solver):

@@ -2,6 +2,11 @@
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """Continuation of a periodic orbit of the scheme in its parameter p.
 
+The loop is the one driver's (:func:`dmi.analysis.driver.continuation`: predictor, step
+control, corners, the fold, landing on p_end, user points ``at=``) on the discretisation
+:class:`dmi.analysis.periodic.Shooting` (its maps, corrector and points) and the orbits' events
+of :mod:`dmi.analysis.orbit_events`.
+
 Pseudo-arclength on z = (x, p), x the shooting state (:mod:`dmi.analysis.shooting`): a secant
 predictor z + ds t (the first step: x at p + step), then a corrector on  F_p(x) - x = 0,
 <t, z - z_pred> = 0.  The corrector is Newton-Picard: the previous point's multipliers leave a
@@ -23,8 +28,9 @@ an autonomous orbit).  A model over tau with a free step h has N = ceil(tau / h)
 the older ones filled by M-periodicity (:meth:`StepMap.extend`); the map reads the last
 N(p) + 1.  The step grows by 1.5 after an easy corrector (Newton-Picard in <= 6 iterations,
 Newton in <= 3),
-halves after a failure, and the branch ends at p_end, at ``max_points``, when it leaves the
-p-range it started in, or when the step falls below ``min_step`` (``Branch.status`` says which).
+halves after a failure, and the branch ends on p_end exactly (its last step landed on it), at
+``max_points``, when it leaves the p-range it started in, or when the step falls below
+``min_step`` (``Branch.status`` says which).
 
 Kinks, where the stick pattern changes, are passed: the map is piecewise smooth, its Newton
 semismooth, and a failing corrector retries with a halved step.
@@ -63,6 +69,7 @@ from .newton import ShootingError
 from .orbit import Orbit, make_orbit
 from .orbit_events import test_function
 from .periodic import AutoMaps, ForcedMaps, Shooting
+from .problem import step_model
 from .refine import refine_orbit
 from .shooting import periodic_orbit
 
@@ -148,7 +155,7 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
             raise ValueError("period=...: an autonomous orbit's period is an unknown of the "
                              "branch; continue it with period=None")
         maps: ForcedMaps = AutoMaps(orbit.make, orbit.steps, orbit.h, 0)
-        tau = maps.problem.probe(orbit.p).tau
+        tau = step_model(maps.problem, orbit.p, orbit.h).tau   # its map's solver later
         maps.rows = maps.auto.rows = max(orbit.rows or x0.size // n,
                                          math.ceil(tau / (0.6 * orbit.h)) + 1)
         F0 = maps(orbit.p)

@@ -93,9 +93,9 @@ class ForcedMaps:
     def memory(self, p: float) -> int:
         """N at p at its step (the probe's: the map at p takes it over)."""
         if self.period is None:
-            return self.problem.memory(p)
+            return int(self.problem.probe(p).N)
         try:
-            return self.problem.memory(p, self.step(p))
+            return int(self.problem.probe(p, self.step(p)).N)
         except TypeError as e:
             raise ValueError(f"continue_orbit(period=...) needs a model make(p, h=...) that "
                              f"takes the step (h = period(p) / M = {self.step(p)!r}): {e}") from e
@@ -110,10 +110,10 @@ class ForcedMaps:
         """A solver of the model at p at its step (the probe's when one was read: it is the
         map's then), not initialised."""
         if self.period is None:
-            return self.problem.take(p)
+            return self.problem.probe(p, take=True)
         h = self.step(p)
         try:
-            return self.problem.take(p, h)
+            return self.problem.probe(p, h, take=True)
         except TypeError as e:
             raise ValueError(f"continue_orbit(period=...) needs a model make(p, h=...) that "
                              f"takes the step (h = period(p) / M = {h!r}): {e}") from e

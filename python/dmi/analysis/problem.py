@@ -6,8 +6,8 @@ A :class:`Problem` holds the model, its step policy (the model keeps its own ste
 h through ``make(p, h=...)``), one cache of the recent objects built from it (step maps,
 one-step maps of equilibria: each built once per key), and the probe solvers read for h, tau
 and N through Solver's public accessors (built once per (p, h), never run; the map at (p, h)
-takes the probe over, :meth:`Problem.take`).  The memory a
-step h needs, N = ceil(tau / h) steps, is asked of the probe (:meth:`Problem.memory`): one
+takes the probe over, ``Problem.probe(..., take=True)``).  The memory a
+step h needs, N = ceil(tau / h) steps, is asked of the probe (:meth:`Problem.probe`): one
 place for the rule.  The step maps of a model whose step h is free (autonomous orbits) by (h,
 p): :class:`AutonomousMaps`, in the same cache; the phase condition through a point of an
 autonomous orbit: :func:`phase_row` with :func:`velocity`.
@@ -95,8 +95,9 @@ class Problem:
             self._cache.move_to_end(key)
         return got
 
-    def probe(self, p: float, h: float | None = None) -> Solver:
-        """The probe solver at (p, h): read for its h, tau, N and model (never run).
+    def probe(self, p: float, h: float | None = None, *, take: bool = False) -> Solver:
+        """The probe solver at (p, h): read for its h, tau, N (N = ceil(tau / h), the memory a
+        step needs) and model, never run while cached.
 
         Parameters
         ----------
@@ -104,55 +105,28 @@ class Problem:
             The parameter.
         h : float, optional
             The step.
-
-        Returns
-        -------
-        dmi.Solver
-            Cached: do not run or close it.
-        """
-        return self.cached(("probe", float(p), h), lambda: self.solver(p, h))
-
-    def take(self, p: float, h: float | None = None) -> Solver:
-        """The probe solver at (p, h), taken out of the cache (the caller owns it and may
-        initialise it: a solver read for N is not built twice), or a new one.
-
-        Parameters
-        ----------
-        p : float
-            The parameter.
-        h : float, optional
-            The step.
+        take : bool
+            Take it out of the cache (or build one): the caller owns it and may initialise it,
+            so that a solver read for N is not built twice (a step map's).
 
         Returns
         -------
         dmi.Solver
             Configured, not initialised.
         """
-        got = self._cache.pop(("probe", float(p), h), None)
-        return got if got is not None else self.solver(p, h)
-
-    def memory(self, p: float, h: float | None = None) -> int:
-        """N, the steps of memory of the model at (p, h): the probe's ``N`` (ceil(tau / h)).
-
-        Parameters
-        ----------
-        p : float
-            The parameter.
-        h : float, optional
-            The step.
-
-        Returns
-        -------
-        int
-            N.
-        """
-        return int(self.probe(p, h).N)
+        key = ("probe", float(p), h)
+        if take:
+            got = self._cache.pop(key, None)
+            return got if got is not None else self.solver(p, h)
+        return self.cached(key, lambda: self.solver(p, h))
 
 
-def step_model(make: Model, p: float, h: float) -> Solver:
-    """make(p, h=h), with a model that does not take the step named."""
+
+def step_model(problem: Problem, p: float, h: float, take: bool = False) -> Solver:
+    """The problem's probe solver make(p, h=h) (taken out of the cache with ``take``), with a
+    model that does not take the step named."""
     try:
-        return build(make, p, h=h)
+        return problem.probe(p, h, take=take)
     except TypeError as e:
         if "h" in str(e) or "argument" in str(e):
             raise ValueError(f"an autonomous orbit needs a model make(p, h=...) that takes the "
@@ -180,7 +154,7 @@ class AutonomousMaps:
                                 f"below the least the state holds, {self.M * self.h_min:.6g}: "
                                 f"the guess period is too long for the orbit (a period near "
                                 f"the orbit's?), or there is no orbit near the guess", [])
-        s = step_model(self.make, p, h)
+        s = step_model(self.problem, p, h, take=True)
         if s.N + 1 > self.rows:
             raise ShootingError(f"the period M h went to {self.M * h:.6g}: its N + 1 = "
                                 f"{s.N + 1} steps of memory exceed the {self.rows} rows the "
