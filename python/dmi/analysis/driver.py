@@ -24,6 +24,10 @@ are fixed; a second discretisation, e.g. collocation of the equation's orbits, i
   ``component``), or None when the check refutes it (the event is then dropped, with a
   ``RuntimeWarning`` that says why when the object sets ``disc.why``; an empty ``why``: a
   known false zero of the test function, dropped silently).
+- optional ``disc.corner(points) -> str``: when the branch ends because the corrector fails at
+  the smallest step, what the discretisation reads from the points so far (e.g. that the
+  branch ended at a corner of a stick pattern, and on which side of it the other branch lies);
+  appended to the status.
 - optional ``disc.adapt(x, p) -> x``: a change of mesh (or of the unknowns) between steps; the
   driver then restarts its tangent from the new x.
 - optional ``disc.correct(x, p, row, target, far) -> tuple[x, p, iterations]``: the
@@ -498,6 +502,10 @@ def continuation(disc: Any, x0: np.ndarray, p0: float, p_end: float, *, step: fl
                     status = (f"corrector failed at the smallest step {min_step!r} near p = "
                               f"{float(z[-1])!r}" + (" (a corner: natural steps from it failed "
                                                      "too)" if cornered else "") + f": {e}")
+                    corner = getattr(disc, "corner", None)
+                    said = corner(pts) if corner is not None else ""
+                    if said:
+                        status += f"; {said}"
                     break
         if zn is None:
             break

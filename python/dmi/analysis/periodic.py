@@ -65,7 +65,6 @@ def orbit_point(F: StepMap, x: np.ndarray, multipliers: int, sections: int, dpds
                        t=t, u=u)
 
 
-
 class ForcedMaps:
     """The maps of a forced branch: StepMaps by p (the last few), all on states of ``rows``
     rows; a p whose N + 1 exceeds it is refused (ShootingError: the corrector retries with a
@@ -92,13 +91,7 @@ class ForcedMaps:
 
     def memory(self, p: float) -> int:
         """N at p at its step (the probe's: the map at p takes it over)."""
-        if self.period is None:
-            return int(self.problem.probe(p).N)
-        try:
-            return int(self.problem.probe(p, self.step(p)).N)
-        except TypeError as e:
-            raise ValueError(f"continue_orbit(period=...) needs a model make(p, h=...) that "
-                             f"takes the step (h = period(p) / M = {self.step(p)!r}): {e}") from e
+        return int(self.build(p, take=False).N)
 
     def model(self, p: float) -> Model:
         """make as a function of p alone at p's step (the StepMap's and an Orbit's ``make``)."""
@@ -106,15 +99,15 @@ class ForcedMaps:
             return self.make
         return fixed_step(self.make, self.step(p))
 
-    def build(self, p: float) -> Solver:
-        """A solver of the model at p at its step (the probe's when one was read: it is the
-        map's then), not initialised."""
-        if self.period is None:
-            return self.problem.probe(p, take=True)
-        h = self.step(p)
+    def build(self, p: float, take: bool = True) -> Solver:
+        """A solver of the model at p at its step, not initialised: the problem's probe, taken
+        out of its cache (``take``: it becomes the map's) or left there (read for N)."""
+        h = None if self.period is None else self.step(p)
         try:
-            return self.problem.probe(p, h, take=True)
+            return self.problem.probe(p, h, take=take)
         except TypeError as e:
+            if h is None:
+                raise
             raise ValueError(f"continue_orbit(period=...) needs a model make(p, h=...) that "
                              f"takes the step (h = period(p) / M = {h!r}): {e}") from e
 
@@ -560,6 +553,44 @@ class Shooting:
                 self.maps.reference(zb, self.maps.of(zb[-self.k:]).trajectory(zb[:-self.k]))
             out.append(e)
         return out
+
+    def corner(self, points: list[BranchPoint]) -> str:
+        """Where a branch that failed at the smallest step ended, read from its last points:
+        a component whose stick pattern changed among the last four (a corner: stick onset or
+        grazing), the p of the orbits on the other side of it and so which way the other
+        branch goes; empty when no stick pattern changed.
+
+        Parameters
+        ----------
+        points : list of BranchPoint
+            The branch's points so far.
+
+        Returns
+        -------
+        str
+            The sentence for the status, or "".
+        """
+        last = points[-1]
+        recent = points[-4:]
+        for i in range(len(last.stick_steps)):
+            kinds = {(int(q.stick_steps[i]) > 0, int(q.stick_phases[i])) for q in recent}
+            if len(kinds) < 2:
+                continue
+            here = (int(last.stick_steps[i]) > 0, int(last.stick_phases[i]))
+            other = [q.p for q in recent if (int(q.stick_steps[i]) > 0,
+                                              int(q.stick_phases[i])) != here]
+            side = "smaller" if float(np.mean(other)) < last.p else "larger"
+            what = "stick" if not here[0] else (
+                "slip throughout" if not any(q.stick_steps[i] for q in recent
+                                             if q.p in other) else "stick otherwise")
+            return (f"the branch ended at a corner of component {i}'s stick pattern (stuck "
+                    f"steps {[int(q.stick_steps[i]) for q in recent]}, stick phases "
+                    f"{[int(q.stick_phases[i]) for q in recent]} over the last points): orbits "
+                    f"that {what} were found at p = {', '.join(f'{p:.8g}' for p in other)}, "
+                    f"{side} than the last point's p = {last.p:.8g}: the other branch goes "
+                    f"towards {side} p; start a branch from one of them (periodic_orbit at its "
+                    "p, or hopf_orbit) and continue it that way")
+        return ""
 
     def _profile(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         zl, _, _, terms = self.last
