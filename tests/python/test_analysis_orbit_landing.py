@@ -63,7 +63,7 @@ def forced(a: float) -> dmi.Solver:
     return s
 
 
-def test_unverified_stability_is_none_and_dotted():
+def test_unverified_stability_is_none_and_dotted(tmp_path):
     o = da.periodic_orbit(forced, 1.0, 2 * math.pi, [0.5], multipliers=0)
     assert o.multipliers.size == 0
     b = da.continue_orbit(o, 1.2, step=0.05, multipliers=0)
@@ -77,6 +77,12 @@ def test_unverified_stability_is_none_and_dotted():
     assert styles == {":"}, styles
     plt.close(fig)
     assert "not verified" in b._repr_html_()
+    path = tmp_path / "branch.html"
+    b.to_html(path)                       # the interactive figure: dotted grey, "not verified"
+    html = path.read_text()
+    # Bokeh writes a dotted line as line_dash [2, 4], a dashed one as [6]
+    assert '"line_dash":[2,4]' in html and '"line_dash":[6]' not in html
+    assert "#7f7f7f" in html and "not verified" in html
 
 
 def test_nan_in_the_guess_is_named():
