@@ -180,8 +180,25 @@ def _sparse_bordered(Jx: Any, Jp: np.ndarray, row: np.ndarray) -> Any:
 
 
 def bordered_det(Jx: Any, Jp: np.ndarray, t: np.ndarray) -> float:
-    """sign(det) |det|^(1 / (m + 1)) of [[J_x, J_p], [t']] (a continuous function whose sign
-    changes at a branch point, not at a fold); NaN for an operator J_x."""
+    """The branch-point test function: sign(det) |det|^(1 / (m + 1)) of [[J_x, J_p], [t']].
+
+    A continuous function whose sign changes at a branch point (a null space of [J_x, J_p] of
+    dimension 2), not at a fold (t oriented continuously).
+
+    Parameters
+    ----------
+    Jx : numpy.ndarray, scipy.sparse matrix or scipy.sparse.linalg.LinearOperator
+        Shape (m, m).
+    Jp : numpy.ndarray
+        Shape (m,).
+    t : numpy.ndarray
+        Shape (m + 1,): the tangent.
+
+    Returns
+    -------
+    float
+        The value; NaN for an operator J_x (no determinant), 0 for a singular matrix.
+    """
     m = Jp.size
     if isinstance(Jx, sla.LinearOperator):
         return math.nan
@@ -217,8 +234,30 @@ def _parity(perm: np.ndarray) -> float:
 
 
 def tangent(curve: Curve, z: np.ndarray, prev: np.ndarray) -> tuple[np.ndarray, Any, np.ndarray]:
-    """The unit tangent (weighted norm) at z oriented along prev (<w t, prev> > 0), and the
-    Jacobian (J_x, J_p) it came from."""
+    """The unit tangent of the curve at z, and the Jacobian it came from.
+
+    The null vector of [J_x, J_p] from the bordered system [[J_x, J_p], [w prev']] t = (0, 1)
+    (the SVD where prev is orthogonal to it), unit in the weighted norm, oriented along prev.
+
+    Parameters
+    ----------
+    curve : Curve
+        The discretisation with the driver's inner product.
+    z : numpy.ndarray
+        The point (x, p).
+    prev : numpy.ndarray
+        The previous tangent (or a direction): <w t, prev> >= 0.
+
+    Returns
+    -------
+    tuple
+        (t, J_x, J_p).
+
+    Raises
+    ------
+    ShootingError
+        An operator Jacobian whose bordered system GMRES does not solve.
+    """
     Jx, Jp = curve.jacobian(z)
     w = curve.w(z.size - 1)
     rhs = np.zeros(z.size)
