@@ -6,7 +6,6 @@ from __future__ import annotations
 import contextlib
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -16,6 +15,7 @@ import scipy.sparse.linalg as sla
 
 from .._solver import Solver
 from ._model import Linearisation, call_make
+from .branch import HopfPoint
 from .equation import equation_roots
 
 #: At most this many state dimensions n N: the one-step matrix is formed and its eigenvalues taken
@@ -159,12 +159,6 @@ def rightmost(lin: Linearisation, count: int) -> np.ndarray:
     return lam[:count]
 
 
-def non_real(values: np.ndarray) -> np.ndarray:
-    """The values (roots, multipliers) that are not real: |Im| > 1e-8 max(1, |value|)."""
-    values = np.asarray(values)
-    return values[np.abs(values.imag) > 1e-8 * np.maximum(1.0, np.abs(values))]
-
-
 def check_of(of: str) -> str:
     """``of`` checked: ``"scheme"`` or ``"equation"``."""
     if of not in ("scheme", "equation"):
@@ -228,25 +222,6 @@ def roots(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 10,
     check_of(of)
     with Linearisation(lambda: call_make(make, p), u_eq, (p,), tol, of) as lin:
         return rightmost_of(lin, int(count), of)
-
-
-@dataclass(frozen=True)
-class HopfPoint:
-    """Where the rightmost root crosses the imaginary axis.
-
-    Attributes
-    ----------
-    p : float
-        The parameter.
-    omega : float
-        The crossing frequency |Im lambda| (radians / time unit); 0: a real root crosses (a fold,
-        not a Hopf point).
-    root : complex
-        The root there, Im >= 0 (1 / time unit).
-    """
-    p: float
-    omega: float
-    root: complex
 
 
 def rightmost_real(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 4,
