@@ -64,6 +64,7 @@ import numpy as np
 from .._solver import Solver
 from .branch import Branch, BranchPoint, Event
 from .driver import continuation
+from .equation_branch import continue_equation_orbit
 from .floquet import Verify, phase_free, ritz
 from .newton import ShootingError
 from .orbit import Orbit, make_orbit
@@ -89,9 +90,25 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     grazing) are passed by natural steps when the secant's hyperplane misses the branch's new
     piece.
 
+    An :class:`dmi.analysis.EquationOrbit` (from :func:`dmi.analysis.collocate` or
+    ``hopf_orbit(..., of="equation")``) is continued by collocation through the same driver
+    (:mod:`dmi.analysis.equation_branch`): the points are EquationOrbits (the equation's
+    period, amplitude, multipliers with their error estimates, signature), the tangent predictor
+    and Newton's corrector on the sparse collocation system, the mesh equidistributed after
+    every step and the signature mended where a segment vanishes or an inequality breaks
+    (``stick-onset`` and ``grazing`` events where it changes), the multipliers' events
+    (``period-doubling``, ``torus``) and the fold, landing on p_end and ``at=``.  Of the
+    options, ``step``, ``max_points``, ``min_step``, ``max_step``, ``multipliers`` (a point's
+    leading multipliers), ``tol`` (at most 1e-12 is used: the corrector's error stays below
+    the collocation's), ``max_iter`` and ``at`` apply; ``period=`` (the period is an
+    unknown, or the model's forcing period), ``refine=`` (the orbit is the equation's
+    already), ``verify=`` (the verdict is the collocation's: the margin against the
+    multipliers' estimated errors), ``sections`` and ``margins`` do not and are refused when
+    set.
+
     Parameters
     ----------
-    orbit : Orbit
+    orbit : Orbit or EquationOrbit
         The start, from :func:`periodic_orbit` or :func:`hopf_orbit`.  An autonomous orbit
         (``orbit.autonomous``) has its period as an unknown: h = P / M with M = orbit.steps, N =
         ceil(tau / h) changing along the branch (the states hold room for h down to 60 % of the
@@ -143,8 +160,20 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     ------
     ValueError
         A bad ``step``, ``p_end``, ``max_points`` or ``period``; ``period`` for an autonomous
-        orbit; ``period(orbit.p)`` not the orbit's period.
+        orbit; ``period(orbit.p)`` not the orbit's period; an option that does not apply to
+        an EquationOrbit.
     """
+    if getattr(orbit, "of", "scheme") == "equation":
+        unused = [name for name, given in (("period", period is not None), ("refine", refine),
+                                           ("verify", verify is not None),
+                                           ("sections", sections != 1),
+                                           ("margins", not margins)) if given]
+        if unused:
+            raise ValueError(f"continue_orbit of an EquationOrbit: {', '.join(unused)}= do not "
+                             "apply to a collocated branch (see continue_orbit's docstring)")
+        return continue_equation_orbit(orbit, p_end, step, max_points=max_points,
+                                       min_step=min_step, max_step=max_step,
+                                       multipliers=multipliers, tol=tol, max_iter=max_iter, at=at)
     if not (math.isfinite(step) and step > 0):
         raise ValueError(f"step = {step!r}: must be finite and > 0 (p units)")
     if not math.isfinite(p_end) or p_end == orbit.p:
@@ -266,12 +295,16 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
     Raises
     ------
     ValueError
-        The event is not a period doubling.
+        The event is not a period doubling; a collocated branch (not taken yet).
     ShootingError
         No period-doubled orbit found (what each kick gave is listed).
     """
     if event.kind != "period-doubling":
         raise ValueError(f"event {event.kind!r}: expected a 'period-doubling' event")
+    if any(getattr(q, "of", "scheme") == "equation" for q in branch.points):
+        raise ValueError("period_doubled_orbit: a collocated branch (of EquationOrbits) is not "
+                         "taken yet; shoot the scheme's orbit there (periodic_orbit at the "
+                         "event's p, period 2 P), then collocate it")
     a, b = branch.points[event.index - 1], branch.points[event.index]
     q = a if np.any(a.multipliers.real < -1) else b
     maps = ForcedMaps(branch.make, branch.steps, branch.h, branch.rows, branch.period)

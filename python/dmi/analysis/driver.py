@@ -29,11 +29,18 @@ are fixed; a second discretisation, e.g. collocation of the equation's orbits, i
   branch ended at a corner of a stick pattern, and on which side of it the other branch lies);
   appended to the status.
 - optional ``disc.adapt(x, p) -> x``: a change of mesh (or of the unknowns) between steps; the
-  driver then restarts its tangent from the new x.
+  driver then restarts its tangent from the new x (oriented by ``disc.carry(t, x)``, a direction
+  on the new unknowns, when their number changed; else by t's p part).
 - optional ``disc.correct(x, p, row, target, far) -> tuple[x, p, iterations]``: the
   discretisation's own corrector on residual(x, p) = 0, row . (x, p) = target (e.g.
   Newton-Picard for shooting); it raises to refuse the step (the driver halves it), ``far`` the
-  largest distance (weighted norm) from the predictor it may stray.
+  largest distance (weighted norm) from the predictor it may stray.  On a step (``far``
+  finite) it may return x of another length (a change of the unknowns, e.g. a segment inserted
+  where the step's point broke an inequality): the driver restarts its tangent as after
+  ``adapt``.
+- optional ``disc.orient(x, p) -> np.ndarray``: with the tangent predictor, where the start's
+  tangent is vertical (no p part to orient it towards p_end), a direction (len(x) + 1) it is
+  oriented along (e.g. the amplitude growing, away from a Hopf point).
 - optional ``disc.weight``: a float or an array of len(x), the weight of x in the arclength's
   inner product <a, b> = sum weight a_x b_x + a_p b_p (default 1 / len(x): x's RMS, so that a
   step is in "p or RMS state units").
@@ -44,7 +51,8 @@ are fixed; a second discretisation, e.g. collocation of the equation's orbits, i
   discretisation from two consecutive points (changes of a count, as a stick pattern's);
   ``middle(z0, z1)`` is the branch's point z on the hyperplane through the middle of z0 and z1
   across their chord (a bisection along the branch, also where it turns at the event); the
-  driver sets the events' indices.
+  driver sets the events' indices.  za and zb differ in size where ``adapt`` changed the
+  unknowns between them.
 
 The driver: ``continuation(disc, x0, p0, p_end, *, step, min_step, max_step, max_points,
 at=(), ...) -> Branch``.
@@ -375,6 +383,8 @@ class _Run:
     def land(self, za: np.ndarray, zb: np.ndarray, p: float) -> np.ndarray:
         """The point at exactly the parameter p between za and zb (p between their p's): from
         the chord's interpolation; where that fails, Brent on p along the chord first."""
+        if za.size != zb.size:   # the unknowns changed between them: from zb alone
+            return self.at_p(zb, p)
         pa, pb = float(za[-1]), float(zb[-1])
         wgt = (p - pa) / (pb - pa) if pb != pa else 0.5
         try:
@@ -490,8 +500,13 @@ def continuation(disc: Any, x0: np.ndarray, p0: float, p_end: float, *, step: fl
     Jx = Jp = None
     if predictor == "tangent":
         t, Jx, Jp = tangent(curve, z, e_p)
-        if abs(t[-1]) > VERTICAL and t[-1] * direction < 0:
-            t = -t
+        orient = getattr(disc, "orient", None)
+        if abs(t[-1]) > VERTICAL:
+            if t[-1] * direction < 0:
+                t = -t
+        elif orient is not None:   # a vertical start: the discretisation's way
+            if float(np.dot(curve.w(z.size - 1) * t, orient(z[:-1].copy(), p0))) < 0:
+                t = -t
     else:
         start = getattr(disc, "start_tangent", None)
         t = None if start is None else start(z[:-1].copy(), p0, direction)
@@ -551,16 +566,20 @@ def continuation(disc: Any, x0: np.ndarray, p0: float, p_end: float, *, step: fl
         grow = grow_first or len(pts) > 1   # else the second step is the user's step again
         natural = False
         adapt = getattr(disc, "adapt", None)
-        restarted = False
+        restarted = zn.size != z.size    # the corrector changed the unknowns
         if adapt is not None:
             xa = np.asarray(adapt(zn[:-1].copy(), float(zn[-1])), dtype=float)
             if xa.size != zn.size - 1 or np.any(xa != zn[:-1]):
                 zn = np.concatenate([xa, [zn[-1]]])
                 restarted = True
-                curve.size = xa.size
+        curve.size = zn.size - 1
         J = None
         if predictor == "tangent" or restarted:
             sec = t if restarted else zn - z
+            if restarted and zn.size != z.size:   # new unknowns: a direction on them
+                carry = getattr(disc, "carry", None)
+                sec = (carry(t, zn[:-1]) if carry is not None else
+                       np.concatenate([np.zeros(zn.size - 1), [t[-1]]]))
             tn, Jxn, Jpn = tangent(curve, zn, sec)
             J = (Jxn, Jpn) if predictor == "tangent" else None
         else:
@@ -572,7 +591,7 @@ def continuation(disc: Any, x0: np.ndarray, p0: float, p_end: float, *, step: fl
         found: list[Event] = []
         _events(run, z, t, fs[-1], zn, tn, f, found, describe, predictor == "tangent",
                 zs[-2:])
-        if between is not None and z.size == zn.size:
+        if between is not None:
             found += between(z, pts[-1], zn, pt, run.middle)
         # p_end crossed by the new point, or twice inside the step (a located fold beyond it):
         # the last point lands on it exactly, at its first crossing

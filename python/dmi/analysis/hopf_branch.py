@@ -20,6 +20,8 @@ from ._model import Linearisation
 from .autonomous import no_equilibrium
 from .branch import Event, HopfPoint
 from .equilibria import equilibrium
+from .equation_branch import equation_branch_start
+from .equation_orbit import EquationOrbit
 from .floquet import Verify
 from .newton import bordered_newton
 from .orbit import Orbit, make_orbit
@@ -73,9 +75,10 @@ def positive_amplitude(value: Any) -> float:
     return v
 
 
-def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: float, steps: int,
-               component: int | None = None, multipliers: int = 10, tol: float = 1e-10,
-               max_iter: int = 30, verify: Verify | None = None) -> Orbit:
+def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: float,
+               steps: int | None = None, component: int | None = None, multipliers: int = 10,
+               tol: float = 1e-10, max_iter: int = 30, verify: Verify | None = None,
+               of: str = "scheme") -> Orbit | EquationOrbit:
     """The autonomous orbit born at a Hopf point, of a given amplitude, its parameter free.
 
     An amplitude condition replaces the parameter: the unknowns are the state, the step h (the
@@ -85,10 +88,17 @@ def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: floa
     t)) over one period 2 pi / omega, v the null vector of the scheme's characteristic matrix at
     the root.
 
+    ``of="equation"`` starts the equation's branch instead, by collocation
+    (:func:`dmi.analysis.equation_hopf_orbit` at the equation's Hopf point, from
+    ``hopf(..., of="equation")``): ``make(p)`` needs no h, ``steps`` is not used, the amplitude
+    is sqrt(2) times the RMS distance from u_eq of the component that moves most in the critical
+    mode (``component`` must be None), and the EquationOrbit returned continues by
+    :func:`dmi.analysis.continue_orbit`.
+
     Parameters
     ----------
     make : callable
-        The model ``make(p, h=...) -> dmi.Solver``: it must take the step.
+        The model ``make(p, h=...) -> dmi.Solver``: it must take the step (``of="scheme"``).
     hopf_point : HopfPoint or Event
         From :func:`dmi.analysis.hopf`, or a ``hopf`` event of
         :func:`dmi.analysis.continue_equilibrium` (the Event or its ``Event.hopf``).
@@ -98,8 +108,8 @@ def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: floa
     amplitude : float
         The half range (max - min) / 2 over the period of the component ``component`` (state
         units), > 0.
-    steps : int
-        M, steps a period (>= 8).
+    steps : int, optional
+        M, steps a period (>= 8); required for ``of="scheme"``, not used for the equation.
     component : int, optional
         Default: the largest component of the critical eigenvector.
     multipliers : int
@@ -109,25 +119,40 @@ def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: floa
     max_iter : int
         Newton iterations at most.
     verify : dmi.analysis.Verify, optional
-        Tolerances and budgets of the multipliers' verification (default ``Verify()``).
+        Tolerances and budgets of the multipliers' verification (default ``Verify()``; the
+        scheme's orbit only).
+    of : {"scheme", "equation"}
+        The scheme's orbit by shooting, or the equation's by collocation.
 
     Returns
     -------
-    Orbit
-        ``autonomous``; its ``p`` is the branch's at that amplitude, its period M h; continue it
-        with :func:`dmi.analysis.continue_orbit`.
+    Orbit or EquationOrbit
+        ``autonomous``; its ``p`` is the branch's at that amplitude, its period M h (the
+        equation's: an EquationOrbit); continue it with :func:`dmi.analysis.continue_orbit`.
 
     Raises
     ------
     ValueError
         Bad input: not a HopfPoint (an event of another kind: said so), omega <= 0 (a fold),
         a root off the imaginary axis, amplitude <= 0, steps < 8, a component
-        out of range or not moving in the critical mode, a model that does not take h.
+        out of range or not moving in the critical mode, a model that does not take h; ``of``
+        not "scheme" or "equation", ``component`` or ``verify`` with ``of="equation"``.
     ShootingError
         Newton fails (every residual listed).
     """
     hopf_point = _hopf_of(hopf_point)
     a = positive_amplitude(amplitude)
+    if of == "equation":
+        if component is not None or verify is not None:
+            raise ValueError("hopf_orbit(of='equation'): component= and verify= do not apply "
+                             "(the component is the critical mode's largest; the verdict is "
+                             "the collocation's)")
+        return equation_branch_start(make, hopf_point, u_eq, a, multipliers, tol, max_iter)
+    if of != "scheme":
+        raise ValueError(f"of = {of!r}: 'scheme' (shooting) or 'equation' (collocation)")
+    if steps is None:
+        raise ValueError("steps = None: give M, steps a period (>= 8), for the scheme's orbit "
+                         "(or of='equation')")
     M = int(steps)
     if M != steps or M < 8:
         raise ValueError(f"steps = {steps!r}: give a whole number of steps a period, >= 8")

@@ -3,7 +3,6 @@
 """dmi.analysis.roots and dmi.analysis.hopf (see docs/stability.md for the method)."""
 from __future__ import annotations
 
-import contextlib
 import math
 from collections.abc import Callable
 from typing import Any
@@ -14,6 +13,7 @@ import scipy.optimize
 import scipy.sparse.linalg as sla
 
 from .._solver import Solver
+from ._blas import _one_blas_thread
 from ._model import Linearisation, call_make
 from .branch import HopfPoint
 from .equation import equation_roots
@@ -124,23 +124,6 @@ def _order(lam: np.ndarray) -> np.ndarray:
     key = np.round(lam.real, 9) if len(lam) else lam.real
     idx = np.lexsort((-lam.imag, -key))
     return lam[idx]
-
-
-_BLAS: list = []
-
-
-def _one_blas_thread() -> Any:
-    """A context with BLAS on one thread (threadpoolctl, if installed): Arnoldi's vectors are long
-    and few, and OpenBLAS's threads spinning on a loaded machine made roots 40x slower
-    (measured)."""
-    if not _BLAS:
-        try:
-            from threadpoolctl import ThreadpoolController
-            _BLAS.append(ThreadpoolController())
-        except ImportError:
-            _BLAS.append(None)
-    return contextlib.nullcontext() if _BLAS[0] is None else _BLAS[0].limit(limits=1,
-                                                                                user_api="blas")
 
 
 def rightmost(lin: Linearisation, count: int) -> np.ndarray:
