@@ -334,20 +334,13 @@ class EquationBranch(CollocationDiscretisation):
         numpy.ndarray
             len(x) + 1 values.
         """
-        lay = self.lay
-        k = lay.rows * lay.n
-        V = x[:k].reshape(-1, lay.n)
-        dev = V - V.mean(axis=0)
         old = self._old_nodes
         grow = 0.0
         if old is not None and old.size <= t.size - 1:
-            Vo = old.reshape(-1, lay.n)
-            dv = t[:Vo.size].reshape(-1, lay.n)
-            grow = float(np.sum((Vo - Vo.mean(axis=0)) * dv))
-        out = np.zeros(x.size + 1)
-        out[:k] = math.copysign(1.0, grow) * dev.ravel() if grow else 0.0
+            grow = float(np.dot(self._deviation(old, old.size)[:old.size], t[:old.size]))
+        out = self.orient(x, 0.0) * (math.copysign(1.0, grow) if grow else 0.0)
         out[-1] = t[-1]
-        if lay.autonomous:
+        if self.lay.autonomous:
             out[-2] = t[-2]
         return out
 
@@ -367,9 +360,14 @@ class EquationBranch(CollocationDiscretisation):
         numpy.ndarray
             len(x) + 1 values.
         """
-        lay = self.lay
-        k = lay.rows * lay.n
-        V = x[:k].reshape(-1, lay.n)
+        return self._deviation(x)
+
+    def _deviation(self, x: np.ndarray, k: int | None = None) -> np.ndarray:
+        """(len(x) + 1,): the first k values of x (default the layout's node values), as
+        (k / n, n) node values, less their mean; 0 elsewhere."""
+        n = self.lay.n
+        k = self.lay.rows * n if k is None else k
+        V = x[:k].reshape(-1, n)
         out = np.zeros(x.size + 1)
         out[:k] = (V - V.mean(axis=0)).ravel()
         return out
