@@ -16,8 +16,8 @@ Interactive HTML figures (:mod:`dmi.analysis.interactive`, Bokeh): ``Branch.to_h
 from __future__ import annotations
 
 from ._model import KinkError
-from .autonomous import hopf_orbit
-from .branch import Branch, BranchPoint, Event
+from .hopf_branch import hopf_orbit
+from .branch import Branch, BranchPoint, Event, HopfPoint
 from .chart import HopfCurve, StabilityChart, plot_stability_chart, stability_chart
 from .continuation import continue_orbit, period_doubled_orbit
 from .equilibria import Equilibrium, EquilibriumPoint, continue_equilibrium, equilibrium
@@ -27,7 +27,7 @@ from .orbit import Orbit
 from .orbit_plot import plot_branch
 from .refine import Refined, refine_orbit
 from .shooting import periodic_orbit
-from .stability import HopfPoint, hopf, roots
+from .stability import hopf, roots
 from .stepmap import StepMap
 
 __all__ = [

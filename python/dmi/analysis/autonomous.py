@@ -1,5 +1,4 @@
-# Periodic orbits of unknown period (autonomous systems): shooting in (state, h), and the orbit
-# born at a Hopf point with its parameter free.
+# Periodic orbits of unknown period (autonomous systems): shooting in (state, h).
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """Autonomous periodic orbits: the period P = M h with M fixed and the step h unknown.
 
@@ -11,11 +10,7 @@ Jacobian (:func:`dmi.analysis.newton.bordered_newton`, D_hF by one difference in
 N = ceil(tau / h) may change with h: the states hold L = ceil(tau / (0.8 h_0)) + 1 rows (h may
 fall by 20 %), the older ones by periodicity.
 
-:func:`hopf_orbit` starts the branch born at a Hopf point: the unknowns are (x, h, p), and an
-amplitude condition (the half range of one component over the period) replaces the parameter,
-so that it works where the branch leaves the Hopf point vertically (piecewise-linear friction)
-as well as where it grows like sqrt|p - p_H|.  Its states hold a whole period (L >= M + 1), from
-which the amplitude is read.
+The orbit born at a Hopf point: :mod:`dmi.analysis.hopf_branch`.
 """
 from __future__ import annotations
 
@@ -26,70 +21,11 @@ from typing import Any
 import numpy as np
 
 from .._solver import Solver
-from ._model import Linearisation
-from .equilibria import equilibrium
 from .floquet import Verify
 from .newton import ShootingError, bordered_newton
 from .orbit import Orbit, loops, make_orbit
-from .stability import HopfPoint
-from .stepmap import Model, StepMap, build, fixed_step, positive_time
-
-
-def step_model(make: Model, p: float, h: float) -> Solver:
-    """make(p, h=h), with a model that does not take the step named."""
-    try:
-        return build(make, p, h=h)
-    except TypeError as e:
-        if "h" in str(e) or "argument" in str(e):
-            raise ValueError(f"an autonomous orbit needs a model make(p, h=...) that takes the "
-                             f"step ({e})") from e
-        raise
-
-
-class AutonomousMaps:
-    """The StepMaps of make(p, h=h) by (h, p) on states of ``rows`` rows, the last few cached;
-    a step h <= h_min, or an N + 1 above ``rows``, is refused (ShootingError)."""
-
-    def __init__(self, make: Model, M: int, rows: int, h_min: float):
-        self.make, self.M, self.rows, self.h_min = make, int(M), int(rows), float(h_min)
-        self._cache: dict[tuple[float, float], StepMap] = {}
-
-    def __call__(self, h: float, p: float) -> StepMap:
-        key = (float(h), float(p))
-        F = self._cache.get(key)
-        if F is None:
-            if not h > self.h_min:
-                raise ShootingError(f"the period M h went to {self.M * h:.6g} (h = {h:.6g}), "
-                                    f"below the least the state holds, {self.M * self.h_min:.6g}"
-                                    f": the guess period is too long for the orbit (a period "
-                                    f"near the orbit's?), or there is no orbit near the guess",
-                                    [])
-            s = step_model(self.make, p, h)
-            if s.N + 1 > self.rows:
-                raise ShootingError(f"the period M h went to {self.M * h:.6g}: its N + 1 = "
-                                    f"{s.N + 1} steps of memory exceed the {self.rows} rows the "
-                                    "state holds (the guess period is too long for the orbit?)",
-                                    [])
-            F = StepMap(fixed_step(self.make, h), p, self.M, self.rows, solver=s)
-            if len(self._cache) > 5:
-                self._cache.pop(next(iter(self._cache)))
-            self._cache[key] = F
-        return F
-
-
-def velocity(U: np.ndarray, h: float) -> np.ndarray:
-    """The velocity at t = 0 of one period U (M + 1 rows), by a central difference across it."""
-    M = U.shape[0] - 1
-    return (U[1] - U[M - 1]) / (2 * h) if M > 1 else (U[1] - U[0]) / h
-
-
-def phase_row(x: np.ndarray, xdot: np.ndarray, ref: np.ndarray, k: int
-              ) -> tuple[float, np.ndarray]:
-    """The phase condition <xdot, x_0 - ref> (x_0 the last row of x) and its row over (x, q)."""
-    n = xdot.size
-    row = np.zeros(x.size + k)
-    row[x.size - n:x.size] = xdot
-    return float(np.dot(xdot, x[-n:] - ref)), row
+from .problem import AutonomousMaps, Problem, phase_row, step_model, velocity
+from .stepmap import Model, guess_rows, positive_time
 
 
 def no_equilibrium(o: Orbit, tol: float, what: str) -> Orbit:
@@ -112,13 +48,14 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
     solver ``make(p, h=guess_period / M)``, or n values) or such a solver run near the orbit (its
     window is taken as it is: any phase)."""
     P0 = positive_time("guess_period", guess_period)
-    M = int(steps) if steps is not None else max(1, round(P0 / build(make, p).h))
+    problem = Problem(make)
+    M = int(steps) if steps is not None else max(1, round(P0 / problem.probe(p).h))
     if M < 1:
         raise ValueError(f"steps = {steps}: must be >= 1")
     h0 = P0 / M
-    s0 = step_model(make, p, h0)
+    s0 = step_model(problem, p, h0)      # read for N and tau; the map at h0 takes it over
     rows = max(s0.N + 1, math.ceil(s0.tau / (0.8 * h0)) + 1)
-    maps = AutonomousMaps(make, M, rows, 0.8 * h0)
+    maps = AutonomousMaps(make, M, rows, 0.8 * h0, problem)
     F0 = maps(h0, p)
     n = F0.n
     if isinstance(guess, Solver):
@@ -127,13 +64,7 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
                              f"model's at h = guess_period / M = {h0!r} (N = {F0.N})")
         x0 = guess.get_window().ravel()
     else:
-        x0 = np.asarray(guess, dtype=float).ravel()
-        if x0.size == n:
-            x0 = np.tile(x0, F0.N + 1)
-        if x0.size % n or not F0.N + 1 <= x0.size // n:
-            raise ValueError(f"guess has {x0.size} values ({np.shape(guess)}); give n = {n} "
-                             f"values (a constant window), or k >= N + 1 = {F0.N + 1} rows of "
-                             f"n = {n} (an (k, {n}) array or k {n} values), the last at t = 0")
+        x0 = guess_rows(guess, n, F0.N)
     x0 = F0.extend(x0)
     xdot = velocity(F0.trajectory(x0), h0)
     if not np.any(xdot):
@@ -173,120 +104,3 @@ def autonomous_orbit(make: Model, p: float, guess: Any, guess_period: float, *,
 
 def _one(gr: tuple[float, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     return np.array([gr[0]]), gr[1][None, :]
-
-
-def critical_vector(lin: Linearisation, lam: complex) -> np.ndarray:
-    """The null vector v (n,) of the scheme's characteristic matrix at the root lam (the last
-    row of the mode U^j = z^j v, z = exp(lam h)), |v|_2 = 1, by the SVD."""
-    R = lin.characteristic(np.exp(complex(lam) * lin.h))
-    _, _, Vh = np.linalg.svd(R)
-    return Vh[-1].conj()
-
-
-def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: float, steps: int,
-               component: int | None = None, multipliers: int = 10, tol: float = 1e-10,
-               max_iter: int = 30, verify: Verify | None = None) -> Orbit:
-    """The autonomous orbit born at a Hopf point, of a given amplitude, its parameter free.
-
-    An amplitude condition replaces the parameter: the unknowns are the state, the step h (the
-    period is M h) and p, the equations the fixed point, a phase condition and the amplitude.
-    So the branch may leave the Hopf point as sqrt|p - p_H| (smooth) or vertically
-    (piecewise-linear friction, up to grazing).  The first guess is u_eq + a Re(v e^(i omega
-    t)) over one period 2 pi / omega, v the null vector of the scheme's characteristic matrix at
-    the root.
-
-    Parameters
-    ----------
-    make : callable
-        The model ``make(p, h=...) -> dmi.Solver``: it must take the step.
-    hopf_point : HopfPoint
-        From :func:`dmi.analysis.hopf` or a ``hopf`` event of
-        :func:`dmi.analysis.continue_equilibrium` (``Event.hopf``).
-    u_eq : array_like
-        Shape (n,): the equilibrium at the Hopf point (``Event.u``), corrected by Newton at the
-        orbit's step.
-    amplitude : float
-        The half range (max - min) / 2 over the period of the component ``component`` (state
-        units), > 0.
-    steps : int
-        M, steps a period (>= 8).
-    component : int, optional
-        Default: the largest component of the critical eigenvector.
-    multipliers : int
-        Leading Floquet multipliers to compute.
-    tol : float
-        Newton's tolerance.
-    max_iter : int
-        Newton iterations at most.
-    verify : dmi.analysis.Verify, optional
-        Tolerances and budgets of the multipliers' verification (default ``Verify()``).
-
-    Returns
-    -------
-    Orbit
-        ``autonomous``; its ``p`` is the branch's at that amplitude, its period M h; continue it
-        with :func:`dmi.analysis.continue_orbit`.
-
-    Raises
-    ------
-    ValueError
-        Bad input: not a HopfPoint, omega <= 0 (a fold), amplitude <= 0, steps < 8, a component
-        out of range or not moving in the critical mode, a model that does not take h.
-    ShootingError
-        Newton fails (every residual listed).
-    """
-    if not isinstance(hopf_point, HopfPoint):
-        raise ValueError(f"hopf_point = {hopf_point!r}: give a dmi.analysis.HopfPoint")
-    if not (hopf_point.omega > 0 and math.isfinite(hopf_point.omega)):
-        raise ValueError(f"hopf_point.omega = {hopf_point.omega!r}: a Hopf point has omega > 0 "
-                         "(omega = 0 is a fold)")
-    a = positive_time("amplitude", amplitude)
-    M = int(steps)
-    if M != steps or M < 8:
-        raise ValueError(f"steps = {steps!r}: give a whole number of steps a period, >= 8")
-    p = float(hopf_point.p)
-    h0 = 2 * math.pi / hopf_point.omega / M
-    made = fixed_step(make, h0)
-    eq = equilibrium(made, p, u_eq, tol=tol, count=4)
-    n = eq.u.size
-    with Linearisation(lambda: build(made, p), eq.u, (p,), 1e-6) as lin:
-        lam = eq.roots[np.argmin(np.abs(eq.roots - 1j * hopf_point.omega))]
-        v = critical_vector(lin, lam)
-        tau = lin.tau
-    c = int(np.argmax(np.abs(v))) if component is None else int(component)
-    if not 0 <= c < n:
-        raise ValueError(f"component = {component!r}: the model has n = {n} components")
-    if abs(v[c]) < 1e-8:
-        raise ValueError(f"component {c} does not move in the critical mode (|v_c| = "
-                         f"{abs(v[c]):.2g}): choose another")
-    omega = abs(lam.imag)
-    h0 = 2 * math.pi / omega / M
-    rows = max(M + 1, math.ceil(tau / (0.8 * h0)) + 1)
-    maps = AutonomousMaps(make, M, rows, 0.8 * h0)
-    t = (np.arange(rows) - (rows - 1)) * h0
-    s = a / abs(v[c])
-    X = eq.u + s * np.real(np.outer(np.exp(1j * omega * t), v))
-    x0 = X.ravel()
-    xdot = np.real(1j * omega * s * v)
-    xdot = xdot / np.linalg.norm(xdot)
-    ref = x0[-n:].copy()
-    dim = x0.size
-    last = slice(dim - (M + 1) * n + c, dim, n)   # component c over the last period
-
-    def conditions(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        g1, r1 = phase_row(z[:dim], xdot, ref, 2)
-        w = z[last]
-        imax, imin = int(np.argmax(w)), int(np.argmin(w))
-        r2 = np.zeros(dim + 2)
-        idx = np.arange(dim)[last]
-        r2[idx[imax]] += 0.5
-        r2[idx[imin]] -= 0.5
-        return np.array([g1, 0.5 * (w[imax] - w[imin]) - a]), np.vstack([r1, r2])
-
-    what = f"orbit born at the Hopf point p = {p!r}, amplitude {a!r}, M = {M} steps"
-    z, res = bordered_newton(lambda q: maps(q[0], q[1]), np.concatenate([x0, [h0, p]]), 2,
-                             conditions, tol=tol, max_iter=max_iter, what=what,
-                             steps=np.array([1e-7 * h0, 1e-7 * max(1.0, abs(p))]))
-    o = make_orbit(maps(z[-2], z[-1]), z[:dim], res, multipliers, autonomous=True,
-                   verify=verify)
-    return no_equilibrium(o, tol, what)

@@ -1,7 +1,8 @@
 # The records of a continued branch: its points, its events, the branch.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
-"""Branch, BranchPoint and Event: what :func:`dmi.analysis.continue_orbit` and
-:func:`dmi.analysis.continue_equilibrium` return."""
+"""Branch, BranchPoint, Event and HopfPoint: what :func:`dmi.analysis.continue_orbit`,
+:func:`dmi.analysis.continue_equilibrium` and :func:`dmi.analysis.hopf` return (records only:
+this module imports no other of the package)."""
 from __future__ import annotations
 
 import os
@@ -11,8 +12,25 @@ from typing import Any
 
 import numpy as np
 
-from .stability import HopfPoint
-from .stepmap import Model
+
+
+@dataclass(frozen=True)
+class HopfPoint:
+    """Where the rightmost root crosses the imaginary axis.
+
+    Attributes
+    ----------
+    p : float
+        The parameter.
+    omega : float
+        The crossing frequency |Im lambda| (radians / time unit); 0: a real root crosses (a fold,
+        not a Hopf point).
+    root : complex
+        The root there, Im >= 0 (1 / time unit).
+    """
+    p: float
+    omega: float
+    root: complex
 
 
 #: Samples of the period a branch point keeps (:attr:`BranchPoint.u`).
@@ -25,6 +43,12 @@ def thinned(U: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
     M = U.shape[0] - 1
     idx = np.unique(np.round(np.linspace(0, M, min(M + 1, ORBIT_SAMPLES))).astype(int))
     return idx * h, np.array(U[idx])
+
+
+def non_real(values: np.ndarray) -> np.ndarray:
+    """The values (roots, multipliers) that are not real: |Im| > 1e-8 max(1, |value|)."""
+    values = np.asarray(values)
+    return values[np.abs(values.imag) > 1e-8 * np.maximum(1.0, np.abs(values))]
 
 
 @dataclass
@@ -41,8 +65,9 @@ class BranchPoint:
         Shape (n,): (max - min) / 2 per component (state units).
     multipliers : numpy.ndarray of complex
         The leading Floquet multipliers, largest |mu| first.
-    stable : bool
-        All |mu| < 1 (on an autonomous branch: all but its phase's multiplier 1).
+    stable : bool or None
+        All |mu| < 1 (on an autonomous branch: all but its phase's multiplier 1); None where
+        no multiplier was computed (``multipliers=0``): not verified.
     stick_steps : numpy.ndarray
         Shape (n,): stuck steps per period.
     stick_phases : numpy.ndarray
@@ -68,12 +93,16 @@ class BranchPoint:
         samples (both ends kept), for plots (time units).
     u : numpy.ndarray
         Shape (k, n): the orbit at those times (state units).
+    floquet : dmi.analysis.Floquet or None
+        The verified multipliers and verdict (:func:`dmi.analysis.floquet_verdict`) when the
+        branch was continued with ``verify=``; then ``stable`` is its verdict and the
+        multipliers' events read its ``nontrivial()`` multipliers.  None otherwise.
     """
     p: float
     period: float
     amplitude: np.ndarray
     multipliers: np.ndarray
-    stable: bool
+    stable: bool | None
     stick_steps: np.ndarray
     stick_phases: np.ndarray
     margin: np.ndarray
@@ -84,6 +113,7 @@ class BranchPoint:
     corrector: str = ""
     t: np.ndarray = field(default_factory=lambda: np.empty(0), repr=False)
     u: np.ndarray = field(default_factory=lambda: np.empty((0, 0)), repr=False)
+    floquet: Any = field(default=None, repr=False)
 
 
 @dataclass
@@ -150,7 +180,7 @@ class Branch:
     points: list[Any]
     events: list[Event]
     status: str
-    make: Model = field(repr=False)
+    make: Callable[..., Any] = field(repr=False)
     steps: int = 0
     h: float = 0.0
     rows: int = 0
@@ -165,8 +195,10 @@ class Branch:
 
     @property
     def stable(self) -> np.ndarray:
-        """The points' ``stable`` flags (booleans)."""
-        return np.array([q.stable for q in self.points])
+        """The points' ``stable`` verdicts: a boolean array when every point's is verified, else
+        an object array of True, False and None (None: not verified, drawn dotted by
+        :func:`dmi.analysis.plot_branch`); ``column("stable")`` is the same."""
+        return self.column("stable")
 
     def column(self, name: str) -> np.ndarray:
         """An attribute of every point, stacked.
@@ -179,14 +211,18 @@ class Branch:
         Returns
         -------
         numpy.ndarray
-            Shape (points,) + the attribute's shape: ``branch.column("amplitude")`` -> (points, n).
+            Shape (points,) + the attribute's shape: ``branch.column("amplitude")`` -> (points, n);
+        an object array of the values when one of them is None (``stable`` not verified).
 
         Raises
         ------
         AttributeError
             The points have no attribute ``name``.
         """
-        return np.array([getattr(q, name) for q in self.points])
+        values = [getattr(q, name) for q in self.points]
+        if any(v is None for v in values):   # a verdict not verified: None stays None
+            return np.array(values, dtype=object)
+        return np.array(values)
 
     def to_html(self, path: str | os.PathLike, component: int = 0,
                 p_label: str = "parameter p") -> None:

@@ -39,7 +39,7 @@ from .collocation_signature import SLIP_NEG, SLIP_POS, Signature
 from .collocation_system import Layout, Terms, assemble, full_jacobian, node_times, solve
 from .equation_orbit import EquationOrbit
 from .newton import ShootingError
-from .stability import HopfPoint
+from .branch import HopfPoint
 from .stepmap import Model, build
 
 

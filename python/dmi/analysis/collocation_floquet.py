@@ -26,7 +26,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from .collocation_system import History, Layout, Terms, full_jacobian
-from .stability import _one_blas_thread
+from ._blas import _one_blas_thread
 
 
 def monodromy(lay: Layout, terms: Terms, x: np.ndarray) -> np.ndarray:

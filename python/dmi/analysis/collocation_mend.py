@@ -116,6 +116,11 @@ def relaid(lay: Layout, terms: Terms, x: np.ndarray, segs: list, T: float
     """The layout of the segments ``segs`` (same L, uniform in each piece) and x on it; an
     autonomous orbit's time origin moved to the middle of its longest segment (no switch at 0)."""
     shift = 0.0
+    segs = sorted(segs, key=lambda s: s[1] % T)
+    # neighbours (around the circle) with the same modes are one segment: a smooth orbit's only
+    # segment, split by a breach, is the stretch before and after it
+    kept = [s for k, s in enumerate(segs) if not np.array_equal(s[0], segs[k - 1][0])]
+    segs = kept or segs[:1]
     if lay.autonomous and len(segs) > 1:
         segs = sorted(segs, key=lambda s: s[1] % T)
         starts = np.array([s[1] % T for s in segs])

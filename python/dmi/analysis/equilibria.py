@@ -9,15 +9,22 @@ semismooth Newton where a resolvent holds a component, as sticking friction does
 rough guess, or the equilibrium of the equation (the continuous integral, O(h) away), is
 corrected.  Its roots are those of :func:`dmi.analysis.roots`.
 
-:func:`continue_equilibrium` follows y = (u, p) by pseudo-arclength: the tangent is the null
-vector of [G_u, G_p] (SVD), the predictor y + ds t, the corrector Newton on (G(y), <t, y -
-y_pred>).  Events between two points, each located by its test function on the branch (Brent's
-method in the arclength from the first point, every evaluation a corrected equilibrium), to
-1e-8 relative in p or better:
+:func:`continue_equilibrium` follows y = (u, p) by pseudo-arclength with the one driver
+(:func:`dmi.analysis.driver.continuation`) on the discretisation :class:`Equilibria`: the
+tangent is the null vector of [G_u, G_p], the predictor y + ds t, the corrector Newton on (G(y),
+<t, y - y_pred>).  Events between two points, each located by its test function on the branch
+(Brent's method in the arclength along their chord, every evaluation a corrected equilibrium),
+to 1e-8 relative in p or better, and checked there:
 
 - ``fold``: the tangent's p component dp/ds changes sign;
-- ``hopf``: Re of the rightmost non-real root changes sign (the event carries its
-  :class:`dmi.analysis.HopfPoint` in ``Event.hopf`` and the equilibrium in ``Event.u``).
+- ``hopf``: a pair of non-real roots crosses Re lambda = 0 (the test function
+  :func:`hopf_test`, whose sign does not change where a pair meets on the real axis and parts
+  into two real roots); checked: a non-real pair on the imaginary axis at the located point.
+  The event carries its :class:`dmi.analysis.HopfPoint` in ``Event.hopf`` and the equilibrium
+  in ``Event.u``;
+- ``branch-point``: a real root crosses 0 while dp/ds keeps its sign (det [[G_u, G_p], [t']]
+  changes sign); checked: the null space of [G_u, G_p] is two-dimensional there.  The branch
+  goes on along the branch it was on.
 """
 from __future__ import annotations
 
@@ -26,13 +33,15 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import scipy.optimize
 
+from .._errors import Error
 from ._model import KinkError, equation_step
-from .branch import Branch, Event
-from .newton import ShootingError, fmt_residuals, judge
-from .stability import HopfPoint, check_of, non_real, roots
-from .stepmap import Model, build
+from .branch import Branch, HopfPoint
+from .driver import Curve, continuation, newton_corrector
+from .newton import ShootingError
+from .problem import Problem
+from .stability import check_of, roots
+from .stepmap import Model
 
 #: Roots computed at each point of a branch (the Hopf test function reads them).
 ROOTS = 6
@@ -53,8 +62,8 @@ class Equilibrium:
     roots : numpy.ndarray of complex
         The rightmost characteristic roots of :func:`dmi.analysis.roots` (rightmost first,
         1 / time unit; empty at a kink of the resolvent).
-    stable : bool
-        Re roots[0] < 0.
+    stable : bool or None
+        Re roots[0] < 0; None when no root was computed (a kink, or ``count=0``).
     residual : float
         |G(u)|_inf (state units).
     iterations : int
@@ -66,7 +75,7 @@ class Equilibrium:
     p: float
     u: np.ndarray
     roots: np.ndarray
-    stable: bool
+    stable: bool | None
     residual: float = 0.0
     iterations: int = 0
     of: str = "scheme"
@@ -84,15 +93,15 @@ class EquilibriumPoint:
         Shape (n,): the equilibrium (state units).
     roots : numpy.ndarray of complex
         The rightmost roots, rightmost first (1 / time unit).
-    stable : bool
-        Re roots[0] < 0.
+    stable : bool or None
+        Re roots[0] < 0; None when no root was computed (a kink, or ``count=0``).
     dpds : float
         The unit tangent's p component (its sign flips at a fold).
     """
     p: float
     u: np.ndarray
     roots: np.ndarray
-    stable: bool
+    stable: bool | None
     dpds: float = 0.0
 
     @property
@@ -106,8 +115,9 @@ class _OneStep:
     step 0 before each evaluation); ``of="equation"``: the step with the continuous integral
     (:func:`dmi.analysis.equation.equation_step`)."""
 
-    def __init__(self, make: Model, p: float, of: str = "scheme"):
-        self.solver = build(make, p)
+    def __init__(self, problem: Problem, p: float, of: str = "scheme"):
+        self.solver = problem.solver(p)
+        self.p = p
         self.n, self.N = self.solver.n, self.solver.N
         self.equation = equation_step(self.solver) if of == "equation" else None
         if self.equation is None:
@@ -115,44 +125,17 @@ class _OneStep:
             self.start = self.solver.save_state()
 
     def __call__(self, u: np.ndarray) -> np.ndarray:
-        if self.equation is not None:
-            return self.equation(u)
-        s = self.solver
-        s.load_state(self.start)
-        s.set_window(np.tile(u, (self.N + 1, 1)))
-        s.step()
-        return s.state - u
-
-
-class _Steps:
-    """_OneStep by p, the last few kept."""
-
-    def __init__(self, make: Model, of: str = "scheme"):
-        self.make, self.of = make, of
-        self._cache: dict[float, _OneStep] = {}
-
-    def __call__(self, p: float) -> _OneStep:
-        G = self._cache.get(p)
-        if G is None:
-            G = _OneStep(self.make, p, self.of)
-            if len(self._cache) > 4:
-                self._cache.pop(next(iter(self._cache)))
-            self._cache[p] = G
-        return G
-
-    def G(self, y: np.ndarray) -> np.ndarray:
-        return self(float(y[-1]))(y[:-1])
-
-    def jacobian(self, y: np.ndarray, Gy: np.ndarray) -> np.ndarray:
-        """[G_u, G_p] at y = (u, p) by forward differences, (n, n + 1)."""
-        m = y.size
-        J = np.empty((m - 1, m))
-        for j in range(m):
-            d = 1e-7 * max(1.0, abs(y[j]))
-            e = y.copy()
-            e[j] += d
-            J[:, j] = (self.G(e) - Gy) / d
-        return J
+        try:
+            if self.equation is not None:
+                return self.equation(u)
+            s = self.solver
+            s.load_state(self.start)
+            s.set_window(np.tile(u, (self.N + 1, 1)))
+            s.step()
+            return s.state - u
+        except Error as e:   # libdmi's non-finite state: name the call
+            raise ShootingError(f"one step of the model make(p = {self.p!r}) from the constant "
+                                f"history u = {u!r} failed: {e}", []) from e
 
 
 def _check_guess(guess: Any, n: int) -> np.ndarray:
@@ -160,45 +143,6 @@ def _check_guess(guess: Any, n: int) -> np.ndarray:
     if u.shape != (n,) or not np.all(np.isfinite(u)):
         raise ValueError(f"guess = {guess!r}: give n = {n} finite numbers (the model's n)")
     return u
-
-
-def _newton(steps: _Steps, y0: np.ndarray, tol: float, max_iter: int, what: str,
-            row: np.ndarray | None = None, target: float = 0.0) -> tuple[np.ndarray, list[float]]:
-    """Newton on G(y) = 0 with p fixed (row None) or with the extra equation row . y = target
-    (the pseudo-arclength hyperplane).  Returns (y, residuals); ShootingError (every residual
-    listed) when it fails."""
-    y = np.array(y0, dtype=float)
-    res: list[float] = []
-    moved = math.inf   # the last Newton correction (max norm)
-    for _ in range(max_iter + 1):
-        Gy = steps.G(y)
-        g = 0.0 if row is None else float(row @ y - target)
-        rn = max(float(np.max(np.abs(Gy))), abs(g))
-        scale = tol * max(1.0, float(np.max(np.abs(y[:-1]))))
-        verdict = judge(res, rn, scale, max_iter, what)
-        # G is one step's movement, O(h) times the error: the correction must be small too
-        if verdict == "converged" and moved <= scale:
-            return y, res
-        if verdict == "exhausted":
-            break
-        J = steps.jacobian(y, Gy)
-        if row is None:
-            A, b = J[:, :-1], -Gy
-        else:
-            A, b = np.vstack([J, row]), -np.concatenate([Gy, [g]])
-        try:
-            d = np.linalg.solve(A, b)
-        except np.linalg.LinAlgError:
-            raise ShootingError(f"{what}: the Jacobian is singular (residuals "
-                                f"{fmt_residuals(res)}): a fold, or no isolated equilibrium",
-                                res) from None
-        moved = float(np.max(np.abs(d)))
-        if row is None:
-            y[:-1] += d
-        else:
-            y += d
-    raise ShootingError(f"{what}: no convergence in {max_iter} iterations (residuals "
-                        f"{fmt_residuals(res)})", res)
 
 
 def _roots(make: Model, p: float, u: np.ndarray, count: int, tol: float, of: str
@@ -210,6 +154,137 @@ def _roots(make: Model, p: float, u: np.ndarray, count: int, tol: float, of: str
         return roots(make, p, u, count, tol=max(tol * 1e3, 1e-9), of=of)
     except KinkError:
         return np.empty(0, complex)
+
+
+def _verdict(lam: np.ndarray) -> bool | None:
+    """Stable (Re roots[0] < 0), unstable, or None when no root was computed (a kink, or none
+    asked): no verdict without its roots."""
+    return bool(lam[0].real < 0) if lam.size else None
+
+
+#: |Im lambda| <= REAL max(1, |lambda|): a real root (the roots' own rounding is about 1e-12).
+REAL = 1e-8
+#: |Re lambda| <= ON_AXIS max(1, |lambda|) at a located Hopf point: a pair on the imaginary axis.
+ON_AXIS = 1e-6
+
+
+def hopf_test(lam: np.ndarray) -> float:
+    """The Hopf test function of the rightmost roots: the sign of the bialternate product
+    prod_{i<j} (lambda_i + lambda_j) over them (its positive factors, those of two distinct
+    pairs or of a pair and a real root, left out: Re lambda of each pair of non-real roots and
+    (r_i + r_j) / 2 of each two real roots), times the geometric mean of their moduli.  It
+    changes sign where a non-real pair crosses Re lambda = 0, and is continuous where a pair
+    meets on the real axis and parts into two real roots (the pair's Re lambda becomes their
+    mean); a real root through 0 does not change it (unless two real roots sum to 0: the
+    event's check refutes that).  NaN without roots."""
+    lam = lam[np.isfinite(lam)]
+    real = np.abs(lam.imag) <= REAL * np.maximum(1.0, np.abs(lam))
+    r = np.sort(lam[real].real)
+    upper = lam[~real & (lam.imag > 0)]
+    f = list(upper.real) + [0.5 * (r[i] + r[j]) for i in range(r.size)
+                            for j in range(i + 1, r.size)]
+    if not f:
+        return math.nan
+    f = np.array(f)
+    if np.any(f == 0):
+        return 0.0
+    return float(np.prod(np.sign(f))) * float(np.exp(np.mean(np.log(np.abs(f)))))
+
+
+class Equilibria:
+    """The discretisation of equilibria for :func:`dmi.analysis.driver.continuation`: the
+    unknowns u (n), the residual G(u) at p (one step of the scheme, or of the equation, from
+    the constant history u), its Jacobian [G_u, G_p] by forward differences (dense), the
+    points with their roots, the Hopf test function :func:`hopf_test`, and the events'
+    checks (:meth:`describe`).
+
+    Parameters
+    ----------
+    make : callable
+        The model.
+    of : {"scheme", "equation"}
+        Whose equilibria.
+    count : int
+        Roots a point.
+    tol : float
+        The corrector's tolerance (the roots' is max(1e3 tol, 1e-9)).
+    """
+
+    #: The arclength weighs u as p (Euclidean in (u, p)).
+    weight = 1.0
+
+    def __init__(self, make: Model, of: str = "scheme", count: int = ROOTS, tol: float = 1e-10):
+        self.problem = Problem(make)
+        self.make, self.of, self.count, self.tol = make, check_of(of), int(count), tol
+        self.why = ""
+
+    def step(self, p: float) -> _OneStep:
+        """G at p (cached)."""
+        return self.problem.cached(("one step", self.of, float(p)),
+                                   lambda: _OneStep(self.problem, float(p), self.of))
+
+    def residual(self, x: np.ndarray, p: float) -> np.ndarray:
+        """G(u) at p."""
+        return self.step(p)(x)
+
+    def jacobian(self, x: np.ndarray, p: float) -> tuple[np.ndarray, np.ndarray]:
+        """(G_u, G_p) by forward differences of step 1e-7 max(1, |y_j|)."""
+        y = np.concatenate([x, [p]])
+        G0 = self.residual(x, p)
+        J = np.empty((x.size, y.size))
+        for j in range(y.size):
+            d = 1e-7 * max(1.0, abs(y[j]))
+            e = y.copy()
+            e[j] += d
+            J[:, j] = (self.residual(e[:-1], float(e[-1])) - G0) / d
+        return J[:, :-1], J[:, -1]
+
+    def point(self, x: np.ndarray, p: float) -> EquilibriumPoint:
+        """The branch's point at (u, p), with its rightmost roots."""
+        lam = _roots(self.make, p, x, self.count, self.tol, self.of)
+        return EquilibriumPoint(p=p, u=x.copy(), roots=lam, stable=_verdict(lam))
+
+    def event_functions(self, x: np.ndarray, p: float, point: EquilibriumPoint
+                        ) -> dict[str, float]:
+        """{"hopf": :func:`hopf_test` of the point's roots}."""
+        return {"hopf": hopf_test(point.roots)}
+
+    def describe(self, kind: str, x: np.ndarray, p: float, point: EquilibriumPoint
+                 ) -> dict[str, Any] | None:
+        """The located event checked: a Hopf point has a non-real pair on the imaginary axis
+        (to ON_AXIS); a branch point a two-dimensional null space of [G_u, G_p] (its smallest
+        singular value below 1e-5 of the largest, the forward differences' reach).  None
+        when the check refutes it (``why`` says why, empty for a neutral saddle)."""
+        if kind == "hopf":
+            lam = point.roots
+            c = lam[np.isfinite(lam) & (lam.imag > REAL * np.maximum(1.0, np.abs(lam)))]
+            if c.size:
+                root = complex(c[np.argmin(np.abs(c.real))])
+                if abs(root.real) <= ON_AXIS * max(1.0, abs(root)):
+                    hp = HopfPoint(p=p, omega=root.imag, root=root)
+                    return {"hopf": hp, "u": x, "detail": "a pair of roots crosses the "
+                            f"imaginary axis at omega = {hp.omega:.8g}"}
+            r = lam[np.isfinite(lam) & ~(lam.imag > REAL * np.maximum(1.0, np.abs(lam)))].real
+            saddle = any(abs(a + b) <= ON_AXIS * max(1.0, abs(a)) for i, a in enumerate(r)
+                         for b in r[i + 1:])
+            # a neutral saddle (two real roots lambda_i + lambda_j = 0) zeroes the test function
+            # too: no event, and nothing to warn of; anything else is said
+            self.why = "" if saddle else (
+                f"no pair of non-real roots on the imaginary axis there (the rightmost roots "
+                f"{np.round(lam[:4], 6)!r}): the set of roots computed changed")
+            return None
+        if kind == "branch-point":
+            Gu, Gp = self.jacobian(x, p)
+            sv = np.linalg.svd(np.column_stack([Gu, Gp]), compute_uv=False)
+            if sv[-1] <= 1e-5 * sv[0]:
+                return {"u": x, "detail": "a real root crosses 0 where the branch goes on: the "
+                        "null space of [G_u, G_p] is two-dimensional (its singular values "
+                        f"{sv[-1]:.2g} of {sv[0]:.2g}); another branch of equilibria crosses "
+                        "this one (the branch continued is the one it was on)"}
+            self.why = (f"the null space of [G_u, G_p] is one-dimensional there (singular "
+                        f"values {sv!r})")
+            return None
+        return {}
 
 
 def equilibrium(make: Model, p: float, guess: Any, *, tol: float = 1e-10, count: int = ROOTS,
@@ -241,52 +316,56 @@ def equilibrium(make: Model, p: float, guess: Any, *, tol: float = 1e-10, count:
     Returns
     -------
     Equilibrium
-        ``.u``, ``.roots`` (rightmost first), ``.stable`` (Re roots[0] < 0), ``.residual``.
+        ``.u``, ``.roots`` (rightmost first), ``.stable`` (Re roots[0] < 0; None when no root
+        was computed: ``count=0`` or a kink), ``.residual``.
 
     Raises
     ------
     ValueError
-        A guess that is not n finite numbers, or ``of`` not one of the two.
+        A p that is not a finite number, a guess that is not n finite numbers, or ``of`` not
+        one of the two.
     ShootingError
         Newton fails: no new least residual in 3 iterations, a singular Jacobian, max_iter
-        reached (every residual is listed).
+        reached (every residual is listed); a step of the model that fails (named).
     Exception
         The model's own, when ``make(p)`` fails (a note names the call).
     """
-    steps = _Steps(make, check_of(of))
-    n = steps(float(p)).n
+    try:
+        p = float(p)
+    except (TypeError, ValueError):
+        raise ValueError(f"equilibrium(make, p = {p!r}, ...): p must be a number") from None
+    if not math.isfinite(p):
+        raise ValueError(f"equilibrium(make, p = {p!r}, ...): p must be finite (the model "
+                         "would be made and stepped at a non-finite parameter)")
+    disc = Equilibria(make, of, count, tol)
+    n = disc.step(p).n
     u0 = _check_guess(guess, n)
-    y, res = _newton(steps, np.concatenate([u0, [float(p)]]), tol, max_iter,
-                     f"equilibrium at p = {p!r}")
-    u = y[:-1]
-    lam = _roots(make, float(p), u, count, tol, of)
-    return Equilibrium(make=make, p=float(p), u=u, roots=lam,
-                       stable=bool(lam.size and lam[0].real < 0), residual=res[-1],
-                       iterations=len(res) - 1, of=of)
+    z, its = newton_corrector(Curve(disc, n), np.concatenate([u0, [p]]), _e_p(n), p, tol=tol,
+                              max_iter=max_iter, far=math.inf, what=f"equilibrium at p = {p!r}")
+    u = z[:-1]
+    lam = _roots(make, p, u, count, tol, of)
+    return Equilibrium(make=make, p=p, u=u, roots=lam, stable=_verdict(lam),
+                       residual=float(np.max(np.abs(disc.residual(u, p)))), iterations=its,
+                       of=of)
 
 
-def _tangent(J: np.ndarray, prev: np.ndarray) -> np.ndarray:
-    """The unit null vector of J (n, n + 1), oriented along prev."""
-    t = np.linalg.svd(J)[2][-1]
-    return t if float(t @ prev) >= 0 else -t
-
-
-def _complex_re(lam: np.ndarray) -> float:
-    """Re of the rightmost non-real root (-inf if none)."""
-    c = non_real(lam)
-    c = c[np.isfinite(c.real)]
-    return float(np.max(c.real)) if c.size else -math.inf
+def _e_p(n: int) -> np.ndarray:
+    """The row of the hyperplane p = const over (u, p)."""
+    e = np.zeros(n + 1)
+    e[-1] = 1.0
+    return e
 
 
 def continue_equilibrium(eq: Equilibrium, p_end: float, step: float = 0.05, *,
                          max_points: int = 200, min_step: float | None = None,
                          max_step: float | None = None, count: int = ROOTS,
-                         tol: float = 1e-10, max_iter: int = 8) -> Branch:
-    """Continues an equilibrium in p by pseudo-arclength, with fold and Hopf events.
+                         tol: float = 1e-10, max_iter: int = 8, at: Any = ()) -> Branch:
+    """Continues an equilibrium in p by pseudo-arclength, with fold, Hopf and branch-point events.
 
-    The tangent is the null vector of [G_u, G_p], the predictor y + ds t, the corrector Newton
-    on (G(y), <t, y - y_pred>); each point gets its ``count`` rightmost roots.  Events are
-    located on the branch by Brent's method in the arclength (see the module).
+    The driver :func:`dmi.analysis.driver.continuation` on :class:`Equilibria`: the tangent is
+    the null vector of [G_u, G_p], the predictor y + ds t, the corrector Newton on (G(y), <t,
+    y - y_pred>); each point gets its ``count`` rightmost roots.  Events are located on the
+    branch by Brent's method in the arclength and checked (see the module).
 
     Parameters
     ----------
@@ -294,7 +373,7 @@ def continue_equilibrium(eq: Equilibrium, p_end: float, step: float = 0.05, *,
         The start, from :func:`equilibrium` (the branch is of the scheme's or the equation's
         equilibria as ``eq.of`` is).
     p_end : float
-        Where to stop (finite, not eq.p).
+        Where to stop (finite, not eq.p); the last point lies on it exactly.
     step : float
         The first step (p units); later steps are arclengths in the Euclidean norm of (u, p).
     max_points : int
@@ -307,14 +386,17 @@ def continue_equilibrium(eq: Equilibrium, p_end: float, step: float = 0.05, *,
         Newton's tolerance.
     max_iter : int
         Corrector iterations a step.
+    at : iterable of float
+        Parameters where a point is wanted (a ``user`` event each).
 
     Returns
     -------
     Branch
         ``kind`` "equilibria": ``points`` of :class:`EquilibriumPoint`, ``events`` (``fold``,
         ``hopf`` with its :class:`HopfPoint` in ``Event.hopf`` and the equilibrium in
-        ``Event.u``), ``status`` (why it ended: a corrector failing at the smallest step, or
-        the model failing there, ends the branch; it does not raise).
+        ``Event.u``, ``branch-point`` where a real root crosses 0 and another branch crosses
+        this one, ``user``), ``status`` (why it ended: a corrector failing at the smallest
+        step, or the model failing there, ends the branch; it does not raise).
 
     Raises
     ------
@@ -327,120 +409,8 @@ def continue_equilibrium(eq: Equilibrium, p_end: float, step: float = 0.05, *,
         raise ValueError(f"step = {step!r}: must be finite and > 0 (p units)")
     if not math.isfinite(p_end) or p_end == eq.p:
         raise ValueError(f"p_end = {p_end!r}: must be finite and differ from eq.p = {eq.p!r}")
-    direction = 1.0 if p_end > eq.p else -1.0
-    min_step = step / 1000 if min_step is None else min_step
-    max_step = 4 * step if max_step is None else max_step
-    make, of = eq.make, eq.of
-    steps = _Steps(make, of)
-    y = np.concatenate([eq.u, [eq.p]])
-    m = y.size
-    t = np.zeros(m)
-    t[-1] = direction
-    t = _tangent(steps.jacobian(y, steps.G(y)), t)
-
-    def point(y: np.ndarray, t: np.ndarray) -> EquilibriumPoint:
-        lam = _roots(make, float(y[-1]), y[:-1], count, tol, of)
-        return EquilibriumPoint(p=float(y[-1]), u=y[:-1].copy(), roots=lam,
-                                stable=bool(lam.size and lam[0].real < 0), dpds=float(t[-1]))
-
-    def correct(yp: np.ndarray, row: np.ndarray, target: float) -> np.ndarray:
-        return _newton(steps, yp, tol, max_iter, f"equilibrium branch near p = {yp[-1]!r}",
-                       row, target)[0]
-
-    pts = [point(y, t)]
-    ts = [t]
-    ys = [y]
-    events: list[Event] = []
-    status = "max_points reached"
-    ds = step
-    while len(pts) < max_points:
-        if (y[-1] - p_end) * direction >= -1e-12 * max(1.0, abs(p_end)):
-            status = f"reached p_end = {p_end!r}"
-            break
-        while True:
-            yp, row = y + ds * t, t
-            target = float(t @ yp)
-            if (yp[-1] - p_end) * direction > 0 and abs(t[-1]) > 0.5:   # end on p = p_end
-                yp = y + ((p_end - y[-1]) / t[-1]) * t
-                row = np.zeros(m)
-                row[-1] = 1.0
-                target = float(p_end)
-            try:
-                yn = correct(yp, row, target)
-                break
-            except Exception as e:   # the model's or the corrector's failure: a shorter step
-                ds /= 2
-                if ds < min_step:
-                    status = f"corrector failed at the smallest step {min_step!r} near p = " \
-                             f"{float(y[-1])!r}: {e}"
-                    yn = None
-                    break
-        if yn is None:
-            break
-        tn = _tangent(steps.jacobian(yn, steps.G(yn)), t)
-        pts.append(point(yn, tn))
-        events += _events(steps, make, ys[-1], ts[-1], pts[-2], yn, pts[-1], len(pts) - 1,
-                          count, tol, correct, of)
-        y, t = yn, tn
-        ys.append(y)
-        ts.append(t)
-        ds = min(max_step, ds * 1.5)
-    return Branch(pts, events, status, make, kind="equilibria")
-
-
-def _events(steps: _Steps, make: Model, ya: np.ndarray, ta: np.ndarray, a: EquilibriumPoint,
-            yb: np.ndarray, b: EquilibriumPoint, index: int, count: int, tol: float,
-            correct: Any, of: str) -> list[Event]:
-    """The fold and Hopf events between a and b, each located by Brent's method on its test
-    function in the arclength s along ta from ya (the equilibrium at s on the hyperplane
-    <ta, y - ya> = s)."""
-    sb = float(ta @ (yb - ya))
-    out: list[Event] = []
-    if sb <= 0:
-        return out
-    cache: dict[float, np.ndarray] = {0.0: ya, sb: yb}
-
-    def at(s: float) -> np.ndarray:
-        if s not in cache:
-            cache[s] = correct(ya + s * ta, ta, float(ta @ ya) + s)
-        return cache[s]
-
-    def locate(fn: Any, fa: float, fb: float) -> float | None:
-        if not (fa * fb < 0):
-            return None
-        try:
-            return float(scipy.optimize.brentq(fn, 0.0, sb, xtol=1e-12 * max(1.0, sb),
-                                               rtol=1e-15, maxiter=100))
-        except (ShootingError, ValueError, RuntimeError):
-            return None
-
-    if a.dpds * b.dpds < 0:
-        def dpds(s: float) -> float:
-            y = at(s)
-            return float(_tangent(steps.jacobian(y, steps.G(y)), ta)[-1])
-        s = locate(dpds, a.dpds, b.dpds)
-        if s is not None:
-            y = at(s)
-            out.append(Event("fold", float(y[-1]), index, None,
-                             "dp/ds changes sign (located on the branch)", u=y[:-1].copy()))
-    fa, fb = _complex_re(a.roots), _complex_re(b.roots)
-    if math.isfinite(fa) and math.isfinite(fb) and fa * fb < 0:
-        roots_at: dict[float, np.ndarray] = {}
-
-        def re(s: float) -> float:
-            y = at(s)
-            roots_at[s] = _roots(make, float(y[-1]), y[:-1], count, tol, of)
-            return _complex_re(roots_at[s])
-        s = locate(re, fa, fb)
-        if s is not None:
-            y = at(s)
-            lam = roots_at[s] if s in roots_at else _roots(make, float(y[-1]), y[:-1], count,
-                                                           tol, of)
-            c = non_real(lam)
-            root = c[np.argmax(c.real)]
-            root = complex(root.real, abs(root.imag))
-            hp = HopfPoint(p=float(y[-1]), omega=root.imag, root=root)
-            out.append(Event("hopf", hp.p, index, None,
-                             f"a pair of roots crosses the imaginary axis at omega = "
-                             f"{hp.omega:.8g}", u=y[:-1].copy(), hopf=hp))
-    return out
+    disc = Equilibria(eq.make, eq.of, count, tol)
+    return continuation(disc, eq.u, eq.p, float(p_end), step=step, min_step=min_step,
+                        max_step=max_step, max_points=max_points, at=at, tol=tol,
+                        max_iter=max_iter, predictor="tangent", easy=max_iter, make=eq.make,
+                        kind="equilibria")

@@ -22,8 +22,22 @@ from typing import Any
 
 import numpy as np
 
-#: colour of the stable and of the unstable parts of a branch
-STABLE_COLOR, UNSTABLE_COLOR = "#1f77b4", "#d62728"
+#: colour of the stable and of the unstable parts of a branch, and of the parts whose stability
+#: is not verified (``stable`` None)
+STABLE_COLOR, UNSTABLE_COLOR, UNVERIFIED_COLOR = "#1f77b4", "#d62728", "#7f7f7f"
+
+
+def _verdict_text(stable: bool | None) -> str:
+    """"stable", "unstable" or "not verified" (``stable`` None)."""
+    return "not verified" if stable is None else "stable" if stable else "unstable"
+
+
+def _verdict_style(stable: bool | None) -> tuple[str, str]:
+    """(Bokeh line_dash, colour) of a part of a branch: solid blue where stable, dashed red where
+    unstable, dotted grey where not verified."""
+    if stable is None:
+        return "dotted", UNVERIFIED_COLOR
+    return ("solid", STABLE_COLOR) if stable else ("dashed", UNSTABLE_COLOR)
 #: The orbit panel's line colours, one per component (then repeated).
 COMPONENT_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2")
 #: What a branch of each kind is a branch of (titles and summaries).
@@ -95,14 +109,14 @@ def _write(models: Any, path: str | os.PathLike | None, title: str) -> str:
 
 
 def _stability_lines(fig: Any, p: np.ndarray, y: np.ndarray, stable: np.ndarray) -> None:
-    """One curve y(p): solid where stable, dashed where not, each run joined to the next point."""
+    """One curve y(p): solid where stable, dashed where not, dotted where not verified
+    (:func:`_verdict_style`), each run joined to the next point."""
     start = 0
     for k in range(1, len(p) + 1):
-        if k == len(p) or stable[k] != stable[start]:
+        if k == len(p) or stable[k] is not stable[start]:
             end = min(k + 1, len(p))
-            fig.line(p[start:end], y[start:end], line_width=2,
-                     line_dash="solid" if stable[start] else "dashed",
-                     color=STABLE_COLOR if stable[start] else UNSTABLE_COLOR)
+            dash, color = _verdict_style(stable[start])
+            fig.line(p[start:end], y[start:end], line_width=2, line_dash=dash, color=color)
             start = k
 
 
@@ -110,7 +124,7 @@ def _point_texts(branch: Any) -> dict[str, list[str]]:
     """The hover texts of the branch's points, by field."""
     pts = branch.points
     out = {"p_text": [number(q.p) for q in pts],
-           "stable_text": ["stable" if q.stable else "unstable" for q in pts]}
+           "stable_text": [_verdict_text(q.stable) for q in pts]}
     if branch.kind == "equilibria":
         out["root_text"] = [complex_text(q.rightmost) for q in pts]
         return out
@@ -241,14 +255,14 @@ def branch_html(branch: Any, values: np.ndarray, label: str,
         raise ValueError("dmi.analysis.branch_html: the branch's points keep no orbit "
                          "(BranchPoint.t and .u are empty): continue the orbit again")
     p = np.asarray(branch.p, float)
-    stable = np.asarray(branch.stable, bool)
+    stable = [None if q.stable is None else bool(q.stable) for q in branch.points]
     fig = figure(sizing_mode="stretch_width", height=height, name="branch", x_axis_label=p_label,
                  y_axis_label=_plain(label), tools="pan,wheel_zoom,box_zoom,reset,save,tap",
                  title=title or f"{KIND_NAMES.get(branch.kind, branch.kind)}: {len(p)} points")
     for j in range(values.shape[1]):
         _stability_lines(fig, p, values[:, j], stable)
     points = ColumnDataSource({"p": p, "y": values[:, 0], **_point_texts(branch),
-                               "color": [STABLE_COLOR if s else UNSTABLE_COLOR for s in stable]},
+                               "color": [_verdict_style(s)[1] for s in stable]},
                               name="points")
     dots = fig.scatter("p", "y", source=points, size=8, name="point_markers", color="color",
                        selection_color="black", nonselection_alpha=0.6)
@@ -383,7 +397,7 @@ def orbit_summary(orbit: Any) -> str:
         ("period", f"{number(orbit.period)} ({orbit.steps} steps of h = {number(orbit.h)})"),
         ("amplitude", ", ".join(number(a) for a in np.atleast_1d(orbit.amplitude))),
         ("multipliers", "; ".join(complex_text(m) for m in mu) or "not computed"),
-        ("stability", "stable" if orbit.stable else "unstable")])
+        ("stability", _verdict_text(orbit.stable))])
 
 
 def branch_summary(branch: Any) -> str:
@@ -401,10 +415,13 @@ def branch_summary(branch: Any) -> str:
         the events (kind at p) and the status.
     """
     p = np.array([q.p for q in branch.points])
+    unverified = sum(q.stable is None for q in branch.points)
+    stable = sum(q.stable is not None and bool(q.stable) for q in branch.points)
     events = ", ".join(f"{e.kind} at p = {number(e.p)}" for e in branch.events) or "none"
     return _table(f"Branch of {KIND_NAMES.get(branch.kind, branch.kind)}", [
         ("points", str(len(branch.points))), ("p", _range(p)),
-        ("stable points", f"{sum(bool(q.stable) for q in branch.points)} of {len(branch.points)}"),
+        ("stable points", f"{stable} of {len(branch.points)}"
+                          + (f" ({unverified} not verified)" if unverified else "")),
         ("events", events), ("status", str(branch.status))])
 
 

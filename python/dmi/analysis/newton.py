@@ -3,7 +3,10 @@
 """Newton's method for x = F(x), x a shooting state, with GMRES on the matrix-free Jacobian
 (forward differences of F: the derivative of the map's smooth piece, a semismooth Newton), and
 the bordered step of a system with extra unknowns and equations (an autonomous orbit's step h,
-a continuation's parameter p; a phase condition, an amplitude condition, an arclength).
+a continuation's parameter p; a phase condition, an amplitude condition, an arclength).  One
+loop, :func:`bordered_newton`; :func:`newton` is its case without extra unknowns, with a
+damped step.  (The continuation driver's corrector, on residuals with their Jacobians, is
+:func:`dmi.analysis.driver.newton_corrector`.)
 
 Every iteration's residual is kept; an iteration gives up when the residual has made no new
 minimum in :data:`NO_PROGRESS` iterations (the semismooth Newton may rise once on its way into
@@ -96,7 +99,7 @@ def directional(F: Callable[[np.ndarray], np.ndarray], x: np.ndarray, Fx: np.nda
 def bordered_step(F: Callable[[np.ndarray], np.ndarray], x: np.ndarray, Fx: np.ndarray,
                   Fq: np.ndarray, border: np.ndarray, g: float | np.ndarray, *, rtol: float
                   ) -> tuple[np.ndarray, float]:
-    """One Newton step for x = F_q(x) with k more unknowns q (an autonomous orbit's step h, a
+    """One Newton step for x = F_q(x) with k >= 0 more unknowns q (an autonomous orbit's step h, a
     continuation's parameter p) and k more equations g = 0 (a phase condition, an amplitude
     condition, the pseudo-arclength hyperplane): dz = (dx, dq) solves the bordered system
 
@@ -107,14 +110,14 @@ def bordered_step(F: Callable[[np.ndarray], np.ndarray], x: np.ndarray, Fx: np.n
     (k, dim + k) rows, linear in dz; ``g``: k values.  Returns (dz, GMRES's relative residual
     |J dz - rhs| / |rhs|, one more product): above about 1e-2 the system is singular."""
     Fq = np.asarray(Fq, dtype=float).reshape(x.size, -1)
-    B = np.atleast_2d(np.asarray(border, dtype=float))
+    B = np.asarray(border, dtype=float).reshape(-1, x.size + Fq.shape[1])
     g = np.atleast_1d(np.asarray(g, dtype=float))
     k = Fq.shape[1]
     eps = fd_eps(x)
 
     def mv(v: np.ndarray) -> np.ndarray:
-        vx = v[:-k]
-        return np.concatenate([directional(F, x, Fx, vx, eps) - vx + Fq @ v[-k:], B @ v])
+        vx = v[:x.size]
+        return np.concatenate([directional(F, x, Fx, vx, eps) - vx + Fq @ v[x.size:], B @ v])
 
     size = x.size + k
     J = sla.LinearOperator((size, size), matvec=mv, dtype=float)
@@ -129,60 +132,26 @@ def newton(F: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, *, tol: float 
            max_iter: int = 30, what: str = "x = F(x)") -> tuple[np.ndarray, list[float]]:
     """Solves x = F(x) by Newton's method with GMRES on the matrix-free Jacobian I - DF
     (forward differences of F, step sqrt(eps_machine) max(1, |x|_inf): the derivative of the
-    map's smooth piece, a semismooth Newton).  Converged when |F(x) - x|_inf <=
-    tol * max(1, |x|_inf).  Returns (x, residual history).  Raises ShootingError, with every
-    residual tried, when F fails, the Jacobian is singular, the residual makes no new minimum in
-    :data:`NO_PROGRESS` iterations, or it does not fall below tol within max_iter iterations."""
-    x = np.array(x0, dtype=float)
-    res: list[float] = []
+    map's smooth piece, a semismooth Newton): :func:`bordered_newton` with no extra unknown,
+    its step halved (at most 5 times) only while it makes the residual 100 times worse (a step
+    into the next piece of a piecewise-smooth map may raise the residual for one iteration
+    before the next lands on the fixed point).  Converged when |F(x) - x|_inf <= tol * max(1,
+    |x|_inf).  Returns (x, residual history).  Raises ShootingError, with every residual tried,
+    when F fails, the Jacobian is singular, the residual makes no new minimum in
+    :data:`NO_PROGRESS` iterations, or it does not fall below tol within max_iter
+    iterations."""
+    return bordered_newton(lambda q: F, x0, 0, _no_conditions, tol=tol, max_iter=max_iter,
+                           what=what, rtol=1e-6, search=True,
+                           hint=": no orbit near the guess, or the orbit is not isolated",
+                           singular=("the Jacobian I - DF is singular or too ill-conditioned",
+                                     ": a Floquet multiplier at 1, a non-isolated orbit, or no "
+                                     "orbit"),
+                           far="the guess is too far from any orbit")
 
-    def ev(z: np.ndarray) -> np.ndarray:
-        try:
-            return F(z)
-        except Error as e:
-            raise ShootingError(f"{what}: the map failed after {len(res)} Newton iterations "
-                                f"(residuals {fmt_residuals(res)}): {e}; the guess is too far "
-                                "from any orbit, or the orbit leaves the model's domain",
-                                res) from e
 
-    Fx = ev(x)
-    for _ in range(max_iter + 1):
-        r = Fx - x
-        rn = float(np.max(np.abs(r)))
-        scale = max(1.0, float(np.max(np.abs(x))))
-        verdict = judge(res, rn, tol * scale, max_iter, what,
-                        ": no orbit near the guess, or the orbit is not isolated")
-        if verdict == "converged":
-            return x, res
-        if verdict == "exhausted":
-            break
-        eps = fd_eps(x)
-
-        def mv(v: np.ndarray, Fx: np.ndarray = Fx, x: np.ndarray = x) -> np.ndarray:
-            return v - directional(ev, x, Fx, v, eps)
-
-        J = sla.LinearOperator((x.size, x.size), matvec=mv, dtype=float)
-        dx, _info = sla.gmres(J, r, rtol=1e-6, atol=0.0, restart=min(x.size, 60), maxiter=4)
-        lin = float(np.linalg.norm(mv(dx) - r)) / max(float(np.linalg.norm(r)), 1e-300)
-        if not np.all(np.isfinite(dx)) or lin > 1e-2 or float(np.max(np.abs(dx))) > 1e8 * scale:
-            raise ShootingError(f"{what}: the Jacobian I - DF is singular or too ill-conditioned "
-                                f"at Newton iteration {len(res)} (GMRES relative residual "
-                                f"{lin:.2g}, residuals {fmt_residuals(res)}): a Floquet "
-                                "multiplier at 1, a non-isolated orbit, or no orbit", res)
-        # the full step, halved (at most 5 times) only while it makes the residual 100 times
-        # worse: a step into the next piece of a piecewise-smooth map may raise the residual for
-        # one iteration before the next lands on the fixed point
-        lam = 1.0
-        for _ in range(6):
-            xn = x + lam * dx
-            Fn = ev(xn)
-            if np.max(np.abs(Fn - xn)) < 100 * rn or lam < 0.05:
-                break
-            lam *= 0.5
-        x, Fx = xn, Fn
-    raise ShootingError(f"{what}: no convergence in {max_iter} Newton iterations (residuals "
-                        f"{fmt_residuals(res)}; tolerance {tol:.3g} relative): the guess is too "
-                        "far from any orbit", res)
+def _no_conditions(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """No equation besides the fixed point."""
+    return np.empty(0), np.empty((0, z.size))
 
 
 def bordered_newton(maps: Callable[[np.ndarray], Callable[[np.ndarray], np.ndarray]],
@@ -190,28 +159,45 @@ def bordered_newton(maps: Callable[[np.ndarray], Callable[[np.ndarray], np.ndarr
                     conditions: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], *,
                     tol: float = 1e-10, max_iter: int = 30, what: str = "x = F_q(x)",
                     steps: np.ndarray | None = None,
-                    check: Callable[[np.ndarray], None] | None = None
-                    ) -> tuple[np.ndarray, list[float]]:
-    """Newton on z = (x, q), q the last k values: F_q(x) - x = 0 and the k equations
+                    check: Callable[[np.ndarray], None] | None = None, rtol: float = 1e-8,
+                    search: bool = False, hint: str = "",
+                    singular: tuple[str, str] = ("the bordered Jacobian is singular", ""),
+                    far: str = "") -> tuple[np.ndarray, list[float]]:
+    """Newton on z = (x, q), q the last k >= 0 values: F_q(x) - x = 0 and the k equations
     ``conditions(z) -> (g (k,), rows (k, dim + k))`` (values and their linearisation), by
-    :func:`bordered_step` (dF/dq by one forward difference of ``steps`` (k,) a column, default
-    1e-7 max(1, |q_j|)).  ``maps(q)`` is the map at q.  ``check(z)``: called on each new
-    iterate, raises to stop (a step outside the model's range).  Converged when
+    :func:`bordered_step` (GMRES to ``rtol``; dF/dq by one forward difference of ``steps`` (k,)
+    a column, default 1e-7 max(1, |q_j|)).  ``maps(q)`` is the map at q; a map that fails
+    (a dmi.Error) is a ShootingError naming the iteration (and ``far``).  ``search``: the step
+    halved (at most 5 times) while it makes the residual 100 times worse.  ``check(z)``: called
+    on each new iterate, raises to stop (a step outside the model's range).  Converged when
     |F(x) - x|_inf and |g|_inf are <= tol max(1, |x|_inf).  Returns (z, residuals); raises
-    ShootingError with every residual tried (no new least residual in NO_PROGRESS iterations,
-    a singular bordered system, non-finite values, max_iter reached)."""
+    ShootingError with every residual tried (no new least residual in NO_PROGRESS iterations
+    (``hint`` appended), a singular bordered system (``singular``: what, and why appended),
+    non-finite values, max_iter reached)."""
     z = np.array(z0, dtype=float)
     dim = z.size - k
     res: list[float] = []
+
+    def ev(q: np.ndarray, x: np.ndarray) -> np.ndarray:
+        try:
+            return maps(q)(x)
+        except Error as e:
+            raise ShootingError(f"{what}: the map failed after {len(res)} Newton iterations "
+                                f"(residuals {fmt_residuals(res)}): {e}; "
+                                f"{far + ', or' if far else 'the iterate is off any orbit:'} "
+                                "the orbit leaves the model's domain", res) from e
+
+    def residual(z: np.ndarray, Fx: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+        g, rows = conditions(z)
+        r = float(np.max(np.abs(Fx - z[:dim])))
+        return max(r, float(np.max(np.abs(g))) if len(g) else 0.0), g, rows
+
+    Fx = ev(z[dim:], z[:dim])
     for _ in range(max_iter + 1):
         x, q = z[:dim], z[dim:]
-        F = maps(q)
-        Fx = F(x)
-        r = Fx - x
-        g, rows = conditions(z)
-        rn = max(float(np.max(np.abs(r))), float(np.max(np.abs(g))) if len(g) else 0.0)
+        rn, g, rows = residual(z, Fx)
         scale = max(1.0, float(np.max(np.abs(x))))
-        verdict = judge(res, rn, tol * scale, max_iter, what)
+        verdict = judge(res, rn, tol * scale, max_iter, what, hint)
         if verdict == "converged":
             return z, res
         if verdict == "exhausted":
@@ -221,14 +207,22 @@ def bordered_newton(maps: Callable[[np.ndarray], Callable[[np.ndarray], np.ndarr
             d = 1e-7 * max(1.0, abs(q[j])) if steps is None else float(steps[j])
             qd = q.copy()
             qd[j] += d
-            cols[:, j] = (maps(qd)(x) - Fx) / d
-        dz, lin = bordered_step(F, x, Fx, cols, rows, g, rtol=1e-8)
-        if lin > 1e-2:
-            raise ShootingError(f"{what}: the bordered Jacobian is singular at Newton iteration "
-                                f"{len(res)} (GMRES relative residual {lin:.2g}, residuals "
-                                f"{fmt_residuals(res)})", res)
-        z = z + dz
+            cols[:, j] = (ev(qd, x) - Fx) / d
+        dz, lin = bordered_step(maps(q), x, Fx, cols, rows, g, rtol=rtol)
+        if lin > 1e-2 or float(np.max(np.abs(dz))) > 1e8 * scale:
+            raise ShootingError(f"{what}: {singular[0]} at Newton iteration {len(res)} (GMRES "
+                                f"relative residual {lin:.2g}, residuals {fmt_residuals(res)})"
+                                f"{singular[1]}", res)
+        lam = 1.0
+        for _ in range(6 if search else 1):
+            zn = z + lam * dz
+            Fn = ev(zn[dim:], zn[:dim])
+            if not search or residual(zn, Fn)[0] < 100 * rn or lam < 0.05:
+                break
+            lam *= 0.5
+        z, Fx = zn, Fn
         if check is not None:
             check(z)
     raise ShootingError(f"{what}: no convergence in {max_iter} Newton iterations (residuals "
-                        f"{fmt_residuals(res)})", res)
+                        f"{fmt_residuals(res)}; tolerance {tol:.3g} relative)"
+                        f"{': ' + far if far else ''}", res)

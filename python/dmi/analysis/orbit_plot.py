@@ -1,7 +1,8 @@
 # Drawing a continued branch of periodic orbits or equilibria.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
-"""plot_branch: a branch's values over p, stable solid, unstable dashed, events marked and named
-beside the marker (no legend over the data), both axes labelled with what is drawn."""
+"""plot_branch: a branch's values over p, stable solid, unstable dashed, not verified (``stable``
+None) dotted, events marked and named beside the marker (no legend over the data), both axes
+labelled with what is drawn."""
 from __future__ import annotations
 
 import os
@@ -15,6 +16,25 @@ import numpy as np
 #: marker of each event kind
 MARKERS = {"fold": "s", "period-doubling": "D", "torus": "^", "stick-onset": "o", "grazing": "v",
            "hopf": "*"}
+
+
+def line_style(stable: bool | None) -> str:
+    """The matplotlib line style of a part of a branch: ``"-"`` where stable, ``"--"`` where
+    unstable, ``":"`` where its stability is not verified (``stable`` None).
+
+    Parameters
+    ----------
+    stable : bool or None
+        A point's verdict.
+
+    Returns
+    -------
+    str
+        The line style.
+    """
+    if stable is None:
+        return ":"
+    return "-" if stable else "--"
 
 
 def branch_values(branch: Branch, component: int = 0) -> tuple[np.ndarray, str]:
@@ -56,7 +76,8 @@ def plot_branch(branch: Branch, ax: Any = None, component: int = 0, color: str =
                 label_events: bool = True, p_label: str = "parameter p",
                 html: str | os.PathLike | None = None) -> None:
     """Draws a branch: the values of :func:`branch_values` against p; solid where the orbit or
-    equilibrium is stable, dashed where it is not; each event a black marker (:data:`MARKERS`) on
+    equilibrium is stable, dashed where it is not, dotted where its stability is not verified
+    (``stable`` None: no multipliers or roots computed, or none that decide); each event a black marker (:data:`MARKERS`) on
     the curve at the event's p, its kind written beside it; the x axis labelled ``p_label``, the
     y axis with what is drawn.
 
@@ -97,16 +118,16 @@ def plot_branch(branch: Branch, ax: Any = None, component: int = 0, color: str =
     p = branch.p
     if p.size == 0:
         return
-    st = branch.stable
+    st = [None if q.stable is None else bool(q.stable) for q in branch.points]
     sec, label = branch_values(branch, component)
     for j in range(sec.shape[1]):
         y = sec[:, j]
         # runs of equal stability, each joined to the next point so the curve is unbroken
         start = 0
         for k in range(1, len(p) + 1):
-            if k == len(p) or st[k] != st[start]:
+            if k == len(p) or st[k] is not st[start]:
                 end = min(k + 1, len(p))
-                ax.plot(p[start:end], y[start:end], "-" if st[start] else "--", color=color,
+                ax.plot(p[start:end], y[start:end], line_style(st[start]), color=color,
                         lw=1.6, zorder=3)
                 start = k
     for e in branch.events:

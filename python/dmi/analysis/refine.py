@@ -124,6 +124,24 @@ def _orders(X: np.ndarray, tiny: np.ndarray) -> np.ndarray:
     return np.where((d1 <= tiny) & (d2 <= tiny), np.nan, q)
 
 
+def _isolation(o: Orbit) -> str:
+    """Why a level may fail: a multiplier at 1 besides an autonomous orbit's phase multiplier
+    (to 1e-3) makes the orbit not isolated at fixed p (a vertical branch, a centre)."""
+    mu = np.asarray(o.multipliers)
+    near = mu[np.abs(mu - 1) <= 1e-3]
+    if near.size > (1 if o.autonomous else 0):
+        return (f"; the orbit is not isolated at fixed p = {o.p!r}: it has "
+                f"{near.size} multiplier(s) at 1 ({', '.join(f'{m:.6g}' for m in near)})"
+                f"{', one its phase' if o.autonomous else ''}: it lies on a vertical branch (a "
+                "centre, orbits of many amplitudes at the same p), where shooting at fixed p "
+                "has no unique solution; refine an orbit of a branch that is not vertical")
+    if mu.size == 0:
+        return ("; if the orbit lies on a vertical branch (a centre, orbits of many amplitudes "
+                "at the same p) it is not isolated at fixed p and cannot be refined (compute "
+                "its multipliers to tell)")
+    return ""
+
+
 def refine_orbit(orbit: Orbit, *, levels: int = 3, tol: float = 1e-10) -> Refined:
     """The orbit recomputed at finer steps and extrapolated to h = 0, with error estimates.
 
@@ -155,7 +173,8 @@ def refine_orbit(orbit: Orbit, *, levels: int = 3, tol: float = 1e-10) -> Refine
     TypeError
         An EquationOrbit (it is the equation's already).
     ShootingError
-        A level's shooting fails.
+        A level's shooting fails (the message says when the orbit is not isolated at fixed p:
+        a multiplier at 1 besides the phase's, as on a vertical branch).
     """
     if getattr(orbit, "of", "scheme") == "equation":
         raise TypeError("refine_orbit: an EquationOrbit (collocate) is the equation's "
@@ -169,7 +188,7 @@ def refine_orbit(orbit: Orbit, *, levels: int = 3, tol: float = 1e-10) -> Refine
             orbits.append(_level(orbits[-1], orbit.steps * 2 ** j, count, tol))
         except ShootingError as e:
             raise ShootingError(f"refine_orbit: the level of {orbit.steps * 2 ** j} steps failed: "
-                                f"{e}", e.residuals) from e
+                                f"{e}{_isolation(orbit)}", e.residuals) from e
     P = np.array([o.period for o in orbits])
     A = np.array([o.amplitude for o in orbits])
     mu = _matched([o.multipliers for o in orbits]) if count else np.zeros((len(orbits), 0))

@@ -14,7 +14,7 @@ from .autonomous import autonomous_orbit
 from .floquet import Verify
 from .newton import ShootingError, newton
 from .orbit import Orbit, make_orbit
-from .stepmap import Model, StepMap, build, state_of, steps_per_period
+from .stepmap import Model, StepMap, build, guess_rows, state_of, steps_per_period
 
 def periodic_orbit(make: Model, p: float, period: float | None = None, guess: Any = None, *,
                    guess_period: float | None = None, steps: int | None = None,
@@ -99,14 +99,7 @@ def periodic_orbit(make: Model, p: float, period: float | None = None, guess: An
                              f"make(p) has n = {F.n}, N = {F.N}, h = {F.h!r}")
         x0 = state_of(guess, M)
     else:
-        x0 = np.asarray(guess, dtype=float).ravel()
-        if x0.size == F.n and F.L > 1:
-            x0 = np.tile(x0, F.L)  # a single state: a constant window
-        if x0.size % F.n or not F.N + 1 <= x0.size // F.n <= F.L:
-            raise ValueError(f"guess has {x0.size} values (shape {np.shape(guess)}); the model has "
-                             f"n = {F.n}: give n = {F.n} values (a constant window), or k rows "
-                             f"of n, N + 1 = {F.N + 1} <= k <= L = {F.L} (an (k, {F.n}) array "
-                             f"or k {F.n} values), the last at t = 0, or a dmi.Solver")
+        x0 = guess_rows(guess, F.n, F.N, F.L)
     x0 = F.extend(x0)
     x, res = newton(F, x0, tol=tol, max_iter=max_iter,
                     what=f"periodic orbit at p = {p!r}, period {period!r} = {M} steps")

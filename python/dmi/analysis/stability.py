@@ -3,10 +3,8 @@
 """dmi.analysis.roots and dmi.analysis.hopf (see docs/stability.md for the method)."""
 from __future__ import annotations
 
-import contextlib
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -15,7 +13,9 @@ import scipy.optimize
 import scipy.sparse.linalg as sla
 
 from .._solver import Solver
+from ._blas import _one_blas_thread
 from ._model import Linearisation, call_make
+from .branch import HopfPoint
 from .equation import equation_roots
 
 #: At most this many state dimensions n N: the one-step matrix is formed and its eigenvalues taken
@@ -126,23 +126,6 @@ def _order(lam: np.ndarray) -> np.ndarray:
     return lam[idx]
 
 
-_BLAS: list = []
-
-
-def _one_blas_thread() -> Any:
-    """A context with BLAS on one thread (threadpoolctl, if installed): Arnoldi's vectors are long
-    and few, and OpenBLAS's threads spinning on a loaded machine made roots 40x slower
-    (measured)."""
-    if not _BLAS:
-        try:
-            from threadpoolctl import ThreadpoolController
-            _BLAS.append(ThreadpoolController())
-        except ImportError:
-            _BLAS.append(None)
-    return contextlib.nullcontext() if _BLAS[0] is None else _BLAS[0].limit(limits=1,
-                                                                                user_api="blas")
-
-
 def rightmost(lin: Linearisation, count: int) -> np.ndarray:
     """The count rightmost roots of a linearisation."""
     if count > lin.dim:
@@ -157,12 +140,6 @@ def rightmost(lin: Linearisation, count: int) -> np.ndarray:
                            "one of the N-step map's rightmost multipliers in Arnoldi's Ritz space "
                            "(inaccurate vectors); try another count")
     return lam[:count]
-
-
-def non_real(values: np.ndarray) -> np.ndarray:
-    """The values (roots, multipliers) that are not real: |Im| > 1e-8 max(1, |value|)."""
-    values = np.asarray(values)
-    return values[np.abs(values.imag) > 1e-8 * np.maximum(1.0, np.abs(values))]
 
 
 def check_of(of: str) -> str:
@@ -228,25 +205,6 @@ def roots(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 10,
     check_of(of)
     with Linearisation(lambda: call_make(make, p), u_eq, (p,), tol, of) as lin:
         return rightmost_of(lin, int(count), of)
-
-
-@dataclass(frozen=True)
-class HopfPoint:
-    """Where the rightmost root crosses the imaginary axis.
-
-    Attributes
-    ----------
-    p : float
-        The parameter.
-    omega : float
-        The crossing frequency |Im lambda| (radians / time unit); 0: a real root crosses (a fold,
-        not a Hopf point).
-    root : complex
-        The root there, Im >= 0 (1 / time unit).
-    """
-    p: float
-    omega: float
-    root: complex
 
 
 def rightmost_real(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 4,

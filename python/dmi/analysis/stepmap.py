@@ -27,16 +27,48 @@ from ._model import call_make
 Model = Callable[..., Solver]
 
 
-def fixed_step(make: Model, h: float) -> Model:
-    """make at the step h: ``made(p)`` is ``make(p, h=h)``, and ``made(p, h=other)`` another
-    step (an autonomous Orbit's ``make``: StepMap(orbit.make, ...) runs at the orbit's step and
-    continuation changes it)."""
-    base = getattr(make, "base", make)     # the user's model, not a made of a made
+class FixedStep:
+    """A model at a fixed step: ``FixedStep(make, h)(p)`` is ``make(p, h=h)``, and
+    ``(p, h=other)`` another step (an autonomous Orbit's ``make``).  A class, not a closure, so
+    that the branches and orbits holding it pickle (when ``make`` does).
 
-    def made(p: float, h: float = h) -> Solver:
-        return base(p, h=h)  # type: ignore[call-arg]
-    made.base = base  # type: ignore[attr-defined]
-    return made
+    Parameters
+    ----------
+    make : callable
+        The model ``make(p, h=...) -> dmi.Solver`` (a FixedStep's own model is taken).
+    h : float
+        The step.
+    """
+
+    def __init__(self, make: Model, h: float):
+        self.base = getattr(make, "base", make)   # the user's model, not a FixedStep of one
+        self.h = float(h)
+
+    def __call__(self, p: float, h: float | None = None) -> Solver:
+        """make(p, h=h).
+
+        Parameters
+        ----------
+        p : float
+            The parameter.
+        h : float, optional
+            The step (default the fixed one).
+
+        Returns
+        -------
+        dmi.Solver
+            The model's solver.
+        """
+        return self.base(p, h=self.h if h is None else h)
+
+    def __repr__(self) -> str:
+        return f"FixedStep({self.base!r}, h={self.h!r})"
+
+
+def fixed_step(make: Model, h: float) -> Model:
+    """make at the step h: a :class:`FixedStep` (``made(p)`` is ``make(p, h=h)``, and
+    ``made(p, h=other)`` another step)."""
+    return FixedStep(make, h)
 
 
 def build(make: Model, p: float, **kw: Any) -> Solver:
@@ -221,6 +253,51 @@ class StepMap:
         if tail:
             W = np.concatenate([W, s.run(tail)[1][1:]])
         return W.ravel()
+
+
+def guess_rows(guess: Any, n: int, N: int, most: int | None = None) -> np.ndarray:
+    """A guess given as values: n values (a constant window of ``most`` or N + 1 rows) or k rows
+    of n, N + 1 <= k (<= most when given), flattened; the shooting of forced and autonomous
+    orbits both read their guesses here.
+
+    Parameters
+    ----------
+    guess : array_like
+        The values.
+    n : int
+        The model's n.
+    N : int
+        Its memory: the map reads N + 1 rows.
+    most : int, optional
+        The most rows the state holds (L).
+
+    Returns
+    -------
+    numpy.ndarray
+        k n values.
+
+    Raises
+    ------
+    ValueError
+        A value that is not finite (its index named), or a shape that is none of these.
+    """
+    x0 = np.asarray(guess, dtype=float).ravel()
+    bad = np.flatnonzero(~np.isfinite(x0))
+    if bad.size:
+        where = ", ".join(f"row {i // n} component {i % n} = {float(x0[i])!r}"
+                          for i in bad[:4])
+        raise ValueError(f"guess has {bad.size} non-finite value(s) ({where}"
+                         f"{', ...' if bad.size > 4 else ''}): give finite values")
+    if x0.size == n:
+        x0 = np.tile(x0, most if most is not None else N + 1)   # a constant window
+    k = x0.size // n
+    if x0.size % n or k < N + 1 or (most is not None and k > most):
+        upper = f" <= k <= L = {most}" if most is not None else " <= k"
+        raise ValueError(f"guess has {x0.size} values (shape {np.shape(guess)}); the model has "
+                         f"n = {n}: give n = {n} values (a constant window), or k rows of n, "
+                         f"N + 1 = {N + 1}{upper} (an (k, {n}) array or k {n} values), the "
+                         "last at t = 0, or a dmi.Solver run onto the orbit")
+    return x0
 
 
 def state_of(solver: Solver, M: int) -> np.ndarray:

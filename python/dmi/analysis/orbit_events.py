@@ -1,0 +1,148 @@
+# The events of a branch of periodic orbits: multipliers' and stick patterns' changes.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""Events between consecutive points of a branch of periodic orbits of the scheme.
+
+- ``period-doubling``: the number of real multipliers < -1 changes;
+- ``torus``: the number of complex multipliers with |mu| > 1 changes;
+- ``stick-onset``: a component starts (or stops) sticking somewhere in the period: its number
+  of stuck steps goes from 0 to > 0 (or back);
+- ``grazing``: a component's number of stick phases changes while it sticks on both sides.
+
+The multipliers' events are placed by the linear interpolation of their test function
+(:func:`test_function`; from the refined multipliers with ``refine=True``,
+:func:`dmi.analysis.continuation.refined_event`), the stick events by bisection along the branch (:func:`locate_stick`,
+every middle corrected across the chord by the driver).  The fold is the driver's
+(:mod:`dmi.analysis.driver`).  A point's stick profile and margins: :func:`stick_profile`.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from .branch import BranchPoint, Event, non_real
+from .floquet import phase_free
+from .orbit import stuck_mask
+from .stepmap import StepMap
+
+
+def stick_profile(F: StepMap, U: np.ndarray, X: np.ndarray | None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Stuck steps, stick phases and margins (see the module) over one period, from its M + 1
+    states U and the resolvent's arguments X of its M steps (:meth:`StepMap.trajectory_terms`);
+    X None: the margins are NaN."""
+    stuck = stuck_mask(U)
+    steps = stuck.sum(axis=0)
+    # stick phases on the circle: starts of runs of stuck steps
+    phases = np.sum(stuck & ~np.roll(stuck, 1, axis=0), axis=0)
+    phases[steps == F.M] = 1
+    margin = np.full(F.n, np.nan if X is None else np.inf)
+    if X is None:
+        return steps, phases, margin
+    u0, u1 = U[:-1], U[1:]          # U^p and U^(p+1) of the steps p = 0 .. M - 1
+    for i in range(F.n):
+        slip = (u1[:, i] != 0.0) & (X[:, i] != u1[:, i])
+        if not slip.any():
+            continue                    # no friction on this component
+        alpha = float(np.median(np.abs(X[slip, i] - u1[slip, i]))) / F.h
+        # the steps where the velocity reaches 0 or crosses it (all steps of a component stuck
+        # throughout), and the force there besides friction, |X - U^p| / h
+        entry = ((u1[:, i] == 0.0) & (u0[:, i] != 0.0)) | (u0[:, i] * u1[:, i] < 0.0)
+        if not entry.any():
+            entry = stuck[:, i]
+        if entry.any():
+            margin[i] = float(np.min(np.abs(X[entry, i] - u0[entry, i]))) / F.h - alpha
+    return steps, phases, margin
+
+
+
+def test_function(kind: str, mu: np.ndarray) -> float:
+    """The test function of a multiplier event, zero at it: 1 + min Re mu for a period doubling
+    (the multiplier that crosses -1 may have been half of a complex pair at the previous point,
+    a pair that met on the negative axis), max |mu| - 1 over the non-real multipliers for a
+    torus (-1 if there is none)."""
+    if kind == "period-doubling":
+        return 1 + float(np.min(mu.real))
+    c = np.abs(non_real(mu))
+    return float(np.max(c)) - 1 if c.size else -1.0
+
+
+def orbit_events(a: BranchPoint, b: BranchPoint, index: int, autonomous: bool = False
+                 ) -> list[Event]:
+    """The events of the orbits' multipliers and stick patterns between the points a and b
+    (period doubling, torus, stick onset, grazing; the fold is the driver's); an
+    ``autonomous`` branch's phase multiplier is left out of the multipliers' events: the
+    verified trivial one (``BranchPoint.floquet``'s ``nontrivial()``) where a verdict is
+    there, else the multiplier nearest 1."""
+    ev: list[Event] = []
+
+    def rest(q: BranchPoint) -> np.ndarray:
+        if q.floquet is not None:
+            return q.floquet.nontrivial()
+        return phase_free(q.multipliers) if autonomous else q.multipliers
+
+    mua, mub = rest(a), rest(b)
+
+    def at(fa: float, fb: float) -> float:
+        w = 0.5 if fa == fb or fa * fb > 0 else fa / (fa - fb)  # no sign change: the middle
+        return a.p + (b.p - a.p) * w
+
+    def real_neg(m: np.ndarray) -> np.ndarray:
+        return m[(np.abs(m.imag) <= 1e-8 * np.maximum(np.abs(m), 1)) & (m.real < 0)].real
+
+
+    na, nb = np.sum(real_neg(mua) < -1), np.sum(real_neg(mub) < -1)
+    if na != nb:
+        fa, fb = (test_function("period-doubling", m) for m in (mua, mub))
+        ev.append(Event("period-doubling", at(fa, fb), index, None,
+                        f"real multipliers < -1: {na} -> {nb}"))
+    ca, cb = np.sum(np.abs(non_real(mua)) > 1), np.sum(np.abs(non_real(mub)) > 1)
+    if ca != cb:
+        fa, fb = (test_function("torus", m) for m in (mua, mub))
+        ev.append(Event("torus", at(fa, fb), index, None,
+                        f"complex multipliers with |mu| > 1: {ca} -> {cb}"))
+    for i in range(len(a.stick_steps)):
+        sa, sb = int(a.stick_steps[i]), int(b.stick_steps[i])
+        if (sa == 0) != (sb == 0):
+            ma, mb = a.margin[i], b.margin[i]
+            ev.append(Event("stick-onset", at(ma, mb) if math.isfinite(ma + mb) else b.p, index,
+                            i, f"component {i}: stuck steps {sa} -> {sb}"))
+        elif sa and a.stick_phases[i] != b.stick_phases[i]:
+            ev.append(Event("grazing", 0.5 * (a.p + b.p), index, i,
+                            f"component {i}: stick phases {a.stick_phases[i]} -> "
+                            f"{b.stick_phases[i]} (stuck steps {sa} -> {sb})"))
+    return ev
+
+
+def locate_stick(a: BranchPoint, b: BranchPoint, e: Event, za: np.ndarray, zb: np.ndarray,
+                 middle: Callable[[np.ndarray, np.ndarray], np.ndarray],
+                 profile: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
+                 norm: Callable[[np.ndarray], float], bisections: int = 6) -> Event:
+    """Bisection between a (za) and b (zb) on the stick pattern of component e.component, along
+    the branch: ``middle(z0, z1)`` is the branch's point on the hyperplane through the middle of
+    the bracket's chord, across it (the driver's; also where the branch turns at the event, as
+    a vertical branch does at grazing), ``profile(z)`` its (stuck steps, stick phases), until
+    the bracket's chord (``norm``) is 2^-bisections of the first (a corrected middle off a bent
+    chord shortens it by less than half); the event's p becomes the final bracket's midpoint.  A
+    failing correction leaves the event where it was."""
+    i = e.component
+    key = (lambda q: (q[0] > 0, q[1])) if e.kind == "stick-onset" else (lambda q: (True, q[1]))
+    ka = key((a.stick_steps[i], a.stick_phases[i]))
+    first = norm(zb - za)
+    for _ in range(4 * bisections):
+        if norm(zb - za) <= first * 2.0 ** -bisections:
+            break
+        try:
+            zm = middle(za, zb)
+            st, ph = profile(zm)
+        except Exception:   # the model's, the map's or the corrector's failure
+            return e
+        if key((st[i], ph[i])) == ka:
+            za = zm
+        else:
+            zb = zm
+    pa, pb = float(za[-1]), float(zb[-1])
+    e.p = 0.5 * (pa + pb)
+    e.detail += f" (located by bisection along the branch in [{min(pa, pb)!r}, {max(pa, pb)!r}])"
+    return e

@@ -1,0 +1,87 @@
+# Analysis events that are real: van der Pol with a distributed delay on its trivial equilibrium
+# (no Hopf point in a in (-2, 0.5], a real root through 0 at a = -1 where w = const is a whole
+# line of equilibria: a branch point), the landing on p_end, and messages that name the cause.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import dmi
+import dmi.analysis as da
+
+TAU = 1.0
+
+
+def vdp(a: float, h: float | None = None) -> dmi.Solver:
+    # w'' + (w^2 - 1) w' + w + (a / tau) int_0^tau w(t - s) ds = 0 as u = (w, v):
+    # u' = -f(u) - int H u, f = (-v, (w^2 - 1) v + w), H = [[0, 0], [a / tau, 0]]
+    s = dmi.Solver(2, TAU, h=0.01 if h is None else h)
+    s.set_rhs(lambda t, u: np.array([-u[1], (u[0] ** 2 - 1) * u[1] + u[0]]))
+    s.set_kernel_exp([0.0], [0.0], [[[0.0, 0.0], [a / TAU, 0.0]]])
+    return s
+
+
+def characteristic(lam: complex, a: float) -> complex:
+    """The equation's characteristic function at w = 0: lam^2 - lam + 1 + a (1 - e^-lam) / lam."""
+    return lam * lam - lam + 1 - a * np.expm1(-lam * TAU) / (lam * TAU)
+
+
+def test_no_hopf_point_of_the_equation_in_the_range():
+    # on lam = i w: Im gives a = -w^2 tau / (1 - cos w tau) <= -2: no Hopf point for a > -2; the
+    # unstable pair of a = -0.85 meets on the real axis before a = -0.95 (two real roots > 0)
+    w = np.linspace(1e-3, 60, 200001)
+    assert np.all(-w ** 2 * TAU / (1 - np.cos(w * TAU) + 1e-300) <= -2 + 1e-6)
+    x = np.linspace(1e-4, 3, 30001)
+    for a, real in ((-0.95, 2), (-0.85, 0)):
+        assert np.count_nonzero(np.diff(np.sign(characteristic(x, a).real))) == real
+    assert characteristic(1e-12, -1.0).real == pytest.approx(0.0, abs=1e-9)   # a root at 0
+
+
+@pytest.mark.parametrize("of", ["scheme", "equation"])
+def test_vdp_trivial_branch_has_a_branch_point_and_no_hopf(of):
+    e = da.equilibrium(vdp, 0.5, [0.0, 0.0], of=of)
+    br = da.continue_equilibrium(e, -2.0, step=0.1, at=[-0.95, -0.9, -0.85, -1.2])
+    assert br.status.startswith("reached p_end"), br.status
+    assert abs(br.p[-1] + 2.0) <= 1e-12                          # landed on p_end
+    assert not [x for x in br.events if x.kind == "hopf"], br.events
+    bp = [x for x in br.events if x.kind == "branch-point"]
+    assert len(bp) == 1, br.events
+    assert abs(bp[0].p + 1.0) <= 1e-8, bp[0].p
+    assert "two-dimensional" in bp[0].detail
+    assert all(np.max(np.abs(q.u)) <= 1e-12 for q in br.points)   # stayed on w = 0
+    # the unstable count: two roots in Re > 0 before a = -1, one after (a real root crossed 0)
+    user = {x.p: br.points[x.index] for x in br.events if x.kind == "user"}
+    assert sorted(user) == [-1.2, -0.95, -0.9, -0.85]
+    before = [user[-0.95], user[-0.9], user[-0.85]]
+    after = [user[-1.2]]
+    for q in before:
+        assert np.sum(q.roots.real > 0) == 2 and q.stable is False
+    for q in after:
+        assert np.sum(q.roots.real > 0) == 1
+
+
+def test_hopf_orbit_refuses_a_non_hopf_event():
+    e = da.equilibrium(vdp, 0.5, [0.0, 0.0])
+    br = da.continue_equilibrium(e, -1.5, step=0.2)
+    bp = [x for x in br.events if x.kind == "branch-point"][0]
+    with pytest.raises(ValueError, match="branch-point.*not a Hopf"):
+        da.hopf_orbit(vdp, bp, bp.u, amplitude=0.1, steps=100)
+    # a HopfPoint whose root is off the imaginary axis (where a pair meets on the real axis)
+    fake = da.HopfPoint(p=-0.913, omega=0.02, root=complex(0.31, 0.02))
+    with pytest.raises(ValueError, match="not on the imaginary axis"):
+        da.hopf_orbit(vdp, fake, [0.0, 0.0], amplitude=0.1, steps=100)
+
+
+def test_hopf_orbit_amplitude_message_is_in_state_units():
+    hp = da.HopfPoint(p=0.0, omega=1.0, root=1j)
+    with pytest.raises(ValueError, match="state units") as ex:
+        da.hopf_orbit(vdp, hp, [0.0, 0.0], amplitude=0, steps=100)
+    assert "time units" not in str(ex.value)
+
+
+def test_equilibrium_at_a_nan_parameter_names_p_and_the_call():
+    with pytest.raises(ValueError, match=r"equilibrium\(make, p = nan"):
+        da.equilibrium(vdp, math.nan, [0.0, 0.0])
