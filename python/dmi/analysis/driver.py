@@ -195,12 +195,10 @@ def bordered_det(Jx: Any, Jp: np.ndarray, t: np.ndarray) -> float:
 
     Parameters
     ----------
-    Jx : numpy.ndarray, scipy.sparse matrix or scipy.sparse.linalg.LinearOperator
-        Shape (m, m).
-    Jp : numpy.ndarray
-        Shape (m,).
+    Jx, Jp : array, sparse matrix or LinearOperator; numpy.ndarray
+        The Jacobian, as for :func:`bordered_solve`.
     t : numpy.ndarray
-        Shape (m + 1,): the tangent.
+        Shape (m + 1,): the tangent, the border's row.
 
     Returns
     -------
