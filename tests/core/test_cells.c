@@ -14,7 +14,10 @@
  * - a kernel of 1e307, and 1e280 s^-1/2 (not finite in double below
  *   s = 1e-55): the step's W is right (no overflow);
  * - dmi_set_kernel_singularity: its checks, and a kernel that cannot be
- *   evaluated below s = 1e-30 integrated to 1e-10 with the exponent given.
+ *   evaluated below s = 1e-30 integrated to 1e-10 with the exponent given;
+ * - s^-0.9999 (1 + s): refused with a message that names the exponent close
+ *   to 1 and dmi_set_kernel_singularity, with which it is integrated;
+ * - 1/sqrt|s - 0.3| refused (cell 2 does not converge), its message whole.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include <math.h>
@@ -70,7 +73,7 @@ static double first_W(dmi_kernel_fn H, void *user, dmi_history_fn z, double tau,
         CU_ASSERT_EQUAL(dmi_set_kernel_singularity(s, alpha), DMI_OK);
     *rc = dmi_init(s);
     if (msg)
-        snprintf(msg, 512, "%s", dmi_last_error(s));
+        snprintf(msg, 1024, "%s", dmi_last_error(s));
     if (*rc == DMI_OK && dmi_step(s) == DMI_OK)
         dmi_get_step_terms(s, &W, NULL);
     dmi_free(&s);
@@ -133,7 +136,7 @@ static int near_W(dmi_kernel_fn H, void *user, double *W, char *msg)
     CU_ASSERT_EQUAL(dmi_set_quadrature(s, DMI_QUAD_CELL), DMI_OK);
     int rc = dmi_init(s);
     if (msg)
-        snprintf(msg, 512, "%s", dmi_last_error(s));
+        snprintf(msg, 1024, "%s", dmi_last_error(s));
     if (rc == DMI_OK && dmi_step(s) == DMI_OK)
         dmi_get_step_terms(s, W, NULL);
     dmi_free(&s);
@@ -183,7 +186,7 @@ static void test_not_integrable_refused(void)
     dmi_kernel_fn kernels[3] = {inverse, inverse_three_halves, log_squared};
     const char *names[3] = {"1/s", "s^-1.5", "1/(s ln^2 s)"};
     for (int i = 0; i < 3; i++) {
-        char msg[512];
+        char msg[1024];
         int rc;
         double W = first_W(kernels[i], NULL, one, 0.5, 8, NAN, &rc, msg);
         if (rc != DMI_EINVAL || !strstr(msg, "cell 0"))
@@ -370,7 +373,7 @@ static void test_singularity_hint(void)
     /* not computable close to 0: refused with a message that says why, unless
      * the exponent is given */
     int rc;
-    char msg[512];
+    char msg[1024];
     double W = first_W(coarse_power, NULL, one, 1.0, 8, NAN, &rc, msg);
     CU_ASSERT_EQUAL(rc, DMI_ECALLBACK);
     CU_ASSERT(strstr(msg, "dmi_set_kernel_singularity") != NULL);
@@ -378,6 +381,49 @@ static void test_singularity_hint(void)
     CU_ASSERT_EQUAL(rc, DMI_OK);
     CU_ASSERT(core_close_rel("W^0 of s^-0.99 not computable below 1e-30, exponent given", W,
                              100.0, 1e-10));
+}
+
+/* s^-0.9999 (1 + s): its local exponents agree to rounding, but the part
+ * below the smallest probe is nearly all of the first cell's integral, so
+ * rounding leaves it unknown to 1e-11: refused with a message that says so
+ * and how to go on (the exponent given), which then integrates it. */
+static void test_exponent_close_to_one(void)
+{
+    double alpha = 0.9999;
+    int rc;
+    char msg[1024];
+    first_W(power_kernel, &alpha, one, 1.0, 8, NAN, &rc, msg);
+    CU_ASSERT_EQUAL(rc, DMI_EINVAL);
+    if (!strstr(msg, "close to 1") || !strstr(msg, "dmi_set_kernel_singularity"))
+        printf("\n  s^-0.9999 (1 + s): \"%s\"\n", msg);
+    CU_ASSERT(strstr(msg, "cell 0 = [0, ") != NULL && strstr(msg, "close to 1") != NULL &&
+              strstr(msg, "dmi_set_kernel_singularity") != NULL);
+    const double W = first_W(power_kernel, &alpha, one, 1.0, 8, alpha, &rc, NULL);
+    CU_ASSERT_EQUAL(rc, DMI_OK);
+    CU_ASSERT(core_close_rel("W^0 of s^-0.9999 (1 + s), exponent given", W,
+                             power_integral(alpha, 1.0), 1e-10));
+}
+
+/* 1/sqrt|s - 0.3|: integrable, but a singularity inside cell 2 that
+ * bisection does not resolve to the rule's tolerance: refused, the message
+ * whole, with its advice. */
+static int inner_singular(double s, double *out, void *user)
+{
+    (void)user;
+    out[0] = 1 / sqrt(fabs(s - 0.3));
+    return 0;
+}
+
+static void test_not_converging_refused(void)
+{
+    int rc;
+    char msg[1024];
+    first_W(inner_singular, NULL, one, 1.0, 8, NAN, &rc, msg);
+    CU_ASSERT_EQUAL(rc, DMI_EINVAL);
+    if (!strstr(msg, "DMI_QUAD_LEFT"))
+        printf("\n  1/sqrt|s - 0.3|: \"%s\"\n", msg);
+    CU_ASSERT(strstr(msg, "cell 2 = [0.25, 0.375]") != NULL &&
+              strstr(msg, "does not converge") != NULL && strstr(msg, "DMI_QUAD_LEFT") != NULL);
 }
 
 int main(int argc, char **argv)
@@ -393,6 +439,8 @@ int main(int argc, char **argv)
         {"a kernel near the largest double", test_huge_kernel},
         {"cells far from 0: a smooth kernel's cost and accuracy", test_far_cells},
         {"the exponent given by dmi_set_kernel_singularity", test_singularity_hint},
+        {"an exponent close to 1: refused with the way on", test_exponent_close_to_one},
+        {"a singularity inside a cell: refused with the way on", test_not_converging_refused},
         {NULL, NULL}};
     return core_main(argc, argv, "cells", tests);
 }
