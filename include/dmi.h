@@ -274,7 +274,11 @@ DMI_API int dmi_set_kernel_exp(dmi_solver *s, size_t K, const double *a, const d
  *                  and the part below those points is added in closed form.
  *                  What is refused, by dmi_init with DMI_EINVAL and a message
  *                  naming the cell and entry: an exponent >= 1 (1/s is not
- *                  integrable); a singularity that is no such power law
+ *                  integrable); an exponent so close to 1 (about 0.9999 and
+ *                  above) that the part below those points, most of the
+ *                  integral, is not known to 1e-11 from the estimate:
+ *                  give it (dmi_set_kernel_singularity); a singularity
+ *                  that is no such power law
  *                  (1/(s ln^2 s): no sampling tells it from 1/s); a cell whose
  *                  integral does not converge (the estimate reached is in the
  *                  message).  A cell integral beyond the largest double:
