@@ -17,7 +17,8 @@
  *   evaluated below s = 1e-30 integrated to 1e-10 with the exponent given;
  * - s^-0.9999 (1 + s): refused with a message that names the exponent close
  *   to 1 and dmi_set_kernel_singularity, with which it is integrated;
- * - 1/sqrt|s - 0.3| refused (cell 2 does not converge), its message whole.
+ * - 1/sqrt|s - 0.3| refused (cell 2 does not converge), its message whole;
+ * - a kernel computed to 8 digits refused, the message naming noise.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include <math.h>
@@ -426,6 +427,33 @@ static void test_not_converging_refused(void)
               strstr(msg, "does not converge") != NULL && strstr(msg, "DMI_QUAD_LEFT") != NULL);
 }
 
+/* e^{-s} (1 + 1e-8 r(s)), r a hash of s's bits in [-1/2, 1/2): a kernel
+ * computed to 8 digits, whose cells the rule cannot integrate to 1e-13:
+ * refused with a message that names noise as a cause, not only jumps. */
+static int noisy(double s, double *out, void *user)
+{
+    (void)user;
+    unsigned long long x;
+    memcpy(&x, &s, sizeof x);
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdULL;
+    x ^= x >> 33;
+    out[0] = exp(-s) * (1 + 1e-8 * ((double)(x >> 11) / 9007199254740992.0 - 0.5));
+    return 0;
+}
+
+static void test_noisy_kernel_refused(void)
+{
+    int rc;
+    char msg[1024];
+    first_W(noisy, NULL, one, 1.0, 8, NAN, &rc, msg);
+    CU_ASSERT_EQUAL(rc, DMI_EINVAL);
+    if (!strstr(msg, "noisy"))
+        printf("\n  e^{-s} with 1e-8 noise: rc %d, \"%s\"\n", rc, msg);
+    CU_ASSERT(strstr(msg, "does not converge") != NULL && strstr(msg, "noisy") != NULL &&
+              strstr(msg, "DMI_QUAD_LEFT") != NULL);
+}
+
 int main(int argc, char **argv)
 {
     static const core_test tests[] = {
@@ -441,6 +469,7 @@ int main(int argc, char **argv)
         {"the exponent given by dmi_set_kernel_singularity", test_singularity_hint},
         {"an exponent close to 1: refused with the way on", test_exponent_close_to_one},
         {"a singularity inside a cell: refused with the way on", test_not_converging_refused},
+        {"a kernel computed to 8 digits: refused naming noise", test_noisy_kernel_refused},
         {NULL, NULL}};
     return core_main(argc, argv, "cells", tests);
 }
