@@ -406,8 +406,7 @@ static void test_exponent_close_to_one(void)
 }
 
 /* 1/sqrt|s - 0.3|: integrable, but a singularity inside cell 2 that
- * bisection does not resolve to the rule's tolerance: refused, the message
- * whole, with its advice. */
+ * bisection does not resolve to the rule's tolerance. */
 static int inner_singular(double s, double *out, void *user)
 {
     (void)user;
@@ -415,21 +414,8 @@ static int inner_singular(double s, double *out, void *user)
     return 0;
 }
 
-static void test_not_converging_refused(void)
-{
-    int rc;
-    char msg[1024];
-    first_W(inner_singular, NULL, one, 1.0, 8, NAN, &rc, msg);
-    CU_ASSERT_EQUAL(rc, DMI_EINVAL);
-    if (!strstr(msg, "DMI_QUAD_LEFT"))
-        printf("\n  1/sqrt|s - 0.3|: \"%s\"\n", msg);
-    CU_ASSERT(strstr(msg, "cell 2 = [0.25, 0.375]") != NULL &&
-              strstr(msg, "does not converge") != NULL && strstr(msg, "DMI_QUAD_LEFT") != NULL);
-}
-
 /* e^{-s} (1 + 1e-8 r(s)), r a hash of s's bits in [-1/2, 1/2): a kernel
- * computed to 8 digits, whose cells the rule cannot integrate to 1e-13:
- * refused with a message that names noise as a cause, not only jumps. */
+ * computed to 8 digits, whose cells the rule cannot integrate to 1e-13. */
 static int noisy(double s, double *out, void *user)
 {
     (void)user;
@@ -442,16 +428,24 @@ static int noisy(double s, double *out, void *user)
     return 0;
 }
 
-static void test_noisy_kernel_refused(void)
+/* Both refused (a cell that does not converge), the message whole, naming
+ * the cell, the causes (noise for the second) and the way on. */
+static void test_not_converging_refused(void)
 {
-    int rc;
-    char msg[1024];
-    first_W(noisy, NULL, one, 1.0, 8, NAN, &rc, msg);
-    CU_ASSERT_EQUAL(rc, DMI_EINVAL);
-    if (!strstr(msg, "noisy"))
-        printf("\n  e^{-s} with 1e-8 noise: rc %d, \"%s\"\n", rc, msg);
-    CU_ASSERT(strstr(msg, "does not converge") != NULL && strstr(msg, "noisy") != NULL &&
-              strstr(msg, "DMI_QUAD_LEFT") != NULL);
+    const dmi_kernel_fn kernels[2] = {inner_singular, noisy};
+    const char *names[2] = {"1/sqrt|s - 0.3|", "e^{-s} with 1e-8 noise"};
+    const char *words[2] = {"cell 2 = [0.25, 0.375]", "noisy"};
+    for (int i = 0; i < 2; i++) {
+        int rc;
+        char msg[1024];
+        first_W(kernels[i], NULL, one, 1.0, 8, NAN, &rc, msg);
+        CU_ASSERT_EQUAL(rc, DMI_EINVAL);
+        const int named = strstr(msg, words[i]) && strstr(msg, "does not converge") &&
+                          strstr(msg, "DMI_QUAD_LEFT");
+        if (!named)
+            printf("\n  %s: \"%s\"\n", names[i], msg);
+        CU_ASSERT(named);
+    }
 }
 
 int main(int argc, char **argv)
@@ -468,8 +462,8 @@ int main(int argc, char **argv)
         {"cells far from 0: a smooth kernel's cost and accuracy", test_far_cells},
         {"the exponent given by dmi_set_kernel_singularity", test_singularity_hint},
         {"an exponent close to 1: refused with the way on", test_exponent_close_to_one},
-        {"a singularity inside a cell: refused with the way on", test_not_converging_refused},
-        {"a kernel computed to 8 digits: refused naming noise", test_noisy_kernel_refused},
+        {"a singularity inside a cell, 8-digit noise: refused with the way on",
+         test_not_converging_refused},
         {NULL, NULL}};
     return core_main(argc, argv, "cells", tests);
 }
