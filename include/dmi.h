@@ -282,8 +282,8 @@ DMI_API int dmi_set_kernel_exp(dmi_solver *s, size_t K, const double *a, const d
  *                  (1/(s ln^2 s): no sampling tells it from 1/s); a cell whose
  *                  integral does not converge (the estimate reached is in the
  *                  message), as for H computed to fewer digits (values noisy
- *                  beyond about 1e-10 of |H|: use DMI_QUAD_LEFT).  A cell integral beyond the largest double:
- *                  DMI_ENONFINITE.  The sums are scaled, so kernels up to the
+ *                  beyond about 1e-10 of |H|: use DMI_QUAD_LEFT).  A cell
+ *                  integral beyond the largest double: DMI_ENONFINITE.  The sums are scaled, so kernels up to the
  *                  largest double are integrated.
  *                  Every method (DIRECT, FFT, RECURSIVE) computes this same
  *                  sum (up to rounding).  The error of the rule is that of the

@@ -70,8 +70,8 @@ static int quad_fail(const dmi_solver *s, const dmi_quad_report *r, int near, si
                                        "singularity inside the cell that bisection does not "
                                        "resolve, or H computed to fewer digits (its values "
                                        "noisy beyond about 1e-10 of |H|); make H smooth "
-                                       "within the cells and accurate, or use DMI_QUAD_LEFT", l, lo, hi, who, i, j, DMI_QUAD_REL_TOL,
-                        r->calls, r->estimate, r->error);
+                                       "within the cells and accurate, or use DMI_QUAD_LEFT",
+                        l, lo, hi, who, i, j, DMI_QUAD_REL_TOL, r->calls, r->estimate, r->error);
     case DMI_QUAD_EOVERFLOW:
         return dmi_fail(s, DMI_ENONFINITE, "dmi_init: cell %zu = [%.17g, %.17g]: the integral of "
                                            "%s entry (%zu, %zu) is beyond the largest double: "
