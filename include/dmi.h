@@ -283,8 +283,9 @@ DMI_API int dmi_set_kernel_exp(dmi_solver *s, size_t K, const double *a, const d
  *                  integral does not converge (the estimate reached is in the
  *                  message), as for H computed to fewer digits (values noisy
  *                  beyond about 1e-10 of |H|: use DMI_QUAD_LEFT).  A cell
- *                  integral beyond the largest double: DMI_ENONFINITE.  The sums are scaled, so kernels up to the
- *                  largest double are integrated.
+ *                  integral beyond the largest double: DMI_ENONFINITE.  The
+ *                  sums are scaled, so kernels up to the largest double are
+ *                  integrated.
  *                  Every method (DIRECT, FFT, RECURSIVE) computes this same
  *                  sum (up to rounding).  The error of the rule is that of the
  *                  product U(t - s) ~ U^{p-l} on the cell, order 1 in h, as the
