@@ -274,12 +274,18 @@ DMI_API int dmi_set_kernel_exp(dmi_solver *s, size_t K, const double *a, const d
  *                  and the part below those points is added in closed form.
  *                  What is refused, by dmi_init with DMI_EINVAL and a message
  *                  naming the cell and entry: an exponent >= 1 (1/s is not
- *                  integrable); a singularity that is no such power law
+ *                  integrable); an exponent so close to 1 (about 0.9999 and
+ *                  above) that the part below those points, most of the
+ *                  integral, is not known to 1e-11 from the estimate:
+ *                  give it (dmi_set_kernel_singularity); a singularity
+ *                  that is no such power law
  *                  (1/(s ln^2 s): no sampling tells it from 1/s); a cell whose
  *                  integral does not converge (the estimate reached is in the
- *                  message).  A cell integral beyond the largest double:
- *                  DMI_ENONFINITE.  The sums are scaled, so kernels up to the
- *                  largest double are integrated.
+ *                  message), as for H computed to fewer digits (values noisy
+ *                  beyond about 1e-10 of |H|: use DMI_QUAD_LEFT).  A cell
+ *                  integral beyond the largest double: DMI_ENONFINITE.  The
+ *                  sums are scaled, so kernels up to the largest double are
+ *                  integrated.
  *                  Every method (DIRECT, FFT, RECURSIVE) computes this same
  *                  sum (up to rounding).  The error of the rule is that of the
  *                  product U(t - s) ~ U^{p-l} on the cell, order 1 in h, as the

@@ -51,13 +51,16 @@ static int quad_fail(const dmi_solver *s, const dmi_quad_report *r, int near, si
                                        "takes H(s) = s^-alpha g(s), alpha < 1, g smooth",
                         l, hi, who, i, j, r->alpha, r->probe_lo, r->probe_hi);
     case DMI_QUAD_ENOTPOWER:
-        return dmi_fail(s, DMI_EINVAL, "dmi_init: cell %zu = [0, %.17g]: %s entry (%zu, %zu) is "
-                                       "not s^-alpha g(s) with g smooth, g(0) != 0 near s = 0: "
-                                       "its local exponent runs from %.12g to %.12g between s = "
-                                       "%.3g and %.3g, so the part below them is unknown "
-                                       "(estimate %.17g, error %.3g); 1/(s ln^2 s) looks so "
-                                       "and no sampling tells it from 1/s; if H is a power law, "
-                                       "give its exponent (dmi_set_kernel_singularity)",
+        return dmi_fail(s, DMI_EINVAL, "dmi_init: cell %zu = [0, %.17g]: %s entry (%zu, %zu): "
+                                       "its local exponent runs from %.17g to %.17g between s = "
+                                       "%.3g and %.3g, which leaves the part of the integral "
+                                       "below them unknown to 1e-11 (estimate %.17g, error "
+                                       "%.3g): either H is not s^-alpha g(s) with g smooth, "
+                                       "g(0) != 0 near s = 0 (1/(s ln^2 s) looks so and no "
+                                       "sampling tells it from 1/s), or its exponent is so "
+                                       "close to 1 that the part below them is most of the "
+                                       "integral; if H is a power law, give its exponent "
+                                       "(dmi_set_kernel_singularity)",
                         l, hi, who, i, j, r->alpha_lo, r->alpha_hi, r->probe_lo, r->probe_hi,
                         r->estimate, r->error);
     case DMI_QUAD_ECONVERGE:
@@ -65,9 +68,10 @@ static int quad_fail(const dmi_solver *s, const dmi_quad_report *r, int near, si
                                        "entry (%zu, %zu) does not converge to %g in %zu calls "
                                        "(estimate %.17g, error estimate %.3g): a jump or a "
                                        "singularity inside the cell that bisection does not "
-                                       "resolve; make H smooth within the cells or use "
-                                       "DMI_QUAD_LEFT", l, lo, hi, who, i, j, DMI_QUAD_REL_TOL,
-                        r->calls, r->estimate, r->error);
+                                       "resolve, or H computed to fewer digits (its values "
+                                       "noisy beyond about 1e-10 of |H|); make H smooth "
+                                       "within the cells and accurate, or use DMI_QUAD_LEFT",
+                        l, lo, hi, who, i, j, DMI_QUAD_REL_TOL, r->calls, r->estimate, r->error);
     case DMI_QUAD_EOVERFLOW:
         return dmi_fail(s, DMI_ENONFINITE, "dmi_init: cell %zu = [%.17g, %.17g]: the integral of "
                                            "%s entry (%zu, %zu) is beyond the largest double: "

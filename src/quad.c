@@ -17,7 +17,9 @@
  *     wt = (pi/2) cosh t / cosh^2 u,
  * the nodes near an end placed by their distance to it, d 2 / (e^{2|u|} + 1)
  * (from the table of dmi_quad_nodes_make), and never at an end: a node that
- * rounds onto an end is left out (its weight is below 1e-30 of the middle's).
+ * rounds onto an end is moved to the nearest double inside, its weight kept
+ * (left out, the weights of such nodes add up to about l 2^-52 of cell l's:
+ * enough to keep the levels of a cell far from 0 from agreeing).
  * The step w halves (new nodes only) until two levels agree to
  * DMI_QUAD_REL_TOL of the integral of |f|, the terms at |t| = T_MAX (the
  * truncation) included in the error; where that fails by LEVEL_WHOLE, the
@@ -218,7 +220,8 @@ static int call(ctx *c, double s)
 }
 
 /* Adds wt f(s(x)) jac(x) to the level's sums (and to the truncation terms
- * when edge); a node whose s is not strictly inside the interval is left out. */
+ * when edge); a node whose s rounds onto an end of the interval is moved to
+ * the nearest double inside, keeping its weight. */
 static int node(ctx *c, double x, double wt, int edge)
 {
     double s = x, jac = 1;
@@ -227,7 +230,11 @@ static int node(ctx *c, double x, double wt, int edge)
         s = c->a * (xp * x);
         jac = c->a * c->p * xp;
     }
-    if (!(s > c->s_lo && s < c->s_hi))
+    if (!(s > c->s_lo)) /* rounded onto the end: the nearest double inside, weight kept */
+        s = nextafter(c->s_lo, c->s_hi);
+    else if (!(s < c->s_hi))
+        s = nextafter(c->s_hi, c->s_lo);
+    if (!(s > c->s_lo && s < c->s_hi)) /* (an interval of one ulp) */
         return DMI_QUAD_OK;
     const int rc = call(c, s);
     if (rc != DMI_QUAD_OK)

@@ -44,7 +44,7 @@ struct dmi_solver {
     double *last_X;     /* X^{p-1} (n) */
     double *work;       /* 5 n scratch values: U^p, f, W, X, U^{p+1} */
 
-    char err[256];
+    char err[1024]; /* dmi_last_error: room for the cell rule's messages and their advice */
 
     /* (since 1.3) the quadrature rule DMI_QUAD_* of the delay sum; for the cell
      * rule: what the last cell adds (nnz values, quad.c) and the exponential

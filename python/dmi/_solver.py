@@ -831,8 +831,11 @@ class Solver:
         self._set_callback("kernel_near", cb.KERNEL, setter, H, user, False)
         self._near_delta = float(delta) if H is not None else 0.0
         if self._near_delta > 0 and self._choices["quadrature"] == "left":
-            # the left rule would sample the fit at l h while the near cells are exact integrals
-            self.set_quadrature("cell")
+            # the left rule would sample the fit at l h while the near cells are exact integrals;
+            # the rule alone is switched: an exponent given by set_quadrature(singularity=) stays
+            with self._using() as s:
+                self._check(_L.dmi_set_quadrature(s, _choice(_lib.QUAD, "cell", "set_quadrature")))
+            self._choices["quadrature"] = "cell"
             warnings.warn("near cells (delta > 0, of set_kernel_fit or set_kernel_near) need the "
                           "cell rule; the quadrature is now the cell rule (call "
                           "set_quadrature('cell') first to make this explicit)", UserWarning,

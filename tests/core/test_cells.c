@@ -9,10 +9,16 @@
  * - a jump inside a cell (H = 1 on [0, 0.3)): W = 0.3 within 1e-10;
  * - every call of the kernel strictly inside a cell: 0 < s < tau and never
  *   at l h;
+ * - cells far from 0 (N = 5000): a smooth kernel in at most 130 calls a
+ *   cell, W to 1e-13;
  * - a kernel of 1e307, and 1e280 s^-1/2 (not finite in double below
  *   s = 1e-55): the step's W is right (no overflow);
  * - dmi_set_kernel_singularity: its checks, and a kernel that cannot be
- *   evaluated below s = 1e-30 integrated to 1e-10 with the exponent given.
+ *   evaluated below s = 1e-30 integrated to 1e-10 with the exponent given;
+ * - s^-0.9999 (1 + s): refused with a message that names the exponent close
+ *   to 1 and dmi_set_kernel_singularity, with which it is integrated;
+ * - 1/sqrt|s - 0.3| refused (cell 2 does not converge), its message whole;
+ * - a kernel computed to 8 digits refused, the message naming noise.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include <math.h>
@@ -68,7 +74,7 @@ static double first_W(dmi_kernel_fn H, void *user, dmi_history_fn z, double tau,
         CU_ASSERT_EQUAL(dmi_set_kernel_singularity(s, alpha), DMI_OK);
     *rc = dmi_init(s);
     if (msg)
-        snprintf(msg, 512, "%s", dmi_last_error(s));
+        snprintf(msg, 1024, "%s", dmi_last_error(s));
     if (*rc == DMI_OK && dmi_step(s) == DMI_OK)
         dmi_get_step_terms(s, &W, NULL);
     dmi_free(&s);
@@ -131,7 +137,7 @@ static int near_W(dmi_kernel_fn H, void *user, double *W, char *msg)
     CU_ASSERT_EQUAL(dmi_set_quadrature(s, DMI_QUAD_CELL), DMI_OK);
     int rc = dmi_init(s);
     if (msg)
-        snprintf(msg, 512, "%s", dmi_last_error(s));
+        snprintf(msg, 1024, "%s", dmi_last_error(s));
     if (rc == DMI_OK && dmi_step(s) == DMI_OK)
         dmi_get_step_terms(s, W, NULL);
     dmi_free(&s);
@@ -181,7 +187,7 @@ static void test_not_integrable_refused(void)
     dmi_kernel_fn kernels[3] = {inverse, inverse_three_halves, log_squared};
     const char *names[3] = {"1/s", "s^-1.5", "1/(s ln^2 s)"};
     for (int i = 0; i < 3; i++) {
-        char msg[512];
+        char msg[1024];
         int rc;
         double W = first_W(kernels[i], NULL, one, 0.5, 8, NAN, &rc, msg);
         if (rc != DMI_EINVAL || !strstr(msg, "cell 0"))
@@ -291,6 +297,31 @@ static void test_calls_inside_cells(void)
     CU_ASSERT(r.calls > 0 && r.outside == 0 && r.at_ends == 0);
 }
 
+/* e^{-s} counting its calls. */
+static int counted_exp(double s, double *out, void *user)
+{
+    ++*(size_t *)user;
+    out[0] = exp(-s);
+    return 0;
+}
+
+/* Cells far from 0 (N = 5000 cells of tau = 1): their nodes round onto the
+ * cell ends at about l 2^-52 of the cell; the rule still converges at the
+ * cost of a smooth kernel (the header: typically 30 to 130 calls a cell) and
+ * W = int_0^1 e^{-s} = 1 - 1/e to the rule's tolerance, 1e-13. */
+static void test_far_cells(void)
+{
+    size_t calls = 0;
+    int rc;
+    const size_t N = 5000;
+    const double W = first_W(counted_exp, &calls, one, 1.0, N, NAN, &rc, NULL);
+    CU_ASSERT_EQUAL(rc, DMI_OK);
+    CU_ASSERT(core_close_rel("W^0 of e^{-s}, N = 5000", W, 1 - exp(-1.0), 1e-13));
+    if ((double)calls > 130.0 * (double)N)
+        printf("\n  e^{-s}, N = %zu: %.1f calls a cell\n", N, (double)calls / (double)N);
+    CU_ASSERT((double)calls <= 130.0 * (double)N);
+}
+
 static int huge(double s, double *out, void *user)
 {
     (void)s;
@@ -343,7 +374,7 @@ static void test_singularity_hint(void)
     /* not computable close to 0: refused with a message that says why, unless
      * the exponent is given */
     int rc;
-    char msg[512];
+    char msg[1024];
     double W = first_W(coarse_power, NULL, one, 1.0, 8, NAN, &rc, msg);
     CU_ASSERT_EQUAL(rc, DMI_ECALLBACK);
     CU_ASSERT(strstr(msg, "dmi_set_kernel_singularity") != NULL);
@@ -351,6 +382,70 @@ static void test_singularity_hint(void)
     CU_ASSERT_EQUAL(rc, DMI_OK);
     CU_ASSERT(core_close_rel("W^0 of s^-0.99 not computable below 1e-30, exponent given", W,
                              100.0, 1e-10));
+}
+
+/* s^-0.9999 (1 + s): its local exponents agree to rounding, but the part
+ * below the smallest probe is nearly all of the first cell's integral, so
+ * rounding leaves it unknown to 1e-11: refused with a message that says so
+ * and how to go on (the exponent given), which then integrates it. */
+static void test_exponent_close_to_one(void)
+{
+    double alpha = 0.9999;
+    int rc;
+    char msg[1024];
+    first_W(power_kernel, &alpha, one, 1.0, 8, NAN, &rc, msg);
+    CU_ASSERT_EQUAL(rc, DMI_EINVAL);
+    if (!strstr(msg, "close to 1") || !strstr(msg, "dmi_set_kernel_singularity"))
+        printf("\n  s^-0.9999 (1 + s): \"%s\"\n", msg);
+    CU_ASSERT(strstr(msg, "cell 0 = [0, ") != NULL && strstr(msg, "close to 1") != NULL &&
+              strstr(msg, "dmi_set_kernel_singularity") != NULL);
+    const double W = first_W(power_kernel, &alpha, one, 1.0, 8, alpha, &rc, NULL);
+    CU_ASSERT_EQUAL(rc, DMI_OK);
+    CU_ASSERT(core_close_rel("W^0 of s^-0.9999 (1 + s), exponent given", W,
+                             power_integral(alpha, 1.0), 1e-10));
+}
+
+/* 1/sqrt|s - 0.3|: integrable, but a singularity inside cell 2 that
+ * bisection does not resolve to the rule's tolerance. */
+static int inner_singular(double s, double *out, void *user)
+{
+    (void)user;
+    out[0] = 1 / sqrt(fabs(s - 0.3));
+    return 0;
+}
+
+/* e^{-s} (1 + 1e-8 r(s)), r a hash of s's bits in [-1/2, 1/2): a kernel
+ * computed to 8 digits, whose cells the rule cannot integrate to 1e-13. */
+static int noisy(double s, double *out, void *user)
+{
+    (void)user;
+    unsigned long long x;
+    memcpy(&x, &s, sizeof x);
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdULL;
+    x ^= x >> 33;
+    out[0] = exp(-s) * (1 + 1e-8 * ((double)(x >> 11) / 9007199254740992.0 - 0.5));
+    return 0;
+}
+
+/* Both refused (a cell that does not converge), the message whole, naming
+ * the cell, the causes (noise for the second) and the way on. */
+static void test_not_converging_refused(void)
+{
+    const dmi_kernel_fn kernels[2] = {inner_singular, noisy};
+    const char *names[2] = {"1/sqrt|s - 0.3|", "e^{-s} with 1e-8 noise"};
+    const char *words[2] = {"cell 2 = [0.25, 0.375]", "noisy"};
+    for (int i = 0; i < 2; i++) {
+        int rc;
+        char msg[1024];
+        first_W(kernels[i], NULL, one, 1.0, 8, NAN, &rc, msg);
+        CU_ASSERT_EQUAL(rc, DMI_EINVAL);
+        const int named = strstr(msg, words[i]) && strstr(msg, "does not converge") &&
+                          strstr(msg, "DMI_QUAD_LEFT");
+        if (!named)
+            printf("\n  %s: \"%s\"\n", names[i], msg);
+        CU_ASSERT(named);
+    }
 }
 
 int main(int argc, char **argv)
@@ -364,7 +459,11 @@ int main(int argc, char **argv)
         {"a jump inside a cell to 1e-10", test_jump_in_cell},
         {"the kernel called strictly inside the cells", test_calls_inside_cells},
         {"a kernel near the largest double", test_huge_kernel},
+        {"cells far from 0: a smooth kernel's cost and accuracy", test_far_cells},
         {"the exponent given by dmi_set_kernel_singularity", test_singularity_hint},
+        {"an exponent close to 1: refused with the way on", test_exponent_close_to_one},
+        {"a singularity inside a cell, 8-digit noise: refused with the way on",
+         test_not_converging_refused},
         {NULL, NULL}};
     return core_main(argc, argv, "cells", tests);
 }

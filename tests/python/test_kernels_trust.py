@@ -100,6 +100,39 @@ def test_near_cells_under_the_left_rule_switch_to_the_cell_rule():
         t.set_quadrature("left")
 
 
+def test_fitted_power_kernel_near_cells_give_its_integral():
+    # s^-0.95 fitted on [0.01, 1] to 1e-8 relative, the near cells below 0.01 exact: with z = 1 the
+    # first step's W is int_0^1 s^-0.95 ds = 20 (closed form), to the fit's 1e-8 of int |H|
+    f = kernels.fit(kernels.PowerKernel(0.95), 1.0, tol=1e-8, relative=True, delta=0.01)
+    s = dmi.Solver(1, 1.0, 100)
+    s.set_history(lambda t: np.array([1.0]))
+    s.set_quadrature("cell")
+    s.set_kernel_fit(f)
+    s.init()
+    s.step()
+    W = s.step_terms()[0][0]
+    assert abs(W - 20.0) <= 20.0 * 1e-8, W
+
+
+def test_switch_to_the_cell_rule_keeps_the_exponent_given():
+    # a near kernel that cannot be evaluated below 1e-30 runs with its exponent given; the switch
+    # from the left rule that set_kernel_fit makes keeps it: W = int_0^1 s^-1/2 ds = 2
+    f = kernels.fit(kernels.PowerKernel(0.5), 1.0, tol=1e-10, relative=True, delta=0.05)
+
+    def near(s: float) -> float:
+        if s < 1e-30:
+            raise ValueError("not below 1e-30")
+        return s ** -0.5
+    s = dmi.Solver(1, 1.0, 100)
+    s.set_history(lambda t: np.array([1.0]))
+    s.set_quadrature("left", singularity=0.5)
+    with pytest.warns(UserWarning, match="cell rule"):
+        s.set_kernel_fit(f, near=near)
+    s.init()
+    s.step()
+    assert s.quadrature == "cell" and abs(s.step_terms()[0][0] - 2.0) <= 2.0 * 1e-9
+
+
 def test_set_kernel_fit_none_is_a_clear_error():
     s = dmi.Solver(1, 1.0, 10)
     with pytest.raises(dmi.InvalidArgument, match="expected a dmi.kernels.KernelFit"):
