@@ -36,17 +36,17 @@ class Sensitivities:
 
     Attributes
     ----------
-    t : numpy.ndarray, shape (steps + 1,)
-        Times t_p = p h (time units).
-    u : numpy.ndarray, shape (steps + 1, n)
-        States U^p (state units).
-    S : numpy.ndarray, shape (steps + 1, n, P)
-        dU^p/dp_j (state units per unit of p_j).
-    x : numpy.ndarray, shape (steps, n)
-        Resolvent arguments X^p of the step into U^{p+1}; (X^p - U^{p+1}) / h is the element of
+    t : numpy.ndarray
+        Shape (steps + 1,): times t_p = p h (time units).
+    u : numpy.ndarray
+        Shape (steps + 1, n): states U^p (state units).
+    S : numpy.ndarray
+        Shape (steps + 1, n, P): dU^p/dp_j (state units per unit of p_j).
+    x : numpy.ndarray
+        Shape (steps, n): resolvent arguments X^p of the step into U^{p+1}; (X^p - U^{p+1}) / h is the element of
         A(U^{p+1}) selected (the friction force).
-    dx : numpy.ndarray, shape (steps, n, P)
-        dX^p/dp_j.
+    dx : numpy.ndarray
+        Shape (steps, n, P): dX^p/dp_j.
     h : float
         The step (time units).
     switches : list of tuple
