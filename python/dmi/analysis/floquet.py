@@ -335,7 +335,7 @@ def across_kick(w: np.ndarray, vel: np.ndarray, n: int) -> np.ndarray:
     r, v0 = np.array(w[-n:]), vel[-n:]
     if float(v0 @ v0) > 0:
         r = r - (float(r @ v0) / float(v0 @ v0)) * v0
-    if float(np.max(np.abs(r))) > 1e-12 * max(1.0, big):
+    if float(np.max(np.abs(r))) > 1e-12:
         w[-n:] = r / float(np.max(np.abs(r)))
     return w
 
