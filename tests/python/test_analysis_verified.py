@@ -15,7 +15,7 @@ import pytest
 import dmi
 from dmi import analysis, kernels
 from dmi.analysis import ShootingError, StepMap, floquet_multipliers
-from dmi.analysis.floquet import monodromy_operator
+from dmi.analysis.floquet import fd_step, growth_rate, monodromy_operator
 
 # The Bautin normal form r' = r (nu + r^2 - r^4), theta' = 1 in Cartesian form, with a long
 # memory -(g / tau) int_0^tau x(t - s) ds on x, tau = 8 periods: its small orbit (r^2 ~ R2) is
@@ -248,3 +248,42 @@ def test_hopf_orbit_takes_the_verification_options(belt_hopf):
         o = analysis.hopf_orbit(belt.make, belt_hopf.hopf, belt_hopf.u, amplitude=0.8,
                                 steps=belt.M, verify=analysis.Verify(periods=0))
     assert o.stable is None and "undecided" in o.floquet.reason
+
+
+def plain_run(o):
+    """(rate, standard error of its log, periods fitted) of the verdict's plain run alone from
+    the orbit along its Ritz vectors (the kick and length of the default Verify)."""
+    F = StepMap(o.make, o.p, o.steps, o.rows)
+    assert F.h == o.h
+    fl = o.floquet
+    w = sum(fl.vectors[:, j] / np.max(np.abs(fl.vectors[:, j])) for j in range(fl.vectors.shape[1]))
+    opts = analysis.Verify()
+    return growth_rate(F, o.state, w, opts.kick, opts.periods, o.autonomous,
+                       fd_step(F, o.state))
+
+
+def test_plain_run_alone_decides_each_orbit_as_independent_runs_do(ring_orbit, belt_hopf):
+    """The verdict's plain run by itself, kicked across each autonomous orbit: on the two unstable
+    orbits it grows as the solver's own runs from a radial kick do (the ring 1.06, the belt's
+    small orbit 1.0012 a period); on the stick-slip orbit, which a kick of 2 % of its amplitude
+    leaves and comes back to, it falls to its floor and stays, a decisive decay (formerly nan:
+    the kick along the Ritz vectors lay almost along the orbit's velocity, 0.007 of it across,
+    and the run sat at the floor, a shift's distance, from its first period on)."""
+    rate, se, span = plain_run(ring_orbit)
+    e = successive_changes(ring_orbit.make, ring_orbit.p, ring_orbit.state, M, 40, 1e-4)
+    assert rate == pytest.approx((e[-1] / e[20]) ** (1 / (len(e) - 21)), rel=1e-2), (rate, e)
+    assert math.log(rate) > 3 * se
+
+    small = belt_orbit(belt_hopf, 0.05)
+    rate, se, span = plain_run(small)
+    e = belt.period_changes(small.make, small.p, small.state, belt.M, 80, 1e-4)
+    assert rate == pytest.approx((e[-1] / e[40]) ** (1 / (len(e) - 41)), abs=1e-3), (rate, e)
+    assert math.log(rate) > 3 * se and math.log(rate) * span >= 0.05
+
+    stick = belt_orbit(belt_hopf, 0.8)
+    dev = belt.amplitude_deviation(stick.make, stick.p, stick.state, belt.M, 100, 0.016,
+                                   stick.amplitude)
+    assert dev[10] < 0.2 * dev[0] and np.max(dev[10:]) < 0.5 * dev[0], dev
+    rate, se, span = plain_run(stick)
+    assert math.isfinite(rate) and math.log(rate) < -3 * se and -math.log(rate) * span >= 0.05, \
+        (rate, se, span)

@@ -35,12 +35,15 @@ The verdict ``stable``: False when a verified multiplier other than the trivial 
 the largest nontrivial |mu| + error < 1; where the largest nontrivial |mu| - 1 lies inside its
 error, or the pairs are not all verified (or, on an autonomous orbit, the trivial pair's error
 leaves room for a second multiplier beside 1), a *plain run* decides: the orbit perturbed
-along the Ritz vectors (by ``Verify.kick`` of its amplitude, and at least the difference step),
-run ``Verify.periods`` periods; its distance from the orbit period by period (across the orbit,
+along the Ritz vectors (by ``Verify.kick`` of its amplitude, and at least the difference step;
+across the orbit, for an autonomous one: the shift along it left out of the kick), run
+``Verify.periods`` periods; its distance from the orbit period by period (across the orbit,
 for an autonomous one: a scheme's stick-slip orbit kicked by less than a step's worth of switch
 motion drifts along itself by fractions of a step for hundreds of periods and locks on again),
-the growth rate fitted to its log.  Growth beyond three standard errors and by 5 % or more over
-the periods fitted: False; decay so (and the pairs verified): True.
+the growth rate fitted to its log above the floor (where a run that only drifts along the
+orbit lies), or the bound of a run that falls to the floor and stays there.  Growth beyond
+three standard errors and by 5 % or more over the periods fitted: False; decay so (and the
+pairs verified): True.
 Otherwise ``None``, with a :class:`StabilityWarning` saying why: never True unverified.
 
 The trivial multiplier of an autonomous orbit (a shift along the orbit) is the Ritz pair whose
@@ -152,7 +155,8 @@ class Verify:
         The plain run's length (periods) where the verdict is left to it; 0: no plain run.
     kick : float
         The plain run's perturbation along the Ritz vectors: the state at t = 0 moved by kick A
-        (A the orbit's largest half range, or max(1, |x|) for a constant orbit), and at least
+        (across the orbit, the history by at most as much, on an autonomous orbit; A the
+        orbit's largest half range, or max(1, |x|) for a constant orbit), and at least
         by the difference step (on an orbit with switches: smaller kicks see the scheme's
         switches frozen at their steps, where an orbit can drift along itself and lock on
         again).
@@ -314,37 +318,73 @@ def off_orbit(B: np.ndarray, P: np.ndarray, h: float, autonomous: bool) -> float
     return float(np.median(np.linalg.norm(B - Pj - d * V, axis=1)))
 
 
+def across_kick(w: np.ndarray, vel: np.ndarray, n: int) -> np.ndarray:
+    """A kick of an autonomous orbit's window along w (L n values) with no shift along the
+    orbit: w less its projection on the window's velocity ``vel`` (:func:`window_velocity`),
+    scaled to |.|_inf = 1 over the window, its last row (the state at t = 0) replaced by that
+    row's part across the velocity there, scaled to |.|_inf = 1 (where that part is nonzero), so
+    that the state at t = 0 moves across the orbit by the whole kick and no value of the history
+    by more."""
+    w = np.array(w, dtype=float)
+    vv = float(vel @ vel)
+    if vv > 0:
+        w = w - (float(w @ vel) / vv) * vel
+    big = float(np.max(np.abs(w)))
+    if big > 0:
+        w = w / big
+    r, v0 = np.array(w[-n:]), vel[-n:]
+    if float(v0 @ v0) > 0:
+        r = r - (float(r @ v0) / float(v0 @ v0)) * v0
+    if float(np.max(np.abs(r))) > 1e-12:
+        w[-n:] = r / float(np.max(np.abs(r)))
+    return w
+
+
 def growth_rate(F: StepMap, x: np.ndarray, v: np.ndarray, kick: float, periods: int,
                 autonomous: bool = False, least: float = 0.0) -> tuple[float, float, int]:
-    """(rate, standard error of its log, periods fitted) of a plain run from
-    x + max(kick A, least) Re(v) / |Re v_0|_inf (v_0: v's last row, the state at t = 0; A the
-    orbit's largest half range, max(1, |x|) for a constant orbit; ``least``: the difference
-    step, so that the run sees the scale the multipliers describe, where a switch moves by
-    many steps).
+    """(rate, standard error of its log, periods fitted) of a plain run from x + max(kick A,
+    least) w (A the orbit's largest half range, max(1, |x|) for a constant orbit; ``least``: the
+    difference step, so that the run sees the scale the multipliers describe, where a switch
+    moves by many steps).
+
+    w is Re(v) / |Re v_0|_inf (v_0: v's last row, the state at t = 0) on a forced orbit.  On an
+    autonomous one, w is v across the orbit (:func:`across_kick`): a shift along the orbit is no
+    distance across it, and the Ritz vectors' sum at t = 0 lies almost along the velocity (the
+    trivial vector's), so that a kick along it barely leaves the orbit.
 
     d_k = :func:`off_orbit` of period k (across the orbit, for an autonomous one: a scheme's
     orbit can drift along itself by fractions of a step for hundreds of periods and lock on
     again), the rate exp(slope) of a least-squares line through log d_k over the periods where
-    d_k lies between the floor (100 times the fixed point's residual |F(x) - x|, the shift's
-    interpolation error h^2 |U''| / 8 (a median over the period), rounding) and 0.1 A (beyond:
-    not linear), the first third of those left out (the other modes fade); a run that falls
-    to the floor and never comes back to a tenth of d_0: the bound (floor / d_0)^(1 / k) over
-    the k periods it took (standard error 0); (nan, nan, 0) with fewer than 5 such periods."""
+    d_k lies between the floor and 0.1 A (beyond: not linear), the first third of those left
+    out (the other modes fade); a run that falls to the floor and never comes back to a tenth of
+    d_0: the bound (floor / d_0)^(1 / k) over the k periods it took (standard error 0); (nan,
+    nan, 0) with fewer than 5 such periods.  The floor: 100 times the fixed point's residual
+    |F(x) - x|, rounding, and on an autonomous orbit the distance across the orbit of a run that
+    only drifts along it: d_0 of a run from the orbit shifted by half a step along its velocity
+    (the worst fraction; a scheme's stick-slip orbit shifted by a fraction of a step is not the
+    orbit shifted, its switches fall on other steps: on the Stribeck belt's orbit 1.6 times the
+    shift's interpolation error h^2 |U''| / 8, which is kept as a least floor; one period only,
+    since on an unstable orbit the shifted run leaves it too)."""
     U = F.trajectory(x)
     A = float(np.max(0.5 * (U.max(axis=0) - U.min(axis=0))))
     scale = max(1.0, float(np.max(np.abs(x))))
     if not A > 0:
         A = scale
     w = np.real(v) if np.max(np.abs(np.real(v))) >= np.max(np.abs(np.imag(v))) else np.imag(v)
-    now = float(np.max(np.abs(w[-F.n:])))     # the kick's size is that of the state at t = 0
-    w = w / (now if now > 1e-3 * np.max(np.abs(w)) else np.max(np.abs(w)))
     P = U[1:]
-    curv = 0.0
+    M = F.M
+    drift = 0.0
     if autonomous:
+        vel = window_velocity(F, U)
+        w = across_kick(w, vel, F.n)
         Q = np.concatenate([P[-1:], P, P[:1]])
         curv = float(np.median(np.linalg.norm(Q[2:] - 2 * Q[1:-1] + Q[:-2], axis=1))) / 8
-    floor = 100 * float(np.max(np.abs(F(x) - x))) + curv + 1e-13 * scale
-    M = F.M
+        S = F.run_from(x + 0.5 * F.h * vel, M)
+        drift = max(curv, off_orbit(S[1:], P, F.h, True))
+    else:
+        now = float(np.max(np.abs(w[-F.n:])))     # the kick's size is that of the state at t = 0
+        w = w / (now if now > 1e-3 * np.max(np.abs(w)) else np.max(np.abs(w)))
+    floor = 100 * float(np.max(np.abs(F(x) - x))) + drift + 1e-13 * scale
     R = F.run_from(x + max(kick * A, least) * w, periods * M)
     d = np.array([off_orbit(R[k * M + 1:(k + 1) * M + 1], P, F.h, autonomous)
                   for k in range(periods)])
