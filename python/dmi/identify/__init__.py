@@ -7,7 +7,8 @@
 equation's sensitivity at O(h) through reversals, sticks and slip onsets; :func:`estimate` fits p
 to one or more :class:`Record` with SciPy's trust-region ``least_squares`` and returns an
 :class:`Estimate` (covariance, correlations, AIC/BIC, the combinations the data cannot determine);
-:func:`profile_likelihood` gives a parameter's likelihood-ratio interval beside the Wald one.
+:func:`profile_likelihood` gives a parameter's :class:`Profile`: its likelihood-ratio interval
+beside the Wald one.
 """
 from __future__ import annotations
 
