@@ -81,9 +81,13 @@ def main() -> None:
         "Prints the CPU time of dmi.identify.sensitivities against a plain run, a forward- and a "
         "central-difference Jacobian, per model variant, and of one Gauss-Newton iteration of the "
         "gallery fit against the P + 1 runs it needs."))
-    ap.add_argument("--rounds", type=positive_int, default=2)
-    ap.add_argument("--steps", type=positive_int, nargs="+", default=[1000, 100000])
-    ap.add_argument("--callback-steps", type=positive_int, default=2000)
+    ap.add_argument("--rounds", type=positive_int, default=2,
+                    help="interleaved rounds; the fastest of each variant counts (default 2)")
+    ap.add_argument("--steps", type=positive_int, nargs="+", default=[1000, 100000],
+                    help="run lengths N = steps (tau = N h) of the exponential-kernel cases "
+                         "(default 1000 100000)")
+    ap.add_argument("--callback-steps", type=positive_int, default=2000,
+                    help="run length of the callback-kernel cases, DIRECT and FFT (default 2000)")
     args = ap.parse_args()
     P = len(P0)
     cases = []
