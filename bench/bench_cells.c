@@ -22,39 +22,17 @@
 
 #include "cli.h"
 #include "dmi.h"
-#include "forced_oscillator.h" /* rhs and history (tests/core) */
+#include "example43.h"
 #include "layout.h"
-
-#define PI 3.14159265358979323846
 
 enum { INIT_CELL, STEP_EXP, STEP_DIRECT, STEP_FFT, CASES };
 static const char *const NAMES[CASES] = {"init, callback, cell rule", "step, exp (recursion)",
                                          "step, callback, DIRECT", "step, callback, default"};
 
-static int kernel(double s, double *out, void *user)
-{
-    (void)user;
-    out[2] = cos(2 * PI * s) + cos(10 * PI * s) + cos(20 * PI * s);
-    return 0;
-}
-
 static dmi_solver *make(size_t N, int c)
 {
     dmi_solver *s = NULL;
-    const double alpha[2] = {0.0, 1.0};
-    const double a[3] = {0, 0, 0}, b[3] = {2 * PI, 10 * PI, 20 * PI};
-    double C[3 * 4] = {0};
-    C[2] = C[6] = C[10] = 1.0;
-    int rc = dmi_create(&s, 2, 1.0, N);
-    if (rc == DMI_OK)
-        rc = dmi_set_rhs(s, rhs, NULL);
-    if (rc == DMI_OK)
-        rc = dmi_set_history(s, history, NULL);
-    if (rc == DMI_OK)
-        rc = dmi_set_friction(s, alpha);
-    if (rc == DMI_OK)
-        rc = c == STEP_EXP ? dmi_set_kernel_exp(s, 3, a, b, C, NULL)
-                           : dmi_set_kernel(s, kernel, NULL);
+    int rc = ex43_create(&s, N, c == STEP_EXP ? EX43_KERNEL_EXP : EX43_KERNEL_CALLBACK);
     if (rc == DMI_OK && c == INIT_CELL)
         rc = dmi_set_quadrature(s, DMI_QUAD_CELL);
     if (rc == DMI_OK && c == STEP_DIRECT)

@@ -23,40 +23,19 @@
 
 #include "cli.h"
 #include "dmi.h"
-#include "forced_oscillator.h" /* rhs and history (tests/core) */
+#include "example43.h"
 #include "layout.h"
-
-#define PI 3.14159265358979323846
 
 enum { EXP, EXP_DIRECT, CALLBACK, NONE, KINDS };
 static const char *const NAMES[KINDS] = {"exp (recursion)", "exp, DIRECT", "callback (default)",
                                          "no kernel"};
 
-static int kernel(double s, double *out, void *user)
-{
-    (void)user;
-    out[2] = cos(2 * PI * s) + cos(10 * PI * s) + cos(20 * PI * s);
-    return 0;
-}
-
 static dmi_solver *make(size_t N, int kind)
 {
     dmi_solver *s = NULL;
-    const double alpha[2] = {0.0, 1.0};
-    const double a[3] = {0, 0, 0}, b[3] = {2 * PI, 10 * PI, 20 * PI};
-    double C[3 * 4] = {0};
-    C[2] = C[6] = C[10] = 1.0;
-    int rc = dmi_create(&s, 2, 1.0, N);
-    if (rc == DMI_OK)
-        rc = dmi_set_rhs(s, rhs, NULL);
-    if (rc == DMI_OK)
-        rc = dmi_set_history(s, history, NULL);
-    if (rc == DMI_OK)
-        rc = dmi_set_friction(s, alpha);
-    if (rc == DMI_OK && (kind == EXP || kind == EXP_DIRECT))
-        rc = dmi_set_kernel_exp(s, 3, a, b, C, NULL);
-    if (rc == DMI_OK && kind == CALLBACK)
-        rc = dmi_set_kernel(s, kernel, NULL);
+    int rc = ex43_create(&s, N, kind == EXP || kind == EXP_DIRECT ? EX43_KERNEL_EXP
+                                : kind == CALLBACK                 ? EX43_KERNEL_CALLBACK
+                                                                   : EX43_KERNEL_NONE);
     if (rc == DMI_OK && kind == EXP_DIRECT)
         rc = dmi_set_convolution(s, DMI_CONV_DIRECT);
     if (rc == DMI_OK)
