@@ -256,3 +256,18 @@ dmi_solver *core_model_solver(core_model *m, size_t N)
         dmi_free(&s);
     return s;
 }
+
+int core_z_one(double t, double *out, void *user)
+{
+    (void)t;
+    (void)user;
+    out[0] = 1;
+    return 0;
+}
+
+int core_z_wave(double t, double *out, void *user)
+{
+    (void)user;
+    out[0] = cos(5 * t);
+    return 0;
+}

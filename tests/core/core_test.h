@@ -1,7 +1,7 @@
 /*
  * Support code of the core test suite: the CUnit runner, the
- * reference files, saved-state comparisons and a small n = 2 model whose
- * callbacks can be made to fail on demand.
+ * reference files, two histories of n = 1, saved-state comparisons and a
+ * small n = 2 model whose callbacks can be made to fail on demand.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #ifndef DMI_CORE_TEST_H
@@ -43,6 +43,14 @@ double core_ls_slope(const double *x, const double *y, size_t n);
 /* A new initialised solver of a paper example (examples/paper.c) with
  * h = tau / N, tau = 1, or NULL; ex must outlive it. */
 dmi_solver *core_paper_solver(paper_example *ex, size_t N);
+
+/* ---- histories of n = 1 (the cell rule's tests) -------------------------- */
+
+/* z(t) = 1: W^0 is then the sum of all cell weights. */
+int core_z_one(double t, double *out, void *user);
+
+/* z(t) = cos(5 t): W^0 = sum_l w_l cos(5 l h) tells each cell's weight apart. */
+int core_z_wave(double t, double *out, void *user);
 
 /* ---- saved states ------------------------------------------------------ */
 

@@ -42,22 +42,6 @@ static double power_integral(double alpha, double x)
     return pow(x, 1 - alpha) / (1 - alpha) + pow(x, 2 - alpha) / (2 - alpha);
 }
 
-static int one(double t, double *out, void *user)
-{
-    (void)t;
-    (void)user;
-    out[0] = 1;
-    return 0;
-}
-
-/* z(t) = cos(5 t): W^0 = sum_l w_l cos(5 l h) tells each cell's weight apart. */
-static int wave(double t, double *out, void *user)
-{
-    (void)user;
-    out[0] = cos(5 * t);
-    return 0;
-}
-
 /* W^0 of a new solver for u' + W = 0 (n = 1, tau, N cells) with the kernel
  * callback H (user), history z, the cell rule, exponent hint alpha (NAN:
  * none): *rc = dmi_init's code, the message into msg (if not NULL). */
@@ -90,7 +74,7 @@ static void test_power_cells(void)
         /* z = 1: W^0 = int_0^1 H */
         int rc;
         char what[96];
-        double W = first_W(power_kernel, &alpha, one, tau, 8, NAN, &rc, NULL);
+        double W = first_W(power_kernel, &alpha, core_z_one, tau, 8, NAN, &rc, NULL);
         CU_ASSERT_EQUAL(rc, DMI_OK);
         snprintf(what, sizeof what, "W^0 of s^-%g (1 + s), z = 1", alpha);
         CU_ASSERT(core_close_rel(what, W, power_integral(alpha, 1.0), 1e-10));
@@ -99,12 +83,12 @@ static void test_power_cells(void)
         for (int l = 0; l < 8; l++)
             ref += (power_integral(alpha, (l + 1) * h) - power_integral(alpha, l * h)) *
                    cos(5 * l * h);
-        W = first_W(power_kernel, &alpha, wave, tau, 8, NAN, &rc, NULL);
+        W = first_W(power_kernel, &alpha, core_z_wave, tau, 8, NAN, &rc, NULL);
         CU_ASSERT_EQUAL(rc, DMI_OK);
         snprintf(what, sizeof what, "W^0 of s^-%g (1 + s), z = cos 5t", alpha);
         CU_ASSERT(core_close_rel(what, W, ref, 1e-10));
         /* the exponent given: the same */
-        W = first_W(power_kernel, &alpha, one, tau, 8, alpha, &rc, NULL);
+        W = first_W(power_kernel, &alpha, core_z_one, tau, 8, alpha, &rc, NULL);
         CU_ASSERT_EQUAL(rc, DMI_OK);
         snprintf(what, sizeof what, "W^0 of s^-%g (1 + s), exponent given", alpha);
         CU_ASSERT(core_close_rel(what, W, power_integral(alpha, 1.0), 1e-10));
@@ -117,7 +101,7 @@ static void test_exponent_near_zero(void)
 {
     double alpha = 1e-17;
     int rc;
-    double W = first_W(power_kernel, &alpha, one, 1.0, 8, NAN, &rc, NULL);
+    double W = first_W(power_kernel, &alpha, core_z_one, 1.0, 8, NAN, &rc, NULL);
     CU_ASSERT_EQUAL(rc, DMI_OK);
     CU_ASSERT(core_close_rel("W^0 of s^-1e-17 (1 + s)", W, 1.5, 1e-12));
 }
@@ -133,7 +117,7 @@ static int near_W(dmi_kernel_fn H, void *user, double *W, char *msg)
     CU_ASSERT_FATAL(dmi_create(&s, 1, 1.0, 8) == DMI_OK);
     CU_ASSERT_EQUAL(dmi_set_kernel_exp(s, 1, NA, NB, NC, NULL), DMI_OK);
     CU_ASSERT_EQUAL(dmi_set_kernel_near(s, H, user, 0.2), DMI_OK);
-    CU_ASSERT_EQUAL(dmi_set_history(s, one, NULL), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_history(s, core_z_one, NULL), DMI_OK);
     CU_ASSERT_EQUAL(dmi_set_quadrature(s, DMI_QUAD_CELL), DMI_OK);
     int rc = dmi_init(s);
     if (msg)
@@ -189,7 +173,7 @@ static void test_not_integrable_refused(void)
     for (int i = 0; i < 3; i++) {
         char msg[1024];
         int rc;
-        double W = first_W(kernels[i], NULL, one, 0.5, 8, NAN, &rc, msg);
+        double W = first_W(kernels[i], NULL, core_z_one, 0.5, 8, NAN, &rc, msg);
         if (rc != DMI_EINVAL || !strstr(msg, "cell 0"))
             printf("\n  %s under the cell rule: rc %d, W %.17g, \"%s\"\n", names[i], rc, W, msg);
         CU_ASSERT_EQUAL(rc, DMI_EINVAL);
@@ -221,7 +205,7 @@ static void test_refusal_leaves_solver(void)
         dmi_solver **x = k ? &ref : &s;
         CU_ASSERT_FATAL(dmi_create(x, 1, 1.0, 16) == DMI_OK);
         CU_ASSERT_EQUAL(dmi_set_kernel(*x, switchable, &bad), DMI_OK);
-        CU_ASSERT_EQUAL(dmi_set_history(*x, wave, NULL), DMI_OK);
+        CU_ASSERT_EQUAL(dmi_set_history(*x, core_z_wave, NULL), DMI_OK);
         CU_ASSERT_EQUAL(dmi_set_quadrature(*x, DMI_QUAD_CELL), DMI_OK);
         CU_ASSERT_FATAL(dmi_init(*x) == DMI_OK);
         CU_ASSERT_EQUAL(dmi_advance(*x, 20), DMI_OK);
@@ -249,12 +233,12 @@ static int step_kernel(double s, double *out, void *user)
 static void test_jump_in_cell(void)
 {
     int rc;
-    double W = first_W(step_kernel, NULL, one, 1.0, 8, NAN, &rc, NULL);
+    double W = first_W(step_kernel, NULL, core_z_one, 1.0, 8, NAN, &rc, NULL);
     CU_ASSERT_EQUAL(rc, DMI_OK);
     CU_ASSERT(core_close_rel("W^0 of H = 1 on [0, 0.3)", W, 0.3, 1e-10));
     /* the cell's own weight: z = cos 5t tells it from its neighbours */
     const double ref = 0.125 * (1 + cos(5 * 0.125)) + 0.05 * cos(5 * 0.25);
-    W = first_W(step_kernel, NULL, wave, 1.0, 8, NAN, &rc, NULL);
+    W = first_W(step_kernel, NULL, core_z_wave, 1.0, 8, NAN, &rc, NULL);
     CU_ASSERT(core_close_rel("W^0 of the jump, z = cos 5t", W, ref, 1e-10));
 }
 
@@ -283,7 +267,7 @@ static void test_calls_inside_cells(void)
     for (int i = 0; i < 3; i++) {
         recorder r = {1.0, 1.0 / (double)Ns[i], Ns[i], 0, 0, 0};
         int rc;
-        first_W(recording, &r, one, 1.0, Ns[i], NAN, &rc, NULL);
+        first_W(recording, &r, core_z_one, 1.0, Ns[i], NAN, &rc, NULL);
         CU_ASSERT_EQUAL(rc, DMI_OK);
         if (r.outside || r.at_ends)
             printf("\n  N = %zu: %zu of %zu calls outside (0, tau), %zu at l h\n", Ns[i],
@@ -314,7 +298,7 @@ static void test_far_cells(void)
     size_t calls = 0;
     int rc;
     const size_t N = 5000;
-    const double W = first_W(counted_exp, &calls, one, 1.0, N, NAN, &rc, NULL);
+    const double W = first_W(counted_exp, &calls, core_z_one, 1.0, N, NAN, &rc, NULL);
     CU_ASSERT_EQUAL(rc, DMI_OK);
     CU_ASSERT(core_close_rel("W^0 of e^{-s}, N = 5000", W, 1 - exp(-1.0), 1e-13));
     if ((double)calls > 130.0 * (double)N)
@@ -340,11 +324,11 @@ static int huge_power(double s, double *out, void *user)
 static void test_huge_kernel(void)
 {
     int rc;
-    double W = first_W(huge, NULL, one, 1.0, 8, NAN, &rc, NULL);
+    double W = first_W(huge, NULL, core_z_one, 1.0, 8, NAN, &rc, NULL);
     CU_ASSERT_EQUAL(rc, DMI_OK);
     CU_ASSERT(core_close_rel("W^0 of H = 1e307", W, 1e307, 1e-12));
     /* 1e280 s^-1/2: beyond the largest double below s = 1e-55, integrable */
-    W = first_W(huge_power, NULL, one, 1.0, 8, NAN, &rc, NULL);
+    W = first_W(huge_power, NULL, core_z_one, 1.0, 8, NAN, &rc, NULL);
     CU_ASSERT_EQUAL(rc, DMI_OK);
     CU_ASSERT(core_close_rel("W^0 of H = 1e280 s^-1/2", W, 2e280, 1e-10));
 }
@@ -375,10 +359,10 @@ static void test_singularity_hint(void)
      * the exponent is given */
     int rc;
     char msg[1024];
-    double W = first_W(coarse_power, NULL, one, 1.0, 8, NAN, &rc, msg);
+    double W = first_W(coarse_power, NULL, core_z_one, 1.0, 8, NAN, &rc, msg);
     CU_ASSERT_EQUAL(rc, DMI_ECALLBACK);
     CU_ASSERT(strstr(msg, "dmi_set_kernel_singularity") != NULL);
-    W = first_W(coarse_power, NULL, one, 1.0, 8, 0.99, &rc, msg);
+    W = first_W(coarse_power, NULL, core_z_one, 1.0, 8, 0.99, &rc, msg);
     CU_ASSERT_EQUAL(rc, DMI_OK);
     CU_ASSERT(core_close_rel("W^0 of s^-0.99 not computable below 1e-30, exponent given", W,
                              100.0, 1e-10));
@@ -393,13 +377,13 @@ static void test_exponent_close_to_one(void)
     double alpha = 0.9999;
     int rc;
     char msg[1024];
-    first_W(power_kernel, &alpha, one, 1.0, 8, NAN, &rc, msg);
+    first_W(power_kernel, &alpha, core_z_one, 1.0, 8, NAN, &rc, msg);
     CU_ASSERT_EQUAL(rc, DMI_EINVAL);
     if (!strstr(msg, "close to 1") || !strstr(msg, "dmi_set_kernel_singularity"))
         printf("\n  s^-0.9999 (1 + s): \"%s\"\n", msg);
     CU_ASSERT(strstr(msg, "cell 0 = [0, ") != NULL && strstr(msg, "close to 1") != NULL &&
               strstr(msg, "dmi_set_kernel_singularity") != NULL);
-    const double W = first_W(power_kernel, &alpha, one, 1.0, 8, alpha, &rc, NULL);
+    const double W = first_W(power_kernel, &alpha, core_z_one, 1.0, 8, alpha, &rc, NULL);
     CU_ASSERT_EQUAL(rc, DMI_OK);
     CU_ASSERT(core_close_rel("W^0 of s^-0.9999 (1 + s), exponent given", W,
                              power_integral(alpha, 1.0), 1e-10));
@@ -438,7 +422,7 @@ static void test_not_converging_refused(void)
     for (int i = 0; i < 2; i++) {
         int rc;
         char msg[1024];
-        first_W(kernels[i], NULL, one, 1.0, 8, NAN, &rc, msg);
+        first_W(kernels[i], NULL, core_z_one, 1.0, 8, NAN, &rc, msg);
         CU_ASSERT_EQUAL(rc, DMI_EINVAL);
         const int named = strstr(msg, words[i]) && strstr(msg, "does not converge") &&
                           strstr(msg, "DMI_QUAD_LEFT");

@@ -43,23 +43,6 @@ static int power_kernel(double s, double *out, void *user)
     return s > 0 ? 0 : 1;
 }
 
-/* z = 1 on [-tau, 0]: W^0 is then the sum of all cell weights. */
-static int one(double t, double *out, void *user)
-{
-    (void)t;
-    (void)user;
-    out[0] = 1;
-    return 0;
-}
-
-/* z(t) = cos(5 t): W^0 = sum_l w_l cos(5 l h) tells each weight apart. */
-static int wave(double t, double *out, void *user)
-{
-    (void)user;
-    out[0] = cos(5 * t);
-    return 0;
-}
-
 /* e^{-s} as a sum, and 2 e^{-s} for the near cells (dmi_set_kernel_near). */
 static const double NA[1] = {-1}, NB[1] = {0}, NC[1] = {1};
 
@@ -129,9 +112,9 @@ static double first_W(dmi_solver *s)
 static void test_default_is_left_bitwise(void)
 {
     for (int method = DMI_CONV_DIRECT; method <= DMI_CONV_RECURSIVE; method++) {
-        dmi_solver *a = solver(0, wave, -1, method, 1.0, 200, 0);
-        dmi_solver *b = solver(0, wave, DMI_QUAD_LEFT, method, 1.0, 200, 0);
-        dmi_solver *c = solver(0, wave, DMI_QUAD_CELL, method, 1.0, 200, 0);
+        dmi_solver *a = solver(0, core_z_wave, -1, method, 1.0, 200, 0);
+        dmi_solver *b = solver(0, core_z_wave, DMI_QUAD_LEFT, method, 1.0, 200, 0);
+        dmi_solver *c = solver(0, core_z_wave, DMI_QUAD_CELL, method, 1.0, 200, 0);
         CU_ASSERT_FATAL(a && b && c);
         CU_ASSERT_EQUAL(dmi_advance(a, 700), DMI_OK);
         CU_ASSERT_EQUAL(dmi_advance(b, 700), DMI_OK);
@@ -179,8 +162,8 @@ static void test_weights_against_integrals(void)
         double tau = cases[c][0], hgiven = cases[c][2];
         size_t Ngiven = (size_t)cases[c][1];
         for (int kernel = 0; kernel <= 2; kernel++) {
-            dmi_solver *s = solver(kernel, kernel == 2 ? one : wave, DMI_QUAD_CELL, DMI_CONV_DIRECT,
-                                   tau, Ngiven, hgiven);
+            dmi_solver *s = solver(kernel, kernel == 2 ? core_z_one : core_z_wave, DMI_QUAD_CELL,
+                                   DMI_CONV_DIRECT, tau, Ngiven, hgiven);
             CU_ASSERT_FATAL(s != NULL);
             size_t N = dmi_get_N(s);
             double h = dmi_get_h(s);
@@ -203,14 +186,16 @@ static void test_engines_agree(void)
     const double hs[2] = {0, 0.0213};
     for (int hi = 0; hi < 2; hi++)
         for (int kernel = 0; kernel <= 1; kernel++) {
-            dmi_solver *ref = solver(kernel, wave, DMI_QUAD_CELL, DMI_CONV_DIRECT, 1.0, 500, hs[hi]);
+            dmi_solver *ref =
+                solver(kernel, core_z_wave, DMI_QUAD_CELL, DMI_CONV_DIRECT, 1.0, 500, hs[hi]);
             CU_ASSERT_FATAL(ref != NULL);
             const double u_ref = state_after(ref, 1200);
             const int methods[3] = {DMI_CONV_FFT, DMI_CONV_RECURSIVE, DMI_CONV_AUTO};
             for (int m = 0; m < 3; m++) {
                 if (kernel == 1 && methods[m] == DMI_CONV_RECURSIVE)
                     continue; /* (a callback runs no recursion) */
-                dmi_solver *s = solver(kernel, wave, DMI_QUAD_CELL, methods[m], 1.0, 500, hs[hi]);
+                dmi_solver *s =
+                    solver(kernel, core_z_wave, DMI_QUAD_CELL, methods[m], 1.0, 500, hs[hi]);
                 CU_ASSERT_FATAL(s != NULL);
                 char what[64];
                 snprintf(what, sizeof what, "kernel %d, h %g, method %d", kernel, hs[hi], methods[m]);
@@ -218,7 +203,8 @@ static void test_engines_agree(void)
                 dmi_free(&s);
             }
             /* the callback's tanh-sinh weights equal the closed form's */
-            dmi_solver *x = solver(1 - kernel, wave, DMI_QUAD_CELL, DMI_CONV_DIRECT, 1.0, 500, hs[hi]);
+            dmi_solver *x =
+                solver(1 - kernel, core_z_wave, DMI_QUAD_CELL, DMI_CONV_DIRECT, 1.0, 500, hs[hi]);
             CU_ASSERT_FATAL(x != NULL);
             CU_ASSERT(core_close_rel("callback vs closed form", state_after(x, 1200), u_ref, 1e-12));
             dmi_free(&x);
@@ -241,7 +227,7 @@ static void test_failed_init_leaves_solver(void)
     dmi_solver *s = NULL;
     CU_ASSERT_FATAL(dmi_create_h(&s, 1, 1.0, 0.0213) == DMI_OK);
     CU_ASSERT_EQUAL(dmi_set_kernel(s, budget_kernel, &left), DMI_OK);
-    CU_ASSERT_EQUAL(dmi_set_history(s, wave, NULL), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_history(s, core_z_wave, NULL), DMI_OK);
     CU_ASSERT_EQUAL(dmi_set_quadrature(s, DMI_QUAD_CELL), DMI_OK);
     CU_ASSERT_FATAL(dmi_init(s) == DMI_OK);
     CU_ASSERT_EQUAL(dmi_advance(s, 30), DMI_OK);
@@ -253,7 +239,7 @@ static void test_failed_init_leaves_solver(void)
     CU_ASSERT(strstr(dmi_last_error(s), "kernel callback returned 7") != NULL);
     CU_ASSERT(core_state_is(s, before, size));
     /* stepping on is the run that never restarted */
-    dmi_solver *ref = solver(1, wave, DMI_QUAD_CELL, DMI_CONV_AUTO, 1.0, 0, 0.0213);
+    dmi_solver *ref = solver(1, core_z_wave, DMI_QUAD_CELL, DMI_CONV_AUTO, 1.0, 0, 0.0213);
     CU_ASSERT_FATAL(ref != NULL);
     CU_ASSERT_EQUAL(dmi_advance(ref, 30), DMI_OK);
     CU_ASSERT(core_close_rel("after a failed restart", state_after(s, 40), state_after(ref, 40), 0));
@@ -286,7 +272,8 @@ static void test_near_cells(void)
     for (int hi = 0; hi < 2; hi++)
         for (int method = DMI_CONV_DIRECT; method <= DMI_CONV_RECURSIVE; method++) {
             /* z = 1: W^0 = int_0^{m h} 2 e^{-s} + int_{m h}^tau e^{-s}, m = ceil(delta / h) */
-            dmi_solver *s = solver_near(3, one, DMI_QUAD_CELL, method, 1.0, 100, hs[hi], 0.05);
+            dmi_solver *s =
+                solver_near(3, core_z_one, DMI_QUAD_CELL, method, 1.0, 100, hs[hi], 0.05);
             CU_ASSERT_FATAL(s != NULL);
             const double h = dmi_get_h(s), mh = ceil(0.05 / h) * h;
             const double ref = 2 * (1 - exp(-mh)) + (exp(-mh) - exp(-1.0));
@@ -296,11 +283,12 @@ static void test_near_cells(void)
             dmi_free(&s);
         }
     /* a wave history over many steps (the recursion anchored and run): every method the same */
-    dmi_solver *ref = solver_near(3, wave, DMI_QUAD_CELL, DMI_CONV_DIRECT, 1.0, 300, 0, 0.02);
+    dmi_solver *ref =
+        solver_near(3, core_z_wave, DMI_QUAD_CELL, DMI_CONV_DIRECT, 1.0, 300, 0, 0.02);
     CU_ASSERT_FATAL(ref != NULL);
     const double u_ref = state_after(ref, 2000);
     for (int method = DMI_CONV_FFT; method <= DMI_CONV_RECURSIVE; method++) {
-        dmi_solver *s = solver_near(3, wave, DMI_QUAD_CELL, method, 1.0, 300, 0, 0.02);
+        dmi_solver *s = solver_near(3, core_z_wave, DMI_QUAD_CELL, method, 1.0, 300, 0, 0.02);
         CU_ASSERT_FATAL(s != NULL);
         CU_ASSERT(core_close_rel("near cells, method against DIRECT", state_after(s, 2000), u_ref,
                                  1e-12));
