@@ -22,14 +22,6 @@ int dmi_fail(const dmi_solver *cs, int code, const char *fmt, ...)
     return code;
 }
 
-size_t dmi_first_nonfinite(const double *x, size_t n)
-{
-    size_t i = 0;
-    while (i < n && isfinite(x[i]))
-        i++;
-    return i;
-}
-
 /* x * 0 is 0 for a finite x, NaN otherwise: a block of 8 with one is then
  * searched value by value. */
 size_t dmi_first_nonfinite_long(const double *x, size_t n)

@@ -7,6 +7,7 @@
 #ifndef DMI_ERRORS_H
 #define DMI_ERRORS_H
 
+#include <math.h>
 #include <stddef.h>
 
 #include "dmi.h"
@@ -15,8 +16,15 @@
  * message buffer is not part of the numerical state: s may be const. */
 int dmi_fail(const dmi_solver *s, int code, const char *fmt, ...);
 
-/* The index of the first non-finite x[i], or n. */
-size_t dmi_first_nonfinite(const double *x, size_t n);
+/* The index of the first non-finite x[i], or n.  (Inline: the step checks
+ * its n values twice, and a call costs more than the loop.) */
+static inline size_t dmi_first_nonfinite(const double *x, size_t n)
+{
+    size_t i = 0;
+    while (i < n && isfinite(x[i]))
+        i++;
+    return i;
+}
 
 /* The same for long arrays (blocks of 8 without a branch per value). */
 size_t dmi_first_nonfinite_long(const double *x, size_t n);
