@@ -141,8 +141,6 @@ class Solver:
         self._n, self._tau, self._N = n, tau, int(_L.dmi_get_N(handle))
         self._h_given = h  # (for repr)
         self._keep: dict[str, cb.Bound] = {}   # callbacks and data libdmi points to
-        self._jit_slots: set[str] = set()
-        self._python_slots: set[str] = set()   # slots holding a Python function's trampoline
         self._resolvent: tuple = ()             # the built-in resolvent and its data
         self._choices = {"convolution": "auto", "quadrature": "left"}
         self._near_delta = 0.0                  # delta of set_kernel_near (0: no near cells)
@@ -176,17 +174,21 @@ class Solver:
         self._raise_jit(rc)
         message = _L.dmi_last_error(self._handle).decode()
         if rc == _lib.ECALLBACK and "callback returned 2 " in message and \
-                self._jit_slots:
+                self._jit_slots():
             message += (" (a jit=True callback returns 2 when its result does not have libdmi's "
                         "shape: (n,), or (n, n) for the kernel)")
         raise from_code(rc, message)
 
+    def _jit_slots(self) -> list[str]:
+        """The slots a jit=True callback fills now, in order of name."""
+        return sorted(k for k, b in self._keep.items() if b.jit)
+
     def _raise_jit(self, rc: int) -> None:
         """Raises the exception of a jit=True callback whose compiled code failed (rc
         DMI_ECALLBACK): the Python function's own, called again where the compiled one failed."""
-        if rc == _lib.ECALLBACK and self._jit_slots:
+        if rc == _lib.ECALLBACK and (slots := self._jit_slots()):
             from . import _jit
-            exc = _jit.raised([self._keep[k] for k in self._jit_slots])
+            exc = _jit.raised([self._keep[k] for k in slots])
             if exc is not None:
                 raise exc
 
@@ -200,15 +202,6 @@ class Solver:
         with self._using() as s:
             self._check(setter(s, bound.address, bound.user))
         self._keep[slot] = bound  # only now: a refused call keeps the former callback alive
-        # a Python function is bound through a trampoline (bound.keep[0]); a C function is kept as given
-        if f is not None and not jit and bound.keep[0] is not f:
-            self._python_slots.add(slot)
-        else:
-            self._python_slots.discard(slot)
-        if jit and f is not None:   # (the slots a jit=True callback fills: their error hint)
-            self._jit_slots.add(slot)
-        else:
-            self._jit_slots.discard(slot)
 
     # ---- sizes ---------------------------------------------------------------------------------
 
@@ -459,9 +452,9 @@ class Solver:
             infinite sample) or ``dmi.ENOMEM``.  The solver is then unchanged.
         """
         with self._using() as s:
-            if self._jit_slots:   # (the values jit=True callbacks read: as they are now)
+            if slots := self._jit_slots():   # (the values jit=True callbacks read: as they are now)
                 from . import _jit
-                for slot in sorted(self._jit_slots):
+                for slot in slots:
                     _jit.refresh(self._keep[slot], "init")
             self._check(_L.dmi_init(s))
 
@@ -1242,7 +1235,7 @@ class Solver:
             raise InvalidArgument(_lib.EINVAL, f"c_callback: part {part!r} is not one of 'rhs', "
                                   "'resolvent', 'kernel', 'kernel_near', 'history'")
         bound = self._keep.get(part)
-        if bound is None or bound.address is None or part in self._python_slots:
+        if bound is None or bound.address is None or bound.python:
             return None
         return int(bound.address), int(bound.user or 0)
 
