@@ -1005,11 +1005,19 @@ class Solver:
     def _call_slot(self, slot: str, fn_type: Any, args: tuple, size: int,
                    what: Callable[[], str]) -> np.ndarray:
         """Calls the C-level function of ``slot`` (libdmi's signature) with args and an output of
-        ``size`` doubles: a Python callback's exception is raised as it is, with a note; ``what()``
-        names the call in that note (built only on failure: a repr of u costs more than a call)."""
+        ``size`` doubles, failing as :meth:`_call_failed` says."""
         out = np.zeros(size)
         bound = self._keep[slot]
         rc = fn_type(bound.address)(*args, out.ctypes.data, bound.user)
+        if rc != 0 or self._failure[0] is not None:
+            self._call_failed(rc, what)
+        return out
+
+    def _call_failed(self, rc: int, what: Callable[[], str]) -> None:
+        """Raises for a call of a callback outside libdmi that returned rc: a Python callback's
+        exception as it is, with a note; a jit=True callback's, its Python function's own; else
+        an Error (code ECALLBACK).  ``what()`` names the call (built only on failure: a repr of u
+        costs more than a call)."""
         failure, self._failure[0] = self._failure[0], None
         if failure is not None:
             failure.add_note(f"raised by the model's {what()}")
@@ -1017,7 +1025,6 @@ class Solver:
         self._raise_jit(_lib.ECALLBACK if rc != 0 else rc)
         if rc != 0:
             raise Error(_lib.ECALLBACK, f"the model's {what()} returned {rc}")
-        return out
 
     def eval_rhs(self, t: float, u: Any) -> np.ndarray:
         """f(t, u) of :meth:`set_rhs` (zero without one), through the same function the
@@ -1198,13 +1205,8 @@ class Solver:
         step = 8 * n
         for c in range(tt.size):
             rc = fn(float(tt[c]), x0 + c * step, o0 + c * step, bound.user)
-            failure, self._failure[0] = self._failure[0], None
-            if failure is not None:
-                failure.add_note(f"raised by the model's rhs at t = {tt[c]!r}, u = {X[c]!r}")
-                raise failure
-            if rc != 0:
-                raise Error(_lib.ECALLBACK, f"the model's rhs at t = {tt[c]!r}, u = {X[c]!r} "
-                            f"returned {rc}")
+            if rc != 0 or self._failure[0] is not None:
+                self._call_failed(rc, lambda: f"rhs at t = {float(tt[c])!r}, u = {X[c]!r}")
         return out
 
     def c_callback(self, part: str) -> tuple[int, int] | None:
