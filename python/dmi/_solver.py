@@ -20,6 +20,9 @@ from ._errors import Error, InvalidArgument, from_code
 
 _L = _lib.lib
 _DP = ctypes.POINTER(ctypes.c_double)
+# what a jit=True callback's return code 2 means (libdmi and eval_* name only the code)
+_JIT_SHAPE = (" (a jit=True callback returns 2 when its result does not have libdmi's shape: (n,), "
+              "or (n, n) for the kernel)")
 
 # A Python function, or a C function: numba cfunc, ctypes function pointer, scipy.LowLevelCallable.
 Callback = Any
@@ -175,8 +178,7 @@ class Solver:
         message = _L.dmi_last_error(self._handle).decode()
         if rc == _lib.ECALLBACK and "callback returned 2 " in message and \
                 self._jit_slots():
-            message += (" (a jit=True callback returns 2 when its result does not have libdmi's "
-                        "shape: (n,), or (n, n) for the kernel)")
+            message += _JIT_SHAPE
         raise from_code(rc, message)
 
     def _jit_slots(self) -> list[str]:
@@ -1010,21 +1012,22 @@ class Solver:
         bound = self._keep[slot]
         rc = fn_type(bound.address)(*args, out.ctypes.data, bound.user)
         if rc != 0 or self._failure[0] is not None:
-            self._call_failed(rc, what)
+            self._call_failed(rc, bound, what)
         return out
 
-    def _call_failed(self, rc: int, what: Callable[[], str]) -> None:
+    def _call_failed(self, rc: int, bound: cb.Bound, what: Callable[[], str]) -> None:
         """Raises for a call of a callback outside libdmi that returned rc: a Python callback's
         exception as it is, with a note; a jit=True callback's, its Python function's own; else
-        an Error (code ECALLBACK).  ``what()`` names the call (built only on failure: a repr of u
-        costs more than a call)."""
+        an Error (code ECALLBACK), which says what 2 means for the jit=True callback ``bound``.
+        ``what()`` names the call (built only on failure: a repr of u costs more than a call)."""
         failure, self._failure[0] = self._failure[0], None
         if failure is not None:
             failure.add_note(f"raised by the model's {what()}")
             raise failure
         self._raise_jit(_lib.ECALLBACK if rc != 0 else rc)
         if rc != 0:
-            raise Error(_lib.ECALLBACK, f"the model's {what()} returned {rc}")
+            raise Error(_lib.ECALLBACK, f"the model's {what()} returned {rc}"
+                        + (_JIT_SHAPE if rc == 2 and bound.jit else ""))
 
     def eval_rhs(self, t: float, u: Any) -> np.ndarray:
         """f(t, u) of :meth:`set_rhs` (zero without one), through the same function the
@@ -1206,7 +1209,7 @@ class Solver:
         for c in range(tt.size):
             rc = fn(float(tt[c]), x0 + c * step, o0 + c * step, bound.user)
             if rc != 0 or self._failure[0] is not None:
-                self._call_failed(rc, lambda: f"rhs at t = {float(tt[c])!r}, u = {X[c]!r}")
+                self._call_failed(rc, bound, lambda: f"rhs at t = {float(tt[c])!r}, u = {X[c]!r}")
         return out
 
     def c_callback(self, part: str) -> tuple[int, int] | None:

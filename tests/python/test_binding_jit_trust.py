@@ -4,7 +4,7 @@
 # from the edited file; globals and closure values are those at init(), also after set_rhs is
 # called again; a kernel returning a vector is told it must return an n x n array; eval_rhs_many
 # raises the function's exception; a built-in resolvent or kernel set after a jit=True one runs
-# alone.
+# alone; eval_rhs names a result of another shape as the step does.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -95,6 +95,16 @@ def test_eval_rhs_many_raises_the_exception():
         assert e.value.args == ("the state left the model's range",)
         assert "0.05" in " ".join(e.value.__notes__)
         assert np.array_equal(s.eval_rhs_many([0.0], [[2.0]]), [[2.0]])
+
+
+def test_result_of_another_shape_is_named_by_eval_rhs_as_by_the_step():
+    s = dmi.Solver(2, 1.0, 10)
+    s.set_rhs(lambda t, u: np.array([u[0], u[1], 0.0]), jit=True)   # 3 values for n = 2
+    s.init()
+    for call in (s.step, lambda: s.eval_rhs(0.0, [1.0, 2.0]),
+                 lambda: s.eval_rhs_many([0.0], [[1.0, 2.0]])):
+        with pytest.raises(dmi.Error, match=r"returned 2 .*does not have libdmi's shape"):
+            call()
 
 
 def test_builtin_part_after_a_jit_callback_runs_alone():
