@@ -11,7 +11,7 @@ import ctypes
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -42,10 +42,14 @@ HISTORY = Kind("history", "int (double, double *, void *)", _lib.HistoryFn, "dpp
 @dataclass
 class Bound:
     """What a setter hands to libdmi: the function's address and the user pointer (None: NULL),
-    and the objects that must stay alive as long as the solver uses them."""
+    the objects that must stay alive as long as the solver uses them, and whether the address is
+    a Python function's trampoline (``python``) or a jit=True callback's compiled code (``jit``,
+    True on _jit.JitBound)."""
     address: int | None
     user: int | None
     keep: tuple
+    python: bool = False
+    jit: ClassVar[bool] = False
 
 
 def _arg_kind(t: Any) -> str:
@@ -176,7 +180,7 @@ def _python_function(kind: Kind, f: Callable, n: int, failure: list) -> Bound:
                 return 1
 
     c = kind.proto(trampoline)
-    return Bound(ctypes.cast(c, ctypes.c_void_p).value, None, (c, f))
+    return Bound(ctypes.cast(c, ctypes.c_void_p).value, None, (c, f), python=True)
 
 
 def bind(kind: Kind, f: Any, user: Any, n: int, failure: list) -> Bound:

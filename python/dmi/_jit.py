@@ -533,6 +533,8 @@ def _compile(kind: Kind, f: types.FunctionType, names: list[str], values: list[A
 class JitBound(Bound):
     """A jit=True callback as handed to libdmi, with what raised() and refresh() need."""
 
+    jit = True
+
     def __init__(self, kind: Kind, f: types.FunctionType, n: int, keys: list[tuple], cfunc: Any,
                  data: np.ndarray, arrays: list):
         super().__init__(int(cfunc.address), int(data.ctypes.data), (cfunc, data, arrays, f))

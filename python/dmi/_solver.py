@@ -20,6 +20,9 @@ from ._errors import Error, InvalidArgument, from_code
 
 _L = _lib.lib
 _DP = ctypes.POINTER(ctypes.c_double)
+# what a jit=True callback's return code 2 means (libdmi and eval_* name only the code)
+_JIT_SHAPE = (" (a jit=True callback returns 2 when its result does not have libdmi's shape: (n,), "
+              "or (n, n) for the kernel)")
 
 # A Python function, or a C function: numba cfunc, ctypes function pointer, scipy.LowLevelCallable.
 Callback = Any
@@ -141,8 +144,6 @@ class Solver:
         self._n, self._tau, self._N = n, tau, int(_L.dmi_get_N(handle))
         self._h_given = h  # (for repr)
         self._keep: dict[str, cb.Bound] = {}   # callbacks and data libdmi points to
-        self._jit_slots: set[str] = set()
-        self._python_slots: set[str] = set()   # slots holding a Python function's trampoline
         self._resolvent: tuple = ()             # the built-in resolvent and its data
         self._choices = {"convolution": "auto", "quadrature": "left"}
         self._near_delta = 0.0                  # delta of set_kernel_near (0: no near cells)
@@ -176,17 +177,20 @@ class Solver:
         self._raise_jit(rc)
         message = _L.dmi_last_error(self._handle).decode()
         if rc == _lib.ECALLBACK and "callback returned 2 " in message and \
-                self._jit_slots:
-            message += (" (a jit=True callback returns 2 when its result does not have libdmi's "
-                        "shape: (n,), or (n, n) for the kernel)")
+                self._jit_slots():
+            message += _JIT_SHAPE
         raise from_code(rc, message)
+
+    def _jit_slots(self) -> list[str]:
+        """The slots a jit=True callback fills now, in order of name."""
+        return sorted(k for k, b in self._keep.items() if b.jit)
 
     def _raise_jit(self, rc: int) -> None:
         """Raises the exception of a jit=True callback whose compiled code failed (rc
         DMI_ECALLBACK): the Python function's own, called again where the compiled one failed."""
-        if rc == _lib.ECALLBACK and self._jit_slots:
+        if rc == _lib.ECALLBACK and (slots := self._jit_slots()):
             from . import _jit
-            exc = _jit.raised([self._keep[k] for k in self._jit_slots])
+            exc = _jit.raised([self._keep[k] for k in slots])
             if exc is not None:
                 raise exc
 
@@ -200,15 +204,6 @@ class Solver:
         with self._using() as s:
             self._check(setter(s, bound.address, bound.user))
         self._keep[slot] = bound  # only now: a refused call keeps the former callback alive
-        # a Python function is bound through a trampoline (bound.keep[0]); a C function is kept as given
-        if f is not None and not jit and bound.keep[0] is not f:
-            self._python_slots.add(slot)
-        else:
-            self._python_slots.discard(slot)
-        if jit and f is not None:   # (the slots a jit=True callback fills: their error hint)
-            self._jit_slots.add(slot)
-        else:
-            self._jit_slots.discard(slot)
 
     # ---- sizes ---------------------------------------------------------------------------------
 
@@ -459,9 +454,9 @@ class Solver:
             infinite sample) or ``dmi.ENOMEM``.  The solver is then unchanged.
         """
         with self._using() as s:
-            if self._jit_slots:   # (the values jit=True callbacks read: as they are now)
+            if slots := self._jit_slots():   # (the values jit=True callbacks read: as they are now)
                 from . import _jit
-                for slot in sorted(self._jit_slots):
+                for slot in slots:
                     _jit.refresh(self._keep[slot], "init")
             self._check(_L.dmi_init(s))
 
@@ -1012,19 +1007,27 @@ class Solver:
     def _call_slot(self, slot: str, fn_type: Any, args: tuple, size: int,
                    what: Callable[[], str]) -> np.ndarray:
         """Calls the C-level function of ``slot`` (libdmi's signature) with args and an output of
-        ``size`` doubles: a Python callback's exception is raised as it is, with a note; ``what()``
-        names the call in that note (built only on failure: a repr of u costs more than a call)."""
+        ``size`` doubles, failing as :meth:`_call_failed` says."""
         out = np.zeros(size)
         bound = self._keep[slot]
         rc = fn_type(bound.address)(*args, out.ctypes.data, bound.user)
+        if rc != 0 or self._failure[0] is not None:
+            self._call_failed(rc, bound, what)
+        return out
+
+    def _call_failed(self, rc: int, bound: cb.Bound, what: Callable[[], str]) -> None:
+        """Raises for a call of a callback outside libdmi that returned rc: a Python callback's
+        exception as it is, with a note; a jit=True callback's, its Python function's own; else
+        an Error (code ECALLBACK), which says what 2 means for the jit=True callback ``bound``.
+        ``what()`` names the call (built only on failure: a repr of u costs more than a call)."""
         failure, self._failure[0] = self._failure[0], None
         if failure is not None:
             failure.add_note(f"raised by the model's {what()}")
             raise failure
         self._raise_jit(_lib.ECALLBACK if rc != 0 else rc)
         if rc != 0:
-            raise Error(_lib.ECALLBACK, f"the model's {what()} returned {rc}")
-        return out
+            raise Error(_lib.ECALLBACK, f"the model's {what()} returned {rc}"
+                        + (_JIT_SHAPE if rc == 2 and bound.jit else ""))
 
     def eval_rhs(self, t: float, u: Any) -> np.ndarray:
         """f(t, u) of :meth:`set_rhs` (zero without one), through the same function the
@@ -1205,13 +1208,8 @@ class Solver:
         step = 8 * n
         for c in range(tt.size):
             rc = fn(float(tt[c]), x0 + c * step, o0 + c * step, bound.user)
-            failure, self._failure[0] = self._failure[0], None
-            if failure is not None:
-                failure.add_note(f"raised by the model's rhs at t = {tt[c]!r}, u = {X[c]!r}")
-                raise failure
-            if rc != 0:
-                raise Error(_lib.ECALLBACK, f"the model's rhs at t = {tt[c]!r}, u = {X[c]!r} "
-                            f"returned {rc}")
+            if rc != 0 or self._failure[0] is not None:
+                self._call_failed(rc, bound, lambda: f"rhs at t = {float(tt[c])!r}, u = {X[c]!r}")
         return out
 
     def c_callback(self, part: str) -> tuple[int, int] | None:
@@ -1242,7 +1240,7 @@ class Solver:
             raise InvalidArgument(_lib.EINVAL, f"c_callback: part {part!r} is not one of 'rhs', "
                                   "'resolvent', 'kernel', 'kernel_near', 'history'")
         bound = self._keep.get(part)
-        if bound is None or bound.address is None or part in self._python_slots:
+        if bound is None or bound.address is None or bound.python:
             return None
         return int(bound.address), int(bound.user or 0)
 

@@ -2,7 +2,9 @@
 # division by zero and an index out of range give the plain callback's exception or libdmi error
 # (the solver unchanged); a function writing into u changes only its copy; a function whose file was edited after import is refused, not compiled
 # from the edited file; globals and closure values are those at init(), also after set_rhs is
-# called again; a kernel returning a vector is told it must return an n x n array.
+# called again; a kernel returning a vector is told it must return an n x n array; eval_rhs_many
+# raises the function's exception; a built-in resolvent or kernel set after a jit=True one runs
+# alone; eval_rhs names a result of another shape as the step does.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -82,6 +84,45 @@ def test_index_out_of_range_is_an_index_error():
         with pytest.raises(IndexError):
             s.step()
         assert s.step_index == 0 and np.array_equal(s.state, [0.0, 0.0])
+
+
+def test_eval_rhs_many_raises_the_exception():
+    for jit in (False, True):             # the plain callback, then the compiled one: the same
+        s = dmi.Solver(1, 1.0, 100)
+        s.set_rhs(raising, jit=jit)
+        with pytest.raises(ValueError) as e:
+            s.eval_rhs_many([0.0, 0.05], [[1.0], [2.0]])   # raising at the second point
+        assert e.value.args == ("the state left the model's range",)
+        assert "0.05" in " ".join(e.value.__notes__)
+        assert np.array_equal(s.eval_rhs_many([0.0], [[2.0]]), [[2.0]])
+
+
+def test_result_of_another_shape_is_named_by_eval_rhs_as_by_the_step():
+    s = dmi.Solver(2, 1.0, 10)
+    s.set_rhs(lambda t, u: np.array([u[0], u[1], 0.0]), jit=True)   # 3 values for n = 2
+    s.init()
+    for call in (s.step, lambda: s.eval_rhs(0.0, [1.0, 2.0]),
+                 lambda: s.eval_rhs_many([0.0], [[1.0, 2.0]])):
+        with pytest.raises(dmi.Error, match=r"returned 2 .*does not have libdmi's shape"):
+            call()
+
+
+def test_builtin_part_after_a_jit_callback_runs_alone():
+    # a jit=True resolvent replaced by set_friction, a jit=True kernel by set_kernel_exp: init
+    # and the steps are those of a solver given only the built-in parts
+    runs = []
+    for replaced in (True, False):
+        s = dmi.Solver(1, 1.0, 10)
+        s.set_rhs(lambda t, u: np.array([1.0 - u[0]]))
+        if replaced:
+            s.set_resolvent(lambda lam, x: x / (1.0 + lam), jit=True)
+            s.set_kernel(lambda x: np.array([[np.exp(-x)]]), jit=True)
+        s.set_friction([0.3])
+        s.set_kernel_exp([-2.0], [0.0], [[[0.5]]])
+        s.init()
+        s.advance(30)
+        runs.append(s.get_window())
+    assert np.array_equal(runs[0], runs[1])
 
 
 def test_kernel_returning_a_vector_is_told_the_shape():
