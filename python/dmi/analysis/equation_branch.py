@@ -142,7 +142,7 @@ class EquationBranch(CollocationDiscretisation):
             lay, xs = got
             probe = CollocationDiscretisation(self.make, lay, xs,
                                               multipliers=self.count)
-            probe._terms = self._terms
+            probe.problem = self.problem
             ref = probe.ref
             try:
                 xs, _ = solve(lay, terms, xs, ref, tol=1e-12)
@@ -269,7 +269,7 @@ class EquationBranch(CollocationDiscretisation):
             # a point landed on (p_end, a user point) whose orbit needed a mend: the mended one
             disc = CollocationDiscretisation(self.make, m[2], m[4],
                                              multipliers=self.count)
-            disc._terms, disc.ref, x = self._terms, m[3], m[4]
+            disc.problem, disc.ref, x = self.problem, m[3], m[4]
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", CollocationWarning)
             pt = CollocationDiscretisation.point(disc, x, p)
