@@ -5,7 +5,8 @@
 # 40 intervals of degree 4, 0.69 s a branch point with its stability at 5e-9): collocate from a
 # scheme orbit (the shooting not counted) with 40 intervals (the orbit returned has 80: the error
 # estimate's finer level) and with tol = 1e-10; one continuation point (a = 0.5 -> 0.55: Newton,
-# the multipliers and the error estimate on the halved mesh, and without the estimate, as
+# the multipliers and the error estimate on the mesh of merged interval pairs, and without the
+# estimate, as
 # DDE-BIFTOOL's points come); and a stick-slip orbit of a belt
 # oscillator with a truncated exponential memory (autonomous, its stick segment read from the
 # scheme).  Errors against a reference collocation at 320 intervals.  Rounds interleave the cases;

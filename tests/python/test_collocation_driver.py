@@ -39,6 +39,16 @@ def test_hopf_orbit_of_equation_starts_the_circles():
                       amplitude=0.1, of="exact")
 
 
+
+def test_hopf_orbit_of_equation_with_a_singular_step_raises_shooting_error():
+    # a model that ignores p: its J_p is exactly 0 and the bordered Newton step singular, which
+    # hopf_orbit reports as the ShootingError its docstring names (not SuperLU's RuntimeError)
+    muH, om, _ = circle_hopf()
+    with pytest.raises(da.ShootingError, match="singular"):
+        da.hopf_orbit(lambda p, h=None: tc.rotating(muH + 0.01, h),
+                      da.HopfPoint(p=muH, omega=om, root=1j * om), [0.0, 0.0], amplitude=0.1,
+                      of="equation")
+
 def test_circle_branch_from_the_hopf_point_lands_on_p_end():
     muH, om, T = circle_hopf()
     e = da.hopf_orbit(tc.rotating, da.HopfPoint(p=muH, omega=om, root=1j * om), [0.0, 0.0],

@@ -127,7 +127,9 @@ class Event:
         branch of equilibria ``"fold"`` or ``"hopf"``.
     p : float
         Where: the linear interpolation of the test function's zero (located further on a
-        branch of equilibria).
+        branch of equilibria); on a collocated branch (of ``EquationOrbit`` points) a
+        ``stick-onset`` or ``grazing`` at the middle of the two points' p, not located (the
+        bracket is in ``detail``).
     index : int
         The branch point after the event.
     component : int or None

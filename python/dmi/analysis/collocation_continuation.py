@@ -29,7 +29,6 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sl
 import scipy.sparse as sp
-import scipy.sparse.linalg as sla
 
 from .collocation import (CollocationWarning, Solved, _errors, _reference, adapted,
                           check_inequalities, equation_orbit, merged, transfer)
@@ -37,8 +36,10 @@ from .collocation_mend import mend
 from .collocation_mesh import periodic_locator, point_matrix
 from .collocation_signature import SLIP_NEG, SLIP_POS, Signature
 from .collocation_system import Layout, Terms, assemble, full_jacobian, node_times, solve
+from .driver import bordered_solve
 from .equation_orbit import EquationOrbit
 from .newton import ShootingError
+from .problem import Problem
 from .branch import HopfPoint
 from .stepmap import Model, build
 
@@ -66,7 +67,7 @@ class CollocationDiscretisation:
                  estimate: bool = True):
         self.make, self.lay = make, layout
         self.count, self.estimate = int(multipliers), bool(estimate)
-        self._terms: dict[float, Terms] = {}
+        self.problem = Problem(make, keep=5)   # the terms of the last few p
         self.ref = _reference(layout, x) if layout.autonomous else None
 
     @classmethod
@@ -113,13 +114,7 @@ class CollocationDiscretisation:
             f, its derivative, the kernel, A's coefficients of ``make(p)``.
         """
         key = float(p)
-        t = self._terms.get(key)
-        if t is None:
-            t = Terms(build(self.make, key))
-            if len(self._terms) > 4:
-                self._terms.pop(next(iter(self._terms)))
-            self._terms[key] = t
-        return t
+        return self.problem.cached(("terms", key), lambda: Terms(build(self.make, key)))
 
     def residual(self, x: np.ndarray, p: float) -> np.ndarray:
         """The collocation system's residual.
@@ -355,10 +350,7 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
         r = disc.residual(x, p)
         J, Jp = disc.jacobian(x, p)
         g, grow = _amplitude_condition(lay, x, ue, c, a, gz, gw)
-        A = sp.bmat([[J, sp.csr_matrix(Jp[:, None])],
-                     [sp.csr_matrix(grow[None, :-1]), sp.csr_matrix(grow[None, -1:])]],
-                    format="csc")
-        dz = sla.splu(A).solve(-np.concatenate([r, [g]]))
+        dz = bordered_solve(J, Jp, grow, -np.concatenate([r, [g]]))
         z = z + dz
         if np.max(np.abs(dz)) <= tol * max(1.0, float(np.max(np.abs(z)))):
             pt = disc.point(z[:-1], z[-1])

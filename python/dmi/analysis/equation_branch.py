@@ -31,8 +31,6 @@ import warnings
 from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as sla
 
 from .branch import Branch, Event
 from .collocation import CollocationWarning, check_inequalities
@@ -40,7 +38,7 @@ from .collocation_continuation import CollocationDiscretisation, equation_hopf_o
 from .collocation_mend import mend
 from .collocation_signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK
 from .collocation_system import solve
-from .driver import Curve, continuation, newton_corrector
+from .driver import Curve, bordered_solve, continuation, newton_corrector
 from .equation_orbit import EquationOrbit
 from .newton import ShootingError
 
@@ -144,7 +142,7 @@ class EquationBranch(CollocationDiscretisation):
             lay, xs = got
             probe = CollocationDiscretisation(self.make, lay, xs,
                                               multipliers=self.count)
-            probe._terms = self._terms
+            probe.problem = self.problem
             ref = probe.ref
             try:
                 xs, _ = solve(lay, terms, xs, ref, tol=1e-12)
@@ -194,12 +192,9 @@ class EquationBranch(CollocationDiscretisation):
         for _ in range(40):
             r = probe.residual(z[:-1], float(z[-1]))
             J, Jp = probe.jacobian(z[:-1], float(z[-1]))
-            A = sp.bmat([[J, sp.csr_matrix(Jp[:, None])],
-                         [sp.csr_matrix(row[None, :-1]), sp.csr_matrix(row[None, -1:])]],
-                        format="csc")
             try:
-                dz = sla.splu(A).solve(-np.concatenate([r, [float(row @ z) - target]]))
-            except RuntimeError as e:   # SuperLU: singular
+                dz = bordered_solve(J, Jp, row, -np.concatenate([r, [float(row @ z) - target]]))
+            except ShootingError as e:   # SuperLU: singular
                 raise ShootingError(f"the orbit breaks its signature ({why}); with p free on "
                                     f"{lay.signature.describe()}: {e}", []) from e
             if np.max(np.abs(dz)) <= 1e-12 * max(1.0, float(np.max(np.abs(z)))):
@@ -274,7 +269,7 @@ class EquationBranch(CollocationDiscretisation):
             # a point landed on (p_end, a user point) whose orbit needed a mend: the mended one
             disc = CollocationDiscretisation(self.make, m[2], m[4],
                                              multipliers=self.count)
-            disc._terms, disc.ref, x = self._terms, m[3], m[4]
+            disc.problem, disc.ref, x = self.problem, m[3], m[4]
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", CollocationWarning)
             pt = CollocationDiscretisation.point(disc, x, p)

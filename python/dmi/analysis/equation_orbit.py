@@ -44,8 +44,9 @@ class EquationOrbit:
     errors : dict
         Estimated errors (same units): ``"period"``, ``"amplitude"`` (n,), ``"multipliers"``
         (as ``multipliers``), ``"u"`` (the largest over the period), from the difference to the
-        solve on the mesh with every interval halved (an upper estimate: the returned orbit is
-        the finer one).
+        solve on the mesh with every interval halved (a continuation point: with every pair of
+        intervals merged), an upper estimate: the returned orbit is the finer one; empty where
+        that solve failed.
     degree : int
         m, the polynomials' degree.
     nodes : numpy.ndarray
