@@ -282,3 +282,32 @@ def test_profile_equals_wald_for_a_linear_parameter_and_differs_for_a_rate():
         assert abs(cost - est.cost - 1.920729) < 1e-3
     with pytest.raises(ValueError, match="fixed"):
         profile_likelihood(est, "z0")
+
+
+def test_profile_end_through_a_refit_that_did_not_converge_is_not_reported(monkeypatch):
+    """A refit stopped before converging overstates the profile's cost: an end found through it is
+    reported as infinite, with a warning, not as a number."""
+    import scipy.optimize
+
+    def make(p):
+        z0, k = p
+        s = dmi.Solver(1, 1.0, h=0.05)
+        s.set_rhs(lambda t, u: k * u)
+        s.set_history(lambda t: np.array([z0]))
+        return s
+    t, y = data(make, [1.0, -0.8], 3.0, comps=(0,))
+    noisy = y[:, 0] + 0.05 * np.random.default_rng(5).standard_normal(len(t))
+    est = estimate(make, [1.1, -0.7], Record(t, noisy, sigma=0.05), names=["z0", "k"])
+    assert est.success, est.message
+    assert np.all(np.isfinite(profile_likelihood(est, "z0").interval))
+    real = scipy.optimize.least_squares
+
+    def stopped_early(*args, **kwargs):     # the refit's result, marked as stopped by max_nfev
+        res = real(*args, **kwargs)
+        res.status, res.success = 0, False
+        return res
+    monkeypatch.setattr(scipy.optimize, "least_squares", stopped_early)
+    with pytest.warns(RuntimeWarning, match="did not converge"):
+        prof = profile_likelihood(est, "z0")
+    assert prof.interval == (-math.inf, math.inf) and not prof.quadratic
+    assert "not verified" in prof.message
