@@ -228,7 +228,7 @@ def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarra
         else:
             code = MEMORY_DIRECT
             dWU = memory.kernel_part()
-            flat = np.ascontiguousarray(memory.G[::-1].transpose(1, 0, 2).reshape(n, N * n))
+            flat = memory.flat()
     kcode = RESOLVENT_NONE
     slipping, dR, meets = none2, none3, np.zeros(0, np.bool_)
     alpha, dalpha = np.zeros(0), none2

@@ -261,12 +261,16 @@ class _Memory:
                 self._recompute(Sall, p)
             out = np.einsum("kij,kjq->iq", self.E, self.Z).real
             return out + self.last @ Sall[p + 1]
-        # sum_l G_l S^{p-l} = sum_m G_{N-1-m} S^{p-N+1+m}: one matrix product on the stored rows
+        rows = Sall[p + 1:p + N + 1]
+        return self.flat() @ rows.reshape(N * rows.shape[1], rows.shape[2])
+
+    def flat(self) -> np.ndarray:
+        """The weights as one (n, N n) matrix [G_{N-1} ... G_0], so that sum_l G_l S^{p-l} =
+        sum_m G_{N-1-m} S^{p-N+1+m} is one matrix product on the stored rows S^{p-N+1}, ..., S^p."""
         if self._flat is None:
             n = self.G.shape[1]
-            self._flat = np.ascontiguousarray(self.G[::-1].transpose(1, 0, 2).reshape(n, N * n))
-        rows = Sall[p + 1:p + N + 1]
-        return self._flat @ rows.reshape(N * rows.shape[1], rows.shape[2])
+            self._flat = np.ascontiguousarray(self.G[::-1].transpose(1, 0, 2).reshape(n, self.N * n))
+        return self._flat
 
     def push(self, Sall: np.ndarray, p: int) -> None:
         """Advances Z from step p to p + 1 once S^{p+1} is in Sall."""
