@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -311,3 +312,24 @@ def test_profile_end_through_a_refit_that_did_not_converge_is_not_reported(monke
         prof = profile_likelihood(est, "z0")
     assert prof.interval == (-math.inf, math.inf) and not prof.quadratic
     assert "not verified" in prof.message
+
+
+def test_a_wald_interval_of_a_fit_that_did_not_converge_warns():
+    def make(p):
+        z0, k = p
+        s = dmi.Solver(1, 1.0, h=0.05)
+        s.set_rhs(lambda t, u: k * u)
+        s.set_history(lambda t: np.array([z0]))
+        return s
+    t, y = data(make, [1.0, -0.8], 3.0, comps=(0,))
+    noisy = y[:, 0] + 0.05 * np.random.default_rng(5).standard_normal(len(t))
+    done = estimate(make, [1.1, -0.7], Record(t, noisy, sigma=0.05), names=["z0", "k"])
+    assert done.success, done.message
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert np.all(np.isfinite(done.wald_interval("k")))
+    stopped = estimate(make, [1.5, -0.3], Record(t, noisy, sigma=0.05), names=["z0", "k"],
+                       callback=lambda info: True)
+    assert not stopped.success
+    with pytest.warns(RuntimeWarning, match="did not converge"):
+        stopped.wald_interval("k")
