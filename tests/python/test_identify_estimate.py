@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -254,13 +255,17 @@ def test_multistart_finds_the_lower_minimum():
     assert abs(many.p[0] - 3.0) < 1e-8 and len(many.starts) == 3
 
 
+def decay(p):
+    """u' = k u, u = z0 on t <= 0; p = (z0, k)."""
+    z0, k = p
+    s = dmi.Solver(1, 1.0, h=0.05)
+    s.set_rhs(lambda t, u: k * u)
+    s.set_history(lambda t: np.array([z0]))
+    return s
+
+
 def test_profile_equals_wald_for_a_linear_parameter_and_differs_for_a_rate():
-    def make(p):
-        z0, k = p
-        s = dmi.Solver(1, 1.0, h=0.05)
-        s.set_rhs(lambda t, u: k * u)
-        s.set_history(lambda t: np.array([z0]))
-        return s
+    make = decay
     t, y = data(make, [1.0, 0.8], 3.0, comps=(0,))
     rng = np.random.default_rng(11)
     noisy = y[:, 0] + 0.15 * rng.standard_normal(len(t))
@@ -282,3 +287,44 @@ def test_profile_equals_wald_for_a_linear_parameter_and_differs_for_a_rate():
         assert abs(cost - est.cost - 1.920729) < 1e-3
     with pytest.raises(ValueError, match="fixed"):
         profile_likelihood(est, "z0")
+
+
+
+def noisy_decay():
+    """A record of decay at (1, -0.8) over t in [0, 3] with noise 0.05 (sigma given)."""
+    t, y = data(decay, [1.0, -0.8], 3.0, comps=(0,))
+    return Record(t, y[:, 0] + 0.05 * np.random.default_rng(5).standard_normal(len(t)), sigma=0.05)
+
+
+def test_profile_end_through_a_refit_that_did_not_converge_is_not_reported(monkeypatch):
+    """A refit stopped before converging overstates the profile's cost: an end found through it is
+    reported as infinite, with a warning, not as a number."""
+    import scipy.optimize
+
+    est = estimate(decay, [1.1, -0.7], noisy_decay(), names=["z0", "k"])
+    assert est.success, est.message
+    assert np.all(np.isfinite(profile_likelihood(est, "z0").interval))
+    real = scipy.optimize.least_squares
+
+    def stopped_early(*args, **kwargs):     # the refit's result, marked as stopped by max_nfev
+        res = real(*args, **kwargs)
+        res.status, res.success = 0, False
+        return res
+    monkeypatch.setattr(scipy.optimize, "least_squares", stopped_early)
+    with pytest.warns(RuntimeWarning, match="did not converge"):
+        prof = profile_likelihood(est, "z0")
+    assert prof.interval == (-math.inf, math.inf) and not prof.quadratic
+    assert "not verified" in prof.message
+
+
+def test_a_wald_interval_of_a_fit_that_did_not_converge_warns():
+    record = noisy_decay()
+    done = estimate(decay, [1.1, -0.7], record, names=["z0", "k"])
+    assert done.success, done.message
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert np.all(np.isfinite(done.wald_interval("k")))
+    stopped = estimate(decay, [1.5, -0.3], record, names=["z0", "k"], callback=lambda info: True)
+    assert not stopped.success
+    with pytest.warns(RuntimeWarning, match="did not converge"):
+        stopped.wald_interval("k")

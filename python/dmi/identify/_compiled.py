@@ -18,11 +18,14 @@ from llvmlite import ir
 from numba import types as nt
 from numba.extending import intrinsic
 
+from ._saltation import REVERSAL, STICK
+from ._saltation import reversal as _reversal_python
+
 # codes of the memory and of the resolvent (arguments of the loop)
 MEMORY_NONE, MEMORY_RECURSIVE, MEMORY_DIRECT = 0, 1, 2
 RESOLVENT_NONE, RESOLVENT_FRICTION, RESOLVENT_BOX = 0, 1, 2
-#: codes of the switches the loop records
-STICK, REVERSAL = 0, 1
+#: the test of a friction component at a step, the Python loop's function compiled
+reversal = numba.njit(cache=True)(_reversal_python)
 
 
 @intrinsic
@@ -148,29 +151,16 @@ def loop(steps, N, h, t, U, X, phi, Sall, dX, delta, has_f, addrs, users,
             if jumps and meets[q]:
                 # the reversals of the step: S_i multiplied by the saltation factor F+ / F-
                 for i in range(n):
-                    if U[q, i] == 0.0 or not alpha[i] > 0.0:
-                        continue
-                    sm = math.copysign(1.0, U[q, i])
-                    nxt = U[q + 1, i]
-                    if nxt * sm > 0.0:
-                        continue
-                    if nxt == 0.0 and not (q + 2 <= steps and U[q + 2, i] * sm < 0.0):
+                    what, rho = reversal(q, i, U, phi, alpha)
+                    if what == STICK:
                         sw_q[count], sw_i[count], sw_kind[count] = q, i, STICK
                         count += 1
-                        continue
-                    frac = U[q, i] / (U[q, i] - nxt)
-                    if q + 1 >= steps:
-                        ph = phi[q, i]
-                    else:
-                        ph = (1.0 - frac) * phi[q, i] + frac * phi[q + 1, i]
-                    before = sm * ph + alpha[i]
-                    after = sm * ph - alpha[i]
-                    if before <= 0.0 or after <= 0.0:
-                        continue
-                    for j in range(P):
-                        Snew[i, j] = (after / before) * (T[i, j] - h * sm * dalpha[i, j])
-                    sw_q[count], sw_i[count], sw_kind[count] = q, i, REVERSAL
-                    count += 1
+                    elif what == REVERSAL:
+                        sm = math.copysign(1.0, U[q, i])
+                        for j in range(P):
+                            Snew[i, j] = rho * (T[i, j] - h * sm * dalpha[i, j])
+                        sw_q[count], sw_i[count], sw_kind[count] = q, i, REVERSAL
+                        count += 1
         elif kind == RESOLVENT_BOX:
             for i in range(n):
                 for j in range(P):
@@ -238,7 +228,7 @@ def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarra
         else:
             code = MEMORY_DIRECT
             dWU = memory.kernel_part()
-            flat = np.ascontiguousarray(memory.G[::-1].transpose(1, 0, 2).reshape(n, N * n))
+            flat = memory.flat()
     kcode = RESOLVENT_NONE
     slipping, dR, meets = none2, none3, np.zeros(0, np.bool_)
     alpha, dalpha = np.zeros(0), none2

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -65,7 +66,8 @@ class Estimate:
         Which were fitted.
     cov : numpy.ndarray, shape (P, P)
         Covariance of the fitted parameters (zero rows for fixed ones; inf on the diagonal of a
-        parameter in an undetermined combination).
+        parameter in an undetermined combination); with ``success`` False, that of the linearised
+        problem at the returned point, which is not a verified minimum.
     stderr : numpy.ndarray, shape (P,)
         Standard errors, sqrt of cov's diagonal (0 for a fixed parameter, inf for an undetermined
         one).
@@ -132,7 +134,8 @@ class Estimate:
         -------
         tuple of float
             (low, high): p +- q stderr, q the normal quantile with sigma known, else Student's
-            with dof degrees of freedom.
+            with dof degrees of freedom; with a RuntimeWarning where the fit did not converge
+            (``success`` False).
 
         Raises
         ------
@@ -142,6 +145,10 @@ class Estimate:
         i = _index(index, self.names)
         if not 0.0 < level < 1.0:
             raise ValueError(f"level = {level!r}: expected a number in (0, 1)")
+        if not self.success:
+            warnings.warn(f"the fit did not converge ({self.message}): this Wald interval is taken at "
+                          "a point that is not a verified least-squares minimum", RuntimeWarning,
+                          stacklevel=2)
         q = _quantile(level, self.dof, self.sigma_known)
         return self.p[i] - q * self.stderr[i], self.p[i] + q * self.stderr[i]
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 
 import numpy as np
 from scipy import optimize, stats
@@ -32,7 +33,8 @@ class Profile:
         cost * F(level; 1, dof) / dof.
     interval : tuple of float
         The likelihood-ratio interval (low, high); an end the profile did not reach within
-        ``max_steps`` or within the fit's bounds is -inf or inf.
+        ``max_steps`` or within the fit's bounds, or reached only through a refit that did not
+        converge (a RuntimeWarning then says so), is -inf or inf.
     wald : tuple of float
         The covariance (Wald) interval.
     level : float
@@ -104,6 +106,7 @@ def profile_likelihood(estimate: Estimate, index: int | str, *, level: float = 0
     free = base.free.copy()
     free[i] = False
     cache: dict[float, tuple[float, np.ndarray]] = {}
+    unconverged: set[float] = set()      # the values whose refit stopped before converging
 
     def prof(v: float, start: np.ndarray) -> tuple[float, np.ndarray]:
         if v in cache:
@@ -116,6 +119,8 @@ def profile_likelihood(estimate: Estimate, index: int | str, *, level: float = 0
             res = optimize.least_squares(sub.residuals, q[free], jac=sub.jacobian, method="trf",
                                          x_scale="jac", bounds=(lo[free], hi[free]))
             out = (float(res.cost), sub.full(res.x))
+            if res.status <= 0:
+                unconverged.add(v)
         else:
             r = sub.residuals(np.empty(0))
             out = (0.5 * float(r @ r), q)
@@ -124,6 +129,7 @@ def profile_likelihood(estimate: Estimate, index: int | str, *, level: float = 0
 
     cache[float(p_hat[i])] = (c_hat, p_hat)
     ends = []
+    unverified = []                      # the ends found through a refit that did not converge
     for sign in (-1.0, 1.0):
         prev_v, prev = float(p_hat[i]), (c_hat, p_hat)
         end = sign * math.inf
@@ -136,7 +142,12 @@ def profile_likelihood(estimate: Estimate, index: int | str, *, level: float = 0
                 def excess(x: float, _start: np.ndarray = prev[1]) -> float:
                     return prof(float(x), _start)[0] - c_hat - thr
                 a, b = sorted((prev_v, v))
+                before = set(unconverged)
                 end = optimize.brentq(excess, a, b, xtol=1e-3 * step)
+                # a refit stopped early overstates the cost: the crossing is then not verified
+                if v in unconverged or unconverged - before:
+                    unverified.append(end)
+                    end = sign * math.inf
                 break
             prev_v, prev = v, cur
         ends.append(end)
@@ -145,7 +156,11 @@ def profile_likelihood(estimate: Estimate, index: int | str, *, level: float = 0
     half = 0.5 * (wald[1] - wald[0])
     quadratic = bool(np.isfinite(half) and all(np.isfinite(ends))
                      and abs(ends[0] - wald[0]) <= 0.1 * half and abs(ends[1] - wald[1]) <= 0.1 * half)
-    if quadratic:
+    if unverified:
+        message = (f"a refit of the other parameters did not converge near {unverified}: the "
+                   "profile's crossing there is not verified and that end is reported as infinite")
+        warnings.warn(message, RuntimeWarning, stacklevel=2)
+    elif quadratic:
         message = "the likelihood-ratio and Wald intervals agree: the cost is close to quadratic"
     elif not all(np.isfinite(ends)):
         message = (f"the profile stays below the threshold within {max_steps} steps on one side: "

@@ -25,6 +25,7 @@ import numpy as np
 from scipy import fft as sp_fft
 
 from .._solver import Solver
+from ._saltation import REVERSAL, STICK, reversal
 
 #: Relative step of the directional differences (about the square root of the unit roundoff).
 REL_STEP = 2.0 ** -26
@@ -260,12 +261,16 @@ class _Memory:
                 self._recompute(Sall, p)
             out = np.einsum("kij,kjq->iq", self.E, self.Z).real
             return out + self.last @ Sall[p + 1]
-        # sum_l G_l S^{p-l} = sum_m G_{N-1-m} S^{p-N+1+m}: one matrix product on the stored rows
+        rows = Sall[p + 1:p + N + 1]
+        return self.flat() @ rows.reshape(N * rows.shape[1], rows.shape[2])
+
+    def flat(self) -> np.ndarray:
+        """The weights as one (n, N n) matrix [G_{N-1} ... G_0], so that sum_l G_l S^{p-l} =
+        sum_m G_{N-1-m} S^{p-N+1+m} is one matrix product on the stored rows S^{p-N+1}, ..., S^p."""
         if self._flat is None:
             n = self.G.shape[1]
-            self._flat = np.ascontiguousarray(self.G[::-1].transpose(1, 0, 2).reshape(n, N * n))
-        rows = Sall[p + 1:p + N + 1]
-        return self._flat @ rows.reshape(N * rows.shape[1], rows.shape[2])
+            self._flat = np.ascontiguousarray(self.G[::-1].transpose(1, 0, 2).reshape(n, self.N * n))
+        return self._flat
 
     def push(self, Sall: np.ndarray, p: int) -> None:
         """Advances Z from step p to p + 1 once S^{p+1} is in Sall."""
@@ -441,29 +446,17 @@ def _bound_diff(b2: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def _reversals(q: int, U: np.ndarray, phi: np.ndarray, alpha: np.ndarray, dalpha: np.ndarray,
                T: np.ndarray, Snew: np.ndarray, h: float, switches: list) -> None:
-    """At step q, for each friction component that slips at U^q and reverses during the step (to
-    the other sign at once, or through one step in the dead zone), S_i^{q+1} = rho (T_i - h s
-    dalpha_i), rho = F+ / F- the ratio of the velocities just after and before the reversal
-    (the saltation of the equation); a component that lands in the dead zone and stays is
-    recorded as a stick."""
-    steps = len(U) - 1
-    for i in np.flatnonzero((U[q] != 0.0) & (alpha > 0.0)):
-        sm = math.copysign(1.0, U[q, i])
-        nxt = U[q + 1, i]
-        if nxt * sm > 0.0:
-            continue
-        if nxt == 0.0 and not (q + 2 <= steps and U[q + 2, i] * sm < 0.0):
-            switches.append((q, int(i), "stick"))
-            continue
-        # where the reversal falls: linear interpolation of u_i across the step
-        frac = U[q, i] / (U[q, i] - nxt)
-        ph = phi[q, i] if q + 1 >= len(phi) else (1.0 - frac) * phi[q, i] + frac * phi[q + 1, i]
-        before = sm * ph + alpha[i]        # -s F-: the speed towards 0 before the reversal
-        after = sm * ph - alpha[i]         # s F+: the speed away from 0 after it
-        if before <= 0.0 or after <= 0.0:
-            continue
-        Snew[i] = (after / before) * (T[i] - h * sm * dalpha[i])
-        switches.append((q, int(i), "reversal"))
+    """At step q, for each friction component that reverses during the step (see
+    :func:`_saltation.reversal`), S_i^{q+1} = rho (T_i - h s dalpha_i), rho = F+ / F- the
+    saltation factor and s the sign of U_i^q; a component that lands in the dead zone and stays
+    is recorded as a stick."""
+    for i in range(U.shape[1]):
+        what, rho = reversal(q, i, U, phi, alpha)
+        if what == STICK:
+            switches.append((q, i, "stick"))
+        elif what == REVERSAL:
+            Snew[i] = rho * (T[i] - h * math.copysign(1.0, U[q, i]) * dalpha[i])
+            switches.append((q, i, "reversal"))
 
 
 def _complex_directions(rhs: Callable, t: float, u: np.ndarray, p: np.ndarray,
