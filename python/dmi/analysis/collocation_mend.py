@@ -84,20 +84,32 @@ def breached(lay: Layout, terms: Terms, x: np.ndarray, segs: list, T: float) -> 
             else:
                 continue
             if np.any(bad):
-                k = np.flatnonzero(bad)
+                k0, k1 = _run(bad)
                 inner = mode.copy()
                 inner[i] = new
+                if lay.S == 0 and k0 == 0 and bad[-1] and not np.all(bad):
+                    # a smooth orbit breached across t = 0 (= T): the run at the end of the
+                    # period and the run at its start are one stretch
+                    first = t.size - 1 - _run(bad[::-1])[1]   # the trailing run's first index
+                    return [(inner, float(t[first])), (mode, float(t[k1]))]
                 # the breach from the piece's start (a switch that should have been another):
                 # the new mode takes the piece's start over, no sliver of the old mode before it
-                at_start = k[0] == 0 and j > 0
+                at_start = k0 == 0 and j > 0
                 out = [sg for sg in segs
                        if not (at_start and abs((sg[1] - e[j] + 0.5 * T) % T - 0.5 * T)
                                <= 1e-12 * T)]
-                out.append((inner, float(e[j] if at_start else t[k[0]])))
-                if k[-1] < t.size - 1:
-                    out.append((mode, float(t[k[-1]])))
+                out.append((inner, float(e[j] if at_start else t[k0])))
+                if k1 < t.size - 1:
+                    out.append((mode, float(t[k1])))
                 return sorted(out, key=lambda s: s[1] % T)
     return None
+
+
+def _run(bad: np.ndarray) -> tuple[int, int]:
+    """(first, last) index of the first run of True in ``bad`` (which holds one)."""
+    k0 = int(np.argmax(bad))
+    rest = np.flatnonzero(~bad[k0:])
+    return k0, (k0 + int(rest[0]) - 1 if rest.size else bad.size - 1)
 
 
 def memory(lay: Layout, terms: Terms, x: np.ndarray, t: np.ndarray) -> np.ndarray:
