@@ -35,7 +35,7 @@ import numpy as np
 from .branch import Branch, Event
 from .collocation import CollocationWarning, check_inequalities
 from .collocation_continuation import CollocationDiscretisation, equation_hopf_orbit
-from .collocation_mend import mend
+from .collocation_mend import circle, mend, relaid, removed
 from .collocation_signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK
 from .collocation_system import solve
 from .driver import Curve, bordered_solve, continuation, newton_corrector
@@ -44,6 +44,10 @@ from .newton import ShootingError
 
 #: Mends (split or removal, then a correction at fixed p) tried on one point at most.
 MENDS = 4
+#: A held segment shorter than this fraction of the period is removed where a step fails.
+SHED = 0.02
+#: The amplitude held past such a removal: (1 - SHRINK^k) of the last point's, k = 1, 2, 3.
+SHRINK = 1e-3
 
 
 def _stuck_like(orbit: EquationOrbit) -> np.ndarray:
@@ -73,6 +77,7 @@ class EquationBranch(CollocationDiscretisation):
         self.tol, self.max_iter = float(tol), int(max_iter)
         self._mended: tuple | None = None   # (x, p, layout, ref, x on it) of the last mend
         self._old_nodes: np.ndarray | None = None   # the node values of the last point
+        self._last: tuple | None = None   # (x, p, layout) of the last point
 
     def _breaks(self, x: np.ndarray, p: float) -> list[str]:
         return check_inequalities(self.lay, self.terms(p), x,
@@ -110,9 +115,19 @@ class EquationBranch(CollocationDiscretisation):
             Newton fails, or the orbit breaks its signature and no mend holds.
         """
         curve = Curve(self, x.size)
-        z, its = newton_corrector(curve, np.concatenate([x, [p]]), row, target, tol=self.tol,
-                                  max_iter=self.max_iter, far=far,
-                                  what=f"collocation near p = {p!r}")
+        try:
+            z, its = newton_corrector(curve, np.concatenate([x, [p]]), row, target, tol=self.tol,
+                                      max_iter=self.max_iter, far=far,
+                                      what=f"collocation near p = {p!r}")
+        except (ShootingError, ValueError) as e:   # ValueError: Degenerate, a piece gone
+            if not math.isfinite(far):
+                raise
+            got = self._shed(str(e))
+            if got is None:
+                raise
+            xm, pm, lay, ref = got
+            self.lay, self.ref = lay, ref
+            return xm, pm, 0
         xz, pz = z[:-1], float(z[-1])
         bad = self._breaks(xz, pz)
         if bad and math.isfinite(far):   # a step: the mended orbit is the step's point
@@ -160,6 +175,48 @@ class EquationBranch(CollocationDiscretisation):
         raise ShootingError(f"p = {p!r}: the orbit breaks its signature ({bad[0]}) and "
                             f"{MENDS} mends did not restore it", [])
 
+    def _shed(self, why: str) -> tuple[np.ndarray, float, Any, Any] | None:
+        """The branch past a corner where a held segment vanishes (a stick-slip branch back to
+        grazing): the last point's shortest segment, when held (stuck, on a face) and shorter
+        than SHED of the period, is removed, and the orbit on the remaining signature is solved
+        with p free and its deviation from its mean held at (1 - SHRINK^k) of the last point's,
+        k = 1, 2, 3 (the orbit on the other side, just inside: at the corner of a vertical
+        branch p is fixed there and the amplitude is the only way on); its inequalities held.
+        (x, p, layout, ref), or None when the last point has no such segment or no solve
+        holds."""
+        last = self._last
+        if last is None or last[2] is not self.lay or self.lay.S < 2:
+            return None
+        x0, p0, lay = last[0], last[1], last[2]
+        segs, T = circle(lay, x0)
+        lengths = [(segs[(j + 1) % len(segs)][1] - sg[1]) % T for j, sg in enumerate(segs)]
+        j = int(np.argmin(lengths))
+        held = np.isin(segs[j][0], (STUCK, LO, HI))
+        if lengths[j] >= SHED * T or not np.any(held & ~np.isin(segs[j - 1][0], (STUCK, LO, HI))):
+            return None
+        terms = self.terms(p0)
+        try:
+            new, xs = relaid(lay, terms, x0, removed(segs, j, T), T)
+        except ValueError:
+            return None
+        probe = CollocationDiscretisation(self.make, new, xs, multipliers=self.count)
+        probe.problem = self.problem
+        dev = self._deviation(xs)
+        dev[:-1] /= max(float(np.linalg.norm(dev[:-1])), 1e-300)
+        base = float(dev[:-1] @ xs)
+        for k in (1, 2, 3):
+            target = base - SHRINK ** k * float(np.linalg.norm(self._deviation(xs)[:-1]))
+            try:
+                xm, pm = self._bordered(probe, xs, p0, dev, target,
+                                        f"{why}; the held segment {lay.signature.describe()[j]}"
+                                        " removed")
+            except ShootingError:
+                continue
+            if not check_inequalities(new, self.terms(pm), xm,
+                                      1e-9 * max(1.0, float(np.max(np.abs(xm))))):
+                return xm, pm, new, probe.ref
+        return None
+
     def _grow(self, probe: CollocationDiscretisation, x: np.ndarray, p: float, why: str
               ) -> tuple[np.ndarray, float]:
         """Newton (sparse LU) on the mended layout with p free and the shortest segment's
@@ -179,7 +236,13 @@ class EquationBranch(CollocationDiscretisation):
             row[k], row[k + S - 1] = 1.0, -1.0
             if lay.autonomous:
                 row[x.size - 1] = 1.0
-        target = float(lengths[j])
+        return self._bordered(probe, x, p, row, float(lengths[j]), why)
+
+    def _bordered(self, probe: CollocationDiscretisation, x: np.ndarray, p: float,
+                  row: np.ndarray, target: float, why: str) -> tuple[np.ndarray, float]:
+        """Damped Newton (sparse LU) on probe's system bordered by row . (x, p) = target, p
+        free, from (x, p).  ShootingError when it fails."""
+        lay = probe.lay
 
         def size(z: np.ndarray) -> float:   # the bordered residual's, inf out of order
             try:
@@ -263,6 +326,7 @@ class EquationBranch(CollocationDiscretisation):
             The orbit breaks its signature (the step's correction should have refused it).
         """
         self._old_nodes = x[:self.lay.rows * self.lay.n].copy()
+        self._last = (x.copy(), float(p), self.lay)
         disc: CollocationDiscretisation = self
         m = self._mended
         if m is not None and m[1] == p and m[0].size == x.size and np.all(m[0] == x):
