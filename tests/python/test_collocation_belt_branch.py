@@ -186,8 +186,8 @@ def corner(points: list[da.EquationOrbit], before, after) -> int:
 
 def check_slip(q: da.EquationOrbit, om: float, pH: float) -> None:
     """A pure-slip point: the linear orbit at p_H, period 2 pi / omega, y = x' - V so y's
-    amplitude is omega times x's, below grazing."""
-    assert abs(q.p - pH) < 1e-9
+    amplitude is omega times x's, below grazing; not isolated at fixed p, so no verdict."""
+    assert abs(q.p - pH) < 1e-9 and q.stable is None
     assert abs(q.period - 2 * math.pi / om) < 1e-9
     assert abs(q.amplitude[1] - om * q.amplitude[0]) < 1e-9
     assert q.amplitude[1] < V
