@@ -120,9 +120,10 @@ class EquationBranch(CollocationDiscretisation):
                                       max_iter=self.max_iter, far=far,
                                       what=f"collocation near p = {p!r}")
         except (ShootingError, ValueError) as e:   # ValueError: Degenerate, a piece gone
-            if not math.isfinite(far):
-                raise
-            got = self._shed(str(e))
+            # a step: p free past the removal; a landing (on the hyperplane p = target): at it
+            landing = row[-1] == 1.0 and not np.any(row[:-1])
+            got = (self._shed(str(e), None) if math.isfinite(far) else
+                   self._shed(str(e), float(target)) if landing else None)
             if got is None:
                 raise
             xm, pm, lay, ref = got
@@ -175,46 +176,59 @@ class EquationBranch(CollocationDiscretisation):
         raise ShootingError(f"p = {p!r}: the orbit breaks its signature ({bad[0]}) and "
                             f"{MENDS} mends did not restore it", [])
 
-    def _shed(self, why: str) -> tuple[np.ndarray, float, Any, Any] | None:
-        """The branch past a corner where a held segment vanishes (a stick-slip branch back to
-        grazing): the last point's shortest segment, when held (stuck, on a face) and shorter
-        than SHED of the period, is removed, and the orbit on the remaining signature is solved
-        with p free and its deviation from its mean held at (1 - SHRINK^k) of the last point's,
-        k = 1, 2, 3 (the orbit on the other side, just inside: at the corner of a vertical
-        branch p is fixed there and the amplitude is the only way on); its inequalities held.
-        (x, p, layout, ref), or None when the last point has no such segment or no solve
+    def _shed(self, why: str, at: float | None) -> tuple[np.ndarray, float, Any, Any] | None:
+        """The branch past a corner where held segments vanish (a stick-slip branch back to
+        grazing, or a landing on p_end before the stick onset the step went past): every held
+        (stuck, on a face) segment of the last point shorter than SHED of the period is
+        removed, and the orbit on the remaining signature is solved at p = ``at``, or, ``at``
+        None, with p free and its deviation from its mean held at (1 - SHRINK^k) of the last
+        point's, k = 1, 2, 3 (the orbit on the other side, just inside: at the corner of a
+        vertical branch p is fixed and the amplitude is the only way on); its inequalities
+        held.  (x, p, layout, ref), or None when the last point has no such segment or no solve
         holds."""
         last = self._last
-        if last is None or last[2] is not self.lay or self.lay.S < 2:
+        if last is None or last[2] is not self.lay:
             return None
-        x0, p0, lay = last[0], last[1], last[2]
-        segs, T = circle(lay, x0)
-        lengths = [(segs[(j + 1) % len(segs)][1] - sg[1]) % T for j, sg in enumerate(segs)]
-        j = int(np.argmin(lengths))
-        held = np.isin(segs[j][0], (STUCK, LO, HI))
-        if lengths[j] >= SHED * T or not np.any(held & ~np.isin(segs[j - 1][0], (STUCK, LO, HI))):
-            return None
-        terms = self.terms(p0)
-        try:
-            new, xs = relaid(lay, terms, x0, removed(segs, j, T), T)
-        except ValueError:
-            return None
-        probe = CollocationDiscretisation(self.make, new, xs, multipliers=self.count)
-        probe.problem = self.problem
-        dev = self._deviation(xs)
-        dev[:-1] /= max(float(np.linalg.norm(dev[:-1])), 1e-300)
-        base = float(dev[:-1] @ xs)
-        for k in (1, 2, 3):
-            target = base - SHRINK ** k * float(np.linalg.norm(self._deviation(xs)[:-1]))
+        x0, p0, lay = last
+        shed = False
+        while lay.S >= 2:
+            segs, T = circle(lay, x0)
+            lengths = [(segs[(j + 1) % len(segs)][1] - sg[1]) % T for j, sg in enumerate(segs)]
+            short = [j for j, sg in enumerate(segs) if lengths[j] < SHED * T
+                     and np.any(np.isin(sg[0], (STUCK, LO, HI)))]
+            if not short:
+                break
             try:
-                xm, pm = self._bordered(probe, xs, p0, dev, target,
-                                        f"{why}; the held segment {lay.signature.describe()[j]}"
-                                        " removed")
-            except ShootingError:
-                continue
-            if not check_inequalities(new, self.terms(pm), xm,
+                lay, x0 = relaid(lay, self.terms(p0), x0, removed(segs, short[0], T), T)
+            except ValueError:
+                return None
+            shed = True
+        if not shed:
+            return None
+        probe = CollocationDiscretisation(self.make, lay, x0, multipliers=self.count)
+        probe.problem = self.problem
+        what = f"{why}; the held segments shorter than {SHED} of the period removed"
+        if at is not None:
+            try:
+                xm, _ = solve(lay, self.terms(at), x0, probe.ref, tol=1e-12)
+            except (ShootingError, ValueError):
+                return None
+            tries = [(xm, at)]
+        else:
+            dev = self._deviation(x0)
+            size = float(np.linalg.norm(dev[:-1]))
+            dev[:-1] /= max(size, 1e-300)
+            tries = []
+            for k in (1, 2, 3):
+                try:
+                    tries.append(self._bordered(probe, x0, p0, dev,
+                                                float(dev[:-1] @ x0) - SHRINK ** k * size, what))
+                except ShootingError:
+                    continue
+        for xm, pm in tries:
+            if not check_inequalities(lay, self.terms(pm), xm,
                                       1e-9 * max(1.0, float(np.max(np.abs(xm))))):
-                return xm, pm, new, probe.ref
+                return xm, pm, lay, probe.ref
         return None
 
     def _grow(self, probe: CollocationDiscretisation, x: np.ndarray, p: float, why: str
