@@ -31,14 +31,15 @@ import warnings
 from typing import Any
 
 import numpy as np
+import scipy.optimize as so
 
 from .branch import Branch, Event
 from .collocation import CollocationWarning, check_inequalities
 from .collocation_continuation import CollocationDiscretisation, equation_hopf_orbit
-from .collocation_mend import circle, mend, relaid, removed
+from .collocation_mend import circle, memory, mend, relaid, removed
 from .collocation_signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK
-from .collocation_system import solve
-from .driver import Curve, bordered_solve, continuation, newton_corrector
+from .collocation_system import evaluate, solve
+from .driver import Curve, bordered_solve, continuation, newton_corrector, tangent
 from .equation_orbit import EquationOrbit
 from .newton import ShootingError
 
@@ -78,6 +79,7 @@ class EquationBranch(CollocationDiscretisation):
         self._mended: tuple | None = None   # (x, p, layout, ref, x on it) of the last mend
         self._old_nodes: np.ndarray | None = None   # the node values of the last point
         self._last: tuple | None = None   # (x, p, layout) of the last point
+        self._prev: tuple | None = None   # the same of the point before it
 
     def _breaks(self, x: np.ndarray, p: float) -> list[str]:
         return check_inequalities(self.lay, self.terms(p), x,
@@ -340,7 +342,7 @@ class EquationBranch(CollocationDiscretisation):
             The orbit breaks its signature (the step's correction should have refused it).
         """
         self._old_nodes = x[:self.lay.rows * self.lay.n].copy()
-        self._last = (x.copy(), float(p), self.lay)
+        self._prev, self._last = self._last, (x.copy(), float(p), self.lay)
         disc: CollocationDiscretisation = self
         m = self._mended
         if m is not None and m[1] == p and m[0].size == x.size and np.all(m[0] == x):
@@ -448,8 +450,11 @@ class EquationBranch(CollocationDiscretisation):
     def between(self, za: np.ndarray, a: EquationOrbit, zb: np.ndarray, b: EquationOrbit,
                 middle: Any) -> list[Event]:
         """The signature's change between two points: ``stick-onset`` when a component's held
-        segments (stuck, on a face) appear or go, else ``grazing``; placed at the middle of the
-        two points' p (the mend happens at the first point past it).
+        segments (stuck, on a face) appear or go, else ``grazing``; located (:meth:`_locate`)
+        on the side whose signature holds on past the change, where the margin of the
+        inequality that breaks there reaches 0, by Brent's method along that side's branch;
+        reported at that p only when bracketed and converged (the detail gives the bound),
+        else at the middle of the two points' p with the detail saying why it is not located.
 
         Parameters
         ----------
@@ -458,7 +463,8 @@ class EquationBranch(CollocationDiscretisation):
         a, b : EquationOrbit
             The points.
         middle : callable
-            The driver's bisection along the branch (not used).
+            The driver's bisection along the branch (not used: the two points may lie on
+            different unknowns).
 
         Returns
         -------
@@ -472,8 +478,79 @@ class EquationBranch(CollocationDiscretisation):
         changed = np.flatnonzero(ha != hb)
         kind = "stick-onset" if changed.size else "grazing"
         comp = int(changed[0]) if changed.size else None
-        return [Event(kind, 0.5 * (a.p + b.p), 0, comp,
-                      f"signature {sa} -> {sb} between p = {a.p!r} and {b.p!r}")]
+        span = f"signature {sa} -> {sb} between p = {a.p!r} and {b.p!r}"
+        try:
+            p, bound = self._locate(za, a, zb, b)
+        except (ShootingError, ValueError) as e:
+            return [Event(kind, 0.5 * (a.p + b.p), 0, comp,
+                          f"{span}; not located (placed at the middle): {e}")]
+        return [Event(kind, p, 0, comp, f"{span}; located at p = {p!r} to {bound:.1g} (Brent "
+                      "on the margin of the breaking inequality along the branch)")]
+
+    def _locate(self, za: np.ndarray, a: EquationOrbit, zb: np.ndarray, b: EquationOrbit
+                ) -> tuple[float, float]:
+        """(p, bound): where the margin (:func:`_margin`) of the side that holds on (the point
+        whose layout is kept: a's, the last but one, or b's, the last) reaches 0 along that
+        side's branch (its tangent oriented towards the other point), by Brent's method on the
+        hyperplanes across the tangent; the bound is the p span of a bracket 4 xtol wide
+        around the root, its margins of opposite signs.  ValueError or ShootingError (why)
+        when the margin is not bracketed within 8 times the points' distance or Brent fails."""
+        sides = []
+        for z, q, other, kept in ((za, a, b, self._prev), (zb, b, a, self._last)):
+            if kept is not None and kept[0].size == z.size - 1 and np.array_equal(kept[0],
+                                                                                z[:-1]):
+                sides.append((z, q, other, kept[2]))
+        for z, q, other, lay in sides:
+            probe = CollocationDiscretisation(self.make, lay, z[:-1], multipliers=self.count)
+            probe.problem = self.problem
+            g0 = _margin(probe, z[:-1], float(z[-1]), other.signature)
+            if g0 is None or not g0 > 0:
+                continue
+            curve = Curve(probe, z.size - 1)
+            gap = float(np.max(np.abs(other.amplitude - q.amplitude)))
+            prev = self._deviation(z[:-1]).copy() if lay is self.lay else probe_deviation(
+                lay, z[:-1])
+            prev *= math.copysign(gap, float(np.sum(other.amplitude - q.amplitude))) / max(
+                curve.norm(prev), 1e-300)
+            prev[-1] = other.p - q.p
+            t = tangent(curve, z, prev)[0]
+            row = curve.w(z.size - 1) * t
+            base = float(row @ z)
+            cache: dict[float, np.ndarray] = {}
+
+            def at(s: float) -> np.ndarray:
+                if s not in cache:
+                    cache[s] = newton_corrector(curve, z + s * t, row, base + s, tol=self.tol,
+                                                max_iter=2 * self.max_iter, far=math.inf,
+                                                what="the event's location")[0]
+                return cache[s]
+
+            def g(s: float) -> float:
+                zs = at(s)
+                m = _margin(probe, zs[:-1], float(zs[-1]), other.signature)
+                if m is None:
+                    raise ValueError("the margin is not defined along the branch")
+                return m
+            L = abs(other.p - q.p) + gap
+            lo, hi = 0.0, None
+            for s in (0.5 * L, L, 2 * L, 4 * L, 8 * L):
+                if g(s) <= 0:
+                    hi = s
+                    break
+                lo = s
+            if hi is None:
+                raise ValueError(f"the margin {g0:.3g} of p = {q.p!r} does not reach 0 within "
+                                 f"{8 * L:.3g} along its branch")
+            xtol = 1e-13 * max(1.0, hi)
+            root, info = so.brentq(g, lo, hi, xtol=xtol, full_output=True, disp=False)
+            if not info.converged:
+                raise ValueError(f"Brent's method did not converge ({info.flag})")
+            s0, s1 = max(lo, root - 2 * xtol), min(hi, root + 2 * xtol)
+            if g(s0) * g(s1) > 0:
+                raise ValueError("the margin's sign does not change around Brent's root")
+            p0, p1 = float(at(s0)[-1]), float(at(s1)[-1])
+            return float(at(root)[-1]), max(abs(p1 - p0), 1e-16 * max(1.0, abs(p0)))
+        raise ValueError("neither side's orbit has a margin that breaks at this change")
 
     def corner(self, points: list[EquationOrbit]) -> str:
         """Where a branch that failed at the smallest step ended: its last signature, a
@@ -527,6 +604,67 @@ def _grazing(disc: CollocationDiscretisation, orbit: EquationOrbit
             if best is None or least < best[1]:
                 best = (int(i), least, float(orbit.amplitude[i]))
     return best
+
+
+def probe_deviation(lay: Any, x: np.ndarray) -> np.ndarray:
+    """(len(x) + 1,): the node values of x on ``lay`` less their mean; 0 elsewhere."""
+    k = lay.rows * lay.n
+    V = x[:k].reshape(-1, lay.n)
+    out = np.zeros(x.size + 1)
+    out[:k] = (V - V.mean(axis=0)).ravel()
+    return out
+
+
+def _margin(disc: CollocationDiscretisation, x: np.ndarray, p: float, other: Any
+            ) -> float | None:
+    """The least margin, at (x, p) on disc's layout, of the inequalities of the components
+    whose modes differ in the signature ``other``: a component slipping throughout one way,
+    its least |u_i| (0 at grazing); at a reversal of a slip (u_i through 0 without a stick),
+    |net force_i| - alpha_i there (0 at the stick's onset); on a stuck piece that leaves into
+    slip s, alpha_i + min s F_i (0 where the force reaches the other bound).  Extrema located
+    on the polynomial (a grid of 64 points an interval, then bounded Brent).  None when no
+    such component has one of these."""
+    lay = disc.lay
+    terms = disc.terms(p)
+    _, b, T = lay.split(x)
+    mine = np.asarray(lay.signature.modes)
+    theirs = np.asarray(other.modes)
+    comps = [i for i in range(lay.n) if set(mine[:, i]) != set(theirs[:, i])]
+    out: list[float] = []
+
+    def least(fn: Any, t0: float, t1: float) -> float:
+        grid = np.linspace(t0, t1, 64 * lay.L + 1)
+        v = fn(grid)
+        k = int(np.argmin(v))
+        lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+        r = so.minimize_scalar(lambda s: float(fn(np.array([s]))[0]), bounds=(lo, hi),
+                               method="bounded", options={"xatol": 1e-13 * max(1.0, T)})
+        return min(float(v[k]), float(r.fun))
+
+    def force(t: np.ndarray, i: int) -> np.ndarray:
+        u = evaluate(lay, x, t)
+        return -terms.f(t, u)[:, i] - memory(lay, terms, x, t)[:, i]
+
+    for i in comps:
+        if terms.alpha[i] <= 0:
+            continue
+        col = mine[:, i]
+        if lay.S == 0 or np.all(col == col[0]):
+            if col[0] in (SLIP_POS, SLIP_NEG):
+                out.append(least(lambda t, i=i, c=int(col[0]): c * evaluate(lay, x, t)[:, i],
+                                 0.0, T))
+            continue
+        for k in range(1, lay.S + 1):
+            j, before, after = lay.signature.switch(k)
+            if j != i:
+                continue
+            if {before, after} == {SLIP_POS, SLIP_NEG}:
+                out.append(float(abs(force(np.array([b[k - 1]]), i)[0])) - terms.alpha[i])
+            elif before == STUCK and after in (SLIP_POS, SLIP_NEG):
+                start = b[k - 2] if k >= 2 else b[-1] - T
+                out.append(terms.alpha[i] + least(lambda t, i=i, s=after: s * force(t, i),
+                                                  float(start), float(b[k - 1])))
+    return min(out) if out else None
 
 
 def continue_equation_orbit(orbit: EquationOrbit, p_end: float, step: float, *,
