@@ -29,6 +29,8 @@ import scipy.optimize as so
 
 import dmi
 from dmi import analysis as da
+import test_collocation as tc
+from orbit_models import DenHartog
 
 V, ALPHA, GB, TAUB = 0.5, 0.4, 0.3, 2.0
 P_UP = 0.05          # the forward branch's end, in stick-slip
@@ -72,14 +74,21 @@ class BeltRun:
     def run(self, z0: list[float], mode: int, periods: int, T: float
             ) -> tuple[float, float, float]:
         """(period, x's amplitude, y's amplitude) of the last whole period (from a stick's
-        end to the next) once two periods agree to 1e-12; AssertionError otherwise."""
+        end to the next) once two periods agree to 1e-12; AssertionError otherwise.
+        ``self.modes``: the modes entered in that period; ``self.stuck_max``: the stuck
+        force's largest value there (at a stick's entry or an interior maximum; None if no
+        stick)."""
         e = math.exp(-TAUB)
         t, z = 0.0, np.array(z0, dtype=float)
         breaks: set[float] = set()                          # the switches' + tau, + 2 tau
         ends: list[float] = []                              # stuck -> slip switches
+        switches: list[tuple[float, int]] = []               # (time, mode entered)
         xs: list[tuple[float, float]] = []
         ys: list[tuple[float, float]] = []
-        while len(ends) < periods + 1 and t < 3 * periods * T:
+        fs: list[tuple[float, float]] = []                   # the stuck force's extrema
+        for _ in range(100 * periods):                       # pieces at most
+            if len(ends) >= periods + 1 or t >= 3 * periods * T:
+                break
             stop = min([b for b in breaks if b > t + 1e-13]
                        + [(math.floor(t / TAUB + 1e-12) + 1) * TAUB])   # pieces <= tau
 
@@ -94,9 +103,12 @@ class BeltRun:
 
                 def up(s, w):
                     return self.force(w) - ALPHA
+
+                def fext(s, w):                              # F' = -V - g I' while stuck
+                    return -V - GB * (w[0] - w[2] - e * self.x(s - TAUB))
                 down.terminal, down.direction = True, -1
                 up.terminal, up.direction = True, 1
-                events = [down, up]
+                events = [down, up, fext]
             else:
                 def zero(s, w):
                     return w[1]
@@ -116,6 +128,8 @@ class BeltRun:
             if mode != 0:
                 xs += [(s, w[0]) for s, w in zip(sol.t_events[1], sol.y_events[1])]
                 ys += [(s, w[1]) for s, w in zip(sol.t_events[2], sol.y_events[2])]
+            else:
+                fs += [(s, self.force(w)) for s, w in zip(sol.t_events[2], sol.y_events[2])]
             if sol.status == 1:
                 if mode == 0:
                     k = 0 if len(sol.t_events[0]) else 1
@@ -127,6 +141,9 @@ class BeltRun:
                     t, z = float(sol.t_events[0][0]), np.array(sol.y_events[0][0])
                     z[1] = 0.0
                     mode = 0 if abs(self.force(z)) <= ALPHA else -mode
+                    if mode == 0:                            # the stuck force at its entry
+                        fs.append((t, self.force(z)))
+                switches.append((t, mode))
                 breaks |= {t + TAUB, t + 2 * TAUB}
             else:
                 t, z = float(sol.t[-1]), sol.y[:, -1].copy()
@@ -136,21 +153,28 @@ class BeltRun:
         gap = abs((ends[-1] - ends[-2]) - (ends[-2] - ends[-3]))
         assert gap < 1e-12, f"the run's periods still differ by {gap:.3g}"
         a, b = ends[-2], ends[-1]
+        self.modes = {m for s, m in switches if a <= s < b}
+        self.stuck_max = max((v for s, v in fs if a <= s < b), default=None)
         xv = [v for s, v in xs if a <= s < b]
         yv = [v for s, v in ys if a <= s < b] + [0.0]       # y = 0 while stuck
         return b - a, 0.5 * (max(xv) - min(xv)), 0.5 * (max(yv) - min(yv))
 
 
-def reference(q: da.EquationOrbit) -> tuple[float, float, float]:
-    """The event-driven run's (period, amplitudes) from q's orbit shifted by 1e-3 in x."""
+def reference(q: da.EquationOrbit, p: float | None = None) -> tuple[float, float, float]:
+    """The event-driven run's (period, amplitudes) at p (default q's) from q's orbit shifted
+    by 1e-3 in x."""
+    return _run(q, q.p if p is None else p)[0]
+
+
+def _run(q: da.EquationOrbit, p: float) -> tuple[tuple[float, float, float], BeltRun]:
     T = q.period
 
     def hist(t: float) -> float:
         return float(q.u_at(np.array([t % T]))[0, 0]) + 1e-3
     I0 = si.quad(lambda s: math.exp(-s) * hist(-s), 0.0, TAUB, epsabs=1e-14, limit=200)[0]
     y0 = float(q.u_at(np.array([0.0]))[0, 1])
-    run = BeltRun(q.p, hist)
-    return run.run([hist(0.0), min(y0, 0.0), I0], -1 if y0 < 0 else 0, 40, T)
+    run = BeltRun(p, hist)
+    return run.run([hist(0.0), min(y0, 0.0), I0], -1 if y0 < 0 else 0, 40, T), run
 
 
 def is_slip(q: da.EquationOrbit) -> bool:
@@ -256,3 +280,67 @@ def test_stick_slip_point_agrees_with_the_scheme_at_order_h(branches):
                                                                        - q.amplitude)))))
     assert gaps[0] > gaps[1] > gaps[2]
     assert 1.6 < gaps[0] / gaps[1] < 2.5 and 1.6 < gaps[1] / gaps[2] < 2.5, gaps
+
+
+def located(ev: da.Event) -> bool:
+    return "; located at p = " in ev.detail
+
+
+def test_stick_onset_and_grazing_located_on_the_belt_branch(branches):
+    # the stick onset of the way up: at grazing, on the vertical branch, so at p_H
+    up, _ = branches
+    om, pH, _ = hopf()
+    (ev,) = up.events
+    assert ev.kind == "stick-onset" and located(ev) and abs(ev.p - pH) < 1e-9, ev
+    # further up, the stuck force reaches +alpha and a slip + segment appears (grazing): its p
+    # bracketed to 1e-6 by the event-driven run (no slip + just below, slip + just above)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        more = da.continue_orbit(up.points[-1], 0.12, step=0.02, min_step=1e-3,
+                                 max_step=MAX_STEP, multipliers=2, max_points=12)
+    assert more.status == "reached p_end = 0.12", more.status
+    (ev,) = [e for e in more.events if e.kind == "grazing"]
+    assert located(ev), ev
+    q = min(more.points, key=lambda q: abs(q.p - ev.p))
+    # the run's margin alpha - max F on the stuck stretch (its entry's here) at p* - k d (k = 1,
+    # 2, 3; no slip + there), extrapolated to 0 by the parabola through them
+    d = 1e-4
+    runs = [_run(q, ev.p - k * d)[1] for k in (1, 2, 3)]
+    assert all(1 not in r.modes and r.stuck_max is not None for r in runs)
+    c = np.polyfit([-d, -2 * d, -3 * d], [ALPHA - r.stuck_max for r in runs], 2)
+    roots = np.roots(c)
+    dp = roots[np.argmin(np.abs(roots))].real
+    assert abs(dp) < 1e-6, dp
+
+
+def den_hartog_stick_margin(p: float) -> float:
+    """|F p cos(w t_s) - a| - F0 at the reversal t_s of Den Hartog's closed form at the forcing
+    F p; -1 where the closed form does not hold (it sticks, or x' changes sign in a half)."""
+    try:
+        d = DenHartog(F=p)
+    except RuntimeError:
+        return -1.0
+    return abs(d.F * math.cos(d.w * (d.t0 + d.T / 2)) - d.a) - d.F0
+
+
+def test_den_hartog_branch_lands_before_its_stick_onset_and_locates_it():
+    d = DenHartog()
+    e = da.collocate(tc.forced_orbit(d, 2000, 20), intervals=24, multipliers=2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        b = da.continue_orbit(e, 0.42, step=0.05, multipliers=2, max_points=40)
+        assert b.status == "reached p_end = 0.42", b.status
+        q = b.points[-1]
+        assert abs(q.p - 0.42) < 1e-12 and q.signature.switches == 2
+        assert not [ev for ev in b.events if ev.kind == "stick-onset"]
+        ref = DenHartog(F=0.42)                        # the closed form: no stick at 0.42
+        assert abs(q.amplitude[0] - ref.a) < 1e-9
+        c = da.continue_orbit(q, 0.40, step=0.01, multipliers=2, max_points=10)
+    assert c.status == "reached p_end = 0.4", c.status
+    onset = so.brentq(den_hartog_stick_margin, 0.412, 0.42, xtol=1e-14)
+    assert 0 < den_hartog_stick_margin(onset + 1e-9) < 1e-6   # the margin itself reaches 0
+    # the sticks at both reversals (one mend each): the symmetric orbit's both at the onset
+    evs = [ev for ev in c.events if ev.kind == "stick-onset"]
+    assert len(evs) == 2
+    for ev in evs:
+        assert located(ev) and abs(ev.p - onset) < 1e-8, (ev, onset)

@@ -52,9 +52,9 @@ SHRINK = 1e-3
 
 
 def _stuck_like(orbit: EquationOrbit) -> np.ndarray:
-    """Shape (n,): which components are held (stuck, or on a face) on some segment."""
+    """Shape (n,): how many segments hold each component (stuck, or on a face)."""
     modes = np.asarray(orbit.signature.modes)
-    return np.any((modes == STUCK) | (modes == LO) | (modes == HI), axis=0)
+    return np.count_nonzero((modes == STUCK) | (modes == LO) | (modes == HI), axis=0)
 
 
 class EquationBranch(CollocationDiscretisation):
@@ -217,7 +217,7 @@ class EquationBranch(CollocationDiscretisation):
                 return None
             tries = [(xm, at)]
         else:
-            dev = self._deviation(x0)
+            dev = _spread(lay, x0)
             size = float(np.linalg.norm(dev[:-1]))
             dev[:-1] /= max(size, 1e-300)
             tries = []
@@ -440,17 +440,12 @@ class EquationBranch(CollocationDiscretisation):
     def _deviation(self, x: np.ndarray, k: int | None = None) -> np.ndarray:
         """(len(x) + 1,): the first k values of x (default the layout's node values), as
         (k / n, n) node values, less their mean; 0 elsewhere."""
-        n = self.lay.n
-        k = self.lay.rows * n if k is None else k
-        V = x[:k].reshape(-1, n)
-        out = np.zeros(x.size + 1)
-        out[:k] = (V - V.mean(axis=0)).ravel()
-        return out
+        return _spread(self.lay, x, k)
 
     def between(self, za: np.ndarray, a: EquationOrbit, zb: np.ndarray, b: EquationOrbit,
                 middle: Any) -> list[Event]:
-        """The signature's change between two points: ``stick-onset`` when a component's held
-        segments (stuck, on a face) appear or go, else ``grazing``; located (:meth:`_locate`)
+        """The signature's change between two points: ``stick-onset`` when the number of a
+        component's held segments (stuck, on a face) changes, else ``grazing``; located (:meth:`_locate`)
         on the side whose signature holds on past the change, where the margin of the
         inequality that breaks there reaches 0, by Brent's method along that side's branch;
         reported at that p only when bracketed and converged (the detail gives the bound),
@@ -508,8 +503,7 @@ class EquationBranch(CollocationDiscretisation):
                 continue
             curve = Curve(probe, z.size - 1)
             gap = float(np.max(np.abs(other.amplitude - q.amplitude)))
-            prev = self._deviation(z[:-1]).copy() if lay is self.lay else probe_deviation(
-                lay, z[:-1])
+            prev = _spread(lay, z[:-1])
             prev *= math.copysign(gap, float(np.sum(other.amplitude - q.amplitude))) / max(
                 curve.norm(prev), 1e-300)
             prev[-1] = other.p - q.p
@@ -606,9 +600,10 @@ def _grazing(disc: CollocationDiscretisation, orbit: EquationOrbit
     return best
 
 
-def probe_deviation(lay: Any, x: np.ndarray) -> np.ndarray:
-    """(len(x) + 1,): the node values of x on ``lay`` less their mean; 0 elsewhere."""
-    k = lay.rows * lay.n
+def _spread(lay: Any, x: np.ndarray, k: int | None = None) -> np.ndarray:
+    """(len(x) + 1,): the first k values of x (default the node values of ``lay``), as
+    (k / n, n) node values, less their mean; 0 elsewhere."""
+    k = lay.rows * lay.n if k is None else k
     V = x[:k].reshape(-1, lay.n)
     out = np.zeros(x.size + 1)
     out[:k] = (V - V.mean(axis=0)).ravel()
@@ -629,7 +624,7 @@ def _margin(disc: CollocationDiscretisation, x: np.ndarray, p: float, other: Any
     _, b, T = lay.split(x)
     mine = np.asarray(lay.signature.modes)
     theirs = np.asarray(other.modes)
-    comps = [i for i in range(lay.n) if set(mine[:, i]) != set(theirs[:, i])]
+    comps = [i for i in range(lay.n) if sorted(mine[:, i]) != sorted(theirs[:, i])]
     out: list[float] = []
 
     def least(fn: Any, t0: float, t1: float) -> float:
@@ -641,7 +636,8 @@ def _margin(disc: CollocationDiscretisation, x: np.ndarray, p: float, other: Any
                                method="bounded", options={"xatol": 1e-13 * max(1.0, T)})
         return min(float(v[k]), float(r.fun))
 
-    def force(t: np.ndarray, i: int) -> np.ndarray:
+    def force(t: np.ndarray, i: int) -> np.ndarray:   # the net force at the times t mod T
+        t = np.mod(t, T)
         u = evaluate(lay, x, t)
         return -terms.f(t, u)[:, i] - memory(lay, terms, x, t)[:, i]
 
