@@ -486,7 +486,8 @@ class EquationBranch(CollocationDiscretisation):
                 ) -> tuple[float, float]:
         """(p, bound): where the margin (:func:`_margin`) of the side that holds on (the point
         whose layout is kept: a's, the last but one, or b's, the last) reaches 0 along that
-        side's branch (its tangent oriented towards the other point), by Brent's method on the
+        side's branch (its tangent oriented towards the other point; behind the point where its
+        margin is already negative, a mend one step late), by Brent's method on the
         hyperplanes across the tangent; the bound is the p span of a bracket 4 xtol wide
         around the root, its margins of opposite signs.  ValueError or ShootingError (why)
         when the margin is not bracketed within 8 times the points' distance or Brent fails."""
@@ -499,8 +500,11 @@ class EquationBranch(CollocationDiscretisation):
             probe = CollocationDiscretisation(self.make, lay, z[:-1], multipliers=self.count)
             probe.problem = self.problem
             g0 = _margin(probe, z[:-1], float(z[-1]), other.signature)
-            if g0 is None or not g0 > 0:
+            if g0 is None or g0 == 0 or not math.isfinite(g0):
                 continue
+            # g0 > 0: the margin breaks towards the other point; g0 < 0: it broke already
+            # before this point (a mend one step late, e.g. the second of two sticks): behind it
+            way = 1.0 if g0 > 0 else -1.0
             curve = Curve(probe, z.size - 1)
             gap = float(np.max(np.abs(other.amplitude - q.amplitude)))
             prev = _spread(lay, z[:-1])
@@ -528,14 +532,15 @@ class EquationBranch(CollocationDiscretisation):
             L = abs(other.p - q.p) + gap
             lo, hi = 0.0, None
             for s in (0.5 * L, L, 2 * L, 4 * L, 8 * L):
-                if g(s) <= 0:
-                    hi = s
+                if g(way * s) * g0 <= 0:
+                    hi = way * s
                     break
-                lo = s
+                lo = way * s
             if hi is None:
                 raise ValueError(f"the margin {g0:.3g} of p = {q.p!r} does not reach 0 within "
                                  f"{8 * L:.3g} along its branch")
-            xtol = 1e-13 * max(1.0, hi)
+            lo, hi = min(lo, hi), max(lo, hi)
+            xtol = 1e-13 * max(1.0, abs(hi), abs(lo))
             root, info = so.brentq(g, lo, hi, xtol=xtol, full_output=True, disp=False)
             if not info.converged:
                 raise ValueError(f"Brent's method did not converge ({info.flag})")
