@@ -600,17 +600,10 @@ def continuation(disc: Any, x0: np.ndarray, p0: float, p_end: float, *, step: fl
             if pb != p_end:
                 zb = np.concatenate([past[0].u, [past[0].p]]) if past else zn
                 try:
-                    zl = run.land(z, zb, float(p_end))
+                    zn = run.land(z, zb, float(p_end))
                 except Exception as e:   # the model's or the corrector's failure
                     status = f"the landing on p_end = {p_end!r} failed: {e}"
                     break
-                if zl.size != zn.size:   # the landing changed the unknowns: tn carried over
-                    curve.size = zl.size - 1
-                    carry = getattr(disc, "carry", None)
-                    tn = (carry(tn, zl[:-1]) if carry is not None else
-                          np.concatenate([np.zeros(zl.size - 1), [tn[-1]]]))
-                    tn = tn / curve.norm(tn)
-                zn = zl
                 pb = float(p_end)
                 if predictor == "tangent":
                     tn, Jxn, Jpn = tangent(curve, zn, tn)

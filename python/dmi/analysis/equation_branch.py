@@ -122,13 +122,17 @@ class EquationBranch(CollocationDiscretisation):
                                       max_iter=self.max_iter, far=far,
                                       what=f"collocation near p = {p!r}")
         except (ShootingError, ValueError) as e:   # ValueError: Degenerate, a piece gone
-            # a step: p free past the removal; a landing (on the hyperplane p = target): at it
+            # a step: p free past the removal, the step's point on the new unknowns; a landing
+            # (on the hyperplane p = target): at it, kept for point() (the unknowns stay)
             landing = row[-1] == 1.0 and not np.any(row[:-1])
             got = (self._shed(str(e), None) if math.isfinite(far) else
                    self._shed(str(e), float(target)) if landing else None)
             if got is None:
                 raise
             xm, pm, lay, ref = got
+            if not math.isfinite(far):
+                self._mended = (x.copy(), pm, lay, ref, xm)
+                return x, pm, 0
             self.lay, self.ref = lay, ref
             return xm, pm, 0
         xz, pz = z[:-1], float(z[-1])
