@@ -61,11 +61,14 @@ class CollocationDiscretisation:
     estimate : bool
         A point's errors from the solve on the mesh with every pair of intervals merged (False:
         none, ``errors`` empty and ``stable`` None: a verdict needs the multipliers' errors).
+    kernel_jumps : sequence of float
+        The lags of the kernel's jumps (cuts of the delay integral's pieces at every p).
     """
 
     def __init__(self, make: Model, layout: Layout, x: np.ndarray, *, multipliers: int = 10,
-                 estimate: bool = True):
+                 estimate: bool = True, kernel_jumps: tuple[float, ...] = ()):
         self.make, self.lay = make, layout
+        self.jumps = tuple(kernel_jumps)
         self.count, self.estimate = int(multipliers), bool(estimate)
         self.problem = Problem(make, keep=5)   # the terms of the last few p
         self.ref = _reference(layout, x) if layout.autonomous else None
@@ -98,6 +101,7 @@ class CollocationDiscretisation:
                      orbit.autonomous, orbit.period, tuple(orbit.carried))
         x = np.concatenate([orbit.nodes.ravel(), orbit.switches,
                             [orbit.period] if orbit.autonomous else []])
+        kw.setdefault("kernel_jumps", tuple(orbit.kernel_jumps))
         return cls(orbit.make, lay, x, **kw), x
 
     def terms(self, p: float) -> Terms:
@@ -114,7 +118,8 @@ class CollocationDiscretisation:
             f, its derivative, the kernel, A's coefficients of ``make(p)``.
         """
         key = float(p)
-        return self.problem.cached(("terms", key), lambda: Terms(build(self.make, key)))
+        return self.problem.cached(("terms", key),
+                                   lambda: Terms(build(self.make, key), self.jumps))
 
     def residual(self, x: np.ndarray, p: float) -> np.ndarray:
         """The collocation system's residual.
@@ -190,7 +195,7 @@ class CollocationDiscretisation:
                 return None
             # the difference to the mesh of merged pairs is about 2^q - 1 >= 1 times the error
             errors = _errors(Solved(coarse, terms, xc, self.count), here)
-        return equation_orbit(here, float(p), self.make, errors)
+        return equation_orbit(here, float(p), self.make, errors, self.jumps)
 
     def event_functions(self, x: np.ndarray, p: float, point: EquationOrbit | None
                         ) -> dict[str, float]:
