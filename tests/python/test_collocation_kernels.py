@@ -169,3 +169,18 @@ def test_kernel_jumps_outside_refused():
     o = scheme_orbit(jump_model(200), 200, 4)
     with pytest.raises(ValueError, match="kernel_jumps"):
         da.collocate(o, intervals=8, kernel_jumps=(1.5,))
+
+
+def test_kernel_jumps_carried_by_continuation():
+    # p scales the forcing of a linear model: the orbit at p is p times the closed form
+    o = scheme_orbit(jump_model(400))
+    e = da.collocate(o, intervals=32, multipliers=2, kernel_jumps=(S1,))
+    assert e.kernel_jumps == (S1,)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CollocationWarning)
+        b = da.continue_orbit(e, 1.3, step=0.15)
+    t = np.linspace(0.0, T, 301)
+    assert len(b.points) >= 3 and abs(b.points[-1].p - 1.3) < 1e-12
+    for pt in b.points:
+        assert pt.kernel_jumps == (S1,)
+        assert np.max(np.abs(pt.u_at(t)[:, 0] - pt.p * jump_exact(t))) < 1e-9

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -38,7 +39,7 @@ from .collocation_signature import SLIP_NEG, SLIP_POS, Signature
 from .collocation_system import Layout, Terms, assemble, full_jacobian, node_times, solve
 from .driver import bordered_solve
 from .equation_orbit import EquationOrbit
-from .newton import ShootingError
+from .newton import ShootingError, newton_loop
 from .problem import Problem
 from .branch import HopfPoint
 from .stepmap import Model, build
@@ -101,8 +102,9 @@ class CollocationDiscretisation:
                      orbit.autonomous, orbit.period, tuple(orbit.carried))
         x = np.concatenate([orbit.nodes.ravel(), orbit.switches,
                             [orbit.period] if orbit.autonomous else []])
-        kw.setdefault("kernel_jumps", tuple(orbit.kernel_jumps))
-        return cls(orbit.make, lay, x, **kw), x
+        disc = cls(orbit.make, lay, x, **kw)
+        disc.jumps = tuple(orbit.kernel_jumps)      # the orbit's, before any terms are built
+        return disc, x
 
     def terms(self, p: float) -> Terms:
         """The model's terms at p (the last few cached).
@@ -349,24 +351,26 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     x = np.concatenate([V.ravel(), [T]])
     disc = CollocationDiscretisation(make, lay, x, multipliers=multipliers)
     gz, gw = lay.basis.gauss()
-    z = np.concatenate([x, [p0]])
-    for _ in range(max_iter):
-        x, p = z[:-1], z[-1]
-        r = disc.residual(x, p)
-        J, Jp = disc.jacobian(x, p)
-        g, grow = _amplitude_condition(lay, x, ue, c, a, gz, gw)
-        dz = bordered_solve(J, Jp, grow, -np.concatenate([r, [g]]))
-        z = z + dz
-        if np.max(np.abs(dz)) <= tol * max(1.0, float(np.max(np.abs(z)))):
-            pt = disc.point(z[:-1], z[-1])
-            if pt is None:            # no estimate at fixed p (a vertical branch): none given
-                disc.estimate = False
-                pt = disc.point(z[:-1], z[-1])
-            if pt is None:
-                raise ShootingError("the orbit from the Hopf point breaks its signature", [])
-            return pt
-    raise ShootingError(f"the orbit from the Hopf point at p = {p0!r}: no convergence in "
-                        f"{max_iter} Newton iterations", [])
+
+    def evaluate(z: np.ndarray) -> tuple[np.ndarray, None]:
+        g, _ = _amplitude_condition(lay, z[:-1], ue, c, a, gz, gw)
+        return np.concatenate([disc.residual(z[:-1], z[-1]), [g]]), None
+
+    def factor(z: np.ndarray, r: np.ndarray, state: None) -> Callable[[np.ndarray], np.ndarray]:
+        J, Jp = disc.jacobian(z[:-1], z[-1])
+        grow = _amplitude_condition(lay, z[:-1], ue, c, a, gz, gw)[1]
+        return lambda r: bordered_solve(J, Jp, grow, -r)
+
+    z, _ = newton_loop(evaluate, factor, np.concatenate([x, [p0]]), tol=tol,
+                       max_iter=max_iter, what=f"the orbit from the Hopf point at p = {p0!r}",
+                       converge="correction", stall=False)
+    pt = disc.point(z[:-1], z[-1])
+    if pt is None:            # no estimate at fixed p (a vertical branch): none given
+        disc.estimate = False
+        pt = disc.point(z[:-1], z[-1])
+    if pt is None:
+        raise ShootingError("the orbit from the Hopf point breaks its signature", [])
+    return pt
 
 
 def _slipping(terms: Terms, ue: np.ndarray) -> np.ndarray:

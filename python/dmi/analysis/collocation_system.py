@@ -19,7 +19,6 @@ central differences of the residual.
 """
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -33,7 +32,7 @@ from ._model import FD_STEP
 from .collocation_mesh import (Basis, Kernel, Locator, Near, delay_matrix, history_locator,
                                history_rows, periodic_locator, point_matrix)
 from .collocation_signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
-from .newton import ShootingError
+from .newton import ShootingError, newton_loop
 
 #: Quadrature nodes a piece of the delay integral: m + QUAD_EXTRA (exact for H u with u of
 #: degree m and H of degree m + 2 QUAD_EXTRA - 1 on the piece; the error h^(2m + 2 QUAD_EXTRA + 1)
@@ -493,49 +492,30 @@ def full_jacobian(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None
 def solve(lay: Layout, terms: Terms, x0: np.ndarray, ref: Callable | None, *,
           tol: float = 1e-12, max_iter: int = 25, what: str = "collocation"
           ) -> tuple[np.ndarray, list[float]]:
-    """Newton's method on the collocation system with sparse LU: the factored Jacobian is kept
-    while the residual falls by 10 or more a step (chord steps cost a residual), refreshed
-    otherwise, and a fresh step is halved until the residual falls; converged when the
-    correction is below tol max(1, |x|_inf) (that correction applied).
+    """Newton's method on the collocation system with sparse LU (:func:`newton_loop`): the
+    factored Jacobian is kept while the residual falls by 10 or more a step (chord steps cost a
+    residual), refreshed otherwise, and a fresh step is halved until the residual falls;
+    converged when the correction is below tol max(1, |x|_inf) (that correction applied).
 
     Raises
     ------
     ShootingError
-        No convergence in max_iter, a singular Jacobian, a non-finite residual, a segment that
-        vanishes on a fresh step (the signature changed).
+        No convergence in max_iter, no progress, a singular Jacobian, a non-finite residual, a
+        segment that vanishes on a fresh step (the signature changed).
     """
-    x = np.array(x0, dtype=float)
     res: list[float] = []
-    r = assemble(lay, terms, x, ref, jacobian=False)[0]
-    lu, age = None, 0
-    for _ in range(max_iter):
-        rn = float(np.max(np.abs(r)))
-        res.append(rn)
-        if not math.isfinite(rn):
-            raise ShootingError(f"{what}: non-finite residual", res)
-        if lu is None or (len(res) > 1 and rn > 0.1 * res[-2]):
-            lu, age = _factor(lay, terms, x, ref, what, res), 0
-        dx = lu.solve(-r)
-        age += 1
-        if np.max(np.abs(dx)) <= tol * max(1.0, float(np.max(np.abs(x)))):
-            return x + dx, res
-        lam = 1.0
-        while True:
-            try:
-                r1 = assemble(lay, terms, x + lam * dx, ref, jacobian=False)[0]
-                if np.max(np.abs(r1)) < rn or lam < 0.05:
-                    break
-            except Degenerate:
-                if lam < 0.05:
-                    raise ShootingError(f"{what}: a segment vanishes (the signature "
-                                        "changed)", res) from None
-            if age > 1:                          # a stale Jacobian: refresh it, not the step
-                lu, age = _factor(lay, terms, x, ref, what, res), 1
-                dx, lam = lu.solve(-r), 1.0
-                continue
-            lam *= 0.5
-        x, r = x + lam * dx, r1
-    raise ShootingError(f"{what}: no convergence in {max_iter} Newton iterations", res)
+
+    def evaluate(x: np.ndarray) -> tuple[np.ndarray, None]:
+        return assemble(lay, terms, x, ref, jacobian=False)[0], None
+
+    def factor(x: np.ndarray, r: np.ndarray, state: None) -> Callable[[np.ndarray], np.ndarray]:
+        lu = _factor(lay, terms, x, ref, what, res)
+        return lambda r: lu.solve(-r)
+
+    return newton_loop(evaluate, factor, x0, tol=tol, max_iter=max_iter, what=what,
+                       converge="correction", chord=0.1, search="descent", reject=(Degenerate,),
+                       reject_why="a segment vanishes (the signature changed)", history=res,
+                       stall=False)
 
 
 def _factor(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None, what: str,
@@ -546,6 +526,7 @@ def _factor(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None, what
         return sla.splu(J)
     except RuntimeError as err:
         raise ShootingError(f"{what}: singular Jacobian ({err})", res) from None
+
 
 def interval_counts(lengths: np.ndarray, L: int) -> np.ndarray:
     """L intervals shared by pieces of these lengths (or weights), at least 1 each."""
