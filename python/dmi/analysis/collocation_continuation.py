@@ -32,7 +32,7 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 
 from .collocation import (CollocationWarning, Solved, _errors, _reference, adapted,
-                          check_inequalities, equation_orbit, merged, transfer)
+                          check_inequalities, equation_orbit, merged, transfer, warn_jumps)
 from .collocation_mend import mend
 from .collocation_mesh import periodic_locator, point_matrix
 from .collocation_signature import SLIP_NEG, SLIP_POS, Signature
@@ -287,7 +287,8 @@ def _hhat(terms: Terms, lam: complex) -> np.ndarray:
 
 def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude: float, *,
                         degree: int = 4, intervals: int = 24, multipliers: int = 10,
-                        tol: float = 1e-12, max_iter: int = 30) -> EquationOrbit:
+                        tol: float = 1e-12, max_iter: int = 30,
+                        kernel_jumps: tuple[float, ...] = ()) -> EquationOrbit:
     """The equation's periodic orbit born at a Hopf point, of a given amplitude, p free.
 
     Parameters
@@ -311,6 +312,9 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
         Newton's tolerance on the correction.
     max_iter : int
         Newton iterations at most.
+    kernel_jumps : sequence of float
+        The lags in (0, tau) where the kernel jumps (as :func:`dmi.analysis.collocate`'s; an
+        undeclared jump of a callback kernel found is warned of).
 
     Returns
     -------
@@ -321,7 +325,8 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     Raises
     ------
     ValueError
-        Bad input: not a HopfPoint, omega <= 0, amplitude <= 0, u_eq not n numbers.
+        Bad input: not a HopfPoint, omega <= 0, amplitude <= 0, u_eq not n numbers, a jump
+        outside (0, tau).
     ShootingError
         Newton fails.
     """
@@ -333,7 +338,8 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     if not (a > 0 and math.isfinite(a)):
         raise ValueError(f"amplitude = {amplitude!r}: give a finite amplitude > 0")
     p0, om = float(hopf_point.p), float(hopf_point.omega)
-    terms = Terms(build(make, p0))
+    terms = Terms(build(make, p0), kernel_jumps)
+    warn_jumps(terms, "hopf_orbit")
     n = terms.n
     ue = np.asarray(u_eq, dtype=float).ravel()
     if ue.shape != (n,):
@@ -349,7 +355,8 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     t = node_times(lay, np.empty(0), T)
     V = ue + a * np.real(np.outer(np.exp(1j * om * t), v))
     x = np.concatenate([V.ravel(), [T]])
-    disc = CollocationDiscretisation(make, lay, x, multipliers=multipliers)
+    disc = CollocationDiscretisation(make, lay, x, multipliers=multipliers,
+                                     kernel_jumps=terms.H.jumps)
     gz, gw = lay.basis.gauss()
 
     def evaluate(z: np.ndarray) -> tuple[np.ndarray, None]:

@@ -154,9 +154,9 @@ def newton_loop(evaluate: Callable[[np.ndarray], tuple[np.ndarray, Any]],
     Raises
     ------
     ShootingError
-        A non-finite residual, no new least residual in NO_PROGRESS iterations (``stall``), max_iter
-        reached, a rejected step at the smallest length, or as ``factor`` and ``check``; every
-        residual listed.
+        A non-finite residual, no new least residual in NO_PROGRESS iterations (``stall``),
+        max_iter reached, a rejected step at the smallest length, or as ``factor`` and
+        ``check``; every residual listed.
     ValueError
         ``converge`` or ``search`` not one of theirs.
     """
@@ -185,7 +185,8 @@ def newton_loop(evaluate: Callable[[np.ndarray], tuple[np.ndarray, Any]],
         if converge == "correction" and float(np.max(np.abs(dz))) <= tol * sc:
             return z + dz, res
         lam = 1.0
-        for _ in range(6 if search == "guard" else 1 if search == "none" else 10 ** 6):
+        # trials: 1, 1 / 2, ..., 1 / 32 (below 0.05: taken); "descent" twice (a refresh between)
+        for _ in range({"none": 1, "guard": 6, "descent": 12}[search]):
             try:
                 rt, st = evaluate(z + lam * dz)
                 done = (search == "none" or lam < 0.05
