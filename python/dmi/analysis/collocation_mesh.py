@@ -13,8 +13,10 @@ negative times to a separate, discontinuous copy of the mesh (the monodromy oper
 The delay integral I(t) = int_0^tau H(s) u(t - s) ds is exact for the piecewise polynomial up to
 the kernel's own smoothness: [0, tau] is cut at every lag s where t - s crosses a mesh point (all
 shifted periods) and at the kernel's own breakpoints, and each piece takes ``q`` Gauss-Legendre
-nodes (exact for H polynomial of degree 2 q - 1 - m on the piece).  A kernel with a jump at an
-unknown lag inside (0, tau) caps the order at 1 there: the pieces do not see it.
+nodes (exact for H polynomial of degree 2 q - 1 - m on the piece).  A :class:`Kernel` brings its
+jumps inside (0, tau) as more cuts (a jump at a lag not given caps the order at 1: the pieces do
+not see it) and its near part s^-beta C on (0, delta] (a fitted PowerKernel's), integrated on each
+piece by product integration with the Gauss-Jacobi rule of the weight s^-beta.
 """
 from __future__ import annotations
 

@@ -3,11 +3,11 @@
 """Newton's method for x = F(x), x a shooting state, with GMRES on the matrix-free Jacobian
 (forward differences of F: the derivative of the map's smooth piece, a semismooth Newton), and
 the bordered step of a system with extra unknowns and equations (an autonomous orbit's step h,
-a continuation's parameter p; a phase condition, an amplitude condition, an arclength).  One
-loop, :func:`bordered_newton`; :func:`newton` is its case without extra unknowns, with a
-damped step.  Both, collocation's sparse-LU Newton and the continuation driver's corrector
-(:func:`dmi.analysis.driver.newton_corrector`) run :func:`newton_loop`, the one loop, each with
-its own linear solve.
+a continuation's parameter p; a phase condition, an amplitude condition, an arclength):
+:func:`bordered_newton`, of which :func:`newton` is the case without extra unknowns, with a
+damped step.  It, collocation's sparse-LU Newton and the continuation driver's corrector
+(:func:`dmi.analysis.driver.newton_corrector`) run :func:`newton_loop`, the one Newton loop,
+each with its own linear solve.
 
 Every iteration's residual is kept; an iteration gives up when the residual has made no new
 minimum in :data:`NO_PROGRESS` iterations (the semismooth Newton may rise once on its way into
