@@ -174,7 +174,7 @@ def test_kernel_jumps_outside_refused():
 def test_kernel_jumps_carried_by_continuation():
     # p scales the forcing of a linear model: the orbit at p is p times the closed form
     o = scheme_orbit(jump_model(400))
-    e = da.collocate(o, intervals=32, multipliers=2, kernel_jumps=(S1,))
+    e = da.collocate(o, intervals=16, multipliers=2, kernel_jumps=(S1,))
     assert e.kernel_jumps == (S1,)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", CollocationWarning)
@@ -183,4 +183,4 @@ def test_kernel_jumps_carried_by_continuation():
     assert len(b.points) >= 3 and abs(b.points[-1].p - 1.3) < 1e-12
     for pt in b.points:
         assert pt.kernel_jumps == (S1,)
-        assert np.max(np.abs(pt.u_at(t)[:, 0] - pt.p * jump_exact(t))) < 1e-9
+        assert np.max(np.abs(pt.u_at(t)[:, 0] - pt.p * jump_exact(t))) < 1e-8   # 1e-4 without
