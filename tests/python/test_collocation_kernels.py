@@ -184,3 +184,26 @@ def test_kernel_jumps_carried_by_continuation():
     for pt in b.points:
         assert pt.kernel_jumps == (S1,)
         assert np.max(np.abs(pt.u_at(t)[:, 0] - pt.p * jump_exact(t))) < 1e-8   # 1e-4 without
+
+
+def test_fitted_power_kernel_autonomous_order():
+    # van der Pol with the fitted fractional damping 0.2 s^-0.5 on its velocity, tau = 2 (its
+    # fit steep past delta: the pieces there graded): the period's order under refinement >= m
+    # and the trivial multiplier at 1
+    fit = dk.fit(dk.PowerKernel(0.5, 0.2), 2.0, delta=0.05, tol=1e-7)
+
+    def make(p: float, h: float | None = None) -> dmi.Solver:
+        s = dmi.Solver(2, 2.0, h=0.01 if h is None else h)
+        s.set_rhs(lambda t, u: np.array([-u[1], (u[0] ** 2 - 1) * u[1] + u[0]]))
+        s.set_quadrature("cell")
+        s.set_kernel_fit(fit, entry=(1, 1))
+        return s
+    s = make(1.0)
+    s.set_history(lambda t: np.array([2.0, 0.0]))
+    s.init()
+    s.advance(6000)
+    o = da.periodic_orbit(make, 1.0, None, s, guess_period=6.5, steps=650, multipliers=0)
+    es = [da.collocate(o, intervals=L, multipliers=2) for L in (16, 32, 64)]
+    d = [abs(a.period - b.period) for a, b in zip(es[:-1], es[1:])]
+    assert math.log2(d[0] / d[1]) >= 4, d
+    assert abs(es[1].multipliers[0] - 1) < 1e-8

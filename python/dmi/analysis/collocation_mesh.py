@@ -216,6 +216,12 @@ def _jacobi(q: int, beta: float) -> tuple[np.ndarray, np.ndarray]:
     return 0.5 * (x + 1.0), w / 2.0 ** (1.0 - beta)
 
 
+def _legendre(q: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights on [0, 1] (q nodes)."""
+    z, w = np.polynomial.legendre.leggauss(q)
+    return 0.5 * (z + 1.0), 0.5 * w
+
+
 def _local(locate: Locator, tp: np.ndarray, a: np.ndarray, d: np.ndarray, S: np.ndarray
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """For pieces [a, a + d] of lags at the times tp (each piece in one interval of u): the
@@ -237,8 +243,7 @@ def _near_nodes(near: Near, a: np.ndarray, d: np.ndarray, q: int, n: int
     the weights W (k, r) and H = C at them (k, r, n, n)."""
     close = a < d
     gy, gw = _jacobi(q, near.beta)
-    lz, lw = np.polynomial.legendre.leggauss(Q_NEAR)
-    lz, lw = 0.5 * (lz + 1.0), 0.5 * lw
+    lz, lw = _legendre(Q_NEAR)
     r = max(2 * q, Q_NEAR)
     S = np.zeros((a.size, r))
     W = np.zeros((a.size, r))
@@ -305,6 +310,12 @@ def delay_matrix(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: floa
     far = getattr(kernel, "far", kernel)
     own = getattr(kernel, "breaks", np.empty(0))
     breaks = own if breaks is None else np.concatenate([np.asarray(breaks, float), own])
+    graded = 0.0
+    if near is not None:         # past delta the fit still follows s^-beta: cuts at delta 2^k
+        grade = near.delta * 2.0 ** np.arange(1, 64)
+        grade = grade[grade < tau * (1.0 - 1e-12)]
+        graded = float(grade[-1]) if grade.size else 0.0
+        breaks = np.concatenate([breaks, grade])
     lo = math.floor((times.min() - tau - pts[-1]) / T) - 1
     hi = math.floor((times.max() - pts[0]) / T) + 1
     ext = (pts[None, :] + T * np.arange(lo, hi + 1)[:, None]).ravel()   # sorted
@@ -326,12 +337,14 @@ def delay_matrix(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: floa
         pattern = np.ones((n, n), bool)
     ia, ib = np.nonzero(pattern)
     close = (a + d <= near.delta * (1.0 + 1e-12)) if near is not None else np.zeros(a.size, bool)
+    # the graded pieces (delta, delta 2^K]: each at least its own length from 0, Q_NEAR nodes
+    steep = ~close & (a + d <= graded * (1.0 + 1e-12))
     groups = []
-    f = ~close                                                   # H smooth on the piece
-    S = a[f, None] + d[f, None] * gz[None, :]                    # (k, q)
-    W = d[f, None] * gw[None, :]
-    H = far(S.ravel()).reshape(S.shape + (n, n))                 # (k, q, n, n)
-    groups.append((C[f], a[f], d[f], S, W, H))
+    for f, (zz, ww) in ((~close & ~steep, (gz, gw)), (steep, _legendre(Q_NEAR))):
+        S = a[f, None] + d[f, None] * zz[None, :]                # (k, q)
+        W = d[f, None] * ww[None, :]
+        H = far(S.ravel()).reshape(S.shape + (n, n))             # (k, q, n, n)
+        groups.append((C[f], a[f], d[f], S, W, H))
     if np.any(close):
         groups.append((C[close], a[close], d[close])
                       + _near_nodes(near, a[close], d[close], basis.q, n))
