@@ -207,3 +207,24 @@ def test_fitted_power_kernel_autonomous_order():
     d = [abs(a.period - b.period) for a, b in zip(es[:-1], es[1:])]
     assert math.log2(d[0] / d[1]) >= 4, d
     assert abs(es[1].multipliers[0] - 1) < 1e-8
+
+
+def test_steep_exponential_sum_graded():
+    # H = 5 e^{-200 s} + 0.3 e^{-s} on [0, 1] (a fit's fast terms): Hhat in closed form; the
+    # pieces near 0 graded at 2^k / 200, the order >= m (without: 8e-7 at 32 intervals)
+    rates, coef = np.array([-200.0, -1.0]), np.array([5.0, 0.3])
+
+    def make(p: float) -> dmi.Solver:
+        s = dmi.Solver(1, TAU, h=T / 400)
+        s.set_rhs(lambda t, u: np.array([K * u[0] - p * C * np.cos(OM * t)]))
+        s.set_kernel_exp(rates, [0.0, 0.0], coef[:, None, None])
+        return s
+    o = scheme_orbit(make)
+    lam = 1j * OM
+    hh = np.sum(coef * (1 - np.exp(-(lam - rates) * TAU)) / (lam - rates))
+    t = np.linspace(0.0, T, 301)
+    exact = np.real(C / (lam + K + hh) * np.exp(lam * t))
+    errs = [float(np.max(np.abs(da.collocate(o, intervals=L, multipliers=0).u_at(t)[:, 0]
+                                - exact))) for L in (8, 16, 32)]
+    orders = [math.log2(a / b) for a, b in zip(errs[:-1], errs[1:])]
+    assert min(orders) >= 4 and errs[-1] < 1e-9, (errs, orders)

@@ -151,6 +151,9 @@ def history_rows(L: int, m: int, periods: int) -> int:
 #: singularity at 0 (s^-beta is analytic in the Bernstein ellipse of parameter 3 + sqrt 8 around
 #: it: the rule's error is below 5.83^-24, 5e-19, relative).
 Q_NEAR = 12
+#: An exponential sum is steep when its fastest rate r exceeds STEEP / tau: its pieces near 0
+#: are then graded (:attr:`Kernel.grading`).
+STEEP = 20.0
 
 
 @dataclass(frozen=True)
@@ -185,11 +188,25 @@ class Kernel:
         The near part.
     jumps : sequence of float
         Lags of jumps of H in (0, tau), sorted.
+    rate : float
+        The fastest decay rate of an exponential sum when it is steep on (0, tau) (0: not).
     """
 
     def __init__(self, far: Callable[[np.ndarray], np.ndarray], near: Near | None = None,
-                 jumps: tuple[float, ...] = ()):
+                 jumps: tuple[float, ...] = (), rate: float = 0.0):
         self.far, self.near, self.jumps = far, near, tuple(float(j) for j in jumps)
+        self.rate = float(rate)
+
+    @property
+    def grading(self) -> float:
+        """Where the graded cuts of (0, tau) start (0: none): past a near part, H (a fit of
+        s^-beta) still varies on the scale of s, so the cuts are delta 2^k (k >= 1); an
+        exponential sum whose fastest rate r is steep (r > STEEP / tau) is cut at 2^k / r
+        (k >= 0).  Each graded piece is at least its own length from 0 and takes Q_NEAR
+        Gauss-Legendre nodes."""
+        if self.near is not None:
+            return 2.0 * self.near.delta
+        return 1.0 / self.rate if self.rate > 0 else 0.0
 
     def __call__(self, s: np.ndarray) -> np.ndarray:
         """H(s) (k, n, n) at the lags s (k,) (the near part at s <= delta)."""
@@ -311,8 +328,9 @@ def delay_matrix(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: floa
     own = getattr(kernel, "breaks", np.empty(0))
     breaks = own if breaks is None else np.concatenate([np.asarray(breaks, float), own])
     graded = 0.0
-    if near is not None:         # past delta the fit still follows s^-beta: cuts at delta 2^k
-        grade = near.delta * 2.0 ** np.arange(1, 64)
+    start = getattr(kernel, "grading", 0.0)
+    if start > 0:                # a steep H near 0: cuts at start 2^k
+        grade = start * 2.0 ** np.arange(0, 64)
         grade = grade[grade < tau * (1.0 - 1e-12)]
         graded = float(grade[-1]) if grade.size else 0.0
         breaks = np.concatenate([breaks, grade])
@@ -337,7 +355,7 @@ def delay_matrix(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: floa
         pattern = np.ones((n, n), bool)
     ia, ib = np.nonzero(pattern)
     close = (a + d <= near.delta * (1.0 + 1e-12)) if near is not None else np.zeros(a.size, bool)
-    # the graded pieces (delta, delta 2^K]: each at least its own length from 0, Q_NEAR nodes
+    # the graded pieces up to start 2^K: each at least its own length from 0, Q_NEAR nodes
     steep = ~close & (a + d <= graded * (1.0 + 1e-12))
     groups = []
     for f, (zz, ww) in ((~close & ~steep, (gz, gw)), (steep, _legendre(Q_NEAR))):

@@ -29,8 +29,8 @@ import scipy.sparse.linalg as sla
 
 from .._solver import Solver
 from ._model import FD_STEP
-from .collocation_mesh import (Basis, Kernel, Locator, Near, delay_matrix, history_locator,
-                               history_rows, periodic_locator, point_matrix)
+from .collocation_mesh import (STEEP, Basis, Kernel, Locator, Near, delay_matrix,
+                               history_locator, history_rows, periodic_locator, point_matrix)
 from .collocation_signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
 from .newton import ShootingError, newton_loop
 
@@ -79,7 +79,9 @@ class Terms:
         self.terms = solver.kernel_terms
         self.kind = solver.kernel_kind
         self.has_rhs = solver.has("rhs")
-        self.H = Kernel(self._far, near_part(solver), kernel_jumps(jumps, self.tau))
+        rate = float(np.max(-self.terms[0], initial=0.0)) if self.kind == "exp" else 0.0
+        self.H = Kernel(self._far, near_part(solver), kernel_jumps(jumps, self.tau),
+                        rate if rate * self.tau > STEEP else 0.0)
 
     def f(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
         """f(t_c, U_c) (P, n) at the times t (P,) and states U (P, n)."""
