@@ -301,9 +301,9 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
         ``orbit`` is not an Orbit of the scheme.
     ValueError
         Bad degree, intervals, tol or kernel_jumps; a model with a user resolvent (use
-        ``refine_orbit``) or with near cells not of a fitted PowerKernel; a result that still breaks an inequality of its signature after
-        MENDS mends (the message names it; refine the scheme's orbit); the estimated error
-        still above ``tol`` at the largest mesh.
+        ``refine_orbit``) or with near cells not of a fitted PowerKernel; a result that still
+        breaks an inequality of its signature after MENDS mends (the message names it; refine
+        the scheme's orbit); the estimated error still above ``tol`` at the largest mesh.
     ShootingError
         Newton fails.
     """
