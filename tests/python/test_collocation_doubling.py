@@ -8,6 +8,7 @@
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
+import dataclasses
 import math
 from functools import lru_cache
 
@@ -17,6 +18,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 import dmi
 from dmi import analysis as da
+from dmi.analysis.equation_branch import EquationBranch
 
 D, BE, W, G, TAU = 0.3, 1.0, 1.2, 0.1, 1.0
 T = 2 * math.pi / W
@@ -171,3 +173,25 @@ def test_doubling_back_to_the_t_orbit_is_refused(branch):
     pd = next(e for e in branch.events if e.kind == "period-doubling")
     with pytest.raises(da.ShootingError, match="returned to the T-orbit"):
         da.period_doubled_orbit(branch, pd, amplitudes=(0.0,), multipliers=4)
+
+
+def test_collocated_events_verified_against_the_multipliers_errors(branch):
+    """The flip's bracketing points: their test functions change sign beyond the multipliers'
+    estimated errors; with error bounds wider than the multiplier's distance to -1 both are 0
+    (no sign change: no event) with an EventWarning each."""
+    from dmi.analysis.orbit_events import EventWarning
+    pd = next(e for e in branch.events if e.kind == "period-doubling")
+    pts = [q for q in branch.points if abs(q.p - pd.p) < 0.02]
+    a = max((q for q in pts if q.p < pd.p), key=lambda q: q.p)
+    b = min((q for q in pts if q.p > pd.p), key=lambda q: q.p)
+    eb, x = EquationBranch.of(a, multipliers=4)
+    fa = eb.event_functions(x, a.p, a)["period-doubling"]
+    eb, x = EquationBranch.of(b, multipliers=4)
+    fb = eb.event_functions(x, b.p, b)["period-doubling"]
+    assert fa < 0 < fb
+    for q in (a, b):
+        wide = dataclasses.replace(q, errors={**q.errors, "multipliers": np.full(
+            q.multipliers.shape, 1.5 * abs(abs(q.multipliers[0]) - 1))})
+        eb, x = EquationBranch.of(wide, multipliers=4)
+        with pytest.warns(EventWarning, match="error bound is larger than their distance"):
+            assert eb.event_functions(x, q.p, wide)["period-doubling"] == 0.0

@@ -103,7 +103,9 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     and Newton's corrector on the sparse collocation system, the mesh equidistributed after
     every step and the signature mended where a segment vanishes or an inequality breaks
     (``stick-onset`` and ``grazing`` events where it changes), the multipliers' events
-    (``period-doubling``, ``torus``) and the fold, landing on p_end and ``at=``.  Of the
+    (``period-doubling``, ``torus``: verified, reported only where the multiplier crosses the
+    unit circle beyond its estimated error on both sides, else an ``EventWarning``; see
+    :mod:`dmi.analysis.orbit_events`) and the fold, landing on p_end and ``at=``.  Of the
     options, ``step``, ``max_points``, ``min_step``, ``max_step``, ``multipliers`` (a point's
     leading multipliers), ``tol`` (at most 1e-12 is used: the corrector's error stays below
     the collocation's), ``max_iter`` and ``at`` apply; ``period=`` (the period is an
@@ -153,7 +155,8 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     verify : dmi.analysis.Verify, optional
         Verify every point's multipliers and stability (:func:`dmi.analysis.floquet_verdict`,
         kept in ``BranchPoint.floquet``; the multipliers' events then leave out the verified
-        trivial multiplier).  None: the Ritz multipliers, ``stable`` from them unverified.
+        trivial multiplier, and are reported only where the multipliers of their kind lie off
+        the unit circle beyond their error bounds on both points, else an ``EventWarning``).  None: the Ritz multipliers, ``stable`` from them unverified.
 
     Returns
     -------
@@ -269,8 +272,9 @@ def refined_event(maps: Any, a: BranchPoint, b: BranchPoint, e: Event, multiplie
 
 def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[float, ...] =
                          (0.03, 0.1, 0.3, 1.0), multipliers: int = 6, tol: float = 1e-10
-                         ) -> Orbit:
-    """The period-2M orbit born at a ``period-doubling`` event of a forced branch.
+                         ) -> Orbit | EquationOrbit:
+    """The period-2M orbit born at a ``period-doubling`` event of a branch (scheme's or
+    collocated).
 
     At the point of the event's pair where the M-periodic orbit has a multiplier < -1 (its
     unstable side, where a supercritical doubling's orbit lives) the M-periodic state x is
@@ -279,6 +283,17 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
     and shot with period 2 M h; the first solution that is not the M-periodic orbit is returned.
     Continue it with ``continue_orbit(..., sections=2 * branch.sections)``, and
     ``period=lambda p: 2 * P(p)`` for a branch continued with ``period=P``.
+
+    On a collocated branch (of EquationOrbits: ``continue_orbit`` of an EquationOrbit,
+    ``hopf_orbit(..., of="equation")``) of smooth orbits, forced or autonomous: at the point of
+    the pair with a real multiplier below -1 by more than its estimated error, the orbit laid
+    twice around (its own mesh twice, period 2 T) plus a A v on the first lap and -a A v on the
+    second, v the multiplier's eigenfunction over the period
+    (:func:`dmi.analysis.collocation_floquet.eigenfunction`), is collocated (Newton with sparse
+    LU, the mesh equidistributed and solved again) and returned as an EquationOrbit of period
+    2 T (a forced one: exactly twice the forcing period) with its multipliers and error
+    estimates, once |u(t + T) - u(t)| exceeds 100 times the estimated error of u (distinct
+    from the T-orbit, verified).  ``continue_orbit`` continues it (no ``sections=``).
 
     Parameters
     ----------
@@ -291,19 +306,23 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
     multipliers : int
         Floquet multipliers of the orbit returned.
     tol : float
-        Newton's tolerance.
+        Newton's tolerance (the scheme's; a collocated orbit is solved to 1e-12).
 
     Returns
     -------
-    Orbit
-        The period-doubled orbit.
+    Orbit or EquationOrbit
+        The period-doubled orbit (an EquationOrbit on a collocated branch).
 
     Raises
     ------
     ValueError
-        The event is not a period doubling; a collocated branch (not taken yet).
+        The event is not a period doubling; on a collocated branch: neither point has a real
+        multiplier below -1 beyond its estimated error, the orbit has switches (stick-slip:
+        shoot the scheme's orbit, period 2 P, and collocate it), or the multiplier nearest -1
+        is not real and negative.
     ShootingError
-        No period-doubled orbit found (what each kick gave is listed).
+        No period-doubled orbit found (what each kick gave is listed: Newton's failure, or a
+        return to the T-orbit).
     """
     if event.kind != "period-doubling":
         raise ValueError(f"event {event.kind!r}: expected a 'period-doubling' event")
