@@ -156,7 +156,8 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
         Verify every point's multipliers and stability (:func:`dmi.analysis.floquet_verdict`,
         kept in ``BranchPoint.floquet``; the multipliers' events then leave out the verified
         trivial multiplier, and are reported only where the multipliers of their kind lie off
-        the unit circle beyond their error bounds on both points, else an ``EventWarning``).  None: the Ritz multipliers, ``stable`` from them unverified.
+        the unit circle beyond their error bounds on both points, else an ``EventWarning``).
+        None: the Ritz multipliers, ``stable`` from them unverified.
 
     Returns
     -------
