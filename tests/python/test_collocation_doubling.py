@@ -4,7 +4,9 @@
 # branch) against an independent Fourier (harmonic balance) solve written here: the orbit's
 # samples on a uniform grid, the linear part with memory exact on each harmonic, Newton; the flip
 # where the linearisation has an antiperiodic solution (its matrix on the antiperiodic samples of
-# the period 2 T singular), found by Brent's method.  About 1 minute.
+# the period 2 T singular), found by Brent's method; the events' test functions against the
+# multipliers' errors; an autonomous branch (Roessler's equations with a memory) doubled, the
+# doubled orbit checked by integrating the equation over its period.  About 2 minutes.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -160,8 +162,8 @@ def test_doubled_orbit_and_its_branch(branch):
     assert np.max(np.abs(o2.amplitude - ref)) < 1e-8, (o2.amplitude, ref)
     # distinct from the T-orbit, whose amplitude at that p is another
     assert np.max(np.abs(o2.amplitude - amplitudes(t_orbit(o2.p), T))) > 1e-3
-    b2 = da.continue_orbit(o2, o2.p + 0.004, step=0.002, multipliers=4)
-    assert b2.points[-1].p == pytest.approx(o2.p + 0.004, abs=1e-12), b2.status
+    b2 = da.continue_orbit(o2, o2.p + 0.003, step=0.003, multipliers=4)
+    assert b2.points[-1].p == pytest.approx(o2.p + 0.003, abs=1e-12), b2.status
     q = b2.points[-1]
     assert q.period == 2 * T
     ref = amplitudes(doubled(q.p), 2 * T)
@@ -195,3 +197,62 @@ def test_collocated_events_verified_against_the_multipliers_errors(branch):
         eb, x = EquationBranch.of(wide, multipliers=4)
         with pytest.warns(EventWarning, match="error bound is larger than their distance"):
             assert eb.event_functions(x, q.p, wide)["period-doubling"] == 0.0
+
+
+# ---- an autonomous branch: Roessler's equations with a memory on x -----------------------------
+# x' = -y - z - g int_0^1 e^{-s} x(t - s) ds, y' = x + a y, z' = b + z (x - c); its orbit doubles
+# near c = 2.99.  The doubled orbit is checked by an independent integration of the equation from
+# its own past: with m = int_0^1 e^{-s} x(t - s) ds, m' = x(t) - e^{-1} x(t - 1) - m, a delay
+# equation integrated by the method of steps (DOP853 on each unit interval, the past from the
+# previous one's dense output) over one period 2 T must come back to its start.
+RA, RB, RG = 0.2, 0.2, 0.02
+
+
+def roessler(c: float, h: float | None = None) -> dmi.Solver:
+    s = dmi.Solver(3, 1.0, h=0.01 if h is None else h)
+    s.set_rhs(lambda t, u: -np.array([-u[1] - u[2], u[0] + RA * u[1], RB + u[2] * (u[0] - c)]))
+    s.set_kernel_exp([-1.0], [0.0], [[[RG, 0, 0], [0, 0, 0], [0, 0, 0]]])
+    return s
+
+
+def test_doubled_orbit_of_an_autonomous_branch():
+    from scipy.integrate import quad, solve_ivp
+    c0 = 2.6
+    run = solve_ivp(lambda t, u: [-u[1] - u[2], u[0] + RA * u[1], RB + u[2] * (u[0] - c0)],
+                    (0, 300), [1, 1, 0], rtol=1e-10, atol=1e-12, dense_output=True)
+    ts = np.linspace(250, 300, 50001)
+    Y = run.sol(ts)
+    i = np.flatnonzero((Y[1][:-1] < 0) & (Y[1][1:] >= 0) & (Y[0][:-1] > 0))
+    o = da.periodic_orbit(roessler, c0, None, Y[:, i[-1]], guess_period=ts[i[-1]] - ts[i[-2]],
+                          steps=1000, multipliers=3)
+    b = da.continue_orbit(da.collocate(o, multipliers=4), 3.0, step=0.05, multipliers=4)
+    pd = [e for e in b.events if e.kind == "period-doubling"]
+    assert len(pd) == 1, b.events
+    o2 = da.period_doubled_orbit(b, pd[0], multipliers=4)
+    q = b.points[pd[0].index]
+    assert o2.autonomous and abs(o2.period - 2 * q.period) < 0.05 * q.period
+    P = o2.period
+
+    def x_past(t: float) -> float:
+        return float(o2.u_at(np.array([t % P]))[0, 0])
+    m0 = quad(lambda s: math.exp(-s) * x_past(-s), 0.0, 1.0, epsabs=1e-13, epsrel=1e-13, limit=200)[0]
+    state = np.concatenate([o2.u_at(np.array([0.0]))[0], [m0]])
+    past = x_past
+    t0 = 0.0
+    while t0 < P - 1e-12:
+        t1 = min(t0 + 1.0, P)
+
+        def rhs(t: float, w: np.ndarray, past=past) -> list[float]:
+            x, y, z, m = w
+            return [-y - z - RG * m, x + RA * y, RB + z * (x - o2.p),
+                    x - math.exp(-1.0) * past(t - 1.0) - m]
+        seg = solve_ivp(rhs, (t0, t1), state, method="DOP853", rtol=1e-13, atol=1e-13,
+                        dense_output=True)
+        prev = past
+
+        def past(t: float, seg=seg, t0=t0, prev=prev) -> float:
+            return float(seg.sol(t)[0]) if t >= t0 else prev(t)
+        state, t0 = seg.y[:, -1], t1
+    start = o2.u_at(np.array([0.0]))[0]
+    assert np.max(np.abs(state[:3] - start)) < 1e-8, state[:3] - start
+    assert np.max(np.abs(o2.u_at(np.array([0.5 * P]))[0] - start)) > 1e-2   # not the T-orbit
