@@ -3,7 +3,8 @@
 # (1 - h c)^3 = -(1 + (p - 1) / 2) exactly (a linear map): it crosses -1 at p = 1, an event
 # placed there by the linear interpolation of the test function (exact here); the same points
 # with error bounds larger than the multiplier's distance to the circle give no event and an
-# EventWarning; undecided() and verified_tests() on hand-made multipliers.
+# EventWarning; without verify= the event says it is not verified; undecided() and
+# verified_tests() on hand-made multipliers.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -84,3 +85,13 @@ def test_undecided_and_verified_tests():
         verified_tests(mu, np.zeros(2), 0.0)
     with pytest.raises(ValueError, match="expected one of"):
         undecided("fold", mu, np.zeros(3))
+
+
+def test_event_without_error_bounds_says_so():
+    """Without verify= the Ritz multipliers have no error bound: the event is the scheme's, its
+    detail says it is not verified."""
+    o = da.periodic_orbit(flip, 0.5, 1.0, [0.0], multipliers=1)
+    b = da.continue_orbit(o, 1.5, step=0.25, multipliers=1)
+    pds = [e for e in b.events if e.kind == "period-doubling"]
+    assert len(pds) == 1 and abs(pds[0].p - 1.0) < 1e-9, b.events
+    assert "not verified" in pds[0].detail

@@ -234,7 +234,9 @@ def orbit_events(a: BranchPoint, b: BranchPoint, index: int, autonomous: bool = 
         fa, fb = (test_function(kind, m) for m in (mua, mub))
         ev.append(Event(kind, at(fa, fb), index, None,
                         detail + (" (verified: beyond the multipliers' error bounds on both "
-                                  "sides)" if verified else "")))
+                                  "sides)" if verified else " (not verified: the Ritz "
+                                  "multipliers have no error bound; continue_orbit(verify=...) "
+                                  "verifies them)")))
     for i in range(len(a.stick_steps)):
         sa, sb = int(a.stick_steps[i]), int(b.stick_steps[i])
         if (sa == 0) != (sb == 0):
