@@ -328,7 +328,7 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
     if event.kind != "period-doubling":
         raise ValueError(f"event {event.kind!r}: expected a 'period-doubling' event")
     if any(getattr(q, "of", "scheme") == "equation" for q in branch.points):
-        return doubled_equation_orbit(branch.points[event.index - 1],
+        return _doubled_equation_orbit(branch.points[event.index - 1],
                                       branch.points[event.index], amplitudes, multipliers)
     a, b = branch.points[event.index - 1], branch.points[event.index]
     q = a if np.any(a.multipliers.real < -1) else b
@@ -360,7 +360,7 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
                         + "; ".join(tried), [])
 
 
-def doubled_equation_orbit(a: EquationOrbit, b: EquationOrbit, amplitudes: tuple[float, ...],
+def _doubled_equation_orbit(a: EquationOrbit, b: EquationOrbit, amplitudes: tuple[float, ...],
                            multipliers: int) -> EquationOrbit:
     """:func:`period_doubled_orbit` on a collocated branch, between its points a and b.
 
