@@ -825,6 +825,7 @@ class Solver:
             return _L.dmi_set_kernel_near(s, address, u, float(delta))
         self._set_callback("kernel_near", cb.KERNEL, setter, H, user, False)
         self._near_delta = float(delta) if H is not None else 0.0
+        self._fit = None        # the kernel is no longer the fit's alone (set_kernel_fit resets it)
         if self._near_delta > 0 and self._choices["quadrature"] == "left":
             # the left rule would sample the fit at l h while the near cells are exact integrals;
             # the rule alone is switched: an exponent given by set_quadrature(singularity=) stays

@@ -29,15 +29,27 @@ def characteristic(lam: complex, a: float) -> complex:
     return lam * lam - lam + 1 - a * np.expm1(-lam * TAU) / (lam * TAU)
 
 
-def test_no_hopf_point_of_the_equation_in_the_range():
-    # on lam = i w: Im gives a = -w^2 tau / (1 - cos w tau) <= -2: no Hopf point for a > -2; the
-    # unstable pair of a = -0.85 meets on the real axis before a = -0.95 (two real roots > 0)
-    w = np.linspace(1e-3, 60, 200001)
-    assert np.all(-w ** 2 * TAU / (1 - np.cos(w * TAU) + 1e-300) <= -2 + 1e-6)
+def test_equation_roots_match_the_closed_form_around_the_branch_point():
+    # the rightmost roots of the equation at w = 0 against the closed-form characteristic function:
+    # two real roots > 0 at a = -0.95 (the unstable pair of a = -0.85 has met on the real axis),
+    # a complex pair with Re > 0 at a = -0.85, and a root through 0 at a = -1 (the branch point)
+    from scipy.optimize import brentq
     x = np.linspace(1e-4, 3, 30001)
-    for a, real in ((-0.95, 2), (-0.85, 0)):
-        assert np.count_nonzero(np.diff(np.sign(characteristic(x, a).real))) == real
-    assert characteristic(1e-12, -1.0).real == pytest.approx(0.0, abs=1e-9)   # a root at 0
+    for a in (-0.95, -0.85, -1.05):
+        r = da.roots(vdp, a, [0.0, 0.0], count=4, of="equation")
+        assert np.all(np.isfinite(r)), r
+        for z in r:                                   # every reported root is one of Delta
+            assert abs(characteristic(complex(z), a)) <= 1e-8 * max(1.0, abs(z) ** 2), (a, z)
+        g = characteristic(x, a).real
+        real = [brentq(lambda y: characteristic(y, a).real, x[i], x[i + 1], xtol=1e-14)
+                for i in np.flatnonzero(np.diff(np.sign(g)))]
+        code = sorted(z.real for z in r if abs(z.imag) <= 1e-9 and z.real > 0)
+        assert len(code) == len(real), (a, r, real)
+        assert np.allclose(code, sorted(real), atol=1e-8), (a, code, real)
+        if a == -0.85:
+            assert not real and r[0].real > 0 and abs(r[0].imag) > 1e-3, r
+    r = da.roots(vdp, -1.0, [0.0, 0.0], count=4, of="equation")
+    assert np.min(np.abs(r)) <= 1e-8, r                # the root through 0 at a = -1
 
 
 @pytest.mark.parametrize("of", ["scheme", "equation"])

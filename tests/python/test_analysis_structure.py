@@ -1,7 +1,8 @@
-# dmi.analysis has one continuation driver, one cache of what it builds from a model, and two
-# Newton loops (newton.bordered_newton on maps, matrix-free, of which newton.newton is a case;
-# the driver's corrector on residuals with their Jacobians), besides shooting's Newton-Picard;
-# its import chain is at most 8 modules deep (it was 9 with two drivers).
+# dmi.analysis has one continuation driver, one cache of what it builds from a model, and one
+# Newton loop (newton.newton_loop, its linear solve given by the caller: the maps' matrix-free
+# bordered_newton, of which newton.newton is a case, collocation's sparse LU, the driver's
+# corrector), besides shooting's Newton-Picard; its import chain is at most 8 modules deep (it
+# was 9 with two drivers).
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -55,16 +56,72 @@ def test_one_driver():
         assert calls(fn, "continuation"), f"{mod}.{name} has a step policy of its own"
 
 
-def test_one_cache_and_two_newton_loops():
+#: Linear solves a Newton iteration calls (by name or attribute).
+LINEAR_SOLVES = {"splu", "spsolve", "bordered_solve", "bordered_step", "gmres", "lu_solve",
+                 "lstsq"}
+#: Loops around a linear solve that are not Newton loops on a residual of their own, or not yet
+#: moved onto newton_loop: shooting's Newton-Picard (its own method), the mend of a collocated
+#: branch past a corner (equation_branch, another change's file).
+OTHER_LOOPS = {("periodic", "_newton_picard"), ("equation_branch", "_grow")}
+
+
+def solving_loops(tree: ast.Module) -> set[str]:
+    """The functions of a module with a for or while loop whose body calls a linear solve (a
+    Newton loop written out) or solves with a factored matrix (``lu.solve``)."""
+    out = set()
+    for fn in functions(tree):
+        for loop in ast.walk(fn):
+            if not isinstance(loop, (ast.For, ast.While)):
+                continue
+            for n in ast.walk(loop):
+                if not isinstance(n, ast.Call):
+                    continue
+                f = n.func
+                name = f.id if isinstance(f, ast.Name) else f.attr if isinstance(
+                    f, ast.Attribute) else ""
+                factored = (isinstance(f, ast.Attribute) and f.attr == "solve"
+                            and isinstance(f.value, ast.Name) and f.value.id in ("lu", "LU"))
+                if name in LINEAR_SOLVES or factored:
+                    out.add(fn.name)
+    return out
+
+
+def test_one_cache_and_one_newton_loop():
     t = trees()
     caches = {mod for mod, tree in t.items() for n in ast.walk(tree)
               if isinstance(n, ast.Attribute) and n.attr == "_cache"
               and isinstance(n.ctx, ast.Store)}
     assert caches == {"problem"}
-    # Newton's residual bookkeeping (newton.judge) is called by the Newton loops only
+    # Newton's residual bookkeeping (newton.judge) is called by the Newton loop only
     loops = {(mod, fn.name) for mod, tree in t.items() for fn in functions(tree)
              if calls(fn, "judge")}
-    assert loops == {("newton", "bordered_newton"), ("driver", "newton_corrector")}, loops
+    assert loops == {("newton", "newton_loop")}, loops
+    # and no other function iterates around a linear solve
+    written = {(mod, name) for mod, tree in t.items() for name in solving_loops(tree)}
+    assert written - OTHER_LOOPS == set(), written - OTHER_LOOPS
+    # the collocation solves, the driver's corrector and the maps' Newton call it
+    for mod, name in (("collocation_system", "solve"), ("driver", "newton_corrector"),
+                      ("collocation_continuation", "equation_hopf_orbit"),
+                      ("newton", "bordered_newton")):
+        fn = next(f for f in functions(t[mod]) if f.name == name)
+        assert calls(fn, "newton_loop"), f"{mod}.{name} does not use newton_loop"
+
+
+def test_solving_loops_finds_a_newton_loop_written_out():
+    # the check above sees the loop the collocation had before it used newton_loop
+    src = """
+def solve(x, r):
+    for _ in range(25):
+        lu = sla.splu(J(x))
+        dx = lu.solve(-r(x))
+        x = x + dx
+    return x
+
+def chord(x, r, lu):
+    while True:
+        x = x + lu.solve(-r(x))
+"""
+    assert solving_loops(ast.parse(src)) == {"solve", "chord"}
 
 
 def test_import_chain_is_shallower():

@@ -87,3 +87,18 @@ def test_choices_and_fit_recorded():
     assert got is fit and entry == (0, 0) and s.kernel_near_delta == 0.0
     s.set_kernel_exp([-1.0], [0.0], np.ones((1, 1, 1)))
     assert s.kernel_fit is None
+
+
+def test_fit_forgotten_once_its_near_cells_are_removed_or_replaced():
+    # a fit with near cells, then the near cells removed or replaced: the model is no longer the
+    # fit, so kernel_fit must not name it (dmi.analysis and dmi.identify read the kernel from it)
+    from dmi import kernels
+    fit = kernels.fit(kernels.PowerKernel(0.5), 1.0, delta=0.05)
+    assert fit.delta > 0
+    for near in (None, lambda s: np.array([[s ** -0.5]])):
+        s = dmi.Solver(1, 1.0, 100)
+        s.set_quadrature("cell")
+        s.set_kernel_fit(fit)
+        assert s.kernel_fit is not None and s.kernel_near_delta == fit.delta
+        s.set_kernel_near(near, 0.0 if near is None else 0.1)
+        assert s.kernel_fit is None

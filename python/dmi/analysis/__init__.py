@@ -45,7 +45,10 @@ __all__ = [
 from .collocation import collocate  # noqa: E402
 from .equation_orbit import EquationOrbit  # noqa: E402
 
-__all__ += ["collocate", "EquationOrbit"]
+from .collocation_system import CollocationWarning  # noqa: E402
+from .orbit_events import EventWarning  # noqa: E402
+
+__all__ += ["collocate", "EquationOrbit", "CollocationWarning", "EventWarning"]
 from .collocation_continuation import (CollocationDiscretisation,  # noqa: E402
                                        equation_hopf_orbit)
 

@@ -24,10 +24,12 @@ estimated from the jumps of u^(m) between intervals) and refined until the estim
 period (an autonomous orbit; it converges as h^(2m) on smooth orbits) or of the amplitudes (a
 forced orbit; h^(m+1): an extremum is inside an interval) is below ``tol``.
 
-Limits: a kernel with a jump inside (0, tau) at a lag not known to collocation caps the order at
-1 (the exponential sums and the truncation at tau are handled exactly); a user resolvent
-(``set_resolvent``) has no A to collocate (use ``refine_orbit``); near cells of fitted kernels
-(``set_kernel_near``) are not collocated here.
+Kernels: exponential sums and the truncation at tau exactly; a fitted kernel's near part
+s^-beta C on (0, delta] (``set_kernel_fit`` of a fitted PowerKernel) by product integration
+(:mod:`dmi.analysis.collocation_mesh`); jumps of H inside (0, tau) given as ``kernel_jumps`` cut
+the pieces.  Limits: a jump not given caps the order at 1 (a callback kernel is sampled for jumps
+and a CollocationWarning names the lag found); a user resolvent (``set_resolvent``) has no A to
+collocate (use ``refine_orbit``); near cells of any other form are refused.
 """
 from __future__ import annotations
 
@@ -40,8 +42,9 @@ import numpy as np
 from .collocation_floquet import multipliers as floquet
 from .collocation_mesh import delay_matrix, equidistribute, periodic_locator
 from .collocation_signature import read_signature, violations
-from .collocation_system import (Layout, Terms, carried, evaluate, interval_counts, node_times,
-                                 solve, uniform_fractions)
+from .collocation_system import (CollocationWarning, Layout, Terms, carried, evaluate,
+                                 interval_counts, node_times, solve, undeclared_jumps,
+                                 uniform_fractions)
 from .collocation_mend import mend
 from .equation_orbit import EquationOrbit
 from .orbit import Orbit
@@ -57,10 +60,6 @@ MENDS = 4
 MAX_INTERVALS = 4000
 #: The errors' floor, relative to their quantities (Newton's 1e-12 and the conditioning).
 FLOOR = 1e-11
-
-
-class CollocationWarning(RuntimeWarning):
-    """A collocated orbit's verdict that could not be verified (its stability)."""
 
 
 def halved(fractions: list[np.ndarray]) -> list[np.ndarray]:
@@ -258,7 +257,8 @@ def _stable(mu: np.ndarray, err: np.ndarray, autonomous: bool) -> bool | None:
 
 
 def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
-              tol: float = 1e-10, multipliers: int = 10) -> EquationOrbit:
+              tol: float = 1e-10, multipliers: int = 10,
+              kernel_jumps: tuple[float, ...] = ()) -> EquationOrbit:
     """The equation's periodic orbit near an orbit of the scheme, by orthogonal collocation.
 
     Piecewise polynomials of degree m on L mesh intervals of one period, collocated at the
@@ -283,6 +283,11 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
         The error asked (time and state units), > 0.
     multipliers : int
         Leading Floquet multipliers (0: none; ``stable`` is then None).
+    kernel_jumps : sequence of float
+        The lags in (0, tau) where the kernel jumps: the delay integral's pieces are cut there,
+        so the order holds (the orbit keeps them for its continuation).  A jump not given caps
+        the order at 1: a callback kernel is sampled and a jump found is warned of
+        (CollocationWarning, naming its lag).
 
     Returns
     -------
@@ -295,10 +300,10 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     TypeError
         ``orbit`` is not an Orbit of the scheme.
     ValueError
-        Bad degree, intervals or tol; a model with a user resolvent (use ``refine_orbit``) or
-        with near cells; a result that still breaks an inequality of its signature after
-        MENDS mends (the message names it; refine the scheme's orbit); the estimated error
-        still above ``tol`` at the largest mesh.
+        Bad degree, intervals, tol or kernel_jumps; a model with a user resolvent (use
+        ``refine_orbit``) or with near cells not of a fitted PowerKernel; a result that still
+        breaks an inequality of its signature after MENDS mends (the message names it; refine
+        the scheme's orbit); the estimated error still above ``tol`` at the largest mesh.
     ShootingError
         Newton fails.
     """
@@ -313,7 +318,8 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
                          "None to adapt")
     if not (tol > 0 and math.isfinite(tol)):
         raise ValueError(f"collocate: tol = {tol!r}: give a finite tol > 0")
-    terms = Terms(build(orbit.make, orbit.p))
+    terms = Terms(build(orbit.make, orbit.p), kernel_jumps)
+    warn_jumps(terms, "collocate")
     sig, b0 = read_signature(orbit.u, orbit.h, terms.alpha, terms.lo, terms.hi)
     T0 = float(orbit.period)
     lay = Layout(m, terms.n, sig, [], bool(orbit.autonomous), T0, carried(terms, sig))
@@ -398,10 +404,20 @@ def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int) -> Equ
     if count > 0:
         c.mu = floquet(c.lay, terms, c.x, count)
         f.mu = floquet(f.lay, terms, f.x, count)
-    return equation_orbit(f, float(orbit.p), orbit.make, _errors(c, f))
+    return equation_orbit(f, float(orbit.p), orbit.make, _errors(c, f), terms.H.jumps)
 
 
-def equation_orbit(f: Solved, p: float, make: Any, errors: dict[str, Any]) -> EquationOrbit:
+def warn_jumps(terms: Terms, what: str) -> None:
+    """A CollocationWarning for each jump of a callback kernel found and not declared."""
+    for j in undeclared_jumps(terms):
+        warnings.warn(f"{what}: the kernel jumps near the lag s = {j:.10g}, not declared: the "
+                      "order of the collocation is capped at 1 there; give the jump "
+                      f"(kernel_jumps=({j:.10g},) with its exact lag)", CollocationWarning,
+                      stacklevel=3)
+
+
+def equation_orbit(f: Solved, p: float, make: Any, errors: dict[str, Any],
+                   kernel_jumps: tuple[float, ...] = ()) -> EquationOrbit:
     """The EquationOrbit of a solution (its stability verified against ``errors``)."""
     V, b, T = f.lay.split(f.x)
     return EquationOrbit(p=p, period=T, amplitude=f.amplitude, multipliers=f.mu,
@@ -411,7 +427,8 @@ def equation_orbit(f: Solved, p: float, make: Any, errors: dict[str, Any]) -> Eq
                          mesh=f.lay.mesh(b, T), signature=f.lay.signature, switches=b.copy(),
                          make=make, autonomous=f.lay.autonomous, errors=errors,
                          degree=f.lay.m, nodes=V.copy(),
-                         fractions=[fr.copy() for fr in f.lay.fractions], carried=f.lay.carried)
+                         fractions=[fr.copy() for fr in f.lay.fractions], carried=f.lay.carried,
+                         kernel_jumps=tuple(kernel_jumps))
 
 
 __all__ = ["collocate", "CollocationWarning"]

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -31,14 +32,14 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 
 from .collocation import (CollocationWarning, Solved, _errors, _reference, adapted,
-                          check_inequalities, equation_orbit, merged, transfer)
+                          check_inequalities, equation_orbit, merged, transfer, warn_jumps)
 from .collocation_mend import mend
 from .collocation_mesh import periodic_locator, point_matrix
 from .collocation_signature import SLIP_NEG, SLIP_POS, Signature
 from .collocation_system import Layout, Terms, assemble, full_jacobian, node_times, solve
 from .driver import bordered_solve
 from .equation_orbit import EquationOrbit
-from .newton import ShootingError
+from .newton import ShootingError, newton_loop
 from .problem import Problem
 from .branch import HopfPoint
 from .stepmap import Model, build
@@ -61,11 +62,14 @@ class CollocationDiscretisation:
     estimate : bool
         A point's errors from the solve on the mesh with every pair of intervals merged (False:
         none, ``errors`` empty and ``stable`` None: a verdict needs the multipliers' errors).
+    kernel_jumps : sequence of float
+        The lags of the kernel's jumps (cuts of the delay integral's pieces at every p).
     """
 
     def __init__(self, make: Model, layout: Layout, x: np.ndarray, *, multipliers: int = 10,
-                 estimate: bool = True):
+                 estimate: bool = True, kernel_jumps: tuple[float, ...] = ()):
         self.make, self.lay = make, layout
+        self.jumps = tuple(kernel_jumps)
         self.count, self.estimate = int(multipliers), bool(estimate)
         self.problem = Problem(make, keep=5)   # the terms of the last few p
         self.ref = _reference(layout, x) if layout.autonomous else None
@@ -98,7 +102,9 @@ class CollocationDiscretisation:
                      orbit.autonomous, orbit.period, tuple(orbit.carried))
         x = np.concatenate([orbit.nodes.ravel(), orbit.switches,
                             [orbit.period] if orbit.autonomous else []])
-        return cls(orbit.make, lay, x, **kw), x
+        disc = cls(orbit.make, lay, x, **kw)
+        disc.jumps = tuple(orbit.kernel_jumps)      # the orbit's, before any terms are built
+        return disc, x
 
     def terms(self, p: float) -> Terms:
         """The model's terms at p (the last few cached).
@@ -114,7 +120,8 @@ class CollocationDiscretisation:
             f, its derivative, the kernel, A's coefficients of ``make(p)``.
         """
         key = float(p)
-        return self.problem.cached(("terms", key), lambda: Terms(build(self.make, key)))
+        return self.problem.cached(("terms", key),
+                                   lambda: Terms(build(self.make, key), self.jumps))
 
     def residual(self, x: np.ndarray, p: float) -> np.ndarray:
         """The collocation system's residual.
@@ -190,7 +197,7 @@ class CollocationDiscretisation:
                 return None
             # the difference to the mesh of merged pairs is about 2^q - 1 >= 1 times the error
             errors = _errors(Solved(coarse, terms, xc, self.count), here)
-        return equation_orbit(here, float(p), self.make, errors)
+        return equation_orbit(here, float(p), self.make, errors, self.jumps)
 
     def event_functions(self, x: np.ndarray, p: float, point: EquationOrbit | None
                         ) -> dict[str, float]:
@@ -280,7 +287,8 @@ def _hhat(terms: Terms, lam: complex) -> np.ndarray:
 
 def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude: float, *,
                         degree: int = 4, intervals: int = 24, multipliers: int = 10,
-                        tol: float = 1e-12, max_iter: int = 30) -> EquationOrbit:
+                        tol: float = 1e-12, max_iter: int = 30,
+                        kernel_jumps: tuple[float, ...] = ()) -> EquationOrbit:
     """The equation's periodic orbit born at a Hopf point, of a given amplitude, p free.
 
     Parameters
@@ -304,6 +312,9 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
         Newton's tolerance on the correction.
     max_iter : int
         Newton iterations at most.
+    kernel_jumps : sequence of float
+        The lags in (0, tau) where the kernel jumps (as :func:`dmi.analysis.collocate`'s; an
+        undeclared jump of a callback kernel found is warned of).
 
     Returns
     -------
@@ -314,7 +325,8 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     Raises
     ------
     ValueError
-        Bad input: not a HopfPoint, omega <= 0, amplitude <= 0, u_eq not n numbers.
+        Bad input: not a HopfPoint, omega <= 0, amplitude <= 0, u_eq not n numbers, a jump
+        outside (0, tau).
     ShootingError
         Newton fails.
     """
@@ -326,7 +338,8 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     if not (a > 0 and math.isfinite(a)):
         raise ValueError(f"amplitude = {amplitude!r}: give a finite amplitude > 0")
     p0, om = float(hopf_point.p), float(hopf_point.omega)
-    terms = Terms(build(make, p0))
+    terms = Terms(build(make, p0), kernel_jumps)
+    warn_jumps(terms, "hopf_orbit")
     n = terms.n
     ue = np.asarray(u_eq, dtype=float).ravel()
     if ue.shape != (n,):
@@ -342,26 +355,29 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     t = node_times(lay, np.empty(0), T)
     V = ue + a * np.real(np.outer(np.exp(1j * om * t), v))
     x = np.concatenate([V.ravel(), [T]])
-    disc = CollocationDiscretisation(make, lay, x, multipliers=multipliers)
+    disc = CollocationDiscretisation(make, lay, x, multipliers=multipliers,
+                                     kernel_jumps=terms.H.jumps)
     gz, gw = lay.basis.gauss()
-    z = np.concatenate([x, [p0]])
-    for _ in range(max_iter):
-        x, p = z[:-1], z[-1]
-        r = disc.residual(x, p)
-        J, Jp = disc.jacobian(x, p)
-        g, grow = _amplitude_condition(lay, x, ue, c, a, gz, gw)
-        dz = bordered_solve(J, Jp, grow, -np.concatenate([r, [g]]))
-        z = z + dz
-        if np.max(np.abs(dz)) <= tol * max(1.0, float(np.max(np.abs(z)))):
-            pt = disc.point(z[:-1], z[-1])
-            if pt is None:            # no estimate at fixed p (a vertical branch): none given
-                disc.estimate = False
-                pt = disc.point(z[:-1], z[-1])
-            if pt is None:
-                raise ShootingError("the orbit from the Hopf point breaks its signature", [])
-            return pt
-    raise ShootingError(f"the orbit from the Hopf point at p = {p0!r}: no convergence in "
-                        f"{max_iter} Newton iterations", [])
+
+    def evaluate(z: np.ndarray) -> tuple[np.ndarray, None]:
+        g, _ = _amplitude_condition(lay, z[:-1], ue, c, a, gz, gw)
+        return np.concatenate([disc.residual(z[:-1], z[-1]), [g]]), None
+
+    def factor(z: np.ndarray, r: np.ndarray, state: None) -> Callable[[np.ndarray], np.ndarray]:
+        J, Jp = disc.jacobian(z[:-1], z[-1])
+        grow = _amplitude_condition(lay, z[:-1], ue, c, a, gz, gw)[1]
+        return lambda r: bordered_solve(J, Jp, grow, -r)
+
+    z, _ = newton_loop(evaluate, factor, np.concatenate([x, [p0]]), tol=tol,
+                       max_iter=max_iter, what=f"the orbit from the Hopf point at p = {p0!r}",
+                       converge="correction", stall=False)
+    pt = disc.point(z[:-1], z[-1])
+    if pt is None:            # no estimate at fixed p (a vertical branch): none given
+        disc.estimate = False
+        pt = disc.point(z[:-1], z[-1])
+    if pt is None:
+        raise ShootingError("the orbit from the Hopf point breaks its signature", [])
+    return pt
 
 
 def _slipping(terms: Terms, ue: np.ndarray) -> np.ndarray:

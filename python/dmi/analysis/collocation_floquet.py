@@ -91,3 +91,71 @@ def multipliers(lay: Layout, terms: Terms, x: np.ndarray, count: int = 10) -> np
         mu = sl.eigvals(monodromy(lay, terms, x))
     mu = mu[np.argsort(-np.abs(mu), kind="stable")][:count]
     return np.where(np.abs(mu) < 1e-12, 0.0, mu)
+
+
+def eigenfunction(lay: Layout, terms: Terms, x: np.ndarray, near: complex = -1.0
+                  ) -> tuple[complex, np.ndarray]:
+    """The Floquet eigenfunction of the multiplier nearest ``near`` over one period, as node
+    values on the orbit's own mesh (for :func:`dmi.analysis.period_doubled_orbit`).
+
+    The eigenvector of :func:`monodromy` is the past over [-tau, 0]; the linearised collocation
+    system of the period from that past (the same system :func:`monodromy` solves) gives the
+    perturbation at the period's nodes, the eigenfunction v on [0, T) (v(t + T) = mu v(t)).  On
+    an orbit with switches these are the node values' perturbations (the nodes move with the
+    switches; the saltation is left out).
+
+    Parameters
+    ----------
+    lay : Layout
+        The orbit's layout.
+    terms : Terms
+        The model's terms at the orbit's p.
+    x : numpy.ndarray
+        The orbit's unknowns.
+    near : complex
+        The multiplier wanted (-1: a period doubling's).
+
+    Returns
+    -------
+    tuple
+        (mu, V): the multiplier nearest ``near`` and the eigenfunction's values (L m, n) at the
+        node times (:func:`dmi.analysis.collocation_system.node_times`), complex, largest
+        |value| 1.
+
+    Raises
+    ------
+    ValueError
+        The eigenfunction vanishes on the period (a multiplier 0).
+    """
+    m, n, L = lay.m, lay.n, lay.L
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    P = max(1, math.ceil(terms.tau / T - 1e-12))
+    k = np.arange(m + 1)
+    cols = (np.arange(L)[:, None] * m + k[None, :]) % lay.rows
+    phi = np.tile(V[cols], (P, 1, 1)).reshape(-1, n)
+    _, J = full_jacobian(lay, terms, x, None, history=History(mesh, P, phi))
+    J = sp.csc_matrix(J)
+    nc = (lay.rows + 1) * n
+    nh = P * L * (m + 1) * n
+    # the past's intervals that meet (-tau, 0], as monodromy's state (its columns' order)
+    g = np.arange(P * L)
+    state = g[mesh[g % L + 1] - (P - g // L) * T > -terms.tau + 1e-14 * T]
+    if state.size == 0 or state[-1] != P * L - 1:
+        state = np.append(state, P * L - 1)
+    scol = (state[:, None, None] * (m + 1) * n + k[None, :, None] * n
+            + np.arange(n)[None, None, :]).ravel()
+    with _one_blas_thread():
+        mu, Y = sl.eig(monodromy(lay, terms, x))
+    j = int(np.argmin(np.abs(mu - near)))
+    Jcur = sp.hstack([J[:, :nc], J[:, nc + nh:]], format="csc")
+    lu = sla.splu(Jcur)
+    rhs = J[:, nc + scol] @ Y[:, j]
+    re, im = np.ascontiguousarray(rhs.real), np.ascontiguousarray(rhs.imag)
+    dV = -(lu.solve(re) + 1j * lu.solve(im))
+    out = dV[:lay.rows * n].reshape(lay.rows, n)
+    big = float(np.max(np.abs(out)))
+    if not big > 0:
+        raise ValueError(f"the eigenfunction of the multiplier {mu[j]:.6g} vanishes on the "
+                         "period: no direction to follow")
+    return complex(mu[j]), out / out.flat[int(np.argmax(np.abs(out)))]

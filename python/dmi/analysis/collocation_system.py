@@ -19,7 +19,6 @@ central differences of the residual.
 """
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -30,15 +29,20 @@ import scipy.sparse.linalg as sla
 
 from .._solver import Solver
 from ._model import FD_STEP
-from .collocation_mesh import (Basis, Locator, delay_matrix, history_locator, history_rows,
-                               periodic_locator, point_matrix)
+from .collocation_mesh import (STEEP, Basis, Kernel, Locator, Near, delay_matrix,
+                               history_locator, history_rows, periodic_locator, point_matrix)
 from .collocation_signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
-from .newton import ShootingError
+from .newton import ShootingError, newton_loop
 
 #: Quadrature nodes a piece of the delay integral: m + QUAD_EXTRA (exact for H u with u of
 #: degree m and H of degree m + 2 QUAD_EXTRA - 1 on the piece; the error h^(2m + 2 QUAD_EXTRA + 1)
 #: a piece stays below the collocation's h^(2m) at the mesh points).
 QUAD_EXTRA = 1
+
+
+class CollocationWarning(RuntimeWarning):
+    """A collocated orbit's verdict that could not be verified (its stability), or an order
+    the method cannot reach (a kernel's jump at a lag not declared)."""
 
 
 class Terms:
@@ -48,24 +52,23 @@ class Terms:
     ----------
     solver : dmi.Solver
         The model at p (configured; its step is not used).
+    jumps : sequence of float
+        Lags in (0, tau) where the kernel jumps (cuts of the delay integral's pieces).
 
     Raises
     ------
     ValueError
         A user resolvent (``set_resolvent``): no A to collocate (use ``refine_orbit``); near
-        cells of a fitted kernel (``set_kernel_near``), not collocated here.
+        cells whose kernel is not s^-beta C with a known beta (``set_kernel_near`` alone, or a
+        ``near=`` kernel of ``set_kernel_fit`` other than the fit's PowerKernel); a jump outside
+        (0, tau).
     """
 
-    def __init__(self, solver: Solver):
+    def __init__(self, solver: Solver, jumps: tuple[float, ...] = ()):
         if solver.resolvent_kind == "callback":
             raise ValueError("collocate: the model sets its own resolvent (set_resolvent): "
                              "collocation needs the operator A itself (set_friction, set_box or "
                              "none); use dmi.analysis.refine_orbit for this model")
-        if solver.has("kernel_near"):
-            raise ValueError("collocate: the model's kernel has exact near cells "
-                             f"(set_kernel_near, delta = {solver.kernel_near_delta!r}): their "
-                             "product integration is not collocated here; use refine_orbit, or "
-                             "a kernel without near cells")
         self.solver = solver
         self.n, self.tau = solver.n, float(solver.tau)
         alpha = solver.friction
@@ -76,6 +79,9 @@ class Terms:
         self.terms = solver.kernel_terms
         self.kind = solver.kernel_kind
         self.has_rhs = solver.has("rhs")
+        rate = float(np.max(-self.terms[0], initial=0.0)) if self.kind == "exp" else 0.0
+        self.H = Kernel(self._far, near_part(solver), kernel_jumps(jumps, self.tau),
+                        rate if rate * self.tau > STEEP else 0.0)
 
     def f(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
         """f(t_c, U_c) (P, n) at the times t (P,) and states U (P, n)."""
@@ -107,7 +113,9 @@ class Terms:
         nonzero C or D entries; all for a callback)."""
         if self.kind == "exp":
             _, _, C, D = self.terms  # type: ignore[misc]
-            return np.any(C != 0, axis=0) | np.any(D != 0, axis=0)
+            near = self.H.near
+            return (np.any(C != 0, axis=0) | np.any(D != 0, axis=0)
+                    | (near.C != 0 if near is not None else False))
         return np.ones((self.n, self.n), bool)
 
     @property
@@ -115,9 +123,9 @@ class Terms:
         """Whether the model has a kernel."""
         return self.kind != ""
 
-    def H(self, s: np.ndarray) -> np.ndarray:
-        """H(s) (P, n, n) at the lags s (P,): an exponential sum in closed form, a callback one
-        lag at a time."""
+    def _far(self, s: np.ndarray) -> np.ndarray:
+        """H(s) (P, n, n) at the lags s (P,) (past a near part's delta): an exponential sum in
+        closed form, a callback one lag at a time."""
         s = np.asarray(s, dtype=float)
         if self.kind == "exp":
             a, b, C, D = self.terms  # type: ignore[misc]
@@ -128,6 +136,85 @@ class Terms:
         if not np.all(np.isfinite(out)):
             raise ValueError("collocate: the model's kernel is not finite on (0, tau)")
         return out
+
+
+def near_part(solver: Solver) -> Near | None:
+    """The near part s^-beta C on (0, delta] of a model's kernel (None without near cells): beta
+    is the exponent of the fit's PowerKernel (``Solver.kernel_fit``), C read from the near kernel
+    at delta and checked to be the same at delta / 2, delta / 7 and delta / 50 (relative 1e-12).
+
+    Raises
+    ------
+    ValueError
+        Near cells without a fit whose kernel has an exponent, or a near kernel not of the form
+        s^-beta C.
+    """
+    if not solver.has("kernel_near"):
+        return None
+    delta = float(solver.kernel_near_delta)
+    fit = solver.kernel_fit
+    beta = getattr(getattr(fit[0], "kernel", None), "beta", None) if fit is not None else None
+    if beta is None:
+        raise ValueError("collocate: the model's kernel has exact near cells (delta = "
+                         f"{delta!r}) whose form s^-beta g(s) is not known: product integration "
+                         "needs the exponent; set the kernel with Solver.set_kernel_fit of a fit "
+                         "of a dmi.kernels.PowerKernel (fit.kernel keeps its beta), or use "
+                         "refine_orbit")
+    lags = delta / np.array([1.0, 2.0, 7.0, 50.0])
+    K = np.array([solver.eval_kernel_near(float(x)) * x ** beta for x in lags])
+    if not (np.all(np.isfinite(K)) and np.max(np.abs(K - K[0])) <= 1e-12 * max(
+            float(np.max(np.abs(K[0]))), 1e-300)):
+        raise ValueError("collocate: the near kernel (set_kernel_fit's near=, or "
+                         f"set_kernel_near) is not s^-beta C with the fit's beta = {beta!r} on "
+                         f"(0, {delta!r}]: product integration needs that form; give the fit's "
+                         "own PowerKernel as the near kernel, or use refine_orbit")
+    return Near(delta, float(beta), K[0])
+
+
+def kernel_jumps(jumps: Any, tau: float) -> tuple[float, ...]:
+    """The declared jumps, checked and sorted.
+
+    Raises
+    ------
+    ValueError
+        A lag not finite or outside (0, tau).
+    """
+    out = sorted(float(j) for j in np.atleast_1d(np.asarray(jumps, dtype=float)))
+    bad = [j for j in out if not (0.0 < j < tau)]
+    if bad:
+        raise ValueError(f"collocate: kernel_jumps = {jumps!r}: {bad[0]!r} is not inside (0, "
+                         f"tau = {tau!r}); give the lags in (0, tau) where H jumps")
+    return tuple(out)
+
+
+def undeclared_jumps(terms: Terms, samples: int = 1024) -> list[float]:
+    """Lags in (0, tau) where a callback kernel jumps and that are not declared: H sampled at
+    ``samples`` lags, a cell whose difference is 4 times both its neighbours' bisected 50 times
+    towards the larger half; a jump keeps 1e-3 of its first difference, a smooth H loses 2^-50
+    of it.  Empty for an exponential sum (smooth past its near part)."""
+    if terms.kind != "callback":
+        return []
+    K = terms.H
+    s = np.linspace(0.0, terms.tau, samples + 1)[1:]
+    V = K(s).reshape(s.size, -1)
+    D = np.max(np.abs(np.diff(V, axis=0)), axis=1)
+    big = float(np.max(np.abs(V)))
+    Dn = np.maximum(np.r_[0.0, D[:-1]], np.r_[D[1:], 0.0])
+    found = []
+    for c in np.flatnonzero((D > 4 * Dn) & (D > 1e-12 * big)):
+        lo, hi = float(s[c]), float(s[c + 1])
+        if any(lo - 1e-12 * terms.tau <= j <= hi + 1e-12 * terms.tau for j in K.jumps):
+            continue
+        for _ in range(50):
+            mid = 0.5 * (lo + hi)
+            v = K(np.array([lo, mid, hi])).reshape(3, -1)
+            if np.max(np.abs(v[1] - v[0])) >= np.max(np.abs(v[2] - v[1])):
+                hi = mid
+            else:
+                lo = mid
+        if np.max(np.abs(np.diff(K(np.array([lo, hi])).reshape(2, -1), axis=0))) > 1e-3 * D[c]:
+            found.append(0.5 * (lo + hi))
+    return found
 
 
 @dataclass
@@ -407,49 +494,30 @@ def full_jacobian(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None
 def solve(lay: Layout, terms: Terms, x0: np.ndarray, ref: Callable | None, *,
           tol: float = 1e-12, max_iter: int = 25, what: str = "collocation"
           ) -> tuple[np.ndarray, list[float]]:
-    """Newton's method on the collocation system with sparse LU: the factored Jacobian is kept
-    while the residual falls by 10 or more a step (chord steps cost a residual), refreshed
-    otherwise, and a fresh step is halved until the residual falls; converged when the
-    correction is below tol max(1, |x|_inf) (that correction applied).
+    """Newton's method on the collocation system with sparse LU (:func:`newton_loop`): the
+    factored Jacobian is kept while the residual falls by 10 or more a step (chord steps cost a
+    residual), refreshed otherwise, and a fresh step is halved until the residual falls;
+    converged when the correction is below tol max(1, |x|_inf) (that correction applied).
 
     Raises
     ------
     ShootingError
-        No convergence in max_iter, a singular Jacobian, a non-finite residual, a segment that
-        vanishes on a fresh step (the signature changed).
+        No convergence in max_iter, no progress, a singular Jacobian, a non-finite residual, a
+        segment that vanishes on a fresh step (the signature changed).
     """
-    x = np.array(x0, dtype=float)
     res: list[float] = []
-    r = assemble(lay, terms, x, ref, jacobian=False)[0]
-    lu, age = None, 0
-    for _ in range(max_iter):
-        rn = float(np.max(np.abs(r)))
-        res.append(rn)
-        if not math.isfinite(rn):
-            raise ShootingError(f"{what}: non-finite residual", res)
-        if lu is None or (len(res) > 1 and rn > 0.1 * res[-2]):
-            lu, age = _factor(lay, terms, x, ref, what, res), 0
-        dx = lu.solve(-r)
-        age += 1
-        if np.max(np.abs(dx)) <= tol * max(1.0, float(np.max(np.abs(x)))):
-            return x + dx, res
-        lam = 1.0
-        while True:
-            try:
-                r1 = assemble(lay, terms, x + lam * dx, ref, jacobian=False)[0]
-                if np.max(np.abs(r1)) < rn or lam < 0.05:
-                    break
-            except Degenerate:
-                if lam < 0.05:
-                    raise ShootingError(f"{what}: a segment vanishes (the signature "
-                                        "changed)", res) from None
-            if age > 1:                          # a stale Jacobian: refresh it, not the step
-                lu, age = _factor(lay, terms, x, ref, what, res), 1
-                dx, lam = lu.solve(-r), 1.0
-                continue
-            lam *= 0.5
-        x, r = x + lam * dx, r1
-    raise ShootingError(f"{what}: no convergence in {max_iter} Newton iterations", res)
+
+    def evaluate(x: np.ndarray) -> tuple[np.ndarray, None]:
+        return assemble(lay, terms, x, ref, jacobian=False)[0], None
+
+    def factor(x: np.ndarray, r: np.ndarray, state: None) -> Callable[[np.ndarray], np.ndarray]:
+        lu = _factor(lay, terms, x, ref, what, res)
+        return lambda r: lu.solve(-r)
+
+    return newton_loop(evaluate, factor, x0, tol=tol, max_iter=max_iter, what=what,
+                       converge="correction", chord=0.1, search="descent", reject=(Degenerate,),
+                       reject_why="a segment vanishes (the signature changed)", history=res,
+                       stall=False)
 
 
 def _factor(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None, what: str,
@@ -460,6 +528,7 @@ def _factor(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None, what
         return sla.splu(J)
     except RuntimeError as err:
         raise ShootingError(f"{what}: singular Jacobian ({err})", res) from None
+
 
 def interval_counts(lengths: np.ndarray, L: int) -> np.ndarray:
     """L intervals shared by pieces of these lengths (or weights), at least 1 each."""
@@ -489,8 +558,10 @@ def node_times(lay: Layout, b: np.ndarray, T: float) -> np.ndarray:
 
 
 def carried(terms: Terms, sig: Any) -> tuple[float, ...]:
-    """The lags at which the memory carries a switch forward: (tau,) where H(tau) != 0 on an
-    orbit with switches (the delay integral's derivative jumps at b_k + tau), else ()."""
+    """The lags at which the memory carries a switch forward on an orbit with switches: the
+    declared jumps of H and tau where H(tau) != 0 (the delay integral's derivative jumps at
+    b_k + s_j), else ()."""
     if sig.switches == 0 or not terms.has_kernel:
         return ()
-    return (terms.tau,) if np.any(terms.H(np.array([terms.tau])) != 0) else ()
+    end = (terms.tau,) if np.any(terms.H(np.array([terms.tau])) != 0) else ()
+    return terms.H.jumps + end

@@ -56,6 +56,7 @@ two points shortened 64 times, each middle corrected across the chord).
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 from typing import Any
 
@@ -63,8 +64,13 @@ import numpy as np
 
 from .._solver import Solver
 from .branch import Branch, BranchPoint, Event
+from .collocation import CollocationWarning
+from .collocation_continuation import CollocationDiscretisation
+from .collocation_floquet import eigenfunction
+from .collocation_system import Layout, evaluate, solve
 from .driver import continuation
 from .equation_branch import continue_equation_orbit
+from .equation_orbit import EquationOrbit
 from .floquet import Verify, phase_free, ritz
 from .newton import ShootingError
 from .orbit import Orbit, make_orbit
@@ -97,7 +103,9 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     and Newton's corrector on the sparse collocation system, the mesh equidistributed after
     every step and the signature mended where a segment vanishes or an inequality breaks
     (``stick-onset`` and ``grazing`` events where it changes), the multipliers' events
-    (``period-doubling``, ``torus``) and the fold, landing on p_end and ``at=``.  Of the
+    (``period-doubling``, ``torus``: verified, reported only where the multiplier crosses the
+    unit circle beyond its estimated error on both sides, else an ``EventWarning``; see
+    :mod:`dmi.analysis.orbit_events`) and the fold, landing on p_end and ``at=``.  Of the
     options, ``step``, ``max_points``, ``min_step``, ``max_step``, ``multipliers`` (a point's
     leading multipliers), ``tol`` (at most 1e-12 is used: the corrector's error stays below
     the collocation's), ``max_iter`` and ``at`` apply; ``period=`` (the period is an
@@ -147,7 +155,9 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
     verify : dmi.analysis.Verify, optional
         Verify every point's multipliers and stability (:func:`dmi.analysis.floquet_verdict`,
         kept in ``BranchPoint.floquet``; the multipliers' events then leave out the verified
-        trivial multiplier).  None: the Ritz multipliers, ``stable`` from them unverified.
+        trivial multiplier, and are reported only where the multipliers of their kind lie off
+        the unit circle beyond their error bounds on both points, else an ``EventWarning``).
+        None: the Ritz multipliers, ``stable`` from them unverified.
 
     Returns
     -------
@@ -263,8 +273,9 @@ def refined_event(maps: Any, a: BranchPoint, b: BranchPoint, e: Event, multiplie
 
 def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[float, ...] =
                          (0.03, 0.1, 0.3, 1.0), multipliers: int = 6, tol: float = 1e-10
-                         ) -> Orbit:
-    """The period-2M orbit born at a ``period-doubling`` event of a forced branch.
+                         ) -> Orbit | EquationOrbit:
+    """The period-2M orbit born at a ``period-doubling`` event of a branch (scheme's or
+    collocated).
 
     At the point of the event's pair where the M-periodic orbit has a multiplier < -1 (its
     unstable side, where a supercritical doubling's orbit lives) the M-periodic state x is
@@ -273,6 +284,17 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
     and shot with period 2 M h; the first solution that is not the M-periodic orbit is returned.
     Continue it with ``continue_orbit(..., sections=2 * branch.sections)``, and
     ``period=lambda p: 2 * P(p)`` for a branch continued with ``period=P``.
+
+    On a collocated branch (of EquationOrbits: ``continue_orbit`` of an EquationOrbit,
+    ``hopf_orbit(..., of="equation")``) of smooth orbits, forced or autonomous: at the point of
+    the pair with a real multiplier below -1 by more than its estimated error, the orbit laid
+    twice around (its own mesh twice, period 2 T) plus a A v on the first lap and -a A v on the
+    second, v the multiplier's eigenfunction over the period
+    (:func:`dmi.analysis.collocation_floquet.eigenfunction`), is collocated (Newton with sparse
+    LU, the mesh equidistributed and solved again) and returned as an EquationOrbit of period
+    2 T (a forced one: exactly twice the forcing period) with its multipliers and error
+    estimates, once |u(t + T) - u(t)| exceeds 100 times the estimated error of u (distinct
+    from the T-orbit, verified).  ``continue_orbit`` continues it (no ``sections=``).
 
     Parameters
     ----------
@@ -285,26 +307,29 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
     multipliers : int
         Floquet multipliers of the orbit returned.
     tol : float
-        Newton's tolerance.
+        Newton's tolerance (the scheme's; a collocated orbit is solved to 1e-12).
 
     Returns
     -------
-    Orbit
-        The period-doubled orbit.
+    Orbit or EquationOrbit
+        The period-doubled orbit (an EquationOrbit on a collocated branch).
 
     Raises
     ------
     ValueError
-        The event is not a period doubling; a collocated branch (not taken yet).
+        The event is not a period doubling; on a collocated branch: neither point has a real
+        multiplier below -1 beyond its estimated error, the orbit has switches (stick-slip:
+        shoot the scheme's orbit, period 2 P, and collocate it), or the multiplier nearest -1
+        is not real and negative.
     ShootingError
-        No period-doubled orbit found (what each kick gave is listed).
+        No period-doubled orbit found (what each kick gave is listed: Newton's failure, or a
+        return to the T-orbit).
     """
     if event.kind != "period-doubling":
         raise ValueError(f"event {event.kind!r}: expected a 'period-doubling' event")
     if any(getattr(q, "of", "scheme") == "equation" for q in branch.points):
-        raise ValueError("period_doubled_orbit: a collocated branch (of EquationOrbits) is not "
-                         "taken yet; shoot the scheme's orbit there (periodic_orbit at the "
-                         "event's p, period 2 P), then collocate it")
+        return _doubled_equation_orbit(branch.points[event.index - 1],
+                                      branch.points[event.index], amplitudes, multipliers)
     a, b = branch.points[event.index - 1], branch.points[event.index]
     q = a if np.any(a.multipliers.real < -1) else b
     maps = ForcedMaps(branch.make, branch.steps, branch.h, branch.rows, branch.period)
@@ -333,6 +358,79 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
         tried.append(f"a = {s}: converged to the M-periodic orbit")
     raise ShootingError(f"no period-doubled orbit at p = {q.p!r} (multiplier {mu[j]:.4g}): "
                         + "; ".join(tried), [])
+
+
+def _doubled_equation_orbit(a: EquationOrbit, b: EquationOrbit, amplitudes: tuple[float, ...],
+                           multipliers: int) -> EquationOrbit:
+    """:func:`period_doubled_orbit` on a collocated branch, between its points a and b.
+
+    At the point of the pair with a real multiplier beyond -1 (beyond its estimated error) the
+    orbit is laid twice around a mesh of the period 2 T (its own mesh twice), plus s A v on the
+    first lap and -s A v on the second, v the eigenfunction of the multiplier
+    (:func:`dmi.analysis.collocation_floquet.eigenfunction`, |v|_inf = 1), A the orbit's
+    largest amplitude, s from ``amplitudes``; Newton (sparse LU) on the collocation system of
+    the period 2 T, the mesh equidistributed and solved again, the point with its error
+    estimates (the merged mesh's).  It is returned when u(t + T) - u(t) exceeds 100 times the
+    estimated error of u: verified distinct from the T-orbit."""
+    q = next((o for o in (a, b) if _beyond_minus_one(o)), None)
+    if q is None:
+        raise ValueError(f"period_doubled_orbit: neither point of the event (p = {a.p!r}, "
+                         f"{b.p!r}) has a real multiplier beyond -1 by more than its estimated "
+                         "error: the doubling is not verified there; continue the branch with "
+                         "a smaller step past the event")
+    if q.switches.size:
+        raise ValueError(f"period_doubled_orbit: the collocated orbit at p = {q.p!r} has "
+                         f"switches ({', '.join(q.signature.describe())}): only smooth orbits "
+                         "are doubled on a collocated branch; shoot the scheme's orbit there "
+                         "(periodic_orbit at p, period 2 P) and collocate it")
+    disc, x = CollocationDiscretisation.of(q, multipliers=multipliers)
+    lay, terms, T = disc.lay, disc.terms(q.p), float(q.period)
+    mu, E = eigenfunction(lay, terms, x, -1.0)
+    if not (mu.real < 0 and abs(mu.imag) <= 1e-9 * abs(mu)):
+        raise ValueError(f"period_doubled_orbit: the multiplier nearest -1 at p = {q.p!r} is "
+                         f"{mu:.6g}, not real and negative: no period doubling to follow there")
+    v = E.real / float(np.max(np.abs(E.real)))
+    f = lay.fractions[0]
+    lay2 = Layout(lay.m, lay.n, lay.signature, [np.concatenate([0.5 * f, 0.5 + 0.5 * f[1:]])],
+                  lay.autonomous, 2 * T, lay.carried)
+    V = q.nodes
+    amp = max(float(np.max(q.amplitude)), 1e-3 * max(1.0, float(np.max(np.abs(V)))))
+    tried = []
+    for s in amplitudes:
+        x0 = np.concatenate([np.concatenate([V + s * amp * v, V - s * amp * v]).ravel(),
+                             [2 * T] if lay.autonomous else []])
+        d2 = CollocationDiscretisation(q.make, lay2, x0, multipliers=multipliers)
+        d2.problem = disc.problem
+        try:
+            xs, _ = solve(lay2, terms, x0, d2.ref, what=f"the doubled orbit at p = {q.p!r}")
+            xs = d2.adapt(xs, q.p)
+            xs, _ = solve(d2.lay, terms, xs, d2.ref, what=f"the doubled orbit at p = {q.p!r}")
+        except (ShootingError, ValueError) as e:
+            tried.append(f"s = {s}: {e}")
+            continue
+        T2 = d2.lay.split(xs)[2]
+        t = np.linspace(0.0, 0.5 * T2, 40 * d2.lay.L, endpoint=False)
+        gap = float(np.max(np.abs(evaluate(d2.lay, xs, t + 0.5 * T2) - evaluate(d2.lay, xs, t))))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", CollocationWarning)
+            o = d2.point(xs, q.p)
+        if o is None or not o.errors:
+            tried.append(f"s = {s}: no error estimate (the merged mesh's solve failed)")
+            continue
+        if gap > 100 * float(o.errors["u"]):
+            return o
+        tried.append(f"s = {s}: returned to the T-orbit (|u(t + T) - u(t)| = {gap:.3g}, its "
+                     f"estimated error {float(o.errors['u']):.3g})")
+    raise ShootingError(f"no period-doubled orbit at p = {q.p!r} (multiplier {mu:.6g}): "
+                        + "; ".join(tried), [])
+
+
+def _beyond_minus_one(o: EquationOrbit) -> bool:
+    """A real multiplier of o below -1 by more than its estimated error."""
+    mu = np.asarray(o.multipliers)
+    err = np.asarray(o.errors.get("multipliers", np.full(mu.shape, np.inf)))
+    real = np.abs(mu.imag) <= 1e-9 * np.maximum(1.0, np.abs(mu))
+    return bool(np.any(real & (mu.real < -1 - err)))
 
 
 __all__ = ["Branch", "BranchPoint", "Event", "continue_orbit", "period_doubled_orbit"]

@@ -94,7 +94,7 @@ import scipy.sparse
 import scipy.sparse.linalg as sla
 
 from .branch import Branch, Event
-from .newton import ShootingError, fmt_residuals, judge
+from .newton import ShootingError, fmt_residuals, newton_loop
 
 #: |dp/ds| below which a branch is vertical: a sign change of dp/ds there is noise, not a fold.
 VERTICAL = 1e-6
@@ -314,31 +314,31 @@ def newton_corrector(curve: Curve, zp: np.ndarray, row: np.ndarray, target: floa
         No convergence, no progress, a singular Jacobian, non-finite values, or an iterate
         farther than ``far`` (every residual listed).
     """
-    z = np.array(zp, dtype=float)
     res: list[float] = []
-    moved = math.inf
-    for _ in range(max_iter + 1):
-        r = curve.residual(z)
-        g = float(row @ z - target)
-        rn = max(float(np.max(np.abs(r))) if r.size else 0.0, abs(g))
-        scale = tol * max(1.0, float(np.max(np.abs(z[:-1]))))
-        verdict = judge(res, rn, scale, max_iter, what)
-        if verdict == "converged" and moved <= scale:
-            return z, len(res) - 1
-        if verdict == "exhausted":
-            break
+
+    def evaluate(z: np.ndarray) -> tuple[np.ndarray, None]:
+        return np.concatenate([curve.residual(z), [float(row @ z - target)]]), None
+
+    def factor(z: np.ndarray, r: np.ndarray, state: None) -> Callable[[np.ndarray], np.ndarray]:
         Jx, Jp = curve.jacobian(z)
-        try:
-            d = bordered_solve(Jx, Jp, row, -np.concatenate([r, [g]]))
-        except ShootingError as e:
-            raise ShootingError(f"{what}: {e} (residuals {fmt_residuals(res)})", res) from None
-        moved = float(np.max(np.abs(d)))
-        z = z + d
+
+        def solve(r: np.ndarray) -> np.ndarray:
+            try:
+                return bordered_solve(Jx, Jp, row, -r)
+            except ShootingError as e:
+                raise ShootingError(f"{what}: {e} (residuals {fmt_residuals(res)})",
+                                    res) from None
+        return solve
+
+    def check(z: np.ndarray) -> None:
         if curve.norm(z - zp) > far:
             raise ShootingError(f"{what}: the corrector strayed {curve.norm(z - zp):.3g} > "
                                 f"{far:.3g} from the predictor", res)
-    raise ShootingError(f"{what}: no convergence in {max_iter} iterations (residuals "
-                        f"{fmt_residuals(res)})", res)
+
+    z, _ = newton_loop(evaluate, factor, zp, tol=tol, max_iter=max_iter, what=what,
+                       converge="both", check=check,
+                       scale=lambda z: max(1.0, float(np.max(np.abs(z[:-1])))), history=res)
+    return z, len(res) - 1
 
 
 class _Run:

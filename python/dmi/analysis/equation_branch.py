@@ -370,9 +370,11 @@ class EquationBranch(CollocationDiscretisation):
 
     def event_functions(self, x: np.ndarray, p: float, point: EquationOrbit
                         ) -> dict[str, float]:
-        """The multipliers' test functions (``period-doubling``, ``torus``; see
-        :meth:`CollocationDiscretisation.event_functions`; its ``fold`` is left to the
-        driver's dp/ds, its ``segment`` to :meth:`between`).
+        """The multipliers' test functions (``period-doubling``, ``torus``) verified against
+        the multipliers' estimated errors (:func:`dmi.analysis.orbit_events.verified_tests`:
+        0, with an EventWarning, where a test function lies within its multiplier's error; a
+        point without error estimates decides nothing); the ``fold`` is left to the driver's
+        dp/ds, the signature's changes to :meth:`between`.
 
         Parameters
         ----------
@@ -388,13 +390,15 @@ class EquationBranch(CollocationDiscretisation):
         dict
             kind -> value.
         """
-        f = super().event_functions(x, p, point)
-        out = {}
-        if "period_doubling" in f:
-            out["period-doubling"] = f["period_doubling"]
-        if "torus" in f:
-            out["torus"] = f["torus"]
-        return out
+        from .orbit_events import verified_tests   # here: this method's own helper
+        if point is None or point.multipliers.size == 0:
+            return {}
+        mu = np.asarray(point.multipliers)
+        err = np.asarray(point.errors.get("multipliers", np.full(mu.shape, np.inf)), float)
+        if self.lay.autonomous:   # the trivial multiplier left out
+            j = int(np.argmin(np.abs(mu - 1)))
+            mu, err = np.delete(mu, j), np.delete(err, j)
+        return verified_tests(mu, err, p)
 
     def carry(self, t: np.ndarray, x: np.ndarray) -> np.ndarray:
         """A direction on the new unknowns x (after a signature change) to orient the new

@@ -57,6 +57,9 @@ class EquationOrbit:
     carried : tuple of float
         The lags c at which the memory carries each switch: the mesh has points at
         (switch + c) mod period.
+    kernel_jumps : tuple of float
+        The lags of the kernel's jumps given to :func:`dmi.analysis.collocate` (its
+        continuation cuts the delay integral there too).
     """
     p: float
     period: float
@@ -73,6 +76,7 @@ class EquationOrbit:
     nodes: np.ndarray = field(default_factory=lambda: np.empty((0, 0)), repr=False)
     fractions: list = field(default_factory=list, repr=False)
     carried: tuple = ()
+    kernel_jumps: tuple = ()
 
     #: What the orbit is of: ``refine_orbit`` and ``floquet_multipliers`` refuse it by this.
     of = "equation"

@@ -3,10 +3,11 @@
 """Newton's method for x = F(x), x a shooting state, with GMRES on the matrix-free Jacobian
 (forward differences of F: the derivative of the map's smooth piece, a semismooth Newton), and
 the bordered step of a system with extra unknowns and equations (an autonomous orbit's step h,
-a continuation's parameter p; a phase condition, an amplitude condition, an arclength).  One
-loop, :func:`bordered_newton`; :func:`newton` is its case without extra unknowns, with a
-damped step.  (The continuation driver's corrector, on residuals with their Jacobians, is
-:func:`dmi.analysis.driver.newton_corrector`.)
+a continuation's parameter p; a phase condition, an amplitude condition, an arclength):
+:func:`bordered_newton`, of which :func:`newton` is the case without extra unknowns, with a
+damped step.  It, collocation's sparse-LU Newton and the continuation driver's corrector
+(:func:`dmi.analysis.driver.newton_corrector`) run :func:`newton_loop`, the one Newton loop,
+each with its own linear solve.
 
 Every iteration's residual is kept; an iteration gives up when the residual has made no new
 minimum in :data:`NO_PROGRESS` iterations (the semismooth Newton may rise once on its way into
@@ -16,6 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import scipy.sparse.linalg as sla
@@ -60,11 +62,12 @@ def stalled(res: list[float]) -> bool:
     return len(res) > NO_PROGRESS and min(res[-NO_PROGRESS:]) >= min(res[:-NO_PROGRESS])
 
 
-def judge(res: list[float], rn: float, tol: float, max_iter: int, what: str, hint: str = ""
-          ) -> str:
+def judge(res: list[float], rn: float, tol: float, max_iter: int, what: str, hint: str = "",
+          stall: bool = True) -> str:
     """Appends an iteration's residual rn to res and judges it: ``"converged"`` (rn <= tol),
     ``"exhausted"`` (max_iter iterations done) or ``"go on"``; raises ShootingError on a
-    non-finite residual or when there is no new least residual in NO_PROGRESS iterations."""
+    non-finite residual or (``stall``) when there is no new least residual in NO_PROGRESS
+    iterations."""
     res.append(rn)
     if not math.isfinite(rn):
         raise ShootingError(f"{what}: non-finite residual (residuals {fmt_residuals(res)}): "
@@ -73,11 +76,139 @@ def judge(res: list[float], rn: float, tol: float, max_iter: int, what: str, hin
         return "converged"
     if len(res) > max_iter:
         return "exhausted"
-    if stalled(res):
+    if stall and stalled(res):
         raise ShootingError(f"{what}: Newton makes no progress: no new least residual in "
                             f"{NO_PROGRESS} iterations (residuals {fmt_residuals(res)}; tolerance "
                             f"{tol:.3g}){hint}", res)
     return "go on"
+
+
+#: Linear solve of one Newton iteration: the residual r -> the correction dz (J dz = -r).
+Solve = Callable[[np.ndarray], np.ndarray]
+
+
+def newton_loop(evaluate: Callable[[np.ndarray], tuple[np.ndarray, Any]],
+                factor: Callable[[np.ndarray, np.ndarray, Any], Solve], z0: np.ndarray, *,
+                tol: float, max_iter: int, what: str, converge: str = "residual",
+                chord: float | None = None, search: str = "none",
+                reject: tuple[type[Exception], ...] = (), reject_why: str = "",
+                check: Callable[[np.ndarray], None] | None = None,
+                scale: Callable[[np.ndarray], float] | None = None, hint: str = "",
+                far: str = "", history: list[float] | None = None, stall: bool = True
+                ) -> tuple[np.ndarray, list[float]]:
+    """Newton's method on r(z) = 0: the one loop of :mod:`dmi.analysis` (the step maps'
+    matrix-free :func:`bordered_newton`, collocation's sparse LU, the continuation driver's
+    corrector), its linear solve given by the caller.
+
+    Parameters
+    ----------
+    evaluate : callable
+        z -> (r, state): the residual vector (its max norm is judged by :func:`judge`) and what
+        ``factor`` needs at z.
+    factor : callable
+        (z, r, state) -> solve: the linear solve at z, solve(r) the correction dz of J dz = -r
+        (a factored Jacobian, a bordered GMRES step); raises ShootingError when singular.
+    z0 : numpy.ndarray
+        The start.
+    tol : float
+        The tolerance, relative to ``scale(z)``.
+    max_iter : int
+        Iterations at most.
+    what : str
+        For the error messages.
+    converge : str
+        ``"residual"``: |r|_inf <= tol scale; ``"correction"``: |dz|_inf <= tol scale, z + dz
+        returned; ``"both"``: the residual and the last correction.
+    chord : float, optional
+        None: a fresh ``factor`` every iteration; c < 1: the factor kept while the residual
+        falls by the factor c or more an iteration (chord steps cost a residual).
+    search : str
+        ``"none"``: full steps; ``"guard"``: the step halved (at most 5 times) while the new
+        residual is 100 times the old or more; ``"descent"``: halved until the residual falls
+        (a step below 0.05 taken as it is), a stale chord factor refreshed before halving.
+    reject : tuple of exception types
+        Failures of ``evaluate`` that reject a trial step (it is halved); below 0.05 a
+        ShootingError saying ``reject_why``.
+    reject_why : str
+        What a rejected step means.
+    check : callable, optional
+        Called on each new iterate; raises to stop.
+    scale : callable, optional
+        z -> the tolerance's scale (default max(1, |z|_inf)).
+    hint : str
+        Appended to the no-progress error.
+    far : str
+        Appended to the no-convergence error.
+    history : list of float, optional
+        The list the residuals are appended to (a caller's message can list them).
+    stall : bool
+        Give up when the residual makes no new minimum in NO_PROGRESS iterations (False: a
+        loop converged on its correction may sit at the residual's rounding floor a few
+        iterations).
+
+    Returns
+    -------
+    tuple
+        (z, the residuals, one an iteration).
+
+    Raises
+    ------
+    ShootingError
+        A non-finite residual, no new least residual in NO_PROGRESS iterations (``stall``),
+        max_iter reached, a rejected step at the smallest length, or as ``factor`` and
+        ``check``; every residual listed.
+    ValueError
+        ``converge`` or ``search`` not one of theirs.
+    """
+    if converge not in ("residual", "correction", "both") or \
+            search not in ("none", "guard", "descent"):
+        raise ValueError(f"newton_loop: converge = {converge!r}, search = {search!r}: give "
+                         "'residual', 'correction' or 'both', and 'none', 'guard' or 'descent'")
+    size = scale or (lambda z: max(1.0, float(np.max(np.abs(z)))))
+    res: list[float] = history if history is not None else []
+    z = np.array(z0, dtype=float)
+    r, state = evaluate(z)
+    solve, age, moved = None, 0, math.inf
+    for _ in range(max_iter + 1):
+        rn = float(np.max(np.abs(r))) if r.size else 0.0
+        sc = size(z)
+        verdict = judge(res, rn, -math.inf if converge == "correction" else tol * sc,
+                        max_iter, what, hint, stall)
+        if verdict == "converged" and (converge == "residual" or moved <= tol * sc):
+            return z, res
+        if verdict == "exhausted":
+            break
+        if solve is None or chord is None or (len(res) > 1 and rn > chord * res[-2]):
+            solve, age = factor(z, r, state), 0
+        dz = solve(r)
+        age += 1
+        if converge == "correction" and float(np.max(np.abs(dz))) <= tol * sc:
+            return z + dz, res
+        lam = 1.0
+        # trials: 1, 1 / 2, ..., 1 / 32 (below 0.05: taken); "descent" twice (a refresh between)
+        for _ in range({"none": 1, "guard": 6, "descent": 12}[search]):
+            try:
+                rt, st = evaluate(z + lam * dz)
+                done = (search == "none" or lam < 0.05
+                        or float(np.max(np.abs(rt))) < (100 * rn if search == "guard" else rn))
+            except reject:
+                if lam < 0.05:
+                    raise ShootingError(f"{what}: {reject_why}", res) from None
+                done = False
+            if done:
+                break
+            if search == "descent" and chord is not None and age > 1:
+                solve, age = factor(z, r, state), 1   # a stale Jacobian: refresh it, not the step
+                dz, lam = solve(r), 1.0
+                continue
+            lam *= 0.5
+        z, r, state = z + lam * dz, rt, st
+        moved = float(np.max(np.abs(lam * dz)))
+        if check is not None:
+            check(z)
+    raise ShootingError(f"{what}: no convergence in {max_iter} Newton iterations (residuals "
+                        f"{fmt_residuals(res)}; tolerance {tol:.3g} relative)"
+                        f"{': ' + far if far else ''}", res)
 
 
 def fd_eps(x: np.ndarray) -> float:
@@ -174,8 +305,7 @@ def bordered_newton(maps: Callable[[np.ndarray], Callable[[np.ndarray], np.ndarr
     ShootingError with every residual tried (no new least residual in NO_PROGRESS iterations
     (``hint`` appended), a singular bordered system (``singular``: what, and why appended),
     non-finite values, max_iter reached)."""
-    z = np.array(z0, dtype=float)
-    dim = z.size - k
+    dim = np.asarray(z0).size - k
     res: list[float] = []
 
     def ev(q: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -187,21 +317,14 @@ def bordered_newton(maps: Callable[[np.ndarray], Callable[[np.ndarray], np.ndarr
                                 f"{far + ', or' if far else 'the iterate is off any orbit:'} "
                                 "the orbit leaves the model's domain", res) from e
 
-    def residual(z: np.ndarray, Fx: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+    def evaluate(z: np.ndarray) -> tuple[np.ndarray, tuple]:
+        Fx = ev(z[dim:], z[:dim])
         g, rows = conditions(z)
-        r = float(np.max(np.abs(Fx - z[:dim])))
-        return max(r, float(np.max(np.abs(g))) if len(g) else 0.0), g, rows
+        return np.concatenate([Fx - z[:dim], np.atleast_1d(g)]), (Fx, g, rows)
 
-    Fx = ev(z[dim:], z[:dim])
-    for _ in range(max_iter + 1):
+    def factor(z: np.ndarray, r: np.ndarray, state: tuple) -> Solve:
+        Fx, g, rows = state
         x, q = z[:dim], z[dim:]
-        rn, g, rows = residual(z, Fx)
-        scale = max(1.0, float(np.max(np.abs(x))))
-        verdict = judge(res, rn, tol * scale, max_iter, what, hint)
-        if verdict == "converged":
-            return z, res
-        if verdict == "exhausted":
-            break
         cols = np.empty((dim, k))
         for j in range(k):
             d = 1e-7 * max(1.0, abs(q[j])) if steps is None else float(steps[j])
@@ -209,20 +332,13 @@ def bordered_newton(maps: Callable[[np.ndarray], Callable[[np.ndarray], np.ndarr
             qd[j] += d
             cols[:, j] = (ev(qd, x) - Fx) / d
         dz, lin = bordered_step(maps(q), x, Fx, cols, rows, g, rtol=rtol)
-        if lin > 1e-2 or float(np.max(np.abs(dz))) > 1e8 * scale:
+        if lin > 1e-2 or float(np.max(np.abs(dz))) > 1e8 * max(1.0, float(np.max(np.abs(x)))):
             raise ShootingError(f"{what}: {singular[0]} at Newton iteration {len(res)} (GMRES "
                                 f"relative residual {lin:.2g}, residuals {fmt_residuals(res)})"
                                 f"{singular[1]}", res)
-        lam = 1.0
-        for _ in range(6 if search else 1):
-            zn = z + lam * dz
-            Fn = ev(zn[dim:], zn[:dim])
-            if not search or residual(zn, Fn)[0] < 100 * rn or lam < 0.05:
-                break
-            lam *= 0.5
-        z, Fx = zn, Fn
-        if check is not None:
-            check(z)
-    raise ShootingError(f"{what}: no convergence in {max_iter} Newton iterations (residuals "
-                        f"{fmt_residuals(res)}; tolerance {tol:.3g} relative)"
-                        f"{': ' + far if far else ''}", res)
+        return lambda _r: dz
+
+    return newton_loop(evaluate, factor, z0, tol=tol, max_iter=max_iter, what=what,
+                       search="guard" if search else "none", check=check,
+                       scale=lambda z: max(1.0, float(np.max(np.abs(z[:dim])))), hint=hint,
+                       far=far, history=res)

@@ -13,10 +13,22 @@ The multipliers' events are placed by the linear interpolation of their test fun
 :func:`dmi.analysis.continuation.refined_event`), the stick events by bisection along the branch (:func:`locate_stick`,
 every middle corrected across the chord by the driver).  The fold is the driver's
 (:mod:`dmi.analysis.driver`).  A point's stick profile and margins: :func:`stick_profile`.
+
+Verified multipliers' events: where the points carry error bounds of their multipliers (a
+scheme's branch with ``verify=``: ``BranchPoint.floquet.errors``; a collocated branch:
+``EquationOrbit.errors["multipliers"]``), a period doubling or a torus is reported only when, on
+both points, every multiplier of its kind (real negative; non-real) is off the unit circle by
+more than its error bound (:func:`undecided`); otherwise no event is reported and an
+:class:`EventWarning` says why.  On a collocated branch the test functions are 0 where they lie
+within the error bound of their multiplier (:func:`verified_tests`), so that the driver sees a
+sign change only between points on which it is verified.  A scheme's branch without
+``verify=`` has no error bounds: its events are the Ritz multipliers' (of the scheme), as
+before.
 """
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 
 import numpy as np
@@ -68,6 +80,108 @@ def test_function(kind: str, mu: np.ndarray) -> float:
     return float(np.max(c)) - 1 if c.size else -1.0
 
 
+class EventWarning(RuntimeWarning):
+    """A multipliers' event (period doubling, torus) not reported, or a point where it is not
+    decided: the multipliers' error bound is larger than their distance to the unit circle."""
+
+
+#: The multipliers' events and the multipliers each reads.
+KINDS = {"period-doubling": "real negative", "torus": "non-real"}
+
+
+def _of_kind(kind: str, mu: np.ndarray) -> np.ndarray:
+    """The indices of the multipliers a ``kind`` event reads: the real negative ones (a period
+    doubling), the non-real ones (a torus)."""
+    real = np.abs(mu.imag) <= 1e-8 * np.maximum(np.abs(mu), 1)
+    return np.flatnonzero(real & (mu.real < 0) if kind == "period-doubling" else ~real)
+
+
+def undecided(kind: str, mu: np.ndarray, err: np.ndarray) -> str | None:
+    """Why the multipliers mu (errors err) do not decide a ``kind`` event, or None: a multiplier
+    of its kind whose distance to the unit circle is not larger than its error bound (a nan
+    bound decides nothing).
+
+    Parameters
+    ----------
+    kind : str
+        ``"period-doubling"`` or ``"torus"``.
+    mu : numpy.ndarray of complex
+        The multipliers (the trivial one left out).
+    err : numpy.ndarray of float
+        Their error bounds, same shape.
+
+    Returns
+    -------
+    str or None
+        The multiplier, its distance and its bound; None when every multiplier of the kind is
+        off the circle by more than its bound.
+
+    Raises
+    ------
+    ValueError
+        ``kind`` is not a multipliers' event, or ``err`` has another shape than ``mu``.
+    """
+    if kind not in KINDS:
+        raise ValueError(f"kind = {kind!r}: expected one of {sorted(KINDS)}")
+    mu, err = np.asarray(mu, dtype=complex), np.asarray(err, dtype=float)
+    if err.shape != mu.shape:
+        raise ValueError(f"{err.shape} error bounds for {mu.shape} multipliers")
+    for j in _of_kind(kind, mu):
+        d = abs(abs(mu[j]) - 1.0)
+        if not d > err[j]:
+            return (f"the {KINDS[kind]} multiplier {mu[j]:.12g} is {d:.3g} from the unit circle, "
+                    f"within its error bound {err[j]:.3g}: the multipliers' error bound is "
+                    "larger than their distance to the circle")
+    return None
+
+
+def verified_tests(mu: np.ndarray, err: np.ndarray, p: float) -> dict[str, float]:
+    """The multipliers' test functions of a point with error bounds (a collocated branch's):
+    ``period-doubling`` the largest |mu| of the real negative multipliers minus 1, ``torus``
+    the largest |mu| of the non-real ones minus 1, each where defined, and 0 where it lies
+    within its multiplier's error bound (with an :class:`EventWarning`: an event is then
+    reported only between points on either side of that bound).
+
+    Parameters
+    ----------
+    mu : numpy.ndarray of complex
+        The multipliers (the trivial one left out).
+    err : numpy.ndarray of float
+        Their error bounds, same shape (nan or inf: no bound).
+    p : float
+        The point's parameter (for the warning).
+
+    Returns
+    -------
+    dict
+        kind -> value.
+
+    Raises
+    ------
+    ValueError
+        ``err`` has another shape than ``mu``.
+    """
+    mu, err = np.asarray(mu, dtype=complex), np.asarray(err, dtype=float)
+    if err.shape != mu.shape:
+        raise ValueError(f"{err.shape} error bounds for {mu.shape} multipliers")
+    out: dict[str, float] = {}
+    for kind in KINDS:
+        idx = _of_kind(kind, mu)
+        if idx.size == 0:
+            continue
+        j = idx[int(np.argmax(np.abs(mu[idx])))]
+        f = float(abs(mu[j])) - 1.0
+        if abs(f) > err[j]:
+            out[kind] = f
+            continue
+        out[kind] = 0.0
+        warnings.warn(f"p = {p!r}: {undecided(kind, mu[j:j + 1], err[j:j + 1])}; this point "
+                      f"does not decide a {kind} (an event is reported only between points on "
+                      "either side of the circle beyond their error bounds; one located at "
+                      "this point lies within its bound)", EventWarning, stacklevel=3)
+    return out
+
+
 def orbit_events(a: BranchPoint, b: BranchPoint, index: int, autonomous: bool = False
                  ) -> list[Event]:
     """The events of the orbits' multipliers and stick patterns between the points a and b
@@ -92,16 +206,37 @@ def orbit_events(a: BranchPoint, b: BranchPoint, index: int, autonomous: bool = 
         return m[(np.abs(m.imag) <= 1e-8 * np.maximum(np.abs(m), 1)) & (m.real < 0)].real
 
 
+    def doubt(kind: str) -> str | None:   # a point's multipliers that do not decide kind
+        for q, m in ((a, mua), (b, mub)):
+            if q.floquet is not None:
+                e = q.floquet.errors
+                if q.floquet.trivial is not None:
+                    e = np.delete(e, q.floquet.trivial)
+                why = undecided(kind, m, e)
+                if why is not None:
+                    return f"at p = {q.p!r}, {why}"
+        return None
+
+    found = []
     na, nb = np.sum(real_neg(mua) < -1), np.sum(real_neg(mub) < -1)
     if na != nb:
-        fa, fb = (test_function("period-doubling", m) for m in (mua, mub))
-        ev.append(Event("period-doubling", at(fa, fb), index, None,
-                        f"real multipliers < -1: {na} -> {nb}"))
+        found.append(("period-doubling", f"real multipliers < -1: {na} -> {nb}"))
     ca, cb = np.sum(np.abs(non_real(mua)) > 1), np.sum(np.abs(non_real(mub)) > 1)
     if ca != cb:
-        fa, fb = (test_function("torus", m) for m in (mua, mub))
-        ev.append(Event("torus", at(fa, fb), index, None,
-                        f"complex multipliers with |mu| > 1: {ca} -> {cb}"))
+        found.append(("torus", f"complex multipliers with |mu| > 1: {ca} -> {cb}"))
+    for kind, detail in found:
+        why = doubt(kind)
+        if why is not None:
+            warnings.warn(f"a {kind} between p = {a.p!r} and {b.p!r} ({detail}) is not "
+                          f"reported: {why}", EventWarning, stacklevel=3)
+            continue
+        verified = a.floquet is not None and b.floquet is not None
+        fa, fb = (test_function(kind, m) for m in (mua, mub))
+        ev.append(Event(kind, at(fa, fb), index, None,
+                        detail + (" (verified: beyond the multipliers' error bounds on both "
+                                  "sides)" if verified else " (not verified: the Ritz "
+                                  "multipliers have no error bound; continue_orbit(verify=...) "
+                                  "verifies them)")))
     for i in range(len(a.stick_steps)):
         sa, sb = int(a.stick_steps[i]), int(b.stick_steps[i])
         if (sa == 0) != (sb == 0):

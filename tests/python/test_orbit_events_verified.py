@@ -1,0 +1,97 @@
+# Verified period-doubling and torus events on a scheme's branch continued with verify=: the
+# scheme of u' + c(p) u = cos(2 pi t) with h = 1/3, three steps a period, whose multiplier is
+# (1 - h c)^3 = -(1 + (p - 1) / 2) exactly (a linear map): it crosses -1 at p = 1, an event
+# placed there by the linear interpolation of the test function (exact here); the same points
+# with error bounds larger than the multiplier's distance to the circle give no event and an
+# EventWarning; without verify= the event says it is not verified; undecided() and
+# verified_tests() on hand-made multipliers.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+from __future__ import annotations
+
+import dataclasses
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+import dmi
+from dmi import analysis as da
+from dmi.analysis.orbit_events import EventWarning, orbit_events, undecided, verified_tests
+
+H = 1.0 / 3.0
+
+
+def flip(p: float) -> dmi.Solver:
+    c = (1 + (1 + 0.5 * (p - 1)) ** (1 / 3)) / H      # (1 - h c)^3 = -(1 + (p - 1) / 2)
+    s = dmi.Solver(1, 1.0, h=H)
+    s.set_rhs(lambda t, u: np.array([c * u[0] - math.cos(2 * math.pi * t)]))
+    return s
+
+
+@pytest.fixture(scope="module")
+def branch() -> da.Branch:
+    o = da.periodic_orbit(flip, 0.5, 1.0, [0.0], multipliers=1)
+    return da.continue_orbit(o, 1.5, step=0.25, multipliers=1, verify=da.Verify())
+
+
+def test_verified_period_doubling_on_a_scheme_branch(branch):
+    for q in branch.points:
+        assert q.multipliers[0].real == pytest.approx(-(1 + 0.5 * (q.p - 1)), abs=1e-9)
+    pds = [e for e in branch.events if e.kind == "period-doubling"]
+    assert len(pds) == 1 and abs(pds[0].p - 1.0) < 1e-9, branch.events
+    assert "verified" in pds[0].detail
+
+
+def test_crossing_within_the_error_bounds_is_not_reported(branch):
+    e = next(e for e in branch.events if e.kind == "period-doubling")
+    a, b = branch.points[e.index - 1], branch.points[e.index]
+    # the same points, their multipliers' error bounds now beyond their distance to -1
+    wide = [dataclasses.replace(q, floquet=dataclasses.replace(
+        q.floquet, errors=np.full(q.floquet.errors.shape, 0.5))) for q in (a, b)]
+    with pytest.warns(EventWarning, match="error bound is larger than their distance"):
+        got = orbit_events(wide[0], wide[1], e.index)
+    assert not [g for g in got if g.kind == "period-doubling"], got
+    # one side only within its bound: still not reported
+    one = dataclasses.replace(b, floquet=dataclasses.replace(
+        b.floquet, errors=np.full(b.floquet.errors.shape, 0.5)))
+    with pytest.warns(EventWarning, match=f"at p = {b.p!r}"):
+        got = orbit_events(a, one, e.index)
+    assert not got
+    # the true bounds: reported, without a warning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", EventWarning)
+        got = orbit_events(a, b, e.index)
+    assert [g.kind for g in got] == ["period-doubling"]
+
+
+def test_undecided_and_verified_tests():
+    mu = np.array([-1.0 - 1e-6, 0.5 + 0.9j, 0.5 - 0.9j])
+    assert undecided("period-doubling", mu, np.array([1e-9, 1e-9, 1e-9])) is None
+    assert "within its error bound" in undecided("period-doubling", mu, np.array([1e-5, 0, 0]))
+    assert undecided("period-doubling", mu, np.array([np.nan, 0, 0])) is not None
+    r = abs(mu[1]) - 1                                  # the pair's distance to the circle
+    assert undecided("torus", mu, np.array([0, abs(r) / 2, abs(r) / 2])) is None
+    assert undecided("torus", mu, np.array([0, 2 * abs(r), 2 * abs(r)])) is not None
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", EventWarning)
+        f = verified_tests(mu, np.array([1e-9, 1e-9, 1e-9]), 0.0)
+    assert f["period-doubling"] == pytest.approx(1e-6, abs=1e-15)
+    assert f["torus"] == pytest.approx(r, abs=1e-15)
+    with pytest.warns(EventWarning, match="does not decide a period-doubling"):
+        f = verified_tests(mu, np.array([1e-5, 1e-9, 1e-9]), 0.0)
+    assert f["period-doubling"] == 0.0 and f["torus"] == pytest.approx(r, abs=1e-15)
+    with pytest.raises(ValueError, match="error bounds for"):
+        verified_tests(mu, np.zeros(2), 0.0)
+    with pytest.raises(ValueError, match="expected one of"):
+        undecided("fold", mu, np.zeros(3))
+
+
+def test_event_without_error_bounds_says_so():
+    """Without verify= the Ritz multipliers have no error bound: the event is the scheme's, its
+    detail says it is not verified."""
+    o = da.periodic_orbit(flip, 0.5, 1.0, [0.0], multipliers=1)
+    b = da.continue_orbit(o, 1.5, step=0.25, multipliers=1)
+    pds = [e for e in b.events if e.kind == "period-doubling"]
+    assert len(pds) == 1 and abs(pds[0].p - 1.0) < 1e-9, b.events
+    assert "not verified" in pds[0].detail
