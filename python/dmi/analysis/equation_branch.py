@@ -12,14 +12,19 @@ step: the driver halves it), the points (the EquationOrbit with its period, ampl
 multipliers and signature; on a vertical branch, where the orbit is not isolated at fixed p,
 without the merged mesh's error estimate and with ``stable`` None), the events of the
 multipliers (``period-doubling``, ``torus``; the fold is the driver's) and of the signature
-(``stick-onset`` where a stuck or face segment appears or goes, ``grazing`` where the segments
-change otherwise).  The signature changes by itself: a corrected point whose orbit breaks an
-inequality of its signature is mended (a segment split around the breach, a vanishing one
-removed: :func:`dmi.analysis.collocation_mend.mend`) and corrected again at its p (where that
-is singular, at the corner of a vertical branch, with p free and the new segment's length
-held), up to four times; the mended point is the step's (the corrector returns it on its new
-unknowns), the mesh is equidistributed after every step (``adapt``), and the driver restarts
-its tangent on the new unknowns (oriented by :meth:`EquationBranch.carry`; a vertical start by
+(``stick-onset`` where the number of a component's stuck or face segments changes,
+``grazing`` where the segments change otherwise; located by Brent's method on the margin of
+the breaking inequality along the branch, :meth:`EquationBranch.between`).  The signature
+changes by itself: a corrected point whose orbit breaks an inequality of its signature is
+mended (a segment split around the breach, a vanishing one removed:
+:func:`dmi.analysis.collocation_mend.mend`) and corrected again at its p (where that is
+singular, at the corner of a vertical branch, with p free and the new segment's length held),
+up to four times; where a step fails next to a held segment shorter than SHED of the period
+(the branch back to a corner), the short held segments are removed and the orbit solved with p
+free and its amplitude held just inside (:meth:`EquationBranch._shed`; a landing there: at the
+landing's p).  The mended point is the step's (the corrector returns it on its new unknowns),
+the mesh is equidistributed after every step (``adapt``), and the driver restarts its tangent
+on the new unknowns (oriented by :meth:`EquationBranch.carry`; a vertical start by
 :meth:`EquationBranch.orient`, the amplitude growing).  A branch that fails at the smallest
 step says so in its status: the corner (grazing: the component and how near its velocity came
 to 0), which way p went there, and what is known of the branch on the other side.
