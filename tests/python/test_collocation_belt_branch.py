@@ -269,6 +269,7 @@ def test_branch_back_from_stick_slip_through_grazing_into_pure_slip(branches):
 def test_stick_slip_point_agrees_with_the_scheme_at_order_h(branches):
     up, _ = branches
     q = up.points[-1]
+    assert is_stick_slip(q)
     gaps = []
     for M in (300, 600, 1200):
         s = belt(q.p, h=q.period / M)
