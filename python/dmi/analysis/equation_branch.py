@@ -458,9 +458,10 @@ class EquationBranch(CollocationDiscretisation):
     def between(self, za: np.ndarray, a: EquationOrbit, zb: np.ndarray, b: EquationOrbit,
                 middle: Any) -> list[Event]:
         """The signature's change between two points: ``stick-onset`` when the number of a
-        component's held segments (stuck, on a face) changes, else ``grazing``; located (:meth:`_locate`)
-        on the side whose signature holds on past the change, where the margin of the
-        inequality that breaks there reaches 0, by Brent's method along that side's branch;
+        component's held segments (stuck, on a face) changes, else ``grazing``; located
+        (:meth:`_locate`) on the side whose signature holds on past the change, where the
+        margin of the inequality that breaks there reaches 0, by Brent's method along that
+        side's branch;
         reported at that p only when bracketed and converged (the detail gives the bound),
         else at the middle of the two points' p with the detail saying why it is not located.
 
