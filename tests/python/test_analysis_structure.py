@@ -59,10 +59,9 @@ def test_one_driver():
 #: Linear solves a Newton iteration calls (by name or attribute).
 LINEAR_SOLVES = {"splu", "spsolve", "bordered_solve", "bordered_step", "gmres", "lu_solve",
                  "lstsq"}
-#: Loops around a linear solve that are not Newton loops on a residual of their own, or not yet
-#: moved onto newton_loop: shooting's Newton-Picard (its own method), the mend of a collocated
-#: branch past a corner (equation_branch, another change's file).
-OTHER_LOOPS = {("periodic", "_newton_picard"), ("equation_branch", "_grow")}
+#: Loops around a linear solve that are not Newton loops on a residual of their own: shooting's
+#: Newton-Picard (its own method).
+OTHER_LOOPS = {("periodic", "_newton_picard")}
 
 
 def solving_loops(tree: ast.Module) -> set[str]:

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -46,7 +47,7 @@ from .collocation_signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK
 from .collocation_system import evaluate, solve
 from .driver import Curve, bordered_solve, continuation, newton_corrector, tangent
 from .equation_orbit import EquationOrbit
-from .newton import ShootingError
+from .newton import ShootingError, newton_loop
 
 #: Mends (split or removal, then a correction at fixed p) tried on one point at most.
 MENDS = 4
@@ -269,35 +270,24 @@ class EquationBranch(CollocationDiscretisation):
         free, from (x, p).  ShootingError when it fails."""
         lay = probe.lay
 
-        def size(z: np.ndarray) -> float:   # the bordered residual's, inf out of order
-            try:
-                r = probe.residual(z[:-1], float(z[-1]))
-            except ValueError:               # Degenerate: the switches out of order
-                return math.inf
-            return max(float(np.max(np.abs(r))), abs(float(row @ z) - target))
+        def evaluate(z: np.ndarray) -> tuple[np.ndarray, None]:
+            r = probe.residual(z[:-1], float(z[-1]))   # Degenerate (a ValueError): rejected
+            return np.concatenate([r, [float(row @ z) - target]]), None
 
-        z = np.concatenate([x, [p]])
-        for _ in range(40):
-            r = probe.residual(z[:-1], float(z[-1]))
+        def factor(z: np.ndarray, r: np.ndarray, _: None) -> Callable[[np.ndarray], np.ndarray]:
             J, Jp = probe.jacobian(z[:-1], float(z[-1]))
-            try:
-                dz = bordered_solve(J, Jp, row, -np.concatenate([r, [float(row @ z) - target]]))
-            except ShootingError as e:   # SuperLU: singular
-                raise ShootingError(f"the orbit breaks its signature ({why}); with p free on "
-                                    f"{lay.signature.describe()}: {e}", []) from e
-            if np.max(np.abs(dz)) <= 1e-12 * max(1.0, float(np.max(np.abs(z)))):
-                return z[:-1] + dz[:-1], float(z[-1] + dz[-1])
-            r0, lam = size(z), 1.0          # damped: halved while the residual grows
-            while size(z + lam * dz) >= r0:
-                lam *= 0.5
-                if lam < 1e-4:
-                    raise ShootingError(f"the orbit breaks its signature ({why}); with p free "
-                                        f"on {lay.signature.describe()}, the segment's length "
-                                        f"held: no descent from residual {r0:.3g}", [])
-            z = z + lam * dz
-        raise ShootingError(f"the orbit breaks its signature ({why}); with p free on "
-                            f"{lay.signature.describe()}, the segment's length held: no "
-                            "convergence", [])
+            return lambda rr: bordered_solve(J, Jp, row, -rr)
+
+        try:
+            z, _ = newton_loop(evaluate, factor, np.concatenate([x, [p]]), tol=1e-12,
+                               max_iter=40, what="Newton with the segment's length held",
+                               converge="correction", search="descent", reject=(ValueError,),
+                               reject_why="every step puts the switches out of order",
+                               stall=False)
+        except ShootingError as e:
+            raise ShootingError(f"the orbit breaks its signature ({why}); with p free on "
+                                f"{lay.signature.describe()}: {e}", e.residuals) from e
+        return z[:-1], float(z[-1])
 
     def adapt(self, x: np.ndarray, p: float) -> np.ndarray:
         """After a step: the signature and mesh adapted
