@@ -46,7 +46,7 @@ from .collocation import collocate  # noqa: E402
 from .equation_orbit import EquationOrbit  # noqa: E402
 
 from .collocation_system import CollocationWarning  # noqa: E402
-from .orbit_events import EventWarning  # noqa: E402
+from .branch import EventWarning  # noqa: E402
 
 __all__ += ["collocate", "EquationOrbit", "CollocationWarning", "EventWarning"]
 from .collocation_continuation import (CollocationDiscretisation,  # noqa: E402

@@ -116,6 +116,12 @@ class BranchPoint:
     floquet: Any = field(default=None, repr=False)
 
 
+
+class EventWarning(RuntimeWarning):
+    """A multipliers' event (period doubling, torus) not reported, or a point where it is not
+    decided: the multipliers' error bound is larger than their distance to the unit circle."""
+
+
 @dataclass
 class Event:
     """A detected event between points ``index - 1`` and ``index`` of the branch.

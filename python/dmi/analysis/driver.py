@@ -93,7 +93,7 @@ import scipy.optimize
 import scipy.sparse
 import scipy.sparse.linalg as sla
 
-from .branch import Branch, Event
+from .branch import Branch, Event, EventWarning
 from .newton import ShootingError, fmt_residuals, newton_loop
 
 #: |dp/ds| below which a branch is vertical: a sign change of dp/ds there is noise, not a fold.
@@ -722,7 +722,9 @@ def _events(run: _Run, za: np.ndarray, ta: np.ndarray, fa: dict[str, float],
             def fn(s: float, kind: str = kind) -> float:
                 z = z_at(s)
                 x, p = z[:-1], float(z[-1])
-                return float(run.disc.event_functions(x, p, run.disc.point(x, p))[kind])
+                with warnings.catch_warnings():   # the zero sought lies within the error band
+                    warnings.simplefilter("ignore", EventWarning)
+                    return float(run.disc.event_functions(x, p, run.disc.point(x, p))[kind])
         s = locate(fn, fa[kind], fb[kind])
         if s is None:
             warnings.warn(f"a {kind} test function changes sign between p = {float(za[-1])!r} "

@@ -33,7 +33,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .branch import BranchPoint, Event, non_real
+from .branch import BranchPoint, Event, EventWarning, non_real
 from .floquet import phase_free
 from .orbit import stuck_mask
 from .stepmap import StepMap
@@ -78,11 +78,6 @@ def test_function(kind: str, mu: np.ndarray) -> float:
         return 1 + float(np.min(mu.real))
     c = np.abs(non_real(mu))
     return float(np.max(c)) - 1 if c.size else -1.0
-
-
-class EventWarning(RuntimeWarning):
-    """A multipliers' event (period doubling, torus) not reported, or a point where it is not
-    decided: the multipliers' error bound is larger than their distance to the unit circle."""
 
 
 #: The multipliers' events and the multipliers each reads.
