@@ -228,3 +228,41 @@ def test_steep_exponential_sum_graded():
                                 - exact))) for L in (8, 16, 32)]
     orders = [math.log2(a / b) for a, b in zip(errs[:-1], errs[1:])]
     assert min(orders) >= 4 and errs[-1] < 1e-9, (errs, orders)
+
+
+# ---- the circles of a rotating model whose kernel jumps, from the Hopf point ---------------------
+W0R, GR, S1R, TAUR = 1.0, 0.5, 0.8, 2.0
+
+
+def jump_rotating(p: float, h: float | None = None) -> dmi.Solver:
+    """u' = (p - |u|^2) u + W0R J u - int_0^TAUR H u, H = GR I on (0, S1R), 0 after."""
+    s = dmi.Solver(2, TAUR, h=0.02 if h is None else h)
+    s.set_rhs(lambda t, u: -((p - u @ u) * u + W0R * np.array([-u[1], u[0]])))
+    s.set_kernel(lambda s: (GR if s < S1R else 0.0) * np.eye(2))
+    return s
+
+
+def test_hopf_orbit_of_equation_carries_kernel_jumps():
+    # z = r e^{i W t}: i W = p - r^2 + i W0R - Hhat(i W), Hhat(q) = GR (1 - e^{-q S1R}) / q, so
+    # W = W0R - Im Hhat(i W), r^2 = p - Re Hhat(i W), the Hopf point at p_H = Re Hhat(i W)
+    from scipy.optimize import brentq
+
+    def hhat(q: complex) -> complex:
+        return GR * (1 - np.exp(-q * S1R)) / q
+    om = brentq(lambda w: w - W0R + hhat(1j * w).imag, 0.1, 3.0, xtol=1e-15)
+    muH, T = hhat(1j * om).real, 2 * math.pi / om
+    hp = da.HopfPoint(p=muH, omega=om, root=1j * om)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", CollocationWarning)
+        e = da.hopf_orbit(jump_rotating, hp, [0.0, 0.0], amplitude=0.1, of="equation",
+                          kernel_jumps=(S1R,))
+        b = da.continue_orbit(e, muH + 0.25, step=0.05, multipliers=0)
+    assert e.kernel_jumps == (S1R,)
+    assert abs(e.p - (muH + 0.01)) < 1e-10 and abs(e.period - T) < 1e-10
+    assert b.status.startswith("reached p_end"), b.status
+    for q in b.points:                    # the radius sqrt(p - p_H) at every point, the period T
+        assert abs(q.period - T) < 1e-9 and np.all(np.abs(q.amplitude - math.sqrt(q.p - muH))
+                                                   < 1e-9), (q.p, q.period, q.amplitude)
+    with pytest.raises(ValueError, match="kernel_jumps"):
+        da.hopf_orbit(jump_rotating, hp, [0.0, 0.0], amplitude=0.1, steps=64,
+                      kernel_jumps=(S1R,))

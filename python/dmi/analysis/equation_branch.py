@@ -724,7 +724,8 @@ def continue_equation_orbit(orbit: EquationOrbit, p_end: float, step: float, *,
 
 
 def equation_branch_start(make: Any, hopf_point: Any, u_eq: Any, amplitude: float,
-                          multipliers: int, tol: float, max_iter: int) -> EquationOrbit:
+                          multipliers: int, tol: float, max_iter: int,
+                          kernel_jumps: tuple[float, ...] = ()) -> EquationOrbit:
     """``hopf_orbit(..., of="equation")``: :func:`equation_hopf_orbit` at the checked Hopf
     point.
 
@@ -744,6 +745,8 @@ def equation_branch_start(make: Any, hopf_point: Any, u_eq: Any, amplitude: floa
         Newton's tolerance (at most 1e-12 is used: the orbit's own accuracy).
     max_iter : int
         Newton iterations at most.
+    kernel_jumps : tuple of float
+        The lags where H jumps (:func:`dmi.analysis.collocate`).
 
     Returns
     -------
@@ -751,7 +754,8 @@ def equation_branch_start(make: Any, hopf_point: Any, u_eq: Any, amplitude: floa
         The start of the collocated branch.
     """
     return equation_hopf_orbit(make, hopf_point, u_eq, amplitude, multipliers=multipliers,
-                               tol=min(tol, 1e-12), max_iter=max_iter)
+                               tol=min(tol, 1e-12), max_iter=max_iter,
+                               kernel_jumps=kernel_jumps)
 
 
 __all__ = ["EquationBranch", "continue_equation_orbit", "equation_branch_start"]

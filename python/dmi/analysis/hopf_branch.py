@@ -78,7 +78,8 @@ def positive_amplitude(value: Any) -> float:
 def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: float,
                steps: int | None = None, component: int | None = None, multipliers: int = 10,
                tol: float = 1e-10, max_iter: int = 30, verify: Verify | None = None,
-               of: str = "scheme") -> Orbit | EquationOrbit:
+               of: str = "scheme", kernel_jumps: tuple[float, ...] = ()
+               ) -> Orbit | EquationOrbit:
     """The autonomous orbit born at a Hopf point, of a given amplitude, its parameter free.
 
     An amplitude condition replaces the parameter: the unknowns are the state, the step h (the
@@ -123,6 +124,9 @@ def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: floa
         scheme's orbit only).
     of : {"scheme", "equation"}
         The scheme's orbit by shooting, or the equation's by collocation.
+    kernel_jumps : sequence of float
+        ``of="equation"`` only: the lags in (0, tau) where H jumps (time units), as for
+        :func:`dmi.analysis.collocate`; the branch carries them.
 
     Returns
     -------
@@ -136,7 +140,8 @@ def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: floa
         Bad input: not a HopfPoint (an event of another kind: said so), omega <= 0 (a fold),
         a root off the imaginary axis, amplitude <= 0, steps < 8, a component
         out of range or not moving in the critical mode, a model that does not take h; ``of``
-        not "scheme" or "equation", ``component`` or ``verify`` with ``of="equation"``.
+        not "scheme" or "equation", ``component`` or ``verify`` with ``of="equation"``,
+        ``kernel_jumps`` with ``of="scheme"`` (the scheme's cell rule locates jumps itself).
     ShootingError
         Newton fails (every residual listed).
     """
@@ -147,7 +152,11 @@ def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: floa
             raise ValueError("hopf_orbit(of='equation'): component= and verify= do not apply "
                              "(the component is the critical mode's largest; the verdict is "
                              "the collocation's)")
-        return equation_branch_start(make, hopf_point, u_eq, a, multipliers, tol, max_iter)
+        return equation_branch_start(make, hopf_point, u_eq, a, multipliers, tol, max_iter,
+                                     tuple(kernel_jumps))
+    if len(kernel_jumps):
+        raise ValueError("hopf_orbit: kernel_jumps= is for of='equation' (the collocation's "
+                         "delay integral); the scheme takes the kernel as libdmi samples it")
     if of != "scheme":
         raise ValueError(f"of = {of!r}: 'scheme' (shooting) or 'equation' (collocation)")
     if steps is None:
