@@ -45,6 +45,40 @@ def call_rhs(typingctx, address, t, u, out, user):
     return sig, codegen
 
 
+@intrinsic
+def call_history(typingctx, address, t, out, user):
+    """int z(double t, double *out, void *user) at address."""
+    sig = nt.int32(nt.int64, nt.float64, out, nt.int64)
+
+    def codegen(context, builder, signature, args):
+        addr, tt, oa, us = args
+        dbl = ir.DoubleType()
+        fnty = ir.FunctionType(ir.IntType(32), [dbl, dbl.as_pointer(), ir.IntType(8).as_pointer()])
+        fn = builder.inttoptr(addr, fnty.as_pointer())
+        op = context.make_array(signature.args[2])(context, builder, oa).data
+        return builder.call(fn, [tt, op, builder.inttoptr(us, ir.IntType(8).as_pointer())])
+    return sig, codegen
+
+
+@numba.njit(cache=True)
+def sample_windows(addrs, users, N, h, tau, out):
+    """out[j, N - k] = z_j(t_k), t_k = -k h (no lower than -tau, -tau at k = N), for the history
+    callbacks (addrs[j], users[j]): the window U^{-N}, ..., U^0 that init samples.  Returns False
+    where a call fails or gives a value that is not finite (init then raises the error)."""
+    for j in range(addrs.shape[0]):
+        for k in range(N + 1):
+            tk = -k * h
+            t = -tau if k == N else (0.0 if k == 0 else (-tau if tk < -tau else tk))
+            u = out[j, N - k]
+            u[:] = 0.0
+            if call_history(addrs[j], t, u, users[j]) != 0:
+                return False
+            for i in range(u.shape[0]):
+                if not math.isfinite(u[i]):
+                    return False
+    return True
+
+
 @numba.njit(cache=True)
 def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users,
          memory, fresh, E, r, rN, rlast, last, flat, dWU, E0, cw, c1, wlast, wslast, dE, dl,

@@ -376,10 +376,13 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     # S of the history: dz(t_q)/dp for q = -N, ..., 0
     Sall = np.zeros((N + steps + 1, n, P))
     if s.has("history") or any(o.has("history") for o in mod.others):
-        # each perturbed model samples its own history in init, as the scheme does
+        windows = _compiled_windows(mod, window) if engine != "python" else None
         for j, other in enumerate(mod.others):
-            other.init()
-            d = other.get_window() - window
+            if windows is None:         # each perturbed model samples its own history in init
+                other.init()
+                d = other.get_window() - window
+            else:
+                d = windows[j] - window
             if d.any():                 # (the columns of parameters the history has not stay 0)
                 Sall[:N + 1, :, j] = d / mod.delta[j]
     memory = _Memory(mod, lambda: np.concatenate([window[1:], U[1:]]), P)   # U^{-N+1}, ..., U^steps
@@ -467,6 +470,26 @@ def _result(t: np.ndarray, U: np.ndarray, S: np.ndarray, X: np.ndarray, dX: np.n
                       f"sensitivity; take a smaller h (now {h:.6g}) so that each reversal is "
                       "resolved", RuntimeWarning, stacklevel=3)
     return out
+
+
+def _compiled_windows(mod: _Perturbed, window: np.ndarray) -> np.ndarray | None:
+    """The perturbed models' windows U^{-N}, ..., U^0, (P, N + 1, n), sampled by calling their
+    compiled history callbacks as init does, without their init; None (init them) where a history
+    is not a C function, numba is not installed, a call fails, or the same sampling of the base
+    model's history does not give its window, as init sampled it, bit for bit."""
+    s = mod.base
+    callbacks = [m.c_callback("history") for m in [s, *mod.others]]
+    if any(c is None for c in callbacks) or importlib.util.find_spec("numba") is None:
+        return None
+    from . import _compiled
+    out = np.empty((len(callbacks), s.N + 1, s.n))
+    addrs = np.array([a for a, _ in callbacks], np.int64)
+    users = np.array([u for _, u in callbacks], np.int64)
+    if not _compiled.sample_windows(addrs, users, s.N, float(s.h), float(s.tau), out):
+        return None
+    if not np.array_equal(out[0], window):
+        return None
+    return out[1:]
 
 
 def _not_compiled(mod: _Perturbed, has_f: bool, rhs: Callable | None) -> str:
