@@ -403,6 +403,27 @@ def test_parameters_that_change_the_structure_are_refused():
         sensitivities(make_conv, [1.0], 0)
 
 
+def test_kernels_whose_weights_the_solver_does_not_expose_are_refused_with_what_to_do():
+    def near(p):            # an exponential fit beyond delta = 0.2 and the exact kernel below it
+        s = dmi.Solver(1, 1.0, 20)
+        s.set_rhs(lambda t, u: -p[0] * u)
+        s.set_quadrature("cell")
+        s.set_kernel_exp([-1.0], [0.0], [[[0.5]]])
+        s.set_kernel_near(lambda x: np.array([[0.5 * math.exp(-x)]]), 0.2)
+        return s
+    with pytest.raises(ValueError, match=r"near kernel.*delta = 0.*central differences"):
+        sensitivities(near, [1.0], 10)
+
+    def cell(p):
+        s = dmi.Solver(1, 1.0, 20)
+        s.set_rhs(lambda t, u: -p[0] * u)
+        s.set_quadrature("cell")
+        s.set_kernel(lambda x: np.array([[math.exp(-x)]]))
+        return s
+    with pytest.raises(ValueError, match=r"cell rule.*set_quadrature\('left'\).*set_kernel_exp"):
+        sensitivities(cell, [1.0], 10)
+
+
 def test_a_failing_callback_of_a_perturbed_model_names_the_call():
     def make(p):
         s = dmi.Solver(1, 1.0, 10)

@@ -144,11 +144,18 @@ def _same_structure(structure: list, b: Solver, j: int) -> None:
 def _supported(a: Solver) -> None:
     """ValueError for the kernels sensitivities do not follow."""
     if a.has("kernel_near"):
-        raise ValueError("a near kernel (set_kernel_near, a fit with delta > 0) is not supported by "
-                         "sensitivities; fit the kernel with delta = 0")
+        raise ValueError("sensitivities do not follow a near kernel (set_kernel_near, or "
+                         "set_kernel_fit of a fit with delta > 0): its near cells' weights are "
+                         "integrals of the singular kernel that the solver does not expose, and S "
+                         "needs the same weights as U.  Fit the kernel with delta = 0 (an "
+                         "exponential sum: set_kernel_fit or set_kernel_exp), or differentiate this "
+                         "model by central differences of runs")
     if a.kernel_kind == "callback" and a.quadrature == "cell":
-        raise ValueError("a callback kernel under the cell rule is not supported by sensitivities "
-                         "(its weights are tanh-sinh integrals); use the left rule or set_kernel_exp")
+        raise ValueError("sensitivities do not follow a callback kernel under the cell rule: its "
+                         "cell weights are tanh-sinh integrals that the solver does not expose, and "
+                         "S needs the same weights as U.  Use the left rule "
+                         "(set_quadrature('left')), an exponential kernel (set_kernel_exp), or "
+                         "central differences of runs")
 
 
 def _theta(s: Solver) -> float:
