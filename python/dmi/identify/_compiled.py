@@ -3,10 +3,14 @@
 """The tangent loop of :func:`dmi.identify.sensitivities` compiled by numba, for models whose f is a
 C function (a ``jit=True`` callback, a numba cfunc, a ctypes function): f is called through its
 address, with no Python in between.  It does step by step what the Python loop of sensitivity.py
-does, on the same precomputed arrays (the memory's weights and the kernel terms' derivatives, the
-resolvent's derivatives along the run), so the two agree to rounding; the exponential kernel's part
-dG_l U^{p-l}, which the Python loop takes from FFT convolutions, runs here by its recursions.  This module imports numba (sensitivity.py imports
-it only where numba is installed); the loop is compiled on first call and cached on disk."""
+does, so the two agree to rounding.  What does not depend on the step comes from Python (the last
+delay cell's weights, the kernel terms' derivatives, the friction's and the box's); the rest is done
+here in the same pass over the steps: R' and dR/dp of the friction from the run, the exponential
+memory's sums on S and the kernel parameters' part dG_l U^{p-l} by their recursions (started by
+Horner's rule over the window, in real arithmetic where the exponents are real), and the saltation
+test.  :func:`history_columns` samples compiled history callbacks as init does.  This module imports
+numba (sensitivity.py imports it only where numba is installed); its functions are compiled on first
+call and cached on disk."""
 from __future__ import annotations
 
 import math
@@ -61,22 +65,35 @@ def call_history(typingctx, address, t, out, user):
 
 
 @numba.njit(cache=True)
-def sample_windows(addrs, users, N, h, tau, out):
-    """out[j, N - k] = z_j(t_k), t_k = -k h (no lower than -tau, -tau at k = N), for the history
-    callbacks (addrs[j], users[j]): the window U^{-N}, ..., U^0 that init samples.  Returns False
-    where a call fails or gives a value that is not finite (init then raises the error)."""
+def history_columns(addrs, users, N, h, tau, window, delta, Sall):
+    """The history's S, Sall[N - k, :, j] = (z_j(t_k) - z(t_k)) / delta_j, by calling the compiled
+    history callbacks (addrs[1 + j], users[1 + j]) of the perturbed models at the times init uses,
+    t_k = -k h (no lower than -tau, -tau at k = N); (addrs[0], users[0]) is the model's own, whose
+    values must equal its window U^{-N}, ..., U^0 as init sampled it, bit for bit.  Returns 0 (and
+    whether any S is nonzero), 1 where a call fails or gives a value that is not finite (init then
+    raises the error), 2 where the model's own values differ from its window."""
+    n = window.shape[1]
+    u = np.empty(n)
+    nonzero = False
     for j in range(addrs.shape[0]):
         for k in range(N + 1):
             tk = -k * h
             t = -tau if k == N else (0.0 if k == 0 else (-tau if tk < -tau else tk))
-            u = out[j, N - k]
             u[:] = 0.0
             if call_history(addrs[j], t, u, users[j]) != 0:
-                return False
-            for i in range(u.shape[0]):
+                return 1, False
+            row = window[N - k]
+            for i in range(n):
                 if not math.isfinite(u[i]):
-                    return False
-    return True
+                    return 1, False
+                if j == 0:
+                    if u[i] != row[i]:
+                        return 2, False
+                else:
+                    d = (u[i] - row[i]) / delta[j - 1]
+                    Sall[N - k, i, j - 1] = d
+                    nonzero = nonzero or d != 0.0
+    return 0, nonzero
 
 
 @numba.njit(cache=True)
@@ -107,9 +124,11 @@ def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users
     since = 0
     dl_used = np.empty(K, np.bool_)            # which kernel terms' derivatives are not all zero
     dE_used = np.empty((K, n, n), np.bool_)
+    Z_used = np.empty((K, n), np.bool_)        # which columns of S the memory's terms read
     for k in range(K):
         dl_used[k] = np.any(dl[k] != 0.0)
         for i in range(n):
+            Z_used[k, i] = np.any(E[k, :, i] != 0.0)
             for m in range(n):
                 dE_used[k, i, m] = np.any(dE[k, i, m] != 0.0)
     Sflat = Sall.reshape(Sall.shape[0] * n, P)
@@ -129,7 +148,7 @@ def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users
                 if call_rhs(addrs[j + 1], t[q], moved, fj, users[j + 1]) != 0:
                     return count, q
                 for i in range(n):
-                    T[i, j] = Sq[i, j] - h * (fj[i] - f0[i]) / delta[j]
+                    T[i, j] = Sq[i, j] - h * ((fj[i] - f0[i]) / delta[j])
         else:
             for i in range(n):
                 for j in range(P):
@@ -231,8 +250,9 @@ def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users
             for k in range(K):
                 rk, rNk = r[k], rN[k]
                 for i in range(n):
-                    for j in range(P):
-                        Z[k, i, j] = rk * Z[k, i, j] + (Snew[i, j] - rNk * Sold[i, j])
+                    if Z_used[k, i]:            # (a column of S that E_k does not read is not kept)
+                        for j in range(P):
+                            Z[k, i, j] = rk * Z[k, i, j] + (Snew[i, j] - rNk * Sold[i, j])
                     Y1[k, i] = rk * (Y1[k, i] + Y[k, i]) - N * rNk * ulast[i]
                     Y[k, i] = rk * Y[k, i] + unew[i] - rNk * ulast[i]
             since += 1
@@ -264,14 +284,15 @@ def _window_sums(q, N, window, U, Sall, r, Z, Y, Y1, with_S):
 
 
 def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarray, phi: np.ndarray,
-        window: np.ndarray, Sall: np.ndarray, delta: np.ndarray, rhs: list | None, memory: Any,
-        kind: str, friction: tuple | None, box: tuple | None, jumps: bool
+        window: np.ndarray, Sall: np.ndarray, fresh: bool, delta: np.ndarray, rhs: list | None,
+        memory: Any, kind: str, friction: tuple | None, box: tuple | None, jumps: bool
         ) -> tuple[np.ndarray, list, int]:
     """The loop over the steps: fills Sall[N + 1:] and returns dX, the switches (p, i, kind) and
     the step whose f call failed (-1: none; the caller then takes the Python loop, which raises
     the callback's own error).
 
-    ``window``: U^{-N}, ..., U^0; ``rhs``: [(address, user)] of f at p and at p + delta_j e_j, or
+    ``window``: U^{-N}, ..., U^0; ``fresh``: whether the history's S in Sall[:N + 1] is nonzero
+    anywhere; ``rhs``: [(address, user)] of f at p and at p + delta_j e_j, or
     None without f; ``memory``: the _Memory of sensitivity.py; ``friction``: (alpha, dalpha);
     ``box``: (lo, hi, dlo, dhi)."""
     n, P = U.shape[1], len(delta)
@@ -285,7 +306,7 @@ def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarra
         users = np.array([u for _, u in rhs], np.int64)
     none2, none3 = np.zeros((0, 0), f64), np.zeros((0, 0, 0), f64)
     flat, dWU, last = none2, none3, np.zeros((n, n))
-    code, fresh = MEMORY_NONE, False
+    code = MEMORY_NONE
     dtype = f64
     if memory.recursive:
         code = MEMORY_RECURSIVE
@@ -300,7 +321,6 @@ def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarra
         wlast, wslast = cast(memory.wlast), cast(memory.wslast)
         dE, dl = cast(memory.dE.transpose(1, 2, 3, 0)), cast(memory.dl.T)
         last = c(memory.last, f64)
-        fresh = bool(np.any(Sall[:N + 1]))      # the history's S enters the memory
     else:
         E, r, rN, rlast = (np.zeros((0, n, n), dtype), np.zeros(0, dtype), np.zeros(0, dtype),
                            np.zeros(0, dtype))

@@ -382,16 +382,16 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     t, U, X = s.run_terms(steps)
     # S of the history: dz(t_q)/dp for q = -N, ..., 0
     Sall = np.zeros((N + steps + 1, n, P))
+    fresh = False                       # whether the history's S is nonzero somewhere
     if s.has("history") or any(o.has("history") for o in mod.others):
-        windows = _compiled_windows(mod, window) if engine != "python" else None
-        for j, other in enumerate(mod.others):
-            if windows is None:         # each perturbed model samples its own history in init
-                other.init()
+        fresh = _compiled_history(mod, window, Sall) if engine != "python" else None
+        if fresh is None:
+            for j, other in enumerate(mod.others):
+                other.init()            # each perturbed model samples its own history in init
                 d = other.get_window() - window
-            else:
-                d = windows[j] - window
-            if d.any():                 # (the columns of parameters the history has not stay 0)
-                Sall[:N + 1, :, j] = d / mod.delta[j]
+                if d.any():             # (the columns of parameters the history has not stay 0)
+                    Sall[:N + 1, :, j] = d / mod.delta[j]
+                    fresh = True
     memory = _Memory(mod, lambda: np.concatenate([window[1:], U[1:]]), P)   # U^{-N+1}, ..., U^steps
     # the resolvent's derivatives in p, as they do not depend on the step
     kind = s.resolvent_kind
@@ -415,8 +415,9 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
         callbacks = ([m.c_callback("rhs") for m in [s, *mod.others]] if has_f else None)
         friction = (alpha, dalpha) if kind == "friction" else None
         box = (lo, hi, dlo, dhi) if kind == "box" else None
-        dX, switches, failed = _compiled.run(steps, N, h, t, U, X, phi, window, Sall, mod.delta,
-                                             callbacks, memory, kind, friction, box, jumps)
+        dX, switches, failed = _compiled.run(steps, N, h, t, U, X, phi, window, Sall, bool(fresh),
+                                             mod.delta, callbacks, memory, kind, friction, box,
+                                             jumps)
         if failed < 0:
             return _result(t, U, Sall[N:], X, dX, h, switches, "compiled")
         # a call of f failed: the Python loop below (which rewrites each S^{q+1} of Sall from
@@ -479,24 +480,24 @@ def _result(t: np.ndarray, U: np.ndarray, S: np.ndarray, X: np.ndarray, dX: np.n
     return out
 
 
-def _compiled_windows(mod: _Perturbed, window: np.ndarray) -> np.ndarray | None:
-    """The perturbed models' windows U^{-N}, ..., U^0, (P, N + 1, n), sampled by calling their
-    compiled history callbacks as init does, without their init; None (init them) where a history
-    is not a C function, numba is not installed, a call fails, or the same sampling of the base
-    model's history does not give its window, as init sampled it, bit for bit."""
+def _compiled_history(mod: _Perturbed, window: np.ndarray, Sall: np.ndarray) -> bool | None:
+    """The history's S into Sall[:N + 1] from the perturbed models' compiled history callbacks,
+    called as init calls them, without their init; whether it is nonzero anywhere.  None (init
+    them) where a history is not a C function, numba is not installed, a call fails, or the same
+    sampling of the model's own history does not give its window, as init sampled it, bit for bit."""
     s = mod.base
     callbacks = [m.c_callback("history") for m in [s, *mod.others]]
     if any(c is None for c in callbacks) or importlib.util.find_spec("numba") is None:
         return None
     from . import _compiled
-    out = np.empty((len(callbacks), s.N + 1, s.n))
     addrs = np.array([a for a, _ in callbacks], np.int64)
     users = np.array([u for _, u in callbacks], np.int64)
-    if not _compiled.sample_windows(addrs, users, s.N, float(s.h), float(s.tau), out):
+    status, nonzero = _compiled.history_columns(addrs, users, s.N, float(s.h), float(s.tau),
+                                                np.ascontiguousarray(window), mod.delta, Sall)
+    if status != 0:
+        Sall[:s.N + 1] = 0.0            # (what it wrote before it stopped)
         return None
-    if not np.array_equal(out[0], window):
-        return None
-    return out[1:]
+    return bool(nonzero)
 
 
 def _not_compiled(mod: _Perturbed, has_f: bool, rhs: Callable | None) -> str:
