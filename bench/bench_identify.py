@@ -11,7 +11,8 @@
 # Gauss-Newton iteration of the gallery's fit (plot_identify_friction_memory.py: one sensitivity
 # run and one residual run) against the P + 1 runs it needs.
 # Rounds interleave the variants; the fastest round of each counts; CPU times of the process (the
-# machine may be shared); one BLAS thread.  --baseline DIR times another version of dmi.identify
+# machine may be shared); one BLAS thread; a case whose forward difference takes under 50 ms is
+# repeated within each timing to about 50 ms (the time of one call is printed).  --baseline DIR times another version of dmi.identify
 # (DIR: a copy of its python/dmi/identify, e.g. from `git show main:...`, loaded as a subpackage
 # of the same dmi) in the same rounds, interleaved: its columns "sens (base)" and "base/sens".
 # Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_identify.py [--rounds 2]
@@ -126,15 +127,23 @@ def main() -> None:
         sensitivities(make, P0, 2, engine=engine)
         if base is not None:
             base.sensitivities(make, P0, 2, engine=engine)
+    # short cases repeated within each timing (at least about 50 ms of CPU), the time of one call
+    reps = {name: max(1, min(50, int(0.05 / max(cpu(lambda: differences(make, P0, steps, False)),
+                                                1e-4))))
+            for name, make, steps, _ in cases}
+
+    def timed(name, f):
+        return cpu(lambda: [f() for _ in range(reps[name])]) / reps[name]
     best: dict = {}
     for _ in range(args.rounds):
         for name, make, steps, engine in cases:
-            times = {"run": cpu(lambda: plain(make, P0, steps)),
-                     "sens": cpu(lambda: sensitivities(make, P0, steps, engine=engine)),
-                     "fwd": cpu(lambda: differences(make, P0, steps, False)),
-                     "central": cpu(lambda: differences(make, P0, steps, True))}
+            times = {"run": timed(name, lambda: plain(make, P0, steps)),
+                     "sens": timed(name, lambda: sensitivities(make, P0, steps, engine=engine)),
+                     "fwd": timed(name, lambda: differences(make, P0, steps, False)),
+                     "central": timed(name, lambda: differences(make, P0, steps, True))}
             if base is not None:
-                times["base"] = cpu(lambda: base.sensitivities(make, P0, steps, engine=engine))
+                times["base"] = timed(name, lambda: base.sensitivities(make, P0, steps,
+                                                                       engine=engine))
             old = best.get(name, {})
             best[name] = {k: min(v, old.get(k, np.inf)) for k, v in times.items()}
     print(f"P = {P} parameters; CPU seconds, fastest of {args.rounds} rounds")
