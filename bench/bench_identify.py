@@ -16,7 +16,7 @@
 # (DIR: a copy of its python/dmi/identify, e.g. from `git show main:...`, loaded as a subpackage
 # of the same dmi) in the same rounds, interleaved: its columns "sens (base)" and "base/sens".
 # Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_identify.py [--rounds 2]
-#        [--steps 1000 100000] [--callback-steps 2000] [--baseline DIR]
+#        [--steps 1000 100000] [--callback-steps 2000] [--cases TEXT] [--baseline DIR]
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -105,6 +105,8 @@ def main() -> None:
                          "(default 1000 100000)")
     ap.add_argument("--callback-steps", type=positive_int, default=2000,
                     help="run length of the callback-kernel cases, DIRECT and FFT (default 2000)")
+    ap.add_argument("--cases", metavar="TEXT", default="",
+                    help="only the cases whose name contains TEXT (default: all)")
     ap.add_argument("--baseline", metavar="DIR",
                     help="a copy of another version's python/dmi/identify, timed in the same rounds")
     args = ap.parse_args()
@@ -122,6 +124,7 @@ def main() -> None:
     for kernel in ("direct", "fft"):
         cases.append((f"{kernel} kernel callback, f jit, N = {args.callback_steps}",
                       model(args.callback_steps, True, kernel), args.callback_steps, "auto"))
+    cases = [c for c in cases if args.cases in c[0]]
     for _, make, steps, engine in cases:   # compile the jit=True callbacks and the loop first
         plain(make, P0, 2)
         sensitivities(make, P0, 2, engine=engine)

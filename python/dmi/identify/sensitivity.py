@@ -235,6 +235,7 @@ class _Memory:
                 self.E = self.E0 * self.c[:, None, None]
                 self.r = np.exp(self.lam * s.h)
                 self.rN = np.exp(self.lam * s.h * N)
+                self._r3, self._rN3 = self.r[:, None, None], self.rN[:, None, None]
                 self.rlast = np.exp(self.lam * s.h * (N - 1))
                 # G_{N-1} less what the full-cell recursion puts on the last cell
                 self.last = np.einsum("k,kij->ij", self.wlast - self.rlast * self.c, self.E0).real
@@ -313,8 +314,7 @@ class _Memory:
     def push(self, Sall: np.ndarray, p: int) -> None:
         """Advances Z from step p to p + 1 once S^{p+1} is in Sall."""
         if self.recursive and self.Z is not None:
-            r, rN = self.r[:, None, None], self.rN[:, None, None]
-            self.Z = r * self.Z + (Sall[p + 1 + self.N] - rN * Sall[p + 1])
+            self.Z = self._r3 * self.Z + (Sall[p + 1 + self.N] - self._rN3 * Sall[p + 1])
             self.since += 1
 
 
@@ -381,11 +381,15 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     window = s.get_window()                                          # U^{-N}, ..., U^0
     t, U, X = s.run_terms(steps)
     # S of the history: dz(t_q)/dp for q = -N, ..., 0
-    Sall = np.zeros((N + steps + 1, n, P))
-    fresh = False                       # whether the history's S is nonzero somewhere
-    if s.has("history") or any(o.has("history") for o in mod.others):
-        fresh = _compiled_history(mod, window, Sall) if engine != "python" else None
-        if fresh is None:
+    # (the rows of the steps are all written by the loops; those of the history, Sall[:N + 1],
+    # by the compiled sampling or zeroed here)
+    Sall = np.empty((N + steps + 1, n, P))
+    fresh = None                        # whether the history's S is nonzero somewhere
+    if engine != "python" and (s.has("history") or any(o.has("history") for o in mod.others)):
+        fresh = _compiled_history(mod, window, Sall)
+    if fresh is None:
+        Sall[:N + 1] = 0.0
+        if s.has("history") or any(o.has("history") for o in mod.others):
             for j, other in enumerate(mod.others):
                 other.init()            # each perturbed model samples its own history in init
                 d = other.get_window() - window
@@ -481,9 +485,9 @@ def _result(t: np.ndarray, U: np.ndarray, S: np.ndarray, X: np.ndarray, dX: np.n
 
 
 def _compiled_history(mod: _Perturbed, window: np.ndarray, Sall: np.ndarray) -> bool | None:
-    """The history's S into Sall[:N + 1] from the perturbed models' compiled history callbacks,
-    called as init calls them, without their init; whether it is nonzero anywhere.  None (init
-    them) where a history is not a C function, numba is not installed, a call fails, or the same
+    """The history's S into all of Sall[:N + 1] from the perturbed models' compiled history
+    callbacks, called as init calls them, without their init; whether it is nonzero anywhere.  None
+    (Sall[:N + 1] then partly written: zero it and init them) where a history is not a C function, numba is not installed, a call fails, or the same
     sampling of the model's own history does not give its window, as init sampled it, bit for bit."""
     s = mod.base
     callbacks = [m.c_callback("history") for m in [s, *mod.others]]
@@ -494,10 +498,7 @@ def _compiled_history(mod: _Perturbed, window: np.ndarray, Sall: np.ndarray) -> 
     users = np.array([u for _, u in callbacks], np.int64)
     status, nonzero = _compiled.history_columns(addrs, users, s.N, float(s.h), float(s.tau),
                                                 np.ascontiguousarray(window), mod.delta, Sall)
-    if status != 0:
-        Sall[:s.N + 1] = 0.0            # (what it wrote before it stopped)
-        return None
-    return bool(nonzero)
+    return bool(nonzero) if status == 0 else None
 
 
 def _not_compiled(mod: _Perturbed, has_f: bool, rhs: Callable | None) -> str:
