@@ -147,3 +147,42 @@ def test_c_callback():
     assert s.c_callback("rhs") == (ctypes.cast(c_rhs, ctypes.c_void_p).value, data.ctypes.data)
     with pytest.raises(dmi.InvalidArgument, match="part 'force'"):
         s.c_callback("force")
+
+
+def jit_history_model(h=None):
+    """A friction oscillator with memory whose compiled history carries parameters; tau = 0.8 with
+    h = 0.8 / 37.4 leaves a short last delay cell (the window's oldest sample at -tau, not -N h);
+    parameters (k, mu, w0, v0, c)."""
+    def make(p):
+        k, mu, w0, v0, c = p
+        s = dmi.Solver(2, 0.8, 40) if h is None else dmi.Solver(2, 0.8, h=h)
+        s.set_rhs(lambda t, u: np.array([-u[1], k * u[0] + 2.0 * math.cos(0.8 * t)]), jit=True)
+        s.set_friction([0.0, mu])
+        C = np.zeros((1, 2, 2))
+        C[0, 1, 0] = c
+        s.set_kernel_exp([-2.0], [0.0], C)
+        s.set_history(lambda t: np.array([w0 + v0 * t + 0.3 * t * t, v0 + 0.6 * t]), jit=True)
+        return s
+    return make
+
+
+@pytest.mark.parametrize("h", [None, 0.8 / 37.4])
+def test_compiled_history_is_sampled_without_init(monkeypatch, h):
+    # the perturbed models' windows come from their compiled history callbacks, called as init
+    # calls them; the Python loop inits every model: both give the same S, through reversals
+    make = jit_history_model(h)
+    p = [1.0, 0.5, 0.3, 0.2, 0.6]
+    slow = sensitivities(make, p, 300, engine="python")
+    inits = []
+    orig = dmi.Solver.init
+
+    def counted(self):
+        inits.append(self)
+        return orig(self)
+    monkeypatch.setattr(dmi.Solver, "init", counted)
+    fast = sensitivities(make, p, 300)
+    assert fast.engine == "compiled" and len(inits) == 1          # the base model's init only
+    assert "reversal" in {kind for _, _, kind in slow.switches}
+    # the history's columns: dU^0/dw0 = (1, 0), dU^0/dv0 = (0, 1)
+    assert np.array_equal(fast.S[0, :, 2:4], np.eye(2))
+    agree(fast, slow)

@@ -52,7 +52,8 @@ def test_synthetic_recovery_from_twenty_percent_off():
     assert est.success, est.message
     assert np.abs(est.p / TRUE - 1.0).max() < 1e-8, est.p
     assert est.njev <= 12, est.njev
-    assert est.unidentifiable == []
+    assert est.unidentifiable == [] and est.unplaced == []
+    assert np.all(np.isfinite(est.stderr))
     assert est.cost < 1e-16 and est.residuals.shape == (2 * len(t),)
     assert est.jacobian.shape == (2 * len(t), 7)
 
@@ -217,6 +218,35 @@ def test_bad_inputs_are_clear_errors():
         return s
     with pytest.raises(ValueError, match="convolution method"):
         estimate(changes_method, [0.5, 1.0], Record(t, y))
+
+
+def test_an_unplaced_reversal_withholds_the_covariance():
+    # the constructed case of test_identify_sensitivity.py: at h = 0.01 the reversal of step 5
+    # cannot be placed inside its step, so the Jacobian there is not the equation's derivative
+    from test_identify_sensitivity import forcing_reversed_in_the_crossing_step
+    make = forcing_reversed_in_the_crossing_step(0.01)
+    t, y = data(make, [1.0], 0.12, comps=(0,))
+    with pytest.warns(RuntimeWarning, match=r"could not place 1 .*step 5 of record 0.*smaller h"):
+        est = estimate(make, [1.1], Record(t, y[:, 0]), names=["mu"])
+    assert abs(est.p[0] - 1.0) < 1e-8                      # the residuals are the scheme's own
+    assert est.unplaced == [(0, 5)] and "smaller h" in est.message
+    assert np.isnan(est.stderr[0]) and np.isnan(est.cov[0, 0])
+    # at h = 0.001 every reversal is placed: a covariance, and no warning
+    make = forcing_reversed_in_the_crossing_step(0.001)
+    t, y = data(make, [1.0], 0.12, comps=(0,))
+    noisy = y[:, 0] + 1e-3 * np.random.default_rng(2).standard_normal(len(t))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        est = estimate(make, [1.1], Record(t, noisy, sigma=1e-3), names=["mu"])
+    assert est.success and est.unplaced == [] and 0.0 < est.stderr[0] < 0.1
+
+
+def test_profile_of_an_estimate_that_did_not_converge_is_refused():
+    record = noisy_decay()
+    stopped = estimate(decay, [1.5, -0.3], record, names=["z0", "k"], callback=lambda info: True)
+    assert not stopped.success
+    with pytest.raises(ValueError, match="did not converge.*refit"):
+        profile_likelihood(stopped, "z0")
 
 
 def test_a_callback_stop_and_ctrl_c_keep_the_best_point():

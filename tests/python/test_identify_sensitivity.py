@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import mpmath
 import numpy as np
@@ -240,7 +241,10 @@ def errors(T, mu, hs, jumps=True, **kw):
     out = []
     for h in hs:
         steps = round(T / h)
-        r = sensitivities(oscillator(h, mu, **kw), [mu, kw.get("c", 0.0)], steps, jumps=jumps)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", RuntimeWarning)      # no reversal left unplaced here
+            r = sensitivities(oscillator(h, mu, **kw), [mu, kw.get("c", 0.0)], steps, jumps=jumps)
+        assert r.unplaced == []
         kinds = {kind for _, _, kind in r.switches}
         out.append((np.abs(r.S[-1, :, :] - ref[:2]).max(), kinds))
     return out
@@ -279,6 +283,40 @@ def test_memory_stick_slip_converges_at_order_one():
         assert "stick" in kinds
         assert e < 20.0 * h, (h, e)
     assert err[-1][0] < err[0][0] / 2.0
+
+
+def forcing_reversed_in_the_crossing_step(h, jit=False):
+    """u' + mu sigma(u) ∋ -f, f = 3 until t = 0.055 and -3 after, u = 0.215 on t <= 0: u reaches 0
+    at t = 0.05375 (speed -4, then -2 after the reversal); at h = 0.01 the step that crosses zero,
+    [0.05, 0.06], also holds the jump of f, so the velocity interpolated at the crossing does not
+    have the sign of a reversal; parameter (mu,)."""
+    def make(p):
+        s = dmi.Solver(1, 1.0, h=h)
+        s.set_rhs(lambda t, u: np.array([3.0 if t < 0.055 else -3.0]), jit=jit)
+        s.set_friction([p[0]])
+        s.set_history(lambda t: np.array([0.215]))
+        return s
+    return make
+
+
+@pytest.mark.parametrize("engine", ["python", "auto"])
+def test_a_reversal_that_cannot_be_placed_is_flagged(engine):
+    jit = engine == "auto"
+    if jit:
+        pytest.importorskip("numba")
+    make = forcing_reversed_in_the_crossing_step(0.01, jit)
+    with pytest.warns(RuntimeWarning, match=r"could not be placed.*steps 5.*smaller h"):
+        r = sensitivities(make, [1.0], 12, engine=engine)
+    # the scheme: U = 0.215 - 0.04 q down to U^5 = 0.015, then U^6 = 0.015 - 0.03 + 0.01 < 0
+    assert np.abs(r.u[:7, 0] - [0.215, 0.175, 0.135, 0.095, 0.055, 0.015, -0.005]).max() < 1e-12
+    assert r.unplaced == [5] and (5, 0, "unplaced") in r.switches
+    assert r.engine == ("compiled" if jit else "python")
+    # a step ten times smaller puts the jump of f after the crossing step: placed, no warning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        fine = sensitivities(forcing_reversed_in_the_crossing_step(0.001, jit), [1.0], 120,
+                             engine=engine)
+    assert fine.unplaced == [] and (53, 0, "reversal") in fine.switches
 
 
 # ---- kernel parameters: mpmath's closed form of u' + k u + int c e^{a s} u(t - s) ds = 0 ---------------
@@ -363,6 +401,27 @@ def test_parameters_that_change_the_structure_are_refused():
         sensitivities(make, [float("nan")], 10)
     with pytest.raises(ValueError, match="steps"):
         sensitivities(make_conv, [1.0], 0)
+
+
+def test_kernels_whose_weights_the_solver_does_not_expose_are_refused_with_what_to_do():
+    def near(p):            # an exponential fit beyond delta = 0.2 and the exact kernel below it
+        s = dmi.Solver(1, 1.0, 20)
+        s.set_rhs(lambda t, u: -p[0] * u)
+        s.set_quadrature("cell")
+        s.set_kernel_exp([-1.0], [0.0], [[[0.5]]])
+        s.set_kernel_near(lambda x: np.array([[0.5 * math.exp(-x)]]), 0.2)
+        return s
+    with pytest.raises(ValueError, match=r"near kernel.*delta = 0.*central differences"):
+        sensitivities(near, [1.0], 10)
+
+    def cell(p):
+        s = dmi.Solver(1, 1.0, 20)
+        s.set_rhs(lambda t, u: -p[0] * u)
+        s.set_quadrature("cell")
+        s.set_kernel(lambda x: np.array([[math.exp(-x)]]))
+        return s
+    with pytest.raises(ValueError, match=r"cell rule.*set_quadrature\('left'\).*set_kernel_exp"):
+        sensitivities(cell, [1.0], 10)
 
 
 def test_a_failing_callback_of_a_perturbed_model_names_the_call():

@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 #: codes of what a component does in a step (the first element of :func:`reversal`'s result)
-NONE, STICK, REVERSAL = 0, 1, 2
+NONE, STICK, REVERSAL, UNPLACED = 0, 1, 2, 3
 
 
 def reversal(q: int, i: int, U: np.ndarray, phi: np.ndarray, alpha: np.ndarray) -> tuple[int, float]:
@@ -36,7 +36,11 @@ def reversal(q: int, i: int, U: np.ndarray, phi: np.ndarray, alpha: np.ndarray) 
         (REVERSAL, rho) where the component slips at U^q and reverses during the step (to the other
         sign at once, or through one step in the dead zone), rho = F+ / F- the ratio of the
         velocities just after and before the reversal (linear interpolation of phi at the reversal);
-        (STICK, 0.0) where it lands in the dead zone and stays; (NONE, 0.0) otherwise.
+        (STICK, 0.0) where it lands in the dead zone and stays; (UNPLACED, 0.0) where it slips at U^q
+        and meets zero or changes sign in the step but the velocities interpolated at the crossing do
+        not have the signs of a reversal (before towards 0, after away from it), so the switching
+        time cannot be placed inside the step and no saltation factor is applied; (NONE, 0.0)
+        otherwise.
     """
     if U[q, i] == 0.0 or not alpha[i] > 0.0:
         return NONE, 0.0
@@ -56,5 +60,5 @@ def reversal(q: int, i: int, U: np.ndarray, phi: np.ndarray, alpha: np.ndarray) 
     before = sm * ph + alpha[i]        # -s F-: the speed towards 0 before the reversal
     after = sm * ph - alpha[i]         # s F+: the speed away from 0 after it
     if before <= 0.0 or after <= 0.0:
-        return NONE, 0.0
+        return UNPLACED, 0.0
     return REVERSAL, after / before

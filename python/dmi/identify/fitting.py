@@ -97,6 +97,11 @@ class Estimate:
         Whether every record gave sigma.
     starts : list of tuple
         (p0, cost) of each start of ``multistart``.
+    unplaced : list of tuple
+        (record, step) of each friction reversal the sensitivities could not place inside its
+        step at the returned point (see :attr:`Sensitivities.unplaced`): the Jacobian is off by
+        O(1) from there on, so ``cov``, ``stderr`` and ``corr`` are NaN (a RuntimeWarning and
+        ``message`` say so; a smaller h resolves them).  Empty otherwise.
     """
 
     p: np.ndarray
@@ -118,6 +123,7 @@ class Estimate:
     dof: int
     sigma_known: bool
     starts: list
+    unplaced: list = dataclasses.field(default_factory=list)
     _problem: Any = dataclasses.field(default=None, repr=False)
 
     def wald_interval(self, index: int | str, level: float = 0.95) -> tuple[float, float]:
@@ -256,6 +262,7 @@ class _Problem:
         self.jumps = True
         self.bounds = (np.full(len(p0), -np.inf), np.full(len(p0), np.inf))
         self.best: tuple[float, np.ndarray] | None = None
+        self.unplaced: list = []        # (record, step) of the last Jacobian's unplaced reversals
         self._cache: tuple[bytes, np.ndarray, np.ndarray] | None = None
 
     def full(self, x: np.ndarray) -> np.ndarray:
@@ -325,18 +332,25 @@ class _Problem:
                 pc = self.p0.astype(complex)
                 pc[self.free] = q
                 return self.rhs(t, u, pc)
-        for make, d in zip(self.makes, self.data):
+        unplaced = []
+        for k, (make, d) in enumerate(zip(self.makes, self.data)):
             def make_free(q: np.ndarray, _make: Callable = make) -> Solver:
                 return _make(self.full(q))
             s0 = make(p.copy())
-            sens: Sensitivities = sensitivities(make_free, p[idx], self._steps(s0, d), rhs=rhs,
-                                                 jumps=self.jumps)
+            with warnings.catch_warnings():
+                # reversals left unplaced are gathered here and reported once by the estimate
+                warnings.filterwarnings("ignore", "sensitivities: .* could not be placed",
+                                        RuntimeWarning)
+                sens: Sensitivities = sensitivities(make_free, p[idx], self._steps(s0, d), rhs=rhs,
+                                                     jumps=self.jumps)
+            unplaced += [(k, q) for q in sens.unplaced]
             val, der = self._predict(d, sens.t, sens.h, sens.u, sens.x, sens.S, sens.dx)
             res.append(((val - d.y) * d.w).ravel())
             rows.append((der * d.w[:, :, None]).reshape(-1, len(idx)))
         J = np.concatenate(rows)
         self.njev += 1
         self._cache = (key, np.concatenate(res), J)
+        self.unplaced = unplaced
         return J
 
 
@@ -593,6 +607,18 @@ def _summarise(problem: _Problem, names: list, x: np.ndarray, cost: float, messa
         outer = np.outer(stderr, stderr)
         corr = cov / outer
     corr[~np.isfinite(corr) | (outer == 0) | ~np.isfinite(outer)] = np.nan
+    if problem.unplaced:
+        # the Jacobian is off by O(1) after a reversal it could not place: no covariance from it
+        cov[np.ix_(idx, idx)] = np.nan
+        stderr[idx] = np.nan
+        corr[np.ix_(idx, idx)] = np.nan
+        shown = ", ".join(f"step {q} of record {k}" for k, q in problem.unplaced[:5])
+        more = ", ..." if len(problem.unplaced) > 5 else ""
+        why = (f"the sensitivities could not place {len(problem.unplaced)} friction reversal(s) inside "
+               f"their step ({shown}{more}), so the Jacobian is off by O(1) from there on and the "
+               "covariance, standard errors and correlations are not reported (NaN); take a smaller h")
+        message = f"{message}; {why}"
+        warnings.warn(f"estimate: {why}", RuntimeWarning, stacklevel=3)
     rss = 2.0 * cost
     if known:
         aic, bic = rss + 2 * F, rss + F * math.log(M)
@@ -603,7 +629,7 @@ def _summarise(problem: _Problem, names: list, x: np.ndarray, cost: float, messa
                     residuals=r, jacobian=J, cost=cost, aic=aic, bic=bic,
                     success=converged and not stopped, message=message, unidentifiable=combos,
                     nfev=problem.nfev, njev=problem.njev, dof=dof, sigma_known=known, starts=[],
-                    _problem=problem)
+                    unplaced=list(problem.unplaced), _problem=problem)
 
 
 def _covariance(J: np.ndarray, x: np.ndarray, names: list) -> tuple[np.ndarray, list, list]:

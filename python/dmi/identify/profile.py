@@ -84,11 +84,17 @@ def profile_likelihood(estimate: Estimate, index: int | str, *, level: float = 0
     Raises
     ------
     ValueError
-        A parameter that was not fitted, an unknown one, a level outside (0, 1), or an estimate
-        without its problem (not made by :func:`estimate`).
+        A parameter that was not fitted, an unknown one, a level outside (0, 1), an estimate
+        without its problem (not made by :func:`estimate`), or one that did not converge
+        (``success`` False).
     """
     if not isinstance(estimate, Estimate) or estimate._problem is None:
         raise ValueError("profile_likelihood: expected an Estimate returned by dmi.identify.estimate")
+    if not estimate.success:
+        raise ValueError(f"profile_likelihood: the estimate did not converge ({estimate.message}); its "
+                         "cost is not a verified minimum, so no likelihood-ratio interval can be "
+                         "measured from it: refit (more max_nfev, another p0 or multistart) and "
+                         "profile a converged estimate")
     i = _index(index, estimate.names)
     if not estimate.free[i]:
         raise ValueError(f"parameter {estimate.names[i]!r} was fixed in the fit; profile a fitted one")

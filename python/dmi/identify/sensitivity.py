@@ -18,6 +18,7 @@ from __future__ import annotations
 import dataclasses
 import importlib.util
 import math
+import warnings
 from collections.abc import Callable
 from typing import Any
 
@@ -25,7 +26,7 @@ import numpy as np
 from scipy import fft as sp_fft
 
 from .._solver import Solver
-from ._saltation import REVERSAL, STICK, reversal
+from ._saltation import REVERSAL, STICK, UNPLACED, reversal
 
 #: Relative step of the directional differences (about the square root of the unit roundoff).
 REL_STEP = 2.0 ** -26
@@ -52,7 +53,9 @@ class Sensitivities:
         The step (time units).
     switches : list of tuple
         (p, i, kind): friction component i reverses in step p (``"reversal"``, S_i multiplied by
-        the saltation factor there) or starts to stick (``"stick"``).
+        the saltation factor there), starts to stick (``"stick"``), or meets zero or changes
+        sign in a way the loop cannot place as a reversal inside the step (``"unplaced"``: no
+        saltation factor applied, S_i there is the plain tangent, off by O(1)).
     engine : str
         The loop over the steps that computed S: ``"compiled"`` (numba, f called through its C
         function) or ``"python"``.
@@ -66,6 +69,19 @@ class Sensitivities:
     h: float
     switches: list
     engine: str = "python"
+
+    @property
+    def unplaced(self) -> list:
+        """The steps p (increasing, each once) with a reversal the loop could not place inside the
+        step: S is not the equation's sensitivity from there on (a smaller h resolves them); empty
+        where every switch was placed.
+
+        Returns
+        -------
+        list of int
+            The steps.
+        """
+        return sorted({q for q, _, kind in self.switches if kind == "unplaced"})
 
 
 @dataclasses.dataclass
@@ -81,6 +97,8 @@ def _build(make: Callable[[np.ndarray], Solver], p: np.ndarray) -> _Perturbed:
     """The solvers at p and p + delta_j e_j, after checking that the parameters change nothing
     the sensitivities cannot follow."""
     base = _call_make(make, p, "p")
+    _supported(base)
+    structure = _structure(base)
     others, delta = [], np.empty(len(p))
     for j in range(len(p)):
         step = REL_STEP * max(1.0, abs(p[j]))
@@ -88,7 +106,7 @@ def _build(make: Callable[[np.ndarray], Solver], p: np.ndarray) -> _Perturbed:
         q[j] = p[j] + step
         delta[j] = q[j] - p[j]          # the step actually applied
         other = _call_make(make, q, f"p + delta e_{j}")
-        _same_structure(base, other, j)
+        _same_structure(structure, other, j)
         others.append(other)
     return _Perturbed(base, others, delta)
 
@@ -104,29 +122,40 @@ def _call_make(make: Callable[[np.ndarray], Solver], q: np.ndarray, what: str) -
     return s
 
 
-def _same_structure(a: Solver, b: Solver, j: int) -> None:
+def _structure(s: Solver) -> list:
+    """(name, value) of what a parameter may not change."""
+    terms = s.kernel_terms
+    return [("n", s.n), ("N", s.N), ("h", s.h), ("tau", s.tau), ("the kind of A", s.resolvent_kind),
+            ("the kind of kernel", s.kernel_kind), ("the convolution method", s.convolution),
+            ("the quadrature rule", s.quadrature), ("the near kernel's delta", s.kernel_near_delta),
+            ("the number of kernel terms", None if terms is None else len(terms[0]))]
+
+
+def _same_structure(structure: list, b: Solver, j: int) -> None:
     """ValueError naming what parameter j changes among the things a sensitivity cannot follow."""
-    checks = [("n", a.n, b.n), ("N", a.N, b.N), ("h", a.h, b.h), ("tau", a.tau, b.tau),
-              ("the kind of A", a.resolvent_kind, b.resolvent_kind),
-              ("the kind of kernel", a.kernel_kind, b.kernel_kind),
-              ("the convolution method", a.convolution, b.convolution),
-              ("the quadrature rule", a.quadrature, b.quadrature),
-              ("the near kernel's delta", a.kernel_near_delta, b.kernel_near_delta)]
-    ta, tb = a.kernel_terms, b.kernel_terms
-    if ta is not None and tb is not None:
-        checks.append(("the number of kernel terms", len(ta[0]), len(tb[0])))
-    for name, x, y in checks:
+    for (name, x), (_, y) in zip(structure, _structure(b)):
         if x != y:
             raise ValueError(f"parameter {j} changes {name} ({x!r} -> {y!r}); a parameter may change "
                              "values of the model, not its structure: keep n, N, h, tau, the kinds of A "
                              "and kernel, the number of kernel terms, the convolution method and the "
                              "quadrature fixed in make")
+
+
+def _supported(a: Solver) -> None:
+    """ValueError for the kernels sensitivities do not follow."""
     if a.has("kernel_near"):
-        raise ValueError("a near kernel (set_kernel_near, a fit with delta > 0) is not supported by "
-                         "sensitivities; fit the kernel with delta = 0")
+        raise ValueError("sensitivities do not follow a near kernel (set_kernel_near, or "
+                         "set_kernel_fit of a fit with delta > 0): its near cells' weights are "
+                         "integrals of the singular kernel that the solver does not expose, and S "
+                         "needs the same weights as U.  Fit the kernel with delta = 0 (an "
+                         "exponential sum: set_kernel_fit or set_kernel_exp), or differentiate this "
+                         "model by central differences of runs")
     if a.kernel_kind == "callback" and a.quadrature == "cell":
-        raise ValueError("a callback kernel under the cell rule is not supported by sensitivities "
-                         "(its weights are tanh-sinh integrals); use the left rule or set_kernel_exp")
+        raise ValueError("sensitivities do not follow a callback kernel under the cell rule: its "
+                         "cell weights are tanh-sinh integrals that the solver does not expose, and "
+                         "S needs the same weights as U.  Use the left rule "
+                         "(set_quadrature('left')), an exponential kernel (set_kernel_exp), or "
+                         "central differences of runs")
 
 
 def _theta(s: Solver) -> float:
@@ -143,26 +172,23 @@ def _theta(s: Solver) -> float:
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(12)
 
 
-def _exp_weights(s: Solver, lam: np.ndarray
+def _exp_weights(s: Solver, lam: np.ndarray, cells: np.ndarray
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Per term k and cell l: w[k, l], the complex weight of e^{lam_k s} over cell l, and ws[k, l],
-    that of s e^{lam_k s} (its derivative in lam_k); c[k] and c1[k], the factors of the full cells
-    (w[k, l] = c_k r_k^l and ws[k, l] = r_k^l (l h c_k + c1_k) for l < N - 1, r_k = e^{lam_k h})."""
+    """Per term k and cell l of ``cells``: w[k, l], the complex weight of e^{lam_k s} over cell l,
+    and ws[k, l], that of s e^{lam_k s} (its derivative in lam_k); c[k] and c1[k], the factors of
+    the full cells (w[k, l] = c_k r_k^l and ws[k, l] = r_k^l (l h c_k + c1_k) for l < N - 1,
+    r_k = e^{lam_k h})."""
     N, h = s.N, s.h
-    theta = _theta(s)
-    lags = np.arange(N) * h
+    lags = cells * h
+    length = np.where(cells == N - 1, _theta(s) * h, h)
     if s.quadrature == "left":
-        cell = np.full(N, h)
-        cell[-1] = theta * h
         e = np.exp(np.outer(lam, lags))
-        return (cell * e, cell * lags * e, np.full(len(lam), h, dtype=complex),
+        return (length * e, length * lags * e, np.full(len(lam), h, dtype=complex),
                 np.zeros(len(lam), dtype=complex))
     # the cell rule: the integrals over each cell, by Gauss-Legendre (the integrands are smooth)
-    length = np.full(N, h)
-    length[-1] = theta * h
-    nodes = lags[:, None] + 0.5 * length[:, None] * (1.0 + _GL_X[None, :])     # (N, G)
+    nodes = lags[:, None] + 0.5 * length[:, None] * (1.0 + _GL_X[None, :])     # (L, G)
     wts = 0.5 * length[:, None] * _GL_W[None, :]
-    e = np.exp(lam[:, None, None] * nodes[None])                                  # (K, N, G)
+    e = np.exp(lam[:, None, None] * nodes[None])                                  # (K, L, G)
     w = np.sum(e * wts[None], axis=2)
     ws = np.sum(e * (nodes * wts)[None], axis=2)
     x = 0.5 * h * (1.0 + _GL_X)
@@ -172,43 +198,47 @@ def _exp_weights(s: Solver, lam: np.ndarray
 
 class _Memory:
     """The delay sum of the tangent, sum_l G_l S^{p-l}, and the kernel's part dG_l U^{p-l}
-    (:meth:`kernel_part`)."""
+    (:meth:`kernel_part`).  An exponential kernel's recursion needs only its last cell's weights
+    (O(K)); the weights of all N cells (``G``, ``w``, ``ws``, ``powers``) are computed where a
+    loop first asks for them."""
 
-    def __init__(self, mod: _Perturbed, Uext: np.ndarray, P: int):
+    def __init__(self, mod: _Perturbed, Uext: Callable[[], np.ndarray], P: int):
         s = mod.base
-        self.N, n = s.N, s.n
-        N = self.N
-        self.Uext, self.P = Uext, P
+        self.N, self.n, self.h = s.N, s.n, s.h
+        self._solver = s
+        self._Uext, self.P = Uext, P
         self._flat: np.ndarray | None = None
         self._dWU: np.ndarray | None = None
         kind = s.kernel_kind
         self.kind = kind
+        self.active = kind in ("exp", "callback")
         self.recursive = False
+        self.Z = None
+        n, N = self.n, self.N
         if kind == "exp":
             a, b, C, D = s.kernel_terms
-            lam = a + 1j * b
-            w, ws, c, c1 = _exp_weights(s, lam)
-            E = C - 1j * D                                                     # (K, n, n)
-            K = len(a)
-            # sum_k w[k, l] E_k as one matrix product (N, K) @ (K, n n)
-            self.G = (w.T @ E.reshape(K, n * n)).real.reshape(N, n, n)
+            self.lam = a + 1j * b
+            self.E0 = C - 1j * D                                                 # (K, n, n)
             # the terms' derivatives: dE[j, k] of C - iD and dl[j, k] of lam_k in p_j
+            K = len(a)
             self.dE = np.empty((P, K, n, n), dtype=complex)
             self.dl = np.empty((P, K), dtype=complex)
             for j, other in enumerate(mod.others):
                 a2, b2, C2, D2 = other.kernel_terms
                 self.dl[j] = ((a2 - a) + 1j * (b2 - b)) / mod.delta[j]
                 self.dE[j] = ((C2 - C) - 1j * (D2 - D)) / mod.delta[j]
-            self.w, self.ws, self.c, self.c1, self.E0 = w, ws, c, c1, E
+            wl, wsl, self.c, self.c1 = _exp_weights(s, self.lam, np.array([N - 1]))
+            self.wlast, self.wslast = wl[:, 0], wsl[:, 0]
             # the recursion: Z_k^p = sum_l r_k^l S^{p-l} (all N cells), then the last cell mended
             self.recursive = bool(np.all(a <= 0.0) and np.all(np.abs(b) * s.h <= math.pi))
             if self.recursive:
-                self.E = E * c[:, None, None]
-                self.r = np.exp(lam * s.h)[:, None, None]
-                self.rN = np.exp(lam * s.h * N)[:, None, None]
-                self.powers = np.exp(np.outer(lam, np.arange(N) * s.h))          # (K, N)
-                full_last = np.einsum("k,kij->ij", self.powers[:, N - 1], self.E).real
-                self.last = self.G[N - 1] - full_last
+                self.E = self.E0 * self.c[:, None, None]
+                self.r = np.exp(self.lam * s.h)
+                self.rN = np.exp(self.lam * s.h * N)
+                self._r3, self._rN3 = self.r[:, None, None], self.rN[:, None, None]
+                self.rlast = np.exp(self.lam * s.h * (N - 1))
+                # G_{N-1} less what the full-cell recursion puts on the last cell
+                self.last = np.einsum("k,kij->ij", self.wlast - self.rlast * self.c, self.E0).real
         elif kind == "callback":
             theta = _theta(s)
             cell = np.full(N, s.h)
@@ -220,16 +250,25 @@ class _Memory:
             for j, other in enumerate(mod.others):
                 Hj = np.array([other.eval_kernel(x) for x in lags])
                 self.dG[j] = cell[:, None, None] * (Hj - H0) / mod.delta[j]
-        else:
-            self.G = None
-        self.Z = None
+
+    def __getattr__(self, name: str) -> Any:
+        # the all-cells weights of an exponential kernel, computed on first use
+        if name in ("w", "ws", "G", "powers") and self.__dict__.get("kind") == "exp":
+            N, K, n = self.N, len(self.lam), self.n
+            w, ws, _, _ = _exp_weights(self._solver, self.lam, np.arange(N))
+            self.w, self.ws = w, ws
+            # sum_k w[k, l] E_k as one matrix product (N, K) @ (K, n n)
+            self.G = (w.T @ self.E0.reshape(K, n * n)).real.reshape(N, n, n)
+            self.powers = np.exp(np.outer(self.lam, np.arange(N) * self.h))       # (K, N)
+            return self.__dict__[name]
+        raise AttributeError(name)
 
     def kernel_part(self) -> np.ndarray:
         """dWU[p, :, j] = sum_l dG_j[l] U^{p-l} for all steps at once (steps, n, P): one FFT
         convolution per parameter, U transformed once (memory O((N + steps) n^2), not times P)."""
         if self._dWU is not None:
             return self._dWU
-        N, P, Uext = self.N, self.P, self.Uext
+        N, P, Uext = self.N, self.P, self._Uext()
         n = Uext.shape[1]
         if self.kind == "exp":
             K = len(self.c)
@@ -275,7 +314,7 @@ class _Memory:
     def push(self, Sall: np.ndarray, p: int) -> None:
         """Advances Z from step p to p + 1 once S^{p+1} is in Sall."""
         if self.recursive and self.Z is not None:
-            self.Z = self.r * self.Z + (Sall[p + 1 + self.N] - self.rN * Sall[p + 1])
+            self.Z = self._r3 * self.Z + (Sall[p + 1 + self.N] - self._rN3 * Sall[p + 1])
             self.since += 1
 
 
@@ -342,25 +381,28 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     window = s.get_window()                                          # U^{-N}, ..., U^0
     t, U, X = s.run_terms(steps)
     # S of the history: dz(t_q)/dp for q = -N, ..., 0
-    Sall = np.zeros((N + steps + 1, n, P))
-    if s.has("history") or any(o.has("history") for o in mod.others):
-        # each perturbed model samples its own history in init, as the scheme does
-        for j, other in enumerate(mod.others):
-            other.init()
-            Sall[:N + 1, :, j] = (other.get_window() - window) / mod.delta[j]
-    Uext = np.concatenate([window[1:], U[1:]])                       # U^{-N+1}, ..., U^steps
-    memory = _Memory(mod, Uext, P)
+    # (the rows of the steps are all written by the loops; those of the history, Sall[:N + 1],
+    # by the compiled sampling or zeroed here)
+    Sall = np.empty((N + steps + 1, n, P))
+    fresh = None                        # whether the history's S is nonzero somewhere
+    if engine != "python" and (s.has("history") or any(o.has("history") for o in mod.others)):
+        fresh = _compiled_history(mod, window, Sall)
+    if fresh is None:
+        Sall[:N + 1] = 0.0
+        if s.has("history") or any(o.has("history") for o in mod.others):
+            for j, other in enumerate(mod.others):
+                other.init()            # each perturbed model samples its own history in init
+                d = other.get_window() - window
+                if d.any():             # (the columns of parameters the history has not stay 0)
+                    Sall[:N + 1, :, j] = d / mod.delta[j]
+                    fresh = True
+    memory = _Memory(mod, lambda: np.concatenate([window[1:], U[1:]]), P)   # U^{-N+1}, ..., U^steps
     # the resolvent's derivatives in p, as they do not depend on the step
     kind = s.resolvent_kind
     alpha = s.friction
     dalpha = dlo = dhi = None
     if kind == "friction":
         dalpha = np.stack([(o.friction - alpha) / d for o, d in zip(mod.others, mod.delta)], axis=1)
-        # R' (1 slipping, 0 stuck) and dR/dp = -h sign(X) dalpha where slipping, for every step
-        slipping = (U[1:] != 0.0).astype(float)
-        dR = (-h * np.sign(X) * slipping)[:, :, None] * dalpha[None]
-        # the steps where a slipping friction component meets zero or changes sign
-        meets = np.any((U[:-1] != 0.0) & (U[:-1] * U[1:] <= 0.0) & (alpha > 0.0), axis=1)
     elif kind == "box":
         lo, hi = s.box
         dlo = np.stack([_bound_diff(o.box[0], lo) / d for o, d in zip(mod.others, mod.delta)], axis=1)
@@ -375,18 +417,25 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     if not why:
         from . import _compiled
         callbacks = ([m.c_callback("rhs") for m in [s, *mod.others]] if has_f else None)
-        friction = (slipping, dR, meets, alpha, dalpha) if kind == "friction" else None
+        friction = (alpha, dalpha) if kind == "friction" else None
         box = (lo, hi, dlo, dhi) if kind == "box" else None
-        dX, switches, failed = _compiled.run(steps, N, h, t, U, X, phi, Sall, mod.delta, callbacks,
-                                             memory, kind, friction, box, jumps)
+        dX, switches, failed = _compiled.run(steps, N, h, t, U, X, phi, window, Sall, bool(fresh),
+                                             mod.delta, callbacks, memory, kind, friction, box,
+                                             jumps)
         if failed < 0:
-            return Sensitivities(t, U, Sall[N:].copy(), X, dX, h, switches, "compiled")
+            return _result(t, U, Sall[N:], X, dX, h, switches, "compiled")
         # a call of f failed: the Python loop below (which rewrites each S^{q+1} of Sall from
         # the history's S on) raises the callback's own error
+    if kind == "friction":
+        # R' (1 slipping, 0 stuck) and dR/dp = -h sign(X) dalpha where slipping, for every step
+        slipping = (U[1:] != 0.0).astype(float)
+        dR = (-h * np.sign(X) * slipping)[:, :, None] * dalpha[None]
+        # the steps where a slipping friction component meets zero or changes sign
+        meets = np.any((U[:-1] != 0.0) & (U[:-1] * U[1:] <= 0.0) & (alpha > 0.0), axis=1)
     dX = np.empty((steps, n, P))
     switches: list = []
     Fd = np.zeros((n, P))
-    dWU = memory.kernel_part() if memory.G is not None else None
+    dWU = memory.kernel_part() if memory.active else None
     for q in range(steps):
         Sq = Sall[q + N]
         if rhs is not None:
@@ -397,7 +446,7 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
             Fd = (np.array([o.eval_rhs(t[q], m) for o, m in zip(mod.others, moved)]).T
                   - f0[:, None]) / mod.delta
         T = Sq - h * Fd
-        if memory.G is not None:
+        if memory.active:
             T -= h * (memory.sum_S(Sall, q) + dWU[q])
         dX[q] = T
         Snew = Sall[q + 1 + N]
@@ -416,7 +465,40 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
         else:
             Snew[:] = T
         memory.push(Sall, q)
-    return Sensitivities(t, U, Sall[N:].copy(), X, dX, h, switches, "python")
+    return _result(t, U, Sall[N:], X, dX, h, switches, "python")
+
+
+def _result(t: np.ndarray, U: np.ndarray, S: np.ndarray, X: np.ndarray, dX: np.ndarray, h: float,
+            switches: list, engine: str) -> Sensitivities:
+    """The Sensitivities of a run, with a RuntimeWarning where a reversal could not be placed."""
+    out = Sensitivities(t, U, S, X, dX, h, switches, engine)
+    if out.unplaced:
+        steps = out.unplaced
+        shown = ", ".join(str(q) for q in steps[:5]) + (", ..." if len(steps) > 5 else "")
+        warnings.warn(f"sensitivities: {len(steps)} reversal(s) of a friction component could not be "
+                      f"placed inside their step (steps {shown}, t = {t[steps[0]]:.6g} first): the "
+                      "velocities interpolated there do not have the signs of a reversal, so S is the "
+                      "plain tangent of the scheme there, off by O(1) from the equation's "
+                      f"sensitivity; take a smaller h (now {h:.6g}) so that each reversal is "
+                      "resolved", RuntimeWarning, stacklevel=3)
+    return out
+
+
+def _compiled_history(mod: _Perturbed, window: np.ndarray, Sall: np.ndarray) -> bool | None:
+    """The history's S into all of Sall[:N + 1] from the perturbed models' compiled history
+    callbacks, called as init calls them, without their init; whether it is nonzero anywhere.  None
+    (Sall[:N + 1] then partly written: zero it and init them) where a history is not a C function, numba is not installed, a call fails, or the same
+    sampling of the model's own history does not give its window, as init sampled it, bit for bit."""
+    s = mod.base
+    callbacks = [m.c_callback("history") for m in [s, *mod.others]]
+    if any(c is None for c in callbacks) or importlib.util.find_spec("numba") is None:
+        return None
+    from . import _compiled
+    addrs = np.array([a for a, _ in callbacks], np.int64)
+    users = np.array([u for _, u in callbacks], np.int64)
+    status, nonzero = _compiled.history_columns(addrs, users, s.N, float(s.h), float(s.tau),
+                                                np.ascontiguousarray(window), mod.delta, Sall)
+    return bool(nonzero) if status == 0 else None
 
 
 def _not_compiled(mod: _Perturbed, has_f: bool, rhs: Callable | None) -> str:
@@ -454,6 +536,8 @@ def _reversals(q: int, U: np.ndarray, phi: np.ndarray, alpha: np.ndarray, dalpha
         what, rho = reversal(q, i, U, phi, alpha)
         if what == STICK:
             switches.append((q, i, "stick"))
+        elif what == UNPLACED:
+            switches.append((q, i, "unplaced"))
         elif what == REVERSAL:
             Snew[i] = rho * (T[i] - h * math.copysign(1.0, U[q, i]) * dalpha[i])
             switches.append((q, i, "reversal"))
