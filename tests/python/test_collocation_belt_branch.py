@@ -29,6 +29,7 @@ import scipy.optimize as so
 
 import dmi
 from dmi import analysis as da
+from dmi.analysis import CollocationWarning
 import test_collocation as tc
 from orbit_models import DenHartog
 
@@ -188,15 +189,28 @@ def is_stick_slip(q: da.EquationOrbit) -> bool:
 @pytest.fixture(scope="module")
 def branches() -> tuple[da.Branch, da.Branch]:
     om, pH, xe = hopf()
-    with warnings.catch_warnings():   # the vertical branch: no verified stability, no estimate
-        warnings.simplefilter("ignore")
+    with warnings.catch_warnings(record=True) as caught:   # the vertical branch: no verified
+        warnings.simplefilter("always")                   # stability, no estimate (warned of)
         e = da.hopf_orbit(belt, da.HopfPoint(p=pH, omega=om, root=1j * om), [xe, -V],
                           amplitude=0.45, of="equation")
         up = da.continue_orbit(e, P_UP, step=0.02, min_step=1e-3, max_step=MAX_STEP,
                                multipliers=2, max_points=30)
         down = da.continue_orbit(up.points[-1], pH - 0.1, step=0.02, min_step=1e-3,
                                  max_step=MAX_STEP, multipliers=2, max_points=17)
+    WARNED[:] = [str(w.message) for w in caught if issubclass(w.category, CollocationWarning)]
     return up, down
+
+
+#: The CollocationWarnings the branches gave.
+WARNED: list[str] = []
+
+
+def test_points_without_a_verdict_say_why(branches):
+    # a point of the vertical branch has no error estimate (not isolated at fixed p): its
+    # stable None comes with a warning naming its p, none for a point with a verdict
+    for q in branches[0].points + branches[1].points:
+        said = [w for w in WARNED if w.startswith(f"p = {q.p!r}: the point has no error estimate")]
+        assert bool(said) == (q.stable is None), (q.p, q.stable, said)
 
 
 def corner(points: list[da.EquationOrbit], before, after) -> int:

@@ -321,7 +321,7 @@ class EquationBranch(CollocationDiscretisation):
     def point(self, x: np.ndarray, p: float) -> EquationOrbit:
         """The EquationOrbit at (x, p): with the merged mesh's error estimate, or, where that
         solve fails (a vertical branch: not isolated at fixed p), without it (``errors`` empty,
-        ``stable`` None).
+        ``stable`` None) and with a CollocationWarning saying why.
 
         Parameters
         ----------
@@ -349,8 +349,8 @@ class EquationBranch(CollocationDiscretisation):
             disc = CollocationDiscretisation(self.make, m[2], m[4],
                                              multipliers=self.count)
             disc.problem, disc.ref, x = self.problem, m[3], m[4]
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", CollocationWarning)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
             pt = CollocationDiscretisation.point(disc, x, p)
         if pt is None and disc.estimate:
             disc.estimate = False
@@ -358,6 +358,15 @@ class EquationBranch(CollocationDiscretisation):
                 pt = CollocationDiscretisation.point(disc, x, p)
             finally:
                 disc.estimate = True
+            if pt is not None:      # one warning for the point: why it has no estimate
+                why = "; ".join(str(w.message) for w in caught
+                                if issubclass(w.category, CollocationWarning))
+                caught = [w for w in caught if not issubclass(w.category, CollocationWarning)]
+                warnings.warn(f"p = {p!r}: the point has no error estimate and no stability "
+                              f"verdict (stable None){': ' + why if why else ''}",
+                              CollocationWarning, stacklevel=2)
+        for w in caught:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         if pt is None:
             raise ShootingError(f"p = {p!r}: the orbit breaks its signature "
                                 f"{self.lay.signature.describe()}", [])
