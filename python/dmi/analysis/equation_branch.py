@@ -40,7 +40,7 @@ import numpy as np
 import scipy.optimize as so
 
 from .branch import Branch, Event
-from .collocation import CollocationWarning, check_inequalities
+from .collocation import CollocationWarning, check_inequalities, transfer
 from .collocation_continuation import CollocationDiscretisation, equation_hopf_orbit
 from .collocation_mend import circle, memory, mend, relaid, removed
 from .collocation_signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK
@@ -362,6 +362,35 @@ class EquationBranch(CollocationDiscretisation):
             raise ShootingError(f"p = {p!r}: the orbit breaks its signature "
                                 f"{self.lay.signature.describe()}", [])
         return pt
+
+    def on_current(self, x: np.ndarray, p: float) -> np.ndarray | None:
+        """The point before the last, (x, p), on the last point's layout (another mesh of the
+        same signature): interpolated and solved again at p (for the driver's location of an
+        event between points whose meshes differ).
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            The unknowns of the point before the last.
+        p : float
+            Its parameter.
+
+        Returns
+        -------
+        numpy.ndarray or None
+            The unknowns on the current layout, or None: x is not that point, the signatures
+            differ, or the solve fails.
+        """
+        prev = self._prev
+        if (prev is None or prev[0].size != x.size or not np.array_equal(prev[0], x)
+                or prev[2].signature.describe() != self.lay.signature.describe()):
+            return None
+        try:
+            xs, _ = solve(self.lay, self.terms(p), transfer(prev[2], x, self.lay), self.ref,
+                          tol=1e-12)
+        except (ShootingError, ValueError):
+            return None
+        return xs
 
     def event_functions(self, x: np.ndarray, p: float, point: EquationOrbit
                         ) -> dict[str, float]:
