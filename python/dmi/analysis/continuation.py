@@ -287,15 +287,17 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
     ``period=lambda p: 2 * P(p)`` for a branch continued with ``period=P``.
 
     On a collocated branch (of EquationOrbits: ``continue_orbit`` of an EquationOrbit,
-    ``hopf_orbit(..., of="equation")``) of smooth orbits, forced or autonomous: at the point of
-    the pair with a real multiplier below -1 by more than its estimated error, the orbit laid
-    twice around (its own mesh twice, period 2 T) plus a A v on the first lap and -a A v on the
-    second, v the multiplier's eigenfunction over the period
-    (:func:`dmi.analysis.collocation_floquet.eigenfunction`), is collocated (Newton with sparse
-    LU, the mesh equidistributed and solved again) and returned as an EquationOrbit of period
-    2 T (a forced one: exactly twice the forcing period) with its multipliers and error
-    estimates, once |u(t + T) - u(t)| exceeds 100 times the estimated error of u (distinct
-    from the T-orbit, verified).  ``continue_orbit`` continues it (no ``sections=``).
+    ``hopf_orbit(..., of="equation")``), forced or autonomous, smooth or with switches
+    (reversals, sticks, box faces): at the point of the pair with a real multiplier below -1 by
+    more than its estimated error, the orbit laid twice around (its own mesh on both laps, its
+    segments repeated with the switching times b and b + T, period 2 T) plus a A v on the first
+    lap and -a A v on the second, v the multiplier's eigenfunction over the period
+    (:func:`dmi.analysis.collocation_floquet.eigenfunction`: the node values' perturbation),
+    is collocated (Newton with sparse LU, the switching times unknowns, the mesh equidistributed
+    and solved again) and returned as an EquationOrbit of period 2 T (a forced one: exactly
+    twice the forcing period) with its multipliers and error estimates, once |u(t + T) - u(t)|
+    exceeds 100 times the estimated error of u (distinct from the T-orbit, verified).
+    ``continue_orbit`` continues it (no ``sections=``).
 
     Parameters
     ----------
@@ -319,9 +321,8 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
     ------
     ValueError
         The event is not a period doubling; on a collocated branch: neither point has a real
-        multiplier below -1 beyond its estimated error, the orbit has switches (stick-slip:
-        shoot the scheme's orbit, period 2 P, and collocate it), or the multiplier nearest -1
-        is not real and negative.
+        multiplier below -1 beyond its estimated error, the multiplier nearest -1 is not real
+        and negative, or the orbit's pieces do not repeat on the period 2 T.
     ShootingError
         No period-doubled orbit found (what each kick gave is listed: Newton's failure, or a
         return to the T-orbit).
@@ -366,7 +367,8 @@ def _doubled_equation_orbit(a: EquationOrbit, b: EquationOrbit, amplitudes: tupl
     """:func:`period_doubled_orbit` on a collocated branch, between its points a and b.
 
     At the point of the pair with a real multiplier beyond -1 (beyond its estimated error) the
-    orbit is laid twice around a mesh of the period 2 T (its own mesh twice), plus s A v on the
+    orbit is laid twice around a mesh of the period 2 T (:func:`_laid_twice`: its own mesh and
+    segments twice, the switching times b and b + T), plus s A v on the
     first lap and -s A v on the second, v the eigenfunction of the multiplier
     (:func:`dmi.analysis.collocation_floquet.eigenfunction`, |v|_inf = 1), A the orbit's
     largest amplitude, s from ``amplitudes``; Newton (sparse LU) on the collocation system of

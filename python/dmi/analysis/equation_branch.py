@@ -86,6 +86,7 @@ class EquationBranch(CollocationDiscretisation):
         self._old_nodes: np.ndarray | None = None   # the node values of the last point
         self._last: tuple | None = None   # (x, p, layout) of the last point
         self._prev: tuple | None = None   # the same of the point before it
+        self._stepped_on: Any = None   # the layout the last step was corrected on
 
     def _breaks(self, x: np.ndarray, p: float) -> list[str]:
         return check_inequalities(self.lay, self.terms(p), x,
@@ -307,6 +308,7 @@ class EquationBranch(CollocationDiscretisation):
             The unknowns on the new layout.
         """
         before = self.lay.signature.describe()
+        self._stepped_on = self.lay
         old = (self.lay, self.ref, x)
         xa = super().adapt(x, p)
         if self.lay.signature.describe() != before or xa.size != x.size:
@@ -364,9 +366,9 @@ class EquationBranch(CollocationDiscretisation):
         return pt
 
     def on_current(self, x: np.ndarray, p: float) -> np.ndarray | None:
-        """The point before the last, (x, p), on the last point's layout (another mesh of the
-        same signature): interpolated and solved again at p (for the driver's location of an
-        event between points whose meshes differ).
+        """The point before the last step, (x, p), on the layout the step's point was adapted
+        to (another mesh of the same signature): interpolated and solved again at p (for the
+        driver's location of an event between points whose meshes differ).
 
         Parameters
         ----------
@@ -378,15 +380,15 @@ class EquationBranch(CollocationDiscretisation):
         Returns
         -------
         numpy.ndarray or None
-            The unknowns on the current layout, or None: x is not that point, the signatures
-            differ, or the solve fails.
+            The unknowns on the current layout, or None: x is not on the layout the step
+            was corrected on, the signatures differ, or the solve fails.
         """
-        prev = self._prev
-        if (prev is None or prev[0].size != x.size or not np.array_equal(prev[0], x)
-                or prev[2].signature.describe() != self.lay.signature.describe()):
+        lay = self._stepped_on
+        if (lay is None or lay.size != x.size
+                or lay.signature.describe() != self.lay.signature.describe()):
             return None
         try:
-            xs, _ = solve(self.lay, self.terms(p), transfer(prev[2], x, self.lay), self.ref,
+            xs, _ = solve(self.lay, self.terms(p), transfer(lay, x, self.lay), self.ref,
                           tol=1e-12)
         except (ShootingError, ValueError):
             return None
