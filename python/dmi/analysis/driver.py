@@ -688,6 +688,13 @@ def _events(run: _Run, za: np.ndarray, ta: np.ndarray, fa: dict[str, float],
         if xa is not None and xa.size == zb.size - 1:
             za, tangents = np.concatenate([xa, za[-1:]]), False
     L = curve.norm(zb - za) if za.size == zb.size else 0.0
+    if za.size != zb.size:   # no common unknowns to locate on: said, not reported
+        for kind in fa:
+            if kind in fb and kind != "branch-point" and _sign_change(fa[kind], fb[kind]):
+                warnings.warn(f"a {kind} test function changes sign between p = "
+                              f"{float(za[-1])!r} and {float(zb[-1])!r}, where the unknowns "
+                              "changed (another signature): not located, no event reported",
+                              RuntimeWarning, stacklevel=3)
     if L == 0:
         return
     c = (zb - za) / L
