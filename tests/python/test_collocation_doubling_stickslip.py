@@ -136,9 +136,10 @@ def doubled(p: float) -> np.ndarray:
 # ---- the collocated branch and its doubling ---------------------------------------------------
 @pytest.fixture(scope="module")
 def branch() -> da.Branch:
-    o = da.periodic_orbit(friction_duffing, 0.27, T, [0.57, 0.41], multipliers=2)
-    e = da.collocate(o, multipliers=4)
-    return da.continue_orbit(e, 0.295, step=0.01, multipliers=4)
+    """The collocated branch from the scheme's orbit at p = 0.27 through the flip."""
+    scheme = da.periodic_orbit(friction_duffing, 0.27, T, [0.57, 0.41], multipliers=2)
+    return da.continue_orbit(da.collocate(scheme, multipliers=4), 0.295, step=0.01,
+                             multipliers=4)
 
 
 def test_the_reference_reverses_and_is_periodic():
