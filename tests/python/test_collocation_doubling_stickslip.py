@@ -7,7 +7,7 @@
 # integration through the reversals, the T-orbit by Newton, the flip where the multiplier crosses
 # -1 by Brent's method, the 2T-orbit by Newton on the map laid twice from a kick along the flip's
 # eigenvector, its amplitudes from the dense output (the extrema of w at the reversals, those of
-# w' where w'' = 0).  About a minute.
+# w' where w'' = 0); the doubled orbit's branch.  About a minute.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -166,9 +166,14 @@ def test_flip_on_the_collocated_stick_slip_branch(branch):
     assert abs(pds[0].p - flip()) < 1e-6, (pds[0].p, flip())
 
 
-def test_doubled_orbit_with_reversals(branch):
+@pytest.fixture(scope="module")
+def doubled_orbit(branch) -> da.EquationOrbit:
     pd = next(e for e in branch.events if e.kind == "period-doubling")
-    o2 = da.period_doubled_orbit(branch, pd, multipliers=4)
+    return da.period_doubled_orbit(branch, pd, multipliers=4)
+
+
+def test_doubled_orbit_with_reversals(doubled_orbit):
+    o2 = doubled_orbit
     assert o2.of == "equation" and o2.p > flip()
     assert o2.period == 2 * T and o2.switches.size == 4
     x2 = doubled(o2.p)
@@ -179,6 +184,18 @@ def test_doubled_orbit_with_reversals(branch):
     assert min(np.max(np.abs(u0 - x2)), np.max(np.abs(u0 - flow(o2.p, x2, T)))) < 1e-8
     # distinct from the T-orbit, whose amplitudes at that p are others
     assert np.max(np.abs(o2.amplitude - amplitudes(o2.p, t_orbit(o2.p), 1))) > 1e-3
+
+
+def test_doubled_stick_slip_branch(doubled_orbit):
+    """continue_orbit continues the doubled orbit: period 2T, four reversals, its amplitudes at
+    the branch's end against the reference's 2T-orbit there."""
+    o2 = doubled_orbit
+    b2 = da.continue_orbit(o2, o2.p + 0.003, step=0.003, multipliers=4)
+    assert b2.points[-1].p == pytest.approx(o2.p + 0.003, abs=1e-12), b2.status
+    q = b2.points[-1]
+    assert q.period == 2 * T and q.switches.size == 4
+    ref = amplitudes(q.p, doubled(q.p), 2)
+    assert np.max(np.abs(q.amplitude - ref)) < 1e-8, (q.amplitude, ref)
 
 
 def test_stick_slip_doubling_back_to_the_t_orbit_is_refused(branch):
