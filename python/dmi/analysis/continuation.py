@@ -67,6 +67,7 @@ from .branch import Branch, BranchPoint, Event
 from .collocation import CollocationWarning
 from .collocation_continuation import CollocationDiscretisation
 from .collocation_floquet import eigenfunction
+from .collocation_signature import Signature
 from .collocation_system import Layout, evaluate, solve
 from .driver import continuation
 from .equation_branch import continue_equation_orbit
@@ -286,15 +287,17 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
     ``period=lambda p: 2 * P(p)`` for a branch continued with ``period=P``.
 
     On a collocated branch (of EquationOrbits: ``continue_orbit`` of an EquationOrbit,
-    ``hopf_orbit(..., of="equation")``) of smooth orbits, forced or autonomous: at the point of
-    the pair with a real multiplier below -1 by more than its estimated error, the orbit laid
-    twice around (its own mesh twice, period 2 T) plus a A v on the first lap and -a A v on the
-    second, v the multiplier's eigenfunction over the period
-    (:func:`dmi.analysis.collocation_floquet.eigenfunction`), is collocated (Newton with sparse
-    LU, the mesh equidistributed and solved again) and returned as an EquationOrbit of period
-    2 T (a forced one: exactly twice the forcing period) with its multipliers and error
-    estimates, once |u(t + T) - u(t)| exceeds 100 times the estimated error of u (distinct
-    from the T-orbit, verified).  ``continue_orbit`` continues it (no ``sections=``).
+    ``hopf_orbit(..., of="equation")``), forced or autonomous, smooth or with switches
+    (reversals, sticks, box faces): at the point of the pair with a real multiplier below -1 by
+    more than its estimated error, the orbit laid twice around (its own mesh on both laps, its
+    segments repeated with the switching times b and b + T, period 2 T) plus a A v on the first
+    lap and -a A v on the second, v the multiplier's eigenfunction over the period
+    (:func:`dmi.analysis.collocation_floquet.eigenfunction`: the node values' perturbation),
+    is collocated (Newton with sparse LU, the switching times unknowns, the mesh equidistributed
+    and solved again) and returned as an EquationOrbit of period 2 T (a forced one: exactly
+    twice the forcing period) with its multipliers and error estimates, once |u(t + T) - u(t)|
+    exceeds 100 times the estimated error of u (distinct from the T-orbit, verified).
+    ``continue_orbit`` continues it (no ``sections=``).
 
     Parameters
     ----------
@@ -318,9 +321,8 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
     ------
     ValueError
         The event is not a period doubling; on a collocated branch: neither point has a real
-        multiplier below -1 beyond its estimated error, the orbit has switches (stick-slip:
-        shoot the scheme's orbit, period 2 P, and collocate it), or the multiplier nearest -1
-        is not real and negative.
+        multiplier below -1 beyond its estimated error, the multiplier nearest -1 is not real
+        and negative, or the orbit's pieces do not repeat on the period 2 T.
     ShootingError
         No period-doubled orbit found (what each kick gave is listed: Newton's failure, or a
         return to the T-orbit).
@@ -365,7 +367,8 @@ def _doubled_equation_orbit(a: EquationOrbit, b: EquationOrbit, amplitudes: tupl
     """:func:`period_doubled_orbit` on a collocated branch, between its points a and b.
 
     At the point of the pair with a real multiplier beyond -1 (beyond its estimated error) the
-    orbit is laid twice around a mesh of the period 2 T (its own mesh twice), plus s A v on the
+    orbit is laid twice around a mesh of the period 2 T (:func:`_laid_twice`: its own mesh and
+    segments twice, the switching times b and b + T), plus s A v on the
     first lap and -s A v on the second, v the eigenfunction of the multiplier
     (:func:`dmi.analysis.collocation_floquet.eigenfunction`, |v|_inf = 1), A the orbit's
     largest amplitude, s from ``amplitudes``; Newton (sparse LU) on the collocation system of
@@ -378,11 +381,6 @@ def _doubled_equation_orbit(a: EquationOrbit, b: EquationOrbit, amplitudes: tupl
                          f"{b.p!r}) has a real multiplier beyond -1 by more than its estimated "
                          "error: the doubling is not verified there; continue the branch with "
                          "a smaller step past the event")
-    if q.switches.size:
-        raise ValueError(f"period_doubled_orbit: the collocated orbit at p = {q.p!r} has "
-                         f"switches ({', '.join(q.signature.describe())}): only smooth orbits "
-                         "are doubled on a collocated branch; shoot the scheme's orbit there "
-                         "(periodic_orbit at p, period 2 P) and collocate it")
     disc, x = CollocationDiscretisation.of(q, multipliers=multipliers)
     lay, terms, T = disc.lay, disc.terms(q.p), float(q.period)
     mu, E = eigenfunction(lay, terms, x, -1.0)
@@ -390,14 +388,12 @@ def _doubled_equation_orbit(a: EquationOrbit, b: EquationOrbit, amplitudes: tupl
         raise ValueError(f"period_doubled_orbit: the multiplier nearest -1 at p = {q.p!r} is "
                          f"{mu:.6g}, not real and negative: no period doubling to follow there")
     v = E.real / float(np.max(np.abs(E.real)))
-    f = lay.fractions[0]
-    lay2 = Layout(lay.m, lay.n, lay.signature, [np.concatenate([0.5 * f, 0.5 + 0.5 * f[1:]])],
-                  lay.autonomous, 2 * T, lay.carried)
+    lay2, b2 = _laid_twice(lay, q.switches, T)
     V = q.nodes
     amp = max(float(np.max(q.amplitude)), 1e-3 * max(1.0, float(np.max(np.abs(V)))))
     tried = []
     for s in amplitudes:
-        x0 = np.concatenate([np.concatenate([V + s * amp * v, V - s * amp * v]).ravel(),
+        x0 = np.concatenate([np.concatenate([V + s * amp * v, V - s * amp * v]).ravel(), b2,
                              [2 * T] if lay.autonomous else []])
         d2 = CollocationDiscretisation(q.make, lay2, x0, multipliers=multipliers)
         d2.problem = disc.problem
@@ -423,6 +419,30 @@ def _doubled_equation_orbit(a: EquationOrbit, b: EquationOrbit, amplitudes: tupl
                      f"estimated error {float(o.errors['u']):.3g})")
     raise ShootingError(f"no period-doubled orbit at p = {q.p!r} (multiplier {mu:.6g}): "
                         + "; ".join(tried), [])
+
+
+def _laid_twice(lay: Layout, b: np.ndarray, T: float) -> tuple[Layout, np.ndarray]:
+    """The layout of the period 2 T that lays an orbit of the layout ``lay`` (switching times b,
+    period T) twice around: its segments repeated (switching times b and b + T), its mesh
+    points on both laps, and those switching times."""
+    modes = lay.signature.modes
+    sig = Signature(np.concatenate([modes, modes])) if lay.S else lay.signature
+    b2 = np.concatenate([b, b + T])
+    lay2 = Layout(lay.m, lay.n, sig, [], lay.autonomous, 2 * T, lay.carried)
+    mesh = lay.mesh(b, T)
+    mesh2 = np.concatenate([mesh[:-1], mesh[:-1] + T, [2 * T]])
+    ends = lay2.bounds(b2, 2 * T)
+    # every piece end of the doubled layout is a mesh point of one of the laps
+    at = np.array([int(np.argmin(np.abs(mesh2 - e))) for e in ends])
+    if np.max(np.abs(mesh2[at] - ends)) > 1e-12 * T or np.any(np.diff(at) <= 0):
+        raise ValueError("period_doubled_orbit: the orbit's pieces do not repeat on the doubled "
+                         "period (a carried breakpoint wraps differently around 2 T)")
+    fractions = []
+    for i, j in zip(at[:-1], at[1:]):
+        f = (mesh2[i:j + 1] - mesh2[i]) / (mesh2[j] - mesh2[i])
+        f[0], f[-1] = 0.0, 1.0
+        fractions.append(f)
+    return Layout(lay.m, lay.n, sig, fractions, lay.autonomous, 2 * T, lay.carried), b2
 
 
 def _beyond_minus_one(o: EquationOrbit) -> bool:

@@ -53,6 +53,10 @@ are fixed; a second discretisation, e.g. collocation of the equation's orbits, i
   across their chord (a bisection along the branch, also where it turns at the event); the
   driver sets the events' indices.  za and zb differ in size where ``adapt`` changed the
   unknowns between them.
+- optional ``disc.on_current(x, p) -> x | None``: the previous point's solution x at p re-solved
+  on the current unknowns (after ``adapt`` changed their number), or None where it cannot be;
+  the test functions' sign changes between two such points are then located on the current
+  unknowns (without it, or with None, events between points of different sizes are not sought).
 
 The driver: ``continuation(disc, x0, p0, p_end, *, step, min_step, max_step, max_points,
 at=(), ...) -> Branch``.
@@ -678,7 +682,19 @@ def _events(run: _Run, za: np.ndarray, ta: np.ndarray, fa: dict[str, float],
     """The events between the points za and zb (their tangents ta, tb and test functions fa,
     fb), located and checked, appended to events (index 0: the caller sets it)."""
     curve = run.curve
+    on_current = getattr(run.disc, "on_current", None)
+    if za.size != zb.size and on_current is not None:   # za re-solved on zb's unknowns
+        xa = on_current(za[:-1], float(za[-1]))
+        if xa is not None and xa.size == zb.size - 1:
+            za, tangents = np.concatenate([xa, za[-1:]]), False
     L = curve.norm(zb - za) if za.size == zb.size else 0.0
+    if za.size != zb.size:   # no common unknowns to locate on: said, not reported
+        for kind in fa:
+            if kind in fb and kind != "branch-point" and _sign_change(fa[kind], fb[kind]):
+                warnings.warn(f"a {kind} test function changes sign between p = "
+                              f"{float(za[-1])!r} and {float(zb[-1])!r}, where the unknowns "
+                              "changed (another signature): not located, no event reported",
+                              RuntimeWarning, stacklevel=3)
     if L == 0:
         return
     c = (zb - za) / L

@@ -40,7 +40,7 @@ import numpy as np
 import scipy.optimize as so
 
 from .branch import Branch, Event
-from .collocation import CollocationWarning, check_inequalities
+from .collocation import CollocationWarning, check_inequalities, transfer
 from .collocation_continuation import CollocationDiscretisation, equation_hopf_orbit
 from .collocation_mend import circle, memory, mend, relaid, removed
 from .collocation_signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK
@@ -86,6 +86,7 @@ class EquationBranch(CollocationDiscretisation):
         self._old_nodes: np.ndarray | None = None   # the node values of the last point
         self._last: tuple | None = None   # (x, p, layout) of the last point
         self._prev: tuple | None = None   # the same of the point before it
+        self._stepped_on: Any = None   # the layout the last step was corrected on
 
     def _breaks(self, x: np.ndarray, p: float) -> list[str]:
         return check_inequalities(self.lay, self.terms(p), x,
@@ -307,6 +308,7 @@ class EquationBranch(CollocationDiscretisation):
             The unknowns on the new layout.
         """
         before = self.lay.signature.describe()
+        self._stepped_on = self.lay
         old = (self.lay, self.ref, x)
         xa = super().adapt(x, p)
         if self.lay.signature.describe() != before or xa.size != x.size:
@@ -371,6 +373,35 @@ class EquationBranch(CollocationDiscretisation):
             raise ShootingError(f"p = {p!r}: the orbit breaks its signature "
                                 f"{self.lay.signature.describe()}", [])
         return pt
+
+    def on_current(self, x: np.ndarray, p: float) -> np.ndarray | None:
+        """The point before the last step, (x, p), on the layout the step's point was adapted
+        to (another mesh of the same signature): interpolated and solved again at p (for the
+        driver's location of an event between points whose meshes differ).
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            The unknowns of the point before the last.
+        p : float
+            Its parameter.
+
+        Returns
+        -------
+        numpy.ndarray or None
+            The unknowns on the current layout, or None: x is not on the layout the step
+            was corrected on, the signatures differ, or the solve fails.
+        """
+        lay = self._stepped_on
+        if (lay is None or lay.size != x.size
+                or lay.signature.describe() != self.lay.signature.describe()):
+            return None
+        try:
+            xs, _ = solve(self.lay, self.terms(p), transfer(lay, x, self.lay), self.ref,
+                          tol=1e-12)
+        except (ShootingError, ValueError):
+            return None
+        return xs
 
     def event_functions(self, x: np.ndarray, p: float, point: EquationOrbit
                         ) -> dict[str, float]:
