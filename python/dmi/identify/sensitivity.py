@@ -383,14 +383,15 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     # S of the history: dz(t_q)/dp for q = -N, ..., 0, sampled only for the parameters whose
     # perturbed model has another history (Solver.same_callback); the other columns are 0
     # (the rows of the steps are all written by the loops; those of the history, Sall[:N + 1],
-    # by the compiled sampling or zeroed here)
+    # zeroed here, then their columns in ``hist`` written by the compiled sampling or from inits)
     Sall = np.empty((N + steps + 1, n, P))
+    Sall[:N + 1] = 0.0
     hist = [j for j, o in enumerate(mod.others) if not s.same_callback(o, "history")]
     fresh = None                        # whether the history's S is nonzero somewhere
     if engine != "python" and hist:
         fresh = _compiled_history(mod, hist, window, Sall)
     if fresh is None:
-        Sall[:N + 1] = 0.0
+        Sall[:N + 1] = 0.0              # (a failed compiled sampling may have written some)
         for j in hist:
             other = mod.others[j]
             other.init()                # each perturbed model samples its own history in init
@@ -398,8 +399,6 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
             if d.any():                 # (the columns of parameters the history has not stay 0)
                 Sall[:N + 1, :, j] = d / mod.delta[j]
                 fresh = True
-    else:
-        Sall[:N + 1, :, [j for j in range(P) if j not in hist]] = 0.0
     memory = _Memory(mod, lambda: np.concatenate([window[1:], U[1:]]), P)   # U^{-N+1}, ..., U^steps
     # the resolvent's derivatives in p, as they do not depend on the step
     kind = s.resolvent_kind
@@ -516,9 +515,9 @@ def _compiled_history(mod: _Perturbed, hist: list, window: np.ndarray,
                       Sall: np.ndarray) -> bool | None:
     """The history's S into the columns ``hist`` of Sall[:N + 1] from those perturbed models'
     compiled history callbacks, called as init calls them, without their init; whether it is
-    nonzero anywhere.  None
-    (Sall[:N + 1] then partly written: zero it and init them) where a history is not a C function, numba is not installed, a call fails, or the same
-    sampling of the model's own history does not give its window, as init sampled it, bit for bit."""
+    nonzero anywhere.  None (Sall[:N + 1] then partly written: zero it and init them) where a
+    history is not a C function, numba is not installed, a call fails, or the same sampling of the
+    model's own history does not give its window, as init sampled it, bit for bit."""
     s = mod.base
     callbacks = [m.c_callback("history") for m in [s, *(mod.others[j] for j in hist)]]
     if any(c is None for c in callbacks) or importlib.util.find_spec("numba") is None:
