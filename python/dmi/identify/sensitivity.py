@@ -333,7 +333,10 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
         not necessarily initialised; it is initialised here).  p may enter f, the friction
         coefficients, the box, the kernel (its exponential terms a, b, C, D, or a kernel
         callback) and the history; it may not change n, N, h, tau, the kinds of A and kernel,
-        the number of kernel terms, the convolution method or the quadrature rule.
+        the number of kernel terms, the convolution method or the quadrature rule.  A parameter
+        enters f (or the history) unless :meth:`dmi.Solver.same_callback` finds the perturbed
+        model's callback the same as the model's; f and the history are differentiated only in the
+        parameters that enter them.
     p : array_like, shape (P,)
         The parameters.
     steps : int
