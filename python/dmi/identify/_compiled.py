@@ -98,13 +98,14 @@ def history_columns(addrs, users, N, h, tau, window, delta, cols, Sall):
 
 @numba.njit(cache=True)
 def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users, fcols, fpar,
-         rel, memory, fresh, E, r, rN, rlast, last, flat, dWU, E0, cw, c1, wlast, wslast, dE, dl,
+         rel, memory, fresh, zcols, E, r, rN, rlast, last, flat, dWU, E0, cw, c1, wlast, wslast, dE, dl,
          kind, alpha, dalpha, jumps, lo, hi, dlo, dhi, sw_q, sw_i, sw_kind):
     """Fills Sall[N + 1:] and dX; returns (switches recorded, the step whose f call failed or -1).
 
     f_u S + f_p by directional differences (fcols False: one call of f per parameter) or, where
     fcols, f_u by n forward-difference columns (steps rel max(1, |u_i|) as applied) times S plus
     f_p by one call of f for each parameter in fpar (those f depends on; f_p is 0 for the others).
+    zcols: the columns of the history's S that may be nonzero (the others are 0).
 
     The memory's arrays (E, r, rN, rlast, E0, cw, c1, wlast, wslast, dE, dl) are all real where
     the kernel's exponents and their derivatives are real, else all complex: numba compiles the
@@ -138,8 +139,9 @@ def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users
             for m in range(n):
                 dE_used[k, i, m] = np.any(dE[k, i, m] != 0.0)
     Sflat = Sall.reshape(Sall.shape[0] * n, P)
+    every = np.ones(P, np.bool_)
     if memory == MEMORY_RECURSIVE:
-        _window_sums(0, N, window, U, Sall, r, Z, Y, Y1, fresh)
+        _window_sums(0, N, window, U, Sall, r, Z, Y, Y1, fresh, zcols, Z_used)
     for q in range(steps):
         Sq = Sall[q + N]
         Sold = Sall[q + 1]                      # S^{q+1-N}
@@ -189,7 +191,7 @@ def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users
         ulast = window[q + 1] if q + 1 <= N else U[q + 1 - N]
         if memory == MEMORY_RECURSIVE:
             if since >= 4 * N:                  # the sums afresh, against the drift of the recursion
-                _window_sums(q, N, window, U, Sall, r, Z, Y, Y1, True)
+                _window_sums(q, N, window, U, Sall, r, Z, Y, Y1, True, every, Z_used)
                 since = 0
             for k in range(K):
                 # A_k = sum_l w_kl U^{q-l}, B = sum_l ws_kl U^{q-l}: the full cells from Y and Y1,
@@ -292,9 +294,10 @@ def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users
 
 
 @numba.njit(cache=True)
-def _window_sums(q, N, window, U, Sall, r, Z, Y, Y1, with_S):
+def _window_sums(q, N, window, U, Sall, r, Z, Y, Y1, with_S, cols, rows):
     """Z_k, Y_k and Y1_k at step q by Horner's rule over the window U^{q-N+1}, ..., U^q (Z only
-    where with_S: it is zero while the history's S is)."""
+    where with_S: it is zero while the history's S is; only its columns j with cols[j] and its
+    rows i with rows[k, i], the others left 0: S is 0 there, or Z is not read there)."""
     K, n, P = Z.shape
     for k in range(K):
         rk = r[k]
@@ -311,14 +314,17 @@ def _window_sums(q, N, window, U, Sall, r, Z, Y, Y1, with_S):
             if with_S:
                 S = Sall[m + N]
                 for i in range(n):
-                    for j in range(P):
-                        Z[k, i, j] = rk * Z[k, i, j] + S[i, j]
+                    if rows[k, i]:
+                        for j in range(P):
+                            if cols[j]:
+                                Z[k, i, j] = rk * Z[k, i, j] + S[i, j]
 
 
 def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarray, phi: np.ndarray,
         window: np.ndarray, Sall: np.ndarray, fresh: bool, delta: np.ndarray, rhs: list | None,
         memory: Any, kind: str, friction: tuple | None, box: tuple | None, jumps: bool,
-        fpar: np.ndarray | None = None, rel: float = 0.0) -> tuple[np.ndarray, list, int]:
+        fpar: np.ndarray | None = None, rel: float = 0.0, hist: list | None = None
+        ) -> tuple[np.ndarray, list, int]:
     """The loop over the steps: fills Sall[N + 1:] and returns dX, the switches (p, i, kind) and
     the step whose f call failed (-1: none; the caller then takes the Python loop, which raises
     the callback's own error).
@@ -328,7 +334,8 @@ def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarra
     None without f; ``memory``: the _Memory of sensitivity.py; ``friction``: (alpha, dalpha);
     ``box``: (lo, hi, dlo, dhi); ``fpar``: None (f_u S_j + f_p_j by one directional difference
     per parameter) or the parameters f depends on (f_u by n columns of relative step ``rel``, f_p
-    by one call for each of these)."""
+    by one call for each of these); ``hist``: the parameters whose columns of the history's S
+    may be nonzero (None: all)."""
     n, P = U.shape[1], len(delta)
     f64, cplx = np.float64, np.complex128
     c = np.ascontiguousarray
@@ -379,8 +386,12 @@ def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarra
     sw_q, sw_i, sw_kind = np.empty(cap, np.int64), np.empty(cap, np.int64), np.empty(cap, np.int64)
     fcols = fpar is not None
     fpar = np.zeros(0, np.int64) if fpar is None else np.asarray(fpar, np.int64)
+    zcols = np.ones(P, np.bool_)
+    if hist is not None:
+        zcols[:] = False
+        zcols[list(hist)] = True
     count, failed = loop(steps, N, float(h), t, U, X, phi, window, Sall, dX, delta, rhs is not None,
-                         addrs, users, fcols, fpar, float(rel), code, fresh, E, r, rN, rlast, last, flat, dWU,
+                         addrs, users, fcols, fpar, float(rel), code, fresh, zcols, E, r, rN, rlast, last, flat, dWU,
                          E0, cw, c1, wlast, wslast, dE, dl,
                          kcode, alpha, dalpha, bool(jumps), lo, hi, dlo, dhi, sw_q, sw_i, sw_kind)
     names = {STICK: "stick", REVERSAL: "reversal", UNPLACED: "unplaced"}

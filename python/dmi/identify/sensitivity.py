@@ -435,7 +435,7 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
         box = (lo, hi, dlo, dhi) if kind == "box" else None
         dX, switches, failed = _compiled.run(steps, N, h, t, U, X, phi, window, Sall, bool(fresh),
                                              mod.delta, callbacks, memory, kind, friction, box,
-                                             jumps, fpar, REL_STEP)
+                                             jumps, fpar, REL_STEP, hist)
         if failed < 0:
             return _result(t, U, Sall[N:], X, dX, h, switches, "compiled")
         # a call of f failed: the Python loop below (which rewrites each S^{q+1} of Sall from
