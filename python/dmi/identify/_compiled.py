@@ -67,8 +67,8 @@ def call_history(typingctx, address, t, out, user):
 @numba.njit(cache=True)
 def history_columns(addrs, users, N, h, tau, window, delta, cols, Sall):
     """The history's S, Sall[N - k, :, cols[j]] = (z_j(t_k) - z(t_k)) / delta_j, by calling the
-    compiled history callbacks (addrs[1 + j], users[1 + j]) of the perturbed models at the times init uses,
-    t_k = -k h (no lower than -tau, -tau at k = N); (addrs[0], users[0]) is the model's own, whose
+    compiled history callbacks (addrs[1 + j], users[1 + j]) of the perturbed models at the times
+    init uses, t_k = -k h (no lower than -tau, -tau at k = N); (addrs[0], users[0]) is the model's own, whose
     values must equal its window U^{-N}, ..., U^0 as init sampled it, bit for bit.  Returns 0 (and
     whether any S is nonzero), 1 where a call fails or gives a value that is not finite (init then
     raises the error), 2 where the model's own values differ from its window."""
@@ -98,8 +98,8 @@ def history_columns(addrs, users, N, h, tau, window, delta, cols, Sall):
 
 @numba.njit(cache=True)
 def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users, fcols, fpar,
-         rel, memory, fresh, zcols, E, r, rN, rlast, last, flat, dWU, E0, cw, c1, wlast, wslast, dE, dl,
-         kind, alpha, dalpha, jumps, lo, hi, dlo, dhi, sw_q, sw_i, sw_kind):
+         rel, memory, fresh, zcols, E, r, rN, rlast, last, flat, dWU, E0, cw, c1, wlast, wslast,
+         dE, dl, kind, alpha, dalpha, jumps, lo, hi, dlo, dhi, sw_q, sw_i, sw_kind):
     """Fills Sall[N + 1:] and dX; returns (switches recorded, the step whose f call failed or -1).
 
     f_u S + f_p by directional differences (fcols False: one call of f per parameter) or, where
@@ -391,8 +391,8 @@ def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarra
         zcols[:] = False
         zcols[list(hist)] = True
     count, failed = loop(steps, N, float(h), t, U, X, phi, window, Sall, dX, delta, rhs is not None,
-                         addrs, users, fcols, fpar, float(rel), code, fresh, zcols, E, r, rN, rlast, last, flat, dWU,
-                         E0, cw, c1, wlast, wslast, dE, dl,
+                         addrs, users, fcols, fpar, float(rel), code, fresh, zcols,
+                         E, r, rN, rlast, last, flat, dWU, E0, cw, c1, wlast, wslast, dE, dl,
                          kcode, alpha, dalpha, bool(jumps), lo, hi, dlo, dhi, sw_q, sw_i, sw_kind)
     names = {STICK: "stick", REVERSAL: "reversal", UNPLACED: "unplaced"}
     switches = [(q, i, names[k]) for q, i, k in zip(sw_q[:count].tolist(), sw_i[:count].tolist(),
