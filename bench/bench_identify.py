@@ -4,7 +4,8 @@
 # The model: a friction oscillator with a viscoelastic memory of two Prony terms on the velocity,
 #   w'' + k w + mu sigma(w') + int_0^tau (c1 e^{a1 s} + c2 e^{a2 s}) w'(t - s) ds + g cos 0.8 t ∋ 0,
 # w = w0 on t <= 0, P = 8 parameters (k, g: f; mu: friction; w0: history; c1, a1, c2, a2: kernel),
-# tau = N h, N = steps.  Variants: f with jit=True (compiled: the sensitivities' compiled loop) or a
+# tau = N h, N = steps; f reads k and g only and the history w0 only (make unpacks p), so the
+# sensitivities differentiate f in 2 parameters (f_u by n = 2 columns) and sample 1 history.  Variants: f with jit=True (compiled: the sensitivities' compiled loop) or a
 # Python function (their Python loop); the history a Python function, or jit=True as well ("all
 # jit"); the kernel as exponentials (RECURSIVE) or as a Python callback (DIRECT, FFT; shorter
 # runs); "f jit, Python loop" times the Python loop on the compiled model.  Then one

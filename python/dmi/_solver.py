@@ -7,6 +7,7 @@ import ctypes
 import math
 import operator
 import threading
+import types
 import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -68,6 +69,63 @@ def _choice(table: dict[str, int], value: Any, what: str) -> int:
         raise InvalidArgument(_lib.EINVAL, f"{what} {value!r}: expected one of "
                               f"{', '.join(map(repr, table))}")
     return code
+
+
+def _same_value(x: Any, y: Any, depth: int) -> bool:
+    """x and y the same object, equal numbers of one type (bit for bit), equal arrays, or Python
+    functions of the same code and values (to a depth of 4)."""
+    if x is y:
+        return True
+    if type(x) is not type(y):
+        return False
+    if isinstance(x, (bool, int, np.integer)):
+        return bool(x == y)
+    if isinstance(x, (float, np.floating)):
+        return np.asarray(x).tobytes() == np.asarray(y).tobytes()
+    if isinstance(x, np.ndarray):
+        return x.dtype == y.dtype and x.shape == y.shape and x.tobytes() == y.tobytes()
+    if isinstance(x, tuple):
+        return len(x) == len(y) and all(_same_value(u, v, depth) for u, v in zip(x, y))
+    return _same_function(x, y, depth + 1)
+
+
+def _same_function(f: Any, g: Any, depth: int) -> bool:
+    """f and g the same object, or Python functions of the same code and globals whose closure
+    values and defaults are the same (:func:`_same_value`)."""
+    if f is g:
+        return True
+    if not isinstance(f, types.FunctionType) or type(g) is not type(f) or depth > 4:
+        return False
+    if f.__code__ is not g.__code__ or f.__globals__ is not g.__globals__:
+        return False
+    cf = tuple(c.cell_contents for c in f.__closure__ or ())
+    cg = tuple(c.cell_contents for c in g.__closure__ or ())
+    return (_same_value(cf, cg, depth) and _same_value(f.__defaults__, g.__defaults__, depth)
+            and f.__kwdefaults__ is None and g.__kwdefaults__ is None)
+
+
+def _same_jit(a: Any, b: Any) -> bool:
+    """Two jit=True callbacks (_jit.JitBound) of the same compiled code whose user data hold the
+    same values: numbers bit for bit, arrays element by element (their addresses may differ)."""
+    if a.address != b.address or a.keys != b.keys or a.n != b.n:
+        return False
+    if len(a.data) != len(b.data):
+        return False
+    slot, arrays = 4, 1     # (the head's 4 slots, the scratch array first)
+    for key in a.keys:
+        if key[0] == "k":   # (a constant of the compiled code: part of its address)
+            continue
+        if key[0] == "a":
+            x, y = a.keep[2][arrays], b.keep[2][arrays]
+            if x.shape != y.shape or x.tobytes() != y.tobytes():
+                return False
+            arrays += 1
+            slot += 1 + x.ndim
+        else:
+            if a.data[slot] != b.data[slot]:
+                return False
+            slot += 1
+    return True
 
 
 def _ptr(a: np.ndarray | None) -> Any:
@@ -1244,6 +1302,51 @@ class Solver:
         if bound is None or bound.address is None or bound.python:
             return None
         return int(bound.address), int(bound.user or 0)
+
+    def same_callback(self, other: Solver, part: str) -> bool:
+        """Whether another solver's callback for a part computes what this one's does: both
+        absent, or the same function with the same data.  True only where that is certain: a C
+        function at the same address with the same user pointer; a ``jit=True`` callback
+        compiled from the same code, with equal closure values and globals passed (numbers bit
+        for bit, arrays element by element); a Python function of the same code and globals
+        whose closure values and defaults are the same objects, equal numbers or equal arrays
+        (functions among them compared in the same way).  Anything else (a closure holding
+        another object, callbacks of different kinds) counts as different.
+
+        Parameters
+        ----------
+        other : dmi.Solver
+            The solver compared with this one.
+        part : str
+            ``"rhs"``, ``"resolvent"``, ``"kernel"``, ``"kernel_near"`` or ``"history"``.
+
+        Returns
+        -------
+        bool
+            True where both call the same function with the same data (or neither has one).
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: another part.
+        TypeError
+            other not a dmi.Solver.
+        """
+        if part not in ("rhs", "resolvent", "kernel", "kernel_near", "history"):
+            raise InvalidArgument(_lib.EINVAL, f"same_callback: part {part!r} is not one of 'rhs', "
+                                  "'resolvent', 'kernel', 'kernel_near', 'history'")
+        if not isinstance(other, Solver):
+            raise TypeError(f"same_callback: other is a {type(other).__name__}; expected a dmi.Solver")
+        a, b = self._keep.get(part), other._keep.get(part)
+        a = a if a is not None and a.address is not None else None
+        b = b if b is not None and b.address is not None else None
+        if a is None or b is None:
+            return a is None and b is None
+        if a.jit or b.jit:
+            return a.jit and b.jit and _same_jit(a, b)
+        if a.python or b.python:
+            return a.python and b.python and _same_function(a.keep[1], b.keep[1], 0)
+        return a.address == b.address and a.user == b.user
 
     def __repr__(self) -> str:
         if self._h_given is not None:

@@ -186,3 +186,55 @@ def test_compiled_history_is_sampled_without_init(monkeypatch, h):
     # the history's columns: dU^0/dw0 = (1, 0), dU^0/dv0 = (0, 1)
     assert np.array_equal(fast.S[0, :, 2:4], np.eye(2))
     agree(fast, slow)
+
+
+def test_same_callback():
+    # Solver.same_callback: the same function with the same data, for the three kinds of callback;
+    # what it cannot be sure of counts as different
+    def solvers(make_rhs, jit=False, values=(1.0, 1.0)):
+        out = []
+        for v in values:
+            s = dmi.Solver(2, 1.0, 10)
+            s.set_rhs(make_rhs(v), jit=jit)
+            out.append(s)
+        return out
+
+    def scalar(k):
+        return lambda t, u: np.array([-u[1], k * u[0]])
+
+    def vector(k):
+        a = np.array([k, 2.0])
+        return lambda t, u: np.array([-u[1], a[0] * u[0]])
+
+    def nested(k):
+        def g(x):
+            return k * x
+        return lambda t, u: np.array([-u[1], g(u[0])])
+    for jit in (False, True):
+        for maker in (scalar, vector, nested if not jit else scalar):
+            a, b = solvers(maker, jit, (1.5, 1.5))
+            assert a.same_callback(b, "rhs") and b.same_callback(a, "rhs"), (jit, maker)
+            a, b = solvers(maker, jit, (1.5, 1.5 + 2.0 ** -40))
+            assert not a.same_callback(b, "rhs"), (jit, maker)
+        a, b = solvers(scalar, jit, (0.0, -0.0))        # numbers compared bit for bit
+        assert not a.same_callback(b, "rhs")
+    # a Python f against the same f compiled; a part absent in both, in one
+    (a,), (b,) = solvers(scalar, False, (1.0,)), solvers(scalar, True, (1.0,))
+    assert not a.same_callback(b, "rhs")
+    assert a.same_callback(b, "history")
+    b.set_history(lambda t: np.zeros(2))
+    assert not a.same_callback(b, "history") and not b.same_callback(a, "history")
+    # C functions: the same address and user pointer
+    fn = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, ctypes.POINTER(ctypes.c_double),
+                          ctypes.POINTER(ctypes.c_double), ctypes.c_void_p)
+    c_rhs = fn(lambda t, u, out, user: 0)
+    data, other = np.zeros(3), np.zeros(3)
+    a.set_rhs(c_rhs, data)
+    b.set_rhs(c_rhs, data)
+    assert a.same_callback(b, "rhs")
+    b.set_rhs(c_rhs, other)
+    assert not a.same_callback(b, "rhs")
+    with pytest.raises(dmi.InvalidArgument, match="part 'force'"):
+        a.same_callback(b, "force")
+    with pytest.raises(TypeError, match="expected a dmi.Solver"):
+        a.same_callback("solver", "rhs")

@@ -109,6 +109,76 @@ def test_against_central_differences_of_the_scheme(kernel, convolution, quadratu
         assert np.abs(r.S[:, :, j] - ref).max() < 1e-6 * scale, (j, np.abs(r.S[:, :, j] - ref).max() / scale)
 
 
+def counted_model(p_whole: bool):
+    """n = 3 with f, history and memory counted: (u0, u1) a nonlinear oscillator with a Prony
+    memory of u0, u2 slipping down under friction all along; parameters (k, g, mu, w0, c1, a1,
+    c2, a2), k and g in f, w0 in the history; ``p_whole``: f and the history read the whole
+    vector p (every parameter then counts as entering both)."""
+    calls = {"f": 0, "z": 0}
+
+    def make(p):
+        k, g, mu, w0, c1, a1, c2, a2 = p
+
+        def f(t, u):
+            calls["f"] += 1
+            return np.array([-u[1], k * math.sin(u[0]) + g * math.cos(t), 3.0 + 0.2 * u[0]])
+
+        def z(t):
+            calls["z"] += 1
+            return np.array([w0, 0.1 * t, -0.1])
+        if p_whole:
+            v = p.copy()
+
+            def f(t, u):  # noqa: F811  (reads k, g from the vector)
+                calls["f"] += 1
+                return np.array([-u[1], v[0] * math.sin(u[0]) + v[1] * math.cos(t), 3.0 + 0.2 * u[0]])
+
+            def z(t):  # noqa: F811
+                calls["z"] += 1
+                return np.array([v[3], 0.1 * t, -0.1])
+        s = dmi.Solver(3, 0.8, 40)
+        s.set_rhs(f)
+        s.set_friction([0.0, 0.0, mu])
+        C = np.zeros((2, 3, 3))
+        C[0, 1, 0], C[1, 1, 0] = c1, c2
+        s.set_kernel_exp([a1, a2], [0.0, 0.0], C)
+        s.set_history(z)
+        return s
+    return make, calls
+
+
+@pytest.mark.parametrize("p_whole", [False, True])
+def test_f_and_history_called_only_for_the_parameters_they_read(p_whole):
+    # with k and g the only parameters in f, f_u S + f_p takes 1 + n + 2 = 6 calls of f a step
+    # (f_u by n columns) instead of 1 + P = 9; the history is sampled for w0 only (2 inits, not 9).
+    # Where f and the history read all of p, every parameter counts: 9 calls a step, 9 inits.
+    p = np.array([1.3, 0.7, 0.4, 0.25, 0.8, -1.1, 0.5, -0.6])
+    steps = 150
+    make, calls = counted_model(p_whole)
+    s = make(p)
+    s.init()
+    sampled = calls["z"]                  # the calls of one init
+    s.run(steps)
+    plain = calls["f"]                    # the calls of one run
+    calls.update(f=0, z=0)
+    r = sensitivities(make, p, steps)
+    assert r.engine == "python"
+    P, n = len(p), 3
+    assert calls["f"] == plain + steps * ((1 + P) if p_whole else (1 + n + 2))
+    assert calls["z"] == sampled * ((1 + P) if p_whole else 2)
+    # the history's S: dU^0/dw0 = e_0, nothing from the other parameters
+    expected = np.zeros((3, P))
+    expected[0, 3] = 1.0
+    assert np.array_equal(r.S[0], expected)
+    # against central differences of the scheme (no reversal: u2 slips all along)
+    assert np.all(r.u[1:, 2] < 0)
+    for j in range(P):
+        ref = central(make, p, steps, j)
+        scale = np.abs(ref).max()
+        assert scale > 1e-3, j
+        assert np.abs(r.S[:, :, j] - ref).max() < 1e-6 * scale, (j, np.abs(r.S[:, :, j] - ref).max() / scale)
+
+
 def test_box_and_resolvent_callback_against_central_differences():
     def make(p, callback=False):
         lo, hi, mu = p

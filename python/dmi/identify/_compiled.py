@@ -65,10 +65,10 @@ def call_history(typingctx, address, t, out, user):
 
 
 @numba.njit(cache=True)
-def history_columns(addrs, users, N, h, tau, window, delta, Sall):
-    """The history's S, Sall[N - k, :, j] = (z_j(t_k) - z(t_k)) / delta_j, by calling the compiled
-    history callbacks (addrs[1 + j], users[1 + j]) of the perturbed models at the times init uses,
-    t_k = -k h (no lower than -tau, -tau at k = N); (addrs[0], users[0]) is the model's own, whose
+def history_columns(addrs, users, N, h, tau, window, delta, cols, Sall):
+    """The history's S, Sall[N - k, :, cols[j]] = (z_j(t_k) - z(t_k)) / delta_j, by calling the
+    compiled history callbacks (addrs[1 + j], users[1 + j]) of the perturbed models at the times
+    init uses, t_k = -k h (no lower than -tau, -tau at k = N); (addrs[0], users[0]) is the model's own, whose
     values must equal its window U^{-N}, ..., U^0 as init sampled it, bit for bit.  Returns 0 (and
     whether any S is nonzero), 1 where a call fails or gives a value that is not finite (init then
     raises the error), 2 where the model's own values differ from its window."""
@@ -91,16 +91,21 @@ def history_columns(addrs, users, N, h, tau, window, delta, Sall):
                         return 2, False
                 else:
                     d = (u[i] - row[i]) / delta[j - 1]
-                    Sall[N - k, i, j - 1] = d
+                    Sall[N - k, i, cols[j - 1]] = d
                     nonzero = nonzero or d != 0.0
     return 0, nonzero
 
 
 @numba.njit(cache=True)
-def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users,
-         memory, fresh, E, r, rN, rlast, last, flat, dWU, E0, cw, c1, wlast, wslast, dE, dl,
-         kind, alpha, dalpha, jumps, lo, hi, dlo, dhi, sw_q, sw_i, sw_kind):
+def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users, fcols, fpar,
+         rel, memory, fresh, zcols, E, r, rN, rlast, last, flat, dWU, E0, cw, c1, wlast, wslast,
+         dE, dl, kind, alpha, dalpha, jumps, lo, hi, dlo, dhi, sw_q, sw_i, sw_kind):
     """Fills Sall[N + 1:] and dX; returns (switches recorded, the step whose f call failed or -1).
+
+    f_u S + f_p by directional differences (fcols False: one call of f per parameter) or, where
+    fcols, f_u by n forward-difference columns (steps rel max(1, |u_i|) as applied) times S plus
+    f_p by one call of f for each parameter in fpar (those f depends on; f_p is 0 for the others).
+    zcols: the columns of the history's S that may be nonzero (the others are 0).
 
     The memory's arrays (E, r, rN, rlast, E0, cw, c1, wlast, wslast, dE, dl) are all real where
     the kernel's exponents and their derivatives are real, else all complex: numba compiles the
@@ -113,6 +118,8 @@ def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users
     acc = np.empty((n, P))
     f0 = np.empty(n)
     fj = np.empty(n)
+    Fd = np.empty((n, P))
+    J = np.empty((n, n))
     moved = np.empty(n)
     Z = np.zeros((K, n, P), dtype=r.dtype)     # Z_k = sum_l r_k^l S^{q-l}
     Y = np.zeros((K, n), dtype=r.dtype)        # Y_k = sum_l r_k^l U^{q-l}
@@ -132,8 +139,9 @@ def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users
             for m in range(n):
                 dE_used[k, i, m] = np.any(dE[k, i, m] != 0.0)
     Sflat = Sall.reshape(Sall.shape[0] * n, P)
+    every = np.ones(P, np.bool_)
     if memory == MEMORY_RECURSIVE:
-        _window_sums(0, N, window, U, Sall, r, Z, Y, Y1, fresh)
+        _window_sums(0, N, window, U, Sall, r, Z, Y, Y1, fresh, zcols, Z_used)
     for q in range(steps):
         Sq = Sall[q + N]
         Sold = Sall[q + 1]                      # S^{q+1-N}
@@ -142,6 +150,32 @@ def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users
         if has_f:
             if call_rhs(addrs[0], t[q], U[q], f0, users[0]) != 0:
                 return count, q
+        if has_f and fcols:
+            for c in range(n):                  # J[:, c] = (f(U + e_c e) - f(U)) / e_c
+                for i in range(n):
+                    moved[i] = U[q, i]
+                e = (U[q, c] + rel * max(1.0, abs(U[q, c]))) - U[q, c]
+                moved[c] = U[q, c] + e
+                if call_rhs(addrs[0], t[q], moved, fj, users[0]) != 0:
+                    return count, q
+                for i in range(n):
+                    J[i, c] = (fj[i] - f0[i]) / e
+            for i in range(n):
+                for j in range(P):
+                    v = 0.0
+                    for c in range(n):
+                        v += J[i, c] * Sq[c, j]
+                    Fd[i, j] = v
+            for m in range(fpar.shape[0]):       # f_p_j = (f(U; p + delta_j e_j) - f(U)) / delta_j
+                j = fpar[m]
+                if call_rhs(addrs[j + 1], t[q], U[q], fj, users[j + 1]) != 0:
+                    return count, q
+                for i in range(n):
+                    Fd[i, j] += (fj[i] - f0[i]) / delta[j]
+            for i in range(n):
+                for j in range(P):
+                    T[i, j] = Sq[i, j] - h * Fd[i, j]
+        elif has_f:
             for j in range(P):
                 for i in range(n):
                     moved[i] = U[q, i] + delta[j] * Sq[i, j]
@@ -157,7 +191,7 @@ def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users
         ulast = window[q + 1] if q + 1 <= N else U[q + 1 - N]
         if memory == MEMORY_RECURSIVE:
             if since >= 4 * N:                  # the sums afresh, against the drift of the recursion
-                _window_sums(q, N, window, U, Sall, r, Z, Y, Y1, True)
+                _window_sums(q, N, window, U, Sall, r, Z, Y, Y1, True, every, Z_used)
                 since = 0
             for k in range(K):
                 # A_k = sum_l w_kl U^{q-l}, B = sum_l ws_kl U^{q-l}: the full cells from Y and Y1,
@@ -260,9 +294,10 @@ def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users
 
 
 @numba.njit(cache=True)
-def _window_sums(q, N, window, U, Sall, r, Z, Y, Y1, with_S):
+def _window_sums(q, N, window, U, Sall, r, Z, Y, Y1, with_S, cols, rows):
     """Z_k, Y_k and Y1_k at step q by Horner's rule over the window U^{q-N+1}, ..., U^q (Z only
-    where with_S: it is zero while the history's S is)."""
+    where with_S: it is zero while the history's S is; only its columns j with cols[j] and its
+    rows i with rows[k, i], the others left 0: S is 0 there, or Z is not read there)."""
     K, n, P = Z.shape
     for k in range(K):
         rk = r[k]
@@ -279,13 +314,16 @@ def _window_sums(q, N, window, U, Sall, r, Z, Y, Y1, with_S):
             if with_S:
                 S = Sall[m + N]
                 for i in range(n):
-                    for j in range(P):
-                        Z[k, i, j] = rk * Z[k, i, j] + S[i, j]
+                    if rows[k, i]:
+                        for j in range(P):
+                            if cols[j]:
+                                Z[k, i, j] = rk * Z[k, i, j] + S[i, j]
 
 
 def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarray, phi: np.ndarray,
         window: np.ndarray, Sall: np.ndarray, fresh: bool, delta: np.ndarray, rhs: list | None,
-        memory: Any, kind: str, friction: tuple | None, box: tuple | None, jumps: bool
+        memory: Any, kind: str, friction: tuple | None, box: tuple | None, jumps: bool,
+        fpar: np.ndarray | None = None, rel: float = 0.0, hist: list | None = None
         ) -> tuple[np.ndarray, list, int]:
     """The loop over the steps: fills Sall[N + 1:] and returns dX, the switches (p, i, kind) and
     the step whose f call failed (-1: none; the caller then takes the Python loop, which raises
@@ -294,7 +332,10 @@ def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarra
     ``window``: U^{-N}, ..., U^0; ``fresh``: whether the history's S in Sall[:N + 1] is nonzero
     anywhere; ``rhs``: [(address, user)] of f at p and at p + delta_j e_j, or
     None without f; ``memory``: the _Memory of sensitivity.py; ``friction``: (alpha, dalpha);
-    ``box``: (lo, hi, dlo, dhi)."""
+    ``box``: (lo, hi, dlo, dhi); ``fpar``: None (f_u S_j + f_p_j by one directional difference
+    per parameter) or the parameters f depends on (f_u by n columns of relative step ``rel``, f_p
+    by one call for each of these); ``hist``: the parameters whose columns of the history's S
+    may be nonzero (None: all)."""
     n, P = U.shape[1], len(delta)
     f64, cplx = np.float64, np.complex128
     c = np.ascontiguousarray
@@ -343,9 +384,15 @@ def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarra
     dX = np.empty((steps, n, P))
     cap = steps * n if kind == "friction" else 0
     sw_q, sw_i, sw_kind = np.empty(cap, np.int64), np.empty(cap, np.int64), np.empty(cap, np.int64)
+    fcols = fpar is not None
+    fpar = np.zeros(0, np.int64) if fpar is None else np.asarray(fpar, np.int64)
+    zcols = np.ones(P, np.bool_)
+    if hist is not None:
+        zcols[:] = False
+        zcols[list(hist)] = True
     count, failed = loop(steps, N, float(h), t, U, X, phi, window, Sall, dX, delta, rhs is not None,
-                         addrs, users, code, fresh, E, r, rN, rlast, last, flat, dWU,
-                         E0, cw, c1, wlast, wslast, dE, dl,
+                         addrs, users, fcols, fpar, float(rel), code, fresh, zcols,
+                         E, r, rN, rlast, last, flat, dWU, E0, cw, c1, wlast, wslast, dE, dl,
                          kcode, alpha, dalpha, bool(jumps), lo, hi, dlo, dhi, sw_q, sw_i, sw_kind)
     names = {STICK: "stick", REVERSAL: "reversal", UNPLACED: "unplaced"}
     switches = [(q, i, names[k]) for q, i, k in zip(sw_q[:count].tolist(), sw_i[:count].tolist(),

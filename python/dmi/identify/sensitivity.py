@@ -333,7 +333,10 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
         not necessarily initialised; it is initialised here).  p may enter f, the friction
         coefficients, the box, the kernel (its exponential terms a, b, C, D, or a kernel
         callback) and the history; it may not change n, N, h, tau, the kinds of A and kernel,
-        the number of kernel terms, the convolution method or the quadrature rule.
+        the number of kernel terms, the convolution method or the quadrature rule.  A parameter
+        enters f (or the history) unless :meth:`dmi.Solver.same_callback` finds the perturbed
+        model's callback the same as the model's; f and the history are differentiated only in the
+        parameters that enter them.
     p : array_like, shape (P,)
         The parameters.
     steps : int
@@ -380,22 +383,25 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     s.init()
     window = s.get_window()                                          # U^{-N}, ..., U^0
     t, U, X = s.run_terms(steps)
-    # S of the history: dz(t_q)/dp for q = -N, ..., 0
+    # S of the history: dz(t_q)/dp for q = -N, ..., 0, sampled only for the parameters whose
+    # perturbed model has another history (Solver.same_callback); the other columns are 0
     # (the rows of the steps are all written by the loops; those of the history, Sall[:N + 1],
-    # by the compiled sampling or zeroed here)
+    # zeroed here, then their columns in ``hist`` written by the compiled sampling or from inits)
     Sall = np.empty((N + steps + 1, n, P))
+    Sall[:N + 1] = 0.0
+    hist = [j for j, o in enumerate(mod.others) if not s.same_callback(o, "history")]
     fresh = None                        # whether the history's S is nonzero somewhere
-    if engine != "python" and (s.has("history") or any(o.has("history") for o in mod.others)):
-        fresh = _compiled_history(mod, window, Sall)
+    if engine != "python" and hist:
+        fresh = _compiled_history(mod, hist, window, Sall)
     if fresh is None:
-        Sall[:N + 1] = 0.0
-        if s.has("history") or any(o.has("history") for o in mod.others):
-            for j, other in enumerate(mod.others):
-                other.init()            # each perturbed model samples its own history in init
-                d = other.get_window() - window
-                if d.any():             # (the columns of parameters the history has not stay 0)
-                    Sall[:N + 1, :, j] = d / mod.delta[j]
-                    fresh = True
+        Sall[:N + 1] = 0.0              # (a failed compiled sampling may have written some)
+        for j in hist:
+            other = mod.others[j]
+            other.init()                # each perturbed model samples its own history in init
+            d = other.get_window() - window
+            if d.any():                 # (the columns of parameters the history has not stay 0)
+                Sall[:N + 1, :, j] = d / mod.delta[j]
+                fresh = True
     memory = _Memory(mod, lambda: np.concatenate([window[1:], U[1:]]), P)   # U^{-N+1}, ..., U^steps
     # the resolvent's derivatives in p, as they do not depend on the step
     kind = s.resolvent_kind
@@ -408,6 +414,14 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
         dlo = np.stack([_bound_diff(o.box[0], lo) / d for o, d in zip(mod.others, mod.delta)], axis=1)
         dhi = np.stack([_bound_diff(o.box[1], hi) / d for o, d in zip(mod.others, mod.delta)], axis=1)
     has_f = s.has("rhs") or any(o.has("rhs") for o in mod.others)
+    # f_u S + f_p: by n columns of f_u and one call for each parameter f depends on, where that
+    # makes fewer calls of f than one directional difference per parameter
+    fpar = None
+    if has_f and rhs is None:
+        depends = np.array([j for j, o in enumerate(mod.others) if not s.same_callback(o, "rhs")],
+                           np.int64)
+        if n + len(depends) < P:
+            fpar = depends
     if rhs is not None:
         _check_complex_rhs(rhs, mod, p, t[0], U[0], Sall[N])
     phi = (U[:-1] - X) / h                                            # f + W at each step
@@ -421,7 +435,7 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
         box = (lo, hi, dlo, dhi) if kind == "box" else None
         dX, switches, failed = _compiled.run(steps, N, h, t, U, X, phi, window, Sall, bool(fresh),
                                              mod.delta, callbacks, memory, kind, friction, box,
-                                             jumps)
+                                             jumps, fpar, REL_STEP, hist)
         if failed < 0:
             return _result(t, U, Sall[N:], X, dX, h, switches, "compiled")
         # a call of f failed: the Python loop below (which rewrites each S^{q+1} of Sall from
@@ -440,6 +454,8 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
         Sq = Sall[q + N]
         if rhs is not None:
             Fd = _complex_directions(rhs, t[q], U[q], p, Sq)
+        elif fpar is not None:
+            Fd = _f_columns(s, mod, fpar, t[q], U[q], Sq)
         elif has_f:
             f0 = s.eval_rhs(t[q], U[q])
             moved = U[q] + mod.delta[:, None] * Sq.T                  # (P, n): U + delta_j S_j
@@ -468,6 +484,20 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     return _result(t, U, Sall[N:], X, dX, h, switches, "python")
 
 
+def _f_columns(s: Solver, mod: _Perturbed, fpar: np.ndarray, t: float, u: np.ndarray,
+               S: np.ndarray) -> np.ndarray:
+    """f_u S + f_p at (t, u): f_u by forward differences of n columns (step 2^-26 max(1, |u_i|)
+    as applied), f_p_j by a difference in p_j for the parameters in fpar (0 for the others)."""
+    n = len(u)
+    f0 = s.eval_rhs(t, u)
+    e = (u + REL_STEP * np.maximum(1.0, np.abs(u))) - u
+    J = (s.eval_rhs_many(np.full(n, t), u + np.diag(e)) - f0).T / e
+    Fd = J @ S
+    for j in fpar:
+        Fd[:, j] += (mod.others[j].eval_rhs(t, u) - f0) / mod.delta[j]
+    return Fd
+
+
 def _result(t: np.ndarray, U: np.ndarray, S: np.ndarray, X: np.ndarray, dX: np.ndarray, h: float,
             switches: list, engine: str) -> Sensitivities:
     """The Sensitivities of a run, with a RuntimeWarning where a reversal could not be placed."""
@@ -484,20 +514,23 @@ def _result(t: np.ndarray, U: np.ndarray, S: np.ndarray, X: np.ndarray, dX: np.n
     return out
 
 
-def _compiled_history(mod: _Perturbed, window: np.ndarray, Sall: np.ndarray) -> bool | None:
-    """The history's S into all of Sall[:N + 1] from the perturbed models' compiled history
-    callbacks, called as init calls them, without their init; whether it is nonzero anywhere.  None
-    (Sall[:N + 1] then partly written: zero it and init them) where a history is not a C function, numba is not installed, a call fails, or the same
-    sampling of the model's own history does not give its window, as init sampled it, bit for bit."""
+def _compiled_history(mod: _Perturbed, hist: list, window: np.ndarray,
+                      Sall: np.ndarray) -> bool | None:
+    """The history's S into the columns ``hist`` of Sall[:N + 1] from those perturbed models'
+    compiled history callbacks, called as init calls them, without their init; whether it is
+    nonzero anywhere.  None (Sall[:N + 1] then partly written: zero it and init them) where a
+    history is not a C function, numba is not installed, a call fails, or the same sampling of the
+    model's own history does not give its window, as init sampled it, bit for bit."""
     s = mod.base
-    callbacks = [m.c_callback("history") for m in [s, *mod.others]]
+    callbacks = [m.c_callback("history") for m in [s, *(mod.others[j] for j in hist)]]
     if any(c is None for c in callbacks) or importlib.util.find_spec("numba") is None:
         return None
     from . import _compiled
     addrs = np.array([a for a, _ in callbacks], np.int64)
     users = np.array([u for _, u in callbacks], np.int64)
     status, nonzero = _compiled.history_columns(addrs, users, s.N, float(s.h), float(s.tau),
-                                                np.ascontiguousarray(window), mod.delta, Sall)
+                                                np.ascontiguousarray(window), mod.delta[hist],
+                                                np.array(hist, np.int64), Sall)
     return bool(nonzero) if status == 0 else None
 
 
