@@ -82,6 +82,20 @@ def differences(make, p, steps, central: bool):
             plain(make, q, steps)
 
 
+def nonempty(text: str) -> str:
+    """An argparse type: a string that is not empty."""
+    if not text:
+        raise argparse.ArgumentTypeError("'' is empty")
+    return text
+
+
+def package_dir(text: str) -> str:
+    """An argparse type: a directory holding an __init__.py (a copy of python/dmi/identify)."""
+    if not text or not os.path.isfile(os.path.join(text, "__init__.py")):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a directory with an __init__.py")
+    return text
+
+
 def baseline(path: str):
     """The package in directory path (a copy of python/dmi/identify) as dmi._identify_baseline."""
     spec = importlib.util.spec_from_file_location("dmi._identify_baseline", os.path.join(path, "__init__.py"),
@@ -106,10 +120,11 @@ def main() -> None:
                          "(default 1000 100000)")
     ap.add_argument("--callback-steps", type=positive_int, default=2000,
                     help="run length of the callback-kernel cases, DIRECT and FFT (default 2000)")
-    ap.add_argument("--cases", metavar="TEXT", default="",
+    ap.add_argument("--cases", metavar="TEXT", type=nonempty, default="",
                     help="only the cases whose name contains TEXT (default: all)")
-    ap.add_argument("--baseline", metavar="DIR",
-                    help="a copy of another version's python/dmi/identify, timed in the same rounds")
+    ap.add_argument("--baseline", metavar="DIR", type=package_dir,
+                    help="a copy of another version's python/dmi/identify, timed in the same "
+                         "rounds (default: none)")
     args = ap.parse_args()
     base = baseline(args.baseline) if args.baseline else None
     P = len(P0)
