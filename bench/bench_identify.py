@@ -120,7 +120,7 @@ def main() -> None:
                          "(default 1000 100000)")
     ap.add_argument("--callback-steps", type=positive_int, default=2000,
                     help="run length of the callback-kernel cases, DIRECT and FFT (default 2000)")
-    ap.add_argument("--cases", metavar="TEXT", type=nonempty, default="",
+    ap.add_argument("--cases", metavar="TEXT", type=nonempty, default=None,
                     help="only the cases whose name contains TEXT (default: all)")
     ap.add_argument("--baseline", metavar="DIR", type=package_dir,
                     help="a copy of another version's python/dmi/identify, timed in the same "
@@ -140,7 +140,7 @@ def main() -> None:
     for kernel in ("direct", "fft"):
         cases.append((f"{kernel} kernel callback, f jit, N = {args.callback_steps}",
                       model(args.callback_steps, True, kernel), args.callback_steps, "auto"))
-    cases = [c for c in cases if args.cases in c[0]]
+    cases = [c for c in cases if args.cases is None or args.cases in c[0]]
     for _, make, steps, engine in cases:   # compile the jit=True callbacks and the loop first
         plain(make, P0, 2)
         sensitivities(make, P0, 2, engine=engine)
