@@ -19,6 +19,7 @@ central differences of the residual.
 """
 from __future__ import annotations
 
+from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -38,6 +39,10 @@ from .newton import ShootingError, newton_loop
 #: degree m and H of degree m + 2 QUAD_EXTRA - 1 on the piece; the error h^(2m + 2 QUAD_EXTRA + 1)
 #: a piece stays below the collocation's h^(2m) at the mesh points).
 QUAD_EXTRA = 1
+#: Delay matrices a Terms keeps (the most recently used): a Newton loop at a fixed mesh (a forced
+#: orbit without switches) builds its matrix once, and the monodromy operator's once for its
+#: multipliers and eigenfunction.
+DELAY_CACHE = 6
 
 
 class CollocationWarning(RuntimeWarning):
@@ -82,6 +87,48 @@ class Terms:
         rate = float(np.max(-self.terms[0], initial=0.0)) if self.kind == "exp" else 0.0
         self.H = Kernel(self._far, near_part(solver), kernel_jumps(jumps, self.tau),
                         rate if rate * self.tau > STEEP else 0.0)
+        self._delays: OrderedDict[tuple, sp.csr_matrix] = OrderedDict()
+
+    def delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc: Locator, basis: Basis,
+              rows: int, history: History | None = None) -> sp.csr_matrix:
+        """The delay integral's matrix (:func:`delay_matrix`) at the collocation times of
+        ``mesh``, kept for the last DELAY_CACHE meshes (it depends on the mesh, T, the basis and
+        the history's mesh only, not on the node values).
+
+        Parameters
+        ----------
+        times : numpy.ndarray
+            The collocation times of ``mesh``.
+        mesh : numpy.ndarray
+            The mesh of one period.
+        T : float
+            The period.
+        loc : callable
+            The locator of the node rows (periodic, or of ``history``).
+        basis : Basis
+            The basis.
+        rows : int
+            The node rows.
+        history : History, optional
+            The past of the monodromy operator's system (its mesh and periods enter the key).
+
+        Returns
+        -------
+        scipy.sparse.csr_matrix
+            G (len(times) n, rows n).
+        """
+        key = (np.asarray(mesh, dtype=float).tobytes(), float(T), basis.m, basis.q, rows,
+               None if history is None else (history.hist.tobytes(), history.periods))
+        G = self._delays.get(key)
+        if G is None:
+            G = delay_matrix(times, self.tau, mesh, T, self.H, loc, basis, self.n, rows,
+                             pattern=self.pattern)[0]
+            self._delays[key] = G
+            if len(self._delays) > DELAY_CACHE:
+                self._delays.popitem(last=False)
+        else:
+            self._delays.move_to_end(key)
+        return G
 
     def f(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
         """f(t_c, U_c) (P, n) at the times t (P,) and states U (P, n)."""
@@ -384,9 +431,12 @@ def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray
     E = point_matrix(tc, loc, basis, mesh, n, rows)
     D = point_matrix(tc, loc, basis, mesh, n, rows, derivative=True)
     scaled = jacobian and lay.autonomous and history is None and lay.S == 0
-    G, dI = (delay_matrix(tc, terms.tau, mesh, T, terms.H, loc, basis, n, rows,
-                          pattern=terms.pattern, slope_of=V if scaled else None)
-             if terms.has_kernel else (None, None))
+    G, dI = None, None
+    if terms.has_kernel and scaled:         # the T column's integral needs the node values
+        G, dI = delay_matrix(tc, terms.tau, mesh, T, terms.H, loc, basis, n, rows,
+                             pattern=terms.pattern, slope_of=V)
+    elif terms.has_kernel:
+        G = terms.delay(tc, mesh, T, loc, basis, rows, history)
     Uc = (E @ u).reshape(-1, n)
     du = (D @ u).reshape(-1, n)
     r = du + terms.f(tc, Uc)
