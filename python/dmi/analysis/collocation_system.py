@@ -39,6 +39,9 @@ from .newton import ShootingError, newton_loop
 #: degree m and H of degree m + 2 QUAD_EXTRA - 1 on the piece; the error h^(2m + 2 QUAD_EXTRA + 1)
 #: a piece stays below the collocation's h^(2m) at the mesh points).
 QUAD_EXTRA = 1
+#: Iterations at the residual's rounding floor without a halving correction after which a
+#: solve that reports its accuracy stops (:func:`solve`).
+FLOOR_ITERATIONS = 3
 #: Delay matrices a Terms keeps (the most recently used): a Newton loop at a fixed mesh (a forced
 #: orbit without switches) builds its matrix once, and the monodromy operator's once for its
 #: multipliers and eigenfunction.
@@ -542,12 +545,18 @@ def full_jacobian(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None
 
 
 def solve(lay: Layout, terms: Terms, x0: np.ndarray, ref: Callable | None, *,
-          tol: float = 1e-12, max_iter: int = 25, what: str = "collocation"
-          ) -> tuple[np.ndarray, list[float]]:
+          tol: float = 1e-12, max_iter: int = 25, what: str = "collocation",
+          accuracy: list[float] | None = None) -> tuple[np.ndarray, list[float]]:
     """Newton's method on the collocation system with sparse LU (:func:`newton_loop`): the
     factored Jacobian is kept while the residual falls by 10 or more a step (chord steps cost a
     residual), refreshed otherwise, and a fresh step is halved until the residual falls;
     converged when the correction is below tol max(1, |x|_inf) (that correction applied).
+
+    With ``accuracy`` (a list the caller adds to its error estimates), also converged when the
+    residual stays at its floor (<= tol max(1, |x|_inf)) while the corrections stop falling
+    (FLOOR_ITERATIONS iterations without halving: rounding amplified by a nearly singular
+    Jacobian, as at a fixed p on a vertical branch); the achieved accuracy (the largest of those
+    corrections, else the last one) is appended to it.
 
     Raises
     ------
@@ -567,7 +576,8 @@ def solve(lay: Layout, terms: Terms, x0: np.ndarray, ref: Callable | None, *,
     return newton_loop(evaluate, factor, x0, tol=tol, max_iter=max_iter, what=what,
                        converge="correction", chord=0.1, search="descent", reject=(Degenerate,),
                        reject_why="a segment vanishes (the signature changed)", history=res,
-                       stall=False)
+                       stall=False, floor=FLOOR_ITERATIONS if accuracy is not None else 0,
+                       accuracy=accuracy)
 
 
 def _factor(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None, what: str,
