@@ -3,7 +3,8 @@
 # matrix is diagonal), and the merged mesh's solve of a belt's orbit at its Hopf point, where the
 # linear slip makes every amplitude an orbit at one p (a vertical branch): the orbit's error
 # estimate is given, and it covers the period's and multipliers' errors against the closed form
-# (lambda^2 - p lambda + 1 + g K(lambda) = 0 at lambda = i omega, both multipliers at 1).
+# (lambda^2 - p lambda + 1 + g K(lambda) = 0 at lambda = i omega, both multipliers at 1; the
+# belt and its Hopf point from test_collocation_belt_branch.py).
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -12,11 +13,10 @@ import warnings
 
 import numpy as np
 import pytest
-import scipy.optimize as so
 
-import dmi
 from dmi import analysis as da
 from dmi.analysis.newton import ShootingError, newton_loop
+from test_collocation_belt_branch import V, belt, hopf
 
 DIAG = np.array([2.0, 1.0, 0.5, 1e-7])     # a nearly singular direction: the last
 RHS = np.array([1.0, -2.0, 0.25, 3e-7])
@@ -65,25 +65,8 @@ def test_floor_rule_leaves_a_well_conditioned_solve_alone():
     assert abs(z[0] - math.sqrt(2.0)) <= 4.5e-16 and got[0] <= 1e-12 * math.sqrt(2.0)
 
 
-V, ALPHA, G, TAU = 0.5, 0.4, 0.3, 2.0
-
-
-def belt(p: float, h: float | None = None) -> dmi.Solver:
-    s = dmi.Solver(2, TAU, h=0.01 if h is None else h)
-    s.set_rhs(lambda t, u: np.array([-(u[1] + V), u[0] - p * (u[1] + V)]))
-    s.set_friction([0.0, ALPHA])
-    s.set_kernel_exp([-1.0], [0.0], [[[0.0, 0.0], [G, 0.0]]])
-    return s
-
-
-def K(lam: complex) -> complex:
-    return (1 - np.exp(-(1 + lam) * TAU)) / (1 + lam)
-
-
 def test_vertical_branch_orbit_has_its_estimate():
-    om = so.brentq(lambda w: 1 - w * w + G * K(1j * w).real, 0.3, 3.0, xtol=1e-15)
-    pH = G * K(1j * om).imag / om
-    xe = ALPHA / (1 + G * (1 - math.exp(-TAU)))
+    om, pH, xe = hopf()
     for a in (0.1, 0.3):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -94,8 +77,8 @@ def test_vertical_branch_orbit_has_its_estimate():
         assert e.errors, "no error estimate"
         assert e.errors["period"] >= abs(e.period - 2 * math.pi / om)
         assert e.errors["period"] < 1e-3                 # the rounding floor's, not a failure
-        mu = e.multipliers[np.argsort(np.abs(e.multipliers - 1))[:2]]     # the two at 1
-        assert np.all(e.errors["multipliers"][:2] >= np.abs(mu - 1))
+        at1 = np.argsort(np.abs(e.multipliers - 1))[:2]                 # the two at 1
+        assert np.all(e.errors["multipliers"][at1] >= np.abs(e.multipliers[at1] - 1))
         # every amplitude is an orbit at p_H: the estimate says it is not determined there
         assert e.errors["amplitude"][1] >= 0.5 * a
         assert e.stable is None
