@@ -91,6 +91,7 @@ class Terms:
         self.H = Kernel(self._far, near_part(solver), kernel_jumps(jumps, self.tau),
                         rate if rate * self.tau > STEEP else 0.0)
         self._delays: OrderedDict[tuple, sp.csr_matrix] = OrderedDict()
+        self._kept: dict[str, tuple[tuple, np.ndarray]] = {}
 
     def delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc: Locator, basis: Basis,
               rows: int, history: History | None = None) -> sp.csr_matrix:
@@ -133,8 +134,27 @@ class Terms:
             self._delays.move_to_end(key)
         return G
 
+    def _last(self, slot: str, t: np.ndarray, U: np.ndarray,
+              compute: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> np.ndarray:
+        """compute(t, U), kept (read-only) in ``slot`` for the next call with the same t and U
+        (Newton's residual and Jacobian at one iterate, the monodromy's Jacobian at the orbit)."""
+        t = np.asarray(t, dtype=float)
+        U = np.asarray(U, dtype=float)
+        key = (t.tobytes(), U.tobytes(), U.shape)
+        kept = self._kept.get(slot)
+        if kept is not None and kept[0] == key:
+            return kept[1]
+        out = compute(t, U)
+        out.setflags(write=False)
+        self._kept[slot] = (key, out)
+        return out
+
     def f(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
-        """f(t_c, U_c) (P, n) at the times t (P,) and states U (P, n)."""
+        """f(t_c, U_c) (P, n) at the times t (P,) and states U (P, n) (read-only)."""
+        return self._last("f", t, U, self._rhs)
+
+    def _rhs(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
+        """f(t_c, U_c) (P, n) from the model's rhs (zero without one)."""
         if not self.has_rhs:
             return np.zeros_like(U)
         out = self.solver.eval_rhs_many(t, U)
@@ -145,7 +165,11 @@ class Terms:
         return out
 
     def fu(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
-        """df/du (P, n, n) by central differences (step FD_STEP max(|u_j|, 1))."""
+        """df/du (P, n, n) by central differences (step FD_STEP max(|u_j|, 1); read-only)."""
+        return self._last("fu", t, U, self._jacobian)
+
+    def _jacobian(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
+        """df/du (P, n, n) by central differences of the model's rhs."""
         P, n = U.shape
         J = np.zeros((P, n, n))
         if not self.has_rhs:
@@ -153,7 +177,7 @@ class Terms:
         e = FD_STEP * np.maximum(np.abs(U), 1.0)                  # (P, n)
         shift = np.einsum("pj,jk->jpk", e, np.eye(n))              # (n, P, n): column j moved
         both = np.concatenate([U[None] + shift, U[None] - shift]).reshape(-1, n)
-        F = self.f(np.tile(t, 2 * n), both).reshape(2, n, P, n)
+        F = self._rhs(np.tile(t, 2 * n), both).reshape(2, n, P, n)
         J[:] = np.transpose((F[0] - F[1]) / (2 * e.T[:, :, None]), (1, 2, 0))
         return J
 
