@@ -606,11 +606,10 @@ def solve(lay: Layout, terms: Terms, x0: np.ndarray, ref: Callable | None, *,
 
 def _factor(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None, what: str,
             res: list[float]) -> Any:
-    """The sparse LU of the Jacobian at x (ShootingError when singular), its columns ordered
-    by minimum degree on J^T + J (less fill than COLAMD for the delay's banded coupling)."""
+    """The sparse LU of the Jacobian at x (ShootingError when singular)."""
     _, J = full_jacobian(lay, terms, x, ref)
     try:
-        return sla.splu(J, permc_spec="MMD_AT_PLUS_A")
+        return sla.splu(J)
     except RuntimeError as err:
         raise ShootingError(f"{what}: singular Jacobian ({err})", res) from None
 
