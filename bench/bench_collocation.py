@@ -10,8 +10,12 @@
 # DDE-BIFTOOL's points come); and a stick-slip orbit of a belt
 # oscillator with a truncated exponential memory (autonomous, its stick segment read from the
 # scheme).  Errors against a reference collocation at 320 intervals.  Rounds interleave the cases;
-# the fastest of each counts; CPU times; one BLAS thread.
+# the fastest of each counts; CPU times; one BLAS thread.  With --against DIR, the same cases on
+# another build of dmi (DIR its python directory, e.g. an older commit's build/python) in one run:
+# two child processes, one a build, each set up once, then asked for one round in turn (the order
+# swapped every round); the table gives both times and their ratio.
 # Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_collocation.py [--rounds 3]
+#        [--against OTHER/build/python]
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -21,6 +25,9 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
+import json  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
 import warnings  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -79,13 +86,8 @@ def point(disc, x: np.ndarray, p: float):
     return disc.point(x, p)
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description="Prints the CPU times and errors of collocate and "
-                                 "of a continuation point.",
-                                 formatter_class=argparse.ArgumentDefaultsHelpFormatter)
-    ap.add_argument("--rounds", type=positive_int, default=3, help="interleaved rounds")
-    a = ap.parse_args(argv)
-    warnings.simplefilter("ignore")
+def setup() -> tuple[dict, dict]:
+    """The cases (name -> a call) and their reference orbits (name -> orbit)."""
     o = scheme_orbit(vdp, 0.5, np.array([2.0, 0.0]), 6.0, 600)
     ref = da.collocate(o, intervals=320, multipliers=4)
     e = da.collocate(o, intervals=40)
@@ -105,22 +107,111 @@ def main(argv: list[str] | None = None) -> int:
     refs = {"vdp, 40 intervals": ref, "vdp, tol 1e-10": ref, "vdp, branch point": ref2,
             "point, no estimate": ref2,
             "belt stick-slip": refb}
-    best = {k: np.inf for k in cases}
-    out = {}
-    for _ in range(a.rounds):
-        for k, f in cases.items():
-            res = []
-            best[k] = min(best[k], cpu(lambda: res.append(f())))
-            out[k] = res[0]
-    print(f"{'case':>20} {'CPU s':>7} {'intervals':>9} {'period error':>12} {'estimate':>9} "
-          f"{'mu2 error':>9} {'signature'}")
+    return cases, refs
+
+
+def one_round(cases: dict, best: dict, out: dict) -> None:
+    """Each case once, its CPU time kept in best (the fastest) and its result in out."""
+    for k, f in cases.items():
+        res: list = []
+        best[k] = min(best.get(k, np.inf), cpu(lambda: res.append(f())))
+        out[k] = res[0]
+
+
+def rows(cases: dict, refs: dict, out: dict) -> dict[str, list]:
+    """name -> [intervals, period error, its estimate, mu2 error, signature]."""
+    table = {}
     for k in cases:
         r, R = out[k], refs[k]
         mu = (abs(r.multipliers[1] - R.multipliers[1]) if r.multipliers.size > 1
               and R.multipliers.size > 1 else float("nan"))
-        print(f"{k:>20} {best[k]:7.3f} {r.intervals:9d} {abs(r.period - R.period):12.2e} "
-              f"{r.errors.get('period', float('nan')):9.1e} {mu:9.1e} "
-              f"{' '.join(r.signature.describe())}")
+        table[k] = [r.intervals, float(abs(r.period - R.period)),
+                    float(r.errors.get("period", float("nan"))), float(mu),
+                    " ".join(r.signature.describe())]
+    return table
+
+
+def serve() -> int:
+    """A child of --against: set up, print "ready", then one round for each "go" line (its CPU
+    times as a JSON line); at "stop" the results' rows as a JSON line."""
+    cases, refs = setup()
+    best: dict = {}
+    out: dict = {}
+    print("ready", flush=True)
+    for line in sys.stdin:
+        if line.strip() == "go":
+            times: dict = {}
+            one_round(cases, times, out)
+            print(json.dumps(times), flush=True)
+        else:
+            print(json.dumps(rows(cases, refs, out)), flush=True)
+            break
+    return 0
+
+
+def against(other: str, rounds: int) -> int:
+    """This build ("new") and the one at ``other`` ("old") in interleaved rounds."""
+    env = dict(os.environ)
+    procs = {"new": subprocess.Popen([sys.executable, __file__, "--serve"], stdin=subprocess.PIPE,
+                                     stdout=subprocess.PIPE, text=True, env=env),
+             "old": subprocess.Popen([sys.executable, __file__, "--serve"], stdin=subprocess.PIPE,
+                                     stdout=subprocess.PIPE, text=True,
+                                     env={**env, "PYTHONPATH": other})}
+    try:
+        for name, pr in procs.items():
+            if pr.stdout.readline().strip() != "ready":
+                raise SystemExit(f"bench_collocation: the {name} build's child failed to set up")
+        best: dict = {"new": {}, "old": {}}
+        for i in range(rounds):
+            for name in (("new", "old") if i % 2 == 0 else ("old", "new")):
+                procs[name].stdin.write("go\n")
+                procs[name].stdin.flush()
+                for k, v in json.loads(procs[name].stdout.readline()).items():
+                    best[name][k] = min(best[name].get(k, np.inf), v)
+        table = {}
+        for name, pr in procs.items():
+            pr.stdin.write("stop\n")
+            pr.stdin.flush()
+            table[name] = json.loads(pr.stdout.readline())
+    finally:
+        for pr in procs.values():
+            pr.stdin.close()
+            pr.wait(timeout=60)
+    print(f"{'case':>20} {'new s':>7} {'old s':>7} {'new/old':>7} {'intervals':>9} "
+          f"{'period error':>12} {'estimate':>9} {'mu2 error':>9} (new; old below)")
+    for k in best["new"]:
+        n, o = best["new"][k], best["old"][k]
+        for name in ("new", "old"):
+            iv, pe, est, mu, _ = table[name][k]
+            lead = (f"{k:>20} {n:7.3f} {o:7.3f} {n / o:7.2f}" if name == "new"
+                    else f"{'':>20} {'':>7} {'':>7} {'':>7}")
+            print(f"{lead} {iv:9d} {pe:12.2e} {est:9.1e} {mu:9.1e}")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description="Prints the CPU times and errors of collocate and "
+                                 "of a continuation point.",
+                                 formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    ap.add_argument("--rounds", type=positive_int, default=3, help="interleaved rounds")
+    ap.add_argument("--against", metavar="DIR", default=None,
+                    help="another build's python directory: both timed in interleaved rounds")
+    ap.add_argument("--serve", action="store_true", help=argparse.SUPPRESS)
+    a = ap.parse_args(argv)
+    warnings.simplefilter("ignore")
+    if a.serve:
+        return serve()
+    if a.against is not None:
+        return against(a.against, a.rounds)
+    cases, refs = setup()
+    best: dict = {}
+    out: dict = {}
+    for _ in range(a.rounds):
+        one_round(cases, best, out)
+    print(f"{'case':>20} {'CPU s':>7} {'intervals':>9} {'period error':>12} {'estimate':>9} "
+          f"{'mu2 error':>9} {'signature'}")
+    for k, (iv, pe, est, mu, sig) in rows(cases, refs, out).items():
+        print(f"{k:>20} {best[k]:7.3f} {iv:9d} {pe:12.2e} {est:9.1e} {mu:9.1e} {sig}")
     return 0
 
 

@@ -216,12 +216,14 @@ def _refine(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, count: int, what
     return Solved(lay, terms, xc, 0), Solved(fine, terms, xf, 0)
 
 
-def _errors(c: Solved, f: Solved) -> dict[str, Any]:
-    """The differences of the two levels: the finer's error estimate."""
+def _errors(c: Solved, f: Solved, reached: float = 0.0) -> dict[str, Any]:
+    """The differences of the two levels: the finer's error estimate (each plus ``reached``,
+    the accuracy of a coarse solve stopped at its rounding floor, in the units of x)."""
     t = np.linspace(0.0, f.T, 40 * f.lay.L, endpoint=False)
     du = float(np.max(np.abs(evaluate(c.lay, c.x, t * c.T / f.T) - evaluate(f.lay, f.x, t))))
-    return with_floor({"period": abs(c.T - f.T), "amplitude": np.abs(c.amplitude - f.amplitude),
-                       "multipliers": _match(f.mu, c.mu), "u": du},
+    return with_floor({"period": abs(c.T - f.T) + reached,
+                       "amplitude": np.abs(c.amplitude - f.amplitude) + reached,
+                       "multipliers": _match(f.mu, c.mu) + reached, "u": du + reached},
                       f.T, f.amplitude, f.mu, float(np.max(np.abs(f.x[:f.lay.rows * f.lay.n]))))
 
 

@@ -189,14 +189,17 @@ class CollocationDiscretisation:
         errors: dict[str, Any] = {}
         if self.estimate:
             coarse = self.lay.with_fractions(merged(self.lay.fractions))
+            reached: list[float] = []
             try:
-                xc, _ = solve(coarse, terms, transfer(self.lay, x, coarse), self.ref)
+                xc, _ = solve(coarse, terms, transfer(self.lay, x, coarse), self.ref,
+                              accuracy=reached)
             except (ShootingError, ValueError) as e:
                 warnings.warn(f"p = {p!r}: the merged mesh's solve failed ({e}): no point",
                               CollocationWarning, stacklevel=2)
                 return None
-            # the difference to the mesh of merged pairs is about 2^q - 1 >= 1 times the error
-            errors = _errors(Solved(coarse, terms, xc, self.count), here)
+            # the difference to the mesh of merged pairs is about 2^q - 1 >= 1 times the error;
+            # a solve stopped at its rounding floor adds the accuracy it reached
+            errors = _errors(Solved(coarse, terms, xc, self.count), here, reached[-1])
         return equation_orbit(here, float(p), self.make, errors, self.jumps)
 
     def event_functions(self, x: np.ndarray, p: float, point: EquationOrbit | None
@@ -319,8 +322,11 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     Returns
     -------
     EquationOrbit
-        Autonomous, at the p found (errors from the mesh of merged pairs; none, and ``stable``
-        None, where the orbit is not isolated at fixed p: a vertical branch).
+        Autonomous, at the p found (errors from the mesh of merged pairs).  Where the orbit is
+        not isolated at fixed p (a vertical branch) the merged mesh's solve stops at its
+        rounding floor, its accuracy added to the errors, and the amplitude's error is about
+        the amplitude itself (not determined at fixed p); ``stable`` is then None (a second
+        multiplier at 1).  Where that solve fails, no errors.
 
     Raises
     ------
@@ -372,7 +378,7 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
                        max_iter=max_iter, what=f"the orbit from the Hopf point at p = {p0!r}",
                        converge="correction", stall=False)
     pt = disc.point(z[:-1], z[-1])
-    if pt is None:            # no estimate at fixed p (a vertical branch): none given
+    if pt is None:            # the merged mesh's solve failed: no estimate
         disc.estimate = False
         pt = disc.point(z[:-1], z[-1])
     if pt is None:

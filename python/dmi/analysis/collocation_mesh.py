@@ -55,8 +55,7 @@ class Basis:
 
     def gauss(self, count: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Gauss-Legendre nodes and weights on [0, 1] (``count`` nodes, default m)."""
-        g, w = np.polynomial.legendre.leggauss(self.m if count is None else count)
-        return 0.5 * (g + 1.0), 0.5 * w
+        return _legendre(self.m if count is None else count)
 
     def values(self, z: np.ndarray) -> np.ndarray:
         """(len(z), m + 1): the basis polynomials at the local coordinates z (their monomial
@@ -226,17 +225,28 @@ class Kernel:
         return np.array(sorted(set(self.jumps) | set(near)), dtype=float)
 
 
+def _frozen(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The arrays made read-only (a cached rule is shared by every caller)."""
+    for a in arrays:
+        a.setflags(write=False)
+    return arrays
+
+
+@functools.lru_cache(maxsize=64)
 def _jacobi(q: int, beta: float) -> tuple[np.ndarray, np.ndarray]:
     """Gauss-Jacobi nodes y and weights w on [0, 1] for the weight y^-beta (q nodes):
-    int_0^1 y^-beta P(y) dy = sum w P(y), exact for P of degree <= 2 q - 1."""
+    int_0^1 y^-beta P(y) dy = sum w P(y), exact for P of degree <= 2 q - 1 (computed once for
+    each (q, beta), read-only)."""
     x, w = roots_jacobi(q, 0.0, -beta)
-    return 0.5 * (x + 1.0), w / 2.0 ** (1.0 - beta)
+    return _frozen(0.5 * (x + 1.0), w / 2.0 ** (1.0 - beta))  # type: ignore[return-value]
 
 
+@functools.lru_cache(maxsize=64)
 def _legendre(q: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss-Legendre nodes and weights on [0, 1] (q nodes)."""
+    """Gauss-Legendre nodes and weights on [0, 1] (q nodes; computed once for each q,
+    read-only)."""
     z, w = np.polynomial.legendre.leggauss(q)
-    return 0.5 * (z + 1.0), 0.5 * w
+    return _frozen(0.5 * (z + 1.0), 0.5 * w)  # type: ignore[return-value]
 
 
 def _local(locate: Locator, tp: np.ndarray, a: np.ndarray, d: np.ndarray, S: np.ndarray
@@ -358,7 +368,10 @@ def delay_matrix(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: floa
     # the graded pieces up to start 2^K: each at least its own length from 0, Q_NEAR nodes
     steep = ~close & (a + d <= graded * (1.0 + 1e-12))
     groups = []
-    for f, (zz, ww) in ((~close & ~steep, (gz, gw)), (steep, _legendre(Q_NEAR))):
+    for f, rule in ((~close & ~steep, (gz, gw)), (steep, None)):
+        if not np.any(f):
+            continue
+        zz, ww = rule if rule is not None else _legendre(Q_NEAR)
         S = a[f, None] + d[f, None] * zz[None, :]                # (k, q)
         W = d[f, None] * ww[None, :]
         H = far(S.ravel()).reshape(S.shape + (n, n))             # (k, q, n, n)

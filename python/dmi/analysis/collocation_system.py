@@ -19,6 +19,7 @@ central differences of the residual.
 """
 from __future__ import annotations
 
+from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -38,6 +39,13 @@ from .newton import ShootingError, newton_loop
 #: degree m and H of degree m + 2 QUAD_EXTRA - 1 on the piece; the error h^(2m + 2 QUAD_EXTRA + 1)
 #: a piece stays below the collocation's h^(2m) at the mesh points).
 QUAD_EXTRA = 1
+#: Iterations at the residual's rounding floor without a halving correction after which a
+#: solve that reports its accuracy stops (:func:`solve`).
+FLOOR_ITERATIONS = 3
+#: Delay matrices a Terms keeps (the most recently used): a Newton loop at a fixed mesh (a forced
+#: orbit without switches) builds its matrix once, and the monodromy operator's once for its
+#: multipliers and eigenfunction.
+DELAY_CACHE = 6
 
 
 class CollocationWarning(RuntimeWarning):
@@ -82,9 +90,71 @@ class Terms:
         rate = float(np.max(-self.terms[0], initial=0.0)) if self.kind == "exp" else 0.0
         self.H = Kernel(self._far, near_part(solver), kernel_jumps(jumps, self.tau),
                         rate if rate * self.tau > STEEP else 0.0)
+        self._delays: OrderedDict[tuple, sp.csr_matrix] = OrderedDict()
+        self._kept: dict[str, tuple[tuple, np.ndarray]] = {}
+
+    def delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc: Locator, basis: Basis,
+              rows: int, history: History | None = None) -> sp.csr_matrix:
+        """The delay integral's matrix (:func:`delay_matrix`) at the collocation times of
+        ``mesh``, kept for the last DELAY_CACHE meshes (it depends on the mesh, T, the basis and
+        the history's mesh only, not on the node values).
+
+        Parameters
+        ----------
+        times : numpy.ndarray
+            The collocation times of ``mesh``.
+        mesh : numpy.ndarray
+            The mesh of one period.
+        T : float
+            The period.
+        loc : callable
+            The locator of the node rows (periodic, or of ``history``).
+        basis : Basis
+            The basis.
+        rows : int
+            The node rows.
+        history : History, optional
+            The past of the monodromy operator's system (its mesh and periods enter the key).
+
+        Returns
+        -------
+        scipy.sparse.csr_matrix
+            G (len(times) n, rows n).
+        """
+        key = (np.asarray(mesh, dtype=float).tobytes(), float(T), basis.m, basis.q, rows,
+               None if history is None else (history.hist.tobytes(), history.periods))
+        G = self._delays.get(key)
+        if G is None:
+            G = delay_matrix(times, self.tau, mesh, T, self.H, loc, basis, self.n, rows,
+                             pattern=self.pattern)[0]
+            self._delays[key] = G
+            if len(self._delays) > DELAY_CACHE:
+                self._delays.popitem(last=False)
+        else:
+            self._delays.move_to_end(key)
+        return G
+
+    def _last(self, slot: str, t: np.ndarray, U: np.ndarray,
+              compute: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> np.ndarray:
+        """compute(t, U), kept (read-only) in ``slot`` for the next call with the same t and U
+        (Newton's residual and Jacobian at one iterate, the monodromy's Jacobian at the orbit)."""
+        t = np.asarray(t, dtype=float)
+        U = np.asarray(U, dtype=float)
+        key = (t.tobytes(), U.tobytes(), U.shape)
+        kept = self._kept.get(slot)
+        if kept is not None and kept[0] == key:
+            return kept[1]
+        out = compute(t, U)
+        out.setflags(write=False)
+        self._kept[slot] = (key, out)
+        return out
 
     def f(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
-        """f(t_c, U_c) (P, n) at the times t (P,) and states U (P, n)."""
+        """f(t_c, U_c) (P, n) at the times t (P,) and states U (P, n) (read-only)."""
+        return self._last("f", t, U, self._rhs)
+
+    def _rhs(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
+        """f(t_c, U_c) (P, n) from the model's rhs (zero without one)."""
         if not self.has_rhs:
             return np.zeros_like(U)
         out = self.solver.eval_rhs_many(t, U)
@@ -95,7 +165,11 @@ class Terms:
         return out
 
     def fu(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
-        """df/du (P, n, n) by central differences (step FD_STEP max(|u_j|, 1))."""
+        """df/du (P, n, n) by central differences (step FD_STEP max(|u_j|, 1); read-only)."""
+        return self._last("fu", t, U, self._jacobian)
+
+    def _jacobian(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
+        """df/du (P, n, n) by central differences of the model's rhs."""
         P, n = U.shape
         J = np.zeros((P, n, n))
         if not self.has_rhs:
@@ -103,7 +177,7 @@ class Terms:
         e = FD_STEP * np.maximum(np.abs(U), 1.0)                  # (P, n)
         shift = np.einsum("pj,jk->jpk", e, np.eye(n))              # (n, P, n): column j moved
         both = np.concatenate([U[None] + shift, U[None] - shift]).reshape(-1, n)
-        F = self.f(np.tile(t, 2 * n), both).reshape(2, n, P, n)
+        F = self._rhs(np.tile(t, 2 * n), both).reshape(2, n, P, n)
         J[:] = np.transpose((F[0] - F[1]) / (2 * e.T[:, :, None]), (1, 2, 0))
         return J
 
@@ -384,9 +458,12 @@ def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray
     E = point_matrix(tc, loc, basis, mesh, n, rows)
     D = point_matrix(tc, loc, basis, mesh, n, rows, derivative=True)
     scaled = jacobian and lay.autonomous and history is None and lay.S == 0
-    G, dI = (delay_matrix(tc, terms.tau, mesh, T, terms.H, loc, basis, n, rows,
-                          pattern=terms.pattern, slope_of=V if scaled else None)
-             if terms.has_kernel else (None, None))
+    G, dI = None, None
+    if terms.has_kernel and scaled:         # the T column's integral needs the node values
+        G, dI = delay_matrix(tc, terms.tau, mesh, T, terms.H, loc, basis, n, rows,
+                             pattern=terms.pattern, slope_of=V)
+    elif terms.has_kernel:
+        G = terms.delay(tc, mesh, T, loc, basis, rows, history)
     Uc = (E @ u).reshape(-1, n)
     du = (D @ u).reshape(-1, n)
     r = du + terms.f(tc, Uc)
@@ -492,12 +569,18 @@ def full_jacobian(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None
 
 
 def solve(lay: Layout, terms: Terms, x0: np.ndarray, ref: Callable | None, *,
-          tol: float = 1e-12, max_iter: int = 25, what: str = "collocation"
-          ) -> tuple[np.ndarray, list[float]]:
+          tol: float = 1e-12, max_iter: int = 25, what: str = "collocation",
+          accuracy: list[float] | None = None) -> tuple[np.ndarray, list[float]]:
     """Newton's method on the collocation system with sparse LU (:func:`newton_loop`): the
     factored Jacobian is kept while the residual falls by 10 or more a step (chord steps cost a
     residual), refreshed otherwise, and a fresh step is halved until the residual falls;
     converged when the correction is below tol max(1, |x|_inf) (that correction applied).
+
+    With ``accuracy`` (a list the caller adds to its error estimates), also converged when the
+    residual stays at its floor (<= tol max(1, |x|_inf)) while the corrections stop falling
+    (FLOOR_ITERATIONS iterations without halving: rounding amplified by a nearly singular
+    Jacobian, as at a fixed p on a vertical branch); the achieved accuracy (the largest of those
+    corrections, else the last one) is appended to it.
 
     Raises
     ------
@@ -517,7 +600,8 @@ def solve(lay: Layout, terms: Terms, x0: np.ndarray, ref: Callable | None, *,
     return newton_loop(evaluate, factor, x0, tol=tol, max_iter=max_iter, what=what,
                        converge="correction", chord=0.1, search="descent", reject=(Degenerate,),
                        reject_why="a segment vanishes (the signature changed)", history=res,
-                       stall=False)
+                       stall=False, floor=FLOOR_ITERATIONS if accuracy is not None else 0,
+                       accuracy=accuracy)
 
 
 def _factor(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None, what: str,

@@ -94,7 +94,8 @@ def newton_loop(evaluate: Callable[[np.ndarray], tuple[np.ndarray, Any]],
                 reject: tuple[type[Exception], ...] = (), reject_why: str = "",
                 check: Callable[[np.ndarray], None] | None = None,
                 scale: Callable[[np.ndarray], float] | None = None, hint: str = "",
-                far: str = "", history: list[float] | None = None, stall: bool = True
+                far: str = "", history: list[float] | None = None, stall: bool = True,
+                floor: int = 0, accuracy: list[float] | None = None
                 ) -> tuple[np.ndarray, list[float]]:
     """Newton's method on r(z) = 0: the one loop of :mod:`dmi.analysis` (the step maps'
     matrix-free :func:`bordered_newton`, collocation's sparse LU, the continuation driver's
@@ -145,6 +146,16 @@ def newton_loop(evaluate: Callable[[np.ndarray], tuple[np.ndarray, Any]],
         Give up when the residual makes no new minimum in NO_PROGRESS iterations (False: a
         loop converged on its correction may sit at the residual's rounding floor a few
         iterations).
+    floor : int
+        ``"correction"`` only, 0: off.  k > 0: also converged when the residual is at most
+        tol scale (its rounding floor) and the correction has not fallen below half its least
+        value (over the iterations at that floor) in k iterations: the corrections are then
+        the rounding of the residual amplified by an ill-conditioned Jacobian (a nearly
+        singular direction), and z is returned as it is, its accuracy the largest of those
+        corrections (appended to ``accuracy``).
+    accuracy : list of float, optional
+        Where the achieved accuracy (max norm, the units of z) is appended on return: the last
+        correction's size with ``"correction"`` (or the floor's, above), else the last step's.
 
     Returns
     -------
@@ -169,12 +180,15 @@ def newton_loop(evaluate: Callable[[np.ndarray], tuple[np.ndarray, Any]],
     z = np.array(z0, dtype=float)
     r, state = evaluate(z)
     solve, age, moved = None, 0, math.inf
+    least, since, worst = math.inf, 0, 0.0      # the corrections at the residual's floor
+    done_to = accuracy if accuracy is not None else []
     for _ in range(max_iter + 1):
         rn = float(np.max(np.abs(r))) if r.size else 0.0
         sc = size(z)
         verdict = judge(res, rn, -math.inf if converge == "correction" else tol * sc,
                         max_iter, what, hint, stall)
         if verdict == "converged" and (converge == "residual" or moved <= tol * sc):
+            done_to.append(moved)
             return z, res
         if verdict == "exhausted":
             break
@@ -182,8 +196,20 @@ def newton_loop(evaluate: Callable[[np.ndarray], tuple[np.ndarray, Any]],
             solve, age = factor(z, r, state), 0
         dz = solve(r)
         age += 1
-        if converge == "correction" and float(np.max(np.abs(dz))) <= tol * sc:
+        step = float(np.max(np.abs(dz)))
+        if converge == "correction" and step <= tol * sc:
+            done_to.append(step)
             return z + dz, res
+        if floor > 0 and converge == "correction" and rn <= tol * sc:
+            if step < 0.5 * least:                 # the corrections still fall
+                least, since, worst = step, 0, step
+            else:
+                since, worst = since + 1, max(worst, step)
+            if since >= floor:                     # rounding amplified: z is as good as it gets
+                done_to.append(worst)
+                return z, res
+        else:
+            least, since, worst = math.inf, 0, 0.0
         lam = 1.0
         # trials: 1, 1 / 2, ..., 1 / 32 (below 0.05: taken); "descent" twice (a refresh between)
         for _ in range({"none": 1, "guard": 6, "descent": 12}[search]):
