@@ -239,9 +239,9 @@ def with_floor(errors: dict[str, Any], T: float, amplitude: np.ndarray, mu: np.n
     return errors
 
 
-def _stable(mu: np.ndarray, err: np.ndarray, autonomous: bool) -> bool | None:
+def _stable(mu: np.ndarray, err: np.ndarray, autonomous: bool, p: float) -> bool | None:
     """All |mu| < 1 but the trivial one (autonomous), verified against the errors; None (with a
-    CollocationWarning) when a multiplier's |mu| is within its error of 1."""
+    CollocationWarning naming p) when a multiplier's |mu| is within its error of 1."""
     if mu.size == 0:
         return None
     keep = np.ones(mu.size, bool)
@@ -252,7 +252,7 @@ def _stable(mu: np.ndarray, err: np.ndarray, autonomous: bool) -> bool | None:
         return False
     if np.all(a < 1 - e):
         return True
-    warnings.warn(f"collocate: a multiplier's modulus is within its estimated error of 1 "
+    warnings.warn(f"p = {p!r}: a multiplier's modulus is within its estimated error of 1 "
                   f"({a[np.argmin(np.abs(a - 1))]:.12g}): stability not verified (None)",
                   CollocationWarning, stacklevel=3)
     return None
@@ -425,7 +425,7 @@ def equation_orbit(f: Solved, p: float, make: Any, errors: dict[str, Any],
     return EquationOrbit(p=p, period=T, amplitude=f.amplitude, multipliers=f.mu,
                          stable=_stable(f.mu, errors.get("multipliers", np.full(f.mu.shape,
                                                                                 np.inf)),
-                                        f.lay.autonomous),
+                                        f.lay.autonomous, p),
                          mesh=f.lay.mesh(b, T), signature=f.lay.signature, switches=b.copy(),
                          make=make, autonomous=f.lay.autonomous, errors=errors,
                          degree=f.lay.m, nodes=V.copy(),
