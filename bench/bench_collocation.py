@@ -35,7 +35,7 @@ import scipy.sparse.linalg as sla  # noqa: E402
 
 import dmi  # noqa: E402
 from dmi import analysis as da  # noqa: E402
-from benchtools import cpu, positive_int  # noqa: E402
+from benchtools import cpu, dir_holding, positive_int  # noqa: E402
 
 TAU = 1.0
 
@@ -189,20 +189,13 @@ def against(other: str, rounds: int) -> int:
     return 0
 
 
-def build_python(text: str) -> str:
-    """An argparse type: a build's python directory (holding dmi/__init__.py)."""
-    if not text or not os.path.isfile(os.path.join(text, "dmi", "__init__.py")):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a build's python directory (no "
-                                         "dmi/__init__.py there)")
-    return text
-
-
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description="Prints the CPU times and errors of collocate and "
                                  "of a continuation point.",
                                  formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     ap.add_argument("--rounds", type=positive_int, default=3, help="interleaved rounds")
-    ap.add_argument("--against", metavar="DIR", type=build_python, default=None,
+    ap.add_argument("--against", metavar="DIR", default=None,
+                    type=dir_holding(os.path.join("dmi", "__init__.py")),
                     help="another build's python directory: both timed in interleaved rounds")
     ap.add_argument("--serve", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)

@@ -34,7 +34,7 @@ import sys  # noqa: E402
 import numpy as np  # noqa: E402
 
 import dmi  # noqa: E402
-from benchtools import cpu, positive_int  # noqa: E402
+from benchtools import cpu, dir_holding, nonempty, positive_int  # noqa: E402
 from dmi.identify import Record, sensitivities  # noqa: E402
 from dmi.identify.fitting import _Problem, _check_record  # noqa: E402
 
@@ -82,20 +82,6 @@ def differences(make, p, steps, central: bool):
             plain(make, q, steps)
 
 
-def nonempty(text: str) -> str:
-    """An argparse type: a string that is not empty."""
-    if not text:
-        raise argparse.ArgumentTypeError("'' is empty")
-    return text
-
-
-def package_dir(text: str) -> str:
-    """An argparse type: a directory holding an __init__.py (a copy of python/dmi/identify)."""
-    if not text or not os.path.isfile(os.path.join(text, "__init__.py")):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a directory with an __init__.py")
-    return text
-
-
 def baseline(path: str):
     """The package in directory path (a copy of python/dmi/identify) as dmi._identify_baseline."""
     spec = importlib.util.spec_from_file_location("dmi._identify_baseline", os.path.join(path, "__init__.py"),
@@ -122,7 +108,7 @@ def main() -> None:
                     help="run length of the callback-kernel cases, DIRECT and FFT (default 2000)")
     ap.add_argument("--cases", metavar="TEXT", type=nonempty, default=None,
                     help="only the cases whose name contains TEXT (default: all)")
-    ap.add_argument("--baseline", metavar="DIR", type=package_dir,
+    ap.add_argument("--baseline", metavar="DIR", type=dir_holding("__init__.py"),
                     help="a copy of another version's python/dmi/identify, timed in the same "
                          "rounds (default: none)")
     args = ap.parse_args()
