@@ -45,6 +45,42 @@ def thinned(U: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
     return idx * h, np.array(U[idx])
 
 
+def corner_sentence(component: int, p: float, towards: str, evidence: str, other: str) -> str:
+    """The status of a branch that ended at a corner of a component's stick pattern (its stick
+    onset or its grazing), one sentence whatever route the corrector took to fail there.
+
+    Parameters
+    ----------
+    component : int
+        The component whose stick pattern changes at the corner.
+    p : float
+        The last point's parameter.
+    towards : str
+        ``"larger"`` or ``"smaller"``: the side of p the branch could not pass to; or
+        ``"either"`` where the last points are at one p (a vertical branch).
+    evidence : str
+        What the last points show of the corner.
+    other : str
+        What is known of the branch on the other side, and how to follow it.
+
+    Returns
+    -------
+    str
+        ``"the branch ended at a corner of component i's stick pattern near p = ..., which it
+        could not pass towards ... p: <evidence>; <other>"``.
+    """
+    return (f"the branch ended at a corner of component {component}'s stick pattern near "
+            f"p = {p:.10g}, which it could not pass towards {towards} p: {evidence}; {other}")
+
+
+def travel(ps: list[float]) -> str:
+    """The way p went over the points ps: ``"larger"``, ``"smaller"``, or ``"either"`` where
+    they lie at one p to 1e-7 (relative)."""
+    if max(ps) - min(ps) <= 1e-7 * max(1.0, abs(ps[-1])):
+        return "either"
+    return "larger" if ps[-1] > ps[0] else "smaller"
+
+
 def non_real(values: np.ndarray) -> np.ndarray:
     """The values (roots, multipliers) that are not real: |Im| > 1e-8 max(1, |value|)."""
     values = np.asarray(values)

@@ -27,7 +27,7 @@ are fixed; a second discretisation, e.g. collocation of the equation's orbits, i
 - optional ``disc.corner(points) -> str``: when the branch ends because the corrector fails at
   the smallest step, what the discretisation reads from the points so far (e.g. that the
   branch ended at a corner of a stick pattern, and on which side of it the other branch lies);
-  appended to the status.
+  it leads the status, the corrector's failure following in parentheses.
 - optional ``disc.adapt(x, p) -> x``: a change of mesh (or of the unknowns) between steps; the
   driver then restarts its tangent from the new x (oriented by ``disc.carry(t, x)``, a direction
   on the new unknowns, when their number changed; else by t's p part).
@@ -556,12 +556,12 @@ def continuation(disc: Any, x0: np.ndarray, p0: float, p_end: float, *, step: fl
                         break
                 if ds < min_step:
                     status = (f"corrector failed at the smallest step {min_step!r} near p = "
-                              f"{float(z[-1])!r}" + (" (a corner: natural steps from it failed "
-                                                     "too)" if cornered else "") + f": {e}")
+                              f"{float(z[-1])!r}" + (" (natural steps from it failed too)"
+                                                     if cornered else "") + f": {e}")
                     corner = getattr(disc, "corner", None)
                     said = corner(pts) if corner is not None else ""
-                    if said:
-                        status += f"; {said}"
+                    if said:   # the corner first, whichever route failed there
+                        status = f"{said} (the {status})"
                     break
         if zn is None:
             break

@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 import scipy.optimize as so
 
-from .branch import Branch, Event
+from .branch import Branch, Event, corner_sentence, travel
 from .collocation import CollocationWarning, check_inequalities, transfer
 from .collocation_continuation import CollocationDiscretisation, equation_hopf_orbit
 from .collocation_mend import circle, memory, mend, relaid, removed
@@ -596,9 +596,11 @@ class EquationBranch(CollocationDiscretisation):
         raise ValueError("neither side's orbit has a margin that breaks at this change")
 
     def corner(self, points: list[EquationOrbit]) -> str:
-        """Where a branch that failed at the smallest step ended: its last signature, a
-        friction component that slips throughout and comes within reach of 0 (grazing), the way
-        p went over the last points, and what is known of the branch on the other side.
+        """Where a branch that failed at the smallest step ended, in the words of
+        :func:`~dmi.analysis.branch.corner_sentence`: a friction component that slips
+        throughout and comes within 1 % of its half range of 0 (grazing), or else the component
+        that switches into the shortest segment of the last signature (a segment that vanishes
+        or appears there); "" for a smooth orbit that does not graze.
 
         Parameters
         ----------
@@ -608,27 +610,38 @@ class EquationBranch(CollocationDiscretisation):
         Returns
         -------
         str
-            The sentence for the status.
+            The sentence for the status, or "".
         """
         last = points[-1]
-        ps = [q.p for q in points[-4:]]
-        vertical = max(ps) - min(ps) <= 1e-7 * max(1.0, abs(last.p))
-        way = "larger" if ps[-1] > ps[0] else "smaller"
-        how = ("at fixed p (a vertical branch: the orbits' amplitude grows at one p)" if vertical
-               else f"towards {way} p")
+        towards = travel([q.p for q in points[-4:]])
         graze = _grazing(self, last)
-        what = (f"grazing: component {graze[0]} slips throughout and its velocity comes within "
-                f"{graze[1]:.3g} of 0" if graze is not None and graze[1] <= 1e-2 * graze[2]
-                else "a segment appears or vanishes")
-        other = ("the stick-slip branch leaves the corner in p (a vertical branch turns there); "
-                 "which way was not computed, since the mended signature's corrector failed "
-                 "(above)" if vertical else
-                 f"the branch on the other side continues towards {way} p with a changed "
-                 "signature, which the mended corrector did not reach (above)")
-        return (f"the collocated branch ended at a corner ({what}) of its signature "
-                f"{last.signature.describe()} at p = {last.p:.10g}, moving {how} over its last "
-                f"points: {other}; to follow it, start from a scheme's orbit past the corner "
-                "(periodic_orbit at p on either side, then collocate)")
+        follow = ("to follow it, start from a scheme's orbit past the corner (periodic_orbit at "
+                  "p on either side, then collocate)")
+        if towards == "either":
+            other = ("the stick-slip branch leaves the corner in p (a vertical branch turns "
+                     "there); which way was not computed, since the mended signature's corrector "
+                     "failed (below); " + follow)
+        else:
+            other = (f"the branch on the other side continues towards {towards} p with a "
+                     "changed signature, which the mended corrector did not reach (below); "
+                     + follow)
+        sig = " ".join(last.signature.describe())
+        if graze is not None and graze[1] <= 1e-2 * graze[2]:
+            return corner_sentence(
+                graze[0], last.p, towards,
+                f"its orbits slip throughout (signature {sig}) and its velocity comes within "
+                f"{graze[1]:.3g} of 0 (half range {graze[2]:.3g}): a grazing", other)
+        S = last.signature.switches
+        if S == 0:
+            return ""
+        b = np.asarray(last.switches, dtype=float)
+        lengths = np.append(np.diff(b), last.period - b[-1] + b[0])   # segments 1..S-1, then 0
+        k = int(np.argmin(lengths)) + 1      # the switch b_k that enters the shortest segment
+        i = last.signature.switch(k)[0]
+        return corner_sentence(
+            i, last.p, towards,
+            f"a segment of its signature {sig} appears or vanishes there (the shortest lasts "
+            f"{float(lengths.min()):.3g} of the period {last.period:.6g})", other)
 
 
 def _grazing(disc: CollocationDiscretisation, orbit: EquationOrbit

@@ -24,7 +24,7 @@ import numpy as np
 import scipy.sparse.linalg as sla
 
 from .._solver import Solver
-from .branch import BranchPoint, Event, thinned
+from .branch import BranchPoint, Event, corner_sentence, thinned, travel
 from .driver import VERTICAL
 from .floquet import Verify, fd_step, floquet_verdict, phase_free, ritz
 from .newton import ShootingError, bordered_newton, bordered_step, directional, fd_eps
@@ -564,10 +564,8 @@ class Shooting:
         return out
 
     def corner(self, points: list[BranchPoint]) -> str:
-        """Where a branch that failed at the smallest step ended, read from its last points:
-        a component whose stick pattern changed among the last four (a corner: stick onset or
-        grazing), the p of the orbits on the other side of it and so which way the other
-        branch goes; empty when no stick pattern changed.
+        """Where a branch that failed at the smallest step ended (:func:`corner_of`), the
+        friction components read from the model at the last point's p.
 
         Parameters
         ----------
@@ -579,27 +577,11 @@ class Shooting:
         str
             The sentence for the status, or "".
         """
-        last = points[-1]
-        recent = points[-4:]
-        for i in range(len(last.stick_steps)):
-            kinds = {(int(q.stick_steps[i]) > 0, int(q.stick_phases[i])) for q in recent}
-            if len(kinds) < 2:
-                continue
-            here = (int(last.stick_steps[i]) > 0, int(last.stick_phases[i]))
-            other = [q.p for q in recent if (int(q.stick_steps[i]) > 0,
-                                              int(q.stick_phases[i])) != here]
-            side = "smaller" if float(np.mean(other)) < last.p else "larger"
-            what = "stick" if not here[0] else (
-                "slip throughout" if not any(q.stick_steps[i] for q in recent
-                                             if q.p in other) else "stick otherwise")
-            return (f"the branch ended at a corner of component {i}'s stick pattern (stuck "
-                    f"steps {[int(q.stick_steps[i]) for q in recent]}, stick phases "
-                    f"{[int(q.stick_phases[i]) for q in recent]} over the last points): orbits "
-                    f"that {what} were found at p = {', '.join(f'{p:.8g}' for p in other)}, "
-                    f"{side} than the last point's p = {last.p:.8g}: the other branch goes "
-                    f"towards {side} p; start a branch from one of them (periodic_orbit at its "
-                    "p, or hopf_orbit) and continue it that way")
-        return ""
+        try:
+            alpha = self.maps.make(points[-1].p).friction
+        except Exception:   # the model's failure: no component is known to have friction
+            alpha = None
+        return corner_of(points, alpha)
 
     def _profile(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         zl, _, _, terms = self.last
@@ -610,3 +592,77 @@ class Shooting:
         return st, ph
 
 
+
+
+# a slipping component's least |velocity| that names a grazing ahead, relative to its half range
+GRAZING_NEAR = 0.05
+
+
+def corner_of(points: list[BranchPoint], alpha: np.ndarray | None) -> str:
+    """Where a branch that failed at the smallest step ended, read from its last four points,
+    in the words of :func:`~dmi.analysis.branch.corner_sentence`: a component whose stick
+    pattern changed among them (the p of the orbits on the other side of the corner, and so which
+    way the other branch goes), or else a friction component that slips throughout on all of
+    them, its least |velocity| falling to below ``GRAZING_NEAR`` of its half range (a grazing
+    ahead, its p extrapolated from the last two points); "" when neither.
+
+    Parameters
+    ----------
+    points : list of BranchPoint
+        The branch's points so far.
+    alpha : numpy.ndarray or None
+        The model's friction levels (n,), or None (no grazing is read then).
+
+    Returns
+    -------
+    str
+        The sentence for the status, or "".
+    """
+    last = points[-1]
+    recent = points[-4:]
+    towards = travel([q.p for q in recent])
+    for i in range(len(last.stick_steps)):
+        kinds = {(int(q.stick_steps[i]) > 0, int(q.stick_phases[i])) for q in recent}
+        if len(kinds) < 2:
+            continue
+        here = (int(last.stick_steps[i]) > 0, int(last.stick_phases[i]))
+        other = [q.p for q in recent if (int(q.stick_steps[i]) > 0,
+                                          int(q.stick_phases[i])) != here]
+        side = "smaller" if float(np.mean(other)) < last.p else "larger"
+        what = "stick" if not here[0] else (
+            "slip throughout" if not any(q.stick_steps[i] for q in recent
+                                         if q.p in other) else "stick otherwise")
+        return corner_sentence(
+            i, last.p, towards,
+            f"its stick pattern changed over the last points (stuck steps "
+            f"{[int(q.stick_steps[i]) for q in recent]}, stick phases "
+            f"{[int(q.stick_phases[i]) for q in recent]})",
+            f"orbits that {what} were found at p = {', '.join(f'{p:.8g}' for p in other)}, "
+            f"{side} than the last point's p = {last.p:.8g}: the other branch goes towards "
+            f"{side} p; start a branch from one of them (periodic_orbit at its p, or "
+            "hopf_orbit) and continue it that way")
+    if alpha is None or len(recent) < 3:
+        return ""
+    best = None
+    for i in np.flatnonzero(np.asarray(alpha) > 0):
+        if any(q.stick_steps[i] for q in recent):
+            continue
+        least = [float(np.min(np.abs(q.u[:, i]))) for q in recent[-3:]]
+        half = float(last.amplitude[i])
+        if not (least[0] > least[1] > least[2]) or least[2] > GRAZING_NEAR * half:
+            continue
+        if best is None or least[2] / half < best[1] / best[2]:
+            best = (int(i), least[2], half, least[1])
+    if best is None:
+        return ""
+    i, m1, half, m0 = best
+    p0, p1 = recent[-2].p, last.p
+    at = p1 + m1 * (p1 - p0) / (m0 - m1)
+    return corner_sentence(
+        i, last.p, towards,
+        f"its orbits slip throughout, and their least |u_{i}| over the orbit fell to {m1:.3g} "
+        f"(half range {half:.3g}) at the last point, reaching 0 near p = {at:.8g} (extrapolated "
+        "from the last two points): a grazing",
+        "no orbit past the corner was computed, so which way the branch of the orbits that "
+        "stick goes is not known; start one from an orbit past the corner (periodic_orbit near "
+        "that p, or collocate and continue the equation's orbit) and continue it either way")
