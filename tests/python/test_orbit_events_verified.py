@@ -3,7 +3,7 @@
 # (1 - h c)^3 = -(1 + (p - 1) / 2) exactly (a linear map): it crosses -1 at p = 1, an event
 # placed there by the linear interpolation of the test function (exact here); the same points
 # with error bounds larger than the multiplier's distance to the circle give no event and an
-# EventWarning; without verify= the event says it is not verified; undecided() and
+# EventWarning; with verify=False the event says it is not verified; undecided() and
 # verified_tests() on hand-made multipliers.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
@@ -88,10 +88,54 @@ def test_undecided_and_verified_tests():
 
 
 def test_event_without_error_bounds_says_so():
-    """Without verify= the Ritz multipliers have no error bound: the event is the scheme's, its
-    detail says it is not verified."""
+    """With verify=False the Ritz multipliers have no error bound: the event is the scheme's,
+    its detail says it is not verified."""
     o = da.periodic_orbit(flip, 0.5, 1.0, [0.0], multipliers=1)
-    b = da.continue_orbit(o, 1.5, step=0.25, multipliers=1)
+    with pytest.warns(UserWarning, match="verify=False"):
+        b = da.continue_orbit(o, 1.5, step=0.25, multipliers=1, verify=False)
     pds = [e for e in b.events if e.kind == "period-doubling"]
     assert len(pds) == 1 and abs(pds[0].p - 1.0) < 1e-9, b.events
     assert "not verified" in pds[0].detail
+
+
+def test_an_undecided_point_between_brackets_the_event_across_it(branch):
+    """A point that decides nothing of the doubling (its bounds beyond its distance to -1)
+    between two that do: the event is reported between the two decided points, at the crossing
+    of the linear interpolation of their test function (exact here: the multiplier is linear in
+    p), with a warning at the undecided point; and without that point the same event."""
+    below = [q for q in branch.points if q.p < 1 - 1e-6]
+    above = [q for q in branch.points if q.p > 1 + 1e-6]
+    x, z = below[-1], above[0]
+    y = dataclasses.replace(z, p=0.5 * (x.p + z.p), floquet=dataclasses.replace(
+        z.floquet, errors=np.full(z.floquet.errors.shape, 0.5)))
+    decided: dict = {}
+    with pytest.warns(EventWarning, match="sought between the points that decide it"):
+        got = orbit_events(x, y, 1, decided=decided)
+    assert not [g for g in got if g.kind == "period-doubling"], got
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", EventWarning)
+        got = orbit_events(y, z, 2, decided=decided)
+    pd = [g for g in got if g.kind == "period-doubling"]
+    assert len(pd) == 1 and abs(pd[0].p - 1.0) < 1e-9, got
+    assert f"bracketed by the points at p = {x.p!r} and {z.p!r}" in pd[0].detail
+    # without a shared record of decided points the undecided middle loses it (the old way)
+    with pytest.warns(EventWarning):
+        lost = orbit_events(x, y, 1) + orbit_events(y, z, 2)
+    assert not [g for g in lost if g.kind == "period-doubling"], lost
+
+
+def test_default_branch_verifies_and_the_opt_out_has_no_verdict():
+    """continue_orbit verifies by default (every point's floquet record, stable from it); with
+    verify=False the Ritz multipliers stay, stable is None and a warning says so."""
+    o = da.periodic_orbit(flip, 0.5, 1.0, [0.0], multipliers=1)
+    b = da.continue_orbit(o, 0.8, step=0.25, multipliers=1)
+    assert all(q.floquet is not None for q in b.points)
+    # the exact multiplier -(1 + (p - 1) / 2) lies inside the circle below p = 1: stable
+    assert all(q.stable is True for q in b.points), [q.stable for q in b.points]
+    with pytest.warns(UserWarning, match="verify=False"):
+        u = da.continue_orbit(o, 0.8, step=0.25, multipliers=1, verify=False)
+    assert all(q.stable is None and q.floquet is None for q in u.points)
+    for q in u.points:
+        assert q.multipliers[0].real == pytest.approx(-(1 + 0.5 * (q.p - 1)), abs=1e-9)
+    with pytest.raises(ValueError, match="verify"):
+        da.continue_orbit(o, 0.8, step=0.25, multipliers=1, verify="yes")

@@ -102,8 +102,10 @@ class BranchPoint:
     multipliers : numpy.ndarray of complex
         The leading Floquet multipliers, largest |mu| first.
     stable : bool or None
-        All |mu| < 1 (on an autonomous branch: all but its phase's multiplier 1); None where
-        no multiplier was computed (``multipliers=0``): not verified.
+        All |mu| < 1 (on an autonomous branch: all but its phase's multiplier 1), verified
+        (:func:`dmi.analysis.floquet_verdict`); None where no multiplier was computed
+        (``multipliers=0``), where the verification was opted out of (``verify=False``: Ritz
+        values have no error bound), or where the verdict stays undecided.
     stick_steps : numpy.ndarray
         Shape (n,): stuck steps per period.
     stick_phases : numpy.ndarray

@@ -72,7 +72,7 @@ from .collocation_system import Layout, evaluate, solve
 from .driver import continuation
 from .equation_branch import continue_equation_orbit
 from .equation_orbit import EquationOrbit
-from .floquet import Verify, phase_free, ritz
+from .floquet import StabilityWarning, Verify, phase_free, ritz
 from .newton import ShootingError
 from .orbit import Orbit, make_orbit
 from .orbit_events import test_function
@@ -87,7 +87,8 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                    multipliers: int = 6, tol: float = 1e-10, max_iter: int = 8,
                    sections: int = 1, margins: bool = True,
                    period: Callable[[float], float] | None = None,
-                   refine: bool = False, at: Any = (), verify: Verify | None = None) -> Branch:
+                   refine: bool = False, at: Any = (), verify: Verify | bool | None = None
+                   ) -> Branch:
     """Continues a periodic orbit in its parameter by pseudo-arclength, with its events.
 
     The corrector is Newton-Picard on the previous point's dominant subspace, Newton-GMRES when
@@ -153,12 +154,15 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
         (:func:`dmi.analysis.refine_orbit`: the equation's, O(h^2)); the model must take h.
     at : iterable of float
         Parameters where a point is wanted (a ``user`` event each, its point at exactly that p).
-    verify : dmi.analysis.Verify, optional
-        Verify every point's multipliers and stability (:func:`dmi.analysis.floquet_verdict`,
-        kept in ``BranchPoint.floquet``; the multipliers' events then leave out the verified
-        trivial multiplier, and are reported only where the multipliers of their kind lie off
-        the unit circle beyond their error bounds on both points, else an ``EventWarning``).
-        None: the Ritz multipliers, ``stable`` from them unverified.
+    verify : dmi.analysis.Verify or False, optional
+        How every point's multipliers and stability are verified (None: ``Verify()``;
+        :func:`dmi.analysis.floquet_verdict`, kept in ``BranchPoint.floquet``; the multipliers'
+        events then leave out the verified trivial multiplier, and are reported only between
+        points whose multipliers of their kind lie off the unit circle beyond their error
+        bounds, points that decide nothing of the kind passed over with an ``EventWarning``).
+        ``False`` opts out (a point costs about 2.5 times less, docs/orbits.md): the points
+        keep the Ritz multipliers, which have no error bound, their ``stable`` is None, and a
+        ``UserWarning`` says so.
 
     Returns
     -------
@@ -187,6 +191,18 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                                        multipliers=multipliers, tol=tol, max_iter=max_iter, at=at)
     if not (math.isfinite(step) and step > 0):
         raise ValueError(f"step = {step!r}: must be finite and > 0 (p units)")
+    if verify is None:
+        verify = Verify()
+    elif verify is False:
+        if multipliers > 0:
+            warnings.warn("continue_orbit(verify=False): the points' multipliers are Ritz "
+                          "values without an error bound, so their stable is None; leave "
+                          "verify at its default (Verify()) for verified verdicts", UserWarning,
+                          stacklevel=2)
+        verify = None
+    elif not isinstance(verify, Verify):
+        raise ValueError(f"verify = {verify!r}: give a dmi.analysis.Verify, or False to opt out "
+                         "of the verification")
     if not math.isfinite(p_end) or p_end == orbit.p:
         raise ValueError(f"p_end = {p_end!r}: must be finite and differ from the orbit's "
                          f"p = {orbit.p!r}")
@@ -239,6 +255,14 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                      kind="autonomous" if auto else "orbits",
                      branch=dict(steps=orbit.steps, h=orbit.h, rows=maps.rows,
                                  sections=sections, period=period))
+    open_ = [q for q in b.points if q.floquet is not None and q.stable is None]
+    if open_:
+        warnings.warn(f"continue_orbit: the stability of {len(open_)} of {len(b.points)} points "
+                      f"is not decided (stable None), at p = "
+                      f"{', '.join(f'{q.p:.8g}' for q in open_[:6])}"
+                      f"{', ...' if len(open_) > 6 else ''}: {open_[0].floquet.reason} (the "
+                      "first; BranchPoint.floquet.reason has each point's)", StabilityWarning,
+                      stacklevel=2)
     if refine:
         for e in b.events:
             if e.kind in ("period-doubling", "torus"):

@@ -177,61 +177,86 @@ def verified_tests(mu: np.ndarray, err: np.ndarray, p: float) -> dict[str, float
     return out
 
 
-def orbit_events(a: BranchPoint, b: BranchPoint, index: int, autonomous: bool = False
-                 ) -> list[Event]:
+def orbit_events(a: BranchPoint, b: BranchPoint, index: int, autonomous: bool = False,
+                 decided: dict[str, BranchPoint] | None = None) -> list[Event]:
     """The events of the orbits' multipliers and stick patterns between the points a and b
     (period doubling, torus, stick onset, grazing; the fold is the driver's); an
     ``autonomous`` branch's phase multiplier is left out of the multipliers' events: the
     verified trivial one (``BranchPoint.floquet``'s ``nontrivial()``) where a verdict is
-    there, else the multiplier nearest 1."""
+    there, else the multiplier nearest 1.
+
+    A point whose verified multipliers do not decide a kind (one of them lies within its error
+    bound of the unit circle: :func:`undecided`) is passed over for that kind: ``decided``
+    (kind -> the last point that decided it, kept by the caller along the branch, updated here)
+    then brackets the event between the last point that decided the kind and the next one, so
+    that an event whose middle point is undecided is reported between decided points, not
+    lost (an :class:`EventWarning` says so at the undecided point).  Without ``decided`` the
+    bracket is (a, b)."""
     ev: list[Event] = []
+    decided = {} if decided is None else decided
 
     def rest(q: BranchPoint) -> np.ndarray:
         if q.floquet is not None:
             return q.floquet.nontrivial()
         return phase_free(q.multipliers) if autonomous else q.multipliers
 
-    mua, mub = rest(a), rest(b)
+    def doubt(kind: str, q: BranchPoint) -> str | None:   # q's multipliers do not decide kind
+        if q.floquet is None:
+            return None
+        e = q.floquet.errors
+        if q.floquet.trivial is not None:
+            e = np.delete(e, q.floquet.trivial)
+        why = undecided(kind, rest(q), e)
+        return None if why is None else f"at p = {q.p!r}, {why}"
+
+    def real_neg(m: np.ndarray) -> np.ndarray:
+        return m[(np.abs(m.imag) <= 1e-8 * np.maximum(np.abs(m), 1)) & (m.real < 0)].real
+
+    counts = {"period-doubling": (lambda m: int(np.sum(real_neg(m) < -1)),
+                                  "real multipliers < -1"),
+              "torus": (lambda m: int(np.sum(np.abs(non_real(m)) > 1)),
+                        "complex multipliers with |mu| > 1")}
+    for kind, (count, what) in counts.items():
+        ref = decided.get(kind)
+        first = doubt(kind, a) if ref is None else None
+        if ref is None and first is None:
+            ref = a
+        base = a if ref is None else ref
+        change = f"({what}: {count(rest(base))} -> {count(rest(b))})"
+        why = doubt(kind, b)
+        if why is not None:     # b decides nothing of this kind: the bracket stays open
+            if count(rest(base)) != count(rest(b)):
+                warnings.warn(f"a {kind} between p = {base.p!r} and {b.p!r} {change} is not "
+                              f"reported there: {why}; it is sought between the points that "
+                              "decide it", EventWarning, stacklevel=3)
+            if ref is not None:
+                decided[kind] = ref
+            continue
+        decided[kind] = b
+        if ref is None:         # a, the first point, decided nothing of it
+            if count(rest(a)) != count(rest(b)):
+                warnings.warn(f"a {kind} between p = {a.p!r} and {b.p!r} {change} is not "
+                              f"reported: {first}; no earlier point decides it", EventWarning,
+                              stacklevel=3)
+            continue
+        na, nb = count(rest(ref)), count(rest(b))
+        if na == nb:
+            continue
+        fa, fb = test_function(kind, rest(ref)), test_function(kind, rest(b))
+        w = 0.5 if fa == fb or fa * fb > 0 else fa / (fa - fb)  # no sign change: the middle
+        verified = ref.floquet is not None and b.floquet is not None
+        span = "" if ref is a else (f" (bracketed by the points at p = {ref.p!r} and {b.p!r}, "
+                                    "those between deciding nothing of it)")
+        ev.append(Event(kind, ref.p + (b.p - ref.p) * w, index, None,
+                        f"{what}: {na} -> {nb}" + span +
+                        (" (verified: beyond the multipliers' error bounds on both sides)"
+                         if verified else " (not verified: the Ritz multipliers have no error "
+                         "bound; continue_orbit(verify=...) verifies them)")))
 
     def at(fa: float, fb: float) -> float:
         w = 0.5 if fa == fb or fa * fb > 0 else fa / (fa - fb)  # no sign change: the middle
         return a.p + (b.p - a.p) * w
 
-    def real_neg(m: np.ndarray) -> np.ndarray:
-        return m[(np.abs(m.imag) <= 1e-8 * np.maximum(np.abs(m), 1)) & (m.real < 0)].real
-
-
-    def doubt(kind: str) -> str | None:   # a point's multipliers that do not decide kind
-        for q, m in ((a, mua), (b, mub)):
-            if q.floquet is not None:
-                e = q.floquet.errors
-                if q.floquet.trivial is not None:
-                    e = np.delete(e, q.floquet.trivial)
-                why = undecided(kind, m, e)
-                if why is not None:
-                    return f"at p = {q.p!r}, {why}"
-        return None
-
-    found = []
-    na, nb = np.sum(real_neg(mua) < -1), np.sum(real_neg(mub) < -1)
-    if na != nb:
-        found.append(("period-doubling", f"real multipliers < -1: {na} -> {nb}"))
-    ca, cb = np.sum(np.abs(non_real(mua)) > 1), np.sum(np.abs(non_real(mub)) > 1)
-    if ca != cb:
-        found.append(("torus", f"complex multipliers with |mu| > 1: {ca} -> {cb}"))
-    for kind, detail in found:
-        why = doubt(kind)
-        if why is not None:
-            warnings.warn(f"a {kind} between p = {a.p!r} and {b.p!r} ({detail}) is not "
-                          f"reported: {why}", EventWarning, stacklevel=3)
-            continue
-        verified = a.floquet is not None and b.floquet is not None
-        fa, fb = (test_function(kind, m) for m in (mua, mub))
-        ev.append(Event(kind, at(fa, fb), index, None,
-                        detail + (" (verified: beyond the multipliers' error bounds on both "
-                                  "sides)" if verified else " (not verified: the Ritz "
-                                  "multipliers have no error bound; continue_orbit(verify=...) "
-                                  "verifies them)")))
     for i in range(len(a.stick_steps)):
         sa, sb = int(a.stick_steps[i]), int(b.stick_steps[i])
         if (sa == 0) != (sb == 0):

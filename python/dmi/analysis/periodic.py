@@ -26,7 +26,7 @@ import scipy.sparse.linalg as sla
 from .._solver import Solver
 from .branch import BranchPoint, Event, corner_sentence, thinned, travel
 from .driver import VERTICAL
-from .floquet import Verify, fd_step, floquet_verdict, phase_free, ritz
+from .floquet import Verify, fd_step, floquet_verdict, ritz
 from .newton import ShootingError, bordered_newton, bordered_step, directional, fd_eps
 from .orbit_events import locate_stick, orbit_events, stick_profile
 from .problem import AutonomousMaps, Problem, phase_row, velocity
@@ -42,7 +42,8 @@ def orbit_point(F: StepMap, x: np.ndarray, multipliers: int, sections: int, dpds
     :meth:`StepMap.trajectory_terms` when the caller has them (:func:`_correct`).  An
     ``autonomous`` orbit's ``stable`` leaves out its phase multiplier.  ``verify``: the
     multipliers and ``stable`` are :func:`floquet_verdict`'s (verified; the Ritz pairs still
-    give the Newton-Picard basis), kept in ``BranchPoint.floquet``."""
+    give the Newton-Picard basis), kept in ``BranchPoint.floquet``; None: the Ritz multipliers
+    and ``stable`` None."""
     U, X = F.trajectory_terms(x) if terms is None else terms
     mu = np.empty(0, complex)
     if multipliers > 0:
@@ -54,8 +55,7 @@ def orbit_point(F: StepMap, x: np.ndarray, multipliers: int, sections: int, dpds
             mu, Q, Z = ritz(F, x, multipliers, eps=eps)
         if warm is not None:
             warm[0] = (Q, Z)
-    rest = phase_free(mu) if autonomous else mu
-    stable = bool(np.all(np.abs(rest) < 1)) if rest.size else None
+    stable = None   # Ritz values have no error bound: no verdict from them
     fl = None
     if verify is not None and multipliers > 0:
         fl = floquet_verdict(F, x, multipliers, autonomous=autonomous, verify=verify)
@@ -464,6 +464,8 @@ class Shooting:
         self.margins, self.tol, self.max_iter = margins, tol, max_iter
         self.k = maps.k
         self.warm: list = [None]
+        # kind -> the last point whose multipliers decided it (:func:`orbit_events`)
+        self.decided: dict[str, BranchPoint] = {}
         # the last corrected z, its iterations, which corrector, and its trajectory terms
         self.last: tuple = (None, iterations, "", None)
 
@@ -555,7 +557,7 @@ class Shooting:
             return _corrector(self.maps, 0.5 * (z0 + z1), t, self.tol, self.max_iter,
                               math.inf)[0]
 
-        for e in orbit_events(a, b, 0, self.maps.autonomous):
+        for e in orbit_events(a, b, 0, self.maps.autonomous, self.decided):
             if e.kind in ("stick-onset", "grazing"):
                 e = locate_stick(a, b, e, za, zb, mid, self._profile,
                                  lambda d: math.sqrt(float(np.dot(w * d, d))))
