@@ -303,3 +303,12 @@ def test_observe_returning_nan_is_named_with_the_record_and_time():
     with pytest.raises(ValueError, match=r"records\[1\] at t = 0\.54 \(row 9\): observe\(t, u, a\) "
                                          r"returned \[nan\]"):
         estimate([make, make], [0.6, 0.9], [Record(t, y), rec])
+
+
+def test_options_of_the_wrong_kind_are_refused():
+    make = coulomb()
+    t, y = noisy(make, [0.5, 1.0], 30, 0.02, 10)
+    with pytest.raises(TypeError, match="expected a dmi.identify.FitOptions"):
+        estimate(make, [0.6, 0.9], Record(t, y), options={"max_steps": 10})
+    with pytest.raises(ValueError, match=r"chi2_alpha = 0.7: expected a probability in \(0, 0.5\)"):
+        estimate(make, [0.6, 0.9], Record(t, y), options=FitOptions(chi2_alpha=0.7))

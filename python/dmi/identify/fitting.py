@@ -719,7 +719,7 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
         problem.bounds, problem.max_steps = (lo, hi), options.max_steps
         why = (f"{', '.join(insensitive)} do{'es' if len(insensitive) == 1 else ''} not move the "
                "records at p0 (a zero column of the Jacobian): kept at p0 and not fitted, infinite "
-               "standard error; fix it yourself, or start from a p0 where it acts")
+               "standard error; fix it in make, or start from a p0 where it acts")
         warnings.warn(f"estimate: {why}", RuntimeWarning, stacklevel=2)
         if not mask.any():
             return _unmoved(problem, names, insensitive, lo, hi)
@@ -1044,7 +1044,8 @@ def _summarise(problem: _Problem, names: list, x: np.ndarray, cost: float, messa
             why = (f"the reduced chi-square {redchi:.4g} ({dof} degrees of freedom) is implausible "
                    f"for the stated sigma (chi-square probability {pvalue if big else low:.3g} "
                    f"of so {'large' if big else 'small'} a value): sigma is "
-                   f"{'understated' if big else 'overstated'} about {math.sqrt(redchi):.3g} times"
+                   f"{'understated' if big else 'overstated'} about "
+                   f"{math.sqrt(redchi) if big else 1.0 / math.sqrt(redchi):.3g} times"
                    f"{', or the model misses something' if big else ''}; the covariance "
                    + ("is scaled by it (scale_covar)" if options.scale_covar else
                       "takes sigma as stated, so the standard errors are off by that factor: "
