@@ -12,9 +12,9 @@ beside the Wald one.
 """
 from __future__ import annotations
 
-from .fitting import Estimate, Record, estimate
+from .fitting import Estimate, FitOptions, Parameter, Record, estimate
 from .profile import Profile, profile_likelihood
-from .sensitivity import Sensitivities, sensitivities
+from .sensitivity import MAX_STEPS, Sensitivities, sensitivities
 
-__all__ = ["sensitivities", "Sensitivities", "Record", "estimate", "Estimate",
-           "profile_likelihood", "Profile"]
+__all__ = ["sensitivities", "Sensitivities", "MAX_STEPS", "Record", "estimate", "Estimate",
+           "FitOptions", "Parameter", "profile_likelihood", "Profile"]

@@ -6,20 +6,84 @@ combinations the data cannot determine."""
 from __future__ import annotations
 
 import dataclasses
+import html
 import math
+import sys
+import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
 from scipy import optimize, stats
 
 from .._solver import Solver
-from .sensitivity import Sensitivities, sensitivities
+from .sensitivity import MAX_STEPS, Sensitivities, check_steps, sensitivities
 
 #: Singular values of the column-normalised Jacobian below this fraction of the largest one mark
 #: a parameter combination as not determined by the data.
 RCOND = 1e-6
+
+#: Singular values below this fraction of the largest one mark the near-null directions along
+#: which the saddle check probes the cost at the end of a fit.
+SADDLE_RCOND = 1e-3
+
+#: The relative sizes of the saddle check's probes (the largest relative change of a parameter).
+SADDLE_STEPS = (0.01, 0.1, 0.3, 1.0, 1.5, 3.0)
+
+
+@dataclasses.dataclass
+class Parameter:
+    """One parameter of a fit, given by name in a mapping ``p0 = {name: Parameter(...)}``.
+
+    Attributes
+    ----------
+    value : float
+        The starting value (the value kept, where ``fixed``).
+    fixed : bool
+        True: kept at ``value``, not fitted.
+    lower, upper : float
+        Bounds (infinite by default); ``value`` must lie within them.
+    """
+
+    value: float
+    fixed: bool = False
+    lower: float = -math.inf
+    upper: float = math.inf
+
+
+@dataclasses.dataclass
+class FitOptions:
+    """Options of :func:`estimate` about bounds on the work, the noise model and the checks at
+    the end.
+
+    Attributes
+    ----------
+    max_steps : int
+        The most steps one record's run may take (default :data:`MAX_STEPS`); a record asking
+        for more is refused before any run, with the memory its sensitivities would hold.
+    scale_covar : bool
+        True: the covariance is multiplied by the reduced chi-square where every record gives
+        sigma (as lmfit's ``scale_covar``): the stated sigma is then taken as relative only, and
+        Wald intervals use Student's t.  Without sigma the covariance is always scaled.
+    chi2_alpha : float
+        A reduced chi-square whose chi-square probability (upper tail: too large; lower tail:
+        too small) is below this is implausible for the stated sigma: a RuntimeWarning and the
+        message say so.
+    saddle_check : bool
+        True (default): at the end of a converged fit, the cost is probed along the near-null
+        directions of the Jacobian (both signs, relative steps :data:`SADDLE_STEPS`); a lower
+        cost found there is reported (``success`` False, ``Estimate.lower``).
+    progress : bool or None
+        A one-line progress display on stderr (start, iteration, cost, model runs, time); None
+        (default): shown only where stderr is a terminal.
+    """
+
+    max_steps: int = MAX_STEPS
+    scale_covar: bool = False
+    chi2_alpha: float = 1e-3
+    saddle_check: bool = True
+    progress: bool | None = None
 
 
 @dataclasses.dataclass
@@ -102,6 +166,28 @@ class Estimate:
         step at the returned point (see :attr:`Sensitivities.unplaced`): the Jacobian is off by
         O(1) from there on, so ``cov``, ``stderr`` and ``corr`` are NaN (a RuntimeWarning and
         ``message`` say so; a smaller h resolves them).  Empty otherwise.
+    chisqr : float
+        The chi-square 2 cost = sum(residuals**2).
+    redchi : float
+        The reduced chi-square chisqr / dof (NaN where dof <= 0).
+    pvalue : float
+        P(chi2_dof >= chisqr), the chi-square probability of so large a misfit where every record
+        gives sigma (NaN otherwise: without sigma there is nothing to test).  Near 0: sigma
+        understated or the model misses something; near 1: sigma overstated.
+    covar_scaled : bool
+        Whether ``cov`` was multiplied by ``redchi`` (without sigma, or with
+        ``FitOptions.scale_covar``).
+    insensitive : list of str
+        The parameters that did not move the records at p0 (a zero column of the Jacobian): kept
+        at their p0 value, not fitted, named in ``unidentifiable``, with an infinite standard
+        error.
+    lower : numpy.ndarray or None
+        A point of lower cost the saddle check found along a near-null direction (the fit then
+        stopped on a saddle: ``success`` is False); None otherwise.
+    lower_cost : float
+        Its cost (NaN where ``lower`` is None).
+    bounds : tuple of numpy.ndarray or None
+        The fit's (lower, upper) bounds of every parameter.
     """
 
     p: np.ndarray
@@ -124,7 +210,118 @@ class Estimate:
     sigma_known: bool
     starts: list
     unplaced: list = dataclasses.field(default_factory=list)
+    chisqr: float = math.nan
+    redchi: float = math.nan
+    pvalue: float = math.nan
+    covar_scaled: bool = False
+    insensitive: list = dataclasses.field(default_factory=list)
+    lower: np.ndarray | None = None
+    lower_cost: float = math.nan
+    bounds: tuple | None = None
     _problem: Any = dataclasses.field(default=None, repr=False)
+
+    def _rows(self) -> list[tuple[str, str, str, str, str]]:
+        """(name, value, stderr, relative error, status) of each parameter, as text."""
+        rows = []
+        for j, name in enumerate(self.names):
+            value, se = float(self.p[j]), float(self.stderr[j])
+            if name in self.insensitive:
+                status = "fixed (no effect at p0)"
+            elif not self.free[j]:
+                status = "fixed"
+            else:
+                status = "free"
+                if self.bounds is not None:
+                    lo, hi = float(self.bounds[0][j]), float(self.bounds[1][j])
+                    if lo > -math.inf or hi < math.inf:
+                        status += f" in [{lo:.6g}, {hi:.6g}]"
+                        if value in (lo, hi):
+                            status += " (at a bound)"
+            if not self.free[j] and name not in self.insensitive:
+                err = rel = "-"
+            else:
+                err = f"{se:.6g}"
+                rel = f"{100 * se / abs(value):.3g} %" if value != 0 and math.isfinite(se) else "-"
+            rows.append((name, f"{value:.10g}", err, rel, status))
+        return rows
+
+    def _correlations(self, threshold: float) -> list[tuple[str, str, float]]:
+        """(name, name, corr) of the fitted pairs with |corr| >= threshold, largest first."""
+        out = []
+        idx = np.flatnonzero(self.free)
+        for a in range(len(idx)):
+            for b in range(a + 1, len(idx)):
+                c = float(self.corr[idx[a], idx[b]])
+                if math.isfinite(c) and abs(c) >= threshold:
+                    out.append((self.names[idx[a]], self.names[idx[b]], c))
+        return sorted(out, key=lambda x: -abs(x[2]))
+
+    def _statistics(self) -> list[tuple[str, str]]:
+        M, F = self.jacobian.shape
+        return [("data points", str(M)), ("free parameters", str(F)), ("dof", str(self.dof)),
+                ("chi-square", f"{self.chisqr:.6g}"), ("reduced chi-square", f"{self.redchi:.6g}"),
+                ("p-value", f"{self.pvalue:.4g}" if self.sigma_known else
+                 "- (no sigma given: not tested)"),
+                ("covariance scaled by reduced chi-square", "yes" if self.covar_scaled else "no"),
+                ("AIC", f"{self.aic:.6g}"), ("BIC", f"{self.bic:.6g}"),
+                ("success", str(self.success)), ("model runs, iterations", f"{self.nfev}, {self.njev}")]
+
+    def _notes(self) -> list[str]:
+        notes = [f"message: {self.message}"]
+        if self.unidentifiable:
+            notes.append("undetermined combinations: " + "; ".join(self.unidentifiable))
+        if self.insensitive:
+            notes.append("no effect on the records at p0 (kept there): " + ", ".join(self.insensitive))
+        if self.unplaced:
+            notes.append("unplaced switches (record, step): "
+                         + ", ".join(f"({k}, {q})" for k, q in self.unplaced))
+        if self.lower is not None:
+            notes.append(f"lower cost {self.lower_cost:.10g} at p = {np.array2string(self.lower)}")
+        return notes
+
+    def report(self, min_correl: float = 0.1) -> str:
+        """A text report of the fit: each parameter's value, standard error and status (free,
+        with its bounds, or fixed), the correlations of at least ``min_correl`` in magnitude,
+        chi-square, reduced chi-square and its p-value, AIC and BIC, the message, the
+        undetermined combinations, the parameters without effect and the unplaced switches.
+
+        Parameters
+        ----------
+        min_correl : float, optional
+            The least |correlation| listed.
+
+        Returns
+        -------
+        str
+            The report.
+        """
+        lines = ["[[Fit statistics]]"]
+        lines += [f"    {k:<40s} {v}" for k, v in self._statistics()]
+        lines.append("[[Parameters]]")
+        width = max(len(n) for n in self.names)
+        for name, value, err, rel, status in self._rows():
+            lines.append(f"    {name:<{width}s}  {value:>17s} +/- {err:<12s} ({rel:>9s})  {status}")
+        lines.append(f"[[Correlations]] (|corr| >= {min_correl:g})")
+        pairs = self._correlations(min_correl)
+        lines += [f"    C({a}, {b}) = {c:+.4f}" for a, b, c in pairs] or ["    none"]
+        lines.append("[[Notes]]")
+        lines += [f"    {x}" for x in self._notes()]
+        return "\n".join(lines)
+
+    def _repr_html_(self) -> str:
+        """The report as HTML tables (for notebooks)."""
+        e = html.escape
+        stats_rows = "".join(f"<tr><td>{e(k)}</td><td>{e(v)}</td></tr>" for k, v in self._statistics())
+        par_rows = "".join("<tr>" + "".join(f"<td>{e(x)}</td>" for x in row) + "</tr>"
+                           for row in self._rows())
+        corr_rows = "".join(f"<tr><td>{e(a)}</td><td>{e(b)}</td><td>{c:+.4f}</td></tr>"
+                            for a, b, c in self._correlations(0.1))
+        notes = "".join(f"<li>{e(x)}</li>" for x in self._notes())
+        return ("<h4>Fit statistics</h4><table>" + stats_rows + "</table>"
+                "<h4>Parameters</h4><table><tr><th>name</th><th>value</th><th>standard error</th>"
+                "<th>relative error</th><th>status</th></tr>" + par_rows + "</table>"
+                "<h4>Correlations (|corr| &ge; 0.1)</h4><table><tr><th></th><th></th><th>corr</th></tr>"
+                + corr_rows + "</table><h4>Notes</h4><ul>" + notes + "</ul>")
 
     def wald_interval(self, index: int | str, level: float = 0.95) -> tuple[float, float]:
         """The Wald (covariance) interval of one parameter.
@@ -155,7 +352,7 @@ class Estimate:
             warnings.warn(f"the fit did not converge ({self.message}): this Wald interval is taken at "
                           "a point that is not a verified least-squares minimum", RuntimeWarning,
                           stacklevel=2)
-        q = _quantile(level, self.dof, self.sigma_known)
+        q = _quantile(level, self.dof, self.sigma_known and not self.covar_scaled)
         return self.p[i] - q * self.stderr[i], self.p[i] + q * self.stderr[i]
 
 
@@ -263,6 +460,7 @@ class _Problem:
         self.bounds = (np.full(len(p0), -np.inf), np.full(len(p0), np.inf))
         self.best: tuple[float, np.ndarray] | None = None
         self.unplaced: list = []        # (record, step) of the last Jacobian's unplaced reversals
+        self.max_steps: int | None = None
         self._cache: tuple[bytes, np.ndarray, np.ndarray] | None = None
 
     def full(self, x: np.ndarray) -> np.ndarray:
@@ -303,14 +501,19 @@ class _Problem:
                 der[m, :, j] = (np.asarray(up, dtype=float).reshape(-1) - val[m]) / eps
         return val, der
 
-    def residuals(self, x: np.ndarray) -> np.ndarray:
+    def residuals(self, x: np.ndarray, check: bool = False) -> np.ndarray:
+        """The weighted residuals at the free parameters x; with ``check``, a ValueError naming
+        the record, the time and the culprit (the run's state or ``observe``) where one is not
+        finite."""
         p = self.full(x)
         out = []
-        for make, d in zip(self.makes, self.data):
+        for k, (make, d) in enumerate(zip(self.makes, self.data)):
             s = make(p.copy())
             s.init()
             t_grid, U, X = s.run_terms(self._steps(s, d))
             val, _ = self._predict(d, t_grid, s.h, U, X, None, None)
+            if check and not np.all(np.isfinite(val)):
+                self._not_finite(k, d, p, t_grid, s.h, U, X, val)
             out.append(((val - d.y) * d.w).ravel())
         r = np.concatenate(out)
         self.nfev += 1
@@ -318,6 +521,23 @@ class _Problem:
         if np.isfinite(cost) and (self.best is None or cost < self.best[0]):
             self.best = (cost, x.copy())
         return r
+
+    def _not_finite(self, k: int, d: _Data, p: np.ndarray, t_grid: np.ndarray, h: float,
+                    U: np.ndarray, X: np.ndarray, val: np.ndarray) -> None:
+        """ValueError for the first value of record k that is not finite, naming its cause."""
+        m = int(np.argwhere(~np.all(np.isfinite(val), axis=1))[0, 0])
+        where = f"records[{k}] at t = {d.t[m]:.10g} (row {m})"
+        ui = _interp(t_grid, h, d.t[m:m + 1], U)[0]
+        if not np.all(np.isfinite(ui)):
+            raise ValueError(f"the model's state is not finite for {where}, at p = {p.tolist()}: "
+                             "the run diverges before the record ends; start from other parameters "
+                             "or a smaller h")
+        if d.observe is not None:
+            ai = _interp(t_grid, h, d.t[m:m + 1], _forces(U, X, h))[0]
+            raise ValueError(f"{where}: observe(t, u, a) returned {val[m].tolist()} (not finite) for "
+                             f"u = {ui.tolist()}, a = {ai.tolist()}, at p = {p.tolist()}; observe "
+                             "must return finite numbers wherever the run goes")
+        raise ValueError(f"the model's values are not finite for {where}, at p = {p.tolist()}")
 
     def jacobian(self, x: np.ndarray) -> np.ndarray:
         key = x.tobytes() + bytes([self.jumps])
@@ -342,7 +562,7 @@ class _Problem:
                 warnings.filterwarnings("ignore", "sensitivities: .* could not be placed",
                                         RuntimeWarning)
                 sens: Sensitivities = sensitivities(make_free, p[idx], self._steps(s0, d), rhs=rhs,
-                                                     jumps=self.jumps)
+                                                     jumps=self.jumps, max_steps=self.max_steps)
             unplaced += [(k, q) for q in sens.unplaced]
             val, der = self._predict(d, sens.t, sens.h, sens.u, sens.x, sens.S, sens.dx)
             res.append(((val - d.y) * d.w).ravel())
@@ -362,7 +582,8 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
              loss: str = "linear", multistart: int | Sequence[Any] | None = None, seed: int = 0,
              max_nfev: int | None = None, callback: Callable[[dict], Any] | None = None,
              verbose: bool = False, polish: bool = True,
-             rhs: Callable[[float, np.ndarray, np.ndarray], np.ndarray] | None = None) -> Estimate:
+             rhs: Callable[[float, np.ndarray, np.ndarray], np.ndarray] | None = None,
+             options: FitOptions | None = None) -> Estimate:
     """Fits the parameters of ``make(p) -> dmi.Solver`` to measured records by SciPy's
     trust-region ``least_squares`` with the Jacobian of :func:`sensitivities`.
 
@@ -372,8 +593,10 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
         ``make(p) -> dmi.Solver`` for the full parameter vector p; a sequence: one model per record
         (several experiments: each takes the full p and uses its shared and its own parameters,
         e.g. its own initial condition through the history).
-    p0 : array_like, shape (P,)
-        The starting point (and the values of the fixed parameters).
+    p0 : array_like, shape (P,), or mapping
+        The starting point (and the values of the fixed parameters); or a mapping
+        ``{name: value or Parameter}`` giving the names, and per parameter whether it is fixed
+        and its bounds (``names``, ``free`` and ``bounds`` are then not given).
     records : Record or sequence of Record
         The measurements; times from t = 0, the start of the model's run.
     names : sequence of str, optional
@@ -411,6 +634,9 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
     rhs : callable, optional
         ``rhs(t, u, p)``: f as a Python function of complex u and the full p, for complex-step
         derivatives (see :func:`sensitivities`).
+    options : FitOptions, optional
+        The bound on a record's steps, the noise-model check and covariance scaling, the saddle
+        check at the end and the progress display (see :class:`FitOptions`).
 
     Returns
     -------
@@ -422,11 +648,28 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
     ValueError
         Records of the wrong shape, NaN in the data, times before 0, sigma not positive, p0 not
         finite or of another length than names, bounds that exclude p0, no free parameter, make
-        raising at p0, or a parameter that changes the model's structure (see
+        raising at p0, a record asking for more steps than ``FitOptions.max_steps`` (before any
+        run), residuals not finite at the start (naming the record, the time, and ``observe``
+        where it returned them), or a parameter that changes the model's structure (see
         :func:`sensitivities`).
+
+    Warns
+    -----
+    RuntimeWarning
+        Parameters without effect on the records at p0 (kept there, named); a reduced
+        chi-square implausible for the stated sigma; a lower cost found along a near-null
+        direction at the end (a saddle); reversals the sensitivities could not place.
     TypeError
         A record that is not a :class:`Record`, or make not returning a dmi.Solver.
     """
+    options = FitOptions() if options is None else options
+    if not isinstance(options, FitOptions):
+        raise TypeError(f"options is a {type(options).__name__}; expected a dmi.identify.FitOptions")
+    if not 0.0 < options.chi2_alpha < 0.5:
+        raise ValueError(f"FitOptions.chi2_alpha = {options.chi2_alpha!r}: expected a probability "
+                         "in (0, 0.5)")
+    if isinstance(p0, Mapping):
+        p0, names, free, bounds = _from_parameters(p0, names, free, bounds)
     p0 = np.array(p0, dtype=float).reshape(-1)
     P = len(p0)
     if P == 0 or not np.all(np.isfinite(p0)):
@@ -458,20 +701,210 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
             raise ValueError(f"make(p0) for records[{k}] raised {type(e).__name__}: {e}") from e
         if not isinstance(s, Solver):
             raise TypeError(f"make(p0) returned {type(s).__name__}; expected a dmi.Solver")
-        data.append(_check_record(r, k, s.n))
+        d = _check_record(r, k, s.n)
+        steps = max(1, math.ceil(d.t[-1] / s.h - 1e-9))
+        check_steps(steps, s.n, s.N, int(mask.sum()), s.h, options.max_steps,
+                    f"records[{k}] (t up to {float(d.t[-1]):.6g})")
+        data.append(d)
     problem = _Problem(makes, p0, mask, data, rhs)
     problem.bounds = (lo, hi)
+    problem.max_steps = options.max_steps
     starts = _starts(multistart, p0, lo, hi, seed)
+    # the parameters that do not move the records at p0: kept there and named, before a fit
+    # could walk the others anywhere to make up for them
+    insensitive = _insensitive(problem, names)
+    if insensitive:
+        mask = mask & ~np.isin(names, insensitive)
+        problem = _Problem(makes, p0, mask, data, rhs)
+        problem.bounds, problem.max_steps = (lo, hi), options.max_steps
+        why = (f"{', '.join(insensitive)} do{'es' if len(insensitive) == 1 else ''} not move the "
+               "records at p0 (a zero column of the Jacobian): kept at p0 and not fitted, infinite "
+               "standard error; fix it in make, or start from a p0 where it acts")
+        warnings.warn(f"estimate: {why}", RuntimeWarning, stacklevel=2)
+        if not mask.any():
+            return _unmoved(problem, names, insensitive, lo, hi)
+    show = sys.stderr.isatty() if options.progress is None else bool(options.progress)
+    clock = time.monotonic()
     fits = []
-    for x_start in starts:
+    for number, x_start in enumerate(starts):
+        def display(iteration: int, cost: float, _number: int = number) -> None:
+            sys.stderr.write(f"\restimate: start {_number + 1}/{len(starts)}, iteration {iteration}, "
+                             f"cost {cost:.8g}, {problem.nfev} runs, "
+                             f"{time.monotonic() - clock:.1f} s   ")
+            sys.stderr.flush()
         fits.append(_fit(problem, x_start, lo, hi, x_scale, loss, max_nfev, callback, verbose,
-                         polish))
+                         polish, display if show else None))
         if fits[-1][3]:                                   # stopped by the user: no more starts
             break
+    if show:
+        sys.stderr.write("\n")
     best = min(fits, key=lambda f: f[1])
-    est = _summarise(problem, names, *best)
+    x, cost, message, stopped, converged = best
+    lower = None
+    if converged and not stopped and options.saddle_check:
+        lower = _saddle(problem, x, cost, names)
+    est = _summarise(problem, names, x, cost, message, stopped, converged, options, insensitive)
     est.starts = [(s.copy(), f[1]) for s, f in zip(starts, fits)]
+    est.bounds = (lo.copy(), hi.copy())
+    if lower is not None:
+        est.lower, est.lower_cost = problem.full(lower[0]), lower[1]
+        why = (f"the cost falls from {cost:.10g} to {lower[1]:.10g} along a near-null direction of "
+               f"the Jacobian ({lower[2]}): the fit stopped on a saddle, not a minimum; refit from "
+               "Estimate.lower (or with multistart)")
+        est.success = False
+        est.message = f"{est.message}; {why}"
+        warnings.warn(f"estimate: {why}", RuntimeWarning, stacklevel=2)
     return est
+
+
+def _from_parameters(params: Mapping, names: Any, free: Any, bounds: Any
+                     ) -> tuple[np.ndarray, list, np.ndarray, tuple]:
+    """p0, names, the free mask and the bounds from ``{name: value or Parameter}``."""
+    if names is not None or free is not None or bounds is not None:
+        raise ValueError("p0 is a mapping of Parameters: give names, fixed flags and bounds there, "
+                         "not also as names=, free= or bounds=")
+    values, lo, hi, mask = [], [], [], []
+    for name, v in params.items():
+        q = v if isinstance(v, Parameter) else Parameter(float(v))
+        values.append(float(q.value))
+        lo.append(float(q.lower))
+        hi.append(float(q.upper))
+        mask.append(not q.fixed)
+    return np.array(values), [str(n) for n in params], np.array(mask, bool), (lo, hi)
+
+
+def _insensitive(problem: _Problem, names: list) -> list:
+    """The free parameters whose column of the Jacobian at p0 is zero (or below 1e-13 of the
+    largest, each scaled by |p_j|)."""
+    x0 = problem.p0[problem.free]
+    J = problem.jacobian(x0)
+    d = np.where(x0 != 0.0, np.abs(x0), 1.0)
+    norms = np.linalg.norm(J, axis=0) * d
+    top = norms.max() if norms.size else 0.0
+    idx = np.flatnonzero(problem.free)
+    return [names[idx[j]] for j in range(len(idx)) if norms[j] == 0.0 or norms[j] <= 1e-13 * top]
+
+
+def _unmoved(problem: _Problem, names: list, insensitive: list, lo: np.ndarray,
+             hi: np.ndarray) -> Estimate:
+    """The Estimate at p0 where no parameter moves the records: success False, all named."""
+    p = problem.p0.copy()
+    r = problem.residuals(np.empty(0), check=True)
+    cost = 0.5 * float(r @ r)
+    P, M = len(p), len(r)
+    cov = np.zeros((P, P))
+    stderr = np.zeros(P)
+    for name in insensitive:
+        j = names.index(name)
+        cov[j, j] = stderr[j] = np.inf
+    known = all(d.sigma_known for d in problem.data)
+    chisqr = 2.0 * cost
+    message = (f"the fit cannot decrease the cost: no free parameter moves the records at p0 "
+               f"({', '.join(insensitive)}); last cost {cost:.10g}")
+    return Estimate(p=p, names=list(names), free=problem.free.copy(), cov=cov, stderr=stderr,
+                    corr=np.full((P, P), np.nan), residuals=r, jacobian=np.zeros((M, 0)), cost=cost,
+                    aic=math.nan, bic=math.nan, success=False, message=message,
+                    unidentifiable=[f"1.00*{n}" for n in insensitive], nfev=problem.nfev,
+                    njev=problem.njev, dof=M, sigma_known=known, starts=[], chisqr=chisqr,
+                    redchi=chisqr / M, pvalue=float(stats.chi2.sf(chisqr, M)) if known else math.nan,
+                    covar_scaled=not known, insensitive=list(insensitive),
+                    bounds=(lo.copy(), hi.copy()), _problem=problem)
+
+
+def _saddle(problem: _Problem, x: np.ndarray, cost: float, names: list
+            ) -> tuple[np.ndarray, float, str] | None:
+    """A point of lower cost than the fit's along the near-null directions of the Jacobian at x
+    (:func:`_probe`), walking one level on along the directions where the cost stays flat (a
+    valley of equal cost may lead to a saddle); None where none is found.  Ctrl-C ends the
+    probes (None)."""
+    zero_cost = 0.5 * sum(float(np.sum((dd.y * dd.w) ** 2)) for dd in problem.data)
+    tol = 1e-6 * cost + 1e-14 * zero_cost        # rounding of the cost
+    try:
+        return _probe(problem, x, cost, names, tol, walk=True)
+    except KeyboardInterrupt:
+        return None
+
+
+def _probe(problem: _Problem, x: np.ndarray, cost: float, names: list, tol: float, walk: bool
+           ) -> tuple[np.ndarray, float, str] | None:
+    """The near-null directions of the Jacobian at x (singular values below SADDLE_RCOND of the
+    largest, columns scaled by |x| and normalised; at most 3), the cost's Hessian in their
+    subspace by central differences, and each of its eigenvectors probed in both signs at the
+    relative steps SADDLE_STEPS within the bounds: the first point whose cost is below ``cost``
+    by more than ``tol``, as (y, cost, the step), else None.  With ``walk``, a probe point of
+    the same cost (to ``tol``) along a null direction, at a relative step of 0.3 or more, is
+    probed the same way (without walking on)."""
+    J = problem.jacobian(x)
+    F = J.shape[1]
+    if F == 0:
+        return None
+    d = np.where(x != 0.0, np.abs(x), 1.0)
+    norms = np.linalg.norm(J * d, axis=0)
+    safe = np.where(norms > 0, norms, 1.0)
+    _, sv, Vt = np.linalg.svd(J * d / safe, full_matrices=True)
+    sv = np.concatenate([sv, np.zeros(F - len(sv))])
+    top = sv.max() if sv.size and sv.max() > 0 else 1.0
+    near = np.flatnonzero(sv <= SADDLE_RCOND * top)[:3]
+    if len(near) == 0:
+        return None
+    # the subspace in relative changes of the parameters, each direction's largest change 1
+    U = (Vt[near] / safe).T                                       # (F, k)
+    U = U / np.abs(U).max(axis=0)
+    lo, hi = (b[problem.free] for b in problem.bounds)
+
+    def at(z: np.ndarray) -> tuple[float, np.ndarray]:
+        """The point x + d (U z) and its cost (inf outside the bounds or where make refuses)."""
+        y = x + d * (U @ z)
+        if np.any((y < lo) | (y > hi)):
+            return math.inf, y
+        try:
+            ry = problem.residuals(y)
+        except Exception:
+            return math.inf, y
+        c = 0.5 * float(ry @ ry)
+        return (c if np.isfinite(c) else math.inf), y
+
+    def found(c: float, y: np.ndarray) -> tuple[np.ndarray, float, str]:
+        moved = ", ".join(f"{names[j]} {v:+.4g}" for j, v in zip(np.flatnonzero(problem.free), y - x)
+                          if abs(v) >= 0.05 * np.abs(y - x).max())
+        return y.copy(), c, moved
+
+    k = len(near)
+    eps = 1e-2
+    e = np.eye(k) * eps
+    H = np.zeros((k, k))
+    for i in range(k):
+        for z in (e[i], -e[i]):
+            c, y = at(z)
+            if c < cost - tol:
+                return found(c, y)
+            H[i, i] += c / eps ** 2
+        H[i, i] -= 2.0 * cost / eps ** 2
+        for j in range(i):
+            corners = [at(z) for z in (e[i] + e[j], e[i] - e[j], e[j] - e[i], -e[i] - e[j])]
+            for c, y in corners:
+                if c < cost - tol:
+                    return found(c, y)
+            H[i, j] = H[j, i] = (corners[0][0] - corners[1][0] - corners[2][0]
+                                 + corners[3][0]) / (4.0 * eps ** 2)
+    # the Hessian's eigenvectors (a negative curvature: a saddle), then the null directions
+    # themselves, walked on where the cost stays flat
+    directions = [(z, False) for z in (np.linalg.eigh(H)[1].T if np.all(np.isfinite(H)) else [])]
+    directions += [(z, walk) for z in np.eye(k)]
+    for z, walking in directions:
+        z = z / np.abs(U @ z).max()
+        for sign in (1.0, -1.0):
+            for step in SADDLE_STEPS:
+                c, y = at(sign * step * z)
+                if c < cost - tol:
+                    return found(c, y)
+                if not math.isfinite(c):
+                    break
+                if walking and step >= 0.3 and abs(c - cost) <= tol:
+                    deeper = _probe(problem, y, cost, names, tol, walk=False)
+                    if deeper is not None:
+                        return deeper[0], deeper[1], found(deeper[1], deeper[0])[2]
+    return None
 
 
 def _free_mask(free: Any, names: list) -> np.ndarray:
@@ -528,7 +961,8 @@ def _starts(multistart: Any, p0: np.ndarray, lo: np.ndarray, hi: np.ndarray, see
 
 
 def _fit(problem: _Problem, start: np.ndarray, lo: np.ndarray, hi: np.ndarray, x_scale: Any,
-         loss: str, max_nfev: int | None, callback: Callable | None, verbose: bool, polish: bool
+         loss: str, max_nfev: int | None, callback: Callable | None, verbose: bool, polish: bool,
+         display: Callable[[int, float], None] | None = None
          ) -> tuple[np.ndarray, float, str, bool, bool]:
     """One least_squares run: (x, cost, message, stopped, converged)."""
     free = problem.free
@@ -541,12 +975,14 @@ def _fit(problem: _Problem, start: np.ndarray, lo: np.ndarray, hi: np.ndarray, x
         cost = float(intermediate_result.cost)
         if verbose:
             print(f"iteration {iteration[0]}: cost {cost:.10g}")
+        if display is not None:
+            display(iteration[0], cost)
         if callback is not None and callback({"iteration": iteration[0], "cost": cost,
                                               "p": problem.full(intermediate_result.x)}):
             raise StopIteration
     xs = x_scale if isinstance(x_scale, str) else np.broadcast_to(np.asarray(x_scale, float),
                                                                   (free.sum(),))
-    r0 = problem.residuals(x0)
+    r0 = problem.residuals(x0, check=True)
     cost0 = 0.5 * float(r0 @ r0)
     def solve(x_start: np.ndarray, jumps: bool, tol: float) -> Any:
         problem.jumps = jumps
@@ -585,7 +1021,9 @@ def _fit(problem: _Problem, start: np.ndarray, lo: np.ndarray, hi: np.ndarray, x
 
 
 def _summarise(problem: _Problem, names: list, x: np.ndarray, cost: float, message: str,
-               stopped: bool, converged: bool) -> Estimate:
+               stopped: bool, converged: bool, options: FitOptions | None = None,
+               insensitive: Sequence[str] = ()) -> Estimate:
+    options = FitOptions() if options is None else options
     free = problem.free
     p = problem.full(x)
     J = problem.jacobian(x)
@@ -594,7 +1032,26 @@ def _summarise(problem: _Problem, names: list, x: np.ndarray, cost: float, messa
     P = len(p)
     dof = M - F
     known = all(d.sigma_known for d in problem.data)
-    s2 = 1.0 if known else (2.0 * cost / dof if dof > 0 else np.inf)
+    chisqr = 2.0 * cost
+    redchi = chisqr / dof if dof > 0 else math.nan
+    pvalue = float(stats.chi2.sf(chisqr, dof)) if known and dof > 0 else math.nan
+    scaled = not known or options.scale_covar
+    s2 = (redchi if dof > 0 else np.inf) if scaled else 1.0
+    if known and dof > 0 and not stopped:
+        low = float(stats.chi2.cdf(chisqr, dof))
+        if pvalue < options.chi2_alpha or low < options.chi2_alpha:
+            big = pvalue < options.chi2_alpha
+            why = (f"the reduced chi-square {redchi:.4g} ({dof} degrees of freedom) is implausible "
+                   f"for the stated sigma (chi-square probability {pvalue if big else low:.3g} "
+                   f"of so {'large' if big else 'small'} a value): sigma is "
+                   f"{'understated' if big else 'overstated'} about "
+                   f"{math.sqrt(redchi) if big else 1.0 / math.sqrt(redchi):.3g} times"
+                   f"{', or the model misses something' if big else ''}; the covariance "
+                   + ("is scaled by it (scale_covar)" if options.scale_covar else
+                      "takes sigma as stated, so the standard errors are off by that factor: "
+                      "FitOptions(scale_covar=True) scales them by the reduced chi-square"))
+            message = f"{message}; {why}"
+            warnings.warn(f"estimate: {why}", RuntimeWarning, stacklevel=3)
     covf, bad, combos = _covariance(J, x, [names[j] for j in np.flatnonzero(free)])
     cov = np.zeros((P, P))
     idx = np.flatnonzero(free)
@@ -603,6 +1060,13 @@ def _summarise(problem: _Problem, names: list, x: np.ndarray, cost: float, messa
     for b in bad:
         cov[idx[b], idx[b]] = np.inf
         stderr[idx[b]] = np.inf
+    for name in insensitive:
+        j = names.index(name)
+        cov[j, j] = stderr[j] = np.inf
+    combos = [f"1.00*{name}" for name in insensitive] + combos
+    if insensitive:
+        message = (f"{message}; not fitted, as they do not move the records at p0: "
+                   f"{', '.join(insensitive)}")
     with np.errstate(invalid="ignore", divide="ignore"):
         outer = np.outer(stderr, stderr)
         corr = cov / outer
@@ -629,7 +1093,8 @@ def _summarise(problem: _Problem, names: list, x: np.ndarray, cost: float, messa
                     residuals=r, jacobian=J, cost=cost, aic=aic, bic=bic,
                     success=converged and not stopped, message=message, unidentifiable=combos,
                     nfev=problem.nfev, njev=problem.njev, dof=dof, sigma_known=known, starts=[],
-                    unplaced=list(problem.unplaced), _problem=problem)
+                    unplaced=list(problem.unplaced), chisqr=chisqr, redchi=redchi, pvalue=pvalue,
+                    covar_scaled=scaled, insensitive=list(insensitive), _problem=problem)
 
 
 def _covariance(J: np.ndarray, x: np.ndarray, names: list) -> tuple[np.ndarray, list, list]:

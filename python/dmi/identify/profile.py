@@ -29,8 +29,8 @@ class Profile:
     p : numpy.ndarray, shape (k, P)
         The refitted parameters there.
     threshold : float
-        The cost increase that bounds the interval: chi2(level, 1) / 2 with sigma known, else
-        cost * F(level; 1, dof) / dof.
+        The cost increase that bounds the interval: chi2(level, 1) / 2 with sigma known (and the
+        covariance not scaled), else cost * F(level; 1, dof) / dof.
     interval : tuple of float
         The likelihood-ratio interval (low, high); an end the profile did not reach within
         ``max_steps`` or within the fit's bounds, or reached only through a refit that did not
@@ -102,7 +102,7 @@ def profile_likelihood(estimate: Estimate, index: int | str, *, level: float = 0
         raise ValueError(f"level = {level!r}: expected a number in (0, 1)")
     base: _Problem = estimate._problem
     p_hat, c_hat = estimate.p.copy(), estimate.cost
-    if estimate.sigma_known:
+    if estimate.sigma_known and not estimate.covar_scaled:
         thr = float(stats.chi2.ppf(level, 1)) / 2.0
     else:
         thr = c_hat * float(stats.f.ppf(level, 1, max(estimate.dof, 1))) / max(estimate.dof, 1)
@@ -168,9 +168,13 @@ def profile_likelihood(estimate: Estimate, index: int | str, *, level: float = 0
         warnings.warn(message, RuntimeWarning, stacklevel=2)
     elif quadratic:
         message = "the likelihood-ratio and Wald intervals agree: the cost is close to quadratic"
+    elif not any(np.isfinite(ends)):
+        message = (f"the profile stays below the threshold within {max_steps} steps (or the bounds) "
+                   "on both sides: the data bound the parameter neither below nor above")
     elif not all(np.isfinite(ends)):
-        message = (f"the profile stays below the threshold within {max_steps} steps on one side: "
-                   "the parameter is not bounded there by the data")
+        side = "below" if not np.isfinite(ends[0]) else "above"
+        message = (f"the profile stays below the threshold within {max_steps} steps (or the bounds) "
+                   f"on one side: the data do not bound the parameter {side}")
     else:
         message = ("the likelihood-ratio interval differs from the Wald interval: the cost is not "
                    "quadratic there; trust the likelihood-ratio interval")

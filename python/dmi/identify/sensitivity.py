@@ -31,6 +31,34 @@ from ._saltation import REVERSAL, STICK, UNPLACED, reversal
 #: Relative step of the directional differences (about the square root of the unit roundoff).
 REL_STEP = 2.0 ** -26
 
+#: Default bound on the steps of one run that :func:`sensitivities` (and so each record of
+#: :func:`estimate`) accepts; more is refused up front with the memory it would take, unless an
+#: explicit ``max_steps`` allows it.
+MAX_STEPS = 2_000_000
+
+
+def memory_bytes(steps: int, n: int, N: int, P: int) -> int:
+    """About the memory a run of ``steps`` steps with its sensitivities holds (bytes): S of the
+    history and the steps and dX/dp (n P numbers a step each), the states U and X, and the
+    kernel's part of the tangent (n P a step)."""
+    return 8 * ((N + steps + 1) * n * P + 2 * steps * n * P + 2 * (steps + 1) * n)
+
+
+def check_steps(steps: int, n: int, N: int, P: int, h: float, max_steps: int | None,
+                where: str) -> None:
+    """ValueError, before any run, where ``steps`` exceeds the bound (MAX_STEPS unless
+    ``max_steps`` is given), saying how much memory the run would hold."""
+    bound = MAX_STEPS if max_steps is None else max_steps
+    if not isinstance(bound, (int, np.integer)) or isinstance(bound, bool) or bound < 1:
+        raise ValueError(f"max_steps = {max_steps!r}: expected an integer >= 1")
+    if steps > bound:
+        gib = memory_bytes(steps, n, N, P) / 2.0 ** 30
+        raise ValueError(f"{where} asks for {steps} steps of h = {h:.6g} (up to t = {steps * h:.6g}), "
+                         f"more than max_steps = {bound}{' (the default)' if max_steps is None else ''}; "
+                         f"its run with the sensitivities in {P} parameter(s) would hold about "
+                         f"{gib:.3g} GiB, and a fit runs it once per iteration.  Shorten the record, take "
+                         "a larger h, or pass a larger max_steps if the memory and the time are there")
+
 
 @dataclasses.dataclass
 class Sensitivities:
@@ -322,7 +350,8 @@ class _Memory:
 
 def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
                   rhs: Callable[[float, np.ndarray, np.ndarray], np.ndarray] | None = None,
-                  jumps: bool = True, engine: str = "auto") -> Sensitivities:
+                  jumps: bool = True, engine: str = "auto", max_steps: int | None = None
+                  ) -> Sensitivities:
     """The states U^p and their sensitivities dU^p/dp of the model ``make(p)`` over ``steps``
     steps from t = 0.
 
@@ -354,6 +383,9 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
         cfunc, a ctypes function) or no f, A zero, friction or a box, no ``rhs``): an error
         where it does not apply; ``"python"``: one step at a time in Python, calling f through
         :meth:`dmi.Solver.eval_rhs`.  Both give the same S to rounding.
+    max_steps : int, optional
+        The most steps accepted (default :data:`MAX_STEPS`, 2 000 000); more is refused before
+        any run, with the memory it would take (:func:`memory_bytes`).
 
     Returns
     -------
@@ -364,9 +396,9 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     ------
     ValueError
         p not a finite vector, steps < 1, make raising at p or near it, a parameter changing the
-        model's structure, a near kernel, a callback kernel under the cell rule, ``rhs``
-        disagreeing with the solver's f, an unknown ``engine``, or ``engine="compiled"`` where
-        it does not apply (the message says why).
+        model's structure, more steps than ``max_steps``, a near kernel, a callback kernel under
+        the cell rule, ``rhs`` disagreeing with the solver's f, an unknown ``engine``, or
+        ``engine="compiled"`` where it does not apply (the message says why).
     TypeError
         make not returning a dmi.Solver.
     """
@@ -380,6 +412,7 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     mod = _build(make, p)
     s = mod.base
     n, N, h, P = s.n, s.N, s.h, len(p)
+    check_steps(steps, n, N, P, h, max_steps, "sensitivities")
     s.init()
     window = s.get_window()                                          # U^{-N}, ..., U^0
     t, U, X = s.run_terms(steps)
