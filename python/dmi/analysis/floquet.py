@@ -457,8 +457,10 @@ def _verdict(F: StepMap, x: np.ndarray, mu: np.ndarray, V: np.ndarray, err: np.n
         return False, f"unstable: {what} grows by {rate:.6g} a period ({reason})", rate
     if decisive and g < 0 and converged and not unver and lead is not None:
         return True, f"stable: {what} decays by {rate:.6g} a period ({reason})", rate
-    return None, (f"undecided: {reason}; {what} changes by {rate:.6g} a period, not "
-                  "decisively (Verify.periods, Verify.kick)"), rate
+    change = (f"changes by {rate:.6g} a period, not decisively" if math.isfinite(rate) else
+              "stays between its floor and a tenth of the orbit's range for fewer than 5 "
+              "periods, too few to fit a rate")
+    return None, (f"undecided: {reason}; {what} {change} (Verify.periods, Verify.kick)"), rate
 
 
 def floquet_verdict(F: StepMap, x: np.ndarray, count: int = 10, *, autonomous: bool = False,
