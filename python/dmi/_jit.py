@@ -561,17 +561,20 @@ class JitBound(Bound):
         self.snapshot(names, values, f"set_{kind.name}")
 
     def snapshot(self, names: list[str], values: list[Any], when: str) -> None:
-        """Remembers the objects the closure cells and globals hold now (their values written)."""
+        """Remembers the objects the closure cells and globals hold now (their values written),
+        and makes same(): whether they still hold them."""
         free = len(self.f.__code__.co_freevars)
         self.cells = tuple(zip(self.f.__closure__ or (), values[:free], names[:free],
                                self.keys[:free]))
         self.globs = tuple(zip(names[free:], values[free:], self.keys[free:]))
         self.when, self.watching = when, True
+        self.same = _identity_check(self.cells, self.globs, self.f.__globals__)
 
     def rebound(self) -> str | None:
-        """None while every closure cell and global the compiled code reads holds the object it
-        held at the snapshot (checked by identity: cheap); else, once, the warning that names
-        the variables rebound to another value."""
+        """After same() found an object replaced: the warning that names the variables rebound
+        to another value than the compiled code's (once: same() is then always True until the
+        next snapshot), or None when the new objects are the same values (taken as the
+        snapshot's)."""
         if not self.watching:
             return None
         changed: list[tuple[str, str, bool]] = []   # (name, "closure" | "global", type kept)
@@ -587,9 +590,13 @@ class JitBound(Bound):
             v = g.get(name, _MISSING)
             if v is not old and not _same_passed(v, old, key):
                 changed.append((name, "global", _kept(v, key)))
-        if not changed:
+        if not changed:   # (equal values: the compiled code's, as the Python function's)
+            self.snapshot([nm for _, _, nm, _ in self.cells] + [nm for nm, _, _ in self.globs],
+                          [_current(c) for c, *_ in self.cells]
+                          + [g.get(nm, _MISSING) for nm, *_ in self.globs], self.when)
             return None
         self.watching = False   # (warned once, until the next set_* or init)
+        self.same = _always
         k = self.kind.name
         what = ", ".join(f"{kind} {name!r}" for name, kind, _ in changed)
         how = (f"init() takes the new value (and restarts at t = 0), set_{k}(..., jit=True) "
@@ -599,6 +606,36 @@ class JitBound(Bound):
         return (f"the jit=True {k} callback {self.f.__qualname__} reads {what}, rebound since "
                 f"{self.when}: its compiled code still computes with the value of {self.when}, "
                 f"while the Python function reads the new one; {how}")
+
+
+def _always() -> bool:
+    return True
+
+
+def _current(cell: Any) -> Any:
+    try:
+        return cell.cell_contents
+    except ValueError:
+        return _MISSING
+
+
+def _identity_check(cells: tuple, globs: tuple, g: dict) -> Any:
+    """A function without arguments: whether every cell and global still holds its object, one
+    `is` per variable (made from source: no loop, no call but dict.get, for the step's cost)."""
+    scope: dict[str, Any] = {"g": g, "M": _MISSING}
+    tests = []
+    for i, (cell, old, *_) in enumerate(cells):
+        scope[f"c{i}"], scope[f"o{i}"] = cell, old
+        tests.append(f"c{i}.cell_contents is o{i}")
+    for j, (name, old, _) in enumerate(globs):
+        scope[f"p{j}"] = old
+        tests.append(f"g.get({name!r}, M) is p{j}")
+    if not tests:
+        return _always
+    src = ("def same():\n    try:\n        return " + " and ".join(tests) +
+           "\n    except ValueError:\n        return False\n")   # (a closure cell emptied)
+    exec(src, scope)  # noqa: S102 - our own expression
+    return scope["same"]
 
 
 def _kept(v: Any, key: tuple) -> bool:

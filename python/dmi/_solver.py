@@ -72,6 +72,10 @@ def _choice(table: dict[str, int], value: Any, what: str) -> int:
     return code
 
 
+def _unwatched() -> bool:
+    return True
+
+
 def _python_calls(message: str) -> str:
     """libdmi's message with the C call that declares the singularity exponent named as the
     Python call that makes it (``set_quadrature("cell", singularity=...)``)."""
@@ -215,6 +219,7 @@ class Solver:
         self._h_given = h  # (for repr)
         self._keep: dict[str, cb.Bound] = {}   # callbacks and data libdmi points to
         self._watched: tuple = ()               # the jit=True callbacks the steps call
+        self._same: Callable[[], bool] = _unwatched  # (their variables unchanged; see _watch)
         self._resolvent: tuple = ()             # the built-in resolvent and its data
         self._choices = {"convolution": "auto", "quadrature": "left"}
         self._near_delta = 0.0                  # delta of set_kernel_near (0: no near cells)
@@ -279,17 +284,22 @@ class Solver:
 
     def _watch(self) -> None:
         """The jit=True callbacks whose closures and globals the steps watch: f and the
-        resolvent, which the steps call (the kernel and the history are called by init only)."""
-        self._watched = tuple(b for k in ("rhs", "resolvent")
-                              if (b := self._keep.get(k)) is not None and b.jit)
+        resolvent, which the steps call (the kernel and the history are called by init only);
+        _same() says whether their variables all hold the objects of their snapshots."""
+        watched = tuple(b for k in ("rhs", "resolvent")
+                        if (b := self._keep.get(k)) is not None and b.jit)
+        self._watched = watched
+        self._same = watched[0].same if len(watched) == 1 else \
+            (lambda: all(b.same() for b in watched))
 
-    def _warn_rebound(self, stacklevel: int = 3) -> None:
-        """Warns (once) of a closure variable or global of a jit=True f or resolvent rebound
-        since its values were written: the compiled code does not see it, the Python function
-        would (an identity check per variable)."""
+    def _rebound(self, stacklevel: int) -> None:
+        """Warns of a closure variable or global of a jit=True f or resolvent rebound since its
+        values were written (the compiled code does not see it, the Python function would).
+        Called when _same() is False (one identity check per variable: the steps' cost)."""
         for b in self._watched:
             if (message := b.rebound()) is not None:
-                warnings.warn(message, UserWarning, stacklevel=stacklevel)
+                warnings.warn(message, UserWarning, stacklevel=stacklevel + 1)
+        self._watch()
 
     # ---- sizes ---------------------------------------------------------------------------------
 
@@ -555,6 +565,7 @@ class Solver:
                 from . import _jit
                 for slot in slots:
                     _jit.refresh(self._keep[slot], "init")
+                self._watch()
             before = _L.dmi_last_error(s)
             self._check(_L.dmi_init(s))
             note = _L.dmi_last_error(s)
@@ -578,8 +589,8 @@ class Solver:
             Code ``dmi.ECALLBACK``: a C callback returned nonzero; code ``dmi.ENONFINITE``:
             f, the delay sum W^p, the resolvent's argument X^p or U^{p+1} has a NaN or infinity.
         """
-        if self._watched:
-            self._warn_rebound()
+        if self._watched and not self._same():
+            self._rebound(2)
         with self._using() as s:
             self._check(_L.dmi_step(s))
 
@@ -600,8 +611,8 @@ class Solver:
             As :meth:`step`.
         """
         steps = _count(steps, "steps", 0)
-        if self._watched:
-            self._warn_rebound()
+        if self._watched and not self._same():
+            self._rebound(2)
         with self._using() as s:
             self._check(_L.dmi_advance(s, steps))
 
@@ -672,8 +683,8 @@ class Solver:
         U = np.empty((cap, self._n))
         X = np.empty((cap - 1, self._n)) if terms else None
         rows = ctypes.c_size_t(0)
-        if self._watched:
-            self._warn_rebound(4)
+        if self._watched and not self._same():
+            self._rebound(3)
         with self._using() as s:
             rc = _lib.pylib.dmi_py_run(s, self._n, steps, stride, _ptr(t), _ptr(U),
                                        None if X is None else _ptr(X), ctypes.byref(rows))
