@@ -277,7 +277,9 @@ DMI_API int dmi_set_kernel_exp(dmi_solver *s, size_t K, const double *a, const d
  *                  integrable); an exponent so close to 1 (about 0.9999 and
  *                  above) that the part below those points, most of the
  *                  integral, is not known to 1e-11 from the estimate:
- *                  give it (dmi_set_kernel_singularity); a singularity
+ *                  give it (dmi_set_kernel_singularity); an exponent
+ *                  given that H's samples near 0 contradict (see
+ *                  dmi_set_kernel_singularity); a singularity
  *                  that is no such power law
  *                  (1/(s ln^2 s): no sampling tells it from 1/s); a cell whose
  *                  integral does not converge (the estimate reached is in the
@@ -330,9 +332,22 @@ DMI_API int dmi_set_kernel_near(dmi_solver *s, dmi_kernel_fn H, void *user, doub
  * (dmi_set_kernel_near).  Without it (alpha = NAN, the default) dmi_init
  * estimates alpha entry by entry from H at s = h 2^-960 .. h 2^-720 and
  * refuses a kernel whose local exponents there disagree; with it, the
- * exponent is taken as given for every entry (an entry that is not singular
- * loses nothing: the part below h 2^-960 is below 1e-280 of its integral)
- * and no consistency is checked: a wrong alpha gives a wrong first cell.
+ * exponent is taken for every entry (an entry that is not singular loses
+ * nothing: the part below h 2^-960 is below 1e-280 of its integral), and
+ * dmi_init checks it against H: the slope of log|H| against
+ * log s between the two of five samples closest to 0 (s = h 2^-960 and
+ * h 2^-900, or higher up to h 2^-60 .. h 2^-50 where H cannot be computed
+ * that close to 0; four calls of H more than unchecked) must not be steeper than -alpha by
+ * more than 1e-6 in any entry (s^alpha H(s) unbounded: the first cell would
+ * be wrong, or a divergent integral finite): refused by dmi_init with
+ * DMI_EINVAL, the message naming this call, the entry and the exponent
+ * measured (and "not integrable" for one >= 1).  An alpha above every
+ * entry's exponent (s^alpha H(s) tends to 0: larger than needed) leaves the
+ * weights right; dmi_init then succeeds and leaves a note in dmi_last_error
+ * (starting "dmi_init: note: "), naming the exponent measured.  An alpha
+ * whose mismatch leaves the part of the first cell below those samples
+ * unknown to 1e-11 (a kernel whose exponent drifts, 1/(s ln^2 s)) is
+ * refused as well.
  * Not part of the saved state.  Errors: DMI_EINVAL for s NULL or alpha
  * outside [0, 1) and not NAN (the message says why); DMI_ESTATE after
  * dmi_init.
@@ -416,7 +431,8 @@ DMI_API int dmi_set_convolution(dmi_solver *s, int method);
  * and a later dmi_set_convolution to another method samples it then; a
  * restart keeps the recursion's engine.
  * Errors: DMI_ECALLBACK / DMI_ENONFINITE (kernel or history callback),
- * DMI_EINVAL (a kernel the cell rule refuses, see dmi_set_quadrature),
+ * DMI_EINVAL (a kernel the cell rule refuses, see dmi_set_quadrature, or
+ * whose singularity is steeper than dmi_set_kernel_singularity declares),
  * DMI_ENOMEM; the solver is then unchanged (still uninitialised, or still at
  * its former t_p if it had been initialised).
  */
@@ -538,7 +554,9 @@ DMI_API int dmi_state_load(dmi_solver *s, const void *buf, size_t size);
 /** ---- errors -------------------------------------------------------------- */
 
 /** Message of the last failure on s ("" if none, a generic text if s is
- * NULL).  Owned by s, valid until the next call on s. */
+ * NULL), or the note of a dmi_init that succeeded with something to say
+ * (starting "dmi_init: note: ": an exponent of dmi_set_kernel_singularity
+ * larger than the kernel's).  Owned by s, valid until the next call on s. */
 DMI_API const char *dmi_last_error(const dmi_solver *s);
 
 /** Static description of an error code ("unknown error code" otherwise). */

@@ -20,6 +20,7 @@
 #include "errors.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -51,6 +52,19 @@ static int quad_fail(const dmi_solver *s, const dmi_quad_report *r, int near, si
                                        "takes H(s) = s^-alpha g(s), alpha < 1, g smooth",
                         l, hi, who, i, j, r->alpha, r->probe_lo, r->probe_hi);
     case DMI_QUAD_ENOTPOWER:
+        if (!isnan(s->alpha))
+            return dmi_fail(s, DMI_EINVAL, "dmi_init: cell %zu = [0, %.17g]: %s entry (%zu, %zu) "
+                                           "does not fit the exponent declared by "
+                                           "dmi_set_kernel_singularity(s, %.15g) closely enough: "
+                                           "its exponent measured between s = %.3g and %.3g is "
+                                           "%.17g, which leaves the part of the integral below "
+                                           "them unknown to 1e-11 (estimate %.17g, error %.3g); "
+                                           "declare the exponent measured, or NAN to have it "
+                                           "estimated; if H is no power law s^-alpha g(s) near 0 "
+                                           "(1/(s ln^2 s) looks like one), use DMI_QUAD_LEFT",
+                            l, hi, who, i, j, s->alpha, r->probe_lo, r->probe_hi,
+                            r->alpha_lo == s->alpha ? r->alpha_hi : r->alpha_lo, r->estimate,
+                            r->error);
         return dmi_fail(s, DMI_EINVAL, "dmi_init: cell %zu = [0, %.17g]: %s entry (%zu, %zu): "
                                        "its local exponent runs from %.17g to %.17g between s = "
                                        "%.3g and %.3g, which leaves the part of the integral "
@@ -72,6 +86,26 @@ static int quad_fail(const dmi_solver *s, const dmi_quad_report *r, int near, si
                                        "noisy beyond about 1e-10 of |H|); make H smooth "
                                        "within the cells and accurate, or use DMI_QUAD_LEFT",
                         l, lo, hi, who, i, j, DMI_QUAD_REL_TOL, r->calls, r->estimate, r->error);
+    case DMI_QUAD_EDECLARED:
+        if (r->slope >= DMI_QUAD_ALPHA_MAX)
+            return dmi_fail(s, DMI_EINVAL, "dmi_init: cell %zu = [0, %.17g]: the exponent declared "
+                                           "by dmi_set_kernel_singularity(s, %.15g) does not fit "
+                                           "the %s: entry (%zu, %zu) grows like s^-%.9g near s = "
+                                           "0 (the slope of log|H| against log s is -%.9g "
+                                           "between s = %.3g and %.3g): exponent >= 1, not "
+                                           "integrable whatever is declared; the cell rule takes "
+                                           "H(s) = s^-alpha g(s), alpha < 1, g smooth",
+                            l, hi, s->alpha, who, i, j, r->slope, r->slope, r->probe_lo,
+                            r->probe_hi);
+        return dmi_fail(s, DMI_EINVAL, "dmi_init: cell %zu = [0, %.17g]: the exponent declared by "
+                                       "dmi_set_kernel_singularity(s, %.15g) is smaller than the "
+                                       "%s's: entry (%zu, %zu) grows like s^-%.9g near s = 0 (the "
+                                       "slope of log|H| against log s is -%.9g between s = %.3g "
+                                       "and %.3g, so s^alpha H(s) is unbounded there); declare "
+                                       "the exponent measured, dmi_set_kernel_singularity(s, "
+                                       "%.9g), or NAN to have it estimated from H",
+                        l, hi, s->alpha, who, i, j, r->slope, r->slope, r->probe_lo, r->probe_hi,
+                        r->slope);
     case DMI_QUAD_EOVERFLOW:
         return dmi_fail(s, DMI_ENONFINITE, "dmi_init: cell %zu = [%.17g, %.17g]: the integral of "
                                            "%s entry (%zu, %zu) is beyond the largest double: "
@@ -79,6 +113,31 @@ static int quad_fail(const dmi_solver *s, const dmi_quad_report *r, int near, si
     default:
         return dmi_fail(s, DMI_ENOMEM, "dmi_init: out of memory for the cell weights");
     }
+}
+
+/* The note of dmi_init (no failure) when the exponent declared is larger than
+ * every entry's near 0 (cell 0 = [0, hi] integrated, r->over). */
+static void over_note(const dmi_solver *s, const dmi_quad_report *r, int near, double hi)
+{
+    const char *who = near ? "near kernel (dmi_set_kernel_near)" : "kernel";
+    char grows[160] = "is 0";
+    if (r->slope_entry != (size_t)-1) {
+        const size_t i = r->slope_entry / s->n, j = r->slope_entry % s->n;
+        const double slope = (0.0 - r->slope) + 0.0; /* (no -0) */
+        if (r->slope > 0)
+            snprintf(grows, sizeof grows, "grows at most like s^-%.9g (entry (%zu, %zu): "
+                                          "the slope of log|H| against log s is %.9g)",
+                     r->slope, i, j, slope);
+        else
+            snprintf(grows, sizeof grows, "is bounded (entry (%zu, %zu): the slope of "
+                                          "log|H| against log s is %.9g)", i, j, slope);
+    }
+    dmi_fail(s, DMI_OK, "dmi_init: note: the exponent declared by dmi_set_kernel_singularity(s, "
+                        "%.15g) is larger than needed: between s = %.3g and %.3g the %s %s, so "
+                        "s^alpha H(s) tends to 0; cell 0 = [0, %.17g] is integrated to the "
+                        "rule's tolerance all the same, but declare the exponent measured, "
+                        "dmi_set_kernel_singularity(s, %.9g), or NAN to have it estimated from H",
+             s->alpha, r->probe_lo, r->probe_hi, who, grows, hi, r->slope > 0 ? r->slope : 0.0);
 }
 
 /* The means over cells [l h, (l+1) h] (the last one up to end, when
@@ -105,6 +164,8 @@ static int cell_means(dmi_solver *s, dmi_quad_nodes *nodes, dmi_kernel_fn H, voi
             rc = quad_fail(s, &r, near, l, lo, hi);
             break;
         }
+        if (r.over)
+            over_note(s, &r, near, hi);
         const double width = hi - lo;
         for (size_t q = 0; q < nn && rc == DMI_OK; q++) {
             row[q] /= width;

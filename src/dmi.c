@@ -256,7 +256,8 @@ int dmi_set_quadrature(dmi_solver *s, int rule)
                                        "DMI_QUAD_CELL = 1)", rule);
     if (s->initialized)
         return dmi_fail(s, DMI_ESTATE, "dmi_set_quadrature: the kernel's weights are computed by "
-                                       "dmi_init and cannot change afterwards");
+                                       "dmi_init and cannot change afterwards: call it before "
+                                       "dmi_init (or create a new solver)");
     s->quad = rule;
     return DMI_OK;
 }
@@ -283,7 +284,8 @@ int dmi_set_kernel_singularity(dmi_solver *s, double alpha)
         return DMI_EINVAL;
     if (s->initialized)
         return dmi_fail(s, DMI_ESTATE, "dmi_set_kernel_singularity: the kernel's weights are "
-                                       "computed by dmi_init and cannot change afterwards");
+                                       "computed by dmi_init and cannot change afterwards: call "
+                                       "it before dmi_init (or create a new solver)");
     if (!isnan(alpha) && !(alpha >= 0 && alpha < 1))
         return dmi_fail(s, DMI_EINVAL, "dmi_set_kernel_singularity: alpha = %g; expected 0 <= "
                                        "alpha < 1 (s^-alpha is not integrable at 0 for alpha >= "

@@ -316,24 +316,26 @@ static void accept_piece(ctx *c)
     }
 }
 
-/* The exponent at 0 from the probes (or the hint) and the part below the
- * smallest probe into S_TOT (its uncertainty in S_UNC); the variable of the
- * rest: [*x0, *x1] with c->a, c->p. */
+/* The exponent at 0 from the probes (or the hint, checked against them) and
+ * the part below the smallest probe into S_TOT (its uncertainty in S_UNC);
+ * the variable of the rest: [*x0, *x1] with c->a, c->p. */
 static int singular_start(ctx *c, double hint, double *x0, double *x1)
 {
     const size_t nn = c->nn;
     const double a = c->s_hi;
-    /* without a hint five probes from s_min = hi 2^-E0 up to hi 2^-(E0-4 gap),
-     * gap = 60 (less once E0 < 300: the probes stay below hi 2^-60); with one
-     * only s_min; E0 = 960, 900, .., 120 (60 with a hint) until f is finite
-     * at every probe */
-    const int given = !isnan(hint), probes = given ? 1 : PROBES;
+    /* five probes from s_min = hi 2^-E0 up to hi 2^-(E0-4 gap), gap = 60 (less
+     * once E0 < 300: the probes stay below hi 2^-60, or below hi 2^-20 with a
+     * hint); E0 = 960, 900, .., 120 (60 with a hint) until f is finite at
+     * every probe */
+    const int given = !isnan(hint);
+    const int top_probe = given ? 20 : 60;
     int E0 = 960, gap = PROBE_GAP, rc = DMI_QUAD_OK;
     if (E0 > ilogb(a) + 1021) /* s_min stays a normal number */
         E0 = ilogb(a) + 1021;
     for (;; E0 -= PROBE_GAP) {
-        gap = E0 - 60 < PROBE_GAP * (PROBES - 1) ? (E0 - 60) / (PROBES - 1) : PROBE_GAP;
-        for (int j = 0; j < probes && rc == DMI_QUAD_OK; j++) {
+        gap = E0 - top_probe < PROBE_GAP * (PROBES - 1) ? (E0 - top_probe) / (PROBES - 1)
+                                                          : PROBE_GAP;
+        for (int j = 0; j < PROBES && rc == DMI_QUAD_OK; j++) {
             rc = call(c, ldexp(a, -E0 + gap * j));
             if (rc == DMI_QUAD_OK)
                 memcpy(c->probe + (size_t)j * nn, c->val, nn * sizeof *c->val);
@@ -346,20 +348,23 @@ static int singular_start(ctx *c, double hint, double *x0, double *x1)
         return rc;
     const double s_min = ldexp(a, -E0);
     c->rep->probe_lo = s_min;
-    c->rep->probe_hi = ldexp(a, -E0 + gap * (probes - 1));
-    double top = 0; /* the largest exponent */
+    /* (with a hint the exponents compared are those of the two probes closest to 0) */
+    c->rep->probe_hi = ldexp(a, -E0 + gap * (given ? 1 : PROBES - 1));
+    double top = 0;          /* the largest exponent */
+    double measured = -1e300; /* with a hint: the largest exponent measured */
+    size_t at_top = (size_t)-1;
+    int all_known = 1;       /* with a hint: every entry a power law or 0 at the probes */
     double *tot = blk(c, S_TOT), *unc = blk(c, S_UNC);
     for (size_t q = 0; q < nn; q++) {
         const double *y = c->probe + q;
         double alpha = 0, lo = 0, hi = 0, big = 0;
-        int power = 1;
-        for (int k = 0; k < probes; k++) {
+        int power = 1, zero = 1;
+        for (int k = 0; k < PROBES; k++) {
             big = fmax(big, fabs(y[k * nn]));
             power = power && y[k * nn] != 0 && (y[k * nn] > 0) == (y[0] > 0);
+            zero = zero && y[k * nn] == 0;
         }
-        if (given) {
-            alpha = lo = hi = hint;
-        } else if (power) {
+        if (power) { /* the local exponents log2(|f(s_k)| / |f(s_k+1)|) / gap */
             for (int k = 0; k + 1 < PROBES; k++) {
                 const double sig = (log2(fabs(y[k * nn])) - log2(fabs(y[(k + 1) * nn]))) / gap;
                 lo = k ? fmin(lo, sig) : sig;
@@ -367,11 +372,34 @@ static int singular_start(ctx *c, double hint, double *x0, double *x1)
                 if (k == 0)
                     alpha = sig;
             }
-            if (alpha >= DMI_QUAD_ALPHA_MAX) {
+        }
+        if (given) {
+            /* the exponent closest to 0 against the hint: above it, refused; the
+             * difference is the uncertainty of the part below s_min */
+            if (power && alpha > hint + DMI_QUAD_SLOPE_TOL) {
                 c->rep->entry = q;
-                c->rep->alpha = alpha;
-                return c->rep->status = DMI_QUAD_ENOTINTEGRABLE;
+                c->rep->alpha = hint;
+                c->rep->slope = alpha;
+                return c->rep->status = DMI_QUAD_EDECLARED;
             }
+            if (power && alpha > measured) {
+                measured = alpha;
+                at_top = q;
+            }
+            all_known = all_known && (power || zero);
+            /* (a difference within the measurement's rounding, that of the two
+             * logarithms over gap, counts as none) */
+            const double ulps = power ? 0x1p-49 * (fabs(log2(fabs(y[0]))) +
+                                                   fabs(log2(fabs(y[nn]))) + 1) / gap : 0;
+            const double off = fmax(fabs(alpha - hint) - ulps, 0);
+            lo = hint - (alpha < hint ? off : 0);
+            hi = hint + (alpha > hint ? off : 0);
+            alpha = hint;
+            power = y[0] != 0; /* (the hint taken for every entry) */
+        } else if (power && alpha >= DMI_QUAD_ALPHA_MAX) {
+            c->rep->entry = q;
+            c->rep->alpha = alpha;
+            return c->rep->status = DMI_QUAD_ENOTINTEGRABLE;
         }
         c->sig[q] = lo;
         c->sig[nn + q] = hi;
@@ -384,6 +412,12 @@ static int singular_start(ctx *c, double hint, double *x0, double *x1)
         }
         if (power && alpha > top)
             top = alpha;
+    }
+    if (given && all_known && hint > fmax(measured, 0) + DMI_QUAD_SLOPE_TOL) {
+        /* s^hint f tends to 0 in every entry: the hint is larger than needed */
+        c->rep->over = 1;
+        c->rep->slope = measured;
+        c->rep->slope_entry = at_top;
     }
     c->rep->alpha = top;
     c->a = a;

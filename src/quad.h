@@ -54,7 +54,9 @@ enum {
     DMI_QUAD_ECONVERGE,      /* no estimate of f[entry] within the tolerance after calls calls:
                               * estimate, error */
     DMI_QUAD_EOVERFLOW,      /* the integral of f[entry] is beyond the largest double */
-    DMI_QUAD_ENOMEM
+    DMI_QUAD_ENOMEM,
+    DMI_QUAD_EDECLARED       /* the exponent given (alpha) is below f[entry]'s: |f| grows like
+                              * s^-slope, slope > alpha, between probe_lo and probe_hi */
 };
 
 typedef struct {
@@ -65,6 +67,10 @@ typedef struct {
     double alpha;              /* the exponent at s = 0 used (0: none) */
     double alpha_lo, alpha_hi; /* local exponents near 0 (ENOTPOWER) */
     double probe_lo, probe_hi; /* where they were measured */
+    double slope;              /* the exponent given: f[entry]'s measured exponent near 0
+                                * (EDECLARED; with over, the largest of the entries') */
+    int over;                  /* the exponent given is above every entry's (OK: a note) */
+    size_t slope_entry;        /* with over: the entry of the largest exponent (-1 if none) */
     double estimate, error;    /* the integral and its error estimate reached */
     size_t calls;              /* calls of f */
 } dmi_quad_report;
@@ -75,6 +81,9 @@ size_t dmi_quad_scratch(size_t nn);
 
 /* The relative accuracy asked of each integral (of the integral of |f|). */
 #define DMI_QUAD_REL_TOL 1e-13
+
+/* A given exponent and the one measured agree to this. */
+#define DMI_QUAD_SLOPE_TOL 1e-6
 
 /* Exponents alpha of s^-alpha at or beyond this are taken as not integrable. */
 #define DMI_QUAD_ALPHA_MAX (1 - 1e-6)
@@ -91,7 +100,14 @@ size_t dmi_quad_scratch(size_t nn);
  * from f at five probes s = hi 2^-E0 (s_min) .. hi 2^-(E0 - 240), E0 = 960
  * (or 900, .., 120 when f fails or is not finite at one of them: the probes
  * move up, staying below hi 2^-60), or given (alpha_hint in [0, 1), not
- * NAN): f is then called at s_min only, E0 down to 60.  The integral from the smallest probe s_min to hi is then taken in
+ * NAN): the five probes then go from s_min = hi 2^-E0 up to at most
+ * hi 2^-20, E0 down to 60, and each entry's exponent there (from the two
+ * probes closest to 0) is checked against alpha: an entry that grows faster
+ * than s^-alpha (by more than DMI_QUAD_SLOPE_TOL) is refused (EDECLARED);
+ * an alpha above every entry's exponent (s^alpha f tends to 0) is reported
+ * (rep->over, the integral computed: the mismatch enters the error of the
+ * part below s_min, refused as ENOTPOWER where it matters).  The integral
+ * from the smallest probe s_min to hi is then taken in
  * the variable x with s = hi x^{1/(1 - alpha)} (smooth in x), and the part
  * below s_min added as s_min f(s_min) / (1 - alpha).  An entry whose
  * exponent is >= DMI_QUAD_ALPHA_MAX is refused (ENOTINTEGRABLE), one whose

@@ -530,15 +530,122 @@ def _compile(kind: Kind, f: types.FunctionType, names: list[str], values: list[A
     raise AssertionError("unreachable")
 
 
+_MISSING = object()  # a closure cell emptied, a global deleted
+
+
+def _same_passed(v: Any, old: Any, key: tuple) -> bool:
+    """Whether v, rebound in place of old (not the same object), is what the compiled code was
+    given: a number of the same type and value, an array of the same memory."""
+    if key[0] == "a":
+        return isinstance(v, np.ndarray) and v.flags.c_contiguous and v.dtype == old.dtype \
+            and v.shape == old.shape and v.ctypes.data == old.ctypes.data
+    if key[0] in ("f", "i", "b"):
+        try:
+            return _param_type("", v, "") == key and v == old
+        except (InvalidArgument, ValueError, TypeError):
+            return False
+    return False  # a module or function: a constant of the compiled code
+
+
 class JitBound(Bound):
-    """A jit=True callback as handed to libdmi, with what raised() and refresh() need."""
+    """A jit=True callback as handed to libdmi, with what raised(), refresh() and rebound()
+    need: what its closure cells and globals held when their values were written (set_* or
+    init), to notice a rebinding the compiled code does not see."""
 
     jit = True
 
     def __init__(self, kind: Kind, f: types.FunctionType, n: int, keys: list[tuple], cfunc: Any,
-                 data: np.ndarray, arrays: list):
+                 data: np.ndarray, arrays: list, names: list[str], values: list[Any]):
         super().__init__(int(cfunc.address), int(data.ctypes.data), (cfunc, data, arrays, f))
         self.kind, self.f, self.n, self.keys, self.data = kind, f, n, keys, data
+        self.snapshot(names, values, f"set_{kind.name}")
+
+    def snapshot(self, names: list[str], values: list[Any], when: str) -> None:
+        """Remembers the objects the closure cells and globals hold now (their values written),
+        and makes same(): whether they still hold them."""
+        free = len(self.f.__code__.co_freevars)
+        self.cells = tuple(zip(self.f.__closure__ or (), values[:free], names[:free],
+                               self.keys[:free]))
+        self.globs = tuple(zip(names[free:], values[free:], self.keys[free:]))
+        self.when, self.watching = when, True
+        self.same = _identity_check(self.cells, self.globs, self.f.__globals__)
+
+    def rebound(self) -> str | None:
+        """After same() found an object replaced: the warning that names the variables rebound
+        to another value than the compiled code's (once: same() is then always True until the
+        next snapshot), or None when the new objects are the same values (taken as the
+        snapshot's)."""
+        if not self.watching:
+            return None
+        changed: list[tuple[str, str, bool]] = []   # (name, "closure" | "global", type kept)
+        for cell, old, name, key in self.cells:
+            try:
+                v = cell.cell_contents
+            except ValueError:
+                v = _MISSING
+            if v is not old and not _same_passed(v, old, key):
+                changed.append((name, "closure variable", _kept(v, key)))
+        g = self.f.__globals__
+        for name, old, key in self.globs:
+            v = g.get(name, _MISSING)
+            if v is not old and not _same_passed(v, old, key):
+                changed.append((name, "global", _kept(v, key)))
+        if not changed:   # (equal values: the compiled code's, as the Python function's)
+            self.snapshot([nm for _, _, nm, _ in self.cells] + [nm for nm, _, _ in self.globs],
+                          [_current(c) for c, *_ in self.cells]
+                          + [g.get(nm, _MISSING) for nm, *_ in self.globs], self.when)
+            return None
+        self.watching = False   # (warned once, until the next set_* or init)
+        self.same = _always
+        k = self.kind.name
+        what = ", ".join(f"{kind} {name!r}" for name, kind, _ in changed)
+        how = (f"init() takes the new value (and restarts at t = 0), set_{k}(..., jit=True) "
+               "takes it from the next step" if all(kept for *_, kept in changed) else
+               f"it no longer fits the compiled code (another type, or a module or function): "
+               f"call set_{k}(..., jit=True) again")
+        return (f"the jit=True {k} callback {self.f.__qualname__} reads {what}, rebound since "
+                f"{self.when}: its compiled code still computes with the value of {self.when}, "
+                f"while the Python function reads the new one; {how}")
+
+
+def _always() -> bool:
+    return True
+
+
+def _current(cell: Any) -> Any:
+    try:
+        return cell.cell_contents
+    except ValueError:
+        return _MISSING
+
+
+def _identity_check(cells: tuple, globs: tuple, g: dict) -> Any:
+    """A function without arguments: whether every cell and global still holds its object, one
+    `is` per variable (made from source: no loop, no call but dict.get, for the step's cost)."""
+    scope: dict[str, Any] = {"g": g, "M": _MISSING}
+    tests = []
+    for i, (cell, old, *_) in enumerate(cells):
+        scope[f"c{i}"], scope[f"o{i}"] = cell, old
+        tests.append(f"c{i}.cell_contents is o{i}")
+    for j, (name, old, _) in enumerate(globs):
+        scope[f"p{j}"] = old
+        tests.append(f"g.get({name!r}, M) is p{j}")
+    if not tests:
+        return _always
+    src = ("def same():\n    try:\n        return " + " and ".join(tests) +
+           "\n    except ValueError:\n        return False\n")   # (a closure cell emptied)
+    exec(src, scope)  # noqa: S102 - our own expression
+    return scope["same"]
+
+
+def _kept(v: Any, key: tuple) -> bool:
+    """Whether v can be passed where a value of key was (init() takes it without compiling)."""
+    if v is _MISSING or key[0] == "k":
+        return False
+    try:
+        return _param_type("", v, "") == key
+    except InvalidArgument:
+        return False
 
 
 def bind(kind: Kind, f: Any, user: Any, n: int) -> Bound:
@@ -560,7 +667,7 @@ def bind(kind: Kind, f: Any, user: Any, n: int) -> Bound:
             _cache[key] = c
             _compilations[0] += 1
     data, arrays = _user_data(kind, n, values, keys)
-    return JitBound(kind, f, n, keys, c, data, arrays)
+    return JitBound(kind, f, n, keys, c, data, arrays, names, values)
 
 
 def refresh(bound: JitBound, what: str) -> None:
@@ -583,6 +690,7 @@ def refresh(bound: JitBound, what: str) -> None:
     data, arrays = _user_data(bound.kind, bound.n, values, keys)
     bound.data[_HEAD:] = data[_HEAD:]    # (the head stays: the scratch's address)
     bound.keep = (bound.keep[0], bound.data, [bound.keep[2][0]] + arrays[1:], bound.f)
+    bound.snapshot(names, values, what + "()")
 
 
 def raised(bounds: list[Bound]) -> BaseException | None:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import ctypes
 import math
 import operator
+import re
 import threading
 import types
 import warnings
@@ -69,6 +70,21 @@ def _choice(table: dict[str, int], value: Any, what: str) -> int:
         raise InvalidArgument(_lib.EINVAL, f"{what} {value!r}: expected one of "
                               f"{', '.join(map(repr, table))}")
     return code
+
+
+def _unwatched() -> bool:
+    return True
+
+
+def _python_calls(message: str) -> str:
+    """libdmi's message with the C call that declares the singularity exponent named as the
+    Python call that makes it (``set_quadrature("cell", singularity=...)``)."""
+    if "dmi_set_kernel_singularity(s, " not in message:
+        return message
+    message = re.sub(r"dmi_set_kernel_singularity\(s, ([^)]*)\)",
+                     r"set_quadrature('cell', singularity=\1)", message)
+    return message.replace("or NAN to have it estimated", "or singularity=None to have it "
+                           "estimated").replace("use DMI_QUAD_LEFT", "use set_quadrature('left')")
 
 
 def _same_value(x: Any, y: Any, depth: int) -> bool:
@@ -202,6 +218,8 @@ class Solver:
         self._n, self._tau, self._N = n, tau, int(_L.dmi_get_N(handle))
         self._h_given = h  # (for repr)
         self._keep: dict[str, cb.Bound] = {}   # callbacks and data libdmi points to
+        self._watched: tuple = ()               # the jit=True callbacks the steps call
+        self._same: Callable[[], bool] = _unwatched  # (their variables unchanged; see _watch)
         self._resolvent: tuple = ()             # the built-in resolvent and its data
         self._choices = {"convolution": "auto", "quadrature": "left"}
         self._near_delta = 0.0                  # delta of set_kernel_near (0: no near cells)
@@ -233,7 +251,7 @@ class Solver:
         if failure is not None:
             raise failure
         self._raise_jit(rc)
-        message = _L.dmi_last_error(self._handle).decode()
+        message = _python_calls(_L.dmi_last_error(self._handle).decode())
         if rc == _lib.ECALLBACK and "callback returned 2 " in message and \
                 self._jit_slots():
             message += _JIT_SHAPE
@@ -262,6 +280,26 @@ class Solver:
         with self._using() as s:
             self._check(setter(s, bound.address, bound.user))
         self._keep[slot] = bound  # only now: a refused call keeps the former callback alive
+        self._watch()
+
+    def _watch(self) -> None:
+        """The jit=True callbacks whose closures and globals the steps watch: f and the
+        resolvent, which the steps call (the kernel and the history are called by init only);
+        _same() says whether their variables all hold the objects of their snapshots."""
+        watched = tuple(b for k in ("rhs", "resolvent")
+                        if (b := self._keep.get(k)) is not None and b.jit)
+        self._watched = watched
+        self._same = watched[0].same if len(watched) == 1 else \
+            (lambda: all(b.same() for b in watched))
+
+    def _rebound(self, stacklevel: int) -> None:
+        """Warns of a closure variable or global of a jit=True f or resolvent rebound since its
+        values were written (the compiled code does not see it, the Python function would).
+        Called when _same() is False (one identity check per variable: the steps' cost)."""
+        for b in self._watched:
+            if (message := b.rebound()) is not None:
+                warnings.warn(message, UserWarning, stacklevel=stacklevel + 1)
+        self._watch()
 
     # ---- sizes ---------------------------------------------------------------------------------
 
@@ -360,6 +398,7 @@ class Solver:
         with self._using() as s:
             self._check(_L.dmi_set_friction(s, _ptr(a)))
         self._keep["resolvent"] = cb.Bound(None, None, ())
+        self._watch()
         self._resolvent = ("friction", a.copy())
 
     def set_box(self, lo: Any, hi: Any) -> None:
@@ -381,6 +420,7 @@ class Solver:
         with self._using() as s:
             self._check(_L.dmi_set_box(s, _ptr(lo_a), _ptr(hi_a)))
         self._keep["resolvent"] = cb.Bound(None, None, ())
+        self._watch()
         self._resolvent = ("box", lo_a.copy(), hi_a.copy())
 
     def set_kernel(self, H: Callback | None, user: Any = None, *, jit: bool = False) -> None:
@@ -496,6 +536,12 @@ class Solver:
         A ``jit=True`` callback computes with its closure's and globals' values as they are now
         (docs/python.md, "jit=True").
 
+        Warns
+        -----
+        UserWarning
+            The exponent of :meth:`set_quadrature` ``(..., singularity=)`` is larger than the
+            kernel's near 0 (the weights are right; the warning names the exponent measured).
+
         Raises
         ------
         Exception
@@ -504,7 +550,10 @@ class Solver:
             Code ``dmi.EINVAL``: a value a ``jit=True`` callback reads changed its type since its
             ``set_*`` call (set it again);
             code ``dmi.ECALLBACK``: a Python callback returned a result of another shape or type;
-            code ``dmi.EINVAL``: near cells of :meth:`set_kernel_near` without a kernel of
+            code ``dmi.EINVAL``: under the cell rule, a kernel it cannot integrate or that grows
+            faster near 0 than the exponent of :meth:`set_quadrature` ``(..., singularity=)``
+            (the message names that call and the exponent measured); near cells of
+            :meth:`set_kernel_near` without a kernel of
             :meth:`set_kernel_exp` or with ceil(delta / h) + 1 > N, or ``"recursive"`` for a
             kernel it refuses (see :meth:`set_convolution`).
         dmi.Error
@@ -516,7 +565,14 @@ class Solver:
                 from . import _jit
                 for slot in slots:
                     _jit.refresh(self._keep[slot], "init")
+                self._watch()
+            before = _L.dmi_last_error(s)
             self._check(_L.dmi_init(s))
+            note = _L.dmi_last_error(s)
+        if note != before and note.startswith(b"dmi_init: note: "):
+            # (a declared singularity exponent larger than the kernel's: the weights are right)
+            warnings.warn(_python_calls(note.decode()[len("dmi_init: note: "):]), UserWarning,
+                          stacklevel=2)
 
     def step(self) -> None:
         """One step t_p -> t_{p+1} (``dmi_step``).  On failure the solver is bitwise where it was,
@@ -533,6 +589,8 @@ class Solver:
             Code ``dmi.ECALLBACK``: a C callback returned nonzero; code ``dmi.ENONFINITE``:
             f, the delay sum W^p, the resolvent's argument X^p or U^{p+1} has a NaN or infinity.
         """
+        if self._watched and not self._same():
+            self._rebound(2)
         with self._using() as s:
             self._check(_L.dmi_step(s))
 
@@ -553,6 +611,8 @@ class Solver:
             As :meth:`step`.
         """
         steps = _count(steps, "steps", 0)
+        if self._watched and not self._same():
+            self._rebound(2)
         with self._using() as s:
             self._check(_L.dmi_advance(s, steps))
 
@@ -623,6 +683,8 @@ class Solver:
         U = np.empty((cap, self._n))
         X = np.empty((cap - 1, self._n)) if terms else None
         rows = ctypes.c_size_t(0)
+        if self._watched and not self._same():
+            self._rebound(3)
         with self._using() as s:
             rc = _lib.pylib.dmi_py_run(s, self._n, steps, stride, _ptr(t), _ptr(U),
                                        None if X is None else _ptr(X), ctypes.byref(rows))
@@ -803,6 +865,7 @@ class Solver:
                 _L.dmi_free(ctypes.byref(s))
                 self._handle = None
             self._keep.clear()
+            self._watched = ()
 
     def __enter__(self) -> Solver:
         return self
@@ -839,7 +902,11 @@ class Solver:
         dmi.InvalidArgument
             Code ``dmi.EINVAL``: another rule, ``"left"`` with near cells
             (:meth:`set_kernel_near`), or ``singularity`` outside [0, 1); code ``dmi.ESTATE``:
-            after :meth:`init`.
+            after :meth:`init` (the message names this call and says to call it before
+            :meth:`init`).  :meth:`init` checks ``singularity`` against the kernel near 0: a
+            kernel that grows faster than s^-singularity is refused there (``dmi.EINVAL``, the
+            message naming this call and the exponent measured); a ``singularity`` larger than the
+            kernel's gives a ``UserWarning`` (the weights are right).
         """
         code = _choice(_lib.QUAD, rule, "set_quadrature: rule")
         if rule == "left" and self._near_delta > 0:
@@ -847,10 +914,21 @@ class Solver:
                                   "set_kernel_fit or set_kernel_near need the cell rule (remove "
                                   "them first: set_kernel_near(None, 0))")
         alpha = math.nan if singularity is None else float(singularity)
+        call = f"set_quadrature({rule!r}" + ("" if singularity is None else
+                                             f", singularity={singularity!r}") + ")"
         with self._using() as s:
             # the exponent first: a refused one leaves the rule as it was
-            self._check(_L.dmi_set_kernel_singularity(s, alpha))
-            self._check(_L.dmi_set_quadrature(s, code))
+            rc = _L.dmi_set_kernel_singularity(s, alpha)
+            if rc == _lib.OK:
+                rc = _L.dmi_set_quadrature(s, code)
+            if rc == _lib.ESTATE:
+                raise InvalidArgument(rc, f"{call}: the kernel's weights are computed by init() "
+                                      "and cannot change afterwards: call set_quadrature before "
+                                      "init() (or make a new Solver)")
+            if rc != _lib.OK:   # (an exponent outside [0, 1): libdmi's reason, in Python's words)
+                why = _L.dmi_last_error(s).decode().split(": ", 1)[-1]
+                raise from_code(rc, f"{call}: " + why.replace("alpha = ", "singularity = ", 1)
+                                .replace("or NAN to", "or None to"))
         self._choices["quadrature"] = rule
 
     def set_kernel_near(self, H: Callback | None, delta: float, user: Any = None) -> None:

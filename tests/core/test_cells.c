@@ -18,7 +18,14 @@
  * - s^-0.9999 (1 + s): refused with a message that names the exponent close
  *   to 1 and dmi_set_kernel_singularity, with which it is integrated;
  * - 1/sqrt|s - 0.3| refused (cell 2 does not converge), its message whole;
- * - a kernel computed to 8 digits refused, the message naming noise.
+ * - a kernel computed to 8 digits refused, the message naming noise;
+ * - a declared exponent checked against H's log-log slope near 0: 1/s
+ *   declared 0.999 and s^-0.99 declared 0.5 (and 0 for s^-1/2) refused, as
+ *   the kernel and as the near kernel, in a few calls, the message naming the
+ *   declaration and the exponent measured; 0.99 declared for s^-1/2 (1 + s)
+ *   integrated to 1e-10 with a note in dmi_last_error; 1/(s ln^2 s) declared
+ *   0.999 refused; an n = 2 kernel with one singular entry takes its
+ *   exponent without a note.
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include <math.h>
@@ -432,6 +439,153 @@ static void test_not_converging_refused(void)
     }
 }
 
+/* s^-beta (1 + s) (1/s (1 + s) for beta = 1), counting its calls. */
+typedef struct {
+    double beta;
+    size_t calls;
+} counted;
+
+static int counted_power(double s, double *out, void *user)
+{
+    counted *c = user;
+    c->calls++;
+    out[0] = (c->beta == 1 ? 1 / s : pow(s, -c->beta)) * (1 + s);
+    return 0;
+}
+
+/* dmi_init of u' + W = 0 with the kernel (or the near kernel of e^{-s} below
+ * delta = 0.2) under the cell rule and the exponent declared: its code, the
+ * message into msg, W^0 into *W (z = 1). */
+static int declared_W(dmi_kernel_fn H, void *user, int near, double alpha, char *msg, double *W)
+{
+    dmi_solver *s = NULL;
+    *W = NAN;
+    CU_ASSERT_FATAL(dmi_create(&s, 1, 1.0, 8) == DMI_OK);
+    if (near) {
+        CU_ASSERT_EQUAL(dmi_set_kernel_exp(s, 1, NA, NB, NC, NULL), DMI_OK);
+        CU_ASSERT_EQUAL(dmi_set_kernel_near(s, H, user, 0.2), DMI_OK);
+    } else {
+        CU_ASSERT_EQUAL(dmi_set_kernel(s, H, user), DMI_OK);
+    }
+    CU_ASSERT_EQUAL(dmi_set_history(s, core_z_one, NULL), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_quadrature(s, DMI_QUAD_CELL), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_kernel_singularity(s, alpha), DMI_OK);
+    const int rc = dmi_init(s);
+    snprintf(msg, 1024, "%s", dmi_last_error(s));
+    if (rc == DMI_OK && dmi_step(s) == DMI_OK)
+        dmi_get_step_terms(s, W, NULL);
+    dmi_free(&s);
+    return rc;
+}
+
+static void test_declared_exponent_checked(void)
+{
+    /* a slope steeper than declared: refused, naming the declaration, the
+     * exponent measured and what to do, after a few calls of H */
+    const struct {
+        double beta, alpha;
+        const char *words[3];
+    } bad[3] = {{1.0, 0.999, {"dmi_set_kernel_singularity(s, 0.999)", "s^-1 ", "not integrable"}},
+                {0.99, 0.5, {"dmi_set_kernel_singularity(s, 0.5)", "s^-0.99 ",
+                             "dmi_set_kernel_singularity(s, 0.99), or NAN"}},
+                {0.5, 0.0, {"dmi_set_kernel_singularity(s, 0)", "s^-0.5 ",
+                            "dmi_set_kernel_singularity(s, 0.5), or NAN"}}};
+    for (int i = 0; i < 3; i++)
+        for (int near = 0; near < 2; near++) {
+            counted c = {bad[i].beta, 0};
+            char msg[1024];
+            double W;
+            const int rc = declared_W(counted_power, &c, near, bad[i].alpha, msg, &W);
+            int named = rc == DMI_EINVAL && strstr(msg, "cell 0 = [0, ") != NULL;
+            for (int k = 0; k < 3; k++)
+                named = named && strstr(msg, bad[i].words[k]) != NULL;
+            if (!named || c.calls > 40)
+                printf("\n  s^-%g declared %g (%s): rc %d, %zu calls, W %g, \"%s\"\n",
+                       bad[i].beta, bad[i].alpha, near ? "near" : "kernel", rc, c.calls, W, msg);
+            CU_ASSERT(named);
+            CU_ASSERT(c.calls <= 40);
+            CU_ASSERT(!near || strstr(msg, "near kernel") != NULL);
+        }
+    /* a declared exponent larger than the kernel's: integrated, with a note */
+    for (int near = 0; near < 2; near++) {
+        counted c = {0.5, 0};
+        char msg[1024];
+        double W;
+        const int rc = declared_W(counted_power, &c, near, 0.99, msg, &W);
+        CU_ASSERT_EQUAL(rc, DMI_OK);
+        const int noted = strncmp(msg, "dmi_init: note: ", 16) == 0 &&
+                          strstr(msg, "dmi_set_kernel_singularity(s, 0.99)") != NULL &&
+                          strstr(msg, "s^-0.5 ") != NULL &&
+                          strstr(msg, "dmi_set_kernel_singularity(s, 0.5), or NAN") != NULL;
+        if (!noted)
+            printf("\n  s^-0.5 (1 + s) declared 0.99: \"%s\"\n", msg);
+        CU_ASSERT(noted);
+        /* W^0 = int_0^1 H (the kernel), or the near cells' int_0^0.25 H plus
+         * e^{-s}'s cells beyond */
+        const double ref = near ? power_integral(0.5, 0.25) + exp(-0.25) - exp(-1.0)
+                                : power_integral(0.5, 1.0);
+        CU_ASSERT(core_close_rel("W^0 of s^-0.5 (1 + s) declared 0.99", W, ref, 1e-10));
+    }
+    /* 1/(s ln^2 s) (local exponent 0.997 at s = 1e-290) declared 0.999: the
+     * part below the probes is 1/665 of the cell's integral, refused */
+    {
+        char msg[1024];
+        double W;
+        dmi_solver *s = NULL;
+        CU_ASSERT_FATAL(dmi_create(&s, 1, 0.5, 8) == DMI_OK);
+        CU_ASSERT_EQUAL(dmi_set_kernel(s, log_squared, NULL), DMI_OK);
+        CU_ASSERT_EQUAL(dmi_set_quadrature(s, DMI_QUAD_CELL), DMI_OK);
+        CU_ASSERT_EQUAL(dmi_set_kernel_singularity(s, 0.999), DMI_OK);
+        const int rc = dmi_init(s);
+        snprintf(msg, sizeof msg, "%s", dmi_last_error(s));
+        W = rc;
+        if (rc != DMI_EINVAL || !strstr(msg, "dmi_set_kernel_singularity(s, 0.999)"))
+            printf("\n  1/(s ln^2 s) declared 0.999: rc %g, \"%s\"\n", W, msg);
+        CU_ASSERT_EQUAL(rc, DMI_EINVAL);
+        CU_ASSERT(strstr(msg, "dmi_set_kernel_singularity(s, 0.999)") != NULL);
+        dmi_free(&s);
+    }
+}
+
+/* n = 2: entry (0, 0) s^-1/2, entry (1, 1) e^{-s} (bounded), (0, 1) s (0 at
+ * 0), (1, 0) zero: the exponent 1/2 declared fits (no note), and the weights
+ * are right. */
+static int mixed(double s, double *out, void *user)
+{
+    (void)user;
+    out[0] = pow(s, -0.5);
+    out[1] = s;
+    out[2] = 0;
+    out[3] = exp(-s);
+    return 0;
+}
+
+static int z_ones(double t, double *u, void *user)
+{
+    (void)t;
+    (void)user;
+    u[0] = u[1] = 1;
+    return 0;
+}
+
+static void test_declared_exponent_of_a_matrix(void)
+{
+    dmi_solver *s = NULL;
+    CU_ASSERT_FATAL(dmi_create(&s, 2, 1.0, 8) == DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_kernel(s, mixed, NULL), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_history(s, z_ones, NULL), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_quadrature(s, DMI_QUAD_CELL), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_set_kernel_singularity(s, 0.5), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_init(s), DMI_OK);
+    CU_ASSERT_STRING_EQUAL(dmi_last_error(s), "");
+    double W[2] = {NAN, NAN};
+    CU_ASSERT_EQUAL(dmi_step(s), DMI_OK);
+    CU_ASSERT_EQUAL(dmi_get_step_terms(s, W, NULL), DMI_OK);
+    CU_ASSERT(core_close_rel("W^0[0] of s^-1/2 + s", W[0], 2.0 + 0.5, 1e-10));
+    CU_ASSERT(core_close_rel("W^0[1] of e^{-s}", W[1], 1 - exp(-1.0), 1e-10));
+    dmi_free(&s);
+}
+
 int main(int argc, char **argv)
 {
     static const core_test tests[] = {
@@ -448,6 +602,8 @@ int main(int argc, char **argv)
         {"an exponent close to 1: refused with the way on", test_exponent_close_to_one},
         {"a singularity inside a cell, 8-digit noise: refused with the way on",
          test_not_converging_refused},
+        {"a declared exponent checked against H's slope near 0", test_declared_exponent_checked},
+        {"a declared exponent of a matrix kernel", test_declared_exponent_of_a_matrix},
         {NULL, NULL}};
     return core_main(argc, argv, "cells", tests);
 }
