@@ -4,9 +4,9 @@
 # (every request to a host goes to a closed port on 127.0.0.1) and the page's requests logged.
 #   browser_check.py SOURCE_DIR BUILD_DIR CHECK...
 # CHECK is one or more of
-#   maths    mathematics.html (and the other pages whose maths was converted): once MathJax has
-#            typeset the page, every maths element holds its rendering, none is a TeX error, and
-#            the text the reader sees has no TeX left (no \( \) \[ \] $$, no \command);
+#   maths    every page of the site: once MathJax has typeset it, every maths element holds its
+#            rendering, none is a TeX error, and the text the reader sees has no TeX left (no
+#            \( \) \[ \] $$, no \command); the pages of MATH_PAGES have at least 5 maths elements;
 #   capi     c-api.html has an entry (the C domain's id c.NAME) with its name shown for every symbol
 #            that libdmi exports (the global: names of src/libdmi.map) and every type that a public
 #            header declares (typedef and struct names of include/*.h, read here by regex);
@@ -171,13 +171,26 @@ MATHS_JS = """(async () => {
 RAW_TEX = re.compile(r"\\[()\[\]]|\$\$|\\(?:[a-zA-Z]+)\b|\$[^$\s][^$]*\$")
 
 
+def site_pages(html: Path) -> list[str]:
+    """Every page of the site (its HTML files but Sphinx's index, search and module pages and the
+    static files), relative to html."""
+    skip = {"genindex.html", "search.html", "py-modindex.html"}
+    return sorted(str(p.relative_to(html)) for p in html.rglob("*.html")
+                  if p.name not in skip and not any(part.startswith("_") for part in
+                                                    p.relative_to(html).parts))
+
+
 def check_maths(b: Browser, html: Path) -> None:
-    for name in MATH_PAGES:
+    pages = site_pages(html)
+    missing = [name for name in MATH_PAGES if name not in pages]
+    if missing:
+        fail(f"pages with maths missing from the site: {missing}")
+    for name in pages:
         b.open((html / name).as_uri())
         r = b.eval(MATHS_JS)
-        if not r["mathjax"]:
+        if r["maths"] and not r["mathjax"]:
             fail(f"{name}: MathJax did not load")
-        if r["maths"] < 5:
+        if name in MATH_PAGES and r["maths"] < 5:
             fail(f"{name}: only {r['maths']} maths elements (the page's maths is not written as maths)")
         if r["rendered"] != r["maths"]:
             fail(f"{name}: {r['maths'] - r['rendered']} of {r['maths']} maths elements not typeset")

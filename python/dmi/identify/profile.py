@@ -96,7 +96,9 @@ def profile_likelihood(estimate: Estimate, index: int | str, *, level: float = 0
                          "measured from it: refit (more max_nfev, another p0 or multistart) and "
                          "profile a converged estimate")
     i = _index(index, estimate.names)
-    if not estimate.free[i]:
+    if not estimate.free[i] and estimate.names[i] not in estimate.insensitive:
+        # (a parameter kept at p0 for having no effect there is profiled: its profile says
+        # where it starts to matter)
         raise ValueError(f"parameter {estimate.names[i]!r} was fixed in the fit; profile a fitted one")
     if not 0.0 < level < 1.0:
         raise ValueError(f"level = {level!r}: expected a number in (0, 1)")
