@@ -28,7 +28,8 @@ Kernels: exponential sums and the truncation at tau exactly; a fitted kernel's n
 s^-beta C on (0, delta] (``set_kernel_fit`` of a fitted PowerKernel) by product integration
 (:mod:`dmi.analysis.collocation_mesh`); jumps of H inside (0, tau) given as ``kernel_jumps`` cut
 the pieces.  Limits: a jump not given caps the order at 1 (a callback kernel is sampled for jumps
-and a CollocationWarning names the lag found); a user resolvent (``set_resolvent``) has no A to
+before any mesh is solved, a CollocationWarning names the lag found, and a declared lag where H
+does not jump is refused); a user resolvent (``set_resolvent``) has no A to
 collocate (use ``refine_orbit``); near cells of any other form are refused.
 """
 from __future__ import annotations
@@ -298,7 +299,7 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
         The lags in (0, tau) where the kernel jumps: the delay integral's pieces are cut there,
         so the order holds (the orbit keeps them for its continuation).  A jump not given caps
         the order at 1: a callback kernel is sampled and a jump found is warned of
-        (CollocationWarning, naming its lag).
+        (CollocationWarning, naming its lag); a lag given where it does not jump is refused.
 
     Returns
     -------
@@ -311,12 +312,20 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     TypeError
         ``orbit`` is not an Orbit of the scheme.
     ValueError
-        Bad degree, intervals, tol or kernel_jumps; a model with a user resolvent (use
-        ``refine_orbit``) or with near cells not of a fitted PowerKernel; a result that still
-        breaks an inequality of its signature after MENDS mends (the message names it; refine
-        the scheme's orbit); the estimated error still above ``tol`` at the largest mesh.
+        Bad degree, intervals, tol or kernel_jumps (a declared lag where a callback kernel
+        does not jump); an orbit whose period is not finite, not steps h, or not a period of
+        the model's forcing; a model ``make(p)`` of another dimension; a constant autonomous
+        orbit (an equilibrium); a memory spanning so many periods that the delay integral would
+        exceed MAX_DELAY_NODES; a model with a user resolvent (use ``refine_orbit``) or with
+        near cells not of a fitted PowerKernel; a result that still breaks an inequality of its
+        signature after MENDS mends (the message names it; refine the scheme's orbit); with
+        ``intervals=None``, the estimate at its floor (FLOOR) above ``tol``, stopped falling,
+        or needing more than MAX_INTERVALS intervals or MAX_ROUNDS rounds (the message names
+        the estimate reached and its mesh).
     ShootingError
-        Newton fails.
+        Newton fails; from the scheme's orbit (the first solve), or onto the equilibrium, with
+        a message saying that the scheme's orbit is too far from the equation's and what to
+        do.
     """
     if not isinstance(orbit, Orbit):
         raise TypeError(f"collocate: give an Orbit of the scheme (periodic_orbit, hopf_orbit), "
@@ -338,7 +347,8 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     bounds = lay.bounds(b0, T0)
     L = int(intervals) if intervals is not None else max(16, 4 * (bounds.size - 1))
     L0 = max(8, 2 * (bounds.size - 1), L // 2)        # a first solve: the indicator, the phase
-    check_cost(terms, m, L0, T0, "the first mesh")
+    check_cost(terms, m, L0, T0, "the first mesh", "check orbit.period (a period far shorter "
+               "than the memory is no orbit of the scheme)")
     lay = lay.with_fractions(uniform_fractions(bounds, L0))
     t_s = np.asarray(orbit.t, dtype=float)
 
@@ -441,7 +451,8 @@ def _levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: b
         lay, x = f.lay, f.x
         if f.lay.L >= MAX_INTERVALS:
             break
-        check_cost(terms, lay.m, 2 * L, f.T, f"the next mesh ({reached})")
+        check_cost(terms, lay.m, 2 * L, f.T, f"the next mesh ({reached})",
+                   "ask a larger tol, or a higher degree")
     raise ValueError(f"collocate: the estimated error {d:.3g} is still above tol = {tol!r} at "
                      f"{f.lay.L} intervals (MAX_INTERVALS = {MAX_INTERVALS}, MAX_ROUNDS = "
                      f"{MAX_ROUNDS}): ask a larger tol or a higher degree")
@@ -560,10 +571,10 @@ def check_orbit(orbit: Orbit, terms: Terms) -> None:
                          "it: make the orbit with periodic_orbit at that period")
 
 
-def check_cost(terms: Terms, m: int, L: int, T: float, where: str) -> None:
+def check_cost(terms: Terms, m: int, L: int, T: float, where: str, fix: str) -> None:
     """ValueError when the delay integral on a mesh of L intervals of one period T needs more
     than MAX_DELAY_NODES quadrature nodes: L m collocation times, each with about L (tau / T
-    + 1) pieces of m + 1 nodes."""
+    + 1) pieces of m + 1 nodes; the message says where and ``fix``."""
     if not terms.has_kernel:
         return
     nodes = L * m * (L * (terms.tau / T + 1.0) + 2 + len(terms.H.jumps)) * (m + 1)
@@ -572,9 +583,7 @@ def check_cost(terms: Terms, m: int, L: int, T: float, where: str) -> None:
                          f"{nodes:.3g} quadrature nodes (L = {L} intervals; the memory tau = "
                          f"{terms.tau!r} spans {terms.tau / T:.3g} periods T = {T!r}), more "
                          f"than MAX_DELAY_NODES = {MAX_DELAY_NODES:g} (about 100 bytes each): "
-                         + ("check orbit.period (a period far shorter than the memory is no "
-                            "orbit of the scheme)" if "first" in where
-                            else "ask a larger tol, or a higher degree"))
+                         f"{fix}")
 
 
 def too_far(orbit: Orbit) -> str:

@@ -332,8 +332,9 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     Raises
     ------
     ValueError
-        Bad input: not a HopfPoint, omega <= 0, amplitude <= 0, u_eq not n numbers, a jump
-        outside (0, tau).
+        Bad input: not a HopfPoint, omega <= 0, amplitude <= 0, u_eq not n finite numbers or
+        not an equilibrium of the equation at p (its residual above EQUILIBRIUM_TOL of its
+        terms' size), a jump outside (0, tau) or declared where the kernel does not jump.
     ShootingError
         Newton fails.
     """
