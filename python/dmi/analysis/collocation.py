@@ -28,7 +28,8 @@ Kernels: exponential sums and the truncation at tau exactly; a fitted kernel's n
 s^-beta C on (0, delta] (``set_kernel_fit`` of a fitted PowerKernel) by product integration
 (:mod:`dmi.analysis.collocation_mesh`); jumps of H inside (0, tau) given as ``kernel_jumps`` cut
 the pieces.  Limits: a jump not given caps the order at 1 (a callback kernel is sampled for jumps
-and a CollocationWarning names the lag found); a user resolvent (``set_resolvent``) has no A to
+before any mesh is solved, a CollocationWarning names the lag found, and a declared lag where H
+does not jump is refused); a user resolvent (``set_resolvent``) has no A to
 collocate (use ``refine_orbit``); near cells of any other form are refused.
 """
 from __future__ import annotations
@@ -43,10 +44,11 @@ from .collocation_floquet import multipliers as floquet
 from .collocation_mesh import delay_matrix, equidistribute, periodic_locator
 from .collocation_signature import read_signature, violations
 from .collocation_system import (CollocationWarning, Layout, Terms, carried, evaluate,
-                                 interval_counts, node_times, solve, undeclared_jumps,
-                                 uniform_fractions)
+                                 interval_counts, misdeclared_jumps, node_times, solve,
+                                 undeclared_jumps, uniform_fractions)
 from .collocation_mend import mend
 from .equation_orbit import EquationOrbit
+from .newton import ShootingError
 from .orbit import Orbit
 from .stepmap import build
 
@@ -60,6 +62,14 @@ MENDS = 4
 MAX_INTERVALS = 4000
 #: The errors' floor, relative to their quantities (Newton's 1e-12 and the conditioning).
 FLOOR = 1e-11
+#: The least observed order of the refinement's estimate (log of its fall over log of the mesh's
+#: growth): below it the estimate has stopped falling.
+LEAST_ORDER = 0.5
+#: Quadrature nodes of the delay integral at most on one mesh (about 100 bytes each): a memory
+#: spanning many periods (tau / T large) or a very fine mesh is refused before it is built.
+MAX_DELAY_NODES = 2e7
+#: A forced model's rhs f(t + T, u) against f(t, u) at these many points of the orbit.
+FORCING_POINTS = 16
 
 
 def halved(fractions: list[np.ndarray]) -> list[np.ndarray]:
@@ -289,7 +299,7 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
         The lags in (0, tau) where the kernel jumps: the delay integral's pieces are cut there,
         so the order holds (the orbit keeps them for its continuation).  A jump not given caps
         the order at 1: a callback kernel is sampled and a jump found is warned of
-        (CollocationWarning, naming its lag).
+        (CollocationWarning, naming its lag); a lag given where it does not jump is refused.
 
     Returns
     -------
@@ -302,12 +312,20 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     TypeError
         ``orbit`` is not an Orbit of the scheme.
     ValueError
-        Bad degree, intervals, tol or kernel_jumps; a model with a user resolvent (use
-        ``refine_orbit``) or with near cells not of a fitted PowerKernel; a result that still
-        breaks an inequality of its signature after MENDS mends (the message names it; refine
-        the scheme's orbit); the estimated error still above ``tol`` at the largest mesh.
+        Bad degree, intervals, tol or kernel_jumps (a declared lag where a callback kernel
+        does not jump); an orbit whose period is not finite, not steps h, or not a period of
+        the model's forcing; a model ``make(p)`` of another dimension; a constant autonomous
+        orbit (an equilibrium); a memory spanning so many periods that the delay integral would
+        exceed MAX_DELAY_NODES; a model with a user resolvent (use ``refine_orbit``) or with
+        near cells not of a fitted PowerKernel; a result that still breaks an inequality of its
+        signature after MENDS mends (the message names it; refine the scheme's orbit); with
+        ``intervals=None``, the estimate at its floor (FLOOR) above ``tol``, stopped falling,
+        or needing more than MAX_INTERVALS intervals or MAX_ROUNDS rounds (the message names
+        the estimate reached and its mesh).
     ShootingError
-        Newton fails.
+        Newton fails; from the scheme's orbit (the first solve), or onto the equilibrium, with
+        a message saying that the scheme's orbit is too far from the equation's and what to
+        do.
     """
     if not isinstance(orbit, Orbit):
         raise TypeError(f"collocate: give an Orbit of the scheme (periodic_orbit, hopf_orbit), "
@@ -320,14 +338,17 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
                          "None to adapt")
     if not (tol > 0 and math.isfinite(tol)):
         raise ValueError(f"collocate: tol = {tol!r}: give a finite tol > 0")
+    T0 = checked_period(orbit)
     terms = Terms(build(orbit.make, orbit.p), kernel_jumps)
-    warn_jumps(terms, "collocate")
+    check_orbit(orbit, terms)
+    capped = check_jumps(terms, "collocate")
     sig, b0 = read_signature(orbit.u, orbit.h, terms.alpha, terms.lo, terms.hi)
-    T0 = float(orbit.period)
     lay = Layout(m, terms.n, sig, [], bool(orbit.autonomous), T0, carried(terms, sig))
     bounds = lay.bounds(b0, T0)
     L = int(intervals) if intervals is not None else max(16, 4 * (bounds.size - 1))
     L0 = max(8, 2 * (bounds.size - 1), L // 2)        # a first solve: the indicator, the phase
+    check_cost(terms, m, L0, T0, "the first mesh", "check orbit.period (a period far shorter "
+               "than the memory is no orbit of the scheme)")
     lay = lay.with_fractions(uniform_fractions(bounds, L0))
     t_s = np.asarray(orbit.t, dtype=float)
 
@@ -338,11 +359,18 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
                          [T0] if orbit.autonomous else []])
     ref0 = _reference(lay, x0) if orbit.autonomous else None
     what = f"collocation of the orbit at p = {orbit.p!r}"
-    x1, _ = solve(lay, terms, x0, ref0, what=what)
+    try:
+        x1, _ = solve(lay, terms, x0, ref0, what=what)
+    except ShootingError as err:
+        raise ShootingError(f"{err} -- {too_far(orbit)}", err.residuals) from None
+    if orbit.autonomous:
+        fell_to_equilibrium(lay, x1, orbit)
     ref = _reference(lay, x1) if orbit.autonomous else None
     count = int(multipliers)
     for attempt in range(MENDS + 1):
-        c, f = _levels(lay, terms, x1, ref, L, intervals is not None, tol, count, what)
+        c, f = _levels(lay, terms, x1, ref, L, intervals is not None, tol, count, what, capped)
+        if orbit.autonomous:
+            fell_to_equilibrium(f.lay, f.x, orbit)
         bad = check_inequalities(f.lay, terms, f.x, 1e-9 * max(1.0, float(np.max(np.abs(f.x)))))
         if not bad:
             return _result(orbit, terms, c, f, count)
@@ -358,32 +386,76 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
 
 
 def _levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bool,
-            tol: float, count: int, what: str) -> tuple[Solved, Solved]:
+            tol: float, count: int, what: str, capped: list[float] | None = None
+            ) -> tuple[Solved, Solved]:
     """The orbit on L intervals equidistributed (``fixed``) or refined until the estimate is
-    below tol, and on that mesh halved: (coarser, finer)."""
+    below tol, and on that mesh halved: (coarser, finer).
+
+    The refinement stops with a ValueError that names the estimate reached and its mesh when
+    the estimate is at its floor (FLOOR times the period or the amplitudes, at least 1), when
+    it has stopped falling (an observed order below LEAST_ORDER), when the observed order (1
+    with an undeclared jump of the kernel, ``capped``) says tol needs more than MAX_INTERVALS
+    intervals, when the next mesh's delay integral would exceed MAX_DELAY_NODES, or after
+    MAX_ROUNDS rounds."""
     last = None
+    autonomous = lay.autonomous
+    name = "period" if autonomous else "amplitudes"
     for _ in range(MAX_ROUNDS):
         lay2 = lay.with_fractions(adapted(lay, x, L))
         c, f = _refine(lay2, terms, transfer(lay, x, lay2), ref, count, what)
         if fixed:
             return c, f
-        d = (abs(c.T - f.T) if lay.autonomous
+        d = (abs(c.T - f.T) if autonomous
              else float(np.max(np.abs(c.amplitude - f.amplitude))))
         if d <= tol:
             return c, f
+        size = f.T if autonomous else float(np.max(np.abs(f.amplitude)))
+        floor = FLOOR * max(1.0, size)
+        reached = (f"the estimated error of the {name} is {d:.3g} at {f.lay.L} intervals of "
+                   f"degree {lay.m}")
+        below = (f"collocate: tol = {tol!r} is below the floor of double precision, "
+                 f"{floor:.3g} (FLOOR = {FLOOR:g} times the {name}, at least 1), where a finer "
+                 f"mesh no longer lowers the estimate: {reached}; ask tol >= {floor:.2g}")
+        if d <= floor:
+            raise ValueError(below)
         # the expected order: the period's h^(2m) (superconvergent), an extremum's h^(m+1)
-        grow = (d / tol) ** (1.0 / (2 * lay.m if lay.autonomous else lay.m + 1)) * 1.2
-        if last is not None and last[1] > d > 0:               # the observed order
+        expected = 2 * lay.m if autonomous else lay.m + 1
+        q = 1.0 if capped else None
+        if last is not None and last[1] > 0:                       # the observed order
             q = math.log(last[1] / d) / math.log(L / last[0])
-            if q > lay.m:
-                grow = (d / tol) ** (1.0 / q) * 1.1
+            if q < LEAST_ORDER:
+                raise ValueError(f"collocate: the estimated error has stopped falling: it was "
+                                 f"{last[1]:.3g} at {2 * last[0]} intervals, {reached} "
+                                 f"(observed order {q:.2g}): tol = {tol!r} is below what this "
+                                 "orbit's collocation reaches (the floor of its conditioning); "
+                                 f"ask tol >= {last[1]:.2g}, or a higher degree")
+        if q is not None:
+            need = L * (d / tol) ** (1.0 / q)
+            if need > MAX_INTERVALS and tol < floor:
+                raise ValueError(below)
+            if need > MAX_INTERVALS:
+                why, fix = (f"at the observed order {q:.2g}", "ask a larger tol, or a "
+                            "higher degree")
+                if capped:
+                    why = (f"with the kernel's jump at s = {capped[0]:.10g} not declared (the "
+                           "order capped at 1)")
+                    fix = f"give kernel_jumps=({capped[0]:.10g},), or ask a larger tol"
+                raise ValueError(f"collocate: {reached}; {why}, tol = {tol!r} needs about "
+                                 f"{need:.2g} intervals, more than MAX_INTERVALS = "
+                                 f"{MAX_INTERVALS}: {fix}")
+        grow = (d / tol) ** (1.0 / expected) * 1.2
+        if q is not None and q > lay.m:
+            grow = (d / tol) ** (1.0 / q) * 1.1
         last = (L, d)
         L = min(MAX_INTERVALS, max(L + 2, math.ceil(L * min(grow, 8.0))))
         lay, x = f.lay, f.x
         if f.lay.L >= MAX_INTERVALS:
             break
+        check_cost(terms, lay.m, 2 * L, f.T, f"the next mesh ({reached})",
+                   "ask a larger tol, or a higher degree")
     raise ValueError(f"collocate: the estimated error {d:.3g} is still above tol = {tol!r} at "
-                     f"{f.lay.L} intervals: ask a larger tol or a higher degree")
+                     f"{f.lay.L} intervals (MAX_INTERVALS = {MAX_INTERVALS}, MAX_ROUNDS = "
+                     f"{MAX_ROUNDS}): ask a larger tol or a higher degree")
 
 
 def _reference(lay: Layout, x: np.ndarray) -> Any:
@@ -409,13 +481,137 @@ def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int) -> Equ
     return equation_orbit(f, float(orbit.p), orbit.make, _errors(c, f), terms.H.jumps)
 
 
-def warn_jumps(terms: Terms, what: str) -> None:
-    """A CollocationWarning for each jump of a callback kernel found and not declared."""
-    for j in undeclared_jumps(terms):
+def check_jumps(terms: Terms, what: str) -> list[float]:
+    """A callback kernel's jumps against ``kernel_jumps``, before any mesh is solved (a bounded
+    number of kernel calls: :func:`undeclared_jumps`, :func:`misdeclared_jumps`): a declared
+    lag where H does not jump raises a ValueError naming it and the jumps found; a jump found
+    and not declared is warned of (CollocationWarning naming its lag).  Returns those."""
+    found = undeclared_jumps(terms)
+    wrong = misdeclared_jumps(terms)
+    if wrong:
+        said = "; ".join(f"H does not jump at s = {j!r}" if at is None
+                         else f"H's jump near s = {j!r} is at s = {at:.15g}" for j, at in wrong)
+        elsewhere = (f"; H jumps at s = {', '.join(f'{j:.15g}' for j in found)}, not declared"
+                     if found else "")
+        right = sorted(set(j for j in terms.H.jumps if all(j != w for w, _ in wrong))
+                       | set(found) | set(at for _, at in wrong if at is not None))
+        fix = (f"give kernel_jumps=({', '.join(f'{j:.15g}' for j in right)},)" if right
+               else "give kernel_jumps=() (H has no jump found inside (0, tau))")
+        raise ValueError(f"{what}: kernel_jumps = {terms.H.jumps!r} is wrong: {said}"
+                         f"{elsewhere} (checked by bisection of H on (0, tau)): {fix}, the "
+                         "lags where H itself jumps (a kink is not a jump)")
+    for j in found:
         warnings.warn(f"{what}: the kernel jumps near the lag s = {j:.10g}, not declared: the "
                       "order of the collocation is capped at 1 there; give the jump "
                       f"(kernel_jumps=({j:.10g},) with its exact lag)", CollocationWarning,
                       stacklevel=3)
+    return found
+
+
+def checked_period(orbit: Orbit) -> float:
+    """The orbit's period, checked to be finite, > 0 and steps h (t and u of steps + 1 rows):
+    ValueError naming the field otherwise (an Orbit edited by hand)."""
+    T = float(orbit.period)
+    if not (math.isfinite(T) and T > 0):
+        raise ValueError(f"collocate: orbit.period = {orbit.period!r}: a period is finite and > "
+                         "0 (steps h of the scheme's orbit); make the orbit with "
+                         "periodic_orbit or hopf_orbit")
+    M, h = int(orbit.steps), float(orbit.h)
+    if not (M >= 1 and math.isfinite(h) and h > 0 and abs(M * h - T) <= 1e-9 * T):
+        raise ValueError(f"collocate: orbit.period = {T!r} is not its steps h = {M} x {h!r} = "
+                         f"{M * h!r}: an Orbit edited by hand; make the orbit with "
+                         "periodic_orbit (at the forcing's period, or a multiple of it) or "
+                         "hopf_orbit, whose period is the scheme's M steps")
+    u, t = np.asarray(orbit.u), np.asarray(orbit.t)
+    if u.ndim != 2 or u.shape[0] != M + 1 or t.shape != (M + 1,):
+        raise ValueError(f"collocate: orbit.u has shape {u.shape} and orbit.t {t.shape}; an "
+                         f"orbit of {M} steps has ({M + 1}, n) and ({M + 1},): an Orbit edited "
+                         "by hand; make it with periodic_orbit or hopf_orbit")
+    if not np.all(np.isfinite(u)):
+        raise ValueError("collocate: orbit.u is not finite: make the orbit with periodic_orbit "
+                         "or hopf_orbit")
+    return T
+
+
+def check_orbit(orbit: Orbit, terms: Terms) -> None:
+    """The orbit against its model ``make(p)``: the same dimension; a forced orbit's period a
+    period of the rhs (f(t + T, u) = f(t, u) at FORCING_POINTS points of the orbit, to 1e-8
+    relative); an autonomous orbit not constant (an equilibrium).  ValueError saying which."""
+    u = np.asarray(orbit.u, dtype=float)
+    if u.shape[1] != terms.n:
+        raise ValueError(f"collocate: the orbit has {u.shape[1]} components (orbit.u's columns) "
+                         f"but its model orbit.make(p = {orbit.p!r}) has n = {terms.n}: the orbit "
+                         "is of another model; collocate the orbit with the make it was found "
+                         "with")
+    T = float(orbit.period)
+    scale = max(1.0, float(np.max(np.abs(u))))
+    if orbit.autonomous:
+        spread = float(np.max(u.max(axis=0) - u.min(axis=0)))
+        if spread <= 1e-9 * scale:
+            raise ValueError(f"collocate: the orbit at p = {orbit.p!r} is constant (its states "
+                             f"differ by {spread:.3g}): an equilibrium of the model, {u[0]!r}, "
+                             "not an orbit (a constant state is periodic with any period); for "
+                             "its stability use dmi.analysis.equilibrium, for the orbits born "
+                             "at a Hopf point hopf_orbit")
+        return
+    if not terms.has_rhs:
+        return
+    k = np.linspace(0, orbit.steps, FORCING_POINTS, endpoint=False).astype(int)
+    t = np.asarray(orbit.t, dtype=float)[k]
+    f0 = terms.solver.eval_rhs_many(t, u[k])
+    f1 = terms.solver.eval_rhs_many(t + T, u[k])
+    miss = np.max(np.abs(f1 - f0), axis=1)
+    size = max(1.0, float(np.max(np.abs(f0))))
+    c = int(np.argmax(miss))
+    if miss[c] > 1e-8 * size:
+        raise ValueError(f"collocate: the orbit's period T = {T!r} is not a period of the "
+                         f"model's forcing at p = {orbit.p!r}: f(t + T, u) differs from f(t, u) "
+                         f"by {miss[c]:.3g} at t = {float(t[c])!r}, u = {u[k[c]]!r} ({miss[c] / size:.2g}"
+                         " relative); a forced orbit's period is the forcing's or a multiple of "
+                         "it: make the orbit with periodic_orbit at that period")
+
+
+def check_cost(terms: Terms, m: int, L: int, T: float, where: str, fix: str) -> None:
+    """ValueError when the delay integral on a mesh of L intervals of one period T needs more
+    than MAX_DELAY_NODES quadrature nodes: L m collocation times, each with about L (tau / T
+    + 1) pieces of m + 1 nodes; the message says where and ``fix``."""
+    if not terms.has_kernel:
+        return
+    nodes = L * m * (L * (terms.tau / T + 1.0) + 2 + len(terms.H.jumps)) * (m + 1)
+    if nodes > MAX_DELAY_NODES:
+        raise ValueError(f"collocate: the delay integral on {where} would need about "
+                         f"{nodes:.3g} quadrature nodes (L = {L} intervals; the memory tau = "
+                         f"{terms.tau!r} spans {terms.tau / T:.3g} periods T = {T!r}), more "
+                         f"than MAX_DELAY_NODES = {MAX_DELAY_NODES:g} (about 100 bytes each): "
+                         f"{fix}")
+
+
+def too_far(orbit: Orbit) -> str:
+    """What to do when Newton's method does not reach the equation's orbit from the scheme's."""
+    base = (f"the scheme's orbit (h = {orbit.h:.3g}, {orbit.steps} steps a period) is too far "
+            "from the equation's for Newton's method to start from it (the scheme's answers "
+            "are O(h) off the equation's)")
+    if not orbit.autonomous:
+        return base + ": refine the scheme's orbit (a smaller h) and collocate again"
+    return (base + "; near a Hopf point the scheme's Hopf point is O(h) off the equation's, and "
+            "at this p the equation may have no orbit of this amplitude: refine the scheme's "
+            "orbit (a smaller h) and collocate again, or start on the equation's branch, hp = "
+            "hopf(make, p_lo, p_hi, u_eq, of='equation'), then hopf_orbit(make, hp, u_eq, "
+            "amplitude=..., of='equation') and continue_orbit")
+
+
+def fell_to_equilibrium(lay: Layout, x: np.ndarray, orbit: Orbit) -> None:
+    """ShootingError when the collocated autonomous orbit x is constant (its node values
+    differ by at most 1e-9 max(1, |u|)) while the scheme's orbit moves: Newton fell onto the
+    equilibrium, which every period solves."""
+    V = lay.split(x)[0]
+    spread = float(np.max(V.max(axis=0) - V.min(axis=0)))
+    if spread > 1e-9 * max(1.0, float(np.max(np.abs(V)))):
+        return
+    raise ShootingError(f"collocation of the orbit at p = {orbit.p!r}: Newton's method fell "
+                        f"onto an equilibrium, {V[0]!r} (the collocated states differ by "
+                        f"{spread:.3g}; the scheme's orbit has the amplitudes "
+                        f"{orbit.amplitude!r}), not an orbit: {too_far(orbit)}", [])
 
 
 def equation_orbit(f: Solved, p: float, make: Any, errors: dict[str, Any],

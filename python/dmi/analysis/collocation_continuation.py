@@ -32,7 +32,8 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 
 from .collocation import (CollocationWarning, Solved, _errors, _reference, adapted,
-                          check_inequalities, equation_orbit, merged, transfer, warn_jumps)
+                          check_inequalities, check_jumps, equation_orbit, merged,
+                          transfer)
 from .collocation_mend import mend
 from .collocation_mesh import periodic_locator, point_matrix
 from .collocation_signature import SLIP_NEG, SLIP_POS, Signature
@@ -331,8 +332,9 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     Raises
     ------
     ValueError
-        Bad input: not a HopfPoint, omega <= 0, amplitude <= 0, u_eq not n numbers, a jump
-        outside (0, tau).
+        Bad input: not a HopfPoint, omega <= 0, amplitude <= 0, u_eq not n finite numbers or
+        not an equilibrium of the equation at p (its residual above EQUILIBRIUM_TOL of its
+        terms' size), a jump outside (0, tau) or declared where the kernel does not jump.
     ShootingError
         Newton fails.
     """
@@ -345,18 +347,22 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
         raise ValueError(f"amplitude = {amplitude!r}: give a finite amplitude > 0")
     p0, om = float(hopf_point.p), float(hopf_point.omega)
     terms = Terms(build(make, p0), kernel_jumps)
-    warn_jumps(terms, "hopf_orbit")
+    check_jumps(terms, "hopf_orbit")
     n = terms.n
     ue = np.asarray(u_eq, dtype=float).ravel()
     if ue.shape != (n,):
         raise ValueError(f"u_eq = {u_eq!r}: give {n} numbers (the model's n)")
+    if not np.all(np.isfinite(ue)):
+        raise ValueError(f"u_eq = {u_eq!r}: give {n} finite numbers (the equilibrium)")
+    modes = _slipping(terms, ue)
+    _equilibrium_residual(terms, ue, modes, p0)
     Jf = terms.fu(np.zeros(1), ue[None, :])[0]
     _, _, Vh = sl.svd(1j * om * np.eye(n) + Jf + _hhat(terms, 1j * om))
     v = Vh[-1].conj()
     c = int(np.argmax(np.abs(v)))
     v = v / v[c]
     T = 2 * math.pi / om
-    lay = Layout(int(degree), n, Signature(_slipping(terms, ue)[None, :]),
+    lay = Layout(int(degree), n, Signature(modes[None, :]),
                  [np.linspace(0.0, 1.0, int(intervals) + 1)], True, T)
     t = node_times(lay, np.empty(0), T)
     V = ue + a * np.real(np.outer(np.exp(1j * om * t), v))
@@ -404,6 +410,59 @@ def _slipping(terms: Terms, ue: np.ndarray) -> np.ndarray:
         elif ue[i] <= terms.lo[i] or ue[i] >= terms.hi[i]:
             raise ValueError(f"u_eq[{i}] = {ue[i]!r} is on the box's face: no Hopf orbit there")
     return modes
+
+
+def _memory_integral(terms: Terms) -> np.ndarray:
+    """int_0^tau H(s) ds (n, n): a near part s^-beta C in closed form on (0, delta], an
+    exponential sum in closed form past it, a callback kernel by Gauss-Legendre (32 panels of
+    16 nodes between each pair of its breaks: delta, the declared jumps, tau)."""
+    n, tau = terms.n, terms.tau
+    out = np.zeros((n, n))
+    if not terms.has_kernel:
+        return out
+    K = terms.H
+    lo = 0.0
+    if K.near is not None:
+        out += K.near.delta ** (1.0 - K.near.beta) / (1.0 - K.near.beta) * K.near.C
+        lo = K.near.delta
+    if terms.kind == "exp":
+        a, b, C, D = terms.terms  # type: ignore[misc]
+        z = a + 1j * b
+        safe = np.where(z == 0, 1.0, z)
+        w = np.where(z == 0, tau - lo, (np.exp(z * tau) - np.exp(z * lo)) / safe)
+        return out + np.einsum("k,kij->ij", w.real, C) + np.einsum("k,kij->ij", w.imag, D)
+    g, gw = np.polynomial.legendre.leggauss(16)
+    edges = np.array([lo] + [j for j in K.jumps if lo < j < tau] + [tau])
+    for a0, a1 in zip(edges[:-1], edges[1:]):
+        e = np.linspace(a0, a1, 33)
+        half = 0.5 * np.diff(e)
+        sn = (e[:-1, None] + half[:, None] * (g[None, :] + 1)).ravel()
+        out += np.einsum("p,pij->ij", (half[:, None] * gw[None, :]).ravel(), K(sn))
+    return out
+
+
+#: An equilibrium's residual at most, relative to its terms' size (:func:`_equilibrium_residual`).
+EQUILIBRIUM_TOL = 1e-6
+
+
+def _equilibrium_residual(terms: Terms, ue: np.ndarray, modes: np.ndarray, p: float) -> None:
+    """ValueError when u_eq is not an equilibrium of the equation at p: the residual f(0, u) +
+    int_0^tau H u + alpha_i sign(u_i) (the slipping components) above EQUILIBRIUM_TOL times the
+    size of its terms (at least 1)."""
+    f = terms.f(np.zeros(1), ue[None, :])[0]
+    mem = _memory_integral(terms) @ ue
+    fr = terms.alpha * ((modes == SLIP_POS).astype(float) - (modes == SLIP_NEG))
+    r = f + mem + fr
+    size = max(1.0, float(np.max(np.abs(np.concatenate([f, mem, fr])))))
+    i = int(np.argmax(np.abs(r)))
+    if abs(r[i]) > EQUILIBRIUM_TOL * size:
+        raise ValueError(f"hopf_orbit (of='equation'): u_eq = {ue!r} is not an equilibrium of "
+                         f"the equation at the Hopf "
+                         f"point p = {p!r}: f(0, u) + int_0^tau H u + alpha sign(u) is {r!r} "
+                         f"(component {i}: {abs(r[i]):.3g}, {abs(r[i]) / size:.2g} relative, "
+                         f"above {EQUILIBRIUM_TOL:g}); give the equation's equilibrium there "
+                         "(dmi.analysis.equilibrium(make, p, guess, of='equation').u, or the "
+                         "Hopf event's u of continue_equilibrium with of='equation')")
 
 
 def _amplitude_condition(lay: Layout, x: np.ndarray, ue: np.ndarray, c: int, a: float,

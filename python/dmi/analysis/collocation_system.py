@@ -261,11 +261,57 @@ def kernel_jumps(jumps: Any, tau: float) -> tuple[float, ...]:
     return tuple(out)
 
 
-def undeclared_jumps(terms: Terms, samples: int = 1024) -> list[float]:
-    """Lags in (0, tau) where a callback kernel jumps and that are not declared: H sampled at
-    ``samples`` lags, a cell whose difference is 4 times both its neighbours' bisected 50 times
-    towards the larger half; a jump keeps 1e-3 of its first difference, a smooth H loses 2^-50
-    of it.  Empty for an exponential sum (smooth past its near part)."""
+#: Lags at which a callback kernel is sampled for its jumps (:func:`undeclared_jumps`).
+JUMP_SAMPLES = 1024
+#: Halvings of a cell that brackets a jump (:func:`_bisect_jump`).
+JUMP_HALVINGS = 50
+
+
+def _bisect_jump(K: Kernel, lo: float, hi: float) -> tuple[float, float]:
+    """(the lag where H's difference concentrates in [lo, hi], the difference left there): the
+    cell bisected JUMP_HALVINGS times towards the half with the larger difference (3 kernel
+    calls a halving); a jump keeps its size, a smooth H loses 2^-JUMP_HALVINGS of it."""
+    for _ in range(JUMP_HALVINGS):
+        mid = 0.5 * (lo + hi)
+        v = K(np.array([lo, mid, hi])).reshape(3, -1)
+        if np.max(np.abs(v[1] - v[0])) >= np.max(np.abs(v[2] - v[1])):
+            hi = mid
+        else:
+            lo = mid
+    left = float(np.max(np.abs(np.diff(K(np.array([lo, hi])).reshape(2, -1), axis=0))))
+    return 0.5 * (lo + hi), left
+
+
+def misdeclared_jumps(terms: Terms) -> list[tuple[float, float | None]]:
+    """The declared lags where a callback kernel does not jump: (the lag, the jump found
+    within a sampling cell of it, or None), each checked by :func:`_bisect_jump` on
+    [lag - tau / JUMP_SAMPLES, lag + tau / JUMP_SAMPLES] (about 150 kernel calls a lag): no
+    jump there (the difference falls below 1e-3 of the cell's), or a jump more than 1e-9 tau
+    away.  Empty for an exponential sum (smooth: a declared lag is only a cut)."""
+    if terms.kind != "callback":
+        return []
+    K, tau = terms.H, terms.tau
+    w = tau / JUMP_SAMPLES
+    big = float(np.max(np.abs(K(np.linspace(0.0, tau, 65)[1:]))))
+    out: list[tuple[float, float | None]] = []
+    for j in K.jumps:
+        lo, hi = max(j - w, 0.5 * j), min(j + w, 0.5 * (j + tau))
+        D = float(np.max(np.abs(np.diff(K(np.array([lo, hi])).reshape(2, -1), axis=0))))
+        at, left = _bisect_jump(K, lo, hi)
+        if D > 1e-12 * big and left > 1e-3 * D:
+            if abs(at - j) > 1e-9 * tau:
+                out.append((j, at))
+        else:
+            out.append((j, None))
+    return out
+
+
+def undeclared_jumps(terms: Terms, samples: int = JUMP_SAMPLES) -> list[float]:
+    """Lags in (0, tau) where a callback kernel jumps and that are not declared (within 1e-9
+    tau): H sampled at ``samples`` lags, a cell whose difference is 4 times both its
+    neighbours' bisected (:func:`_bisect_jump`); a jump keeps 1e-3 of its first difference, a
+    smooth H loses 2^-50 of it.  Kernel calls: ``samples`` and about 150 a suspect cell.  Empty
+    for an exponential sum (smooth past its near part)."""
     if terms.kind != "callback":
         return []
     K = terms.H
@@ -277,17 +323,9 @@ def undeclared_jumps(terms: Terms, samples: int = 1024) -> list[float]:
     found = []
     for c in np.flatnonzero((D > 4 * Dn) & (D > 1e-12 * big)):
         lo, hi = float(s[c]), float(s[c + 1])
-        if any(lo - 1e-12 * terms.tau <= j <= hi + 1e-12 * terms.tau for j in K.jumps):
-            continue
-        for _ in range(50):
-            mid = 0.5 * (lo + hi)
-            v = K(np.array([lo, mid, hi])).reshape(3, -1)
-            if np.max(np.abs(v[1] - v[0])) >= np.max(np.abs(v[2] - v[1])):
-                hi = mid
-            else:
-                lo = mid
-        if np.max(np.abs(np.diff(K(np.array([lo, hi])).reshape(2, -1), axis=0))) > 1e-3 * D[c]:
-            found.append(0.5 * (lo + hi))
+        at, left = _bisect_jump(K, lo, hi)
+        if left > 1e-3 * D[c] and not any(abs(at - j) <= 1e-9 * terms.tau for j in K.jumps):
+            found.append(at)
     return found
 
 
@@ -586,7 +624,7 @@ def solve(lay: Layout, terms: Terms, x0: np.ndarray, ref: Callable | None, *,
     ------
     ShootingError
         No convergence in max_iter, no progress, a singular Jacobian, a non-finite residual, a
-        segment that vanishes on a fresh step (the signature changed).
+        fresh step rejected at every length (:func:`reject_why`).
     """
     res: list[float] = []
 
@@ -599,9 +637,20 @@ def solve(lay: Layout, terms: Terms, x0: np.ndarray, ref: Callable | None, *,
 
     return newton_loop(evaluate, factor, x0, tol=tol, max_iter=max_iter, what=what,
                        converge="correction", chord=0.1, search="descent", reject=(Degenerate,),
-                       reject_why="a segment vanishes (the signature changed)", history=res,
+                       reject_why=reject_why(lay), history=res,
                        stall=False, floor=FLOOR_ITERATIONS if accuracy is not None else 0,
                        accuracy=accuracy)
+
+
+def reject_why(lay: Layout) -> str:
+    """What a Newton step that :func:`assemble` rejects (:class:`Degenerate`) on every length
+    tried means: with switches, a segment that vanishes (the signature read from the start no
+    longer holds); without, a period that leaves (0, inf) (Newton diverges)."""
+    if lay.S > 0:
+        return ("a segment of the signature vanishes on every step length tried (the start's "
+                "signature " + ", ".join(lay.signature.describe()) + " does not hold near it)")
+    return ("the period leaves (0, inf) on every step length tried (Newton diverges from the "
+            "start)")
 
 
 def _factor(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None, what: str,

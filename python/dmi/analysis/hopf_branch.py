@@ -141,7 +141,9 @@ def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: floa
         a root off the imaginary axis, amplitude <= 0, steps < 8, a component
         out of range or not moving in the critical mode, a model that does not take h; ``of``
         not "scheme" or "equation", ``component`` or ``verify`` with ``of="equation"``,
-        ``kernel_jumps`` with ``of="scheme"`` (the scheme's cell rule locates jumps itself).
+        ``kernel_jumps`` with ``of="scheme"`` (the scheme's cell rule locates jumps itself);
+        with ``of="equation"``, a ``u_eq`` that is not an equilibrium of the equation at the
+        Hopf point.
     ShootingError
         Newton fails (every residual listed).
     """
