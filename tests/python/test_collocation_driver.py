@@ -110,10 +110,11 @@ def test_continue_orbit_verify_reports_verified_stability():
     with warnings.catch_warnings():
         warnings.simplefilter("error", da.StabilityWarning)
         b = da.continue_orbit(o, 1.5, step=0.25, multipliers=2, verify=da.Verify())
-    plain = da.continue_orbit(o, 1.5, step=0.25, multipliers=2)
+    with pytest.warns(UserWarning, match="verify=False"):
+        plain = da.continue_orbit(o, 1.5, step=0.25, multipliers=2, verify=False)
     assert b.points[-1].p == pytest.approx(1.5, abs=1e-12)
     for q in b.points:
         assert q.floquet is not None and q.stable is True
         assert np.all(np.isfinite(q.floquet.errors[:2]))
         assert np.all(np.abs(np.abs(q.multipliers[:2]) - closed) < 1e-6)
-    assert all(q.floquet is None for q in plain.points)
+    assert all(q.floquet is None and q.stable is None for q in plain.points)
