@@ -225,6 +225,7 @@ class Solver:
         self._near_delta = 0.0                  # delta of set_kernel_near (0: no near cells)
         self._fit: tuple | None = None          # (fit, entry) of set_kernel_fit
         self._failure: list = [None]           # an exception raised in a Python callback
+        self._derivatives: tuple | None = None  # (fu, d2, d3) of set_rhs_derivatives
         self._busy = threading.Lock()
 
     # ---- helpers -----------------------------------------------------------------------------
@@ -357,6 +358,63 @@ class Solver:
             array, or a ``user``.
         """
         self._set_callback("rhs", cb.RHS, _L.dmi_set_rhs, f, user, jit)
+        self._derivatives = None   # those of the former f: set them again for this one
+
+    def set_rhs_derivatives(self, fu: Callable[..., Any] | None,
+                            d2: Callable[..., Any] | None = None,
+                            d3: Callable[..., Any] | None = None) -> None:
+        """Sets the derivatives of f in u, for the analyses that differentiate f
+        (:mod:`dmi.analysis`: the Jacobian at an equilibrium, the first Lyapunov coefficient of a
+        Hopf point); the scheme does not use them.  Without them those analyses take central
+        differences of f (docs/stability.md, "Criticality of a Hopf point").  Call it after
+        :meth:`set_rhs`: setting f again forgets them.
+
+        Parameters
+        ----------
+        fu : callable or None
+            ``fu(t, u) -> array (n, n)``: the Jacobian df/du (units of f per state unit).  None
+            forgets all three.
+        d2 : callable, optional
+            ``d2(t, u, v, w) -> array (n)``: the second derivative of f at u in the directions
+            v and w, sum_jk d^2 f / du_j du_k v_j w_k.
+        d3 : callable, optional
+            ``d3(t, u, v, w, z) -> array (n)``: the third derivative in the directions v, w, z.
+            Given without d2 it is not used for the Jacobian's directional derivatives; each
+            missing one is taken by central differences of the next lower one given (or of f).
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.EINVAL``: a derivative that is not callable, d2 or d3 without fu, or no
+            f set (:meth:`set_rhs`) to be the derivatives of.
+
+        Notes
+        -----
+        The functions are Python callables, called with float64 NumPy arrays (t a float); the
+        analyses check fu and d2, d3 against central differences of f at the points they use
+        them and refuse derivatives that disagree.
+        """
+        for name, g in (("fu", fu), ("d2", d2), ("d3", d3)):
+            if g is not None and not callable(g):
+                raise InvalidArgument(_lib.EINVAL, f"set_rhs_derivatives: {name} = {g!r} is not "
+                                      "callable (give a function, or None)")
+        if fu is None:
+            if d2 is not None or d3 is not None:
+                raise InvalidArgument(_lib.EINVAL, "set_rhs_derivatives: d2 or d3 without fu; "
+                                      "give the Jacobian fu(t, u) too")
+            self._derivatives = None
+            return
+        if not self.has("rhs"):
+            raise InvalidArgument(_lib.EINVAL, "set_rhs_derivatives: no right-hand side f is set; "
+                                  "call set_rhs(f) first (setting f forgets its derivatives)")
+        self._derivatives = (fu, d2, d3)
+
+    @property
+    def rhs_derivatives(self) -> tuple[Callable[..., Any], Callable[..., Any] | None,
+                                       Callable[..., Any] | None] | None:
+        """(fu, d2, d3) of :meth:`set_rhs_derivatives` (d2, d3 None where not given), None where
+        none is set."""
+        return self._derivatives
 
     def set_resolvent(self, r: Callback | None, user: Any = None, *, jit: bool = False) -> None:
         """Sets A through its resolvent (``dmi_set_resolvent``).  Replaces an earlier resolvent,

@@ -136,6 +136,38 @@ def _central(g: Callable[[np.ndarray], np.ndarray], x: np.ndarray, scale: float,
     return Jac
 
 
+#: The Jacobian of a derivative hook may differ from central differences of f by this much,
+#: relative to max(1, |J|) (the differences' own error is about 1e-10).
+HOOK_TOL = 1e-6
+
+
+def rhs_jacobian(s: Solver, t: float, u: np.ndarray) -> np.ndarray:
+    """f_u(t, u) (n x n): the model's derivative hook ``fu`` (:meth:`dmi.Solver.set_rhs_derivatives`),
+    checked against central differences of f (ValueError naming the hook where they disagree),
+    or those differences where no hook is set; 0 without a right-hand side."""
+    n = s.n
+    if not s.has("rhs"):
+        return np.zeros((n, n))
+    J = _central(lambda x: _call(s, "rhs", t, x), u, np.max(np.abs(u)) or 1.0, None)
+    hook = s.rhs_derivatives
+    if hook is None:
+        return J
+    try:
+        Jh = np.array(hook[0](float(t), np.array(u, dtype=float)), dtype=float)
+    except BaseException as e:
+        e.add_note(f"dmi.analysis: raised by the model's derivative fu at t = {t!r}, u = {u!r}")
+        raise
+    if Jh.shape != (n, n) or not np.all(np.isfinite(Jh)):
+        raise ValueError(f"dmi.analysis: the derivative hook fu(t, u) of set_rhs_derivatives "
+                         f"returned {Jh!r} at u = {u!r}: give n x n = {n} x {n} finite numbers")
+    gap = float(np.max(np.abs(Jh - J)))
+    if gap > HOOK_TOL * max(1.0, float(np.max(np.abs(J)))):
+        raise ValueError(f"dmi.analysis: the derivative hook fu of set_rhs_derivatives disagrees "
+                         f"with central differences of f at u = {u!r} by {gap:.3g} (fu = {Jh!r}, "
+                         f"differences {J!r}): correct fu (df_i/du_j in row i, column j)")
+    return Jh
+
+
 def _resolvent_derivative(s: Solver, X: np.ndarray, h: float, scale: float) -> np.ndarray:
     """D = R'(X): exact for the built-in friction and box, central differences for a callback."""
     n = s.n
@@ -294,10 +326,7 @@ class Linearisation:
                              f"{scale:.3g}; tolerance {tol:g}): correct it with "
                              "dmi.analysis.equilibrium")
         scale_u = max(np.max(np.abs(u)), np.max(np.abs(X))) or 1.0
-        if not s.has("rhs"):
-            J = np.zeros((n, n))
-        else:
-            J = _central(lambda x: _call(s, "rhs", t0, x), u, np.max(np.abs(u)) or 1.0, None)
+        J = rhs_jacobian(s, t0, u)
         self.D = _resolvent_derivative(s, X, h, scale_u)
         self.J, self.u_eq, self.X = J, u, X
         self.n, self.N, self.h, self.tau = n, N, h, s.tau

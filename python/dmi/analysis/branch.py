@@ -27,10 +27,40 @@ class HopfPoint:
         not a Hopf point).
     root : complex
         The root there, Im >= 0 (1 / time unit).
+    l1 : float or None
+        The first Lyapunov coefficient in Kuznetsov's normalisation (q^H q = 1,
+        p Delta'(i omega) q = 1; l1 = Re c1 / omega), of the equation's Hopf points only
+        (``hopf(..., of="equation")``, a branch of the equation's equilibria); None for the
+        scheme's, or where it could not be computed (a warning says why).
+    l1_error : float or None
+        Its estimated error (units of l1).
+    criticality : str or None
+        ``"supercritical"`` (l1 < 0: a stable orbit is born) or ``"subcritical"`` (l1 > 0: an
+        unstable one), only where |l1| > l1_error; else None.
+    kappa : numpy.ndarray or None
+        Shape (n,): the amplitude coefficients of the orbit born there, (max - min) / 2 of
+        component j ~ kappa_j sqrt|p - p_H| on the side :attr:`side` (state units per
+        sqrt(parameter unit)); None where the criticality or the crossing speed is not decided.
+    crossing_speed : float or None
+        Re lambda'(p_H), the speed at which the pair crosses the imaginary axis (1 / (time unit
+        parameter unit)); None where not computed.
     """
     p: float
     omega: float
     root: complex
+    l1: float | None = None
+    l1_error: float | None = None
+    criticality: str | None = None
+    kappa: np.ndarray | None = field(default=None, compare=False)
+    crossing_speed: float | None = None
+
+    @property
+    def side(self) -> int | None:
+        """+1 where the orbit born exists for p > p_H, -1 for p < p_H (the sign of
+        -l1 Re lambda'(p_H)); None where the criticality or the crossing speed is unknown."""
+        if self.criticality is None or not self.crossing_speed:
+            return None
+        return -1 if (self.l1 > 0) == (self.crossing_speed > 0) else 1
 
 
 #: Samples of the period a branch point keeps (:attr:`BranchPoint.u`).

@@ -39,6 +39,7 @@ from ._model import KinkError, equation_step
 from .branch import Branch, HopfPoint
 from .driver import Curve, continuation, newton_corrector
 from .newton import ShootingError
+from .normal_form import criticality
 from .problem import Problem
 from .stability import check_of, roots
 from .stepmap import Model
@@ -262,6 +263,8 @@ class Equilibria:
                 root = complex(c[np.argmin(np.abs(c.real))])
                 if abs(root.real) <= ON_AXIS * max(1.0, abs(root)):
                     hp = HopfPoint(p=p, omega=root.imag, root=root)
+                    if self.of == "equation":
+                        hp = criticality(self.make, hp, x, tol=max(self.tol * 1e3, 1e-9))
                     return {"hopf": hp, "u": x, "detail": "a pair of roots crosses the "
                             f"imaginary axis at omega = {hp.omega:.8g}"}
             r = lam[np.isfinite(lam) & ~(lam.imag > REAL * np.maximum(1.0, np.abs(lam)))].real

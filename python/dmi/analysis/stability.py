@@ -17,6 +17,7 @@ from ._blas import _one_blas_thread
 from ._model import Linearisation, call_make
 from .branch import HopfPoint
 from .equation import equation_roots
+from .normal_form import criticality
 
 #: At most this many state dimensions n N: the one-step matrix is formed and its eigenvalues taken
 #: directly (Arnoldi needs a state larger than the roots asked for).
@@ -240,7 +241,9 @@ def hopf(make: Callable[[float], Solver], p_lo: float, p_hi: float, u_eq: Any, *
     Returns
     -------
     HopfPoint
-        ``.p``, ``.omega`` (|Im lambda_1|; 0: a real root crosses, a fold) and ``.root``.
+        ``.p``, ``.omega`` (|Im lambda_1|; 0: a real root crosses, a fold) and ``.root``;
+        with ``of="equation"`` also ``.l1``, ``.l1_error``, ``.criticality``, ``.kappa`` and
+        ``.crossing_speed`` (:func:`dmi.analysis.normal_form.criticality`).
 
     Raises
     ------
@@ -270,4 +273,5 @@ def hopf(make: Callable[[float], Solver], p_lo: float, p_hi: float, u_eq: Any, *
                                   maxiter=200)
     lam = roots(make, p, u_eq, count, tol=tol, of=of)[0]
     lam = complex(lam.real, abs(lam.imag))
-    return HopfPoint(p=float(p), omega=abs(lam.imag), root=lam)
+    hp = HopfPoint(p=float(p), omega=abs(lam.imag), root=lam)
+    return criticality(make, hp, u_eq, tol=tol) if of == "equation" else hp
