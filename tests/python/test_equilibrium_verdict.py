@@ -186,6 +186,8 @@ def test_opt_out_and_branch():
     assert any(issubclass(w.category, UserWarning) and "verify" in str(w.message) for w in got)
     with pytest.raises(ValueError, match="verify"):
         analysis.equilibrium(mean_delay, 1.0, [0.0], verify="yes")
+    with pytest.raises(ValueError, match="verify"):
+        analysis.continue_equilibrium(eq, 0.9 * A_STAR, verify=1)
     with warnings.catch_warnings(record=True) as got:
         warnings.simplefilter("always")
         br = analysis.continue_equilibrium(eq, 0.9 * A_STAR, step=0.5, verify=False)

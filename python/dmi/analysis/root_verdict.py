@@ -41,7 +41,8 @@ from .equation import ROOT_TOL, Characteristic
 
 #: Samples of the line at most (beyond them the count is left undecided).
 MAX_SAMPLES = 400_000
-#: An interval of the line is halved while its length times |d log det Delta / d lambda| exceeds this.
+#: An interval of the line is halved while its length times |d log det Delta / d lambda| exceeds
+#: this.
 STEP = 0.3
 #: The scheme's second eigen-solve: multipliers asked, Krylov space (at least), start vector.
 SECOND_MULTIPLIERS = 4
@@ -121,7 +122,8 @@ def count_right(ch: Characteristic, sigma: float, max_samples: int = MAX_SAMPLES
         return None, f"a root lies on the line Re lambda = {sigma:.3g} (det Delta = 0 there)"
     turned = float(np.sum(np.angle(np.exp(1j * np.diff(phase)))))
     end = complex(sigma, omega)
-    tail = float(np.angle(np.exp(1j * (phase[-1] - m * np.angle(end)))))   # arg det Delta / lambda^m
+    # arg(det Delta / lambda^m) at the line's end
+    tail = float(np.angle(np.exp(1j * (phase[-1] - m * np.angle(end)))))
     z = (m * math.atan2(omega, sigma) + tail - turned) / math.pi
     count = round(z)
     if abs(z - count) > 0.05 or count < 0:
