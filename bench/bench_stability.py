@@ -13,8 +13,12 @@
 #    periods, velocity-weakening friction), at M steps a period (M = 1250: h = 0.005, N = 1e4):
 #    the verdict's wall-clock time, its operator products and plain-run periods, against one
 #    period's simulation.
+# 4. The verified verdict of an equilibrium by default (dmi.analysis.root_verdict): equilibrium()
+#    of the oscillator with verify=True against verify=False, for the scheme (a second
+#    eigen-solve) and the equation (the argument principle), at N = 1e3, 1e4 (--verify-N), CPU
+#    time, the fastest of the interleaved rounds.
 # Usage: bench/bench_stability.py [--N 1000 10000 100000] [--rounds R] [--chart P Q] [--chart-N N]
-#        [--workers W] [--no-dask] [--chart-rounds R] [--verdict-M 200 1250]
+#        [--workers W] [--no-dask] [--chart-rounds R] [--verdict-M 200 1250] [--verify-N 1000 10000]
 #        (needs dmi importable: PYTHONPATH=<build>/python; numba)
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
@@ -181,6 +185,37 @@ def bench_verdict(Ms: list[int]) -> None:
                   f"{one * 1e3:.1f} ms), {fl.products} products, {fl.reason}")
 
 
+def bench_verify(Ns: list[int], rounds: int) -> None:
+    """equilibrium() with and without the verdict's verification, interleaved."""
+    import warnings
+    cases = [(k, N, of, a) for N in Ns for k in ("exp", "callback") for of in ("scheme", "equation")
+             for a in ((0.5, A_GAIN) if k == "exp" else (A_GAIN,))]
+    # a = 0.5: a stable point, where the count runs (the callback kernel's gain is fixed at 1)
+    best: dict = {}
+    for _ in range(rounds):
+        for c in cases:
+            k, N, of, a = c
+            for verify in (False, True):
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", UserWarning)
+                    t0 = time.process_time()
+                    eq = analysis.equilibrium(lambda g: model(k, N, g), a, [0.0, 0.0],
+                                              of=of, verify=verify)
+                    dt = time.process_time() - t0
+                key = c + (verify,)
+                if dt < best.get(key, (math.inf,))[0]:
+                    best[key] = (dt, eq.stable, eq.reason)
+    print(f"equilibrium(count = 6), n = 2, tau = {TAU}: verify=False against verify=True, best of "
+          f"{rounds} interleaved rounds, CPU time")
+    print(f"{'kernel':>8} {'N':>7} {'of':>9} {'a':>4} {'unverified (s)':>15} {'verified (s)':>13} "
+          f"{'ratio':>6}  verdict")
+    for c in cases:
+        off, on = best[c + (False,)], best[c + (True,)]
+        print(f"{c[0]:>8} {c[1]:>7} {c[2]:>9} {c[3]:4} {off[0]:15.4f} {on[0]:13.4f} "
+              f"{on[0] / off[0]:6.2f}"
+              f"  {on[1]} ({on[2][:60]})")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(
         description="Prints the cost of roots(count = 10) of the distributed-delay oscillator "
@@ -188,8 +223,8 @@ def main() -> None:
                     "processes and on a Dask LocalCluster, and of the verified verdict of the "
                     "Stribeck belt's orbits.",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
-    ap.add_argument("--N", type=int, nargs="+", default=[1000, 10000, 100000],
-                    help="steps per delay of the roots cases")
+    ap.add_argument("--N", type=int, nargs="*", default=[1000, 10000, 100000],
+                    help="steps per delay of the roots cases (none: skip parts 1-3)")
     ap.add_argument("--rounds", type=int, default=3, help="interleaved rounds of the roots cases")
     ap.add_argument("--chart", type=int, nargs=2, default=[100, 100], metavar=("P", "Q"),
                     help="grid of the chart (0 0: no chart)")
@@ -199,7 +234,13 @@ def main() -> None:
     ap.add_argument("--chart-rounds", type=int, default=2, help="interleaved rounds of the chart")
     ap.add_argument("--verdict-M", type=int, nargs="*", default=[200, 1250],
                     help="steps a period of the belt's verdicts (none: skip)")
+    ap.add_argument("--verify-N", type=int, nargs="*", default=[1000, 10000],
+                    help="steps per delay of the verified equilibria (none: skip)")
     a = ap.parse_args()
+    if a.verify_N:
+        bench_verify(a.verify_N, a.rounds)
+    if not a.N:
+        return
     bench_roots(a.N, a.rounds)
     if a.chart[0] > 0:
         bench_chart(a.chart[0], a.chart[1], a.chart_N, a.workers, not a.no_dask, a.chart_rounds)

@@ -27,6 +27,7 @@ reported (:class:`RefinementWarning`) and returned as nan.
 """
 from __future__ import annotations
 
+import math
 import warnings
 
 import numpy as np
@@ -67,6 +68,12 @@ class Characteristic:
         self._terms = lin.kernel_terms
         # a fitted singular kernel's near cells: the exact kernel on [0, delta], not the sum
         self._near = near_shift(lin.tangent) if self._terms is not None else None
+        # (c, beta, delta) of those near cells' power kernel c s^-beta (for :meth:`bound`)
+        self._power: tuple[float, float, float] | None = None
+        if self._near is not None:
+            fit, _ = lin.tangent.kernel_fit
+            self._power = (float(fit.kernel.c), float(fit.kernel.beta),
+                           float(lin.tangent.kernel_near_delta))
         self._panel: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         if self._terms is None and lin.kernel is not None:
             s, w, H = kernel_panels(lin.kernel, lin.tau, max(1.0, float(reach)))
@@ -85,6 +92,37 @@ class Characteristic:
             s, w, H = self._panel
             return np.tensordot(w * np.exp(-np.multiply.outer(lam, s)), H, axes=(-1, 0))
         return np.zeros(lam.shape + (self.m, self.m), dtype=complex)
+
+    def bound(self, sigma: float, scale: np.ndarray | None = None) -> float:
+        """A bound on |S^-1 Hhat(lambda) S|_2 over the half-plane Re lambda >= sigma (S =
+        diag(scale) on the free components, default I): int_0^tau |S^-1 H(s) S|_F e^(-sigma s)
+        ds, in closed form for an exponential sum (each term's |C_k|_F + |D_k|_F times
+        int_0^tau e^((a_k - sigma) s) ds; a fitted singular kernel's near cells add int_0^delta
+        |c| s^-beta e^(-sigma s) ds and the sum's own part there again), twice the panels'
+        quadrature of it for a callback kernel."""
+        d = np.ones(self.m) if scale is None else np.asarray(scale, dtype=float)
+        ratio = d[None, :] / d[:, None]          # (S^-1 X S)_ij = X_ij d_j / d_i
+        if self._terms is not None:
+            a, _, C, D = self._terms
+            f = self.free
+            C = np.asarray(C, dtype=float)[:, f][:, :, f] * ratio
+            D = (np.zeros_like(C) if D is None
+                 else np.asarray(D, dtype=float)[:, f][:, :, f] * ratio)
+            size = np.linalg.norm(C, axis=(1, 2)) + np.linalg.norm(D, axis=(1, 2))
+            r = (np.asarray(a, dtype=float) - sigma) * self.tau
+            with np.errstate(over="ignore"):
+                grow = np.where(np.abs(r) < 1e-8, 1.0 + r / 2, np.expm1(r) / np.where(r == 0, 1, r))
+            total = float(np.sum(size * self.tau * grow))
+            if self._power is not None:
+                c, beta, delta = self._power
+                total = 2 * total + float(np.max(ratio)) * abs(c) \
+                    * math.exp(max(0.0, -sigma) * delta) * delta ** (1 - beta) / (1 - beta)
+            return total
+        if self._panel is not None:
+            s, w, H = self._panel
+            return 2.0 * float(np.sum(w * np.exp(-sigma * s)
+                                      * np.linalg.norm(H * ratio, axis=(1, 2))))
+        return 0.0
 
     def __call__(self, lam: complex) -> np.ndarray:
         """Delta(lambda) (m x m, complex)."""

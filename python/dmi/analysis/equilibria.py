@@ -29,19 +29,22 @@ to 1e-8 relative in p or better, and checked there:
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from .._errors import Error
-from ._model import KinkError, equation_step
+from ._model import KinkError, Linearisation, call_make, equation_step
 from .branch import Branch, HopfPoint
 from .driver import Curve, continuation, newton_corrector
+from .floquet import StabilityWarning
 from .newton import ShootingError
 from .normal_form import criticality
 from .problem import Problem
-from .stability import check_of, roots
+from .root_verdict import RootVerdict, check
+from .stability import DENSE_MAX, check_of, rightmost_of
 from .stepmap import Model
 
 #: Roots computed at each point of a branch (the Hopf test function reads them).
@@ -64,13 +67,21 @@ class Equilibrium:
         The rightmost characteristic roots of :func:`dmi.analysis.roots` (rightmost first,
         1 / time unit; empty at a kink of the resolvent).
     stable : bool or None
-        Re roots[0] < 0; None when no root was computed (a kink, or ``count=0``).
+        The verified verdict (:mod:`dmi.analysis.root_verdict`): True when Re roots[0] <
+        -error and no root lies further right, False when a root's Re lambda exceeds its
+        error; None when not decided (``reason`` says why; a :class:`StabilityWarning` was
+        issued), when not verified (``verify=False``), or without roots (a kink,
+        ``count=0``).
     residual : float
         |G(u)|_inf (state units).
     iterations : int
         Newton's.
     of : str
         ``"scheme"`` or ``"equation"``: whose equilibrium and roots, see :func:`equilibrium`.
+    error : float
+        The error of Re roots[0] the verdict used (1 / time unit; nan when not verified).
+    reason : str
+        How the verdict was reached, or why there is none.
     """
     make: Model = field(repr=False)
     p: float
@@ -80,6 +91,8 @@ class Equilibrium:
     residual: float = 0.0
     iterations: int = 0
     of: str = "scheme"
+    error: float = math.nan
+    reason: str = ""
 
 
 @dataclass
@@ -95,15 +108,21 @@ class EquilibriumPoint:
     roots : numpy.ndarray of complex
         The rightmost roots, rightmost first (1 / time unit).
     stable : bool or None
-        Re roots[0] < 0; None when no root was computed (a kink, or ``count=0``).
+        The verified verdict, as :attr:`Equilibrium.stable`.
     dpds : float
         The unit tangent's p component (its sign flips at a fold).
+    error : float
+        The error of Re roots[0] the verdict used (nan when not verified).
+    reason : str
+        How the verdict was reached, or why there is none.
     """
     p: float
     u: np.ndarray
     roots: np.ndarray
     stable: bool | None
     dpds: float = 0.0
+    error: float = math.nan
+    reason: str = ""
 
     @property
     def rightmost(self) -> complex:
@@ -146,21 +165,36 @@ def _check_guess(guess: Any, n: int) -> np.ndarray:
     return u
 
 
-def _roots(make: Model, p: float, u: np.ndarray, count: int, tol: float, of: str
-           ) -> np.ndarray:
-    """The roots at an equilibrium (empty at a kink; none asked: empty)."""
+#: The verdict of points not verified.
+UNVERIFIED = RootVerdict(None, "not verified (verify=False): the roots are ARPACK's Ritz values "
+                         "without an error bound")
+
+
+def _roots(make: Model, p: float, u: np.ndarray, count: int, tol: float, of: str,
+           verify: bool, lam: np.ndarray | None = None) -> tuple[np.ndarray, RootVerdict]:
+    """The rightmost roots at an equilibrium (``lam``: those already computed) and their
+    verdict, verified (:func:`dmi.analysis.root_verdict.check`) or not; no roots (empty, verdict
+    None) at a kink or where none are asked."""
     if count < 1:
-        return np.empty(0, complex)
+        return np.empty(0, complex), RootVerdict(None, "no root was asked (count=0)")
+    if lam is not None and not verify:
+        return lam, UNVERIFIED
     try:
-        return roots(make, p, u, count, tol=max(tol * 1e3, 1e-9), of=of)
-    except KinkError:
-        return np.empty(0, complex)
+        with Linearisation(lambda: call_make(make, p), u, (p,), max(tol * 1e3, 1e-9),
+                           of) as lin:
+            if lam is None:
+                lam = rightmost_of(lin, int(count), of)
+            if not verify:
+                return lam, UNVERIFIED
+            return lam, check(lin, lam, of, lin.dim <= max(DENSE_MAX, count + 4))
+    except KinkError as e:
+        return np.empty(0, complex), RootVerdict(None, f"no roots: {e}")
 
 
-def _verdict(lam: np.ndarray) -> bool | None:
-    """Stable (Re roots[0] < 0), unstable, or None when no root was computed (a kink, or none
-    asked): no verdict without its roots."""
-    return bool(lam[0].real < 0) if lam.size else None
+def _unverified_warning(what: str) -> None:
+    warnings.warn(f"{what}(verify=False): the roots are ARPACK's Ritz values without an error "
+                  "bound, so stable is None; leave verify at its default (True) for a verified "
+                  "verdict", UserWarning, stacklevel=3)
 
 
 #: |Im lambda| <= REAL max(1, |lambda|): a real root (the roots' own rounding is about 1e-12).
@@ -219,6 +253,13 @@ class Equilibria:
         self.make, self.of, self.count, self.tol = make, check_of(of), int(count), tol
         self.why = ""
 
+    def verdict(self, point: EquilibriumPoint, verify: bool) -> None:
+        """The point's ``stable``, ``error`` and ``reason`` from its roots, verified (a
+        linearisation of its own) or not."""
+        _, v = _roots(self.make, point.p, point.u, self.count, self.tol, self.of, verify,
+                      point.roots)
+        point.stable, point.error, point.reason = v.stable, v.error, v.reason
+
     def step(self, p: float) -> _OneStep:
         """G at p (cached)."""
         return self.problem.cached(("one step", self.of, float(p)),
@@ -241,9 +282,10 @@ class Equilibria:
         return J[:, :-1], J[:, -1]
 
     def point(self, x: np.ndarray, p: float) -> EquilibriumPoint:
-        """The branch's point at (u, p), with its rightmost roots."""
-        lam = _roots(self.make, p, x, self.count, self.tol, self.of)
-        return EquilibriumPoint(p=p, u=x.copy(), roots=lam, stable=_verdict(lam))
+        """The branch's point at (u, p), with its rightmost roots (its verdict is left None:
+        :meth:`verdict` gives it to the points a branch keeps)."""
+        lam, _ = _roots(self.make, p, x, self.count, self.tol, self.of, False)
+        return EquilibriumPoint(p=p, u=x.copy(), roots=lam, stable=None, reason=UNVERIFIED.reason)
 
     def event_functions(self, x: np.ndarray, p: float, point: EquilibriumPoint
                         ) -> dict[str, float]:
@@ -291,12 +333,15 @@ class Equilibria:
 
 
 def equilibrium(make: Model, p: float, guess: Any, *, tol: float = 1e-10, count: int = ROOTS,
-                max_iter: int = 30, of: str = "scheme") -> Equilibrium:
+                max_iter: int = 30, of: str = "scheme", verify: bool = True) -> Equilibrium:
     """The equilibrium of the scheme of ``make(p)`` near ``guess``, by Newton's method.
 
     Newton on one step from a constant history (the n x n Jacobian by forward differences of
     single steps), until |G(u)|_inf and the last correction are <= tol max(1, |u|_inf) (G is
-    O(h) times the error: the correction bounds it); with its rightmost roots.
+    O(h) times the error: the correction bounds it); with its rightmost roots and their
+    verified verdict (:mod:`dmi.analysis.root_verdict`: the equation's roots counted by the
+    argument principle, the scheme's largest multiplier found again by a second eigen-solve,
+    each with its error).
 
     Parameters
     ----------
@@ -315,12 +360,16 @@ def equilibrium(make: Model, p: float, guess: Any, *, tol: float = 1e-10, count:
     of : {"scheme", "equation"}
         ``"equation"``: the equation's equilibrium, with the continuous integral int_0^tau H
         instead of the scheme's h sum_l H(l h) (O(h) apart), and the equation's roots.
+    verify : bool
+        Verify the verdict (the default; see docs/stability.md for its cost).  False opts out:
+        ``stable`` is None, with a ``UserWarning`` saying so.
 
     Returns
     -------
     Equilibrium
-        ``.u``, ``.roots`` (rightmost first), ``.stable`` (Re roots[0] < 0; None when no root
-        was computed: ``count=0`` or a kink), ``.residual``.
+        ``.u``, ``.roots`` (rightmost first), ``.stable`` (verified: True, False, or None with
+        a :class:`dmi.analysis.StabilityWarning` saying why; None without roots: ``count=0``
+        or a kink), ``.error`` and ``.reason`` of the verdict, ``.residual``.
 
     Raises
     ------
@@ -337,6 +386,9 @@ def equilibrium(make: Model, p: float, guess: Any, *, tol: float = 1e-10, count:
         p = float(p)
     except (TypeError, ValueError):
         raise ValueError(f"equilibrium(make, p = {p!r}, ...): p must be a number") from None
+    if not isinstance(verify, bool):
+        raise ValueError(f"equilibrium(..., verify = {verify!r}): give True (the default: a "
+                         "verified verdict) or False (opt out: stable None)")
     if not math.isfinite(p):
         raise ValueError(f"equilibrium(make, p = {p!r}, ...): p must be finite (the model "
                          "would be made and stepped at a non-finite parameter)")
@@ -346,10 +398,15 @@ def equilibrium(make: Model, p: float, guess: Any, *, tol: float = 1e-10, count:
     z, its = newton_corrector(Curve(disc, n), np.concatenate([u0, [p]]), _e_p(n), p, tol=tol,
                               max_iter=max_iter, far=math.inf, what=f"equilibrium at p = {p!r}")
     u = z[:-1]
-    lam = _roots(make, p, u, count, tol, of)
-    return Equilibrium(make=make, p=p, u=u, roots=lam, stable=_verdict(lam),
+    if not verify and count >= 1:
+        _unverified_warning("equilibrium")
+    lam, v = _roots(make, p, u, count, tol, of, verify)
+    if verify and count >= 1 and v.stable is None:
+        warnings.warn(f"equilibrium at p = {p!r}: stable is None: {v.reason}", StabilityWarning,
+                      stacklevel=2)
+    return Equilibrium(make=make, p=p, u=u, roots=lam, stable=v.stable,
                        residual=float(np.max(np.abs(disc.residual(u, p)))), iterations=its,
-                       of=of)
+                       of=of, error=v.error, reason=v.reason)
 
 
 def _e_p(n: int) -> np.ndarray:
@@ -362,7 +419,8 @@ def _e_p(n: int) -> np.ndarray:
 def continue_equilibrium(eq: Equilibrium, p_end: float, step: float = 0.05, *,
                          max_points: int = 200, min_step: float | None = None,
                          max_step: float | None = None, count: int = ROOTS,
-                         tol: float = 1e-10, max_iter: int = 8, at: Any = ()) -> Branch:
+                         tol: float = 1e-10, max_iter: int = 8, at: Any = (),
+                         verify: bool = True) -> Branch:
     """Continues an equilibrium in p by pseudo-arclength, with fold, Hopf and branch-point events.
 
     The driver :func:`dmi.analysis.driver.continuation` on :class:`Equilibria`: the tangent is
@@ -391,11 +449,17 @@ def continue_equilibrium(eq: Equilibrium, p_end: float, step: float = 0.05, *,
         Corrector iterations a step.
     at : iterable of float
         Parameters where a point is wanted (a ``user`` event each).
+    verify : bool
+        Verify every point's verdict (the default, as :func:`equilibrium`; the events' test
+        functions read the roots and are not affected).  False opts out: the points' ``stable``
+        is None, with one ``UserWarning``.
 
     Returns
     -------
     Branch
-        ``kind`` "equilibria": ``points`` of :class:`EquilibriumPoint`, ``events`` (``fold``,
+        ``kind`` "equilibria": ``points`` of :class:`EquilibriumPoint` (their verdicts
+        verified; one :class:`dmi.analysis.StabilityWarning` names the points not decided),
+        ``events`` (``fold``,
         ``hopf`` with its :class:`HopfPoint` in ``Event.hopf`` and the equilibrium in
         ``Event.u``, ``branch-point`` where a real root crosses 0 and another branch crosses
         this one, ``user``), ``status`` (why it ended: a corrector failing at the smallest
@@ -412,8 +476,23 @@ def continue_equilibrium(eq: Equilibrium, p_end: float, step: float = 0.05, *,
         raise ValueError(f"step = {step!r}: must be finite and > 0 (p units)")
     if not math.isfinite(p_end) or p_end == eq.p:
         raise ValueError(f"p_end = {p_end!r}: must be finite and differ from eq.p = {eq.p!r}")
+    if not isinstance(verify, bool):
+        raise ValueError(f"continue_equilibrium(..., verify = {verify!r}): give True (the "
+                         "default: verified verdicts) or False (opt out: stable None)")
+    if not verify and count >= 1:
+        _unverified_warning("continue_equilibrium")
     disc = Equilibria(eq.make, eq.of, count, tol)
-    return continuation(disc, eq.u, eq.p, float(p_end), step=step, min_step=min_step,
-                        max_step=max_step, max_points=max_points, at=at, tol=tol,
-                        max_iter=max_iter, predictor="tangent", easy=max_iter, make=eq.make,
-                        kind="equilibria")
+    b = continuation(disc, eq.u, eq.p, float(p_end), step=step, min_step=min_step,
+                     max_step=max_step, max_points=max_points, at=at, tol=tol,
+                     max_iter=max_iter, predictor="tangent", easy=max_iter, make=eq.make,
+                     kind="equilibria")
+    for q in b.points:
+        disc.verdict(q, verify)
+    open_ = [q for q in b.points if q.stable is None]
+    if verify and count >= 1 and open_:
+        warnings.warn(f"continue_equilibrium: the stability of {len(open_)} of {len(b.points)} "
+                      f"points is not decided (stable None), at p = "
+                      f"{', '.join(f'{q.p:.8g}' for q in open_[:6])}"
+                      f"{', ...' if len(open_) > 6 else ''}: {open_[0].reason} (the first; "
+                      "EquilibriumPoint.reason has each point's)", StabilityWarning, stacklevel=2)
+    return b
