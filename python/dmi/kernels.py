@@ -247,7 +247,48 @@ class KernelFit:
             warnings.warn(f"refit: the error of the refit is {out.max_error:.3g}, above tol = "
                           f"{tol:.3g}: this fit's {K} rates do not suit H; fit it anew (fit), at a "
                           "kernel nearer the ones refitted", stacklevel=2)
-        return _with_l1(out, H, None)
+        done = _with_l1(out, H, None)
+        object.__setattr__(done, "_source", (s, pinv))
+        return done
+
+    def refit_derivative(self, dH: Callable[[np.ndarray], Any]) -> tuple[np.ndarray, np.ndarray]:
+        """The derivative of this refit's coefficients along a derivative of its kernel: a refit
+        is linear in the kernel's values, so the derivative of ``C, D`` in a parameter of the
+        kernel is the same linear map applied to the kernel's derivative in it (computed from a
+        closed form of the derivative, not from differences of coefficients, in which the
+        least-squares map's conditioning would amplify rounding).
+
+        Parameters
+        ----------
+        dH : callable
+            The kernel's derivative in the parameter, vectorised over s (an array of points),
+            of the kernel's shape.
+
+        Returns
+        -------
+        (numpy.ndarray, numpy.ndarray)
+            dC and dD, the shapes of ``C`` and ``D``.
+
+        Raises
+        ------
+        ValueError
+            This fit is not one of :meth:`refit`, or dH gives values of another shape.
+        """
+        source = self.__dict__.get("_source")
+        if source is None:
+            raise ValueError(f"refit_derivative: this fit's method is {self.method!r}, not a "
+                             "refit's ('fixed'): its rates were chosen for its kernel")
+        s, pinv = source
+        V = np.asarray(dH(s), dtype=np.float64)
+        if V.shape != (len(s),) + self.C.shape[1:]:
+            raise ValueError(f"refit_derivative: dH gives values of shape {V.shape[1:]}; the "
+                             f"kernel's shape is {self.C.shape[1:]}")
+        K = len(self.a)
+        X = pinv @ V.reshape(len(s), -1)
+        dC = X[:K].reshape(self.C.shape)
+        dD = np.zeros_like(dC)
+        dD[self.b > 0] = X[K:].reshape((-1,) + self.C.shape[1:])
+        return dC, dD
 
     def _refit_map(self) -> tuple[np.ndarray, np.ndarray]:
         """The points s of :meth:`refit` and the linear map from H's values there to (C; D of the
