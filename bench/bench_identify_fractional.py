@@ -74,7 +74,7 @@ def study(tau: float, T: float, h: float, every: int, sigma: float, seeds: int) 
         z = (est.p - TRUTH) / est.stderr
         zs.append(z)
         print(f"seed {seed}: p = {np.array2string(est.p, precision=5)}, stderr = "
-              f"{np.array2string(est.stderr, precision=2)}, z = {np.array2string(z, precision=2)}, "
+              f"{np.array2string(est.stderr, formatter={'float_kind': lambda v: f'{v:.2e}'})}, z = {np.array2string(z, precision=2)}, "
               f"success {est.success}, {time.process_time() - t0:.1f} s CPU")
     zs = np.array(zs)
     print(f"RMS z = {np.sqrt(np.mean(zs ** 2)):.3f}, max |z| = {np.abs(zs).max():.2f}")
