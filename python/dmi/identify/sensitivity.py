@@ -426,8 +426,10 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     make : callable
         ``make(p) -> dmi.Solver``, the model at the parameter vector p (a new solver, set but
         not necessarily initialised; it is initialised here).  p may enter f, the friction
-        coefficients, the box, the kernel (its exponential terms a, b, C, D, or a kernel
-        callback) and the history; it may not change n, N, h, tau, the kinds of A and kernel,
+        coefficients, the box, the kernel (its exponential terms a, b, C, D, a kernel callback
+        under either rule, the near kernel of ``set_kernel_near``, a ``PowerKernel``'s c and beta
+        through ``KernelFit.refit``: through the weights libdmi computes, ``Solver.kernel_weights``)
+        and the history; it may not change n, N, h, tau, the kinds of A and kernel,
         the number of kernel terms, the convolution method or the quadrature rule.  A parameter
         enters f (or the history) unless :meth:`dmi.Solver.same_callback` finds the perturbed
         model's callback the same as the model's; f and the history are differentiated only in the
@@ -462,8 +464,9 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     ------
     ValueError
         p not a finite vector, steps < 1, make raising at p or near it, a parameter changing the
-        model's structure, more steps than ``max_steps``, a near kernel, a callback kernel under
-        the cell rule, ``rhs`` disagreeing with the solver's f, an unknown ``engine``, or
+        model's structure or the rates of a kernel fit chosen by ``dmi.kernels.fit`` (use
+        ``KernelFit.refit``), more steps than ``max_steps``, a perturbed model failing in init,
+        ``rhs`` disagreeing with the solver's f, an unknown ``engine``, or
         ``engine="compiled"`` where it does not apply (the message says why).
     TypeError
         make not returning a dmi.Solver.
