@@ -281,6 +281,14 @@ class _Memory:
                 refit = _refit_terms(fitted, other.kernel_fit, mod.delta[j], n)
                 if refit is not None:
                     self.dE[j] = refit
+                elif (fitted is not None and getattr(fitted[0], "method", "") == "fixed"
+                        and np.any(self.dE[j] != 0)):
+                    warnings.warn(f"sensitivities: parameter {j} changes the coefficients of a "
+                                  "KernelFit.refit of a kernel that is not a PowerKernel: they are "
+                                  "differentiated by differences, which the refit's least-squares "
+                                  "conditioning makes inaccurate (to about 1e-3 on a 25-term fit); "
+                                  "set the kernel's terms from its parameters (set_kernel_exp) or "
+                                  "use a PowerKernel", RuntimeWarning, stacklevel=4)
                 elif (fitted is not None and getattr(fitted[0], "method", "") in ("esprit", "laplace")
                         and np.any(self.dl[j] != 0)):
                     raise ValueError(f"parameter {j} moves the rates of the kernel's fit "
