@@ -15,7 +15,8 @@
 ! - dmi_set_kernel_exp (since 1.1) needs the array d (C accepts NULL for all
 !   D_k = 0: pass zeros).  c and d hold K n x n matrices, each row-major as
 !   above: entry (i, j) of term k (1-based) is c((k - 1) * n * n + (i - 1) * n + j).
-! - dmi_get_step_terms needs both arrays (C accepts NULL for either).
+! - dmi_get_step_terms needs both arrays (C accepts NULL for either), and so
+!   does dmi_get_kernel_weights (since 1.5): count * n * n values each.
 ! - The state buffer of dmi_state_save / dmi_state_load is an array of
 !   integer(c_int8_t) of dmi_state_size(s) elements.
 ! - C's size_t is integer(c_size_t), uint64_t is integer(c_int64_t).
@@ -29,7 +30,7 @@ module dmi
 
   ! Version of this binding (the same as the C header it mirrors).
   integer(c_int), parameter, public :: DMI_VERSION_MAJOR = 1
-  integer(c_int), parameter, public :: DMI_VERSION_MINOR = 4
+  integer(c_int), parameter, public :: DMI_VERSION_MINOR = 5
   integer(c_int), parameter, public :: DMI_VERSION_PATCH = 0
 
   ! Error codes.
@@ -56,7 +57,7 @@ module dmi
   public :: dmi_set_quadrature, dmi_set_kernel_near, dmi_set_kernel_singularity
   public :: dmi_init, dmi_step, dmi_advance
   public :: dmi_time, dmi_get_step_index, dmi_get_h, dmi_get_N, dmi_get_state, dmi_get_past
-  public :: dmi_get_step_terms, dmi_get_window, dmi_set_window
+  public :: dmi_get_step_terms, dmi_get_window, dmi_set_window, dmi_get_kernel_weights
   public :: dmi_state_size, dmi_state_save, dmi_state_load
   public :: dmi_last_error, dmi_strerror
 
@@ -296,6 +297,18 @@ module dmi
       real(c_double), intent(in) :: u(*)
       integer(c_int) :: rc
     end function dmi_set_window
+
+    ! (since 1.5) the delay sum's weights G_l of the lags first .. first + count - 1
+    ! (0-based), as the steps use them, and the near cells' part of them: lag l's
+    ! n x n matrix row-major at g((l - first) * n * n + 1 : (l - first + 1) * n * n).
+    function dmi_get_kernel_weights(s, first, count, g, g_near) result(rc) &
+        bind(C, name='dmi_get_kernel_weights')
+      import :: c_int, c_size_t, c_double, c_ptr
+      type(c_ptr), value :: s
+      integer(c_size_t), value :: first, count
+      real(c_double), intent(out) :: g(*), g_near(*)
+      integer(c_int) :: rc
+    end function dmi_get_kernel_weights
 
     function dmi_get_step_terms(s, w, x) result(rc) bind(C, name='dmi_get_step_terms')
       import :: c_int, c_double, c_ptr

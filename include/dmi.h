@@ -50,7 +50,7 @@ extern "C" {
 /** Major version of this header; dmi_version() gives the version of the library. */
 #define DMI_VERSION_MAJOR 1
 /** Minor version of this header. */
-#define DMI_VERSION_MINOR 4
+#define DMI_VERSION_MINOR 5
 /** Patch version of this header. */
 #define DMI_VERSION_PATCH 0
 
@@ -512,6 +512,41 @@ DMI_API int dmi_set_window(dmi_solver *s, const double *U);
  * DMI_ESTATE before dmi_init or before the first step.
  */
 DMI_API int dmi_get_step_terms(const dmi_solver *s, double *W, double *X);
+
+/**
+ * (Since 1.5.)  The weights of the delay sum as the steps use them: with
+ * them the sum of every step is
+ *
+ *     W^p = sum_{l=0}^{N-1} G_l U^{p-l},
+ *
+ * G_l an n x n matrix (row-major: G_l[i n + j] weighs U_j^{p-l} in W_i^p),
+ * in the kernel's unit times the time unit (a weight is an integral of H
+ * over a cell, or h H(l h)).  They are what dmi_init computed: under
+ * DMI_QUAD_LEFT h H(l h) (theta h H((N-1) h) for a partial last cell);
+ * under DMI_QUAD_CELL the cells' integrals of H (exponential kernels in
+ * closed form, callback kernels by the tanh-sinh rule of dmi_init); with
+ * near cells (dmi_set_kernel_near) the near kernel's integrals over the m
+ * near cells and the exponential sum's weights beyond.  The steps compute
+ * the same sum: DIRECT and FFT from these weights, RECURSIVE (and AUTO's
+ * recursion) as the exponential sum's recursion plus the near cells' part
+ * G_near below, equal to it up to rounding.
+ * Writes G[(l - first) n n + i n + j] = G_l[i n + j] for the lags
+ * l = first .. first + count - 1, and G_near alike: the part of G_l that
+ * the near cells add to the exponential sum's weights (the near kernel's
+ * integral over cell l less the sum's weight there; zero for l >= m and
+ * without near cells), what RECURSIVE adds to its recursion's sum.  Either
+ * array may be NULL (count n n doubles each otherwise, written whole; the
+ * solver keeps no pointer).  A call under RECURSIVE with full cells,
+ * DMI_QUAD_LEFT and no near cells, where dmi_init kept no samples, computes
+ * them from the exponential terms (N n n doubles of memory for the call).
+ * Does not change the solver.
+ * Errors: DMI_EINVAL for s NULL, both arrays NULL, or first + count > N
+ * (the message names the lags); DMI_ESTATE before dmi_init; DMI_ENOMEM when
+ * the samples of the recursion cannot be allocated; DMI_ENONFINITE when one
+ * of them is not finite.
+ */
+DMI_API int dmi_get_kernel_weights(const dmi_solver *s, size_t first, size_t count, double *G,
+                                   double *G_near);
 
 /** ---- saving and restoring the time-stepping state -----------------------
  * The state is the step counter, the N + 1 stored states U^{p-N..p}, the

@@ -65,6 +65,7 @@ _PROTOTYPES = {
     "dmi_get_state": (c_int, [_solver_p, _d]),
     "dmi_get_past": (c_int, [_solver_p, c_size_t, _d]),
     "dmi_get_step_terms": (c_int, [_solver_p, _d, _d]),
+    "dmi_get_kernel_weights": (c_int, [_solver_p, c_size_t, c_size_t, _d, _d]),
     "dmi_get_window": (c_int, [_solver_p, _d]),
     "dmi_set_window": (c_int, [_solver_p, _d]),
     "dmi_state_size": (c_size_t, [_solver_p]),

@@ -866,6 +866,31 @@ class Solver:
             self._check(_L.dmi_get_step_terms(s, _ptr(W), _ptr(X)))
         return W, X
 
+    def kernel_weights(self) -> tuple[np.ndarray, np.ndarray]:
+        """The weights of the delay sum as the steps use them (``dmi_get_kernel_weights``, since
+        libdmi 1.5): W^p = sum_l G[l] @ U^{p-l}, l = 0..N-1.
+
+        Returns
+        -------
+        G : numpy.ndarray, shape (N, n, n)
+            G[l], the weight of U^{p-l} (kernel units times time units): h H(l h) under the left
+            rule, the integral of H over cell l under the cell rule, the near kernel's integral
+            over a near cell (:meth:`set_kernel_near`, :meth:`set_kernel_fit` with delta > 0).
+        G_near : numpy.ndarray, shape (N, n, n)
+            The part of G[l] the near cells add to the exponential sum's weights (zero beyond
+            the near cells and without them).
+
+        Raises
+        ------
+        dmi.InvalidArgument
+            Code ``dmi.ESTATE``: before :meth:`init` (the weights are computed there).
+        """
+        n, N = self._n, self._N
+        G, G_near = np.empty((N, n, n)), np.empty((N, n, n))
+        with self._using() as s:
+            self._check(_L.dmi_get_kernel_weights(s, 0, N, _ptr(G), _ptr(G_near)))
+        return G, G_near
+
     # ---- saving and restoring ------------------------------------------------------------------
 
     def save_state(self) -> bytes:

@@ -129,7 +129,8 @@ class KernelFit:
         int_0^tau ||H|| ds, >= 0 (the kernel must be integrable: :func:`fit` refuses one that
         is not).
     method : str
-        The method of the fit returned: ``"esprit"`` or ``"laplace"``.
+        The method of the fit returned: ``"esprit"`` or ``"laplace"`` (:func:`fit`: the rates
+        chosen for the kernel), or ``"fixed"`` (:meth:`refit`: the rates of another fit).
     grid_points : int
         Points of the check grid.
     kernel : PowerKernel or None
@@ -175,6 +176,137 @@ class KernelFit:
             ``H~(s)``: shape ``s.shape`` (+ (n, n)).
         """
         return _transform.evaluate(s, self.a, self.b, self.C, self.D)
+
+    def refit(self, H: Callable[[float], Any], *, tol: float | None = None,
+              certify: bool = False) -> KernelFit:
+        """A fit of another kernel on the same ``[delta, tau]`` with this fit's rates and
+        frequencies ``a, b``: only ``C, D`` change.
+
+        They are the weighted least-squares fit of H's values at points fixed by this fit, with
+        row weights fixed by this fit's values: a fixed linear map of H's values.  So the fit of
+        a kernel with parameters (a :class:`PowerKernel`'s ``c`` and ``beta``) keeps its
+        structure (term count, rates) and is smooth in them, which :func:`dmi.identify.sensitivities`
+        needs to differentiate a model through it; :func:`fit` chooses its rates anew for each
+        kernel, a choice that is not differentiable.  Fit once at a typical kernel, then refit
+        inside ``make(p)``.
+
+        Parameters
+        ----------
+        H : callable or PowerKernel
+            The kernel, of this fit's shape (scalar, or n x n), finite on ``[delta, tau]``.
+        tol : float, optional
+            The error accepted (relative if this fit is), > 0; default: ten times this fit's
+            ``max_error``.  A refit whose measured error exceeds it warns (the rates do not suit
+            H: fit H anew, at a kernel nearer the ones refitted).
+        certify : bool, optional
+            For a PowerKernel: whether to bound the error between the check grid's points as
+            :func:`fit` does (``certified``; about a second for a tight tol, so off by default:
+            a refit inside ``make(p)`` runs several times per fit iteration).
+
+        Returns
+        -------
+        KernelFit
+            ``method = "fixed"``, its ``max_error`` measured on a grid ten times finer than the
+            least-squares points (``certified`` only with ``certify``), ``kernel`` H when it is a
+            PowerKernel.
+
+        Raises
+        ------
+        ValueError
+            tol not > 0; H of another shape, or not finite on ``[delta, tau]``; a PowerKernel
+            refitted from a fit with ``delta = 0``.
+        """
+        if tol is None:
+            tol = 10 * self.max_error
+        if not tol > 0:
+            raise ValueError(f"refit: tol = {tol}; expected > 0")
+        lo, tau = self.delta, self.tau
+        if lo == 0 and isinstance(H, PowerKernel):
+            raise ValueError("refit: a PowerKernel is singular at 0: refit a fit with delta > 0")
+        K = len(self.a)
+        s, pinv = self._refit_map()
+        V = _values(H, s)
+        shape = self.C.shape[1:]
+        if V.shape[1:] != shape or not np.all(np.isfinite(V)):
+            raise ValueError(f"refit: H gives values of shape {V.shape[1:]} on [delta, tau] "
+                             f"({'finite' if np.all(np.isfinite(V)) else 'not all finite'}); this "
+                             f"fit's kernel has shape {shape} and must be finite there")
+        X = pinv @ V.reshape(len(s), -1)
+        C = X[:K]
+        D = np.zeros_like(C)
+        D[self.b > 0] = X[K:]
+        # the error on a grid ten times finer than the least-squares points
+        check_s = np.unique(np.concatenate([_log_grid(lo, tau, 10 * len(s) // 2),
+                                            np.linspace(lo, tau, 10 * len(s) // 2)]))
+        check_v = _values(H, check_s)
+        certified_fn = (_certifier(H, lo, tau, tol, self.relative)
+                        if certify and isinstance(H, PowerKernel) else None)
+        out = _build(self.a.copy(), self.b.copy(), C, D, shape, tau, lo, self.relative, "fixed",
+                     check_s, check_v, certified_fn, check_s, check_v)
+        if out.max_error > tol:
+            warnings.warn(f"refit: the error of the refit is {out.max_error:.3g}, above tol = "
+                          f"{tol:.3g}: this fit's {K} rates do not suit H; fit it anew (fit), at a "
+                          "kernel nearer the ones refitted", stacklevel=2)
+        done = _with_l1(out, H, None)
+        object.__setattr__(done, "_source", (s, pinv))
+        return done
+
+    def refit_derivative(self, dH: Callable[[np.ndarray], Any]) -> tuple[np.ndarray, np.ndarray]:
+        """The derivative of this refit's coefficients along a derivative of its kernel: a refit
+        is linear in the kernel's values, so the derivative of ``C, D`` in a parameter of the
+        kernel is the same linear map applied to the kernel's derivative in it (computed from a
+        closed form of the derivative, not from differences of coefficients, in which the
+        least-squares map's conditioning would amplify rounding).
+
+        Parameters
+        ----------
+        dH : callable
+            The kernel's derivative in the parameter, vectorised over s (an array of points),
+            of the kernel's shape.
+
+        Returns
+        -------
+        (numpy.ndarray, numpy.ndarray)
+            dC and dD, the shapes of ``C`` and ``D``.
+
+        Raises
+        ------
+        ValueError
+            This fit is not one of :meth:`refit`, or dH gives values of another shape.
+        """
+        source = self.__dict__.get("_source")
+        if source is None:
+            raise ValueError(f"refit_derivative: this fit's method is {self.method!r}, not a "
+                             "refit's ('fixed'): its rates were chosen for its kernel")
+        s, pinv = source
+        V = np.asarray(dH(s), dtype=np.float64)
+        if V.shape != (len(s),) + self.C.shape[1:]:
+            raise ValueError(f"refit_derivative: dH gives values of shape {V.shape[1:]}; the "
+                             f"kernel's shape is {self.C.shape[1:]}")
+        K = len(self.a)
+        X = pinv @ V.reshape(len(s), -1)
+        dC = X[:K].reshape(self.C.shape)
+        dD = np.zeros_like(dC)
+        dD[self.b > 0] = X[K:].reshape((-1,) + self.C.shape[1:])
+        return dC, dD
+
+    def _refit_map(self) -> tuple[np.ndarray, np.ndarray]:
+        """The points s of :meth:`refit` and the linear map from H's values there to (C; D of the
+        oscillating terms): the weighted least-squares pseudo-inverse, computed once per fit."""
+        cached = self.__dict__.get("_refit_cache")
+        if cached is not None:
+            return cached
+        lo, tau = self.delta, self.tau
+        m = max(400, 16 * len(self.a))
+        s = np.unique(np.concatenate([_log_grid(lo, tau, m), np.linspace(lo, tau, m)]))
+        own = self(s).reshape(len(s), -1)
+        size = np.abs(own).max(axis=1)
+        rw = (1 / np.maximum(size, 1e-12 * size.max()) if self.relative
+              else np.full(len(s), 1 / max(size.max(), np.finfo(float).tiny)))
+        pinv = np.linalg.pinv(_real_basis(s, self.a, self.b) * rw[:, None]) * rw[None, :]
+        object.__setattr__(self, "_refit_cache", (s, pinv))
+        return s, pinv
+
 
     def coefficient_sum(self) -> float:
         """The coefficients' size: compare with max |H| to see there is no cancellation.

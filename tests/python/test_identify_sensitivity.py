@@ -473,25 +473,35 @@ def test_parameters_that_change_the_structure_are_refused():
         sensitivities(make_conv, [1.0], 0)
 
 
-def test_kernels_whose_weights_the_solver_does_not_expose_are_refused_with_what_to_do():
+def test_near_cells_and_a_callback_kernel_under_the_cell_rule_are_followed():
+    # once refused (their weights were libdmi's alone), now through Solver.kernel_weights: S of a
+    # parameter of f against central differences of the scheme (more in test_identify_nearcells.py)
     def near(p):            # an exponential fit beyond delta = 0.2 and the exact kernel below it
         s = dmi.Solver(1, 1.0, 20)
         s.set_rhs(lambda t, u: -p[0] * u)
         s.set_quadrature("cell")
         s.set_kernel_exp([-1.0], [0.0], [[[0.5]]])
-        s.set_kernel_near(lambda x: np.array([[0.5 * math.exp(-x)]]), 0.2)
+        s.set_kernel_near(lambda x: np.array([[0.5 * math.exp(-x) / math.sqrt(x)]]), 0.2)
+        s.set_history(lambda t: np.array([1.0]))
         return s
-    with pytest.raises(ValueError, match=r"near kernel.*delta = 0.*central differences"):
-        sensitivities(near, [1.0], 10)
 
     def cell(p):
         s = dmi.Solver(1, 1.0, 20)
         s.set_rhs(lambda t, u: -p[0] * u)
         s.set_quadrature("cell")
-        s.set_kernel(lambda x: np.array([[math.exp(-x)]]))
+        s.set_kernel(lambda x: np.array([[math.exp(-x) / math.sqrt(x)]]))
+        s.set_history(lambda t: np.array([1.0]))
         return s
-    with pytest.raises(ValueError, match=r"cell rule.*set_quadrature\('left'\).*set_kernel_exp"):
-        sensitivities(cell, [1.0], 10)
+    for make in (near, cell):
+        S = sensitivities(make, [1.0], 30).S[:, 0, 0]
+        runs = []
+        for q in (1.0 + 1e-5, 1.0 - 1e-5):
+            m = make([q])
+            m.init()
+            runs.append(m.run(30)[1][:, 0])
+        ref = (runs[0] - runs[1]) / 2e-5
+        assert np.abs(ref).max() > 0.1
+        assert np.abs(S - ref).max() < 1e-6 * np.abs(ref).max()
 
 
 def test_a_failing_callback_of_a_perturbed_model_names_the_call():

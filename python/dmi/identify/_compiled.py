@@ -22,6 +22,7 @@ from llvmlite import ir
 from numba import types as nt
 from numba.extending import intrinsic
 
+from ._near import near_sum as _near_sum_python
 from ._saltation import NONE, REVERSAL, STICK, UNPLACED
 from ._saltation import reversal as _reversal_python
 
@@ -30,6 +31,8 @@ MEMORY_NONE, MEMORY_RECURSIVE, MEMORY_DIRECT = 0, 1, 2
 RESOLVENT_NONE, RESOLVENT_FRICTION, RESOLVENT_BOX = 0, 1, 2
 #: the test of a friction component at a step, the Python loop's function compiled
 reversal = numba.njit(cache=True)(_reversal_python)
+#: the near cells' part of the delay sum on S, the Python loop's function compiled
+near_sum = numba.njit(cache=True)(_near_sum_python)
 
 
 @intrinsic
@@ -99,7 +102,7 @@ def history_columns(addrs, users, N, h, tau, window, delta, cols, Sall):
 @numba.njit(cache=True)
 def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users, fcols, fpar,
          rel, memory, fresh, zcols, E, r, rN, rlast, last, flat, dWU, E0, cw, c1, wlast, wslast,
-         dE, dl, kind, alpha, dalpha, jumps, lo, hi, dlo, dhi, sw_q, sw_i, sw_kind):
+         dE, dl, near, dWn, kind, alpha, dalpha, jumps, lo, hi, dlo, dhi, sw_q, sw_i, sw_kind):
     """Fills Sall[N + 1:] and dX; returns (switches recorded, the step whose f call failed or -1).
 
     f_u S + f_p by directional differences (fcols False: one call of f per parameter) or, where
@@ -109,7 +112,8 @@ def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users
 
     The memory's arrays (E, r, rN, rlast, E0, cw, c1, wlast, wslast, dE, dl) are all real where
     the kernel's exponents and their derivatives are real, else all complex: numba compiles the
-    loop once for each."""
+    loop once for each.  near (m, n, n) and dWn (steps, n, P): the near cells' part of the weights
+    and of the kernel parameters' part beside the recursion (m = 0: none)."""
     n = U.shape[1]
     P = delta.shape[0]
     K = r.shape[0]
@@ -121,6 +125,7 @@ def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users
     Fd = np.empty((n, P))
     J = np.empty((n, n))
     moved = np.empty(n)
+    nacc = np.zeros((n, P))                    # the near cells' part of the delay sum on S
     Z = np.zeros((K, n, P), dtype=r.dtype)     # Z_k = sum_l r_k^l S^{q-l}
     Y = np.zeros((K, n), dtype=r.dtype)        # Y_k = sum_l r_k^l U^{q-l}
     Y1 = np.zeros((K, n), dtype=r.dtype)       # Y1_k = sum_l l r_k^l U^{q-l}
@@ -237,6 +242,12 @@ def loop(steps, N, h, t, U, X, phi, window, Sall, dX, delta, has_f, addrs, users
                                 acc[i, j] += d.real * a.real - d.imag * a.imag
                 for j in range(P):
                     T[i, j] -= h * acc[i, j]
+            if near.shape[0] > 0:               # the near cells, beside the recursion
+                nacc[:, :] = 0.0
+                near_sum(near, Sall, q, N, nacc)
+                for i in range(n):
+                    for j in range(P):
+                        T[i, j] -= h * (nacc[i, j] + dWn[q, i, j])
         elif memory == MEMORY_DIRECT:
             W = flat @ Sflat[(q + 1) * n:(q + N + 1) * n]
             for i in range(n):
@@ -347,6 +358,7 @@ def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarra
         users = np.array([u for _, u in rhs], np.int64)
     none2, none3 = np.zeros((0, 0), f64), np.zeros((0, 0, 0), f64)
     flat, dWU, last = none2, none3, np.zeros((n, n))
+    near, dWn = np.zeros((0, n, n)), none3
     code = MEMORY_NONE
     dtype = f64
     if memory.recursive:
@@ -362,6 +374,8 @@ def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarra
         wlast, wslast = cast(memory.wlast), cast(memory.wslast)
         dE, dl = cast(memory.dE.transpose(1, 2, 3, 0)), cast(memory.dl.T)
         last = c(memory.last, f64)
+        if len(memory.near):
+            near, dWn = c(memory.near, f64), c(memory.near_kernel_part(), f64)
     else:
         E, r, rN, rlast = (np.zeros((0, n, n), dtype), np.zeros(0, dtype), np.zeros(0, dtype),
                            np.zeros(0, dtype))
@@ -393,7 +407,7 @@ def run(steps: int, N: int, h: float, t: np.ndarray, U: np.ndarray, X: np.ndarra
     count, failed = loop(steps, N, float(h), t, U, X, phi, window, Sall, dX, delta, rhs is not None,
                          addrs, users, fcols, fpar, float(rel), code, fresh, zcols,
                          E, r, rN, rlast, last, flat, dWU, E0, cw, c1, wlast, wslast, dE, dl,
-                         kcode, alpha, dalpha, bool(jumps), lo, hi, dlo, dhi, sw_q, sw_i, sw_kind)
+                         near, dWn, kcode, alpha, dalpha, bool(jumps), lo, hi, dlo, dhi, sw_q, sw_i, sw_kind)
     names = {STICK: "stick", REVERSAL: "reversal", UNPLACED: "unplaced"}
     switches = [(q, i, names[k]) for q, i, k in zip(sw_q[:count].tolist(), sw_i[:count].tolist(),
                                                     sw_kind[:count].tolist())]

@@ -26,6 +26,7 @@ import numpy as np
 from scipy import fft as sp_fft
 
 from .._solver import Solver
+from ._near import near_kernel_part, near_sum
 from ._saltation import REVERSAL, STICK, UNPLACED, reversal
 
 #: Relative step of the directional differences (about the square root of the unit roundoff).
@@ -125,7 +126,6 @@ def _build(make: Callable[[np.ndarray], Solver], p: np.ndarray) -> _Perturbed:
     """The solvers at p and p + delta_j e_j, after checking that the parameters change nothing
     the sensitivities cannot follow."""
     base = _call_make(make, p, "p")
-    _supported(base)
     structure = _structure(base)
     others, delta = [], np.empty(len(p))
     for j in range(len(p)):
@@ -163,27 +163,13 @@ def _same_structure(structure: list, b: Solver, j: int) -> None:
     """ValueError naming what parameter j changes among the things a sensitivity cannot follow."""
     for (name, x), (_, y) in zip(structure, _structure(b)):
         if x != y:
-            raise ValueError(f"parameter {j} changes {name} ({x!r} -> {y!r}); a parameter may change "
-                             "values of the model, not its structure: keep n, N, h, tau, the kinds of A "
-                             "and kernel, the number of kernel terms, the convolution method and the "
-                             "quadrature fixed in make")
-
-
-def _supported(a: Solver) -> None:
-    """ValueError for the kernels sensitivities do not follow."""
-    if a.has("kernel_near"):
-        raise ValueError("sensitivities do not follow a near kernel (set_kernel_near, or "
-                         "set_kernel_fit of a fit with delta > 0): its near cells' weights are "
-                         "integrals of the singular kernel that the solver does not expose, and S "
-                         "needs the same weights as U.  Fit the kernel with delta = 0 (an "
-                         "exponential sum: set_kernel_fit or set_kernel_exp), or differentiate this "
-                         "model by central differences of runs")
-    if a.kernel_kind == "callback" and a.quadrature == "cell":
-        raise ValueError("sensitivities do not follow a callback kernel under the cell rule: its "
-                         "cell weights are tanh-sinh integrals that the solver does not expose, and "
-                         "S needs the same weights as U.  Use the left rule "
-                         "(set_quadrature('left')), an exponential kernel (set_kernel_exp), or "
-                         "central differences of runs")
+            hint = (" (dmi.kernels.fit chooses its terms anew for each kernel: fit once, outside "
+                    "make, and set KernelFit.refit(kernel) in make, which keeps the rates)"
+                    if name == "the number of kernel terms" and b.kernel_fit is not None else "")
+            raise ValueError(f"parameter {j} changes {name} ({x!r} -> {y!r}){hint}; a parameter may "
+                             "change values of the model, not its structure: keep n, N, h, tau, the "
+                             "kinds of A and kernel, the number of kernel terms, the convolution "
+                             "method and the quadrature fixed in make")
 
 
 def _theta(s: Solver) -> float:
@@ -193,6 +179,42 @@ def _theta(s: Solver) -> float:
     if M >= 1 and tau / M == h:
         return 1.0
     return tau / h - (N - 1)
+
+
+def _refit_terms(fitted: Any, other: Any, delta: float, n: int) -> np.ndarray | None:
+    """dE_j = dC - i dD of a kernel set from KernelFit.refit of a PowerKernel, where the model at
+    p + delta e_j refits another PowerKernel: the refit's linear map applied to the closed-form
+    derivative of c s^-beta in c and beta (dc and dbeta by differences of the two kernels'
+    parameters), shaped (K, n, n); None for other kernels (their terms are then differentiated
+    by differences)."""
+    from ..kernels import PowerKernel
+    if fitted is None or other is None:
+        return None
+    f, entry = fitted
+    k0, k1 = getattr(f, "kernel", None), getattr(other[0], "kernel", None)
+    if (getattr(f, "method", "") != "fixed" or not isinstance(k0, PowerKernel)
+            or not isinstance(k1, PowerKernel) or other[1] != entry
+            or not np.array_equal(other[0].a, f.a) or not np.array_equal(other[0].b, f.b)):
+        return None
+    dbeta, dc = (k1.beta - k0.beta) / delta, (k1.c - k0.c) / delta
+    dC, dDs = f.refit_derivative(lambda x: k0(x) * (dc / k0.c - dbeta * np.log(x)))
+    out = np.zeros((len(f.a), n, n), dtype=complex)
+    if entry is None:
+        out[:] = dC - 1j * dDs
+    else:
+        out[:, entry[0], entry[1]] = dC - 1j * dDs
+    return out
+
+
+def _weights_of(other: Solver, j: int) -> tuple[np.ndarray, np.ndarray]:
+    """Solver.kernel_weights of the model at p + delta_j e_j, initialised for them."""
+    try:
+        other.init()
+    except Exception as e:
+        raise ValueError(f"the model at p + delta e_{j} fails in init ({type(e).__name__}: {e}); "
+                         "its kernel's weights, which the sensitivities differentiate, are "
+                         "computed there") from e
+    return other.kernel_weights()
 
 
 # ---- the kernel's weights and their derivatives --------------------------------------------------
@@ -251,10 +273,30 @@ class _Memory:
             K = len(a)
             self.dE = np.empty((P, K, n, n), dtype=complex)
             self.dl = np.empty((P, K), dtype=complex)
+            fitted = s.kernel_fit
             for j, other in enumerate(mod.others):
                 a2, b2, C2, D2 = other.kernel_terms
                 self.dl[j] = ((a2 - a) + 1j * (b2 - b)) / mod.delta[j]
                 self.dE[j] = ((C2 - C) - 1j * (D2 - D)) / mod.delta[j]
+                refit = _refit_terms(fitted, other.kernel_fit, mod.delta[j], n)
+                if refit is not None:
+                    self.dE[j] = refit
+                elif (fitted is not None and getattr(fitted[0], "method", "") == "fixed"
+                        and np.any(self.dE[j] != 0)):
+                    warnings.warn(f"sensitivities: parameter {j} changes the coefficients of a "
+                                  "KernelFit.refit of a kernel that is not a PowerKernel: they are "
+                                  "differentiated by differences, which the refit's least-squares "
+                                  "conditioning makes inaccurate (to about 1e-3 on a 25-term fit); "
+                                  "set the kernel's terms from its parameters (set_kernel_exp) or "
+                                  "use a PowerKernel", RuntimeWarning, stacklevel=4)
+                elif (fitted is not None and getattr(fitted[0], "method", "") in ("esprit", "laplace")
+                        and np.any(self.dl[j] != 0)):
+                    raise ValueError(f"parameter {j} moves the rates of the kernel's fit "
+                                     f"(dmi.kernels.fit, method {fitted[0].method!r}): fit chooses "
+                                     "its rates anew for each kernel, a choice that is not "
+                                     "differentiable, so the sensitivities would follow it wrongly; "
+                                     "fit once, outside make, and set KernelFit.refit(kernel) in "
+                                     "make (the same rates, coefficients linear in the kernel)")
             wl, wsl, self.c, self.c1 = _exp_weights(s, self.lam, np.array([N - 1]))
             self.wlast, self.wslast = wl[:, 0], wsl[:, 0]
             # the recursion: Z_k^p = sum_l r_k^l S^{p-l} (all N cells), then the last cell mended
@@ -268,16 +310,37 @@ class _Memory:
                 # G_{N-1} less what the full-cell recursion puts on the last cell
                 self.last = np.einsum("k,kij->ij", self.wlast - self.rlast * self.c, self.E0).real
         elif kind == "callback":
-            theta = _theta(s)
-            cell = np.full(N, s.h)
-            cell[-1] = theta * s.h
-            lags = np.arange(N) * s.h
-            H0 = np.array([s.eval_kernel(x) for x in lags])
-            self.G = cell[:, None, None] * H0
-            self.dG = np.empty((P, N, n, n))
+            # the weights libdmi computed in init (the left rule's, or the cell rule's integrals),
+            # and their derivatives from those of the models whose kernel differs
+            self.G = s.kernel_weights()[0]
+            self.dG = np.zeros((P, N, n, n))
             for j, other in enumerate(mod.others):
-                Hj = np.array([other.eval_kernel(x) for x in lags])
-                self.dG[j] = cell[:, None, None] * (Hj - H0) / mod.delta[j]
+                if not s.same_callback(other, "kernel"):
+                    self.dG[j] = (_weights_of(other, j)[0] - self.G) / mod.delta[j]
+        # the near cells' part of the weights (set_kernel_near, set_kernel_fit with delta > 0):
+        # what they add to the exponential sum's weights, D (m, n, n), and its derivatives: the
+        # whole weights' derivative on the near cells (differences of libdmi's weights, in which
+        # the sum's coefficients do not enter) less the exponential sum's there
+        self.near = np.zeros((0, n, n))
+        self.dnear = np.zeros((P, 0, n, n))
+        if kind == "exp" and s.has("kernel_near"):
+            q = s.kernel_near_delta / s.h
+            m = N if q >= N else math.ceil(q)
+            G0, D = s.kernel_weights()
+            K = len(self.lam)
+            wm, wsm, _, _ = _exp_weights(s, self.lam, np.arange(m))
+            dD = np.zeros((P, m, n, n))
+            terms = s.kernel_terms
+            for j, other in enumerate(mod.others):
+                if (s.same_callback(other, "kernel_near")
+                        and all(np.array_equal(x, y) for x, y in zip(terms, other.kernel_terms))):
+                    continue
+                whole = (_weights_of(other, j)[0][:m] - G0[:m]) / mod.delta[j]
+                summed = (wm.T @ self.dE[j].reshape(K, n * n)
+                          + (wsm * self.dl[j][:, None]).T @ self.E0.reshape(K, n * n))
+                dD[j] = whole - summed.real.reshape(m, n, n)
+            self.near = np.ascontiguousarray(D[:m])
+            self.dnear = dD
 
     def __getattr__(self, name: str) -> Any:
         # the all-cells weights of an exponential kernel, computed on first use
@@ -287,6 +350,7 @@ class _Memory:
             self.w, self.ws = w, ws
             # sum_k w[k, l] E_k as one matrix product (N, K) @ (K, n n)
             self.G = (w.T @ self.E0.reshape(K, n * n)).real.reshape(N, n, n)
+            self.G[:len(self.near)] += self.near
             self.powers = np.exp(np.outer(self.lam, np.arange(N) * self.h))       # (K, N)
             return self.__dict__[name]
         raise AttributeError(name)
@@ -307,13 +371,22 @@ class _Memory:
         else:
             dG = self.dG
         steps = len(Uext) - N
+        if len(self.near):
+            self._dWU = self.near_kernel_part()
+        else:
+            self._dWU = np.zeros((steps, n, P))
         size = sp_fft.next_fast_len(N + len(Uext) - 1, real=True)
         FU = sp_fft.rfft(Uext, size, axis=0)[:, :, None]                       # (F, n, 1)
-        self._dWU = np.empty((steps, n, P))
         for j in range(P):
             conv = sp_fft.irfft((sp_fft.rfft(dG[j], size, axis=0) @ FU)[:, :, 0], size, axis=0)
-            self._dWU[:, :, j] = conv[N - 1:N - 1 + steps]
+            self._dWU[:, :, j] += conv[N - 1:N - 1 + steps]
         return self._dWU
+
+    def near_kernel_part(self) -> np.ndarray:
+        """sum_{l<m} dD_j[l] U^{p-l} for all steps (steps, n, P): the near cells' part of
+        :meth:`kernel_part`, which the compiled loop takes on its own beside its recursion."""
+        Uext = self._Uext()
+        return near_kernel_part(self.dnear, Uext, self.N, len(Uext) - self.N)
 
     def _recompute(self, Sall: np.ndarray, p: int) -> None:
         window = Sall[p + 1:p + self.N + 1][::-1]                                # S^{p-l}
@@ -326,8 +399,9 @@ class _Memory:
         if self.recursive:
             if self.Z is None or self.since >= 4 * N:
                 self._recompute(Sall, p)
-            out = np.einsum("kij,kjq->iq", self.E, self.Z).real
-            return out + self.last @ Sall[p + 1]
+            out = np.einsum("kij,kjq->iq", self.E, self.Z).real + self.last @ Sall[p + 1]
+            near_sum(self.near, Sall, p, N, out)
+            return out
         rows = Sall[p + 1:p + N + 1]
         return self.flat() @ rows.reshape(N * rows.shape[1], rows.shape[2])
 
@@ -360,8 +434,10 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     make : callable
         ``make(p) -> dmi.Solver``, the model at the parameter vector p (a new solver, set but
         not necessarily initialised; it is initialised here).  p may enter f, the friction
-        coefficients, the box, the kernel (its exponential terms a, b, C, D, or a kernel
-        callback) and the history; it may not change n, N, h, tau, the kinds of A and kernel,
+        coefficients, the box, the kernel (its exponential terms a, b, C, D, a kernel callback
+        under either rule, the near kernel of ``set_kernel_near``, a ``PowerKernel``'s c and beta
+        through ``KernelFit.refit``: through the weights libdmi computes, ``Solver.kernel_weights``)
+        and the history; it may not change n, N, h, tau, the kinds of A and kernel,
         the number of kernel terms, the convolution method or the quadrature rule.  A parameter
         enters f (or the history) unless :meth:`dmi.Solver.same_callback` finds the perturbed
         model's callback the same as the model's; f and the history are differentiated only in the
@@ -396,8 +472,9 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     ------
     ValueError
         p not a finite vector, steps < 1, make raising at p or near it, a parameter changing the
-        model's structure, more steps than ``max_steps``, a near kernel, a callback kernel under
-        the cell rule, ``rhs`` disagreeing with the solver's f, an unknown ``engine``, or
+        model's structure or the rates of a kernel fit chosen by ``dmi.kernels.fit`` (use
+        ``KernelFit.refit``), more steps than ``max_steps``, a perturbed model failing in init,
+        ``rhs`` disagreeing with the solver's f, an unknown ``engine``, or
         ``engine="compiled"`` where it does not apply (the message says why).
     TypeError
         make not returning a dmi.Solver.
