@@ -565,7 +565,9 @@ def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: floa
     events: list[CurveEvent] = []
     for e in b.events:
         if e.kind == "user":
-            i = next((k for k, pt in enumerate(points) if pt.q == e.p), e.index)
+            # the driver's index is the landed point's; else the nearest point on that q
+            on = [k for k, pt in enumerate(points) if pt.q == e.p]
+            i = e.index if e.index in on or not on else min(on, key=lambda k: abs(k - e.index))
             events.append(CurveEvent("user", points[i].p, float(e.p), i, e.detail,
                                      points[i].u))
         elif e.kind in ("bautin", "zero-hopf", "hopf-hopf", "cusp", "bogdanov-takens") \
@@ -573,7 +575,8 @@ def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: floa
             events.append(CurveEvent(e.kind, float(e.u[n]), float(e.p), e.index, e.detail,
                                      e.u[:n].copy(), e.hopf))
         # the driver's "fold" (a turning point in q) and "branch-point" are not the curve's
-    status = b.status
+    # the driver's words for its parameter are p's: here it is q
+    status = b.status.replace("p_end", "q_end").replace(" near p = ", " near q = ")
     if kind == "hopf" and not status.startswith(("reached", "left", "max_points")) \
             and points and points[-1].omega < 0.05 * omega0:
         status += (f"; omega fell from {omega0:.6g} to {points[-1].omega:.3g}: a "
