@@ -2,7 +2,8 @@
 # against closed forms written here: the Hopf curve of a rotationally symmetric oscillator with a
 # distributed memory (its characteristic equation is a scalar one), through two turning points in
 # q, with its Bautin point (with and without the derivative hook); the fold curve and the cusp of
-# a scalar cubic with a memory; the refusals.
+# a scalar cubic with a memory; the fold curve and the Bogdanov-Takens point of a planar model
+# with a memory; the refusals.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -205,6 +206,37 @@ def test_fold_curve_through_its_cusp():
     assert [e.kind for e in curve.events] == ["cusp"]
 
 
+# ---- x' = y, y' = p + q y + x^2 + x y - int_0^TAU2 GB e^-s x(t - s) ds ------------------------
+# Delta(lambda) = [[lambda, -1], [-2 x + g(lambda), lambda - q - x]] at (x, 0), det = lambda^2 -
+# (q + x) lambda - 2 x + g(lambda), g = GB (1 - e^-(1 + lambda) TAU2) / (1 + lambda): a root 0
+# where x = g(0) / 2, so the fold curve is p = g(0)^2 / 4 for every q, and the root 0 is double
+# (a Bogdanov-Takens point) where q = g'(0) - g(0) / 2.
+TAU2, GB = 2.0, 0.5
+
+
+def planar(p: float, q: float) -> dmi.Solver:
+    s = dmi.Solver(2, TAU2, 30)
+    s.set_rhs(lambda t, u: -np.array([u[1], p + q * u[1] + u[0] ** 2 + u[0] * u[1]]))
+    s.set_kernel_exp([-1.0], [0.0], [np.array([[0.0, 0.0], [GB, 0.0]])])
+    return s
+
+
+@pytest.mark.filterwarnings("ignore::dmi.analysis.equation.RefinementWarning")   # the branch in p
+def test_fold_curve_with_its_bogdanov_takens_point():
+    g0 = ghat(0.0, GB).real
+    q_bt = dghat(0.0, GB).real - g0 / 2
+    eq = da.equilibrium(lambda p: planar(p, 0.0), 0.0, [g0, 0.0], of="equation")
+    br = da.continue_equilibrium(eq, 0.2, step=0.02)
+    fold = [e for e in br.events if e.kind == "fold"][0]
+    curve = da.continue_curve(fold, planar, 0.0, -1.0, step=0.1)
+    assert curve.status == "reached q_end = -1.0", curve.status
+    for pt in curve.points:
+        assert close(pt.p, g0 * g0 / 4, 1e-9) and close(pt.u[0], g0 / 2, 1e-9), (pt.p, pt.u)
+    (bt,) = [e for e in curve.events if e.kind == "bogdanov-takens"]
+    assert close(bt.q, q_bt, 1e-9) and close(bt.p, g0 * g0 / 4, 1e-9), (bt.q - q_bt, bt.p)
+    assert [e.kind for e in curve.events] == ["bogdanov-takens"]
+
+
 # ---- refusals --------------------------------------------------------------------------------
 def test_refusals():
     om0, q0 = exact_hopf(-1.5)
@@ -218,6 +250,8 @@ def test_refusals():
     with pytest.raises(ValueError, match="omega = 0.0 is not > 0"):
         da.continue_curve(da.HopfPoint(p=-1.5, omega=0.0, root=0j), with_hook, q0, 3.0,
                           u_eq=[0.0, 0.0])
+    with pytest.raises(ValueError, match="the fold event has no equilibrium"):
+        da.continue_curve(da.Event("fold", 2.0, 3), cubic, K + 3.0, K)
     # a point that is not a Hopf point of make2 at q0
     with pytest.raises(ValueError, match="is not a Hopf point"):
         da.continue_curve(da.HopfPoint(p=-1.0, omega=om0, root=complex(0, om0)), with_hook,

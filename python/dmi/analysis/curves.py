@@ -28,7 +28,8 @@ differences), the resolvent's derivative and the kernel's transform.
   ``hopf-hopf`` the product of Re lambda over the other non-real pairs (upper half-plane, the
   pair at i omega left out).
 - Fold curve: unknowns (u, p, v), equations G = 0, Delta(0) v = 0, c v = 1.  With w the left
-  null vector from the bordered system [[Delta(0), c'], [c, 0]] (continuous along the curve):
+  null vector from the bordered system [[Delta(0), b], [c, 0]] (b the start's left null vector,
+  c its right one: w continuous along the curve, w b = 1):
   ``cusp`` the fold's quadratic coefficient w D^2 f(u)(v, v) (the model's hook ``d2``, else
   central differences); ``bogdanov-takens`` w Delta'(0) v (a second root at 0: the Hopf curve's
   omega -> 0 ends here); ``zero-hopf`` the product of Re lambda over the non-real pairs.
@@ -54,7 +55,7 @@ from ._model import (_resolvent_derivative, call_make, equation_step, equation_t
                      rhs_jacobian)
 from .branch import Event, HopfPoint
 from .driver import continuation
-from .equation import Characteristic
+from .equation import Characteristic, RefinementWarning
 from .newton import ShootingError
 from .normal_form import CriticalityWarning, _delta_prime, _Forms, criticality
 from .stability import roots as equation_roots
@@ -96,7 +97,8 @@ class CurvePoint:
     dqds : float
         The unit tangent's q component (its sign flips at a turning point in q).
     note : str
-        Why l1, kappa or the crossing speed is None (the criticality's warnings), or empty.
+        Why l1, kappa or the crossing speed is None (the criticality's warnings), or which roots
+        could not be refined (NaN in ``roots``); empty when nothing was left out.
     """
     p: float
     q: float
@@ -229,6 +231,7 @@ class _Extended:
         self.make2, self.kind, self.n, self.free, self.m = make2, kind, n, free, free.size
         self.c, self.tol, self.count = c, tol, count
         self.why = ""
+        self.b = c   # a fold curve's border column: the start's left null vector (set below)
         self.reach = 1.0   # a callback kernel's panels reach |lambda| <= reach
         m = self.m
         # the arclength: u and p as the equilibria's branch (Euclidean), omega too, v little
@@ -302,12 +305,12 @@ class _Extended:
             J[:, j] = (self.residual(e[:-1], float(e[-1])) - r0) / d
         if self.kind == "hopf":
             # rows (Re, Im) of Delta v and of c v over the columns omega, Re v, Im v
-            J[n:n + m, n + 1], J[n + m:n + 2 * m, n + 1] = dM.real, dM.imag
-            J[n:n + m, n + 2:n + 2 + m], J[n:n + m, n + 2 + m:n + 2 + 2 * m] = M.real, -M.imag
-            J[n + m:n + 2 * m, n + 2:n + 2 + m], J[n + m:n + 2 * m, n + 2 + m:n + 2 + 2 * m] = M.imag, M.real
-            k = n + 2 * m
-            J[k, n + 2:n + 2 + m], J[k, n + 2 + m:n + 2 + 2 * m] = self.c.real, -self.c.imag
-            J[k + 1, n + 2:n + 2 + m], J[k + 1, n + 2 + m:n + 2 + 2 * m] = self.c.imag, self.c.real
+            re, im = slice(n + 2, n + 2 + m), slice(n + 2 + m, n + 2 + 2 * m)
+            top, low, k = slice(n, n + m), slice(n + m, n + 2 * m), n + 2 * m
+            J[top, n + 1], J[low, n + 1] = dM.real, dM.imag
+            J[top, re], J[top, im], J[low, re], J[low, im] = M.real, -M.imag, M.imag, M.real
+            J[k, re], J[k, im] = self.c.real, -self.c.imag
+            J[k + 1, re], J[k + 1, im] = self.c.imag, self.c.real
         else:
             J[n:n + m, n + 1:n + 1 + m] = M.real
             J[n + m, n + 1:n + 1 + m] = self.c
@@ -318,12 +321,18 @@ class _Extended:
         point's criticality (its warnings kept: they say why a value is None)."""
         u, p, omega, _ = self.split(x)
         make1 = _Fixed(self.make2, q)
-        try:
-            lam = equation_roots(make1, p, u, self.count, tol=max(self.tol * 1e3, 1e-9),
-                                 of="equation")
-        except Exception:   # the roots' failure: the test functions read NaN
-            lam = np.empty(0, complex)
-        pt = CurvePoint(p=p, q=float(q), u=u.copy(), omega=omega, roots=lam)
+        # a root that cannot be refined (near a double root: Bogdanov-Takens) is NaN, which the
+        # test functions leave out; its warning goes into the point's note
+        with warnings.catch_warnings(record=True) as unrefined:
+            warnings.simplefilter("always", RefinementWarning)
+            try:
+                lam = equation_roots(make1, p, u, self.count, tol=max(self.tol * 1e3, 1e-9),
+                                     of="equation")
+            except Exception as e:   # the roots' failure: the test functions read NaN
+                lam = np.empty(0, complex)
+                warnings.warn(f"no roots: {e}", RefinementWarning, stacklevel=1)
+        pt = CurvePoint(p=p, q=float(q), u=u.copy(), omega=omega, roots=lam,
+                        note="; ".join(str(w.message) for w in unrefined))
         if self.kind == "hopf":
             hp = HopfPoint(p=p, omega=omega, root=complex(0.0, omega))
             with warnings.catch_warnings(record=True) as caught:
@@ -331,7 +340,7 @@ class _Extended:
                 hp = criticality(make1, hp, u, tol=max(self.tol * 1e3, 1e-9))
             pt.hopf, pt.l1, pt.l1_error = hp, hp.l1, hp.l1_error
             pt.criticality, pt.kappa = hp.criticality, hp.kappa
-            pt.note = "; ".join(str(w.message) for w in caught)
+            pt.note = "; ".join([pt.note] * bool(pt.note) + [str(w.message) for w in caught])
         return pt
 
     def _others(self, lam: np.ndarray, omega: float) -> tuple[np.ndarray, np.ndarray]:
@@ -351,7 +360,7 @@ class _Extended:
             M = ch(0.0).real
             m = self.m
             A = np.zeros((m + 1, m + 1))
-            A[:m, :m], A[:m, m], A[m, :m] = M, self.c, self.c
+            A[:m, :m], A[:m, m], A[m, :m] = M, self.b, self.c
             rhs = np.zeros(m + 1)
             rhs[m] = 1.0
             w = np.linalg.solve(A.T, rhs)[:m]
@@ -548,6 +557,8 @@ def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: floa
     disc = _Extended(make2, kind, n, free, v0.conj() if kind == "hopf" else v0.real, tol,
                      int(count))
     disc.reach = 2.5 * omega0 + 1.0
+    if kind == "fold":
+        disc.b = _null_vector(ch(0.0).real.T).real
     if kind == "hopf":
         x0 = np.concatenate([u0, [p0, omega0], v0.real, v0.imag])
     else:
