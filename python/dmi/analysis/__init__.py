@@ -53,3 +53,7 @@ from .collocation_continuation import (CollocationDiscretisation,  # noqa: E402
                                        equation_hopf_orbit)
 
 __all__ += ["CollocationDiscretisation", "equation_hopf_orbit"]
+from .curves import Curve, CurveEvent, CurvePoint, continue_curve  # noqa: E402
+
+# Hopf and fold curves of the equation's equilibria in two parameters (docs/stability.md)
+__all__ += ["continue_curve", "Curve", "CurvePoint", "CurveEvent"]
