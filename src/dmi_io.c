@@ -252,6 +252,8 @@ int dmi_set_convolution(dmi_solver *s, int method)
     return DMI_OK;
 }
 
+/* ---- queries ---------------------------------------------------------------- */
+
 double dmi_time(const dmi_solver *s)
 {
     return s && s->initialized ? (double)s->p * s->h : 0.0;
