@@ -1,7 +1,8 @@
 /*
- * The solver of libdmi (dmi.c), for the files that handle its innards: the
- * engine (engine.c), the cell rule (cells.c), the errors (errors.c) and the
- * saved state (state.c).
+ * The solver of libdmi (its life cycle, sampling and step in dmi.c, its
+ * setters and queries in dmi_io.c), for the files that handle its innards:
+ * those two, the engine (engine.c), the cell rule (cells.c), the errors
+ * (errors.c) and the saved state (state.c).
  * Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
  */
 #ifndef DMI_SOLVER_H
@@ -14,6 +15,10 @@
 #include "dmi.h"
 #include "exp.h"
 
+/* The kinds of the operator A (s->a_kind): none (U = X), a resolvent
+ * callback, friction, a box (dmi_io.c sets it, dmi.c's step applies it). */
+enum { A_NONE, A_CALLBACK, A_FRICTION, A_BOX };
+
 struct dmi_solver {
     size_t n, N;
     double tau, h;
@@ -21,7 +26,7 @@ struct dmi_solver {
 
     dmi_rhs_fn f;
     void *f_user;
-    int a_kind;         /* A_NONE, A_CALLBACK, A_FRICTION, A_BOX (dmi.c) */
+    int a_kind;         /* A_NONE, A_CALLBACK, A_FRICTION, A_BOX */
     dmi_resolvent_fn r;
     void *r_user;
     double *a_lo;  /* friction: alpha (n); box: lo (n) */
@@ -63,6 +68,11 @@ struct dmi_solver {
     double near_delta;
     dmi_kernel near;
 };
+
+/* Samples H(l h), l = 0..N-1, into k (nonzero entries only), for fn's
+ * messages (dmi.c: dmi_init; dmi_set_convolution when the recursion went
+ * without them).  DMI_OK, or an error code with the message set. */
+int dmi_sample_kernel(dmi_solver *s, dmi_kernel *k, const char *fn);
 
 /* Whether s's kernel is the exponential one of dmi_set_kernel_exp. */
 static inline int dmi_has_expk(const dmi_solver *s)
