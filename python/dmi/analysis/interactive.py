@@ -212,8 +212,8 @@ def branch_html(branch: Any, values: np.ndarray, label: str,
     ----------
     branch : dmi.analysis.Branch
         The branch.
-    values : numpy.ndarray, shape (points, k)
-        What is drawn against p (:func:`dmi.analysis.orbit_plot.branch_values` of
+    values : numpy.ndarray, shape (m, k)
+        What is drawn against p at the m points (:func:`dmi.analysis.orbit_plot.branch_values` of
         ``component``).
     label : str
         Its name, the vertical axis' label (matplotlib's ``$...$`` maths shown as plain text).

@@ -55,8 +55,8 @@ def branch_values(branch: Branch, component: int = 0) -> tuple[np.ndarray, str]:
 
     Returns
     -------
-    values : numpy.ndarray, shape (points, k)
-        The k curves (state units).
+    values : numpy.ndarray, shape (m, k)
+        The k curves at the branch's m points (state units).
     label : str
         Their axis label (matplotlib ``$...$`` maths).
     """
