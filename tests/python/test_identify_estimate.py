@@ -53,7 +53,7 @@ def test_synthetic_recovery_from_twenty_percent_off():
     assert np.abs(est.p / TRUE - 1.0).max() < 1e-8, est.p
     # the exact sensitivities give a trust region's fast convergence: 11 Jacobians from 20 % off
     # here (the count is the route, which rounding may lengthen by a step or two; a wrong
-    # Jacobian takes many more, or stops short of 1e-8)
+    # Jacobian slows it down, which the bound is for)
     assert est.njev <= 20, est.njev
     assert est.unidentifiable == [] and est.unplaced == []
     assert np.all(np.isfinite(est.stderr))
