@@ -97,8 +97,9 @@ def check_grazing(status: str, points, make, steps: int) -> None:
     assert stuck_steps(make, a, steps) == stuck_steps(make, b, steps) == 0
     assert va.min() > vb.min() >= 0.0      # neither sticks, the least |v| falls
     assert least <= 0.05 * half
-    # the status reads the orbits' samples (3 digits): at most a little above the plain run's
-    assert vb.min() * (1 - 1e-3) <= least <= vb.min() + 0.2 * (va.min() - vb.min()), \
+    # the status reads the orbits' samples to 3 digits (a relative rounding of up to 5e-3):
+    # at most a little above the plain run's
+    assert vb.min() * (1 - 5e-3) <= least <= vb.min() + 0.2 * (va.min() - vb.min()), \
         (least, vb.min())
     ours = b.p + vb.min() * (b.p - a.p) / (va.min() - vb.min())
     assert abs(at - ours) <= 0.2 * abs(b.p - a.p), (at, ours)
