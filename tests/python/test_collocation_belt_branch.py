@@ -368,6 +368,6 @@ def test_den_hartog_branch_lands_before_its_stick_onset_and_locates_it():
             assert abs(ev.p - onset) < 1e-8, (ev, onset)
             continue
         assert "; not located (placed at the middle): " in ev.detail, ev
-        a, b = (float(x) for x in re.search(r"between p = (\S+) and (\S+);", ev.detail).groups())
-        assert ev.p == pytest.approx(0.5 * (a + b), abs=1e-15), ev
-        assert abs(ev.p - onset) <= abs(b - a) + 1e-8, (ev, onset)
+        pa, pb = (float(x) for x in re.search(r"between p = (\S+) and (\S+);", ev.detail).groups())
+        assert ev.p == pytest.approx(0.5 * (pa + pb), abs=1e-15), ev
+        assert abs(ev.p - onset) <= abs(pb - pa) + 1e-8, (ev, onset)
