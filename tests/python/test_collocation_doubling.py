@@ -74,9 +74,13 @@ def fourier_orbit(p: float, N: int, P: float, w0: np.ndarray) -> np.ndarray:
 
 @lru_cache(maxsize=None)
 def t_orbit(p: float) -> np.ndarray:
-    """The T-orbit at p, continued in p from the large orbit of the right well at p = 0.2."""
+    """The T-orbit at p, continued in p from the large orbit of the right well at p = 0.2 (its
+    guess: the orbit's mean and leading harmonics to 2 digits, within Newton's quadratic reach;
+    a rougher guess sent the damped Newton on a long walk whose end depended on the rounding
+    of the linear solves)."""
     t = np.arange(N1) * T / N1
-    w = fourier_orbit(0.2, N1, T, 0.865 - 0.295 * np.cos(W * t) + 0.34 * np.sin(W * t))
+    w = fourier_orbit(0.2, N1, T, 0.83 - 0.033 * np.cos(W * t) + 0.44 * np.sin(W * t)
+                      - 0.058 * np.cos(2 * W * t))
     for q in np.linspace(0.2, p, 8)[1:]:
         w = fourier_orbit(float(q), N1, T, w)
     return w
