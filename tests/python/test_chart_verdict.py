@@ -111,7 +111,7 @@ def test_verify_false_gives_none_and_a_user_warning(verified):
     msgs = [str(w.message) for w in got if w.category is UserWarning]
     assert len(msgs) == 1 and "verify=False" in msgs[0], msgs
     assert not [w for w in got if issubclass(w.category, StabilityWarning)]
-    with pytest.raises(ValueError, match="verify"):
+    with pytest.raises(ValueError, match=r"verify = .yes.\): give True"):   # bad-inputs SC01
         analysis.stability_chart(mean_delay, GAINS, TAUS, [0.0], client=InProcess(),
                                  verify="yes")
 

@@ -145,8 +145,9 @@ class StabilityChart:
 def _is(verdict: np.ndarray, value: bool | None) -> np.ndarray:
     """Boolean mask of the cells whose verdict is ``value`` (True, False or None)."""
     v = np.asarray(verdict, dtype=object)
-    return np.vectorize(lambda x: x is value, otypes=[bool])(v) if v.size else np.zeros(v.shape,
-                                                                                          bool)
+    same = ((x is None) if value is None else (x is not None and bool(x) is value)
+            for x in v.ravel())
+    return np.fromiter(same, dtype=bool, count=v.size).reshape(v.shape)
 
 
 def _cell(make2: Callable[[float, float], Solver], p: float, q: float, u_eq: Any, count: int,
@@ -342,7 +343,8 @@ def stability_chart(make2: Callable[[float, float], Solver], p_values: Sequence[
     ------
     ValueError
         Fewer than 2 p values or 1 q value, not one-dimensional or not finite, ``of`` unknown,
-        ``verify`` not a bool, or as :func:`roots` at a grid point (u_eq not an equilibrium, :class:`KinkError`).
+        ``verify`` not a bool, or as :func:`roots` at a grid point (u_eq not an equilibrium,
+        :class:`KinkError`).
     TypeError
         ``make2`` or ``u_eq`` cannot be pickled (without ``client``).
     Exception
