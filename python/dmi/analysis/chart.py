@@ -7,6 +7,7 @@ from __future__ import annotations
 import functools
 import os
 import pickle
+import warnings
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
@@ -17,10 +18,17 @@ import scipy.optimize
 
 from .._solver import Solver
 from ._model import Linearisation, call_make
-from .stability import check_of, rightmost_of
+from .floquet import StabilityWarning
+from .root_verdict import RootVerdict, check
+from .stability import DENSE_MAX, check_of, rightmost_of
 
 #: Relative tolerance (of the range of p) of a traced point's p.
 TRACE_TOL = 1e-9
+#: The fill of the chart's cells without a verdict (grey, hatched).
+UNDECIDED_COLOR = "#d9d9d9"
+#: The reason of a cell not verified (``verify=False``).
+UNVERIFIED = ("not verified (verify=False): the roots are ARPACK's Ritz values without an error "
+              "bound")
 
 
 @dataclass
@@ -56,20 +64,56 @@ class StabilityChart:
         The grid's parameters, shapes (P,) and (Q,).
     re, im : numpy.ndarray, shape (Q, P)
         ``re[j, i]`` and ``im[j, i]``: the real and imaginary parts (1 / time unit) of the
-        rightmost root at (p_values[i], q_values[j]) (re < 0: stable).
+        rightmost root at (p_values[i], q_values[j]), as the root finder gave them (not a
+        verdict: see ``verdict``).
     curves : list of HopfCurve
         The traced Hopf and fold curves.
+    verdict : numpy.ndarray of object, shape (Q, P)
+        ``verdict[j, i]``: the verified verdict at the grid point
+        (:mod:`dmi.analysis.root_verdict`, as :attr:`Equilibrium.stable`): True (verified
+        stable), False (verified unstable) or None (not decided, ``reason`` says why; or not
+        verified: ``verify=False``, or a chart built without verdicts).
+    reason : numpy.ndarray of str, shape (Q, P)
+        How each cell's verdict was reached, or why there is none.
+    error : numpy.ndarray, shape (Q, P)
+        The error of ``re`` the verdict used (1 / time unit; nan where not verified).
     """
     p_values: np.ndarray
     q_values: np.ndarray
     re: np.ndarray
     im: np.ndarray
     curves: list[HopfCurve] = field(default_factory=list)
+    verdict: np.ndarray | None = None
+    reason: np.ndarray | None = None
+    error: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        shape = np.shape(self.re)
+        if self.verdict is None:
+            self.verdict = np.full(shape, None, dtype=object)
+            if self.reason is None:
+                self.reason = np.full(shape, "not verified (no verdict was given)", dtype=object)
+        if self.reason is None:
+            self.reason = np.full(shape, "", dtype=object)
+        if self.error is None:
+            self.error = np.full(shape, np.nan)
 
     @property
     def stable(self) -> np.ndarray:
-        """re < 0: the grid points whose equilibrium is asymptotically stable."""
-        return self.re < 0
+        """Boolean mask of the grid points verified asymptotically stable (verdict True).  A
+        cell whose verdict is None is neither in ``stable`` nor in ``unstable``."""
+        return _is(self.verdict, True)
+
+    @property
+    def unstable(self) -> np.ndarray:
+        """Boolean mask of the grid points verified unstable (verdict False)."""
+        return _is(self.verdict, False)
+
+    @property
+    def undecided(self) -> np.ndarray:
+        """Boolean mask of the grid points without a verdict (None: not decided or not
+        verified)."""
+        return _is(self.verdict, None)
 
     def to_html(self, path: str | os.PathLike, p_label: str = "parameter p",
                 q_label: str = "parameter q", title: str | None = None) -> None:
@@ -98,6 +142,25 @@ class StabilityChart:
         return chart_summary(self)
 
 
+def _is(verdict: np.ndarray, value: bool | None) -> np.ndarray:
+    """Boolean mask of the cells whose verdict is ``value`` (True, False or None)."""
+    v = np.asarray(verdict, dtype=object)
+    same = ((x is None) if value is None else (x is not None and bool(x) is value)
+            for x in v.ravel())
+    return np.fromiter(same, dtype=bool, count=v.size).reshape(v.shape)
+
+
+def _cell(make2: Callable[[float, float], Solver], p: float, q: float, u_eq: Any, count: int,
+          tol: float, of: str, verify: bool) -> tuple[complex, RootVerdict]:
+    """The rightmost root at (p, q) and its verdict, verified
+    (:func:`dmi.analysis.root_verdict.check`) or not."""
+    with Linearisation(lambda: call_make(make2, p, q), u_eq, (p, q), tol, of) as lin:
+        lam = rightmost_of(lin, count, of)
+        if not verify:
+            return complex(lam[0]), RootVerdict(None, UNVERIFIED)
+        return complex(lam[0]), check(lin, lam, of, lin.dim <= max(DENSE_MAX, count + 4))
+
+
 def _root_at(make2: Callable[[float, float], Solver], p: float, q: float, u_eq: Any, count: int,
              tol: float, of: str = "scheme") -> np.ndarray:
     with Linearisation(lambda: call_make(make2, p, q), u_eq, (p, q), tol, of) as lin:
@@ -105,9 +168,11 @@ def _root_at(make2: Callable[[float, float], Solver], p: float, q: float, u_eq: 
 
 
 def _row(make2: Callable, p_values: np.ndarray, q: float, u_eq: Any, count: int,
-         tol: float, of: str = "scheme") -> np.ndarray:
-    """The rightmost root at every p of one row q (a task of the pool or of Dask)."""
-    return np.array([_root_at(make2, p, q, u_eq, count, tol, of)[0] for p in p_values])
+         tol: float, of: str = "scheme", verify: bool = True
+         ) -> list[tuple[complex, RootVerdict]]:
+    """The rightmost root and its verdict at every p of one row q (a task of the pool or of
+    Dask)."""
+    return [_cell(make2, p, q, u_eq, count, tol, of, verify) for p in p_values]
 
 
 def _tracked(make2: Callable, p: float, q: float, u_eq: Any, count: int, tol: float,
@@ -227,11 +292,13 @@ def _run_all(executor: Any, tasks: list[Callable[[], Any]]) -> list[Any]:
 def stability_chart(make2: Callable[[float, float], Solver], p_values: Sequence[float],
                     q_values: Sequence[float], u_eq: Any, *, count: int = 4,
                     workers: int | None = None, client: Any = None, trace: bool = True,
-                    tol: float = 1e-9, of: str = "scheme") -> StabilityChart:
+                    tol: float = 1e-9, of: str = "scheme", verify: bool = True
+                    ) -> StabilityChart:
     """The stability chart of a two-parameter model: the rightmost root (:func:`roots`) at every
-    grid point, computed row by row (one task per q), and the :class:`HopfCurve` s traced by
-    continuation from each chain of sign changes of the grid (one task per chain).  The pool this
-    function starts is shut down before it returns, also on an error.
+    grid point and its verified verdict (:mod:`dmi.analysis.root_verdict`, as
+    :func:`equilibrium`'s), computed row by row (one task per q), and the :class:`HopfCurve` s
+    traced by continuation from each chain of sign changes of the grid (one task per chain).  The
+    pool this function starts is shut down before it returns, also on an error.
 
     Parameters
     ----------
@@ -260,17 +327,24 @@ def stability_chart(make2: Callable[[float, float], Solver], p_values: Sequence[
     of : {"scheme", "equation"}, optional
         ``"scheme"`` (the default: the roots that match simulation) or ``"equation"`` (each root
         refined to the continuous equation's, :func:`roots`).
+    verify : bool, optional
+        True (the default): every cell's verdict is verified (the equation's roots counted by
+        the argument principle, the scheme's largest multiplier by a second eigen-solve); one
+        :class:`dmi.analysis.StabilityWarning` names the cells not decided (verdict None) and
+        the first one's reason.  False opts out: every verdict is None, with a ``UserWarning``
+        (the roots ``re``, ``im`` and the curves are computed as with True).
 
     Returns
     -------
     StabilityChart
-        The grid's rightmost roots and the traced curves.
+        The grid's rightmost roots, their verdicts and the traced curves.
 
     Raises
     ------
     ValueError
-        Fewer than 2 p values or 1 q value, not one-dimensional or not finite, ``of`` unknown, or
-        as :func:`roots` at a grid point (u_eq not an equilibrium, :class:`KinkError`).
+        Fewer than 2 p values or 1 q value, not one-dimensional or not finite, ``of`` unknown,
+        ``verify`` not a bool, or as :func:`roots` at a grid point (u_eq not an equilibrium,
+        :class:`KinkError`).
     TypeError
         ``make2`` or ``u_eq`` cannot be pickled (without ``client``).
     Exception
@@ -284,6 +358,9 @@ def stability_chart(make2: Callable[[float, float], Solver], p_values: Sequence[
                          ">= 1, one-dimensional")
     if not (np.all(np.isfinite(P)) and np.all(np.isfinite(Q))):
         raise ValueError("dmi.analysis.stability_chart: p_values and q_values must be finite")
+    if not isinstance(verify, bool):
+        raise ValueError(f"dmi.analysis.stability_chart(..., verify = {verify!r}): give True (the "
+                         "default: verified verdicts) or False (opt out: verdicts None)")
     args = (make2, u_eq, int(count), float(tol))
     pool = None
     if client is None:
@@ -297,9 +374,18 @@ def stability_chart(make2: Callable[[float, float], Solver], p_values: Sequence[
         pool = ProcessPoolExecutor(max_workers=max(1, min(n, len(Q))))
     try:
         ex = client if client is not None else pool
-        lam = np.array(_run_all(ex, [functools.partial(_row, make2, P, q, u_eq, args[2], args[3],
-                                                       of) for q in Q]))
-        chart = StabilityChart(P, Q, lam.real.copy(), lam.imag.copy())
+        rows = _run_all(ex, [functools.partial(_row, make2, P, q, u_eq, args[2], args[3], of,
+                                               verify) for q in Q])
+        lam = np.array([[c[0] for c in row] for row in rows], dtype=complex)
+        verdict = np.empty(lam.shape, dtype=object)
+        reason = np.empty(lam.shape, dtype=object)
+        error = np.empty(lam.shape)
+        for j, row in enumerate(rows):
+            for i, (_, v) in enumerate(row):
+                verdict[j, i], reason[j, i], error[j, i] = v.stable, v.reason, v.error
+        chart = StabilityChart(P, Q, lam.real.copy(), lam.imag.copy(), verdict=verdict,
+                               reason=reason, error=error)
+        _warn_undecided(chart, verify)
         if trace:
             starts = _brackets(chart.re)
             curves = _run_all(ex, [functools.partial(_trace, make2, P, Q, u_eq, args[2], args[3],
@@ -314,12 +400,42 @@ def stability_chart(make2: Callable[[float, float], Solver], p_values: Sequence[
             pool.shutdown(wait=True, cancel_futures=True)
 
 
+def _edges(x: np.ndarray) -> np.ndarray:
+    """The cells' edges of grid values x (sorted either way): half-way between neighbours, the
+    outer ones as far out as the inner ones."""
+    mid = 0.5 * (x[:-1] + x[1:])
+    return np.concatenate([[x[0] - (mid[0] - x[0])], mid, [x[-1] + (x[-1] - mid[-1])]])
+
+
+def _warn_undecided(chart: StabilityChart, verify: bool) -> None:
+    """verify=False: one UserWarning; otherwise one StabilityWarning naming the cells not
+    decided, if any, and the first one's reason."""
+    if not verify:
+        warnings.warn("stability_chart(verify=False): the roots are ARPACK's Ritz values without "
+                      "an error bound, so every verdict is None (stable is empty); leave verify at "
+                      "its default (True) for verified verdicts", UserWarning, stacklevel=3)
+        return
+    open_ = np.argwhere(chart.undecided)
+    if len(open_):
+        where = ", ".join(f"(p, q) = ({chart.p_values[i]:.8g}, {chart.q_values[j]:.8g})"
+                          for j, i in open_[:4])
+        j, i = open_[0]
+        warnings.warn(f"stability_chart: the stability of {len(open_)} of {chart.re.size} grid "
+                      f"points is not decided (verdict None), at {where}"
+                      f"{', ...' if len(open_) > 4 else ''}: {chart.reason[j, i]} (the first; "
+                      "StabilityChart.reason has each cell's)", StabilityWarning, stacklevel=3)
+
+
 def plot_stability_chart(chart: StabilityChart, ax: Any = None, *, p_label: str = "parameter p",
                          q_label: str = "parameter q", title: str | None = None,
                          html: str | os.PathLike | None = None) -> Any:
-    """Draws a stability chart: the stable region (Re lambda_1 < 0) shaded, the traced Hopf curves
-    as solid lines and the fold curves (a real root crossing) dashed, p on the horizontal axis,
-    q on the vertical one.  The key sits below the axes, not over the data.
+    """Draws a stability chart: the stable region shaded (Re lambda_1 < 0, its zero level
+    interpolated between grid points, where the verdicts are verified), the grid points whose
+    verdict is None (not decided, or not verified) as grey hatched cells, left out of the shading
+    (each cell reaches half-way to its neighbours), the traced Hopf curves as solid lines and the
+    fold curves (a real root crossing) dashed, p on the horizontal axis, q on the vertical one.  A
+    cell verified unstable is not shaded, whatever its ``re``.  The key sits below the axes, not
+    over the data.
 
     Parameters
     ----------
@@ -351,14 +467,22 @@ def plot_stability_chart(chart: StabilityChart, ax: Any = None, *, p_label: str 
         chart_html(chart, html, p_label=p_label, q_label=q_label, title=title)
     import matplotlib.pyplot as plt
     from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
+    from matplotlib.patches import Patch, Rectangle
 
     if ax is None:
         _, ax = plt.subplots(figsize=(6.4, 5.2), constrained_layout=True)
     P, Q = chart.p_values, chart.q_values
+    undecided = chart.undecided
     if len(Q) > 1:   # Re lambda_1 < 0, its zero level interpolated between the grid points
-        re = np.nan_to_num(chart.re, nan=np.inf, neginf=-1e300)
-        ax.contourf(P, Q, np.clip(re, -1.0, 1.0), levels=[-2.0, 0.0], colors=["#c6dbef"])
+        re = np.clip(np.nan_to_num(chart.re, nan=np.inf, neginf=-1e300), -1.0, 1.0)
+        re[chart.unstable & (re < 0)] = 1.0      # a cell verified unstable is not shaded
+        ax.contourf(P, Q, np.ma.masked_array(re, mask=undecided), levels=[-2.0, 0.0],
+                    colors=["#c6dbef"])
+        pe, qe = _edges(P), _edges(Q)
+        for j, i in np.argwhere(undecided):
+            ax.add_patch(Rectangle((pe[i], qe[j]), pe[i + 1] - pe[i], qe[j + 1] - qe[j],
+                                   facecolor=UNDECIDED_COLOR, edgecolor="#969696", hatch="///",
+                                   lw=0.0))
     for c in chart.curves:
         ax.plot(c.p, c.q, color="black", lw=1.4, ls="-" if c.is_hopf else "--")
     ax.set_xlim(P.min(), P.max())
@@ -371,6 +495,9 @@ def plot_stability_chart(chart: StabilityChart, ax: Any = None, *, p_label: str 
     handles = [Patch(facecolor="#c6dbef", label="stable: Re λ₁ < 0"),
                Line2D([], [], color="black", lw=1.4, label="Hopf curve: λ = ±iω"),
                Line2D([], [], color="black", lw=1.4, ls="--", label="fold: λ = 0")]
-    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=3,
-              frameon=False, fontsize="small")
+    if len(Q) > 1 and undecided.any():
+        handles.append(Patch(facecolor=UNDECIDED_COLOR, edgecolor="#969696", hatch="///",
+                             label="not decided"))
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13),
+              ncol=len(handles), frameon=False, fontsize="small")
     return ax
