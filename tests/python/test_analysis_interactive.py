@@ -250,7 +250,11 @@ def test_chart_summary():
     r = rows(c._repr_html_())
     assert r["grid"] == "3 p x 2 q"
     assert r["p"] == "0 .. 2" and r["q"] == "5 .. 6"
-    assert r["stable points"] == "3 of 6"
+    # a chart built by hand has no verdicts: no point is called stable from the sign of re alone
+    assert r["stable points"] == "0 of 6 (6 not verified)"
+    d = da.StabilityChart(c.p_values, c.q_values, c.re, c.im, c.curves,
+                          verdict=np.array([[True, False, None], [True, True, None]], dtype=object))
+    assert rows(d._repr_html_())["stable points"] == "3 of 6 (2 not verified)"
     assert r["largest Re"] == "2.5"
     assert r["curves"] == "1 Hopf, 1 fold"
 

@@ -347,8 +347,9 @@ def chart_html(chart: Any, path: str | os.PathLike | None = None, *,
         "re": np.where(finite, re, np.nan).ravel(),
         "p_text": [number(x) for x in pp.ravel()], "q_text": [number(x) for x in qq.ravel()],
         "root_text": [complex_text(complex(a, b)) for a, b in zip(re.ravel(), im.ravel())],
-        "stable_text": ["stable" if a < 0 else ("unstable" if a >= 0 else "no root")
-                        for a in re.ravel()]}, name="cells")
+        "stable_text": [_verdict_text(v) if np.isfinite(a) else "no root"
+                        for a, v in zip(re.ravel(), np.asarray(chart.verdict).ravel())]},
+        name="cells")
     mapper = LinearColorMapper(palette=RdBu10, low=-scale or -1.0, high=scale or 1.0,
                                nan_color="#bbbbbb")
     fig = figure(sizing_mode="stretch_width", height=height, name="chart", x_axis_label=p_label,
@@ -436,14 +437,16 @@ def chart_summary(chart: Any) -> str:
     Returns
     -------
     str
-        A table of the grid (sizes, ranges of p and q), how many grid points are stable, the
-        largest Re of a rightmost root and the curves.
+        A table of the grid (sizes, ranges of p and q), how many grid points are verified
+        stable (and how many have no verdict), the largest Re of a rightmost root and the curves.
     """
     re = np.asarray(chart.re, float)
     hopf = sum(c.is_hopf for c in chart.curves)
+    unverified = int(np.sum(chart.undecided))
     return _table("StabilityChart", [
         ("grid", f"{len(chart.p_values)} p x {len(chart.q_values)} q"),
         ("p", _range(chart.p_values)), ("q", _range(chart.q_values)),
-        ("stable points", f"{int(np.sum(re < 0))} of {re.size}"),
+        ("stable points", f"{int(np.sum(chart.stable))} of {re.size}"
+                          + (f" ({unverified} not verified)" if unverified else "")),
         ("largest Re", number(float(np.nanmax(re))) if np.isfinite(re).any() else "none"),
         ("curves", f"{hopf} Hopf, {len(chart.curves) - hopf} fold")])
