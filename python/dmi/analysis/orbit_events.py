@@ -177,6 +177,13 @@ def verified_tests(mu: np.ndarray, err: np.ndarray, p: float) -> dict[str, float
     return out
 
 
+def _crossing(pa: float, pb: float, fa: float, fb: float) -> float:
+    """Where the line through (pa, fa) and (pb, fb) crosses 0; the middle without a sign
+    change."""
+    w = 0.5 if fa == fb or fa * fb > 0 else fa / (fa - fb)
+    return pa + (pb - pa) * w
+
+
 def orbit_events(a: BranchPoint, b: BranchPoint, index: int, autonomous: bool = False,
                  decided: dict[str, BranchPoint] | None = None) -> list[Event]:
     """The events of the orbits' multipliers and stick patterns between the points a and b
@@ -242,20 +249,18 @@ def orbit_events(a: BranchPoint, b: BranchPoint, index: int, autonomous: bool = 
         na, nb = count(rest(ref)), count(rest(b))
         if na == nb:
             continue
-        fa, fb = test_function(kind, rest(ref)), test_function(kind, rest(b))
-        w = 0.5 if fa == fb or fa * fb > 0 else fa / (fa - fb)  # no sign change: the middle
         verified = ref.floquet is not None and b.floquet is not None
         span = "" if ref is a else (f" (bracketed by the points at p = {ref.p!r} and {b.p!r}, "
                                     "those between deciding nothing of it)")
-        ev.append(Event(kind, ref.p + (b.p - ref.p) * w, index, None,
+        ev.append(Event(kind, _crossing(ref.p, b.p, test_function(kind, rest(ref)),
+                                        test_function(kind, rest(b))), index, None,
                         f"{what}: {na} -> {nb}" + span +
                         (" (verified: beyond the multipliers' error bounds on both sides)"
                          if verified else " (not verified: the Ritz multipliers have no error "
-                         "bound; continue_orbit(verify=...) verifies them)")))
+                         "bound; continue_orbit verifies them unless verify=False)")))
 
     def at(fa: float, fb: float) -> float:
-        w = 0.5 if fa == fb or fa * fb > 0 else fa / (fa - fb)  # no sign change: the middle
-        return a.p + (b.p - a.p) * w
+        return _crossing(a.p, b.p, fa, fb)
 
     for i in range(len(a.stick_steps)):
         sa, sb = int(a.stick_steps[i]), int(b.stick_steps[i])
