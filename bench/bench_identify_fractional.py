@@ -83,15 +83,17 @@ def study(tau: float, T: float, h: float, every: int, sigma: float, seeds: int) 
 
 def main() -> None:
     ap = argparse.ArgumentParser(
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
         description="Fits the fractional belt's friction level, c_f and beta to noisy records of "
                     "a stick-slip run for each seed and prints each estimate, its standard error "
                     "and z = (estimate - truth) / stderr, and the RMS of z.")
-    ap.add_argument("--tau", type=float, default=50.0)
-    ap.add_argument("--T", type=float, default=60.0)
-    ap.add_argument("--h", type=float, default=0.005)
-    ap.add_argument("--every", type=int, default=20)
-    ap.add_argument("--sigma", type=float, default=0.01)
-    ap.add_argument("--seeds", type=int, default=5)
+    ap.add_argument("--tau", type=float, default=50.0, help="the memory (time units)")
+    ap.add_argument("--T", type=float, default=60.0, help="the records' length (time units)")
+    ap.add_argument("--h", type=float, default=0.005, help="the step (time units)")
+    ap.add_argument("--every", type=int, default=20, help="steps between two samples of x")
+    ap.add_argument("--sigma", type=float, default=0.01,
+                    help="the noise's standard deviation (state units)")
+    ap.add_argument("--seeds", type=int, default=5, help="fits, one a noise seed")
     a = ap.parse_args()
     study(a.tau, a.T, a.h, a.every, a.sigma, a.seeds)
 
