@@ -154,8 +154,8 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
         (:func:`dmi.analysis.refine_orbit`: the equation's, O(h^2)); the model must take h.
     at : iterable of float
         Parameters where a point is wanted (a ``user`` event each, its point at exactly that p).
-    verify : dmi.analysis.Verify or False, optional
-        How every point's multipliers and stability are verified (None: ``Verify()``;
+    verify : dmi.analysis.Verify or bool, optional
+        How every point's multipliers and stability are verified (None or True: ``Verify()``;
         :func:`dmi.analysis.floquet_verdict`, kept in ``BranchPoint.floquet``; the multipliers'
         events then leave out the verified trivial multiplier, and are reported only between
         points whose multipliers of their kind lie off the unit circle beyond their error
@@ -191,7 +191,7 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                                        multipliers=multipliers, tol=tol, max_iter=max_iter, at=at)
     if not (math.isfinite(step) and step > 0):
         raise ValueError(f"step = {step!r}: must be finite and > 0 (p units)")
-    if verify is None:
+    if verify is None or verify is True:
         verify = Verify()
     elif verify is False:
         if multipliers > 0:

@@ -50,6 +50,7 @@ from typing import Any
 
 import numpy as np
 
+from .._errors import Error
 from .._solver import Solver
 from ._model import (_resolvent_derivative, call_make, equation_step, equation_terms, kernel_of,
                      rhs_jacobian)
@@ -57,7 +58,7 @@ from .branch import Event, HopfPoint
 from .driver import continuation
 from .equation import Characteristic, RefinementWarning
 from .newton import ShootingError
-from .normal_form import CriticalityWarning, _delta_prime, _Forms, criticality
+from .normal_form import CriticalityWarning, _check_hooks, _delta_prime, _Forms, criticality
 from .stability import roots as equation_roots
 
 #: Roots computed at each point (the zero-Hopf and Hopf-Hopf test functions read them).
@@ -231,6 +232,7 @@ class _Extended:
         self.make2, self.kind, self.n, self.free, self.m = make2, kind, n, free, free.size
         self.c, self.tol, self.count = c, tol, count
         self.why = ""
+        self.hooks_checked = False   # the model's d2 checked against differences of f
         self.b = c   # a fold curve's border column: the start's left null vector (set below)
         self.reach = 1.0   # a callback kernel's panels reach |lambda| <= reach
         m = self.m
@@ -328,7 +330,8 @@ class _Extended:
             try:
                 lam = equation_roots(make1, p, u, self.count, tol=max(self.tol * 1e3, 1e-9),
                                      of="equation")
-            except Exception as e:   # the roots' failure: the test functions read NaN
+            except (ValueError, ArithmeticError, RuntimeError, np.linalg.LinAlgError,
+                    Error) as e:   # the roots' failure: the test functions read NaN
                 lam = np.empty(0, complex)
                 warnings.warn(f"no roots: {e}", RefinementWarning, stacklevel=1)
         pt = CurvePoint(p=p, q=float(q), u=u.copy(), omega=omega, roots=lam,
@@ -367,6 +370,9 @@ class _Extended:
             vf = np.zeros(self.n)
             vf[self.free] = v
             forms = _Forms(s, u)
+            if not self.hooks_checked and forms.d2 is not None:   # the model's d2, once
+                _check_hooks(forms, vf / float(np.max(np.abs(vf))))
+                self.hooks_checked = True
             a = float(w @ forms.b_real(vf, vf, same=True)[self.free])
             bt = float(w @ _delta_prime(ch, 0.0).real @ v)
         finally:
@@ -385,7 +391,7 @@ class _Extended:
             return f
         try:
             a, bt = self._null(x, q)
-        except (ShootingError, np.linalg.LinAlgError, ValueError):
+        except (ShootingError, np.linalg.LinAlgError):
             a = bt = math.nan
         f = {"cusp": a, "bogdanov-takens": bt}
         if point.roots.size:

@@ -41,6 +41,7 @@ from typing import Any
 
 import numpy as np
 
+from .._errors import Error
 from ._model import Linearisation, _call, call_make, equation_step, equilibrium
 from .branch import HopfPoint
 from .equation import Characteristic, refine
@@ -189,8 +190,13 @@ def _corrected(s: Any, u0: np.ndarray) -> np.ndarray:
         du = np.linalg.solve(J, -g)
         u = u + du
         size = float(np.max(np.abs(du)))
-        if size <= 4 * EPS * max(1.0, float(np.max(np.abs(u)))) or size >= 0.5 * last:
+        if size <= 4 * EPS * max(1.0, float(np.max(np.abs(u)))):
             return u
+        if size >= 0.5 * last:     # stalled at rounding: accepted only with a small residual
+            if float(np.max(np.abs(G(u)))) <= 1e-9 * max(1.0, float(np.max(np.abs(u)))):
+                return u
+            raise _Unavailable(f"the equilibrium near u = {u0!r} could not be corrected (Newton "
+                               f"stalled with the residual {float(np.max(np.abs(G(u)))):.3g})")
         last = size
     raise _Unavailable(f"the equilibrium near u = {u0!r} could not be corrected (Newton did not "
                        "settle in 30 iterations)")
@@ -213,13 +219,17 @@ def _crossing_speed(make: Any, p: float, u_eq: Any, u: np.ndarray, omega: float,
     D = {}
     for j in (-4, -2, -1, 1, 2, 4):
         pj = p + j * delta
-        s = call_make(make, pj)
         try:
-            u0 = equilibrium(u_eq, s.n, (pj,)) if callable(u_eq) else u
-            uj = _corrected(s, u0)
-        finally:
-            s.close()
-        ch = _characteristic(make, pj, uj, tol, reach)
+            s = call_make(make, pj)
+            try:
+                u0 = equilibrium(u_eq, s.n, (pj,)) if callable(u_eq) else u
+                uj = _corrected(s, u0)
+            finally:
+                s.close()
+            ch = _characteristic(make, pj, uj, tol, reach)
+        except (np.linalg.LinAlgError, ArithmeticError, ValueError, RuntimeError, Error) as e:
+            raise _Unavailable(f"the equilibrium or its characteristic matrix at p = {pj!r} "
+                               f"(for the difference in p): {type(e).__name__}: {e}") from e
         if not np.array_equal(ch.free, free):
             raise _Unavailable(f"the components the resolvent holds change between p = {p!r} "
                                f"and {pj!r}: no crossing speed (the Hopf point is at a switch)")
@@ -392,6 +402,12 @@ def _criticality(make: Any, hp: HopfPoint, u_eq: Any, tol: float) -> HopfPoint:
         warnings.warn(f"dmi.analysis: no crossing speed (nor kappa) at the Hopf point p = {p!r}: "
                       f"{why}", CriticalityWarning, stacklevel=4)
         return out
+    if not abs(speed) > 10 * speed_err:
+        warnings.warn(f"dmi.analysis: the Hopf point p = {p!r} has a crossing speed {speed:.6g} "
+                      f"not distinct from 0 (its error {speed_err:.3g}): no crossing speed, no "
+                      "kappa and no side (the orbit does not grow as sqrt|p - p_H|)",
+                      CriticalityWarning, stacklevel=4)
+        return out
     out = dataclasses.replace(out, crossing_speed=speed)
     if word is None:
         warnings.warn(f"dmi.analysis: the Hopf point p = {p!r} has l1 = {l1:.6g} within its "
@@ -399,11 +415,6 @@ def _criticality(make: Any, hp: HopfPoint, u_eq: Any, tol: float) -> HopfPoint:
                       "degenerate Hopf point, or differences of f too inaccurate: give "
                       "Solver.set_rhs_derivatives), and no kappa", CriticalityWarning,
                       stacklevel=4)
-        return out
-    if not abs(speed) > 10 * speed_err:
-        warnings.warn(f"dmi.analysis: the Hopf point p = {p!r} has a crossing speed {speed:.6g} "
-                      f"not distinct from 0 (its error {speed_err:.3g}): no kappa (the orbit "
-                      "does not grow as sqrt|p - p_H|)", CriticalityWarning, stacklevel=4)
         return out
     kappa = np.zeros(len(u))
     kappa[ch.free] = 2 * np.abs(q) * math.sqrt(abs(speed) / (omega * abs(l1)))

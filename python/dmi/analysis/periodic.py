@@ -580,9 +580,13 @@ class Shooting:
             The sentence for the status, or "".
         """
         try:
-            alpha = self.maps.make(points[-1].p).friction
+            s = self.maps.make(points[-1].p)
         except Exception:   # the model's failure: no component is known to have friction
-            alpha = None
+            return corner_of(points, None)
+        try:
+            alpha = s.friction
+        finally:
+            s.close()
         return corner_of(points, alpha)
 
     def _profile(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -17,9 +17,11 @@ check that does not use the root finder:
   most :data:`STEP` (so a root near the line, where the log-derivative grows, is resolved).
 - **The scheme**: a second, independent eigen-solve (ARPACK with another start vector and a
   wider Krylov space, :data:`SECOND_MULTIPLIERS` multipliers) must find the same largest
-  multiplier; its residual |M^N v - mu v|, by a fresh product, is the multiplier's error.  A
+  multiplier; its residual |M^N v - mu v|, by a fresh product, is the multiplier's error: a
+  backward error, which a multiplier of a far-from-normal map can exceed (its condition number
+  is not estimated; a verdict within a few such errors of the axis deserves a plain run).  A
   state of at most 64 values has all its roots from the dense one-step matrix: its error is the
-  least singular value of M - z I.
+  least singular value of M - z I times z's condition number (from both eigenvectors).
 
 The verdict (:func:`check`): False when the rightmost root's Re lambda exceeds its error (or a
 root the finder missed is counted, or found, beyond its error); True when Re lambda_0 < -error
@@ -197,14 +199,21 @@ def _omega(ch: Characteristic, sigma: float) -> float:
 
 
 def _dense_error(lin: Linearisation, lam0: complex) -> float:
-    """The error of Re lambda_0 from the dense one-step matrix: the least singular value of
-    M - z_0 I (the backward error of z_0 = e^(lambda_0 h)) over |z_0| h, and rounding."""
+    """The error of Re lambda_0 from the dense one-step matrix M: the backward error of
+    z_0 = e^(lambda_0 h) (the least singular value of M - z_0 I, and rounding) times z_0's
+    condition number |x| |y| / |y^H x| (x, y its right and left eigenvectors: M is far from
+    normal for a delay), over |z_0| h."""
     I = np.eye(lin.dim)
     M = np.column_stack([lin.apply(I[:, j], 1) for j in range(lin.dim)])
     z0 = complex(np.exp(lam0 * lin.h))
     s = scipy.linalg.svdvals(M - z0 * I)[-1]
     eps = np.finfo(float).eps
-    return float((s + 4 * eps * np.linalg.norm(M, 2)) / (abs(z0) * lin.h))
+    w, Y, X = scipy.linalg.eig(M, left=True, right=True)
+    j = int(np.argmin(np.abs(w - z0)))
+    x, y = X[:, j], Y[:, j]
+    overlap = abs(np.vdot(y, x))
+    cond = np.linalg.norm(x) * np.linalg.norm(y) / overlap if overlap > 0 else math.inf
+    return float(cond * (s + 4 * eps * np.linalg.norm(M, 2)) / (abs(z0) * lin.h))
 
 
 def scheme_verdict(lin: Linearisation, lam: np.ndarray, dense: bool) -> RootVerdict:

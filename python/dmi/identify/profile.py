@@ -109,8 +109,9 @@ def profile_likelihood(estimate: Estimate, index: int | str, *, level: float = 0
     else:
         thr = c_hat * float(stats.f.ppf(level, 1, max(estimate.dof, 1))) / max(estimate.dof, 1)
     se = estimate.stderr[i]
-    if step is None:
-        step = 0.5 * se if np.isfinite(se) and se > 0 else 0.05 * max(abs(p_hat[i]), 1e-12)
+    if step is None:   # (a parameter without effect at p0 has no finite se: steps of its size)
+        least = 1.0 if estimate.names[i] in estimate.insensitive else 1e-12
+        step = 0.5 * se if np.isfinite(se) and se > 0 else 0.05 * max(abs(p_hat[i]), least)
     free = base.free.copy()
     free[i] = False
     cache: dict[float, tuple[float, np.ndarray]] = {}
