@@ -376,7 +376,13 @@ static int singular_start(ctx *c, double hint, double *x0, double *x1)
         if (given) {
             /* the exponent closest to 0 against the hint: above it, refused; the
              * difference is the uncertainty of the part below s_min */
-            if (power && alpha > hint + DMI_QUAD_SLOPE_TOL) {
+            /* (a difference within the measurement's rounding, that of the two
+             * logarithms over gap, counts as none) */
+            const double ulps = power ? 0x1p-49 * (fabs(log2(fabs(y[0]))) +
+                                                   fabs(log2(fabs(y[nn]))) + 1) / gap : 0;
+            /* steeper than declared, or not integrable (1 within rounding): refused */
+            if (power && (alpha > hint + DMI_QUAD_SLOPE_TOL ||
+                          alpha + ulps >= 1.0)) {
                 c->rep->entry = q;
                 c->rep->alpha = hint;
                 c->rep->slope = alpha;
@@ -387,10 +393,6 @@ static int singular_start(ctx *c, double hint, double *x0, double *x1)
                 at_top = q;
             }
             all_known = all_known && (power || zero);
-            /* (a difference within the measurement's rounding, that of the two
-             * logarithms over gap, counts as none) */
-            const double ulps = power ? 0x1p-49 * (fabs(log2(fabs(y[0]))) +
-                                                   fabs(log2(fabs(y[nn]))) + 1) / gap : 0;
             const double off = fmax(fabs(alpha - hint) - ulps, 0);
             lo = hint - (alpha < hint ? off : 0);
             hi = hint + (alpha > hint ? off : 0);

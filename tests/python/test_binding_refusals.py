@@ -59,6 +59,19 @@ def test_kernel_steeper_than_declared_is_refused_naming_the_call(beta, declared,
     assert calls[0] <= 40          # refused from the samples near 0, before any cell's quadrature
 
 
+def test_divergent_kernel_declared_within_rounding_of_its_slope_is_refused():
+    # 1/s declared just below 1, as close as the slope measured near 0 (its rounding): the
+    # integral diverges whatever is declared, so no finite U^1 may come out
+    for declared in (0.9999995, 0.9999999999999447):
+        with pytest.raises(dmi.InvalidArgument) as e:
+            first_step(lambda s: np.array([[1.0 / s]]), declared)
+        assert "not integrable" in e.value.message, e.value.message
+    # s^-0.9999995 declared so is integrable: 1 - h int_0^1 s^-beta ds = 1 - (1/8) / (1 - beta)
+    beta = 0.9999995
+    got = first_step(lambda s: np.array([[s ** -beta]]), beta)
+    assert got == pytest.approx(1 - 0.125 / (1 - beta), rel=1e-6)
+
+
 def test_declared_larger_than_the_kernels_warns_and_integrates():
     _, H = counted(0.5)
     with pytest.warns(UserWarning, match=r"larger than needed") as w:
