@@ -567,7 +567,7 @@ class JitBound(Bound):
         self.cells = tuple(zip(self.f.__closure__ or (), values[:free], names[:free],
                                self.keys[:free]))
         self.globs = tuple(zip(names[free:], values[free:], self.keys[free:]))
-        self.when, self.watching = when, True
+        self.when, self.watching = when, bool(self.cells or self.globs)  # (nothing to watch)
         self.same = _identity_check(self.cells, self.globs, self.f.__globals__)
 
     def rebound(self) -> str | None:

@@ -285,13 +285,18 @@ class Solver:
 
     def _watch(self) -> None:
         """The jit=True callbacks whose closures and globals the steps watch: f and the
-        resolvent, which the steps call (the kernel and the history are called by init only);
-        _same() says whether their variables all hold the objects of their snapshots."""
+        resolvent, which the steps call (the kernel and the history are called by init only),
+        while they read variables and have not warned (a warned callback is left alone until the
+        next set_* or init); _same() says whether their variables all hold the objects of their
+        snapshots."""
         watched = tuple(b for k in ("rhs", "resolvent")
-                        if (b := self._keep.get(k)) is not None and b.jit)
+                        if (b := self._keep.get(k)) is not None and b.jit and b.watching)
         self._watched = watched
-        self._same = watched[0].same if len(watched) == 1 else \
-            (lambda: all(b.same() for b in watched))
+        if len(watched) == 2:
+            first, second = watched[0].same, watched[1].same
+            self._same = lambda: first() and second()
+        else:
+            self._same = watched[0].same if watched else _unwatched
 
     def _rebound(self, stacklevel: int) -> None:
         """Warns of a closure variable or global of a jit=True f or resolvent rebound since its

@@ -231,10 +231,7 @@ class KernelFit:
             raise ValueError(f"refit: H gives values of shape {V.shape[1:]} on [delta, tau] "
                              f"({'finite' if np.all(np.isfinite(V)) else 'not all finite'}); this "
                              f"fit's kernel has shape {shape} and must be finite there")
-        X = pinv @ V.reshape(len(s), -1)
-        C = X[:K]
-        D = np.zeros_like(C)
-        D[self.b > 0] = X[K:]
+        C, D = _split(pinv @ V.reshape(len(s), -1), self.b)
         # the error on a grid ten times finer than the least-squares points
         check_s = np.unique(np.concatenate([_log_grid(lo, tau, 10 * len(s) // 2),
                                             np.linspace(lo, tau, 10 * len(s) // 2)]))
@@ -283,12 +280,8 @@ class KernelFit:
         if V.shape != (len(s),) + self.C.shape[1:]:
             raise ValueError(f"refit_derivative: dH gives values of shape {V.shape[1:]}; the "
                              f"kernel's shape is {self.C.shape[1:]}")
-        K = len(self.a)
-        X = pinv @ V.reshape(len(s), -1)
-        dC = X[:K].reshape(self.C.shape)
-        dD = np.zeros_like(dC)
-        dD[self.b > 0] = X[K:].reshape((-1,) + self.C.shape[1:])
-        return dC, dD
+        dC, dD = _split(pinv @ V.reshape(len(s), -1), self.b)
+        return dC.reshape(self.C.shape), dD.reshape(self.C.shape)
 
     def _refit_map(self) -> tuple[np.ndarray, np.ndarray]:
         """The points s of :meth:`refit` and the linear map from H's values there to (C; D of the
@@ -521,8 +514,13 @@ def _coefficients(s: np.ndarray, V: np.ndarray, a: np.ndarray, b: np.ndarray,
                   w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Least-squares C, D (K, E) for values V (M, E) at s, rows weighted by w."""
     B = _real_basis(s, a, b)
-    X = np.linalg.lstsq(B * w[:, None], V * w[:, None], rcond=None)[0]
-    K = len(a)
+    return _split(np.linalg.lstsq(B * w[:, None], V * w[:, None], rcond=None)[0], b)
+
+
+def _split(X: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(C, D) from the coefficients X of :func:`_real_basis` (K rows of C, then a row of D for
+    each term with b > 0); D is 0 on the terms with b = 0."""
+    K = len(b)
     C = X[:K]
     D = np.zeros_like(C)
     D[b > 0] = X[K:]

@@ -162,6 +162,37 @@ def test_closure_rebound_after_init_is_warned_once_naming_it():
     assert "init() takes the new value" in told[0]
 
 
+def test_both_jit_callbacks_are_watched_each_warned_once():
+    # a jit=True f and a jit=True resolvent: a variable of either rebound is named at the next
+    # step, each once; the first warned stays quiet while the other is still watched
+    pytest.importorskip("numba")
+    rhs, set_b, g = closure_model()
+    level = 0.5
+
+    def resolvent(h, x):      # the friction's resolvent of level `level`, written out
+        lam = h * level
+        return np.array([x[0] - lam if x[0] > lam else (x[0] + lam if x[0] < -lam else 0.0)])
+
+    s = dmi.Solver(1, 1.0, 100)
+    s.set_history(lambda t: np.array([1.0]))
+    s.set_rhs(rhs, jit=True)
+    s.set_resolvent(resolvent, jit=True)
+    s.init()
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        s.step()
+        set_b(2.0)
+        s.step()
+        s.step()
+        level = 0.25
+        s.step()
+        s.step()
+    told = [str(x.message) for x in w]
+    assert len(told) == 2, told
+    assert "closure variable 'b'" in told[0] and "rhs" in told[0]
+    assert "closure variable 'level'" in told[1] and "resolvent" in told[1]
+
+
 def test_init_or_set_rhs_again_takes_the_new_value():
     pytest.importorskip("numba")
     python, _ = run_with_change(False, lambda set_b, g: set_b(2.0))

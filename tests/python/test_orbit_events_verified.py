@@ -118,10 +118,11 @@ def test_an_undecided_point_between_brackets_the_event_across_it(branch):
     pd = [g for g in got if g.kind == "period-doubling"]
     assert len(pd) == 1 and abs(pd[0].p - 1.0) < 1e-9, got
     assert f"bracketed by the points at p = {x.p!r} and {z.p!r}" in pd[0].detail
-    # without a shared record of decided points the undecided middle loses it (the old way)
-    with pytest.warns(EventWarning):
-        lost = orbit_events(x, y, 1) + orbit_events(y, z, 2)
-    assert not [g for g in lost if g.kind == "period-doubling"], lost
+    # without the undecided point: the same event, between the same two points
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", EventWarning)
+        direct = [g for g in orbit_events(x, z, 1) if g.kind == "period-doubling"]
+    assert len(direct) == 1 and abs(direct[0].p - pd[0].p) < 1e-12, direct
 
 
 def test_default_branch_verifies_and_the_opt_out_has_no_verdict():

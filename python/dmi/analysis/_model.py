@@ -274,6 +274,35 @@ def equation_step(s: Solver) -> Callable[[np.ndarray], np.ndarray]:
     return lambda u: terms(u)[1]
 
 
+def checked_equilibrium(s: Solver, u: np.ndarray, args: tuple, tol: float, of: str
+                        ) -> tuple[np.ndarray, float]:
+    """(X*, t0): the resolvent's argument at the equilibrium u and the step's time, after
+    checking that one step of the scheme from the constant history u (or, ``of="equation"``,
+    of the equation's step with the continuous integral) moves it by at most tol times
+    max(1, |u|, |u - X*|); ValueError naming the move otherwise.  The scheme's check
+    initialises s."""
+    t0 = 0.0
+    if of == "equation":
+        X, moved = equation_terms(s)(u)
+    else:
+        s.init()
+        s.set_window(np.tile(u, (s.N + 1, 1)))
+        t0 = s.time
+        s.step()
+        _, X = s.step_terms()
+        moved = s.state - u
+    scale = max(1.0, np.max(np.abs(u)), np.max(np.abs(u - X)))
+    res = np.max(np.abs(moved))
+    if not res <= tol * scale:
+        raise ValueError(f"dmi.analysis: u_eq = {u!r} is not an equilibrium of the "
+                         f"{'equation' if of == 'equation' else 'step map'} "
+                         f"at {args!r}: one step moves it by {moved!r} (max {res:.3g}, "
+                         f"{res / scale:.3g} relative to max(1, |u_eq|, |u_eq - X*|) = "
+                         f"{scale:.3g}; tolerance {tol:g}): correct it with "
+                         "dmi.analysis.equilibrium")
+    return X, t0
+
+
 class Linearisation:
     """The step map of the model's solver linearised at the constant history u_eq, and the
     tangent solver that applies it (:meth:`apply`).  Use as a context manager (frees both)."""
@@ -306,25 +335,7 @@ class Linearisation:
         n, N = s.n, s.N
         u = equilibrium(u_eq, n, args)
         h = s.h
-        t0 = 0.0
-        if of == "equation":
-            X, moved = equation_terms(s)(u)
-        else:
-            s.init()
-            s.set_window(np.tile(u, (N + 1, 1)))
-            t0 = s.time
-            s.step()
-            _, X = s.step_terms()
-            moved = s.state - u
-        scale = max(1.0, np.max(np.abs(u)), np.max(np.abs(u - X)))
-        res = np.max(np.abs(moved))
-        if not res <= tol * scale:
-            raise ValueError(f"dmi.analysis: u_eq = {u!r} is not an equilibrium of the "
-                             f"{'equation' if of == 'equation' else 'step map'} "
-                             f"at {args!r}: one step moves it by {moved!r} (max {res:.3g}, "
-                             f"{res / scale:.3g} relative to max(1, |u_eq|, |u_eq - X*|) = "
-                             f"{scale:.3g}; tolerance {tol:g}): correct it with "
-                             "dmi.analysis.equilibrium")
+        X, t0 = checked_equilibrium(s, u, args, tol, of)
         scale_u = max(np.max(np.abs(u)), np.max(np.abs(X))) or 1.0
         J = rhs_jacobian(s, t0, u)
         self.D = _resolvent_derivative(s, X, h, scale_u)

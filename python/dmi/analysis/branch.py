@@ -14,6 +14,12 @@ import numpy as np
 
 
 
+#: |Im lambda| <= REAL max(1, |lambda|): a real root (the roots' own rounding is about 1e-12).
+REAL = 1e-8
+#: |Re lambda| <= ON_AXIS max(1, |lambda|) at a located Hopf point: a pair on the imaginary axis.
+ON_AXIS = 1e-6
+
+
 @dataclass(frozen=True)
 class HopfPoint:
     """Where the rightmost root crosses the imaginary axis.

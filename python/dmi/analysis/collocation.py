@@ -544,10 +544,9 @@ def check_orbit(orbit: Orbit, terms: Terms) -> None:
                          "is of another model; collocate the orbit with the make it was found "
                          "with")
     T = float(orbit.period)
-    scale = max(1.0, float(np.max(np.abs(u))))
     if orbit.autonomous:
-        spread = float(np.max(u.max(axis=0) - u.min(axis=0)))
-        if spread <= 1e-9 * scale:
+        spread = constant_spread(u)
+        if spread is not None:
             raise ValueError(f"collocate: the orbit at p = {orbit.p!r} is constant (its states "
                              f"differ by {spread:.3g}): an equilibrium of the model, {u[0]!r}, "
                              "not an orbit (a constant state is periodic with any period); for "
@@ -600,13 +599,20 @@ def too_far(orbit: Orbit) -> str:
             "amplitude=..., of='equation') and continue_orbit")
 
 
+def constant_spread(U: np.ndarray) -> float | None:
+    """The spread max_i (max U_i - min U_i) of states U (rows) that are constant, i.e. differ
+    by at most 1e-9 max(1, |U|); None when they move."""
+    spread = float(np.max(U.max(axis=0) - U.min(axis=0)))
+    return spread if spread <= 1e-9 * max(1.0, float(np.max(np.abs(U)))) else None
+
+
 def fell_to_equilibrium(lay: Layout, x: np.ndarray, orbit: Orbit) -> None:
     """ShootingError when the collocated autonomous orbit x is constant (its node values
     differ by at most 1e-9 max(1, |u|)) while the scheme's orbit moves: Newton fell onto the
     equilibrium, which every period solves."""
     V = lay.split(x)[0]
-    spread = float(np.max(V.max(axis=0) - V.min(axis=0)))
-    if spread > 1e-9 * max(1.0, float(np.max(np.abs(V)))):
+    spread = constant_spread(V)
+    if spread is None:
         return
     raise ShootingError(f"collocation of the orbit at p = {orbit.p!r}: Newton's method fell "
                         f"onto an equilibrium, {V[0]!r} (the collocated states differ by "

@@ -31,6 +31,7 @@ import numpy as np
 import scipy.linalg as sl
 import scipy.sparse as sp
 
+from ._model import checked_equilibrium
 from .collocation import (CollocationWarning, Solved, _errors, _reference, adapted,
                           check_inequalities, check_jumps, equation_orbit, merged,
                           transfer)
@@ -333,8 +334,8 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     ------
     ValueError
         Bad input: not a HopfPoint, omega <= 0, amplitude <= 0, u_eq not n finite numbers or
-        not an equilibrium of the equation at p (its residual above EQUILIBRIUM_TOL of its
-        terms' size), a jump outside (0, tau) or declared where the kernel does not jump.
+        not an equilibrium of the equation at p (one equation step moves it by more than
+        EQUILIBRIUM_TOL, relative: :func:`dmi.analysis._model.checked_equilibrium`), a jump outside (0, tau) or declared where the kernel does not jump.
     ShootingError
         Newton fails.
     """
@@ -355,7 +356,7 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     if not np.all(np.isfinite(ue)):
         raise ValueError(f"u_eq = {u_eq!r}: give {n} finite numbers (the equilibrium)")
     modes = _slipping(terms, ue)
-    _equilibrium_residual(terms, ue, modes, p0)
+    checked_equilibrium(terms.solver, ue, (p0,), EQUILIBRIUM_TOL, "equation")
     Jf = terms.fu(np.zeros(1), ue[None, :])[0]
     _, _, Vh = sl.svd(1j * om * np.eye(n) + Jf + _hhat(terms, 1j * om))
     v = Vh[-1].conj()
@@ -412,57 +413,9 @@ def _slipping(terms: Terms, ue: np.ndarray) -> np.ndarray:
     return modes
 
 
-def _memory_integral(terms: Terms) -> np.ndarray:
-    """int_0^tau H(s) ds (n, n): a near part s^-beta C in closed form on (0, delta], an
-    exponential sum in closed form past it, a callback kernel by Gauss-Legendre (32 panels of
-    16 nodes between each pair of its breaks: delta, the declared jumps, tau)."""
-    n, tau = terms.n, terms.tau
-    out = np.zeros((n, n))
-    if not terms.has_kernel:
-        return out
-    K = terms.H
-    lo = 0.0
-    if K.near is not None:
-        out += K.near.delta ** (1.0 - K.near.beta) / (1.0 - K.near.beta) * K.near.C
-        lo = K.near.delta
-    if terms.kind == "exp":
-        a, b, C, D = terms.terms  # type: ignore[misc]
-        z = a + 1j * b
-        safe = np.where(z == 0, 1.0, z)
-        w = np.where(z == 0, tau - lo, (np.exp(z * tau) - np.exp(z * lo)) / safe)
-        return out + np.einsum("k,kij->ij", w.real, C) + np.einsum("k,kij->ij", w.imag, D)
-    g, gw = np.polynomial.legendre.leggauss(16)
-    edges = np.array([lo] + [j for j in K.jumps if lo < j < tau] + [tau])
-    for a0, a1 in zip(edges[:-1], edges[1:]):
-        e = np.linspace(a0, a1, 33)
-        half = 0.5 * np.diff(e)
-        sn = (e[:-1, None] + half[:, None] * (g[None, :] + 1)).ravel()
-        out += np.einsum("p,pij->ij", (half[:, None] * gw[None, :]).ravel(), K(sn))
-    return out
-
-
-#: An equilibrium's residual at most, relative to its terms' size (:func:`_equilibrium_residual`).
-EQUILIBRIUM_TOL = 1e-6
-
-
-def _equilibrium_residual(terms: Terms, ue: np.ndarray, modes: np.ndarray, p: float) -> None:
-    """ValueError when u_eq is not an equilibrium of the equation at p: the residual f(0, u) +
-    int_0^tau H u + alpha_i sign(u_i) (the slipping components) above EQUILIBRIUM_TOL times the
-    size of its terms (at least 1)."""
-    f = terms.f(np.zeros(1), ue[None, :])[0]
-    mem = _memory_integral(terms) @ ue
-    fr = terms.alpha * ((modes == SLIP_POS).astype(float) - (modes == SLIP_NEG))
-    r = f + mem + fr
-    size = max(1.0, float(np.max(np.abs(np.concatenate([f, mem, fr])))))
-    i = int(np.argmax(np.abs(r)))
-    if abs(r[i]) > EQUILIBRIUM_TOL * size:
-        raise ValueError(f"hopf_orbit (of='equation'): u_eq = {ue!r} is not an equilibrium of "
-                         f"the equation at the Hopf "
-                         f"point p = {p!r}: f(0, u) + int_0^tau H u + alpha sign(u) is {r!r} "
-                         f"(component {i}: {abs(r[i]):.3g}, {abs(r[i]) / size:.2g} relative, "
-                         f"above {EQUILIBRIUM_TOL:g}); give the equation's equilibrium there "
-                         "(dmi.analysis.equilibrium(make, p, guess, of='equation').u, or the "
-                         "Hopf event's u of continue_equilibrium with of='equation')")
+#: The equilibrium check's tolerance (:func:`dmi.analysis._model.checked_equilibrium`): that of
+#: :func:`dmi.analysis.roots`, which the equation's Hopf point was found with.
+EQUILIBRIUM_TOL = 1e-9
 
 
 def _amplitude_condition(lay: Layout, x: np.ndarray, ue: np.ndarray, c: int, a: float,

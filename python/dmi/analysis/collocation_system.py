@@ -323,6 +323,8 @@ def undeclared_jumps(terms: Terms, samples: int = JUMP_SAMPLES) -> list[float]:
     found = []
     for c in np.flatnonzero((D > 4 * Dn) & (D > 1e-12 * big)):
         lo, hi = float(s[c]), float(s[c + 1])
+        if any(lo - 1e-12 * terms.tau <= j <= hi + 1e-12 * terms.tau for j in K.jumps):
+            continue   # a declared lag's cell: misdeclared_jumps bisects around it
         at, left = _bisect_jump(K, lo, hi)
         if left > 1e-3 * D[c] and not any(abs(at - j) <= 1e-9 * terms.tau for j in K.jumps):
             found.append(at)

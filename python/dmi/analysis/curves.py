@@ -41,7 +41,6 @@ its error, a cusp or Bogdanov-Takens point a test function that vanishes (not a 
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 import warnings
 from collections.abc import Callable, Iterable
@@ -54,8 +53,9 @@ from .._errors import Error
 from .._solver import Solver
 from ._model import (_resolvent_derivative, call_make, equation_step, equation_terms, kernel_of,
                      rhs_jacobian)
-from .branch import Event, HopfPoint
+from .branch import ON_AXIS, REAL, Event, HopfPoint
 from .driver import continuation
+from .equilibria import signed_mean
 from .equation import Characteristic, RefinementWarning
 from .newton import ShootingError
 from .normal_form import CriticalityWarning, _check_hooks, _delta_prime, _Forms, criticality
@@ -63,10 +63,6 @@ from .stability import roots as equation_roots
 
 #: Roots computed at each point (the zero-Hopf and Hopf-Hopf test functions read them).
 ROOTS = 6
-#: |Im lambda| <= REAL max(1, |lambda|): a real root.
-REAL = 1e-8
-#: |Re lambda| <= ON_AXIS max(1, |lambda|) at a located zero-Hopf or Hopf-Hopf point.
-ON_AXIS = 1e-6
 
 
 @dataclass
@@ -81,15 +77,6 @@ class CurvePoint:
         Shape (n,): the equation's equilibrium there (state units).
     omega : float
         The crossing frequency (radians / time unit) on a Hopf curve; 0 on a fold curve.
-    l1, l1_error : float or None
-        The first Lyapunov coefficient and its estimated error (Hopf curves; None where not
-        computed, a :class:`dmi.analysis.normal_form.CriticalityWarning` said why).
-    criticality : str or None
-        ``"supercritical"``, ``"subcritical"`` or None (not decided), as
-        :attr:`HopfPoint.criticality`.
-    kappa : numpy.ndarray or None
-        The amplitude coefficients of the orbit born, for p moving at fixed q
-        (:attr:`HopfPoint.kappa`).
     hopf : HopfPoint or None
         The Hopf point at fixed q (its ``p``, ``omega``, ``root``, ``l1``, ``kappa``,
         ``crossing_speed``); None on a fold curve.
@@ -105,14 +92,30 @@ class CurvePoint:
     q: float
     u: np.ndarray = field(repr=False)
     omega: float = 0.0
-    l1: float | None = None
-    l1_error: float | None = None
-    criticality: str | None = None
-    kappa: np.ndarray | None = field(default=None, repr=False)
     hopf: HopfPoint | None = field(default=None, repr=False)
     roots: np.ndarray = field(default_factory=lambda: np.empty(0, complex), repr=False)
     dqds: float = 0.0
     note: str = field(default="", repr=False)
+
+    @property
+    def l1(self) -> float | None:
+        """The Hopf point's first Lyapunov coefficient (None on a fold curve)."""
+        return None if self.hopf is None else self.hopf.l1
+
+    @property
+    def l1_error(self) -> float | None:
+        """Its estimated error (None on a fold curve)."""
+        return None if self.hopf is None else self.hopf.l1_error
+
+    @property
+    def criticality(self) -> str | None:
+        """The Hopf point's criticality (None on a fold curve)."""
+        return None if self.hopf is None else self.hopf.criticality
+
+    @property
+    def kappa(self) -> np.ndarray | None:
+        """The Hopf point's amplitude coefficients (None on a fold curve)."""
+        return None if self.hopf is None else self.hopf.kappa
 
     @property
     def dpds(self) -> float:
@@ -212,16 +215,6 @@ class _At:
         self.tangent = s
 
 
-def _product(values: Iterable[float]) -> float:
-    """sign(prod values) times the geometric mean of |values|; NaN for none, 0 with a zero."""
-    f = np.array(list(values), dtype=float)
-    if f.size == 0:
-        return math.nan
-    if np.any(f == 0):
-        return 0.0
-    return float(np.prod(np.sign(f))) * float(np.exp(np.mean(np.log(np.abs(f)))))
-
-
 class _Extended:
     """The extended system of a Hopf curve (``kind="hopf"``) or a fold curve (``"fold"``) for
     the driver: the unknowns x = (u, p, omega, Re v, Im v) or (u, p, v), the driver's parameter
@@ -233,6 +226,7 @@ class _Extended:
         self.c, self.tol, self.count = c, tol, count
         self.why = ""
         self.hooks_checked = False   # the model's d2 checked against differences of f
+        self.cusp_warned = False     # no cusp test (a resolvent callback) said once
         self.b = c   # a fold curve's border column: the start's left null vector (set below)
         self.reach = 1.0   # a callback kernel's panels reach |lambda| <= reach
         m = self.m
@@ -341,8 +335,7 @@ class _Extended:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", CriticalityWarning)
                 hp = criticality(make1, hp, u, tol=max(self.tol * 1e3, 1e-9))
-            pt.hopf, pt.l1, pt.l1_error = hp, hp.l1, hp.l1_error
-            pt.criticality, pt.kappa = hp.criticality, hp.kappa
+            pt.hopf = hp
             pt.note = "; ".join([pt.note] * bool(pt.note) + [str(w.message) for w in caught])
         return pt
 
@@ -373,7 +366,16 @@ class _Extended:
             if not self.hooks_checked and forms.d2 is not None:   # the model's d2, once
                 _check_hooks(forms, vf / float(np.max(np.abs(vf))))
                 self.hooks_checked = True
-            a = float(w @ forms.b_real(vf, vf, same=True)[self.free])
+            if s.resolvent_kind == "callback":   # D^2 G holds R'', which is not computed
+                if not self.cusp_warned:
+                    warnings.warn("dmi.analysis: no cusp test on this fold curve: the model's A "
+                                  "is a resolvent callback, whose second derivative the test "
+                                  "needs (put the nonlinear terms in f, or use the built-in "
+                                  "friction or box)", CriticalityWarning, stacklevel=2)
+                    self.cusp_warned = True
+                a = math.nan
+            else:
+                a = float(w @ forms.b_real(vf, vf, same=True)[self.free])
             bt = float(w @ _delta_prime(ch, 0.0).real @ v)
         finally:
             s.close()
@@ -386,8 +388,8 @@ class _Extended:
         if self.kind == "hopf":
             f = {"bautin": math.nan if point.l1 is None else float(point.l1)}
             if point.roots.size:
-                f["zero-hopf"] = _product(real)
-                f["hopf-hopf"] = _product(upper.real)
+                f["zero-hopf"] = signed_mean(real)
+                f["hopf-hopf"] = signed_mean(upper.real)
             return f
         try:
             a, bt = self._null(x, q)
@@ -395,7 +397,7 @@ class _Extended:
             a = bt = math.nan
         f = {"cusp": a, "bogdanov-takens": bt}
         if point.roots.size:
-            f["zero-hopf"] = _product(upper.real)
+            f["zero-hopf"] = signed_mean(upper.real)
         return f
 
     def describe(self, kind: str, x: np.ndarray, q: float, point: CurvePoint

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -37,7 +38,7 @@ import numpy as np
 
 from .._errors import Error
 from ._model import KinkError, Linearisation, call_make, equation_step
-from .branch import Branch, HopfPoint
+from .branch import ON_AXIS, REAL, Branch, HopfPoint
 from .driver import Curve, continuation, newton_corrector
 from .floquet import StabilityWarning
 from .newton import ShootingError
@@ -197,12 +198,6 @@ def _unverified_warning(what: str) -> None:
                   "verdict", UserWarning, stacklevel=3)
 
 
-#: |Im lambda| <= REAL max(1, |lambda|): a real root (the roots' own rounding is about 1e-12).
-REAL = 1e-8
-#: |Re lambda| <= ON_AXIS max(1, |lambda|) at a located Hopf point: a pair on the imaginary axis.
-ON_AXIS = 1e-6
-
-
 def hopf_test(lam: np.ndarray) -> float:
     """The Hopf test function of the rightmost roots: the sign of the bialternate product
     prod_{i<j} (lambda_i + lambda_j) over them (its positive factors, those of two distinct
@@ -218,9 +213,16 @@ def hopf_test(lam: np.ndarray) -> float:
     upper = lam[~real & (lam.imag > 0)]
     f = list(upper.real) + [0.5 * (r[i] + r[j]) for i in range(r.size)
                             for j in range(i + 1, r.size)]
-    if not f:
+    return signed_mean(f)
+
+
+def signed_mean(values: Iterable[float]) -> float:
+    """sign(prod values) times the geometric mean of |values|; NaN for none, 0 with a zero
+    (the test functions' form: the sign of a product, a size that does not under- or
+    overflow)."""
+    f = np.array(list(values), dtype=float)
+    if f.size == 0:
         return math.nan
-    f = np.array(f)
     if np.any(f == 0):
         return 0.0
     return float(np.prod(np.sign(f))) * float(np.exp(np.mean(np.log(np.abs(f)))))

@@ -43,7 +43,7 @@ import numpy as np
 
 from .._errors import Error
 from ._model import Linearisation, _call, call_make, equation_step, equilibrium
-from .branch import HopfPoint
+from .branch import ON_AXIS, HopfPoint
 from .equation import Characteristic, refine
 
 EPS = float(np.finfo(float).eps)
@@ -351,6 +351,9 @@ def _criticality(make: Any, hp: HopfPoint, u_eq: Any, tol: float) -> HopfPoint:
         if why or not abs(lam.imag - omega0) <= 1e-6 * omega0:
             raise _Unavailable(f"the root i omega = {1j * omega0!r} of the equation could not be "
                                f"refined ({why or f'it converged to {lam!r}'})")
+        if not abs(lam.real) <= ON_AXIS * max(1.0, abs(lam)):
+            raise _Unavailable(f"not a Hopf point: the root refined from i omega = "
+                               f"{1j * omega0!r} is {lam!r}, off the imaginary axis")
         omega = lam.imag
         m = ch.m
         U, sv, Vh = np.linalg.svd(ch(lam))

@@ -567,7 +567,7 @@ class Shooting:
 
     def corner(self, points: list[BranchPoint]) -> str:
         """Where a branch that failed at the smallest step ended (:func:`corner_of`), the
-        friction components read from the model at the last point's p.
+        friction components read from the branch's map at the last point's p.
 
         Parameters
         ----------
@@ -579,14 +579,10 @@ class Shooting:
         str
             The sentence for the status, or "".
         """
-        try:
-            s = self.maps.make(points[-1].p)
-        except Exception:   # the model's failure: no component is known to have friction
-            return corner_of(points, None)
-        try:
-            alpha = s.friction
-        finally:
-            s.close()
+        try:   # the branch's own (cached) map at the last point
+            alpha = self.maps(points[-1].p).solver.friction
+        except Exception:   # the model's failure there: no component is known to have friction
+            alpha = None
         return corner_of(points, alpha)
 
     def _profile(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -450,6 +450,11 @@ def _forces(U: np.ndarray, X: np.ndarray, h: float) -> np.ndarray:
     return a
 
 
+def record_steps(s: Solver, d: _Data) -> int:
+    """The steps of s that a record reaches: its last time over h, at least 1."""
+    return max(1, math.ceil(d.t[-1] / s.h - 1e-9))
+
+
 class _Problem:
     """The residuals of all records as a function of the free parameters."""
 
@@ -467,9 +472,6 @@ class _Problem:
         p = self.p0.copy()
         p[self.free] = x
         return p
-
-    def _steps(self, s: Solver, d: _Data) -> int:
-        return max(1, math.ceil(d.t[-1] / s.h - 1e-9))
 
     def _predict(self, d: _Data, t_grid: np.ndarray, h: float, U: np.ndarray, X: np.ndarray,
                  S: np.ndarray | None, dX: np.ndarray | None) -> tuple[np.ndarray, np.ndarray | None]:
@@ -510,7 +512,7 @@ class _Problem:
         for k, (make, d) in enumerate(zip(self.makes, self.data)):
             s = make(p.copy())
             s.init()
-            t_grid, U, X = s.run_terms(self._steps(s, d))
+            t_grid, U, X = s.run_terms(record_steps(s, d))
             val, _ = self._predict(d, t_grid, s.h, U, X, None, None)
             if check and not np.all(np.isfinite(val)):
                 self._not_finite(k, d, p, t_grid, s.h, U, X, val)
@@ -561,7 +563,7 @@ class _Problem:
                 # reversals left unplaced are gathered here and reported once by the estimate
                 warnings.filterwarnings("ignore", "sensitivities: .* could not be placed",
                                         RuntimeWarning)
-                sens: Sensitivities = sensitivities(make_free, p[idx], self._steps(s0, d), rhs=rhs,
+                sens: Sensitivities = sensitivities(make_free, p[idx], record_steps(s0, d), rhs=rhs,
                                                      jumps=self.jumps, max_steps=self.max_steps)
             unplaced += [(k, q) for q in sens.unplaced]
             val, der = self._predict(d, sens.t, sens.h, sens.u, sens.x, sens.S, sens.dx)
@@ -702,7 +704,7 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
         if not isinstance(s, Solver):
             raise TypeError(f"make(p0) returned {type(s).__name__}; expected a dmi.Solver")
         d = _check_record(r, k, s.n)
-        steps = max(1, math.ceil(d.t[-1] / s.h - 1e-9))
+        steps = record_steps(s, d)
         check_steps(steps, s.n, s.N, int(mask.sum()), s.h, options.max_steps,
                     f"records[{k}] (t up to {float(d.t[-1]):.6g})")
         data.append(d)
