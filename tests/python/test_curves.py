@@ -15,6 +15,7 @@ import pytest
 import scipy.optimize as so
 
 import dmi
+import hopf_models
 from dmi import analysis as da
 
 # ---- z' = (q - (p^3 - p) + i W0) z + c1 |z|^2 z + c2 |z|^4 z - int_0^TAU G e^-s z(t - s) ds ----
@@ -34,12 +35,11 @@ def gmem(p: float) -> float:
 
 
 def ghat(lam: complex, G: float) -> complex:
-    return G * (1 - np.exp(-(1 + lam) * TAU)) / (1 + lam)
+    return hopf_models.ghat(lam, G, TAU)
 
 
 def dghat(lam: complex, G: float) -> complex:
-    e = np.exp(-(1 + lam) * TAU)
-    return G * (TAU * e * (1 + lam) - (1 - e)) / (1 + lam) ** 2
+    return hopf_models.dghat(lam, G, TAU)
 
 
 def exact_hopf(p: float) -> tuple[float, float]:
@@ -56,49 +56,8 @@ def exact_l1(p: float) -> float:
 
 
 def circle_model(p: float, q: float, hook: bool) -> dmi.Solver:
-    a = complex(q - (p ** 3 - p), W0)
-    c1, c2 = complex(p, C1I), C2
-
-    def g(z: complex) -> complex:
-        r2 = abs(z) ** 2
-        return a * z + c1 * r2 * z + c2 * r2 * r2 * z
-
-    s = dmi.Solver(2, TAU, 40)
-    s.set_rhs(lambda t, u: -np.array([g(complex(*u)).real, g(complex(*u)).imag]))
-    s.set_kernel_exp([-1.0], [0.0], [gmem(p) * np.eye(2)])
-    if hook:
-        # g = a z + c1 z^2 zb + c2 z^3 zb^2: the derivatives of each monomial in the complex
-        # directions A_i (zb: their conjugates)
-        def fu(t, u):
-            z = complex(*u)
-            r2 = abs(z) ** 2
-            dz = a + 2 * c1 * r2 + 3 * c2 * r2 * r2
-            dzb = c1 * z * z + 2 * c2 * r2 * z * z
-            cols = [dz + dzb, 1j * dz - 1j * dzb]
-            return -np.array([[c.real for c in cols], [c.imag for c in cols]])
-
-        def d2(t, u, v, w):
-            z, A, B = complex(*u), complex(*v), complex(*w)
-            zb, Ab, Bb = z.conjugate(), A.conjugate(), B.conjugate()
-            r = c1 * (2 * A * B * zb + 2 * z * (A * Bb + B * Ab))
-            r += c2 * (6 * z * A * B * zb ** 2 + 6 * z * z * zb * (A * Bb + B * Ab)
-                       + 2 * z ** 3 * Ab * Bb)
-            return -np.array([r.real, r.imag])
-
-        def d3(t, u, v, w, x):
-            z = complex(*u)
-            zb = z.conjugate()
-            A = [complex(*v), complex(*w), complex(*x)]
-            Ab = [e.conjugate() for e in A]
-            trip = ((0, 1, 2), (0, 2, 1), (1, 2, 0))
-            r = c1 * 2 * sum(A[i] * A[j] * Ab[k] for i, j, k in trip)
-            r += c2 * (6 * A[0] * A[1] * A[2] * zb ** 2
-                       + sum(12 * z * zb * A[i] * A[j] * Ab[k] for i, j, k in trip)
-                       + sum(6 * z * z * A[k] * Ab[i] * Ab[j] for i, j, k in trip))
-            return -np.array([r.real, r.imag])
-
-        s.set_rhs_derivatives(fu, d2, d3)
-    return s
+    return hopf_models.circle_solver(complex(q - (p ** 3 - p), W0), complex(p, C1I), C2,
+                                     gmem(p), TAU, 40, hook)
 
 
 def with_hook(p: float, q: float) -> dmi.Solver:

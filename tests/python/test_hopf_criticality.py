@@ -8,13 +8,13 @@
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 import pytest
 import scipy.optimize as so
 
 import dmi
+import hopf_models
 from dmi import analysis as da
 from dmi.analysis.normal_form import CriticalityWarning
 
@@ -29,12 +29,11 @@ C2 = 0.3 - 0.2j
 
 
 def ghat(lam: complex) -> complex:
-    return G * (1 - np.exp(-(1 + lam) * TAU)) / (1 + lam)
+    return hopf_models.ghat(lam, G, TAU)
 
 
 def dghat(lam: complex) -> complex:
-    e = np.exp(-(1 + lam) * TAU)
-    return G * (TAU * e * (1 + lam) - (1 - e)) / (1 + lam) ** 2
+    return hopf_models.dghat(lam, G, TAU)
 
 
 def circle_hopf() -> tuple[float, float, complex]:
@@ -46,48 +45,7 @@ def circle_hopf() -> tuple[float, float, complex]:
 def circle_model(c1: complex, hook: bool, c2: complex = C2):
     """make(mu); f = -(the right-hand side) in (x, y); with hook: its exact derivatives."""
     def make(mu: float) -> dmi.Solver:
-        a = complex(mu, W0)
-
-        def g(z: complex) -> complex:
-            r2 = abs(z) ** 2
-            return a * z + c1 * r2 * z + c2 * r2 * r2 * z
-
-        s = dmi.Solver(2, TAU, 100)
-        s.set_rhs(lambda t, u: -np.array([g(complex(*u)).real, g(complex(*u)).imag]))
-        s.set_kernel_exp([-1.0], [0.0], [G * np.eye(2)])
-        if hook:
-            # g = a z + c1 z^2 zb + c2 z^3 zb^2: derivatives of each monomial z^m zb^l in the
-            # complex directions A_i (zb: their conjugates)
-            def fu(t, u):
-                z = complex(*u)
-                r2 = abs(z) ** 2
-                dz = a + 2 * c1 * r2 + 3 * c2 * r2 * r2       # dg/dz
-                dzb = c1 * z * z + 2 * c2 * r2 * z * z         # dg/dzb
-                cols = [dz + dzb, 1j * dz - 1j * dzb]          # along dx and dy
-                return -np.array([[c.real for c in cols], [c.imag for c in cols]])
-
-            def d2(t, u, v, w):
-                z, A, B = complex(*u), complex(*v), complex(*w)
-                zb, Ab, Bb = z.conjugate(), A.conjugate(), B.conjugate()
-                r = c1 * (2 * A * B * zb + 2 * z * (A * Bb + B * Ab))
-                r += c2 * (6 * z * A * B * zb ** 2 + 6 * z * z * zb * (A * Bb + B * Ab)
-                           + 2 * z ** 3 * Ab * Bb)
-                return -np.array([r.real, r.imag])
-
-            def d3(t, u, v, w, x):
-                z = complex(*u)
-                zb = z.conjugate()
-                A = [complex(*v), complex(*w), complex(*x)]
-                Ab = [e.conjugate() for e in A]
-                trip = ((0, 1, 2), (0, 2, 1), (1, 2, 0))
-                r = c1 * 2 * sum(A[i] * A[j] * Ab[k] for i, j, k in trip)
-                r += c2 * (6 * A[0] * A[1] * A[2] * zb ** 2
-                           + sum(12 * z * zb * A[i] * A[j] * Ab[k] for i, j, k in trip)
-                           + sum(6 * z * z * A[k] * Ab[i] * Ab[j] for i, j, k in trip))
-                return -np.array([r.real, r.imag])
-
-            s.set_rhs_derivatives(fu, d2, d3)
-        return s
+        return hopf_models.circle_solver(complex(mu, W0), c1, c2, G, TAU, 100, hook)
     return make
 
 
