@@ -115,7 +115,7 @@ void dmi_free(dmi_solver **ps)
  * messages.  An exponential kernel is sampled entry by entry
  * (dmi_expk_sample: no N n n array); where a sample is not finite, the
  * general path below names it. */
-int dmi_sample_kernel(dmi_solver *s, dmi_kernel *k, const char *fn)
+int dmi_sample_kernel(const dmi_solver *s, dmi_kernel *k, const char *fn)
 {
     const size_t n = s->n, N = s->N, nn = n * n;
     if (!s->H)

@@ -334,19 +334,19 @@ int dmi_get_step_terms(const dmi_solver *s, double *W, double *X)
     return DMI_OK;
 }
 
-/* Adds the weights of kernel k (nonzero entries, lags 0..k->N - 1) times w
+/* Adds the weights of kernel k (nonzero entries, lags 0..k->N - 1) times h
  * for the lags first .. first + count - 1 into G (count n n values); the
  * last lag N - 1 of the delay sum gets its change, per entry last[e] (the
  * cell rule's) or (theta - 1) h samples (the left rule's), when last_of. */
-static void add_weights(const dmi_solver *s, const dmi_kernel *k, double w, size_t first,
-                        size_t count, int last_of, double *G)
+static void add_weights(const dmi_solver *s, const dmi_kernel *k, size_t first, size_t count,
+                        int last_of, double *G)
 {
     const size_t n = s->n, nn = n * n, N = s->N;
     for (size_t e = 0; e < k->nnz; e++) {
         const size_t q = k->row[e] * n + k->col[e];
         const double *x = k->samples + e * k->N;
         for (size_t l = first; l < first + count && l < k->N; l++)
-            G[(l - first) * nn + q] += w * x[l];
+            G[(l - first) * nn + q] += s->h * x[l];
         if (last_of && s->theta != 1 && N - 1 >= first && N - 1 < first + count)
             G[(N - 1 - first) * nn + q] += s->quad == DMI_QUAD_CELL
                                                ? s->cell_last[e]
@@ -372,25 +372,20 @@ int dmi_get_kernel_weights(const dmi_solver *s, size_t first, size_t count, doub
     dmi_kernel k = {0}; /* the samples dmi_init left out for the recursion, now */
     const dmi_kernel *used = &s->kernel;
     if (G && count > 0 && !s->kernel_sampled && dmi_has_expk(s)) {
-        int rc = dmi_expk_sample(&s->expk, N, s->h, &k);
-        if (rc < 0)
-            return dmi_fail(s, DMI_ENOMEM, "%s: out of memory for %zu kernel samples", fn, N);
-        if (rc > 0) {
-            dmi_kernel_release(&k);
-            return dmi_fail(s, DMI_ENONFINITE, "%s: a sample of the exponential kernel is not "
-                                               "finite", fn);
-        }
+        int rc = dmi_sample_kernel(s, &k, fn);
+        if (rc != DMI_OK)
+            return rc;
         used = &k;
     }
     if (G) {
         for (size_t q = 0; q < count * nn; q++)
             G[q] = 0.0;
-        add_weights(s, used, s->h, first, count, 1, G);
+        add_weights(s, used, first, count, 1, G);
     }
     if (G_near) {
         for (size_t q = 0; q < count * nn; q++)
             G_near[q] = 0.0;
-        add_weights(s, &s->near, s->h, first, count, 0, G_near);
+        add_weights(s, &s->near, first, count, 0, G_near);
     }
     dmi_kernel_release(&k);
     return DMI_OK;

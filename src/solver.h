@@ -72,7 +72,7 @@ struct dmi_solver {
 /* Samples H(l h), l = 0..N-1, into k (nonzero entries only), for fn's
  * messages (dmi.c: dmi_init; dmi_set_convolution when the recursion went
  * without them).  DMI_OK, or an error code with the message set. */
-int dmi_sample_kernel(dmi_solver *s, dmi_kernel *k, const char *fn);
+int dmi_sample_kernel(const dmi_solver *s, dmi_kernel *k, const char *fn);
 
 /* Whether s's kernel is the exponential one of dmi_set_kernel_exp. */
 static inline int dmi_has_expk(const dmi_solver *s)
