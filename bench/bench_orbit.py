@@ -35,8 +35,8 @@ sys.path.insert(0, str(ROOT / "examples" / "python"))
 import orbit_tau  # noqa: E402
 
 from dmi.analysis import continue_orbit, periodic_orbit  # noqa: E402
-from dmi.analysis.floquet import floquet_multipliers  # noqa: E402
-from dmi.analysis.shooting import StepMap, state_of  # noqa: E402
+from dmi.analysis.scheme.floquet import floquet_multipliers  # noqa: E402
+from dmi.analysis.shooting.shoot import StepMap, state_of  # noqa: E402
 from benchtools import cpu  # noqa: E402
 
 TAU = 2.2

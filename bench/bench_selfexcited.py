@@ -32,7 +32,7 @@ import numpy as np  # noqa: E402
 
 import dmi  # noqa: E402
 from dmi import analysis as da  # noqa: E402
-from dmi.analysis.newton import ShootingError  # noqa: E402
+from dmi.analysis.core.newton import ShootingError  # noqa: E402
 from benchtools import cpu  # noqa: E402
 
 K, G, ALPHA, VB, TAU = 1.0, 0.8, 0.5, 0.3, 1.0

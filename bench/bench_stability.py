@@ -9,12 +9,12 @@
 # 2. A stability chart of the oscillator over (a, tau) on the local processes (--workers), the
 #    same chart with verify=False (its verdicts not verified), and the same chart through a Dask
 #    LocalCluster of as many workers, interleaved; wall-clock time.
-# 3. The verified stability verdict (dmi.analysis.floquet) of the Stribeck belt's orbits born at
+# 3. The verified stability verdict (dmi.analysis.scheme.floquet) of the Stribeck belt's orbits born at
 #    its Hopf point (examples/python/stribeck_belt.py: fractional damping fitted, a memory of 8
 #    periods, velocity-weakening friction), at M steps a period (M = 1250: h = 0.005, N = 1e4):
 #    the verdict's wall-clock time, its operator products and plain-run periods, against one
 #    period's simulation.
-# 4. The verified verdict of an equilibrium by default (dmi.analysis.root_verdict): equilibrium()
+# 4. The verified verdict of an equilibrium by default (dmi.analysis.equilibria.root_verdict): equilibrium()
 #    of the oscillator with verify=True against verify=False, for the scheme (a second
 #    eigen-solve) and the equation (the argument principle), at N = 1e3, 1e4 (--verify-N), CPU
 #    time, the fastest of the interleaved rounds.
@@ -36,7 +36,7 @@ import numpy as np
 
 import dmi
 from dmi import analysis
-from dmi.analysis import _model
+from dmi.analysis.core import model as _model
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "examples" / "python"))

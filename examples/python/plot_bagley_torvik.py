@@ -52,7 +52,7 @@ import numpy as np
 
 import dmi
 from dmi import analysis, kernels
-from dmi.analysis.floquet import monodromy_operator
+from dmi.analysis.scheme.floquet import monodromy_operator
 
 C, K, F, OMEGA = 0.5, 1.0, 1.0, 0.8       # fractional damping, stiffness, forcing
 P = 2 * math.pi / OMEGA                   # the forcing period

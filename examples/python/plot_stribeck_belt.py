@@ -46,7 +46,7 @@ exactly when the force besides friction is below :math:`\\mu_s`, and slides with
    worth of switch motion, the scheme's run drifts along the orbit by a fraction of a step and
    locks on again, 1e-4 from it: the discrete orbit's own phase locking, which the verdict at
    the difference step's scale does not take for an instability.) The multipliers are verified
-   by :func:`dmi.analysis.floquet`: ARPACK on the monodromy operator, each pair's residual by a
+   by :func:`dmi.analysis.scheme.floquet`: ARPACK on the monodromy operator, each pair's residual by a
    fresh product and the operator's noise, and a plain run where :math:`|\\mu| - 1` lies
    inside that error, or where a multiplier may hide beside the trivial one.
 """

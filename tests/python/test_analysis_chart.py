@@ -126,7 +126,7 @@ def test_grid_is_the_rightmost_root(charts):
 
 
 def test_one_start_per_chain_of_sign_changes():
-    from dmi.analysis.chart import _brackets
+    from dmi.analysis.equilibria.chart import _brackets
     re = np.ones((8, 12))
     re[:, :2] = -1                       # a vertical boundary between columns 1 and 2
     for j in range(6):                   # a diagonal one, one column further left each row

@@ -1,4 +1,4 @@
-# The one continuation driver (dmi.analysis.driver) on discretisations written here: the S-curve
+# The one continuation driver (dmi.analysis.continuation.driver) on discretisations written here: the S-curve
 # x^3 - 3x = p (two folds at p = +-2, x = -+1), a transcritical crossing x (p - x) = 0 (a branch
 # point at p = 0), each curve's points known in closed form.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -13,7 +13,7 @@ import pytest
 import scipy.sparse
 import scipy.sparse.linalg as sla
 
-from dmi.analysis.driver import continuation
+from dmi.analysis.continuation.driver import continuation
 
 
 class SCurve:

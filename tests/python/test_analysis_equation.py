@@ -15,7 +15,7 @@ import scipy.optimize as so
 
 import dmi
 from dmi import analysis as da
-from dmi.analysis.equation import RefinementWarning
+from dmi.analysis.equilibria.equation import RefinementWarning
 
 TAU = 1.0
 C0 = 0.3

@@ -18,9 +18,9 @@ import numpy as np
 import pytest
 
 from dmi import analysis as da
-from dmi.analysis.branch import BranchPoint
-from dmi.analysis.chart import HopfCurve
-from dmi.analysis.orbit import Orbit
+from dmi.analysis.continuation.branch import BranchPoint
+from dmi.analysis.equilibria.chart import HopfCurve
+from dmi.analysis.scheme.orbit import Orbit
 
 import interactive_models as im
 

@@ -58,7 +58,7 @@ def test_loops_counts_repeats_and_not_single_loops():
     k = 3 and 7, 333.3 and 142.9 steps a loop), and single loops that a global threshold took for
     repeats (found in review): a sawtooth with a fast return, components of scales 0.01 and 5, a
     constant."""
-    from dmi.analysis.autonomous import loops
+    from dmi.analysis.shooting.autonomous import loops
     M = 1000
     s = np.arange(M + 1) / M * 2 * np.pi
     for k in (1, 2, 3, 4, 7):

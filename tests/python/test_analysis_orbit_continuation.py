@@ -100,7 +100,7 @@ def test_stick_onset_located_and_passed():
     assert [q.corrector for q in b.points[1:]].count("newton-picard") >= len(b.points) - 2
     assert np.all(b.column("stick_steps")[:, 0] == 0)
     # the points past the kink are orbits: the map's residual at each
-    from dmi.analysis.shooting import StepMap
+    from dmi.analysis.shooting.shoot import StepMap
     for q in b.points[-3:]:
         F = StepMap(d.make_for(M), q.p, M, rows=b.rows)
         assert np.max(np.abs(F(q.state) - q.state)) < 1e-9

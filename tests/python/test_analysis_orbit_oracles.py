@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from dmi.analysis import floquet_multipliers, periodic_orbit
-from dmi.analysis.shooting import StepMap
+from dmi.analysis.shooting.shoot import StepMap
 from orbit_models import DenHartog, StickSlip1
 
 
@@ -123,7 +123,7 @@ def test_ritz_on_a_rank_deficient_map():
     dimensions, eigenvalues 0.9, -0.6, 0.3 and 0: the Ritz values are those, the basis handed to
     the continuation orthonormal (a block orthogonalised by qr of its own columns alone was not:
     0.904 for 0.9, |Q'Q - I| = 0.14, found in review)."""
-    from dmi.analysis.floquet import ritz
+    from dmi.analysis.scheme.floquet import ritz
     dim = 100
     P = np.linalg.qr(np.random.default_rng(1).standard_normal((dim, dim)))[0]
     A = P @ np.diag(np.r_[0.9, -0.6, 0.3, np.zeros(dim - 3)]) @ P.T

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from dmi.analysis import floquet_multipliers, periodic_orbit
-from dmi.analysis.shooting import StepMap
+from dmi.analysis.shooting.shoot import StepMap
 from orbit_models import SlipOnly1
 
 

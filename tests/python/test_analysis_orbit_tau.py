@@ -62,7 +62,7 @@ def test_branch_points_are_orbits_of_fresh_maps(branches):
     """Every point of both branches is a fixed point of the map built anew at its p (the
     corrector's own residual not trusted), and Newton-Picard (on the subspace of the 6 leading
     multipliers) converged at most of them."""
-    from dmi.analysis.shooting import StepMap
+    from dmi.analysis.shooting.shoot import StepMap
     _, b, _, b2 = branches
     for br in (b, b2):
         for q in br.points:

@@ -12,7 +12,7 @@ import scipy.optimize as so
 
 import dmi
 from dmi import analysis as da
-from dmi.analysis.newton import NO_PROGRESS, newton
+from dmi.analysis.core.newton import NO_PROGRESS, newton
 from orbit_models import DenHartog
 
 # ---- a closed-form autonomous orbit with a distributed delay ------------------------------------

@@ -15,7 +15,7 @@ import pytest
 import dmi
 from dmi import analysis, kernels
 from dmi.analysis import ShootingError, StepMap, floquet_multipliers
-from dmi.analysis.floquet import fd_step, growth_rate, monodromy_operator
+from dmi.analysis.scheme.floquet import fd_step, growth_rate, monodromy_operator
 
 # The Bautin normal form r' = r (nu + r^2 - r^4), theta' = 1 in Cartesian form, with a long
 # memory -(g / tau) int_0^tau x(t - s) ds on x, tau = 8 periods: its small orbit (r^2 ~ R2) is

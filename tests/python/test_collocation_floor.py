@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from dmi import analysis as da
-from dmi.analysis.newton import ShootingError, newton_loop
+from dmi.analysis.core.newton import ShootingError, newton_loop
 from test_collocation_belt_branch import V, belt, hopf
 
 DIAG = np.array([2.0, 1.0, 0.5, 1e-7])     # a nearly singular direction: the last

@@ -26,7 +26,7 @@ import scipy.optimize as so
 
 import dmi
 from dmi import analysis as da
-from dmi.analysis.newton import ShootingError
+from dmi.analysis.core.newton import ShootingError
 
 #: Seconds a subprocess may take before it counts as a hang (the fixed calls answer in about 2).
 LIMIT = 90

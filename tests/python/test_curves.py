@@ -117,7 +117,7 @@ def test_bautin_point_without_the_derivative_hook_from_a_branch_event():
     (ev,) = [e for e in br.events if e.kind == "hopf"]
     assert close(ev.hopf.p, -0.2, 1e-9)
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", da.normal_form.CriticalityWarning)   # l1 ~ 0 at Bautin
+        warnings.simplefilter("ignore", da.equilibria.normal_form.CriticalityWarning)   # l1 ~ 0 at Bautin
         curve = da.continue_curve(ev, without_hook, q0, 0.1, step=0.1)
     assert curve.status == "reached q_end = 0.1", curve.status
     for pt in curve.points:
@@ -180,7 +180,7 @@ def planar(p: float, q: float) -> dmi.Solver:
     return s
 
 
-@pytest.mark.filterwarnings("ignore::dmi.analysis.equation.RefinementWarning")   # the branch in p
+@pytest.mark.filterwarnings("ignore::dmi.analysis.equilibria.equation.RefinementWarning")   # the branch in p
 def test_fold_curve_with_its_bogdanov_takens_point():
     g0 = ghat(0.0, GB).real
     q_bt = dghat(0.0, GB).real - g0 / 2

@@ -1,4 +1,4 @@
-# The verified stability verdict of equilibria (dmi.analysis.root_verdict): closed-form stability
+# The verified stability verdict of equilibria (dmi.analysis.equilibria.root_verdict): closed-form stability
 # boundaries, the argument principle's count against polynomial roots, roots the root finder
 # misses, a root on the imaginary axis, and the opt-out.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -13,10 +13,11 @@ import scipy.optimize
 
 import dmi
 from dmi import analysis
-from dmi.analysis import StabilityWarning, stability
-from dmi.analysis._model import Linearisation
-from dmi.analysis.equation import Characteristic
-from dmi.analysis.root_verdict import count_right
+from dmi.analysis import StabilityWarning
+from dmi.analysis.equilibria import stability
+from dmi.analysis.core.model import Linearisation
+from dmi.analysis.equilibria.equation import Characteristic
+from dmi.analysis.equilibria.root_verdict import count_right
 
 TAU = 1.0
 #: x' = -(a / tau) int_0^tau x(t - s) ds: Delta(lambda) = lambda + a (1 - e^(-lambda tau)) /

@@ -1,4 +1,4 @@
-# The criticality of the equation's Hopf points (dmi.analysis.normal_form): l1 in Kuznetsov's
+# The criticality of the equation's Hopf points (dmi.analysis.equilibria.normal_form): l1 in Kuznetsov's
 # normalisation with its error, the crossing speed and the amplitude coefficients kappa, against
 # closed forms of a rotationally symmetric oscillator with a distributed memory (its circles are
 # exact), a harmonic-balance solve of an oscillator with quadratic and cubic terms and a memory,
@@ -16,7 +16,7 @@ import scipy.optimize as so
 import dmi
 import hopf_models
 from dmi import analysis as da
-from dmi.analysis.normal_form import CriticalityWarning
+from dmi.analysis.equilibria.normal_form import CriticalityWarning
 
 # ---- z' = (mu + i W0) z + c1 |z|^2 z + c2 |z|^4 z - int_0^TAU G e^-s z(t - s) ds, z = x + i y ----
 # Its circles z = r e^(i Om t) solve d(i Om) = c1 r^2 + c2 r^4 with d(lam) = lam + g(lam) - mu - i W0

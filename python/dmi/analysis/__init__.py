@@ -9,26 +9,26 @@ Equilibria and their stability (docs/stability.md): :func:`equilibrium`,
 :func:`period_doubled_orbit`, :func:`refine_orbit` and :func:`plot_branch`.  The answers are the
 scheme's (they match simulation); ``of="equation"`` (:func:`roots`, :func:`hopf`,
 :func:`stability_chart`, :func:`equilibrium`) and :func:`refine_orbit` give the equation's.
-Interactive HTML figures (:mod:`dmi.analysis.interactive`, Bokeh): ``Branch.to_html``,
+Interactive HTML figures (:mod:`dmi.analysis.plot.interactive`, Bokeh): ``Branch.to_html``,
 ``StabilityChart.to_html`` and the ``html`` of :func:`plot_branch` and
 :func:`plot_stability_chart`.
 """
 from __future__ import annotations
 
-from ._model import KinkError
-from .hopf_branch import hopf_orbit
-from .branch import Branch, BranchPoint, Event, HopfPoint
-from .chart import HopfCurve, StabilityChart, plot_stability_chart, stability_chart
-from .continuation import continue_orbit, period_doubled_orbit
-from .equilibria import Equilibrium, EquilibriumPoint, continue_equilibrium, equilibrium
-from .floquet import Floquet, StabilityWarning, Verify, floquet_multipliers, floquet_verdict
-from .newton import ShootingError
-from .orbit import Orbit
-from .orbit_plot import plot_branch
-from .refine import Refined, refine_orbit
-from .shooting import periodic_orbit
-from .stability import hopf, roots
-from .stepmap import StepMap
+from .core.model import KinkError
+from .hopf_orbits import hopf_orbit
+from .continuation.branch import Branch, BranchPoint, Event, HopfPoint
+from .equilibria.chart import HopfCurve, StabilityChart, plot_stability_chart, stability_chart
+from .orbits import continue_orbit, period_doubled_orbit
+from .equilibria.equilibrium import Equilibrium, EquilibriumPoint, continue_equilibrium, equilibrium
+from .scheme.floquet import Floquet, StabilityWarning, Verify, floquet_multipliers, floquet_verdict
+from .core.newton import ShootingError
+from .scheme.orbit import Orbit
+from .plot.branch import plot_branch
+from .shooting.refine import Refined, refine_orbit
+from .shooting.shoot import periodic_orbit
+from .equilibria.stability import hopf, roots
+from .scheme.stepmap import StepMap
 
 __all__ = [
     # equilibria and their stability (docs/stability.md)
@@ -42,18 +42,18 @@ __all__ = [
     # verified Floquet multipliers and stability verdicts (docs/orbits.md)
     "floquet_verdict", "Floquet", "Verify", "StabilityWarning",
 ]
-from .collocation import collocate  # noqa: E402
-from .equation_orbit import EquationOrbit  # noqa: E402
+from .collocation.collocate import collocate  # noqa: E402
+from .collocation.orbit import EquationOrbit  # noqa: E402
 
-from .collocation_system import CollocationWarning  # noqa: E402
-from .branch import EventWarning  # noqa: E402
+from .collocation.system import CollocationWarning  # noqa: E402
+from .continuation.branch import EventWarning  # noqa: E402
 
 __all__ += ["collocate", "EquationOrbit", "CollocationWarning", "EventWarning"]
-from .collocation_continuation import (CollocationDiscretisation,  # noqa: E402
+from .collocation.discretisation import (CollocationDiscretisation,  # noqa: E402
                                        equation_hopf_orbit)
 
 __all__ += ["CollocationDiscretisation", "equation_hopf_orbit"]
-from .curves import Curve, CurveEvent, CurvePoint, continue_curve  # noqa: E402
+from .equilibria.curves import Curve, CurveEvent, CurvePoint, continue_curve  # noqa: E402
 
 # Hopf and fold curves of the equation's equilibria in two parameters (docs/stability.md)
 __all__ += ["continue_curve", "Curve", "CurvePoint", "CurveEvent"]

@@ -1,0 +1,161 @@
+# Floquet multipliers of a collocated orbit: the discretised monodromy operator of the linearised
+# equation over one period, with the switches' saltation.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""Multipliers of :mod:`dmi.analysis.collocation.collocate`'s orbits; private to the package.
+
+As DDE-BIFTOOL does: the state is the past over [-tau, 0] as a piecewise polynomial on the
+orbit's own mesh shifted back (each interval its own m + 1 nodes, so a perturbation may jump at a
+switch); one period forward is the collocation system of the period from that past (u(0) =
+phi(0-), the collocation, the switching conditions with their times unknown), linearised at the
+orbit; the image is the new past over [T - tau, T].  The monodromy matrix is dense and small (the
+intervals that meet [-tau, 0]), its eigenvalues the multipliers.
+
+A switching time's variation moves the nodes of the pieces it bounds: the perturbation at a
+fixed time is the node value's minus u*' (one-sided, inside the node's interval) times the node's
+motion.  That is the saltation of Barton (2008) in the collocation's terms: linearising the
+switching condition with the switching time as an unknown gives it (a stuck piece's component
+is held, so its perturbation is wiped out: the zero multipliers it should give).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.linalg as sl
+import scipy.sparse as sp
+import scipy.sparse.linalg as sla
+
+from .system import History, Layout, Terms, full_jacobian
+from ..core.blas import _one_blas_thread
+
+
+def monodromy(lay: Layout, terms: Terms, x: np.ndarray) -> np.ndarray:
+    """The monodromy matrix on the past's nodes over the intervals that meet [-tau, 0]."""
+    m, n, L = lay.m, lay.n, lay.L
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    P = max(1, math.ceil(terms.tau / T - 1e-12))
+    i = np.arange(L)
+    k = np.arange(m + 1)
+    cols = (i[:, None] * m + k[None, :]) % lay.rows
+    one = V[cols]                                          # (L, m + 1, n)
+    phi = np.tile(one, (P, 1, 1)).reshape(-1, n)
+    _, J = full_jacobian(lay, terms, x, None, history=History(mesh, P, phi))
+    J = sp.csc_matrix(J)
+    nc = (lay.rows + 1) * n
+    nh = P * L * (m + 1) * n
+    Jcur = sp.hstack([J[:, :nc], J[:, nc + nh:]], format="csc")
+    # the past's intervals g (oldest first) that meet (-tau, 0]
+    g = np.arange(P * L)
+    per = P - g // L
+    end = mesh[g % L + 1] - per * T
+    state = g[end > -terms.tau + 1e-14 * T]
+    if state.size == 0 or state[-1] != P * L - 1:
+        state = np.append(state, P * L - 1)
+    scol = (state[:, None, None] * (m + 1) * n + k[None, :, None] * n
+            + np.arange(n)[None, None, :]).ravel()
+    Z = -sla.splu(Jcur).solve(J[:, nc + scol].toarray())   # d(nodes, b) / d(state)
+    dV, db = Z[:nc].reshape(lay.rows + 1, n, -1), Z[nc:]
+    # the image: interval g + L of the past, or interval g + L - P L of the period
+    h = np.diff(mesh)
+    dz = lay.basis.derivatives(lay.basis.nodes)             # (m + 1 nodes, m + 1 basis)
+    left, right = lay.node_motion()
+    piece = lay.piece_of_interval()
+    who = lay.ends(b, T)[1]                                 # the switch each piece end moves with
+    where = {int(gg): j for j, gg in enumerate(state)}
+    dim = scol.size
+    M = np.zeros((dim, dim))
+    for j, gg in enumerate(state):
+        out = slice(j * (m + 1) * n, (j + 1) * (m + 1) * n)
+        ng = int(gg) + L
+        if ng < P * L:
+            src = where[ng]
+            M[out, src * (m + 1) * n:(src + 1) * (m + 1) * n] = np.eye((m + 1) * n)
+            continue
+        iv = ng - P * L
+        rows = dV[iv * m + k]                               # (m + 1, n, dim)
+        slope = dz @ one[iv] / h[iv]                        # u*' inside interval iv at its nodes
+        move = np.zeros((m + 1, dim))                       # d t_node / d state
+        pc = piece[iv]
+        if who[pc] >= 0:
+            move += left[iv][:, None] * db[who[pc]][None, :]
+        if who[pc + 1] >= 0:
+            move += right[iv][:, None] * db[who[pc + 1]][None, :]
+        M[out] = (rows - slope[:, :, None] * move[:, None, :]).reshape((m + 1) * n, dim)
+    return M
+
+
+def multipliers(lay: Layout, terms: Terms, x: np.ndarray, count: int = 10) -> np.ndarray:
+    """The ``count`` multipliers of largest modulus (largest first; below 1e-12: 0)."""
+    with _one_blas_thread():          # a small dense problem: BLAS threads only contend
+        mu = sl.eigvals(monodromy(lay, terms, x))
+    mu = mu[np.argsort(-np.abs(mu), kind="stable")][:count]
+    return np.where(np.abs(mu) < 1e-12, 0.0, mu)
+
+
+def eigenfunction(lay: Layout, terms: Terms, x: np.ndarray, near: complex = -1.0
+                  ) -> tuple[complex, np.ndarray]:
+    """The Floquet eigenfunction of the multiplier nearest ``near`` over one period, as node
+    values on the orbit's own mesh (for :func:`dmi.analysis.period_doubled_orbit`).
+
+    The eigenvector of :func:`monodromy` is the past over [-tau, 0]; the linearised collocation
+    system of the period from that past (the same system :func:`monodromy` solves) gives the
+    perturbation at the period's nodes, the eigenfunction v on [0, T) (v(t + T) = mu v(t)).  On
+    an orbit with switches these are the node values' perturbations (the nodes move with the
+    switches; the saltation is left out).
+
+    Parameters
+    ----------
+    lay : Layout
+        The orbit's layout.
+    terms : Terms
+        The model's terms at the orbit's p.
+    x : numpy.ndarray
+        The orbit's unknowns.
+    near : complex
+        The multiplier wanted (-1: a period doubling's).
+
+    Returns
+    -------
+    tuple
+        (mu, V): the multiplier nearest ``near`` and the eigenfunction's values (L m, n) at the
+        node times (:func:`dmi.analysis.collocation.system.node_times`), complex, largest
+        |value| 1.
+
+    Raises
+    ------
+    ValueError
+        The eigenfunction vanishes on the period (a multiplier 0).
+    """
+    m, n, L = lay.m, lay.n, lay.L
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    P = max(1, math.ceil(terms.tau / T - 1e-12))
+    k = np.arange(m + 1)
+    cols = (np.arange(L)[:, None] * m + k[None, :]) % lay.rows
+    phi = np.tile(V[cols], (P, 1, 1)).reshape(-1, n)
+    _, J = full_jacobian(lay, terms, x, None, history=History(mesh, P, phi))
+    J = sp.csc_matrix(J)
+    nc = (lay.rows + 1) * n
+    nh = P * L * (m + 1) * n
+    # the past's intervals that meet (-tau, 0], as monodromy's state (its columns' order)
+    g = np.arange(P * L)
+    state = g[mesh[g % L + 1] - (P - g // L) * T > -terms.tau + 1e-14 * T]
+    if state.size == 0 or state[-1] != P * L - 1:
+        state = np.append(state, P * L - 1)
+    scol = (state[:, None, None] * (m + 1) * n + k[None, :, None] * n
+            + np.arange(n)[None, None, :]).ravel()
+    with _one_blas_thread():
+        mu, Y = sl.eig(monodromy(lay, terms, x))
+    j = int(np.argmin(np.abs(mu - near)))
+    Jcur = sp.hstack([J[:, :nc], J[:, nc + nh:]], format="csc")
+    lu = sla.splu(Jcur)
+    rhs = J[:, nc + scol] @ Y[:, j]
+    re, im = np.ascontiguousarray(rhs.real), np.ascontiguousarray(rhs.imag)
+    dV = -(lu.solve(re) + 1j * lu.solve(im))
+    out = dV[:lay.rows * n].reshape(lay.rows, n)
+    big = float(np.max(np.abs(out)))
+    if not big > 0:
+        raise ValueError(f"the eigenfunction of the multiplier {mu[j]:.6g} vanishes on the "
+                         "period: no direction to follow")
+    return complex(mu[j]), out / out.flat[int(np.argmax(np.abs(out)))]

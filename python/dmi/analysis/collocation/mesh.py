@@ -1,0 +1,432 @@
+# Piecewise polynomials on a mesh of one period: the Lagrange basis, evaluation, the delay
+# integral's quadrature matrix and the equidistribution of the mesh.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""The mesh machinery of :mod:`dmi.analysis.collocation.collocate`; private to the package.
+
+A function on one period [0, T] is a continuous piecewise polynomial of degree m on a mesh
+0 = t_0 < t_1 < ... < t_L = T: on interval i it interpolates m + 1 equispaced nodes t_i + k h_i / m
+(k = 0..m), the last node of an interval being the first of the next.  A *locator* maps times
+(any real numbers) to (interval, local coordinate in [0, 1], the columns of that interval's m + 1
+nodes in the unknowns): the periodic one wraps times mod T (the orbit), the history one sends
+negative times to a separate, discontinuous copy of the mesh (the monodromy operator).
+
+The delay integral I(t) = int_0^tau H(s) u(t - s) ds is exact for the piecewise polynomial up to
+the kernel's own smoothness: [0, tau] is cut at every lag s where t - s crosses a mesh point (all
+shifted periods) and at the kernel's own breakpoints, and each piece takes ``q`` Gauss-Legendre
+nodes (exact for H polynomial of degree 2 q - 1 - m on the piece).  A :class:`Kernel` brings its
+jumps inside (0, tau) as more cuts (a jump at a lag not given caps the order at 1: the pieces do
+not see it) and its near part s^-beta C on (0, delta] (a fitted PowerKernel's), integrated on each
+piece by product integration with the Gauss-Jacobi rule of the weight s^-beta.
+"""
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.special import roots_jacobi
+
+#: Locator: times -> (interval (k,), local coordinate (k,), columns (k, m + 1) of node rows).
+Locator = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]
+
+
+@dataclass(frozen=True)
+class Basis:
+    """The Lagrange basis of degree m on the equispaced nodes k / m of [0, 1], with the m Gauss
+    points (collocation) and the Gauss-Legendre rule of q nodes (quadrature) on [0, 1]."""
+    m: int
+    q: int
+
+    @property
+    def nodes(self) -> np.ndarray:
+        """The m + 1 interpolation nodes k / m."""
+        return np.linspace(0.0, 1.0, self.m + 1)
+
+    @property
+    def weights(self) -> np.ndarray:
+        """Barycentric weights 1 / prod_{j != k} (x_k - x_j)."""
+        x = self.nodes
+        d = x[:, None] - x[None, :]
+        np.fill_diagonal(d, 1.0)
+        return 1.0 / np.prod(d, axis=1)
+
+    def gauss(self, count: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Gauss-Legendre nodes and weights on [0, 1] (``count`` nodes, default m)."""
+        return _legendre(self.m if count is None else count)
+
+    def values(self, z: np.ndarray) -> np.ndarray:
+        """(len(z), m + 1): the basis polynomials at the local coordinates z (their monomial
+        coefficients in y = 2 z - 1, by Horner's scheme)."""
+        y = 2.0 * np.asarray(z, dtype=float) - 1.0
+        C = _monomials(self.m)
+        out = np.broadcast_to(C[self.m], (y.size, self.m + 1)).copy()
+        for j in range(self.m - 1, -1, -1):
+            out *= y[:, None]
+            out += C[j]
+        return out
+
+    def derivatives(self, z: np.ndarray) -> np.ndarray:
+        """(len(z), m + 1): the basis polynomials' first derivatives at z (d/dz, z in [0, 1])."""
+        z = np.asarray(z, dtype=float)
+        x, w = self.nodes, self.weights
+        d = z[:, None] - x[None, :]
+        out = np.zeros((z.size, self.m + 1))
+        for k in range(self.m + 1):
+            others = [j for j in range(self.m + 1) if j != k]
+            for i in others:
+                rest = [j for j in others if j != i]
+                out[:, k] += np.prod(d[:, rest], axis=1)
+            out[:, k] *= w[k]
+        return out
+
+    @property
+    def top(self) -> np.ndarray:
+        """(m + 1,): the m-th derivative (d/dz) of each basis polynomial, a constant."""
+        return self.weights * math.factorial(self.m)
+
+
+@functools.lru_cache(maxsize=16)
+def _monomials(m: int) -> np.ndarray:
+    """(m + 1, m + 1): row j holds the y^j coefficients of the m + 1 Lagrange polynomials on the
+    equispaced nodes of [-1, 1] (y = 2 z - 1; well conditioned for m <= 8)."""
+    y = np.linspace(-1.0, 1.0, m + 1)
+    return np.linalg.inv(np.vander(y, m + 1, increasing=True))
+
+
+def interval_of(mesh: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For times t in [mesh[0], mesh[-1]]: the interval index and the local coordinate in [0, 1]."""
+    L = mesh.size - 1
+    i = np.clip(np.searchsorted(mesh, t, side="right") - 1, 0, L - 1)
+    z = (t - mesh[i]) / (mesh[i + 1] - mesh[i])
+    return i, z
+
+
+def periodic_locator(mesh: np.ndarray, m: int) -> Locator:
+    """The locator of the periodic continuous piecewise polynomial: L m node rows, times mod T."""
+    T = float(mesh[-1])
+    L = mesh.size - 1
+    k = np.arange(m + 1)
+
+    def locate(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        i, z = interval_of(mesh, np.mod(t, T))
+        return i, z, (i[:, None] * m + k[None, :]) % (L * m)
+    return locate
+
+
+def history_locator(mesh: np.ndarray, hist: np.ndarray, m: int, periods: int) -> Locator:
+    """The locator of one period forward from a history: times t >= 0 on ``mesh`` (L m + 1
+    continuous node rows, node 0 at t = 0), times t < 0 on ``periods`` copies of ``hist`` shifted
+    back by whole periods, each interval with its own m + 1 rows (a discontinuous piecewise
+    polynomial: a perturbation may jump at a switch), after the L m + 1 rows of the period."""
+    T = float(hist[-1])
+    L = mesh.size - 1
+    k = np.arange(m + 1)
+    base = L * m + 1
+
+    def locate(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        t = np.asarray(t, dtype=float)
+        i, z = interval_of(mesh, np.clip(t, 0.0, mesh[-1]))
+        cols = i[:, None] * m + k[None, :]
+        back = t < 0
+        if np.any(back):
+            per = np.ceil(-t[back] / T).astype(int)            # 1 .. periods
+            ih, zh = interval_of(hist, t[back] + per * T)
+            i[back], z[back] = ih, zh
+            g = (periods - per) * L + ih                        # history interval, oldest first
+            cols[back] = base + g[:, None] * (m + 1) + k[None, :]
+        return i, z, cols
+    return locate
+
+
+def history_rows(L: int, m: int, periods: int) -> int:
+    """The node rows of :func:`history_locator`: L m + 1 for the period, L (m + 1) a past period."""
+    return L * m + 1 + periods * L * (m + 1)
+
+
+#: Gauss-Legendre nodes a piece of the near part that keeps at least its own length from the
+#: singularity at 0 (s^-beta is analytic in the Bernstein ellipse of parameter 3 + sqrt 8 around
+#: it: the rule's error is below 5.83^-24, 5e-19, relative).
+Q_NEAR = 12
+#: An exponential sum is steep when its fastest rate r exceeds STEEP / tau: its pieces near 0
+#: are then graded (:attr:`Kernel.grading`).
+STEEP = 20.0
+
+
+@dataclass(frozen=True)
+class Near:
+    """The near part of a kernel: H(s) = s^-beta C on (0, delta] (a fitted kernel's exact part,
+    weakly singular at 0).
+
+    Attributes
+    ----------
+    delta : float
+        Its length, > 0 (time units).
+    beta : float
+        The exponent, 0 < beta < 1.
+    C : numpy.ndarray
+        (n, n): the factor.
+    """
+    delta: float
+    beta: float
+    C: np.ndarray
+
+
+class Kernel:
+    """H(s) on (0, tau]: ``far`` (callable s (k,) -> (k, n, n)) past the near part, the near
+    part s^-beta C on (0, delta] when ``near`` is given, and the lags of its known jumps inside
+    (0, tau) (each a breakpoint of the delay integral's pieces, as delta is).
+
+    Parameters
+    ----------
+    far : callable
+        s (k,) -> H(s) (k, n, n), the kernel (past delta with a near part).
+    near : Near, optional
+        The near part.
+    jumps : sequence of float
+        Lags of jumps of H in (0, tau), sorted.
+    rate : float
+        The fastest decay rate of an exponential sum when it is steep on (0, tau) (0: not).
+    """
+
+    def __init__(self, far: Callable[[np.ndarray], np.ndarray], near: Near | None = None,
+                 jumps: tuple[float, ...] = (), rate: float = 0.0):
+        self.far, self.near, self.jumps = far, near, tuple(float(j) for j in jumps)
+        self.rate = float(rate)
+
+    @property
+    def grading(self) -> float:
+        """Where the graded cuts of (0, tau) start (0: none): past a near part, H (a fit of
+        s^-beta) still varies on the scale of s, so the cuts are delta 2^k (k >= 1); an
+        exponential sum whose fastest rate r is steep (r > STEEP / tau) is cut at 2^k / r
+        (k >= 0).  Each graded piece is at least its own length from 0 and takes Q_NEAR
+        Gauss-Legendre nodes."""
+        if self.near is not None:
+            return 2.0 * self.near.delta
+        return 1.0 / self.rate if self.rate > 0 else 0.0
+
+    def __call__(self, s: np.ndarray) -> np.ndarray:
+        """H(s) (k, n, n) at the lags s (k,) (the near part at s <= delta)."""
+        s = np.asarray(s, dtype=float)
+        out = np.asarray(self.far(s), dtype=float)
+        if self.near is not None:
+            close = s <= self.near.delta
+            if np.any(close):
+                out = out.copy()
+                out[close] = s[close, None, None] ** -self.near.beta * self.near.C
+        return out
+
+    @property
+    def breaks(self) -> np.ndarray:
+        """The lags where the pieces of the delay integral are cut: the jumps and delta."""
+        near = [self.near.delta] if self.near is not None else []
+        return np.array(sorted(set(self.jumps) | set(near)), dtype=float)
+
+
+def _frozen(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The arrays made read-only (a cached rule is shared by every caller)."""
+    for a in arrays:
+        a.setflags(write=False)
+    return arrays
+
+
+@functools.lru_cache(maxsize=64)
+def _jacobi(q: int, beta: float) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Jacobi nodes y and weights w on [0, 1] for the weight y^-beta (q nodes):
+    int_0^1 y^-beta P(y) dy = sum w P(y), exact for P of degree <= 2 q - 1 (computed once for
+    each (q, beta), read-only)."""
+    x, w = roots_jacobi(q, 0.0, -beta)
+    return _frozen(0.5 * (x + 1.0), w / 2.0 ** (1.0 - beta))  # type: ignore[return-value]
+
+
+@functools.lru_cache(maxsize=64)
+def _legendre(q: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights on [0, 1] (q nodes; computed once for each q,
+    read-only)."""
+    z, w = np.polynomial.legendre.leggauss(q)
+    return _frozen(0.5 * (z + 1.0), 0.5 * w)  # type: ignore[return-value]
+
+
+def _local(locate: Locator, tp: np.ndarray, a: np.ndarray, d: np.ndarray, S: np.ndarray
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """For pieces [a, a + d] of lags at the times tp (each piece in one interval of u): the
+    columns (k, m + 1) of its interval, the local coordinates (k, q) of tp - S on that interval's
+    polynomial (extended past the interval: S may lie outside the piece) and dz/dt (k,)."""
+    mid = tp - (a + 0.5 * d)
+    _, z1, cols = locate(mid)
+    _, z2, _ = locate(mid + 0.25 * d)
+    slope = (z2 - z1) / (0.25 * d)
+    return cols, z1[:, None] + (tp[:, None] - S - mid[:, None]) * slope[:, None], slope
+
+
+def _near_nodes(near: Near, a: np.ndarray, d: np.ndarray, q: int, n: int
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Product integration of s^-beta C P(s) on the pieces [a, a + d] of (0, delta] (P a
+    polynomial): a piece that keeps its own length from 0 by Q_NEAR Gauss-Legendre nodes with the
+    weight s^-beta at them; one closer (a < d) by the Gauss-Jacobi rule of s^-beta on [0, a + d]
+    minus the one on [0, a] (both on the piece's polynomial, exact).  Returns the lags S (k, r),
+    the weights W (k, r) and H = C at them (k, r, n, n)."""
+    close = a < d
+    gy, gw = _jacobi(q, near.beta)
+    lz, lw = _legendre(Q_NEAR)
+    r = max(2 * q, Q_NEAR)
+    S = np.zeros((a.size, r))
+    W = np.zeros((a.size, r))
+    b = a + d
+    ac, bc = a[close], b[close]
+    S[close, :2 * q] = np.concatenate([bc[:, None] * gy, ac[:, None] * gy], axis=1)
+    W[close, :2 * q] = np.concatenate([bc[:, None] ** (1.0 - near.beta) * gw,
+                                       -ac[:, None] ** (1.0 - near.beta) * gw], axis=1)
+    far = ~close
+    Sf = a[far, None] + d[far, None] * lz
+    S[far, :Q_NEAR] = Sf
+    W[far, :Q_NEAR] = d[far, None] * lw * Sf ** -near.beta
+    S[W == 0] = np.where(close, 0.5 * b, a + 0.5 * d)[:, None].repeat(r, 1)[W == 0]
+    H = np.broadcast_to(near.C, (a.size, r, n, n))
+    return S, W, H
+
+
+def delay_matrix(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: float,
+                 kernel: Callable[[np.ndarray], np.ndarray], locate: Locator, basis: Basis,
+                 n: int, rows: int, breaks: np.ndarray | None = None,
+                 pattern: np.ndarray | None = None, slope_of: np.ndarray | None = None
+                 ) -> tuple[sp.csr_matrix, np.ndarray | None]:
+    """The sparse matrix G (len(times) n, rows n) with G u = (int_0^tau H(s) u(t_c - s) ds)_c.
+
+    Parameters
+    ----------
+    times : numpy.ndarray
+        The times t_c.
+    tau : float
+        The memory's length.
+    mesh_points : numpy.ndarray
+        The mesh points of one period (where u's pieces join), repeated every T.
+    T : float
+        The period.
+    kernel : callable
+        s (k,) -> H(s) (k, n, n); a :class:`Kernel` also brings its near part (by product
+        integration) and its jumps (breakpoints).
+    locate : callable
+        The locator of u's node rows.
+    basis : Basis
+        The basis (degree m, q quadrature nodes a piece).
+    n : int
+        The state's dimension.
+    rows : int
+        The node rows of u.
+    breaks : numpy.ndarray, optional
+        The kernel's own breakpoints in (0, tau) (besides a Kernel's).
+    pattern : numpy.ndarray of bool, optional
+        (n, n): the entries of H that may be nonzero (default all).
+    slope_of : numpy.ndarray, optional
+        Node rows (rows, n) of u: then also (1 / T) int_0^tau s H(s) u'(t_c - s) ds (len(times),
+        n), the derivative of G u in T when the mesh scales with T (an autonomous orbit).
+
+    Returns
+    -------
+    tuple
+        G (scipy.sparse.csr_matrix; row c n + a, column (node row) n + b) and the T derivative
+        (or None).
+    """
+    gz, gw = basis.gauss(basis.q)
+    pts = np.asarray(mesh_points[:-1], dtype=float)
+    times = np.asarray(times, dtype=float)
+    near = getattr(kernel, "near", None)
+    far = getattr(kernel, "far", kernel)
+    own = getattr(kernel, "breaks", np.empty(0))
+    breaks = own if breaks is None else np.concatenate([np.asarray(breaks, float), own])
+    graded = 0.0
+    start = getattr(kernel, "grading", 0.0)
+    if start > 0:                # a steep H near 0: cuts at start 2^k
+        grade = start * 2.0 ** np.arange(0, 64)
+        grade = grade[grade < tau * (1.0 - 1e-12)]
+        graded = float(grade[-1]) if grade.size else 0.0
+        breaks = np.concatenate([breaks, grade])
+    lo = math.floor((times.min() - tau - pts[-1]) / T) - 1
+    hi = math.floor((times.max() - pts[0]) / T) + 1
+    ext = (pts[None, :] + T * np.arange(lo, hi + 1)[:, None]).ravel()   # sorted
+    j0 = np.searchsorted(ext, times - tau, side="right")
+    j1 = np.searchsorted(ext, times, side="left")
+    K = int(np.max(j1 - j0)) if times.size else 0
+    idx = j0[:, None] + np.arange(K)[None, :]
+    inside = idx < j1[:, None]
+    cut = np.where(inside, times[:, None] - ext[np.minimum(idx, ext.size - 1)], 0.0)
+    extra = [np.zeros((times.size, 1)), np.full((times.size, 1), tau)]
+    if breaks.size:
+        extra.append(np.broadcast_to(breaks, (times.size, breaks.size)))
+    s = np.sort(np.concatenate([cut] + extra, axis=1), axis=1)
+    a, d = s[:, :-1], np.diff(s, axis=1)
+    keep = d > 1e-14 * max(tau, 1.0)
+    C = np.nonzero(keep)[0]
+    a, d = a[keep], d[keep]                                      # the pieces (k,)
+    if pattern is None:
+        pattern = np.ones((n, n), bool)
+    ia, ib = np.nonzero(pattern)
+    close = (a + d <= near.delta * (1.0 + 1e-12)) if near is not None else np.zeros(a.size, bool)
+    # the graded pieces up to start 2^K: each at least its own length from 0, Q_NEAR nodes
+    steep = ~close & (a + d <= graded * (1.0 + 1e-12))
+    groups = []
+    for f, rule in ((~close & ~steep, (gz, gw)), (steep, None)):
+        if not np.any(f):
+            continue
+        zz, ww = rule if rule is not None else _legendre(Q_NEAR)
+        S = a[f, None] + d[f, None] * zz[None, :]                # (k, q)
+        W = d[f, None] * ww[None, :]
+        H = far(S.ravel()).reshape(S.shape + (n, n))             # (k, q, n, n)
+        groups.append((C[f], a[f], d[f], S, W, H))
+    if np.any(close):
+        groups.append((C[close], a[close], d[close])
+                      + _near_nodes(near, a[close], d[close], basis.q, n))
+    vals, rr, cc = [], [], []
+    dT = np.zeros((times.size, n)) if slope_of is not None else None
+    for Cg, ag, dg, S, W, H in groups:
+        if not Cg.size:
+            continue
+        cols, z, slope = _local(locate, times[Cg], ag, dg, S)
+        B = basis.values(z.ravel()).reshape(S.shape + (basis.m + 1,))   # (k, q, m + 1)
+        val = np.einsum("kq,kqe,kqj->kej", W, H[:, :, ia, ib], B)   # (k, entries, m + 1)
+        vals.append(val.ravel())
+        rr.append(np.broadcast_to((Cg[:, None] * n + ia[None, :])[:, :, None],
+                                  val.shape).ravel())
+        cc.append(np.broadcast_to(cols[:, None, :] * n + ib[None, :, None], val.shape).ravel())
+        if dT is not None:
+            Bd = basis.derivatives(z.ravel()).reshape(S.shape + (basis.m + 1,))
+            Ud = np.einsum("kqj,kjb->kqb", Bd * slope[:, None, None], slope_of[cols])
+            np.add.at(dT, Cg, np.einsum("kq,kqab,kqb->ka", W * S, H, Ud) / T)
+    G = sp.csr_matrix((np.concatenate(vals) if vals else np.empty(0),
+                       (np.concatenate(rr) if rr else np.empty(0, int),
+                        np.concatenate(cc) if cc else np.empty(0, int))),
+                      shape=(times.size * n, rows * n))
+    return G, dT
+
+
+def point_matrix(times: np.ndarray, locate: Locator, basis: Basis, mesh: np.ndarray, n: int,
+                 rows: int, derivative: bool = False) -> sp.csr_matrix:
+    """The sparse matrix E (len(times) n, rows n) of u(t_c) (or u'(t_c), d/dt, with
+    ``derivative``) from the node rows."""
+    i, z, cols = locate(np.asarray(times, dtype=float))
+    if derivative:
+        B = basis.derivatives(z) / (mesh[i + 1] - mesh[i])[:, None]
+    else:
+        B = basis.values(z)
+    P = len(times)
+    val = np.broadcast_to(B[:, None, :], (P, n, basis.m + 1))
+    r = np.broadcast_to((np.arange(P)[:, None, None] * n + np.arange(n)[None, :, None]),
+                        val.shape)
+    cc = cols[:, None, :] * n + np.arange(n)[None, :, None]
+    return sp.csr_matrix((val.ravel(), (r.ravel(), cc.ravel())), shape=(P * n, rows * n))
+
+
+def equidistribute(mesh: np.ndarray, indicator: np.ndarray, L: int) -> np.ndarray:
+    """A mesh of L intervals over [mesh[0], mesh[-1]] on which the piecewise constant density
+    ``indicator`` (per interval of ``mesh``, >= 0) has equal integrals (as AUTO and COLSYS), a
+    floor of 1 % of its mean keeping quiet stretches meshed."""
+    h = np.diff(mesh)
+    d = np.maximum(indicator, 1e-2 * max(float(np.sum(indicator * h) / np.sum(h)), 1e-300))
+    cum = np.concatenate([[0.0], np.cumsum(d * h)])
+    target = np.linspace(0.0, cum[-1], L + 1)
+    new = np.interp(target, cum, mesh)
+    new[0], new[-1] = mesh[0], mesh[-1]
+    return new

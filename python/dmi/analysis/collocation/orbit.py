@@ -1,0 +1,106 @@
+# A periodic orbit of the equation (not of the scheme): a piecewise polynomial of one period.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""The :class:`EquationOrbit` that :func:`dmi.analysis.collocate` returns."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .mesh import Basis, periodic_locator
+from .signature import Signature
+
+
+@dataclass
+class EquationOrbit:
+    """A periodic orbit of the equation u' + A(u) + f(t, u) + int_0^tau H(s) u(t - s) ds ∋ 0,
+    by orthogonal collocation (:func:`dmi.analysis.collocate`).
+
+    Attributes
+    ----------
+    p : float
+        The parameter.
+    period : float
+        The period (time units).
+    amplitude : numpy.ndarray
+        Shape (n,): (max - min) / 2 of each component over the period, its extrema located on
+        the piecewise polynomial (state units).
+    multipliers : numpy.ndarray of complex
+        The leading Floquet multipliers, largest |mu| first (with the saltation at every switch).
+    stable : bool or None
+        All |mu| < 1 (an autonomous orbit: but its trivial multiplier), verified: the margin
+        exceeds the multipliers' estimated error; None when it does not.
+    mesh : numpy.ndarray
+        The L + 1 mesh points of one period, 0 ... period (time units).
+    signature : Signature
+        The modes of each component on each segment (one segment: a smooth orbit).
+    switches : numpy.ndarray
+        The switching times b_1 < ... < b_S in (0, period) (time units; empty when smooth).
+    make : callable
+        The model ``make(p) -> dmi.Solver``.
+    autonomous : bool
+        The period is an unknown (with an integral phase condition).
+    errors : dict
+        Estimated errors (same units): ``"period"``, ``"amplitude"`` (n,), ``"multipliers"``
+        (as ``multipliers``), ``"u"`` (the largest over the period), from the difference to the
+        solve on the mesh with every interval halved (a continuation point: with every pair of
+        intervals merged), an upper estimate: the returned orbit is the finer one; empty where
+        that solve failed.
+    degree : int
+        m, the polynomials' degree.
+    nodes : numpy.ndarray
+        Shape (L m, n): the values at the nodes t_i + k h_i / m, k = 0..m-1 of each interval.
+    fractions : list of numpy.ndarray
+        Each piece's mesh as fractions of the piece (the pieces: the signature's segments in
+        order over [0, period], cut again at the carried breakpoints).
+    carried : tuple of float
+        The lags c at which the memory carries each switch: the mesh has points at
+        (switch + c) mod period.
+    kernel_jumps : tuple of float
+        The lags of the kernel's jumps given to :func:`dmi.analysis.collocate` (its
+        continuation cuts the delay integral there too).
+    """
+    p: float
+    period: float
+    amplitude: np.ndarray
+    multipliers: np.ndarray
+    stable: bool | None
+    mesh: np.ndarray
+    signature: Signature
+    switches: np.ndarray
+    make: Any = field(repr=False)
+    autonomous: bool = False
+    errors: dict[str, Any] = field(default_factory=dict)
+    degree: int = 4
+    nodes: np.ndarray = field(default_factory=lambda: np.empty((0, 0)), repr=False)
+    fractions: list = field(default_factory=list, repr=False)
+    carried: tuple = ()
+    kernel_jumps: tuple = ()
+
+    #: What the orbit is of: ``refine_orbit`` and ``floquet_multipliers`` refuse it by this.
+    of = "equation"
+
+    def u_at(self, t: Any) -> np.ndarray:
+        """The state at times t (any reals: the orbit is periodic).
+
+        Parameters
+        ----------
+        t : float or array_like
+            Times (time units).
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n,) for a scalar t, else (len(t), n) (state units).
+        """
+        tt = np.atleast_1d(np.asarray(t, dtype=float)).ravel()
+        basis = Basis(self.degree, self.degree)
+        _, z, cols = periodic_locator(self.mesh, self.degree)(tt)
+        out = np.einsum("pk,pkn->pn", basis.values(z), self.nodes[cols])
+        return out[0] if np.ndim(t) == 0 else out
+
+    @property
+    def intervals(self) -> int:
+        """L, the mesh's intervals."""
+        return self.mesh.size - 1

@@ -1,0 +1,702 @@
+# The collocation equations of a periodic orbit of the equation: the model's terms, the layout of
+# the unknowns, the residual with its sparse Jacobian, and Newton's method on them.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""The collocation system of :mod:`dmi.analysis.collocation.collocate`; private to the package.
+
+The equation is u' + A(u) + f(t, u) + int_0^tau H(s) u(t - s) ds ∋ 0.  The unknowns are the node
+values of the periodic piecewise polynomial (:mod:`dmi.analysis.collocation.mesh`), the switching
+times b_1 < ... < b_S of the signature (:mod:`dmi.analysis.collocation.signature`) and, for an
+autonomous orbit, the period T.  The period is cut into pieces at 0, the b's, the points (b_k + c)
+mod T the memory carries them to, and T; the mesh of each piece is a fixed set of fractions of it,
+so the mesh moves with the b's and T.  The equations: at the m Gauss points of each interval
+u' + f + int H u + (alpha_i sign on slip components) = 0, a held component (stuck, on a face) held
+at its value instead; one switching condition at each b_k; for an autonomous orbit the integral
+phase condition int_0^1 <u(theta T), r'(theta)> d theta = 0 against a reference orbit r.
+
+The Jacobian's columns of the node values are exact (f_u by central differences of the model's
+rhs), T's exact for a smooth autonomous orbit; the few columns of the b's (and T with switches) by
+central differences of the residual.
+"""
+from __future__ import annotations
+
+from collections import OrderedDict
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as sla
+
+from ..._solver import Solver
+from ..core.model import FD_STEP
+from .mesh import (STEEP, Basis, Kernel, Locator, Near, delay_matrix,
+                               history_locator, history_rows, periodic_locator, point_matrix)
+from .signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
+from ..core.newton import ShootingError, newton_loop
+
+#: Quadrature nodes a piece of the delay integral: m + QUAD_EXTRA (exact for H u with u of
+#: degree m and H of degree m + 2 QUAD_EXTRA - 1 on the piece; the error h^(2m + 2 QUAD_EXTRA + 1)
+#: a piece stays below the collocation's h^(2m) at the mesh points).
+QUAD_EXTRA = 1
+#: Iterations at the residual's rounding floor without a halving correction after which a
+#: solve that reports its accuracy stops (:func:`solve`).
+FLOOR_ITERATIONS = 3
+#: Delay matrices a Terms keeps (the most recently used): a Newton loop at a fixed mesh (a forced
+#: orbit without switches) builds its matrix once, and the monodromy operator's once for its
+#: multipliers and eigenfunction.
+DELAY_CACHE = 6
+
+
+class CollocationWarning(RuntimeWarning):
+    """A collocated orbit's verdict that could not be verified (its stability), or an order
+    the method cannot reach (a kernel's jump at a lag not declared)."""
+
+
+class Terms:
+    """The equation's terms of a model at p, read through the Solver's public accessors.
+
+    Parameters
+    ----------
+    solver : dmi.Solver
+        The model at p (configured; its step is not used).
+    jumps : sequence of float
+        Lags in (0, tau) where the kernel jumps (cuts of the delay integral's pieces).
+
+    Raises
+    ------
+    ValueError
+        A user resolvent (``set_resolvent``): no A to collocate (use ``refine_orbit``); near
+        cells whose kernel is not s^-beta C with a known beta (``set_kernel_near`` alone, or a
+        ``near=`` kernel of ``set_kernel_fit`` other than the fit's PowerKernel); a jump outside
+        (0, tau).
+    """
+
+    def __init__(self, solver: Solver, jumps: tuple[float, ...] = ()):
+        if solver.resolvent_kind == "callback":
+            raise ValueError("collocate: the model sets its own resolvent (set_resolvent): "
+                             "collocation needs the operator A itself (set_friction, set_box or "
+                             "none); use dmi.analysis.refine_orbit for this model")
+        self.solver = solver
+        self.n, self.tau = solver.n, float(solver.tau)
+        alpha = solver.friction
+        self.alpha = np.zeros(self.n) if alpha is None else np.asarray(alpha, dtype=float)
+        box = solver.box
+        self.lo = np.full(self.n, -np.inf) if box is None else np.asarray(box[0], dtype=float)
+        self.hi = np.full(self.n, np.inf) if box is None else np.asarray(box[1], dtype=float)
+        self.terms = solver.kernel_terms
+        self.kind = solver.kernel_kind
+        self.has_rhs = solver.has("rhs")
+        rate = float(np.max(-self.terms[0], initial=0.0)) if self.kind == "exp" else 0.0
+        self.H = Kernel(self._far, near_part(solver), kernel_jumps(jumps, self.tau),
+                        rate if rate * self.tau > STEEP else 0.0)
+        self._delays: OrderedDict[tuple, sp.csr_matrix] = OrderedDict()
+        self._kept: dict[str, tuple[tuple, np.ndarray]] = {}
+
+    def delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc: Locator, basis: Basis,
+              rows: int, history: History | None = None) -> sp.csr_matrix:
+        """The delay integral's matrix (:func:`delay_matrix`) at the collocation times of
+        ``mesh``, kept for the last DELAY_CACHE meshes (it depends on the mesh, T, the basis and
+        the history's mesh only, not on the node values).
+
+        Parameters
+        ----------
+        times : numpy.ndarray
+            The collocation times of ``mesh``.
+        mesh : numpy.ndarray
+            The mesh of one period.
+        T : float
+            The period.
+        loc : callable
+            The locator of the node rows (periodic, or of ``history``).
+        basis : Basis
+            The basis.
+        rows : int
+            The node rows.
+        history : History, optional
+            The past of the monodromy operator's system (its mesh and periods enter the key).
+
+        Returns
+        -------
+        scipy.sparse.csr_matrix
+            G (len(times) n, rows n).
+        """
+        key = (np.asarray(mesh, dtype=float).tobytes(), float(T), basis.m, basis.q, rows,
+               None if history is None else (history.hist.tobytes(), history.periods))
+        G = self._delays.get(key)
+        if G is None:
+            G = delay_matrix(times, self.tau, mesh, T, self.H, loc, basis, self.n, rows,
+                             pattern=self.pattern)[0]
+            self._delays[key] = G
+            if len(self._delays) > DELAY_CACHE:
+                self._delays.popitem(last=False)
+        else:
+            self._delays.move_to_end(key)
+        return G
+
+    def _last(self, slot: str, t: np.ndarray, U: np.ndarray,
+              compute: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> np.ndarray:
+        """compute(t, U), kept (read-only) in ``slot`` for the next call with the same t and U
+        (Newton's residual and Jacobian at one iterate, the monodromy's Jacobian at the orbit)."""
+        t = np.asarray(t, dtype=float)
+        U = np.asarray(U, dtype=float)
+        key = (t.tobytes(), U.tobytes(), U.shape)
+        kept = self._kept.get(slot)
+        if kept is not None and kept[0] == key:
+            return kept[1]
+        out = compute(t, U)
+        out.setflags(write=False)
+        self._kept[slot] = (key, out)
+        return out
+
+    def f(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
+        """f(t_c, U_c) (P, n) at the times t (P,) and states U (P, n) (read-only)."""
+        return self._last("f", t, U, self._rhs)
+
+    def _rhs(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
+        """f(t_c, U_c) (P, n) from the model's rhs (zero without one)."""
+        if not self.has_rhs:
+            return np.zeros_like(U)
+        out = self.solver.eval_rhs_many(t, U)
+        if not np.all(np.isfinite(out)):
+            c = int(np.flatnonzero(~np.all(np.isfinite(out), axis=1))[0])
+            raise ValueError(f"collocate: the model's rhs is not finite at t = {t[c]!r}, "
+                             f"u = {U[c]!r}: {out[c]!r}")
+        return out
+
+    def fu(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
+        """df/du (P, n, n) by central differences (step FD_STEP max(|u_j|, 1); read-only)."""
+        return self._last("fu", t, U, self._jacobian)
+
+    def _jacobian(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
+        """df/du (P, n, n) by central differences of the model's rhs."""
+        P, n = U.shape
+        J = np.zeros((P, n, n))
+        if not self.has_rhs:
+            return J
+        e = FD_STEP * np.maximum(np.abs(U), 1.0)                  # (P, n)
+        shift = np.einsum("pj,jk->jpk", e, np.eye(n))              # (n, P, n): column j moved
+        both = np.concatenate([U[None] + shift, U[None] - shift]).reshape(-1, n)
+        F = self._rhs(np.tile(t, 2 * n), both).reshape(2, n, P, n)
+        J[:] = np.transpose((F[0] - F[1]) / (2 * e.T[:, :, None]), (1, 2, 0))
+        return J
+
+    @property
+    def pattern(self) -> np.ndarray:
+        """(n, n) booleans: the kernel's entries that may be nonzero (an exponential sum's
+        nonzero C or D entries; all for a callback)."""
+        if self.kind == "exp":
+            _, _, C, D = self.terms  # type: ignore[misc]
+            near = self.H.near
+            return (np.any(C != 0, axis=0) | np.any(D != 0, axis=0)
+                    | (near.C != 0 if near is not None else False))
+        return np.ones((self.n, self.n), bool)
+
+    @property
+    def has_kernel(self) -> bool:
+        """Whether the model has a kernel."""
+        return self.kind != ""
+
+    def _far(self, s: np.ndarray) -> np.ndarray:
+        """H(s) (P, n, n) at the lags s (P,) (past a near part's delta): an exponential sum in
+        closed form, a callback one lag at a time."""
+        s = np.asarray(s, dtype=float)
+        if self.kind == "exp":
+            a, b, C, D = self.terms  # type: ignore[misc]
+            e = np.exp(np.outer(s, a))
+            return (np.einsum("pk,kij->pij", e * np.cos(np.outer(s, b)), C)
+                    + np.einsum("pk,kij->pij", e * np.sin(np.outer(s, b)), D))
+        out = np.array([self.solver.eval_kernel(float(x)) for x in s]).reshape(-1, self.n, self.n)
+        if not np.all(np.isfinite(out)):
+            raise ValueError("collocate: the model's kernel is not finite on (0, tau)")
+        return out
+
+
+def near_part(solver: Solver) -> Near | None:
+    """The near part s^-beta C on (0, delta] of a model's kernel (None without near cells): beta
+    is the exponent of the fit's PowerKernel (``Solver.kernel_fit``), C read from the near kernel
+    at delta and checked to be the same at delta / 2, delta / 7 and delta / 50 (relative 1e-12).
+
+    Raises
+    ------
+    ValueError
+        Near cells without a fit whose kernel has an exponent, or a near kernel not of the form
+        s^-beta C.
+    """
+    if not solver.has("kernel_near"):
+        return None
+    delta = float(solver.kernel_near_delta)
+    fit = solver.kernel_fit
+    beta = getattr(getattr(fit[0], "kernel", None), "beta", None) if fit is not None else None
+    if beta is None:
+        raise ValueError("collocate: the model's kernel has exact near cells (delta = "
+                         f"{delta!r}) whose form s^-beta g(s) is not known: product integration "
+                         "needs the exponent; set the kernel with Solver.set_kernel_fit of a fit "
+                         "of a dmi.kernels.PowerKernel (fit.kernel keeps its beta), or use "
+                         "refine_orbit")
+    lags = delta / np.array([1.0, 2.0, 7.0, 50.0])
+    K = np.array([solver.eval_kernel_near(float(x)) * x ** beta for x in lags])
+    if not (np.all(np.isfinite(K)) and np.max(np.abs(K - K[0])) <= 1e-12 * max(
+            float(np.max(np.abs(K[0]))), 1e-300)):
+        raise ValueError("collocate: the near kernel (set_kernel_fit's near=, or "
+                         f"set_kernel_near) is not s^-beta C with the fit's beta = {beta!r} on "
+                         f"(0, {delta!r}]: product integration needs that form; give the fit's "
+                         "own PowerKernel as the near kernel, or use refine_orbit")
+    return Near(delta, float(beta), K[0])
+
+
+def kernel_jumps(jumps: Any, tau: float) -> tuple[float, ...]:
+    """The declared jumps, checked and sorted.
+
+    Raises
+    ------
+    ValueError
+        A lag not finite or outside (0, tau).
+    """
+    out = sorted(float(j) for j in np.atleast_1d(np.asarray(jumps, dtype=float)))
+    bad = [j for j in out if not (0.0 < j < tau)]
+    if bad:
+        raise ValueError(f"collocate: kernel_jumps = {jumps!r}: {bad[0]!r} is not inside (0, "
+                         f"tau = {tau!r}); give the lags in (0, tau) where H jumps")
+    return tuple(out)
+
+
+#: Lags at which a callback kernel is sampled for its jumps (:func:`undeclared_jumps`).
+JUMP_SAMPLES = 1024
+#: Halvings of a cell that brackets a jump (:func:`_bisect_jump`).
+JUMP_HALVINGS = 50
+
+
+def _bisect_jump(K: Kernel, lo: float, hi: float) -> tuple[float, float]:
+    """(the lag where H's difference concentrates in [lo, hi], the difference left there): the
+    cell bisected JUMP_HALVINGS times towards the half with the larger difference (3 kernel
+    calls a halving); a jump keeps its size, a smooth H loses 2^-JUMP_HALVINGS of it."""
+    for _ in range(JUMP_HALVINGS):
+        mid = 0.5 * (lo + hi)
+        v = K(np.array([lo, mid, hi])).reshape(3, -1)
+        if np.max(np.abs(v[1] - v[0])) >= np.max(np.abs(v[2] - v[1])):
+            hi = mid
+        else:
+            lo = mid
+    left = float(np.max(np.abs(np.diff(K(np.array([lo, hi])).reshape(2, -1), axis=0))))
+    return 0.5 * (lo + hi), left
+
+
+def misdeclared_jumps(terms: Terms) -> list[tuple[float, float | None]]:
+    """The declared lags where a callback kernel does not jump: (the lag, the jump found
+    within a sampling cell of it, or None), each checked by :func:`_bisect_jump` on
+    [lag - tau / JUMP_SAMPLES, lag + tau / JUMP_SAMPLES] (about 150 kernel calls a lag): no
+    jump there (the difference falls below 1e-3 of the cell's), or a jump more than 1e-9 tau
+    away.  Empty for an exponential sum (smooth: a declared lag is only a cut)."""
+    if terms.kind != "callback":
+        return []
+    K, tau = terms.H, terms.tau
+    w = tau / JUMP_SAMPLES
+    big = float(np.max(np.abs(K(np.linspace(0.0, tau, 65)[1:]))))
+    out: list[tuple[float, float | None]] = []
+    for j in K.jumps:
+        lo, hi = max(j - w, 0.5 * j), min(j + w, 0.5 * (j + tau))
+        D = float(np.max(np.abs(np.diff(K(np.array([lo, hi])).reshape(2, -1), axis=0))))
+        at, left = _bisect_jump(K, lo, hi)
+        if D > 1e-12 * big and left > 1e-3 * D:
+            if abs(at - j) > 1e-9 * tau:
+                out.append((j, at))
+        else:
+            out.append((j, None))
+    return out
+
+
+def undeclared_jumps(terms: Terms, samples: int = JUMP_SAMPLES) -> list[float]:
+    """Lags in (0, tau) where a callback kernel jumps and that are not declared (within 1e-9
+    tau): H sampled at ``samples`` lags, a cell whose difference is 4 times both its
+    neighbours' bisected (:func:`_bisect_jump`); a jump keeps 1e-3 of its first difference, a
+    smooth H loses 2^-50 of it.  Kernel calls: ``samples`` and about 150 a suspect cell.  Empty
+    for an exponential sum (smooth past its near part)."""
+    if terms.kind != "callback":
+        return []
+    K = terms.H
+    s = np.linspace(0.0, terms.tau, samples + 1)[1:]
+    V = K(s).reshape(s.size, -1)
+    D = np.max(np.abs(np.diff(V, axis=0)), axis=1)
+    big = float(np.max(np.abs(V)))
+    Dn = np.maximum(np.r_[0.0, D[:-1]], np.r_[D[1:], 0.0])
+    found = []
+    for c in np.flatnonzero((D > 4 * Dn) & (D > 1e-12 * big)):
+        lo, hi = float(s[c]), float(s[c + 1])
+        if any(lo - 1e-12 * terms.tau <= j <= hi + 1e-12 * terms.tau for j in K.jumps):
+            continue   # a declared lag's cell: misdeclared_jumps bisects around it
+        at, left = _bisect_jump(K, lo, hi)
+        if left > 1e-3 * D[c] and not any(abs(at - j) <= 1e-9 * terms.tau for j in K.jumps):
+            found.append(at)
+    return found
+
+
+@dataclass
+class Layout:
+    """The unknowns x = (node values (L m, n) row-major, b_1..b_S, T if autonomous) and the mesh.
+
+    Attributes
+    ----------
+    m : int
+        The degree.
+    n : int
+        The state's dimension.
+    signature : Signature
+        The modes of the pieces.
+    fractions : list of numpy.ndarray
+        Each piece's mesh as fractions 0 = f_0 < ... < f_k = 1 of the piece.
+    autonomous : bool
+        The period is an unknown.
+    period : float
+        The period of a forced orbit (unused when autonomous).
+    carried : tuple of float
+        Lags c at which the memory carries each switch forward: the pieces are also cut at
+        (b_k + c) mod T (c = tau where H(tau) != 0: the delay integral's derivative jumps there),
+        so that no interval holds a jump of a derivative of u.
+    """
+    m: int
+    n: int
+    signature: Signature
+    fractions: list[np.ndarray]
+    autonomous: bool
+    period: float
+    carried: tuple[float, ...] = ()
+    basis: Basis = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.basis = Basis(self.m, self.m + QUAD_EXTRA)
+
+    @property
+    def L(self) -> int:
+        """The intervals."""
+        return sum(len(f) - 1 for f in self.fractions)
+
+    @property
+    def rows(self) -> int:
+        """The node rows, L m."""
+        return self.L * self.m
+
+    @property
+    def S(self) -> int:
+        """The switching times."""
+        return self.signature.switches
+
+    @property
+    def size(self) -> int:
+        """len(x)."""
+        return self.rows * self.n + self.S + int(self.autonomous)
+
+    def split(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+        """(node values (L m, n), b (S,), T)."""
+        k = self.rows * self.n
+        T = float(x[-1]) if self.autonomous else self.period
+        return x[:k].reshape(self.rows, self.n), x[k:k + self.S], T
+
+    def ends(self, b: np.ndarray, T: float) -> tuple[np.ndarray, np.ndarray]:
+        """The pieces' ends in order (0, the b_k, the carried (b_k + c) mod T, T) and the switch
+        each moves with (k - 1 for b_k and its carried points, -1 for 0 and T)."""
+        S = self.S
+        t = [0.0, T] + list(b) + [float((b[k] + c) % T) for k in range(S) for c in self.carried]
+        who = [-1, -1] + list(range(S)) + [k for k in range(S) for _ in self.carried]
+        order = np.argsort(t, kind="stable")
+        t, who = np.asarray(t)[order], np.asarray(who)[order]
+        if t[0] != 0.0 or t[-1] != T:          # a carried point at 0 or T: keep 0 and T outside
+            inner = (t > 0) & (t < T)
+            t = np.concatenate([[0.0], t[inner], [T]])
+            who = np.concatenate([[-1], who[inner], [-1]])
+        return t, who
+
+    def bounds(self, b: np.ndarray, T: float) -> np.ndarray:
+        """The pieces' ends (:meth:`ends`)."""
+        return self.ends(b, T)[0]
+
+    def mesh(self, b: np.ndarray, T: float) -> np.ndarray:
+        """The L + 1 mesh points."""
+        e = self.bounds(b, T)
+        if e.size != len(self.fractions) + 1:
+            raise Degenerate(f"a carried breakpoint left (0, T): {e.size - 1} pieces for "
+                             f"{len(self.fractions)} meshes")
+        parts = [e[j] + (e[j + 1] - e[j]) * f[:-1] for j, f in enumerate(self.fractions)]
+        return np.concatenate(parts + [[T]])
+
+    def piece_modes(self, b: np.ndarray, T: float) -> list[np.ndarray]:
+        """The modes of the pieces: those of the segment holding each piece."""
+        e = self.bounds(b, T)
+        seg = np.searchsorted(b, 0.5 * (e[:-1] + e[1:]))
+        pieces = self.signature.pieces()
+        return [pieces[int(k)] for k in seg]
+
+    def piece_of_interval(self) -> np.ndarray:
+        """(L,): the piece of each interval."""
+        return np.concatenate([np.full(len(f) - 1, j) for j, f in enumerate(self.fractions)])
+
+    def node_motion(self) -> tuple[np.ndarray, np.ndarray]:
+        """For each interval's m + 1 nodes (L, m + 1): d t / d (left end of its piece) and d t /
+        d (right end) (the nodes move with their piece's ends)."""
+        z = self.basis.nodes
+        left, right = [], []
+        for f in self.fractions:
+            fr = f[:-1, None] + np.diff(f)[:, None] * z[None, :]
+            left.append(1.0 - fr)
+            right.append(fr)
+        return np.concatenate(left), np.concatenate(right)
+
+    def with_fractions(self, fractions: list[np.ndarray]) -> Layout:
+        """The same layout on other meshes of its pieces."""
+        return Layout(self.m, self.n, self.signature, fractions, self.autonomous, self.period,
+                      self.carried)
+
+
+class Degenerate(ValueError):
+    """A piece's length went to zero or below (a segment vanishes)."""
+
+
+@dataclass
+class History:
+    """A fixed past for the monodromy operator: ``periods`` copies of the mesh ``hist`` behind
+    t = 0, with the node values ``phi`` (periods L (m + 1), n), each interval its own m + 1."""
+    hist: np.ndarray
+    periods: int
+    phi: np.ndarray
+
+
+def _held(mode: np.ndarray, terms: Terms) -> tuple[np.ndarray, np.ndarray]:
+    """(P, n) masks of held components and their values, for modes (P, n)."""
+    held = (mode == STUCK) | (mode == LO) | (mode == HI)
+    value = np.where(mode == LO, terms.lo, np.where(mode == HI, terms.hi, 0.0))
+    return held, np.nan_to_num(value)
+
+
+def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray], np.ndarray]
+             | None, *, jacobian: bool = True, history: History | None = None
+             ) -> tuple[np.ndarray, sp.csr_matrix | None, np.ndarray | None]:
+    """The residual, its Jacobian's columns of the node values (sparse) and, for a smooth
+    autonomous orbit, its column of T (exact; else None), at x.
+
+    With ``history``, the system of one period forward from that past (the monodromy operator):
+    node rows L m + 1 (u(T) too), then the past's rows; equations u(0) = phi(0-), the
+    collocation and the switching conditions (no phase condition, T fixed).
+    """
+    m, n, basis = lay.m, lay.n, lay.basis
+    V, b, T = lay.split(x)
+    e = lay.bounds(b, T)
+    if np.any(np.diff(e) <= 0) or not np.isfinite(T) or e.size != len(lay.fractions) + 1:
+        raise Degenerate(f"a piece's length went to {np.min(np.diff(e)):.3g}: the switching "
+                         f"times {b!r} (and their carried points) are out of order in (0, {T!r})")
+    mesh = lay.mesh(b, T)
+    h = np.diff(mesh)
+    gz, gw = basis.gauss()
+    tc = (mesh[:-1, None] + h[:, None] * gz[None, :]).ravel()
+    if history is None:
+        rows = lay.rows
+        loc: Locator = periodic_locator(mesh, m)
+        u = V.ravel()
+    else:
+        rows = history_rows(lay.L, m, history.periods)
+        loc = history_locator(mesh, history.hist, m, history.periods)
+        u = np.concatenate([V.ravel(), V[0], history.phi.ravel()])
+    E = point_matrix(tc, loc, basis, mesh, n, rows)
+    D = point_matrix(tc, loc, basis, mesh, n, rows, derivative=True)
+    scaled = jacobian and lay.autonomous and history is None and lay.S == 0
+    G, dI = None, None
+    if terms.has_kernel and scaled:         # the T column's integral needs the node values
+        G, dI = delay_matrix(tc, terms.tau, mesh, T, terms.H, loc, basis, n, rows,
+                             pattern=terms.pattern, slope_of=V)
+    elif terms.has_kernel:
+        G = terms.delay(tc, mesh, T, loc, basis, rows, history)
+    Uc = (E @ u).reshape(-1, n)
+    du = (D @ u).reshape(-1, n)
+    r = du + terms.f(tc, Uc)
+    if G is not None:
+        r += (G @ u).reshape(-1, n)
+    mode = np.repeat(np.array(lay.piece_modes(b, T))[lay.piece_of_interval()], m, axis=0)
+    r += terms.alpha * ((mode == SLIP_POS).astype(float) - (mode == SLIP_NEG))
+    held, value = _held(mode, terms)
+    r = np.where(held, Uc - value, r)
+    J = None
+    if jacobian:
+        P = len(tc)
+        fu = terms.fu(tc, Uc)
+        FU = sp.block_diag(list(fu), format="csr") if P else None
+        J = D + FU @ E
+        if G is not None:
+            J = J + G
+        hv = held.ravel().astype(float)
+        J = sp.diags(1.0 - hv) @ J + sp.diags(hv) @ E
+    dT = None
+    if scaled:        # d r / d T with the nodes fixed in theta = t / T (an autonomous rhs)
+        dT = np.where(held, 0.0, -du / T + (dI if dI is not None else 0.0)).ravel()
+    extra_r, extra_J = [], []
+    if history is not None:                        # u(0) = phi(0-): the last past node
+        last = history_rows(lay.L, m, history.periods) - 1
+        extra_r.append(V[0] - history.phi[-1])
+        if jacobian:
+            extra_J.append(sp.csr_matrix((np.r_[np.ones(n), -np.ones(n)],
+                                          (np.r_[np.arange(n), np.arange(n)],
+                                           np.r_[np.arange(n), last * n + np.arange(n)])),
+                                         shape=(n, rows * n)))
+    for k in range(1, lay.S + 1):
+        g, row = _switch_condition(lay, terms, k, b[k - 1], mesh, T, loc, rows, u, jacobian)
+        extra_r.append(np.array([g]))
+        if jacobian:
+            extra_J.append(row)
+    if lay.autonomous and history is None and ref is not None:
+        w = (h[:, None] * gw[None, :]).ravel() / T
+        R = ref(tc / T)                                     # r'(theta_c) (P, n)
+        extra_r.append(np.array([np.sum(w[:, None] * R * Uc)]))
+        if jacobian:
+            extra_J.append(sp.csr_matrix((w[:, None] * R).reshape(1, -1)) @ E)
+    res = np.concatenate([r.ravel()] + extra_r)
+    if jacobian:
+        J = sp.vstack([J] + extra_J, format="csr")
+        if history is None:
+            J = J[:, :lay.rows * n]
+    if dT is not None:                  # the phase condition does not move with T
+        dT = np.concatenate([dT, np.zeros(res.size - dT.size)])
+    return res, J, dT
+
+
+def _switch_condition(lay: Layout, terms: Terms, k: int, tb: float, mesh: np.ndarray, T: float,
+                      loc: Locator, rows: int, u: np.ndarray, jacobian: bool
+                      ) -> tuple[float, sp.csr_matrix | None]:
+    """The switching condition at b_k and its row in the node values: the component reaching
+    0 or a face (a slip ending, a contact starting), or its net force -f_i - (int H u)_i reaching
+    +-alpha_i (a stick ending) or 0 (a contact ending)."""
+    n = lay.n
+    i, before, after = lay.signature.switch(k)
+    t = np.array([tb])
+    Eb = point_matrix(t, loc, lay.basis, mesh, n, rows)
+    ub = Eb @ u
+    if before in (SLIP_POS, SLIP_NEG) or after in (LO, HI):
+        target = terms.lo[i] if after == LO else terms.hi[i] if after == HI else 0.0
+        return float(ub[i] - target), (Eb[i] if jacobian else None)
+    Gb = (delay_matrix(t, terms.tau, mesh, T, terms.H, loc, lay.basis, n, rows,
+                       pattern=terms.pattern)[0] if terms.has_kernel else None)
+    force = -terms.f(t, ub[None, :])[0] - (Gb @ u if Gb is not None else 0.0)
+    target = terms.alpha[i] * (after == SLIP_POS) - terms.alpha[i] * (after == SLIP_NEG)
+    row = None
+    if jacobian:
+        fu = terms.fu(t, ub[None, :])[0]
+        row = -(sp.csr_matrix(fu[i:i + 1]) @ Eb)
+        if Gb is not None:
+            row = row - Gb[i]
+    return float(force[i] - target), row
+
+
+def full_jacobian(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None,
+                  history: History | None = None) -> tuple[np.ndarray, sp.csc_matrix]:
+    """The residual and the whole Jacobian: the node columns of :func:`assemble`, then the
+    columns of the b's and T by central differences of the residual (step 1e-6 T)."""
+    r, J, dT = assemble(lay, terms, x, ref, history=history)
+    extra = lay.S + int(lay.autonomous and history is None)
+    cols = []
+    first = lay.rows * lay.n
+    T = lay.split(x)[2]
+    for j in range(first, first + extra):
+        if dT is not None and j == first + extra - 1:
+            cols.append(dT)
+            continue
+        d = 1e-6 * T
+        xp, xm = x.copy(), x.copy()
+        xp[j] += d
+        xm[j] -= d
+        rp = assemble(lay, terms, xp, ref, jacobian=False, history=history)[0]
+        rm = assemble(lay, terms, xm, ref, jacobian=False, history=history)[0]
+        cols.append((rp - rm) / (2 * d))
+    if cols:
+        J = sp.hstack([J, sp.csr_matrix(np.column_stack(cols))])
+    return r, sp.csc_matrix(J)
+
+
+def solve(lay: Layout, terms: Terms, x0: np.ndarray, ref: Callable | None, *,
+          tol: float = 1e-12, max_iter: int = 25, what: str = "collocation",
+          accuracy: list[float] | None = None) -> tuple[np.ndarray, list[float]]:
+    """Newton's method on the collocation system with sparse LU (:func:`newton_loop`): the
+    factored Jacobian is kept while the residual falls by 10 or more a step (chord steps cost a
+    residual), refreshed otherwise, and a fresh step is halved until the residual falls;
+    converged when the correction is below tol max(1, |x|_inf) (that correction applied).
+
+    With ``accuracy`` (a list the caller adds to its error estimates), also converged when the
+    residual stays at its floor (<= tol max(1, |x|_inf)) while the corrections stop falling
+    (FLOOR_ITERATIONS iterations without halving: rounding amplified by a nearly singular
+    Jacobian, as at a fixed p on a vertical branch); the achieved accuracy (the largest of those
+    corrections, else the last one) is appended to it.
+
+    Raises
+    ------
+    ShootingError
+        No convergence in max_iter, no progress, a singular Jacobian, a non-finite residual, a
+        fresh step rejected at every length (:func:`reject_why`).
+    """
+    res: list[float] = []
+
+    def evaluate(x: np.ndarray) -> tuple[np.ndarray, None]:
+        return assemble(lay, terms, x, ref, jacobian=False)[0], None
+
+    def factor(x: np.ndarray, r: np.ndarray, state: None) -> Callable[[np.ndarray], np.ndarray]:
+        lu = _factor(lay, terms, x, ref, what, res)
+        return lambda r: lu.solve(-r)
+
+    return newton_loop(evaluate, factor, x0, tol=tol, max_iter=max_iter, what=what,
+                       converge="correction", chord=0.1, search="descent", reject=(Degenerate,),
+                       reject_why=reject_why(lay), history=res,
+                       stall=False, floor=FLOOR_ITERATIONS if accuracy is not None else 0,
+                       accuracy=accuracy)
+
+
+def reject_why(lay: Layout) -> str:
+    """What a Newton step that :func:`assemble` rejects (:class:`Degenerate`) on every length
+    tried means: with switches, a segment that vanishes (the signature read from the start no
+    longer holds); without, a period that leaves (0, inf) (Newton diverges)."""
+    if lay.S > 0:
+        return ("a segment of the signature vanishes on every step length tried (the start's "
+                "signature " + ", ".join(lay.signature.describe()) + " does not hold near it)")
+    return ("the period leaves (0, inf) on every step length tried (Newton diverges from the "
+            "start)")
+
+
+def _factor(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None, what: str,
+            res: list[float]) -> Any:
+    """The sparse LU of the Jacobian at x (ShootingError when singular)."""
+    _, J = full_jacobian(lay, terms, x, ref)
+    try:
+        return sla.splu(J)
+    except RuntimeError as err:
+        raise ShootingError(f"{what}: singular Jacobian ({err})", res) from None
+
+
+def interval_counts(lengths: np.ndarray, L: int) -> np.ndarray:
+    """L intervals shared by pieces of these lengths (or weights), at least 1 each."""
+    w = np.asarray(lengths, dtype=float)
+    c = np.maximum(1, np.round(L * w / w.sum()).astype(int))
+    return c
+
+
+def uniform_fractions(bounds: np.ndarray, L: int) -> list[np.ndarray]:
+    """Each piece of [0, T] (ends ``bounds``) cut into equal intervals, L in all (about)."""
+    return [np.linspace(0.0, 1.0, c + 1) for c in interval_counts(np.diff(bounds), L)]
+
+
+def evaluate(lay: Layout, x: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """u(t) (len(t), n) of the collocated orbit x (t any reals)."""
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    _, z, cols = periodic_locator(mesh, lay.m)(np.asarray(t, dtype=float))
+    return np.einsum("pk,pkn->pn", lay.basis.values(z), V[cols])
+
+
+def node_times(lay: Layout, b: np.ndarray, T: float) -> np.ndarray:
+    """The times of the L m node rows."""
+    mesh = lay.mesh(b, T)
+    z = lay.basis.nodes[:-1]
+    return (mesh[:-1, None] + np.diff(mesh)[:, None] * z[None, :]).ravel()
+
+
+def carried(terms: Terms, sig: Any) -> tuple[float, ...]:
+    """The lags at which the memory carries a switch forward on an orbit with switches: the
+    declared jumps of H and tau where H(tau) != 0 (the delay integral's derivative jumps at
+    b_k + s_j), else ()."""
+    if sig.switches == 0 or not terms.has_kernel:
+        return ()
+    end = (terms.tau,) if np.any(terms.H(np.array([terms.tau])) != 0) else ()
+    return terms.H.jumps + end
