@@ -43,7 +43,9 @@ import numpy as np
 import websocket
 
 FAILURES: list[str] = []
-MATH_PAGES = ("mathematics.html", "paper.html", "stability.html", "orbits.html", "python.html")
+MATH_PAGES = ("mathematics.html", "paper.html", "stability.html", "orbits.html", "python.html",
+              "analysis-method-equilibria.html", "analysis-method-shooting.html",
+              "analysis-method-continuation.html", "identify-method.html", "tutorial-simulate.html")
 
 
 def fail(msg: str) -> None:
