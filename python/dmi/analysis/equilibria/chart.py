@@ -19,16 +19,13 @@ import scipy.optimize
 from ..._solver import Solver
 from ..core.model import Linearisation, call_make
 from ..scheme.floquet import StabilityWarning
-from .root_verdict import RootVerdict, check
-from .stability import DENSE_MAX, check_of, rightmost_of
+from .root_verdict import RootVerdict, roots_verdict
+from .stability import check_of, rightmost_of
 
 #: Relative tolerance (of the range of p) of a traced point's p.
 TRACE_TOL = 1e-9
 #: The fill of the chart's cells without a verdict (grey, hatched).
 UNDECIDED_COLOR = "#d9d9d9"
-#: The reason of a cell not verified (``verify=False``).
-UNVERIFIED = ("not verified (verify=False): the roots are ARPACK's Ritz values without an error "
-              "bound")
 
 
 @dataclass
@@ -154,11 +151,9 @@ def _cell(make2: Callable[[float, float], Solver], p: float, q: float, u_eq: Any
           tol: float, of: str, verify: bool) -> tuple[complex, RootVerdict]:
     """The rightmost root at (p, q) and its verdict, verified
     (:func:`dmi.analysis.equilibria.root_verdict.check`) or not."""
-    with Linearisation(lambda: call_make(make2, p, q), u_eq, (p, q), tol, of) as lin:
-        lam = rightmost_of(lin, count, of)
-        if not verify:
-            return complex(lam[0]), RootVerdict(None, UNVERIFIED)
-        return complex(lam[0]), check(lin, lam, of, lin.dim <= max(DENSE_MAX, count + 4))
+    lam, verdict = roots_verdict(lambda: call_make(make2, p, q), u_eq, (p, q), count, tol, of,
+                                 verify)
+    return complex(lam[0]), verdict
 
 
 def _root_at(make2: Callable[[float, float], Solver], p: float, q: float, u_eq: Any, count: int,

@@ -51,14 +51,13 @@ import numpy as np
 
 from ..._errors import Error
 from ..._solver import Solver
-from ..core.model import (_resolvent_derivative, call_make, equation_step, equation_terms, kernel_of,
-                     rhs_jacobian)
 from ..continuation.branch import ON_AXIS, REAL, Event, HopfPoint
 from ..continuation.driver import continuation
-from .equilibrium import signed_mean
-from .equation import Characteristic, RefinementWarning
+from ..core.model import call_make, equation_step
 from ..core.newton import ShootingError
-from .normal_form import CriticalityWarning, _check_hooks, _delta_prime, _Forms, criticality
+from .equation import Characteristic, RefinementWarning
+from .normal_form import CriticalityWarning, _check_hooks, _Forms, criticality
+from .numerics import forward_jacobian, null_vectors, signed_mean
 from .stability import roots as equation_roots
 
 #: Roots computed at each point (the zero-Hopf and Hopf-Hopf test functions read them).
@@ -200,21 +199,6 @@ class Curve:
         return np.array([pt.omega for pt in self.points])
 
 
-class _At:
-    """What :class:`Characteristic` reads of a linearisation, at any u (not only at an
-    equilibrium: the curve's corrector asks between them)."""
-
-    def __init__(self, s: Solver, u: np.ndarray):
-        X, _ = equation_terms(s)(u)
-        scale = max(float(np.max(np.abs(u))), float(np.max(np.abs(X)))) or 1.0
-        self.h, self.tau = s.h, s.tau
-        self.J = rhs_jacobian(s, 0.0, u)
-        self.D = _resolvent_derivative(s, X, s.h, scale)
-        self.resolvent_kind = s.resolvent_kind if s.resolvent_kind != "callback" else ""
-        self.kernel_terms, self.kernel = kernel_of(s)
-        self.tangent = s
-
-
 class _Extended:
     """The extended system of a Hopf curve (``kind="hopf"``) or a fold curve (``"fold"``) for
     the driver: the unknowns x = (u, p, omega, Re v, Im v) or (u, p, v), the driver's parameter
@@ -249,7 +233,7 @@ class _Extended:
         s = call_make(self.make2, p, q)
         try:
             G = equation_step(s)(u) / s.h
-            ch = Characteristic(_At(s, u), self.reach)
+            ch = Characteristic.at(s, u, self.reach)
         except BaseException:
             s.close()
             raise
@@ -283,7 +267,7 @@ class _Extended:
         G, ch, s = self._at(u, p, q)
         try:
             M = ch(1j * omega)
-            dM = 1j * _delta_prime(ch, 1j * omega) @ v if self.kind == "hopf" else None
+            dM = 1j * ch.prime(1j * omega, order=4) @ v if self.kind == "hopf" else None
         finally:
             s.close()
         r = M @ v
@@ -293,12 +277,8 @@ class _Extended:
         else:
             r0 = np.concatenate([G, r.real, [norm.real]])
         y = np.concatenate([x, [q]])
-        J = np.zeros((r0.size, y.size))
-        for j in list(range(n + 1)) + [y.size - 1]:
-            d = 1e-7 * max(1.0, abs(y[j]))
-            e = y.copy()
-            e[j] += d
-            J[:, j] = (self.residual(e[:-1], float(e[-1])) - r0) / d
+        J = forward_jacobian(lambda e: self.residual(e[:-1], float(e[-1])), y, r0,
+                             list(range(n + 1)) + [y.size - 1])
         if self.kind == "hopf":
             # rows (Re, Im) of Delta v and of c v over the columns omega, Re v, Im v
             re, im = slice(n + 2, n + 2 + m), slice(n + 2 + m, n + 2 + 2 * m)
@@ -376,7 +356,7 @@ class _Extended:
                 a = math.nan
             else:
                 a = float(w @ forms.b_real(vf, vf, same=True)[self.free])
-            bt = float(w @ _delta_prime(ch, 0.0).real @ v)
+            bt = float(w @ ch.prime(0.0, order=4).real @ v)
         finally:
             s.close()
         return a, bt
@@ -478,12 +458,6 @@ def _start(start: Any, u_eq: Any) -> tuple[str, float, np.ndarray, float]:
                      "equilibria (continue_equilibrium from equilibrium(..., of='equation'))")
 
 
-def _null_vector(M: np.ndarray) -> np.ndarray:
-    """The unit right null vector of M (the smallest singular value's)."""
-    v = np.linalg.svd(M)[2][-1].conj()
-    return v / np.linalg.norm(v)
-
-
 def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: float, q_end: float,
                    *, u_eq: Any = None, step: float | None = None, at: Iterable[float] = (),
                    max_points: int = 200, min_step: float | None = None,
@@ -557,8 +531,8 @@ def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: floa
         if u0.shape != (n,) or not np.all(np.isfinite(u0)):
             raise ValueError(f"continue_curve: the equilibrium {u0!r} is not n = {n} finite "
                              "numbers")
-        ch = Characteristic(_At(s, u0), 2.5 * omega0 + 1.0)
-        v0 = _null_vector(ch(1j * omega0) if kind == "hopf" else ch(0.0).real)
+        ch = Characteristic.at(s, u0, 2.5 * omega0 + 1.0)
+        v0 = null_vectors(ch(1j * omega0) if kind == "hopf" else ch(0.0).real)[0]
     finally:
         s.close()
     free = ch.free
@@ -566,7 +540,7 @@ def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: floa
                      int(count))
     disc.reach = 2.5 * omega0 + 1.0
     if kind == "fold":
-        disc.b = _null_vector(ch(0.0).real.T).real
+        disc.b = null_vectors(ch(0.0).real.T)[0].real
     if kind == "hopf":
         x0 = np.concatenate([u0, [p0, omega0], v0.real, v0.imag])
     else:

@@ -42,14 +42,15 @@ from typing import Any
 import numpy as np
 
 from ..._errors import Error
-from ..core.model import Linearisation, _call, call_make, equation_step, equilibrium
 from ..continuation.branch import ON_AXIS, HopfPoint
-from .equation import Characteristic, refine
+from ..core.model import Linearisation, _call, call_make, equation_step, equilibrium
+from .equation import SLOPE, Characteristic, refine
+from .numerics import forward_jacobian, null_vectors
 
 EPS = float(np.finfo(float).eps)
 
 #: Fourth-order central stencils of the k-th derivative: offsets (times the step) and weights.
-STENCILS = {1: (np.array([-2.0, -1.0, 1.0, 2.0]), np.array([1.0, -8.0, 8.0, -1.0]) / 12),
+STENCILS = {1: SLOPE[4][:2],
             2: (np.array([-2.0, -1.0, 0.0, 1.0, 2.0]),
                 np.array([-1.0, 16.0, -30.0, 16.0, -1.0]) / 12),
             3: (np.array([-3.0, -2.0, -1.0, 1.0, 2.0, 3.0]),
@@ -165,15 +166,6 @@ class _Forms:
                 + 1j * (self.c_real(x, x, y) + self.c_real(y, y, y)))
 
 
-def _delta_prime(ch: Characteristic, lam: complex) -> np.ndarray:
-    """Delta'(lambda) = I + Hhat'(lambda), Hhat' by the fourth-order central difference of step
-    1e-3 max(1, |lambda|) (Hhat is analytic: its error is about 1e-13)."""
-    d = 1e-3 * max(1.0, abs(lam))
-    offsets, w = STENCILS[1]
-    H = ch.hhat(np.array([lam + o * d for o in offsets]))
-    return np.eye(ch.m) + np.tensordot(w, H, axes=(0, 0)) / d
-
-
 def _corrected(s: Any, u0: np.ndarray) -> np.ndarray:
     """The equation's equilibrium near u0 by Newton on G(u) = R(X(u)) - u (the Jacobian by
     forward differences), to rounding."""
@@ -182,12 +174,7 @@ def _corrected(s: Any, u0: np.ndarray) -> np.ndarray:
     last = math.inf
     for _ in range(30):
         g = G(u)
-        J = np.empty((u.size, u.size))
-        for j in range(u.size):
-            e = np.zeros(u.size)
-            e[j] = 1e-7 * max(1.0, abs(u[j]))
-            J[:, j] = (G(u + e) - g) / e[j]
-        du = np.linalg.solve(J, -g)
+        du = np.linalg.solve(forward_jacobian(G, u, g), -g)
         u = u + du
         size = float(np.max(np.abs(du)))
         if size <= 4 * EPS * max(1.0, float(np.max(np.abs(u)))):
@@ -336,6 +323,55 @@ def criticality(make: Callable[[float], Any], hopf_point: HopfPoint, u_eq: Any, 
         return hopf_point
 
 
+def _vectors(ch: Characteristic, lam: complex) -> tuple[np.ndarray, np.ndarray, float]:
+    """(q, p, the condition of q): Delta(lambda) q = 0 with |q| = 1, p Delta(lambda) = 0 with
+    p Delta'(lambda) q = 1 (Delta' of order 4)."""
+    q, prow, sv = null_vectors(ch(lam))
+    if ch.m > 1 and sv[-2] <= 1e-8 * sv[0]:
+        raise _Unavailable("the null space of Delta(i omega) is not one-dimensional (singular "
+                           f"values {sv!r}): a double root")
+    norm = complex(prow @ ch.prime(lam, order=4) @ q)
+    if abs(norm) <= 1e-10 * np.linalg.norm(prow):
+        raise _Unavailable("p Delta'(i omega) q = 0: the root is not simple")
+    return q, prow / norm, (sv[0] / sv[-2] if ch.m > 1 else 1.0)
+
+
+def _inverses(ch: Characteristic, omega: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """(Delta(2 i omega)^-1, Delta(0)^-1, the sum of their condition numbers)."""
+    M2, M0 = ch(2j * omega), ch(0.0)
+    conds = 0.0
+    for name, M in (("Delta(2 i omega)", M2), ("Delta(0)", M0)):
+        c = np.linalg.cond(M)
+        if not c <= 1e10:
+            raise _Unavailable(f"{name} is singular (condition {c:.3g}): "
+                               + ("a root at 2 i omega (a 1:2 resonance)" if M is M2 else
+                                  "a root at 0 as well (a zero-Hopf point)"))
+        conds += c
+    return np.linalg.inv(M2), np.linalg.inv(M0), conds
+
+
+def _first_coefficient(s: Any, u: np.ndarray, ch: Characteristic, q: np.ndarray,
+                       prow: np.ndarray, cond_q: float, omega: float) -> tuple[complex, float]:
+    """(c1, its estimated error): the differences' rounding, their truncation (c1 again at
+    twice the steps, without the hook's d2 and d3) and the linear algebra's rounding."""
+    inv2, inv0, conds = _inverses(ch, omega)
+    forms = _Forms(s, u)
+    if forms.d2 is not None or forms.d3 is not None:
+        x = np.zeros(s.n)
+        x[ch.free] = q.real if np.any(q.real) else q.imag
+        _check_hooks(forms, x / np.max(np.abs(x)))
+    forms.level = 1
+    c1, rounding, size = _c1(forms, ch, q, prow, inv2, inv0)
+    err = rounding
+    if not forms.exact:
+        forms.level = 0
+        c1_coarse, _, _ = _c1(forms, ch, q, prow, inv2, inv0)
+        err += abs(c1.real - c1_coarse.real)
+    # the linear algebra's rounding, and (without fu) the Jacobian's differences, ~1e-10
+    err += size * (1e3 * EPS * (cond_q + conds) + (1e-9 * cond_q if forms.fu is None else 0.0))
+    return c1, err
+
+
 def _criticality(make: Any, hp: HopfPoint, u_eq: Any, tol: float) -> HopfPoint:
     p, omega0 = float(hp.p), float(hp.omega)
     reach = 2.5 * omega0 + 1.0
@@ -355,42 +391,8 @@ def _criticality(make: Any, hp: HopfPoint, u_eq: Any, tol: float) -> HopfPoint:
             raise _Unavailable(f"not a Hopf point: the root refined from i omega = "
                                f"{1j * omega0!r} is {lam!r}, off the imaginary axis")
         omega = lam.imag
-        m = ch.m
-        U, sv, Vh = np.linalg.svd(ch(lam))
-        if m > 1 and sv[-2] <= 1e-8 * sv[0]:
-            raise _Unavailable("the null space of Delta(i omega) is not one-dimensional (singular "
-                               f"values {sv!r}): a double root")
-        q = Vh[-1].conj()
-        q = q / np.linalg.norm(q)
-        prow = U[:, -1].conj()
-        norm = complex(prow @ _delta_prime(ch, lam) @ q)
-        if abs(norm) <= 1e-10 * np.linalg.norm(prow):
-            raise _Unavailable("p Delta'(i omega) q = 0: the root is not simple")
-        prow = prow / norm
-        M2, M0 = ch(2j * omega), ch(0.0)
-        for name, M in (("Delta(2 i omega)", M2), ("Delta(0)", M0)):
-            c = np.linalg.cond(M)
-            if not c <= 1e10:
-                raise _Unavailable(f"{name} is singular (condition {c:.3g}): "
-                                   + ("a root at 2 i omega (a 1:2 resonance)" if M is M2 else
-                                      "a root at 0 as well (a zero-Hopf point)"))
-        inv2, inv0 = np.linalg.inv(M2), np.linalg.inv(M0)
-        forms = _Forms(s, u)
-        if forms.d2 is not None or forms.d3 is not None:
-            x = np.zeros(s.n)
-            x[ch.free] = q.real if np.any(q.real) else q.imag
-            _check_hooks(forms, x / np.max(np.abs(x)))
-        forms.level = 1
-        c1, rounding, size = _c1(forms, ch, q, prow, inv2, inv0)
-        err = rounding
-        if not forms.exact:
-            forms.level = 0
-            c1_coarse, _, _ = _c1(forms, ch, q, prow, inv2, inv0)
-            err += abs(c1.real - c1_coarse.real)
-        # the linear algebra's rounding, and (without fu) the Jacobian's differences, ~1e-10
-        cond_q = sv[0] / sv[-2] if m > 1 else 1.0
-        err += size * (1e3 * EPS * (cond_q + np.linalg.cond(M2) + np.linalg.cond(M0))
-                       + (1e-9 * cond_q if forms.fu is None else 0.0))
+        q, prow, cond_q = _vectors(ch, lam)
+        c1, err = _first_coefficient(s, u, ch, q, prow, cond_q, omega)
     finally:
         s.close()
     l1 = c1.real / omega
