@@ -1,7 +1,8 @@
 # The first Lyapunov coefficient of the equation's Hopf points, the crossing speed, and the
 # amplitude coefficients of the orbit born there.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
-"""Criticality of a Hopf point of the equation: :func:`criticality`.
+"""Criticality of a Hopf point of the equation: :func:`criticality`, and the parameter of the
+orbit of a given amplitude born there, :func:`predicted_parameter`.
 
 What it holds: the first Lyapunov coefficient l1 of a Hopf point of the continuous equation
 u' + A(u) + f(t, u) + int_0^tau H(s) u(t - s) ds ∋ 0 at an equilibrium u_eq, with its estimated
@@ -426,4 +427,57 @@ def _criticality(make: Any, hp: HopfPoint, u_eq: Any, tol: float) -> HopfPoint:
     return dataclasses.replace(out, kappa=kappa)
 
 
-__all__ = ["CriticalityWarning", "criticality"]
+def predicted_parameter(hopf_point: HopfPoint, amplitude: float,
+                        component: int | None = None) -> float:
+    """The parameter where the orbit born at a Hopf point has a given amplitude, to leading
+    order: p = p_H + side (A / kappa_j)^2.
+
+    The orbit's half range (max - min) / 2 of component j grows as kappa_j sqrt|p - p_H| on the
+    side where it exists (``hopf_point.side``: the sign of -l1 Re lambda'(p_H)), so a wanted
+    amplitude A of that component is met near p_H + side (A / kappa_j)^2, off by O(A^4): the
+    predictor of an orbit of amplitude A.
+
+    Parameters
+    ----------
+    hopf_point : HopfPoint
+        A Hopf point of the equation with its ``kappa`` and ``side``
+        (:func:`criticality`: ``hopf(..., of="equation")``, a ``hopf`` event of a branch of
+        the equation's equilibria).
+    amplitude : float
+        A, the wanted (max - min) / 2 of component j (state units), finite and > 0.
+    component : int, optional
+        j; default the component that moves most (the largest kappa_j).
+
+    Returns
+    -------
+    float
+        The predicted parameter.
+
+    Raises
+    ------
+    ValueError
+        A hopf_point without kappa or side (the scheme's, or one whose criticality or crossing
+        speed is not decided: its CriticalityWarning said why), an amplitude that is not finite
+        and > 0, a component out of range or whose kappa is 0 (a held component).
+    """
+    if not isinstance(hopf_point, HopfPoint):
+        raise ValueError(f"predicted_parameter: hopf_point = {hopf_point!r}: give a "
+                         "dmi.analysis.HopfPoint")
+    kappa, side = hopf_point.kappa, hopf_point.side
+    if kappa is None or side is None:
+        raise ValueError(f"predicted_parameter: the Hopf point at p = {hopf_point.p!r} has no "
+                         "kappa (the scheme's, or its criticality or crossing speed not "
+                         "decided): compute it with hopf(..., of='equation')")
+    a = float(amplitude)
+    if not (a > 0 and math.isfinite(a)):
+        raise ValueError(f"predicted_parameter: amplitude = {amplitude!r}: give a finite "
+                         "amplitude > 0 (state units)")
+    kappa = np.asarray(kappa, dtype=float)
+    j = int(np.argmax(kappa)) if component is None else component
+    if not (isinstance(j, (int, np.integer)) and 0 <= j < kappa.size and kappa[j] > 0):
+        raise ValueError(f"predicted_parameter: component = {component!r}: give an index in "
+                         f"[0, {kappa.size}) whose kappa is > 0 (kappa = {kappa!r})")
+    return float(hopf_point.p) + side * (a / float(kappa[j])) ** 2
+
+
+__all__ = ["CriticalityWarning", "criticality", "predicted_parameter"]
