@@ -115,13 +115,13 @@ def test_predicted_parameter_against_the_exact_circles(case):
 def test_refusals(case):
     c1, om, mu_h, hp = case
     scheme = da.hopf(model(c1), mu_h - 0.3, mu_h + 0.3, [0.0, 0.0])   # no kappa
-    with pytest.raises(ValueError, match="no kappa"):
+    with pytest.raises(ValueError, match="no kappa"):                 # bad-inputs PP01
         predicted_parameter(scheme, 0.01)
     for bad in (0.0, -0.01, math.nan, math.inf):
-        with pytest.raises(ValueError, match="amplitude"):
+        with pytest.raises(ValueError, match="amplitude"):            # bad-inputs PP02
             predicted_parameter(hp, bad)
     for bad in (2, -1, 0.5):
-        with pytest.raises(ValueError, match="component"):
+        with pytest.raises(ValueError, match="component"):            # bad-inputs PP03
             predicted_parameter(hp, 0.01, component=bad)
-    with pytest.raises(ValueError, match="HopfPoint"):
+    with pytest.raises(ValueError, match="HopfPoint"):                # bad-inputs PP04
         predicted_parameter((hp.p, hp.omega), 0.01)
