@@ -11,8 +11,11 @@ curve passes its turning points in q and lands on q_end and on the user's q exac
 functions of codimension-two points, and the records.  What it may import: numpy, the driver,
 the records (:mod:`dmi.analysis.continuation.branch`), the model's linearisation (:mod:`dmi.analysis.core.model`),
 the characteristic matrix (:mod:`dmi.analysis.equilibria.equation`), the roots
-(:mod:`dmi.analysis.equilibria.stability`) and the normal forms (:mod:`dmi.analysis.equilibria.normal_form`); nothing
-imports it but the package's ``__init__``.
+(:mod:`dmi.analysis.equilibria.stability`), the normal forms
+(:mod:`dmi.analysis.equilibria.normal_form`) and the room's tools
+(:mod:`dmi.analysis.equilibria.numerics`); the package's ``__init__`` and the stability chart
+(:mod:`dmi.analysis.equilibria.chart`, whose traced curves are these systems with the chart's
+equilibrium given: :func:`system`, :func:`curve_of`) import it.
 
 The systems (docs/stability.md, "Hopf and fold curves").  G(u; p, q) = R(X(u)) - u is the
 equation's equilibrium residual (:func:`dmi.analysis.core.model.equation_step`, divided by h), Delta

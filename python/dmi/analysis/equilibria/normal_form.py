@@ -10,9 +10,12 @@ error and the word ``"supercritical"`` / ``"subcritical"``; the crossing speed R
 the amplitude coefficients kappa of the orbit born there; and the second and third derivatives
 of f it needs (the model's derivative hook :meth:`dmi.Solver.set_rhs_derivatives`, or central
 differences of f with their error).  What it may import: numpy, the records
-(:mod:`dmi.analysis.continuation.branch`), the model's linearisation (:mod:`dmi.analysis.core.model`) and the
-characteristic matrix (:mod:`dmi.analysis.equilibria.equation`); :mod:`dmi.analysis.equilibria.stability` and
-:mod:`dmi.analysis.equilibria.equilibrium` call it, so it imports neither.
+(:mod:`dmi.analysis.continuation.branch`), the model's linearisation
+(:mod:`dmi.analysis.core.model`), the characteristic matrix
+(:mod:`dmi.analysis.equilibria.equation`) and the room's tools
+(:mod:`dmi.analysis.equilibria.numerics`); :mod:`dmi.analysis.equilibria.crossing`,
+:mod:`dmi.analysis.equilibria.equilibrium` and :mod:`dmi.analysis.equilibria.curves` call it,
+so it imports none of them.
 
 The method (docs/stability.md, "Criticality of a Hopf point").  On the free components (those
 the resolvent does not hold; A is locally constant on them for dry friction and the box) the
