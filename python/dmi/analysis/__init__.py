@@ -27,7 +27,8 @@ from .scheme.orbit import Orbit
 from .plot.branch import plot_branch
 from .shooting.refine import Refined, refine_orbit
 from .shooting.shoot import periodic_orbit
-from .equilibria.stability import hopf, roots
+from .equilibria.crossing import hopf
+from .equilibria.stability import roots
 from .scheme.stepmap import StepMap
 
 __all__ = [

@@ -17,18 +17,21 @@ import numpy as np
 import scipy.optimize
 
 from ..._solver import Solver
-from ..core.model import Linearisation, call_make
+from ..core.model import Linearisation, call_make, equilibrium
 from ..scheme.floquet import StabilityWarning
-from .root_verdict import RootVerdict, check
-from .stability import DENSE_MAX, check_of, rightmost_of
+from ..continuation.driver import continuation
+from ..core.newton import ShootingError
+from .curves import CurvePoint, curve_of, not_a_start, system
+from .root_verdict import RootVerdict, roots_verdict
+from .stability import check_of, rightmost_of
 
-#: Relative tolerance (of the range of p) of a traced point's p.
+#: Relative tolerance (of the range of p) of a traced curve's start p; a tenth of it is the
+#: corrector's tolerance on the curve.
 TRACE_TOL = 1e-9
+#: A crossing root with |Im lambda| above this starts a Hopf curve, else a fold curve.
+OMEGA_MIN = 1e-8
 #: The fill of the chart's cells without a verdict (grey, hatched).
 UNDECIDED_COLOR = "#d9d9d9"
-#: The reason of a cell not verified (``verify=False``).
-UNVERIFIED = ("not verified (verify=False): the roots are ARPACK's Ritz values without an error "
-              "bound")
 
 
 @dataclass
@@ -154,11 +157,9 @@ def _cell(make2: Callable[[float, float], Solver], p: float, q: float, u_eq: Any
           tol: float, of: str, verify: bool) -> tuple[complex, RootVerdict]:
     """The rightmost root at (p, q) and its verdict, verified
     (:func:`dmi.analysis.equilibria.root_verdict.check`) or not."""
-    with Linearisation(lambda: call_make(make2, p, q), u_eq, (p, q), tol, of) as lin:
-        lam = rightmost_of(lin, count, of)
-        if not verify:
-            return complex(lam[0]), RootVerdict(None, UNVERIFIED)
-        return complex(lam[0]), check(lin, lam, of, lin.dim <= max(DENSE_MAX, count + 4))
+    lam, verdict = roots_verdict(lambda: call_make(make2, p, q), u_eq, (p, q), count, tol, of,
+                                 verify)
+    return complex(lam[0]), verdict
 
 
 def _root_at(make2: Callable[[float, float], Solver], p: float, q: float, u_eq: Any, count: int,
@@ -175,72 +176,74 @@ def _row(make2: Callable, p_values: np.ndarray, q: float, u_eq: Any, count: int,
     return [_cell(make2, p, q, u_eq, count, tol, of, verify) for p in p_values]
 
 
-def _tracked(make2: Callable, p: float, q: float, u_eq: Any, count: int, tol: float,
-             ref: complex, of: str = "scheme") -> complex:
-    """The root nearest ref (Im >= 0) among the count rightmost at (p, q)."""
-    lam = _root_at(make2, p, q, u_eq, count, tol, of)
-    lam = lam[np.isfinite(lam.real)]
-    lam = np.where(lam.imag < 0, lam.conj(), lam)
-    return complex(lam[np.argmin(np.abs(lam - ref))])
+def _given(u_eq: Any, n: int, p: float, q: float) -> np.ndarray:
+    """The chart's equilibrium at (p, q): u_eq(p, q), or the constant u_eq."""
+    return equilibrium(u_eq, n, (p, q))
+
+
+def _leg(make2: Callable, p0: float, q0: float, q_end: float, omega0: float, u_eq: Any,
+         rows: np.ndarray, tol: float, of: str, lo: float, hi: float) -> list[CurvePoint]:
+    """The curve's points on the grid's rows from (p0, q0) towards q_end, in the order traced,
+    up to where it leaves the p range [lo, hi]: the driver on the extended system of
+    :func:`dmi.analysis.equilibria.curves.system`, the chart's equilibrium given and the
+    characteristic matrix of ``of``."""
+    s = call_make(make2, p0, q0)
+    n = s.n
+    s.close()
+    given = functools.partial(_given, u_eq, n)
+    inside = [q for q in rows if min(q0, q_end) < q < max(q0, q_end)]
+    disc, x0 = system("hopf" if omega0 > OMEGA_MIN else "fold", p0, given(p0, q0), omega0,
+                      make2, q0, tol=0.1 * TRACE_TOL, given=given, of=of, lin_tol=tol,
+                      tests=False)
+    try:   # the first step a row's spacing (the points between rows are not kept)
+        b = continuation(disc, x0, q0, q_end, step=abs(q_end - q0) / (len(inside) + 1),
+                         at=inside, tol=0.1 * TRACE_TOL, max_iter=10, predictor="tangent",
+                         easy=4, make=make2, kind=disc.kind)
+    except ShootingError as e:
+        raise not_a_start(disc, x0, q0, 0.1 * TRACE_TOL, e) from None
+    curve = curve_of(b, disc, omega0)
+    slack = 1e-9 * max(1.0, hi - lo)
+    out = []
+    for pt in curve.points:
+        if not lo - slack <= pt.p <= hi + slack:
+            break
+        if pt.q in rows:
+            out.append(pt)
+    return out
 
 
 def _trace(make2: Callable, p_values: np.ndarray, q_values: np.ndarray, u_eq: Any, count: int,
            tol: float, j0: int, p_a: float, p_b: float, of: str = "scheme") -> HopfCurve:
-    """The curve through the crossing of the rightmost root between p_a and p_b on row j0,
-    continued over the rows q_values (both ways): on each row, the p where the tracked root has
-    Re = 0, by the secant method from the secant prediction of the two rows before (a task)."""
+    """The curve through the crossing of the rightmost root between p_a and p_b on row j0 (by
+    Brent's method), continued by arclength both ways in q over the grid's rows
+    (:func:`_leg`, through turning points in q): its points on
+    the rows, in the order traced, until it leaves the grid (a task).  A curve that cannot be
+    continued from its crossing is that one point, with a ``UserWarning`` saying why."""
     q0 = float(q_values[j0])
     span = float(np.ptp(p_values)) or 1.0
     lo, hi = float(np.min(p_values)), float(np.max(p_values))
     g = lambda p: float(_root_at(make2, p, q0, u_eq, count, tol, of)[0].real)  # noqa: E731
     p0 = scipy.optimize.brentq(g, p_a, p_b, xtol=TRACE_TOL * span)
     lam0 = _root_at(make2, p0, q0, u_eq, count, tol, of)[0]
-    lam0 = complex(lam0.real, abs(lam0.imag))
-    points = {j0: (p0, lam0)}
-    for direction in (1, -1):
-        path = [(p0, lam0)]
-        j = j0 + direction
-        while 0 <= j < len(q_values):
-            q = float(q_values[j])
-            if len(path) >= 2:   # secant prediction of p and of the root
-                pred_p = 2 * path[-1][0] - path[-2][0]
-                pred_l = 2 * path[-1][1] - path[-2][1]
-            else:
-                pred_p, pred_l = path[-1]
-            try:
-                found = _secant(lambda p: _tracked(make2, p, q, u_eq, count, tol, pred_l, of), pred_p,
-                                1e-3 * span, TRACE_TOL * span)
-            except (RuntimeError, ValueError):   # e.g. a kink or no equilibrium off the grid
-                found = None
-            # the curve ends where it leaves the p range, turns back in q (no convergence) or
-            # where the tracked root is lost among the count rightmost (a jump in the root)
-            if (found is None or not (lo <= found[0] <= hi)
-                    or abs(found[1] - pred_l) > 0.25 * max(abs(pred_l), 1e-6)):
-                break
-            path.append(found)
-            points[j] = found
-            j += direction
-    js = sorted(points)
-    return HopfCurve(p=np.array([points[j][0] for j in js]), q=np.array([q_values[j] for j in js],
-                     dtype=float), omega=np.array([abs(points[j][1].imag) for j in js]))
-
-
-def _secant(root_of: Callable[[float], complex], p0: float, dp: float, xtol: float,
-            maxiter: int = 15) -> tuple[float, complex] | None:
-    """Re root_of(p) = 0 by the secant method from p0, p0 + dp; None if it does not converge."""
-    l0 = root_of(p0)
-    p1 = p0 + dp
-    l1 = root_of(p1)
-    for _ in range(maxiter):
-        d = l1.real - l0.real
-        if d == 0 or not np.isfinite(d):
-            return None
-        p2 = p1 - l1.real * (p1 - p0) / d
-        p0, l0 = p1, l1
-        p1, l1 = p2, root_of(p2)
-        if abs(p1 - p0) <= xtol:
-            return p1, l1
-    return None
+    omega0 = abs(lam0.imag)
+    rows = np.array(q_values, dtype=float)
+    first, last = (rows.min(), rows.max()) if rows[0] <= rows[-1] else (rows.max(), rows.min())
+    legs = []
+    for q_end in (first, last):
+        if q_end == q0:
+            legs.append([])
+            continue
+        try:
+            legs.append(_leg(make2, p0, q0, q_end, omega0, u_eq, rows, tol, of, lo, hi))
+        except ValueError as e:
+            warnings.warn(f"stability_chart: the curve through (p, q) = ({p0:.10g}, {q0:.10g}) "
+                          f"could not be continued towards q = {q_end:.10g}: {e}", UserWarning,
+                          stacklevel=2)
+            legs.append([])
+    here = [CurvePoint(p=p0, q=q0, u=np.empty(0), omega=omega0)]
+    pts = (legs[0] or here)[::-1] + (legs[1] or here)[1:]   # each leg starts at q0
+    return HopfCurve(p=np.array([pt.p for pt in pts]), q=np.array([pt.q for pt in pts]),
+                     omega=np.array([abs(pt.omega) for pt in pts]))
 
 
 def _brackets(re: np.ndarray) -> list[tuple[int, int]]:
@@ -268,11 +271,11 @@ def _brackets(re: np.ndarray) -> list[tuple[int, int]]:
 
 
 def _same_curve(a: HopfCurve, b: HopfCurve, span: float) -> bool:
-    """b lies on a: at least 80 % of b's points at a row of a within 1e-6 span in p."""
+    """b lies on a: at least 80 % of b's points at a point of a on the same row within 1e-6
+    span in p."""
     on = 0
     for p, q in zip(b.p, b.q):
-        k = np.nonzero(a.q == q)[0]
-        on += bool(len(k)) and abs(a.p[k[0]] - p) <= 1e-6 * span
+        on += bool(np.any((a.q == q) & (np.abs(a.p - p) <= 1e-6 * span)))
     return on >= 0.8 * len(b.p)
 
 

@@ -11,8 +11,11 @@ curve passes its turning points in q and lands on q_end and on the user's q exac
 functions of codimension-two points, and the records.  What it may import: numpy, the driver,
 the records (:mod:`dmi.analysis.continuation.branch`), the model's linearisation (:mod:`dmi.analysis.core.model`),
 the characteristic matrix (:mod:`dmi.analysis.equilibria.equation`), the roots
-(:mod:`dmi.analysis.equilibria.stability`) and the normal forms (:mod:`dmi.analysis.equilibria.normal_form`); nothing
-imports it but the package's ``__init__``.
+(:mod:`dmi.analysis.equilibria.stability`), the normal forms
+(:mod:`dmi.analysis.equilibria.normal_form`) and the room's tools
+(:mod:`dmi.analysis.equilibria.numerics`); the package's ``__init__`` and the stability chart
+(:mod:`dmi.analysis.equilibria.chart`, whose traced curves are these systems with the chart's
+equilibrium given: :func:`system`, :func:`curve_of`) import it.
 
 The systems (docs/stability.md, "Hopf and fold curves").  G(u; p, q) = R(X(u)) - u is the
 equation's equilibrium residual (:func:`dmi.analysis.core.model.equation_step`, divided by h), Delta
@@ -51,14 +54,13 @@ import numpy as np
 
 from ..._errors import Error
 from ..._solver import Solver
-from ..core.model import (_resolvent_derivative, call_make, equation_step, equation_terms, kernel_of,
-                     rhs_jacobian)
 from ..continuation.branch import ON_AXIS, REAL, Event, HopfPoint
 from ..continuation.driver import continuation
-from .equilibrium import signed_mean
-from .equation import Characteristic, RefinementWarning
+from ..core.model import Linearisation, call_make, equation_step
 from ..core.newton import ShootingError
-from .normal_form import CriticalityWarning, _check_hooks, _delta_prime, _Forms, criticality
+from .equation import Characteristic, RefinementWarning
+from .normal_form import CriticalityWarning, _check_hooks, _Forms, criticality
+from .numerics import forward_jacobian, null_vectors, signed_mean
 from .stability import roots as equation_roots
 
 #: Roots computed at each point (the zero-Hopf and Hopf-Hopf test functions read them).
@@ -200,30 +202,27 @@ class Curve:
         return np.array([pt.omega for pt in self.points])
 
 
-class _At:
-    """What :class:`Characteristic` reads of a linearisation, at any u (not only at an
-    equilibrium: the curve's corrector asks between them)."""
-
-    def __init__(self, s: Solver, u: np.ndarray):
-        X, _ = equation_terms(s)(u)
-        scale = max(float(np.max(np.abs(u))), float(np.max(np.abs(X)))) or 1.0
-        self.h, self.tau = s.h, s.tau
-        self.J = rhs_jacobian(s, 0.0, u)
-        self.D = _resolvent_derivative(s, X, s.h, scale)
-        self.resolvent_kind = s.resolvent_kind if s.resolvent_kind != "callback" else ""
-        self.kernel_terms, self.kernel = kernel_of(s)
-        self.tangent = s
-
-
 class _Extended:
     """The extended system of a Hopf curve (``kind="hopf"``) or a fold curve (``"fold"``) for
     the driver: the unknowns x = (u, p, omega, Re v, Im v) or (u, p, v), the driver's parameter
-    q (see the module)."""
+    q (see the module).
+
+    ``given``: the equilibrium is known, u = given(p, q) (a stability chart's), and not an
+    unknown: x = (p, omega, Re v, Im v) or (p, v), no equation G = 0.  ``of="scheme"`` (only
+    with ``given``): the scheme's characteristic matrix at the multiplier e^(i omega h)
+    (:meth:`dmi.analysis.core.model.Linearisation.characteristic`, every component) in place
+    of Delta(i omega), its derivative in omega by a central difference.  ``tests=False``: the
+    points carry no roots nor criticality, and there are no test functions (a chart's
+    curves)."""
 
     def __init__(self, make2: Callable[[float, float], Solver], kind: str, n: int,
-                 free: np.ndarray, c: np.ndarray, tol: float, count: int):
+                 free: np.ndarray, c: np.ndarray, tol: float, count: int, *,
+                 given: Callable[[float, float], np.ndarray] | None = None,
+                 of: str = "equation", lin_tol: float = 1e-9, tests: bool = True):
         self.make2, self.kind, self.n, self.free, self.m = make2, kind, n, free, free.size
         self.c, self.tol, self.count = c, tol, count
+        self.given, self.of, self.lin_tol, self.tests = given, of, lin_tol, tests
+        self.k = 0 if given is not None else n    # the unknowns of u
         self.why = ""
         self.hooks_checked = False   # the model's d2 checked against differences of f
         self.cusp_warned = False     # no cusp test (a resolvent callback) said once
@@ -231,25 +230,27 @@ class _Extended:
         self.reach = 1.0   # a callback kernel's panels reach |lambda| <= reach
         m = self.m
         # the arclength: u and p as the equilibria's branch (Euclidean), omega too, v little
-        self.weight = np.concatenate([np.ones(n + 1), np.ones(1 if kind == "hopf" else 0),
+        self.weight = np.concatenate([np.ones(self.k + 1), np.ones(1 if kind == "hopf" else 0),
                                       np.full(2 * m if kind == "hopf" else m, 1e-2)])
 
     # ---- the unknowns --------------------------------------------------------------------
-    def split(self, x: np.ndarray) -> tuple[np.ndarray, float, float, np.ndarray]:
+    def split(self, x: np.ndarray, q: float) -> tuple[np.ndarray, float, float, np.ndarray]:
         """(u, p, omega, v): v complex on a Hopf curve, real on a fold curve (omega 0)."""
-        n, m = self.n, self.m
-        u, p = x[:n], float(x[n])
+        k, m = self.k, self.m
+        p = float(x[k])
+        u = x[:k] if self.given is None else self.given(p, float(q))
         if self.kind == "hopf":
-            return u, p, float(x[n + 1]), x[n + 2:n + 2 + m] + 1j * x[n + 2 + m:]
-        return u, p, 0.0, x[n + 1:]
+            return u, p, float(x[k + 1]), x[k + 2:k + 2 + m] + 1j * x[k + 2 + m:]
+        return u, p, 0.0, x[k + 1:]
 
     def _at(self, u: np.ndarray, p: float, q: float) -> tuple[np.ndarray, Characteristic,
                                                                Solver]:
-        """(G(u) / h, Delta, the open solver) at (p, q); the caller closes the solver."""
+        """(G(u) / h (empty with ``given``), Delta, the open solver) at (p, q); the caller
+        closes the solver."""
         s = call_make(self.make2, p, q)
         try:
-            G = equation_step(s)(u) / s.h
-            ch = Characteristic(_At(s, u), self.reach)
+            G = equation_step(s)(u) / s.h if self.given is None else np.empty(0)
+            ch = Characteristic.at(s, u, self.reach)
         except BaseException:
             s.close()
             raise
@@ -260,62 +261,70 @@ class _Extended:
                                 f"{self.free.tolist()}): the curve meets a switch", [])
         return G, ch, s
 
-    # ---- the driver's contract -----------------------------------------------------------
-    def residual(self, x: np.ndarray, q: float) -> np.ndarray:
-        """(G / h, Delta v, c v - 1) at (x, q), real."""
-        u, p, omega, v = self.split(x)
+    def matrices(self, u: np.ndarray, p: float, q: float, omega: float, slope: bool
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """(G / h, the characteristic matrix at i omega, its derivative in omega if ``slope``)
+        at (p, q): the equation's Delta(i omega) and i Delta'(i omega), or the scheme's."""
+        if self.of == "scheme":
+            with Linearisation(lambda: call_make(self.make2, p, q), u, (p, q), self.lin_tol,
+                               "scheme") as lin:
+                def at(w: float) -> np.ndarray:
+                    return lin.characteristic(complex(np.exp(1j * w * lin.h)))
+                M, dM = at(omega), None
+                if slope:
+                    d = 1e-6 * max(1.0, abs(omega))
+                    dM = (at(omega + d) - at(omega - d)) / (2 * d)
+            return np.empty(0), M, dM
         G, ch, s = self._at(u, p, q)
         try:
-            r = ch(1j * omega) @ v
+            return G, ch(1j * omega), 1j * ch.prime(1j * omega, order=4) if slope else None
         finally:
             s.close()
+
+    def _stack(self, G: np.ndarray, r: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """The residual (G / h, M v, c v - 1), real."""
         norm = complex(self.c @ v) - 1.0
         if self.kind == "hopf":
             return np.concatenate([G, r.real, r.imag, [norm.real, norm.imag]])
         return np.concatenate([G, r.real, [norm.real]])
 
+    # ---- the driver's contract -----------------------------------------------------------
+    def residual(self, x: np.ndarray, q: float) -> np.ndarray:
+        """(G / h, Delta v, c v - 1) at (x, q), real."""
+        u, p, omega, v = self.split(x, q)
+        G, M, _ = self.matrices(u, p, q, omega, False)
+        return self._stack(G, M @ v, v)
+
     def jacobian(self, x: np.ndarray, q: float) -> tuple[np.ndarray, np.ndarray]:
         """(d/dx, d/dq): the columns of u, p and q by forward differences of step 1e-7 max(1,
         |y_j|); those of v (Delta, and c in the normalisation) and omega (i Delta'(i omega) v)
         in closed form."""
-        n, m = self.n, self.m
-        u, p, omega, v = self.split(x)
-        G, ch, s = self._at(u, p, q)
-        try:
-            M = ch(1j * omega)
-            dM = 1j * _delta_prime(ch, 1j * omega) @ v if self.kind == "hopf" else None
-        finally:
-            s.close()
-        r = M @ v
-        norm = complex(self.c @ v) - 1.0
-        if self.kind == "hopf":
-            r0 = np.concatenate([G, r.real, r.imag, [norm.real, norm.imag]])
-        else:
-            r0 = np.concatenate([G, r.real, [norm.real]])
+        k, m = self.k, self.m
+        u, p, omega, v = self.split(x, q)
+        G, M, dM = self.matrices(u, p, q, omega, self.kind == "hopf")
         y = np.concatenate([x, [q]])
-        J = np.zeros((r0.size, y.size))
-        for j in list(range(n + 1)) + [y.size - 1]:
-            d = 1e-7 * max(1.0, abs(y[j]))
-            e = y.copy()
-            e[j] += d
-            J[:, j] = (self.residual(e[:-1], float(e[-1])) - r0) / d
+        J = forward_jacobian(lambda e: self.residual(e[:-1], float(e[-1])), y,
+                             self._stack(G, M @ v, v), list(range(k + 1)) + [y.size - 1])
         if self.kind == "hopf":
             # rows (Re, Im) of Delta v and of c v over the columns omega, Re v, Im v
-            re, im = slice(n + 2, n + 2 + m), slice(n + 2 + m, n + 2 + 2 * m)
-            top, low, k = slice(n, n + m), slice(n + m, n + 2 * m), n + 2 * m
-            J[top, n + 1], J[low, n + 1] = dM.real, dM.imag
+            dMv = dM @ v
+            re, im = slice(k + 2, k + 2 + m), slice(k + 2 + m, k + 2 + 2 * m)
+            top, low, c = slice(k, k + m), slice(k + m, k + 2 * m), k + 2 * m
+            J[top, k + 1], J[low, k + 1] = dMv.real, dMv.imag
             J[top, re], J[top, im], J[low, re], J[low, im] = M.real, -M.imag, M.imag, M.real
-            J[k, re], J[k, im] = self.c.real, -self.c.imag
-            J[k + 1, re], J[k + 1, im] = self.c.imag, self.c.real
+            J[c, re], J[c, im] = self.c.real, -self.c.imag
+            J[c + 1, re], J[c + 1, im] = self.c.imag, self.c.real
         else:
-            J[n:n + m, n + 1:n + 1 + m] = M.real
-            J[n + m, n + 1:n + 1 + m] = self.c
+            J[k:k + m, k + 1:k + 1 + m] = M.real
+            J[k + m, k + 1:k + 1 + m] = self.c
         return J[:, :-1], J[:, -1]
 
     def point(self, x: np.ndarray, q: float) -> CurvePoint:
         """The curve's point: the equation's rightmost roots, and on a Hopf curve the Hopf
         point's criticality (its warnings kept: they say why a value is None)."""
-        u, p, omega, _ = self.split(x)
+        u, p, omega, _ = self.split(x, q)
+        if not self.tests:
+            return CurvePoint(p=p, q=float(q), u=np.array(u, dtype=float), omega=omega)
         make1 = _Fixed(self.make2, q)
         # a root that cannot be refined (near a double root: Bogdanov-Takens) is NaN, which the
         # test functions leave out; its warning goes into the point's note
@@ -350,7 +359,7 @@ class _Extended:
 
     def _null(self, x: np.ndarray, q: float) -> tuple[float, float]:
         """A fold curve's (w D^2 f(u)(v, v), w Delta'(0) v), w the bordered left null vector."""
-        u, p, _, v = self.split(x)
+        u, p, _, v = self.split(x, q)
         _, ch, s = self._at(u, p, q)
         try:
             M = ch(0.0).real
@@ -376,13 +385,16 @@ class _Extended:
                 a = math.nan
             else:
                 a = float(w @ forms.b_real(vf, vf, same=True)[self.free])
-            bt = float(w @ _delta_prime(ch, 0.0).real @ v)
+            bt = float(w @ ch.prime(0.0, order=4).real @ v)
         finally:
             s.close()
         return a, bt
 
     def event_functions(self, x: np.ndarray, q: float, point: CurvePoint) -> dict[str, float]:
-        """The test functions (see the module); NaN where not computable."""
+        """The test functions (see the module); NaN where not computable; none without
+        ``tests``."""
+        if not self.tests:
+            return {}
         real, upper = self._others(point.roots, point.omega) if point.roots.size else (
             np.empty(0), np.empty(0, complex))
         if self.kind == "hopf":
@@ -403,7 +415,7 @@ class _Extended:
     def describe(self, kind: str, x: np.ndarray, q: float, point: CurvePoint
                  ) -> dict[str, Any] | None:
         """The located event checked (see the module); None, with ``why``, when refuted."""
-        u, p, omega, _ = self.split(x)
+        u, p, omega, _ = self.split(x, q)
         self.why = ""
         if kind in ("zero-hopf", "hopf-hopf"):
             real, upper = self._others(point.roots, omega)
@@ -478,12 +490,6 @@ def _start(start: Any, u_eq: Any) -> tuple[str, float, np.ndarray, float]:
                      "equilibria (continue_equilibrium from equilibrium(..., of='equation'))")
 
 
-def _null_vector(M: np.ndarray) -> np.ndarray:
-    """The unit right null vector of M (the smallest singular value's)."""
-    v = np.linalg.svd(M)[2][-1].conj()
-    return v / np.linalg.norm(v)
-
-
 def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: float, q_end: float,
                    *, u_eq: Any = None, step: float | None = None, at: Iterable[float] = (),
                    max_points: int = 200, min_step: float | None = None,
@@ -551,48 +557,85 @@ def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: floa
         step = abs(q_end - q0) / 20
     if not (isinstance(step, (int, float)) and math.isfinite(step) and step > 0):
         raise ValueError(f"continue_curve: step = {step!r}: must be finite and > 0")
+    disc, x0 = system(kind, p0, u0, omega0, make2, q0, tol=tol, count=count)
+    try:
+        b = continuation(disc, x0, q0, q_end, step=float(step), min_step=min_step,
+                         max_step=max_step, max_points=max_points, at=at, tol=tol,
+                         max_iter=10, predictor="tangent", easy=4, make=make2, kind=kind)
+    except ShootingError as e:
+        raise not_a_start(disc, x0, q0, tol, e) from None
+    return curve_of(b, disc, omega0)
+
+
+def _start_matrix(make2: Callable[[float, float], Solver], kind: str, p0: float, q0: float,
+                  u0: np.ndarray, omega0: float, of: str, lin_tol: float
+                  ) -> tuple[int, np.ndarray, np.ndarray]:
+    """(n, the free components, the characteristic matrix at the start: real on a fold)."""
+    if of == "scheme":
+        with Linearisation(lambda: call_make(make2, p0, q0), u0, (p0, q0), lin_tol,
+                           "scheme") as lin:
+            M = lin.characteristic(complex(np.exp(1j * omega0 * lin.h)))
+            return lin.n, np.arange(lin.n), M if kind == "hopf" else M.real
     s = call_make(make2, p0, q0)
     try:
         n = s.n
         if u0.shape != (n,) or not np.all(np.isfinite(u0)):
             raise ValueError(f"continue_curve: the equilibrium {u0!r} is not n = {n} finite "
                              "numbers")
-        ch = Characteristic(_At(s, u0), 2.5 * omega0 + 1.0)
-        v0 = _null_vector(ch(1j * omega0) if kind == "hopf" else ch(0.0).real)
+        ch = Characteristic.at(s, u0, 2.5 * omega0 + 1.0)
     finally:
         s.close()
-    free = ch.free
+    return n, ch.free, ch(1j * omega0) if kind == "hopf" else ch(0.0).real
+
+
+def system(kind: str, p0: float, u0: np.ndarray, omega0: float,
+           make2: Callable[[float, float], Solver], q0: float, *, tol: float = 1e-10,
+           count: int = ROOTS, given: Callable[[float, float], np.ndarray] | None = None,
+           of: str = "equation", lin_tol: float = 1e-9, tests: bool = True
+           ) -> tuple[_Extended, np.ndarray]:
+    """The extended system of the Hopf (``kind="hopf"``) or fold curve through (p0, q0), u0 the
+    equilibrium there and omega0 the crossing frequency, and its start x0, for the driver
+    (``given``, ``of``, ``lin_tol`` and ``tests`` as :class:`_Extended`'s)."""
+    n, free, M0 = _start_matrix(make2, kind, p0, q0, u0, omega0, of, lin_tol)
+    v0 = null_vectors(M0)[0]
     disc = _Extended(make2, kind, n, free, v0.conj() if kind == "hopf" else v0.real, tol,
-                     int(count))
+                     int(count), given=given, of=of, lin_tol=lin_tol, tests=tests)
     disc.reach = 2.5 * omega0 + 1.0
     if kind == "fold":
-        disc.b = _null_vector(ch(0.0).real.T).real
+        disc.b = null_vectors(M0.T)[0].real
+    head = [p0] if given is not None else [*u0, p0]
     if kind == "hopf":
-        x0 = np.concatenate([u0, [p0, omega0], v0.real, v0.imag])
-    else:
-        x0 = np.concatenate([u0, [p0], v0.real])
-    try:
-        b = continuation(disc, x0, q0, q_end, step=float(step), min_step=min_step,
-                         max_step=max_step, max_points=max_points, at=at, tol=tol,
-                         max_iter=10, predictor="tangent", easy=4, make=make2, kind=kind)
-    except ShootingError as e:
-        raise ValueError(f"continue_curve: the start (p, q) = ({p0!r}, {q0!r}) is not a "
-                         f"{'Hopf point' if kind == 'hopf' else 'fold'} of the equation's "
-                         f"equilibria of make2 to the tolerance {tol!r}: the corrector "
-                         f"failed there: {e}") from None
+        return disc, np.concatenate([head, [omega0], v0.real, v0.imag])
+    return disc, np.concatenate([head, v0.real])
+
+
+def not_a_start(disc: _Extended, x0: np.ndarray, q0: float, tol: float, e: Exception
+                ) -> ValueError:
+    """The error of a start where the corrector fails."""
+    _, p0, _, _ = disc.split(x0, q0)
+    return ValueError(f"continue_curve: the start (p, q) = ({p0!r}, {q0!r}) is not a "
+                      f"{'Hopf point' if disc.kind == 'hopf' else 'fold'} of the {disc.of}'s "
+                      f"equilibria of make2 to the tolerance {tol!r}: the corrector failed "
+                      f"there: {e}")
+
+
+def curve_of(b: Any, disc: _Extended, omega0: float) -> Curve:
+    """The :class:`Curve` of the driver's branch b on ``disc``: its points, its events (the
+    codimension-two points and the user points), its status in q's words."""
+    kind = disc.kind
     points: list[CurvePoint] = list(b.points)
     events: list[CurveEvent] = []
     for e in b.events:
         if e.kind == "user":
             # the driver's index is the landed point's; else the nearest point on that q
-            on = [k for k, pt in enumerate(points) if pt.q == e.p]
-            i = e.index if e.index in on or not on else min(on, key=lambda k: abs(k - e.index))
+            on = [j for j, pt in enumerate(points) if pt.q == e.p]
+            i = e.index if e.index in on or not on else min(on, key=lambda j: abs(j - e.index))
             events.append(CurveEvent("user", points[i].p, float(e.p), i, e.detail,
                                      points[i].u))
         elif e.kind in ("bautin", "zero-hopf", "hopf-hopf", "cusp", "bogdanov-takens") \
                 and e.u is not None:
-            events.append(CurveEvent(e.kind, float(e.u[n]), float(e.p), e.index, e.detail,
-                                     e.u[:n].copy(), e.hopf))
+            events.append(CurveEvent(e.kind, float(e.u[disc.k]), float(e.p), e.index, e.detail,
+                                     np.array(disc.split(e.u, e.p)[0], dtype=float), e.hopf))
         # the driver's "fold" (a turning point in q) and "branch-point" are not the curve's
     # the driver's words for its parameter are p's: here it is q
     status = b.status.replace("p_end", "q_end").replace(" near p = ", " near q = ")
@@ -601,7 +644,7 @@ def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: floa
         status += (f"; omega fell from {omega0:.6g} to {points[-1].omega:.3g}: a "
                    "Bogdanov-Takens point is near (p, q) = "
                    f"({points[-1].p:.8g}, {points[-1].q:.8g}) (locate it on the fold curve)")
-    return Curve(kind=kind, points=points, events=events, status=status, make2=make2)
+    return Curve(kind=kind, points=points, events=events, status=status, make2=disc.make2)
 
 
 __all__ = ["Curve", "CurveEvent", "CurvePoint", "continue_curve"]

@@ -21,7 +21,7 @@ Gauss-Legendre quadrature on panels sampled once for a callback kernel (panels o
 
 Each of the scheme's roots (:func:`dmi.analysis.roots`) is refined by Newton's method on
 det Delta(lambda) = 0, the step 1 / tr(Delta^-1 Delta'(lambda)) (Delta' = I + Hhat', Hhat' by a
-central difference of the analytic Hhat), until |dlambda| <= 1e-10 max(1, |lambda|) twice
+central difference of the analytic Hhat, :meth:`Characteristic.prime`), until |dlambda| <= 1e-10 max(1, |lambda|) twice
 running; a root that does not converge in 40 iterations, or converges onto another's, is
 reported (:class:`RefinementWarning`) and returned as nan.
 """
@@ -33,10 +33,18 @@ import warnings
 import numpy as np
 
 from ..._transform import laplace, near_shift
-from ..core.model import Linearisation, kernel_panels
+from ..._solver import Solver
+from ..core.model import (Linearisation, _resolvent_derivative, equation_terms, kernel_of,
+                          kernel_panels, rhs_jacobian)
 
 #: Relative tolerance of a refined root: |dlambda| <= ROOT_TOL max(1, |lambda|).
 ROOT_TOL = 1e-10
+
+#: Central stencils of a first derivative by their order: offsets (times the step), weights and
+#: the step relative to max(1, |lambda|) (order 2 for Newton's step and the argument principle,
+#: order 4 for the normal forms, whose Hhat' is then about 1e-13 off).
+SLOPE = {2: (np.array([1.0, -1.0]), np.array([0.5, -0.5]), 1e-6),
+         4: (np.array([-2.0, -1.0, 1.0, 2.0]), np.array([1.0, -8.0, 8.0, -1.0]) / 12, 1e-3)}
 
 
 class RefinementWarning(RuntimeWarning):
@@ -124,19 +132,47 @@ class Characteristic:
                                       * np.linalg.norm(H * ratio, axis=(1, 2))))
         return 0.0
 
+    @classmethod
+    def at(cls, s: Solver, u: np.ndarray, reach: float = 10.0) -> Characteristic:
+        """Delta of the equation of the solver s at any state u, not only at an equilibrium (a
+        corrector asks between them): f_u(u), the resolvent's derivative at the equation's X(u)
+        and the kernel's transform, as a :class:`Linearisation` gives them at an equilibrium."""
+        return cls(_Terms(s, u), reach)
+
     def __call__(self, lam: complex) -> np.ndarray:
         """Delta(lambda) (m x m, complex)."""
         return complex(lam) * np.eye(self.m) + self.B + self.hhat(lam)
 
+    def prime(self, lam: complex | np.ndarray, order: int = 2) -> np.ndarray:
+        """Delta'(lambda) = I + Hhat'(lambda), (m, m) complex, or (k, m, m) for k values; Hhat'
+        by the central difference of :data:`SLOPE` of this order (2 or 4)."""
+        lam = np.asarray(lam, dtype=complex)
+        offsets, w, rel = SLOPE[order]
+        flat = lam.reshape(-1)
+        d = rel * np.maximum(1.0, np.abs(flat))
+        H = self.hhat((flat[:, None] + offsets[None, :] * d[:, None]).reshape(-1))
+        dH = np.einsum("s,ksij->kij", w, H.reshape(flat.size, offsets.size, self.m, self.m))
+        dH = dH / d[:, None, None]
+        return (np.eye(self.m) + dH).reshape(lam.shape + (self.m, self.m))
+
     def newton_step(self, lam: complex) -> complex:
-        """det Delta / (det Delta)' = 1 / tr(Delta^-1 Delta'(lambda)) (Hhat at lambda and
-        lambda +- d in one evaluation)."""
-        d = 1e-6 * max(1.0, abs(lam))
-        H = self.hhat(np.array([lam, lam + d, lam - d]))
-        dH = (H[1] - H[2]) / (2 * d)
-        Dl = complex(lam) * np.eye(self.m) + self.B + H[0]
-        tr = np.trace(np.linalg.solve(Dl, np.eye(self.m) + dH))
+        """det Delta / (det Delta)' = 1 / tr(Delta^-1 Delta'(lambda))."""
+        tr = np.trace(np.linalg.solve(self(lam), self.prime(lam)))
         return 1.0 / tr
+
+
+class _Terms:
+    """What :class:`Characteristic` reads of a linearisation, at any state u of the solver s."""
+
+    def __init__(self, s: Solver, u: np.ndarray):
+        X, _ = equation_terms(s)(u)
+        scale = max(float(np.max(np.abs(u))), float(np.max(np.abs(X)))) or 1.0
+        self.h, self.tau = s.h, s.tau
+        self.J = rhs_jacobian(s, 0.0, u)
+        self.D = _resolvent_derivative(s, X, s.h, scale)
+        self.resolvent_kind = s.resolvent_kind if s.resolvent_kind != "callback" else ""
+        self.kernel_terms, self.kernel = kernel_of(s)
+        self.tangent = s
 
 
 def refine(ch: Characteristic, lam0: complex, max_iter: int = 40) -> tuple[complex, str]:

@@ -30,23 +30,23 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from ..._errors import Error
-from ..core.model import KinkError, Linearisation, call_make, equation_step
 from ..continuation.branch import ON_AXIS, REAL, Branch, HopfPoint
 from ..continuation.driver import Curve, continuation, newton_corrector
-from ..scheme.floquet import StabilityWarning
+from ..core.model import KinkError, call_make, equation_step
 from ..core.newton import ShootingError
-from .normal_form import criticality
+from ..scheme.floquet import StabilityWarning
 from ..scheme.problem import Problem
-from .root_verdict import RootVerdict, check
-from .stability import DENSE_MAX, check_of, rightmost_of
 from ..scheme.stepmap import Model
+from .normal_form import criticality
+from .numerics import forward_jacobian, null_vectors, signed_mean
+from .root_verdict import UNVERIFIED, RootVerdict, roots_verdict
+from .stability import check_of
 
 #: Roots computed at each point of a branch (the Hopf test function reads them).
 ROOTS = 6
@@ -166,11 +166,6 @@ def _check_guess(guess: Any, n: int) -> np.ndarray:
     return u
 
 
-#: The verdict of points not verified.
-UNVERIFIED = RootVerdict(None, "not verified (verify=False): the roots are ARPACK's Ritz values "
-                         "without an error bound")
-
-
 def _roots(make: Model, p: float, u: np.ndarray, count: int, tol: float, of: str,
            verify: bool, lam: np.ndarray | None = None) -> tuple[np.ndarray, RootVerdict]:
     """The rightmost roots at an equilibrium (``lam``: those already computed) and their
@@ -181,13 +176,8 @@ def _roots(make: Model, p: float, u: np.ndarray, count: int, tol: float, of: str
     if lam is not None and not verify:
         return lam, UNVERIFIED
     try:
-        with Linearisation(lambda: call_make(make, p), u, (p,), max(tol * 1e3, 1e-9),
-                           of) as lin:
-            if lam is None:
-                lam = rightmost_of(lin, int(count), of)
-            if not verify:
-                return lam, UNVERIFIED
-            return lam, check(lin, lam, of, lin.dim <= max(DENSE_MAX, count + 4))
+        return roots_verdict(lambda: call_make(make, p), u, (p,), count, max(tol * 1e3, 1e-9),
+                             of, verify, lam)
     except KinkError as e:
         return np.empty(0, complex), RootVerdict(None, f"no roots: {e}")
 
@@ -214,18 +204,6 @@ def hopf_test(lam: np.ndarray) -> float:
     f = list(upper.real) + [0.5 * (r[i] + r[j]) for i in range(r.size)
                             for j in range(i + 1, r.size)]
     return signed_mean(f)
-
-
-def signed_mean(values: Iterable[float]) -> float:
-    """sign(prod values) times the geometric mean of |values|; NaN for none, 0 with a zero
-    (the test functions' form: the sign of a product, a size that does not under- or
-    overflow)."""
-    f = np.array(list(values), dtype=float)
-    if f.size == 0:
-        return math.nan
-    if np.any(f == 0):
-        return 0.0
-    return float(np.prod(np.sign(f))) * float(np.exp(np.mean(np.log(np.abs(f)))))
 
 
 class Equilibria:
@@ -273,14 +251,8 @@ class Equilibria:
 
     def jacobian(self, x: np.ndarray, p: float) -> tuple[np.ndarray, np.ndarray]:
         """(G_u, G_p) by forward differences of step 1e-7 max(1, |y_j|)."""
-        y = np.concatenate([x, [p]])
-        G0 = self.residual(x, p)
-        J = np.empty((x.size, y.size))
-        for j in range(y.size):
-            d = 1e-7 * max(1.0, abs(y[j]))
-            e = y.copy()
-            e[j] += d
-            J[:, j] = (self.residual(e[:-1], float(e[-1])) - G0) / d
+        J = forward_jacobian(lambda y: self.residual(y[:-1], float(y[-1])),
+                             np.concatenate([x, [p]]), self.residual(x, p))
         return J[:, :-1], J[:, -1]
 
     def point(self, x: np.ndarray, p: float) -> EquilibriumPoint:
@@ -322,7 +294,7 @@ class Equilibria:
             return None
         if kind == "branch-point":
             Gu, Gp = self.jacobian(x, p)
-            sv = np.linalg.svd(np.column_stack([Gu, Gp]), compute_uv=False)
+            sv = null_vectors(np.column_stack([Gu, Gp]))[2]
             if sv[-1] <= 1e-5 * sv[0]:
                 return {"u": x, "detail": "a real root crosses 0 where the branch goes on: the "
                         "null space of [G_u, G_p] is two-dimensional (its singular values "

@@ -1,7 +1,8 @@
 # The first Lyapunov coefficient of the equation's Hopf points, the crossing speed, and the
 # amplitude coefficients of the orbit born there.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
-"""Criticality of a Hopf point of the equation: :func:`criticality`.
+"""Criticality of a Hopf point of the equation: :func:`criticality`, and the parameter of the
+orbit of a given amplitude born there, :func:`predicted_parameter`.
 
 What it holds: the first Lyapunov coefficient l1 of a Hopf point of the continuous equation
 u' + A(u) + f(t, u) + int_0^tau H(s) u(t - s) ds ∋ 0 at an equilibrium u_eq, with its estimated
@@ -9,9 +10,12 @@ error and the word ``"supercritical"`` / ``"subcritical"``; the crossing speed R
 the amplitude coefficients kappa of the orbit born there; and the second and third derivatives
 of f it needs (the model's derivative hook :meth:`dmi.Solver.set_rhs_derivatives`, or central
 differences of f with their error).  What it may import: numpy, the records
-(:mod:`dmi.analysis.continuation.branch`), the model's linearisation (:mod:`dmi.analysis.core.model`) and the
-characteristic matrix (:mod:`dmi.analysis.equilibria.equation`); :mod:`dmi.analysis.equilibria.stability` and
-:mod:`dmi.analysis.equilibria.equilibrium` call it, so it imports neither.
+(:mod:`dmi.analysis.continuation.branch`), the model's linearisation
+(:mod:`dmi.analysis.core.model`), the characteristic matrix
+(:mod:`dmi.analysis.equilibria.equation`) and the room's tools
+(:mod:`dmi.analysis.equilibria.numerics`); :mod:`dmi.analysis.equilibria.crossing`,
+:mod:`dmi.analysis.equilibria.equilibrium` and :mod:`dmi.analysis.equilibria.curves` call it,
+so it imports none of them.
 
 The method (docs/stability.md, "Criticality of a Hopf point").  On the free components (those
 the resolvent does not hold; A is locally constant on them for dry friction and the box) the
@@ -42,14 +46,15 @@ from typing import Any
 import numpy as np
 
 from ..._errors import Error
-from ..core.model import Linearisation, _call, call_make, equation_step, equilibrium
 from ..continuation.branch import ON_AXIS, HopfPoint
-from .equation import Characteristic, refine
+from ..core.model import Linearisation, _call, call_make, equation_step, equilibrium
+from .equation import SLOPE, Characteristic, refine
+from .numerics import forward_jacobian, null_vectors
 
 EPS = float(np.finfo(float).eps)
 
 #: Fourth-order central stencils of the k-th derivative: offsets (times the step) and weights.
-STENCILS = {1: (np.array([-2.0, -1.0, 1.0, 2.0]), np.array([1.0, -8.0, 8.0, -1.0]) / 12),
+STENCILS = {1: SLOPE[4][:2],
             2: (np.array([-2.0, -1.0, 0.0, 1.0, 2.0]),
                 np.array([-1.0, 16.0, -30.0, 16.0, -1.0]) / 12),
             3: (np.array([-3.0, -2.0, -1.0, 1.0, 2.0, 3.0]),
@@ -165,15 +170,6 @@ class _Forms:
                 + 1j * (self.c_real(x, x, y) + self.c_real(y, y, y)))
 
 
-def _delta_prime(ch: Characteristic, lam: complex) -> np.ndarray:
-    """Delta'(lambda) = I + Hhat'(lambda), Hhat' by the fourth-order central difference of step
-    1e-3 max(1, |lambda|) (Hhat is analytic: its error is about 1e-13)."""
-    d = 1e-3 * max(1.0, abs(lam))
-    offsets, w = STENCILS[1]
-    H = ch.hhat(np.array([lam + o * d for o in offsets]))
-    return np.eye(ch.m) + np.tensordot(w, H, axes=(0, 0)) / d
-
-
 def _corrected(s: Any, u0: np.ndarray) -> np.ndarray:
     """The equation's equilibrium near u0 by Newton on G(u) = R(X(u)) - u (the Jacobian by
     forward differences), to rounding."""
@@ -182,12 +178,7 @@ def _corrected(s: Any, u0: np.ndarray) -> np.ndarray:
     last = math.inf
     for _ in range(30):
         g = G(u)
-        J = np.empty((u.size, u.size))
-        for j in range(u.size):
-            e = np.zeros(u.size)
-            e[j] = 1e-7 * max(1.0, abs(u[j]))
-            J[:, j] = (G(u + e) - g) / e[j]
-        du = np.linalg.solve(J, -g)
+        du = np.linalg.solve(forward_jacobian(G, u, g), -g)
         u = u + du
         size = float(np.max(np.abs(du)))
         if size <= 4 * EPS * max(1.0, float(np.max(np.abs(u)))):
@@ -336,6 +327,55 @@ def criticality(make: Callable[[float], Any], hopf_point: HopfPoint, u_eq: Any, 
         return hopf_point
 
 
+def _vectors(ch: Characteristic, lam: complex) -> tuple[np.ndarray, np.ndarray, float]:
+    """(q, p, the condition of q): Delta(lambda) q = 0 with |q| = 1, p Delta(lambda) = 0 with
+    p Delta'(lambda) q = 1 (Delta' of order 4)."""
+    q, prow, sv = null_vectors(ch(lam))
+    if ch.m > 1 and sv[-2] <= 1e-8 * sv[0]:
+        raise _Unavailable("the null space of Delta(i omega) is not one-dimensional (singular "
+                           f"values {sv!r}): a double root")
+    norm = complex(prow @ ch.prime(lam, order=4) @ q)
+    if abs(norm) <= 1e-10 * np.linalg.norm(prow):
+        raise _Unavailable("p Delta'(i omega) q = 0: the root is not simple")
+    return q, prow / norm, (sv[0] / sv[-2] if ch.m > 1 else 1.0)
+
+
+def _inverses(ch: Characteristic, omega: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """(Delta(2 i omega)^-1, Delta(0)^-1, the sum of their condition numbers)."""
+    M2, M0 = ch(2j * omega), ch(0.0)
+    conds = 0.0
+    for name, M in (("Delta(2 i omega)", M2), ("Delta(0)", M0)):
+        c = np.linalg.cond(M)
+        if not c <= 1e10:
+            raise _Unavailable(f"{name} is singular (condition {c:.3g}): "
+                               + ("a root at 2 i omega (a 1:2 resonance)" if M is M2 else
+                                  "a root at 0 as well (a zero-Hopf point)"))
+        conds += c
+    return np.linalg.inv(M2), np.linalg.inv(M0), conds
+
+
+def _first_coefficient(s: Any, u: np.ndarray, ch: Characteristic, q: np.ndarray,
+                       prow: np.ndarray, cond_q: float, omega: float) -> tuple[complex, float]:
+    """(c1, its estimated error): the differences' rounding, their truncation (c1 again at
+    twice the steps, without the hook's d2 and d3) and the linear algebra's rounding."""
+    inv2, inv0, conds = _inverses(ch, omega)
+    forms = _Forms(s, u)
+    if forms.d2 is not None or forms.d3 is not None:
+        x = np.zeros(s.n)
+        x[ch.free] = q.real if np.any(q.real) else q.imag
+        _check_hooks(forms, x / np.max(np.abs(x)))
+    forms.level = 1
+    c1, rounding, size = _c1(forms, ch, q, prow, inv2, inv0)
+    err = rounding
+    if not forms.exact:
+        forms.level = 0
+        c1_coarse, _, _ = _c1(forms, ch, q, prow, inv2, inv0)
+        err += abs(c1.real - c1_coarse.real)
+    # the linear algebra's rounding, and (without fu) the Jacobian's differences, ~1e-10
+    err += size * (1e3 * EPS * (cond_q + conds) + (1e-9 * cond_q if forms.fu is None else 0.0))
+    return c1, err
+
+
 def _criticality(make: Any, hp: HopfPoint, u_eq: Any, tol: float) -> HopfPoint:
     p, omega0 = float(hp.p), float(hp.omega)
     reach = 2.5 * omega0 + 1.0
@@ -355,42 +395,8 @@ def _criticality(make: Any, hp: HopfPoint, u_eq: Any, tol: float) -> HopfPoint:
             raise _Unavailable(f"not a Hopf point: the root refined from i omega = "
                                f"{1j * omega0!r} is {lam!r}, off the imaginary axis")
         omega = lam.imag
-        m = ch.m
-        U, sv, Vh = np.linalg.svd(ch(lam))
-        if m > 1 and sv[-2] <= 1e-8 * sv[0]:
-            raise _Unavailable("the null space of Delta(i omega) is not one-dimensional (singular "
-                               f"values {sv!r}): a double root")
-        q = Vh[-1].conj()
-        q = q / np.linalg.norm(q)
-        prow = U[:, -1].conj()
-        norm = complex(prow @ _delta_prime(ch, lam) @ q)
-        if abs(norm) <= 1e-10 * np.linalg.norm(prow):
-            raise _Unavailable("p Delta'(i omega) q = 0: the root is not simple")
-        prow = prow / norm
-        M2, M0 = ch(2j * omega), ch(0.0)
-        for name, M in (("Delta(2 i omega)", M2), ("Delta(0)", M0)):
-            c = np.linalg.cond(M)
-            if not c <= 1e10:
-                raise _Unavailable(f"{name} is singular (condition {c:.3g}): "
-                                   + ("a root at 2 i omega (a 1:2 resonance)" if M is M2 else
-                                      "a root at 0 as well (a zero-Hopf point)"))
-        inv2, inv0 = np.linalg.inv(M2), np.linalg.inv(M0)
-        forms = _Forms(s, u)
-        if forms.d2 is not None or forms.d3 is not None:
-            x = np.zeros(s.n)
-            x[ch.free] = q.real if np.any(q.real) else q.imag
-            _check_hooks(forms, x / np.max(np.abs(x)))
-        forms.level = 1
-        c1, rounding, size = _c1(forms, ch, q, prow, inv2, inv0)
-        err = rounding
-        if not forms.exact:
-            forms.level = 0
-            c1_coarse, _, _ = _c1(forms, ch, q, prow, inv2, inv0)
-            err += abs(c1.real - c1_coarse.real)
-        # the linear algebra's rounding, and (without fu) the Jacobian's differences, ~1e-10
-        cond_q = sv[0] / sv[-2] if m > 1 else 1.0
-        err += size * (1e3 * EPS * (cond_q + np.linalg.cond(M2) + np.linalg.cond(M0))
-                       + (1e-9 * cond_q if forms.fu is None else 0.0))
+        q, prow, cond_q = _vectors(ch, lam)
+        c1, err = _first_coefficient(s, u, ch, q, prow, cond_q, omega)
     finally:
         s.close()
     l1 = c1.real / omega
@@ -424,4 +430,57 @@ def _criticality(make: Any, hp: HopfPoint, u_eq: Any, tol: float) -> HopfPoint:
     return dataclasses.replace(out, kappa=kappa)
 
 
-__all__ = ["CriticalityWarning", "criticality"]
+def predicted_parameter(hopf_point: HopfPoint, amplitude: float,
+                        component: int | None = None) -> float:
+    """The parameter where the orbit born at a Hopf point has a given amplitude, to leading
+    order: p = p_H + side (A / kappa_j)^2.
+
+    The orbit's half range (max - min) / 2 of component j grows as kappa_j sqrt|p - p_H| on the
+    side where it exists (``hopf_point.side``: the sign of -l1 Re lambda'(p_H)), so a wanted
+    amplitude A of that component is met near p_H + side (A / kappa_j)^2, off by O(A^4): the
+    predictor of an orbit of amplitude A.
+
+    Parameters
+    ----------
+    hopf_point : HopfPoint
+        A Hopf point of the equation with its ``kappa`` and ``side``
+        (:func:`criticality`: ``hopf(..., of="equation")``, a ``hopf`` event of a branch of
+        the equation's equilibria).
+    amplitude : float
+        A, the wanted (max - min) / 2 of component j (state units), finite and > 0.
+    component : int, optional
+        j; default the component that moves most (the largest kappa_j).
+
+    Returns
+    -------
+    float
+        The predicted parameter.
+
+    Raises
+    ------
+    ValueError
+        A hopf_point without kappa or side (the scheme's, or one whose criticality or crossing
+        speed is not decided: its CriticalityWarning said why), an amplitude that is not finite
+        and > 0, a component out of range or whose kappa is 0 (a held component).
+    """
+    if not isinstance(hopf_point, HopfPoint):
+        raise ValueError(f"predicted_parameter: hopf_point = {hopf_point!r}: give a "
+                         "dmi.analysis.HopfPoint")
+    kappa, side = hopf_point.kappa, hopf_point.side
+    if kappa is None or side is None:
+        raise ValueError(f"predicted_parameter: the Hopf point at p = {hopf_point.p!r} has no "
+                         "kappa (the scheme's, or its criticality or crossing speed not "
+                         "decided): compute it with hopf(..., of='equation')")
+    a = float(amplitude)
+    if not (a > 0 and math.isfinite(a)):
+        raise ValueError(f"predicted_parameter: amplitude = {amplitude!r}: give a finite "
+                         "amplitude > 0 (state units)")
+    kappa = np.asarray(kappa, dtype=float)
+    j = int(np.argmax(kappa)) if component is None else component
+    if not (isinstance(j, (int, np.integer)) and 0 <= j < kappa.size and kappa[j] > 0):
+        raise ValueError(f"predicted_parameter: component = {component!r}: give an index in "
+                         f"[0, {kappa.size}) whose kappa is > 0 (kappa = {kappa!r})")
+    return float(hopf_point.p) + side * (a / float(kappa[j])) ** 2
+
+
+__all__ = ["CriticalityWarning", "criticality", "predicted_parameter"]

@@ -31,15 +31,18 @@ with the reason.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
 import scipy.sparse.linalg as sla
 
+from ..._solver import Solver
 from ..core.blas import _one_blas_thread
 from ..core.model import Linearisation
 from .equation import ROOT_TOL, Characteristic
+from .stability import is_dense, rightmost_of
 
 #: Samples of the line at most (beyond them the count is left undecided).
 MAX_SAMPLES = 400_000
@@ -77,12 +80,8 @@ def _eval(ch: Characteristic, sigma: float, w: np.ndarray
           ) -> tuple[np.ndarray, np.ndarray]:
     """(phase of det Delta, |d log det Delta / d lambda|) at lambda = sigma + i w."""
     lam = sigma + 1j * w
-    k, m = w.size, ch.m
-    d = 1e-6 * np.maximum(1.0, np.abs(lam))
-    H = ch.hhat(np.concatenate([lam, lam + d, lam - d]))
-    eye = np.eye(m)
-    D = lam[:, None, None] * eye + ch.B + H[:k]
-    dD = eye + (H[k:2 * k] - H[2 * k:]) / (2 * d)[:, None, None]
+    D = lam[:, None, None] * np.eye(ch.m) + ch.B + ch.hhat(lam)
+    dD = ch.prime(lam)
     sign, _ = np.linalg.slogdet(D)
     if np.any(sign == 0):
         raise np.linalg.LinAlgError
@@ -284,4 +283,25 @@ def check(lin: Linearisation, lam: np.ndarray, of: str, dense: bool) -> RootVerd
     return scheme_verdict(lin, lam, dense)
 
 
-__all__ = ["RootVerdict", "check", "count_right", "equation_verdict", "scheme_verdict"]
+#: The verdict of roots not verified (``verify=False``).
+UNVERIFIED = RootVerdict(None, "not verified (verify=False): the roots are ARPACK's Ritz values "
+                         "without an error bound")
+
+
+def roots_verdict(factory: Callable[[], Solver], u: object, args: tuple, count: int, tol: float,
+                  of: str, verify: bool, lam: np.ndarray | None = None
+                  ) -> tuple[np.ndarray, RootVerdict]:
+    """The ``count`` rightmost roots at the equilibrium u of the model ``factory()`` (``lam``:
+    those already computed) and their verdict, verified (:func:`check`) or not
+    (:data:`UNVERIFIED`); the errors of :class:`Linearisation` (u not an equilibrium to tol, a
+    kink)."""
+    with Linearisation(factory, u, args, tol, of) as lin:
+        if lam is None:
+            lam = rightmost_of(lin, int(count), of)
+        if not verify:
+            return lam, UNVERIFIED
+        return lam, check(lin, lam, of, is_dense(lin, count))
+
+
+__all__ = ["UNVERIFIED", "RootVerdict", "check", "count_right", "equation_verdict",
+           "roots_verdict", "scheme_verdict"]

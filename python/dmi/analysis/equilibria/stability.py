@@ -1,23 +1,22 @@
-# Characteristic roots of an equilibrium of the scheme, and the Hopf point of a one-parameter model.
+# Characteristic roots of an equilibrium of the scheme (or of the equation).
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
-"""dmi.analysis.roots and dmi.analysis.hopf (see docs/stability.md for the method)."""
+"""dmi.analysis.roots (see docs/stability.md for the method): the rightmost roots of a
+linearisation, from the dense one-step matrix or by Arnoldi on the N-step map (:func:`is_dense`
+says which), refined to the equation's where asked.  The Hopf point of a one-parameter model is
+:mod:`dmi.analysis.equilibria.crossing`'s."""
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 import scipy.linalg
-import scipy.optimize
 import scipy.sparse.linalg as sla
 
 from ..._solver import Solver
 from ..core.blas import _one_blas_thread
 from ..core.model import Linearisation, call_make
-from ..continuation.branch import HopfPoint
 from .equation import equation_roots
-from .normal_form import criticality
 
 #: At most this many state dimensions n N: the one-step matrix is formed and its eigenvalues taken
 #: directly (Arnoldi needs a state larger than the roots asked for).
@@ -127,14 +126,19 @@ def _order(lam: np.ndarray) -> np.ndarray:
     return lam[idx]
 
 
+def is_dense(lin: Linearisation, count: int) -> bool:
+    """The rule of the root finder: all roots from the dense one-step matrix when the state has
+    at most max(DENSE_MAX, count + 4) values (Arnoldi needs k < n N - 1), else Arnoldi."""
+    return lin.dim <= max(DENSE_MAX, count + 4)
+
+
 def rightmost(lin: Linearisation, count: int) -> np.ndarray:
     """The count rightmost roots of a linearisation."""
     if count > lin.dim:
         raise ValueError(f"dmi.analysis: count = {count} roots asked; the step map has n N = "
                          f"{lin.dim}")
-    dense = lin.dim <= max(DENSE_MAX, count + 4)      # (Arnoldi needs k < n N - 1)
     with _one_blas_thread():
-        lam = _one_step_roots(lin, count) if dense else _arnoldi_roots(lin, count)
+        lam = _one_step_roots(lin, count) if is_dense(lin, count) else _arnoldi_roots(lin, count)
     lam = _order(lam)
     if np.any(np.isnan(lam[:count])):
         raise RuntimeError(f"dmi.analysis: the one-step map has no multiplier z with z^{lin.N} = "
@@ -208,70 +212,4 @@ def roots(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 10,
         return rightmost_of(lin, int(count), of)
 
 
-def rightmost_real(make: Callable[[float], Solver], p: float, u_eq: Any, count: int = 4,
-                   tol: float = 1e-9, of: str = "scheme") -> float:
-    """Re of the rightmost root at p (1 / time unit)."""
-    return float(roots(make, p, u_eq, count, tol=tol, of=of)[0].real)
-
-
-def hopf(make: Callable[[float], Solver], p_lo: float, p_hi: float, u_eq: Any, *,
-         rtol: float = 1e-10, count: int = 4, tol: float = 1e-9, of: str = "scheme"
-         ) -> HopfPoint:
-    """The parameter where the rightmost root crosses the imaginary axis.
-
-    Brent's method on Re lambda_1(p), each value from :func:`roots`.
-
-    Parameters
-    ----------
-    make : callable
-        The model ``make(p) -> dmi.Solver``.
-    p_lo, p_hi : float
-        The bracket (Re lambda_1 of opposite signs at its ends).
-    u_eq : array_like or callable
-        The equilibrium, or a function ``u_eq(p)``.
-    rtol : float
-        Tolerance on p, relative.
-    count : int
-        Roots computed at each p.
-    tol : float
-        The equilibrium-residual tolerance of :func:`roots`.
-    of : {"scheme", "equation"}
-        The scheme's roots (default) or the equation's (see :func:`roots`).
-
-    Returns
-    -------
-    HopfPoint
-        ``.p``, ``.omega`` (|Im lambda_1|; 0: a real root crosses, a fold) and ``.root``;
-        with ``of="equation"`` also ``.l1``, ``.l1_error``, ``.criticality``, ``.kappa`` and
-        ``.crossing_speed`` (:func:`dmi.analysis.equilibria.normal_form.criticality`).
-
-    Raises
-    ------
-    ValueError
-        p_lo = p_hi, or Re lambda_1 has the same sign at both ends (no crossing bracketed); the
-        errors of :func:`roots`.
-    """
-    check_of(of)
-    p_lo, p_hi = float(p_lo), float(p_hi)
-    if not (math.isfinite(p_lo) and math.isfinite(p_hi)) or p_lo == p_hi:
-        raise ValueError(f"dmi.analysis.hopf: [p_lo, p_hi] = [{p_lo!r}, {p_hi!r}] is not an "
-                         "interval (two different finite values)")
-    g_lo = rightmost_real(make, p_lo, u_eq, count, tol, of)
-    g_hi = rightmost_real(make, p_hi, u_eq, count, tol, of)
-    if g_lo == 0:
-        p = p_lo
-    elif g_hi == 0:
-        p = p_hi
-    elif (g_lo > 0) == (g_hi > 0):
-        raise ValueError(f"dmi.analysis.hopf: no crossing bracketed: Re lambda_1 = {g_lo:.6g} at "
-                         f"p = {p_lo!r} and {g_hi:.6g} at p = {p_hi!r} (same sign)")
-    else:
-        scale = max(abs(p_lo), abs(p_hi))
-        p = scipy.optimize.brentq(lambda x: rightmost_real(make, x, u_eq, count, tol, of), p_lo,
-                                  p_hi,
-                                  xtol=rtol * scale * 1e-2, rtol=max(rtol * 1e-2, 4.5e-16),
-                                  maxiter=200)
-    lam = roots(make, p, u_eq, count, tol=tol, of=of)[0]
-    lam = complex(lam.real, abs(lam.imag))
-    hp = HopfPoint(p=float(p), omega=abs(lam.imag), root=lam)
-    return criticality(make, hp, u_eq, tol=tol) if of == "equation" else hp
+__all__ = ["check_of", "is_dense", "rightmost", "rightmost_of", "roots"]
