@@ -26,6 +26,7 @@ import numpy as np
 
 from ... import _lib
 from ... import _resolvent as rule
+from ..._make import call_make  # noqa: F401  (the equilibria's model calls)
 from ..._solver import Solver
 from ..._transform import laplace, near_shift
 
@@ -46,22 +47,6 @@ class KinkError(ValueError):
     message : str
         Which component, and where.
     """
-
-
-def call_make(make: Callable[..., Any], *args: Any, **kw: Any) -> Solver:
-    """make(*args, **kw), checked to be a dmi.Solver; its exception (the model's own) gets a
-    note naming the call, ``make(p = ...)``."""
-    call = ", ".join([f"p = {a!r}" if i == 0 else repr(a) for i, a in enumerate(args)]
-                     + [f"{k}={v!r}" for k, v in kw.items()])
-    try:
-        s = make(*args, **kw)
-    except Exception as e:
-        e.add_note(f"dmi.analysis: raised by the model make({call})")
-        raise
-    if not isinstance(s, Solver):
-        raise TypeError(f"dmi.analysis: the model make({call}) returned {type(s).__name__}, "
-                        "not a dmi.Solver")
-    return s
 
 
 def equilibrium(u_eq: Any, n: int, args: tuple) -> np.ndarray:

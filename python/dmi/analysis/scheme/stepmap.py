@@ -21,8 +21,8 @@ from typing import Any
 
 import numpy as np
 
+from ..._make import call_make
 from ..._solver import Solver
-from ..core.model import call_make
 
 Model = Callable[..., Solver]
 
@@ -73,7 +73,7 @@ def fixed_step(make: Model, h: float) -> Model:
 
 def build(make: Model, p: float, **kw: Any) -> Solver:
     """``make(p, **kw)``: the model's own exception, with a note naming the call, when it
-    fails (:func:`dmi.analysis.core.model.call_make`); TypeError when it returns no dmi.Solver."""
+    fails (:func:`dmi._make.call_make`); TypeError when it returns no dmi.Solver."""
     return call_make(make, p, **kw)
 
 def positive_time(name: str, value: Any) -> float:
