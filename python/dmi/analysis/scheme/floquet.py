@@ -86,11 +86,9 @@ class PeriodMap(Protocol):
 
     def __call__(self, x: np.ndarray) -> np.ndarray: ...
 
-    def trajectory(self, x: np.ndarray) -> np.ndarray: ...
+    def trajectory(self, x: np.ndarray, periods: int = 1) -> np.ndarray: ...
 
     def trajectory_terms(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
-
-    def run_from(self, x: np.ndarray, steps: int) -> np.ndarray: ...
 
 
 def fd_step(F: PeriodMap, x: np.ndarray, U: np.ndarray | None = None,
@@ -402,13 +400,13 @@ def growth_rate(F: PeriodMap, x: np.ndarray, v: np.ndarray, kick: float, periods
         w = across_kick(w, vel, F.n)
         Q = np.concatenate([P[-1:], P, P[:1]])
         curv = float(np.median(np.linalg.norm(Q[2:] - 2 * Q[1:-1] + Q[:-2], axis=1))) / 8
-        S = F.run_from(x + 0.5 * F.h * vel, M)
+        S = F.trajectory(x + 0.5 * F.h * vel)
         drift = max(curv, off_orbit(S[1:], P, F.h, True))
     else:
         now = float(np.max(np.abs(w[-F.n:])))     # the kick's size is that of the state at t = 0
         w = w / (now if now > 1e-3 * np.max(np.abs(w)) else np.max(np.abs(w)))
     floor = 100 * float(np.max(np.abs(F(x) - x))) + drift + 1e-13 * scale
-    R = F.run_from(x + max(kick * A, least) * w, periods * M)
+    R = F.trajectory(x + max(kick * A, least) * w, periods)
     d = np.array([off_orbit(R[k * M + 1:(k + 1) * M + 1], P, F.h, autonomous)
                   for k in range(periods)])
     inside = (d > floor) & (d < 0.1 * A)
@@ -577,16 +575,10 @@ def floquet_multipliers(F: PeriodMap, x: np.ndarray, count: int = 10, *,
 
     Parameters
     ----------
-    F : StepMap
-        The M-step map, e.g. ``StepMap(orbit.make, orbit.p, orbit.steps, orbit.rows)``.
-    x : numpy.ndarray
-        Its fixed point, e.g. ``orbit.state``.
+    F, x, eps, central : StepMap, numpy.ndarray, float, bool
+        The map, its fixed point and the differences, as for :func:`floquet_verdict`.
     count : int
         How many multipliers.
-    eps : float, optional
-        The difference step (state units), instead of :func:`fd_step`'s.
-    central : bool
-        Central differences (2 evaluations a product), else forward (1).
     autonomous : bool
         An autonomous orbit (its trivial multiplier is found by its vector; it stays in the
         list).

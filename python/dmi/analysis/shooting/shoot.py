@@ -142,7 +142,7 @@ def period_of_model(F: StepMap, x: np.ndarray, period: float) -> None:
     """ValueError when the fixed point x of F is no orbit: two periods run from x (the second
     from t = P, with the model's own time) differ by more than 1e-5 max(1, |U|): the model's
     forcing does not have the period P."""
-    U = F.run_from(x, 2 * F.M)
+    U = F.trajectory(x, 2)
     miss = float(np.max(np.abs(U[F.M:] - U[:F.M + 1])))
     scale = max(1.0, float(np.max(np.abs(U))))
     if miss > 1e-5 * scale:
