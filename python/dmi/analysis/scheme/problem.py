@@ -22,7 +22,7 @@ import numpy as np
 from ..._cache import Cache
 from ..._solver import Solver
 from ..core.newton import ShootingError
-from .stepmap import Model, StepMap, build, fixed_step
+from .stepmap import Model, StepMap, build, fixed_step, user_model
 
 #: Objects the cache keeps (the least recently used goes first).
 KEEP = 8
@@ -42,7 +42,7 @@ class Problem:
 
     def __init__(self, make: Model, keep: int = KEEP):
         self.model = make                        # make(p) as given
-        self.make = getattr(make, "base", make)  # the user's model (a FixedStep's own)
+        self.make = user_model(make)
         self.keep = int(keep)
         self._cache = Cache(keep)
 

@@ -27,6 +27,11 @@ from ..._solver import Solver
 Model = Callable[..., Solver]
 
 
+def user_model(make: Model) -> Model:
+    """The user's model behind make: a :class:`FixedStep`'s own, else make itself."""
+    return getattr(make, "base", make)
+
+
 class FixedStep:
     """A model at a fixed step: ``FixedStep(make, h)(p)`` is ``make(p, h=h)``, and
     ``(p, h=other)`` another step (an autonomous Orbit's ``make``).  A class, not a closure, so
@@ -41,7 +46,7 @@ class FixedStep:
     """
 
     def __init__(self, make: Model, h: float):
-        self.base = getattr(make, "base", make)   # the user's model, not a FixedStep of one
+        self.base = user_model(make)
         self.h = float(h)
 
     def __call__(self, p: float, h: float | None = None) -> Solver:
@@ -152,37 +157,22 @@ class StepMap:
         self.evaluations += 1
         return s
 
-    def trajectory(self, x: np.ndarray) -> np.ndarray:
-        """The M + 1 states from a state.
-
-        Parameters
-        ----------
-        x : numpy.ndarray
-            A state (L n values).
-
-        Returns
-        -------
-        numpy.ndarray
-            Shape (M + 1, n): U^0 .. U^M (U^0 is x's last row).
-        """
-        return self._start_at(x).run(self.M)[1]
-
-    def run_from(self, x: np.ndarray, steps: int) -> np.ndarray:
+    def trajectory(self, x: np.ndarray, periods: int = 1) -> np.ndarray:
         """The states of a run from a state, in the model's own time from t = 0.
 
         Parameters
         ----------
         x : numpy.ndarray
             A state (L n values).
-        steps : int
-            Steps to run (several periods: one evaluation).
+        periods : int
+            Periods to run (one evaluation).
 
         Returns
         -------
         numpy.ndarray
-            Shape (steps + 1, n): U^0 .. U^steps.
+            Shape (periods M + 1, n): U^0 .. U^(periods M) (U^0 is x's last row).
         """
-        return self._start_at(x).run(int(steps))[1]
+        return self._start_at(x).run(int(periods) * self.M)[1]
 
     def trajectory_terms(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The trajectory and the resolvent's arguments, from one run.

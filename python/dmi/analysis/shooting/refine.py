@@ -42,11 +42,12 @@ class Refined:
     Attributes
     ----------
     period : float
-        The period (time units).
+        The period at h = 0 (time units): extrapolated where the levels are smooth, else the
+        finest level's.
     amplitude : numpy.ndarray
-        Shape (n,): (max - min) / 2 per component (state units).
+        Shape (n,): (max - min) / 2 per component at h = 0, as the period (state units).
     multipliers : numpy.ndarray of complex
-        The leading Floquet multipliers, largest |mu| first.
+        The leading Floquet multipliers at h = 0, as the period; largest |mu| first.
     errors : dict
         Their estimated errors, keyed ``"period"``, ``"amplitude"``, ``"multipliers"`` (arrays
         of the same shapes, same units).
