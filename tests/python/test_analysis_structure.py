@@ -323,3 +323,14 @@ def local(k):
     return seen
 """
     assert caches(ast.parse(src)) == {"nodes", "other", "TABLE", "_memo"}
+
+
+def test_scheme_and_shooting_rooms_are_shallow():
+    # the step map and the multipliers import nothing of dmi.analysis (the model's construction is
+    # dmi._make's, floquet reads its map through a Protocol): an orbit's record is two modules
+    # deep; the forced and autonomous shootings sit side by side under shoot and refine
+    edges = graph(PYTHON / "dmi")
+    assert depth(edges, "dmi.analysis.scheme.") <= 2
+    assert depth(edges, "dmi.analysis.shooting.") <= 2
+    for leaf in ("scheme.stepmap", "scheme.floquet"):
+        assert not {n for n in edges[f"dmi.analysis.{leaf}"] if n.startswith("dmi.analysis")}, leaf
