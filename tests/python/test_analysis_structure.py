@@ -179,3 +179,158 @@ def test_climbs_sees_an_import_back_up():
              "dmi.analysis.plot.branch": {"dmi.analysis.plot.interactive"}}
     assert climbs(edges) == [("dmi.analysis.core.model", "dmi.analysis.scheme.stepmap"),
                              ("dmi.analysis.shooting.shoot", "dmi.analysis.orbits")]
+
+
+# ---- caches, found by what they are -------------------------------------------------------------
+
+IDENTIFY = PYTHON / "dmi" / "identify"
+#: Callables that make a dict a memo may live in.
+DICT_MAKERS = {"dict", "OrderedDict", "defaultdict"}
+#: Decorators that memoise a function.
+MEMO_DECORATORS = {"lru_cache", "cache"}
+#: Memoising tables of pure constants, the same for every problem (by (module, name)), allowed
+#: with the reason.
+CONSTANT_CACHES = {
+    ("analysis.collocation.mesh", "_monomials"): "the Lagrange basis' coefficients by its degree",
+    ("analysis.collocation.mesh", "_jacobi"): "Gauss-Jacobi nodes and weights by (q, beta)",
+    ("analysis.collocation.mesh", "_legendre"): "Gauss-Legendre nodes and weights by q",
+}
+#: Memos kept inside an object that the problem's cache itself holds (the collocation's Terms of
+#: one p, cached by CollocationDiscretisation's Problem): per problem already, by way of it;
+#: folding them into Problem.cached is the collocation room's change.
+INSIDE_CACHED = {
+    ("analysis.collocation.system", "_delays"): "the delay integral's matrices by mesh",
+    ("analysis.collocation.system", "_kept"): "f and its Jacobian at the last iterate",
+}
+
+
+def _target(node: ast.AST) -> str | None:
+    """The name a dict is kept under: an attribute (on self or any object) or a plain name."""
+    if isinstance(node, ast.Attribute):
+        return node.attr
+    if isinstance(node, ast.Name):
+        return node.id
+    return None
+
+
+def _new_dict(value: ast.AST | None) -> bool:
+    if isinstance(value, (ast.Dict, ast.DictComp)):
+        return True
+    if isinstance(value, ast.Call):
+        f = value.func
+        return (f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute)
+                else "") in DICT_MAKERS
+    return False
+
+
+def _memo_uses(fn: ast.AST, name: str) -> tuple[bool, bool]:
+    """(looked up, stored into) by key inside fn: d.get(k), k in d, d[k]; d[k] = v, d.setdefault."""
+    look = store = False
+    for n in ast.walk(fn):
+        if isinstance(n, ast.Subscript) and _target(n.value) == name:
+            store |= isinstance(n.ctx, ast.Store)
+            look |= isinstance(n.ctx, ast.Load)
+        elif isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute) \
+                and _target(n.func.value) == name:
+            look |= n.func.attr in ("get", "setdefault")
+            store |= n.func.attr == "setdefault"
+        elif isinstance(n, ast.Compare) and any(isinstance(o, (ast.In, ast.NotIn)) for o in n.ops) \
+                and any(_target(c) == name for c in n.comparators):
+            look = True
+    return look, store
+
+
+def caches(tree: ast.Module) -> set[str]:
+    """The caches of a module: functions under an lru_cache / cache decorator, and dicts kept on
+    an object (``self.x = {}``) or at module level that one function both looks up and stores
+    into by key (a memo).  A dict local to a function is not kept beyond its call."""
+    out = set()
+    for fn in functions(tree):
+        for d in fn.decorator_list:
+            f = d.func if isinstance(d, ast.Call) else d
+            if _target(f) in MEMO_DECORATORS:
+                out.add(fn.name)
+    kept = set()
+    for n in ast.walk(tree):
+        if isinstance(n, (ast.Assign, ast.AnnAssign)) and _new_dict(n.value):
+            for t in (n.targets if isinstance(n, ast.Assign) else [n.target]):
+                if isinstance(t, ast.Attribute):
+                    kept.add(t.attr)
+    for n in tree.body:     # module level
+        if isinstance(n, (ast.Assign, ast.AnnAssign)) and _new_dict(n.value):
+            kept |= {t.id for t in (n.targets if isinstance(n, ast.Assign) else [n.target])
+                     if isinstance(t, ast.Name)}
+    for name in kept:
+        if any(all(_memo_uses(fn, name)) for fn in functions(tree)):
+            out.add(name)
+    return out
+
+
+def package_caches() -> dict[tuple[str, str], None]:
+    found = {}
+    for root in (ANALYSIS, IDENTIFY):
+        for f in sorted(root.rglob("*.py")):
+            mod = ".".join(f.relative_to(root.parent).with_suffix("").parts)
+            for name in caches(ast.parse(f.read_text())):
+                found[(mod, name)] = None
+    return found
+
+
+def test_caches_are_found_by_what_they_are():
+    found = set(package_caches())
+    allowed = set(CONSTANT_CACHES) | set(INSIDE_CACHED)
+    assert found - allowed == set(), (
+        f"memoising tables besides the problem's cache (Problem.cached, dmi._cache.Cache): "
+        f"{sorted(found - allowed)}")
+    # the problems keep one dmi._cache.Cache each: scheme.problem's and identify's fit
+    made = {mod for mod, tree in [(".".join(f.relative_to(r.parent).with_suffix("").parts),
+                                   ast.parse(f.read_text()))
+                                  for r in (ANALYSIS, IDENTIFY) for f in r.rglob("*.py")]
+            if calls(tree, "Cache")}
+    assert made == {"analysis.scheme.problem", "identify.fitting"}, made
+    # the check sees each kind of cache
+    src = """
+import functools
+from collections import OrderedDict
+TABLE = {}
+
+@functools.lru_cache(maxsize=8)
+def nodes(q): return q
+
+@cache
+def other(q): return q
+
+def lookup(k):
+    if k not in TABLE:
+        TABLE[k] = k
+    return TABLE[k]
+
+class Holder:
+    def __init__(self):
+        self._memo = OrderedDict()
+        self.data = {}
+    def get(self, k):
+        got = self._memo.get(k)
+        if got is None:
+            got = self._memo[k] = k
+        return got
+    def fill(self, k):
+        self.data[k] = k          # stored, never looked up: data, not a memo
+
+def local(k):
+    seen = {}
+    seen[k] = seen.get(k, 0) + 1  # local to the call
+    return seen
+"""
+    assert caches(ast.parse(src)) == {"nodes", "other", "TABLE", "_memo"}
+
+
+def test_scheme_and_shooting_rooms_are_shallow():
+    # the step map and the multipliers import nothing of dmi.analysis (the model's construction is
+    # dmi._make's, floquet reads its map through a Protocol): an orbit's record is two modules
+    # deep; the forced and autonomous shootings sit side by side under shoot and refine
+    edges = graph(PYTHON / "dmi")
+    assert depth(edges, "dmi.analysis.scheme.") <= 2
+    assert depth(edges, "dmi.analysis.shooting.") <= 2
+    for leaf in ("scheme.stepmap", "scheme.floquet"):
+        assert not {n for n in edges[f"dmi.analysis.{leaf}"] if n.startswith("dmi.analysis")}, leaf

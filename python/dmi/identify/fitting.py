@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 from scipy import optimize, stats
 
+from .._cache import Cache
 from .._solver import Solver
 from .sensitivity import MAX_STEPS, Sensitivities, check_steps, sensitivities
 
@@ -466,7 +467,7 @@ class _Problem:
         self.best: tuple[float, np.ndarray] | None = None
         self.unplaced: list = []        # (record, step) of the last Jacobian's unplaced reversals
         self.max_steps: int | None = None
-        self._cache: tuple[bytes, np.ndarray, np.ndarray] | None = None
+        self.cache = Cache(1)           # the residuals and Jacobian at the last x
 
     def full(self, x: np.ndarray) -> np.ndarray:
         p = self.p0.copy()
@@ -542,9 +543,16 @@ class _Problem:
         raise ValueError(f"the model's values are not finite for {where}, at p = {p.tolist()}")
 
     def jacobian(self, x: np.ndarray) -> np.ndarray:
-        key = x.tobytes() + bytes([self.jumps])
-        if self._cache is not None and self._cache[0] == key:
-            return self._cache[2]
+        """The Jacobian of the weighted residuals at the free parameters x (:meth:`linearised`)."""
+        return self.linearised(x)[1]
+
+    def linearised(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(r, J): the weighted residuals and their Jacobian at the free parameters x, from the
+        sensitivities' runs (kept in the problem's cache for the next call at the same x)."""
+        return self.cache.cached(("linearised", x.tobytes(), self.jumps),
+                                 lambda: self._linearise(x))
+
+    def _linearise(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         p = self.full(x)
         idx = np.flatnonzero(self.free)
         rows, res = [], []
@@ -571,9 +579,8 @@ class _Problem:
             rows.append((der * d.w[:, :, None]).reshape(-1, len(idx)))
         J = np.concatenate(rows)
         self.njev += 1
-        self._cache = (key, np.concatenate(res), J)
         self.unplaced = unplaced
-        return J
+        return np.concatenate(res), J
 
 
 # ---- the fit --------------------------------------------------------------------------------------
@@ -664,12 +671,59 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
     TypeError
         A record that is not a :class:`Record`, or make not returning a dmi.Solver.
     """
+    options = _options(options)
+    p0, names, mask, (lo, hi), records, makes = _parameters(make, p0, records, names, free, bounds)
+    data = _records(records, makes, p0, mask, options.max_steps)
+    problem = _new_problem(makes, p0, mask, data, rhs, (lo, hi), options.max_steps)
+    starts = _starts(multistart, p0, lo, hi, seed)
+    # the parameters that do not move the records at p0: kept there and named, before a fit
+    # could walk the others anywhere to make up for them
+    insensitive = _insensitive(problem, names)
+    if insensitive:
+        mask = mask & ~np.isin(names, insensitive)
+        problem = _new_problem(makes, p0, mask, data, rhs, (lo, hi), options.max_steps)
+        why = (f"{', '.join(insensitive)} do{'es' if len(insensitive) == 1 else ''} not move the "
+               "records at p0 (a zero column of the Jacobian): kept at p0 and not fitted, infinite "
+               "standard error; fix it in make, or start from a p0 where it acts")
+        warnings.warn(f"estimate: {why}", RuntimeWarning, stacklevel=2)
+        if not mask.any():
+            return _unmoved(problem, names, insensitive, lo, hi)
+    fits = _run_starts(problem, starts, (lo, hi), x_scale, loss, max_nfev, callback, verbose,
+                       polish, options.progress)
+    best = min(fits, key=lambda f: f[1])
+    x, cost, message, stopped, converged = best
+    lower = None
+    if converged and not stopped and options.saddle_check:
+        lower = _saddle(problem, x, cost, names)
+    est = _summarise(problem, names, x, cost, message, stopped, converged, options, insensitive)
+    est.starts = [(s.copy(), f[1]) for s, f in zip(starts, fits)]
+    est.bounds = (lo.copy(), hi.copy())
+    if lower is not None:
+        est.lower, est.lower_cost = problem.full(lower[0]), lower[1]
+        why = (f"the cost falls from {cost:.10g} to {lower[1]:.10g} along a near-null direction of "
+               f"the Jacobian ({lower[2]}): the fit stopped on a saddle, not a minimum; refit from "
+               "Estimate.lower (or with multistart)")
+        est.success = False
+        est.message = f"{est.message}; {why}"
+        warnings.warn(f"estimate: {why}", RuntimeWarning, stacklevel=2)
+    return est
+
+
+def _options(options: FitOptions | None) -> FitOptions:
+    """The fit's options (default ``FitOptions()``), checked."""
     options = FitOptions() if options is None else options
     if not isinstance(options, FitOptions):
         raise TypeError(f"options is a {type(options).__name__}; expected a dmi.identify.FitOptions")
     if not 0.0 < options.chi2_alpha < 0.5:
         raise ValueError(f"FitOptions.chi2_alpha = {options.chi2_alpha!r}: expected a probability "
                          "in (0, 0.5)")
+    return options
+
+
+def _parameters(make: Any, p0: Any, records: Any, names: Any, free: Any, bounds: Any
+                ) -> tuple[np.ndarray, list, np.ndarray, tuple, list, list]:
+    """(p0, names, the free mask, (lo, hi), the records, a model per record) from estimate's
+    arguments, checked (ValueError naming the one at fault)."""
     if isinstance(p0, Mapping):
         p0, names, free, bounds = _from_parameters(p0, names, free, bounds)
     p0 = np.array(p0, dtype=float).reshape(-1)
@@ -695,6 +749,13 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
         j = outside[0]
         raise ValueError(f"bounds exclude p0: {names[j]} = {float(p0[j])!r} is outside "
                          f"[{float(lo[j])!r}, {float(hi[j])!r}]; move p0 or widen the bounds")
+    return p0, names, mask, (lo, hi), records, makes
+
+
+def _records(records: list, makes: list, p0: np.ndarray, mask: np.ndarray,
+             max_steps: int | None) -> list:
+    """The records checked against their models at p0 (their n, and the steps they reach against
+    max_steps, before any run)."""
     data = []
     for k, (r, mk) in enumerate(zip(records, makes)):
         try:
@@ -705,27 +766,27 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
             raise TypeError(f"make(p0) returned {type(s).__name__}; expected a dmi.Solver")
         d = _check_record(r, k, s.n)
         steps = record_steps(s, d)
-        check_steps(steps, s.n, s.N, int(mask.sum()), s.h, options.max_steps,
+        check_steps(steps, s.n, s.N, int(mask.sum()), s.h, max_steps,
                     f"records[{k}] (t up to {float(d.t[-1]):.6g})")
         data.append(d)
+    return data
+
+
+def _new_problem(makes: list, p0: np.ndarray, mask: np.ndarray, data: list, rhs: Any,
+                 bounds: tuple[np.ndarray, np.ndarray], max_steps: int | None) -> _Problem:
+    """The residuals' problem of a fit of the parameters ``mask`` within ``bounds``."""
     problem = _Problem(makes, p0, mask, data, rhs)
-    problem.bounds = (lo, hi)
-    problem.max_steps = options.max_steps
-    starts = _starts(multistart, p0, lo, hi, seed)
-    # the parameters that do not move the records at p0: kept there and named, before a fit
-    # could walk the others anywhere to make up for them
-    insensitive = _insensitive(problem, names)
-    if insensitive:
-        mask = mask & ~np.isin(names, insensitive)
-        problem = _Problem(makes, p0, mask, data, rhs)
-        problem.bounds, problem.max_steps = (lo, hi), options.max_steps
-        why = (f"{', '.join(insensitive)} do{'es' if len(insensitive) == 1 else ''} not move the "
-               "records at p0 (a zero column of the Jacobian): kept at p0 and not fitted, infinite "
-               "standard error; fix it in make, or start from a p0 where it acts")
-        warnings.warn(f"estimate: {why}", RuntimeWarning, stacklevel=2)
-        if not mask.any():
-            return _unmoved(problem, names, insensitive, lo, hi)
-    show = sys.stderr.isatty() if options.progress is None else bool(options.progress)
+    problem.bounds = bounds
+    problem.max_steps = max_steps
+    return problem
+
+
+def _run_starts(problem: _Problem, starts: list, bounds: tuple[np.ndarray, np.ndarray],
+                x_scale: Any, loss: str, max_nfev: int | None, callback: Any, verbose: bool,
+                polish: bool, progress: bool | None) -> list:
+    """The fits from each start (:func:`_fit`), until one is stopped by the user; the progress
+    shown on a terminal's stderr (``progress`` None) or as asked."""
+    show = sys.stderr.isatty() if progress is None else bool(progress)
     clock = time.monotonic()
     fits = []
     for number, x_start in enumerate(starts):
@@ -734,30 +795,13 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
                              f"cost {cost:.8g}, {problem.nfev} runs, "
                              f"{time.monotonic() - clock:.1f} s   ")
             sys.stderr.flush()
-        fits.append(_fit(problem, x_start, lo, hi, x_scale, loss, max_nfev, callback, verbose,
-                         polish, display if show else None))
+        fits.append(_fit(problem, x_start, bounds[0], bounds[1], x_scale, loss, max_nfev, callback,
+                         verbose, polish, display if show else None))
         if fits[-1][3]:                                   # stopped by the user: no more starts
             break
     if show:
         sys.stderr.write("\n")
-    best = min(fits, key=lambda f: f[1])
-    x, cost, message, stopped, converged = best
-    lower = None
-    if converged and not stopped and options.saddle_check:
-        lower = _saddle(problem, x, cost, names)
-    est = _summarise(problem, names, x, cost, message, stopped, converged, options, insensitive)
-    est.starts = [(s.copy(), f[1]) for s, f in zip(starts, fits)]
-    est.bounds = (lo.copy(), hi.copy())
-    if lower is not None:
-        est.lower, est.lower_cost = problem.full(lower[0]), lower[1]
-        why = (f"the cost falls from {cost:.10g} to {lower[1]:.10g} along a near-null direction of "
-               f"the Jacobian ({lower[2]}): the fit stopped on a saddle, not a minimum; refit from "
-               "Estimate.lower (or with multistart)")
-        est.success = False
-        est.message = f"{est.message}; {why}"
-        warnings.warn(f"estimate: {why}", RuntimeWarning, stacklevel=2)
-    return est
-
+    return fits
 
 def _from_parameters(params: Mapping, names: Any, free: Any, bounds: Any
                      ) -> tuple[np.ndarray, list, np.ndarray, tuple]:
@@ -1028,8 +1072,7 @@ def _summarise(problem: _Problem, names: list, x: np.ndarray, cost: float, messa
     options = FitOptions() if options is None else options
     free = problem.free
     p = problem.full(x)
-    J = problem.jacobian(x)
-    r = problem._cache[1]
+    r, J = problem.linearised(x)
     M, F = J.shape
     P = len(p)
     dof = M - F

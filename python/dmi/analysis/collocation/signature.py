@@ -17,7 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-FREE, SLIP_POS, SLIP_NEG, STUCK, LO, HI = 0, 1, -1, 2, 3, 4
+from ... import _resolvent as rule
+from ..._resolvent import FREE, HI, LO, SLIP_NEG, SLIP_POS, STUCK
+
 NAMES = {FREE: "free", SLIP_POS: "slip +", SLIP_NEG: "slip -", STUCK: "stuck", LO: "on lo",
          HI: "on hi"}
 
@@ -53,23 +55,23 @@ class Signature:
 
 
 def step_modes(U: np.ndarray, alpha: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """(M, n) modes of the steps of one period of the scheme (U: M + 1 rows): a friction
-    component is stuck where U_i = 0 exactly for 2 steps or more (the resolvent's dead zone), else
-    slips with the sign of U_i (a lone zero, a transversal reversal, takes the next step's sign);
-    a box component is on a face where U_i equals it exactly (the clip), else free."""
+    """(M, n) modes of the steps of one period of the scheme (U: M + 1 rows), read periodically
+    by the resolvent's rule (:func:`dmi._resolvent.friction_mode`, :func:`~dmi._resolvent.box_mode`):
+    a friction component is stuck where U_i = 0 exactly for 2 steps or more (the resolvent's dead
+    zone), else slips with the sign of U_i (a lone zero, a transversal reversal, takes the next
+    step's sign); a box component is on a face where U_i equals it exactly (the clip), else free."""
     U = np.asarray(U, dtype=float)[1:]
     M, n = U.shape
     modes = np.zeros((M, n), dtype=int)
     for i in range(n):
+        u = U[:, i]
         if alpha[i] > 0:
-            z = U[:, i] == 0.0
-            stuck = z & (np.roll(z, 1) | np.roll(z, -1))
-            sign = np.sign(U[:, i])
-            for k in np.flatnonzero(sign == 0)[::-1]:       # a lone zero: the next step's sign
-                sign[k] = sign[(k + 1) % M]
-            modes[:, i] = np.where(stuck, STUCK, np.where(sign > 0, SLIP_POS, SLIP_NEG))
+            nxt = np.roll(u, -1)
+            m = rule.friction_mode(np.roll(u, 1), u, nxt)
+            lone = (m == rule.REVERSAL) | (m == rule.TOUCH)
+            modes[:, i] = np.where(lone, np.where(nxt > 0, SLIP_POS, SLIP_NEG), m)
         elif np.isfinite(lo[i]) or np.isfinite(hi[i]):
-            modes[:, i] = np.where(U[:, i] == lo[i], LO, np.where(U[:, i] == hi[i], HI, FREE))
+            modes[:, i] = rule.box_mode(u, lo[i], hi[i])
     return modes
 
 

@@ -19,12 +19,14 @@ from __future__ import annotations
 
 import ctypes
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
 
 from ... import _lib
+from ... import _resolvent as rule
+from ..._make import call_make  # noqa: F401  (the equilibria's model calls)
 from ..._solver import Solver
 from ..._transform import laplace, near_shift
 
@@ -45,22 +47,6 @@ class KinkError(ValueError):
     message : str
         Which component, and where.
     """
-
-
-def call_make(make: Callable[..., Any], *args: Any, **kw: Any) -> Solver:
-    """make(*args, **kw), checked to be a dmi.Solver; its exception (the model's own) gets a
-    note naming the call, ``make(p = ...)``."""
-    call = ", ".join([f"p = {a!r}" if i == 0 else repr(a) for i, a in enumerate(args)]
-                     + [f"{k}={v!r}" for k, v in kw.items()])
-    try:
-        s = make(*args, **kw)
-    except Exception as e:
-        e.add_note(f"dmi.analysis: raised by the model make({call})")
-        raise
-    if not isinstance(s, Solver):
-        raise TypeError(f"dmi.analysis: the model make({call}) returned {type(s).__name__}, "
-                        "not a dmi.Solver")
-    return s
 
 
 def equilibrium(u_eq: Any, n: int, args: tuple) -> np.ndarray:
@@ -169,33 +155,27 @@ def rhs_jacobian(s: Solver, t: float, u: np.ndarray) -> np.ndarray:
 
 
 def _resolvent_derivative(s: Solver, X: np.ndarray, h: float, scale: float) -> np.ndarray:
-    """D = R'(X): exact for the built-in friction and box, central differences for a callback."""
+    """D = R'(X): exact for the built-in friction and box (:mod:`dmi._resolvent`, libdmi's
+    rule), central differences for a callback; KinkError where X is on a kink."""
     n = s.n
     kind = s.resolvent_kind
     if kind == "friction":
-        alpha = s.friction
-        d = np.ones(n)
+        lam = h * s.friction
         for i in range(n):
-            lam = h * alpha[i]
-            if lam == 0:
-                continue
-            if abs(abs(X[i]) - lam) <= KINK_TOL * max(abs(X[i]), lam):
+            if lam[i] != 0 and rule.near(abs(X[i]), lam[i], KINK_TOL):
                 raise KinkError(f"dmi.analysis: dry friction component {i} sticks exactly at its "
-                                f"threshold (|X*| = {abs(X[i])!r}, h alpha = {lam!r}): a kink of "
-                                "the resolvent, no linearisation there")
-            d[i] = 1.0 if abs(X[i]) > lam else 0.0
-        return np.diag(d)
+                                f"threshold (|X*| = {abs(X[i])!r}, h alpha = {lam[i]!r}): a kink "
+                                "of the resolvent, no linearisation there")
+        return np.diag(rule.friction_slope(X, lam))
     if kind == "box":
         lo, hi = s.box
-        d = np.ones(n)
         for i in range(n):
             for b in (lo[i], hi[i]):
-                if np.isfinite(b) and abs(X[i] - b) <= KINK_TOL * max(abs(X[i]), abs(b)):
+                if np.isfinite(b) and rule.near(X[i], b, KINK_TOL):
                     raise KinkError(f"dmi.analysis: box component {i}: X*[{i}] = {X[i]!r} is on "
                                     f"the face {b!r}: a kink of the projection, no linearisation "
                                     "there")
-            d[i] = 1.0 if lo[i] < X[i] < hi[i] else 0.0
-        return np.diag(d)
+        return np.diag(rule.box_slope(X, lo, hi))
     if kind != "callback":
         return np.eye(n)
     return _central(lambda x: _call(s, "resolvent", h, x), X, scale, "resolvent")
@@ -228,13 +208,21 @@ def kernel_of(s: Solver) -> tuple[tuple | None, Callable[[float], np.ndarray] | 
     return None, None
 
 
-def kernel_panels(call: Callable[[float], np.ndarray], tau: float, reach: float
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _panels(length: float, tau: float, reach: float) -> int:
+    """Panels of width at most min(tau / 8, 1 / reach) on a piece of [0, tau] of that length."""
+    return max(1, math.ceil(8 * length / tau), math.ceil(length * reach))
+
+
+def kernel_panels(call: Callable[[float], np.ndarray], tau: float, reach: float,
+                  jumps: Sequence[float] = ()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Gauss-Legendre nodes s, weights w and kernel samples H(s) (k, n, n) on panels of [0, tau]
-    of width at most min(tau / 8, 1 / reach), PANEL_NODES nodes each."""
-    panels = max(8, math.ceil(tau * reach))
+    of width at most min(tau / 8, 1 / reach), PANEL_NODES nodes each; the lags ``jumps`` inside
+    (0, tau) where H jumps are panel edges (each piece between them is integrated on its own, so
+    that a jump costs no accuracy)."""
     x, wx = np.polynomial.legendre.leggauss(PANEL_NODES)
-    edges = np.linspace(0.0, tau, panels + 1)
+    cuts = sorted({0.0, float(tau)} | {float(j) for j in jumps if 0.0 < j < tau})
+    edges = np.concatenate([np.linspace(a, b, _panels(b - a, tau, reach) + 1)[:-1]
+                            for a, b in zip(cuts[:-1], cuts[1:])] + [[float(tau)]])
     half = 0.5 * np.diff(edges)
     s = (edges[:-1, None] + half[:, None] * (x[None, :] + 1)).ravel()
     w = (half[:, None] * wx[None, :]).ravel()
@@ -242,25 +230,27 @@ def kernel_panels(call: Callable[[float], np.ndarray], tau: float, reach: float
     return s, w, H
 
 
-def kernel_integral(s: Solver) -> np.ndarray:
+def kernel_integral(s: Solver, jumps: Sequence[float] = ()) -> np.ndarray:
     """int_0^tau H(s) ds (n x n) of the model's kernel: Hhat(0) in closed form for an
     exponential sum (with a fitted singular kernel's exact near part), by the panels'
-    quadrature for a callback, 0 without a kernel."""
+    quadrature for a callback (piecewise between its declared ``jumps``, lags in (0, tau)), 0
+    without a kernel."""
     terms, kernel = kernel_of(s)
     if terms is not None:
         near = near_shift(s)      # a fitted singular kernel: exact on [0, delta]
         return np.real(laplace(0.0, *terms, tau=s.tau) + (near(0.0) if near else 0.0))
     if kernel is not None:
-        _, w, H = kernel_panels(kernel, s.tau, 1.0)
+        _, w, H = kernel_panels(kernel, s.tau, 1.0, jumps)
         return np.tensordot(w, H, axes=(0, 0))
     return np.zeros((s.n, s.n))
 
 
-def equation_terms(s: Solver) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
+def equation_terms(s: Solver, jumps: Sequence[float] = ()
+                   ) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
     """u -> (X, G): the resolvent's argument X = u - h f(0, u) - h K u with the continuous
-    integral K = int_0^tau H (the scheme's has h sum_l H(l h) for K), and G(u) = R(X) - u, zero at
-    the equation's equilibria."""
-    h, f, R, K = s.h, rhs_of(s), resolvent_of(s), kernel_integral(s)
+    integral K = int_0^tau H (the scheme's has h sum_l H(l h) for K; a callback kernel's declared
+    ``jumps`` cut its quadrature), and G(u) = R(X) - u, zero at the equation's equilibria."""
+    h, f, R, K = s.h, rhs_of(s), resolvent_of(s), kernel_integral(s, jumps)
 
     def terms(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         X = u - h * f(u) - h * (K @ u)
@@ -274,16 +264,16 @@ def equation_step(s: Solver) -> Callable[[np.ndarray], np.ndarray]:
     return lambda u: terms(u)[1]
 
 
-def checked_equilibrium(s: Solver, u: np.ndarray, args: tuple, tol: float, of: str
-                        ) -> tuple[np.ndarray, float]:
+def checked_equilibrium(s: Solver, u: np.ndarray, args: tuple, tol: float, of: str,
+                        jumps: Sequence[float] = ()) -> tuple[np.ndarray, float]:
     """(X*, t0): the resolvent's argument at the equilibrium u and the step's time, after
     checking that one step of the scheme from the constant history u (or, ``of="equation"``,
-    of the equation's step with the continuous integral) moves it by at most tol times
-    max(1, |u|, |u - X*|); ValueError naming the move otherwise.  The scheme's check
-    initialises s."""
+    of the equation's step with the continuous integral, cut at a callback kernel's declared
+    ``jumps``) moves it by at most tol times max(1, |u|, |u - X*|); ValueError naming the move
+    otherwise.  The scheme's check initialises s."""
     t0 = 0.0
     if of == "equation":
-        X, moved = equation_terms(s)(u)
+        X, moved = equation_terms(s, jumps)(u)
     else:
         s.init()
         s.set_window(np.tile(u, (s.N + 1, 1)))

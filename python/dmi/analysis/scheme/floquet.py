@@ -55,12 +55,12 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 import scipy.linalg as sl
 import scipy.sparse.linalg as sla
 
-from .stepmap import StepMap
 
 #: c in eps = c A min(M^(-1/3), FD_CAP) (see the module's docstring).
 FD_FACTOR = 1.0
@@ -70,7 +70,28 @@ FD_FACTOR = 1.0
 FD_CAP = 0.05
 
 
-def fd_step(F: StepMap, x: np.ndarray, U: np.ndarray | None = None,
+class PeriodMap(Protocol):
+    """What the multipliers read of the M-step map of an orbit: a
+    :class:`dmi.analysis.scheme.stepmap.StepMap` (this module does not import it, so that the
+    orbit's record, which imports both, stays two modules deep)."""
+    p: float
+    M: int
+    L: int
+    n: int
+    h: float
+    evaluations: int
+
+    @property
+    def dim(self) -> int: ...
+
+    def __call__(self, x: np.ndarray) -> np.ndarray: ...
+
+    def trajectory(self, x: np.ndarray, periods: int = 1) -> np.ndarray: ...
+
+    def trajectory_terms(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+
+
+def fd_step(F: PeriodMap, x: np.ndarray, U: np.ndarray | None = None,
             X: np.ndarray | None = None) -> float:
     """The difference step (state units) at the fixed point x, from its trajectory ``U`` and the
     resolvent's arguments ``X`` (:meth:`StepMap.trajectory_terms`, else one run of M steps).
@@ -104,7 +125,7 @@ def fd_step(F: StepMap, x: np.ndarray, U: np.ndarray | None = None,
     return FD_FACTOR * A * min(F.M ** (-1.0 / 3.0), FD_CAP)
 
 
-def monodromy_operator(F: StepMap, x: np.ndarray, eps: float | None = None,
+def monodromy_operator(F: PeriodMap, x: np.ndarray, eps: float | None = None,
                        central: bool = True) -> sla.LinearOperator:
     """The linearisation of the M-step map F at its fixed point x by differences of step
     ``eps`` (default :func:`fd_step`) along v / |v|_inf: central (2 evaluations, 2 M steps, a
@@ -230,7 +251,7 @@ class Floquet:
         return np.delete(self.multipliers, self.trivial)
 
 
-def check_fixed_point(F: StepMap, x: np.ndarray, tol: float) -> None:
+def check_fixed_point(F: PeriodMap, x: np.ndarray, tol: float) -> None:
     """ValueError when x is not a fixed point of F to tol max(1, |x|_inf) (the residual given)."""
     r = float(np.max(np.abs(F(x) - x)))
     scale = max(1.0, float(np.max(np.abs(x))))
@@ -242,7 +263,7 @@ def check_fixed_point(F: StepMap, x: np.ndarray, tol: float) -> None:
                          "refine_orbit)")
 
 
-def window_velocity(F: StepMap, U: np.ndarray) -> np.ndarray:
+def window_velocity(F: PeriodMap, U: np.ndarray) -> np.ndarray:
     """The velocity of the window along an M-periodic orbit: row i of the L rows (time
     (i - L + 1) h) is (U^(k+1) - U^(k-1)) / (2 h), k its step, U one period (M + 1 rows) read
     periodically; flattened (L n values)."""
@@ -340,7 +361,7 @@ def across_kick(w: np.ndarray, vel: np.ndarray, n: int) -> np.ndarray:
     return w
 
 
-def growth_rate(F: StepMap, x: np.ndarray, v: np.ndarray, kick: float, periods: int,
+def growth_rate(F: PeriodMap, x: np.ndarray, v: np.ndarray, kick: float, periods: int,
                 autonomous: bool = False, least: float = 0.0) -> tuple[float, float, int]:
     """(rate, standard error of its log, periods fitted) of a plain run from x + max(kick A,
     least) w (A the orbit's largest half range, max(1, |x|) for a constant orbit; ``least``: the
@@ -379,13 +400,13 @@ def growth_rate(F: StepMap, x: np.ndarray, v: np.ndarray, kick: float, periods: 
         w = across_kick(w, vel, F.n)
         Q = np.concatenate([P[-1:], P, P[:1]])
         curv = float(np.median(np.linalg.norm(Q[2:] - 2 * Q[1:-1] + Q[:-2], axis=1))) / 8
-        S = F.run_from(x + 0.5 * F.h * vel, M)
+        S = F.trajectory(x + 0.5 * F.h * vel)
         drift = max(curv, off_orbit(S[1:], P, F.h, True))
     else:
         now = float(np.max(np.abs(w[-F.n:])))     # the kick's size is that of the state at t = 0
         w = w / (now if now > 1e-3 * np.max(np.abs(w)) else np.max(np.abs(w)))
     floor = 100 * float(np.max(np.abs(F(x) - x))) + drift + 1e-13 * scale
-    R = F.run_from(x + max(kick * A, least) * w, periods * M)
+    R = F.trajectory(x + max(kick * A, least) * w, periods)
     d = np.array([off_orbit(R[k * M + 1:(k + 1) * M + 1], P, F.h, autonomous)
                   for k in range(periods)])
     inside = (d > floor) & (d < 0.1 * A)
@@ -414,7 +435,7 @@ def growth_rate(F: StepMap, x: np.ndarray, v: np.ndarray, kick: float, periods: 
 TRIVIAL_TOL = 1e-6
 
 
-def _verdict(F: StepMap, x: np.ndarray, mu: np.ndarray, V: np.ndarray, err: np.ndarray,
+def _verdict(F: PeriodMap, x: np.ndarray, mu: np.ndarray, V: np.ndarray, err: np.ndarray,
              res: np.ndarray, trivial: int | None, converged: bool, why: list[str],
              opts: Verify, eps: float) -> tuple[bool | None, str, float]:
     """(stable, reason, plain run's rate) from the verified pairs (see the module)."""
@@ -463,7 +484,7 @@ def _verdict(F: StepMap, x: np.ndarray, mu: np.ndarray, V: np.ndarray, err: np.n
     return None, (f"undecided: {reason}; {what} {change} (Verify.periods, Verify.kick)"), rate
 
 
-def floquet_verdict(F: StepMap, x: np.ndarray, count: int = 10, *, autonomous: bool = False,
+def floquet_verdict(F: PeriodMap, x: np.ndarray, count: int = 10, *, autonomous: bool = False,
             eps: float | None = None, central: bool = True, verify: Verify | None = None
             ) -> Floquet:
     """The leading Floquet multipliers of a periodic orbit, verified, and its stability verdict.
@@ -538,7 +559,7 @@ def floquet_verdict(F: StepMap, x: np.ndarray, count: int = 10, *, autonomous: b
     return Floquet(mu, err, V, trivial, stable, reason, rate, products)
 
 
-def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
+def floquet_multipliers(F: PeriodMap, x: np.ndarray, count: int = 10, *,
                         eps: float | None = None, central: bool = True,
                         autonomous: bool = False, verify: Verify | None = None) -> np.ndarray:
     """The leading Floquet multipliers of a periodic orbit, right at stick/slip transitions,
@@ -554,16 +575,10 @@ def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
 
     Parameters
     ----------
-    F : StepMap
-        The M-step map, e.g. ``StepMap(orbit.make, orbit.p, orbit.steps, orbit.rows)``.
-    x : numpy.ndarray
-        Its fixed point, e.g. ``orbit.state``.
+    F, x, eps, central : StepMap, numpy.ndarray, float, bool
+        The map, its fixed point and the differences, as for :func:`floquet_verdict`.
     count : int
         How many multipliers.
-    eps : float, optional
-        The difference step (state units), instead of :func:`fd_step`'s.
-    central : bool
-        Central differences (2 evaluations a product), else forward (1).
     autonomous : bool
         An autonomous orbit (its trivial multiplier is found by its vector; it stays in the
         list).
@@ -597,7 +612,7 @@ def floquet_multipliers(F: StepMap, x: np.ndarray, count: int = 10, *,
     return fl.multipliers[:count]
 
 
-def ritz(F: StepMap, x: np.ndarray, count: int, *, blocks: int = 2,
+def ritz(F: PeriodMap, x: np.ndarray, count: int, *, blocks: int = 2,
          start: np.ndarray | None = None, eps: float | None = None, central: bool = True
          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(multipliers, Q, Z) of Rayleigh-Ritz on ``blocks`` blocks of a block Krylov space of b =

@@ -9,6 +9,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ... import _resolvent as rule
+
 from .floquet import Floquet, StabilityWarning, Verify, floquet_verdict
 from .stepmap import Model, StepMap
 
@@ -92,8 +94,9 @@ def stuck_mask(u: np.ndarray) -> np.ndarray:
     within a run of at least 2 such steps, on the period's circle.  A lone zero step is the
     scheme's transversal crossing of a velocity reversal (|net force| > alpha: the next step
     leaves zero), not a stick."""
-    z = np.asarray(u)[1:] == 0.0
-    return z & (np.roll(z, 1, axis=0) | np.roll(z, -1, axis=0))
+    z = np.asarray(u)[1:]
+    modes = rule.friction_mode(np.roll(z, 1, axis=0), z, np.roll(z, -1, axis=0))
+    return modes == rule.STUCK
 
 
 def stick_fraction(u: np.ndarray) -> np.ndarray:

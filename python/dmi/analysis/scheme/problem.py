@@ -3,8 +3,8 @@
 """One value for what every analysis builds from a model ``make(p) -> dmi.Solver``.
 
 A :class:`Problem` holds the model, its step policy (the model keeps its own step h, or gets
-h through ``make(p, h=...)``), one cache of the recent objects built from it (step maps,
-one-step maps of equilibria: each built once per key), and the probe solvers read for h, tau
+h through ``make(p, h=...)``), one cache of the recent objects built from it (a
+:class:`dmi._cache.Cache`: step maps, one-step maps of equilibria: each built once per key), and the probe solvers read for h, tau
 and N through Solver's public accessors (built once per (p, h), never run; the map at (p, h)
 takes the probe over, ``Problem.probe(..., take=True)``).  The memory a
 step h needs, N = ceil(tau / h) steps, is asked of the probe (:meth:`Problem.probe`): one
@@ -14,15 +14,15 @@ autonomous orbit: :func:`phase_row` with :func:`velocity`.
 """
 from __future__ import annotations
 
-from collections import OrderedDict
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
+from ..._cache import Cache
 from ..._solver import Solver
 from ..core.newton import ShootingError
-from .stepmap import Model, StepMap, build, fixed_step
+from .stepmap import Model, StepMap, build, fixed_step, user_model
 
 #: Objects the cache keeps (the least recently used goes first).
 KEEP = 8
@@ -42,9 +42,9 @@ class Problem:
 
     def __init__(self, make: Model, keep: int = KEEP):
         self.model = make                        # make(p) as given
-        self.make = getattr(make, "base", make)  # the user's model (a FixedStep's own)
+        self.make = user_model(make)
         self.keep = int(keep)
-        self._cache: OrderedDict[Any, Any] = OrderedDict()
+        self._cache = Cache(keep)
 
     def solver(self, p: float, h: float | None = None) -> Solver:
         """A new solver of the model at p (and the step h when given).
@@ -85,15 +85,7 @@ class Problem:
         object
             The cached or new object.
         """
-        got = self._cache.get(key)
-        if got is None:
-            got = factory()
-            self._cache[key] = got
-            while len(self._cache) > self.keep:
-                self._cache.popitem(last=False)
-        else:
-            self._cache.move_to_end(key)
-        return got
+        return self._cache.cached(key, factory)
 
     def probe(self, p: float, h: float | None = None, *, take: bool = False) -> Solver:
         """The probe solver at (p, h): read for its h, tau, N (N = ceil(tau / h), the memory a
@@ -116,7 +108,7 @@ class Problem:
         """
         key = ("probe", float(p), h)
         if take:
-            got = self._cache.pop(key, None)
+            got = self._cache.pop(key)
             return got if got is not None else self.solver(p, h)
         return self.cached(key, lambda: self.solver(p, h))
 

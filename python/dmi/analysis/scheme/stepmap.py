@@ -21,10 +21,15 @@ from typing import Any
 
 import numpy as np
 
+from ..._make import call_make
 from ..._solver import Solver
-from ..core.model import call_make
 
 Model = Callable[..., Solver]
+
+
+def user_model(make: Model) -> Model:
+    """The user's model behind make: a :class:`FixedStep`'s own, else make itself."""
+    return getattr(make, "base", make)
 
 
 class FixedStep:
@@ -41,7 +46,7 @@ class FixedStep:
     """
 
     def __init__(self, make: Model, h: float):
-        self.base = getattr(make, "base", make)   # the user's model, not a FixedStep of one
+        self.base = user_model(make)
         self.h = float(h)
 
     def __call__(self, p: float, h: float | None = None) -> Solver:
@@ -73,7 +78,7 @@ def fixed_step(make: Model, h: float) -> Model:
 
 def build(make: Model, p: float, **kw: Any) -> Solver:
     """``make(p, **kw)``: the model's own exception, with a note naming the call, when it
-    fails (:func:`dmi.analysis.core.model.call_make`); TypeError when it returns no dmi.Solver."""
+    fails (:func:`dmi._make.call_make`); TypeError when it returns no dmi.Solver."""
     return call_make(make, p, **kw)
 
 def positive_time(name: str, value: Any) -> float:
@@ -152,37 +157,22 @@ class StepMap:
         self.evaluations += 1
         return s
 
-    def trajectory(self, x: np.ndarray) -> np.ndarray:
-        """The M + 1 states from a state.
-
-        Parameters
-        ----------
-        x : numpy.ndarray
-            A state (L n values).
-
-        Returns
-        -------
-        numpy.ndarray
-            Shape (M + 1, n): U^0 .. U^M (U^0 is x's last row).
-        """
-        return self._start_at(x).run(self.M)[1]
-
-    def run_from(self, x: np.ndarray, steps: int) -> np.ndarray:
+    def trajectory(self, x: np.ndarray, periods: int = 1) -> np.ndarray:
         """The states of a run from a state, in the model's own time from t = 0.
 
         Parameters
         ----------
         x : numpy.ndarray
             A state (L n values).
-        steps : int
-            Steps to run (several periods: one evaluation).
+        periods : int
+            Periods to run (one evaluation).
 
         Returns
         -------
         numpy.ndarray
-            Shape (steps + 1, n): U^0 .. U^steps.
+            Shape (periods M + 1, n): U^0 .. U^(periods M) (U^0 is x's last row).
         """
-        return self._start_at(x).run(int(steps))[1]
+        return self._start_at(x).run(int(periods) * self.M)[1]
 
     def trajectory_terms(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The trajectory and the resolvent's arguments, from one run.

@@ -30,7 +30,8 @@ import numpy as np
 
 from ..core.newton import ShootingError
 from ..scheme.orbit import Orbit
-from .shoot import periodic_orbit
+from .autonomous import autonomous_orbit
+from .forced import forced_orbit
 from ..scheme.stepmap import build, fixed_step
 
 
@@ -42,11 +43,12 @@ class Refined:
     Attributes
     ----------
     period : float
-        The period (time units).
+        The period at h = 0 (time units): extrapolated where the levels are smooth, else the
+        finest level's.
     amplitude : numpy.ndarray
-        Shape (n,): (max - min) / 2 per component (state units).
+        Shape (n,): (max - min) / 2 per component at h = 0, as the period (state units).
     multipliers : numpy.ndarray of complex
-        The leading Floquet multipliers, largest |mu| first.
+        The leading Floquet multipliers at h = 0, as the period; largest |mu| first.
     errors : dict
         Their estimated errors, keyed ``"period"``, ``"amplitude"``, ``"multipliers"`` (arrays
         of the same shapes, same units).
@@ -87,10 +89,9 @@ def _level(o: Orbit, M: int, count: int, tol: float) -> Orbit:
                          f"forced orbit too ({e})") from e
     guess = _resampled(o, h, solver.N + 1)
     if o.autonomous:
-        return periodic_orbit(o.make, o.p, guess=guess, guess_period=o.period, steps=M, tol=tol,
-                              multipliers=count)
-    return periodic_orbit(fixed_step(o.make, h), o.p, o.period, guess, tol=tol,
-                          multipliers=count)
+        return autonomous_orbit(o.make, o.p, guess, o.period, steps=M, tol=tol,
+                                multipliers=count)
+    return forced_orbit(fixed_step(o.make, h), o.p, o.period, guess, tol=tol, multipliers=count)
 
 
 def _matched(levels: list[np.ndarray]) -> np.ndarray:
