@@ -72,7 +72,7 @@ def test_every_q_has_one_row_and_the_failure_its_error(grid):
     (bad,) = grid.failed
     assert bad.q == FAILING and bad.branches == {}
     assert bad.error.startswith("RuntimeError: no branches at G = 0.4")
-    with pytest.warns(da.GridWarning, match=r"1 of 2 values of q failed, at q = 0.4"):
+    with pytest.warns(da.GridWarning, match=r"1 of 2 values of q failed, at q = 0.4"):   # PL06
         da.continue_over((0.1, FAILING), lambda G: branches(FAILING) if G == FAILING else {})
 
 
@@ -166,7 +166,7 @@ def test_a_verdict_none_decides_no_region_and_warns():
     assert regions(row) == [(0.0, 2.0, UNDECIDED)]
     assert facts_at(row, 0.5)[3] is True
     grid = da.Grid(np.array([0.0]), [row])
-    with pytest.warns(da.StabilityWarning, match="not decided"):
+    with pytest.warns(da.StabilityWarning, match="not decided"):   # bad-inputs PL08
         da.plot_curves([], grid)
     # a stable rest beside an orbit branch whose verdict is None: not "stable rest"
     orbits = trace("o", "orbits", [0.0, 2.0], [None, None], [False, False])
@@ -181,20 +181,20 @@ def test_a_change_of_verdict_without_an_event_decides_nothing():
 
 
 def test_refusals():
-    with pytest.raises(ValueError, match="a value twice"):
+    with pytest.raises(ValueError, match="a value twice"):   # bad-inputs PL01
         da.continue_over([0.1, 0.1], branches)
-    with pytest.raises(ValueError, match="finite"):
+    with pytest.raises(ValueError, match="finite"):   # bad-inputs PL02
         da.continue_over([0.1, float("nan")], branches)
     with pytest.raises(ValueError, match="finite values"):
         da.continue_over([], branches)
-    with pytest.raises(ValueError, match="give a function"):
+    with pytest.raises(ValueError, match="give a function"):   # bad-inputs PL03
         da.continue_over([0.1], 3)
-    with pytest.raises(ValueError, match="nothing to draw"):
+    with pytest.raises(ValueError, match="nothing to draw"):   # bad-inputs PL04
         da.plot_curves([])
-    with pytest.raises(ValueError, match="not a Curve"):
+    with pytest.raises(ValueError, match="not a Curve"):   # bad-inputs PL05
         da.plot_curves([object()])
     # a task that returns something other than branches: its row's error names it
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", da.GridWarning)
         g = da.continue_over([0.1], lambda q: {"x": 1.0})
-    assert g.rows[0].error.startswith("TypeError: branches(q = 0.1) gave x = float")
+    assert g.rows[0].error.startswith("TypeError: branches(q = 0.1) gave x = float")   # PL07
