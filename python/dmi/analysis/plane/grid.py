@@ -272,6 +272,25 @@ def continue_over(q_values: Sequence[float], branches: Callable[[float], Any], *
     ValueError
         ``q_values`` empty, not one-dimensional, not finite or with a value twice; ``branches``
         not callable.
+
+    Examples
+    --------
+    A grid of the equilibria and the orbits born at their Hopf point, on the cluster of a
+    scheduler reached over TLS (``dmi_sweep.run.make_client``; ``make_client(4, None)`` starts a
+    LocalCluster of 4 processes; a dask-jobqueue ``SLURMCluster`` or a Kubernetes cluster gives
+    its ``Client(cluster)`` the same way)::
+
+        def branches(q):
+            make = lambda p: make2(p, q)
+            rest = continue_equilibrium(equilibrium(make, p0, u0, of="equation"), p1)
+            (h,) = [e for e in rest.events if e.kind == "hopf"]
+            orbit = hopf_orbit(make, h.hopf, h.u, amplitude=0.01, of="equation")
+            return {"rest": rest, "orbits": continue_orbit(orbit, p0)}
+
+        address = "tls://scheduler:8786"
+        client = make_client(None, address, security(address, ca_file, cert_file, key_file))
+        grid = continue_over(np.linspace(q0, q1, 40), branches, client=client)
+        plot_curves(curves, grid, html="map.html")
     TypeError
         ``client`` given and ``branches`` cannot be sent to it (pickle).
     """

@@ -198,3 +198,33 @@ def test_refusals():
         warnings.simplefilter("ignore", da.GridWarning)
         g = da.continue_over([0.1], lambda q: {"x": 1.0})
     assert g.rows[0].error.startswith("TypeError: branches(q = 0.1) gave x = float")   # PL07
+
+
+class LosingClient:
+    """A client (submit -> future with .result()) that runs each task here, but whose future of
+    one value of q raises as a cluster's does when it loses the worker."""
+
+    def __init__(self, lose: float):
+        self.lose, self.cancelled = lose, 0
+
+    def submit(self, fn):
+        client = self
+
+        class Future:
+            def result(self):
+                if fn.args[1] == client.lose:
+                    raise RuntimeError("KilledWorker: the worker died running the task")
+                return fn()
+
+            def cancel(self):
+                client.cancelled += 1
+        return Future()
+
+
+def test_a_task_the_cluster_loses_keeps_its_row():
+    qs = [0.1, 0.2, 0.3]
+    with pytest.warns(da.GridWarning, match="at q = 0.2: the cluster lost the task"):
+        g = da.continue_over(qs, lambda q: {}, client=LosingClient(0.2))
+    assert [r.q for r in g.rows] == qs                     # every q once, in order
+    assert [r.error is None for r in g.rows] == [True, False, True]
+    assert "KilledWorker" in g.rows[1].error
