@@ -48,6 +48,8 @@ def plot_curves(curves: Sequence[Any] = (), grid: Grid | None = None, ax: Any = 
     curves (Hopf curves by criticality, fold curves) with their codimension-two points, and the
     grid's events (Hopf points by criticality, folds of orbits, stick onsets, grazings, period
     doublings, tori).  p on the horizontal axis, q on the vertical one; the key below the axes.
+    Curves of the orbits' folds, stick onsets and grazings are not continued yet: the grid's
+    events are those boundaries, as points, one per row and branch (see the module).
 
     Parameters
     ----------
