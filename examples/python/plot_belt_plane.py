@@ -117,13 +117,15 @@ for e in codim2:
 
 # 2. the grid of one-parameter continuations over the damping
 with warnings.catch_warnings():
-    warnings.simplefilter("ignore", analysis.CollocationWarning)
+    warnings.simplefilter("ignore", analysis.GridWarning)   # each row keeps its warnings
     grid = analysis.continue_over(dampings, branches)
 for r in grid.rows:
     if r.error:
         print(f"c = {r.q:.4f}: failed: {r.error.splitlines()[0]}")
         continue
     evs = [e for t in r.branches.values() for e in t.events if e.kind != "user"]
+    if r.warnings:
+        print(f"c = {r.q:.4f}: {len(r.warnings)} warnings, the first: {r.warnings[0][:160]}")
     print(f"c = {r.q:.4f}: orbits: {r.branches['orbits'].status}; events: " + ", ".join(
         f"{e.kind} at v_b = {e.p:.5f}" + (f" ({e.criticality})" if e.criticality else "")
         for e in evs))

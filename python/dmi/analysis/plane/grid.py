@@ -35,7 +35,8 @@ STICK_EVENTS = ("stick-onset", "grazing")
 
 
 class GridWarning(UserWarning):
-    """Values of q whose continuation failed (their :class:`GridRow` holds the error)."""
+    """Values of q whose continuation failed (their :class:`GridRow` holds the error), or whose
+    task issued warnings (kept in :attr:`GridRow.warnings`)."""
 
 
 @dataclass(frozen=True)
@@ -265,7 +266,9 @@ def continue_over(q_values: Sequence[float], branches: Callable[[float], Any], *
     Grid
         One :class:`GridRow` a value of q, in the order given.  A task that raised, or that the
         cluster lost (a worker killed, ...), gives a row with its ``error`` and no branches, and
-        one :class:`GridWarning` names those values; the others are kept.
+        one :class:`GridWarning` names those values; the others are kept.  The tasks' own
+        warnings are kept in their rows (``GridRow.warnings``), one :class:`GridWarning` saying
+        which rows have some.
 
     Raises
     ------
@@ -310,6 +313,11 @@ def continue_over(q_values: Sequence[float], branches: Callable[[float], Any], *
     else:
         rows = _on_cluster(client, branches, Q)
     grid = Grid(Q, rows)
+    said = [r for r in rows if r.warnings]
+    if said:   # a task's warnings are kept in its row (a worker's would not reach here)
+        warnings.warn(f"continue_over: the tasks at {len(said)} of {len(Q)} values of q issued "
+                      f"warnings, the first at q = {said[0].q:.8g}: {said[0].warnings[0]} "
+                      "(GridRow.warnings has each)", GridWarning, stacklevel=2)
     if grid.failed:
         warnings.warn(f"continue_over: the continuations at {len(grid.failed)} of {len(Q)} "
                       f"values of q failed, at q = "
