@@ -92,6 +92,10 @@ stage "dmi.analysis: a stick-slip orbit of the equation with memory by collocati
 PYTHONPATH="$build/python" MPLBACKEND=Agg DMI_FIGURE="$out/collocation_stickslip.png" "$py" \
   examples/python/plot_collocation_stickslip.py | tee "$out/collocation_stickslip.txt"
 
+stage "dmi.analysis: the belt with memory in its (belt speed, damping) plane: Hopf curve, grid, regions"
+PYTHONPATH="$build/python" MPLBACKEND=Agg DMI_PLANE_ROWS=8 DMI_FIGURE="$out/belt_plane.png" \
+  DMI_FIGURE_HTML="$out/belt_plane.html" "$py" examples/python/plot_belt_plane.py | tee "$out/belt_plane.txt"
+
 stage "dmi.identify: a friction oscillator with a viscoelastic memory identified from noisy data"
 PYTHONPATH="$build/python" MPLBACKEND=Agg DMI_FIGURE="$out/identify_friction_memory.png" "$py" \
   examples/python/plot_identify_friction_memory.py | tee "$out/identify_friction_memory.txt"

@@ -58,3 +58,9 @@ from .equilibria.curves import Curve, CurveEvent, CurvePoint, continue_curve  # 
 
 # Hopf and fold curves of the equation's equilibria in two parameters (docs/stability.md)
 __all__ += ["continue_curve", "Curve", "CurvePoint", "CurveEvent"]
+from .plane.diagram import plot_curves  # noqa: E402
+from .plane.grid import Grid, GridEvent, GridRow, GridWarning, Trace, continue_over  # noqa: E402
+
+# the plane (p, q): one-parameter continuations over q (serially or on Dask) and the diagram
+__all__ += ["continue_over", "Grid", "GridRow", "GridEvent", "Trace", "GridWarning",
+            "plot_curves"]
