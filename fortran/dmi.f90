@@ -30,7 +30,7 @@ module dmi
 
   ! Version of this binding (the same as the C header it mirrors).
   integer(c_int), parameter, public :: DMI_VERSION_MAJOR = 1
-  integer(c_int), parameter, public :: DMI_VERSION_MINOR = 5
+  integer(c_int), parameter, public :: DMI_VERSION_MINOR = 6
   integer(c_int), parameter, public :: DMI_VERSION_PATCH = 0
 
   ! Error codes.

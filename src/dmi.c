@@ -14,6 +14,7 @@
 #include "core.h"
 #include "engine.h"
 #include "errors.h"
+#include "holds.h"
 
 #include "bytes.h"
 
@@ -270,21 +271,6 @@ int dmi_init(dmi_solver *s)
 }
 
 /* ---- stepping -------------------------------------------------------------- */
-
-/* The holds of the built-in operators, for the step and for the watch:
- * friction's resolvent holds U_i at 0 when |x| <= lam = h alpha_i (side 0),
- * else it moves x by lam towards 0 (side +1 above lam, -1 below -lam); the
- * box's projection holds U_i at lo_i when x <= lo_i (side -1), at hi_i when
- * x >= hi_i (+1), else U_i = x (0). */
-static inline int friction_side(double x, double lam)
-{
-    return x > lam ? 1 : x < -lam ? -1 : 0;
-}
-
-static inline int box_side(double x, double lo, double hi)
-{
-    return x <= lo ? -1 : x >= hi ? 1 : 0;
-}
 
 static int apply_resolvent(dmi_solver *s, const double *x, double *out)
 {

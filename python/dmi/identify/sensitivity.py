@@ -16,7 +16,7 @@ onset).  S then converges at O(h) to the equation's sensitivity.
 from __future__ import annotations
 
 import dataclasses
-import importlib.util
+import ctypes
 import math
 import warnings
 from collections.abc import Callable
@@ -25,9 +25,13 @@ from typing import Any
 import numpy as np
 from scipy import fft as sp_fft
 
+from .._errors import Error
 from .._solver import Solver
 from ._near import near_kernel_part, near_sum
 from ._saltation import REVERSAL, STICK, UNPLACED, reversal
+
+#: libdmi's history callback type (int z(double t, double *out, void *user))
+_HistoryFn = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, ctypes.c_void_p, ctypes.c_void_p)
 
 #: Relative step of the directional differences (about the square root of the unit roundoff).
 REL_STEP = 2.0 ** -26
@@ -492,16 +496,16 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     check_steps(steps, n, N, P, h, max_steps, "sensitivities")
     s.init()
     window = s.get_window()                                          # U^{-N}, ..., U^0
-    t, U, X = s.run_terms(steps)
     # S of the history: dz(t_q)/dp for q = -N, ..., 0, sampled only for the parameters whose
     # perturbed model has another history (Solver.same_callback); the other columns are 0
     # (the rows of the steps are all written by the loops; those of the history, Sall[:N + 1],
-    # zeroed here, then their columns in ``hist`` written by the compiled sampling or from inits)
+    # zeroed here, then their columns in ``hist`` written from the compiled history callbacks
+    # or from inits)
     Sall = np.empty((N + steps + 1, n, P))
     Sall[:N + 1] = 0.0
     hist = [j for j, o in enumerate(mod.others) if not s.same_callback(o, "history")]
     fresh = None                        # whether the history's S is nonzero somewhere
-    if engine != "python" and hist:
+    if hist:
         fresh = _compiled_history(mod, hist, window, Sall)
     if fresh is None:
         Sall[:N + 1] = 0.0              # (a failed compiled sampling may have written some)
@@ -512,7 +516,8 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
             if d.any():                 # (the columns of parameters the history has not stay 0)
                 Sall[:N + 1, :, j] = d / mod.delta[j]
                 fresh = True
-    memory = _Memory(mod, lambda: np.concatenate([window[1:], U[1:]]), P)   # U^{-N+1}, ..., U^steps
+    run: list = []                      # [U] of the run, once made
+    memory = _Memory(mod, lambda: np.concatenate([window[1:], run[0][1:]]), P)   # U^{-N+1}, ..., U^steps
     # the resolvent's derivatives in p, as they do not depend on the step
     kind = s.resolvent_kind
     alpha = s.friction
@@ -527,29 +532,26 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     # f_u S + f_p: by n columns of f_u and one call for each parameter f depends on, where that
     # makes fewer calls of f than one directional difference per parameter
     fpar = None
+    depends = None
     if has_f and rhs is None:
-        depends = np.array([j for j, o in enumerate(mod.others) if not s.same_callback(o, "rhs")],
-                           np.int64)
-        if n + len(depends) < P:
-            fpar = depends
-    if rhs is not None:
-        _check_complex_rhs(rhs, mod, p, t[0], U[0], Sall[N])
-    phi = (U[:-1] - X) / h                                            # f + W at each step
+        depends = np.array([not s.same_callback(o, "rhs") for o in mod.others])
+        if n + int(depends.sum()) < P:
+            fpar = np.flatnonzero(depends).astype(np.int64)
     why = _not_compiled(mod, has_f, rhs) if engine != "python" else "engine='python'"
     if why and engine == "compiled":
         raise ValueError(f"engine='compiled' does not apply: {why}; use engine='auto' or 'python'")
     if not why:
-        from . import _compiled
-        callbacks = ([m.c_callback("rhs") for m in [s, *mod.others]] if has_f else None)
-        friction = (alpha, dalpha) if kind == "friction" else None
-        box = (lo, hi, dlo, dhi) if kind == "box" else None
-        dX, switches, failed = _compiled.run(steps, N, h, t, U, X, phi, window, Sall, bool(fresh),
-                                             mod.delta, callbacks, memory, kind, friction, box,
-                                             jumps, fpar, REL_STEP, hist)
-        if failed < 0:
-            return _result(t, U, Sall[N:], X, dX, h, switches, "compiled")
+        fast = _libdmi_loop(mod, steps, Sall, memory, run, depends, jumps)
+        if fast is not None:
+            return fast
         # a call of f failed: the Python loop below (which rewrites each S^{q+1} of Sall from
         # the history's S on) raises the callback's own error
+        s.init()
+    t, U, X = s.run_terms(steps)
+    run[:] = [U]
+    if rhs is not None:
+        _check_complex_rhs(rhs, mod, p, t[0], U[0], Sall[N])
+    phi = (U[:-1] - X) / h                                            # f + W at each step
     if kind == "friction":
         # R' (1 slipping, 0 stuck) and dR/dp = -h sign(X) dalpha where slipping, for every step
         slipping = (U[1:] != 0.0).astype(float)
@@ -594,6 +596,42 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     return _result(t, U, Sall[N:], X, dX, h, switches, "python")
 
 
+def _kernel_depends(memory: _Memory) -> bool:
+    """Whether a parameter moves the kernel's weights (the tangent then has dG_l U^{p-l})."""
+    if not memory.active:
+        return False
+    if memory.kind == "exp":
+        return bool(np.any(memory.dE) or np.any(memory.dl) or np.any(memory.dnear))
+    return bool(np.any(memory.dG))
+
+
+def _libdmi_loop(mod: _Perturbed, steps: int, Sall: np.ndarray, memory: _Memory, run: list,
+                 depends: np.ndarray | None, jumps: bool) -> Sensitivities | None:
+    """The run and its tangent by libdmi's loop (dmi_tangent_run) from the initialised model;
+    None where it fails (the model is then where it was).  Where a parameter moves the kernel,
+    the kernel parameters' part of the delay sum, sum_l dG_l U^{p-l}, needs the states first: a
+    plain run gives them, and the model goes back to its start (its saved state) for libdmi's."""
+    s = mod.base
+    N, h = s.N, s.h
+    dWU = None
+    if _kernel_depends(memory):
+        start = s.save_state()
+        run[:] = [s.run_terms(steps)[1]]
+        dWU = memory.kernel_part()
+        s.load_state(start)
+    try:
+        U, X, S, dX, codes = s._tangent(mod.others, mod.delta, steps, Sall[:N + 1], dWU,
+                                        depends, jumps)
+    except Error:
+        return None
+    Sall[N:] = S
+    names = {1: "stick", 2: "reversal", 3: "unplaced"}
+    qs, comps = np.nonzero(codes)
+    switches = [(q, i, names[int(codes[q, i])]) for q, i in zip(qs.tolist(), comps.tolist())]
+    t = np.arange(steps + 1) * h
+    return _result(t, U, Sall[N:], X, dX, h, switches, "compiled")
+
+
 def _f_columns(s: Solver, mod: _Perturbed, fpar: np.ndarray, t: float, u: np.ndarray,
                S: np.ndarray) -> np.ndarray:
     """f_u S + f_p at (t, u): f_u by forward differences of n columns (step 2^-26 max(1, |u_i|)
@@ -627,21 +665,36 @@ def _result(t: np.ndarray, U: np.ndarray, S: np.ndarray, X: np.ndarray, dX: np.n
 def _compiled_history(mod: _Perturbed, hist: list, window: np.ndarray,
                       Sall: np.ndarray) -> bool | None:
     """The history's S into the columns ``hist`` of Sall[:N + 1] from those perturbed models'
-    compiled history callbacks, called as init calls them, without their init; whether it is
-    nonzero anywhere.  None (Sall[:N + 1] then partly written: zero it and init them) where a
-    history is not a C function, numba is not installed, a call fails, or the same sampling of the
-    model's own history does not give its window, as init sampled it, bit for bit."""
+    compiled history callbacks, called (through ctypes) as init calls them, without their init;
+    whether it is nonzero anywhere.  None (Sall[:N + 1] then partly written: zero it and init
+    them) where a history is not a C function, a call fails or gives a value that is not finite,
+    or the same sampling of the model's own history does not give its window, as init sampled
+    it, bit for bit."""
     s = mod.base
     callbacks = [m.c_callback("history") for m in [s, *(mod.others[j] for j in hist)]]
-    if any(c is None for c in callbacks) or importlib.util.find_spec("numba") is None:
+    if any(c is None for c in callbacks):
         return None
-    from . import _compiled
-    addrs = np.array([a for a, _ in callbacks], np.int64)
-    users = np.array([u for _, u in callbacks], np.int64)
-    status, nonzero = _compiled.history_columns(addrs, users, s.N, float(s.h), float(s.tau),
-                                                np.ascontiguousarray(window), mod.delta[hist],
-                                                np.array(hist, np.int64), Sall)
-    return bool(nonzero) if status == 0 else None
+    N, h, tau, n = s.N, float(s.h), float(s.tau), s.n
+    u = np.empty(n)
+    out = u.ctypes.data_as(ctypes.c_void_p)
+    nonzero = False
+    for c, ((address, user), col) in enumerate(zip(callbacks, [-1, *hist])):
+        z = _HistoryFn(address)
+        for k in range(N + 1):        # t_k = -k h (no lower than -tau, -tau at k = N), as init
+            tk = -k * h
+            tt = -tau if k == N else (0.0 if k == 0 else (-tau if tk < -tau else tk))
+            u[:] = 0.0
+            if z(tt, out, user) != 0 or not np.all(np.isfinite(u)):
+                return None
+            row = window[N - k]
+            if c == 0:
+                if not np.array_equal(u, row):
+                    return None
+            else:
+                d = (u - row) / mod.delta[col]
+                Sall[N - k, :, col] = d
+                nonzero = nonzero or bool(d.any())
+    return nonzero
 
 
 def _not_compiled(mod: _Perturbed, has_f: bool, rhs: Callable | None) -> str:
@@ -657,8 +710,6 @@ def _not_compiled(mod: _Perturbed, has_f: bool, rhs: Callable | None) -> str:
                 where = "p" if j == 0 else f"p + delta e_{j - 1}"
                 return (f"f of the model at {where} is a Python function (set_rhs(f, jit=True) or a "
                         "C function makes it compiled)")
-    if importlib.util.find_spec("numba") is None:
-        return "numba is not installed"
     return ""
 
 
