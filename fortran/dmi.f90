@@ -18,9 +18,10 @@
 ! - dmi_get_step_terms needs both arrays (C accepts NULL for either), and so
 !   does dmi_get_kernel_weights (since 1.5): count * n * n values each.
 ! - The tangent (since 1.6): dmi_tangent_create takes the other models'
-!   handles as an array of type(c_ptr); dmi_tangent_set_history and
-!   dmi_tangent_set_rhs_parameters need their arrays (C accepts NULL to reset:
-!   pass zeros, or 1 for every parameter f depends on), and dmi_tangent_run
+!   handles as an array of type(c_ptr); dmi_tangent_set_history,
+!   dmi_tangent_sample_history and dmi_tangent_set_rhs_parameters need their
+!   arrays (C accepts NULL for a default: pass zeros, or 1 for every
+!   parameter the history or f depends on), and dmi_tangent_run
 !   needs every array (C accepts NULL for all but s_out: pass zeros for dwu);
 !   switches is an array of integer(c_int8_t).  Arrays are row-major as in C:
 !   S of step q (0-based), component i, parameter j (1-based) is
@@ -73,7 +74,8 @@ module dmi
   public :: dmi_time, dmi_get_step_index, dmi_get_h, dmi_get_N, dmi_get_state, dmi_get_past
   public :: dmi_get_step_terms, dmi_get_window, dmi_set_window, dmi_get_kernel_weights
   public :: dmi_state_size, dmi_state_save, dmi_state_load
-  public :: dmi_tangent_create, dmi_tangent_set_history, dmi_tangent_set_rhs_parameters
+  public :: dmi_tangent_create, dmi_tangent_set_history, dmi_tangent_sample_history
+  public :: dmi_tangent_set_rhs_parameters
   public :: dmi_tangent_run, dmi_tangent_free
   public :: dmi_last_error, dmi_strerror
 
@@ -376,6 +378,14 @@ module dmi
       real(c_double), intent(in) :: s0(*)
       integer(c_int) :: rc
     end function dmi_tangent_set_history
+
+    function dmi_tangent_sample_history(t, columns) result(rc) &
+        bind(C, name='dmi_tangent_sample_history')
+      import :: c_int, c_ptr
+      type(c_ptr), value :: t
+      integer(c_int), intent(in) :: columns(*)
+      integer(c_int) :: rc
+    end function dmi_tangent_sample_history
 
     function dmi_tangent_set_rhs_parameters(t, depends) result(rc) &
         bind(C, name='dmi_tangent_set_rhs_parameters')

@@ -618,7 +618,8 @@ DMI_API int dmi_state_load(dmi_solver *s, const void *buf, size_t size);
  * The object keeps the handle s (which must outlive it and is stepped by
  * dmi_tangent_run) and copies from others what it needs (their f and
  * resolvent callbacks with their user pointers, which must stay valid, and
- * the differences of their friction or box); others may be freed after
+ * the differences of their friction or box, their history callbacks with
+ * their user pointers); others may be freed after
  * dmi_tangent_create.  No other state is kept between calls.
  */
 /**/
@@ -652,7 +653,7 @@ enum {
  * others[0..P-1] at p + delta_j e_j (delta: P finite nonzero values, the
  * steps actually applied, in the unit of p_j).  s must be an initialised
  * solver when dmi_tangent_run is called; others need not be (only their f,
- * resolvent callback, friction or box are read, here, and copied).  f
+ * resolvent and history callbacks, friction or box are read, here, and copied).  f
  * depends on p_j unless others[j]'s f and user pointer equal s's
  * (dmi_tangent_set_rhs_parameters overrides); the history's sensitivity is 0
  * unless dmi_tangent_set_history sets it.  On success *out owns the object
@@ -676,6 +677,23 @@ DMI_API int dmi_tangent_create(dmi_tangent **out, dmi_solver *s, size_t P,
  * it); DMI_ENOMEM.  On error the object is unchanged.
  */
 DMI_API int dmi_tangent_set_history(dmi_tangent *t, const double *S0);
+
+/**
+ * (Since 1.6.)  The sensitivity of the window from the history callbacks, as
+ * dmi_init samples them (at t_{-k} = -k h, k = 0..N, and -tau at k = N):
+ * for the parameters j with columns[j] nonzero (P values; NULL: those whose
+ * others[j] has another history callback or user pointer than s),
+ * S0 = (z_j(t_{-k}) - z(t_{-k})) / delta_j, z_j the history of others[j]
+ * and z s's (0 where a model has none), computed once here (2 calls a time
+ * at most: s's once for all parameters) and used by every later
+ * dmi_tangent_run as dmi_tangent_set_history's S0; the other columns are 0.
+ * (For a run from the window dmi_init sampled: p = 0.)
+ * Errors (the message in dmi_last_error(s)): DMI_EINVAL for t NULL;
+ * DMI_ECALLBACK when a history callback returns nonzero, DMI_ENONFINITE when
+ * it gives a value that is not finite (the message names the model, s or
+ * others[j], and t); DMI_ENOMEM.  On error the object is unchanged.
+ */
+DMI_API int dmi_tangent_sample_history(dmi_tangent *t, const int *columns);
 
 /**
  * (Since 1.6.)  Which parameters f depends on: depends[j] nonzero when p_j

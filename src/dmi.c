@@ -165,11 +165,7 @@ static int sample_history(dmi_solver *s, dmi_history *ring)
     const size_t n = s->n, N = s->N;
     double *u = s->work;
     for (size_t k = 0; k <= N; k++) { /* U^{-k} = z(-k h) */
-        /* t_{-k} = -k h, and -tau at k = N: -N h may round below it, and is
-         * below it for a partial last cell (dmi_create_h; U^{-N} is read by no
-         * step), and z is called on [-tau, 0] only */
-        const double tk = -(double)k * s->h; /* (fmax of the two, without a libm call) */
-        double t = k == s->N ? -s->tau : k == 0 ? 0.0 : tk < -s->tau ? -s->tau : tk;
+        const double t = dmi_history_time(s, k);
         for (size_t j = 0; j < n; j++) /* (a loop: n is small) */
             u[j] = 0;
         if (s->z) {

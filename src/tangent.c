@@ -28,6 +28,8 @@ typedef struct {
     void *f_user;
     dmi_resolvent_fn r;
     void *r_user;
+    dmi_history_fn z;
+    void *z_user;
 } model;
 
 struct dmi_tangent {
@@ -128,10 +130,10 @@ int dmi_tangent_create(dmi_tangent **out, dmi_solver *s, size_t P, const dmi_sol
                  ? DMI_OK : dmi_fail(s, DMI_ENOMEM, "dmi_tangent_create: out of memory");
     if (rc == DMI_OK) {
         memcpy(t->delta, delta, P * sizeof *delta);
-        t->m[0] = (model){s->f, s->f_user, s->r, s->r_user};
+        t->m[0] = (model){s->f, s->f_user, s->r, s->r_user, s->z, s->z_user};
         for (size_t j = 0; j < P; j++) {
             const dmi_solver *o = others[j];
-            t->m[j + 1] = (model){o->f, o->f_user, o->r, o->r_user};
+            t->m[j + 1] = (model){o->f, o->f_user, o->r, o->r_user, o->z, o->z_user};
         }
         dmi_tangent_set_rhs_parameters(t, NULL);
         rc = resolvent_diffs(t, others);
@@ -183,6 +185,65 @@ int dmi_tangent_set_history(dmi_tangent *t, const double *S0)
     memcpy(copy, S0, count * sizeof *copy);
     free(t->S0);
     t->S0 = copy;
+    return DMI_OK;
+}
+
+/* out = z(t) of model m (0 without z), checked; DMI_OK or the error naming
+ * the model (j = 0: s, else others[j - 1]). */
+static int call_z(const dmi_solver *s, const model *m, size_t j, double t, double *out)
+{
+    for (size_t i = 0; i < s->n; i++)
+        out[i] = 0;
+    const int rc = m->z ? m->z(t, out, m->z_user) : 0;
+    if (rc != 0)
+        return j == 0 ? dmi_fail(s, DMI_ECALLBACK, "dmi_tangent_sample_history: history callback "
+                                 "of s returned %d at t = %.17g", rc, t)
+                      : dmi_fail(s, DMI_ECALLBACK, "dmi_tangent_sample_history: history callback "
+                                 "of others[%zu] returned %d at t = %.17g", j - 1, rc, t);
+    const size_t bad = dmi_first_nonfinite(out, s->n);
+    if (bad < s->n)
+        return j == 0 ? dmi_fail(s, DMI_ENONFINITE, "dmi_tangent_sample_history: history z(%.17g)"
+                                 "[%zu] = %g of s", t, bad, out[bad])
+                      : dmi_fail(s, DMI_ENONFINITE, "dmi_tangent_sample_history: history z(%.17g)"
+                                 "[%zu] = %g of others[%zu]", t, bad, out[bad], j - 1);
+    return DMI_OK;
+}
+
+int dmi_tangent_sample_history(dmi_tangent *t, const int *columns)
+{
+    if (!t)
+        return DMI_EINVAL;
+    const dmi_solver *s = t->s;
+    const size_t n = s->n, N = s->N, P = t->P;
+    if (dmi_mul_size(N + 1, n * P, sizeof(double)) == 0)
+        return dmi_fail(s, DMI_ENOMEM, "dmi_tangent_sample_history: (N + 1) n P overflows");
+    double *S0 = calloc((N + 1) * n * P, sizeof *S0);
+    double *base = malloc(2 * n * sizeof *base), *other = base ? base + n : NULL;
+    int rc = S0 && base ? DMI_OK
+                        : dmi_fail(s, DMI_ENOMEM, "dmi_tangent_sample_history: out of memory");
+    for (size_t k = 0; k <= N && rc == DMI_OK; k++) { /* U^{-k}: row N - k */
+        const double tk = dmi_history_time(s, k);
+        int sampled = 0;
+        for (size_t j = 0; j < P && rc == DMI_OK; j++) {
+            const model *m = &t->m[j + 1];
+            if (columns ? !columns[j] : m->z == t->m[0].z && m->z_user == t->m[0].z_user)
+                continue;
+            if (!sampled)
+                rc = call_z(s, &t->m[0], 0, tk, base);
+            sampled = 1;
+            if (rc == DMI_OK)
+                rc = call_z(s, m, j + 1, tk, other);
+            for (size_t i = 0; i < n && rc == DMI_OK; i++)
+                S0[((N - k) * n + i) * P + j] = (other[i] - base[i]) / t->delta[j];
+        }
+    }
+    free(base);
+    if (rc != DMI_OK) {
+        free(S0);
+        return rc;
+    }
+    free(t->S0);
+    t->S0 = S0;
     return DMI_OK;
 }
 

@@ -1437,12 +1437,14 @@ class Solver:
                 self._call_failed(rc, bound, lambda: f"rhs at t = {float(tt[c])!r}, u = {X[c]!r}")
         return out
 
-    def _tangent(self, others: list[Solver], delta: np.ndarray, steps: int, S0: np.ndarray | None,
-                 dWU: np.ndarray | None, depends: np.ndarray | None, jumps: bool
+    def _tangent(self, others: list[Solver], delta: np.ndarray, steps: int,
+                 S0: np.ndarray | list | None, dWU: np.ndarray | None, depends: np.ndarray | None,
+                 jumps: bool
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Steps this (initialised) solver ``steps`` times with the sensitivities of its states in
         P parameters through libdmi's tangent (``dmi_tangent_run``): ``others`` the models at
-        p + delta_j e_j, ``S0`` the window's sensitivity ((N + 1, n, P), None: zero), ``dWU`` the
+        p + delta_j e_j, ``S0`` the window's sensitivity ((N + 1, n, P), None: zero; a list of
+        parameters: sampled from those models' history callbacks by libdmi), ``dWU`` the
         kernel parameters' part of the delay sum ((steps, n, P), None: zero), ``depends`` which
         parameters f depends on (P booleans, None: libdmi's rule), ``jumps`` the saltation factor
         at reversals.  Returns U (steps + 1, n), X (steps, n), S (steps + 1, n, P), dX
@@ -1457,6 +1459,10 @@ class Solver:
         U, X = np.empty((steps + 1, n)), np.empty((steps, n))
         S, dX = np.empty((steps + 1, n, P)), np.empty((steps, n, P))
         switches = np.zeros((steps, n), np.int8)
+        columns = None
+        if isinstance(S0, list):
+            columns = (ctypes.c_int * P)(*[int(j in S0) for j in range(P)])
+            S0 = None
         S0 = None if S0 is None else c(S0, dtype=float)
         dWU = None if dWU is None else c(dWU, dtype=float)
         for m in (self, *others):
@@ -1469,6 +1475,8 @@ class Solver:
                 rc = _L.dmi_tangent_create(ctypes.byref(tangent), s, P, handles, _ptr(delta))
                 if rc == _lib.OK and S0 is not None:
                     rc = _L.dmi_tangent_set_history(tangent, _ptr(S0))
+                if rc == _lib.OK and columns is not None:
+                    rc = _L.dmi_tangent_sample_history(tangent, columns)
                 if rc == _lib.OK and depends is not None:
                     flags = (ctypes.c_int * P)(*[int(bool(d)) for d in depends])
                     rc = _L.dmi_tangent_set_rhs_parameters(tangent, flags)

@@ -275,6 +275,44 @@ static void test_saltation_follows_the_equation(void)
     setup_free(&c);
 }
 
+/* The history's S sampled by libdmi from the history callbacks is the
+ * difference of the initialised windows, bit for bit; a failing history
+ * callback is named and leaves the object as it was. */
+static void test_sampled_history(void)
+{
+    const double h = 0.01;
+    const size_t steps = 300;
+    setup c;
+    CU_ASSERT_FATAL(setup_make(&c, h, steps, 0) == 0);
+    const size_t count = (steps + 1) * n * P;
+    double *S1 = malloc(count * sizeof *S1);
+    CU_ASSERT_FATAL(S1 != NULL);
+    CU_ASSERT_FATAL(dmi_tangent_run(c.t, steps, 0, c.dWU, NULL, NULL, S1, NULL, NULL) == DMI_OK);
+    int any = 0; /* (the history moves with z0 only) */
+    for (size_t k = 0; k < (c.N + 1) * n * P; k++)
+        any |= c.S0[k] != 0 && k % P != 3;
+    CU_ASSERT(!any);
+    CU_ASSERT_FATAL(dmi_init(c.s) == DMI_OK);
+    CU_ASSERT_FATAL(dmi_tangent_set_history(c.t, NULL) == DMI_OK);
+    CU_ASSERT_FATAL(dmi_tangent_sample_history(c.t, NULL) == DMI_OK);
+    CU_ASSERT_FATAL(dmi_tangent_run(c.t, steps, 0, c.dWU, NULL, NULL, c.S, NULL, NULL) == DMI_OK);
+    CU_ASSERT(memcmp(S1, c.S, count * sizeof *S1) == 0);
+    /* only z0's column asked for: the same, as the others are 0 */
+    const int only_z0[P] = {0, 0, 0, 1};
+    CU_ASSERT_FATAL(dmi_init(c.s) == DMI_OK);
+    CU_ASSERT_FATAL(dmi_tangent_sample_history(c.t, only_z0) == DMI_OK);
+    CU_ASSERT_FATAL(dmi_tangent_run(c.t, steps, 0, c.dWU, NULL, NULL, c.S, NULL, NULL) == DMI_OK);
+    CU_ASSERT(memcmp(S1, c.S, count * sizeof *S1) == 0);
+    /* none asked for: S^0 = 0 */
+    const int none[P] = {0, 0, 0, 0};
+    CU_ASSERT_FATAL(dmi_init(c.s) == DMI_OK);
+    CU_ASSERT_FATAL(dmi_tangent_sample_history(c.t, none) == DMI_OK);
+    CU_ASSERT_FATAL(dmi_tangent_run(c.t, 1, 0, NULL, NULL, NULL, c.S, NULL, NULL) == DMI_OK);
+    CU_ASSERT(c.S[3] == 0.0 && c.S[n * P - 1] == 0.0);
+    free(S1);
+    setup_free(&c);
+}
+
 /* A failing callback leaves the solver bitwise where it was, with a message
  * naming the model; the refusals name their argument. */
 static void test_failures_and_refusals(void)
@@ -344,6 +382,7 @@ int main(int argc, char **argv)
     static const core_test tests[] = {
         {"the plain tangent is the scheme's derivative", test_plain_tangent_is_the_schemes_derivative},
         {"the saltation follows the equation through reversals", test_saltation_follows_the_equation},
+        {"the history's S sampled from its callbacks", test_sampled_history},
         {"failures leave the solver as it was; refusals", test_failures_and_refusals},
         {NULL, NULL}};
     return core_main(argc, argv, "core: the tangent of the scheme", tests);

@@ -16,7 +16,6 @@ onset).  S then converges at O(h) to the equation's sensitivity.
 from __future__ import annotations
 
 import dataclasses
-import ctypes
 import math
 import warnings
 from collections.abc import Callable
@@ -29,9 +28,6 @@ from .._errors import Error
 from .._solver import Solver
 from ._near import near_kernel_part, near_sum
 from ._saltation import REVERSAL, STICK, UNPLACED, reversal
-
-#: libdmi's history callback type (int z(double t, double *out, void *user))
-_HistoryFn = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, ctypes.c_void_p, ctypes.c_void_p)
 
 #: Relative step of the directional differences (about the square root of the unit roundoff).
 REL_STEP = 2.0 ** -26
@@ -496,26 +492,6 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     check_steps(steps, n, N, P, h, max_steps, "sensitivities")
     s.init()
     window = s.get_window()                                          # U^{-N}, ..., U^0
-    # S of the history: dz(t_q)/dp for q = -N, ..., 0, sampled only for the parameters whose
-    # perturbed model has another history (Solver.same_callback); the other columns are 0
-    # (the rows of the steps are all written by the loops; those of the history, Sall[:N + 1],
-    # zeroed here, then their columns in ``hist`` written from the compiled history callbacks
-    # or from inits)
-    Sall = np.empty((N + steps + 1, n, P))
-    Sall[:N + 1] = 0.0
-    hist = [j for j, o in enumerate(mod.others) if not s.same_callback(o, "history")]
-    fresh = None                        # whether the history's S is nonzero somewhere
-    if hist:
-        fresh = _compiled_history(mod, hist, window, Sall)
-    if fresh is None:
-        Sall[:N + 1] = 0.0              # (a failed compiled sampling may have written some)
-        for j in hist:
-            other = mod.others[j]
-            other.init()                # each perturbed model samples its own history in init
-            d = other.get_window() - window
-            if d.any():                 # (the columns of parameters the history has not stay 0)
-                Sall[:N + 1, :, j] = d / mod.delta[j]
-                fresh = True
     run: list = []                      # [U] of the run, once made
     memory = _Memory(mod, lambda: np.concatenate([window[1:], run[0][1:]]), P)   # U^{-N+1}, ..., U^steps
     # the resolvent's derivatives in p, as they do not depend on the step
@@ -540,13 +516,24 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     why = _not_compiled(mod, has_f, rhs) if engine != "python" else "engine='python'"
     if why and engine == "compiled":
         raise ValueError(f"engine='compiled' does not apply: {why}; use engine='auto' or 'python'")
+    # S of the history: dz(t_q)/dp for q = -N, ..., 0, only for the parameters whose perturbed
+    # model has another history (Solver.same_callback); the other columns are 0.  libdmi's loop
+    # samples compiled history callbacks itself (dmi_tangent_sample_history, as init does);
+    # otherwise each such perturbed model's init samples its own
+    Sall = np.empty((N + steps + 1, n, P))
+    hist = [j for j, o in enumerate(mod.others) if not s.same_callback(o, "history")]
+    compiled_history = all(m.c_callback("history") is not None
+                           for m in [s, *(mod.others[j] for j in hist)])
     if not why:
-        fast = _libdmi_loop(mod, steps, Sall, memory, run, depends, jumps)
+        if not (hist and compiled_history):
+            _history_by_init(mod, hist, window, Sall)
+        fast = _libdmi_loop(mod, steps, Sall, memory, run, depends, jumps,
+                            hist if hist and compiled_history else None)
         if fast is not None:
             return fast
-        # a call of f failed: the Python loop below (which rewrites each S^{q+1} of Sall from
-        # the history's S on) raises the callback's own error
+        # a call of f failed: the Python loop below raises the callback's own error
         s.init()
+    _history_by_init(mod, hist, window, Sall)
     t, U, X = s.run_terms(steps)
     run[:] = [U]
     if rhs is not None:
@@ -605,10 +592,27 @@ def _kernel_depends(memory: _Memory) -> bool:
     return bool(np.any(memory.dG))
 
 
+def _history_by_init(mod: _Perturbed, hist: list, window: np.ndarray, Sall: np.ndarray) -> None:
+    """The history's S into Sall[:N + 1]: for the parameters in ``hist``, the window of the
+    perturbed model (after its init, which samples its own history) less the model's, over
+    delta_j; 0 for the others."""
+    N = mod.base.N
+    Sall[:N + 1] = 0.0
+    for j in hist:
+        other = mod.others[j]
+        other.init()
+        d = other.get_window() - window
+        if d.any():                     # (the columns of parameters the history has not stay 0)
+            Sall[:N + 1, :, j] = d / mod.delta[j]
+
+
 def _libdmi_loop(mod: _Perturbed, steps: int, Sall: np.ndarray, memory: _Memory, run: list,
-                 depends: np.ndarray | None, jumps: bool) -> Sensitivities | None:
+                 depends: np.ndarray | None, jumps: bool,
+                 history: list | None) -> Sensitivities | None:
     """The run and its tangent by libdmi's loop (dmi_tangent_run) from the initialised model;
-    None where it fails (the model is then where it was).  Where a parameter moves the kernel,
+    None where it fails (the model is then where it was).  The history's S is Sall[:N + 1], or,
+    where ``history`` lists parameters, sampled by libdmi from those perturbed models' compiled
+    history callbacks.  Where a parameter moves the kernel,
     the kernel parameters' part of the delay sum, sum_l dG_l U^{p-l}, needs the states first: a
     plain run gives them, and the model goes back to its start (its saved state) for libdmi's."""
     s = mod.base
@@ -620,7 +624,8 @@ def _libdmi_loop(mod: _Perturbed, steps: int, Sall: np.ndarray, memory: _Memory,
         dWU = memory.kernel_part()
         s.load_state(start)
     try:
-        U, X, S, dX, codes = s._tangent(mod.others, mod.delta, steps, Sall[:N + 1], dWU,
+        U, X, S, dX, codes = s._tangent(mod.others, mod.delta, steps,
+                                        Sall[:N + 1] if history is None else history, dWU,
                                         depends, jumps)
     except Error:
         return None
@@ -660,41 +665,6 @@ def _result(t: np.ndarray, U: np.ndarray, S: np.ndarray, X: np.ndarray, dX: np.n
                       f"sensitivity; take a smaller h (now {h:.6g}) so that each reversal is "
                       "resolved", RuntimeWarning, stacklevel=3)
     return out
-
-
-def _compiled_history(mod: _Perturbed, hist: list, window: np.ndarray,
-                      Sall: np.ndarray) -> bool | None:
-    """The history's S into the columns ``hist`` of Sall[:N + 1] from those perturbed models'
-    compiled history callbacks, called (through ctypes) as init calls them, without their init;
-    whether it is nonzero anywhere.  None (Sall[:N + 1] then partly written: zero it and init
-    them) where a history is not a C function, a call fails or gives a value that is not finite,
-    or the same sampling of the model's own history does not give its window, as init sampled
-    it, bit for bit."""
-    s = mod.base
-    callbacks = [m.c_callback("history") for m in [s, *(mod.others[j] for j in hist)]]
-    if any(c is None for c in callbacks):
-        return None
-    N, h, tau, n = s.N, float(s.h), float(s.tau), s.n
-    u = np.empty(n)
-    out = u.ctypes.data_as(ctypes.c_void_p)
-    nonzero = False
-    for c, ((address, user), col) in enumerate(zip(callbacks, [-1, *hist])):
-        z = _HistoryFn(address)
-        for k in range(N + 1):        # t_k = -k h (no lower than -tau, -tau at k = N), as init
-            tk = -k * h
-            tt = -tau if k == N else (0.0 if k == 0 else (-tau if tk < -tau else tk))
-            u[:] = 0.0
-            if z(tt, out, user) != 0 or not np.all(np.isfinite(u)):
-                return None
-            row = window[N - k]
-            if c == 0:
-                if not np.array_equal(u, row):
-                    return None
-            else:
-                d = (u - row) / mod.delta[col]
-                Sall[N - k, :, col] = d
-                nonzero = nonzero or bool(d.any())
-    return nonzero
 
 
 def _not_compiled(mod: _Perturbed, has_f: bool, rhs: Callable | None) -> str:
