@@ -75,7 +75,7 @@ module dmi
   public :: dmi_get_step_terms, dmi_get_window, dmi_set_window, dmi_get_kernel_weights
   public :: dmi_state_size, dmi_state_save, dmi_state_load
   public :: dmi_tangent_create, dmi_tangent_set_history, dmi_tangent_sample_history
-  public :: dmi_tangent_set_rhs_parameters
+  public :: dmi_tangent_set_kernel_terms, dmi_tangent_set_rhs_parameters
   public :: dmi_tangent_run, dmi_tangent_free
   public :: dmi_last_error, dmi_strerror
 
@@ -386,6 +386,15 @@ module dmi
       integer(c_int), intent(in) :: columns(*)
       integer(c_int) :: rc
     end function dmi_tangent_sample_history
+
+    ! (dd: pass zeros where C accepts NULL)
+    function dmi_tangent_set_kernel_terms(t, da, db, dc, dd) result(rc) &
+        bind(C, name='dmi_tangent_set_kernel_terms')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: t
+      real(c_double), intent(in) :: da(*), db(*), dc(*), dd(*)
+      integer(c_int) :: rc
+    end function dmi_tangent_set_kernel_terms
 
     function dmi_tangent_set_rhs_parameters(t, depends) result(rc) &
         bind(C, name='dmi_tangent_set_rhs_parameters')

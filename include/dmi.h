@@ -696,6 +696,29 @@ DMI_API int dmi_tangent_set_history(dmi_tangent *t, const double *S0);
 DMI_API int dmi_tangent_sample_history(dmi_tangent *t, const int *columns);
 
 /**
+ * (Since 1.6.)  The derivatives of the exponential kernel's terms of s
+ * (dmi_set_kernel_exp) in the parameters, for the kernel parameters' part of
+ * the tangent's delay sum, computed by dmi_tangent_run in O(K n^2 P) a step
+ * (the recursions of sum_l r_k^l U^{q-l} and sum_l l r_k^l U^{q-l},
+ * r_k = e^{(a_k + i b_k) h}, restarted every 4 N steps from the states):
+ * da[k P + j] = da_k/dp_j, db alike (K P values each; 1 / time unit per unit
+ * of p_j), dC[((k n + i) n + m) P + j] = d(C_k)_{im}/dp_j and dD alike (K n n P
+ * values each, dD NULL: all zero), under either quadrature rule (the cells'
+ * weights of each term and their derivatives in a_k + i b_k in closed form).
+ * This is the part dmi_tangent_run's dWU would otherwise carry (both are
+ * added: give dWU only for what the terms do not say, e.g. the near cells of
+ * dmi_set_kernel_near).  da NULL removes them.  The arrays are copied.
+ * dmi_tangent_run then needs s's delay sum to be the recursion
+ * (DMI_CONV_RECURSIVE, or AUTO choosing it) and refuses with DMI_EINVAL
+ * otherwise.  Errors (the message in dmi_last_error(s)): DMI_EINVAL for t
+ * NULL, db or dC NULL with da given, a kernel of s that is not of
+ * dmi_set_kernel_exp, a value not finite (named); DMI_ENOMEM.  On error the
+ * object is unchanged.
+ */
+DMI_API int dmi_tangent_set_kernel_terms(dmi_tangent *t, const double *da, const double *db,
+                                         const double *dC, const double *dD);
+
+/**
  * (Since 1.6.)  Which parameters f depends on: depends[j] nonzero when p_j
  * enters f (P values; NULL: the rule of dmi_tangent_create again).  A
  * parameter marked 0 gets f_p_j = 0 where f_u comes by columns; the
@@ -731,7 +754,9 @@ DMI_API int dmi_tangent_set_rhs_parameters(dmi_tangent *t, const int *depends);
  * given, and one engine and window of S per parameter.
  * Errors (the message in dmi_last_error(s)): DMI_EINVAL for t NULL, S NULL,
  * steps = 0, or unknown flags; DMI_ESTATE when s is not initialised;
- * DMI_ENOMEM (also when the sizes overflow); the errors of dmi_step;
+ * DMI_EINVAL also for kernel terms' derivatives without the recursion
+ * (dmi_tangent_set_kernel_terms); DMI_ENOMEM (also when the sizes
+ * overflow); the errors of dmi_step;
  * DMI_ECALLBACK when f or the resolvent callback of s or others[j] returns
  * nonzero in the tangent (the message names j and t); DMI_ENONFINITE when a
  * sensitivity is not finite (the message names the step, component and

@@ -13,7 +13,9 @@
 #include "engine.h"
 #include "errors.h"
 #include "holds.h"
+#include "quad.h"
 
+#include <complex.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -41,6 +43,10 @@ struct dmi_tangent {
     double *dlo;   /* n P: friction's dalpha, or the box's dlo (NULL: none) */
     double *dhi;   /* n P: the box's dhi (NULL: none) */
     double *S0;    /* (N + 1) n P, or NULL: zero */
+    /* the exponential kernel's terms' derivatives (dmi_tangent_set_kernel_terms; K = 0: none) */
+    size_t K;
+    double complex *dE; /* K n n P: d(C_k - i D_k)[i][m]/dp_j at ((k n + i) n + m) P + j */
+    double complex *dl; /* K P: d(a_k + i b_k)/dp_j at k P + j */
 };
 
 /* ---- the object -------------------------------------------------------------- */
@@ -157,6 +163,8 @@ void dmi_tangent_free(dmi_tangent **pt)
     free(t->dlo);
     free(t->dhi);
     free(t->S0);
+    free(t->dE);
+    free(t->dl);
     free(t);
     *pt = NULL;
 }
@@ -244,6 +252,54 @@ int dmi_tangent_sample_history(dmi_tangent *t, const int *columns)
     }
     free(t->S0);
     t->S0 = S0;
+    return DMI_OK;
+}
+
+int dmi_tangent_set_kernel_terms(dmi_tangent *t, const double *da, const double *db,
+                                 const double *dC, const double *dD)
+{
+    if (!t)
+        return DMI_EINVAL;
+    const dmi_solver *s = t->s;
+    if (!da) {
+        free(t->dE);
+        free(t->dl);
+        t->dE = t->dl = NULL;
+        t->K = 0;
+        return DMI_OK;
+    }
+    if (!db || !dC)
+        return dmi_fail(s, DMI_EINVAL, "dmi_tangent_set_kernel_terms: %s is NULL", !db ? "db" : "dC");
+    if (!dmi_has_expk(s))
+        return dmi_fail(s, DMI_EINVAL, "dmi_tangent_set_kernel_terms: the kernel of s is not one "
+                        "of dmi_set_kernel_exp");
+    const size_t K = s->expk.K, n = s->n, P = t->P, KP = K * P, KnnP = K * n * n * P;
+    if (dmi_mul_size(K * n * n, P, sizeof(double complex)) == 0)
+        return dmi_fail(s, DMI_ENOMEM, "dmi_tangent_set_kernel_terms: K n n P overflows");
+    const double *arrays[4] = {da, db, dC, dD};
+    const char *names[4] = {"da", "db", "dC", "dD"};
+    for (int a = 0; a < 4; a++) {
+        const size_t count = a < 2 ? KP : KnnP;
+        const size_t bad = arrays[a] ? dmi_first_nonfinite_long(arrays[a], count) : count;
+        if (bad < count)
+            return dmi_fail(s, DMI_EINVAL, "dmi_tangent_set_kernel_terms: %s[%zu] = %g", names[a],
+                            bad, arrays[a][bad]);
+    }
+    double complex *dE = malloc(KnnP * sizeof *dE), *dl = malloc(KP * sizeof *dl);
+    if (!dE || !dl) {
+        free(dE);
+        free(dl);
+        return dmi_fail(s, DMI_ENOMEM, "dmi_tangent_set_kernel_terms: out of memory");
+    }
+    for (size_t q = 0; q < KP; q++)
+        dl[q] = da[q] + I * db[q];
+    for (size_t q = 0; q < KnnP; q++)
+        dE[q] = dC[q] - I * (dD ? dD[q] : 0.0);
+    free(t->dE);
+    free(t->dl);
+    t->dE = dE;
+    t->dl = dl;
+    t->K = K;
     return DMI_OK;
 }
 
@@ -483,10 +539,161 @@ static int resolvent_part(const dmi_tangent *t, size_t q, size_t steps, const do
     return DMI_OK;
 }
 
+/* The kernel parameters' part of the tangent's delay sum for an exponential
+ * kernel, sum_l dG_l U^{q-l} = Re sum_k (dE_k A_k + dl_k E_k B_k) with
+ * A_k = sum_l w_k(l) U^{q-l}, B_k = sum_l dw_k(l)/dl_k U^{q-l}, w_k(l) the
+ * weight of e^{l_k s} over cell l (h r^l by the left rule, its integral by
+ * the cell rule; the last cell's its own): from the recursions of
+ * Y_k = sum_{l<N} r_k^l U^{q-l} and Y1_k = sum_{l<N} l r_k^l U^{q-l},
+ * r_k = e^{l_k h}, started (and restarted every 4 N steps) by Horner's rule
+ * over the window. */
+typedef struct {
+    size_t K;
+    double complex *buf;                       /* everything below */
+    double complex *r, *rN, *rlast, *cw, *c1, *wlast, *wslast; /* K each */
+    double complex *E0;                        /* K n n: C_k - i D_k of s */
+    double complex *Y, *Y1, *A, *EB, *B;       /* K n, K n, K n, K n, n */
+    const double *window;                      /* U^{p0-N..p0}, (N + 1) n */
+    const double *U;                           /* U^{p0..p0+steps} */
+    size_t since;
+} kpart;
+
+/* U^{p0+m}, -N <= m. */
+static const double *state_at(const kpart *kp, const dmi_solver *s, long long m)
+{
+    return m <= 0 ? kp->window + (size_t)((long long)s->N + m) * s->n : kp->U + (size_t)m * s->n;
+}
+
+static int kpart_make(kpart *kp, const dmi_tangent *t, const double *window, const double *U)
+{
+    const dmi_solver *s = t->s;
+    const size_t K = t->K, n = s->n, N = s->N;
+    const double h = s->h;
+    memset(kp, 0, sizeof *kp);
+    kp->K = K;
+    if (K == 0)
+        return DMI_OK;
+    kp->buf = malloc((7 * K + K * n * n + 4 * K * n + n) * sizeof *kp->buf);
+    if (!kp->buf)
+        return dmi_fail(s, DMI_ENOMEM, "dmi_tangent_run: out of memory");
+    double complex *b = kp->buf;
+    kp->r = b, kp->rN = b + K, kp->rlast = b + 2 * K, kp->cw = b + 3 * K, kp->c1 = b + 4 * K;
+    kp->wlast = b + 5 * K, kp->wslast = b + 6 * K, kp->E0 = b + 7 * K;
+    kp->Y = kp->E0 + K * n * n, kp->Y1 = kp->Y + K * n, kp->A = kp->Y1 + K * n;
+    kp->EB = kp->A + K * n, kp->B = kp->EB + K * n;
+    kp->window = window;
+    kp->U = U;
+    const dmi_expk *x = &s->expk;
+    const double lastlag = (double)(N - 1) * h, lastlen = s->theta * h;
+    for (size_t k = 0; k < K; k++) {
+        const double complex lam = x->a[k] + I * x->b[k];
+        kp->r[k] = cexp(lam * h);
+        kp->rN[k] = cexp(lam * h * (double)N);
+        kp->rlast[k] = cexp(lam * lastlag);
+        if (s->quad == DMI_QUAD_CELL) { /* int_0^L e^{lam x} dx = L phi1, int_0^L x e^{..} = L^2 psi */
+            double pr, pi, qr, qi;
+            dmi_quad_phi1(x->a[k] * h, x->b[k] * h, &pr, &pi);
+            dmi_quad_psi(x->a[k] * h, x->b[k] * h, &qr, &qi);
+            kp->cw[k] = h * (pr + I * pi);
+            kp->c1[k] = h * h * (qr + I * qi);
+            dmi_quad_phi1(x->a[k] * lastlen, x->b[k] * lastlen, &pr, &pi);
+            dmi_quad_psi(x->a[k] * lastlen, x->b[k] * lastlen, &qr, &qi);
+            const double complex i0 = lastlen * (pr + I * pi);
+            const double complex i1 = lastlen * lastlen * (qr + I * qi);
+            kp->wlast[k] = kp->rlast[k] * i0;
+            kp->wslast[k] = kp->rlast[k] * (lastlag * i0 + i1);
+        } else {
+            kp->cw[k] = h;
+            kp->c1[k] = 0;
+            kp->wlast[k] = lastlen * kp->rlast[k];
+            kp->wslast[k] = lastlen * lastlag * kp->rlast[k];
+        }
+        for (size_t q = 0; q < n * n; q++)
+            kp->E0[k * n * n + q] = x->C[k * n * n + q] - I * (x->D ? x->D[k * n * n + q] : 0.0);
+    }
+    return DMI_OK;
+}
+
+/* Y and Y1 at step q by Horner's rule over U^{q-N+1..q}. */
+static void kpart_anchor(kpart *kp, const dmi_solver *s, size_t q)
+{
+    const size_t n = s->n, N = s->N;
+    for (size_t k = 0; k < kp->K; k++) {
+        const double complex r = kp->r[k];
+        double complex *Y = kp->Y + k * n, *Y1 = kp->Y1 + k * n;
+        for (size_t i = 0; i < n; i++)
+            Y[i] = Y1[i] = 0;
+        for (long long m = (long long)q - (long long)N + 1; m <= (long long)q; m++) {
+            const double *u = state_at(kp, s, m);
+            for (size_t i = 0; i < n; i++) {
+                Y1[i] = r * (Y1[i] + Y[i]);
+                Y[i] = r * Y[i] + u[i];
+            }
+        }
+    }
+    kp->since = 0;
+}
+
+/* T -= h Re sum_k (dE_k A_k + dl_k E_k B_k) at step q. */
+static void kpart_apply(kpart *kp, const dmi_tangent *t, size_t q, double *T)
+{
+    const dmi_solver *s = t->s;
+    const size_t n = s->n, N = s->N, P = t->P, K = kp->K;
+    const double h = s->h;
+    if (q == 0 || kp->since >= 4 * N)
+        kpart_anchor(kp, s, q);
+    const double *ulast = state_at(kp, s, (long long)q - (long long)N + 1);
+    for (size_t k = 0; k < K; k++) {
+        const double complex cw = kp->cw[k], c1 = kp->c1[k];
+        const double complex fa = kp->wlast[k] - cw * kp->rlast[k];
+        const double complex fb = kp->wslast[k] - kp->rlast[k] * ((double)(N - 1) * h * cw + c1);
+        for (size_t i = 0; i < n; i++) {
+            kp->A[k * n + i] = cw * kp->Y[k * n + i] + fa * ulast[i];
+            kp->B[i] = h * cw * kp->Y1[k * n + i] + c1 * kp->Y[k * n + i] + fb * ulast[i];
+        }
+        for (size_t i = 0; i < n; i++) {
+            double complex v = 0;
+            for (size_t m = 0; m < n; m++)
+                v += kp->E0[(k * n + i) * n + m] * kp->B[m];
+            kp->EB[k * n + i] = v;
+        }
+    }
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = 0; j < P; j++) {
+            double acc = 0;
+            for (size_t k = 0; k < K; k++) {
+                const double complex *dE = t->dE + (k * n + i) * n * P, dl = t->dl[k * P + j];
+                double complex v = dl != 0 ? dl * kp->EB[k * n + i] : 0;
+                for (size_t m = 0; m < n; m++)
+                    if (dE[m * P + j] != 0) /* (a kernel acting on some entries: most are 0) */
+                        v += dE[m * P + j] * kp->A[k * n + m];
+                acc += creal(v);
+            }
+            T[i * P + j] -= h * acc;
+        }
+}
+
+/* Y, Y1 from step q to q + 1. */
+static void kpart_advance(kpart *kp, const dmi_solver *s, size_t q)
+{
+    const size_t n = s->n, N = s->N;
+    const double *unew = state_at(kp, s, (long long)q + 1);
+    const double *ulast = state_at(kp, s, (long long)q + 1 - (long long)N);
+    for (size_t k = 0; k < kp->K; k++) {
+        const double complex r = kp->r[k], rN = kp->rN[k];
+        for (size_t i = 0; i < n; i++) {
+            double complex *Y = kp->Y + k * n + i, *Y1 = kp->Y1 + k * n + i;
+            *Y1 = r * (*Y1 + *Y) - (double)N * rN * ulast[i];
+            *Y = r * *Y + unew[i] - rN * ulast[i];
+        }
+    }
+    kp->since++;
+}
+
 /* The tangent along the run U, X from the solver's step p0 = s->p. */
 static int tangent_loop(const dmi_tangent *t, size_t steps, int flags, const double *dWU,
                         const double *U, const double *X, double *S, double *dX,
-                        signed char *switches, columns *cols, scratch *w)
+                        signed char *switches, columns *cols, kpart *kp, scratch *w)
 {
     const dmi_solver *s = t->s;
     const size_t n = s->n, P = t->P, nP = n * P;
@@ -513,6 +720,8 @@ static int tangent_loop(const dmi_tangent *t, size_t steps, int flags, const dou
         if (!cols->col && dWU)
             for (size_t i = 0; i < nP; i++)
                 w->T[i] -= h * dWU[q * nP + i];
+        if (kp->K)
+            kpart_apply(kp, t, q, w->T);
         if (dX)
             memcpy(dX + q * nP, w->T, nP * sizeof *dX);
         rc = resolvent_part(t, q, steps, U, X, jumps, w, switches);
@@ -524,6 +733,8 @@ static int tangent_loop(const dmi_tangent *t, size_t steps, int flags, const dou
                             "t = %.17g (step %zu of the run)", bad / P, bad % P, w->Snew[bad],
                             tq + h, q + 1);
         memcpy(S + (q + 1) * nP, w->Snew, nP * sizeof *S);
+        if (kp->K)
+            kpart_advance(kp, s, q);
         for (size_t j = 0; cols->col && j < P; j++) { /* the windows and engines move on */
             dmi_solver *col = &cols->col[j];
             for (size_t i = 0; i < n; i++)
@@ -556,8 +767,9 @@ int dmi_tangent_run(dmi_tangent *t, size_t steps, int flags, const double *dWU, 
     unsigned char *saved = malloc(saved_size);
     double *Ub = U ? NULL : malloc((steps + 1) * n * sizeof *Ub);
     double *Xb = X ? NULL : malloc(steps * n * sizeof *Xb);
-    double *pool = malloc((5 * n * P + n * n + 4 * n + (N + 1) * n) * sizeof *pool);
+    double *pool = malloc((5 * n * P + n * n + 4 * n + 2 * (N + 1) * n) * sizeof *pool);
     columns cols = {0};
+    kpart kp = {0};
     if (!saved || (!U && !Ub) || (!X && !Xb) || !pool) {
         free(saved);
         free(Ub);
@@ -574,11 +786,20 @@ int dmi_tangent_run(dmi_tangent *t, size_t steps, int flags, const double *dWU, 
     w.moved = w.fj + n;
     w.W = w.moved + n;
     w.Snew = w.W + n;
-    double *row = w.Snew + n * P; /* (N + 1) n: a window of one column of S */
+    double *row = w.Snew + n * P;    /* (N + 1) n: a window of one column of S */
+    double *window = row + (N + 1) * n; /* (N + 1) n: the states' window at the start */
     const uint64_t p0 = s->p;
     int rc = dmi_state_save(s, saved, saved_size);
+    if (rc == DMI_OK && t->K && !s->rec)
+        rc = dmi_fail(s, DMI_EINVAL, "dmi_tangent_run: the kernel terms' derivatives "
+                      "(dmi_tangent_set_kernel_terms) need the recursion (DMI_CONV_RECURSIVE, or "
+                      "AUTO choosing it): give the kernel's part as dWU");
     if (rc == DMI_OK)
         rc = columns_make(&cols, s, P, t->S0, row);
+    if (rc == DMI_OK)
+        rc = kpart_make(&kp, t, window, U);
+    for (size_t k = 0; k <= N && rc == DMI_OK; k++) /* row k: U^{p-N+k} */
+        dmi_history_get(&s->ring, N - k, window + k * n);
     /* the plain run, as dmi_advance */
     dmi_history_get(&s->ring, 0, U);
     for (size_t q = 0; q < steps && rc == DMI_OK; q++) {
@@ -595,7 +816,7 @@ int dmi_tangent_run(dmi_tangent *t, size_t steps, int flags, const double *dWU, 
             memset(switches, DMI_SWITCH_NONE, steps * n);
         for (size_t i = 0; i < n * P; i++) /* S^p: the window's last row */
             S[i] = t->S0 ? t->S0[N * n * P + i] : 0.0;
-        rc = tangent_loop(t, steps, flags, dWU, U, X, S, dX, switches, &cols, &w);
+        rc = tangent_loop(t, steps, flags, dWU, U, X, S, dX, switches, &cols, &kp, &w);
         s->p = p_end;
     }
     if (rc != DMI_OK && s->p != p0) {
@@ -606,6 +827,7 @@ int dmi_tangent_run(dmi_tangent *t, size_t steps, int flags, const double *dWU, 
         memcpy(s->err, msg, sizeof msg);
     }
     columns_free(&cols);
+    free(kp.buf);
     free(saved);
     free(Ub);
     free(Xb);

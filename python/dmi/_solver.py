@@ -1439,7 +1439,7 @@ class Solver:
 
     def _tangent(self, others: list[Solver], delta: np.ndarray, steps: int,
                  S0: np.ndarray | list | None, dWU: np.ndarray | None, depends: np.ndarray | None,
-                 jumps: bool
+                 jumps: bool, terms: tuple | None = None
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Steps this (initialised) solver ``steps`` times with the sensitivities of its states in
         P parameters through libdmi's tangent (``dmi_tangent_run``): ``others`` the models at
@@ -1447,7 +1447,8 @@ class Solver:
         parameters: sampled from those models' history callbacks by libdmi), ``dWU`` the
         kernel parameters' part of the delay sum ((steps, n, P), None: zero), ``depends`` which
         parameters f depends on (P booleans, None: libdmi's rule), ``jumps`` the saltation factor
-        at reversals.  Returns U (steps + 1, n), X (steps, n), S (steps + 1, n, P), dX
+        at reversals, ``terms`` the exponential kernel's terms' derivatives (da, db, dC, dD) as
+        ``dmi_tangent_set_kernel_terms`` takes them (None: none).  Returns U (steps + 1, n), X (steps, n), S (steps + 1, n, P), dX
         (steps, n, P) and the switches (steps, n) as DMI_SWITCH_* codes (for dmi.identify).
 
         Raises dmi.Error with libdmi's message (the solver then is where it was); a Python
@@ -1477,6 +1478,9 @@ class Solver:
                     rc = _L.dmi_tangent_set_history(tangent, _ptr(S0))
                 if rc == _lib.OK and columns is not None:
                     rc = _L.dmi_tangent_sample_history(tangent, columns)
+                if rc == _lib.OK and terms is not None:
+                    arrays = [c(a, dtype=float) for a in terms]
+                    rc = _L.dmi_tangent_set_kernel_terms(tangent, *[_ptr(a) for a in arrays])
                 if rc == _lib.OK and depends is not None:
                     flags = (ctypes.c_int * P)(*[int(bool(d)) for d in depends])
                     rc = _L.dmi_tangent_set_rhs_parameters(tangent, flags)

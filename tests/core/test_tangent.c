@@ -245,6 +245,30 @@ static void test_plain_tangent_is_the_schemes_derivative(void)
         for (size_t k = 0; k < (steps + 1) * n * P; k++)
             diff = fmax(diff, fabs(S1[k] - c.S[k]) / (1 + fabs(S1[k])));
         CU_ASSERT(diff < 1e-6);
+        if (!callback_kernel) {
+            /* the kernel's part from its term's derivative (dC_0[1][1]/dg = 1) in the loop, not
+             * from dWU: the same S to rounding */
+            const double da[P] = {0}, db[P] = {0};
+            double dC[4 * P] = {0};
+            dC[3 * P + 2] = 1.0;
+            CU_ASSERT_FATAL(dmi_init(c.s) == DMI_OK);
+            CU_ASSERT_FATAL(dmi_tangent_set_kernel_terms(c.t, da, db, dC, NULL) == DMI_OK);
+            CU_ASSERT_FATAL(dmi_tangent_run(c.t, steps, DMI_TANGENT_PLAIN, NULL, NULL, NULL, S1,
+                                            NULL, NULL) == DMI_OK);
+            diff = 0;
+            for (size_t k = 0; k < (steps + 1) * n * P; k++)
+                diff = fmax(diff, fabs(S1[k] - c.S[k]) / (1 + fabs(c.S[k])));
+            printf("  kernel terms' derivatives against dWU: %.3g\n", diff);
+            CU_ASSERT(diff < 1e-12);
+            dC[3 * P + 2] = NAN;
+            CU_ASSERT(dmi_tangent_set_kernel_terms(c.t, da, db, dC, NULL) == DMI_EINVAL);
+            CU_ASSERT(strstr(dmi_last_error(c.s), "dC[") != NULL);
+            CU_ASSERT(dmi_tangent_set_kernel_terms(c.t, NULL, NULL, NULL, NULL) == DMI_OK);
+        } else {
+            const double zeros[4 * P] = {0};
+            CU_ASSERT(dmi_tangent_set_kernel_terms(c.t, zeros, zeros, zeros, NULL) == DMI_EINVAL);
+            CU_ASSERT(strstr(dmi_last_error(c.s), "dmi_set_kernel_exp") != NULL);
+        }
         free(S1);
         setup_free(&c);
     }

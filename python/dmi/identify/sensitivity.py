@@ -520,20 +520,18 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     # model has another history (Solver.same_callback); the other columns are 0.  libdmi's loop
     # samples compiled history callbacks itself (dmi_tangent_sample_history, as init does);
     # otherwise each such perturbed model's init samples its own
-    Sall = np.empty((N + steps + 1, n, P))
     hist = [j for j, o in enumerate(mod.others) if not s.same_callback(o, "history")]
     compiled_history = all(m.c_callback("history") is not None
                            for m in [s, *(mod.others[j] for j in hist)])
     if not why:
-        if not (hist and compiled_history):
-            _history_by_init(mod, hist, window, Sall)
-        fast = _libdmi_loop(mod, steps, Sall, memory, run, depends, jumps,
-                            hist if hist and compiled_history else None)
+        history = (hist if hist and compiled_history else _history_by_init(mod, hist, window))
+        fast = _libdmi_loop(mod, steps, history, memory, run, depends, jumps)
         if fast is not None:
             return fast
         # a call of f failed: the Python loop below raises the callback's own error
         s.init()
-    _history_by_init(mod, hist, window, Sall)
+    Sall = np.empty((N + steps + 1, n, P))
+    Sall[:N + 1] = _history_by_init(mod, hist, window)
     t, U, X = s.run_terms(steps)
     run[:] = [U]
     if rhs is not None:
@@ -592,49 +590,54 @@ def _kernel_depends(memory: _Memory) -> bool:
     return bool(np.any(memory.dG))
 
 
-def _history_by_init(mod: _Perturbed, hist: list, window: np.ndarray, Sall: np.ndarray) -> None:
-    """The history's S into Sall[:N + 1]: for the parameters in ``hist``, the window of the
+def _history_by_init(mod: _Perturbed, hist: list, window: np.ndarray) -> np.ndarray:
+    """The history's S, (N + 1, n, P): for the parameters in ``hist``, the window of the
     perturbed model (after its init, which samples its own history) less the model's, over
     delta_j; 0 for the others."""
-    N = mod.base.N
-    Sall[:N + 1] = 0.0
+    S0 = np.zeros(window.shape + (len(mod.delta),))
     for j in hist:
         other = mod.others[j]
         other.init()
         d = other.get_window() - window
         if d.any():                     # (the columns of parameters the history has not stay 0)
-            Sall[:N + 1, :, j] = d / mod.delta[j]
+            S0[:, :, j] = d / mod.delta[j]
+    return S0
 
 
-def _libdmi_loop(mod: _Perturbed, steps: int, Sall: np.ndarray, memory: _Memory, run: list,
-                 depends: np.ndarray | None, jumps: bool,
-                 history: list | None) -> Sensitivities | None:
+def _libdmi_loop(mod: _Perturbed, steps: int, history: np.ndarray | list, memory: _Memory,
+                 run: list, depends: np.ndarray | None, jumps: bool) -> Sensitivities | None:
     """The run and its tangent by libdmi's loop (dmi_tangent_run) from the initialised model;
-    None where it fails (the model is then where it was).  The history's S is Sall[:N + 1], or,
-    where ``history`` lists parameters, sampled by libdmi from those perturbed models' compiled
-    history callbacks.  Where a parameter moves the kernel,
-    the kernel parameters' part of the delay sum, sum_l dG_l U^{p-l}, needs the states first: a
-    plain run gives them, and the model goes back to its start (its saved state) for libdmi's."""
+    None where it fails (the model is then where it was).  The history's S is ``history``,
+    (N + 1, n, P), or, where it lists parameters, sampled by libdmi from those perturbed models'
+    compiled history callbacks.  Where a parameter moves the kernel, the kernel parameters' part of the
+    delay sum, sum_l dG_l U^{p-l}, comes from the exponential terms' derivatives in libdmi's loop
+    or, for what they do not say, needs the states first: a plain run gives them, and the model
+    goes back to its start (its saved state) for libdmi's."""
     s = mod.base
-    N, h = s.N, s.h
-    dWU = None
-    if _kernel_depends(memory):
+    h = s.h
+    dWU = terms = None
+    # an exponential kernel under the recursion: libdmi differentiates its terms in the loop;
+    # the near cells' part, and any other kernel's, come as dWU from the states of a plain run
+    by_terms = (memory.kind == "exp" and memory.recursive
+                and s.convolution in ("auto", "recursive"))
+    if by_terms and (np.any(memory.dE) or np.any(memory.dl)):
+        dE = memory.dE.transpose(1, 2, 3, 0)                    # (K, n, n, P)
+        terms = (memory.dl.real.T, memory.dl.imag.T, dE.real, -dE.imag)
+    if (np.any(memory.dnear) if by_terms else _kernel_depends(memory)):
         start = s.save_state()
         run[:] = [s.run_terms(steps)[1]]
-        dWU = memory.kernel_part()
+        dWU = memory.near_kernel_part() if by_terms else memory.kernel_part()
         s.load_state(start)
     try:
-        U, X, S, dX, codes = s._tangent(mod.others, mod.delta, steps,
-                                        Sall[:N + 1] if history is None else history, dWU,
-                                        depends, jumps)
+        U, X, S, dX, codes = s._tangent(mod.others, mod.delta, steps, history, dWU, depends,
+                                        jumps, terms)
     except Error:
         return None
-    Sall[N:] = S
     names = {1: "stick", 2: "reversal", 3: "unplaced"}
     qs, comps = np.nonzero(codes)
     switches = [(q, i, names[int(codes[q, i])]) for q, i in zip(qs.tolist(), comps.tolist())]
     t = np.arange(steps + 1) * h
-    return _result(t, U, Sall[N:], X, dX, h, switches, "compiled")
+    return _result(t, U, S, X, dX, h, switches, "compiled")
 
 
 def _f_columns(s: Solver, mod: _Perturbed, fpar: np.ndarray, t: float, u: np.ndarray,
