@@ -86,8 +86,8 @@ class Sensitivities:
         sign in a way the loop cannot place as a reversal inside the step (``"unplaced"``: no
         saltation factor applied, S_i there is the plain tangent, off by O(1)).
     engine : str
-        The loop over the steps that computed S: ``"compiled"`` (numba, f called through its C
-        function) or ``"python"``.
+        The loop over the steps that computed S: ``"compiled"`` (libdmi's, ``dmi_tangent_run``:
+        f called through its C function) or ``"python"``.
     """
 
     t: np.ndarray
@@ -455,9 +455,10 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
         sensitivity); False: the plain tangent of the scheme everywhere.
     engine : str, optional
         The loop over the steps: ``"auto"`` (default) the compiled one where it applies, else
-        the Python one; ``"compiled"`` (numba; f a C function in every model (``jit=True``, a
-        cfunc, a ctypes function) or no f, A zero, friction or a box, no ``rhs``): an error
-        where it does not apply; ``"python"``: one step at a time in Python, calling f through
+        the Python one; ``"compiled"`` (libdmi's loop, ``dmi_tangent_run``, nothing compiled
+        at the first call; f a C function in every model (``jit=True``, a cfunc, a ctypes
+        function) or no f, A zero, friction or a box, no ``rhs``): an error where it does not
+        apply; ``"python"``: one step at a time in Python, calling f through
         :meth:`dmi.Solver.eval_rhs`.  Both give the same S to rounding.
     max_steps : int, optional
         The most steps accepted (default :data:`MAX_STEPS`, 2 000 000); more is refused before
