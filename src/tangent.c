@@ -358,6 +358,7 @@ typedef struct {
     size_t P;
     dmi_solver *col; /* P copies of the solver (NULL: no kernel) */
     size_t made;     /* the copies whose window exists */
+    double *zeros;   /* the sums of a zero window (NULL: none) */
 } columns;
 
 static void columns_free(columns *c)
@@ -367,6 +368,7 @@ static void columns_free(columns *c)
         dmi_engine_free(c->col[j].conv, c->col[j].rec);
     }
     free(c->col);
+    free(c->zeros);
 }
 
 /* The method of s's engine now (its engines as dmi_init or
@@ -382,11 +384,16 @@ static int columns_make(columns *c, const dmi_solver *s, size_t P, const double 
     c->P = P;
     c->made = 0;
     c->col = NULL;
+    c->zeros = NULL;
     if (!s->H)
         return DMI_OK;
     c->col = malloc(P * sizeof *c->col);
     if (!c->col)
         return dmi_fail(s, DMI_ENOMEM, "dmi_tangent_run: out of memory");
+    /* zero sums for the recursion's engines of zero columns (2 doubles a sum) */
+    const dmi_expk *x = s->quad == DMI_QUAD_CELL ? &s->cell_expk : &s->expk;
+    c->zeros = s->rec ? calloc(2 * dmi_expk_sums(x) + 1, sizeof *c->zeros) : NULL;
+    const double *sums = c->zeros;
     for (size_t j = 0; j < P; j++) {
         dmi_solver *col = &c->col[j];
         *col = *s;
@@ -395,17 +402,23 @@ static int columns_make(columns *c, const dmi_solver *s, size_t P, const double 
         if (dmi_history_alloc(&col->ring, n, N) != 0)
             return dmi_fail(s, DMI_ENOMEM, "dmi_tangent_run: out of memory for the windows of S");
         c->made++;
+        int zero = 1; /* whether this column of S0 is zero */
         if (S0) {
             for (size_t k = 0; k <= N; k++) /* row k: S^{p-N+k} */
-                for (size_t i = 0; i < n; i++)
+                for (size_t i = 0; i < n; i++) {
                     row[k * n + i] = S0[(k * n + i) * P + j];
+                    zero &= row[k * n + i] == 0;
+                }
             dmi_history_put_window(&col->ring, row);
         }
         int rc = dmi_engine_make(s, &s->kernel, engine_method(s), &col->conv, &col->rec,
                                  "dmi_tangent_run");
         if (rc != DMI_OK)
             return rc;
-        dmi_engine_rebuild(col, col->conv, col->rec);
+        if (zero && col->rec && sums) /* the recursion's sums of a zero window: zero, no O(N) */
+            dmi_exp_set(col->rec, sums, col->p);
+        else
+            dmi_engine_rebuild(col, col->conv, col->rec);
     }
     return DMI_OK;
 }
