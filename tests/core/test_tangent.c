@@ -337,6 +337,73 @@ static void test_sampled_history(void)
     setup_free(&c);
 }
 
+/* A resolvent callback (differenced by the loop) against the built-in box it
+ * computes (its hold rule): u' + a u = cos 2t clipped to [-0.4, b], p = (a, b). */
+typedef struct {
+    double a, b;
+} clip_model;
+
+static int clip_rhs(double t, const double *u, double *out, void *user)
+{
+    const clip_model *m = user;
+    out[0] = m->a * u[0] - cos(2 * t);
+    return 0;
+}
+
+static int clip_resolvent(double lambda, const double *x, double *out, void *user)
+{
+    const clip_model *m = user;
+    (void)lambda;
+    out[0] = x[0] < -0.4 ? -0.4 : x[0] > m->b ? m->b : x[0];
+    return 0;
+}
+
+static dmi_solver *clip_solver(clip_model *m, int callback)
+{
+    dmi_solver *s = NULL;
+    const double lo[1] = {-0.4}, hi[1] = {m->b};
+    if (dmi_create(&s, 1, 1.0, 50) != DMI_OK)
+        return NULL;
+    int rc = dmi_set_rhs(s, clip_rhs, m);
+    rc |= callback ? dmi_set_resolvent(s, clip_resolvent, m) : dmi_set_box(s, lo, hi);
+    if (rc != DMI_OK || dmi_init(s) != DMI_OK)
+        dmi_free(&s);
+    return s;
+}
+
+static void test_resolvent_callback(void)
+{
+    enum { STEPS = 400, NP = 2 };
+    double S[2][(STEPS + 1) * NP];
+    signed char sw[STEPS];
+    size_t clipped = 0;
+    for (int callback = 0; callback <= 1; callback++) {
+        clip_model base = {0.5, 0.3}, pert[NP] = {{0.5 + 0x1p-26, 0.3}, {0.5, 0.3 + 0x1p-26}};
+        dmi_solver *s = clip_solver(&base, callback);
+        dmi_solver *o[NP] = {clip_solver(&pert[0], callback), clip_solver(&pert[1], callback)};
+        const double delta[NP] = {pert[0].a - base.a, pert[1].b - base.b};
+        CU_ASSERT_FATAL(s && o[0] && o[1]);
+        dmi_tangent *t = NULL;
+        double U[STEPS + 1];
+        CU_ASSERT_FATAL(dmi_tangent_create(&t, s, NP, (const dmi_solver *const *)o, delta) ==
+                        DMI_OK);
+        CU_ASSERT_FATAL(dmi_tangent_run(t, STEPS, 0, NULL, U, NULL, S[callback], NULL, sw) ==
+                        DMI_OK);
+        for (size_t q = 1; callback && q <= STEPS; q++)
+            clipped += U[q] == 0.3 || U[q] == -0.4;
+        dmi_tangent_free(&t);
+        dmi_free(&o[0]);
+        dmi_free(&o[1]);
+        dmi_free(&s);
+    }
+    double diff = 0;
+    for (size_t k = 0; k < (STEPS + 1) * NP; k++)
+        diff = fmax(diff, fabs(S[0][k] - S[1][k]) / (1 + fabs(S[0][k])));
+    printf("  resolvent callback against the box: %.3g (%zu clipped steps)\n", diff, clipped);
+    CU_ASSERT(clipped > 20 && clipped < STEPS - 20);
+    CU_ASSERT(diff < 1e-6);
+}
+
 /* A failing callback leaves the solver bitwise where it was, with a message
  * naming the model; the refusals name their argument. */
 static void test_failures_and_refusals(void)
@@ -407,6 +474,7 @@ int main(int argc, char **argv)
         {"the plain tangent is the scheme's derivative", test_plain_tangent_is_the_schemes_derivative},
         {"the saltation follows the equation through reversals", test_saltation_follows_the_equation},
         {"the history's S sampled from its callbacks", test_sampled_history},
+        {"a resolvent callback against the built-in box", test_resolvent_callback},
         {"failures leave the solver as it was; refusals", test_failures_and_refusals},
         {NULL, NULL}};
     return core_main(argc, argv, "core: the tangent of the scheme", tests);
