@@ -17,6 +17,15 @@
 !   above: entry (i, j) of term k (1-based) is c((k - 1) * n * n + (i - 1) * n + j).
 ! - dmi_get_step_terms needs both arrays (C accepts NULL for either), and so
 !   does dmi_get_kernel_weights (since 1.5): count * n * n values each.
+! - The tangent (since 1.6): dmi_tangent_create takes the other models'
+!   handles as an array of type(c_ptr); dmi_tangent_set_history,
+!   dmi_tangent_sample_history and dmi_tangent_set_rhs_parameters need their
+!   arrays (C accepts NULL for a default: pass zeros, or 1 for every
+!   parameter the history or f depends on), and dmi_tangent_run
+!   needs every array (C accepts NULL for all but s_out: pass zeros for dwu);
+!   switches is an array of integer(c_int8_t).  Arrays are row-major as in C:
+!   S of step q (0-based), component i, parameter j (1-based) is
+!   s_out((q * n + i - 1) * p + j).
 ! - The state buffer of dmi_state_save / dmi_state_load is an array of
 !   integer(c_int8_t) of dmi_state_size(s) elements.
 ! - C's size_t is integer(c_size_t), uint64_t is integer(c_int64_t).
@@ -30,7 +39,7 @@ module dmi
 
   ! Version of this binding (the same as the C header it mirrors).
   integer(c_int), parameter, public :: DMI_VERSION_MAJOR = 1
-  integer(c_int), parameter, public :: DMI_VERSION_MINOR = 5
+  integer(c_int), parameter, public :: DMI_VERSION_MINOR = 6
   integer(c_int), parameter, public :: DMI_VERSION_PATCH = 0
 
   ! Error codes.
@@ -49,6 +58,12 @@ module dmi
   ! Quadrature rules of the delay sum (since 1.3), see dmi_set_quadrature.
   integer(c_int), parameter, public :: DMI_QUAD_LEFT = 0
   integer(c_int), parameter, public :: DMI_QUAD_CELL = 1
+  ! The tangent (since 1.6): the flag of dmi_tangent_run and the switches it reports.
+  integer(c_int), parameter, public :: DMI_TANGENT_PLAIN = 1
+  integer(c_int), parameter, public :: DMI_SWITCH_NONE = 0
+  integer(c_int), parameter, public :: DMI_SWITCH_STICK = 1
+  integer(c_int), parameter, public :: DMI_SWITCH_REVERSAL = 2
+  integer(c_int), parameter, public :: DMI_SWITCH_UNPLACED = 3
 
   public :: dmi_rhs_fn, dmi_resolvent_fn, dmi_kernel_fn, dmi_history_fn
   public :: dmi_version, dmi_create, dmi_create_h, dmi_free
@@ -59,6 +74,9 @@ module dmi
   public :: dmi_time, dmi_get_step_index, dmi_get_h, dmi_get_N, dmi_get_state, dmi_get_past
   public :: dmi_get_step_terms, dmi_get_window, dmi_set_window, dmi_get_kernel_weights
   public :: dmi_state_size, dmi_state_save, dmi_state_load
+  public :: dmi_tangent_create, dmi_tangent_set_history, dmi_tangent_sample_history
+  public :: dmi_tangent_set_kernel_terms, dmi_tangent_set_rhs_parameters
+  public :: dmi_tangent_run, dmi_tangent_free
   public :: dmi_last_error, dmi_strerror
 
   ! The callbacks.  Each returns 0 on success, anything else makes the calling
@@ -339,6 +357,69 @@ module dmi
       integer(c_size_t), value :: size
       integer(c_int) :: rc
     end function dmi_state_load
+
+    ! ---- sensitivities: the tangent of the scheme (since 1.6) --------------
+    ! p is the number of parameters P; others(1:p) the handles of the models at
+    ! p + delta_j e_j.
+    function dmi_tangent_create(out, s, p, others, delta) result(rc) &
+        bind(C, name='dmi_tangent_create')
+      import :: c_int, c_size_t, c_double, c_ptr
+      type(c_ptr), intent(out) :: out
+      type(c_ptr), value :: s
+      integer(c_size_t), value :: p
+      type(c_ptr), intent(in) :: others(*)
+      real(c_double), intent(in) :: delta(*)
+      integer(c_int) :: rc
+    end function dmi_tangent_create
+
+    function dmi_tangent_set_history(t, s0) result(rc) bind(C, name='dmi_tangent_set_history')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: t
+      real(c_double), intent(in) :: s0(*)
+      integer(c_int) :: rc
+    end function dmi_tangent_set_history
+
+    function dmi_tangent_sample_history(t, columns) result(rc) &
+        bind(C, name='dmi_tangent_sample_history')
+      import :: c_int, c_ptr
+      type(c_ptr), value :: t
+      integer(c_int), intent(in) :: columns(*)
+      integer(c_int) :: rc
+    end function dmi_tangent_sample_history
+
+    ! (dd: pass zeros where C accepts NULL)
+    function dmi_tangent_set_kernel_terms(t, da, db, dc, dd) result(rc) &
+        bind(C, name='dmi_tangent_set_kernel_terms')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: t
+      real(c_double), intent(in) :: da(*), db(*), dc(*), dd(*)
+      integer(c_int) :: rc
+    end function dmi_tangent_set_kernel_terms
+
+    function dmi_tangent_set_rhs_parameters(t, depends) result(rc) &
+        bind(C, name='dmi_tangent_set_rhs_parameters')
+      import :: c_int, c_ptr
+      type(c_ptr), value :: t
+      integer(c_int), intent(in) :: depends(*)
+      integer(c_int) :: rc
+    end function dmi_tangent_set_rhs_parameters
+
+    function dmi_tangent_run(t, steps, flags, dwu, u, x, s_out, dx, switches) result(rc) &
+        bind(C, name='dmi_tangent_run')
+      import :: c_int, c_size_t, c_double, c_int8_t, c_ptr
+      type(c_ptr), value :: t
+      integer(c_size_t), value :: steps
+      integer(c_int), value :: flags
+      real(c_double), intent(in) :: dwu(*)
+      real(c_double), intent(out) :: u(*), x(*), s_out(*), dx(*)
+      integer(c_int8_t), intent(out) :: switches(*)
+      integer(c_int) :: rc
+    end function dmi_tangent_run
+
+    subroutine dmi_tangent_free(t) bind(C, name='dmi_tangent_free')
+      import :: c_ptr
+      type(c_ptr), intent(inout) :: t
+    end subroutine dmi_tangent_free
   end interface
 
   ! The C functions behind the string-returning procedures.

@@ -50,7 +50,7 @@ extern "C" {
 /** Major version of this header; dmi_version() gives the version of the library. */
 #define DMI_VERSION_MAJOR 1
 /** Minor version of this header. */
-#define DMI_VERSION_MINOR 5
+#define DMI_VERSION_MINOR 6
 /** Patch version of this header. */
 #define DMI_VERSION_PATCH 0
 
@@ -585,6 +585,190 @@ DMI_API int dmi_state_save(const dmi_solver *s, void *buf, size_t size);
  * use the same callbacks and convolution method (another method differs by
  * rounding only). */
 DMI_API int dmi_state_load(dmi_solver *s, const void *buf, size_t size);
+
+/** ---- sensitivities: the tangent of the scheme (since 1.6) ---------------
+ * The states U^q and their sensitivities S^q = dU^q/dp in P parameters p_j,
+ * stepped together: with X^q = U^q - h f(t_q, U^q) - h W^q the resolvent's
+ * argument and T^q = dX^q/dp,
+ *
+ *     T^q     = S^q - h (f_u S^q + f_p) - h (sum_l G_l S^{q-l} + dW^q),
+ *     S^{q+1} = R'(X^q) T^q + dR/dp,
+ *
+ * G_l the weights of the delay sum (dmi_get_kernel_weights, summed by the
+ * solver's own engine) and dW^q = sum_l dG_l/dp U^{q-l} the kernel
+ * parameters' part, which the caller gives (dmi_tangent_run).  f_u S + f_p
+ * comes from the model at p (the solver s) and the models at
+ * p + delta_j e_j (the solvers others[j], built by the caller with the same
+ * n, N, h and kind of A): one call of each f per step and parameter (the
+ * directional difference (f_j(U + delta_j S_j) - f(U)) / delta_j), or,
+ * where that makes fewer calls, n forward-difference columns of f_u (relative
+ * step 2^-26 max(1, |u_i|), as applied) and one call for each parameter that
+ * f depends on (dmi_tangent_set_rhs_parameters).  R' is the resolvent's rule
+ * of the step: friction holds a component (S_i = 0) or slips
+ * (S_i = T_i -+ h dalpha_i/dp); the box holds at a bound (S_i = dlo_i/dp or
+ * dhi_i/dp) or passes T_i; a resolvent callback is differenced,
+ * (r_j(h, X + delta_j T_j) - U^{q+1}) / delta_j.  Where a friction component
+ * reverses during a step (to the other sign at once, or through one step in
+ * the dead zone), S_i of that component becomes rho (T_i - h s dalpha_i/dp),
+ * rho = F+ / F- the saltation factor (F = u' just before and after the
+ * reversal, phi = (U - X) / h interpolated linearly at the crossing, s the
+ * sign of U_i^q), so that S converges at O(h) to the equation's
+ * sensitivity, which the plain tangent misses by O(1) there.
+ * Parameters are dimensionless here: S_j has the unit of U per unit of p_j.
+ * The object keeps the handle s (which must outlive it and is stepped by
+ * dmi_tangent_run) and copies from others what it needs (their f and
+ * resolvent callbacks with their user pointers, which must stay valid, and
+ * the differences of their friction or box, their history callbacks with
+ * their user pointers); others may be freed after
+ * dmi_tangent_create.  No other state is kept between calls.
+ */
+/**/
+
+/** Opaque tangent object (dmi_tangent_create). */
+typedef struct dmi_tangent dmi_tangent;
+
+/** Flags of dmi_tangent_run (since 1.6). */
+enum {
+    /** The plain tangent of the scheme everywhere: no saltation factor. */
+    DMI_TANGENT_PLAIN = 1
+};
+
+/** What a friction component does in a step, written by dmi_tangent_run
+ * (since 1.6). */
+enum {
+    /** Nothing to report. */
+    DMI_SWITCH_NONE = 0,
+    /** It lands in the dead zone and stays (starts to stick). */
+    DMI_SWITCH_STICK = 1,
+    /** It reverses during the step: S_i was multiplied by the saltation factor. */
+    DMI_SWITCH_REVERSAL = 2,
+    /** It meets zero or changes sign, but the velocities interpolated at the
+     * crossing do not have the signs of a reversal: no saltation factor (S_i
+     * is the plain tangent there, off by O(1); a smaller h resolves it). */
+    DMI_SWITCH_UNPLACED = 3
+};
+
+/**
+ * (Since 1.6.)  A tangent object for the model s at p and the models
+ * others[0..P-1] at p + delta_j e_j (delta: P finite nonzero values, the
+ * steps actually applied, in the unit of p_j).  s must be an initialised
+ * solver when dmi_tangent_run is called; others need not be (only their f,
+ * resolvent and history callbacks, friction or box are read, here, and copied).  f
+ * depends on p_j unless others[j]'s f and user pointer equal s's
+ * (dmi_tangent_set_rhs_parameters overrides); the history's sensitivity is 0
+ * unless dmi_tangent_set_history sets it.  On success *out owns the object
+ * (dmi_tangent_free).
+ * Errors (the message in dmi_last_error(s)): DMI_EINVAL for out or s NULL
+ * (no message), P = 0, others or delta NULL, others[j] NULL, with another n,
+ * N, h, last-cell weight or kind of A than s, a delta_j zero or not finite,
+ * a friction or box of others[j] whose difference to s's is not finite
+ * (a bound moved to or from infinity); DMI_ENOMEM.  *out is NULL on error.
+ */
+DMI_API int dmi_tangent_create(dmi_tangent **out, dmi_solver *s, size_t P,
+                               const dmi_solver *const *others, const double *delta);
+
+/**
+ * (Since 1.6.)  The sensitivity of the window of stored states at the start
+ * of the next dmi_tangent_run: S0[(k n + i) P + j] = dU_i^{p-N+k}/dp_j,
+ * k = 0..N, oldest first as in dmi_get_window ((N + 1) n P doubles, copied;
+ * NULL: zero again).  For a history z(t; p): (z(t_k; p + delta_j e_j) -
+ * z(t_k; p)) / delta_j, e.g. from the windows of the initialised others.
+ * Errors: DMI_EINVAL for t NULL or a value not finite (the message names
+ * it); DMI_ENOMEM.  On error the object is unchanged.
+ */
+DMI_API int dmi_tangent_set_history(dmi_tangent *t, const double *S0);
+
+/**
+ * (Since 1.6.)  The sensitivity of the window from the history callbacks, as
+ * dmi_init samples them (at t_{-k} = -k h, k = 0..N, and -tau at k = N):
+ * for the parameters j with columns[j] nonzero (P values; NULL: those whose
+ * others[j] has another history callback or user pointer than s),
+ * S0 = (z_j(t_{-k}) - z(t_{-k})) / delta_j, z_j the history of others[j]
+ * and z s's (0 where a model has none), computed once here (2 calls a time
+ * at most: s's once for all parameters) and used by every later
+ * dmi_tangent_run as dmi_tangent_set_history's S0; the other columns are 0.
+ * (For a run from the window dmi_init sampled: p = 0.)
+ * Errors (the message in dmi_last_error(s)): DMI_EINVAL for t NULL;
+ * DMI_ECALLBACK when a history callback returns nonzero, DMI_ENONFINITE when
+ * it gives a value that is not finite (the message names the model, s or
+ * others[j], and t); DMI_ENOMEM.  On error the object is unchanged.
+ */
+DMI_API int dmi_tangent_sample_history(dmi_tangent *t, const int *columns);
+
+/**
+ * (Since 1.6.)  The derivatives of the exponential kernel's terms of s
+ * (dmi_set_kernel_exp) in the parameters, for the kernel parameters' part of
+ * the tangent's delay sum, computed by dmi_tangent_run in O(K n^2 P) a step
+ * (the recursions of sum_l r_k^l U^{q-l} and sum_l l r_k^l U^{q-l},
+ * r_k = e^{(a_k + i b_k) h}, restarted every 4 N steps from the states):
+ * da[k P + j] = da_k/dp_j, db alike (K P values each; 1 / time unit per unit
+ * of p_j), dC[((k n + i) n + m) P + j] = d(C_k)_{im}/dp_j and dD alike (K n n P
+ * values each, dD NULL: all zero), under either quadrature rule (the cells'
+ * weights of each term and their derivatives in a_k + i b_k in closed form).
+ * This is the part dmi_tangent_run's dWU would otherwise carry (both are
+ * added: give dWU only for what the terms do not say, e.g. the near cells of
+ * dmi_set_kernel_near).  da NULL removes them.  The arrays are copied.
+ * dmi_tangent_run then needs s's delay sum to be the recursion
+ * (DMI_CONV_RECURSIVE, or AUTO choosing it) and refuses with DMI_EINVAL
+ * otherwise.  Errors (the message in dmi_last_error(s)): DMI_EINVAL for t
+ * NULL, db or dC NULL with da given, a kernel of s that is not of
+ * dmi_set_kernel_exp, a value not finite (named); DMI_ENOMEM.  On error the
+ * object is unchanged.
+ */
+DMI_API int dmi_tangent_set_kernel_terms(dmi_tangent *t, const double *da, const double *db,
+                                         const double *dC, const double *dD);
+
+/**
+ * (Since 1.6.)  Which parameters f depends on: depends[j] nonzero when p_j
+ * enters f (P values; NULL: the rule of dmi_tangent_create again).  A
+ * parameter marked 0 gets f_p_j = 0 where f_u comes by columns; the
+ * directional differences call every others[j]'s f (exact either way when
+ * the mark is right).  Errors: DMI_EINVAL for t NULL.
+ */
+DMI_API int dmi_tangent_set_rhs_parameters(dmi_tangent *t, const int *depends);
+
+/**
+ * (Since 1.6.)  Steps s and its sensitivities steps times from its current
+ * step p (t_q = (p + q) h):
+ *   S         (steps + 1) n P doubles, required: S[(q n + i) P + j] =
+ *             dU_i^{p+q}/dp_j (row 0 from dmi_tangent_set_history);
+ *   dWU       steps n P doubles, or NULL (zero: the kernel does not depend
+ *             on p): dWU[(q n + i) P + j] = sum_l dG_l/dp_j U^{p+q-l}, the
+ *             kernel parameters' part of the delay sum at step q (the
+ *             weights' derivatives, e.g. differences of the others'
+ *             dmi_get_kernel_weights, applied to the states of this run:
+ *             with dWU given, the run is usually made once without it to
+ *             get the states, then again from the same start);
+ *   U         (steps + 1) n doubles or NULL: U^{p+q};
+ *   X         steps n doubles or NULL: X^{p+q}, the resolvent's argument of
+ *             the step into U^{p+q+1};
+ *   dX        steps n P doubles or NULL: T^q = dX^{p+q}/dp;
+ *   switches  steps n values or NULL: DMI_SWITCH_* of component i in step q
+ *             at [q n + i] (friction only, and not with DMI_TANGENT_PLAIN;
+ *             all DMI_SWITCH_NONE otherwise).
+ * flags: 0 or DMI_TANGENT_PLAIN.  The arrays are row-major, written whole,
+ * and not kept.  s is stepped as by dmi_advance (the same states, bitwise),
+ * then the tangent is run along those states with s's own delay-sum engine
+ * (one per parameter, on the columns of S), its weights and its resolvent
+ * rule.  Memory: about (steps + 1) n (2 + P) doubles beside the outputs
+ * given, and one engine and window of S per parameter.
+ * Errors (the message in dmi_last_error(s)): DMI_EINVAL for t NULL, S NULL,
+ * steps = 0, or unknown flags; DMI_ESTATE when s is not initialised;
+ * DMI_EINVAL also for kernel terms' derivatives without the recursion
+ * (dmi_tangent_set_kernel_terms); DMI_ENOMEM (also when the sizes
+ * overflow); the errors of dmi_step;
+ * DMI_ECALLBACK when f or the resolvent callback of s or others[j] returns
+ * nonzero in the tangent (the message names j and t); DMI_ENONFINITE when a
+ * sensitivity is not finite (the message names the step, component and
+ * parameter).  On error s is bitwise the solver it was before the call
+ * (its state is saved and restored) and the outputs are unspecified.
+ */
+DMI_API int dmi_tangent_run(dmi_tangent *t, size_t steps, int flags, const double *dWU,
+                            double *U, double *X, double *S, double *dX, signed char *switches);
+
+/** (Since 1.6.)  Frees *t and sets *t = NULL (not the solvers); t == NULL
+ * and *t == NULL are allowed and do nothing. */
+DMI_API void dmi_tangent_free(dmi_tangent **t);
 
 /** ---- errors -------------------------------------------------------------- */
 

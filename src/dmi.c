@@ -14,6 +14,7 @@
 #include "core.h"
 #include "engine.h"
 #include "errors.h"
+#include "holds.h"
 
 #include "bytes.h"
 
@@ -164,11 +165,7 @@ static int sample_history(dmi_solver *s, dmi_history *ring)
     const size_t n = s->n, N = s->N;
     double *u = s->work;
     for (size_t k = 0; k <= N; k++) { /* U^{-k} = z(-k h) */
-        /* t_{-k} = -k h, and -tau at k = N: -N h may round below it, and is
-         * below it for a partial last cell (dmi_create_h; U^{-N} is read by no
-         * step), and z is called on [-tau, 0] only */
-        const double tk = -(double)k * s->h; /* (fmax of the two, without a libm call) */
-        double t = k == s->N ? -s->tau : k == 0 ? 0.0 : tk < -s->tau ? -s->tau : tk;
+        const double t = dmi_history_time(s, k);
         for (size_t j = 0; j < n; j++) /* (a loop: n is small) */
             u[j] = 0;
         if (s->z) {
@@ -270,21 +267,6 @@ int dmi_init(dmi_solver *s)
 }
 
 /* ---- stepping -------------------------------------------------------------- */
-
-/* The holds of the built-in operators, for the step and for the watch:
- * friction's resolvent holds U_i at 0 when |x| <= lam = h alpha_i (side 0),
- * else it moves x by lam towards 0 (side +1 above lam, -1 below -lam); the
- * box's projection holds U_i at lo_i when x <= lo_i (side -1), at hi_i when
- * x >= hi_i (+1), else U_i = x (0). */
-static inline int friction_side(double x, double lam)
-{
-    return x > lam ? 1 : x < -lam ? -1 : 0;
-}
-
-static inline int box_side(double x, double lo, double hi)
-{
-    return x <= lo ? -1 : x >= hi ? 1 : 0;
-}
 
 static int apply_resolvent(dmi_solver *s, const double *x, double *out)
 {

@@ -59,7 +59,7 @@
 /* ---- exponential kernels ------------------------------------------------- */
 
 /* phi1(x + i y) = (e^z - 1) / z without cancellation near 0. */
-static void phi1(double x, double y, double *re, double *im)
+void dmi_quad_phi1(double x, double y, double *re, double *im)
 {
     const double r = hypot(x, y);
     if (r < 1e-5) { /* 1 + z/2 + z^2/6 */
@@ -74,6 +74,29 @@ static void phi1(double x, double y, double *re, double *im)
     *im = (ni * x - nr * y) / den;
 }
 
+void dmi_quad_psi(double x, double y, double *re, double *im)
+{
+    if (hypot(x, y) < 1) { /* sum_k z^k / (k! (k + 2)): 30 terms to below 1e-17 */
+        double pr = 1, pi = 0; /* z^k / k! */
+        *re = 0.5;
+        *im = 0;
+        for (int k = 1; k < 30; k++) {
+            const double nr = (pr * x - pi * y) / k, ni = (pr * y + pi * x) / k;
+            pr = nr;
+            pi = ni;
+            *re += pr / (k + 2);
+            *im += pi / (k + 2);
+        }
+        return;
+    }
+    /* (e^z (z - 1) + 1) / z^2 */
+    const double er = exp(x) * cos(y), ei = exp(x) * sin(y);
+    const double nr = er * (x - 1) - ei * y + 1, ni = er * y + ei * (x - 1);
+    const double zr = x * x - y * y, zi = 2 * x * y, den = zr * zr + zi * zi;
+    *re = (nr * zr + ni * zi) / den;
+    *im = (ni * zr - nr * zi) / den;
+}
+
 int dmi_quad_expk(const dmi_expk *k, double h, dmi_expk *out)
 {
     if (dmi_expk_copy(out, k->n, k->K, k->a, k->b, k->C, k->C) != 0) /* D: room for C' - i D' */
@@ -81,7 +104,7 @@ int dmi_quad_expk(const dmi_expk *k, double h, dmi_expk *out)
     const size_t nn = k->n * k->n;
     for (size_t t = 0; t < k->K; t++) {
         double pr, pi;
-        phi1(k->a[t] * h, k->b[t] * h, &pr, &pi);
+        dmi_quad_phi1(k->a[t] * h, k->b[t] * h, &pr, &pi);
         for (size_t q = t * nn; q < (t + 1) * nn; q++) {
             const double C = k->C[q], D = k->D ? k->D[q] : 0.0;
             /* (C - i D)(pr + i pi) = (C pr + D pi) - i (D pr - C pi) */
@@ -106,7 +129,7 @@ double dmi_quad_expk_last(const dmi_expk *k, size_t q, size_t N, double h, doubl
         if (C == 0 && D == 0)
             continue;
         double pr, pi;
-        phi1(k->a[t] * w, k->b[t] * w, &pr, &pi);
+        dmi_quad_phi1(k->a[t] * w, k->b[t] * w, &pr, &pi);
         const double e = exp(k->a[t] * s0), er = e * cos(k->b[t] * s0), ei = e * sin(k->b[t] * s0);
         const double zr = pr * er - pi * ei, zi = pr * ei + pi * er; /* phi1 e^{mu s0} */
         sum += w * (C * zr + D * zi); /* Re((C - i D)(zr + i zi)) */

@@ -14,6 +14,14 @@
 
 #include "exp.h"
 
+/* phi1(z) = (e^z - 1) / z = int_0^1 e^{z x} dx at z = x + i y, without
+ * cancellation near 0: *re + i *im. */
+void dmi_quad_phi1(double x, double y, double *re, double *im);
+
+/* psi(z) = int_0^1 x e^{z x} dx = (e^z (z - 1) + 1) / z^2, by its series
+ * for |z| < 1: *re + i *im. */
+void dmi_quad_psi(double x, double y, double *re, double *im);
+
 /* out = the exponential kernel with k's (a, b) whose samples at l h are
  * k's cells' means (1/h) int_{l h}^{(l+1) h} H: C' - i D' = (C - i D)
  * phi1((a + i b) h), entry by entry; it uses the same entries as k (its

@@ -80,6 +80,16 @@ static inline int dmi_has_expk(const dmi_solver *s)
     return s->H == dmi_expk_eval;
 }
 
+/* The time t_{-k} at which dmi_init samples the history for U^{-k},
+ * k = 0..N: -k h, and -tau at k = N (-N h may round below it, and is below
+ * it for a partial last cell of dmi_create_h; U^{-N} is read by no step), so
+ * that z is called on [-tau, 0] only (dmi.c's init, tangent.c's sampling). */
+static inline double dmi_history_time(const dmi_solver *s, size_t k)
+{
+    const double tk = -(double)k * s->h; /* (fmax of the two, without a libm call) */
+    return k == s->N ? -s->tau : k == 0 ? 0.0 : tk < -s->tau ? -s->tau : tk;
+}
+
 /* Whether h is the tau / N of dmi_create(n, tau, N) (not only theta = 1:
  * the state format records h when it is not, state.c). */
 static inline int dmi_h_is_tau_over_N(const dmi_solver *s)

@@ -71,6 +71,13 @@ _PROTOTYPES = {
     "dmi_state_size": (c_size_t, [_solver_p]),
     "dmi_state_save": (c_int, [_solver_p, c_void_p, c_size_t]),
     "dmi_state_load": (c_int, [_solver_p, c_void_p, c_size_t]),
+    "dmi_tangent_create": (c_int, [POINTER(c_void_p), _solver_p, c_size_t, POINTER(c_void_p), _d]),
+    "dmi_tangent_set_history": (c_int, [c_void_p, _d]),
+    "dmi_tangent_sample_history": (c_int, [c_void_p, POINTER(c_int)]),
+    "dmi_tangent_set_kernel_terms": (c_int, [c_void_p, _d, _d, _d, _d]),
+    "dmi_tangent_set_rhs_parameters": (c_int, [c_void_p, POINTER(c_int)]),
+    "dmi_tangent_run": (c_int, [c_void_p, c_size_t, c_int, _d, _d, _d, _d, _d, c_void_p]),
+    "dmi_tangent_free": (None, [POINTER(c_void_p)]),
     "dmi_last_error": (c_char_p, [_solver_p]),
     "dmi_strerror": (c_char_p, [c_int]),
 }

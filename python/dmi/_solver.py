@@ -1437,6 +1437,66 @@ class Solver:
                 self._call_failed(rc, bound, lambda: f"rhs at t = {float(tt[c])!r}, u = {X[c]!r}")
         return out
 
+    def _tangent(self, others: list[Solver], delta: np.ndarray, steps: int,
+                 S0: np.ndarray | list | None, dWU: np.ndarray | None, depends: np.ndarray | None,
+                 jumps: bool, terms: tuple | None = None
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Steps this (initialised) solver ``steps`` times with the sensitivities of its states in
+        P parameters through libdmi's tangent (``dmi_tangent_run``): ``others`` the models at
+        p + delta_j e_j, ``S0`` the window's sensitivity ((N + 1, n, P), None: zero; a list of
+        parameters: sampled from those models' history callbacks by libdmi), ``dWU`` the
+        kernel parameters' part of the delay sum ((steps, n, P), None: zero), ``depends`` which
+        parameters f depends on (P booleans, None: libdmi's rule), ``jumps`` the saltation factor
+        at reversals, ``terms`` the exponential kernel's terms' derivatives (da, db, dC, dD) as
+        ``dmi_tangent_set_kernel_terms`` takes them (None: none).  Returns U (steps + 1, n), X (steps, n), S (steps + 1, n, P), dX
+        (steps, n, P) and the switches (steps, n) as DMI_SWITCH_* codes (for dmi.identify).
+
+        Raises dmi.Error with libdmi's message (the solver then is where it was); a Python
+        callback's own exception, of this solver or of another, is dropped: the caller runs its
+        own loop to raise it."""
+        n, P = self._n, len(others)
+        c = np.ascontiguousarray
+        delta = c(delta, dtype=float)
+        U, X = np.empty((steps + 1, n)), np.empty((steps, n))
+        S, dX = np.empty((steps + 1, n, P)), np.empty((steps, n, P))
+        switches = np.zeros((steps, n), np.int8)
+        columns = None
+        if isinstance(S0, list):
+            columns = (ctypes.c_int * P)(*[int(j in S0) for j in range(P)])
+            S0 = None
+        S0 = None if S0 is None else c(S0, dtype=float)
+        dWU = None if dWU is None else c(dWU, dtype=float)
+        for m in (self, *others):
+            if m._watched and not m._same():
+                m._rebound(3)
+        handles = (ctypes.c_void_p * P)(*[o._handle for o in others])
+        tangent = ctypes.c_void_p()
+        try:
+            with self._using() as s:
+                rc = _L.dmi_tangent_create(ctypes.byref(tangent), s, P, handles, _ptr(delta))
+                if rc == _lib.OK and S0 is not None:
+                    rc = _L.dmi_tangent_set_history(tangent, _ptr(S0))
+                if rc == _lib.OK and columns is not None:
+                    rc = _L.dmi_tangent_sample_history(tangent, columns)
+                if rc == _lib.OK and terms is not None:
+                    arrays = [c(a, dtype=float) for a in terms]
+                    rc = _L.dmi_tangent_set_kernel_terms(tangent, *[_ptr(a) for a in arrays])
+                if rc == _lib.OK and depends is not None:
+                    flags = (ctypes.c_int * P)(*[int(bool(d)) for d in depends])
+                    rc = _L.dmi_tangent_set_rhs_parameters(tangent, flags)
+                if rc == _lib.OK:
+                    rc = _L.dmi_tangent_run(tangent, steps, 0 if jumps else 1, _ptr(dWU), _ptr(U),
+                                            _ptr(X), _ptr(S), _ptr(dX),
+                                            switches.ctypes.data_as(ctypes.c_void_p))
+                if rc != _lib.OK:
+                    for o in others:
+                        o._failure[0] = None
+                    self._failure[0] = None
+                    raise from_code(rc, _python_calls(_L.dmi_last_error(s).decode()))
+        finally:
+            _L.dmi_tangent_free(ctypes.byref(tangent))
+        return U, X, S, dX, switches
+
     def c_callback(self, part: str) -> tuple[int, int] | None:
         """The C function libdmi calls for a part of the model, for code that calls it directly
         (compiled code: no Python in between).

@@ -1,4 +1,4 @@
-# dmi.identify.sensitivities: the compiled loop (numba, f called through its C function) against
+# dmi.identify.sensitivities: libdmi's loop (dmi_tangent_run, f called through its C function) against
 # the Python loop, step by step, on the models of test_identify_sensitivity.py with f compiled
 # (jit=True): smooth runs with exponential and callback kernels, two reversals, stick-slip, and
 # stick-slip with memory; a box; which loop is taken; and Solver.c_callback, called directly.

@@ -2,8 +2,9 @@
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """The near cells' part of the delay sum of the tangent, sum_{l<m} D_l S^{q-l}, with D_l the part of
 the weights that libdmi's near cells add to the exponential sum's (``Solver.kernel_weights``).  The
-Python loop of sensitivity.py calls :func:`near_sum`; the compiled loop of _compiled.py compiles the
-same function with numba, so both use the weights the same way.  (Plain NumPy, no numba import.)"""
+Python loop of sensitivity.py calls :func:`near_sum` (libdmi's loop adds the near cells with the
+solver's own engine); :func:`near_kernel_part` gives the kernel parameters' part of them to both.
+(Plain NumPy.)"""
 from __future__ import annotations
 
 import numpy as np

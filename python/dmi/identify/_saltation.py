@@ -1,7 +1,7 @@
 # dmi.identify._saltation: how a friction component leaves a step of the scheme (the saltation test).
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
-"""The test of one friction component at one step, shared by the Python loop of sensitivity.py and the
-compiled loop of _compiled.py (which compiles this same function with numba): whether the component
+"""The test of one friction component at one step, for the Python loop of sensitivity.py (libdmi's loop,
+dmi_tangent_run, has the same test in C, src/tangent.c): whether the component
 reverses during the step (S_i then multiplied by the saltation factor rho = F+ / F-), starts to stick,
 or neither.  Plain Python on NumPy arrays, importable without numba."""
 from __future__ import annotations

@@ -16,7 +16,6 @@ onset).  S then converges at O(h) to the equation's sensitivity.
 from __future__ import annotations
 
 import dataclasses
-import importlib.util
 import math
 import warnings
 from collections.abc import Callable
@@ -25,6 +24,7 @@ from typing import Any
 import numpy as np
 from scipy import fft as sp_fft
 
+from .._errors import Error
 from .._solver import Solver
 from ._near import near_kernel_part, near_sum
 from ._saltation import REVERSAL, STICK, UNPLACED, reversal
@@ -86,8 +86,8 @@ class Sensitivities:
         sign in a way the loop cannot place as a reversal inside the step (``"unplaced"``: no
         saltation factor applied, S_i there is the plain tangent, off by O(1)).
     engine : str
-        The loop over the steps that computed S: ``"compiled"`` (numba, f called through its C
-        function) or ``"python"``.
+        The loop over the steps that computed S: ``"compiled"`` (libdmi's, ``dmi_tangent_run``:
+        f called through its C function) or ``"python"``.
     """
 
     t: np.ndarray
@@ -455,9 +455,10 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
         sensitivity); False: the plain tangent of the scheme everywhere.
     engine : str, optional
         The loop over the steps: ``"auto"`` (default) the compiled one where it applies, else
-        the Python one; ``"compiled"`` (numba; f a C function in every model (``jit=True``, a
-        cfunc, a ctypes function) or no f, A zero, friction or a box, no ``rhs``): an error
-        where it does not apply; ``"python"``: one step at a time in Python, calling f through
+        the Python one; ``"compiled"`` (libdmi's loop, ``dmi_tangent_run``, nothing compiled
+        at the first call; f a C function in every model (``jit=True``, a cfunc, a ctypes
+        function) or no f, A zero, friction or a box, no ``rhs``): an error where it does not
+        apply; ``"python"``: one step at a time in Python, calling f through
         :meth:`dmi.Solver.eval_rhs`.  Both give the same S to rounding.
     max_steps : int, optional
         The most steps accepted (default :data:`MAX_STEPS`, 2 000 000); more is refused before
@@ -492,27 +493,8 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     check_steps(steps, n, N, P, h, max_steps, "sensitivities")
     s.init()
     window = s.get_window()                                          # U^{-N}, ..., U^0
-    t, U, X = s.run_terms(steps)
-    # S of the history: dz(t_q)/dp for q = -N, ..., 0, sampled only for the parameters whose
-    # perturbed model has another history (Solver.same_callback); the other columns are 0
-    # (the rows of the steps are all written by the loops; those of the history, Sall[:N + 1],
-    # zeroed here, then their columns in ``hist`` written by the compiled sampling or from inits)
-    Sall = np.empty((N + steps + 1, n, P))
-    Sall[:N + 1] = 0.0
-    hist = [j for j, o in enumerate(mod.others) if not s.same_callback(o, "history")]
-    fresh = None                        # whether the history's S is nonzero somewhere
-    if engine != "python" and hist:
-        fresh = _compiled_history(mod, hist, window, Sall)
-    if fresh is None:
-        Sall[:N + 1] = 0.0              # (a failed compiled sampling may have written some)
-        for j in hist:
-            other = mod.others[j]
-            other.init()                # each perturbed model samples its own history in init
-            d = other.get_window() - window
-            if d.any():                 # (the columns of parameters the history has not stay 0)
-                Sall[:N + 1, :, j] = d / mod.delta[j]
-                fresh = True
-    memory = _Memory(mod, lambda: np.concatenate([window[1:], U[1:]]), P)   # U^{-N+1}, ..., U^steps
+    run: list = []                      # [U] of the run, once made
+    memory = _Memory(mod, lambda: np.concatenate([window[1:], run[0][1:]]), P)   # U^{-N+1}, ..., U^steps
     # the resolvent's derivatives in p, as they do not depend on the step
     kind = s.resolvent_kind
     alpha = s.friction
@@ -527,29 +509,35 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     # f_u S + f_p: by n columns of f_u and one call for each parameter f depends on, where that
     # makes fewer calls of f than one directional difference per parameter
     fpar = None
+    depends = None
     if has_f and rhs is None:
-        depends = np.array([j for j, o in enumerate(mod.others) if not s.same_callback(o, "rhs")],
-                           np.int64)
-        if n + len(depends) < P:
-            fpar = depends
-    if rhs is not None:
-        _check_complex_rhs(rhs, mod, p, t[0], U[0], Sall[N])
-    phi = (U[:-1] - X) / h                                            # f + W at each step
+        depends = np.array([not s.same_callback(o, "rhs") for o in mod.others])
+        if n + int(depends.sum()) < P:
+            fpar = np.flatnonzero(depends).astype(np.int64)
     why = _not_compiled(mod, has_f, rhs) if engine != "python" else "engine='python'"
     if why and engine == "compiled":
         raise ValueError(f"engine='compiled' does not apply: {why}; use engine='auto' or 'python'")
+    # S of the history: dz(t_q)/dp for q = -N, ..., 0, only for the parameters whose perturbed
+    # model has another history (Solver.same_callback); the other columns are 0.  libdmi's loop
+    # samples compiled history callbacks itself (dmi_tangent_sample_history, as init does);
+    # otherwise each such perturbed model's init samples its own
+    hist = [j for j, o in enumerate(mod.others) if not s.same_callback(o, "history")]
+    compiled_history = all(m.c_callback("history") is not None
+                           for m in [s, *(mod.others[j] for j in hist)])
     if not why:
-        from . import _compiled
-        callbacks = ([m.c_callback("rhs") for m in [s, *mod.others]] if has_f else None)
-        friction = (alpha, dalpha) if kind == "friction" else None
-        box = (lo, hi, dlo, dhi) if kind == "box" else None
-        dX, switches, failed = _compiled.run(steps, N, h, t, U, X, phi, window, Sall, bool(fresh),
-                                             mod.delta, callbacks, memory, kind, friction, box,
-                                             jumps, fpar, REL_STEP, hist)
-        if failed < 0:
-            return _result(t, U, Sall[N:], X, dX, h, switches, "compiled")
-        # a call of f failed: the Python loop below (which rewrites each S^{q+1} of Sall from
-        # the history's S on) raises the callback's own error
+        history = (hist if hist and compiled_history else _history_by_init(mod, hist, window))
+        fast = _libdmi_loop(mod, steps, history, memory, run, depends, jumps)
+        if fast is not None:
+            return fast
+        # a call of f failed: the Python loop below raises the callback's own error
+        s.init()
+    Sall = np.empty((N + steps + 1, n, P))
+    Sall[:N + 1] = _history_by_init(mod, hist, window)
+    t, U, X = s.run_terms(steps)
+    run[:] = [U]
+    if rhs is not None:
+        _check_complex_rhs(rhs, mod, p, t[0], U[0], Sall[N])
+    phi = (U[:-1] - X) / h                                            # f + W at each step
     if kind == "friction":
         # R' (1 slipping, 0 stuck) and dR/dp = -h sign(X) dalpha where slipping, for every step
         slipping = (U[1:] != 0.0).astype(float)
@@ -594,6 +582,65 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     return _result(t, U, Sall[N:], X, dX, h, switches, "python")
 
 
+def _kernel_depends(memory: _Memory) -> bool:
+    """Whether a parameter moves the kernel's weights (the tangent then has dG_l U^{p-l})."""
+    if not memory.active:
+        return False
+    if memory.kind == "exp":
+        return bool(np.any(memory.dE) or np.any(memory.dl) or np.any(memory.dnear))
+    return bool(np.any(memory.dG))
+
+
+def _history_by_init(mod: _Perturbed, hist: list, window: np.ndarray) -> np.ndarray:
+    """The history's S, (N + 1, n, P): for the parameters in ``hist``, the window of the
+    perturbed model (after its init, which samples its own history) less the model's, over
+    delta_j; 0 for the others."""
+    S0 = np.zeros(window.shape + (len(mod.delta),))
+    for j in hist:
+        other = mod.others[j]
+        other.init()
+        d = other.get_window() - window
+        if d.any():                     # (the columns of parameters the history has not stay 0)
+            S0[:, :, j] = d / mod.delta[j]
+    return S0
+
+
+def _libdmi_loop(mod: _Perturbed, steps: int, history: np.ndarray | list, memory: _Memory,
+                 run: list, depends: np.ndarray | None, jumps: bool) -> Sensitivities | None:
+    """The run and its tangent by libdmi's loop (dmi_tangent_run) from the initialised model;
+    None where it fails (the model is then where it was).  The history's S is ``history``,
+    (N + 1, n, P), or, where it lists parameters, sampled by libdmi from those perturbed models'
+    compiled history callbacks.  Where a parameter moves the kernel, the kernel parameters' part of the
+    delay sum, sum_l dG_l U^{p-l}, comes from the exponential terms' derivatives in libdmi's loop
+    or, for what they do not say, needs the states first: a plain run gives them, and the model
+    goes back to its start (its saved state) for libdmi's."""
+    s = mod.base
+    h = s.h
+    dWU = terms = None
+    # an exponential kernel under the recursion: libdmi differentiates its terms in the loop;
+    # the near cells' part, and any other kernel's, come as dWU from the states of a plain run
+    by_terms = (memory.kind == "exp" and memory.recursive
+                and s.convolution in ("auto", "recursive"))
+    if by_terms and (np.any(memory.dE) or np.any(memory.dl)):
+        dE = memory.dE.transpose(1, 2, 3, 0)                    # (K, n, n, P)
+        terms = (memory.dl.real.T, memory.dl.imag.T, dE.real, -dE.imag)
+    if (np.any(memory.dnear) if by_terms else _kernel_depends(memory)):
+        start = s.save_state()
+        run[:] = [s.run_terms(steps)[1]]
+        dWU = memory.near_kernel_part() if by_terms else memory.kernel_part()
+        s.load_state(start)
+    try:
+        U, X, S, dX, codes = s._tangent(mod.others, mod.delta, steps, history, dWU, depends,
+                                        jumps, terms)
+    except Error:
+        return None
+    names = {1: "stick", 2: "reversal", 3: "unplaced"}
+    qs, comps = np.nonzero(codes)
+    switches = [(q, i, names[int(codes[q, i])]) for q, i in zip(qs.tolist(), comps.tolist())]
+    t = np.arange(steps + 1) * h
+    return _result(t, U, S, X, dX, h, switches, "compiled")
+
+
 def _f_columns(s: Solver, mod: _Perturbed, fpar: np.ndarray, t: float, u: np.ndarray,
                S: np.ndarray) -> np.ndarray:
     """f_u S + f_p at (t, u): f_u by forward differences of n columns (step 2^-26 max(1, |u_i|)
@@ -624,26 +671,6 @@ def _result(t: np.ndarray, U: np.ndarray, S: np.ndarray, X: np.ndarray, dX: np.n
     return out
 
 
-def _compiled_history(mod: _Perturbed, hist: list, window: np.ndarray,
-                      Sall: np.ndarray) -> bool | None:
-    """The history's S into the columns ``hist`` of Sall[:N + 1] from those perturbed models'
-    compiled history callbacks, called as init calls them, without their init; whether it is
-    nonzero anywhere.  None (Sall[:N + 1] then partly written: zero it and init them) where a
-    history is not a C function, numba is not installed, a call fails, or the same sampling of the
-    model's own history does not give its window, as init sampled it, bit for bit."""
-    s = mod.base
-    callbacks = [m.c_callback("history") for m in [s, *(mod.others[j] for j in hist)]]
-    if any(c is None for c in callbacks) or importlib.util.find_spec("numba") is None:
-        return None
-    from . import _compiled
-    addrs = np.array([a for a, _ in callbacks], np.int64)
-    users = np.array([u for _, u in callbacks], np.int64)
-    status, nonzero = _compiled.history_columns(addrs, users, s.N, float(s.h), float(s.tau),
-                                                np.ascontiguousarray(window), mod.delta[hist],
-                                                np.array(hist, np.int64), Sall)
-    return bool(nonzero) if status == 0 else None
-
-
 def _not_compiled(mod: _Perturbed, has_f: bool, rhs: Callable | None) -> str:
     """Why the compiled loop does not apply ("" where it does)."""
     if rhs is not None:
@@ -657,8 +684,6 @@ def _not_compiled(mod: _Perturbed, has_f: bool, rhs: Callable | None) -> str:
                 where = "p" if j == 0 else f"p + delta e_{j - 1}"
                 return (f"f of the model at {where} is a Python function (set_rhs(f, jit=True) or a "
                         "C function makes it compiled)")
-    if importlib.util.find_spec("numba") is None:
-        return "numba is not installed"
     return ""
 
 

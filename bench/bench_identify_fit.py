@@ -1,0 +1,118 @@
+#!/usr/bin/env python3
+# dmi.identify.estimate against SciPy's least_squares with 2-point forward differences of plain runs
+# (a benchmark, not a test): the same model, data, start and h.  The model: bench_identify.py's
+# friction oscillator with a two-term Prony memory, 7 free parameters (k, mu, w0, c1, a1, c2, a2;
+# g = 2 fixed), f and the history jit=True, 1000 steps of h = 0.01 with stick-slip, 500 samples of
+# the position with Gaussian noise 1e-3 (seeded); the start 5-15 % off the truth.  estimate as it is
+# (its default polish: a second least_squares at tolerance 1e-8 after the first at 1e-5) and with
+# polish=False; least_squares at its default tolerances.  CPU seconds of
+# the process, fastest of the rounds (interleaved), one BLAS thread; each fit's runs of the model
+# and its cost at the end are printed.  Then the floor: one sensitivity run against the 1 + P plain
+# runs of one forward-difference Jacobian.  --baseline DIR fits with another version of
+# dmi.identify in the same rounds (as bench_identify.py).
+# Usage: PYTHONPATH=build/python:bench .venv/bin/python bench/bench_identify_fit.py [--rounds 3]
+#        [--baseline DIR]
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import argparse  # noqa: E402
+import warnings  # noqa: E402
+
+import numpy as np  # noqa: E402
+from scipy import optimize  # noqa: E402
+
+import bench_identify as b  # noqa: E402
+from benchtools import cpu, dir_holding, positive_int  # noqa: E402
+from dmi.identify import Record, estimate, sensitivities  # noqa: E402
+
+STEPS = 1000
+G = 2.0
+TRUTH = np.delete(b.P0, 1)                          # k, mu, w0, c1, a1, c2, a2
+START = TRUTH * (1 + np.array([0.1, -0.1, 0.05, 0.15, -0.1, 0.1, -0.05]))
+
+
+def model():
+    """make(p) of the 7 free parameters (g fixed)."""
+    make8 = b.model(STEPS, True, "exp", True)
+
+    def make(p):
+        return make8(np.insert(np.asarray(p, dtype=float), 1, G))
+    return make
+
+
+def data(make):
+    """500 samples of the position, noise 1e-3."""
+    s = make(TRUTH)
+    s.init()
+    t, U = s.run(STEPS)
+    rng = np.random.default_rng(1)
+    return t[2::2], U[2::2, 0] + 1e-3 * rng.standard_normal(STEPS // 2)
+
+
+def residuals_fd(make, t, y):
+    """The residual function of a least_squares fit by differences (the plain runs)."""
+    def residuals(p):
+        s = make(p)
+        s.init()
+        _, U = s.run(STEPS)
+        return U[2::2, 0] - y
+    return residuals
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=(
+        "Prints the CPU seconds of dmi.identify.estimate against least_squares with 2-point "
+        "differences on a 7-parameter friction model with a two-term memory."))
+    ap.add_argument("--rounds", type=positive_int, default=3,
+                    help="interleaved rounds; the fastest of each counts (default 3)")
+    ap.add_argument("--baseline", metavar="DIR", type=dir_holding("__init__.py"),
+                    help="a copy of another version's python/dmi/identify (default: none)")
+    args = ap.parse_args()
+    make = model()
+    t, y = data(make)
+    record = Record(t, y)
+    fits = {"estimate": lambda: estimate(make, START, record),
+            "estimate, polish=False": lambda: estimate(make, START, record, polish=False),
+            "least_squares 2-point": lambda: optimize.least_squares(
+                residuals_fd(make, t, y), START, jac="2-point", method="trf", x_scale="jac")}
+    if args.baseline:
+        base = b.baseline(args.baseline)
+        base_record = base.Record(t, y)        # (the baseline's own Record class)
+        fits["estimate (baseline)"] = lambda: base.estimate(make, START, base_record)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for f in fits.values():                     # compile and warm up
+            f()
+        best = {k: np.inf for k in fits}
+        last: dict = {}
+        for _ in range(args.rounds):
+            for name, f in fits.items():
+                box: list = []
+                best[name] = min(best[name], cpu(lambda: box.append(f())))
+                last[name] = box[0]
+    ref = best["least_squares 2-point"]
+    print(f"7 parameters, {len(t)} samples, {STEPS} steps; CPU seconds, fastest of {args.rounds}")
+    for name, r in last.items():
+        x = r.x if hasattr(r, "x") else r.p
+        cost = float(r.cost)
+        err = np.max(np.abs(np.asarray(x) - TRUTH) / np.abs(TRUTH))
+        print(f"{name:24} {best[name]:8.3f} s  ratio {best[name] / ref:5.2f}  runs {r.nfev:4d}  "
+              f"jacobians {r.njev if r.njev is not None else 0:3d}  cost {cost:.6g}  "
+              f"max rel. error {err:.2e}")
+    # the floor: a sensitivity run against the 1 + P runs of a forward difference
+    P = len(TRUTH)
+    resid = residuals_fd(make, t, y)
+    sens = min(cpu(lambda: sensitivities(make, START, STEPS)) for _ in range(5))
+    fwd = min(cpu(lambda: [resid(START) for _ in range(P + 1)]) for _ in range(5))
+    one = min(cpu(lambda: resid(START)) for _ in range(5))
+    print(f"one sensitivity run {sens:.4f} s; one residual run {one:.4f} s; 1 + P = {P + 1} "
+          f"runs {fwd:.4f} s; sensitivities / (1 + P runs) = {sens / fwd:.2f}")
+
+
+if __name__ == "__main__":
+    main()
