@@ -10,6 +10,8 @@ import math
 
 import numpy as np
 
+from .._resolvent import crossing, saltation_factor
+
 #: codes of what a component does in a step (the first element of :func:`reversal`'s result)
 NONE, STICK, REVERSAL, UNPLACED = 0, 1, 2, 3
 
@@ -52,13 +54,12 @@ def reversal(q: int, i: int, U: np.ndarray, phi: np.ndarray, alpha: np.ndarray) 
     if nxt == 0.0 and not (q + 2 <= steps and U[q + 2, i] * sm < 0.0):
         return STICK, 0.0
     # where the reversal falls: linear interpolation of u_i across the step
-    frac = U[q, i] / (U[q, i] - nxt)
+    frac = crossing(U[q, i], nxt)
     if q + 1 >= phi.shape[0]:
         ph = phi[q, i]
     else:
         ph = (1.0 - frac) * phi[q, i] + frac * phi[q + 1, i]
-    before = sm * ph + alpha[i]        # -s F-: the speed towards 0 before the reversal
-    after = sm * ph - alpha[i]         # s F+: the speed away from 0 after it
-    if before <= 0.0 or after <= 0.0:
+    rho = saltation_factor(sm, ph, alpha[i])
+    if math.isnan(rho):
         return UNPLACED, 0.0
-    return REVERSAL, after / before
+    return REVERSAL, rho

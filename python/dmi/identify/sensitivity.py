@@ -27,6 +27,7 @@ from scipy import fft as sp_fft
 from .._errors import Error
 from .._solver import Solver
 from ._near import near_kernel_part, near_sum
+from .._resolvent import friction_slope, friction_slope_alpha, salted
 from ._saltation import REVERSAL, STICK, UNPLACED, reversal
 
 #: Relative step of the directional differences (about the square root of the unit roundoff).
@@ -540,8 +541,8 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     phi = (U[:-1] - X) / h                                            # f + W at each step
     if kind == "friction":
         # R' (1 slipping, 0 stuck) and dR/dp = -h sign(X) dalpha where slipping, for every step
-        slipping = (U[1:] != 0.0).astype(float)
-        dR = (-h * np.sign(X) * slipping)[:, :, None] * dalpha[None]
+        slipping = friction_slope(X, h * alpha)
+        dR = friction_slope_alpha(X, h * alpha, h)[:, :, None] * dalpha[None]
         # the steps where a slipping friction component meets zero or changes sign
         meets = np.any((U[:-1] != 0.0) & (U[:-1] * U[1:] <= 0.0) & (alpha > 0.0), axis=1)
     dX = np.empty((steps, n, P))
@@ -707,7 +708,7 @@ def _reversals(q: int, U: np.ndarray, phi: np.ndarray, alpha: np.ndarray, dalpha
         elif what == UNPLACED:
             switches.append((q, i, "unplaced"))
         elif what == REVERSAL:
-            Snew[i] = rho * (T[i] - h * math.copysign(1.0, U[q, i]) * dalpha[i])
+            Snew[i] = salted(rho, T[i], h, math.copysign(1.0, U[q, i]), dalpha[i])
             switches.append((q, i, "reversal"))
 
 
