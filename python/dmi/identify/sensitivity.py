@@ -481,39 +481,21 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
     TypeError
         make not returning a dmi.Solver.
     """
-    p = np.array(p, dtype=float).reshape(-1) if np.ndim(p) <= 1 else None
-    if p is None or len(p) == 0 or not np.all(np.isfinite(p)):
-        raise ValueError("p: expected a nonempty vector of finite numbers")
-    if not isinstance(steps, (int, np.integer)) or steps < 1:
-        raise ValueError(f"steps = {steps!r}: expected an integer >= 1")
-    if engine not in ("auto", "compiled", "python"):
-        raise ValueError(f"engine = {engine!r}: expected 'auto', 'compiled' or 'python'")
+    p = _checked(p, steps, engine)
     mod = _build(make, p)
     s = mod.base
-    n, N, h, P = s.n, s.N, s.h, len(p)
-    check_steps(steps, n, N, P, h, max_steps, "sensitivities")
+    check_steps(steps, s.n, s.N, len(p), s.h, max_steps, "sensitivities")
     s.init()
     window = s.get_window()                                          # U^{-N}, ..., U^0
     run: list = []                      # [U] of the run, once made
-    memory = _Memory(mod, lambda: np.concatenate([window[1:], run[0][1:]]), P)   # U^{-N+1}, ..., U^steps
-    # the resolvent's derivatives in p, as they do not depend on the step
-    kind = s.resolvent_kind
-    alpha = s.friction
-    dalpha = dlo = dhi = None
-    if kind == "friction":
-        dalpha = np.stack([(o.friction - alpha) / d for o, d in zip(mod.others, mod.delta)], axis=1)
-    elif kind == "box":
-        lo, hi = s.box
-        dlo = np.stack([_bound_diff(o.box[0], lo) / d for o, d in zip(mod.others, mod.delta)], axis=1)
-        dhi = np.stack([_bound_diff(o.box[1], hi) / d for o, d in zip(mod.others, mod.delta)], axis=1)
+    memory = _Memory(mod, lambda: np.concatenate([window[1:], run[0][1:]]), len(p))
     has_f = s.has("rhs") or any(o.has("rhs") for o in mod.others)
     # f_u S + f_p: by n columns of f_u and one call for each parameter f depends on, where that
     # makes fewer calls of f than one directional difference per parameter
-    fpar = None
-    depends = None
+    fpar = depends = None
     if has_f and rhs is None:
         depends = np.array([not s.same_callback(o, "rhs") for o in mod.others])
-        if n + int(depends.sum()) < P:
+        if s.n + int(depends.sum()) < len(p):
             fpar = np.flatnonzero(depends).astype(np.int64)
     why = _not_compiled(mod, has_f, rhs) if engine != "python" else "engine='python'"
     if why and engine == "compiled":
@@ -532,48 +514,120 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
             return fast
         # a call of f failed: the Python loop below raises the callback's own error
         s.init()
+    return _python_loop(_Loop(mod, p, steps, rhs, jumps, has_f, fpar, memory, run),
+                        _history_by_init(mod, hist, window))
+
+
+def _checked(p: Any, steps: Any, engine: str) -> np.ndarray:
+    """The parameters as a vector of floats; a ValueError for bad p, steps or engine."""
+    p = np.array(p, dtype=float).reshape(-1) if np.ndim(p) <= 1 else None
+    if p is None or len(p) == 0 or not np.all(np.isfinite(p)):
+        raise ValueError("p: expected a nonempty vector of finite numbers")
+    if not isinstance(steps, (int, np.integer)) or steps < 1:
+        raise ValueError(f"steps = {steps!r}: expected an integer >= 1")
+    if engine not in ("auto", "compiled", "python"):
+        raise ValueError(f"engine = {engine!r}: expected 'auto', 'compiled' or 'python'")
+    return p
+
+
+@dataclasses.dataclass
+class _Loop:
+    """What the Python loop over the steps needs: the models, the parameters, the run's length and
+    options, how f is differentiated (``fpar``: the parameters f depends on, when by columns), the
+    memory of S and the run (filled by the loop)."""
+    mod: _Perturbed
+    p: np.ndarray
+    steps: int
+    rhs: Callable | None
+    jumps: bool
+    has_f: bool
+    fpar: np.ndarray | None
+    memory: _Memory
+    run: list
+
+
+@dataclasses.dataclass
+class _Resolvent:
+    """The resolvent's kind and its derivatives in p, which do not depend on the step: the
+    friction levels and their derivatives, or the box's faces and theirs."""
+    kind: str
+    alpha: Any = None
+    dalpha: Any = None
+    lo: Any = None
+    hi: Any = None
+    dlo: Any = None
+    dhi: Any = None
+
+
+def _resolvent_of(mod: _Perturbed) -> _Resolvent:
+    """The base model's resolvent and its differences against the perturbed models'."""
+    s = mod.base
+    r = _Resolvent(s.resolvent_kind, alpha=s.friction)
+    if r.kind == "friction":
+        r.dalpha = np.stack([(o.friction - r.alpha) / d for o, d in zip(mod.others, mod.delta)],
+                            axis=1)
+    elif r.kind == "box":
+        r.lo, r.hi = s.box
+        r.dlo = np.stack([_bound_diff(o.box[0], r.lo) / d for o, d in zip(mod.others, mod.delta)],
+                         axis=1)
+        r.dhi = np.stack([_bound_diff(o.box[1], r.hi) / d for o, d in zip(mod.others, mod.delta)],
+                         axis=1)
+    return r
+
+
+def _f_directions(L: _Loop, t: float, u: np.ndarray, Sq: np.ndarray) -> np.ndarray:
+    """f_u S + f_p at one step: by complex step, by columns, or one directional difference per
+    parameter (zero without f)."""
+    mod, s = L.mod, L.mod.base
+    if L.rhs is not None:
+        return _complex_directions(L.rhs, t, u, L.p, Sq)
+    if L.fpar is not None:
+        return _f_columns(s, mod, L.fpar, t, u, Sq)
+    if not L.has_f:
+        return np.zeros((s.n, len(L.p)))
+    f0 = s.eval_rhs(t, u)
+    moved = u + mod.delta[:, None] * Sq.T                             # (P, n): U + delta_j S_j
+    return (np.array([o.eval_rhs(t, m) for o, m in zip(mod.others, moved)]).T
+            - f0[:, None]) / mod.delta
+
+
+def _python_loop(L: _Loop, history: np.ndarray) -> Sensitivities:
+    """The tangent step by step in Python, f through :meth:`dmi.Solver.eval_rhs`."""
+    mod, s, steps, memory = L.mod, L.mod.base, L.steps, L.memory
+    n, N, h, P = s.n, s.N, s.h, len(L.p)
+    r = _resolvent_of(mod)
     Sall = np.empty((N + steps + 1, n, P))
-    Sall[:N + 1] = _history_by_init(mod, hist, window)
+    Sall[:N + 1] = history
     t, U, X = s.run_terms(steps)
-    run[:] = [U]
-    if rhs is not None:
-        _check_complex_rhs(rhs, mod, p, t[0], U[0], Sall[N])
+    L.run[:] = [U]
+    if L.rhs is not None:
+        _check_complex_rhs(L.rhs, mod, L.p, t[0], U[0], Sall[N])
     phi = (U[:-1] - X) / h                                            # f + W at each step
-    if kind == "friction":
+    if r.kind == "friction":
         # R' (1 slipping, 0 stuck) and dR/dp = -h sign(X) dalpha where slipping, for every step
-        slipping = friction_slope(X, h * alpha)
-        dR = friction_slope_alpha(X, h * alpha, h)[:, :, None] * dalpha[None]
+        slipping = friction_slope(X, h * r.alpha)
+        dR = friction_slope_alpha(X, h * r.alpha, h)[:, :, None] * r.dalpha[None]
         # the steps where a slipping friction component meets zero or changes sign
-        meets = np.any((U[:-1] != 0.0) & (U[:-1] * U[1:] <= 0.0) & (alpha > 0.0), axis=1)
+        meets = np.any((U[:-1] != 0.0) & (U[:-1] * U[1:] <= 0.0) & (r.alpha > 0.0), axis=1)
     dX = np.empty((steps, n, P))
     switches: list = []
-    Fd = np.zeros((n, P))
     dWU = memory.kernel_part() if memory.active else None
     for q in range(steps):
         Sq = Sall[q + N]
-        if rhs is not None:
-            Fd = _complex_directions(rhs, t[q], U[q], p, Sq)
-        elif fpar is not None:
-            Fd = _f_columns(s, mod, fpar, t[q], U[q], Sq)
-        elif has_f:
-            f0 = s.eval_rhs(t[q], U[q])
-            moved = U[q] + mod.delta[:, None] * Sq.T                  # (P, n): U + delta_j S_j
-            Fd = (np.array([o.eval_rhs(t[q], m) for o, m in zip(mod.others, moved)]).T
-                  - f0[:, None]) / mod.delta
-        T = Sq - h * Fd
+        T = Sq - h * _f_directions(L, t[q], U[q], Sq)
         if memory.active:
             T -= h * (memory.sum_S(Sall, q) + dWU[q])
         dX[q] = T
         Snew = Sall[q + 1 + N]
-        if kind == "friction":
+        if r.kind == "friction":
             np.multiply(T, slipping[q][:, None], out=Snew)
             Snew += dR[q]
-            if jumps and meets[q]:
-                _reversals(q, U, phi, alpha, dalpha, T, Snew, h, switches)
-        elif kind == "box":
-            below, above = X[q] < lo, X[q] > hi
-            Snew[:] = np.where(below[:, None], dlo, np.where(above[:, None], dhi, T))
-        elif kind == "callback":
+            if L.jumps and meets[q]:
+                _reversals(q, U, phi, r.alpha, r.dalpha, T, Snew, h, switches)
+        elif r.kind == "box":
+            below, above = X[q] < r.lo, X[q] > r.hi
+            Snew[:] = np.where(below[:, None], r.dlo, np.where(above[:, None], r.dhi, T))
+        elif r.kind == "callback":
             for j, other in enumerate(mod.others):
                 Snew[:, j] = (other.eval_resolvent(h, X[q] + mod.delta[j] * T[:, j])
                               - U[q + 1]) / mod.delta[j]
