@@ -98,23 +98,44 @@ def plot_curves(curves: Sequence[Any] = (), grid: Grid | None = None, ax: Any = 
         from .interactive import diagram_html
         diagram_html(curves, grid, html, p_label=p_label, q_label=q_label, title=title)
     import matplotlib.pyplot as plt
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch, Rectangle
 
     if ax is None:
         _, ax = plt.subplots(figsize=(7.0, 5.4), constrained_layout=True)
-    handles = []
+    handles = _draw_regions(ax, boxes) + _draw_curves(ax, curves)
+    if grid is not None:
+        handles += _draw_grid_events(ax, grid)
+    ax.margins(0.02)
+    ax.autoscale_view()
+    ax.set_xlabel(p_label)
+    ax.set_ylabel(q_label)
+    if title:
+        ax.set_title(title)
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=3,
+              frameon=False, fontsize="small")
+    return ax
+
+
+def _draw_regions(ax: Any, boxes: list) -> list:
+    """The regions' rectangles (hatched grey where undecided), and their keys."""
+    from matplotlib.patches import Patch, Rectangle
+
     seen = set()
     for lo, hi, qlo, qhi, name, _ in boxes:
         hatch = "///" if name == UNDECIDED else None
         ax.add_patch(Rectangle((lo, qlo), hi - lo, qhi - qlo, facecolor=REGION_COLORS[name],
                                edgecolor="#969696" if hatch else "none", hatch=hatch, lw=0.0))
         seen.add(name)
-    for name in list(REGIONS) + [UNDECIDED]:
-        if name in seen:
-            handles.append(Patch(facecolor=REGION_COLORS[name], label=name,
-                                 hatch="///" if name == UNDECIDED else None,
-                                 edgecolor="#969696" if name == UNDECIDED else "none"))
+    return [Patch(facecolor=REGION_COLORS[name], label=name,
+                  hatch="///" if name == UNDECIDED else None,
+                  edgecolor="#969696" if name == UNDECIDED else "none")
+            for name in list(REGIONS) + [UNDECIDED] if name in seen]
+
+
+def _draw_curves(ax: Any, curves: list) -> list:
+    """The curves (Hopf curves dashed by criticality, fold curves dash-dotted) and their
+    codimension-two points, and their keys."""
+    from matplotlib.lines import Line2D
+
     kinds = set()
     for c in curves:
         for p, q, crit in curve_pieces(c):
@@ -127,6 +148,7 @@ def plot_curves(curves: Sequence[Any] = (), grid: Grid | None = None, ax: Any = 
                 ax.annotate(e.kind, (e.p, e.q), textcoords="offset points", xytext=(6, 6),
                             fontsize="small", color="#cb181d")
                 kinds.add(("codim-2", None))
+    handles = []
     for kind, crit in sorted(kinds, key=str):
         if kind == "hopf":
             handles.append(Line2D([], [], color="black", lw=1.6, ls=CRITICALITY_DASH[crit],
@@ -136,33 +158,29 @@ def plot_curves(curves: Sequence[Any] = (), grid: Grid | None = None, ax: Any = 
         elif kind == "codim-2":
             handles.append(Line2D([], [], ls="", marker="P", color="#cb181d",
                                   label="codimension-two point"))
-    if grid is not None:
-        for kind, (marker, color, label) in EVENT_MARKERS.items():
-            evs = [e for e in grid.events(kind)
-                   if kind != "fold" or e.on == "orbits"]
-            if not evs:
-                continue
-            if kind == "hopf":
-                for crit, fill in (("supercritical", color), ("subcritical", "white"),
-                                   (None, "#bbbbbb")):
-                    sel = [e for e in evs if e.criticality == crit]
-                    if sel:
-                        ax.plot([e.p for e in sel], [e.q for e in sel], ls="", marker=marker,
-                                mfc=fill, mec=color, ms=6, zorder=6)
-                        handles.append(Line2D([], [], ls="", marker=marker, mfc=fill, mec=color,
-                                              label=f"Hopf point of the grid "
-                                                    f"({crit or 'not decided'})"))
-            else:
-                ax.plot([e.p for e in evs], [e.q for e in evs], ls="", marker=marker,
-                        color=color, ms=6, zorder=6)
-                handles.append(Line2D([], [], ls="", marker=marker, color=color,
-                                      label=f"{label} (grid)"))
-    ax.margins(0.02)
-    ax.autoscale_view()
-    ax.set_xlabel(p_label)
-    ax.set_ylabel(q_label)
-    if title:
-        ax.set_title(title)
-    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=3,
-              frameon=False, fontsize="small")
-    return ax
+    return handles
+
+
+def _draw_grid_events(ax: Any, grid: Grid) -> list:
+    """The grid's events as markers (Hopf points filled by criticality), and their keys."""
+    from matplotlib.lines import Line2D
+
+    handles = []
+    for kind, (marker, color, label) in EVENT_MARKERS.items():
+        evs = [e for e in grid.events(kind) if kind != "fold" or e.on == "orbits"]
+        if not evs:
+            continue
+        if kind != "hopf":
+            ax.plot([e.p for e in evs], [e.q for e in evs], ls="", marker=marker,
+                    color=color, ms=6, zorder=6)
+            handles.append(Line2D([], [], ls="", marker=marker, color=color,
+                                  label=f"{label} (grid)"))
+            continue
+        for crit, fill in (("supercritical", color), ("subcritical", "white"), (None, "#bbbbbb")):
+            sel = [e for e in evs if e.criticality == crit]
+            if sel:
+                ax.plot([e.p for e in sel], [e.q for e in sel], ls="", marker=marker,
+                        mfc=fill, mec=color, ms=6, zorder=6)
+                handles.append(Line2D([], [], ls="", marker=marker, mfc=fill, mec=color,
+                                      label=f"Hopf point of the grid ({crit or 'not decided'})"))
+    return handles
