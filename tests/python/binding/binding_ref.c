@@ -1,6 +1,6 @@
 /*
  * The C library's own results for the Python binding's tests
- * (test_binding_vs_c.py): the paper's oscillator (examples/paper.c) at
+ * (test_vs_c.py): the paper's oscillator (examples/paper.c) at
  * N = 500, stepped in C, in four scenarios:
  *   box     Example 4.3's rhs and kernel (callbacks) with the box
  *           [-0.01, 0.01] x [-0.05, 0.05] instead of the friction;

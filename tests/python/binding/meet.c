@@ -1,6 +1,6 @@
 /*
  * A right-hand side for the threads test of the Python binding
- * (test_binding_threads.py): on its first call it announces itself on a
+ * (test_threads.py): on its first call it announces itself on a
  * counter shared by two solvers and waits until the other solver's callback
  * has arrived too.  Both can be inside it at once only if the two threads are
  * inside libdmi at the same time, i.e. the binding released the GIL.  The wait
