@@ -12,7 +12,7 @@ reports z = (estimate - truth) / stderr.
 
 Run: PYTHONPATH=build/python python bench/bench_identify_fractional.py [--tau 50] [--seeds 5]
 (the full size of docs/identify.md: tau = 50, T = 60, h = 0.005; the test of
-tests/python/test_identify_nearcells.py runs a small one)."""
+tests/python/identify/test_nearcells.py runs a small one)."""
 from __future__ import annotations
 
 import argparse

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # The cost of self-excited oscillations in dmi.analysis (a benchmark, not a test), in periods of
 # plain simulation and in roots calls measured in the same run.  The model: a mass on a moving
-# belt with a memory that destabilises sliding (tests/python/test_analysis_selfexcited.py's
+# belt with a memory that destabilises sliding (tests/python/analysis/shooting/test_selfexcited.py's
 # belt: numba right-hand side with the damping c in its user data, a constant kernel by the O(1)
 # recursion), with h = tau / N for N about 1e3 and 1e4.  Per N:
 # - one period of plain simulation (advance(M));

@@ -26,7 +26,7 @@ parts, :math:`\\int_\\tau^\\infty s^{-1/2} w'(t-s)\\,ds = \\tau^{-1/2}(w(t-\\tau
 leading term is a spring: the model puts it back, :math:`k_\\tau = k + c/\\sqrt{\\pi\\tau}`, leaving a
 remainder of order :math:`\\tau^{-3/2}`. (The Caputo derivative of a run from rest, with
 :math:`\\tau` at least the run's length, is checked against the Laplace transform's inverse in
-``tests/python/test_kernels_bagley_torvik.py``.)
+``tests/python/kernels/test_bagley_torvik.py``.)
 
 **The analysis** (:mod:`dmi.analysis`): :func:`~dmi.analysis.periodic_orbit` finds the forced
 orbit by shooting for each friction level :math:`\\mu` (the previous orbit as the guess). As

@@ -29,7 +29,7 @@ a jump of :math:`\\mu_s - \\mu_d` in g at 0: not Lipschitz.) The scheme's step t
 exactly when the force besides friction is below :math:`\\mu_s`, and slides with
 :math:`\\mu_s\\,\\mathrm{sign} + g = F`. The model is ``examples/python/stribeck_belt.py``.
 
-**The checks** (printed below, and asserted in ``tests/python/test_analysis_verified.py``):
+**The checks** (printed below, and asserted in ``tests/python/analysis/scheme/test_verified.py``):
 
 1. the split gives back F away from 0 and g is Lipschitz with L (sampled);
 2. the equation's equilibrium (``of="equation"``, the fractional kernel's near cell by its exact

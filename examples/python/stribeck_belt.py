@@ -1,6 +1,6 @@
 # A mass on a moving belt with velocity-weakening (Stribeck) friction and fractional (Caputo 1/2)
 # damping of a long memory: the model of plot_stribeck_belt.py (and of its checks in
-# tests/python/test_analysis_verified.py).
+# tests/python/analysis/scheme/test_verified.py).
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """x'' + c D^(1/2) x + k x + F(x' - v_b) ∋ 0 with the Stribeck law
 

@@ -26,7 +26,7 @@ import time
 
 import numpy as np
 
-# The model (also read by the test, tests/python/test_binding_example.py).
+# The model (also read by the test, tests/python/binding/test_example.py).
 K1, K2 = 1.0, 0.8          # spring stiffnesses
 M1, M2 = 1.0, 0.5          # masses
 MU = (0.12, 0.1)           # friction forces

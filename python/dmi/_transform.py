@@ -163,7 +163,7 @@ def power_laplace(lam: Any, beta: float, c: float, delta: float) -> np.ndarray:
     w = min(delta, 4 / max|lambda|), the first ``[0, w]`` by Gauss-Jacobi with the weight
     ``s^-beta`` (40 nodes: e^{-lambda s} on it is a polynomial to rounding), the others by
     Gauss-Legendre (40 nodes, the integrand smooth there).  Relative error below 1e-11 (checked
-    against mpmath's incomplete gamma in tests/python/test_analysis_verified_equation.py).
+    against mpmath's incomplete gamma in tests/python/analysis/equilibria/test_verified_equation.py).
 
     Parameters
     ----------

@@ -16,7 +16,7 @@
 #            each page has only file: URLs inside BUILD/docs/html (and data:/blob:/about: ones),
 #            and no request failed;
 #   figures  dmi.analysis's interactive HTML figures, written here (into a temporary folder) from
-#            the small model of tests/python/interactive_models.py, no site needed: hovering a
+#            the small model of tests/python/models/interactive_models.py, no site needed: hovering a
 #            point of the orbit branch shows its p and period, clicking it makes the orbit panel's
 #            lines draw that point's BranchPoint.t and .u; hovering a point of the branch of
 #            equilibria and a cell of the chart shows its rightmost root; a branch of equilibria
@@ -442,10 +442,10 @@ def check_chart(b: Browser, chart, page: Path) -> None:
 
 
 def check_figures(b: Browser, src: Path, build: Path) -> None:
-    """The HTML figures of a small model's branches and chart (tests/python/interactive_models.py)
+    """The HTML figures of a small model's branches and chart (tests/python/models/interactive_models.py)
     in the browser: hover and click on the data points, and the network log."""
     sys.path[:0] = [str(build / "python"), str(src / "tests" / "python")]
-    import interactive_models as im
+    from models import interactive_models as im
     equilibria, orbits = im.branches()
     chart = im.chart()
     with tempfile.TemporaryDirectory() as tmp:

@@ -14,7 +14,7 @@ A the orbit's amplitude and M = period / h the steps per period.  The quotient i
 system's linearisation (with its saltation) up to two errors: the switch's rounding to a step, at most
 (jump) h / eps, and the curvature, O(eps^2) (central differences); eps ~ A h^(1/3) balances
 them, error O(h^(2/3)) (0.2 % at M = 2e4 against Den Hartog's saltation oracle, see
-tests/python/test_analysis_orbit_oracles.py).  Multipliers of a stuck phase come out exactly
+tests/python/analysis/shooting/test_orbit_oracles.py).  Multipliers of a stuck phase come out exactly
 0: a perturbation that keeps the stick is wiped out.
 
 The leading multipliers (:func:`floquet_verdict`, :func:`floquet_multipliers`) are the

@@ -21,10 +21,7 @@ import scipy.optimize as so
 from dmi import analysis as da
 from dmi.analysis.plane.grid import GridEvent, GridRow, Trace
 
-try:   # the shared models' package (tests/python/models) or, before it, tests/python itself
-    from models import hopf_models
-except ImportError:
-    import hopf_models
+from models import hopf_models
 
 W0, TAU, C1, C2 = 1.0, 2.0, 1.0, -1.0
 QS = (0.3, 0.45, 0.6)

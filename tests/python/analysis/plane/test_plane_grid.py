@@ -20,10 +20,7 @@ from dmi import analysis as da
 from dmi.analysis.plane.grid import (UNDECIDED, GridEvent, GridRow, Trace, facts_at, region_of,
                                      regions)
 
-try:   # the shared models' package (tests/python/models) or, before it, tests/python itself
-    from models import hopf_models
-except ImportError:
-    import hopf_models
+from models import hopf_models
 
 W0, TAU = 1.0, 2.0
 C1, C2 = 1.0, -1.0
