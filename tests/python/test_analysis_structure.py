@@ -45,16 +45,20 @@ def depth(edges: dict[str, set[str]], prefix: str) -> int:
 
 
 def test_one_driver():
-    # every function with a step policy (min_step) is the driver or hands it to the driver
+    # every function with a step policy (min_step) is the driver or hands it to the driver: it
+    # calls it, or maps its keywords onto the driver's options (a value: ContinuationOptions)
     t = trees()
     with_steps = {(mod, fn.name) for mod, tree in t.items() for fn in functions(tree)
                   if "min_step" in [a.arg for a in fn.args.args + fn.args.kwonlyargs]}
-    assert ("continuation.driver", "continuation") in with_steps
+    policy = next(n for n in ast.walk(t["continuation.driver"])
+                  if isinstance(n, ast.ClassDef) and n.name == "ContinuationOptions")
+    assert "min_step" in {a.target.id for a in policy.body if isinstance(a, ast.AnnAssign)}
     assert ("orbits", "continue_orbit") in with_steps
     assert ("equilibria.equilibrium", "continue_equilibrium") in with_steps
-    for mod, name in with_steps - {("continuation.driver", "continuation")}:
+    for mod, name in with_steps:
         fn = next(f for f in functions(t[mod]) if f.name == name)
-        assert calls(fn, "continuation"), f"{mod}.{name} has a step policy of its own"
+        assert calls(fn, "continuation") or calls(fn, "ContinuationOptions"), \
+            f"{mod}.{name} has a step policy of its own"
 
 
 #: Linear solves a Newton iteration calls (by name or attribute).
@@ -179,3 +183,238 @@ def test_climbs_sees_an_import_back_up():
              "dmi.analysis.plot.branch": {"dmi.analysis.plot.interactive"}}
     assert climbs(edges) == [("dmi.analysis.core.model", "dmi.analysis.scheme.stepmap"),
                              ("dmi.analysis.shooting.shoot", "dmi.analysis.orbits")]
+
+
+def _called(n: ast.Call) -> str:
+    """The name a call calls (``f`` of ``f(...)`` or ``a.b.f(...)``)."""
+    f = n.func
+    return f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) else ""
+
+
+def owners(tree: ast.Module) -> dict[ast.AST, str]:
+    """Every node of a module -> the name of the innermost function (or ``Class.method``) that
+    holds it ("" at the module's level)."""
+    out: dict[ast.AST, str] = {}
+
+    def walk(node: ast.AST, name: str, cls: str) -> None:
+        for child in ast.iter_child_nodes(node):
+            here, inner = name, cls
+            if isinstance(child, ast.ClassDef):
+                inner = child.name
+            elif isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                here = f"{cls}.{child.name}" if cls and not name else child.name if not name \
+                    else name
+            out[child] = here
+            walk(child, here, inner)
+    walk(tree, "", "")
+    return out
+
+
+def callers(names: set[str], t: dict[str, ast.Module] | None = None) -> set[tuple[str, str]]:
+    """(module, function) of every call in dmi.analysis to one of ``names``."""
+    t = trees() if t is None else t
+    out = set()
+    for mod, tree in t.items():
+        where = owners(tree)
+        for n in ast.walk(tree):
+            if isinstance(n, ast.Call) and _called(n) in names:
+                out.add((mod, where[n]))
+    return out
+
+
+#: Root finders of a scalar function: along a branch only the driver's locator calls them.
+ROOT_FINDERS = {"brentq", "brenth", "ridder", "bisect", "root_scalar", "toms748"}
+#: Scalar roots of a defined function, not events along a branch: the Hopf crossing of the
+#: rightmost root between two parameters (stability.hopf), a Hopf curve's crossing on its first
+#: row (chart._trace).
+SCALAR_ROOTS = {("equilibria.stability", "hopf"), ("equilibria.chart", "_trace")}
+
+
+def test_one_event_locator():
+    # Brent's method along a branch: the driver's locator (Along.root, locate) and landing only
+    found = callers(ROOT_FINDERS)
+    assert found - SCALAR_ROOTS == {("continuation.driver", "Along.root"),
+                                    ("continuation.driver", "locate"),
+                                    ("continuation.driver", "_Run.land")}, found
+    # a bisection along the branch (a loop around a corrected middle) is the driver's too
+    for mod, tree in trees().items():
+        if mod == "continuation.driver":
+            continue
+        for loop in ast.walk(tree):
+            if isinstance(loop, (ast.For, ast.While)):
+                inner = {_called(n) for n in ast.walk(loop) if isinstance(n, ast.Call)}
+                assert not inner & {"middle", "mid", "across"}, f"{mod} bisects a branch"
+    # the shooting's stick events and the collocation's signature changes use it
+    t = trees()
+    assert callers({"bisect_along"}, t) >= {("shooting.branch", "Shooting.between")}
+    assert ("collocation.branch", "EquationBranch._locate") in callers({"locate"}, t)
+
+
+#: Functions of dmi.analysis that call a dense, sparse or Krylov solver, and what they solve;
+#: the one bordered solve is core.newton.bordered_system (bordered_solve), the other entries are
+#: systems without a border.  A new caller fails the test: a bordered system goes through
+#: bordered_solve.
+RAW_SOLVES = {
+    ("core.newton", "bordered_system"): "the one bordered solve",
+    ("continuation.driver", "bordered_det"): "the branch-point test function's determinant",
+    ("collocation.system", "_factor"): "the collocation system's Jacobian",
+    ("collocation.floquet", "monodromy"): "the monodromy's sensitivities",
+    ("collocation.floquet", "eigenfunction"): "the Floquet eigenfunction",
+    ("equilibria.normal_form", "_corrected"): "the equilibrium's Jacobian",
+    ("equilibria.root_verdict", "_eval"): "the characteristic matrix's trace",
+    ("equilibria.equation", "Characteristic.newton_step"): "the characteristic matrix's trace",
+    ("scheme.floquet", "growth_rate"): "a least-squares fit",
+    ("shooting.branch", "_Picard.solve"): "Newton-Picard's reduced system (b + k unknowns)",
+    # a bordered system solved on its own, to go through bordered_solve (its owner's change)
+    ("equilibria.curves", "_Extended._null"): "the bordered left null vector of a fold curve",
+}
+SOLVERS = {"gmres", "splu", "spsolve", "lu_solve", "lstsq", "cho_solve", "bicgstab"}
+
+
+def raw_solves(t: dict[str, ast.Module]) -> set[tuple[str, str]]:
+    """(module, function) of the calls to a solver, or to ``linalg.solve``."""
+    out = callers(SOLVERS, t)
+    for mod, tree in t.items():
+        where = owners(tree)
+        for n in ast.walk(tree):
+            if isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute) and \
+                    n.func.attr == "solve" and isinstance(n.func.value, ast.Attribute) and \
+                    n.func.value.attr == "linalg":
+                out.add((mod, where[n]))
+    return out
+
+
+def test_one_bordered_solve():
+    t = trees()
+    got = raw_solves(t)
+    assert got == set(RAW_SOLVES), (got - set(RAW_SOLVES), set(RAW_SOLVES) - got)
+    # the driver's corrector and tangent, the maps' Newton step and the collocation's Newton
+    # with a held length border through bordered_solve
+    users = callers({"bordered_solve", "bordered_system"}, t)
+    assert {("continuation.driver", "tangent"), ("core.newton", "bordered_step"),
+            ("core.newton", "bordered_solve")} <= users, users
+    assert not [m for m, _ in users if m.startswith(("shooting", "collocation"))
+                and m != "collocation.discretisation"], users
+    # no bordered solve of its own: none defines one
+    defined = {(mod, fn.name) for mod, tree in t.items() for fn in functions(tree)
+               if "bordered" in fn.name and mod != "core.newton"}
+    assert defined <= {("continuation.driver", "bordered_det"),
+                       ("collocation.branch", "_bordered")}, defined
+
+
+def test_raw_solves_finds_a_solve():
+    src = """
+def f(A, b):
+    return np.linalg.solve(A, b)
+
+class C:
+    def g(self, A, b):
+        return sla.splu(A).solve(b)
+"""
+    assert raw_solves({"m": ast.parse(src)}) == {("m", "f"), ("m", "C.g")}
+
+
+def test_newton_picard_is_a_strategy_of_the_one_loop():
+    t = trees()
+    fn = next(f for f in functions(t["shooting.branch"]) if f.name == "_newton_picard")
+    assert calls(fn, "newton_loop")
+    assert ("shooting.branch", "_newton_picard") not in {
+        (mod, name) for mod, tree in t.items() for name in solving_loops(tree)}
+
+
+def test_driver_contract_is_typed():
+    import dmi.analysis.continuation.driver as driver
+    # no hook found by getattr / hasattr on the discretisation: its protocols say them
+    tree = trees()["continuation.driver"]
+    for n in ast.walk(tree):
+        if isinstance(n, ast.Call) and _called(n) in ("getattr", "hasattr") and n.args:
+            a = n.args[0]
+            name = a.id if isinstance(a, ast.Name) else a.attr if isinstance(
+                a, ast.Attribute) else ""
+            assert name != "disc" or (isinstance(n.args[1], ast.Name)), ast.unparse(n)
+    for hook in ("HasEvents", "Describes", "Corners", "Accepts", "Recovers", "Adapts",
+                 "Carries", "Orients", "Weighted", "StartsTangent", "Between", "OnCurrent"):
+        assert getattr(driver, hook)._is_protocol, hook
+    # the collocated branch gets its mends through accept / recover, not an own corrector
+    from dmi.analysis.collocation.branch import EquationBranch
+    assert not hasattr(EquationBranch, "correct")
+    assert issubclass(EquationBranch, (driver.Accepts,)) or all(
+        callable(getattr(EquationBranch, m)) for m in ("accept", "recover"))
+
+
+def test_dispatch_on_the_orbit_class():
+    # no "of" attribute read to tell a scheme's orbit from the equation's in these modules
+    t = trees()
+    for mod in ("orbits", "hopf_orbits", "collocation.branch", "continuation.driver",
+                "shooting.branch", "shooting.events", "shooting.autonomous"):
+        for n in ast.walk(t[mod]):
+            if isinstance(n, ast.Call) and _called(n) == "getattr" and len(n.args) >= 2:
+                a = n.args[1]
+                assert not (isinstance(a, ast.Constant) and a.value == "of"), (mod,
+                                                                               ast.unparse(n))
+
+
+def memos(t: dict[str, ast.Module]) -> set[tuple[str, str]]:
+    """(module, function) of the caches of dmi.analysis by what they are: a function that
+    fills a dict where a key is missing (``if k not in d: d[k] = ...``; ``v = d.get(k)``, then
+    ``d[k] = ...``) and returns what the dict holds (``return d[k]``, ``return v``), and
+    functions decorated with ``lru_cache`` or ``cache``."""
+    out = set()
+    for mod, tree in t.items():
+        where = owners(tree)
+        for fn in functions(tree):
+            missing = {ast.unparse(c.comparators[0]) for c in ast.walk(fn)
+                       if isinstance(c, ast.Compare) and isinstance(c.ops[0], ast.NotIn)}
+            read = set(missing)   # what a return of the memo's value mentions
+            for a in ast.walk(fn):
+                if isinstance(a, ast.Assign) and isinstance(a.value, ast.Call) and \
+                        isinstance(a.value.func, ast.Attribute) and a.value.func.attr == "get":
+                    missing.add(ast.unparse(a.value.func.value))
+                    read |= {ast.unparse(x) for x in a.targets}
+            stores = any(isinstance(n, ast.Subscript) and isinstance(n.ctx, ast.Store)
+                         and ast.unparse(n.value) in missing for n in ast.walk(fn))
+            returns = any(isinstance(r, ast.Return) and r.value is not None and
+                          any(m in ast.unparse(r.value) for m in read | missing)
+                          for r in ast.walk(fn))
+            if stores and returns:
+                out.add((mod, where.get(fn, fn.name) or fn.name))
+            for d in fn.decorator_list:
+                name = ast.unparse(d)
+                if "lru_cache" in name or name.endswith("cache"):
+                    out.add((mod, fn.name))
+    return out
+
+
+def test_caches_found_by_what_they_are():
+    got = memos(trees())
+    # the one cache of a model's objects (Problem.cached), the driver's points along one chord
+    # (dropped with it), and tables of pure functions of numbers (quadrature rules)
+    assert got == {("scheme.problem", "Problem.cached"), ("continuation.driver", "Along.__call__"),
+                   ("collocation.mesh", "_monomials"), ("collocation.mesh", "_jacobi"),
+                   ("collocation.mesh", "_legendre"),
+                   # the collocation terms' delay matrices and memo of their last evaluations:
+                   # caches of a Terms (one p) beside Problem.cached (their owner's to fold)
+                   ("collocation.system", "Terms.delay"), ("collocation.system", "Terms._last")
+                   }, got
+
+
+def test_memos_finds_a_local_cache():
+    src = """
+def at(s):
+    if s not in cache:
+        cache[s] = f(s)
+    return cache[s]
+
+class P:
+    def got(self, k):
+        v = self.d.get(k)
+        if v is None:
+            v = self.d[k] = f(k)
+        return v
+
+def bookkeeping(d, k, b):
+    ref = d.get(k)
+    d[k] = b
+    return b
+"""
+    assert memos({"m": ast.parse(src)}) == {("m", "at"), ("m", "P.got")}
