@@ -148,7 +148,7 @@ class NoJacobian:
 
 
 def test_a_discretisation_without_a_required_method_is_a_type_error_naming_it():
-    with pytest.raises(TypeError, match="NoJacobian lacks jacobian"):
+    with pytest.raises(TypeError, match="NoJacobian lacks jacobian"):   # bad-inputs DC01
         continuation(NoJacobian(), [0.0], 0.0, 1.0)
     assert isinstance(SCurve(), Discretisation) and not isinstance(NoJacobian(), Discretisation)
     assert isinstance(Circle(), HasEvents) and not isinstance(SCurve(), HasEvents)
@@ -168,13 +168,13 @@ def test_options_are_values_and_the_keywords_map_onto_them():
     s = continuation(SCurve(), [x0], x0 ** 3 - 3 * x0, 10.0, o, predictor="secant")
     assert s.status.startswith("reached p_end") and abs(s.points[-1].x - cubic_roots(10.0)[-1]) \
         <= 1e-10
-    with pytest.raises(TypeError, match="no field stepsize"):
+    with pytest.raises(TypeError, match="no field stepsize"):   # bad-inputs DC02
         continuation(SCurve(), [x0], x0 ** 3 - 3 * x0, 10.0, stepsize=0.1)
-    with pytest.raises(ValueError, match="predictor"):
+    with pytest.raises(ValueError, match="predictor"):   # bad-inputs DC03
         ContinuationOptions(predictor="chord")
     with pytest.raises(ValueError, match="converge"):
         NewtonOptions(converge="energy")
-    with pytest.raises(TypeError, match="no field damping"):
+    with pytest.raises(TypeError, match="no field damping"):   # bad-inputs DC04
         NewtonOptions().but(damping=0.5)
     assert NewtonOptions(converge="both", search="descent") == NewtonOptions(
         converge=Converge.BOTH, search=Search.DESCENT)
@@ -252,3 +252,9 @@ def test_recover_gives_the_point_where_the_corrector_fails():
     assert b.status.startswith("reached p_end") and b.points[-1].p == 2.0
     assert d.recovered > 0 and any(1.0 < q.p < 1.2 for q in b.points)
     assert all(abs(q.x - q.p) <= 1e-12 for q in b.points)
+
+
+def test_continue_orbit_of_something_else_is_a_type_error():
+    from dmi.analysis import continue_orbit
+    with pytest.raises(TypeError, match="orbit is a dict: give an Orbit"):   # bad-inputs DC05
+        continue_orbit({"p": 0.0}, 1.0)

@@ -260,7 +260,7 @@ class EquationBranch(CollocationDiscretisation):
             tries = []
             for k in (1, 2, 3):
                 try:
-                    tries.append(self._bordered(probe, x0, p0, dev,
+                    tries.append(self._held(probe, x0, p0, dev,
                                                 float(dev[:-1] @ x0) - SHRINK ** k * size, what))
                 except ShootingError:
                     continue
@@ -289,9 +289,9 @@ class EquationBranch(CollocationDiscretisation):
             row[k], row[k + S - 1] = 1.0, -1.0
             if lay.autonomous:
                 row[x.size - 1] = 1.0
-        return self._bordered(probe, x, p, row, float(lengths[j]), why)
+        return self._held(probe, x, p, row, float(lengths[j]), why)
 
-    def _bordered(self, probe: CollocationDiscretisation, x: np.ndarray, p: float,
+    def _held(self, probe: CollocationDiscretisation, x: np.ndarray, p: float,
                   row: np.ndarray, target: float, why: str) -> tuple[np.ndarray, float]:
         """Damped Newton (sparse LU; the driver's corrector) on probe's system bordered by
         row . (x, p) = target, p free, from (x, p).  ShootingError when it fails."""

@@ -51,8 +51,11 @@ protocol the driver tests with ``isinstance``:
 Options are values: :class:`ContinuationOptions` (step control, predictor, the corrector's
 :class:`~dmi.analysis.core.newton.NewtonOptions`).
 
-The driver: ``continuation(disc, x0, p0, p_end, *, step, min_step, max_step, max_points,
-at=(), ...) -> Branch``.
+The driver: ``continuation(disc, x0, p0, p_end, options=ContinuationOptions(...)) -> Branch``
+(the options' fields also as keywords: ``step=``, ``min_step=``, ``at=``, ...).  Its locators
+along a branch: Brent's method on a test function across the chord of two points (:class:`Along`),
+:func:`locate` (a discretisation's own function of the points, from one point along a
+direction) and :func:`bisect_along` (a predicate, e.g. a stick pattern).
 
 - Predictor: the unit tangent t, the null vector of [J_x, J_p], from the bordered system
   [[J_x, J_p], [w t_prev']] t = (0, 1) (dense: LU; sparse: SuperLU; an operator: GMRES); with
