@@ -513,20 +513,29 @@ def newton_corrector(curve: Curve, zp: np.ndarray, row: np.ndarray, target: floa
     return z, len(res) - 1
 
 
+#: The optional hooks: the name a run's ``has`` table gives each, and its protocol.
+HOOKS = {"events": HasEvents, "describe": Describes, "corner": Corners, "accept": Accepts,
+         "recover": Recovers, "adapt": Adapts, "carry": Carries, "orient": Orients,
+         "start_tangent": StartsTangent, "between": Between, "on_current": OnCurrent,
+         "correct": OwnCorrector}
+
+
 class _Run:
-    """One continuation: the curve, the corrector's settings and the points found."""
+    """One continuation: the curve, the corrector's settings, and the discretisation's hooks
+    (``has``: name -> whether it implements that protocol, tested once)."""
 
     def __init__(self, disc: Discretisation, size: int, options: ContinuationOptions):
         self.curve = Curve(disc, size)
         self.disc = disc
         self.newton = options.corrector
+        self.has = {name: isinstance(disc, proto) for name, proto in HOOKS.items()}
 
     def correct(self, zp: np.ndarray, row: np.ndarray, target: float, far: float
                 ) -> tuple[np.ndarray, int]:
         """The point on row . z = target near zp: Newton's (then the discretisation's
         ``accept``, or its ``recover`` where Newton fails), or shooting's own corrector."""
         disc = self.disc
-        if isinstance(disc, OwnCorrector):
+        if self.has["correct"]:
             x, p, its = disc.correct(zp[:-1].copy(), float(zp[-1]), row, target, far)
             return np.concatenate([np.asarray(x, dtype=float), [float(p)]]), int(its)
         step = math.isfinite(far)
@@ -534,13 +543,13 @@ class _Run:
             z, its = newton_corrector(self.curve, zp, row, target, self.newton, far=far,
                                       what=f"corrector near p = {float(zp[-1])!r}")
         except (ShootingError, ValueError) as e:   # ValueError: the residual refuses z
-            if not isinstance(disc, Recovers):
+            if not self.has["recover"]:
                 raise
             got = disc.recover(zp[:-1].copy(), float(zp[-1]), row, target, step, e)
             if got is None:
                 raise
             return np.concatenate([np.asarray(got[0], dtype=float), [float(got[1])]]), 0
-        if isinstance(disc, Accepts):
+        if self.has["accept"]:
             x, p = disc.accept(z[:-1], float(z[-1]), step)
             z = np.concatenate([np.asarray(x, dtype=float), [float(p)]])
         return z, its
@@ -825,13 +834,13 @@ class _Walk:
             if abs(t[-1]) > VERTICAL:
                 if t[-1] * self.direction < 0:
                     t = -t
-            elif isinstance(disc, Orients):   # a vertical start: the discretisation's way
+            elif self.run.has["orient"]:   # a vertical start: the discretisation's way
                 if float(np.dot(self.curve.w(z.size - 1) * t,
                                 disc.orient(z[:-1].copy(), float(z[-1])))) < 0:
                     t = -t
             return t, (Jx, Jp), False
         t = (disc.start_tangent(z[:-1].copy(), float(z[-1]), self.direction)
-             if isinstance(disc, StartsTangent) else None)
+             if self.run.has["start_tangent"] else None)
         if t is None:
             return e_p, None, True
         return np.asarray(t, dtype=float), None, False
@@ -844,7 +853,7 @@ class _Walk:
 
     def tests(self, z: np.ndarray, pt: Any, t: np.ndarray, J: tuple | None) -> dict[str, float]:
         f = (dict(self.disc.event_functions(z[:-1], float(z[-1]), pt))
-             if isinstance(self.disc, HasEvents) else {})
+             if self.run.has["events"] else {})
         if J is not None:
             f["branch-point"] = bordered_det(J[0], J[1], t)
         return f
@@ -879,7 +888,7 @@ class _Walk:
                                    f"p = {float(z[-1])!r}" + (" (natural steps from it failed "
                                                               "too)" if cornered else "") +
                                    f": {e}")
-                    said = self.disc.corner(self.pts) if isinstance(self.disc, Corners) else ""
+                    said = self.disc.corner(self.pts) if self.run.has["corner"] else ""
                     if said:   # the corner first, whichever route failed there
                         self.status = f"{said} (the {self.status})"
                     return None
@@ -896,7 +905,7 @@ class _Walk:
         f = self.tests(zn, pt, tn, J)
         found: list[Event] = []
         _events(self.run, z, t, self.fs[-1], zn, tn, f, found, self.tangents, self.zs[-2:])
-        if isinstance(self.disc, Between):
+        if self.run.has["between"]:
             found += self.disc.between(z, self.pts[-1], zn, pt, self.run.middle)
         # p_end crossed by the new point, or twice inside the step (a located fold beyond it):
         # the last point lands on it exactly, at its first crossing
@@ -939,7 +948,7 @@ class _Walk:
         Jacobian that came with it (tangent predictor), or None."""
         disc = self.disc
         restarted = zn.size != z.size    # the corrector changed the unknowns
-        if isinstance(disc, Adapts):
+        if self.run.has["adapt"]:
             xa = np.asarray(disc.adapt(zn[:-1].copy(), float(zn[-1])), dtype=float)
             if xa.size != zn.size - 1 or np.any(xa != zn[:-1]):
                 zn = np.concatenate([xa, [zn[-1]]])
@@ -950,7 +959,7 @@ class _Walk:
             return zn, sec / self.curve.norm(sec), None
         sec = t if restarted else zn - z
         if restarted and zn.size != z.size:   # new unknowns: a direction on them
-            sec = (disc.carry(t, zn[:-1]) if isinstance(disc, Carries) else
+            sec = (disc.carry(t, zn[:-1]) if self.run.has["carry"] else
                    np.concatenate([np.zeros(zn.size - 1), [t[-1]]]))
         tn, Jxn, Jpn = tangent(self.curve, zn, sec)
         return zn, tn, ((Jxn, Jpn) if self.tangents else None)
@@ -1019,7 +1028,7 @@ def _events(run: _Run, za: np.ndarray, ta: np.ndarray, fa: dict[str, float],
     fb), located and checked, appended to events (index 0: the caller sets it)."""
     curve = run.curve
     disc = run.disc
-    if za.size != zb.size and isinstance(disc, OnCurrent):   # za re-solved on zb's unknowns
+    if za.size != zb.size and run.has["on_current"]:   # za re-solved on zb's unknowns
         xa = disc.on_current(za[:-1], float(za[-1]))
         if xa is not None and xa.size == zb.size - 1:
             za, tangents = np.concatenate([xa, za[-1:]]), False
@@ -1083,7 +1092,7 @@ def _located(run: _Run, along: Along, kind: str, ta: np.ndarray, fa: float, fb: 
     x, p = ze[:-1].copy(), float(ze[-1])
     fields: dict[str, Any] = {"detail": f"the {kind} test function changes sign (located on "
                                         "the branch)", "u": x}
-    if isinstance(disc, Describes):
+    if run.has["describe"]:
         got = disc.describe(kind, x, p, disc.point(x, p))
         if got is None:
             why = disc.why

@@ -359,8 +359,8 @@ def bordered_solve(Jx: Any, Jp: np.ndarray, rows: np.ndarray, rhs: np.ndarray, *
 
     Parameters
     ----------
-    Jx : numpy.ndarray, scipy.sparse matrix or scipy.sparse.linalg.LinearOperator
-        Shape (m, m).
+    Jx : numpy.ndarray, scipy.sparse matrix, scipy.sparse.linalg.LinearOperator or callable
+        Shape (m, m); a callable: v -> J_x v (matrix-free, as an operator).
     Jp : numpy.ndarray
         Shape (m,) or (m, k): the columns of the k extra unknowns.
     rows : numpy.ndarray
@@ -394,12 +394,14 @@ def bordered_system(Jx: Any, Jp: np.ndarray, rows: np.ndarray, rhs: np.ndarray, 
     a direct solve; GMRES's, one more product, for an operator J_x: above about 1e-2 the
     system is singular; inf for a non-finite solution).  A singular direct solve raises
     ShootingError."""
-    m = Jx.shape[0]
+    m = np.shape(Jp)[0]
     Jc = np.asarray(Jp, dtype=float).reshape(m, -1)
     B = np.asarray(rows, dtype=float).reshape(-1, m + Jc.shape[1])
-    if isinstance(Jx, sla.LinearOperator):
+    if isinstance(Jx, sla.LinearOperator) or callable(Jx):
+        jv = Jx.matvec if isinstance(Jx, sla.LinearOperator) else Jx
+
         def mv(v: np.ndarray) -> np.ndarray:
-            return np.concatenate([Jx.matvec(v[:m]) + Jc @ v[m:], B @ v])
+            return np.concatenate([jv(v[:m]) + Jc @ v[m:], B @ v])
         size = m + Jc.shape[1]
         A = sla.LinearOperator((size, size), matvec=mv, dtype=float)
         dz, _ = sla.gmres(A, rhs, rtol=rtol, atol=0.0, restart=min(size, 60), maxiter=maxiter)
@@ -449,9 +451,8 @@ def bordered_step(F: Callable[[np.ndarray], np.ndarray], x: np.ndarray, Fx: np.n
     Fq = np.asarray(Fq, dtype=float).reshape(x.size, -1)
     g = np.atleast_1d(np.asarray(g, dtype=float))
     eps = fd_eps(x)
-    J = sla.LinearOperator((x.size, x.size), dtype=float,
-                           matvec=lambda v: directional(F, x, Fx, v, eps) - v)
-    return bordered_system(J, Fq, border, -np.concatenate([Fx - x, g]), rtol=rtol, maxiter=4)
+    return bordered_system(lambda v: directional(F, x, Fx, v, eps) - v, Fq, border,
+                           -np.concatenate([Fx - x, g]), rtol=rtol, maxiter=4)
 
 
 def newton(F: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, *, tol: float = 1e-10,
