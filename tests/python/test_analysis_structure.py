@@ -1,8 +1,9 @@
-# dmi.analysis has one continuation driver, one cache of what it builds from a model, and one
-# Newton loop (newton.newton_loop, its linear solve given by the caller: the maps' matrix-free
-# bordered_newton, of which newton.newton is a case, collocation's sparse LU, the driver's
-# corrector), besides shooting's Newton-Picard; its import chain is at most 8 modules deep (it
-# was 9 with two drivers).
+# dmi.analysis has one continuation driver (its contract typed, its options a value), one cache
+# of what it builds from a model, one Newton loop (newton.newton_loop, its linear solve given by
+# the caller: the maps' matrix-free bordered_newton, of which newton.newton is a case,
+# collocation's sparse LU, the driver's corrector, shooting's Newton-Picard), one bordered solve
+# (newton.bordered_solve) and one locator of events along a branch (the driver's); its import
+# chain is at most 8 modules deep (it was 9 with two drivers).
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -64,9 +65,9 @@ def test_one_driver():
 #: Linear solves a Newton iteration calls (by name or attribute).
 LINEAR_SOLVES = {"splu", "spsolve", "bordered_solve", "bordered_step", "gmres", "lu_solve",
                  "lstsq"}
-#: Loops around a linear solve that are not Newton loops on a residual of their own: shooting's
-#: Newton-Picard (its own method).
-OTHER_LOOPS = {("shooting.branch", "_newton_picard")}
+#: Loops around a linear solve that are not Newton loops on a residual of their own: none
+#: (shooting's Newton-Picard is a linear solve of newton_loop).
+OTHER_LOOPS: set[tuple[str, str]] = set()
 
 
 def solving_loops(tree: ast.Module) -> set[str]:
