@@ -55,6 +55,7 @@ two points shortened 64 times, each middle corrected across the chord).
 """
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from collections.abc import Callable
@@ -69,7 +70,7 @@ from .collocation.discretisation import CollocationDiscretisation
 from .collocation.floquet import eigenfunction
 from .collocation.signature import Signature
 from .collocation.system import Layout, evaluate, solve
-from .continuation.driver import continuation
+from .continuation.driver import ContinuationOptions, Predictor, continuation
 from .collocation.branch import continue_equation_orbit
 from .collocation.orbit import EquationOrbit
 from .scheme.floquet import StabilityWarning, Verify, phase_free, ritz
@@ -82,7 +83,7 @@ from .shooting.refine import refine_orbit
 from .shooting.shoot import periodic_orbit
 
 
-def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points: int = 200,
+def continue_orbit(orbit: Orbit | EquationOrbit, p_end: float, step: float = 0.05, *, max_points: int = 200,
                    min_step: float | None = None, max_step: float | None = None,
                    multipliers: int = 6, tol: float = 1e-10, max_iter: int = 8,
                    sections: int = 1, margins: bool = True,
@@ -177,82 +178,66 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
         A bad ``step``, ``p_end``, ``max_points`` or ``period``; ``period`` for an autonomous
         orbit; ``period(orbit.p)`` not the orbit's period; an option that does not apply to
         an EquationOrbit.
+    TypeError
+        ``orbit`` is neither an Orbit nor an EquationOrbit.
     """
-    if getattr(orbit, "of", "scheme") == "equation":
-        unused = [name for name, given in (("period", period is not None), ("refine", refine),
-                                           ("verify", verify is not None),
-                                           ("sections", sections != 1),
-                                           ("margins", not margins)) if given]
-        if unused:
-            raise ValueError(f"continue_orbit of an EquationOrbit: {', '.join(unused)}= do not "
-                             "apply to a collocated branch (see continue_orbit's docstring)")
-        return continue_equation_orbit(orbit, p_end, step, max_points=max_points,
-                                       min_step=min_step, max_step=max_step,
-                                       multipliers=multipliers, tol=tol, max_iter=max_iter, at=at)
     if not (math.isfinite(step) and step > 0):
         raise ValueError(f"step = {step!r}: must be finite and > 0 (p units)")
-    if verify is None or verify is True:
-        verify = Verify()
-    elif verify is False:
-        if multipliers > 0:
-            warnings.warn("continue_orbit(verify=False): the points' multipliers are Ritz "
-                          "values without an error bound, so their stable is None; leave "
-                          "verify at its default (Verify()) for verified verdicts", UserWarning,
-                          stacklevel=2)
-        verify = None
-    elif not isinstance(verify, Verify):
-        raise ValueError(f"verify = {verify!r}: give a dmi.analysis.Verify, or False to opt out "
-                         "of the verification")
+    if max_points < 2:
+        raise ValueError(f"max_points = {max_points!r}: must be >= 2")
+    options = ContinuationOptions(step=step, min_step=min_step, max_step=max_step,
+                                  max_points=max_points, at=tuple(at), tol=tol,
+                                  max_iter=max_iter)
+    return _continue(orbit, p_end, options, multipliers=multipliers, sections=sections,
+                     margins=margins, period=period, refine=refine, verify=verify)
+
+
+@functools.singledispatch
+def _continue(orbit: Any, p_end: float, options: ContinuationOptions, *, multipliers: int,
+              sections: int, margins: bool, period: Callable[[float], float] | None,
+              refine: bool, verify: Verify | bool | None) -> Branch:
+    """:func:`continue_orbit` by the orbit's class: neither an Orbit nor an EquationOrbit."""
+    raise TypeError(f"continue_orbit: orbit is a {type(orbit).__name__}: give an Orbit (from "
+                    "periodic_orbit or hopf_orbit) or an EquationOrbit (from collocate or "
+                    "hopf_orbit(..., of=\"equation\"))")
+
+
+@_continue.register
+def _(orbit: EquationOrbit, p_end: float, options: ContinuationOptions, *, multipliers: int,
+      sections: int, margins: bool, period: Callable[[float], float] | None, refine: bool,
+      verify: Verify | bool | None) -> Branch:
+    """An EquationOrbit's branch: by collocation
+    (:func:`dmi.analysis.collocation.branch.continue_equation_orbit`); the scheme's options
+    refused."""
+    unused = [name for name, given in (("period", period is not None), ("refine", refine),
+                                       ("verify", verify is not None),
+                                       ("sections", sections != 1),
+                                       ("margins", not margins)) if given]
+    if unused:
+        raise ValueError(f"continue_orbit of an EquationOrbit: {', '.join(unused)}= do not "
+                         "apply to a collocated branch (see continue_orbit's docstring)")
+    return continue_equation_orbit(orbit, p_end, options, multipliers=multipliers)
+
+
+@_continue.register
+def _(orbit: Orbit, p_end: float, options: ContinuationOptions, *, multipliers: int,
+      sections: int, margins: bool, period: Callable[[float], float] | None, refine: bool,
+      verify: Verify | bool | None) -> Branch:
+    """The scheme's Orbit's branch: shooting (see the module)."""
+    verify = _verification(verify, multipliers)
     if not math.isfinite(p_end) or p_end == orbit.p:
         raise ValueError(f"p_end = {p_end!r}: must be finite and differ from the orbit's "
                          f"p = {orbit.p!r}")
-    if max_points < 2:
-        raise ValueError(f"max_points = {max_points!r}: must be >= 2")
-    n = orbit.u.shape[1]
-    x0 = np.array(orbit.state)
-    if orbit.autonomous:
-        if period is not None:
-            raise ValueError("period=...: an autonomous orbit's period is an unknown of the "
-                             "branch; continue it with period=None")
-        maps: ForcedMaps = AutoMaps(orbit.make, orbit.steps, orbit.h, 0)
-        tau = step_model(maps.problem, orbit.p, orbit.h).tau   # its map's solver later
-        maps.rows = maps.auto.rows = max(orbit.rows or x0.size // n,
-                                         math.ceil(tau / (0.6 * orbit.h)) + 1)
-        F0 = maps(orbit.p)
-        if F0.dim != x0.size:
-            x0 = F0.extend(x0)
-        x0 = np.concatenate([x0, [orbit.h]])
-    else:
-        if period is not None and not callable(period):
-            raise ValueError(f"period = {period!r}: give a function p -> period (time units)")
-        maps = ForcedMaps(orbit.make, orbit.steps, orbit.h, 0, period)
-        if period is not None:
-            P0 = maps.step(orbit.p) * orbit.steps
-            if abs(P0 - orbit.period) > 1e-9 * orbit.period:
-                raise ValueError(f"period(p = {orbit.p!r}) = {P0!r} but the orbit's period is "
-                                 f"{orbit.period!r} (= {orbit.steps} steps h = {orbit.h!r})")
-        # rows for the whole range: N may grow with p (tau with a fixed h, or h with the
-        # period); the probes of both ends (the start's becomes its map's solver)
-        rows = max(orbit.rows or x0.size // n, maps.memory(orbit.p) + 1)
-        try:
-            rows = max(rows, maps.memory(float(p_end)) + 1)
-        except Exception:   # make refuses p_end: the branch will stop where make does
-            pass
-        maps.rows = rows + max(2, rows // 50)  # room for a corrector a little beyond the ends
-        F0 = maps(orbit.p)
-        if F0.dim != x0.size:
-            x0 = F0.extend(x0)
-    disc = Shooting(maps, multipliers, sections, margins, tol, max_iter, orbit.iterations,
-                    verify)
+    maps, x0, F0 = (_autonomous_maps(orbit, period) if orbit.autonomous else
+                    _forced_maps(orbit, float(p_end), period))
+    disc = Shooting(maps, multipliers, sections, margins, options.tol, options.max_iter,
+                    orbit.iterations, verify)
     disc.size = x0.size
     if orbit.autonomous:   # the phase condition through the start
         maps.reference(np.concatenate([x0, [orbit.p]]), F0.trajectory(x0[:-1]))
-    auto = maps.autonomous
-    b = continuation(disc, x0, orbit.p, float(p_end), step=step, min_step=min_step,
-                     max_step=max_step, max_points=max_points, at=at, tol=tol,
-                     max_iter=max_iter, predictor="secant", easy=3, grow_first=False,
-                     make=orbit.make,
-                     kind="autonomous" if auto else "orbits",
+    b = continuation(disc, x0, orbit.p, float(p_end), options, predictor=Predictor.SECANT,
+                     easy=3, grow_first=False, make=orbit.make,
+                     kind="autonomous" if maps.autonomous else "orbits",
                      branch=dict(steps=orbit.steps, h=orbit.h, rows=maps.rows,
                                  sections=sections, period=period))
     open_ = [q for q in b.points if q.floquet is not None and q.stable is None]
@@ -262,13 +247,73 @@ def continue_orbit(orbit: Orbit, p_end: float, step: float = 0.05, *, max_points
                       f"{', '.join(f'{q.p:.8g}' for q in open_[:6])}"
                       f"{', ...' if len(open_) > 6 else ''}: {open_[0].floquet.reason} (the "
                       "first; BranchPoint.floquet.reason has each point's)", StabilityWarning,
-                      stacklevel=2)
+                      stacklevel=4)
     if refine:
         for e in b.events:
             if e.kind in ("period-doubling", "torus"):
                 refined_event(maps, b.points[e.index - 1], b.points[e.index], e, multipliers,
-                              tol)
+                              options.tol)
     return b
+
+
+def _verification(verify: Verify | bool | None, multipliers: int) -> Verify | None:
+    """continue_orbit's ``verify=`` as a Verify, or None (opted out, with a UserWarning)."""
+    if verify is None or verify is True:
+        return Verify()
+    if verify is False:
+        if multipliers > 0:
+            warnings.warn("continue_orbit(verify=False): the points' multipliers are Ritz "
+                          "values without an error bound, so their stable is None; leave "
+                          "verify at its default (Verify()) for verified verdicts", UserWarning,
+                          stacklevel=5)
+        return None
+    if not isinstance(verify, Verify):
+        raise ValueError(f"verify = {verify!r}: give a dmi.analysis.Verify, or False to opt out "
+                         "of the verification")
+    return verify
+
+
+def _autonomous_maps(orbit: Orbit, period: Any) -> tuple[ForcedMaps, np.ndarray, Any]:
+    """The maps of an autonomous branch from orbit, its start x0 = (state, h) and its map."""
+    if period is not None:
+        raise ValueError("period=...: an autonomous orbit's period is an unknown of the "
+                         "branch; continue it with period=None")
+    n = orbit.u.shape[1]
+    x0 = np.array(orbit.state)
+    maps = AutoMaps(orbit.make, orbit.steps, orbit.h, 0)
+    tau = step_model(maps.problem, orbit.p, orbit.h).tau   # its map's solver later
+    maps.rows = maps.auto.rows = max(orbit.rows or x0.size // n,
+                                     math.ceil(tau / (0.6 * orbit.h)) + 1)
+    F0 = maps(orbit.p)
+    if F0.dim != x0.size:
+        x0 = F0.extend(x0)
+    return maps, np.concatenate([x0, [orbit.h]]), F0
+
+
+def _forced_maps(orbit: Orbit, p_end: float, period: Any) -> tuple[ForcedMaps, np.ndarray, Any]:
+    """The maps of a forced branch from orbit to p_end, its start x0 and its map."""
+    if period is not None and not callable(period):
+        raise ValueError(f"period = {period!r}: give a function p -> period (time units)")
+    n = orbit.u.shape[1]
+    x0 = np.array(orbit.state)
+    maps = ForcedMaps(orbit.make, orbit.steps, orbit.h, 0, period)
+    if period is not None:
+        P0 = maps.step(orbit.p) * orbit.steps
+        if abs(P0 - orbit.period) > 1e-9 * orbit.period:
+            raise ValueError(f"period(p = {orbit.p!r}) = {P0!r} but the orbit's period is "
+                             f"{orbit.period!r} (= {orbit.steps} steps h = {orbit.h!r})")
+    # rows for the whole range: N may grow with p (tau with a fixed h, or h with the
+    # period); the probes of both ends (the start's becomes its map's solver)
+    rows = max(orbit.rows or x0.size // n, maps.memory(orbit.p) + 1)
+    try:
+        rows = max(rows, maps.memory(p_end) + 1)
+    except Exception:   # make refuses p_end: the branch will stop where make does
+        pass
+    maps.rows = rows + max(2, rows // 50)  # room for a corrector a little beyond the ends
+    F0 = maps(orbit.p)
+    if F0.dim != x0.size:
+        x0 = F0.extend(x0)
+    return maps, x0, F0
 
 
 def refined_event(maps: Any, a: BranchPoint, b: BranchPoint, e: Event, multipliers: int,
@@ -353,10 +398,15 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
     """
     if event.kind != "period-doubling":
         raise ValueError(f"event {event.kind!r}: expected a 'period-doubling' event")
-    if any(getattr(q, "of", "scheme") == "equation" for q in branch.points):
-        return _doubled_equation_orbit(branch.points[event.index - 1],
-                                      branch.points[event.index], amplitudes, multipliers)
-    a, b = branch.points[event.index - 1], branch.points[event.index]
+    return _doubled(branch.points[event.index - 1], branch.points[event.index], branch,
+                    amplitudes, multipliers, tol)
+
+
+@functools.singledispatch
+def _doubled(a: BranchPoint, b: BranchPoint, branch: Branch, amplitudes: tuple[float, ...],
+             multipliers: int, tol: float) -> Orbit | EquationOrbit:
+    """:func:`period_doubled_orbit` by the class of the branch's points: a scheme's branch
+    (BranchPoints), by shooting with period 2 M h from the kicked state."""
     q = a if np.any(a.multipliers.real < -1) else b
     maps = ForcedMaps(branch.make, branch.steps, branch.h, branch.rows, branch.period)
     F = maps(q.p)
@@ -386,8 +436,10 @@ def period_doubled_orbit(branch: Branch, event: Event, *, amplitudes: tuple[floa
                         + "; ".join(tried), [])
 
 
-def _doubled_equation_orbit(a: EquationOrbit, b: EquationOrbit, amplitudes: tuple[float, ...],
-                           multipliers: int) -> EquationOrbit:
+@_doubled.register
+def _doubled_equation_orbit(a: EquationOrbit, b: EquationOrbit, branch: Branch,
+                            amplitudes: tuple[float, ...], multipliers: int, tol: float
+                            ) -> EquationOrbit:
     """:func:`period_doubled_orbit` on a collocated branch, between its points a and b.
 
     At the point of the pair with a real multiplier beyond -1 (beyond its estimated error) the

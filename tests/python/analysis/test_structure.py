@@ -1,8 +1,9 @@
-# dmi.analysis has one continuation driver, one cache of what it builds from a model, and one
-# Newton loop (newton.newton_loop, its linear solve given by the caller: the maps' matrix-free
-# bordered_newton, of which newton.newton is a case, collocation's sparse LU, the driver's
-# corrector), besides shooting's Newton-Picard; its import chain is at most 8 modules deep (it
-# was 9 with two drivers).
+# dmi.analysis has one continuation driver (its contract typed, its options a value), one cache
+# of what it builds from a model, one Newton loop (newton.newton_loop, its linear solve given by
+# the caller: the maps' matrix-free bordered_newton, of which newton.newton is a case,
+# collocation's sparse LU, the driver's corrector, shooting's Newton-Picard), one bordered solve
+# (newton.bordered_solve) and one locator of events along a branch (the driver's); its import
+# chain is at most 8 modules deep (it was 9 with two drivers).
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -45,24 +46,28 @@ def depth(edges: dict[str, set[str]], prefix: str) -> int:
 
 
 def test_one_driver():
-    # every function with a step policy (min_step) is the driver or hands it to the driver
+    # every function with a step policy (min_step) is the driver or hands it to the driver: it
+    # calls it, or maps its keywords onto the driver's options (a value: ContinuationOptions)
     t = trees()
     with_steps = {(mod, fn.name) for mod, tree in t.items() for fn in functions(tree)
                   if "min_step" in [a.arg for a in fn.args.args + fn.args.kwonlyargs]}
-    assert ("continuation.driver", "continuation") in with_steps
+    policy = next(n for n in ast.walk(t["continuation.driver"])
+                  if isinstance(n, ast.ClassDef) and n.name == "ContinuationOptions")
+    assert "min_step" in {a.target.id for a in policy.body if isinstance(a, ast.AnnAssign)}
     assert ("orbits", "continue_orbit") in with_steps
     assert ("equilibria.equilibrium", "continue_equilibrium") in with_steps
-    for mod, name in with_steps - {("continuation.driver", "continuation")}:
+    for mod, name in with_steps:
         fn = next(f for f in functions(t[mod]) if f.name == name)
-        assert calls(fn, "continuation"), f"{mod}.{name} has a step policy of its own"
+        assert calls(fn, "continuation") or calls(fn, "ContinuationOptions"), \
+            f"{mod}.{name} has a step policy of its own"
 
 
 #: Linear solves a Newton iteration calls (by name or attribute).
 LINEAR_SOLVES = {"splu", "spsolve", "bordered_solve", "bordered_step", "gmres", "lu_solve",
                  "lstsq"}
-#: Loops around a linear solve that are not Newton loops on a residual of their own: shooting's
-#: Newton-Picard (its own method).
-OTHER_LOOPS = {("shooting.branch", "_newton_picard")}
+#: Loops around a linear solve that are not Newton loops on a residual of their own: none
+#: (shooting's Newton-Picard is a linear solve of newton_loop).
+OTHER_LOOPS: set[tuple[str, str]] = set()
 
 
 def solving_loops(tree: ast.Module) -> set[str]:
@@ -334,3 +339,176 @@ def test_scheme_and_shooting_rooms_are_shallow():
     assert depth(edges, "dmi.analysis.shooting.") <= 2
     for leaf in ("scheme.stepmap", "scheme.floquet"):
         assert not {n for n in edges[f"dmi.analysis.{leaf}"] if n.startswith("dmi.analysis")}, leaf
+
+
+def _called(n: ast.Call) -> str:
+    """The name a call calls (``f`` of ``f(...)`` or ``a.b.f(...)``)."""
+    f = n.func
+    return f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) else ""
+
+
+def owners(tree: ast.Module) -> dict[ast.AST, str]:
+    """Every node of a module -> the name of the innermost function (or ``Class.method``) that
+    holds it ("" at the module's level)."""
+    out: dict[ast.AST, str] = {}
+
+    def walk(node: ast.AST, name: str, cls: str) -> None:
+        for child in ast.iter_child_nodes(node):
+            here, inner = name, cls
+            if isinstance(child, ast.ClassDef):
+                inner = child.name
+            elif isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                here = f"{cls}.{child.name}" if cls and not name else child.name if not name \
+                    else name
+            out[child] = here
+            walk(child, here, inner)
+    walk(tree, "", "")
+    return out
+
+
+def callers(names: set[str], t: dict[str, ast.Module] | None = None) -> set[tuple[str, str]]:
+    """(module, function) of every call in dmi.analysis to one of ``names``."""
+    t = trees() if t is None else t
+    out = set()
+    for mod, tree in t.items():
+        where = owners(tree)
+        for n in ast.walk(tree):
+            if isinstance(n, ast.Call) and _called(n) in names:
+                out.add((mod, where[n]))
+    return out
+
+
+#: Root finders of a scalar function: along a branch only the driver's locator calls them.
+ROOT_FINDERS = {"brentq", "brenth", "ridder", "bisect", "root_scalar", "toms748"}
+#: Scalar roots of a defined function, not events along a branch: the Hopf crossing of the
+#: rightmost root between two parameters (stability.hopf), a Hopf curve's crossing on its first
+#: row (chart._trace).
+SCALAR_ROOTS = {("equilibria.stability", "hopf"), ("equilibria.chart", "_trace")}
+
+
+def test_one_event_locator():
+    # Brent's method along a branch: the driver's locator (Along.root, locate) and landing only
+    found = callers(ROOT_FINDERS)
+    assert found - SCALAR_ROOTS == {("continuation.driver", "Along.root"),
+                                    ("continuation.driver", "locate"),
+                                    ("continuation.driver", "_Run.land")}, found
+    # a bisection along the branch (a loop around a corrected middle) is the driver's too
+    for mod, tree in trees().items():
+        if mod == "continuation.driver":
+            continue
+        for loop in ast.walk(tree):
+            if isinstance(loop, (ast.For, ast.While)):
+                inner = {_called(n) for n in ast.walk(loop) if isinstance(n, ast.Call)}
+                assert not inner & {"middle", "mid", "across"}, f"{mod} bisects a branch"
+    # the shooting's stick events and the collocation's signature changes use it
+    t = trees()
+    assert callers({"bisect_along"}, t) >= {("shooting.branch", "Shooting.between")}
+    assert ("collocation.branch", "EquationBranch._locate") in callers({"locate"}, t)
+
+
+#: Functions of dmi.analysis that call a dense, sparse or Krylov solver, and what they solve;
+#: the one bordered solve is core.newton.bordered_system (bordered_solve), the other entries are
+#: systems without a border.  A new caller fails the test: a bordered system goes through
+#: bordered_solve.
+RAW_SOLVES = {
+    ("core.newton", "bordered_system"): "the one bordered solve",
+    ("continuation.driver", "bordered_det"): "the branch-point test function's determinant",
+    ("collocation.system", "_factor"): "the collocation system's Jacobian",
+    ("collocation.floquet", "monodromy"): "the monodromy's sensitivities",
+    ("collocation.floquet", "eigenfunction"): "the Floquet eigenfunction",
+    ("equilibria.normal_form", "_corrected"): "the equilibrium's Jacobian",
+    ("equilibria.root_verdict", "_eval"): "the characteristic matrix's trace",
+    ("equilibria.equation", "Characteristic.newton_step"): "the characteristic matrix's trace",
+    ("scheme.floquet", "growth_rate"): "a least-squares fit",
+    ("shooting.branch", "_Picard.solve"): "Newton-Picard's reduced system (b + k unknowns)",
+    # a bordered system solved on its own, to go through bordered_solve (its owner's change)
+    ("equilibria.curves", "_Extended._null"): "the bordered left null vector of a fold curve",
+}
+SOLVERS = {"gmres", "splu", "spsolve", "lu_solve", "lstsq", "cho_solve", "bicgstab"}
+
+
+def raw_solves(t: dict[str, ast.Module]) -> set[tuple[str, str]]:
+    """(module, function) of the calls to a solver, or to ``linalg.solve``."""
+    out = callers(SOLVERS, t)
+    for mod, tree in t.items():
+        where = owners(tree)
+        for n in ast.walk(tree):
+            if isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute) and \
+                    n.func.attr == "solve" and isinstance(n.func.value, ast.Attribute) and \
+                    n.func.value.attr == "linalg":
+                out.add((mod, where[n]))
+    return out
+
+
+def test_one_bordered_solve():
+    t = trees()
+    got = raw_solves(t)
+    assert got == set(RAW_SOLVES), (got - set(RAW_SOLVES), set(RAW_SOLVES) - got)
+    # the driver's corrector and tangent, the maps' Newton step and the collocation's Newton
+    # with a held length border through bordered_solve
+    users = callers({"bordered_solve", "bordered_system"}, t)
+    assert {("continuation.driver", "tangent"), ("core.newton", "bordered_step"),
+            ("core.newton", "bordered_solve")} <= users, users
+    assert not [m for m, _ in users if m.startswith(("shooting", "collocation"))
+                and m != "collocation.discretisation"], users
+    # no bordered solve of its own: none defines one
+    defined = {(mod, fn.name) for mod, tree in t.items() for fn in functions(tree)
+               if "bordered" in fn.name and mod != "core.newton"}
+    assert defined == {("continuation.driver", "bordered_det")}, defined
+    # the collocated branch's Newton with a held length is the driver's corrector
+    held = next(f for f in functions(t["collocation.branch"]) if f.name == "_held")
+    assert calls(held, "newton_corrector")
+
+
+def test_raw_solves_finds_a_solve():
+    src = """
+def f(A, b):
+    return np.linalg.solve(A, b)
+
+class C:
+    def g(self, A, b):
+        return sla.splu(A).solve(b)
+"""
+    assert raw_solves({"m": ast.parse(src)}) == {("m", "f"), ("m", "C.g")}
+
+
+def test_newton_picard_is_a_strategy_of_the_one_loop():
+    t = trees()
+    fn = next(f for f in functions(t["shooting.branch"]) if f.name == "_newton_picard")
+    assert calls(fn, "newton_loop")
+    assert ("shooting.branch", "_newton_picard") not in {
+        (mod, name) for mod, tree in t.items() for name in solving_loops(tree)}
+
+
+def test_driver_contract_is_typed():
+    import dmi.analysis.continuation.driver as driver
+    # no hook found by getattr / hasattr on the discretisation: its protocols say them
+    tree = trees()["continuation.driver"]
+    for n in ast.walk(tree):
+        if isinstance(n, ast.Call) and _called(n) in ("getattr", "hasattr") and n.args:
+            a = n.args[0]
+            name = a.id if isinstance(a, ast.Name) else a.attr if isinstance(
+                a, ast.Attribute) else ""
+            assert name != "disc" or (isinstance(n.args[1], ast.Name)), ast.unparse(n)
+    for hook in ("HasEvents", "Describes", "Corners", "Accepts", "Recovers", "Adapts",
+                 "Carries", "Orients", "Weighted", "StartsTangent", "Between", "OnCurrent"):
+        assert getattr(driver, hook)._is_protocol, hook
+    # the collocated branch gets its mends through accept / recover, not an own corrector
+    from dmi.analysis.collocation.branch import EquationBranch
+    assert not hasattr(EquationBranch, "correct")
+    assert issubclass(EquationBranch, (driver.Accepts,)) or all(
+        callable(getattr(EquationBranch, m)) for m in ("accept", "recover"))
+
+
+def test_dispatch_on_the_orbit_class():
+    # no "of" attribute read to tell a scheme's orbit from the equation's in these modules
+    t = trees()
+    for mod in ("orbits", "hopf_orbits", "collocation.branch", "continuation.driver",
+                "shooting.branch", "shooting.events", "shooting.autonomous"):
+        for n in ast.walk(t[mod]):
+            if isinstance(n, ast.Call) and _called(n) == "getattr" and len(n.args) >= 2:
+                a = n.args[1]
+                assert not (isinstance(a, ast.Constant) and a.value == "of"), (mod,
+                                                                               ast.unparse(n))
+
+

@@ -13,16 +13,18 @@ multipliers and signature; on a vertical branch, where the orbit is not isolated
 without the merged mesh's error estimate and with ``stable`` None), the events of the
 multipliers (``period-doubling``, ``torus``; the fold is the driver's) and of the signature
 (``stick-onset`` where the number of a component's stuck or face segments changes,
-``grazing`` where the segments change otherwise; located by Brent's method on the margin of
-the breaking inequality along the branch, :meth:`EquationBranch.between`).  The signature
-changes by itself: a corrected point whose orbit breaks an inequality of its signature is
-mended (a segment split around the breach, a vanishing one removed:
-:func:`dmi.analysis.collocation.mend.mend`) and corrected again at its p (where that is
+``grazing`` where the segments change otherwise; located by the driver's
+:func:`~dmi.analysis.continuation.driver.locate`, Brent's method on the margin of the breaking
+inequality along the branch, :meth:`EquationBranch.between`).  The signature changes by itself,
+through the driver's hooks: a point the driver's corrector converged to whose orbit breaks an
+inequality of its signature is mended (``accept``: a segment split around the breach, a
+vanishing one removed, :func:`dmi.analysis.collocation.mend.mend`) and corrected again at its p (where that is
 singular, at the corner of a vertical branch, with p free and the new segment's length held),
 up to four times; where a step fails next to a held segment shorter than SHED of the period
 (the branch back to a corner), the short held segments are removed and the orbit solved with p
-free and its amplitude held just inside (:meth:`EquationBranch._shed`; a landing there: at the
-landing's p).  The mended point is the step's (the corrector returns it on its new unknowns),
+free and its amplitude held just inside (``recover``, :meth:`EquationBranch._shed`; a landing
+there: at the landing's p).  The mended point is the step's (``accept`` returns it on its new
+unknowns),
 the mesh is equidistributed after every step (``adapt``), and the driver restarts its tangent
 on the new unknowns (oriented by :meth:`EquationBranch.carry`; a vertical start by
 :meth:`EquationBranch.orient`, the amplitude growing).  A branch that fails at the smallest
@@ -33,7 +35,6 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -45,9 +46,10 @@ from .discretisation import CollocationDiscretisation, equation_hopf_orbit
 from .mend import circle, memory, mend, relaid, removed
 from .signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK
 from .system import evaluate, solve
-from ..continuation.driver import Curve, bordered_solve, continuation, newton_corrector, tangent
+from ..continuation.driver import (ContinuationOptions, Curve, Predictor, continuation, locate,
+                                   newton_corrector, tangent)
 from .orbit import EquationOrbit
-from ..core.newton import ShootingError, newton_loop
+from ..core.newton import Converge, NewtonOptions, Search, ShootingError
 
 #: Mends (split or removal, then a correction at fixed p) tried on one point at most.
 MENDS = 4
@@ -55,6 +57,11 @@ MENDS = 4
 SHED = 0.02
 #: The amplitude held past such a removal: (1 - SHRINK^k) of the last point's, k = 1, 2, 3.
 SHRINK = 1e-3
+#: Newton with a segment's length (or the amplitude) held, p free: converged on the correction,
+#: damped, a step that puts the switches out of order (Degenerate, a ValueError) halved.
+HELD = NewtonOptions(tol=1e-12, max_iter=40, converge=Converge.CORRECTION, search=Search.DESCENT,
+                     reject=(ValueError,), reject_why="every step puts the switches out of order",
+                     stall=False)
 
 
 def _stuck_like(orbit: EquationOrbit) -> np.ndarray:
@@ -64,9 +71,10 @@ def _stuck_like(orbit: EquationOrbit) -> np.ndarray:
 
 
 class EquationBranch(CollocationDiscretisation):
-    """The collocation discretisation of a branch for :func:`dmi.analysis.continuation.driver.continuation`
-    (see the module): :class:`CollocationDiscretisation` (its residual and Jacobian) with the
-    driver's corrector, mends, points, events and corners.
+    """The collocation discretisation of a branch for
+    :func:`dmi.analysis.continuation.driver.continuation` (see the module):
+    :class:`CollocationDiscretisation` (its residual and Jacobian) with the driver's hooks:
+    ``accept`` and ``recover`` (mends and sheds), ``adapt``, points, events and corners.
 
     Parameters
     ----------
@@ -88,69 +96,87 @@ class EquationBranch(CollocationDiscretisation):
         self._prev: tuple | None = None   # the same of the point before it
         self._stepped_on: Any = None   # the layout the last step was corrected on
 
+    @property
+    def newton(self) -> NewtonOptions:
+        """The driver's corrector on this branch: Newton to ``tol`` in ``max_iter``
+        iterations, converged on the residual and the last correction."""
+        return NewtonOptions(tol=self.tol, max_iter=self.max_iter, converge=Converge.BOTH)
+
     def _breaks(self, x: np.ndarray, p: float) -> list[str]:
         return check_inequalities(self.lay, self.terms(p), x,
                                   1e-9 * max(1.0, float(np.max(np.abs(x)))))
 
-    def correct(self, x: np.ndarray, p: float, row: np.ndarray, target: float, far: float
-                ) -> tuple[np.ndarray, float, int]:
-        """The driver's Newton corrector on the bordered system, then the inequalities checked:
-        an orbit that breaks its signature is mended (:meth:`_mend`): on a step (``far``
-        finite) the mended orbit, on its new unknowns, is returned (the driver restarts its
-        tangent); on a point landed on at fixed p it is kept for :meth:`point`.  One that
-        cannot be mended is refused (the driver halves the step).
+    def accept(self, x: np.ndarray, p: float, step: bool) -> tuple[np.ndarray, float]:
+        """The driver's corrected point checked against its signature's inequalities: an orbit
+        that breaks its signature is mended (:meth:`_mend`): on a step the mended orbit, on its
+        new unknowns, is returned (the driver restarts its tangent); on a point at fixed p (a
+        landing, a chord's point) it is kept for :meth:`point` and the point returned as it is.
+        One that cannot be mended is refused (the driver halves the step).
 
         Parameters
         ----------
         x : numpy.ndarray
-            The predictor's unknowns.
+            The corrected unknowns.
         p : float
-            The predictor's parameter.
-        row : numpy.ndarray
-            The hyperplane's row over (x, p).
-        target : float
-            Its value.
-        far : float
-            How far from the predictor the corrector may go.
+            Their parameter.
+        step : bool
+            A step's point (else a point on a fixed hyperplane).
 
         Returns
         -------
         tuple
-            (x, p, iterations).
+            (x, p), on the mended layout where a step's orbit was mended.
 
         Raises
         ------
         ShootingError
-            Newton fails, or the orbit breaks its signature and no mend holds.
+            The orbit breaks its signature and no mend holds.
         """
-        curve = Curve(self, x.size)
-        try:
-            z, its = newton_corrector(curve, np.concatenate([x, [p]]), row, target, tol=self.tol,
-                                      max_iter=self.max_iter, far=far,
-                                      what=f"collocation near p = {p!r}")
-        except (ShootingError, ValueError) as e:   # ValueError: Degenerate, a piece gone
-            # a step: p free past the removal, the step's point on the new unknowns; a landing
-            # (on the hyperplane p = target): at it, kept for point() (the unknowns stay)
-            landing = row[-1] == 1.0 and not np.any(row[:-1])
-            got = (self._shed(str(e), None) if math.isfinite(far) else
-                   self._shed(str(e), float(target)) if landing else None)
-            if got is None:
-                raise
-            xm, pm, lay, ref = got
-            if not math.isfinite(far):
-                self._mended = (x.copy(), pm, lay, ref, xm)
-                return x, pm, 0
+        bad = self._breaks(x, p)
+        if bad and step:   # a step: the mended orbit is the step's point
+            _, pm, lay, ref, xm = self._mend(x, p, bad, free=True)
             self.lay, self.ref = lay, ref
-            return xm, pm, 0
-        xz, pz = z[:-1], float(z[-1])
-        bad = self._breaks(xz, pz)
-        if bad and math.isfinite(far):   # a step: the mended orbit is the step's point
-            _, pm, lay, ref, xm = self._mend(xz, pz, bad, free=True)
-            self.lay, self.ref = lay, ref
-            return xm, pm, its
+            return xm, pm
         if bad:   # a point landed on at fixed p: mended at that p, for point()
-            self._mended = self._mend(xz, pz, bad, free=False)
-        return xz, pz, its
+            self._mended = self._mend(x, p, bad, free=False)
+        return x, p
+
+    def recover(self, x: np.ndarray, p: float, row: np.ndarray, target: float, step: bool,
+                error: Exception) -> tuple[np.ndarray, float] | None:
+        """Where the driver's corrector failed from the predictor (x, p): past a corner where
+        held segments vanish (:meth:`_shed`): on a step with p free, the step's point on the new
+        unknowns; on a landing (the hyperplane p = target) at that p, the mended orbit kept for
+        :meth:`point` and the predictor returned (the unknowns stay).  None otherwise.
+
+        Parameters
+        ----------
+        x, p : numpy.ndarray, float
+            The predictor.
+        row : numpy.ndarray
+            The hyperplane's row over (x, p).
+        target : float
+            Its value.
+        step : bool
+            A step (else a point on a fixed hyperplane).
+        error : Exception
+            The corrector's failure.
+
+        Returns
+        -------
+        tuple or None
+            (x, p), or None: the failure stands.
+        """
+        landing = row[-1] == 1.0 and not np.any(row[:-1])
+        got = (self._shed(str(error), None) if step else
+               self._shed(str(error), float(target)) if landing else None)
+        if got is None:
+            return None
+        xm, pm, lay, ref = got
+        if not step:
+            self._mended = (x.copy(), pm, lay, ref, xm)
+            return x, pm
+        self.lay, self.ref = lay, ref
+        return xm, pm
 
     def _mend(self, x: np.ndarray, p: float, bad: list[str], free: bool) -> tuple:
         """(x, p, layout, ref, x on it): the orbit on a mended signature, corrected at fixed p
@@ -234,7 +260,7 @@ class EquationBranch(CollocationDiscretisation):
             tries = []
             for k in (1, 2, 3):
                 try:
-                    tries.append(self._bordered(probe, x0, p0, dev,
+                    tries.append(self._held(probe, x0, p0, dev,
                                                 float(dev[:-1] @ x0) - SHRINK ** k * size, what))
                 except ShootingError:
                     continue
@@ -263,31 +289,20 @@ class EquationBranch(CollocationDiscretisation):
             row[k], row[k + S - 1] = 1.0, -1.0
             if lay.autonomous:
                 row[x.size - 1] = 1.0
-        return self._bordered(probe, x, p, row, float(lengths[j]), why)
+        return self._held(probe, x, p, row, float(lengths[j]), why)
 
-    def _bordered(self, probe: CollocationDiscretisation, x: np.ndarray, p: float,
+    def _held(self, probe: CollocationDiscretisation, x: np.ndarray, p: float,
                   row: np.ndarray, target: float, why: str) -> tuple[np.ndarray, float]:
-        """Damped Newton (sparse LU) on probe's system bordered by row . (x, p) = target, p
-        free, from (x, p).  ShootingError when it fails."""
-        lay = probe.lay
-
-        def evaluate(z: np.ndarray) -> tuple[np.ndarray, None]:
-            r = probe.residual(z[:-1], float(z[-1]))   # Degenerate (a ValueError): rejected
-            return np.concatenate([r, [float(row @ z) - target]]), None
-
-        def factor(z: np.ndarray, r: np.ndarray, _: None) -> Callable[[np.ndarray], np.ndarray]:
-            J, Jp = probe.jacobian(z[:-1], float(z[-1]))
-            return lambda rr: bordered_solve(J, Jp, row, -rr)
-
+        """Damped Newton (sparse LU; the driver's corrector) on probe's system bordered by
+        row . (x, p) = target, p free, from (x, p).  ShootingError when it fails."""
+        z0 = np.concatenate([x, [p]])
         try:
-            z, _ = newton_loop(evaluate, factor, np.concatenate([x, [p]]), tol=1e-12,
-                               max_iter=40, what="Newton with the segment's length held",
-                               converge="correction", search="descent", reject=(ValueError,),
-                               reject_why="every step puts the switches out of order",
-                               stall=False)
+            z, _ = newton_corrector(Curve(probe, x.size), z0, row, target, HELD,
+                                    what="Newton with the segment's length held",
+                                    scale=lambda z: max(1.0, float(np.max(np.abs(z)))))
         except ShootingError as e:
             raise ShootingError(f"the orbit breaks its signature ({why}); with p free on "
-                                f"{lay.signature.describe()}: {e}", e.residuals) from e
+                                f"{probe.lay.signature.describe()}: {e}", e.residuals) from e
         return z[:-1], float(z[-1])
 
     def adapt(self, x: np.ndarray, p: float) -> np.ndarray:
@@ -556,43 +571,20 @@ class EquationBranch(CollocationDiscretisation):
                 curve.norm(prev), 1e-300)
             prev[-1] = other.p - q.p
             t = tangent(curve, z, prev)[0]
-            row = curve.w(z.size - 1) * t
-            base = float(row @ z)
-            cache: dict[float, np.ndarray] = {}
 
-            def at(s: float) -> np.ndarray:
-                if s not in cache:
-                    cache[s] = newton_corrector(curve, z + s * t, row, base + s, tol=self.tol,
-                                                max_iter=2 * self.max_iter, far=math.inf,
-                                                what="the event's location")[0]
-                return cache[s]
-
-            def g(s: float) -> float:
-                zs = at(s)
+            def g(zs: np.ndarray) -> float:
                 m = _margin(probe, zs[:-1], float(zs[-1]), other.signature)
                 if m is None:
                     raise ValueError("the margin is not defined along the branch")
                 return m
             L = abs(other.p - q.p) + gap
-            lo, hi = 0.0, None
-            for s in (0.5 * L, L, 2 * L, 4 * L, 8 * L):
-                if g(way * s) * g0 <= 0:
-                    hi = way * s
-                    break
-                lo = way * s
-            if hi is None:
+            got = locate(probe, z, t, g, g0, [way * s * L for s in (0.5, 1, 2, 4, 8)],
+                         self.newton.but(max_iter=2 * self.max_iter))
+            if got is None:
                 raise ValueError(f"the margin {g0:.3g} of p = {q.p!r} does not reach 0 within "
                                  f"{8 * L:.3g} along its branch")
-            lo, hi = min(lo, hi), max(lo, hi)
-            xtol = 1e-13 * max(1.0, abs(hi), abs(lo))
-            root, info = so.brentq(g, lo, hi, xtol=xtol, full_output=True, disp=False)
-            if not info.converged:
-                raise ValueError(f"Brent's method did not converge ({info.flag})")
-            s0, s1 = max(lo, root - 2 * xtol), min(hi, root + 2 * xtol)
-            if g(s0) * g(s1) > 0:
-                raise ValueError("the margin's sign does not change around Brent's root")
-            p0, p1 = float(at(s0)[-1]), float(at(s1)[-1])
-            return float(at(root)[-1]), max(abs(p1 - p0), 1e-16 * max(1.0, abs(p0)))
+            p0, p1 = float(got[1][-1]), float(got[2][-1])
+            return float(got[0][-1]), max(abs(p1 - p0), 1e-16 * max(1.0, abs(p0)))
         raise ValueError("neither side's orbit has a margin that breaks at this change")
 
     def corner(self, points: list[EquationOrbit]) -> str:
@@ -725,9 +717,8 @@ def _margin(disc: CollocationDiscretisation, x: np.ndarray, p: float, other: Any
     return min(out) if out else None
 
 
-def continue_equation_orbit(orbit: EquationOrbit, p_end: float, step: float, *,
-                            max_points: int, min_step: float | None, max_step: float | None,
-                            multipliers: int, tol: float, max_iter: int, at: Any) -> Branch:
+def continue_equation_orbit(orbit: EquationOrbit, p_end: float, options: ContinuationOptions,
+                            *, multipliers: int) -> Branch:
     """:func:`dmi.analysis.continue_orbit` of an EquationOrbit (see its docstring).
 
     Parameters
@@ -736,20 +727,11 @@ def continue_equation_orbit(orbit: EquationOrbit, p_end: float, step: float, *,
         The start.
     p_end : float
         Where the branch ends (exactly).
-    step : float
-        The first step.
-    max_points : int
-        Points at most.
-    min_step, max_step : float or None
-        Step bounds.
+    options : ContinuationOptions
+        The step control, user points, the start's tolerance; the corrector's: Newton to
+        min(tol, 1e-12) in max_iter iterations.
     multipliers : int
         Leading multipliers a point.
-    tol : float
-        The corrector's tolerance (at most 1e-12 is used).
-    max_iter : int
-        The corrector's iterations a step.
-    at : iterable of float
-        User points.
 
     Returns
     -------
@@ -759,20 +741,16 @@ def continue_equation_orbit(orbit: EquationOrbit, p_end: float, step: float, *,
     Raises
     ------
     ValueError
-        A bad ``step``, ``p_end`` or ``max_points``.
+        A bad ``p_end``.
     """
-    if not (math.isfinite(step) and step > 0):
-        raise ValueError(f"step = {step!r}: must be finite and > 0 (p units)")
     if not math.isfinite(p_end) or p_end == orbit.p:
         raise ValueError(f"p_end = {p_end!r}: must be finite and differ from the orbit's "
                          f"p = {orbit.p!r}")
     eb, x = EquationBranch.of(orbit, multipliers=multipliers)
-    eb.tol = min(float(tol), 1e-12)     # the corrector's error well below the collocation's
-    eb.max_iter = int(max_iter)
-    return continuation(eb, x, float(orbit.p), float(p_end), step=step, min_step=min_step,
-                        max_step=max_step, max_points=max_points, at=at, tol=tol,
-                        max_iter=max_iter,
-                        predictor="tangent", make=orbit.make,
+    eb.tol = min(float(options.tol), 1e-12)   # the corrector's error well below the collocation's
+    eb.max_iter = int(options.max_iter)
+    return continuation(eb, x, float(orbit.p), float(p_end), options, newton=eb.newton,
+                        predictor=Predictor.TANGENT, make=orbit.make,
                         kind="autonomous" if orbit.autonomous else "orbits")
 
 

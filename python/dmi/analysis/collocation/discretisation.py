@@ -39,9 +39,8 @@ from .mend import mend
 from .mesh import periodic_locator, point_matrix
 from .signature import SLIP_NEG, SLIP_POS, Signature
 from .system import Layout, Terms, assemble, full_jacobian, node_times, solve
-from ..continuation.driver import bordered_solve
 from .orbit import EquationOrbit
-from ..core.newton import ShootingError, newton_loop
+from ..core.newton import Converge, NewtonOptions, ShootingError, bordered_solve, newton_loop
 from ..scheme.problem import Problem
 from ..continuation.branch import HopfPoint
 from ..scheme.stepmap import Model, build
@@ -381,9 +380,10 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
         grow = _amplitude_condition(lay, z[:-1], ue, c, a, gz, gw)[1]
         return lambda r: bordered_solve(J, Jp, grow, -r)
 
-    z, _ = newton_loop(evaluate, factor, np.concatenate([x, [p0]]), tol=tol,
-                       max_iter=max_iter, what=f"the orbit from the Hopf point at p = {p0!r}",
-                       converge="correction", stall=False)
+    z, _ = newton_loop(evaluate, factor, np.concatenate([x, [p0]]),
+                       NewtonOptions(tol=tol, max_iter=max_iter, converge=Converge.CORRECTION,
+                                     stall=False),
+                       what=f"the orbit from the Hopf point at p = {p0!r}")
     pt = disc.point(z[:-1], z[-1])
     if pt is None:            # the merged mesh's solve failed: no estimate
         disc.estimate = False

@@ -9,9 +9,12 @@ through the previous point).  :class:`Shooting` implements the driver's contract
 F_p(x) - x (and the phase condition), its Jacobian as a LinearOperator (forward differences of
 the map) with dF/dp by one difference, the points (:func:`orbit_point`: multipliers, stick
 profile, margins), the orbits' events between two points
-(:func:`dmi.analysis.shooting.events.orbit_events`, the ``between`` hook), and its own corrector
-(``correct``): Newton-Picard on the previous point's dominant subspace (Lust, Roose, Spence
-and Champneys, SIAM J. Sci. Comput. 19 (1998) 1188), Newton with GMRES on the bordered
+(:func:`dmi.analysis.shooting.events.orbit_events`, the ``between`` hook; the stick events
+located by the driver's :func:`~dmi.analysis.continuation.driver.bisect_along`), and its own
+corrector (``correct``, the driver's ``OwnCorrector``): Newton-Picard on the previous point's
+dominant subspace (Lust, Roose, Spence and Champneys, SIAM J. Sci. Comput. 19 (1998) 1188), a
+linear solve and convergence test of the one Newton loop
+(:func:`dmi.analysis.core.newton.newton_loop`), then Newton with GMRES on the bordered
 matrix-free Jacobian when that contracts too slowly.  The maps come from one cache, the
 model's :class:`dmi.analysis.scheme.problem.Problem`.
 """
@@ -25,10 +28,11 @@ import scipy.sparse.linalg as sla
 
 from ..._solver import Solver
 from ..continuation.branch import BranchPoint, Event, corner_sentence, thinned, travel
-from ..continuation.driver import VERTICAL
+from ..continuation.driver import VERTICAL, bisect_along
 from ..scheme.floquet import Verify, fd_step, floquet_verdict, ritz
-from ..core.newton import ShootingError, bordered_newton, bordered_step, directional, fd_eps
-from .events import locate_stick, orbit_events, stick_profile
+from ..core.newton import (NewtonOptions, ShootingError, bordered_newton, bordered_step,
+                           directional, fd_eps, newton_loop)
+from .events import orbit_events, stick_profile
 from ..scheme.problem import AutonomousMaps, Problem, phase_row, velocity
 from ..scheme.stepmap import Model, StepMap, build, fixed_step, positive_time
 
@@ -258,69 +262,117 @@ def _newton_picard(maps: ForcedMaps, zp: np.ndarray, t: np.ndarray, tol: float, 
     span Q, is kept).  Returns (z, iterations); raises _Slow when, after the second iteration,
     the residual falls by less than half in one, or at its rate would not reach tol within
     max_iter; ShootingError as :func:`_corrector`."""
-    k = maps.k
-    dim = zp.size - k
-    z = zp.copy() if z0 is None else z0.copy()
-    x = z[:-k]
-    F = maps.of(z[-k:])
-    if F.dim != dim or Q.shape[0] != dim:
-        raise _Slow("the state's size changed")
-    Fx = F(x)
-    Fq = _columns(maps, z, Fx)
-    S = Q.T @ Z
-    ZC = Z - Q @ S                   # (I - Q Q') Z
-    FqC = Fq - Q @ (Q.T @ Fq)
-    b = Q.shape[1]
-    _, B = _borders(maps, z, zp, t)  # linear equations: constant rows
-    Bx, Bq = B[:, :dim], B[:, dim:]
-    K = np.zeros((b + k, b + k))
-    K[:b, :b] = S - np.eye(b)
-    K[:b, b:] = Q.T @ Fq
-    K[b:, :b] = Bx @ Q + Bx @ ZC
-    K[b:, b:] = Bx @ FqC + Bq
     w = maps.weights(zp.size)
-    prev, best, z_best = math.inf, math.inf, z
-    for it in range(max_iter + 1):
-        r = Fx - x
-        g, _ = _borders(maps, z, zp, t)
-        rn = float(np.max(np.abs(r)))
-        if not math.isfinite(rn):
-            raise ShootingError(f"non-finite residual at p = {float(z[-1])!r}", [rn])
-        scale = max(1.0, float(np.max(np.abs(x))))
-        if rn <= tol * scale and float(np.max(np.abs(g))) <= 1e-8 * max(1.0, abs(z[-1])):
-            return z, it
-        if rn < best:
-            best, z_best = rn, z
-        if it == max_iter or (it >= 2 and _too_slow(rn, prev, tol * scale, max_iter - it)):
-            raise _Slow(f"residual {rn:.3g} after {it} iterations (previous {prev:.3g})",
-                        z_best, it)
-        prev = rn
-        Qr = Q.T @ r
-        rC = r - Q @ Qr
-        try:
-            sol = np.linalg.solve(K, np.concatenate([-Qr, -g - Bx @ rC]))
-        except np.linalg.LinAlgError:
-            raise _Slow("singular reduced system", None, it) from None
-        xi, dq = sol[:b], sol[b:]
-        z = z + np.concatenate([Q @ xi + rC + FqC @ dq + ZC @ xi, dq])
+    np_ = _Picard(maps, zp, t, tol, Q, Z, max_iter)
+
+    def strayed(z: np.ndarray) -> None:
         d = z - zp
         far = math.sqrt(float(np.dot(w * d, d)))
         if far > ds:
             raise ShootingError(f"corrector strayed {far:.3g} > ds = {ds:.3g} from the predictor "
-                                f"at p = {float(z[-1])!r}", [rn])
-        x = z[:-k]
-        F = maps.of(z[-k:])
-        if F.dim != dim:
+                                f"at p = {float(z[-1])!r}", [np_.prev])
+
+    z, res = newton_loop(np_.evaluate, np_.factor, zp if z0 is None else z0,
+                         NewtonOptions(tol=tol, max_iter=max_iter, converge=np_.converged,
+                                       chord=math.inf, stall=False),
+                         what=f"Newton-Picard near p = {float(zp[-1])!r}", check=strayed)
+    return z, len(res) - 1
+
+
+class _Picard:
+    """Newton-Picard as the linear solve of :func:`dmi.analysis.core.newton.newton_loop` (see
+    :func:`_newton_picard`): the residual (F(x) - x, the borders), the reduced system factored
+    once (a chord: ``chord=inf``) and updated by Broyden from each step, and the convergence
+    test (the state's residual to tol, the borders to 1e-8) that raises _Slow on a slow
+    contraction."""
+
+    def __init__(self, maps: ForcedMaps, zp: np.ndarray, t: np.ndarray, tol: float,
+                 Q: np.ndarray, Z: np.ndarray, max_iter: int):
+        self.maps, self.zp, self.t, self.tol, self.Q, self.Z = maps, zp, t, tol, Q, Z
+        self.max_iter = max_iter
+        self.k = maps.k
+        self.dim = zp.size - self.k
+        self.started = False
+        self.Fx = np.empty(0)        # F(x) at the last iterate evaluated
+        self.pending: tuple | None = None   # (xi, dq, F(x) before the step) of the last step
+        self.prev, self.best, self.z_best, self.it = math.inf, math.inf, zp, 0
+
+    def evaluate(self, z: np.ndarray) -> tuple[np.ndarray, None]:
+        """(F(x) - x, the borders' values) at z."""
+        k, dim = self.k, self.dim
+        F = self.maps.of(z[-k:])
+        if not self.started:
+            if F.dim != dim or self.Q.shape[0] != dim:
+                raise _Slow("the state's size changed")
+            self.started = True
+        elif F.dim != dim:
             raise ShootingError(f"the state grew to {F.dim} values at p = {float(z[-1])!r}", [])
-        Fx, Fold = F(x), Fx
-        # Broyden's update of the reduced Jacobian S = Q' D_xF Q by the step just taken (Q' dx =
-        # xi): S xi := Q' (F(x_new) - F(x_old) - F_q dq); no evaluation, and a multiplier that
-        # moved since the previous point (near 1, the chord's rate |dmu| / |1 - mu|) is caught
-        nxi = float(np.dot(xi, xi))
-        if nxi > 0:
-            S = S + np.outer(Q.T @ (Fx - Fold - Fq @ dq) - S @ xi, xi / nxi)
-            K[:b, :b] = S - np.eye(b)
-    raise AssertionError("unreachable")
+        x = z[:-k]
+        self.Fx = F(x)
+        g, _ = _borders(self.maps, z, self.zp, self.t)
+        return np.concatenate([self.Fx - x, g]), None
+
+    def converged(self, z: np.ndarray, r: np.ndarray, res: list[float]) -> bool:
+        """The state's residual <= tol max(1, |x|_inf) and the borders' <= 1e-8 max(1, |p|);
+        _Slow when, after the second iteration, the residual falls by less than half in one,
+        or at its rate would not reach tol within max_iter."""
+        it = self.it = len(res) - 1
+        x = z[:-self.k]
+        rn = float(np.max(np.abs(r[:self.dim])))
+        scale = max(1.0, float(np.max(np.abs(x))))
+        if rn <= self.tol * scale and float(np.max(np.abs(r[self.dim:]))) <= 1e-8 * max(
+                1.0, abs(z[-1])):
+            return True
+        if rn < self.best:
+            self.best, self.z_best = rn, z
+        if it == self.max_iter or (it >= 2 and _too_slow(rn, self.prev, self.tol * scale,
+                                                         self.max_iter - it)):
+            raise _Slow(f"residual {rn:.3g} after {it} iterations (previous {self.prev:.3g})",
+                        self.z_best, it)
+        self.prev = rn
+        return False
+
+    def factor(self, z: np.ndarray, r: np.ndarray, state: None) -> Callable:
+        """The reduced system at the first iterate: S = Q' Z, the leak ZC = Z - Q S, F_q by
+        one difference a column, the borders' rows."""
+        maps, Q, Z, dim = self.maps, self.Q, self.Z, self.dim
+        self.Fq = _columns(maps, z, self.Fx)
+        self.S = Q.T @ Z
+        self.ZC = Z - Q @ self.S                   # (I - Q Q') Z
+        self.FqC = self.Fq - Q @ (Q.T @ self.Fq)
+        b = Q.shape[1]
+        _, B = _borders(maps, z, self.zp, self.t)   # linear equations: constant rows
+        self.Bx, Bq = B[:, :dim], B[:, dim:]
+        K = self.K = np.zeros((b + self.k, b + self.k))
+        K[:b, :b] = self.S - np.eye(b)
+        K[:b, b:] = Q.T @ self.Fq
+        K[b:, :b] = self.Bx @ Q + self.Bx @ self.ZC
+        K[b:, b:] = self.Bx @ self.FqC + Bq
+        return self.solve
+
+    def solve(self, r: np.ndarray) -> np.ndarray:
+        """The Newton-Picard correction for the residual r, after Broyden's update of the
+        reduced Jacobian S = Q' D_xF Q by the step before (Q' dx = xi): S xi := Q' (F(x_new) -
+        F(x_old) - F_q dq); no evaluation, and a multiplier that moved since the previous point
+        (near 1, the chord's rate |dmu| / |1 - mu|) is caught."""
+        Q, b = self.Q, self.Q.shape[1]
+        if self.pending is not None:
+            xi, dq, Fold = self.pending
+            nxi = float(np.dot(xi, xi))
+            if nxi > 0:
+                self.S = self.S + np.outer(Q.T @ (self.Fx - Fold - self.Fq @ dq) - self.S @ xi,
+                                           xi / nxi)
+                self.K[:b, :b] = self.S - np.eye(b)
+        rx, g = r[:self.dim], r[self.dim:]
+        Qr = Q.T @ rx
+        rC = rx - Q @ Qr
+        try:
+            sol = np.linalg.solve(self.K, np.concatenate([-Qr, -g - self.Bx @ rC]))
+        except np.linalg.LinAlgError:
+            raise _Slow("singular reduced system", None, self.it) from None
+        xi, dq = sol[:b], sol[b:]
+        self.pending = (xi, dq, self.Fx)
+        return np.concatenate([Q @ xi + rC + self.FqC @ dq + self.ZC @ xi, dq])
 
 
 def _correct(maps: ForcedMaps, zp: np.ndarray, t: np.ndarray, tol: float, max_iter: int, ds: float,
@@ -559,8 +611,21 @@ class Shooting:
 
         for e in orbit_events(a, b, 0, self.maps.autonomous, self.decided):
             if e.kind in ("stick-onset", "grazing"):
-                e = locate_stick(a, b, e, za, zb, mid, self._profile,
-                                 lambda d: math.sqrt(float(np.dot(w * d, d))))
+                i = e.component
+                key = (lambda st, ph: (st > 0, ph)) if e.kind == "stick-onset" else (
+                    lambda st, ph: (True, ph))
+                ka = key(a.stick_steps[i], a.stick_phases[i])
+
+                def same(z: np.ndarray, i: int = i, key: Callable = key, ka: tuple = ka
+                         ) -> bool:
+                    st, ph = self._profile(z)
+                    return key(st[i], ph[i]) == ka
+                got = bisect_along(za, zb, same, mid, lambda d: math.sqrt(float(np.dot(w * d, d))))
+                if got is not None:   # the event at the final bracket's middle
+                    pa, pb = float(got[0][-1]), float(got[1][-1])
+                    e.p = 0.5 * (pa + pb)
+                    e.detail += (f" (located by bisection along the branch in "
+                                 f"[{min(pa, pb)!r}, {max(pa, pb)!r}])")
                 self.maps.reference(zb, self.maps.of(zb[-self.k:]).trajectory(zb[:-self.k]))
             out.append(e)
         return out

@@ -10,8 +10,9 @@
 
 The multipliers' events are placed by the linear interpolation of their test function
 (:func:`test_function`; from the refined multipliers with ``refine=True``,
-:func:`dmi.analysis.orbits.refined_event`), the stick events by bisection along the branch (:func:`locate_stick`,
-every middle corrected across the chord by the driver).  The fold is the driver's
+:func:`dmi.analysis.orbits.refined_event`), the stick events by the driver's bisection along the
+branch (:func:`dmi.analysis.continuation.driver.bisect_along`, called by
+:meth:`dmi.analysis.shooting.branch.Shooting.between`).  The fold is the driver's
 (:mod:`dmi.analysis.continuation.driver`).  A point's stick profile and margins: :func:`stick_profile`.
 
 Verified multipliers' events: where the points carry error bounds of their multipliers (a
@@ -29,7 +30,6 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable
 
 import numpy as np
 
@@ -273,36 +273,3 @@ def orbit_events(a: BranchPoint, b: BranchPoint, index: int, autonomous: bool = 
                             f"component {i}: stick phases {a.stick_phases[i]} -> "
                             f"{b.stick_phases[i]} (stuck steps {sa} -> {sb})"))
     return ev
-
-
-def locate_stick(a: BranchPoint, b: BranchPoint, e: Event, za: np.ndarray, zb: np.ndarray,
-                 middle: Callable[[np.ndarray, np.ndarray], np.ndarray],
-                 profile: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
-                 norm: Callable[[np.ndarray], float], bisections: int = 6) -> Event:
-    """Bisection between a (za) and b (zb) on the stick pattern of component e.component, along
-    the branch: ``middle(z0, z1)`` is the branch's point on the hyperplane through the middle of
-    the bracket's chord, across it (the driver's; also where the branch turns at the event, as
-    a vertical branch does at grazing), ``profile(z)`` its (stuck steps, stick phases), until
-    the bracket's chord (``norm``) is 2^-bisections of the first (a corrected middle off a bent
-    chord shortens it by less than half); the event's p becomes the final bracket's midpoint.  A
-    failing correction leaves the event where it was."""
-    i = e.component
-    key = (lambda q: (q[0] > 0, q[1])) if e.kind == "stick-onset" else (lambda q: (True, q[1]))
-    ka = key((a.stick_steps[i], a.stick_phases[i]))
-    first = norm(zb - za)
-    for _ in range(4 * bisections):
-        if norm(zb - za) <= first * 2.0 ** -bisections:
-            break
-        try:
-            zm = middle(za, zb)
-            st, ph = profile(zm)
-        except Exception:   # the model's, the map's or the corrector's failure
-            return e
-        if key((st[i], ph[i])) == ka:
-            za = zm
-        else:
-            zb = zm
-    pa, pb = float(za[-1]), float(zb[-1])
-    e.p = 0.5 * (pa + pb)
-    e.detail += f" (located by bisection along the branch in [{min(pa, pb)!r}, {max(pa, pb)!r}])"
-    return e

@@ -13,7 +13,10 @@ import pytest
 import scipy.sparse
 import scipy.sparse.linalg as sla
 
-from dmi.analysis.continuation.driver import continuation
+from dmi.analysis.continuation.driver import (ContinuationOptions, Discretisation, HasEvents,
+                                               Predictor, continuation)
+from dmi.analysis.core.newton import (Converge, NewtonOptions, Search, ShootingError,
+                                      newton_loop)
 
 
 class SCurve:
@@ -133,3 +136,125 @@ def test_bad_input_is_named():
         continuation(SCurve(), [0.0], 0.0, 1.0, step=-1)
     with pytest.raises(ValueError, match="non-finite"):
         continuation(SCurve(), [math.nan], 0.0, 1.0)
+
+
+class NoJacobian:
+    """A discretisation that forgot its Jacobian."""
+    def residual(self, x, p):
+        return np.array([x[0] - p])
+
+    def point(self, x, p):
+        return SimpleNamespace(p=p)
+
+
+def test_a_discretisation_without_a_required_method_is_a_type_error_naming_it():
+    with pytest.raises(TypeError, match="NoJacobian lacks jacobian"):   # bad-inputs DC01
+        continuation(NoJacobian(), [0.0], 0.0, 1.0)
+    assert isinstance(SCurve(), Discretisation) and not isinstance(NoJacobian(), Discretisation)
+    assert isinstance(Circle(), HasEvents) and not isinstance(SCurve(), HasEvents)
+
+
+def test_options_are_values_and_the_keywords_map_onto_them():
+    x0 = -3.0
+    o = ContinuationOptions(step=0.3, max_points=400, at=(5.0, 0.0))
+    assert o.at == (0.0, 5.0) and o.predictor is Predictor.TANGENT
+    b = continuation(SCurve(), [x0], x0 ** 3 - 3 * x0, 10.0, o)
+    k = continuation(SCurve(), [x0], x0 ** 3 - 3 * x0, 10.0, step=0.3, max_points=400,
+                     at=[0.0, 5.0])
+    assert [q.p for q in b.points] == [q.p for q in k.points]
+    folds = sorted(e.p for e in b.events if e.kind == "fold")
+    assert len(folds) == 2 and abs(folds[0] + 2) <= 1e-9 and abs(folds[1] - 2) <= 1e-9
+    # a keyword replaces the options' field
+    s = continuation(SCurve(), [x0], x0 ** 3 - 3 * x0, 10.0, o, predictor="secant")
+    assert s.status.startswith("reached p_end") and abs(s.points[-1].x - cubic_roots(10.0)[-1]) \
+        <= 1e-10
+    with pytest.raises(TypeError, match="no field stepsize"):   # bad-inputs DC02
+        continuation(SCurve(), [x0], x0 ** 3 - 3 * x0, 10.0, stepsize=0.1)
+    with pytest.raises(ValueError, match="predictor"):   # bad-inputs DC03
+        ContinuationOptions(predictor="chord")
+    with pytest.raises(ValueError, match="converge"):
+        NewtonOptions(converge="energy")
+    with pytest.raises(TypeError, match="no field damping"):   # bad-inputs DC04
+        NewtonOptions().but(damping=0.5)
+    assert NewtonOptions(converge="both", search="descent") == NewtonOptions(
+        converge=Converge.BOTH, search=Search.DESCENT)
+
+
+def test_newton_loop_takes_a_convergence_test():
+    # x^2 = 2 from 1: the caller's test stops once x^2 is within 1e-14 of 2 (Newton's
+    # residual); it sees every residual and may stop the loop
+    seen = []
+
+    def near(z, r, res):
+        seen.append(len(res))
+        return abs(z[0] ** 2 - 2) <= 1e-14
+
+    z, res = newton_loop(lambda z: (np.array([z[0] ** 2 - 2]), None),
+                         lambda z, r, s: (lambda r: -r / (2 * z)), np.array([1.0]),
+                         NewtonOptions(converge=near, max_iter=20), what="sqrt 2")
+    assert abs(z[0] - math.sqrt(2)) <= 1e-15 and seen == list(range(1, len(res) + 1))
+
+    def slow(z, r, res):
+        if len(res) > 2:
+            raise OverflowError("too slow")
+        return False
+    with pytest.raises(OverflowError, match="too slow"):
+        newton_loop(lambda z: (np.array([z[0] ** 2 - 2]), None),
+                    lambda z, r, s: (lambda r: -r / (2 * z)), np.array([1.0]),
+                    NewtonOptions(converge=slow), what="sqrt 2")
+
+
+class Refusing(SCurve):
+    """The S-curve whose points with x > 0 are refused (``accept`` raises): a mend that fails."""
+    def accept(self, x, p, step):
+        if x[0] > 0:
+            raise ShootingError(f"x = {x[0]} > 0 refused", [])
+        return x, p
+
+
+def test_accept_refuses_points_and_the_branch_ends_before_them():
+    x0 = -3.0
+    b = continuation(Refusing(), [x0], x0 ** 3 - 3 * x0, 10.0, step=0.3, max_points=400)
+    # from x = -3 (p = -18) towards p = 10: x grows past the fold at x = -1 (p = 2), p falls
+    # back, x reaches 0 at p = 0: no point with x > 0, the step fell to its smallest just
+    # before x = 0
+    assert b.status.startswith("corrector failed at the smallest step"), b.status
+    assert "refused" in b.status
+    assert all(q.x <= 0 for q in b.points) and b.points[-1].x > -0.01
+
+
+class Holed:
+    """x = p, whose residual refuses 1 < p < 1.2 (a model that fails there); ``recover`` gives
+    the exact point on the hyperplane where Newton failed."""
+    def __init__(self):
+        self.recovered = 0
+
+    def residual(self, x, p):
+        if 1.0 < p < 1.2:
+            raise ValueError(f"p = {p} in the hole")
+        return np.array([x[0] - p])
+
+    def jacobian(self, x, p):
+        return np.array([[1.0]]), np.array([-1.0])
+
+    def point(self, x, p):
+        return SimpleNamespace(p=p, x=float(x[0]))
+
+    def recover(self, x, p, row, target, step, error):
+        self.recovered += 1
+        s = target / (row[0] + row[1])       # x = p on row . (x, p) = target
+        return np.array([s]), s
+
+
+def test_recover_gives_the_point_where_the_corrector_fails():
+    d = Holed()
+    b = continuation(d, [0.0], 0.0, 2.0, step=0.05, max_points=400)
+    assert b.status.startswith("reached p_end") and b.points[-1].p == 2.0
+    assert d.recovered > 0 and any(1.0 < q.p < 1.2 for q in b.points)
+    assert all(abs(q.x - q.p) <= 1e-12 for q in b.points)
+
+
+def test_continue_orbit_of_something_else_is_a_type_error():
+    from dmi.analysis import continue_orbit
+    with pytest.raises(TypeError, match="orbit is a dict: give an Orbit"):   # bad-inputs DC05
+        continue_orbit({"p": 0.0}, 1.0)
