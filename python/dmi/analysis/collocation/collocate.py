@@ -41,7 +41,7 @@ import math
 import numpy as np
 
 from .adapt import Solved as _Solved
-from .adapt import adapted, check_cost, estimate, levels, merged, transfer
+from .adapt import adapted, check_cost, equidistribute, estimate, levels, merged, transfer
 from .floquet import multipliers as floquet
 from .mend import check_inequalities, mend
 from .orbit import EquationOrbit, equation_orbit
@@ -152,24 +152,8 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     bounds = lay.bounds(b0, T0)
     L = int(intervals) if intervals is not None else max(16, 4 * (bounds.size - 1))
     L0 = max(8, 2 * (bounds.size - 1), L // 2)        # a first solve: the indicator, the phase
-    check_cost(terms, m, L0, T0, "the first mesh", "check orbit.period (a period far shorter "
-               "than the memory is no orbit of the scheme)")
-    lay = lay.with_fractions(uniform_fractions(bounds, L0))
-    t_s = np.asarray(orbit.t, dtype=float)
-
-    def scheme(t: np.ndarray) -> np.ndarray:
-        tt = np.mod(t, T0)
-        return np.column_stack([np.interp(tt, t_s, orbit.u[:, i]) for i in range(terms.n)])
-    x0 = np.concatenate([scheme(node_times(lay, b0, T0)).ravel(), b0,
-                         [T0] if orbit.autonomous else []])
-    ref0 = reference(lay, x0) if orbit.autonomous else None
     what = f"collocation of the orbit at p = {orbit.p!r}"
-    try:
-        x1, _ = solve(lay, terms, x0, ref0, what=what)
-    except ShootingError as err:
-        raise ShootingError(f"{err} -- {too_far(orbit)}", err.residuals) from None
-    if orbit.autonomous:
-        fell_to_equilibrium(lay, x1, orbit)
+    lay, x1 = first_solve(orbit, terms, lay, b0, L0, what)
     ref = reference(lay, x1) if orbit.autonomous else None
     count = int(multipliers)
     for attempt in range(MENDS + 1):
@@ -188,6 +172,50 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
                      f"({'; '.join(bad[:4])}) after {attempt} mends of the signature read from "
                      f"the scheme ({', '.join(f.lay.signature.describe())}); refine the scheme's "
                      "orbit (a smaller h) and collocate again")
+
+
+def first_solve(orbit: Orbit, terms: Terms, lay: Layout, b0: np.ndarray, L0: int, what: str
+                ) -> tuple[Layout, np.ndarray]:
+    """The first solve from the scheme's orbit, on L0 equal intervals of each piece; where
+    Newton fails there (a steep orbit, a relaxation oscillation, on too coarse a mesh), again on
+    2 L0 and 4 L0 intervals, a smooth orbit's graded to the scheme's speed |u'| (equal arc
+    length).  ShootingError saying what to do when the last fails too."""
+    T0 = float(orbit.period)
+    t_s = np.asarray(orbit.t, dtype=float)
+    U = np.asarray(orbit.u, dtype=float)
+    bounds = lay.bounds(b0, T0)
+
+    def scheme(t: np.ndarray) -> np.ndarray:
+        tt = np.mod(t, T0)
+        return np.column_stack([np.interp(tt, t_s, U[:, i]) for i in range(terms.n)])
+    failed: ShootingError | None = None
+    for k, count in enumerate((L0, 2 * L0, 4 * L0)):
+        try:
+            check_cost(terms, lay.m, count, T0, "the first mesh", "check orbit.period (a "
+                       "period far shorter than the memory is no orbit of the scheme)")
+        except ValueError:
+            if failed is None:
+                raise
+            break                                 # no finer first mesh: the first failure
+        if k > 0 and lay.S == 0:
+            speed = np.linalg.norm(np.diff(U, axis=0), axis=1) / np.diff(t_s)
+            fractions = [equidistribute(t_s, speed, count) / T0]
+        else:
+            fractions = uniform_fractions(bounds, count)
+        lay = lay.with_fractions(fractions)
+        x0 = np.concatenate([scheme(node_times(lay, b0, T0)).ravel(), b0,
+                             [T0] if orbit.autonomous else []])
+        try:
+            x1, _ = solve(lay, terms, x0, reference(lay, x0) if orbit.autonomous else None,
+                          what=what)
+        except ShootingError as err:
+            failed = failed or err                # the first mesh's failure is the one said
+            continue
+        if orbit.autonomous:
+            fell_to_equilibrium(lay, x1, orbit)
+        return lay, x1
+    assert failed is not None
+    raise ShootingError(f"{failed} -- {too_far(orbit)}", failed.residuals) from None
 
 
 def _result(orbit: Orbit, terms: Terms, c: _Solved, f: _Solved, count: int) -> EquationOrbit:

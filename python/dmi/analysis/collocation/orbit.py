@@ -46,10 +46,11 @@ class EquationOrbit:
         The period is an unknown (with an integral phase condition).
     errors : dict
         Estimated errors (same units): ``"period"``, ``"amplitude"`` (n,), ``"multipliers"``
-        (as ``multipliers``), ``"u"`` (the largest over the period), from the difference to the
-        solve on the mesh with every interval halved (a continuation point: with every pair of
-        intervals merged), an upper estimate: the returned orbit is the finer one; empty where
-        that solve failed.
+        (as ``multipliers``), ``"u"`` (the largest over the period, at equal phase t / T; an
+        autonomous orbit's after aligning the two solutions' phase: the error of its shape),
+        from the difference to the solve on the mesh with every interval halved (a
+        continuation point: with every pair of intervals merged), an upper estimate: the
+        returned orbit is the finer one; empty where that solve failed.
     degree : int
         m, the polynomials' degree.
     nodes : numpy.ndarray

@@ -3,7 +3,8 @@
 # circle of a rotating system with a memory in closed form; van der Pol with a distributed delay
 # and its relaxation oscillation at epsilon = 10 against collocations of degree 8 on finer
 # meshes), and two collocations of one orbit on different meshes within the sum of their
-# estimates.
+# estimates; the relaxation oscillation collocated from a coarse scheme orbit (Newton fails on the
+# first mesh of equal intervals: a finer one graded to the scheme's speed takes over).
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -119,3 +120,15 @@ def test_relaxation_estimate_bounds_the_aligned_error():
     true = distance(at_phases(e), ref.u_at, ref.period)
     assert ref.errors["u"] < 1e-2 * true
     assert 1.0 <= e.errors["u"] / true <= 100.0, (e.errors["u"], true)
+
+
+def test_relaxation_from_a_coarse_scheme_orbit():
+    make = van_der_pol(10.0)
+    o = scheme_orbit(make, 0.5, [2.0, 0.0], 16.0, 1000)
+    ref = da.collocate(scheme_orbit(make, 0.5, [2.0, 0.0], 16.0, 2000), intervals=60, degree=8,
+                       multipliers=0)
+    assert abs(o.period - ref.period) > 0.5                 # the scheme's orbit is far from it
+    e = da.collocate(o, degree=6, tol=1e-8, multipliers=0)
+    assert e.errors["period"] <= 1e-8
+    # the true error is at most the distance to the reference plus the reference's error
+    assert abs(e.period - ref.period) + ref.errors["period"] <= e.errors["period"]
