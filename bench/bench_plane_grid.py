@@ -5,7 +5,7 @@
 #    fastest of the rounds (the cluster started once, outside the timing; its start-up reported
 #    apart).
 # 2. A real grid: one equilibrium branch and one collocated orbit branch a value of q of the
-#    rotationally symmetric oscillator with a memory (tests/python/hopf_models.py), Q values,
+#    rotationally symmetric oscillator with a memory (tests/python/models/hopf_models.py), Q values,
 #    serially and on the cluster, interleaved; wall-clock time, the speed-up, and the load of the
 #    machine (os.getloadavg) before each round.
 # Usage: bench/bench_plane_grid.py [--workers W] [--tasks T] [--q Q] [--rounds R]

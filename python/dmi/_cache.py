@@ -3,7 +3,7 @@
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """The cache every problem of dmi.analysis (:class:`dmi.analysis.scheme.problem.Problem`) and
 dmi.identify (a fit's residuals and Jacobian) keeps of what it builds; private to the package.
-Nothing else in those packages memoises per problem (tests/python/test_analysis_structure.py
+Nothing else in those packages memoises per problem (tests/python/analysis/test_structure.py
 finds memoising dicts and ``lru_cache`` tables by what they are)."""
 from __future__ import annotations
 

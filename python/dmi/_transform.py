@@ -22,6 +22,7 @@ shape (K, n, n) and gives an n x n matrix per point (trailing axes).
 """
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from typing import Any
@@ -29,7 +30,8 @@ from typing import Any
 import numpy as np
 from scipy.special import roots_jacobi
 
-__all__ = ["phi1", "laplace", "Hhat", "cell_weights", "evaluate", "power_laplace", "near_shift"]
+__all__ = ["phi1", "laplace", "Hhat", "cell_weights", "evaluate", "power_laplace", "near_shift",
+           "gauss_jacobi"]
 
 # Below this |z| the series 1 + z/2 + z^2/6 is exact to rounding (the next term z^3/24 < 4e-17).
 _SERIES = 1e-5
@@ -155,6 +157,20 @@ def cell_weights(a: Any, b: Any, C: Any, D: Any = None, *, h: float, N: int,
 _NEAR_NODES = 40
 
 
+@functools.lru_cache(maxsize=64)
+def gauss_jacobi(q: int, beta: float) -> tuple[np.ndarray, np.ndarray]:
+    """The Gauss-Jacobi rule of the near part's weight y^-beta on [0, 1] (q nodes):
+    ``int_0^1 y^-beta P(y) dy = sum w P(y)``, exact for P of degree <= 2 q - 1.  On [0, w] the
+    nodes are w y and the weights w^(1 - beta) w.  Computed once for each (q, beta); the arrays
+    are read-only (shared by every caller: the near part's transform here, the collocation's
+    product integration in :mod:`dmi.analysis.collocation.mesh`)."""
+    x, wx = roots_jacobi(q, 0.0, -beta)
+    y, w = 0.5 * (x + 1.0), wx / 2.0 ** (1.0 - beta)
+    y.setflags(write=False)
+    w.setflags(write=False)
+    return y, w
+
+
 def power_laplace(lam: Any, beta: float, c: float, delta: float) -> np.ndarray:
     """``int_0^delta c s^-beta e^{-lambda s} ds`` (0 < beta < 1) at the (complex) points ``lam``:
     ``c lambda^(beta - 1) gamma(1 - beta, lambda delta)``, the lower incomplete gamma function.
@@ -195,10 +211,10 @@ def power_laplace(lam: Any, beta: float, c: float, delta: float) -> np.ndarray:
     w = min(delta, 4.0 / reach) if reach > 0 else delta
     panels = max(1, math.ceil(delta / w - 1e-9))
     w = delta / panels
-    # Gauss-Jacobi on [-1, 1] with the weight (1 + x)^-beta; s = w (1 + x) / 2
-    x, wx = roots_jacobi(_NEAR_NODES, 0.0, -beta)
-    s = w * (1 + x) / 2
-    ws = wx * (w / 2) ** (1 - beta)
+    # Gauss-Jacobi on [0, w] with the weight s^-beta
+    y, wy = gauss_jacobi(_NEAR_NODES, float(beta))
+    s = w * y
+    ws = wy * w ** (1 - beta)
     out = np.tensordot(np.exp(-np.multiply.outer(lam, s)), ws, axes=(-1, 0))
     if panels > 1:
         g, wg = np.polynomial.legendre.leggauss(_NEAR_NODES)

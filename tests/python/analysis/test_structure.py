@@ -383,7 +383,7 @@ ROOT_FINDERS = {"brentq", "brenth", "ridder", "bisect", "root_scalar", "toms748"
 #: Scalar roots of a defined function, not events along a branch: the Hopf crossing of the
 #: rightmost root between two parameters (stability.hopf), a Hopf curve's crossing on its first
 #: row (chart._trace).
-SCALAR_ROOTS = {("equilibria.stability", "hopf"), ("equilibria.chart", "_trace")}
+SCALAR_ROOTS = {("equilibria.crossing", "hopf"), ("equilibria.chart", "_trace")}
 
 
 def test_one_event_locator():

@@ -1,5 +1,5 @@
 # Piecewise polynomials on a mesh of one period: the Lagrange basis, evaluation, the delay
-# integral's quadrature matrix and the equidistribution of the mesh.
+# integral's quadrature matrix.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """The mesh machinery of :mod:`dmi.analysis.collocation.collocate`; private to the package.
 
@@ -27,7 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.special import roots_jacobi
+
+from ..._transform import gauss_jacobi
 
 #: Locator: times -> (interval (k,), local coordinate (k,), columns (k, m + 1) of node rows).
 Locator = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]
@@ -233,15 +234,6 @@ def _frozen(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
 
 
 @functools.lru_cache(maxsize=64)
-def _jacobi(q: int, beta: float) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss-Jacobi nodes y and weights w on [0, 1] for the weight y^-beta (q nodes):
-    int_0^1 y^-beta P(y) dy = sum w P(y), exact for P of degree <= 2 q - 1 (computed once for
-    each (q, beta), read-only)."""
-    x, w = roots_jacobi(q, 0.0, -beta)
-    return _frozen(0.5 * (x + 1.0), w / 2.0 ** (1.0 - beta))  # type: ignore[return-value]
-
-
-@functools.lru_cache(maxsize=64)
 def _legendre(q: int) -> tuple[np.ndarray, np.ndarray]:
     """Gauss-Legendre nodes and weights on [0, 1] (q nodes; computed once for each q,
     read-only)."""
@@ -269,7 +261,7 @@ def _near_nodes(near: Near, a: np.ndarray, d: np.ndarray, q: int, n: int
     minus the one on [0, a] (both on the piece's polynomial, exact).  Returns the lags S (k, r),
     the weights W (k, r) and H = C at them (k, r, n, n)."""
     close = a < d
-    gy, gw = _jacobi(q, near.beta)
+    gy, gw = gauss_jacobi(q, near.beta)
     lz, lw = _legendre(Q_NEAR)
     r = max(2 * q, Q_NEAR)
     S = np.zeros((a.size, r))
@@ -417,16 +409,3 @@ def point_matrix(times: np.ndarray, locate: Locator, basis: Basis, mesh: np.ndar
                         val.shape)
     cc = cols[:, None, :] * n + np.arange(n)[None, :, None]
     return sp.csr_matrix((val.ravel(), (r.ravel(), cc.ravel())), shape=(P * n, rows * n))
-
-
-def equidistribute(mesh: np.ndarray, indicator: np.ndarray, L: int) -> np.ndarray:
-    """A mesh of L intervals over [mesh[0], mesh[-1]] on which the piecewise constant density
-    ``indicator`` (per interval of ``mesh``, >= 0) has equal integrals (as AUTO and COLSYS), a
-    floor of 1 % of its mean keeping quiet stretches meshed."""
-    h = np.diff(mesh)
-    d = np.maximum(indicator, 1e-2 * max(float(np.sum(indicator * h) / np.sum(h)), 1e-300))
-    cum = np.concatenate([[0.0], np.cumsum(d * h)])
-    target = np.linspace(0.0, cum[-1], L + 1)
-    new = np.interp(target, cum, mesh)
-    new[0], new[-1] = mesh[0], mesh[-1]
-    return new

@@ -1,8 +1,10 @@
 # A periodic orbit of the equation (not of the scheme): a piecewise polynomial of one period.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
-"""The :class:`EquationOrbit` that :func:`dmi.analysis.collocate` returns."""
+"""The :class:`EquationOrbit` that :func:`dmi.analysis.collocate` returns, and the one way a solution
+becomes one (:func:`equation_orbit`, its stability verified against its errors)."""
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -10,6 +12,7 @@ import numpy as np
 
 from .mesh import Basis, periodic_locator
 from .signature import Signature
+from .system import CollocationWarning
 
 
 @dataclass
@@ -43,10 +46,11 @@ class EquationOrbit:
         The period is an unknown (with an integral phase condition).
     errors : dict
         Estimated errors (same units): ``"period"``, ``"amplitude"`` (n,), ``"multipliers"``
-        (as ``multipliers``), ``"u"`` (the largest over the period), from the difference to the
-        solve on the mesh with every interval halved (a continuation point: with every pair of
-        intervals merged), an upper estimate: the returned orbit is the finer one; empty where
-        that solve failed.
+        (as ``multipliers``), ``"u"`` (the largest over the period, at equal phase t / T; an
+        autonomous orbit's after aligning the two solutions' phase: the error of its shape),
+        from the difference to the solve on the mesh with every interval halved (a
+        continuation point: with every pair of intervals merged), an upper estimate: the
+        returned orbit is the finer one; empty where that solve failed.
     degree : int
         m, the polynomials' degree.
     nodes : numpy.ndarray
@@ -104,3 +108,38 @@ class EquationOrbit:
     def intervals(self) -> int:
         """L, the mesh's intervals."""
         return self.mesh.size - 1
+
+
+def stable(mu: np.ndarray, err: np.ndarray, autonomous: bool, p: float) -> bool | None:
+    """All |mu| < 1 but the trivial one (autonomous), verified against the errors; None (with a
+    CollocationWarning naming p) when a multiplier's |mu| is within its error of 1."""
+    if mu.size == 0:
+        return None
+    keep = np.ones(mu.size, bool)
+    if autonomous:
+        keep[int(np.argmin(np.abs(mu - 1)))] = False
+    a, e = np.abs(mu[keep]), err[keep]
+    if np.any(a > 1 + e):
+        return False
+    if np.all(a < 1 - e):
+        return True
+    warnings.warn(f"p = {p!r}: a multiplier's modulus is within its estimated error of 1 "
+                  f"({a[np.argmin(np.abs(a - 1))]:.12g}): stability not verified (None)",
+                  CollocationWarning, stacklevel=3)
+    return None
+
+
+def equation_orbit(f: Any, p: float, make: Any, errors: dict[str, Any],
+                   kernel_jumps: tuple[float, ...] = ()) -> EquationOrbit:
+    """The EquationOrbit of a solution ``f`` (an :class:`~.adapt.Solved`: lay, x, amplitude, mu),
+    its stability verified against ``errors``."""
+    V, b, T = f.lay.split(f.x)
+    return EquationOrbit(p=p, period=T, amplitude=f.amplitude, multipliers=f.mu,
+                         stable=stable(f.mu, errors.get("multipliers", np.full(f.mu.shape,
+                                                                                np.inf)),
+                                        f.lay.autonomous, p),
+                         mesh=f.lay.mesh(b, T), signature=f.lay.signature, switches=b.copy(),
+                         make=make, autonomous=f.lay.autonomous, errors=errors,
+                         degree=f.lay.m, nodes=V.copy(),
+                         fractions=[fr.copy() for fr in f.lay.fractions], carried=f.lay.carried,
+                         kernel_jumps=tuple(kernel_jumps))

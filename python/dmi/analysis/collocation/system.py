@@ -19,6 +19,7 @@ central differences of the residual.
 """
 from __future__ import annotations
 
+import warnings
 from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -700,3 +701,45 @@ def carried(terms: Terms, sig: Any) -> tuple[float, ...]:
         return ()
     end = (terms.tau,) if np.any(terms.H(np.array([terms.tau])) != 0) else ()
     return terms.H.jumps + end
+
+
+def reference(lay: Layout, x: np.ndarray) -> Any:
+    """theta -> r'(theta) (P, n): the derivative in theta = t / T of the orbit x (the phase
+    condition's reference), by its polynomial."""
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T) / T
+    loc = periodic_locator(mesh, lay.m)
+    basis = lay.basis
+
+    def r(theta: np.ndarray) -> np.ndarray:
+        i, z, cols = loc(np.asarray(theta, dtype=float))
+        B = basis.derivatives(z) / np.diff(mesh)[i][:, None]
+        return np.einsum("pk,pkn->pn", B, V[cols])
+    return r
+
+
+def check_jumps(terms: Terms, what: str) -> list[float]:
+    """A callback kernel's jumps against ``kernel_jumps``, before any mesh is solved (a bounded
+    number of kernel calls: :func:`undeclared_jumps`, :func:`misdeclared_jumps`): a declared
+    lag where H does not jump raises a ValueError naming it and the jumps found; a jump found
+    and not declared is warned of (CollocationWarning naming its lag).  Returns those."""
+    found = undeclared_jumps(terms)
+    wrong = misdeclared_jumps(terms)
+    if wrong:
+        said = "; ".join(f"H does not jump at s = {j!r}" if at is None
+                         else f"H's jump near s = {j!r} is at s = {at:.15g}" for j, at in wrong)
+        elsewhere = (f"; H jumps at s = {', '.join(f'{j:.15g}' for j in found)}, not declared"
+                     if found else "")
+        right = sorted(set(j for j in terms.H.jumps if all(j != w for w, _ in wrong))
+                       | set(found) | set(at for _, at in wrong if at is not None))
+        fix = (f"give kernel_jumps=({', '.join(f'{j:.15g}' for j in right)},)" if right
+               else "give kernel_jumps=() (H has no jump found inside (0, tau))")
+        raise ValueError(f"{what}: kernel_jumps = {terms.H.jumps!r} is wrong: {said}"
+                         f"{elsewhere} (checked by bisection of H on (0, tau)): {fix}, the "
+                         "lags where H itself jumps (a kink is not a jump)")
+    for j in found:
+        warnings.warn(f"{what}: the kernel jumps near the lag s = {j:.10g}, not declared: the "
+                      "order of the collocation is capped at 1 there; give the jump "
+                      f"(kernel_jumps=({j:.10g},) with its exact lag)", CollocationWarning,
+                      stacklevel=3)
+    return found

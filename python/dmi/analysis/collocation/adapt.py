@@ -1,0 +1,329 @@
+# Mesh adaptation of a collocated orbit: the indicator, the equidistribution, the adaptation step
+# between solves, and the two-level error estimate with the refinement it steers.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""Where the mesh of a collocated orbit comes from and how good the orbit on it is; private to the
+package (:mod:`dmi.analysis.collocation.collocate` and the collocated branch use it).
+
+- The indicator (:func:`indicator`): |u^(m+1)|^(1 / (m + 1)) on each interval, from the jumps of the
+  piecewise constant u^(m) (AUTO's); :func:`equidistribute` puts equal integrals of it on each new
+  interval (AUTO, COLSYS), :func:`adapted` does so piece by piece of a nonsmooth orbit.
+- The adaptation step (:func:`readapted`): an orbit moved onto its mesh equidistributed again (the
+  same intervals), between the steps of a branch.
+- The two-level estimate (:func:`estimate`): the orbit on a mesh and on that mesh with every interval
+  halved (:func:`halved`) or every pair merged (:func:`merged`); the difference of their period,
+  amplitudes, multipliers and u is the finer one's error estimate.  An autonomous orbit's two
+  solutions are compared after aligning their phase (:func:`aligned`): its phase is free, and a
+  shift along a steep orbit is no error of its shape.
+- The refinement (:func:`levels`): equidistribute, solve on two levels, grow the mesh until the
+  estimate meets tol, with its stopping rules and the cost check of the delay integral
+  (:func:`check_cost`).
+
+May import: :mod:`.mesh`, :mod:`.signature`, :mod:`.system` (no module of the package above them).
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from .system import Layout, Terms, evaluate, interval_counts, node_times, reference, solve
+
+#: Mesh refinement rounds at most (intervals=None).
+MAX_ROUNDS = 6
+#: Intervals at most.
+MAX_INTERVALS = 4000
+#: The errors' floor, relative to their quantities (Newton's 1e-12 and the conditioning).
+FLOOR = 1e-11
+#: The least observed order of the refinement's estimate (log of its fall over log of the mesh's
+#: growth): below it the estimate has stopped falling.
+LEAST_ORDER = 0.5
+#: Quadrature nodes of the delay integral at most on one mesh (about 100 bytes each): a memory
+#: spanning many periods (tau / T large) or a very fine mesh is refused before it is built.
+MAX_DELAY_NODES = 2e7
+
+
+def equidistribute(mesh: np.ndarray, indicator: np.ndarray, L: int) -> np.ndarray:
+    """A mesh of L intervals over [mesh[0], mesh[-1]] on which the piecewise constant density
+    ``indicator`` (per interval of ``mesh``, >= 0) has equal integrals (as AUTO and COLSYS), a
+    floor of 1 % of its mean keeping quiet stretches meshed."""
+    h = np.diff(mesh)
+    d = np.maximum(indicator, 1e-2 * max(float(np.sum(indicator * h) / np.sum(h)), 1e-300))
+    cum = np.concatenate([[0.0], np.cumsum(d * h)])
+    target = np.linspace(0.0, cum[-1], L + 1)
+    new = np.interp(target, cum, mesh)
+    new[0], new[-1] = mesh[0], mesh[-1]
+    return new
+
+
+def halved(fractions: list[np.ndarray]) -> list[np.ndarray]:
+    """Every interval cut in two."""
+    out = []
+    for f in fractions:
+        mid = 0.5 * (f[:-1] + f[1:])
+        out.append(np.sort(np.concatenate([f, mid])))
+    return out
+
+
+def merged(fractions: list[np.ndarray]) -> list[np.ndarray]:
+    """Every pair of intervals made one (a piece of an odd count keeps its last interval)."""
+    out = []
+    for f in fractions:
+        g = f[::2]
+        out.append(g if g[-1] == f[-1] else np.append(g, f[-1]))
+    return out
+
+
+def transfer(lay: Layout, x: np.ndarray, new: Layout) -> np.ndarray:
+    """x's orbit on the layout ``new`` (same signature, b's and T)."""
+    _, b, T = lay.split(x)
+    V = evaluate(lay, x, node_times(new, b, T))
+    return np.concatenate([V.ravel(), x[lay.rows * lay.n:]])
+
+
+def indicator(lay: Layout, x: np.ndarray) -> np.ndarray:
+    """(L,): |u^(m+1)|^(1/(m+1)) estimated on each interval from the jumps of the piecewise
+    constant u^(m) to its neighbours in the same piece (AUTO's indicator); an interval alone in
+    its piece takes |u^(m)| / h (no neighbour to difference with)."""
+    m = lay.m
+    V, b, T = lay.split(x)
+    h = np.diff(lay.mesh(b, T))
+    k = np.arange(m + 1)
+    cols = (np.arange(lay.L)[:, None] * m + k[None, :]) % lay.rows
+    top = np.einsum("k,lkn->ln", lay.basis.top, V[cols]) / h[:, None] ** m   # u^(m) (L, n)
+    piece = lay.piece_of_interval()
+    jump = np.zeros(lay.L)
+    same = piece[1:] == piece[:-1]
+    if lay.signature.switches == 0:                        # one piece: around the circle
+        d = np.linalg.norm(np.roll(top, -1, axis=0) - top, axis=1)
+        dist = 0.5 * (h + np.roll(h, -1))
+        g = d / dist
+        jump = np.maximum(g, np.roll(g, 1))
+    else:
+        d = np.linalg.norm(top[1:] - top[:-1], axis=1) / (0.5 * (h[1:] + h[:-1]))
+        d = np.where(same, d, 0.0)
+        jump[:-1] = np.maximum(jump[:-1], d)
+        jump[1:] = np.maximum(jump[1:], d)
+        alone = np.ones(lay.L, bool)
+        alone[:-1] &= ~same
+        alone[1:] &= ~same
+        jump = np.where(alone, np.linalg.norm(top, axis=1) / h, jump)
+    return jump ** (1.0 / (m + 1))
+
+
+def adapted(lay: Layout, x: np.ndarray, L: int) -> list[np.ndarray]:
+    """Fractions of L intervals (about) equidistributing :func:`indicator` piece by piece."""
+    rho = indicator(lay, x)
+    _, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    e = lay.bounds(b, T)
+    piece = lay.piece_of_interval()
+    h = np.diff(mesh)
+    weight = np.array([np.sum((rho * h)[piece == j]) for j in range(len(lay.fractions))])
+    # a floor: a quarter of the share of the piece's length (a quiet piece stays meshed)
+    weight = np.maximum(weight, 0.25 * np.diff(e) / T * weight.sum())
+    counts = interval_counts(weight, L)
+    out = []
+    for j, c in enumerate(counts):
+        sel = piece == j
+        pm = np.concatenate([mesh[:-1][sel], [mesh[1:][sel][-1]]])
+        new = equidistribute(pm, rho[sel], int(c))
+        out.append((new - e[j]) / (e[j + 1] - e[j]))
+        out[-1][0], out[-1][-1] = 0.0, 1.0
+    return out
+
+
+def readapted(lay: Layout, x: np.ndarray) -> tuple[Layout, np.ndarray]:
+    """The adaptation step: the layout on the mesh that equidistributes x's :func:`indicator`
+    again (the same intervals, piece by piece), and x moved onto it."""
+    new = lay.with_fractions(adapted(lay, x, lay.L))
+    return new, transfer(lay, x, new)
+
+
+def extrema(lay: Layout, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(max (n,), min (n,)) of each component on the piecewise polynomial: the derivative's
+    roots in the intervals next to the largest and smallest nodes."""
+    m, n = lay.m, lay.n
+    V = lay.split(x)[0]
+    k = np.arange(m + 1)
+    y = 2 * lay.basis.nodes - 1
+    hi, lo = V.max(axis=0).copy(), V.min(axis=0).copy()
+    for i in range(n):
+        for sign, best in ((1.0, hi), (-1.0, lo)):
+            node = int(np.argmax(sign * V[:, i]))
+            iv = node // m
+            for j in {(iv - 1) % lay.L, iv, (iv + 1) % lay.L}:
+                vals = V[(j * m + k) % lay.rows, i]
+                c = np.polynomial.polynomial.polyfit(y, vals, m)
+                r = np.polynomial.polynomial.polyroots(np.polynomial.polynomial.polyder(c))
+                r = r.real[(np.abs(r.imag) < 1e-9) & (np.abs(r.real) <= 1)]
+                if r.size:
+                    v = np.polynomial.polynomial.polyval(r, c)
+                    best[i] = max(best[i], v.max()) if sign > 0 else min(best[i], v.min())
+    return hi, lo
+
+
+class Solved:
+    """A solution on one layout, with its derived quantities: b, T, the amplitudes and the
+    multipliers ``mu`` (given; none by default)."""
+
+    def __init__(self, lay: Layout, x: np.ndarray, mu: np.ndarray | None = None):
+        self.lay, self.x = lay, x
+        _, self.b, self.T = lay.split(x)
+        hi, lo = extrema(lay, x)
+        self.amplitude = 0.5 * (hi - lo)
+        self.mu = np.empty(0, complex) if mu is None else mu
+
+
+def _match(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """|a_j - (the nearest b)| for each a_j."""
+    if b.size == 0:
+        return np.full(a.shape, np.inf)
+    return np.min(np.abs(a[:, None] - b[None, :]), axis=1)
+
+
+def estimate(c: Solved, f: Solved, reached: float = 0.0) -> dict[str, Any]:
+    """The differences of the two levels: the finer's error estimate (each plus ``reached``,
+    the accuracy of a coarse solve stopped at its rounding floor, in the units of x).  ``u``
+    compares the two at equal phase theta = t / T, an autonomous orbit's after aligning its
+    phase (:func:`aligned`)."""
+    theta = np.linspace(0.0, 1.0, 40 * f.lay.L, endpoint=False)
+    fine = evaluate(f.lay, f.x, theta * f.T)
+    shift = aligned(c, theta[::5], fine[::5]) if f.lay.autonomous else 0.0    # 8 an interval
+    du = float(np.max(np.abs(evaluate(c.lay, c.x, (theta + shift) * c.T) - fine)))
+    return with_floor({"period": abs(c.T - f.T) + reached,
+                       "amplitude": np.abs(c.amplitude - f.amplitude) + reached,
+                       "multipliers": _match(f.mu, c.mu) + reached, "u": du + reached},
+                      f.T, f.amplitude, f.mu, float(np.max(np.abs(f.x[:f.lay.rows * f.lay.n]))))
+
+
+def aligned(c: Solved, theta: np.ndarray, target: np.ndarray, rounds: int = 8) -> float:
+    """The phase shift s (a fraction of the period) that brings the orbit c closest to the
+    values ``target`` at the phases ``theta`` (least squares: sum |u_c((theta + s) T) -
+    target|^2 least, by Gauss-Newton from s = 0); 0 when the shift found does not lower the
+    largest difference (an autonomous orbit's phase is free: two solutions of one orbit differ
+    by a shift that is no error of its shape)."""
+    slope = reference(c.lay, c.x)                          # d u_c / d theta
+    gap = evaluate(c.lay, c.x, theta * c.T) - target
+    start = float(np.max(np.abs(gap)))
+    s = 0.0
+    for _ in range(rounds):
+        R = slope(np.mod(theta + s, 1.0))
+        norm = float(np.sum(R * R))
+        if norm == 0.0:
+            break
+        step = -float(np.sum(gap * R)) / norm
+        s += step
+        gap = evaluate(c.lay, c.x, (theta + s) * c.T) - target
+        if abs(step) <= 1e-13:
+            break
+    return s if abs(s) < 0.25 and float(np.max(np.abs(gap))) < start else 0.0
+
+
+def with_floor(errors: dict[str, Any], T: float, amplitude: np.ndarray, mu: np.ndarray,
+               u: float) -> dict[str, Any]:
+    """The errors, each at least FLOOR times its quantity's size (at least 1): Newton stops at
+    a correction of 1e-12 relative, and the conditioning adds a few digits."""
+    errors["period"] = max(errors["period"], FLOOR * max(1.0, T))
+    errors["amplitude"] = np.maximum(errors["amplitude"], FLOOR * np.maximum(1.0, amplitude))
+    errors["multipliers"] = np.maximum(errors["multipliers"], FLOOR * np.maximum(1.0,
+                                                                                   np.abs(mu)))
+    errors["u"] = max(errors["u"], FLOOR * max(1.0, u))
+    return errors
+
+
+def two_levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, what: str
+               ) -> tuple[Solved, Solved]:
+    """The orbit on ``lay`` (from x on another layout) and on ``lay`` halved."""
+    xc, _ = solve(lay, terms, x, ref, what=what)
+    fine = lay.with_fractions(halved(lay.fractions))
+    xf, _ = solve(fine, terms, transfer(lay, xc, fine), ref, what=what)
+    return Solved(lay, xc), Solved(fine, xf)
+
+
+def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bool,
+            tol: float, what: str, capped: list[float] | None = None
+            ) -> tuple[Solved, Solved]:
+    """The orbit on L intervals equidistributed (``fixed``) or refined until the estimate is
+    below tol, and on that mesh halved: (coarser, finer).
+
+    The refinement stops with a ValueError that names the estimate reached and its mesh when
+    the estimate is at its floor (FLOOR times the period or the amplitudes, at least 1), when
+    it has stopped falling (an observed order below LEAST_ORDER), when the observed order (1
+    with an undeclared jump of the kernel, ``capped``) says tol needs more than MAX_INTERVALS
+    intervals, when the next mesh's delay integral would exceed MAX_DELAY_NODES, or after
+    MAX_ROUNDS rounds."""
+    last = None
+    autonomous = lay.autonomous
+    name = "period" if autonomous else "amplitudes"
+    for _ in range(MAX_ROUNDS):
+        lay2 = lay.with_fractions(adapted(lay, x, L))
+        c, f = two_levels(lay2, terms, transfer(lay, x, lay2), ref, what)
+        if fixed:
+            return c, f
+        d = (abs(c.T - f.T) if autonomous
+             else float(np.max(np.abs(c.amplitude - f.amplitude))))
+        if d <= tol:
+            return c, f
+        size = f.T if autonomous else float(np.max(np.abs(f.amplitude)))
+        floor = FLOOR * max(1.0, size)
+        reached = (f"the estimated error of the {name} is {d:.3g} at {f.lay.L} intervals of "
+                   f"degree {lay.m}")
+        below = (f"collocate: tol = {tol!r} is below the floor of double precision, "
+                 f"{floor:.3g} (FLOOR = {FLOOR:g} times the {name}, at least 1), where a finer "
+                 f"mesh no longer lowers the estimate: {reached}; ask tol >= {floor:.2g}")
+        if d <= floor:
+            raise ValueError(below)
+        # the expected order: the period's h^(2m) (superconvergent), an extremum's h^(m+1)
+        expected = 2 * lay.m if autonomous else lay.m + 1
+        q = 1.0 if capped else None
+        if last is not None and last[1] > 0:                       # the observed order
+            q = math.log(last[1] / d) / math.log(L / last[0])
+            if q < LEAST_ORDER:
+                raise ValueError(f"collocate: the estimated error has stopped falling: it was "
+                                 f"{last[1]:.3g} at {2 * last[0]} intervals, {reached} "
+                                 f"(observed order {q:.2g}): tol = {tol!r} is below what this "
+                                 "orbit's collocation reaches (the floor of its conditioning); "
+                                 f"ask tol >= {last[1]:.2g}, or a higher degree")
+        if q is not None:
+            need = L * (d / tol) ** (1.0 / q)
+            if need > MAX_INTERVALS and tol < floor:
+                raise ValueError(below)
+            if need > MAX_INTERVALS:
+                why, fix = (f"at the observed order {q:.2g}", "ask a larger tol, or a "
+                            "higher degree")
+                if capped:
+                    why = (f"with the kernel's jump at s = {capped[0]:.10g} not declared (the "
+                           "order capped at 1)")
+                    fix = f"give kernel_jumps=({capped[0]:.10g},), or ask a larger tol"
+                raise ValueError(f"collocate: {reached}; {why}, tol = {tol!r} needs about "
+                                 f"{need:.2g} intervals, more than MAX_INTERVALS = "
+                                 f"{MAX_INTERVALS}: {fix}")
+        grow = (d / tol) ** (1.0 / expected) * 1.2
+        if q is not None and q > lay.m:
+            grow = (d / tol) ** (1.0 / q) * 1.1
+        last = (L, d)
+        L = min(MAX_INTERVALS, max(L + 2, math.ceil(L * min(grow, 8.0))))
+        lay, x = f.lay, f.x
+        if f.lay.L >= MAX_INTERVALS:
+            break
+        check_cost(terms, lay.m, 2 * L, f.T, f"the next mesh ({reached})",
+                   "ask a larger tol, or a higher degree")
+    raise ValueError(f"collocate: the estimated error {d:.3g} is still above tol = {tol!r} at "
+                     f"{f.lay.L} intervals (MAX_INTERVALS = {MAX_INTERVALS}, MAX_ROUNDS = "
+                     f"{MAX_ROUNDS}): ask a larger tol or a higher degree")
+
+
+def check_cost(terms: Terms, m: int, L: int, T: float, where: str, fix: str) -> None:
+    """ValueError when the delay integral on a mesh of L intervals of one period T needs more
+    than MAX_DELAY_NODES quadrature nodes: L m collocation times, each with about L (tau / T
+    + 1) pieces of m + 1 nodes; the message says where and ``fix``."""
+    if not terms.has_kernel:
+        return
+    nodes = L * m * (L * (terms.tau / T + 1.0) + 2 + len(terms.H.jumps)) * (m + 1)
+    if nodes > MAX_DELAY_NODES:
+        raise ValueError(f"collocate: the delay integral on {where} would need about "
+                         f"{nodes:.3g} quadrature nodes (L = {L} intervals; the memory tau = "
+                         f"{terms.tau!r} spans {terms.tau / T:.3g} periods T = {T!r}), more "
+                         f"than MAX_DELAY_NODES = {MAX_DELAY_NODES:g} (about 100 bytes each): "
+                         f"{fix}")
