@@ -65,7 +65,7 @@ import numpy as np
 
 from .._solver import Solver
 from .continuation.branch import Branch, BranchPoint, Event
-from .collocation.collocate import CollocationWarning
+from .collocation.system import CollocationWarning
 from .collocation.discretisation import CollocationDiscretisation
 from .collocation.floquet import eigenfunction
 from .collocation.signature import Signature

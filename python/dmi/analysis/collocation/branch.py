@@ -41,11 +41,11 @@ import numpy as np
 import scipy.optimize as so
 
 from ..continuation.branch import Branch, Event, corner_sentence, travel
-from .collocate import CollocationWarning, check_inequalities, transfer
+from .adapt import transfer
 from .discretisation import CollocationDiscretisation, equation_hopf_orbit
-from .mend import circle, memory, mend, relaid, removed
+from .mend import check_inequalities, circle, memory, mend, relaid, removed
 from .signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK
-from .system import evaluate, solve
+from .system import CollocationWarning, evaluate, solve
 from ..continuation.driver import (ContinuationOptions, Curve, Predictor, continuation, locate,
                                    newton_corrector, tangent)
 from .orbit import EquationOrbit

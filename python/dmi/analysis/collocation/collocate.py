@@ -40,8 +40,7 @@ import math
 
 import numpy as np
 
-from .adapt import Solved as _Solved
-from .adapt import adapted, check_cost, equidistribute, estimate, levels, merged, transfer
+from .adapt import Solved, check_cost, equidistribute, estimate, levels
 from .floquet import multipliers as floquet
 from .mend import check_inequalities, mend
 from .orbit import EquationOrbit, equation_orbit
@@ -51,21 +50,6 @@ from .system import (CollocationWarning, Layout, Terms, carried, check_jumps, no
 from ..core.newton import ShootingError
 from ..scheme.orbit import Orbit
 from ..scheme.stepmap import build
-
-# Kept importable from here for the collocated branch (discretisation.py, branch.py) until their
-# imports name the modules that hold them: adapt, mend, orbit, system.
-_errors, _reference = estimate, reference
-__reexported__ = (CollocationWarning, adapted, check_inequalities, check_jumps, equation_orbit,
-                  merged, transfer)
-
-
-class Solved(_Solved):
-    """:class:`.adapt.Solved` with its ``count`` leading multipliers computed (0: none), the
-    constructor the collocated branch calls."""
-
-    def __init__(self, lay: Layout, terms: Terms, x: np.ndarray, count: int):
-        super().__init__(lay, x, floquet(lay, terms, x, count) if count > 0 else None)
-
 
 #: Signature mends at most (a segment split or removed where an inequality breaks).
 MENDS = 4
@@ -218,7 +202,7 @@ def first_solve(orbit: Orbit, terms: Terms, lay: Layout, b0: np.ndarray, L0: int
     raise ShootingError(f"{failed} -- {too_far(orbit)}", failed.residuals) from None
 
 
-def _result(orbit: Orbit, terms: Terms, c: _Solved, f: _Solved, count: int) -> EquationOrbit:
+def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int) -> EquationOrbit:
     """The EquationOrbit of the finer level f, with its multipliers and the coarser's."""
     if count > 0:
         c.mu = floquet(c.lay, terms, c.x, count)

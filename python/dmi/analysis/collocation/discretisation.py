@@ -32,10 +32,11 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 
 from ..core.model import checked_equilibrium
-from .collocate import (CollocationWarning, Solved, _errors, _reference, adapted,
-                          check_inequalities, check_jumps, equation_orbit, merged,
-                          transfer)
-from .mend import mend
+from .adapt import Solved, estimate, merged, readapted, transfer
+from .floquet import multipliers as floquet
+from .mend import check_inequalities, mend
+from .orbit import equation_orbit
+from .system import CollocationWarning, check_jumps, reference
 from .mesh import periodic_locator, point_matrix
 from .signature import SLIP_NEG, SLIP_POS, Signature
 from .system import Layout, Terms, assemble, full_jacobian, node_times, solve
@@ -73,7 +74,7 @@ class CollocationDiscretisation:
         self.jumps = tuple(kernel_jumps)
         self.count, self.estimate = int(multipliers), bool(estimate)
         self.problem = Problem(make, keep=5)   # the terms of the last few p
-        self.ref = _reference(layout, x) if layout.autonomous else None
+        self.ref = reference(layout, x) if layout.autonomous else None
 
     @classmethod
     def of(cls, orbit: EquationOrbit, **kw: Any) -> tuple[CollocationDiscretisation, np.ndarray]:
@@ -186,7 +187,7 @@ class CollocationDiscretisation:
             warnings.warn(f"p = {p!r}: the orbit breaks its signature ({bad[0]}): no point",
                           CollocationWarning, stacklevel=2)
             return None
-        here = Solved(self.lay, terms, x, self.count)
+        here = self._solved(self.lay, terms, x)
         errors: dict[str, Any] = {}
         if self.estimate:
             coarse = self.lay.with_fractions(merged(self.lay.fractions))
@@ -200,8 +201,12 @@ class CollocationDiscretisation:
                 return None
             # the difference to the mesh of merged pairs is about 2^q - 1 >= 1 times the error;
             # a solve stopped at its rounding floor adds the accuracy it reached
-            errors = _errors(Solved(coarse, terms, xc, self.count), here, reached[-1])
+            errors = estimate(self._solved(coarse, terms, xc), here, reached[-1])
         return equation_orbit(here, float(p), self.make, errors, self.jumps)
+
+    def _solved(self, lay: Layout, terms: Terms, x: np.ndarray) -> Solved:
+        """x on lay with its leading multipliers (none where the branch carries none)."""
+        return Solved(lay, x, floquet(lay, terms, x, self.count) if self.count > 0 else None)
 
     def event_functions(self, x: np.ndarray, p: float, point: EquationOrbit | None
                         ) -> dict[str, float]:
@@ -269,11 +274,10 @@ class CollocationDiscretisation:
         if mended is not None:
             new_lay, x = mended
         else:
-            new_lay = lay.with_fractions(adapted(lay, x, lay.L))
-            x = transfer(lay, x, new_lay)
+            new_lay, x = readapted(lay, x)
         self.lay = new_lay
         if lay.autonomous:
-            self.ref = _reference(new_lay, x)
+            self.ref = reference(new_lay, x)
         return x
 
 

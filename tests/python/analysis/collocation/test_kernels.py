@@ -19,7 +19,7 @@ import pytest
 import dmi
 from dmi import analysis as da
 from dmi import kernels as dk
-from dmi.analysis.collocation.collocate import CollocationWarning
+from dmi.analysis.collocation.system import CollocationWarning
 
 BETA, CK, TAU, DELTA = 0.4, 0.3, 1.0, 0.05
 K, C, OM = 0.1, 1.0, 2.0
