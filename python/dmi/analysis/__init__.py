@@ -50,7 +50,7 @@ from .collocation.system import CollocationWarning  # noqa: E402
 from .continuation.branch import EventWarning  # noqa: E402
 
 __all__ += ["collocate", "EquationOrbit", "CollocationWarning", "EventWarning"]
-from .collocation.discretisation import (CollocationDiscretisation,  # noqa: E402
+from .branches.discretisation import (CollocationDiscretisation,  # noqa: E402
                                        equation_hopf_orbit)
 
 __all__ += ["CollocationDiscretisation", "equation_hopf_orbit"]

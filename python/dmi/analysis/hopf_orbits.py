@@ -20,7 +20,7 @@ from .core.model import Linearisation
 from .shooting.autonomous import no_equilibrium
 from .continuation.branch import Event, HopfPoint
 from .equilibria.equilibrium import equilibrium
-from .collocation.branch import equation_branch_start
+from .branches.collocated import equation_branch_start
 from .collocation.orbit import EquationOrbit
 from .scheme.floquet import Verify
 from .core.newton import bordered_newton

@@ -4,8 +4,8 @@
 
 The loop is the one driver's (:func:`dmi.analysis.continuation.driver.continuation`: predictor, step
 control, corners, the fold, landing on p_end, user points ``at=``) on the discretisation
-:class:`dmi.analysis.shooting.branch.Shooting` (its maps, corrector and points) and the orbits' events
-of :mod:`dmi.analysis.shooting.events`.
+:class:`dmi.analysis.branches.shooting.Shooting` (its maps, corrector and points) and the orbits' events
+of :mod:`dmi.analysis.branches.events`.
 
 Pseudo-arclength on z = (x, p), x the shooting state (:mod:`dmi.analysis.shooting.shoot`): a secant
 predictor z + ds t (the first step: x at p + step), then a corrector on  F_p(x) - x = 0,
@@ -66,18 +66,18 @@ import numpy as np
 from .._solver import Solver
 from .continuation.branch import Branch, BranchPoint, Event
 from .collocation.system import CollocationWarning
-from .collocation.discretisation import CollocationDiscretisation
+from .branches.discretisation import CollocationDiscretisation
 from .collocation.floquet import eigenfunction
 from .collocation.signature import Signature
 from .collocation.system import Layout, evaluate, solve
 from .continuation.driver import ContinuationOptions, Predictor, continuation
-from .collocation.branch import continue_equation_orbit
+from .branches.collocated import continue_equation_orbit
 from .collocation.orbit import EquationOrbit
 from .scheme.floquet import StabilityWarning, Verify, phase_free, ritz
 from .core.newton import ShootingError
 from .scheme.orbit import Orbit, make_orbit
-from .shooting.events import test_function
-from .shooting.branch import AutoMaps, ForcedMaps, Shooting
+from .branches.events import test_function
+from .branches.shooting import AutoMaps, ForcedMaps, Shooting
 from .scheme.problem import step_model
 from .shooting.refine import refine_orbit
 from .shooting.shoot import periodic_orbit
@@ -101,14 +101,14 @@ def continue_orbit(orbit: Orbit | EquationOrbit, p_end: float, step: float = 0.0
 
     An :class:`dmi.analysis.EquationOrbit` (from :func:`dmi.analysis.collocate` or
     ``hopf_orbit(..., of="equation")``) is continued by collocation through the same driver
-    (:mod:`dmi.analysis.collocation.branch`): the points are EquationOrbits (the equation's
+    (:mod:`dmi.analysis.branches.collocated`): the points are EquationOrbits (the equation's
     period, amplitude, multipliers with their error estimates, signature), the tangent predictor
     and Newton's corrector on the sparse collocation system, the mesh equidistributed after
     every step and the signature mended where a segment vanishes or an inequality breaks
     (``stick-onset`` and ``grazing`` events where it changes), the multipliers' events
     (``period-doubling``, ``torus``: verified, reported only where the multiplier crosses the
     unit circle beyond its estimated error on both sides, else an ``EventWarning``; see
-    :mod:`dmi.analysis.shooting.events`) and the fold, landing on p_end and ``at=``.  Of the
+    :mod:`dmi.analysis.branches.events`) and the fold, landing on p_end and ``at=``.  Of the
     options, ``step``, ``max_points``, ``min_step``, ``max_step``, ``multipliers`` (a point's
     leading multipliers), ``tol`` (at most 1e-12 is used: the corrector's error stays below
     the collocation's), ``max_iter`` and ``at`` apply; ``period=`` (the period is an
@@ -207,7 +207,7 @@ def _(orbit: EquationOrbit, p_end: float, options: ContinuationOptions, *, multi
       sections: int, margins: bool, period: Callable[[float], float] | None, refine: bool,
       verify: Verify | bool | None) -> Branch:
     """An EquationOrbit's branch: by collocation
-    (:func:`dmi.analysis.collocation.branch.continue_equation_orbit`); the scheme's options
+    (:func:`dmi.analysis.branches.collocated.continue_equation_orbit`); the scheme's options
     refused."""
     unused = [name for name, given in (("period", period is not None), ("refine", refine),
                                        ("verify", verify is not None),

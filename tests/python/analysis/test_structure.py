@@ -2,8 +2,10 @@
 # of what it builds from a model, one Newton loop (newton.newton_loop, its linear solve given by
 # the caller: the maps' matrix-free bordered_newton, of which newton.newton is a case,
 # collocation's sparse LU, the driver's corrector, shooting's Newton-Picard), one bordered solve
-# (newton.bordered_solve) and one locator of events along a branch (the driver's); its import
-# chain is at most 8 modules deep (it was 9 with two drivers).
+# (newton.bordered_solve), one locator of events along a branch (the driver's), one hold rule
+# (dmi._resolvent) and one cache per problem; its rooms import only rooms below them, with import
+# chains of at most 4 modules inside a room and 7 across dmi.analysis; no function of analysis or
+# identify has more than 80 lines of code.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -106,7 +108,7 @@ def test_one_cache_and_one_newton_loop():
     assert written - OTHER_LOOPS == set(), written - OTHER_LOOPS
     # the collocation solves, the driver's corrector and the maps' Newton call it
     for mod, name in (("collocation.system", "solve"), ("continuation.driver", "newton_corrector"),
-                      ("collocation.discretisation", "equation_hopf_orbit"),
+                      ("branches.discretisation", "equation_hopf_orbit"),
                       ("core.newton", "bordered_newton")):
         fn = next(f for f in functions(t[mod]) if f.name == name)
         assert calls(fn, "newton_loop"), f"{mod}.{name} does not use newton_loop"
@@ -129,16 +131,11 @@ def chord(x, r, lu):
     assert solving_loops(ast.parse(src)) == {"solve", "chord"}
 
 
-def test_import_chain_is_shallower():
-    assert depth(graph(PYTHON / "dmi"), "dmi.analysis.") <= 8
-    assert depth({"a": {"b"}, "b": {"c"}, "c": set()}, "") == 3
-
-
 #: The rooms of dmi.analysis, lowest first: a room imports only rooms of a lower rank; the
 #: modules at the top (dmi.analysis itself, orbits, hopf_orbits) may import any room, and no room
 #: imports them.
 RANK = {"core": 0, "plot": 0, "scheme": 1, "continuation": 2, "equilibria": 3, "shooting": 4,
-        "collocation": 5, "plane": 6}
+        "collocation": 5, "branches": 6, "plane": 7}
 
 
 def room_of(module: str) -> str | None:
@@ -402,8 +399,8 @@ def test_one_event_locator():
                 assert not inner & {"middle", "mid", "across"}, f"{mod} bisects a branch"
     # the shooting's stick events and the collocation's signature changes use it
     t = trees()
-    assert callers({"bisect_along"}, t) >= {("shooting.branch", "Shooting.between")}
-    assert ("collocation.branch", "EquationBranch._locate") in callers({"locate"}, t)
+    assert callers({"bisect_along"}, t) >= {("branches.shooting", "Shooting.between")}
+    assert ("branches.collocated", "EquationBranch._locate") in callers({"locate"}, t)
 
 
 #: Functions of dmi.analysis that call a dense, sparse or Krylov solver, and what they solve;
@@ -420,7 +417,7 @@ RAW_SOLVES = {
     ("equilibria.root_verdict", "_eval"): "the characteristic matrix's trace",
     ("equilibria.equation", "Characteristic.newton_step"): "the characteristic matrix's trace",
     ("scheme.floquet", "growth_rate"): "a least-squares fit",
-    ("shooting.branch", "_Picard.solve"): "Newton-Picard's reduced system (b + k unknowns)",
+    ("branches.shooting", "_Picard.solve"): "Newton-Picard's reduced system (b + k unknowns)",
     # a bordered system solved on its own, to go through bordered_solve (its owner's change)
     ("equilibria.curves", "_Extended._null"): "the bordered left null vector of a fold curve",
 }
@@ -450,13 +447,13 @@ def test_one_bordered_solve():
     assert {("continuation.driver", "tangent"), ("core.newton", "bordered_step"),
             ("core.newton", "bordered_solve")} <= users, users
     assert not [m for m, _ in users if m.startswith(("shooting", "collocation"))
-                and m != "collocation.discretisation"], users
+                and m != "branches.discretisation"], users
     # no bordered solve of its own: none defines one
     defined = {(mod, fn.name) for mod, tree in t.items() for fn in functions(tree)
                if "bordered" in fn.name and mod != "core.newton"}
     assert defined == {("continuation.driver", "bordered_det")}, defined
     # the collocated branch's Newton with a held length is the driver's corrector
-    held = next(f for f in functions(t["collocation.branch"]) if f.name == "_held")
+    held = next(f for f in functions(t["branches.collocated"]) if f.name == "_held")
     assert calls(held, "newton_corrector")
 
 
@@ -474,9 +471,9 @@ class C:
 
 def test_newton_picard_is_a_strategy_of_the_one_loop():
     t = trees()
-    fn = next(f for f in functions(t["shooting.branch"]) if f.name == "_newton_picard")
+    fn = next(f for f in functions(t["branches.shooting"]) if f.name == "_newton_picard")
     assert calls(fn, "newton_loop")
-    assert ("shooting.branch", "_newton_picard") not in {
+    assert ("branches.shooting", "_newton_picard") not in {
         (mod, name) for mod, tree in t.items() for name in solving_loops(tree)}
 
 
@@ -494,7 +491,7 @@ def test_driver_contract_is_typed():
                  "Carries", "Orients", "Weighted", "StartsTangent", "Between", "OnCurrent"):
         assert getattr(driver, hook)._is_protocol, hook
     # the collocated branch gets its mends through accept / recover, not an own corrector
-    from dmi.analysis.collocation.branch import EquationBranch
+    from dmi.analysis.branches.collocated import EquationBranch
     assert not hasattr(EquationBranch, "correct")
     assert issubclass(EquationBranch, (driver.Accepts,)) or all(
         callable(getattr(EquationBranch, m)) for m in ("accept", "recover"))
@@ -503,8 +500,8 @@ def test_driver_contract_is_typed():
 def test_dispatch_on_the_orbit_class():
     # no "of" attribute read to tell a scheme's orbit from the equation's in these modules
     t = trees()
-    for mod in ("orbits", "hopf_orbits", "collocation.branch", "continuation.driver",
-                "shooting.branch", "shooting.events", "shooting.autonomous"):
+    for mod in ("orbits", "hopf_orbits", "branches.collocated", "continuation.driver",
+                "branches.shooting", "branches.events", "shooting.autonomous"):
         for n in ast.walk(t[mod]):
             if isinstance(n, ast.Call) and _called(n) == "getattr" and len(n.args) >= 2:
                 a = n.args[1]
@@ -512,3 +509,54 @@ def test_dispatch_on_the_orbit_class():
                                                                                ast.unparse(n))
 
 
+
+
+def chain(edges: dict[str, set[str]], start: str, within: str) -> list[str]:
+    """The longest import chain from ``start`` through modules whose names start with ``within``
+    (a package's import of its own submodules counts, as Python runs them)."""
+    @functools.lru_cache(None)
+    def longest(m: str) -> tuple[str, ...]:
+        nxt = [longest(n) for n in edges.get(m, ()) if n.startswith(within)]
+        return (m,) + max(nxt, key=len, default=())
+    return list(longest(start))
+
+
+def test_import_chains_are_short():
+    edges = graph(PYTHON / "dmi")
+    # across dmi.analysis, from the package itself: at most 7 modules
+    top = chain(edges, "dmi.analysis", "dmi.analysis")
+    assert len(top) <= 7, top
+    # inside each room: at most 4
+    for room in RANK:
+        prefix = f"dmi.analysis.{room}."
+        worst = max((chain(edges, m, prefix) for m in edges if m.startswith(prefix)), key=len)
+        assert len(worst) <= 4, worst
+    assert chain({"a": {"b", "c"}, "b": {"c"}, "c": set()}, "a", "") == ["a", "b", "c"]
+
+
+def test_no_function_over_80_lines():
+    long = []
+    for root in (ANALYSIS, PYTHON / "dmi" / "identify"):
+        for f in sorted(root.rglob("*.py")):
+            lines = f.read_text().splitlines()
+            for fn in functions(ast.parse(f.read_text())):
+                if code_lines(fn, lines) > 80:
+                    long.append(f"{f.relative_to(PYTHON)}:{fn.lineno} {fn.name}")
+    assert long == []
+
+
+def code_lines(fn: ast.FunctionDef, lines: list[str]) -> int:
+    """A function's lines of code: not its docstring, blank lines or comment lines."""
+    doc = range(0)
+    first = fn.body[0]
+    if isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant) \
+            and isinstance(first.value.value, str):
+        doc = range(first.lineno, first.end_lineno + 1)
+    return sum(1 for i in range(fn.lineno, fn.end_lineno + 1)
+               if i not in doc and lines[i - 1].strip() and not lines[i - 1].strip().startswith("#"))
+
+
+def test_code_lines_skips_the_docstring_and_comments():
+    src = 'def f(x):\n    """doc\n    more"""\n    # a comment\n\n    return x\n'
+    fn = functions(ast.parse(src))[0]
+    assert code_lines(fn, src.splitlines()) == 2

@@ -3,7 +3,7 @@
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """The check of a result's inequalities on a fine grid (:func:`check_inequalities`) and the
 signature changes for :mod:`dmi.analysis.collocation.collocate` (a result that breaks an inequality) and
-:mod:`dmi.analysis.collocation.discretisation` (between steps); private to the package.
+:mod:`dmi.analysis.branches.discretisation` (between steps); private to the package.
 
 The segments around the circle are (modes, start) pairs, segment 0 the one holding t = 0.  A
 segment shorter than VANISH of the period is removed (its neighbours meet at its middle, or merge

@@ -6,4 +6,4 @@ regions they decide (:mod:`.diagram`), and its interactive Bokeh page (:mod:`.in
 
 May import every room below it: :mod:`dmi.analysis.core`, :mod:`dmi.analysis.plot`,
 :mod:`dmi.analysis.scheme`, :mod:`dmi.analysis.continuation`, :mod:`dmi.analysis.equilibria`,
-:mod:`dmi.analysis.shooting` and :mod:`dmi.analysis.collocation`."""
+:mod:`dmi.analysis.shooting`, :mod:`dmi.analysis.collocation` and :mod:`dmi.analysis.branches`."""

@@ -20,7 +20,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 import dmi
 from dmi import analysis as da
-from dmi.analysis.collocation.branch import EquationBranch
+from dmi.analysis.branches.collocated import EquationBranch
 
 D, BE, W, G, TAU = 0.3, 1.0, 1.2, 0.1, 1.0
 T = 2 * math.pi / W
@@ -185,7 +185,7 @@ def test_collocated_events_verified_against_the_multipliers_errors(branch):
     """The flip's bracketing points: their test functions change sign beyond the multipliers'
     estimated errors; with error bounds wider than the multiplier's distance to -1 both are 0
     (no sign change: no event) with an EventWarning each."""
-    from dmi.analysis.shooting.events import EventWarning
+    from dmi.analysis.branches.events import EventWarning
     pd = next(e for e in branch.events if e.kind == "period-doubling")
     pts = [q for q in branch.points if abs(q.p - pd.p) < 0.02]
     a = max((q for q in pts if q.p < pd.p), key=lambda q: q.p)

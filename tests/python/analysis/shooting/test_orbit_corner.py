@@ -17,7 +17,7 @@ import pytest
 
 import dmi
 import dmi.analysis as da
-from dmi.analysis.shooting.branch import corner_of
+from dmi.analysis.branches.shooting import corner_of
 
 K, G, ALPHA, C, GAMMA, TAU = 1.0, 0.8, 0.5, 0.6, 0.8, 1.0
 CORNER = "a corner of component 1's stick pattern"

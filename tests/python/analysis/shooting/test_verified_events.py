@@ -17,7 +17,7 @@ import pytest
 
 import dmi
 from dmi import analysis as da
-from dmi.analysis.shooting.events import EventWarning, orbit_events, undecided, verified_tests
+from dmi.analysis.branches.events import EventWarning, orbit_events, undecided, verified_tests
 
 H = 1.0 / 3.0
 

@@ -32,15 +32,15 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 
 from ..core.model import checked_equilibrium
-from .adapt import Solved, estimate, merged, readapted, transfer
-from .floquet import multipliers as floquet
-from .mend import check_inequalities, mend
-from .orbit import equation_orbit
-from .system import CollocationWarning, check_jumps, reference
-from .mesh import periodic_locator, point_matrix
-from .signature import SLIP_NEG, SLIP_POS, Signature
-from .system import Layout, Terms, assemble, full_jacobian, node_times, solve
-from .orbit import EquationOrbit
+from ..collocation.adapt import Solved, estimate, merged, readapted, transfer
+from ..collocation.floquet import multipliers as floquet
+from ..collocation.mend import check_inequalities, mend
+from ..collocation.orbit import equation_orbit
+from ..collocation.system import CollocationWarning, check_jumps, reference
+from ..collocation.mesh import periodic_locator, point_matrix
+from ..collocation.signature import SLIP_NEG, SLIP_POS, Signature
+from ..collocation.system import Layout, Terms, assemble, full_jacobian, node_times, solve
+from ..collocation.orbit import EquationOrbit
 from ..core.newton import Converge, NewtonOptions, ShootingError, bordered_solve, newton_loop
 from ..scheme.problem import Problem
 from ..continuation.branch import HopfPoint

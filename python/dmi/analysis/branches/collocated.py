@@ -41,14 +41,14 @@ import numpy as np
 import scipy.optimize as so
 
 from ..continuation.branch import Branch, Event, corner_sentence, travel
-from .adapt import transfer
+from ..collocation.adapt import transfer
 from .discretisation import CollocationDiscretisation, equation_hopf_orbit
-from .mend import check_inequalities, circle, memory, mend, relaid, removed
-from .signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK
-from .system import CollocationWarning, evaluate, solve
+from ..collocation.mend import check_inequalities, circle, memory, mend, relaid, removed
+from ..collocation.signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK
+from ..collocation.system import CollocationWarning, evaluate, solve
 from ..continuation.driver import (ContinuationOptions, Curve, Predictor, continuation, locate,
                                    newton_corrector, tangent)
-from .orbit import EquationOrbit
+from ..collocation.orbit import EquationOrbit
 from ..core.newton import Converge, NewtonOptions, Search, ShootingError
 
 #: Mends (split or removal, then a correction at fixed p) tried on one point at most.
@@ -421,7 +421,7 @@ class EquationBranch(CollocationDiscretisation):
     def event_functions(self, x: np.ndarray, p: float, point: EquationOrbit
                         ) -> dict[str, float]:
         """The multipliers' test functions (``period-doubling``, ``torus``) verified against
-        the multipliers' estimated errors (:func:`dmi.analysis.shooting.events.verified_tests`:
+        the multipliers' estimated errors (:func:`dmi.analysis.branches.events.verified_tests`:
         0, with an EventWarning, where a test function lies within its multiplier's error; a
         point without error estimates decides nothing); the ``fold`` is left to the driver's
         dp/ds, the signature's changes to :meth:`between`.
@@ -440,7 +440,7 @@ class EquationBranch(CollocationDiscretisation):
         dict
             kind -> value.
         """
-        from ..shooting.events import verified_tests   # here: this method's own helper
+        from .events import verified_tests   # here: this method's own helper
         if point is None or point.multipliers.size == 0:
             return {}
         mu = np.asarray(point.multipliers)

@@ -12,7 +12,7 @@ The multipliers' events are placed by the linear interpolation of their test fun
 (:func:`test_function`; from the refined multipliers with ``refine=True``,
 :func:`dmi.analysis.orbits.refined_event`), the stick events by the driver's bisection along the
 branch (:func:`dmi.analysis.continuation.driver.bisect_along`, called by
-:meth:`dmi.analysis.shooting.branch.Shooting.between`).  The fold is the driver's
+:meth:`dmi.analysis.branches.shooting.Shooting.between`).  The fold is the driver's
 (:mod:`dmi.analysis.continuation.driver`).  A point's stick profile and margins: :func:`stick_profile`.
 
 Verified multipliers' events: where the points carry error bounds of their multipliers (a

@@ -9,7 +9,7 @@ through the previous point).  :class:`Shooting` implements the driver's contract
 F_p(x) - x (and the phase condition), its Jacobian as a LinearOperator (forward differences of
 the map) with dF/dp by one difference, the points (:func:`orbit_point`: multipliers, stick
 profile, margins), the orbits' events between two points
-(:func:`dmi.analysis.shooting.events.orbit_events`, the ``between`` hook; the stick events
+(:func:`dmi.analysis.branches.events.orbit_events`, the ``between`` hook; the stick events
 located by the driver's :func:`~dmi.analysis.continuation.driver.bisect_along`), and its own
 corrector (``correct``, the driver's ``OwnCorrector``): Newton-Picard on the previous point's
 dominant subspace (Lust, Roose, Spence and Champneys, SIAM J. Sci. Comput. 19 (1998) 1188), a
