@@ -103,6 +103,12 @@ def box_mode(u: Any, lo: Any, hi: Any) -> Any:
     return LO * (u == lo) + HI * ((u == hi) & (u != lo))
 
 
+def reaches_zero(u0: Any, u1: Any) -> Any:
+    """True where a friction component that slips at u0 (!= 0) reaches zero or changes sign in
+    the step to u1: where it may stick or reverse."""
+    return (u0 != 0.0) & ((u1 == 0.0) | ((u0 > 0.0) != (u1 > 0.0)))
+
+
 def crossing(u0: float, u1: float) -> float:
     """Where in a step from u0 (!= 0) to u1 the linear interpolation of u reaches 0: the
     fraction u0 / (u0 - u1) of the step."""

@@ -27,7 +27,7 @@ from scipy import fft as sp_fft
 from .._errors import Error
 from .._solver import Solver
 from ._near import near_kernel_part, near_sum
-from .._resolvent import friction_slope, friction_slope_alpha, salted
+from .._resolvent import friction_slope, friction_slope_alpha, reaches_zero, salted
 from ._saltation import REVERSAL, STICK, UNPLACED, reversal
 
 #: Relative step of the directional differences (about the square root of the unit roundoff).
@@ -608,7 +608,7 @@ def _python_loop(L: _Loop, history: np.ndarray) -> Sensitivities:
         slipping = friction_slope(X, h * r.alpha)
         dR = friction_slope_alpha(X, h * r.alpha, h)[:, :, None] * r.dalpha[None]
         # the steps where a slipping friction component meets zero or changes sign
-        meets = np.any((U[:-1] != 0.0) & (U[:-1] * U[1:] <= 0.0) & (r.alpha > 0.0), axis=1)
+        meets = np.any(reaches_zero(U[:-1], U[1:]) & (r.alpha > 0.0), axis=1)
     dX = np.empty((steps, n, P))
     switches: list = []
     dWU = memory.kernel_part() if memory.active else None

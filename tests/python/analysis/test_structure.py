@@ -560,3 +560,58 @@ def test_code_lines_skips_the_docstring_and_comments():
     src = 'def f(x):\n    """doc\n    more"""\n    # a comment\n\n    return x\n'
     fn = functions(ast.parse(src))[0]
     assert code_lines(fn, src.splitlines()) == 2
+
+
+#: The functions that read a friction or box component's hold or mode, each through the one rule
+#: (dmi._resolvent, checked against libdmi's C rule in binding/test_resolvent_rule.py).
+RULE_USERS = {("analysis.core.model", "_resolvent_derivative"),
+              ("analysis.scheme.orbit", "stuck_mask"),
+              ("analysis.collocation.signature", "step_modes"),
+              ("analysis.branches.events", "stick_profile"),
+              ("identify.sensitivity", "_python_loop"),
+              ("identify._saltation", "reversal")}
+
+
+def rule_names(tree: ast.Module) -> set[str]:
+    """The names under which a module reaches dmi._resolvent: its alias, or names imported from
+    it."""
+    out = set()
+    for n in ast.walk(tree):
+        if isinstance(n, ast.ImportFrom):
+            if (n.module or "").endswith("_resolvent"):
+                out |= {a.asname or a.name for a in n.names}
+            else:
+                out |= {a.asname or a.name for a in n.names if a.name == "_resolvent"}
+    return out
+
+
+def threshold_tests(tree: ast.Module) -> list[str]:
+    """Comparisons with the friction's threshold h alpha (both names in one comparison)."""
+    out = []
+    for n in ast.walk(tree):
+        if isinstance(n, ast.Compare):
+            names = {x.id if isinstance(x, ast.Name) else x.attr for x in ast.walk(n)
+                     if isinstance(x, (ast.Name, ast.Attribute))}
+            if {"h", "alpha"} <= names:
+                out.append(ast.unparse(n))
+    return out
+
+
+def test_one_hold_rule():
+    mods = {}
+    for root in (ANALYSIS, PYTHON / "dmi" / "identify"):
+        for f in sorted(root.rglob("*.py")):
+            mods[".".join(f.relative_to(root.parent).with_suffix("").parts)] = ast.parse(
+                f.read_text())
+    for mod, name in RULE_USERS:
+        fn = next(f for f in functions(mods[mod]) if f.name == name)
+        used = {x.id for x in ast.walk(fn) if isinstance(x, ast.Name)}
+        assert used & rule_names(mods[mod]), f"{mod}.{name} does not read dmi._resolvent"
+    # nobody else compares with the friction's threshold
+    found = {mod: threshold_tests(tree) for mod, tree in mods.items() if threshold_tests(tree)}
+    assert found == {}, found
+    rule = ast.parse((PYTHON / "dmi" / "_resolvent.py").read_text())
+    assert threshold_tests(ast.parse("held = abs(x) <= h * alpha")) == ["abs(x) <= h * alpha"]
+    assert rule_names(ast.parse("from .. import _resolvent as rule")) == {"rule"}
+    assert {fn.name for fn in functions(rule)} >= {"friction_held", "box_held", "friction_mode",
+                                                     "saltation_factor", "reaches_zero"}

@@ -37,6 +37,7 @@ from ..continuation.branch import BranchPoint, Event, EventWarning, non_real
 from ..scheme.floquet import phase_free
 from ..scheme.orbit import stuck_mask
 from ..scheme.stepmap import StepMap
+from ..._resolvent import reaches_zero
 
 
 def stick_profile(F: StepMap, U: np.ndarray, X: np.ndarray | None
@@ -60,7 +61,7 @@ def stick_profile(F: StepMap, U: np.ndarray, X: np.ndarray | None
         alpha = float(np.median(np.abs(X[slip, i] - u1[slip, i]))) / F.h
         # the steps where the velocity reaches 0 or crosses it (all steps of a component stuck
         # throughout), and the force there besides friction, |X - U^p| / h
-        entry = ((u1[:, i] == 0.0) & (u0[:, i] != 0.0)) | (u0[:, i] * u1[:, i] < 0.0)
+        entry = reaches_zero(u0[:, i], u1[:, i])
         if not entry.any():
             entry = stuck[:, i]
         if entry.any():
