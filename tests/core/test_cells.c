@@ -72,6 +72,16 @@ static double first_W(dmi_kernel_fn H, void *user, dmi_history_fn z, double tau,
     return W;
 }
 
+/* first_W of a kernel that must be accepted: asserts dmi_init's DMI_OK. */
+static double accepted_W(dmi_kernel_fn H, void *user, dmi_history_fn z, double tau, size_t N,
+                         double alpha)
+{
+    int rc;
+    const double W = first_W(H, user, z, tau, N, alpha, &rc, NULL);
+    CU_ASSERT_EQUAL(rc, DMI_OK);
+    return W;
+}
+
 static void test_power_cells(void)
 {
     const double alphas[5] = {0.5, 0.8, 0.9, 0.95, 0.99};
@@ -79,10 +89,8 @@ static void test_power_cells(void)
         double alpha = alphas[i];
         const double tau = 1.0, h = 0.125;
         /* z = 1: W^0 = int_0^1 H */
-        int rc;
         char what[96];
-        double W = first_W(power_kernel, &alpha, core_z_one, tau, 8, NAN, &rc, NULL);
-        CU_ASSERT_EQUAL(rc, DMI_OK);
+        double W = accepted_W(power_kernel, &alpha, core_z_one, tau, 8, NAN);
         snprintf(what, sizeof what, "W^0 of s^-%g (1 + s), z = 1", alpha);
         CU_ASSERT(core_close_rel(what, W, power_integral(alpha, 1.0), 1e-10));
         /* z = cos 5t: each cell's weight */
@@ -90,13 +98,11 @@ static void test_power_cells(void)
         for (int l = 0; l < 8; l++)
             ref += (power_integral(alpha, (l + 1) * h) - power_integral(alpha, l * h)) *
                    cos(5 * l * h);
-        W = first_W(power_kernel, &alpha, core_z_wave, tau, 8, NAN, &rc, NULL);
-        CU_ASSERT_EQUAL(rc, DMI_OK);
+        W = accepted_W(power_kernel, &alpha, core_z_wave, tau, 8, NAN);
         snprintf(what, sizeof what, "W^0 of s^-%g (1 + s), z = cos 5t", alpha);
         CU_ASSERT(core_close_rel(what, W, ref, 1e-10));
         /* the exponent given: the same */
-        W = first_W(power_kernel, &alpha, core_z_one, tau, 8, alpha, &rc, NULL);
-        CU_ASSERT_EQUAL(rc, DMI_OK);
+        W = accepted_W(power_kernel, &alpha, core_z_one, tau, 8, alpha);
         snprintf(what, sizeof what, "W^0 of s^-%g (1 + s), exponent given", alpha);
         CU_ASSERT(core_close_rel(what, W, power_integral(alpha, 1.0), 1e-10));
     }
@@ -107,9 +113,7 @@ static void test_power_cells(void)
 static void test_exponent_near_zero(void)
 {
     double alpha = 1e-17;
-    int rc;
-    double W = first_W(power_kernel, &alpha, core_z_one, 1.0, 8, NAN, &rc, NULL);
-    CU_ASSERT_EQUAL(rc, DMI_OK);
+    double W = accepted_W(power_kernel, &alpha, core_z_one, 1.0, 8, NAN);
     CU_ASSERT(core_close_rel("W^0 of s^-1e-17 (1 + s)", W, 1.5, 1e-12));
 }
 
@@ -239,13 +243,11 @@ static int step_kernel(double s, double *out, void *user)
 
 static void test_jump_in_cell(void)
 {
-    int rc;
-    double W = first_W(step_kernel, NULL, core_z_one, 1.0, 8, NAN, &rc, NULL);
-    CU_ASSERT_EQUAL(rc, DMI_OK);
+    double W = accepted_W(step_kernel, NULL, core_z_one, 1.0, 8, NAN);
     CU_ASSERT(core_close_rel("W^0 of H = 1 on [0, 0.3)", W, 0.3, 1e-10));
     /* the cell's own weight: z = cos 5t tells it from its neighbours */
     const double ref = 0.125 * (1 + cos(5 * 0.125)) + 0.05 * cos(5 * 0.25);
-    W = first_W(step_kernel, NULL, core_z_wave, 1.0, 8, NAN, &rc, NULL);
+    W = accepted_W(step_kernel, NULL, core_z_wave, 1.0, 8, NAN);
     CU_ASSERT(core_close_rel("W^0 of the jump, z = cos 5t", W, ref, 1e-10));
 }
 
@@ -273,9 +275,7 @@ static void test_calls_inside_cells(void)
     const size_t Ns[3] = {8, 10, 1000};
     for (int i = 0; i < 3; i++) {
         recorder r = {1.0, 1.0 / (double)Ns[i], Ns[i], 0, 0, 0};
-        int rc;
-        first_W(recording, &r, core_z_one, 1.0, Ns[i], NAN, &rc, NULL);
-        CU_ASSERT_EQUAL(rc, DMI_OK);
+        accepted_W(recording, &r, core_z_one, 1.0, Ns[i], NAN);
         if (r.outside || r.at_ends)
             printf("\n  N = %zu: %zu of %zu calls outside (0, tau), %zu at l h\n", Ns[i],
                    r.outside, r.calls, r.at_ends);
@@ -303,10 +303,8 @@ static int counted_exp(double s, double *out, void *user)
 static void test_far_cells(void)
 {
     size_t calls = 0;
-    int rc;
     const size_t N = 5000;
-    const double W = first_W(counted_exp, &calls, core_z_one, 1.0, N, NAN, &rc, NULL);
-    CU_ASSERT_EQUAL(rc, DMI_OK);
+    const double W = accepted_W(counted_exp, &calls, core_z_one, 1.0, N, NAN);
     CU_ASSERT(core_close_rel("W^0 of e^{-s}, N = 5000", W, 1 - exp(-1.0), 1e-13));
     if ((double)calls > 130.0 * (double)N)
         printf("\n  e^{-s}, N = %zu: %.1f calls a cell\n", N, (double)calls / (double)N);
@@ -330,13 +328,10 @@ static int huge_power(double s, double *out, void *user)
 
 static void test_huge_kernel(void)
 {
-    int rc;
-    double W = first_W(huge, NULL, core_z_one, 1.0, 8, NAN, &rc, NULL);
-    CU_ASSERT_EQUAL(rc, DMI_OK);
+    double W = accepted_W(huge, NULL, core_z_one, 1.0, 8, NAN);
     CU_ASSERT(core_close_rel("W^0 of H = 1e307", W, 1e307, 1e-12));
     /* 1e280 s^-1/2: beyond the largest double below s = 1e-55, integrable */
-    W = first_W(huge_power, NULL, core_z_one, 1.0, 8, NAN, &rc, NULL);
-    CU_ASSERT_EQUAL(rc, DMI_OK);
+    W = accepted_W(huge_power, NULL, core_z_one, 1.0, 8, NAN);
     CU_ASSERT(core_close_rel("W^0 of H = 1e280 s^-1/2", W, 2e280, 1e-10));
 }
 
@@ -390,8 +385,7 @@ static void test_exponent_close_to_one(void)
         printf("\n  s^-0.9999 (1 + s): \"%s\"\n", msg);
     CU_ASSERT(strstr(msg, "cell 0 = [0, ") != NULL && strstr(msg, "close to 1") != NULL &&
               strstr(msg, "dmi_set_kernel_singularity") != NULL);
-    const double W = first_W(power_kernel, &alpha, core_z_one, 1.0, 8, alpha, &rc, NULL);
-    CU_ASSERT_EQUAL(rc, DMI_OK);
+    const double W = accepted_W(power_kernel, &alpha, core_z_one, 1.0, 8, alpha);
     CU_ASSERT(core_close_rel("W^0 of s^-0.9999 (1 + s), exponent given", W,
                              power_integral(alpha, 1.0), 1e-10));
 }
