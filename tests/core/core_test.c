@@ -115,14 +115,24 @@ double core_ls_slope(const double *x, const double *y, size_t n)
     return sxy / sxx;
 }
 
-dmi_solver *core_paper_solver(paper_example *ex, size_t N)
+dmi_solver *core_init_or_free(dmi_solver *s, int rc)
 {
-    dmi_solver *s = NULL;
-    if (dmi_create(&s, 2, 1.0, N) != DMI_OK)
-        return NULL;
-    if (paper_setup(s, ex) != DMI_OK || dmi_init(s) != DMI_OK)
+    if (rc != DMI_OK || dmi_init(s) != DMI_OK)
         dmi_free(&s);
     return s;
+}
+
+/* A new solver of n = 2, tau = 1, N steps, or NULL. */
+static dmi_solver *new_n2(size_t N)
+{
+    dmi_solver *s = NULL;
+    return dmi_create(&s, 2, 1.0, N) == DMI_OK ? s : NULL;
+}
+
+dmi_solver *core_paper_solver(paper_example *ex, size_t N)
+{
+    dmi_solver *s = new_n2(N);
+    return s ? core_init_or_free(s, paper_setup(s, ex)) : NULL;
 }
 
 /* ---- saved states ---------------------------------------------------------- */
@@ -249,12 +259,8 @@ int core_model_setup(dmi_solver *s, core_model *m)
 
 dmi_solver *core_model_solver(core_model *m, size_t N)
 {
-    dmi_solver *s = NULL;
-    if (dmi_create(&s, 2, 1.0, N) != DMI_OK)
-        return NULL;
-    if (core_model_setup(s, m) != DMI_OK || dmi_init(s) != DMI_OK)
-        dmi_free(&s);
-    return s;
+    dmi_solver *s = new_n2(N);
+    return s ? core_init_or_free(s, core_model_setup(s, m)) : NULL;
 }
 
 int core_z_one(double t, double *out, void *user)

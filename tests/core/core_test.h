@@ -40,6 +40,10 @@ int core_close_rel(const char *what, double a, double b, double rel);
 /* Least-squares slope of y against x (n points). */
 double core_ls_slope(const double *x, const double *y, size_t n);
 
+/* s after dmi_init(s) if rc (the setup's code) is DMI_OK and dmi_init
+ * succeeds; otherwise s is freed and NULL returned. */
+dmi_solver *core_init_or_free(dmi_solver *s, int rc);
+
 /* A new initialised solver of a paper example (examples/paper.c) with
  * h = tau / N, tau = 1, or NULL; ex must outlive it. */
 dmi_solver *core_paper_solver(paper_example *ex, size_t N);

@@ -222,10 +222,10 @@ static dmi_solver *exp_solver(core_model *m)
     dmi_solver *s = NULL;
     if (dmi_create(&s, 2, 1.0, N) != DMI_OK)
         return NULL;
-    if (core_model_setup(s, m) != DMI_OK || dmi_set_kernel_exp(s, 3, a, b, C, NULL) != DMI_OK ||
-        dmi_init(s) != DMI_OK)
-        dmi_free(&s);
-    return s;
+    int rc = core_model_setup(s, m);
+    if (rc == DMI_OK)
+        rc = dmi_set_kernel_exp(s, 3, a, b, C, NULL);
+    return core_init_or_free(s, rc);
 }
 
 /* A state of libdmi 1.0 (format version 1, no recursion sums), built from

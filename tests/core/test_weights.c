@@ -71,13 +71,22 @@ static int wave(double t, double *out, void *user)
 
 enum { NC = 16 };
 
-static void test_left_callback(void)
+/* A new initialised solver of n components, tau = 1, N = NC, with the kernel
+ * callback H under the quadrature rule. */
+static dmi_solver *callback_solver(size_t n, dmi_kernel_fn H, int rule)
 {
     dmi_solver *s = NULL;
-    const double tau = 1.0, h = 1.0 / NC;
-    CU_ASSERT_FATAL(dmi_create(&s, 1, tau, NC) == DMI_OK);
-    CU_ASSERT_FATAL(dmi_set_kernel(s, decay, NULL) == DMI_OK);
+    CU_ASSERT_FATAL(dmi_create(&s, n, 1.0, NC) == DMI_OK);
+    CU_ASSERT_FATAL(dmi_set_kernel(s, H, NULL) == DMI_OK);
+    CU_ASSERT_FATAL(dmi_set_quadrature(s, rule) == DMI_OK);
     CU_ASSERT_FATAL(dmi_init(s) == DMI_OK);
+    return s;
+}
+
+static void test_left_callback(void)
+{
+    const double h = 1.0 / NC;
+    dmi_solver *s = callback_solver(1, decay, DMI_QUAD_LEFT);
     double G[NC], G_near[NC];
     CU_ASSERT_FATAL(dmi_get_kernel_weights(s, 0, NC, G, G_near) == DMI_OK);
     int ok = 1;
@@ -128,12 +137,8 @@ static void test_exponential(void)
 
 static void test_cell_callback(void)
 {
-    dmi_solver *s = NULL;
     const double h = 1.0 / NC;
-    CU_ASSERT_FATAL(dmi_create(&s, 1, 1.0, NC) == DMI_OK);
-    CU_ASSERT_FATAL(dmi_set_kernel(s, singular, NULL) == DMI_OK);
-    CU_ASSERT_FATAL(dmi_set_quadrature(s, DMI_QUAD_CELL) == DMI_OK);
-    CU_ASSERT_FATAL(dmi_init(s) == DMI_OK);
+    dmi_solver *s = callback_solver(1, singular, DMI_QUAD_CELL);
     double G[NC];
     CU_ASSERT_FATAL(dmi_get_kernel_weights(s, 0, NC, G, NULL) == DMI_OK);
     int ok = 1;
@@ -186,11 +191,8 @@ static void test_near_cells(void)
 
 static void test_matrix_entry(void)
 {
-    dmi_solver *s = NULL;
     const double h = 1.0 / NC;
-    CU_ASSERT_FATAL(dmi_create(&s, 2, 1.0, NC) == DMI_OK);
-    CU_ASSERT_FATAL(dmi_set_kernel(s, corner, NULL) == DMI_OK);
-    CU_ASSERT_FATAL(dmi_init(s) == DMI_OK);
+    dmi_solver *s = callback_solver(2, corner, DMI_QUAD_LEFT);
     double G[4 * NC];
     CU_ASSERT_FATAL(dmi_get_kernel_weights(s, 0, NC, G, NULL) == DMI_OK);
     int ok = 1;
