@@ -49,6 +49,19 @@ static double power_integral(double alpha, double x)
     return pow(x, 1 - alpha) / (1 - alpha) + pow(x, 2 - alpha) / (2 - alpha);
 }
 
+/* dmi_init(s), its message into msg (if not NULL) and, if it succeeds, one
+ * step's W^0 into *W; frees s and returns dmi_init's code. */
+static int init_first_step(dmi_solver *s, char *msg, double *W)
+{
+    const int rc = dmi_init(s);
+    if (msg)
+        snprintf(msg, 1024, "%s", dmi_last_error(s));
+    if (rc == DMI_OK && dmi_step(s) == DMI_OK)
+        dmi_get_step_terms(s, W, NULL);
+    dmi_free(&s);
+    return rc;
+}
+
 /* W^0 of a new solver for u' + W = 0 (n = 1, tau, N cells) with the kernel
  * callback H (user), history z, the cell rule, exponent hint alpha (NAN:
  * none): *rc = dmi_init's code, the message into msg (if not NULL). */
@@ -63,12 +76,7 @@ static double first_W(dmi_kernel_fn H, void *user, dmi_history_fn z, double tau,
     CU_ASSERT_EQUAL(dmi_set_quadrature(s, DMI_QUAD_CELL), DMI_OK);
     if (!isnan(alpha))
         CU_ASSERT_EQUAL(dmi_set_kernel_singularity(s, alpha), DMI_OK);
-    *rc = dmi_init(s);
-    if (msg)
-        snprintf(msg, 1024, "%s", dmi_last_error(s));
-    if (*rc == DMI_OK && dmi_step(s) == DMI_OK)
-        dmi_get_step_terms(s, &W, NULL);
-    dmi_free(&s);
+    *rc = init_first_step(s, msg, &W);
     return W;
 }
 
@@ -130,13 +138,7 @@ static int near_W(dmi_kernel_fn H, void *user, double *W, char *msg)
     CU_ASSERT_EQUAL(dmi_set_kernel_near(s, H, user, 0.2), DMI_OK);
     CU_ASSERT_EQUAL(dmi_set_history(s, core_z_one, NULL), DMI_OK);
     CU_ASSERT_EQUAL(dmi_set_quadrature(s, DMI_QUAD_CELL), DMI_OK);
-    int rc = dmi_init(s);
-    if (msg)
-        snprintf(msg, 1024, "%s", dmi_last_error(s));
-    if (rc == DMI_OK && dmi_step(s) == DMI_OK)
-        dmi_get_step_terms(s, W, NULL);
-    dmi_free(&s);
-    return rc;
+    return init_first_step(s, msg, W);
 }
 
 static void test_power_near_cells(void)
@@ -464,12 +466,7 @@ static int declared_W(dmi_kernel_fn H, void *user, int near, double alpha, char 
     CU_ASSERT_EQUAL(dmi_set_history(s, core_z_one, NULL), DMI_OK);
     CU_ASSERT_EQUAL(dmi_set_quadrature(s, DMI_QUAD_CELL), DMI_OK);
     CU_ASSERT_EQUAL(dmi_set_kernel_singularity(s, alpha), DMI_OK);
-    const int rc = dmi_init(s);
-    snprintf(msg, 1024, "%s", dmi_last_error(s));
-    if (rc == DMI_OK && dmi_step(s) == DMI_OK)
-        dmi_get_step_terms(s, W, NULL);
-    dmi_free(&s);
-    return rc;
+    return init_first_step(s, msg, W);
 }
 
 static void test_declared_exponent_checked(void)

@@ -74,6 +74,24 @@ def fmus(build_dir, name):
     return {"2": str(build_dir / f"{name}.fmu"), "3": str(build_dir / "fmi3" / f"{name}.fmu")}
 
 
+# The history z = 1 on [-tau, 0] of a model source: the C callback one.
+HISTORY_ONE = r"""static int one(double t, double *out, void *user)
+{
+    (void)t, (void)user;
+    out[0] = 1.0;
+    return 0;
+}
+"""
+
+
+def built_fmus(tmp_path_factory, prefix, name, source):
+    """The FMUs (as fmus gives them) of the model name from the C source source,
+    built with dmi_add_fmu in a new temporary folder against the installed dmi at prefix."""
+    src = write_project(tmp_path_factory.mktemp(name.lower()), name, source)
+    build(src, src / "build", prefix)
+    return fmus(src / "build", name)
+
+
 class Instance:
     """An FMU2Slave or FMU3Slave of the FMU at path with the calls the tests
     use under one name; self.log holds (status, category, message) (FMI 2.0:

@@ -10,7 +10,7 @@
 import pytest
 from fmpy.fmi1 import FMICallException
 
-from conftest import Instance, build, fmus, write_project
+from conftest import HISTORY_ONE, Instance, built_fmus
 
 MODEL = r"""#include <stdio.h>
 #include "dmi_fmu.h"
@@ -28,13 +28,7 @@ static int rhs(double t, const double *u, double *out, void *user)
     out[0] = u[0];
     return 0;
 }
-static int one(double t, double *out, void *user)
-{
-    (void)t, (void)user;
-    out[0] = 1.0;
-    return 0;
-}
-static int configure(const dmi_fmu_values *m, dmi_solver *s, char *err)
+""" + HISTORY_ONE + r"""static int configure(const dmi_fmu_values *m, dmi_solver *s, char *err)
 {
     (void)m, (void)err;
     int rc = dmi_set_rhs(s, rhs, NULL);
@@ -59,9 +53,7 @@ const dmi_fmu_model DMI_FMU_MODEL = {"u' + u = 0", TABLE, NVARS, 1, VR_tau, VR_N
 
 @pytest.fixture(scope="module")
 def pair(prefix, tmp_path_factory):
-    src = write_project(tmp_path_factory.mktemp("pair"), "Pair", MODEL)
-    build(src, src / "build", prefix)
-    return fmus(src / "build", "Pair")
+    return built_fmus(tmp_path_factory, prefix, "Pair", MODEL)
 
 
 @pytest.mark.parametrize("version", ["2", "3"])

@@ -10,7 +10,7 @@
 import pytest
 from fmpy.fmi1 import FMICallException
 
-from conftest import Instance, build, fmus, write_project
+from conftest import HISTORY_ONE, Instance, build, fmus, write_project
 
 # w' = -k w + F, no friction, no kernel; ROW is the row under test.
 MODEL = r"""#include <stdio.h>
@@ -29,13 +29,7 @@ static int rhs(double t, const double *u, double *out, void *user)
     out[0] = m->value[2] * u[0];
     return 0;
 }
-static int history(double t, double *out, void *user)
-{
-    (void)t, (void)user;
-    out[0] = 1.0;
-    return 0;
-}
-static int configure(const dmi_fmu_values *m, dmi_solver *s, char *err)
+""" + HISTORY_ONE + r"""static int configure(const dmi_fmu_values *m, dmi_solver *s, char *err)
 {
     const double negative[1] = {-1.0};
     if (m->value[2] < 0) {
@@ -45,7 +39,7 @@ static int configure(const dmi_fmu_values *m, dmi_solver *s, char *err)
     if (m->value[2] == 0) /* libdmi refuses it: its message */
         return dmi_set_friction(s, negative);
     dmi_set_rhs(s, rhs, (void *)m);
-    return dmi_set_history(s, history, NULL);
+    return dmi_set_history(s, one, NULL);
 }
 /* explicit in f: h k > 1 overshoots (a warning), h k > 2 grows (refused) */
 static int check(const dmi_fmu_values *m, double T, char *msg)

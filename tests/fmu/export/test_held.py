@@ -14,7 +14,7 @@ from fmpy import simulate_fmu
 from fmpy.fmi1 import FMICallException
 
 import dmi
-from conftest import Instance, build, fmus, write_project
+from conftest import Instance, built_fmus
 
 MODEL = r"""#include "dmi_fmu.h"
 #include <math.h>
@@ -59,9 +59,7 @@ T, H, LO, HI = 20.0, 0.01, -0.5, 0.5
 
 @pytest.fixture(scope="module")
 def held(prefix, tmp_path_factory):
-    src = write_project(tmp_path_factory.mktemp("held"), "Held", MODEL)
-    build(src, src / "build", prefix)
-    return fmus(src / "build", "Held")
+    return built_fmus(tmp_path_factory, prefix, "Held", MODEL)
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,7 @@
 import pytest
 from fmpy.fmi1 import FMICallException
 
-from conftest import Instance, build, fmus, write_project
+from conftest import HISTORY_ONE, Instance, built_fmus
 
 MODEL = r"""#include "dmi_fmu.h"
 #define VARS(X)                                                                  \
@@ -29,13 +29,7 @@ static int rhs(double t, const double *u, double *out, void *user)
     out[0] = m->value[VR_k] * u[0];
     return 0;
 }
-static int one(double t, double *out, void *user)
-{
-    (void)t, (void)user;
-    out[0] = 1.0;
-    return 0;
-}
-static int configure(const dmi_fmu_values *m, dmi_solver *s, char *err)
+""" + HISTORY_ONE + r"""static int configure(const dmi_fmu_values *m, dmi_solver *s, char *err)
 {
     (void)err;
     int rc = dmi_set_rhs(s, rhs, (void *)m);
@@ -55,9 +49,7 @@ const dmi_fmu_model DMI_FMU_MODEL = {"u' + k u = 0", TABLE, NVARS, 1, VR_tau, VR
 
 @pytest.fixture(scope="module")
 def kinds(prefix, tmp_path_factory):
-    src = write_project(tmp_path_factory.mktemp("kinds"), "Kinds", MODEL)
-    build(src, src / "build", prefix)
-    return fmus(src / "build", "Kinds")
+    return built_fmus(tmp_path_factory, prefix, "Kinds", MODEL)
 
 
 class Typed:
