@@ -65,13 +65,8 @@ static void snap_take(const dmi_solver *s, snapshot *sn)
     memset(sn, 0, sizeof *sn);
     sn->init = dmi_get_step_index(s, &sn->p) == DMI_OK;
     sn->size = dmi_state_size(s);
-    if (sn->init) {
-        sn->bytes = malloc(sn->size);
-        if (sn->bytes && dmi_state_save(s, sn->bytes, sn->size) != DMI_OK) {
-            free(sn->bytes);
-            sn->bytes = NULL;
-        }
-    }
+    if (sn->init)
+        sn->bytes = core_save(s, &sn->size);
     sn->terms_rc = dmi_get_step_terms(s, sn->W, sn->X);
     sn->time = dmi_time(s);
 }
@@ -123,14 +118,8 @@ static unsigned char *reference_state(size_t *size)
     model_default(&m);
     dmi_solver *s = NULL;
     unsigned char *b = NULL;
-    if (build(S_INIT0, &m, &s) == DMI_OK && dmi_advance(s, REF_STEPS) == DMI_OK) {
-        *size = dmi_state_size(s);
-        b = malloc(*size);
-        if (b && dmi_state_save(s, b, *size) != DMI_OK) {
-            free(b);
-            b = NULL;
-        }
-    }
+    if (build(S_INIT0, &m, &s) == DMI_OK && dmi_advance(s, REF_STEPS) == DMI_OK)
+        b = core_save(s, size);
     dmi_free(&s);
     return b;
 }
@@ -145,14 +134,8 @@ static unsigned char *saved_state(size_t n, double tau, size_t N, size_t *size)
     unsigned char *b = NULL;
     *size = 0;
     if (dmi_create(&s, n, tau, N) == DMI_OK && dmi_set_history(s, model_history, &m) == DMI_OK &&
-        dmi_init(s) == DMI_OK && dmi_step(s) == DMI_OK) {
-        *size = dmi_state_size(s);
-        b = malloc(*size);
-        if (b && dmi_state_save(s, b, *size) != DMI_OK) {
-            free(b);
-            b = NULL;
-        }
-    }
+        dmi_init(s) == DMI_OK && dmi_step(s) == DMI_OK)
+        b = core_save(s, size);
     dmi_free(&s);
     return b;
 }
@@ -554,6 +537,23 @@ static void created(const char *id, const char *fn, const char *input, int rc, i
         dmi_free(&s);
 }
 
+/* dmi_create (N) or, if by_h, dmi_create_h (h) of case id, its output a
+ * sentinel (the address of the case's row, never dereferenced) or NULL if
+ * null_out, with the library's messages quietened; the outcome checked by
+ * created. */
+static void create_case(const void *case_row, const char *id, const char *input, int null_out,
+                        size_t n, double tau, int by_h, size_t N, double h, int expect)
+{
+    dmi_solver *sentinel = (dmi_solver *)case_row;
+    dmi_solver *s = sentinel;
+    hard_quiet q;
+    int quiet = hard_quiet_begin(&q);
+    int rc = by_h ? dmi_create_h(null_out ? NULL : &s, n, tau, h)
+                  : dmi_create(null_out ? NULL : &s, n, tau, N);
+    created(id, by_h ? "dmi_create_h" : "dmi_create", input, rc, expect, null_out, s, sentinel,
+            quiet, hard_quiet_end(&q));
+}
+
 static void test_create(void)
 {
     static const struct {
@@ -583,15 +583,9 @@ static void test_create(void)
         {"C15", "n = 2^44, N = 1: history of 1 PiB cannot be allocated", 0, (size_t)1 << 44, 1.0,
          1, DMI_ENOMEM},
     };
-    for (size_t i = 0; i < sizeof t / sizeof t[0]; i++) {
-        dmi_solver *sentinel = (dmi_solver *)&t[i]; /* never dereferenced */
-        dmi_solver *s = sentinel;
-        hard_quiet q;
-        int quiet = hard_quiet_begin(&q);
-        int rc = dmi_create(t[i].null_out ? NULL : &s, t[i].n, t[i].tau, t[i].N);
-        created(t[i].id, "dmi_create", t[i].input, rc, t[i].expect, t[i].null_out, s, sentinel,
-                quiet, hard_quiet_end(&q));
-    }
+    for (size_t i = 0; i < sizeof t / sizeof t[0]; i++)
+        create_case(&t[i], t[i].id, t[i].input, t[i].null_out, t[i].n, t[i].tau, 0, t[i].N, 0.0,
+                    t[i].expect);
 }
 
 /* dmi_create_h (libdmi 1.2): the same checks as dmi_create, on h. */
@@ -620,15 +614,9 @@ static void test_create_h(void)
         {"C147", "n = 2^44, h > tau (N = 1): history of 1 PiB cannot be allocated", 0,
          (size_t)1 << 44, 1.0, 3.0, DMI_ENOMEM},
     };
-    for (size_t i = 0; i < sizeof t / sizeof t[0]; i++) {
-        dmi_solver *sentinel = (dmi_solver *)&t[i]; /* never dereferenced */
-        dmi_solver *s = sentinel;
-        hard_quiet q;
-        int quiet = hard_quiet_begin(&q);
-        int rc = dmi_create_h(t[i].null_out ? NULL : &s, t[i].n, t[i].tau, t[i].h);
-        created(t[i].id, "dmi_create_h", t[i].input, rc, t[i].expect, t[i].null_out, s, sentinel,
-                quiet, hard_quiet_end(&q));
-    }
+    for (size_t i = 0; i < sizeof t / sizeof t[0]; i++)
+        create_case(&t[i], t[i].id, t[i].input, t[i].null_out, t[i].n, t[i].tau, 1, 0, t[i].h,
+                    t[i].expect);
     /* a state loads only into a solver with the same h (N = 41 for all three) */
     dmi_solver *a = NULL, *b = NULL, *c = NULL;
     CU_ASSERT_EQUAL_FATAL(dmi_create_h(&a, 2, 1.0, 1.0 / 40.37), DMI_OK);
