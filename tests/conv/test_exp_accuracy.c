@@ -191,13 +191,8 @@ static void test_n3_box(void)
     CU_ASSERT(run(&m, 100000, 1000000, 1) <= 1e-11);
 }
 
-int main(int argc, char **argv)
-{
-    static const core_test tests[] = {
-        {"n = 1, N = 10^6, 10^6 steps, every kind of term", test_n1_N1e6},
-        {"n = 1, N = 1000, 1.2 10^6 steps (300 anchors)", test_n1_N1000},
-        {"n = 1 at rest (U = 1 by a box), N = 10^6: one slow term, the four terms", test_at_rest},
-        {"n = 3, box, full C_k, D_k, N = 10^5, 10^6 steps", test_n3_box},
-        {NULL, NULL}};
-    return core_main(argc, argv, "conv: RECURSIVE accuracy over 10^6 steps", tests);
-}
+CORE_MAIN("conv: RECURSIVE accuracy over 10^6 steps",
+          {"n = 1, N = 10^6, 10^6 steps, every kind of term", test_n1_N1e6},
+          {"n = 1, N = 1000, 1.2 10^6 steps (300 anchors)", test_n1_N1000},
+          {"n = 1 at rest (U = 1 by a box), N = 10^6: one slow term, the four terms", test_at_rest},
+          {"n = 3, box, full C_k, D_k, N = 10^5, 10^6 steps", test_n3_box})

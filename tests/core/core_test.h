@@ -26,6 +26,15 @@ typedef struct {
  * is the reference directory (../shared/reference). */
 int core_main(int argc, char **argv, const char *suite, const core_test *tests);
 
+/* Defines main: core_main(argc, argv, suite, tests) with the tests given
+ * after suite (each {"name", function}; the {NULL, NULL} end is added). */
+#define CORE_MAIN(suite, ...)                                                  \
+    int main(int argc, char **argv)                                            \
+    {                                                                          \
+        static const core_test core_main_tests[] = {__VA_ARGS__, {NULL, NULL}}; \
+        return core_main(argc, argv, suite, core_main_tests);                  \
+    }
+
 /* The reference directory given on the command line (NULL if none). */
 const char *core_refdir(void);
 

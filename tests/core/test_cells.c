@@ -577,24 +577,19 @@ static void test_declared_exponent_of_a_matrix(void)
     dmi_free(&s);
 }
 
-int main(int argc, char **argv)
-{
-    static const core_test tests[] = {
-        {"s^-alpha (1 + s) to 1e-10, alpha up to 0.99", test_power_cells},
-        {"near cells of s^-alpha (1 + s) to 1e-10", test_power_near_cells},
-        {"an exponent within rounding of 0", test_exponent_near_zero},
-        {"1/s, s^-1.5, 1/(s ln^2 s) refused naming cell 0", test_not_integrable_refused},
-        {"a refused kernel leaves the solver as it was", test_refusal_leaves_solver},
-        {"a jump inside a cell to 1e-10", test_jump_in_cell},
-        {"the kernel called strictly inside the cells", test_calls_inside_cells},
-        {"a kernel near the largest double", test_huge_kernel},
-        {"cells far from 0: a smooth kernel's cost and accuracy", test_far_cells},
-        {"the exponent given by dmi_set_kernel_singularity", test_singularity_hint},
-        {"an exponent close to 1: refused with the way on", test_exponent_close_to_one},
-        {"a singularity inside a cell, 8-digit noise: refused with the way on",
-         test_not_converging_refused},
-        {"a declared exponent checked against H's slope near 0", test_declared_exponent_checked},
-        {"a declared exponent of a matrix kernel", test_declared_exponent_of_a_matrix},
-        {NULL, NULL}};
-    return core_main(argc, argv, "cells", tests);
-}
+CORE_MAIN("cells",
+          {"s^-alpha (1 + s) to 1e-10, alpha up to 0.99", test_power_cells},
+          {"near cells of s^-alpha (1 + s) to 1e-10", test_power_near_cells},
+          {"an exponent within rounding of 0", test_exponent_near_zero},
+          {"1/s, s^-1.5, 1/(s ln^2 s) refused naming cell 0", test_not_integrable_refused},
+          {"a refused kernel leaves the solver as it was", test_refusal_leaves_solver},
+          {"a jump inside a cell to 1e-10", test_jump_in_cell},
+          {"the kernel called strictly inside the cells", test_calls_inside_cells},
+          {"a kernel near the largest double", test_huge_kernel},
+          {"cells far from 0: a smooth kernel's cost and accuracy", test_far_cells},
+          {"the exponent given by dmi_set_kernel_singularity", test_singularity_hint},
+          {"an exponent close to 1: refused with the way on", test_exponent_close_to_one},
+          {"a singularity inside a cell, 8-digit noise: refused with the way on",
+           test_not_converging_refused},
+          {"a declared exponent checked against H's slope near 0", test_declared_exponent_checked},
+          {"a declared exponent of a matrix kernel", test_declared_exponent_of_a_matrix})

@@ -447,18 +447,12 @@ static void test_refused(void)
     CU_ASSERT_EQUAL(dmi_get_N(NULL), 0);
 }
 
-int main(int argc, char **argv)
-{
-    static const core_test tests[] = {
-        {"h = tau / N gives dmi_create's solver bitwise, every method", test_bitwise_dmi_create},
-        {"the step's W is the quadrature with the partial last cell", test_quadrature},
-        {"DIRECT = FFT = RECURSIVE = AUTO to 1e-12, h not in tau / N", test_methods_agree},
-        {"order 1 on Example 4.2 with h not in tau / N", test_order_example42},
-        {"the history is sampled at -k h, k < N, and at -tau", test_history_times},
-        {"the window's oldest row is read by no step", test_oldest_row_unread},
-        {"saved states record h", test_states},
-        {"bad arguments", test_refused},
-        {NULL, NULL},
-    };
-    return core_main(argc, argv, "core: dmi_create_h", tests);
-}
+CORE_MAIN("core: dmi_create_h",
+          {"h = tau / N gives dmi_create's solver bitwise, every method", test_bitwise_dmi_create},
+          {"the step's W is the quadrature with the partial last cell", test_quadrature},
+          {"DIRECT = FFT = RECURSIVE = AUTO to 1e-12, h not in tau / N", test_methods_agree},
+          {"order 1 on Example 4.2 with h not in tau / N", test_order_example42},
+          {"the history is sampled at -k h, k < N, and at -tau", test_history_times},
+          {"the window's oldest row is read by no step", test_oldest_row_unread},
+          {"saved states record h", test_states},
+          {"bad arguments", test_refused})

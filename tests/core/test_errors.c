@@ -468,20 +468,15 @@ static void test_overflow(void)
     expect_overflow(2, 1, DBL_MAX, -DBL_MAX / 2, 1.0, -1);
 }
 
-int main(int argc, char **argv)
-{
-    static const core_test tests[] = {
-        {"dmi_create: invalid n, N, tau and sizes too large", test_create},
-        {"dmi_init: N n^2 kernel samples too large to allocate", test_kernel_too_large},
-        {"every function with a NULL solver", test_null_solver},
-        {"invalid arguments: error, message, solver unchanged", test_invalid_arguments},
-        {"calls in the wrong state: DMI_ESTATE", test_wrong_state},
-        {"dmi_strerror of every code", test_strerror},
-        {"kernel / history callbacks failing in the first dmi_init", test_init_callbacks},
-        {"kernel / history callbacks failing in a second dmi_init", test_reinit_callbacks},
-        {"f / resolvent failing in dmi_step: rollback and retry", test_step_callbacks},
-        {"dmi_advance stops at the first failure", test_advance_stops},
-        {"finite callbacks overflowing inside a step", test_overflow},
-        {NULL, NULL}};
-    return core_main(argc, argv, "core: error paths", tests);
-}
+CORE_MAIN("core: error paths",
+          {"dmi_create: invalid n, N, tau and sizes too large", test_create},
+          {"dmi_init: N n^2 kernel samples too large to allocate", test_kernel_too_large},
+          {"every function with a NULL solver", test_null_solver},
+          {"invalid arguments: error, message, solver unchanged", test_invalid_arguments},
+          {"calls in the wrong state: DMI_ESTATE", test_wrong_state},
+          {"dmi_strerror of every code", test_strerror},
+          {"kernel / history callbacks failing in the first dmi_init", test_init_callbacks},
+          {"kernel / history callbacks failing in a second dmi_init", test_reinit_callbacks},
+          {"f / resolvent failing in dmi_step: rollback and retry", test_step_callbacks},
+          {"dmi_advance stops at the first failure", test_advance_stops},
+          {"finite callbacks overflowing inside a step", test_overflow})

@@ -320,16 +320,11 @@ static void test_near_errors(void)
     dmi_free(&s);
 }
 
-int main(int argc, char **argv)
-{
-    static const core_test tests[] = {
-        {"default and DMI_QUAD_LEFT bitwise the same", test_default_is_left_bitwise},
-        {"cell weights against exact integrals", test_weights_against_integrals},
-        {"every engine, the same sum", test_engines_agree},
-        {"errors", test_errors},
-        {"a failed restart leaves the solver as it was", test_failed_init_leaves_solver},
-        {"near cells of a singular kernel", test_near_cells},
-        {"near cells: errors", test_near_errors},
-        {NULL, NULL}};
-    return core_main(argc, argv, "quad", tests);
-}
+CORE_MAIN("quad",
+          {"default and DMI_QUAD_LEFT bitwise the same", test_default_is_left_bitwise},
+          {"cell weights against exact integrals", test_weights_against_integrals},
+          {"every engine, the same sum", test_engines_agree},
+          {"errors", test_errors},
+          {"a failed restart leaves the solver as it was", test_failed_init_leaves_solver},
+          {"near cells of a singular kernel", test_near_cells},
+          {"near cells: errors", test_near_errors})

@@ -390,20 +390,15 @@ static void test_restart_bytes(void)
     dmi_free(&b);
 }
 
-int main(int argc, char **argv)
-{
-    static const core_test tests[] = {
-        {"two solvers interleaved = each alone", test_interleaved},
-        {"dmi_free sets NULL, accepts NULL", test_free},
-        {"last of set_resolvent / set_friction / set_box wins", test_last_wins},
-        {"setters between steps: nothing stored changes, act from the next step",
-         test_settings_between_steps},
-        {"defaults: nothing set gives U = z(0) exactly", test_defaults},
-        {"user soft-threshold resolvent = built-in friction, bitwise", test_user_friction},
-        {"dmi_time = p * (tau / N) from the counter", test_time},
-        {"history sampled on [-tau, 0] only, z(-tau) at lag N", test_history_domain},
-        {"dmi_init restarts a solver exactly", test_restart},
-        {"after dmi_init a restarted solver saves the bytes of a new one", test_restart_bytes},
-        {NULL, NULL}};
-    return core_main(argc, argv, "core: solver life cycle and settings", tests);
-}
+CORE_MAIN("core: solver life cycle and settings",
+          {"two solvers interleaved = each alone", test_interleaved},
+          {"dmi_free sets NULL, accepts NULL", test_free},
+          {"last of set_resolvent / set_friction / set_box wins", test_last_wins},
+          {"setters between steps: nothing stored changes, act from the next step",
+           test_settings_between_steps},
+          {"defaults: nothing set gives U = z(0) exactly", test_defaults},
+          {"user soft-threshold resolvent = built-in friction, bitwise", test_user_friction},
+          {"dmi_time = p * (tau / N) from the counter", test_time},
+          {"history sampled on [-tau, 0] only, z(-tau) at lag N", test_history_domain},
+          {"dmi_init restarts a solver exactly", test_restart},
+          {"after dmi_init a restarted solver saves the bytes of a new one", test_restart_bytes})

@@ -393,16 +393,11 @@ static void test_layout(void)
     dmi_free(&s);
 }
 
-int main(int argc, char **argv)
-{
-    static const core_test tests[] = {
-        {"save, load elsewhere, replay: bitwise the same run", test_replay},
-        {"replay with the direct, FFT and automatic delay sum, N = 500", test_replay_methods},
-        {"other n/N/tau, truncated, corrupted, bad magic: refused, solver unchanged",
-         test_refused},
-        {"the layout of bytes.h: FNV-1a vectors, the saved bytes at its offsets", test_layout},
-        {"a state of libdmi 1.0 (format version 1) loads and steps on as the saving run",
-         test_version_1},
-        {NULL, NULL}};
-    return core_main(argc, argv, "core: state save and load", tests);
-}
+CORE_MAIN("core: state save and load",
+          {"save, load elsewhere, replay: bitwise the same run", test_replay},
+          {"replay with the direct, FFT and automatic delay sum, N = 500", test_replay_methods},
+          {"other n/N/tau, truncated, corrupted, bad magic: refused, solver unchanged",
+           test_refused},
+          {"the layout of bytes.h: FNV-1a vectors, the saved bytes at its offsets", test_layout},
+          {"a state of libdmi 1.0 (format version 1) loads and steps on as the saving run",
+           test_version_1})

@@ -468,14 +468,9 @@ static void test_failures_and_refusals(void)
     setup_free(&c);
 }
 
-int main(int argc, char **argv)
-{
-    static const core_test tests[] = {
-        {"the plain tangent is the scheme's derivative", test_plain_tangent_is_the_schemes_derivative},
-        {"the saltation follows the equation through reversals", test_saltation_follows_the_equation},
-        {"the history's S sampled from its callbacks", test_sampled_history},
-        {"a resolvent callback against the built-in box", test_resolvent_callback},
-        {"failures leave the solver as it was; refusals", test_failures_and_refusals},
-        {NULL, NULL}};
-    return core_main(argc, argv, "core: the tangent of the scheme", tests);
-}
+CORE_MAIN("core: the tangent of the scheme",
+          {"the plain tangent is the scheme's derivative", test_plain_tangent_is_the_schemes_derivative},
+          {"the saltation follows the equation through reversals", test_saltation_follows_the_equation},
+          {"the history's S sampled from its callbacks", test_sampled_history},
+          {"a resolvent callback against the built-in box", test_resolvent_callback},
+          {"failures leave the solver as it was; refusals", test_failures_and_refusals})

@@ -260,18 +260,13 @@ static void test_refused(void)
     dmi_free(&s);
 }
 
-int main(int argc, char **argv)
-{
-    static const core_test tests[] = {
-        {"the left rule: h H(l h), a partial last cell theta h", test_left_callback},
-        {"an exponential kernel, RECURSIVE: left and cell rule in closed form", test_exponential},
-        {"the cell rule, s^-1/2 (1 + s): the cells' integrals", test_cell_callback},
-        {"near cells: their integrals, the sum's weights beyond, G_near", test_near_cells},
-        {"an n = 2 kernel: row-major", test_matrix_entry},
-        {"the step's W is sum_l G_l U^{p-l} (RECURSIVE with near cells, DIRECT)",
-         test_step_sum},
-        {"a slice of lags", test_slice},
-        {"NULL, no array, lags beyond N, before init: refused", test_refused},
-        {NULL, NULL}};
-    return core_main(argc, argv, "core: the delay sum's weights", tests);
-}
+CORE_MAIN("core: the delay sum's weights",
+          {"the left rule: h H(l h), a partial last cell theta h", test_left_callback},
+          {"an exponential kernel, RECURSIVE: left and cell rule in closed form", test_exponential},
+          {"the cell rule, s^-1/2 (1 + s): the cells' integrals", test_cell_callback},
+          {"near cells: their integrals, the sum's weights beyond, G_near", test_near_cells},
+          {"an n = 2 kernel: row-major", test_matrix_entry},
+          {"the step's W is sum_l G_l U^{p-l} (RECURSIVE with near cells, DIRECT)",
+           test_step_sum},
+          {"a slice of lags", test_slice},
+          {"NULL, no array, lags beyond N, before init: refused", test_refused})
