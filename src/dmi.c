@@ -278,7 +278,7 @@ static int apply_resolvent(dmi_solver *s, const double *x, double *out)
         int rc = s->r(h, x, out, s->r_user);
         if (rc != 0)
             return dmi_fail(s, DMI_ECALLBACK, "dmi_step: resolvent callback returned %d at "
-                                              "t = %.17g", rc, dmi_time(s));
+                                              "t = %.17g", rc, (double)s->p * s->h);
         break;
     }
     case A_FRICTION:

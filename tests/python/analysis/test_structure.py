@@ -498,17 +498,14 @@ def test_driver_contract_is_typed():
 
 
 def test_dispatch_on_the_orbit_class():
-    # no "of" attribute read to tell a scheme's orbit from the equation's in these modules
+    # no "of" attribute read to tell a scheme's orbit from the equation's: the class says which
     t = trees()
-    for mod in ("orbits", "hopf_orbits", "branches.collocated", "continuation.driver",
-                "branches.shooting", "branches.events", "shooting.autonomous"):
+    for mod in t:
         for n in ast.walk(t[mod]):
             if isinstance(n, ast.Call) and _called(n) == "getattr" and len(n.args) >= 2:
                 a = n.args[1]
                 assert not (isinstance(a, ast.Constant) and a.value == "of"), (mod,
                                                                                ast.unparse(n))
-
-
 
 
 def chain(edges: dict[str, set[str]], start: str, within: str) -> list[str]:

@@ -34,7 +34,7 @@ from ..core.model import FD_STEP
 from .mesh import (STEEP, Basis, Kernel, Locator, Near, delay_matrix,
                                history_locator, history_rows, periodic_locator, point_matrix)
 from .signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
-from ..core.newton import ShootingError, newton_loop
+from ..core.newton import Converge, NewtonOptions, Search, ShootingError, newton_loop
 
 #: Quadrature nodes a piece of the delay integral: m + QUAD_EXTRA (exact for H u with u of
 #: degree m and H of degree m + 2 QUAD_EXTRA - 1 on the piece; the error h^(2m + 2 QUAD_EXTRA + 1)
@@ -638,11 +638,11 @@ def solve(lay: Layout, terms: Terms, x0: np.ndarray, ref: Callable | None, *,
         lu = _factor(lay, terms, x, ref, what, res)
         return lambda r: lu.solve(-r)
 
-    return newton_loop(evaluate, factor, x0, tol=tol, max_iter=max_iter, what=what,
-                       converge="correction", chord=0.1, search="descent", reject=(Degenerate,),
-                       reject_why=reject_why(lay), history=res,
-                       stall=False, floor=FLOOR_ITERATIONS if accuracy is not None else 0,
-                       accuracy=accuracy)
+    options = NewtonOptions(tol=tol, max_iter=max_iter, converge=Converge.CORRECTION, chord=0.1,
+                            search=Search.DESCENT, reject=(Degenerate,),
+                            reject_why=reject_why(lay), stall=False,
+                            floor=FLOOR_ITERATIONS if accuracy is not None else 0)
+    return newton_loop(evaluate, factor, x0, options, what=what, history=res, accuracy=accuracy)
 
 
 def reject_why(lay: Layout) -> str:

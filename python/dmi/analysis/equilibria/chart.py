@@ -19,7 +19,7 @@ import scipy.optimize
 from ..._solver import Solver
 from ..core.model import Linearisation, call_make, equilibrium
 from ..scheme.floquet import StabilityWarning
-from ..continuation.driver import continuation
+from ..continuation.driver import ContinuationOptions, continuation
 from ..core.newton import ShootingError
 from .curves import CurvePoint, curve_of, not_a_start, system
 from .root_verdict import RootVerdict, roots_verdict
@@ -196,9 +196,9 @@ def _leg(make2: Callable, p0: float, q0: float, q_end: float, omega0: float, u_e
                       make2, q0, tol=0.1 * TRACE_TOL, given=given, of=of, lin_tol=tol,
                       tests=False)
     try:   # the first step a row's spacing (the points between rows are not kept)
-        b = continuation(disc, x0, q0, q_end, step=abs(q_end - q0) / (len(inside) + 1),
-                         at=inside, tol=0.1 * TRACE_TOL, max_iter=10, predictor="tangent",
-                         easy=4, make=make2, kind=disc.kind)
+        options = ContinuationOptions(step=abs(q_end - q0) / (len(inside) + 1), at=tuple(inside),
+                                      tol=0.1 * TRACE_TOL, max_iter=10, easy=4)
+        b = continuation(disc, x0, q0, q_end, options, make=make2, kind=disc.kind)
     except ShootingError as e:
         raise not_a_start(disc, x0, q0, 0.1 * TRACE_TOL, e) from None
     curve = curve_of(b, disc, omega0)

@@ -55,7 +55,7 @@ import numpy as np
 from ..._errors import Error
 from ..._solver import Solver
 from ..continuation.branch import ON_AXIS, REAL, Event, HopfPoint
-from ..continuation.driver import continuation
+from ..continuation.driver import ContinuationOptions, continuation
 from ..core.model import Linearisation, call_make, equation_step
 from ..core.newton import ShootingError
 from .equation import Characteristic, RefinementWarning
@@ -559,9 +559,10 @@ def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: floa
         raise ValueError(f"continue_curve: step = {step!r}: must be finite and > 0")
     disc, x0 = system(kind, p0, u0, omega0, make2, q0, tol=tol, count=count)
     try:
-        b = continuation(disc, x0, q0, q_end, step=float(step), min_step=min_step,
-                         max_step=max_step, max_points=max_points, at=at, tol=tol,
-                         max_iter=10, predictor="tangent", easy=4, make=make2, kind=kind)
+        options = ContinuationOptions(step=float(step), min_step=min_step, max_step=max_step,
+                                      max_points=max_points, at=tuple(at), tol=tol, max_iter=10,
+                                      easy=4)
+        b = continuation(disc, x0, q0, q_end, options, make=make2, kind=kind)
     except ShootingError as e:
         raise not_a_start(disc, x0, q0, tol, e) from None
     return curve_of(b, disc, omega0)

@@ -37,9 +37,9 @@ import numpy as np
 
 from ..._errors import Error
 from ..continuation.branch import ON_AXIS, REAL, Branch, HopfPoint
-from ..continuation.driver import Curve, continuation, newton_corrector
+from ..continuation.driver import ContinuationOptions, Curve, continuation, newton_corrector
 from ..core.model import KinkError, call_make, equation_step
-from ..core.newton import ShootingError
+from ..core.newton import NewtonOptions, ShootingError
 from ..scheme.floquet import StabilityWarning
 from ..scheme.problem import Problem
 from ..scheme.stepmap import Model
@@ -369,8 +369,9 @@ def equilibrium(make: Model, p: float, guess: Any, *, tol: float = 1e-10, count:
     disc = Equilibria(make, of, count, tol)
     n = disc.step(p).n
     u0 = _check_guess(guess, n)
-    z, its = newton_corrector(Curve(disc, n), np.concatenate([u0, [p]]), _e_p(n), p, tol=tol,
-                              max_iter=max_iter, far=math.inf, what=f"equilibrium at p = {p!r}")
+    z, its = newton_corrector(Curve(disc, n), np.concatenate([u0, [p]]), _e_p(n), p,
+                              NewtonOptions(tol=tol, max_iter=max_iter), far=math.inf,
+                              what=f"equilibrium at p = {p!r}")
     u = z[:-1]
     if not verify and count >= 1:
         _unverified_warning("equilibrium")
@@ -456,10 +457,10 @@ def continue_equilibrium(eq: Equilibrium, p_end: float, step: float = 0.05, *,
     if not verify and count >= 1:
         _unverified_warning("continue_equilibrium")
     disc = Equilibria(eq.make, eq.of, count, tol)
-    b = continuation(disc, eq.u, eq.p, float(p_end), step=step, min_step=min_step,
-                     max_step=max_step, max_points=max_points, at=at, tol=tol,
-                     max_iter=max_iter, predictor="tangent", easy=max_iter, make=eq.make,
-                     kind="equilibria")
+    options = ContinuationOptions(step=step, min_step=min_step, max_step=max_step,
+                                  max_points=max_points, at=tuple(at), tol=tol,
+                                  max_iter=max_iter, easy=max_iter)
+    b = continuation(disc, eq.u, eq.p, float(p_end), options, make=eq.make, kind="equilibria")
     for q in b.points:
         disc.verdict(q, verify)
     open_ = [q for q in b.points if q.stable is None]

@@ -596,11 +596,11 @@ def floquet_multipliers(F: PeriodMap, x: np.ndarray, count: int = 10, *,
     ValueError
         x is not a fixed point of F (the residual is given), count < 1.
     TypeError
-        An EquationOrbit (it carries its multipliers).
+        F not a map (an EquationOrbit carries its multipliers).
     """
-    if getattr(F, "of", "scheme") == "equation":
-        raise TypeError("floquet_multipliers: an EquationOrbit (collocate) carries its own "
-                        ".multipliers; this takes a StepMap of the scheme")
+    if not callable(F):
+        raise TypeError(f"floquet_multipliers: a {type(F).__name__}: this takes a StepMap of the "
+                        "scheme (an EquationOrbit, from collocate, carries its own .multipliers)")
     opts = Verify(periods=0) if verify is None else verify
     fl = floquet_verdict(F, x, count, autonomous=autonomous, eps=eps, central=central, verify=opts)
     bad = np.flatnonzero(~np.isfinite(fl.errors[:count]))

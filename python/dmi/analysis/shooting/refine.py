@@ -172,14 +172,14 @@ def refine_orbit(orbit: Orbit, *, levels: int = 3, tol: float = 1e-10) -> Refine
     ValueError
         levels < 3, or a model that does not take h.
     TypeError
-        An EquationOrbit (it is the equation's already).
+        Not an Orbit of the scheme (an EquationOrbit is the equation's already).
     ShootingError
         A level's shooting fails (the message says when the orbit is not isolated at fixed p:
         a multiplier at 1 besides the phase's, as on a vertical branch).
     """
-    if getattr(orbit, "of", "scheme") == "equation":
-        raise TypeError("refine_orbit: an EquationOrbit (collocate) is the equation's "
-                        "already; refine_orbit takes an Orbit of the scheme")
+    if not isinstance(orbit, Orbit):
+        raise TypeError(f"refine_orbit: a {type(orbit).__name__}: refine_orbit takes an Orbit of "
+                        "the scheme (an EquationOrbit, from collocate, is the equation's already)")
     if int(levels) != levels or levels < 3:
         raise ValueError(f"levels = {levels!r}: give 3 or more (M, 2 M, 4 M, ...)")
     count = int(orbit.multipliers.size)
