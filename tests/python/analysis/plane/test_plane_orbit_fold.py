@@ -150,16 +150,16 @@ def test_the_curve_ends_at_the_bautin_point(branch, fold):
 
 
 def test_refusals(branch, fold):
-    with pytest.raises(ValueError, match=r"a fold event needs branch="):
+    with pytest.raises(ValueError, match=r"a fold event needs branch="):   # bad-inputs OC01
         continue_orbit_curve(fold, make2, Q0, 1.5)
-    with pytest.raises(ValueError, match=r"give a 'fold' event of a branch of EquationOrbits"):
+    with pytest.raises(ValueError, match=r"give a 'fold' event of a branch of "):   # OC02
         continue_orbit_curve(Event("torus", fold.p, fold.index), make2, Q0, 1.5, branch=branch)
-    with pytest.raises(ValueError, match=r"not one of branch.events"):
+    with pytest.raises(ValueError, match=r"not one of branch.events"):   # bad-inputs OC03
         continue_orbit_curve(Event("fold", fold.p, fold.index), make2, Q0, 1.5, branch=branch)
-    with pytest.raises(ValueError, match=r"give two different finite values"):
+    with pytest.raises(ValueError, match=r"give two different finite values"):   # OC04
         continue_orbit_curve(fold, make2, Q0, Q0, branch=branch)
-    with pytest.raises(ValueError, match=r"step = -0.1: must be finite and > 0"):
+    with pytest.raises(ValueError, match=r"step = -0.1: must be finite and > 0"):   # OC05
         continue_orbit_curve(fold, make2, Q0, 1.5, branch=branch, step=-0.1)
     # make2 at q0 is not the branch's model: the fold is elsewhere
-    with pytest.raises(ValueError, match=r"make2\(\., q0 = 1.2\)"):
+    with pytest.raises(ValueError, match=r"make2\(\., q0 = 1.2\)"):   # bad-inputs OC06
         continue_orbit_curve(fold, make2, 1.2, 1.5, branch=branch)
