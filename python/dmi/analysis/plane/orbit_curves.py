@@ -268,15 +268,15 @@ class OrbitFold:
                 ) -> tuple[np.ndarray, float, int]:
         """The driver's Newton corrector, then the orbit's inequalities checked: an orbit that
         breaks its signature is refused (the curve does not cross signatures yet)."""
+        if math.isfinite(far) and _turned_small(self._track):   # no step past a Bautin point
+            self.breach = ("the curve turned back in q where its orbits shrink to the "
+                           "equilibrium (a Bautin point)")
+            raise ShootingError(self.breach, [])
         z, its = newton_corrector(DriverCurve(self, y.size), np.concatenate([y, [q]]), row,
                                   target, tol=self.tol, max_iter=self.max_iter, far=far,
                                   what=f"the orbits' fold near q = {q!r}")
         yz, qz = z[:-1], float(z[-1])
         x, p = yz[:-1], float(yz[-1])
-        if math.isfinite(far) and _turned_small(self._track):
-            self.breach = ("the curve turned back in q where its orbits shrink to the "
-                           "equilibrium (a Bautin point)")
-            raise ShootingError(self.breach, [])
         bad = check_inequalities(self.lay, self.terms(p, qz), x,
                                  1e-9 * max(1.0, float(np.max(np.abs(x)))))
         if bad:
@@ -349,11 +349,9 @@ class OrbitFold:
         return Solved(lay, self.terms(pc, q), yc[:-1], self.count), pc
 
     def corner(self, points: list[OrbitCurvePoint]) -> str:
-        """Why the curve could not go on: the signature it would leave, or the orbits shrinking
-        towards an equilibrium (a Bautin point), else ""."""
-        if self.breach:
-            return self.breach
-        return shrinking(points)
+        """Why the curve could not go on: the signature its orbits would leave, or its turn
+        where they shrink to the equilibrium (a Bautin point), else ""."""
+        return self.breach
 
 
 def _null_pair(J: Any, border: np.ndarray, row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -393,25 +391,6 @@ def _others_stable(mu: np.ndarray, err: Any, autonomous: bool, p: float, q: floa
                   "estimated error of the unit circle: the verdict is None",
                   CollocationWarning, stacklevel=3)
     return None
-
-
-def shrinking(points: list[OrbitCurvePoint]) -> str:
-    """Where the orbits' amplitude extrapolates to 0 (linearly in its square against q over the
-    last two points: near a Bautin point the fold's orbits have amplitude^2 ~ |q - q_B|), when
-    the last amplitude is below a tenth of the first's; else ""."""
-    if len(points) < 2:
-        return ""
-    a0 = float(np.max(points[0].orbit.amplitude))
-    a = [float(np.max(pt.orbit.amplitude)) for pt in points[-2:]]
-    if not a[-1] < 0.1 * a0:
-        return ""
-    (pa, qa), (pb, qb) = [(pt.p, pt.q) for pt in points[-2:]]
-    s = a[1] ** 2 / (a[0] ** 2 - a[1] ** 2) if a[0] != a[1] else math.inf
-    if not math.isfinite(s) or s < 0:
-        return ""
-    return (f"the fold's orbits shrink towards an equilibrium: their amplitude {a[-1]:.3g} "
-            f"(from {a0:.3g}) extrapolates to 0 near (p, q) = ({pb + s * (pb - pa):.8g}, "
-            f"{qb + s * (qb - qa):.8g}), a Bautin point of the Hopf curve (locate it there)")
 
 
 def _turned_small(track: list[tuple[float, float]]) -> bool:

@@ -149,6 +149,15 @@ def test_the_curve_ends_at_the_bautin_point(branch, fold):
         assert abs(pt.p - fold_closed_form(pt.q)[0]) <= 1e-9
 
 
+def test_a_start_from_an_orbit_near_the_fold(branch, fold):
+    near = branch.points[fold.index]            # the first orbit past the fold
+    assert abs(near.p - fold.p) > 1e-6
+    c = continue_orbit_curve(near, make2, Q0, 1.2, step=0.1)
+    assert c.status == "reached q_end = 1.2"
+    for pt in c.points:
+        assert abs(pt.p - fold_closed_form(pt.q)[0]) <= 1e-9
+
+
 def test_refusals(branch, fold):
     with pytest.raises(ValueError, match=r"a fold event needs branch="):   # bad-inputs OC01
         continue_orbit_curve(fold, make2, Q0, 1.5)
