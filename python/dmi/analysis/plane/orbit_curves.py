@@ -161,6 +161,7 @@ class OrbitFold:
         self._last: tuple | None = None     # (key, evaluation) of the last y evaluated
         self.b: np.ndarray | None = None
         self.c: np.ndarray | None = None
+        self.gscale = 1.0   # g's unit: 1 / its gradient's largest entry at the start
         self.breach = ""                    # why the last correction was refused (a signature)
         self._track: list[tuple[float, float]] = []   # (q, amplitude) of the points stepped to
 
@@ -189,10 +190,14 @@ class OrbitFold:
         v, w = _null_pair(J, Fp, one)
         self.c, self.b = v / np.linalg.norm(v), w / np.linalg.norm(w)
         self._last = None
+        self.gscale = 1.0
+        row = self._jy(np.concatenate([x, [p]]), q)[0][-1, :].toarray().ravel()
+        self.gscale = 1.0 / max(float(np.max(np.abs(row))), 1e-300)
+        self._last = None
 
     def _eval(self, y: np.ndarray, q: float) -> dict[str, Any]:
         """F, J, v, w and g at (y, q) (the last kept)."""
-        key = (y.tobytes(), float(q), id(self.lay), id(self.b))
+        key = (y.tobytes(), float(q), id(self.lay), id(self.b), self.gscale)
         if self._last is not None and self._last[0] == key:
             return self._last[1]
         x, p = y[:-1], float(y[-1])
@@ -211,7 +216,8 @@ class OrbitFold:
         if not (np.all(np.isfinite(vg)) and np.all(np.isfinite(wh))):
             raise ShootingError("the fold's bordered matrix is singular (non-finite solution)",
                                 [])
-        ev = {"r": r, "J": J, "v": vg[:-1], "g": float(vg[-1]), "w": wh[:-1], "terms": t}
+        ev = {"r": r, "J": J, "v": vg[:-1], "g": float(vg[-1]) * self.gscale, "w": wh[:-1],
+              "terms": t}
         self._last = (key, ev)
         return ev
 
@@ -227,11 +233,11 @@ class OrbitFold:
         J, v, w, t = ev["J"], ev["v"], ev["w"], ev["terms"]
         eps = DIFF * max(1.0, float(np.max(np.abs(x)))) / max(float(np.max(np.abs(v))), 1e-300)
         J1 = full_jacobian(self.lay, t, x + eps * v, self.ref)[1]
-        gx = -(J1.T @ w - J.T @ w) / eps
+        gx = -self.gscale * (J1.T @ w - J.T @ w) / eps
         d = DIFF * max(1.0, abs(p))
         rp, Jp = full_jacobian(self.lay, self.terms(p + d, q), x, self.ref)
         Fp = (rp - ev["r"]) / d
-        gp = -float(w @ (Jp @ v - J @ v)) / d
+        gp = -self.gscale * float(w @ (Jp @ v - J @ v)) / d
         Jy = sp.bmat([[J, sp.csc_matrix(Fp[:, None])],
                       [sp.csc_matrix(gx[None, :]), sp.csc_matrix([[gp]])]], format="csc")
         return Jy, ev
@@ -243,7 +249,7 @@ class OrbitFold:
         d = DIFF * max(1.0, abs(q))
         rq, Jq = full_jacobian(self.lay, self.terms(p, q + d), x, self.ref)
         Fq = (rq - ev["r"]) / d
-        gq = -float(ev["w"] @ (Jq @ ev["v"] - ev["J"] @ ev["v"])) / d
+        gq = -self.gscale * float(ev["w"] @ (Jq @ ev["v"] - ev["J"] @ ev["v"])) / d
         return Jy, np.concatenate([Fq, [gq]])
 
     def solve_at(self, y0: np.ndarray, q: float, what: str) -> np.ndarray:
@@ -443,10 +449,10 @@ def _start_orbit(start: Any, branch: Branch | None) -> tuple[EquationOrbit, np.n
         before, after = pts[k - 1], pts[k]
         orbit = before if abs(before.p - start.p) <= abs(after.p - start.p) else after
         u = None
-        if start.u is not None and np.size(start.u) == before.nodes.size + before.switches.size \
-                + int(before.autonomous):
+        if start.u is not None and np.size(start.u) == after.nodes.size + after.switches.size \
+                + int(after.autonomous):   # located on the layout of the point after it
             u = np.array(start.u, dtype=float)
-            orbit = before
+            orbit = after
         return orbit, u, float(start.p)
     raise ValueError(f"continue_orbit_curve: start = {start!r}: give a 'fold' event of a branch "
                      "of EquationOrbits (with branch=) or an EquationOrbit near a fold")
@@ -457,7 +463,7 @@ def continue_orbit_curve(start: Any, make2: Callable[[float, float], Solver], q0
                          step: float | None = None, at: Iterable[float] = (),
                          max_points: int = 100, min_step: float | None = None,
                          max_step: float | None = None, multipliers: int = 10,
-                         tol: float = 1e-12, max_iter: int = 10, estimate: bool = True
+                         tol: float = 1e-10, max_iter: int = 10, estimate: bool = True
                          ) -> Curve:
     """Continues a fold of the equation's periodic orbits (collocated) in the plane (p, q).
 

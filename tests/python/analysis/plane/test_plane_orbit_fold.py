@@ -9,7 +9,10 @@
 #   D(lam) = [[lam - A + g(lam + i Om), -B], [-B, lam - conj(A) + g(lam - i Om)]],
 #   A = mu + i (W0 - Om) + 2 q r^2 + 3 C2 r^4,  B = q r^2 + 2 C2 r^4,
 # and the verdict is checked by counting the zeros of det D with Re lam > 0 (argument principle).
-# Also the refusals.
+# A forced orbit too: the hardening Duffing oscillator x'' + c x' + x + x^3 = F cos(1.4 t), its
+# resonance's fold in F continued in c, against the fold solved in the test by shooting with
+# scipy's integrator (x(P) = x(0) and det(M - I) = 0, M the monodromy matrix), and against
+# harmonic balance.  Also the refusals.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -18,6 +21,9 @@ import math
 import numpy as np
 import pytest
 import scipy.optimize as so
+from scipy.integrate import solve_ivp
+
+import dmi
 
 from dmi import analysis as da
 from dmi.analysis.continuation.branch import Event
@@ -172,3 +178,56 @@ def test_refusals(branch, fold):
     # make2 at q0 is not the branch's model: the fold is elsewhere
     with pytest.raises(ValueError, match=r"make2\(\., q0 = 1.2\)"):   # bad-inputs OC06
         continue_orbit_curve(fold, make2, 1.2, 1.5, branch=branch)
+
+
+DW = 1.4                      # the Duffing oscillator's forcing frequency
+DP = 2 * math.pi / DW
+
+
+def duffing2(F: float, c: float):
+    s = dmi.Solver(2, 1.0, h=DP / 400)
+    s.set_rhs(lambda t, u: -np.array([u[1], -c * u[1] - u[0] - u[0] ** 3 + F * math.cos(DW * t)]))
+    return s
+
+
+def duffing_fold(c: float, guess: np.ndarray) -> float:
+    """F at the fold: (x(0), F) with x(P) = x(0) and det(M - I) = 0, by scipy's DOP853."""
+    def flow(x0, F):
+        def rhs(t, z):
+            A = np.array([[0.0, 1.0], [-1 - 3 * z[0] ** 2, -c]])
+            return np.concatenate([[z[1], -c * z[1] - z[0] - z[0] ** 3 + F * math.cos(DW * t)],
+                                   (A @ z[2:].reshape(2, 2)).ravel()])
+        s = solve_ivp(rhs, (0, DP), np.concatenate([x0, np.eye(2).ravel()]), method="DOP853",
+                      rtol=1e-13, atol=1e-13)
+        return s.y[:2, -1], s.y[2:, -1].reshape(2, 2)
+
+    def eqs(z):
+        xe, M = flow(z[:2], z[2])
+        return np.concatenate([xe - z[:2], [np.linalg.det(M - np.eye(2))]])
+    z = so.fsolve(eqs, guess, xtol=1e-12)
+    assert np.max(np.abs(eqs(z))) < 1e-11
+    return float(z[2])
+
+
+def harmonic_balance_fold(c: float) -> float:
+    """The smaller F where x = a cos(W t - phi) folds: F^2 = s ((K + k s)^2 + c^2 W^2), s = a^2,
+    K = 1 - W^2, k = 3/4, d F^2 / d s = 0 at the larger root s."""
+    K, k = 1 - DW ** 2, 0.75
+    s = (-4 * k * K + math.sqrt(16 * k * k * K * K - 12 * k * k * (K * K + c * c * DW * DW))) \
+        / (6 * k * k)
+    return math.sqrt(s * ((K + k * s) ** 2 + c * c * DW * DW))
+
+
+def test_a_forced_orbits_fold_curve_against_shooting():
+    make = lambda F: duffing2(F, 0.1)   # noqa: E731
+    o = da.periodic_orbit(make, 0.3, DP, np.array([1.5, 0.0]), steps=400, multipliers=4)
+    b = da.continue_orbit(da.collocate(o, multipliers=6, intervals=40), 0.0, step=0.02)
+    (f,) = [e for e in b.events if e.kind == "fold"]
+    c = continue_orbit_curve(f, duffing2, 0.1, 0.2, branch=b, step=0.02)
+    assert c.status == "reached q_end = 0.2" and c.points[-1].q == 0.2
+    for pt in (c.points[0], c.points[len(c.points) // 2], c.points[-1]):
+        assert not pt.orbit.autonomous and pt.orbit.period == DP
+        ref = duffing_fold(pt.q, np.concatenate([pt.orbit.u_at(0.0), [pt.p]]))
+        assert abs(pt.p - ref) <= 1e-8                      # measured 2e-14
+        assert abs(pt.p - ref) <= pt.p_error
+        assert abs(pt.p - harmonic_balance_fold(pt.q)) <= 0.01 * pt.p
