@@ -15,7 +15,8 @@ equation is g(x, p; q) = 0, g from the bordered system
 
     [[J, b], [c', 0]] (v, g) = (0, 1),     [[J', c], [b', 0]] (w, h) = (0, 1),
 
-one sparse LU for both.  g = 0 where J is singular: there the orbit's branch in p at fixed q has
+one sparse LU for both (g in units of its gradient's largest entry at the start: its rounding is
+then comparable to F's).  g = 0 where J is singular: there the orbit's branch in p at fixed q has
 dp/ds = 0, a fold.  g's derivatives are -w' J_alpha v: along x the row w' (J(x + eps v) - J(x))
 / eps (one more assembly of J), along p and q the differences of J v; they only steer Newton
 (the curve's points solve F = 0, g = 0 to the corrector's tolerance).  The borders start from
