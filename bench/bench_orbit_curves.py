@@ -7,7 +7,8 @@
 # the same q (no event), and the fold curve from q = 1 to 2; degree 4, 24 intervals, 10
 # multipliers a point with their error estimates on every curve.  CPU time of the process a point
 # (time.process_time), the fastest of the rounds.
-# Usage: bench/bench_orbit_curves.py [--rounds R]   (needs dmi importable: PYTHONPATH=<build>/python)
+# Usage: bench/bench_orbit_curves.py [--rounds R]
+#        (needs dmi importable: PYTHONPATH=<build>/python)
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
