@@ -42,19 +42,18 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as sla
 
 from ..._solver import Solver
-from ..collocation.collocate import (FLOOR, CollocationWarning, Solved, _errors, _reference,
-                                     adapted, check_inequalities, equation_orbit, merged,
-                                     transfer)
-from ..collocation.orbit import EquationOrbit
-from ..collocation.system import Layout, Terms, full_jacobian
+from ..collocation.adapt import FLOOR, Solved, adapted, merged, transfer
+from ..collocation.adapt import estimate as level_errors
+from ..collocation.floquet import multipliers as floquet
+from ..collocation.mend import check_inequalities
+from ..collocation.orbit import EquationOrbit, equation_orbit
+from ..collocation.system import CollocationWarning, Layout, Terms, full_jacobian, reference
 from ..continuation.branch import Branch, Event
 from ..continuation.driver import Curve as DriverCurve
 from ..continuation.driver import continuation, newton_corrector
-from ..core.newton import ShootingError, newton_loop
+from ..core.newton import ShootingError, bordered_solve, newton_loop, sparse_bordered
 from ..equilibria.curves import Curve, CurveEvent
 from ..scheme.problem import Problem
 from ..scheme.stepmap import build
@@ -155,7 +154,7 @@ class OrbitFold:
                  *, jumps: tuple[float, ...] = (), multipliers: int = 10, tol: float = 1e-12,
                  max_iter: int = 10, estimate: bool = True):
         self.make2, self.lay, self.jumps = make2, layout, tuple(jumps)
-        self.ref = _reference(layout, x) if layout.autonomous else None
+        self.ref = reference(layout, x) if layout.autonomous else None
         self.count, self.tol, self.max_iter = int(multipliers), float(tol), int(max_iter)
         self.estimate = bool(estimate)
         self.problem = Problem(make2, keep=KEEP)   # the terms of the last few (p, q)
@@ -192,7 +191,7 @@ class OrbitFold:
         self.c, self.b = v / np.linalg.norm(v), w / np.linalg.norm(w)
         self._last = None
         self.gscale = 1.0
-        row = self._jy(np.concatenate([x, [p]]), q)[0][-1, :].toarray().ravel()
+        row = self._jy(np.concatenate([x, [p]]), q)[2]
         self.gscale = 1.0 / max(float(np.max(np.abs(row))), 1e-300)
         self._last = None
 
@@ -204,19 +203,7 @@ class OrbitFold:
         x, p = y[:-1], float(y[-1])
         t = self.terms(p, q)
         r, J = full_jacobian(self.lay, t, x, self.ref)
-        M = sp.bmat([[J, sp.csc_matrix(self.b[:, None])], [sp.csc_matrix(self.c[None, :]), None]],
-                    format="csc")
-        try:
-            lu = sla.splu(M)
-        except RuntimeError as e:
-            raise ShootingError(f"the fold's bordered matrix is singular ({e})", []) from None
-        e1 = np.zeros(x.size + 1)
-        e1[-1] = 1.0
-        vg = lu.solve(e1)
-        wh = lu.solve(e1, trans="T")
-        if not (np.all(np.isfinite(vg)) and np.all(np.isfinite(wh))):
-            raise ShootingError("the fold's bordered matrix is singular (non-finite solution)",
-                                [])
+        vg, wh = _pair(J, self.b, self.c)
         ev = {"r": r, "J": J, "v": vg[:-1], "g": float(vg[-1]) * self.gscale, "w": wh[:-1],
               "terms": t}
         self._last = (key, ev)
@@ -227,8 +214,8 @@ class OrbitFold:
         ev = self._eval(y, q)
         return np.concatenate([ev["r"], [ev["g"]]])
 
-    def _jy(self, y: np.ndarray, q: float) -> tuple[Any, dict[str, Any]]:
-        """[[J, F_p], [g_x, g_p]] (sparse) and the evaluation at (y, q)."""
+    def _jy(self, y: np.ndarray, q: float) -> tuple[Any, np.ndarray, np.ndarray, dict]:
+        """(J, F_p, (g_x, g_p), the evaluation) at (y, q): the blocks of the Jacobian in y."""
         ev = self._eval(y, q)
         x, p = y[:-1], float(y[-1])
         J, v, w, t = ev["J"], ev["v"], ev["w"], ev["terms"]
@@ -239,19 +226,17 @@ class OrbitFold:
         rp, Jp = full_jacobian(self.lay, self.terms(p + d, q), x, self.ref)
         Fp = (rp - ev["r"]) / d
         gp = -self.gscale * float(w @ (Jp @ v - J @ v)) / d
-        Jy = sp.bmat([[J, sp.csc_matrix(Fp[:, None])],
-                      [sp.csc_matrix(gx[None, :]), sp.csc_matrix([[gp]])]], format="csc")
-        return Jy, ev
+        return J, Fp, np.append(gx, gp), ev
 
     def jacobian(self, y: np.ndarray, q: float) -> tuple[Any, np.ndarray]:
         """(J_y sparse, J_q): the driver's Jacobian in the unknowns y and in its parameter q."""
-        Jy, ev = self._jy(y, q)
+        J, Fp, grow, ev = self._jy(y, q)
         x, p = y[:-1], float(y[-1])
         d = DIFF * max(1.0, abs(q))
         rq, Jq = full_jacobian(self.lay, self.terms(p, q + d), x, self.ref)
         Fq = (rq - ev["r"]) / d
         gq = -self.gscale * float(ev["w"] @ (Jq @ ev["v"] - ev["J"] @ ev["v"])) / d
-        return Jy, np.concatenate([Fq, [gq]])
+        return sparse_bordered(J, Fp, grow), np.concatenate([Fq, [gq]])
 
     def solve_at(self, y0: np.ndarray, q: float, what: str) -> np.ndarray:
         """The fold at fixed q from y0 (Newton on (F, g) in (x, p), sparse LU)."""
@@ -259,12 +244,8 @@ class OrbitFold:
             return self.residual(y, q), None
 
         def factor(y: np.ndarray, r: np.ndarray, _: None) -> Callable[[np.ndarray], np.ndarray]:
-            Jy, _ = self._jy(y, q)
-            try:
-                lu = sla.splu(Jy)
-            except RuntimeError as e:
-                raise ShootingError(f"{what}: singular Jacobian ({e})", []) from None
-            return lambda rr: lu.solve(-rr)
+            J, Fp, grow, _ = self._jy(y, q)
+            return lambda rr: bordered_solve(J, Fp, grow, -rr)
 
         y, _ = newton_loop(evaluate, factor, np.array(y0, dtype=float), tol=self.tol,
                            max_iter=3 * self.max_iter, what=what, converge="correction",
@@ -306,7 +287,7 @@ class OrbitFold:
         x = transfer(self.lay, x, new)
         self.lay = new
         if new.autonomous:
-            self.ref = _reference(new, x)
+            self.ref = reference(new, x)
         self._last = None
         return np.concatenate([x, [p]])
 
@@ -315,14 +296,14 @@ class OrbitFold:
         verdict on the other multipliers."""
         x, p = y[:-1], float(y[-1])
         t = self.terms(p, q)
-        fine = Solved(self.lay, t, x, self.count)
+        fine = self._solved(self.lay, t, x)
         errors: dict[str, Any] = {}
         p_error = None
         if self.estimate:
             got = self._coarse(y, q)
             if got is not None:
                 coarse, pc = got
-                errors = _errors(coarse, fine)
+                errors = level_errors(coarse, fine)
                 p_error = max(abs(pc - p), FLOOR * max(1.0, abs(p)))
                 errors["p"] = p_error
         with warnings.catch_warnings():   # a fold's multiplier at 1: the orbit's stable is None
@@ -332,6 +313,10 @@ class OrbitFold:
         return OrbitCurvePoint(p, float(q), orbit, p_error,
                                _others_stable(fine.mu, errors.get("multipliers"),
                                               self.lay.autonomous, p, q))
+
+    def _solved(self, lay: Layout, terms: Terms, x: np.ndarray) -> Solved:
+        """x on lay with its amplitudes and leading multipliers."""
+        return Solved(lay, x, floquet(lay, terms, x, self.count) if self.count > 0 else None)
 
     def _coarse(self, y: np.ndarray, q: float) -> tuple[Solved, float] | None:
         """The fold at q on the mesh of merged pairs of intervals (and its p); None, with a
@@ -353,7 +338,7 @@ class OrbitFold:
                           stacklevel=3)
             return None
         pc = float(yc[-1])
-        return Solved(lay, self.terms(pc, q), yc[:-1], self.count), pc
+        return self._solved(lay, self.terms(pc, q), yc[:-1]), pc
 
     def corner(self, points: list[OrbitCurvePoint]) -> str:
         """Why the curve could not go on: the signature its orbits would leave, or its turn
@@ -361,21 +346,21 @@ class OrbitFold:
         return self.breach
 
 
+def _pair(J: Any, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(v, g) of [[J, b], [c', 0]] (v, g) = (0, 1) and (w, h) of its transpose."""
+    e1 = np.zeros(c.size + 1)
+    e1[-1] = 1.0
+    try:
+        return (bordered_solve(J, b, np.append(c, 0.0), e1),
+                bordered_solve(J.T.tocsc(), c, np.append(b, 0.0), e1))
+    except ShootingError as e:
+        raise ShootingError(f"the fold's bordered matrix is singular: {e}", []) from None
+
+
 def _null_pair(J: Any, border: np.ndarray, row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """v and w of [[J, border], [row', 0]] (v, .) = (0, 1) and its transpose (w, .) = (0, 1)."""
-    M = sp.bmat([[J, sp.csc_matrix(border[:, None])], [sp.csc_matrix(row[None, :]), None]],
-                format="csc")
-    try:
-        lu = sla.splu(M)
-    except RuntimeError as e:
-        raise ShootingError(f"the fold's start: the bordered Jacobian is singular ({e}): not a "
-                            "simple fold", []) from None
-    e1 = np.zeros(row.size + 1)
-    e1[-1] = 1.0
-    v, w = lu.solve(e1)[:-1], lu.solve(e1, trans="T")[:-1]
-    if not (np.all(np.isfinite(v)) and np.all(np.isfinite(w))):
-        raise ShootingError("the fold's start: the bordered Jacobian is singular", [])
-    return v, w
+    vg, wh = _pair(J, border, row)
+    return vg[:-1], wh[:-1]
 
 
 def _others_stable(mu: np.ndarray, err: Any, autonomous: bool, p: float, q: float
