@@ -1,0 +1,574 @@
+# Curves of the bifurcations of the equation's periodic orbits in two parameters: the fold of
+# collocated orbits continued in (p, q) by a minimally augmented system on the one driver.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""The fold of collocated orbits (limit point of cycles) continued in the plane (p, q):
+:func:`continue_orbit_curve`, its points :class:`OrbitCurvePoint` in a
+:class:`dmi.analysis.Curve` of kind ``"orbit-fold"``.
+
+The system (minimally augmented, as MatCont's LPC curves; Govaerts, Kuznetsov and Dhooge, SIAM
+J. Sci. Comput. 27 (2005) 231): F(x; p, q) = 0 is the collocation system of the orbit
+(:mod:`dmi.analysis.collocation.system`: node values, switching times, the period and its phase
+condition for an autonomous orbit), J = F_x its sparse Jacobian.  The unknowns are (x, p), the
+driver's parameter is q (:func:`dmi.analysis.continuation.driver.continuation`, so that the curve
+passes its turning points in q and lands on q_end and on the user's q exactly), and the extra
+equation is g(x, p; q) = 0, g from the bordered system
+
+    [[J, b], [c', 0]] (v, g) = (0, 1),     [[J', c], [b', 0]] (w, h) = (0, 1),
+
+one sparse LU for both (g in units of its gradient's largest entry at the start: its rounding is
+then comparable to F's).  g = 0 where J is singular: there the orbit's branch in p at fixed q has
+dp/ds = 0, a fold.  g's derivatives are -w' J_alpha v: along x the row w' (J(x + eps v) - J(x))
+/ eps (one more assembly of J), along p and q the differences of J v; they only steer Newton
+(the curve's points solve F = 0, g = 0 to the corrector's tolerance).  The borders start from
+the one-parameter branch's tangent at the fold (b = F_p, c uniform: the null vectors of J and
+J'), and move to the last point's v and w after every step, when the mesh is equidistributed
+again (as the one-parameter branches do) and the phase condition's reference moves.
+
+Each point carries its :class:`EquationOrbit` (the multipliers, their error estimates: the
+difference to the fold solved again, at the same q, on the mesh with every pair of intervals
+merged, which also gives the error estimate of p) and a verified verdict on the multipliers
+other than the trivial one and the fold's (the orbit's own ``stable`` is None at a fold: a
+multiplier is 1 there).  A curve that would leave its orbits' signature (a stick onset, a
+grazing) ends there, its status saying so; a curve whose orbits shrink towards an equilibrium
+(the fold curve's end at a Bautin point of the Hopf curve) ends with a status that says where
+the amplitude extrapolates to 0.
+"""
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..._solver import Solver
+from ..collocation.adapt import FLOOR, Solved, adapted, merged, transfer
+from ..collocation.adapt import estimate as level_errors
+from ..collocation.floquet import multipliers as floquet
+from ..collocation.mend import check_inequalities
+from ..collocation.orbit import EquationOrbit, equation_orbit
+from ..collocation.system import CollocationWarning, Layout, Terms, full_jacobian, reference
+from ..continuation.branch import Branch, Event
+from ..continuation.driver import Curve as DriverCurve
+from ..continuation.driver import continuation, newton_corrector
+from ..core.newton import ShootingError, bordered_solve, newton_loop, sparse_bordered
+from ..equilibria.curves import Curve, CurveEvent
+from ..scheme.problem import Problem
+from ..scheme.stepmap import build
+
+#: Relative step of the differences of J along v, p and q (they steer Newton only).
+DIFF = 1e-7
+#: A start's fold at q0 must lie within this (relative to max(1, |p|)) of the event's p.
+START_TOL = 1e-6
+#: Terms kept (the last few (p, q) evaluated).
+KEEP = 12
+#: A turn back in q where the orbits' amplitude is below this share of the curve's largest is
+#: the fold curve's end at a Bautin point (the curve in x passes through the equilibrium).
+BAUTIN_SHARE = 0.2
+
+
+@dataclass
+class OrbitCurvePoint:
+    """A point of an orbit curve (:func:`continue_orbit_curve`).
+
+    Attributes
+    ----------
+    p, q : float
+        The parameters.
+    orbit : EquationOrbit
+        The orbit there (at fixed q, ``orbit.make(p)`` is ``make2(p, q)``): its period,
+        amplitude, multipliers and their error estimates (``orbit.errors``; with ``"p"``, the
+        estimated error of p); its ``stable`` is None (a fold has a multiplier at 1).
+    p_error : float or None
+        The estimated error of p (the difference to the fold on the mesh of merged pairs of
+        intervals at the same q); None where that solve failed (a warning says so).
+    stable : bool or None
+        Every multiplier but the trivial one and the fold's inside the unit circle (True), one
+        outside (False), verified against their estimated errors; None where one is within its
+        error of the circle or no error estimate exists (a CollocationWarning says so).
+    dqds : float
+        The unit tangent's q component (its sign flips at a turning point in q).
+    """
+    p: float
+    q: float
+    orbit: EquationOrbit = field(repr=False)
+    p_error: float | None = None
+    stable: bool | None = None
+    dqds: float = 0.0
+
+    @property
+    def omega(self) -> float:
+        """The orbit's angular frequency 2 pi / period (radians / time unit)."""
+        return 2 * math.pi / self.orbit.period
+
+    @property
+    def u(self) -> np.ndarray:
+        """The orbit's node values (as a curve point's state)."""
+        return self.orbit.nodes
+
+    @property
+    def dpds(self) -> float:
+        """The driver's name of :attr:`dqds` (its parameter is q)."""
+        return self.dqds
+
+    @dpds.setter
+    def dpds(self, value: float) -> None:
+        self.dqds = float(value)
+
+
+class _AtQ:
+    """make2 at a fixed q as a one-parameter model make(p) (picklable where make2 is)."""
+
+    def __init__(self, make2: Callable[[float, float], Solver], q: float):
+        self.make2, self.q = make2, float(q)
+
+    def __call__(self, p: float) -> Solver:
+        return self.make2(p, self.q)
+
+
+class OrbitFold:
+    """The minimally augmented system of a fold of collocated orbits (see the module) as a
+    discretisation of the one driver: unknowns y = (x, p), parameter q.
+
+    Parameters
+    ----------
+    make2 : callable
+        ``make2(p, q) -> dmi.Solver``.
+    layout : Layout
+        The collocation's layout.
+    x : numpy.ndarray
+        The orbit's unknowns on it (the phase condition's reference).
+    jumps : tuple of float
+        The kernel's jumps (lags).
+    multipliers : int
+        Leading multipliers a point carries.
+    tol, max_iter : float, int
+        The corrector's tolerance and iterations.
+    estimate : bool
+        A point's error estimates from the merged mesh (False: none, the verdict None).
+    """
+
+    def __init__(self, make2: Callable[[float, float], Solver], layout: Layout, x: np.ndarray,
+                 *, jumps: tuple[float, ...] = (), multipliers: int = 10, tol: float = 1e-12,
+                 max_iter: int = 10, estimate: bool = True):
+        self.make2, self.lay, self.jumps = make2, layout, tuple(jumps)
+        self.ref = reference(layout, x) if layout.autonomous else None
+        self.count, self.tol, self.max_iter = int(multipliers), float(tol), int(max_iter)
+        self.estimate = bool(estimate)
+        self.problem = Problem(make2, keep=KEEP)   # the terms of the last few (p, q)
+        self._last: tuple | None = None     # (key, evaluation) of the last y evaluated
+        self.b: np.ndarray | None = None
+        self.c: np.ndarray | None = None
+        self.gscale = 1.0   # g's unit: 1 / its gradient's largest entry at the start
+        self.breach = ""                    # why the last correction was refused (a signature)
+        self._track: list[tuple[float, float]] = []   # (q, amplitude) of the points stepped to
+
+    @property
+    def weight(self) -> np.ndarray:
+        """The driver's weights on y: x's RMS, p as itself."""
+        m = self.lay.size
+        return np.concatenate([np.full(m, 1.0 / m), [1.0]])
+
+    def terms(self, p: float, q: float) -> Terms:
+        """The model's terms at (p, q) (the last few kept)."""
+        key = (float(p), float(q))
+        return self.problem.cached(("terms", key),
+                                   lambda: Terms(build(_AtQ(self.make2, key[1]), key[0]),
+                                                 self.jumps))
+
+    def borders(self, x: np.ndarray, p: float, q: float) -> None:
+        """b and c from the one-parameter branch's tangent at a fold: with F_p as J's border and
+        a uniform row, the null vectors of J and J' (F_p is outside J's range at a fold)."""
+        t = self.terms(p, q)
+        r, J = full_jacobian(self.lay, t, x, self.ref)
+        d = DIFF * max(1.0, abs(p))
+        Fp = (full_jacobian(self.lay, self.terms(p + d, q), x, self.ref)[0] - r) / d
+        m = x.size
+        one = np.full(m, 1.0 / math.sqrt(m))
+        v, w = _null_pair(J, Fp, one)
+        self.c, self.b = v / np.linalg.norm(v), w / np.linalg.norm(w)
+        self._last = None
+        self.gscale = 1.0
+        row = self._jy(np.concatenate([x, [p]]), q)[2]
+        self.gscale = 1.0 / max(float(np.max(np.abs(row))), 1e-300)
+        self._last = None
+
+    def _eval(self, y: np.ndarray, q: float) -> dict[str, Any]:
+        """F, J, v, w and g at (y, q) (the last kept)."""
+        key = (y.tobytes(), float(q), id(self.lay), id(self.b), self.gscale)
+        if self._last is not None and self._last[0] == key:
+            return self._last[1]
+        x, p = y[:-1], float(y[-1])
+        t = self.terms(p, q)
+        r, J = full_jacobian(self.lay, t, x, self.ref)
+        vg, wh = _pair(J, self.b, self.c)
+        ev = {"r": r, "J": J, "v": vg[:-1], "g": float(vg[-1]) * self.gscale, "w": wh[:-1],
+              "terms": t}
+        self._last = (key, ev)
+        return ev
+
+    def residual(self, y: np.ndarray, q: float) -> np.ndarray:
+        """(F, g) at (y, q): len(y) values."""
+        ev = self._eval(y, q)
+        return np.concatenate([ev["r"], [ev["g"]]])
+
+    def _jy(self, y: np.ndarray, q: float) -> tuple[Any, np.ndarray, np.ndarray, dict]:
+        """(J, F_p, (g_x, g_p), the evaluation) at (y, q): the blocks of the Jacobian in y."""
+        ev = self._eval(y, q)
+        x, p = y[:-1], float(y[-1])
+        J, v, w, t = ev["J"], ev["v"], ev["w"], ev["terms"]
+        eps = DIFF * max(1.0, float(np.max(np.abs(x)))) / max(float(np.max(np.abs(v))), 1e-300)
+        J1 = full_jacobian(self.lay, t, x + eps * v, self.ref)[1]
+        gx = -self.gscale * (J1.T @ w - J.T @ w) / eps
+        d = DIFF * max(1.0, abs(p))
+        rp, Jp = full_jacobian(self.lay, self.terms(p + d, q), x, self.ref)
+        Fp = (rp - ev["r"]) / d
+        gp = -self.gscale * float(w @ (Jp @ v - J @ v)) / d
+        return J, Fp, np.append(gx, gp), ev
+
+    def jacobian(self, y: np.ndarray, q: float) -> tuple[Any, np.ndarray]:
+        """(J_y sparse, J_q): the driver's Jacobian in the unknowns y and in its parameter q."""
+        J, Fp, grow, ev = self._jy(y, q)
+        x, p = y[:-1], float(y[-1])
+        d = DIFF * max(1.0, abs(q))
+        rq, Jq = full_jacobian(self.lay, self.terms(p, q + d), x, self.ref)
+        Fq = (rq - ev["r"]) / d
+        gq = -self.gscale * float(ev["w"] @ (Jq @ ev["v"] - ev["J"] @ ev["v"])) / d
+        return sparse_bordered(J, Fp, grow), np.concatenate([Fq, [gq]])
+
+    def solve_at(self, y0: np.ndarray, q: float, what: str) -> np.ndarray:
+        """The fold at fixed q from y0 (Newton on (F, g) in (x, p), sparse LU)."""
+        def evaluate(y: np.ndarray) -> tuple[np.ndarray, None]:
+            return self.residual(y, q), None
+
+        def factor(y: np.ndarray, r: np.ndarray, _: None) -> Callable[[np.ndarray], np.ndarray]:
+            J, Fp, grow, _ = self._jy(y, q)
+            return lambda rr: bordered_solve(J, Fp, grow, -rr)
+
+        y, _ = newton_loop(evaluate, factor, np.array(y0, dtype=float), tol=self.tol,
+                           max_iter=3 * self.max_iter, what=what, converge="correction",
+                           stall=False)
+        return y
+
+    def correct(self, y: np.ndarray, q: float, row: np.ndarray, target: float, far: float
+                ) -> tuple[np.ndarray, float, int]:
+        """The driver's Newton corrector, then the orbit's inequalities checked: an orbit that
+        breaks its signature is refused (the curve does not cross signatures yet)."""
+        if math.isfinite(far) and _turned_small(self._track):   # no step past a Bautin point
+            self.breach = ("the curve turned back in q where its orbits shrink to the "
+                           "equilibrium (a Bautin point)")
+            raise ShootingError(self.breach, [])
+        z, its = newton_corrector(DriverCurve(self, y.size), np.concatenate([y, [q]]), row,
+                                  target, tol=self.tol, max_iter=self.max_iter, far=far,
+                                  what=f"the orbits' fold near q = {q!r}")
+        yz, qz = z[:-1], float(z[-1])
+        x, p = yz[:-1], float(yz[-1])
+        bad = check_inequalities(self.lay, self.terms(p, qz), x,
+                                 1e-9 * max(1.0, float(np.max(np.abs(x)))))
+        if bad:
+            self.breach = (f"near (p, q) = ({p:.10g}, {qz:.10g}) the fold's orbit breaks its "
+                           f"signature ({bad[0]}): a stick onset or grazing meets the fold "
+                           "curve there (curves across signatures are not continued yet)")
+            raise ShootingError(self.breach, [])
+        return yz, qz, its
+
+    def adapt(self, y: np.ndarray, q: float) -> np.ndarray:
+        """Between steps: the borders moved to the point's v and w, the mesh equidistributed
+        again, the phase condition's reference moved to the point."""
+        ev = self._eval(y, q)
+        V = y[:self.lay.rows * self.lay.n].reshape(-1, self.lay.n)
+        self._track.append((float(q), float(np.max(V.max(axis=0) - V.min(axis=0))) / 2))
+        self.c = ev["v"] / np.linalg.norm(ev["v"])
+        self.b = ev["w"] / np.linalg.norm(ev["w"])
+        x, p = y[:-1], float(y[-1])
+        new = self.lay.with_fractions(adapted(self.lay, x, self.lay.L))
+        x = transfer(self.lay, x, new)
+        self.lay = new
+        if new.autonomous:
+            self.ref = reference(new, x)
+        self._last = None
+        return np.concatenate([x, [p]])
+
+    def point(self, y: np.ndarray, q: float) -> OrbitCurvePoint:
+        """The curve's point at (y, q): the orbit, its errors from the merged mesh's fold, the
+        verdict on the other multipliers."""
+        x, p = y[:-1], float(y[-1])
+        t = self.terms(p, q)
+        fine = self._solved(self.lay, t, x)
+        errors: dict[str, Any] = {}
+        p_error = None
+        if self.estimate:
+            got = self._coarse(y, q)
+            if got is not None:
+                coarse, pc = got
+                errors = level_errors(coarse, fine)
+                p_error = max(abs(pc - p), FLOOR * max(1.0, abs(p)))
+                errors["p"] = p_error
+        with warnings.catch_warnings():   # a fold's multiplier at 1: the orbit's stable is None
+            warnings.simplefilter("ignore", CollocationWarning)
+            orbit = equation_orbit(fine, p, _AtQ(self.make2, q), errors, self.jumps)
+        orbit.stable = None
+        return OrbitCurvePoint(p, float(q), orbit, p_error,
+                               _others_stable(fine.mu, errors.get("multipliers"),
+                                              self.lay.autonomous, p, q))
+
+    def _solved(self, lay: Layout, terms: Terms, x: np.ndarray) -> Solved:
+        """x on lay with its amplitudes and leading multipliers."""
+        return Solved(lay, x, floquet(lay, terms, x, self.count) if self.count > 0 else None)
+
+    def _coarse(self, y: np.ndarray, q: float) -> tuple[Solved, float] | None:
+        """The fold at q on the mesh of merged pairs of intervals (and its p); None, with a
+        CollocationWarning, where that solve fails."""
+        x, p = y[:-1], float(y[-1])
+        lay = self.lay.with_fractions(merged(self.lay.fractions))
+        xc = transfer(self.lay, x, lay)
+        other = OrbitFold(self.make2, lay, xc, jumps=self.jumps, multipliers=self.count,
+                          tol=self.tol, max_iter=self.max_iter, estimate=False)
+        other.ref = self.ref
+        other.problem = self.problem
+        try:
+            other.borders(xc, p, q)
+            yc = other.solve_at(np.concatenate([xc, [p]]), q,
+                                f"the fold at q = {q!r} on the merged mesh")
+        except (ShootingError, ValueError) as e:
+            warnings.warn(f"(p, q) = ({p!r}, {q!r}): the fold on the merged mesh failed ({e}): "
+                          "no error estimate, the verdict None", CollocationWarning,
+                          stacklevel=3)
+            return None
+        pc = float(yc[-1])
+        return self._solved(lay, self.terms(pc, q), yc[:-1]), pc
+
+    def corner(self, points: list[OrbitCurvePoint]) -> str:
+        """Why the curve could not go on: the signature its orbits would leave, or its turn
+        where they shrink to the equilibrium (a Bautin point), else ""."""
+        return self.breach
+
+
+def _pair(J: Any, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(v, g) of [[J, b], [c', 0]] (v, g) = (0, 1) and (w, h) of its transpose."""
+    e1 = np.zeros(c.size + 1)
+    e1[-1] = 1.0
+    try:
+        return (bordered_solve(J, b, np.append(c, 0.0), e1),
+                bordered_solve(J.T.tocsc(), c, np.append(b, 0.0), e1))
+    except ShootingError as e:
+        raise ShootingError(f"the fold's bordered matrix is singular: {e}", []) from None
+
+
+def _null_pair(J: Any, border: np.ndarray, row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """v and w of [[J, border], [row', 0]] (v, .) = (0, 1) and its transpose (w, .) = (0, 1)."""
+    vg, wh = _pair(J, border, row)
+    return vg[:-1], wh[:-1]
+
+
+def _others_stable(mu: np.ndarray, err: Any, autonomous: bool, p: float, q: float
+                   ) -> bool | None:
+    """The multipliers but the trivial one (autonomous) and the fold's (the nearest 1 of the
+    rest) all inside the unit circle (True) or one outside (False) beyond their errors; None
+    (with a CollocationWarning) otherwise."""
+    if mu.size == 0 or err is None:
+        return None
+    keep = np.ones(mu.size, bool)
+    for _ in range(2 if autonomous else 1):
+        rest = np.flatnonzero(keep)
+        keep[rest[int(np.argmin(np.abs(mu[rest] - 1)))]] = False
+    a, e = np.abs(mu[keep]), np.asarray(err)[keep]
+    if np.any(a > 1 + e):
+        return False
+    if np.all(a < 1 - e):
+        return True
+    warnings.warn(f"(p, q) = ({p!r}, {q!r}): a multiplier other than the fold's is within its "
+                  "estimated error of the unit circle: the verdict is None",
+                  CollocationWarning, stacklevel=3)
+    return None
+
+
+def _turned_small(track: list[tuple[float, float]]) -> bool:
+    """The last points turned back in q where the amplitude is below BAUTIN_SHARE of the
+    largest so far."""
+    if len(track) < 3:
+        return False
+    (q0, _), (q1, a1), (q2, a2) = track[-3:]
+    top = max(a for _, a in track)
+    return (q2 - q1) * (q1 - q0) < 0 and min(a1, a2) < BAUTIN_SHARE * top
+
+
+def bautin_end(points: list[OrbitCurvePoint]) -> tuple[int, float, float] | None:
+    """Where the curve turns back in q with its orbits' amplitude below BAUTIN_SHARE of the
+    largest: (k, p_B, q_B), k the first point past the turn, (p_B, q_B) where q and p,
+    fitted as quadratics in the amplitude squared through the last three points before it,
+    reach amplitude 0 (near a Bautin point the fold's orbits have amplitude^2 ~ q - q_B).
+    None where the curve does not turn so."""
+    q = np.array([pt.q for pt in points])
+    a = np.array([float(np.max(pt.orbit.amplitude)) for pt in points])
+    for k in range(2, len(points)):
+        if (q[k] - q[k - 1]) * (q[k - 1] - q[k - 2]) < 0 and \
+                min(a[k - 1], a[k]) < BAUTIN_SHARE * float(a[:k + 1].max()):
+            j = np.arange(max(0, k - 3), k)
+            deg = min(2, j.size - 1)
+            s = a[j] ** 2
+            pB = float(np.polyval(np.polyfit(s, [points[i].p for i in j], deg), 0.0))
+            qB = float(np.polyval(np.polyfit(s, q[j], deg), 0.0))
+            return k, pB, qB
+    return None
+
+
+def _start_orbit(start: Any, branch: Branch | None) -> tuple[EquationOrbit, np.ndarray | None,
+                                                              float]:
+    """(the orbit near the fold, the event's unknowns if on its layout, the event's p)."""
+    if isinstance(start, EquationOrbit):
+        return start, None, float(start.p)
+    if isinstance(start, Event) and start.kind == "fold":
+        if branch is None or not isinstance(branch, Branch):
+            raise ValueError("continue_orbit_curve: a fold event needs branch=, the Branch of "
+                             "EquationOrbits it belongs to (continue_orbit of an EquationOrbit)")
+        pts = branch.points
+        if not pts or not all(isinstance(pt, EquationOrbit) for pt in pts):
+            raise ValueError("continue_orbit_curve: branch= is not a branch of EquationOrbits "
+                             "(continue_orbit of an EquationOrbit, from collocate or "
+                             "hopf_orbit(..., of='equation'))")
+        if start not in branch.events:
+            raise ValueError("continue_orbit_curve: the fold event is not one of branch.events")
+        k = min(max(int(start.index), 1), len(pts) - 1)
+        before, after = pts[k - 1], pts[k]
+        orbit = before if abs(before.p - start.p) <= abs(after.p - start.p) else after
+        u = None
+        if start.u is not None and np.size(start.u) == after.nodes.size + after.switches.size \
+                + int(after.autonomous):   # located on the layout of the point after it
+            u = np.array(start.u, dtype=float)
+            orbit = after
+        return orbit, u, float(start.p)
+    raise ValueError(f"continue_orbit_curve: start = {start!r}: give a 'fold' event of a branch "
+                     "of EquationOrbits (with branch=) or an EquationOrbit near a fold")
+
+
+def continue_orbit_curve(start: Any, make2: Callable[[float, float], Solver], q0: float,
+                         q_end: float, *, branch: Branch | None = None,
+                         step: float | None = None, at: Iterable[float] = (),
+                         max_points: int = 100, min_step: float | None = None,
+                         max_step: float | None = None, multipliers: int = 10,
+                         tol: float = 1e-10, max_iter: int = 10, estimate: bool = True
+                         ) -> Curve:
+    """Continues a fold of the equation's periodic orbits (collocated) in the plane (p, q).
+
+    The curve of (p, q) where the orbit of ``make2(p, q)`` folds (its branch in p at fixed q
+    turns back: a limit point of cycles), by pseudo-arclength in (x, p, q) with the minimally
+    augmented system of :mod:`dmi.analysis.plane.orbit_curves`, from the start at q0, through
+    turning points in q, until q_end.
+
+    Parameters
+    ----------
+    start : Event or EquationOrbit
+        A ``fold`` event of a branch of EquationOrbits of ``make2(., q0)``
+        (:func:`dmi.analysis.continue_orbit` of an EquationOrbit; give that Branch as
+        ``branch=``), or an EquationOrbit of ``make2(., q0)`` near a fold.
+    make2 : callable
+        The model ``make2(p, q) -> dmi.Solver``, configured, not initialised.
+    q0 : float
+        The start's q.
+    q_end : float
+        Where to stop (finite, not q0); the last point lies on it exactly when the curve gets
+        there.
+    branch : Branch, optional
+        The start event's branch (required with an event).
+    step : float, optional
+        The first step (arclength in (x, p, q): x as its RMS, p and q as themselves; default
+        |q_end - q0| / 20).
+    at : iterable of float
+        Values of q where a point is wanted (a ``user`` event each, the point on it exactly).
+    max_points : int
+        Points at most.
+    min_step, max_step : float, optional
+        Step bounds (default step / 1000 and 4 step).
+    multipliers : int
+        Leading multipliers a point.
+    tol : float
+        The corrector's tolerance (relative to max(1, |x|_inf)).
+    max_iter : int
+        The corrector's iterations a step.
+    estimate : bool
+        Every point's error estimates (the fold solved again on the mesh of merged pairs of
+        intervals); False: none, and every verdict None.
+
+    Returns
+    -------
+    Curve
+        ``kind`` ``"orbit-fold"``; ``points`` (:class:`OrbitCurvePoint`: ``p``, ``q``,
+        ``orbit``, ``p_error``, ``stable``), ``events`` (``user``), ``status`` (it does not
+        raise when the corrector fails on the way: the curve ends there, the status says why:
+        q_end reached, a turn back past q0, max_points, a signature the orbits would leave, or
+        the orbits shrinking towards a Bautin point).
+
+    Raises
+    ------
+    ValueError
+        A start of another kind, an event without its branch, bad q0, q_end or step; a start
+        that is not a fold of ``make2(., q0)`` (Newton fails at q0, or finds the fold farther
+        than START_TOL from the event's p).
+    """
+    orbit, u, p_event = _start_orbit(start, branch)
+    q0, q_end = float(q0), float(q_end)
+    if not (math.isfinite(q0) and math.isfinite(q_end)) or q0 == q_end:
+        raise ValueError(f"continue_orbit_curve: q0 = {q0!r}, q_end = {q_end!r}: give two "
+                         "different finite values")
+    if step is None:
+        step = abs(q_end - q0) / 20
+    if not (isinstance(step, (int, float)) and math.isfinite(step) and step > 0):
+        raise ValueError(f"continue_orbit_curve: step = {step!r}: must be finite and > 0")
+    if not callable(make2):
+        raise ValueError(f"continue_orbit_curve: make2 = {make2!r}: give a function "
+                         "(p, q) -> dmi.Solver")
+    n = orbit.nodes.shape[1]
+    lay = Layout(orbit.degree, n, orbit.signature, [f.copy() for f in orbit.fractions],
+                 orbit.autonomous, orbit.period, tuple(orbit.carried))
+    x = u if u is not None else np.concatenate([orbit.nodes.ravel(), orbit.switches,
+                                                [orbit.period] if orbit.autonomous else []])
+    disc = OrbitFold(make2, lay, x, jumps=tuple(orbit.kernel_jumps), multipliers=multipliers,
+                     tol=tol, max_iter=max_iter, estimate=estimate)
+    what = f"the orbits' fold at q0 = {q0!r} from p = {p_event!r}"
+    try:
+        disc.borders(x, p_event, q0)
+        y0 = disc.solve_at(np.concatenate([x, [p_event]]), q0, what)
+    except (ShootingError, ValueError) as e:
+        raise ValueError(f"continue_orbit_curve: the start is not a fold of make2(., q0 = "
+                         f"{q0!r}) near p = {p_event!r}: {e}") from None
+    if isinstance(start, Event) and abs(float(y0[-1]) - p_event) > START_TOL * max(1.0,
+                                                                                abs(p_event)):
+        raise ValueError(f"continue_orbit_curve: the fold of make2(., q0 = {q0!r}) is at p = "
+                         f"{float(y0[-1])!r}, not at the event's p = {p_event!r}: is make2(p, "
+                         "q0) the branch's model make(p)?")
+    b = continuation(disc, y0, q0, q_end, step=float(step), min_step=min_step,
+                     max_step=max_step, max_points=max_points, at=at, tol=tol,
+                     max_iter=max_iter, predictor="tangent", easy=4, make=make2,
+                     kind="orbit-fold")
+    return _curve_of(b, disc)
+
+
+def _curve_of(b: Branch, disc: OrbitFold) -> Curve:
+    """The Curve of the driver's branch: its points, the user points, its status in q's
+    words."""
+    points: list[OrbitCurvePoint] = list(b.points)
+    events: list[CurveEvent] = []
+    status = b.status.replace("p_end", "q_end").replace(" near p = ", " near q = ")
+    end = bautin_end(points)
+    if end is not None:
+        k, pB, qB = end
+        points = points[:k]
+        status = (f"reached a Bautin point near (p, q) = ({pB:.10g}, {qB:.10g}): the fold's "
+                  "orbits shrink to the equilibrium there, where the fold curve meets the Hopf "
+                  "curve (extrapolated to amplitude 0 from the last three points)")
+    for e in b.events:
+        if e.kind == "user" and e.index < len(points):
+            on = [j for j, pt in enumerate(points) if pt.q == e.p]
+            i = e.index if e.index in on or not on else min(on, key=lambda j: abs(j - e.index))
+            events.append(CurveEvent("user", points[i].p, float(e.p), i, e.detail))
+        # the driver's "fold" (a turning point in q) and "branch-point" are not the curve's
+    if end is not None:
+        events.append(CurveEvent("bautin", end[1], end[2], len(points), status))
+    return Curve(kind="orbit-fold", points=points, events=events, status=status,
+                 make2=disc.make2)
+
+
+__all__ = ["OrbitCurvePoint", "continue_orbit_curve"]
