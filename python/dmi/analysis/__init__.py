@@ -11,25 +11,42 @@ scheme's (they match simulation); ``of="equation"`` (:func:`roots`, :func:`hopf`
 :func:`stability_chart`, :func:`equilibrium`) and :func:`refine_orbit` give the equation's.
 Interactive HTML figures (:mod:`dmi.analysis.plot.interactive`, Bokeh): ``Branch.to_html``,
 ``StabilityChart.to_html`` and the ``html`` of :func:`plot_branch` and
-:func:`plot_stability_chart`.
+:func:`plot_stability_chart`.  Two parameters: :func:`continue_curve` (Hopf and fold curves of
+equilibria, folds of orbits), :func:`continue_over` (one-parameter continuations over q, on Dask)
+and :func:`plot_curves` (the diagram).
+
+The package is in rooms, each a subpackage whose docstring says what it holds and what it may
+import, lowest first: ``core`` and ``plot``, ``scheme``, ``continuation`` (the one driver),
+``equilibria``, ``shooting``, ``collocation``, ``branches`` (orbit branches on the driver),
+``plane``; ``orbits``, ``hopf_orbits`` and ``curves`` at the top reach several rooms.
 """
 from __future__ import annotations
 
+from .branches.discretisation import CollocationDiscretisation, equation_hopf_orbit
+from .collocation.collocate import collocate
+from .collocation.orbit import EquationOrbit
+from .collocation.system import CollocationWarning
+from .continuation.branch import (Branch, BranchPoint, Curve, CurveEvent, Event, EventWarning,
+                                  HopfPoint)
 from .core.model import KinkError
-from .hopf_orbits import hopf_orbit
-from .continuation.branch import Branch, BranchPoint, Event, HopfPoint
-from .equilibria.chart import HopfCurve, StabilityChart, plot_stability_chart, stability_chart
-from .orbits import continue_orbit, period_doubled_orbit
-from .equilibria.equilibrium import Equilibrium, EquilibriumPoint, continue_equilibrium, equilibrium
-from .scheme.floquet import Floquet, StabilityWarning, Verify, floquet_multipliers, floquet_verdict
 from .core.newton import ShootingError
-from .scheme.orbit import Orbit
-from .plot.branch import plot_branch
-from .shooting.refine import Refined, refine_orbit
-from .shooting.shoot import periodic_orbit
+from .curves import continue_curve
+from .equilibria.chart import HopfCurve, StabilityChart, plot_stability_chart, stability_chart
+from .equilibria.curves import CurvePoint
+from .equilibria.equilibrium import Equilibrium, EquilibriumPoint, continue_equilibrium, equilibrium
 from .equilibria.crossing import hopf
 from .equilibria.stability import roots
+from .hopf_orbits import hopf_orbit
+from .orbits import continue_orbit, period_doubled_orbit
+from .plane.diagram import plot_curves
+from .plane.grid import Grid, GridEvent, GridRow, GridWarning, Trace, continue_over
+from .plane.orbit_curves import OrbitCurvePoint, continue_orbit_curve
+from .plot.branch import plot_branch
+from .scheme.floquet import Floquet, StabilityWarning, Verify, floquet_multipliers, floquet_verdict
+from .scheme.orbit import Orbit
 from .scheme.stepmap import StepMap
+from .shooting.refine import Refined, refine_orbit
+from .shooting.shoot import periodic_orbit
 
 __all__ = [
     # equilibria and their stability (docs/stability.md)
@@ -42,25 +59,12 @@ __all__ = [
     "refine_orbit", "Refined",
     # verified Floquet multipliers and stability verdicts (docs/orbits.md)
     "floquet_verdict", "Floquet", "Verify", "StabilityWarning",
+    # the equation's orbits by collocation
+    "collocate", "EquationOrbit", "CollocationWarning", "EventWarning",
+    "CollocationDiscretisation", "equation_hopf_orbit",
+    # curves in two parameters: Hopf and fold curves of equilibria, folds of orbits
+    "continue_curve", "Curve", "CurvePoint", "CurveEvent", "continue_orbit_curve",
+    "OrbitCurvePoint",
+    # the plane (p, q): one-parameter continuations over q (serially or on Dask) and the diagram
+    "continue_over", "Grid", "GridRow", "GridEvent", "Trace", "GridWarning", "plot_curves",
 ]
-from .collocation.collocate import collocate  # noqa: E402
-from .collocation.orbit import EquationOrbit  # noqa: E402
-
-from .collocation.system import CollocationWarning  # noqa: E402
-from .continuation.branch import EventWarning  # noqa: E402
-
-__all__ += ["collocate", "EquationOrbit", "CollocationWarning", "EventWarning"]
-from .branches.discretisation import (CollocationDiscretisation,  # noqa: E402
-                                       equation_hopf_orbit)
-
-__all__ += ["CollocationDiscretisation", "equation_hopf_orbit"]
-from .equilibria.curves import Curve, CurveEvent, CurvePoint, continue_curve  # noqa: E402
-
-# Hopf and fold curves of the equation's equilibria in two parameters (docs/stability.md)
-__all__ += ["continue_curve", "Curve", "CurvePoint", "CurveEvent"]
-from .plane.diagram import plot_curves  # noqa: E402
-from .plane.grid import Grid, GridEvent, GridRow, GridWarning, Trace, continue_over  # noqa: E402
-
-# the plane (p, q): one-parameter continuations over q (serially or on Dask) and the diagram
-__all__ += ["continue_over", "Grid", "GridRow", "GridEvent", "Trace", "GridWarning",
-            "plot_curves"]

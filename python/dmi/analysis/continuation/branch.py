@@ -333,3 +333,77 @@ class Branch:
     def _repr_html_(self) -> str:
         from ..plot.interactive import branch_summary
         return branch_summary(self)
+
+
+@dataclass
+class CurveEvent:
+    """A point of codimension two on a :class:`Curve`, or a point asked for with ``at=``.
+
+    Attributes
+    ----------
+    kind : str
+        ``"bautin"`` (l1 changes sign on a Hopf curve), ``"zero-hopf"`` (a real root crosses 0 on
+        a Hopf curve; a pair crosses the imaginary axis on a fold curve), ``"hopf-hopf"`` (a
+        second pair crosses on a Hopf curve), ``"cusp"`` and ``"bogdanov-takens"`` (on a fold
+        curve), or ``"user"``.
+    p, q : float
+        Where.
+    index : int
+        The curve's point after the event (the point itself for ``"user"``).
+    detail : str
+        A description, with the located test function's values.
+    u : numpy.ndarray or None
+        The equilibrium there.
+    hopf : HopfPoint or None
+        A Bautin point's Hopf point (l1 about 0).
+    """
+    kind: str
+    p: float
+    q: float
+    index: int
+    detail: str = ""
+    u: np.ndarray | None = field(default=None, repr=False)
+    hopf: HopfPoint | None = field(default=None, repr=False)
+
+
+@dataclass
+class Curve:
+    """A curve in the plane (p, q) from :func:`dmi.analysis.continue_curve`: a Hopf or fold curve
+    of the equation's equilibria, or a fold of its orbits (``"orbit-fold"``).
+
+    Attributes
+    ----------
+    kind : str
+        ``"hopf"``, ``"fold"`` or ``"orbit-fold"``.
+    points : list of CurvePoint or OrbitCurvePoint
+        The points, in the order continued (the last on q_end when it was reached).
+    events : list of CurveEvent
+        The codimension-two points located on it, and the ``user`` points, in the order met.
+    status : str
+        Why it ended: ``"reached q_end = ..."``, ``"left the range [...] after a fold"`` (it
+        turned back in q past its start), ``"max_points reached"``, or the corrector failing
+        at the smallest step (with, on a Hopf curve whose omega fell towards 0, a sentence
+        saying that a Bogdanov-Takens point is near).
+    make2 : callable
+        The model.
+    """
+    kind: str
+    points: list[Any]
+    events: list[CurveEvent]
+    status: str
+    make2: Callable[[float, float], Any] = field(repr=False)
+
+    @property
+    def p(self) -> np.ndarray:
+        """The points' p."""
+        return np.array([pt.p for pt in self.points])
+
+    @property
+    def q(self) -> np.ndarray:
+        """The points' q."""
+        return np.array([pt.q for pt in self.points])
+
+    @property
+    def omega(self) -> np.ndarray:
+        """The points' omega (0 on a fold curve)."""
+        return np.array([pt.omega for pt in self.points])

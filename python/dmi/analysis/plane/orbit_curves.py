@@ -50,11 +50,10 @@ from ..collocation.floquet import multipliers as floquet
 from ..collocation.mend import check_inequalities
 from ..collocation.orbit import EquationOrbit, equation_orbit
 from ..collocation.system import CollocationWarning, Layout, Terms, full_jacobian, reference
-from ..continuation.branch import Branch, Event
+from ..continuation.branch import Branch, Curve, CurveEvent, Event
 from ..continuation.driver import Curve as DriverCurve
 from ..continuation.driver import continuation, newton_corrector
 from ..core.newton import ShootingError, bordered_solve, newton_loop, sparse_bordered
-from ..equilibria.curves import Curve, CurveEvent
 from ..scheme.problem import Problem
 from ..scheme.stepmap import build
 

@@ -1,0 +1,49 @@
+# dmi.analysis.curves: the one entry point of curves in two parameters, by the start's type.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+""":func:`continue_curve`: a curve in the plane (p, q) from its start, as BifurcationKit's
+``continuation`` takes a problem of any kind: a Hopf point or a fold of the equation's equilibria
+(:func:`dmi.analysis.equilibria.curves.continue_curve`), or a fold of the equation's periodic
+orbits, an orbit branch's ``fold`` event given with its ``branch=`` or an EquationOrbit near a fold
+(:func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`).  It sits above the rooms because it
+reaches both."""
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from .._solver import Solver
+from .collocation.orbit import EquationOrbit
+from .equilibria.curves import Curve
+from .equilibria.curves import continue_curve as equilibrium_curve
+from .plane.orbit_curves import continue_orbit_curve
+
+
+def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: float, q_end: float,
+                   **options: Any) -> Curve:
+    """Continues a curve of codimension one in the plane (p, q) from ``start`` at q0 to q_end.
+
+    Parameters
+    ----------
+    start : HopfPoint, Event or EquationOrbit
+        A Hopf point of the equation (``hopf(..., of="equation")``, with ``u_eq=``), a ``hopf``
+        or ``fold`` event of a branch of the equation's equilibria, a ``fold`` event of a branch
+        of EquationOrbits (with ``branch=``, that branch), or an EquationOrbit near a fold.
+    make2 : callable
+        The model ``make2(p, q) -> dmi.Solver``, configured, not initialised.
+    q0 : float
+        The start's q.
+    q_end : float
+        Where to stop; the last point lies on it exactly when the curve gets there.
+    **options
+        The options of :func:`dmi.analysis.equilibria.curves.continue_curve` (equilibria) or of
+        :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve` (orbits).
+
+    Returns
+    -------
+    Curve
+        The curve: ``kind`` ``"hopf"``, ``"fold"`` or ``"orbit-fold"``, its points, events and
+        status.
+    """
+    if isinstance(start, EquationOrbit) or options.get("branch") is not None:
+        return continue_orbit_curve(start, make2, q0, q_end, **options)
+    return equilibrium_curve(start, make2, q0, q_end, **options)
