@@ -29,6 +29,8 @@ import statistics
 import subprocess
 import sys
 
+from benchtools import nonempty, positive_int
+
 FMU2 = "fmu/DelayFrictionOscillator/binaries/linux64/DelayFrictionOscillator.so"
 FMU3 = "fmu/fmi3/DelayFrictionOscillator/binaries/x86_64-linux/DelayFrictionOscillator.so"
 
@@ -165,20 +167,26 @@ def main() -> int:
         return 0
     ap = argparse.ArgumentParser(description="Runs the benchmarks of two checkouts in interleaved "
                                  "pairs of processes and prints new / old pair by pair.")
-    ap.add_argument("old", help="the old checkout (its BUILD built)")
-    ap.add_argument("new", help="the new checkout (its BUILD built alike)")
-    ap.add_argument("--build", default="build-rel", help="the build directory in each (default build-rel)")
-    ap.add_argument("--pairs", type=int, default=6, help="pairs of processes per bench (default 6)")
+    ap.add_argument("old", nargs="?", type=nonempty, help="the old checkout (its BUILD built)")
+    ap.add_argument("new", nargs="?", type=nonempty, help="the new checkout (its BUILD built alike)")
+    ap.add_argument("--build", type=nonempty, default="build-rel",
+                    help="the build directory in each (default build-rel)")
+    ap.add_argument("--pairs", type=positive_int, default=6,
+                    help="pairs of processes per bench (default 6)")
     ap.add_argument("--set", choices=("c", "python"), default="c", help="which benchmarks (default c)")
-    ap.add_argument("--python", default=sys.executable, help="the Python of --set python")
-    ap.add_argument("--identify-args", default="--rounds 2 --steps 1000 --callback-steps 2000",
-                    help="bench_identify.py's arguments")
-    ap.add_argument("--only", default=None,
-                    help="only these benches, by the names of parse() (e.g. cells,binding)")
-    ap.add_argument("--log", default=None, help="a file for every process's output (default none)")
+    ap.add_argument("--python", type=nonempty, default=sys.executable,
+                    help="the Python of --set python (default this one)")
+    ap.add_argument("--identify-args", type=nonempty,
+                    default="--rounds 2 --steps 1000 --callback-steps 2000",
+                    help="bench_identify.py's arguments (default --rounds 2 --steps 1000 "
+                         "--callback-steps 2000)")
+    ap.add_argument("--only", type=nonempty, default=None,
+                    help="only these benches, by the names of parse(), e.g. cells,binding "
+                         "(default all of --set)")
+    ap.add_argument("--log", type=nonempty, default=None, help="a file for every process's output (default none)")
     a = ap.parse_args()
-    if a.pairs < 1:
-        ap.error("--pairs must be >= 1")
+    if a.old is None or a.new is None:
+        ap.error("give the two checkouts, OLD and NEW")
     trees = {"old": a.old, "new": a.new}
     if a.set == "c":
         runs = {k: c_runs(t, a.build) for k, t in trees.items()}
