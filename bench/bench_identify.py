@@ -174,7 +174,12 @@ def main() -> None:
     fwd = np.inf
 
     def iteration(problem):
-        problem._cache = None            # (a Jacobian at a point it has seen would be reused)
+        # forget what the problem has computed (a Jacobian at a point it has seen would be
+        # reused): its Cache now, the attribute _cache before
+        if hasattr(problem, "cache"):
+            problem.cache = type(problem.cache)(1)
+        else:
+            problem._cache = None
         problem.residuals(P0 * 1.01)
         problem.jacobian(P0 * 1.02)
     for _ in range(args.rounds):

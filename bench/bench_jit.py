@@ -30,7 +30,7 @@ import numpy as np  # noqa: E402
 
 import dmi  # noqa: E402
 from dmi.analysis import continue_orbit, periodic_orbit  # noqa: E402
-from dmi.analysis.shooting.shoot import state_of  # noqa: E402
+from dmi.analysis.scheme.stepmap import state_of  # noqa: E402
 from benchtools import cpu  # noqa: E402
 
 C, V, ALPHA, G, THETA, TAU, W = 0.1, 0.4, 0.3, 0.2, 0.5, 1.0, 1.1

@@ -36,7 +36,7 @@ import orbit_tau  # noqa: E402
 
 from dmi.analysis import continue_orbit, periodic_orbit  # noqa: E402
 from dmi.analysis.scheme.floquet import floquet_multipliers  # noqa: E402
-from dmi.analysis.shooting.shoot import StepMap, state_of  # noqa: E402
+from dmi.analysis.scheme.stepmap import StepMap, state_of  # noqa: E402
 from benchtools import cpu  # noqa: E402
 
 TAU = 2.2

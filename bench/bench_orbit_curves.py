@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # The cost of a point of a fold curve of collocated orbits (continue_orbit_curve) against a point
 # of the one-parameter branch of the same orbit and mesh (a benchmark, not a test).
-# The rotationally symmetric oscillator with a memory (tests/python/hopf_models.py), c1 = q: the
+# The rotationally symmetric oscillator with a memory (tests/python/models/hopf_models.py), c1 = q: the
 # one-parameter branch at q = 1 from its Hopf point through the fold of its circles (as a user
 # computes it, with the fold located), then the large circles past the fold continued up in p at
 # the same q (no event), and the fold curve from q = 1 to 2; degree 4, 24 intervals, 10
@@ -42,8 +42,10 @@ def per_point(fn) -> tuple[float, int, object]:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--rounds", type=int, default=3)
+    ap = argparse.ArgumentParser(description="Prints the CPU time of a point of a fold curve of collocated orbits "
+                                 "(continue_orbit_curve) against a point of the one-parameter branch of "
+                                 "the same orbit and mesh, and their ratio.")
+    ap.add_argument("--rounds", type=int, default=3, help="rounds, the fastest kept (default: 3)")
     a = ap.parse_args()
     om = so.brentq(lambda w: w + hopf_models.ghat(1j * w, G, TAU).imag - W0, 0.1, 3.0)
     mu_h = hopf_models.ghat(1j * om, G, TAU).real
