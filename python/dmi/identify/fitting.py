@@ -1071,7 +1071,12 @@ def _fit(problem: _Problem, start: np.ndarray, lo: np.ndarray, hi: np.ndarray, x
         if res.status > 0 and polish:
             # the scheme's own tangent, exact where nothing switches: quadratic convergence to
             # the scheme's least squares from a point the equation's sensitivities found
-            fine = solve(res.x, False, 1e-8)
+            fine = None
+            if loss == "linear" and max_nfev is None:
+                fine = _gauss_newton(problem, res.x, float(res.cost), lo[free], hi[free], 1e-8,
+                                     progress)
+            if fine is None:        # a step that did not decrease the cost: least_squares's
+                fine = solve(res.x, False, 1e-8)
             if fine.status > 0 and fine.cost <= res.cost:
                 res = fine
     except KeyboardInterrupt:
@@ -1091,6 +1096,56 @@ def _fit(problem: _Problem, start: np.ndarray, lo: np.ndarray, hi: np.ndarray, x
                              f"{J.shape[1]}): last cost {cost:.10g}"), False, False
     msg = f"{res.message} (cost {cost:.10g} after {problem.njev} iterations)"
     return x, cost, msg, False, converged
+
+
+def _gauss_newton(problem: _Problem, x: np.ndarray, cost: float, lo: np.ndarray, hi: np.ndarray,
+                  tol: float, progress: Callable[[Any], None]) -> Any:
+    """The polish: full Gauss-Newton steps with the scheme's own tangent from x (its Jacobian the
+    exact derivative of the residuals where nothing switches, so the steps converge fast), each
+    taken where it lowers the cost, until the next step is below ``tol`` (as least_squares's
+    xtol: |dx| <= tol (tol + |x|)) or would lower the cost by less than ``tol`` of it (ftol, by
+    the linear model), and is then not taken (its change is within the tolerance), or a step
+    taken lowered it by less than that.  A result as least_squares's (x, cost, fun, status,
+    success, message; status -2 where ``progress`` stopped it); None where a step leaves the
+    bounds or does not lower the cost (or after 20 steps): least_squares then polishes."""
+    problem.jumps = False
+    try:
+        r, J = problem.linearised(x)
+        for _ in range(20):
+            dx = np.linalg.lstsq(J, -r, rcond=None)[0]
+            if not np.all(np.isfinite(dx)):
+                return None
+            if np.linalg.norm(dx) <= tol * (tol + np.linalg.norm(x)):
+                return _result(x, r, 3, "`xtol` termination condition is satisfied.")
+            fitted = r + J @ dx
+            if cost - 0.5 * float(fitted @ fitted) < tol * cost:
+                # the step would lower the cost by less than the tolerance (the linear model's
+                # prediction, exact to second order at a Gauss-Newton step)
+                return _result(x, r, 2, "`ftol` termination condition is satisfied.")
+            y = x + dx
+            if np.any(y < lo) or np.any(y > hi):
+                return None
+            ry = problem.residuals(y)
+            cy = 0.5 * float(ry @ ry)
+            if not cy <= cost:
+                return None
+            x, r, drop, cost = y, ry, cost - cy, cy
+            try:
+                progress(optimize.OptimizeResult(x=x, cost=cost))
+            except StopIteration:
+                return _result(x, r, -2, "stopped by the callback")
+            if drop < tol * cost:
+                return _result(x, r, 2, "`ftol` termination condition is satisfied.")
+            r, J = problem.linearised(x)
+        return None
+    finally:
+        problem.jumps = True
+
+
+def _result(x: np.ndarray, r: np.ndarray, status: int, message: str) -> Any:
+    """A least_squares result of the polish."""
+    return optimize.OptimizeResult(x=x, fun=r, cost=0.5 * float(r @ r), status=status,
+                                   success=status > 0, message=message)
 
 
 def _summarise(problem: _Problem, names: list, x: np.ndarray, cost: float, message: str,
