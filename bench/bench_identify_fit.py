@@ -9,9 +9,12 @@
 # the process, fastest of the rounds (interleaved), one BLAS thread; each fit's runs of the model
 # and its cost at the end are printed.  Then the floor: one sensitivity run against the 1 + P plain
 # runs of one forward-difference Jacobian.  --baseline DIR fits with another version of
-# dmi.identify in the same rounds (as bench_identify.py).
+# dmi.identify in the same rounds (as bench_identify.py); --baseline-package DIR with another
+# version of the whole package (a copy of a build's build/python/dmi, its libraries with it,
+# imported as dmi_baseline: its model, its estimate and least_squares on its runs), and prints
+# the ratios of the two versions.
 # Usage: PYTHONPATH=build/python:bench .venv/bin/python bench/bench_identify_fit.py [--rounds 3]
-#        [--baseline DIR]
+#        [--baseline DIR] [--baseline-package DIR]
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -21,6 +24,8 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
+import importlib.util  # noqa: E402
+import sys  # noqa: E402
 import warnings  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -36,9 +41,10 @@ TRUTH = np.delete(b.P0, 1)                          # k, mu, w0, c1, a1, c2, a2
 START = TRUTH * (1 + np.array([0.1, -0.1, 0.05, 0.15, -0.1, 0.1, -0.05]))
 
 
-def model():
-    """make(p) of the 7 free parameters (g fixed)."""
-    make8 = b.model(STEPS, True, "exp", True)
+def model(bench=b):
+    """make(p) of the 7 free parameters (g fixed), with bench_identify's model (or that of a
+    copy of bench_identify bound to another package)."""
+    make8 = bench.model(STEPS, True, "exp", True)
 
     def make(p):
         return make8(np.insert(np.asarray(p, dtype=float), 1, G))
@@ -64,6 +70,24 @@ def residuals_fd(make, t, y):
     return residuals
 
 
+def baseline_package(path: str):
+    """(dmi.identify, bench_identify) of the package in path imported as dmi_baseline: a copy
+    of bench_identify whose models are that package's Solvers."""
+    spec = importlib.util.spec_from_file_location("dmi_baseline", os.path.join(path, "__init__.py"),
+                                                  submodule_search_locations=[path])
+    if spec is None or spec.loader is None:
+        raise SystemExit(f"--baseline-package {path}: no __init__.py there")
+    package = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = package
+    spec.loader.exec_module(package)
+    identify = importlib.import_module("dmi_baseline.identify")
+    spec = importlib.util.spec_from_file_location("bench_identify_baseline", b.__file__)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    bench.dmi = package                 # (model() reads the global at each call)
+    return identify, bench
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=(
         "Prints the CPU seconds of dmi.identify.estimate against least_squares with 2-point "
@@ -72,6 +96,8 @@ def main() -> None:
                     help="interleaved rounds; the fastest of each counts (default 3)")
     ap.add_argument("--baseline", metavar="DIR", type=dir_holding("__init__.py"),
                     help="a copy of another version's python/dmi/identify (default: none)")
+    ap.add_argument("--baseline-package", metavar="DIR", type=dir_holding("__init__.py"),
+                    help="a copy of another build's build/python/dmi (default: none)")
     args = ap.parse_args()
     make = model()
     t, y = data(make)
@@ -84,6 +110,13 @@ def main() -> None:
         base = b.baseline(args.baseline)
         base_record = base.Record(t, y)        # (the baseline's own Record class)
         fits["estimate (baseline)"] = lambda: base.estimate(make, START, base_record)
+    if args.baseline_package:
+        ident, bench = baseline_package(args.baseline_package)
+        make_b = model(bench)
+        record_b = ident.Record(t, y)
+        fits["estimate (package baseline)"] = lambda: ident.estimate(make_b, START, record_b)
+        fits["least_squares (package baseline)"] = lambda: optimize.least_squares(
+            residuals_fd(make_b, t, y), START, jac="2-point", method="trf", x_scale="jac")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for f in fits.values():                     # compile and warm up
@@ -104,6 +137,11 @@ def main() -> None:
         print(f"{name:24} {best[name]:8.3f} s  ratio {best[name] / ref:5.2f}  runs {r.nfev:4d}  "
               f"jacobians {r.njev if r.njev is not None else 0:3d}  cost {cost:.6g}  "
               f"max rel. error {err:.2e}")
+    if args.baseline_package:
+        old = best["estimate (package baseline)"] / best["least_squares (package baseline)"]
+        print(f"estimate / least_squares: this version {best['estimate'] / ref:.2f}, the baseline "
+              f"package {old:.2f}; estimate this / baseline "
+              f"{best['estimate'] / best['estimate (package baseline)']:.2f}")
     # the floor: a sensitivity run against the 1 + P runs of a forward difference
     P = len(TRUTH)
     resid = residuals_fd(make, t, y)

@@ -12,7 +12,7 @@
 # rounds (the compilation time is printed apart).  Also the cost of a step (advance over --steps
 # steps) with jit=True against the same rhs written by hand as a numba cfunc (its parameter in
 # the user pointer): what jit=True's index checks, error model, copy of u and exception capture
-# cost.
+# cost.  And one make(p) (a Solver with its rhs set; with jit=True a bind of the compiled code).
 # Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_jit.py [--rounds 2] [--M 400]
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
@@ -98,7 +98,8 @@ def main(argv: list[str] | None = None) -> int:
         ap.error("--rounds and --steps must be >= 1 and --M >= 10")
     P = 2 * math.pi / W
     compile_s = cpu(lambda: belt(a.M, True)(A))
-    best = {(k, jit): math.inf for k in ("solve", "step", "period") for jit in (False, True)}
+    best = {(k, jit): math.inf for k in ("solve", "step", "period", "make")
+            for jit in (False, True)}
     ns = {"jit": math.inf, "cfunc": math.inf}
     states = {}
     for _ in range(a.rounds):
@@ -107,6 +108,7 @@ def main(argv: list[str] | None = None) -> int:
             ns[name] = min(ns[name], t)
         for jit in (False, True):
             make = belt(a.M, jit)
+            best["make", jit] = min(best["make", jit], cpu(lambda: [make(A) for _ in range(200)]) / 200)
             s = make(A)
             s.init()
             s.advance(20 * a.M)  # near the orbit, not on it
@@ -129,6 +131,8 @@ def main(argv: list[str] | None = None) -> int:
           f"{ns['cfunc']:.1f} ns, ratio {ns['jit'] / ns['cfunc']:.3f} (final states differ by "
           f"{np.max(np.abs(states['jit'] - states['cfunc'])):.1e})")
     print(f"{'':<22} {'Python rhs':>11} {'jit=True':>9} {'Python / jit':>13}")
+    print(f"make(p), a Solver with its rhs set: Python rhs {best['make', False] * 1e6:.1f} us, "
+          f"jit=True {best['make', True] * 1e6:.1f} us (a bind of the compiled code)")
     for k, label in (("period", "one period (advance)"), ("solve", "shooting solve"),
                      ("step", "continuation step")):
         py, jt = best[k, False], best[k, True]

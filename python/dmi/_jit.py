@@ -80,15 +80,41 @@ def _global_type(value: Any) -> tuple:
         return ("k", id(value))
 
 
+_ANALYSIS_MAX = 4096
+_analysed: dict[types.CodeType, tuple[tuple[str, ...], tuple[str, ...]]] = {}
+
+
+def _analysis(code: types.CodeType) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """What the bytecode says, kept per code object (a function of its bytecode, names and
+    constants alone, so every function of that code shares it; the values are read per call):
+    the names code loads as globals (LOAD_GLOBAL, LOAD_NAME), in order of first use, and those
+    its nested code objects (comprehensions, nested functions, at any depth) load."""
+    got = _analysed.get(code)
+    if got is None:
+        nested: list[str] = []
+        for c in _nested_codes(code):
+            nested += [g for g in _loaded_globals(c) if g not in nested]
+        got = (_loaded_globals(code), tuple(nested))
+        if len(_analysed) >= _ANALYSIS_MAX:
+            _analysed.clear()
+        _analysed[code] = got
+    return got
+
+
+def _loaded_globals(code: types.CodeType) -> tuple[str, ...]:
+    """The names code loads as globals or module names, in order of first use (each once)."""
+    import dis
+    names: list[str] = []
+    for ins in dis.get_instructions(code):
+        if ins.opname in ("LOAD_GLOBAL", "LOAD_NAME") and ins.argval not in names:
+            names.append(ins.argval)
+    return tuple(names)
+
+
 def _global_names(code: types.CodeType, f: types.FunctionType) -> list[str]:
     """The names code reads from f's globals (LOAD_GLOBAL; not builtins), in order of first use."""
-    import dis
-    names = []
-    for ins in dis.get_instructions(code):
-        if ins.opname in ("LOAD_GLOBAL", "LOAD_NAME") and ins.argval in f.__globals__ \
-                and ins.argval not in names:
-            names.append(ins.argval)
-    return names
+    g = f.__globals__
+    return [name for name in _analysis(code)[0] if name in g]
 
 
 def _nested_codes(code: types.CodeType) -> list[types.CodeType]:
@@ -111,7 +137,8 @@ def _parameters(f: types.FunctionType, what: str) -> tuple[list[str], list[Any],
         names.append(g)
         values.append(f.__globals__[g])
         keys.append(_global_type(values[-1]))
-    for g in sorted({g for c in _nested_codes(code) for g in _global_names(c, f)} - set(names)):
+    glob = f.__globals__
+    for g in sorted({g for g in _analysis(code)[1] if g in glob} - set(names)):
         names.append(g)   # read inside a comprehension or nested function: a constant, keyed
         values.append(f.__globals__[g])
         keys.append(("k", id(values[-1])))
@@ -619,23 +646,34 @@ def _current(cell: Any) -> Any:
         return _MISSING
 
 
+_checks: dict[tuple, Any] = {}  # (cells, global names) -> the maker of same()
+
+
 def _identity_check(cells: tuple, globs: tuple, g: dict) -> Any:
     """A function without arguments: whether every cell and global still holds its object, one
-    `is` per variable (made from source: no loop, no call but dict.get, for the step's cost)."""
-    scope: dict[str, Any] = {"g": g, "M": _MISSING}
-    tests = []
-    for i, (cell, old, *_) in enumerate(cells):
-        scope[f"c{i}"], scope[f"o{i}"] = cell, old
-        tests.append(f"c{i}.cell_contents is o{i}")
-    for j, (name, old, _) in enumerate(globs):
-        scope[f"p{j}"] = old
-        tests.append(f"g.get({name!r}, M) is p{j}")
-    if not tests:
+    `is` per variable (made from source: no loop, no call but dict.get, for the step's cost).
+    The source depends only on the number of cells and the globals' names: it is compiled once
+    for them, into a maker that closes over the objects of each call."""
+    if not cells and not globs:
         return _always
-    src = ("def same():\n    try:\n        return " + " and ".join(tests) +
-           "\n    except ValueError:\n        return False\n")   # (a closure cell emptied)
-    exec(src, scope)  # noqa: S102 - our own expression
-    return scope["same"]
+    shape = (len(cells), tuple(name for name, *_ in globs))
+    maker = _checks.get(shape)
+    if maker is None:
+        tests = [f"c{i}.cell_contents is o{i}" for i in range(len(cells))]
+        tests += [f"g.get({name!r}, M) is p{j}" for j, name in enumerate(shape[1])]
+        args = [f"c{i}, o{i}" for i in range(len(cells))] + [f"p{j}" for j in range(len(globs))]
+        src = (f"def maker(g, M, {', '.join(args)}):\n"
+               "    def same():\n        try:\n            return " + " and ".join(tests) +
+               "\n        except ValueError:\n            return False\n"   # (a cell emptied)
+               "    return same\n")
+        scope: dict[str, Any] = {}
+        exec(src, scope)  # noqa: S102 - our own expression
+        maker = scope["maker"]
+        if len(_checks) >= _ANALYSIS_MAX:
+            _checks.clear()
+        _checks[shape] = maker
+    values = [v for cell, old, *_ in cells for v in (cell, old)] + [old for _, old, _ in globs]
+    return maker(g, _MISSING, *values)
 
 
 def _kept(v: Any, key: tuple) -> bool:

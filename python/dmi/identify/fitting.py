@@ -11,7 +11,7 @@ import math
 import sys
 import time
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Hashable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -19,7 +19,7 @@ from scipy import optimize, stats
 
 from .._cache import Cache
 from .._solver import Solver
-from .sensitivity import MAX_STEPS, Sensitivities, check_steps, sensitivities
+from .sensitivity import MAX_STEPS, Sensitivities, _build, _sensitivities_of, check_steps
 
 #: Singular values of the column-normalised Jacobian below this fraction of the largest one mark
 #: a parameter combination as not determined by the data.
@@ -467,7 +467,11 @@ class _Problem:
         self.best: tuple[float, np.ndarray] | None = None
         self.unplaced: list = []        # (record, step) of the last Jacobian's unplaced reversals
         self.max_steps: int | None = None
-        self.cache = Cache(1)           # the residuals and Jacobian at the last x
+        # the residuals and Jacobian at the last x, the models of the last Jacobian (the next one
+        # at the same p, with or without the saltation, steps the same solvers again) and the
+        # residuals at the last two x
+        self.cache = Cache(4 + len(makes))
+        self.recent: list = []          # the keys of the residuals kept, oldest first
 
     def full(self, x: np.ndarray) -> np.ndarray:
         p = self.p0.copy()
@@ -505,9 +509,20 @@ class _Problem:
         return val, der
 
     def residuals(self, x: np.ndarray, check: bool = False) -> np.ndarray:
-        """The weighted residuals at the free parameters x; with ``check``, a ValueError naming
-        the record, the time and the culprit (the run's state or ``observe``) where one is not
-        finite."""
+        """The weighted residuals at the free parameters x (those of a recent call at the same x
+        kept); with ``check``, a ValueError naming the record, the time and the culprit (the
+        run's state or ``observe``) where one is not finite."""
+        key = ("residuals", x.tobytes())
+        if key not in self.recent:
+            self.recent.append(key)
+            if len(self.recent) > 2:
+                self.cache.pop(self.recent.pop(0))
+        r = self.cache.cached(key, lambda: self._residuals(x, check))
+        if check and not np.all(np.isfinite(r)):
+            return self._residuals(x, check)
+        return r.copy()
+
+    def _residuals(self, x: np.ndarray, check: bool) -> np.ndarray:
         p = self.full(x)
         out = []
         for k, (make, d) in enumerate(zip(self.makes, self.data)):
@@ -549,8 +564,16 @@ class _Problem:
     def linearised(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(r, J): the weighted residuals and their Jacobian at the free parameters x, from the
         sensitivities' runs (kept in the problem's cache for the next call at the same x)."""
-        return self.cache.cached(("linearised", x.tobytes(), self.jumps),
-                                 lambda: self._linearise(x))
+        return self._slot("linearised", (x.tobytes(), self.jumps), lambda: self._linearise(x))
+
+    def _slot(self, slot: Hashable, key: Hashable, factory: Callable[[], Any]) -> Any:
+        """What the cache's ``slot`` holds for ``key``, else factory() there in its place (one
+        object a slot: the last one)."""
+        got = self.cache.pop(slot)
+        if got is None or got[0] != key:
+            got = (key, factory())
+        self.cache.cached(slot, lambda: got)
+        return got[1]
 
     def _linearise(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         p = self.full(x)
@@ -566,13 +589,16 @@ class _Problem:
         for k, (make, d) in enumerate(zip(self.makes, self.data)):
             def make_free(q: np.ndarray, _make: Callable = make) -> Solver:
                 return _make(self.full(q))
-            s0 = make(p.copy())
+            # the models at p and p + delta_j e_j: those of the last Jacobian at this p (made by
+            # make at the same parameters; each run starts from their init), else made now
+            mod = self._slot(("models", k), p.tobytes(), lambda: _build(make_free, p[idx]))
             with warnings.catch_warnings():
                 # reversals left unplaced are gathered here and reported once by the estimate
                 warnings.filterwarnings("ignore", "sensitivities: .* could not be placed",
                                         RuntimeWarning)
-                sens: Sensitivities = sensitivities(make_free, p[idx], record_steps(s0, d), rhs=rhs,
-                                                     jumps=self.jumps, max_steps=self.max_steps)
+                sens: Sensitivities = _sensitivities_of(
+                    mod, p[idx], record_steps(mod.base, d), rhs=rhs, jumps=self.jumps,
+                    max_steps=self.max_steps)
             unplaced += [(k, q) for q in sens.unplaced]
             val, der = self._predict(d, sens.t, sens.h, sens.u, sens.x, sens.S, sens.dx)
             res.append(((val - d.y) * d.w).ravel())
@@ -887,7 +913,8 @@ def _probe(problem: _Problem, x: np.ndarray, cost: float, names: list, tol: floa
     d = np.where(x != 0.0, np.abs(x), 1.0)
     norms = np.linalg.norm(J * d, axis=0)
     safe = np.where(norms > 0, norms, 1.0)
-    _, sv, Vt = np.linalg.svd(J * d / safe, full_matrices=True)
+    # all F right singular vectors: the thin SVD has them where M >= F (not the M x M U)
+    _, sv, Vt = np.linalg.svd(J * d / safe, full_matrices=J.shape[0] < F)
     sv = np.concatenate([sv, np.zeros(F - len(sv))])
     top = sv.max() if sv.size and sv.max() > 0 else 1.0
     near = np.flatnonzero(sv <= SADDLE_RCOND * top)[:3]
@@ -1044,7 +1071,12 @@ def _fit(problem: _Problem, start: np.ndarray, lo: np.ndarray, hi: np.ndarray, x
         if res.status > 0 and polish:
             # the scheme's own tangent, exact where nothing switches: quadratic convergence to
             # the scheme's least squares from a point the equation's sensitivities found
-            fine = solve(res.x, False, 1e-8)
+            fine = None
+            if loss == "linear" and max_nfev is None:
+                fine = _gauss_newton(problem, res.x, float(res.cost), lo[free], hi[free], 1e-8,
+                                     progress)
+            if fine is None:        # a step that did not decrease the cost: least_squares's
+                fine = solve(res.x, False, 1e-8)
             if fine.status > 0 and fine.cost <= res.cost:
                 res = fine
     except KeyboardInterrupt:
@@ -1064,6 +1096,56 @@ def _fit(problem: _Problem, start: np.ndarray, lo: np.ndarray, hi: np.ndarray, x
                              f"{J.shape[1]}): last cost {cost:.10g}"), False, False
     msg = f"{res.message} (cost {cost:.10g} after {problem.njev} iterations)"
     return x, cost, msg, False, converged
+
+
+def _gauss_newton(problem: _Problem, x: np.ndarray, cost: float, lo: np.ndarray, hi: np.ndarray,
+                  tol: float, progress: Callable[[Any], None]) -> Any:
+    """The polish: full Gauss-Newton steps with the scheme's own tangent from x (its Jacobian the
+    exact derivative of the residuals where nothing switches, so the steps converge fast), each
+    taken where it lowers the cost, until the next step is below ``tol`` (as least_squares's
+    xtol: |dx| <= tol (tol + |x|)) or would lower the cost by less than ``tol`` of it (ftol, by
+    the linear model), and is then not taken (its change is within the tolerance), or a step
+    taken lowered it by less than that.  A result as least_squares's (x, cost, fun, status,
+    success, message; status -2 where ``progress`` stopped it); None where a step leaves the
+    bounds or does not lower the cost (or after 20 steps): least_squares then polishes."""
+    problem.jumps = False
+    try:
+        r, J = problem.linearised(x)
+        for _ in range(20):
+            dx = np.linalg.lstsq(J, -r, rcond=None)[0]
+            if not np.all(np.isfinite(dx)):
+                return None
+            if np.linalg.norm(dx) <= tol * (tol + np.linalg.norm(x)):
+                return _result(x, r, 3, "`xtol` termination condition is satisfied.")
+            fitted = r + J @ dx
+            if cost - 0.5 * float(fitted @ fitted) < tol * cost:
+                # the step would lower the cost by less than the tolerance (the linear model's
+                # prediction, exact to second order at a Gauss-Newton step)
+                return _result(x, r, 2, "`ftol` termination condition is satisfied.")
+            y = x + dx
+            if np.any(y < lo) or np.any(y > hi):
+                return None
+            ry = problem.residuals(y)
+            cy = 0.5 * float(ry @ ry)
+            if not cy <= cost:
+                return None
+            x, r, drop, cost = y, ry, cost - cy, cy
+            try:
+                progress(optimize.OptimizeResult(x=x, cost=cost))
+            except StopIteration:
+                return _result(x, r, -2, "stopped by the callback")
+            if drop < tol * cost:
+                return _result(x, r, 2, "`ftol` termination condition is satisfied.")
+            r, J = problem.linearised(x)
+        return None
+    finally:
+        problem.jumps = True
+
+
+def _result(x: np.ndarray, r: np.ndarray, status: int, message: str) -> Any:
+    """A least_squares result of the polish."""
+    return optimize.OptimizeResult(x=x, fun=r, cost=0.5 * float(r @ r), status=status,
+                                   success=status > 0, message=message)
 
 
 def _summarise(problem: _Problem, names: list, x: np.ndarray, cost: float, message: str,
@@ -1152,7 +1234,7 @@ def _covariance(J: np.ndarray, x: np.ndarray, names: list) -> tuple[np.ndarray, 
     norms = np.linalg.norm(Js, axis=0)
     safe = np.where(norms > 0, norms, 1.0)
     Jn = Js / safe
-    _, sv, Vt = np.linalg.svd(Jn, full_matrices=True)
+    _, sv, Vt = np.linalg.svd(Jn, full_matrices=Jn.shape[0] < F)   # (all F rows of Vt either way)
     sv = np.concatenate([sv, np.zeros(F - len(sv))])
     top = sv.max() if sv.size and sv.max() > 0 else 1.0
     weak = sv <= RCOND * top

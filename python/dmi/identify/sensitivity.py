@@ -482,7 +482,17 @@ def sensitivities(make: Callable[[np.ndarray], Solver], p: Any, steps: int, *,
         make not returning a dmi.Solver.
     """
     p = _checked(p, steps, engine)
-    mod = _build(make, p)
+    return _sensitivities_of(_build(make, p), p, steps, rhs=rhs, jumps=jumps, engine=engine,
+                             max_steps=max_steps)
+
+
+def _sensitivities_of(mod: _Perturbed, p: np.ndarray, steps: int, *,
+                      rhs: Callable[[float, np.ndarray, np.ndarray], np.ndarray] | None = None,
+                      jumps: bool = True, engine: str = "auto", max_steps: int | None = None
+                      ) -> Sensitivities:
+    """:func:`sensitivities` of the models ``mod`` (:func:`_build`: the model at p and at
+    p + delta_j e_j) made at the checked p; the models may be those of an earlier call at the
+    same p (each run starts from their init)."""
     s = mod.base
     check_steps(steps, s.n, s.N, len(p), s.h, max_steps, "sensitivities")
     s.init()

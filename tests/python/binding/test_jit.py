@@ -151,6 +151,36 @@ def test_compilation_count_sees_a_new_function():
     s.close()
 
 
+
+def test_code_analysis_is_shared_but_closure_values_are_read_per_call():
+    """The bytecode analysis is kept per code object (one entry for 200 closures of one lambda);
+    the closure's values are still read at each set_rhs and init: a cell rebound between two
+    init() calls gives the scheme's closed form with the new value, not the cached one's."""
+    def damped(b: float):
+        def f(t, u):
+            return np.array([b * u[0]])
+
+        def rebind(v: float) -> None:
+            nonlocal b
+            b = v
+        return f, rebind
+    s = dmi.Solver(1, 1.0, 100)
+    s.set_history(lambda t: np.array([1.0]))
+    fns = [damped(b) for b in np.linspace(0.1, 2.0, 200)]
+    for f, _ in fns:
+        s.set_rhs(f, jit=True)
+    f, rebind = fns[0]
+    assert sum(1 for c in _jit._analysed if c is f.__code__) == 1
+    s.set_rhs(f, jit=True)
+    s.init()
+    s.advance(40)
+    assert s.state[0] == pytest.approx((1 - s.h * 0.1) ** 40, rel=1e-13)
+    rebind(1.7)
+    s.init()
+    s.advance(40)
+    assert s.state[0] == pytest.approx((1 - s.h * 1.7) ** 40, rel=1e-13)
+    s.close()
+
 # ---- errors ------------------------------------------------------------------------------------
 
 def refused(t, u):
