@@ -1,8 +1,9 @@
 # The rule of libdmi's built-in resolvents (dry friction, box) in one place: when a component
 # holds, the resolvent's derivative, a component's mode in a step and the saltation factor.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
-"""The built-in resolvents' rule, as libdmi applies it (src/dmi.c: ``friction_side``, ``box_side``,
-``held_of``), for the analyses and the sensitivities; private to the package.
+"""The built-in resolvents' rule, as libdmi applies it (src/holds.h: ``friction_side``,
+``box_side``; src/dmi.c: ``held_of``), for the analyses and the sensitivities; private to the
+package.
 
 Dry friction with the threshold lam = h alpha_i moves the resolvent's argument x by lam towards 0
 (side +1 where x > lam, -1 where x < -lam) and *holds* U_i at 0 where |x| <= lam (side 0, ties

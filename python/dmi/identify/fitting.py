@@ -1058,14 +1058,14 @@ def _fit(problem: _Problem, start: np.ndarray, lo: np.ndarray, hi: np.ndarray, x
     r0 = problem.residuals(x0, check=True)
     cost0 = 0.5 * float(r0 @ r0)
     def solve(x_start: np.ndarray, jumps: bool, tol: float) -> Any:
-        problem.jumps = jumps
+        before, problem.jumps = problem.jumps, jumps
         try:
             return optimize.least_squares(problem.residuals, x_start, jac=problem.jacobian,
                                           bounds=(lo[free], hi[free]), method="trf", x_scale=xs,
                                           loss=loss, max_nfev=max_nfev, callback=progress,
                                           ftol=tol, xtol=tol)
         finally:
-            problem.jumps = True
+            problem.jumps = before
     try:
         res = solve(x0, True, 1e-5 if polish else 1e-8)
         if res.status > 0 and polish:
@@ -1108,7 +1108,7 @@ def _gauss_newton(problem: _Problem, x: np.ndarray, cost: float, lo: np.ndarray,
     taken lowered it by less than that.  A result as least_squares's (x, cost, fun, status,
     success, message; status -2 where ``progress`` stopped it); None where a step leaves the
     bounds or does not lower the cost (or after 20 steps): least_squares then polishes."""
-    problem.jumps = False
+    before, problem.jumps = problem.jumps, False
     try:
         r, J = problem.linearised(x)
         for _ in range(20):
@@ -1139,7 +1139,7 @@ def _gauss_newton(problem: _Problem, x: np.ndarray, cost: float, lo: np.ndarray,
             r, J = problem.linearised(x)
         return None
     finally:
-        problem.jumps = True
+        problem.jumps = before
 
 
 def _result(x: np.ndarray, r: np.ndarray, status: int, message: str) -> Any:

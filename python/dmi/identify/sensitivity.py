@@ -24,10 +24,12 @@ from typing import Any
 import numpy as np
 from scipy import fft as sp_fft
 
+from .. import _lib
 from .._errors import Error
 from .._solver import Solver
 from ._near import near_kernel_part, near_sum
-from .._resolvent import friction_slope, friction_slope_alpha, reaches_zero, salted
+from .._resolvent import (box_side, friction_slope, friction_slope_alpha, reaches_zero,
+                          salted)
 from ._saltation import REVERSAL, STICK, UNPLACED, reversal
 
 #: Relative step of the directional differences (about the square root of the unit roundoff).
@@ -635,8 +637,8 @@ def _python_loop(L: _Loop, history: np.ndarray) -> Sensitivities:
             if L.jumps and meets[q]:
                 _reversals(q, U, phi, r.alpha, r.dalpha, T, Snew, h, switches)
         elif r.kind == "box":
-            below, above = X[q] < r.lo, X[q] > r.hi
-            Snew[:] = np.where(below[:, None], r.dlo, np.where(above[:, None], r.dhi, T))
+            side = box_side(X[q], r.lo, r.hi)[:, None]
+            Snew[:] = np.where(side < 0, r.dlo, np.where(side > 0, r.dhi, T))
         elif r.kind == "callback":
             for j, other in enumerate(mod.others):
                 Snew[:, j] = (other.eval_resolvent(h, X[q] + mod.delta[j] * T[:, j])
@@ -697,8 +699,10 @@ def _libdmi_loop(mod: _Perturbed, steps: int, history: np.ndarray | list, memory
     try:
         U, X, S, dX, codes = s._tangent(mod.others, mod.delta, steps, history, dWU, depends,
                                         jumps, terms)
-    except Error:
-        return None
+    except Error as e:
+        if e.code != _lib.ECALLBACK:
+            raise
+        return None     # a failing callback: the Python loop raises the callback's own error
     names = {1: "stick", 2: "reversal", 3: "unplaced"}
     qs, comps = np.nonzero(codes)
     switches = [(q, i, names[int(codes[q, i])]) for q, i in zip(qs.tolist(), comps.tolist())]

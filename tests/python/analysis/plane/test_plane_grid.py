@@ -122,7 +122,10 @@ def test_dask_gives_the_same_rows_bitwise(grid):
     started = [p for p in psutil.Process().children(recursive=True) if p.pid not in before
                and "resource_tracker" not in " ".join(p.cmdline())]
     gone, alive = psutil.wait_procs(started, timeout=30)
-    assert not alive, f"processes left running: {[p.cmdline() for p in alive]}"
+    left = [p.cmdline() for p in alive]
+    for p in alive:
+        p.kill()
+    assert not left, f"processes left running: {left}"
     assert [r.q for r in other.rows] == [r.q for r in grid.rows]
     for a, b in zip(grid.rows, other.rows):
         assert (a.error or "").splitlines()[:1] == (b.error or "").splitlines()[:1]
