@@ -39,7 +39,7 @@ from ..._errors import Error
 from ..continuation.branch import ON_AXIS, REAL, Branch, HopfPoint
 from ..continuation.driver import ContinuationOptions, Curve, continuation, newton_corrector
 from ..core.model import KinkError, call_make, equation_step
-from ..core.newton import NewtonOptions, ShootingError
+from ..core.newton import Converge, NewtonOptions, ShootingError
 from ..scheme.floquet import StabilityWarning
 from ..scheme.problem import Problem
 from ..scheme.stepmap import Model
@@ -370,7 +370,8 @@ def equilibrium(make: Model, p: float, guess: Any, *, tol: float = 1e-10, count:
     n = disc.step(p).n
     u0 = _check_guess(guess, n)
     z, its = newton_corrector(Curve(disc, n), np.concatenate([u0, [p]]), _e_p(n), p,
-                              NewtonOptions(tol=tol, max_iter=max_iter), far=math.inf,
+                              NewtonOptions(tol=tol, max_iter=max_iter, converge=Converge.BOTH),
+                              far=math.inf,
                               what=f"equilibrium at p = {p!r}")
     u = z[:-1]
     if not verify and count >= 1:
