@@ -16,8 +16,8 @@ previous point's dominant subspace (Lust, Roose, Spence and Champneys, SIAM J. S
 (1998) 1188), a linear solve and convergence test of the one Newton loop
 (:func:`dmi.analysis.core.newton.newton_loop`), then Newton with GMRES on the bordered
 matrix-free Jacobian when that contracts too slowly; the ``accept`` hook refuses a point of a
-branch of several forcing periods that is periodic over a part of them.  The maps come from one cache, the
-model's :class:`dmi.analysis.scheme.problem.Problem`.
+branch of several forcing periods that is periodic over a part of them.  The maps come from one
+cache, the model's :class:`dmi.analysis.scheme.problem.Problem`.
 """
 from __future__ import annotations
 

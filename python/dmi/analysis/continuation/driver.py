@@ -69,10 +69,10 @@ direction) and :func:`bisect_along` (a predicate, e.g. a stick pattern).
 - Corrector: Newton (:func:`~dmi.analysis.core.newton.newton_loop`) on (residual(x, p),
   <w t, z - z_pred>) with the bordered Jacobian (:func:`~dmi.analysis.core.newton.bordered_solve`),
   or the discretisation's strategies (:func:`corrected`), then ``accept`` (or ``recover`` when
-  it fails).  Converged when |residual|_inf <= tol max(1, |x|_inf) and the last
-  correction is as small.  The iterations the step control counts: those of every strategy
-  tried, at the weight of the one that converged.  A corrector that strays more than the step from the predictor is
-  refused (another branch on the hyperplane).
+  it fails).  Converged when |residual|_inf <= tol max(1, |x|_inf) and the last correction
+  is as small.  The iterations the step control counts: those of every strategy tried, at the
+  weight of the one that converged.  A corrector that strays more than the step from the
+  predictor is refused (another branch on the hyperplane).
 - Step control: the step grows by 1.5 after a corrector of at most ``easy`` iterations, halves
   after a failure; the branch ends when it falls below ``min_step``.
 - Corners: when the step has been halved below step / 8, natural steps are tried once (the

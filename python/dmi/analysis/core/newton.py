@@ -8,10 +8,11 @@ a continuation's parameter p; a phase condition, an amplitude condition, an arcl
 damped step.  It, collocation's sparse-LU Newton, the continuation driver's corrector
 (:func:`dmi.analysis.continuation.driver.newton_corrector`) and shooting's Newton-Picard (its
 reduced system the linear solve, its contraction test the convergence test; a
-:class:`Strategy` the driver's corrector tries) run :func:`newton_loop`, the one Newton loop, each with its own linear solve, its options a value
-(:class:`NewtonOptions`: the convergence test :class:`Converge` or a callable, the line search
-:class:`Search`).  Their bordered systems are solved by :func:`bordered_solve` (dense LU,
-SuperLU, or GMRES on an operator), the one bordered solve.
+:class:`Strategy` the driver's corrector tries) run :func:`newton_loop`, the one Newton loop,
+each with its own linear solve, its options a value (:class:`NewtonOptions`: the convergence
+test :class:`Converge` or a callable, the line search :class:`Search`).  Their bordered
+systems are solved by :func:`bordered_solve` (dense LU, SuperLU, or GMRES on an operator), the
+one bordered solve.
 
 Every iteration's residual is kept; an iteration gives up when the residual has made no new
 minimum in :data:`NO_PROGRESS` iterations (the semismooth Newton may rise once on its way into
