@@ -1,7 +1,8 @@
 # dmi.analysis has one continuation driver (its contract typed, its options a value), one cache
 # of what it builds from a model, one Newton loop (newton.newton_loop, its linear solve given by
 # the caller: the maps' matrix-free bordered_newton, of which newton.newton is a case,
-# collocation's sparse LU, the driver's corrector, shooting's Newton-Picard), one bordered solve
+# collocation's sparse LU, the driver's corrector and its strategies, of which shooting's
+# Newton-Picard is one; no discretisation has a corrector of its own), one bordered solve
 # (newton.bordered_solve), one locator of events along a branch (the driver's), one hold rule
 # (dmi._resolvent) and one cache per problem; its rooms import only rooms below them, with import
 # chains of at most 4 modules inside a room and 7 across dmi.analysis; no function of analysis or
@@ -106,12 +107,16 @@ def test_one_cache_and_one_newton_loop():
     # and no other function iterates around a linear solve
     written = {(mod, name) for mod, tree in t.items() for name in solving_loops(tree)}
     assert written - OTHER_LOOPS == set(), written - OTHER_LOOPS
-    # the collocation solves, the driver's corrector and the maps' Newton call it
-    for mod, name in (("collocation.system", "solve"), ("continuation.driver", "newton_corrector"),
-                      ("branches.discretisation", "equation_hopf_orbit"),
-                      ("core.newton", "bordered_newton")):
+    # the collocation solves, the driver's corrector (through its loop over strategies, each
+    # run by newton_loop) and the maps' Newton (a strategy) call it
+    for mod, name, callee in (("collocation.system", "solve", "newton_loop"),
+                              ("continuation.driver", "newton_corrector", "corrected"),
+                              ("continuation.driver", "corrected", "run"),
+                              ("core.newton", "run", "newton_loop"),
+                              ("branches.discretisation", "equation_hopf_orbit", "newton_loop"),
+                              ("core.newton", "bordered_newton", "map_strategy")):
         fn = next(f for f in functions(t[mod]) if f.name == name)
-        assert calls(fn, "newton_loop"), f"{mod}.{name} does not use newton_loop"
+        assert calls(fn, callee), f"{mod}.{name} does not use {callee}"
 
 
 def test_solving_loops_finds_a_newton_loop_written_out():
@@ -472,7 +477,11 @@ class C:
 def test_newton_picard_is_a_strategy_of_the_one_loop():
     t = trees()
     fn = next(f for f in functions(t["branches.shooting"]) if f.name == "_newton_picard")
-    assert calls(fn, "newton_loop")
+    # a strategy the driver's corrector runs, not a Newton loop of its own
+    assert calls(fn, "Strategy") and not calls(fn, "newton_loop")
+    assert not [(mod, f.name) for mod, tree in t.items() for f in functions(tree)
+                if mod.startswith(("branches", "shooting")) and calls(f, "newton_loop")
+                and f.name != "equation_hopf_orbit"]
     assert ("branches.shooting", "_newton_picard") not in {
         (mod, name) for mod, tree in t.items() for name in solving_loops(tree)}
 
@@ -488,13 +497,62 @@ def test_driver_contract_is_typed():
                 a, ast.Attribute) else ""
             assert name != "disc" or (isinstance(n.args[1], ast.Name)), ast.unparse(n)
     for hook in ("HasEvents", "Describes", "Corners", "Accepts", "Recovers", "Adapts",
-                 "Carries", "Orients", "Weighted", "StartsTangent", "Between", "OnCurrent"):
+                 "Carries", "Orients", "Weighted", "StartsTangent", "Between", "OnCurrent",
+                 "HasStrategies"):
         assert getattr(driver, hook)._is_protocol, hook
+    # one corrector: no hook hands the driver a corrector of the discretisation's own
+    assert not hasattr(driver, "OwnCorrector")
+    assert "correct" not in driver.HOOKS
+    assert not [name for proto in driver.HOOKS.values() for name in vars(proto)
+                if name == "correct"]
+    # the driver's corrector asks the discretisation for its strategies, accept and recover
+    # only
+    run = next(n for n in ast.walk(tree) if isinstance(n, ast.ClassDef) and n.name == "_Run")
+    method = next(f for f in run.body if isinstance(f, ast.FunctionDef) and f.name == "correct")
+    asked = {n.func.attr for n in ast.walk(method) if isinstance(n, ast.Call)
+             and isinstance(n.func, ast.Attribute) and isinstance(n.func.value, ast.Name)
+             and n.func.value.id == "disc"}
+    assert asked == {"strategies", "accept", "recover"}, asked
+    # no discretisation of dmi.analysis defines a corrector
+    own = [(mod, c.name) for mod, t in trees().items() for c in ast.walk(t)
+           if isinstance(c, ast.ClassDef)
+           and {"residual", "jacobian", "correct"} <= {f.name for f in c.body
+                                                       if isinstance(f, ast.FunctionDef)}]
+    assert own == [], own
+    from dmi.analysis.branches.shooting import Shooting
+    assert not hasattr(Shooting, "correct") and isinstance(Shooting, type)
+    assert issubclass(Shooting, driver.HasStrategies) and issubclass(Shooting, driver.Accepts)
     # the collocated branch gets its mends through accept / recover, not an own corrector
     from dmi.analysis.branches.collocated import EquationBranch
     assert not hasattr(EquationBranch, "correct")
     assert issubclass(EquationBranch, (driver.Accepts,)) or all(
         callable(getattr(EquationBranch, m)) for m in ("accept", "recover"))
+
+
+def test_a_corrector_of_the_discretisation_is_not_called():
+    # x - p = 0 from (0, 0) to p = 1: a method named correct (the hook that left the contract)
+    # is never called; the points are the exact x = p, found by the driver's Newton
+    import numpy as np
+
+    from dmi.analysis.continuation.driver import continuation
+
+    class Line:
+        def residual(self, x, p):
+            return x - p
+
+        def jacobian(self, x, p):
+            return np.eye(1), -np.ones(1)
+
+        def point(self, x, p):
+            return type("P", (), {"p": p, "x": x.copy(), "stable": None})()
+
+        def correct(self, x, p, row, target, far):
+            raise AssertionError("the driver called a discretisation's own corrector")
+
+    b = continuation(Line(), np.zeros(1), 0.0, 1.0, step=0.25)
+    assert len(b.points) >= 4
+    for pt in b.points:
+        assert abs(pt.x[0] - pt.p) <= 1e-12
 
 
 def test_dispatch_on_the_orbit_class():

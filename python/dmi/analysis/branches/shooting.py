@@ -10,28 +10,29 @@ F_p(x) - x (and the phase condition), its Jacobian as a LinearOperator (forward 
 the map) with dF/dp by one difference, the points (:func:`orbit_point`: multipliers, stick
 profile, margins), the orbits' events between two points
 (:func:`dmi.analysis.branches.events.orbit_events`, the ``between`` hook; the stick events
-located by the driver's :func:`~dmi.analysis.continuation.driver.bisect_along`), and its own
-corrector (``correct``, the driver's ``OwnCorrector``): Newton-Picard on the previous point's
-dominant subspace (Lust, Roose, Spence and Champneys, SIAM J. Sci. Comput. 19 (1998) 1188), a
-linear solve and convergence test of the one Newton loop
+located by the driver's :func:`~dmi.analysis.continuation.driver.bisect_along`), and the
+linear-solve strategies of the driver's corrector (the ``strategies`` hook): Newton-Picard on the
+previous point's dominant subspace (Lust, Roose, Spence and Champneys, SIAM J. Sci. Comput. 19
+(1998) 1188), a linear solve and convergence test of the one Newton loop
 (:func:`dmi.analysis.core.newton.newton_loop`), then Newton with GMRES on the bordered
-matrix-free Jacobian when that contracts too slowly.  The maps come from one cache, the
-model's :class:`dmi.analysis.scheme.problem.Problem`.
+matrix-free Jacobian when that contracts too slowly; the ``accept`` hook refuses a point of a
+branch of several forcing periods that is periodic over a part of them.  The maps come from one
+cache, the model's :class:`dmi.analysis.scheme.problem.Problem`.
 """
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 import numpy as np
 import scipy.sparse.linalg as sla
 
 from ..._solver import Solver
 from ..continuation.branch import BranchPoint, Event, corner_sentence, thinned, travel
-from ..continuation.driver import VERTICAL, bisect_along
+from ..continuation.driver import VERTICAL, bisect_along, corrected
 from ..scheme.floquet import Verify, fd_step, floquet_verdict, ritz
-from ..core.newton import (NewtonOptions, ShootingError, bordered_newton, bordered_step,
-                           directional, fd_eps, newton_loop)
+from ..core.newton import (NewtonOptions, ShootingError, Strategy, bordered_step, directional,
+                           fd_eps, map_strategy)
 from .events import orbit_events, stick_profile
 from ..scheme.problem import AutonomousMaps, Problem, phase_row, velocity
 from ..scheme.stepmap import Model, StepMap, build, fixed_step, positive_time
@@ -43,7 +44,7 @@ def orbit_point(F: StepMap, x: np.ndarray, multipliers: int, sections: int, dpds
     """The BranchPoint at the fixed point x of F; ``warm``: a one-element list holding the
     previous point's (Q, Z) of :func:`ritz` (replaced by this point's): the Ritz step starts
     from Z, one block of products instead of two from random vectors.  ``terms``: x's
-    :meth:`StepMap.trajectory_terms` when the caller has them (:func:`_correct`).  An
+    :meth:`StepMap.trajectory_terms` when the caller has them (:meth:`Shooting.accept`).  An
     ``autonomous`` orbit's ``stable`` leaves out its phase multiplier.  ``verify``: the
     multipliers and ``stable`` are :func:`floquet_verdict`'s (verified; the Ritz pairs still
     give the Newton-Picard basis), kept in ``BranchPoint.floquet``; None: the Ritz multipliers
@@ -245,9 +246,10 @@ def _borders(maps: ForcedMaps, z: np.ndarray, zp: np.ndarray, t: np.ndarray
 
 def _newton_picard(maps: ForcedMaps, zp: np.ndarray, t: np.ndarray, tol: float, ds: float,
                    Q: np.ndarray, Z: np.ndarray, z0: np.ndarray | None = None,
-                   max_iter: int = 16) -> tuple[np.ndarray, int]:
+                   max_iter: int = 16) -> tuple[Strategy, _Picard]:
     """The corrector by Newton-Picard (Lust, Roose, Spence & Champneys 1998) from z0 (default the
-    predictor zp) on the hyperplane through zp: the Jacobian D_xF is replaced by its rank-b
+    predictor zp) on the hyperplane through zp, as a linear-solve strategy of the driver's
+    corrector (its iterations count half): the Jacobian D_xF is replaced by its rank-b
     approximation Z Q' on the previous point's dominant subspace (Q orthonormal, Z = D_xF Q
     there, from :func:`ritz`), D_qF (the k extra unknowns' columns) by one difference each at
     z0, and the bordered system
@@ -259,9 +261,11 @@ def _newton_picard(maps: ForcedMaps, zp: np.ndarray, t: np.ndarray, tol: float, 
     Picard step (x takes F(x)'s component), which contracts at the rate of the largest
     multiplier left out; on span Q a chord Newton step.  One evaluation of F an iteration (k
     more for F_q); S = Q' Z gets Broyden's update from each step (ZC = Z - Q S, the leak off
-    span Q, is kept).  Returns (z, iterations); raises _Slow when, after the second iteration,
-    the residual falls by less than half in one, or at its rate would not reach tol within
-    max_iter; ShootingError as :func:`_corrector`."""
+    span Q, is kept).  Returns (the strategy, its :class:`_Picard`); the strategy's run raises
+    _Slow (the next strategy is tried; the _Picard's ``restart``: its iterate of least
+    residual, or None) when, after the second iteration, the residual falls by less than half
+    in one, or at its rate would not reach tol within max_iter; ShootingError (the point
+    refused) as :func:`_newton`."""
     w = maps.weights(zp.size)
     np_ = _Picard(maps, zp, t, tol, Q, Z, max_iter)
 
@@ -272,11 +276,12 @@ def _newton_picard(maps: ForcedMaps, zp: np.ndarray, t: np.ndarray, tol: float, 
             raise ShootingError(f"corrector strayed {far:.3g} > ds = {ds:.3g} from the predictor "
                                 f"at p = {float(z[-1])!r}", [np_.prev])
 
-    z, res = newton_loop(np_.evaluate, np_.factor, zp if z0 is None else z0,
-                         NewtonOptions(tol=tol, max_iter=max_iter, converge=np_.converged,
-                                       chord=math.inf, stall=False),
-                         what=f"Newton-Picard near p = {float(zp[-1])!r}", check=strayed)
-    return z, len(res) - 1
+    return Strategy(np_.evaluate, np_.factor,
+                    NewtonOptions(tol=tol, max_iter=max_iter, converge=np_.converged,
+                                  chord=math.inf, stall=False),
+                    f"Newton-Picard near p = {float(zp[-1])!r}", name="newton-picard",
+                    weight=0.5, start=zp if z0 is None else z0, check=strayed,
+                    retry=(_Slow,)), np_
 
 
 class _Picard:
@@ -296,6 +301,11 @@ class _Picard:
         self.Fx = np.empty(0)        # F(x) at the last iterate evaluated
         self.pending: tuple | None = None   # (xi, dq, F(x) before the step) of the last step
         self.prev, self.best, self.z_best, self.it = math.inf, math.inf, zp, 0
+        self.restart: np.ndarray | None = None   # where the next try starts after _Slow
+
+    def _slow(self, message: str, z: np.ndarray | None) -> _Slow:
+        self.restart = z
+        return _Slow(message, z, self.it)
 
     def evaluate(self, z: np.ndarray) -> tuple[np.ndarray, None]:
         """(F(x) - x, the borders' values) at z."""
@@ -303,7 +313,7 @@ class _Picard:
         F = self.maps.of(z[-k:])
         if not self.started:
             if F.dim != dim or self.Q.shape[0] != dim:
-                raise _Slow("the state's size changed")
+                raise self._slow("the state's size changed", None)
             self.started = True
         elif F.dim != dim:
             raise ShootingError(f"the state grew to {F.dim} values at p = {float(z[-1])!r}", [])
@@ -327,8 +337,8 @@ class _Picard:
             self.best, self.z_best = rn, z
         if it == self.max_iter or (it >= 2 and _too_slow(rn, self.prev, self.tol * scale,
                                                          self.max_iter - it)):
-            raise _Slow(f"residual {rn:.3g} after {it} iterations (previous {self.prev:.3g})",
-                        self.z_best, it)
+            raise self._slow(f"residual {rn:.3g} after {it} iterations (previous "
+                             f"{self.prev:.3g})", self.z_best)
         self.prev = rn
         return False
 
@@ -369,21 +379,19 @@ class _Picard:
         try:
             sol = np.linalg.solve(self.K, np.concatenate([-Qr, -g - self.Bx @ rC]))
         except np.linalg.LinAlgError:
-            raise _Slow("singular reduced system", None, self.it) from None
+            raise self._slow("singular reduced system", None) from None
         xi, dq = sol[:b], sol[b:]
         self.pending = (xi, dq, self.Fx)
         return np.concatenate([Q @ xi + rC + self.FqC @ dq + self.ZC @ xi, dq])
 
 
-def _correct(maps: ForcedMaps, zp: np.ndarray, t: np.ndarray, tol: float, max_iter: int, ds: float,
-             dominant: tuple[np.ndarray, np.ndarray] | None, sections: int = 1
-             ) -> tuple[np.ndarray, int, str, tuple[np.ndarray, np.ndarray]]:
-    """:func:`_solve` and the solution's trajectory terms (:meth:`StepMap.trajectory_terms`, for
-    :func:`_point`); refused (ShootingError: the step is halved) when the orbit of a branch of
-    ``sections`` > 1 forcing periods is periodic over a part of them: the corrector fell onto
+def _periodic_part(maps: ForcedMaps, z: np.ndarray, sections: int
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """The trajectory terms of the point z (:meth:`StepMap.trajectory_terms`, for
+    :func:`orbit_point`); refused (ShootingError: the step is halved) when the orbit of a branch
+    of ``sections`` > 1 forcing periods is periodic over a part of them: the corrector fell onto
     the branch it was born from (a doubled branch near its doubling, where both cross the first
     step's hyperplane p = p1 close together)."""
-    z, its, how = _solve(maps, zp, t, tol, max_iter, ds, dominant)
     k = maps.k
     F = maps.of(z[-k:])
     U, X = F.trajectory_terms(z[:-k])
@@ -394,49 +402,45 @@ def _correct(maps: ForcedMaps, zp: np.ndarray, t: np.ndarray, tol: float, max_it
             raise ShootingError(f"the corrector fell onto an orbit of {m} steps (period "
                                 f"{sections // q} of the branch's {sections} forcing periods) "
                                 f"at p = {float(z[-1])!r}", [])
-    return z, its, how, (U, X)
+    return U, X
 
 
-def _solve(maps: ForcedMaps, zp: np.ndarray, t: np.ndarray, tol: float, max_iter: int, ds: float,
-           dominant: tuple[np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, int, str]:
-    """The corrector from the predictor zp: Newton-Picard on the previous point's ``dominant``
-    (Q, Z) when there is one; when it contracts too slowly, once more from its iterate of least
-    residual with (Q, Z) renewed there: one block of forward differences of Newton's step
+def _strategies(maps: ForcedMaps, zp: np.ndarray, t: np.ndarray, tol: float, max_iter: int,
+                ds: float, dominant: tuple[np.ndarray, np.ndarray] | None
+                ) -> Iterator[Strategy]:
+    """The corrector's strategies from the predictor zp, built as the driver asks for the next:
+    Newton-Picard on the previous point's ``dominant`` (Q, Z) when there is one; when it
+    contracts too slowly, once more from its iterate of least residual with (Q, Z) renewed
+    there: one block of forward differences of Newton's step
     (:func:`dmi.analysis.core.newton.fd_eps`) from qr(Z), the dominant subspace of the derivative
     the iteration actually sees (:func:`ritz`); then Newton (GMRES) from zp (not from an
     iterate: near a period doubling, Newton-Picard may have headed for the other branch that
-    crosses the first step's hyperplane p = p1).  Returns (z, iterations, which): the iterations
-    of all tries, and ``newton-picard`` or ``newton`` (which converged)."""
-    done = 0   # Newton-Picard iterations spent, counted in the step's (the step control's)
+    crosses the first step's hyperplane p = p1)."""
     k = maps.k
     if dominant is not None:
         z = zp
         Q, Z = dominant
         for renew in (False, True):
-            try:
-                if renew:
-                    F, x = maps.of(z[-k:]), z[:-k]
-                    if F.dim != x.size:
-                        break
-                    _, Q, Z = ritz(F, x, max(1, Q.shape[1] - 2), start=Z, eps=fd_eps(x),
-                                   central=False)
-                z, its = _newton_picard(maps, zp, t, tol, ds, Q, Z, z)
-                return z, done + its, "newton-picard"
-            except _Slow as e:
-                done += e.iterations
-                if e.z is None:
+            if renew:
+                F, x = maps.of(z[-k:]), z[:-k]
+                if F.dim != x.size:
                     break
-                z = e.z
-    z, its = _corrector(maps, zp, t, tol, max_iter, ds)
-    return z, done + its, "newton"
+                _, Q, Z = ritz(F, x, max(1, Q.shape[1] - 2), start=Z, eps=fd_eps(x),
+                               central=False)
+            strategy, picard = _newton_picard(maps, zp, t, tol, ds, Q, Z, z)
+            yield strategy
+            if picard.restart is None:
+                break
+            z = picard.restart
+    yield _newton(maps, zp, t, tol, max_iter, ds)
 
 
-def _corrector(maps: ForcedMaps, zp: np.ndarray, t: np.ndarray, tol: float, max_iter: int,
-               ds: float) -> tuple[np.ndarray, int]:
-    """Newton (:func:`dmi.analysis.core.newton.bordered_newton`) on (F_q(x) - x, the family's
-    equations, <w t, z - zp>) from the predictor zp; returns (z, iterations).  ShootingError
-    when an iterate strays more than ds from the predictor (weighted norm): the step is then
-    too long for the predictor, and another branch may lie on the hyperplane."""
+def _newton(maps: ForcedMaps, zp: np.ndarray, t: np.ndarray, tol: float, max_iter: int,
+            ds: float) -> Strategy:
+    """Newton (:func:`dmi.analysis.core.newton.map_strategy`) on (F_q(x) - x, the family's
+    equations, <w t, z - zp>) from the predictor zp.  ShootingError when an iterate strays more
+    than ds from the predictor (weighted norm): the step is then too long for the predictor, and
+    another branch may lie on the hyperplane."""
     w = maps.weights(zp.size)
     dim = zp.size - maps.k
 
@@ -452,10 +456,9 @@ def _corrector(maps: ForcedMaps, zp: np.ndarray, t: np.ndarray, tol: float, max_
             raise ShootingError(f"the state grew to {F.dim} values at p = {float(q[-1])!r}", [])
         return F
 
-    z, res = bordered_newton(of, zp, maps.k, lambda z: _borders(maps, z, zp, t), tol=tol,
-                             max_iter=max_iter, what=f"corrector near p = {float(zp[-1])!r}",
-                             steps=maps.col_steps(zp[-maps.k:]), check=far)
-    return z, len(res) - 1
+    return map_strategy(of, zp.size, maps.k, lambda z: _borders(maps, z, zp, t), tol=tol,
+                        max_iter=max_iter, what=f"corrector near p = {float(zp[-1])!r}",
+                        steps=maps.col_steps(zp[-maps.k:]), check=far)
 
 
 def _first_tangent(maps: ForcedMaps, z: np.ndarray, direction: float) -> np.ndarray:
@@ -520,6 +523,7 @@ class Shooting:
         self.decided: dict[str, BranchPoint] = {}
         # the last corrected z, its iterations, which corrector, and its trajectory terms
         self.last: tuple = (None, iterations, "", None)
+        self.tried: list[Strategy] = []   # the strategies of the last corrector
 
     @property
     def weight(self) -> np.ndarray:
@@ -556,17 +560,28 @@ class Shooting:
         J = sla.LinearOperator((x.size, x.size), matvec=mv, dtype=float)
         return J, np.concatenate([cols[:, -1], rows[:, -1]])
 
-    def correct(self, x: np.ndarray, p: float, row: np.ndarray, target: float, far: float
-                ) -> tuple[np.ndarray, float, int]:
-        """Newton-Picard, then Newton-GMRES, on the hyperplane row . z = target through the
-        predictor (x, p) (:func:`_correct`); the iterations count for the driver's step
-        control as Newton's (Newton-Picard's halved)."""
+    def strategies(self, x: np.ndarray, p: float, row: np.ndarray, target: float, far: float
+                   ) -> Iterator[Strategy]:
+        """The driver's corrector's strategies on the hyperplane row . z = target through the
+        predictor (x, p) (:func:`_strategies`: Newton-Picard, its iterations counted half, then
+        Newton-GMRES), kept for :meth:`accept`."""
         zp = np.concatenate([x, [p]])
         w = self.maps.weights(zp.size)
-        z, its, how, terms = _correct(self.maps, zp, row / w, self.tol, self.max_iter, far,
-                                      self.warm[0], self.sections)
-        self.last = (z.copy(), its, how, terms)
-        return z[:-1], float(z[-1]), its if how == "newton" else math.ceil(its / 2)
+        self.tried = []
+        for s in _strategies(self.maps, zp, row / w, self.tol, self.max_iter, far,
+                             self.warm[0]):
+            self.tried.append(s)
+            yield s
+
+    def accept(self, x: np.ndarray, p: float, step: bool) -> tuple[np.ndarray, float]:
+        """The corrected point (x, p) kept with its iterations (of every strategy tried), the
+        strategy that converged and its trajectory terms (:func:`_periodic_part`, which refuses
+        an orbit periodic over a part of the branch's forcing periods)."""
+        z = np.concatenate([x, [p]])
+        terms = _periodic_part(self.maps, z, self.sections)
+        its = sum(max(0, len(s.history) - 1) for s in self.tried)
+        self.last = (z.copy(), its, self.tried[-1].name, terms)
+        return x, p
 
     def point(self, x: np.ndarray, p: float) -> BranchPoint:
         """The branch's point (multipliers, stick profile), and a new phase reference."""
@@ -606,8 +621,9 @@ class Shooting:
                 self.maps.reference(z0, self.maps.of(z0[-self.k:]).trajectory(z0[:-self.k]))
             d = z1 - z0
             t = d / math.sqrt(float(np.dot(w * d, d)))
-            return _corrector(self.maps, 0.5 * (z0 + z1), t, self.tol, self.max_iter,
-                              math.inf)[0]
+            zm = 0.5 * (z0 + z1)
+            return corrected([_newton(self.maps, zm, t, self.tol, self.max_iter, math.inf)],
+                             zm)[0]
 
         for e in orbit_events(a, b, 0, self.maps.autonomous, self.decided):
             if e.kind in ("stick-onset", "grazing"):

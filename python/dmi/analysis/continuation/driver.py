@@ -44,9 +44,14 @@ protocol the driver tests with ``isinstance``:
 - :class:`OnCurrent`: ``on_current(x, p) -> x | None``, the previous point re-solved on the
   current unknowns after ``adapt`` changed their number (events between points of different
   sizes are located there; without it they are not sought).
-- :class:`OwnCorrector`: ``correct(x, p, row, target, far) -> (x, p, iterations)``, the
-  shooting's Newton-Picard corrector (its own contraction test and fallback); it raises to
-  refuse the step.
+- :class:`HasStrategies`: ``strategies(x, p, row, target, far) -> iterable of
+  :class:`~dmi.analysis.core.newton.Strategy``, the linear-solve strategies the driver's
+  corrector tries in order on the hyperplane row . z = target through the predictor (x, p)
+  (``far``: the step, the distance an iterate may stray; inf off a step), the next after one
+  fails (from the predictor, or the start it names; e.g. shooting's Newton-Picard, then
+  Newton-GMRES); an iterable may be lazy and build the next from what the failed one left.
+  Without it, Newton with the bordered Jacobian.  There is no corrector of a discretisation's
+  own: what it checks of a converged point goes through ``accept``.
 
 Options are values: :class:`ContinuationOptions` (step control, predictor, the corrector's
 :class:`~dmi.analysis.core.newton.NewtonOptions`).
@@ -63,9 +68,11 @@ direction) and :func:`bisect_along` (a predicate, e.g. a stick pattern).
   no Jacobian a step for discretisations whose Jacobian is an operator.
 - Corrector: Newton (:func:`~dmi.analysis.core.newton.newton_loop`) on (residual(x, p),
   <w t, z - z_pred>) with the bordered Jacobian (:func:`~dmi.analysis.core.newton.bordered_solve`),
-  then ``accept`` (or ``recover`` when it fails); shooting's ``correct``.  Converged when |residual|_inf <= tol max(1, |x|_inf) and the last
-  correction is as small.  A corrector that strays more than the step from the predictor is
-  refused (another branch on the hyperplane).
+  or the discretisation's strategies (:func:`corrected`), then ``accept`` (or ``recover`` when
+  it fails).  Converged when |residual|_inf <= tol max(1, |x|_inf) and the last correction
+  is as small.  The iterations the step control counts: those of every strategy tried, at the
+  weight of the one that converged.  A corrector that strays more than the step from the
+  predictor is refused (another branch on the hyperplane).
 - Step control: the step grows by 1.5 after a corrector of at most ``easy`` iterations, halves
   after a failure; the branch ends when it falls below ``min_step``.
 - Corners: when the step has been halved below step / 8, natural steps are tried once (the
@@ -97,8 +104,8 @@ import scipy.sparse
 import scipy.sparse.linalg as sla
 
 from .branch import Branch, Event, EventWarning
-from ..core.newton import (Converge, NewtonOptions, ShootingError, bordered_solve, fmt_residuals,
-                           newton_loop, sparse_bordered)
+from ..core.newton import (Converge, NewtonOptions, ShootingError, Strategy, bordered_solve,
+                           fmt_residuals, sparse_bordered)
 
 #: |dp/ds| below which a branch is vertical: a sign change of dp/ds there is noise, not a fold.
 VERTICAL = 1e-6
@@ -218,12 +225,12 @@ class OnCurrent(Protocol):
 
 
 @runtime_checkable
-class OwnCorrector(Protocol):
-    """Shooting's Newton-Picard corrector."""
+class HasStrategies(Protocol):
+    """The linear-solve strategies of the driver's corrector."""
 
-    def correct(self, x: np.ndarray, p: float, row: np.ndarray, target: float, far: float
-                ) -> tuple[np.ndarray, float, int]:
-        """(x, p, iterations) on row . (x, p) = target near (x, p); raises to refuse."""
+    def strategies(self, x: np.ndarray, p: float, row: np.ndarray, target: float, far: float
+                   ) -> Iterable[Strategy]:
+        """The strategies on row . (x, p) = target from the predictor (x, p), in order."""
 
 
 def _required(disc: Any) -> None:
@@ -446,10 +453,11 @@ def newton_corrector(curve: Curve, zp: np.ndarray, row: np.ndarray, target: floa
                      options: NewtonOptions | None = None, *, far: float = math.inf,
                      what: str = "corrector",
                      scale: Callable[[np.ndarray], float] | None = None,
-                     tol: float | None = None, max_iter: int | None = None
-                     ) -> tuple[np.ndarray, int]:
-    """Newton on (residual(z), row . z - target) = 0 from zp with the bordered Jacobian: the
-    one corrector of :mod:`dmi.analysis`.
+                     tol: float | None = None, max_iter: int | None = None,
+                     strategies: Iterable[Strategy] | None = None) -> tuple[np.ndarray, int]:
+    """Newton on (residual(z), row . z - target) = 0 from zp with the bordered Jacobian, or
+    with the discretisation's ``strategies`` (:func:`corrected`): the one corrector of
+    :mod:`dmi.analysis`.
 
     Parameters
     ----------
@@ -472,11 +480,13 @@ def newton_corrector(curve: Curve, zp: np.ndarray, row: np.ndarray, target: floa
         z -> the tolerance's scale (default max(1, |x|_inf)).
     tol, max_iter : float, int, optional
         Replace the options' (the keywords of the corrector before its options were a value).
+    strategies : iterable of Strategy, optional
+        Tried in order in place of the bordered Newton (their own options, checks and scales).
 
     Returns
     -------
     tuple
-        (z, iterations).
+        (z, iterations: with strategies, as :func:`corrected` counts them).
 
     Raises
     ------
@@ -484,6 +494,20 @@ def newton_corrector(curve: Curve, zp: np.ndarray, row: np.ndarray, target: floa
         No convergence, no progress, a singular Jacobian, non-finite values, or an iterate
         farther than ``far`` (every residual listed).
     """
+    if strategies is not None:
+        return corrected(strategies, zp)
+    return corrected([newton_strategy(curve, zp, row, target, options, far=far, what=what,
+                                      scale=scale, tol=tol, max_iter=max_iter)], zp)
+
+
+def newton_strategy(curve: Curve, zp: np.ndarray, row: np.ndarray, target: float,
+                    options: NewtonOptions | None = None, *, far: float = math.inf,
+                    what: str = "corrector",
+                    scale: Callable[[np.ndarray], float] | None = None,
+                    tol: float | None = None, max_iter: int | None = None) -> Strategy:
+    """The driver's own linear-solve strategy (the arguments of :func:`newton_corrector`): the
+    bordered Jacobian [[J_x, J_p], [row]] solved by
+    :func:`~dmi.analysis.core.newton.bordered_solve`, the iterates kept within ``far`` of zp."""
     o = options or NewtonOptions(converge=Converge.BOTH)
     o = o.but(**{k: v for k, v in (("tol", tol), ("max_iter", max_iter)) if v is not None})
     res: list[float] = []
@@ -507,17 +531,35 @@ def newton_corrector(curve: Curve, zp: np.ndarray, row: np.ndarray, target: floa
             raise ShootingError(f"{what}: the corrector strayed {curve.norm(z - zp):.3g} > "
                                 f"{far:.3g} from the predictor", res)
 
-    z, _ = newton_loop(evaluate, factor, zp, o, what=what, check=check,
-                       scale=scale or (lambda z: max(1.0, float(np.max(np.abs(z[:-1]))))),
-                       history=res)
-    return z, len(res) - 1
+    return Strategy(evaluate, factor, o, what, check=check, history=res,
+                    scale=scale or (lambda z: max(1.0, float(np.max(np.abs(z[:-1]))))))
+
+
+def corrected(strategies: Iterable[Strategy], zp: np.ndarray) -> tuple[np.ndarray, int]:
+    """The corrector's loop over its linear-solve strategies: each run by
+    :func:`~dmi.analysis.core.newton.newton_loop` from its start (default the predictor zp);
+    after a failure of one of its ``retry`` types the next is tried, any other failure refuses
+    the point.  Returns (z, iterations): those of every strategy tried, times the weight of the
+    one that converged, rounded up.  Raises the last failure when none converges."""
+    total = 0
+    last: BaseException = ShootingError("corrector: no linear-solve strategy", [])
+    for s in strategies:
+        try:
+            z, res = s.run(zp)
+        except s.retry as e:
+            total += max(0, len(s.history) - 1)
+            last = e
+            continue
+        total += len(res) - 1
+        return z, math.ceil(s.weight * total)
+    raise last
 
 
 #: The optional hooks: the name a run's ``has`` table gives each, and its protocol.
 HOOKS = {"events": HasEvents, "describe": Describes, "corner": Corners, "accept": Accepts,
          "recover": Recovers, "adapt": Adapts, "carry": Carries, "orient": Orients,
          "start_tangent": StartsTangent, "between": Between, "on_current": OnCurrent,
-         "correct": OwnCorrector}
+         "strategies": HasStrategies}
 
 
 class _Run:
@@ -532,16 +574,17 @@ class _Run:
 
     def correct(self, zp: np.ndarray, row: np.ndarray, target: float, far: float
                 ) -> tuple[np.ndarray, int]:
-        """The point on row . z = target near zp: Newton's (then the discretisation's
-        ``accept``, or its ``recover`` where Newton fails), or shooting's own corrector."""
+        """The point on row . z = target near zp: Newton's, with the discretisation's
+        strategies where it has them (then its ``accept``, or its ``recover`` where Newton
+        fails)."""
         disc = self.disc
-        if self.has["correct"]:
-            x, p, its = disc.correct(zp[:-1].copy(), float(zp[-1]), row, target, far)
-            return np.concatenate([np.asarray(x, dtype=float), [float(p)]]), int(its)
         step = math.isfinite(far)
         try:
+            tries = disc.strategies(zp[:-1].copy(), float(zp[-1]), row, target, far) \
+                if self.has["strategies"] else None
             z, its = newton_corrector(self.curve, zp, row, target, self.newton, far=far,
-                                      what=f"corrector near p = {float(zp[-1])!r}")
+                                      what=f"corrector near p = {float(zp[-1])!r}",
+                                      strategies=tries)
         except (ShootingError, ValueError) as e:   # ValueError: the residual refuses z
             if not self.has["recover"]:
                 raise

@@ -7,11 +7,12 @@ a continuation's parameter p; a phase condition, an amplitude condition, an arcl
 :func:`bordered_newton`, of which :func:`newton` is the case without extra unknowns, with a
 damped step.  It, collocation's sparse-LU Newton, the continuation driver's corrector
 (:func:`dmi.analysis.continuation.driver.newton_corrector`) and shooting's Newton-Picard (its
-reduced system the linear solve, its contraction test the convergence test) run
-:func:`newton_loop`, the one Newton loop, each with its own linear solve, its options a value
-(:class:`NewtonOptions`: the convergence test :class:`Converge` or a callable, the line search
-:class:`Search`).  Their bordered systems are solved by :func:`bordered_solve` (dense LU,
-SuperLU, or GMRES on an operator), the one bordered solve.
+reduced system the linear solve, its contraction test the convergence test; a
+:class:`Strategy` the driver's corrector tries) run :func:`newton_loop`, the one Newton loop,
+each with its own linear solve, its options a value (:class:`NewtonOptions`: the convergence
+test :class:`Converge` or a callable, the line search :class:`Search`).  Their bordered
+systems are solved by :func:`bordered_solve` (dense LU, SuperLU, or GMRES on an operator), the
+one bordered solve.
 
 Every iteration's residual is kept; an iteration gives up when the residual has made no new
 minimum in :data:`NO_PROGRESS` iterations (the semismooth Newton may rise once on its way into
@@ -482,6 +483,32 @@ def _no_conditions(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.empty(0), np.empty((0, z.size))
 
 
+@dataclasses.dataclass
+class Strategy:
+    """One linear-solve strategy of :func:`newton_loop`: what the loop takes (the residual, the
+    linear solve, the options, the iterates' check and the tolerance's scale), where it starts
+    (None: the corrector's predictor), the weight its iterations count for a continuation's step
+    control, and the failures after which a corrector tries its next strategy (others refuse the
+    point).  ``history``: the residuals of its run, one an iteration."""
+    evaluate: Callable[[np.ndarray], tuple[np.ndarray, Any]]
+    factor: Callable[[np.ndarray, np.ndarray, Any], Solve]
+    options: NewtonOptions
+    what: str
+    name: str = "newton"
+    weight: float = 1.0
+    start: np.ndarray | None = None
+    check: Callable[[np.ndarray], None] | None = None
+    scale: Callable[[np.ndarray], float] | None = None
+    retry: tuple[type[BaseException], ...] = (Exception,)
+    history: list[float] = dataclasses.field(default_factory=list)
+
+    def run(self, z0: np.ndarray) -> tuple[np.ndarray, list[float]]:
+        """:func:`newton_loop` from ``start`` (or z0); returns (z, the residuals)."""
+        return newton_loop(self.evaluate, self.factor, z0 if self.start is None else self.start,
+                           self.options, what=self.what, check=self.check, scale=self.scale,
+                           history=self.history)
+
+
 def bordered_newton(maps: Callable[[np.ndarray], Callable[[np.ndarray], np.ndarray]],
                     z0: np.ndarray, k: int,
                     conditions: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], *,
@@ -492,17 +519,35 @@ def bordered_newton(maps: Callable[[np.ndarray], Callable[[np.ndarray], np.ndarr
                     singular: tuple[str, str] = ("the bordered Jacobian is singular", ""),
                     far: str = "") -> tuple[np.ndarray, list[float]]:
     """Newton on z = (x, q), q the last k >= 0 values: F_q(x) - x = 0 and the k equations
+    ``conditions(z)``: the strategy of :func:`map_strategy` run from z0.  Returns (z,
+    residuals); raises ShootingError as :func:`map_strategy` says."""
+    return map_strategy(maps, np.asarray(z0).size, k, conditions, tol=tol, max_iter=max_iter,
+                        what=what, steps=steps, check=check, rtol=rtol, search=search,
+                        hint=hint, singular=singular, far=far).run(z0)
+
+
+def map_strategy(maps: Callable[[np.ndarray], Callable[[np.ndarray], np.ndarray]],
+                 size: int, k: int,
+                 conditions: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], *,
+                 tol: float = 1e-10, max_iter: int = 30, what: str = "x = F_q(x)",
+                 steps: np.ndarray | None = None,
+                 check: Callable[[np.ndarray], None] | None = None, rtol: float = 1e-8,
+                 search: bool = False, hint: str = "",
+                 singular: tuple[str, str] = ("the bordered Jacobian is singular", ""),
+                 far: str = "", start: np.ndarray | None = None) -> Strategy:
+    """Newton on z = (x, q), q the last k >= 0 values: F_q(x) - x = 0 and the k equations
     ``conditions(z) -> (g (k,), rows (k, dim + k))`` (values and their linearisation), by
     :func:`bordered_step` (GMRES to ``rtol``; dF/dq by one forward difference of ``steps`` (k,)
     a column, default 1e-7 max(1, |q_j|)).  ``maps(q)`` is the map at q; a map that fails
     (a dmi.Error) is a ShootingError naming the iteration (and ``far``).  ``search``: the step
     halved (at most 5 times) while it makes the residual 100 times worse.  ``check(z)``: called
     on each new iterate, raises to stop (a step outside the model's range).  Converged when
-    |F(x) - x|_inf and |g|_inf are <= tol max(1, |x|_inf).  Returns (z, residuals); raises
+    |F(x) - x|_inf and |g|_inf are <= tol max(1, |x|_inf).  Returns the :class:`Strategy`
+    (from ``start``, default the caller's z0); its run returns (z, residuals) and raises
     ShootingError with every residual tried (no new least residual in NO_PROGRESS iterations
     (``hint`` appended), a singular bordered system (``singular``: what, and why appended),
     non-finite values, max_iter reached)."""
-    dim = np.asarray(z0).size - k
+    dim = size - k
     res: list[float] = []
 
     def ev(q: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -537,5 +582,5 @@ def bordered_newton(maps: Callable[[np.ndarray], Callable[[np.ndarray], np.ndarr
 
     options = NewtonOptions(tol=tol, max_iter=max_iter, hint=hint, far=far,
                             search=Search.GUARD if search else Search.NONE)
-    return newton_loop(evaluate, factor, z0, options, what=what, check=check,
-                       scale=lambda z: max(1.0, float(np.max(np.abs(z[:dim])))), history=res)
+    return Strategy(evaluate, factor, options, what, start=start, check=check,
+                    scale=lambda z: max(1.0, float(np.max(np.abs(z[:dim])))), history=res)

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -52,8 +52,8 @@ from ..collocation.orbit import EquationOrbit, equation_orbit
 from ..collocation.system import CollocationWarning, Layout, Terms, full_jacobian, reference
 from ..continuation.branch import Branch, Curve, CurveEvent, Event
 from ..continuation.driver import Curve as DriverCurve
-from ..continuation.driver import continuation, newton_corrector
-from ..core.newton import ShootingError, bordered_solve, newton_loop, sparse_bordered
+from ..continuation.driver import continuation, newton_strategy
+from ..core.newton import ShootingError, Strategy, bordered_solve, newton_loop, sparse_bordered
 from ..scheme.problem import Problem
 from ..scheme.stepmap import build
 
@@ -251,27 +251,30 @@ class OrbitFold:
                            stall=False)
         return y
 
-    def correct(self, y: np.ndarray, q: float, row: np.ndarray, target: float, far: float
-                ) -> tuple[np.ndarray, float, int]:
-        """The driver's Newton corrector, then the orbit's inequalities checked: an orbit that
-        breaks its signature is refused (the curve does not cross signatures yet)."""
+    def strategies(self, y: np.ndarray, q: float, row: np.ndarray, target: float, far: float
+                   ) -> Iterator[Strategy]:
+        """The driver's Newton strategy (:func:`newton_strategy`), after refusing a step past a
+        Bautin point (the curve turned back in q where its orbits shrink)."""
         if math.isfinite(far) and _turned_small(self._track):   # no step past a Bautin point
             self.breach = ("the curve turned back in q where its orbits shrink to the "
                            "equilibrium (a Bautin point)")
             raise ShootingError(self.breach, [])
-        z, its = newton_corrector(DriverCurve(self, y.size), np.concatenate([y, [q]]), row,
-                                  target, tol=self.tol, max_iter=self.max_iter, far=far,
-                                  what=f"the orbits' fold near q = {q!r}")
-        yz, qz = z[:-1], float(z[-1])
-        x, p = yz[:-1], float(yz[-1])
-        bad = check_inequalities(self.lay, self.terms(p, qz), x,
+        yield newton_strategy(DriverCurve(self, y.size), np.concatenate([y, [q]]), row, target,
+                              tol=self.tol, max_iter=self.max_iter, far=far,
+                              what=f"the orbits' fold near q = {q!r}")
+
+    def accept(self, y: np.ndarray, q: float, step: bool) -> tuple[np.ndarray, float]:
+        """The orbit's inequalities checked: an orbit that breaks its signature is refused (the
+        curve does not cross signatures yet)."""
+        x, p = y[:-1], float(y[-1])
+        bad = check_inequalities(self.lay, self.terms(p, q), x,
                                  1e-9 * max(1.0, float(np.max(np.abs(x)))))
         if bad:
-            self.breach = (f"near (p, q) = ({p:.10g}, {qz:.10g}) the fold's orbit breaks its "
+            self.breach = (f"near (p, q) = ({p:.10g}, {q:.10g}) the fold's orbit breaks its "
                            f"signature ({bad[0]}): a stick onset or grazing meets the fold "
                            "curve there (curves across signatures are not continued yet)")
             raise ShootingError(self.breach, [])
-        return yz, qz, its
+        return y, q
 
     def adapt(self, y: np.ndarray, q: float) -> np.ndarray:
         """Between steps: the borders moved to the point's v and w, the mesh equidistributed
