@@ -275,6 +275,8 @@ def continue_over(q_values: Sequence[float], branches: Callable[[float], Any], *
     ValueError
         ``q_values`` empty, not one-dimensional, not finite or with a value twice; ``branches``
         not callable.
+    TypeError
+        ``client`` given and ``branches`` cannot be sent to it (pickle).
 
     Examples
     --------
@@ -294,8 +296,6 @@ def continue_over(q_values: Sequence[float], branches: Callable[[float], Any], *
         client = make_client(None, address, security(address, ca_file, cert_file, key_file))
         grid = continue_over(np.linspace(q0, q1, 40), branches, client=client)
         plot_curves(curves, grid, html="map.html")
-    TypeError
-        ``client`` given and ``branches`` cannot be sent to it (pickle).
     """
     Q = np.array(q_values, dtype=float, ndmin=1)
     if Q.ndim != 1 or Q.size == 0 or not np.all(np.isfinite(Q)):
