@@ -13,6 +13,7 @@ import signal
 import subprocess
 import time
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -151,6 +152,12 @@ def test_prefix_processes_are_found_and_stopped(tmp_path):
     child = subprocess.Popen(["sleep", "60"], env=dict(os.environ, WINEPREFIX=prefix))
     other = subprocess.Popen(["sleep", "60"], env=dict(os.environ, WINEPREFIX=prefix + "x"))
     try:
+        # until both have exec'd, /proc/<pid>/environ is still this process's environment
+        for _ in range(100):
+            if all(Path(f"/proc/{p.pid}/cmdline").read_bytes().startswith(b"sleep")
+                   for p in (child, other)):
+                break
+            time.sleep(0.05)
         assert prefix_processes(prefix) == [child.pid]
         stop([child.pid], signal.SIGTERM)
         assert child.wait(timeout=10) == -signal.SIGTERM
