@@ -129,6 +129,17 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
+def _interrupted(signum: int, frame) -> None:
+    raise KeyboardInterrupt(f"signal {signum}")
+
+
+def pytest_configure(config):
+    """A SIGTERM (ctest stopping the run, a cancelled CI job) ends the session as Ctrl-C does:
+    pytest then tears the active fixtures down, so that ``processes`` stops what the tests
+    started (the default action would end pytest at once and leave them running)."""
+    signal.signal(signal.SIGTERM, _interrupted)
+
+
 class Processes:
     """Processes started by a test, each in its own process group, and the log files they write;
     stop() ends each process by its pid (SIGTERM, then SIGKILL), then its group (what it started),
