@@ -417,8 +417,9 @@ def _doubled(a: BranchPoint, b: BranchPoint, branch: Branch, amplitudes: tuple[f
     v = (Q @ Y[:, j]).real
     v /= np.max(np.abs(v))
     amp = max(float(np.max(q.amplitude)), 0.1 * max(1.0, float(np.max(np.abs(x)))))
-    make = branch.make
-    if branch.period is not None:   # make(p) at the branch's step period(p) / M unless h is given
+    if branch.period is None:
+        make = branch.make
+    else:   # make(p) at the branch's step period(p) / M unless h is given
         def make(p: float, h: float | None = None) -> Solver:
             return branch.make(p, h=maps.step(p) if h is None else h)  # type: ignore[call-arg]
     tried = []

@@ -35,7 +35,7 @@ from ..core.newton import (NewtonOptions, ShootingError, Strategy, bordered_step
                            fd_eps, map_strategy)
 from .events import orbit_events, stick_profile
 from ..scheme.problem import AutonomousMaps, Problem, phase_row, velocity
-from ..scheme.stepmap import Model, StepMap, build, fixed_step, positive_time
+from ..scheme.stepmap import Model, StepMap, fixed_step, positive_time
 
 def orbit_point(F: StepMap, x: np.ndarray, multipliers: int, sections: int, dpds: float,
            iterations: int, margins: bool = True, warm: list | None = None,
