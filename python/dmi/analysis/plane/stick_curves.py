@@ -508,7 +508,7 @@ class StickBoundary:
         fa, fb = a.fold_test, b.fold_test
         if not (math.isfinite(fa) and math.isfinite(fb)) or fa * fb >= 0:
             return []
-        span = f"the fold test changes sign between q = {a.q!r} and {b.q!r}"
+        span = f"the fold test changes sign in the step from q = {a.q!r}"
         try:
             z = fold_crossing(self, zb)
         except (ShootingError, ValueError) as e:
@@ -601,6 +601,13 @@ def _start(start: Any, make2: Callable[[float, float], Solver], q0: float, branc
         raise ValueError("continue_stick_curve: neither orbit around the event has an "
                          "inequality that breaks towards the other's signature")
     p_event, why = float(start.p), []
+    a, b = _sides(start, branch)[0]
+    lo, hi = sorted((float(a.p), float(b.p)))
+    near = START_TOL * max(1.0, abs(p_event))
+    if "not located" in start.detail:   # the branch's bracket, widened by its width each side
+        lo, hi = lo - (hi - lo), hi + (hi - lo)
+    else:
+        lo, hi = p_event - near, p_event + near
     for _, mine, lay, x, m in sorted(tries, key=lambda t: t[0]):
         disc = StickBoundary(make2, lay, x, m, start.kind, jumps=tuple(mine.kernel_jumps),
                              **options)
@@ -609,12 +616,13 @@ def _start(start: Any, make2: Callable[[float, float], Solver], q0: float, branc
         except (ShootingError, ValueError) as e:
             why.append(f"{m.describe()}: {e}")
             continue
-        if abs(float(y0[-1]) - p_event) <= START_TOL * max(1.0, abs(p_event)):
+        if lo <= float(y0[-1]) <= hi:
             disc.y0 = y0
             return disc
         why.append(f"{m.describe()}: at p = {float(y0[-1])!r}")
     raise ValueError(f"continue_stick_curve: no boundary of make2(., q0 = {q0!r}) at the "
-                     f"event's p = {p_event!r} (is make2(p, q0) the branch's model make(p)?): "
+                     f"event's p = {p_event!r} (in [{lo!r}, {hi!r}]; is make2(p, q0) the "
+                     "branch's model make(p)?): "
                      + "; ".join(why))
 
 
