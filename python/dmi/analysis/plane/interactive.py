@@ -14,7 +14,8 @@ from typing import Any
 import numpy as np
 
 from ..plot.interactive import _bokeh, _plain, _write, number
-from .style import CRITICALITY_DASH, EVENT_MARKERS, REGION_COLORS, curve_pieces, region_boxes
+from .style import (CRITICALITY_DASH, EVENT_MARKERS, REGION_COLORS, curve_pieces,
+                    curve_regions, curve_style, p_range, region_boxes)
 
 #: Bokeh's dash for matplotlib's.
 _DASH = {"-": "solid", "--": "dashed", ":": "dotted", "-.": "dashdot"}
@@ -80,12 +81,17 @@ def diagram_html(curves: Sequence[Any], grid: Any, path: str | os.PathLike | Non
                          legend_field="region")
         fig.add_tools(HoverTool(renderers=[quads], name="region_hover", tooltips=[
             ("region", "@region"), ("q", "@q_text"), ("p", "@p_text")]))
+    _curve_regions(fig, curves, grid)
     for k, c in enumerate(curves):
         for j, (p, q, crit) in enumerate(curve_pieces(c)):
-            dash = _DASH[CRITICALITY_DASH[crit] if c.kind == "hopf" else "-."]
-            fig.line(p, q, color="black", line_width=2, line_dash=dash,
-                     legend_label=(f"Hopf curve ({crit or 'not decided'})" if c.kind == "hopf"
-                                   else "fold curve"))
+            if c.kind == "hopf":
+                fig.line(p, q, color="black", line_width=2,
+                         line_dash=_DASH[CRITICALITY_DASH[crit]],
+                         legend_label=f"Hopf curve ({crit or 'not decided'})")
+            else:
+                color, ls, label = curve_style(c.kind)
+                fig.line(p, q, color=color, line_width=2, line_dash=_DASH[ls],
+                         legend_label=label)
         pts = c.points
         src = ColumnDataSource({
             "p": np.asarray(c.p, float), "q": np.asarray(c.q, float),
@@ -135,3 +141,20 @@ def diagram_html(curves: Sequence[Any], grid: Any, path: str | os.PathLike | Non
     fig.legend.location = "top_left"
     fig.legend.click_policy = "hide"
     return _write(fig, path, fig.title.text)
+
+
+def _curve_regions(fig: Any, curves: Sequence[Any], grid: Any) -> None:
+    """The regions the curves decide, as patches (hovering one shows its name)."""
+    from bokeh.models import ColumnDataSource, HoverTool
+
+    regions = curve_regions(list(curves), p_range(list(curves), grid))
+    if not regions:
+        return
+    src = ColumnDataSource({"xs": [list(p) for _, p, _ in regions],
+                            "ys": [list(q) for _, _, q in regions],
+                            "color": [REGION_COLORS[n] for n, _, _ in regions],
+                            "region": [f"{n} (from the curves)" for n, _, _ in regions]},
+                           name="curve_regions")
+    r = fig.patches("xs", "ys", source=src, fill_color="color", line_color=None,
+                    fill_alpha=0.85, legend_field="region", name="curve_region_patches")
+    fig.add_tools(HoverTool(renderers=[r], tooltips=[("region", "@region")]))

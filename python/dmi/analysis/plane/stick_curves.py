@@ -251,6 +251,10 @@ class StickCurvePoint:
     fold_test : float
         det F_x's sign times the fold's test function (a fold of the orbits at fixed q where it
         changes sign).
+    side : int
+        Where in p, at this q, the orbits stick (stick onset) or graze into a new signature:
+        +1 at larger p, -1 at smaller (the sign opposite to d m / d p along the orbits' branch
+        at fixed q, m the margin); 0 where that derivative is not computable.
     dqds : float
         The unit tangent's q component.
     """
@@ -261,6 +265,7 @@ class StickCurvePoint:
     p_error: float | None = None
     stable: bool | None = None
     fold_test: float = math.nan
+    side: int = 0
     dqds: float = 0.0
 
     @property
@@ -474,7 +479,19 @@ class StickBoundary:
         orbit = equation_orbit(fine, p, _AtQ(self.make2, q), errors, self.jumps)
         _, t_star = self._margin(y, q)
         return StickCurvePoint(p, float(q), orbit, t_star, p_error, orbit.stable,
-                               self.fold_test(y, q))
+                               self.fold_test(y, q), self.side(y, q))
+
+    def side(self, y: np.ndarray, q: float) -> int:
+        """-sign(d m / d p) along the orbits' branch at fixed q: from the bordered system
+        [[F_x, F_p], [m_x, m_p]] (v, s) = (0, 1), whose s is 1 / (d m / d p)."""
+        J, Fp, row, _, _ = self.parts(y, q)
+        e1 = np.zeros(y.size)
+        e1[-1] = 1.0
+        try:
+            s = float(bordered_solve(J, Fp, row, e1)[-1])
+        except ShootingError:
+            return 0
+        return -int(np.sign(s))
 
     def _solved(self, lay: Layout, terms: Terms, x: np.ndarray) -> Solved:
         return Solved(lay, x, floquet(lay, terms, x, self.count) if self.count > 0 else None)

@@ -284,3 +284,43 @@ def test_refusals(den_hartog_curve):
     with pytest.raises(ValueError, match="no boundary of make2"):
         continue_stick_curve(ev, lambda F, w: den_hartog(F + 0.05, w), W_START, 0.8,
                              branch=br)
+
+
+def test_the_side_where_the_orbits_stick(den_hartog_curve, rotating_curve):
+    # Den Hartog: the orbits stick at smaller forcing; the circles on the belt at smaller mu
+    # while the small (unstable) circles grow as mu falls, at larger mu past the fold crossing
+    # (the large circles grow with mu)
+    assert all(pt.side == -1 for pt in den_hartog_curve[2].points)
+    for pt in rotating_curve[2].points:
+        assert pt.side == (-1 if CB < math.sqrt(pt.q / (2 * abs(C2))) else 1)
+
+
+def test_the_map_draws_the_curve_and_the_bistable_region(rotating_curve, tmp_path):
+    # the Hopf curve mu = mu_H (subcritical for q > 0: c1 = q) and the stick-onset curve, whose
+    # circles are unstable for q > 1/2: the bistable region lies between them there
+    import matplotlib.pyplot as plt
+    _, _, c = rotating_curve
+    mu_h = rotating_hopf()
+    hp = da.hopf(lambda mu: rotating(mu, Q0), mu_h - 0.2, mu_h + 0.2, [0.0, -CB], of="equation")
+    h = da.continue_curve(hp, rotating, Q0, 0.3, u_eq=[0.0, -CB])
+    assert all(pt.criticality == "subcritical" for pt in h.points)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ax = da.plot_curves([h, c], p_label="mu", q_label="q", html=tmp_path / "map.html")
+    (line,) = [ln for ln in ax.get_lines() if ln.get_color() == "#d94801"]
+    assert np.array_equal(line.get_xdata(), c.p)
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert {"stick-onset curve", "bistable (from the curves)",
+            "codimension-two point"} <= set(labels)
+    from dmi.analysis.plane.style import curve_regions
+    (bi,) = [(p, q) for name, p, q in curve_regions([h, c]) if name == "bistable"]
+    p, q = bi
+    k = p.size // 2
+    assert abs(q.min() - 0.5) <= 0.2 and q.max() == 1.0
+    # one side on the Hopf curve, the other on the stick onset's closed form (interpolated)
+    assert np.all(np.abs(p[:k] - mu_h) <= 1e-8)
+    on = np.abs(p[k:] - (mu_h - q[k:] * CB ** 2 - C2 * CB ** 4))
+    assert np.max(on) <= 2e-3
+    text = (tmp_path / "map.html").read_text()
+    assert '"curve_regions"' in text
+    plt.close("all")
