@@ -269,19 +269,19 @@ def test_belt_onset_against_shooting_on_the_slip_phase(belt_curve):
 # ---- refusals ----------------------------------------------------------------------------
 def test_refusals(den_hartog_curve):
     br, ev, _ = den_hartog_curve
-    with pytest.raises(ValueError, match="give a 'stick-onset' or 'grazing' event"):
+    with pytest.raises(ValueError, match="give a 'stick-onset' or 'grazing' event"):   # SC01
         continue_stick_curve(br.points[0], den_hartog, W_START, 0.8, branch=br)
-    with pytest.raises(ValueError, match="needs branch="):
+    with pytest.raises(ValueError, match="needs branch="):   # bad-inputs SC02
         continue_stick_curve(ev, den_hartog, W_START, 0.8)
-    with pytest.raises(ValueError, match="not one of branch.events"):
+    with pytest.raises(ValueError, match="not one of branch.events"):   # SC03
         continue_stick_curve(Event("stick-onset", ev.p, ev.index, 1, ev.detail), den_hartog,
                              W_START, 0.8, branch=br)
-    with pytest.raises(ValueError, match="two different finite values"):
+    with pytest.raises(ValueError, match="two different finite values"):   # SC04
         continue_stick_curve(ev, den_hartog, W_START, W_START, branch=br)
-    with pytest.raises(ValueError, match="step = -1"):
+    with pytest.raises(ValueError, match="step = -1"):   # bad-inputs SC05
         continue_stick_curve(ev, den_hartog, W_START, 0.8, branch=br, step=-1)
     # a model that is not the branch's at q0: no boundary at the event's p
-    with pytest.raises(ValueError, match="no boundary of make2"):
+    with pytest.raises(ValueError, match="no boundary of make2"):   # bad-inputs SC06
         continue_stick_curve(ev, lambda F, w: den_hartog(F + 0.05, w), W_START, 0.8,
                              branch=br)
 
