@@ -20,8 +20,11 @@
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
+import importlib.util
 import math
+import shutil
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -324,3 +327,20 @@ def test_the_map_draws_the_curve_and_the_bistable_region(rotating_curve, tmp_pat
     text = (tmp_path / "map.html").read_text()
     assert '"curve_regions"' in text
     plt.close("all")
+    # hovering the page in headless Chromium (where installed): inside the bistable polygon
+    if importlib.util.find_spec("websocket") is None or shutil.which("chromium") is None:
+        return
+    path = Path(__file__).resolve().parents[3] / "docs" / "browser_check.py"
+    spec = importlib.util.spec_from_file_location("browser_check", path)
+    bc = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bc)
+    b = bc.Browser()
+    try:
+        b.open((tmp_path / "map.html").as_uri())
+        assert b.eval(bc.BOKEH_READY_JS) is not None, "BokehJS did not draw the page"
+        q = 0.8
+        inside = 0.5 * (mu_h + mu_h - q * CB ** 2 - C2 * CB ** 4)
+        hover = bc.hover_text(b, "diagram", inside, q)
+        assert "bistable (from the curves)" in hover, hover
+    finally:
+        b.close()
