@@ -122,11 +122,11 @@ def _curve_regions(fig: Any, curves: Sequence[Any], grid: Any) -> None:
     src = ColumnDataSource({"xs": [list(p) for _, p, _ in regions],
                             "ys": [list(q) for _, _, q in regions],
                             "color": [REGION_COLORS[n] for n, _, _ in regions],
-                            "region": [f"{n} (from the curves)" for n, _, _ in regions]},
+                            "curve_region": [f"{n} (from the curves)" for n, _, _ in regions]},
                            name="curve_regions")
     r = fig.patches("xs", "ys", source=src, fill_color="color", line_color=None,
-                    fill_alpha=0.85, legend_field="region", name="curve_region_patches")
-    fig.add_tools(HoverTool(renderers=[r], tooltips=[("region", "@region")]))
+                    fill_alpha=0.85, legend_field="curve_region", name="curve_region_patches")
+    fig.add_tools(HoverTool(renderers=[r], tooltips=[("region", "@curve_region")]))
 
 
 def _curves(fig: Any, curves: Sequence[Any]) -> None:
