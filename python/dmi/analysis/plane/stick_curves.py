@@ -442,9 +442,9 @@ class StickBoundary:
         return np.concatenate([x, [p]])
 
     def fold_test(self, y: np.ndarray, q: float) -> float:
-        """sign(det F_x) |g|, g the fold's bordered test function (borders the null vectors'
-        approximations at the first point of this layout): its sign changes where the orbit's
-        branch at fixed q folds."""
+        """sign(det F_x) |g|, g the fold's bordered test function with fixed uniform borders
+        (sign(det F_x) = sign(g) sign(det) of the bordered matrix): its sign changes where the
+        orbit's branch at fixed q folds, not where the borders change."""
         x, p = y[:-1], float(y[-1])
         J = full_jacobian(self.lay, self.terms(p, q), x, self.ref)[1]
         m = x.size

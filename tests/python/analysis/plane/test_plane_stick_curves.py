@@ -16,7 +16,8 @@
 #   memory G e^-8s on [0, 4], its tail e^-32): the curve's points against the grazing orbit
 #   solved here by shooting on the smooth slip phase with scipy's DOP853, the memory as a third
 #   state z' = G x - 8 z, at three q.
-# Also the refusals.  About 40 s.
+# Also the map's bistable region between the Hopf and stick-onset curves, and the refusals.
+# About 70 s on a loaded machine.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
