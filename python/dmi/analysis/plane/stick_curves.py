@@ -336,7 +336,6 @@ class StickBoundary:
         self.problem = Problem(make2, keep=KEEP)
         self.breach = ""
         self.t_star = 0.0
-        self._fold: tuple[np.ndarray, np.ndarray] | None = None   # the fold test's borders
         self.y0: np.ndarray | None = None   # the start, solved at q0
 
     @property
@@ -438,7 +437,6 @@ class StickBoundary:
         self.lay = new
         if new.autonomous:
             self.ref = reference(new, x)
-        self._fold = None
         return np.concatenate([x, [p]])
 
     def fold_test(self, y: np.ndarray, q: float) -> float:
@@ -448,10 +446,7 @@ class StickBoundary:
         x, p = y[:-1], float(y[-1])
         J = full_jacobian(self.lay, self.terms(p, q), x, self.ref)[1]
         m = x.size
-        if self._fold is None or self._fold[0].size != m:
-            one = np.full(m, 1.0 / math.sqrt(m))
-            self._fold = (one, one)
-        b, c = self._fold
+        b = c = np.full(m, 1.0 / math.sqrt(m))
         e1 = np.zeros(m + 1)
         e1[-1] = 1.0
         try:
