@@ -32,15 +32,23 @@ What the map shows, each from one call of :mod:`dmi.analysis`:
    unstable orbit grows with :math:`v_b` until the relative velocity touches 0: a *stick onset*,
    where it turns into the stable stick-slip orbit. The grid's events are marked: the Hopf points
    (open: subcritical), the stick onsets (squares), the folds of orbits (triangles).
-3. **The regions**, decided row by row from the verified verdicts of the grid's branches
+3. **The stick-onset curve** by :func:`~dmi.analysis.plane.stick_curves.continue_stick_curve`
+   from the stick-onset event of the orbits' branch at :math:`c = 0.3`: where the unstable
+   slipping orbit's relative velocity touches 0, continued in :math:`c` both ways (its least
+   velocity held at 0 on the slipping orbit; each point with the estimated error of
+   :math:`v_b` and the orbit's verified verdict, unstable all along). The grid's stick-onset
+   events are its cross-check (printed: each row's event against the curve's point on that
+   row's damping).
+4. **The regions**, decided row by row from the verified verdicts of the grid's branches
    (:func:`~dmi.analysis.plot_curves`): *stable rest*; *bistable*, where the stable rest and the
    stable stick-slip orbit coexist, between the subcritical Hopf curve and the stick onset that
    ends the unstable orbit; *stick-slip* below the Hopf curve, where the stick-slip orbit is
-   stable and the rest is not; grey hatched where a verdict is not decided.
+   stable and the rest is not; grey hatched where a verdict is not decided. The curves decide
+   the bistable region too: between the subcritical Hopf curve and the stick-onset curve of the
+   unstable orbit, drawn as a polygon keyed "bistable (from the curves)".
 
-**What is not there yet.** The curves of the orbits' folds and of their stick onset or grazing are
-not continued in two parameters (that is later work): the grid's events give those boundaries as
-points, one per row, and the regions between rows are each row's band. A region is named only where
+**What is not there yet.** The fold curve of the orbits is not drawn here (this belt's unstable
+orbit ends at its stick onset, not at a smooth fold). A region of the grid is named only where
 the verdicts that decide it are verified; an orbit branch of this grid may end before it reaches
 the edge of the map (its status is printed), and beyond its last point nothing is claimed about
 the orbits. ``scripts/main.sh`` runs this example with more rows (``DMI_PLANE_ROWS``) and writes
@@ -56,6 +64,7 @@ import numpy as np
 
 import dmi
 from dmi import analysis
+from dmi.analysis.plane.stick_curves import continue_stick_curve
 
 K, G, TAU = 1.0, 0.5, 1.0                  # stiffness, memory gain, memory length
 MU_S, MU_D, V_S = 0.5, 0.3, 0.3            # static and dynamic friction, Stribeck velocity
@@ -115,7 +124,20 @@ print(f"codimension-two points on the Hopf curve: {len(codim2)}")
 for e in codim2:
     print(f"  {e.kind} at (v_b, c) = ({e.p:.8f}, {e.q:.8f}): {e.detail}")
 
-# 2. the grid of one-parameter continuations over the damping
+# 2. the stick-onset curve from the stick onset of the orbits' branch at c = C0, both ways in c
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")      # the branch's own warnings (printed in the grid below)
+    orbits = branches(C0)["orbits"]
+onset = [e for e in orbits.events if e.kind == "stick-onset"][0]
+sticks = [continue_stick_curve(onset, make2, C0, q_end, branch=orbits, step=0.03,
+                               at=dampings, multipliers=4) for q_end in (0.26, 0.40)]
+for cur in sticks:
+    print(f"stick-onset curve to c = {cur.q[-1]:.4f}: {len(cur.points)} points, {cur.status}; "
+          f"v_b from {cur.p.min():.4f} to {cur.p.max():.4f}; largest estimated error of v_b "
+          f"{max(pt.p_error or math.inf for pt in cur.points):.1e}; the orbits "
+          f"{sorted({str(pt.stable) for pt in cur.points})} stable")
+
+# 3. the grid of one-parameter continuations over the damping
 with warnings.catch_warnings():
     warnings.simplefilter("ignore", analysis.GridWarning)   # each row keeps its warnings
     grid = analysis.continue_over(dampings, branches)
@@ -139,10 +161,22 @@ if gaps:
     print(f"the grid's {len(gaps)} Hopf points against the curve's points at their c: "
           f"largest difference in v_b {max(gaps):.1e}")
 
-# 3. the map
+# the grid's stick onsets against the stick-onset curve's points at their c
+# (a branch's event that could not be located, at a corner of its stick-slip branch, is placed
+# between its two points: counted, not compared)
+on_stick = {round(e.q, 12): e.p for cur in sticks for e in cur.events if e.kind == "user"}
+grid_onsets = [e for e in grid.events("stick-onset") if round(e.q, 12) in on_stick]
+located = [e for e in grid_onsets if "not located" not in e.detail]
+for e in located:
+    print(f"c = {e.q:.4f}: the grid's stick onset at v_b = {e.p:.8f}, the curve's at "
+          f"{on_stick[round(e.q, 12)]:.8f}")
+print(f"the grid's stick onsets not located (placed between two points of their branch): "
+      f"{len(grid_onsets) - len(located)}")
+
+# 4. the map
 fig, ax = plt.subplots(figsize=(8, 6.2), layout="constrained")
 html = os.environ.get("DMI_FIGURE_HTML")
-analysis.plot_curves(curves, grid, ax=ax, p_label="belt speed $v_b$",
+analysis.plot_curves(curves + sticks, grid, ax=ax, p_label="belt speed $v_b$",
                      q_label="damping $c$", html=html,
                      title="the belt with memory and Stribeck friction")
 ax.set_xlim(V_LO, V_HI)

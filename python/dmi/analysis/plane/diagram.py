@@ -9,13 +9,19 @@ on the branches of equilibria, the orbits' on the orbit branches, their sticking
 only at an event of its branch (a Hopf point or fold of the equilibria; a fold, period doubling,
 torus, stick onset or grazing of the orbits); an interval where a verdict that would decide it is
 None is drawn hatched grey, with one :class:`dmi.analysis.StabilityWarning`.  Each row's
-regions fill the band of q half-way to its neighbours.  The curves (Hopf and fold curves of
-equilibria by :func:`dmi.analysis.continue_curve`) are drawn over them: a Hopf curve solid where
-supercritical, dashed where subcritical, dotted where its criticality is not decided; a fold
-curve dash-dotted; their codimension-two points marked.  The grid's events mark where its
-branches met a Hopf point (filled: supercritical, open: subcritical), a fold of orbits, a stick
-onset or a grazing: curves of the orbits' folds and grazing are not computed here, and these
-points are where the map has those boundaries.
+regions fill the band of q half-way to its neighbours.  The curves decide regions too
+(:func:`dmi.analysis.plane.style.curve_regions`): *bistable* between a subcritical Hopf curve
+and the curve that ends the unstable orbit born there (a fold curve of orbits, or a stick-onset or
+grazing curve whose orbits are verified unstable), *stick-slip* on the side of a stick-onset curve
+where its verified stable orbits stick; they are drawn as polygons between the curves, keyed
+"(from the curves)".  The curves are drawn over them: a Hopf curve solid where supercritical,
+dashed where subcritical, dotted where its criticality is not decided; the other kinds by
+:data:`dmi.analysis.plane.style.CURVE_STYLES` (fold curves dash-dotted, stick-onset curves solid
+orange, grazing curves dashed brown, period-doubling and torus curves green); their
+codimension-two points marked, with the crossing of an orbits' fold and a stick-onset curve
+(``"orbit-fold"`` events of a stick-onset curve).  The grid's events mark where its branches met
+a Hopf point (filled: supercritical, open: subcritical), a fold of orbits, a stick onset or a
+grazing: the cross-check of the curves.
 """
 from __future__ import annotations
 
@@ -27,7 +33,11 @@ from typing import Any
 from ..scheme.floquet import StabilityWarning
 from .grid import REGIONS, UNDECIDED, Grid
 from .style import (CRITICALITY_DASH, EVENT_MARKERS, REGION_COLORS, curve_pieces,
-                    region_boxes)
+                    curve_regions, curve_style, p_range, region_boxes)
+
+#: The curve events marked as points of codimension two (with the crossing of an orbits' fold
+#: curve and a stick-onset or grazing curve).
+CODIM2 = ("bautin", "bogdanov-takens", "zero-hopf", "hopf-hopf", "cusp", "orbit-fold")
 
 def _warn_undecided(boxes: list) -> None:
     open_ = [b for b in boxes if b[4] == UNDECIDED]
@@ -48,13 +58,16 @@ def plot_curves(curves: Sequence[Any] = (), grid: Grid | None = None, ax: Any = 
     curves (Hopf curves by criticality, fold curves) with their codimension-two points, and the
     grid's events (Hopf points by criticality, folds of orbits, stick onsets, grazings, period
     doublings, tori).  p on the horizontal axis, q on the vertical one; the key below the axes.
-    Curves of the orbits' folds, stick onsets and grazings are not continued yet: the grid's
-    events are those boundaries, as points, one per row and branch (see the module).
+    The curves decide regions too: bistable between a subcritical Hopf curve and the fold,
+    stick-onset or grazing curve that ends the unstable orbit, stick-slip beside a stick-onset
+    curve of stable orbits (see the module).
 
     Parameters
     ----------
     curves : sequence of Curve
-        From :func:`dmi.analysis.continue_curve` (may be empty).
+        From :func:`dmi.analysis.continue_curve` (may be empty): Hopf and fold curves of
+        equilibria, fold, period-doubling and torus curves of orbits, stick-onset and grazing
+        curves.
     grid : Grid, optional
         From :func:`dmi.analysis.continue_over`: the regions and the events.
     ax : matplotlib.axes.Axes, optional
@@ -101,7 +114,8 @@ def plot_curves(curves: Sequence[Any] = (), grid: Grid | None = None, ax: Any = 
 
     if ax is None:
         _, ax = plt.subplots(figsize=(7.0, 5.4), constrained_layout=True)
-    handles = _draw_regions(ax, boxes) + _draw_curves(ax, curves)
+    handles = (_draw_regions(ax, boxes) + _draw_curve_regions(ax, curves, grid)
+               + _draw_curves(ax, curves))
     if grid is not None:
         handles += _draw_grid_events(ax, grid)
     ax.margins(0.02)
@@ -131,19 +145,36 @@ def _draw_regions(ax: Any, boxes: list) -> list:
             for name in list(REGIONS) + [UNDECIDED] if name in seen]
 
 
+def _draw_curve_regions(ax: Any, curves: list, grid: Grid | None) -> list:
+    """The regions the curves decide (:func:`~dmi.analysis.plane.style.curve_regions`), as
+    polygons under the curves, and their keys."""
+    from matplotlib.patches import Patch
+
+    seen = []
+    for name, p, q in curve_regions(curves, p_range(curves, grid)):
+        ax.fill(p, q, facecolor=REGION_COLORS[name], edgecolor="none", alpha=0.85, zorder=1)
+        if name not in seen:
+            seen.append(name)
+    return [Patch(facecolor=REGION_COLORS[n], label=f"{n} (from the curves)") for n in seen]
+
+
 def _draw_curves(ax: Any, curves: list) -> list:
-    """The curves (Hopf curves dashed by criticality, fold curves dash-dotted) and their
-    codimension-two points, and their keys."""
+    """The curves (Hopf curves dashed by criticality, the others by kind: fold curves
+    dash-dotted, stick-onset and grazing curves in orange) and their codimension-two points,
+    and their keys."""
     from matplotlib.lines import Line2D
 
     kinds = set()
     for c in curves:
         for p, q, crit in curve_pieces(c):
-            ls = CRITICALITY_DASH[crit] if c.kind == "hopf" else "-."
-            ax.plot(p, q, color="black", lw=1.6, ls=ls)
+            if c.kind == "hopf":
+                ax.plot(p, q, color="black", lw=1.6, ls=CRITICALITY_DASH[crit], zorder=3)
+            else:
+                color, ls, _ = curve_style(c.kind)
+                ax.plot(p, q, color=color, lw=1.6, ls=ls, zorder=3)
             kinds.add((c.kind, crit))
         for e in c.events:
-            if e.kind in ("bautin", "bogdanov-takens", "zero-hopf", "hopf-hopf", "cusp"):
+            if e.kind in CODIM2:
                 ax.plot([e.p], [e.q], "P", color="#cb181d", ms=9, zorder=5)
                 ax.annotate(e.kind, (e.p, e.q), textcoords="offset points", xytext=(6, 6),
                             fontsize="small", color="#cb181d")
@@ -153,11 +184,12 @@ def _draw_curves(ax: Any, curves: list) -> list:
         if kind == "hopf":
             handles.append(Line2D([], [], color="black", lw=1.6, ls=CRITICALITY_DASH[crit],
                                   label=f"Hopf curve ({crit or 'criticality not decided'})"))
-        elif kind == "fold":
-            handles.append(Line2D([], [], color="black", lw=1.6, ls="-.", label="fold curve"))
         elif kind == "codim-2":
             handles.append(Line2D([], [], ls="", marker="P", color="#cb181d",
                                   label="codimension-two point"))
+        else:
+            color, ls, label = curve_style(kind)
+            handles.append(Line2D([], [], color=color, lw=1.6, ls=ls, label=label))
     return handles
 
 
