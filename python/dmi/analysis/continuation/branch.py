@@ -345,7 +345,8 @@ class CurveEvent:
         ``"bautin"`` (l1 changes sign on a Hopf curve), ``"zero-hopf"`` (a real root crosses 0 on
         a Hopf curve; a pair crosses the imaginary axis on a fold curve), ``"hopf-hopf"`` (a
         second pair crosses on a Hopf curve), ``"cusp"`` and ``"bogdanov-takens"`` (on a fold
-        curve), or ``"user"``.
+        curve), ``"orbit-fold"`` (a stick-onset or grazing curve crosses a fold of its orbits),
+        or ``"user"``.
     p, q : float
         Where.
     index : int
@@ -369,13 +370,14 @@ class CurveEvent:
 @dataclass
 class Curve:
     """A curve in the plane (p, q) from :func:`dmi.analysis.continue_curve`: a Hopf or fold curve
-    of the equation's equilibria, or a fold of its orbits (``"orbit-fold"``).
+    of the equation's equilibria, a fold of its orbits (``"orbit-fold"``), or where its orbits
+    begin to stick or graze (``"stick-onset"``, ``"grazing"``).
 
     Attributes
     ----------
     kind : str
-        ``"hopf"``, ``"fold"`` or ``"orbit-fold"``.
-    points : list of CurvePoint or OrbitCurvePoint
+        ``"hopf"``, ``"fold"``, ``"orbit-fold"``, ``"stick-onset"`` or ``"grazing"``.
+    points : list of CurvePoint, OrbitCurvePoint or StickCurvePoint
         The points, in the order continued (the last on q_end when it was reached).
     events : list of CurveEvent
         The codimension-two points located on it, and the ``user`` points, in the order met.
