@@ -78,10 +78,12 @@ def mesh_row(o, ref, L: int, m: int) -> None:
     tT = abs(f.T - ref.period)
     k = 1                                          # the largest nontrivial multiplier
     tmu = float(np.min(np.abs(ref.multipliers - f.mu[k])))
+    seen = tmu > 100 * np.spacing(max(1.0, abs(f.mu[k])))       # above 100 ulp
+    mu = (f"{two['multipliers'][k] / tmu:8.3g} | {three['multipliers'][k] / tmu:8.3g}" if seen
+          else f"{'-':>8} | {'-':>8}")
     print(f"{fine.L:4d} x {m} | {tT:9.2e} | {two['period'] / tT:8.3g} | {three['period'] / tT:8.3g}"
-          f" | {tmu:9.2e} | {two['multipliers'][k] / tmu:8.3g} | "
-          f"{three['multipliers'][k] / tmu:8.3g} | {n1}, {t1:.2f} s | {n2}, {t2:.2f} s | "
-          f"{n2s}, {t2s:.2f} s | {n3}, {t3:.2f} s", flush=True)
+          f" | {tmu:9.2e} | {mu} | {n1}, {t1:.2f} s | {n2}, {t2:.2f} s | {n2s}, {t2s:.2f} s | "
+          f"{n3}, {t3:.2f} s", flush=True)
 
 
 def main() -> None:
