@@ -9,14 +9,16 @@ package (:mod:`dmi.analysis.collocation.collocate` and the collocated branch use
   interval (AUTO, COLSYS), :func:`adapted` does so piece by piece of a nonsmooth orbit.
 - The adaptation step (:func:`readapted`): an orbit moved onto its mesh equidistributed again (the
   same intervals), between the steps of a branch.
-- The two-level estimate (:func:`estimate`): the orbit on a mesh and on that mesh with every interval
+- The estimate (:func:`estimate`): the orbit on a mesh and on that mesh with every interval
   halved (:func:`halved`) or every pair merged (:func:`merged`); the difference of their period,
-  amplitudes, multipliers and u is the finer one's error estimate.  An autonomous orbit's two
-  solutions are compared after aligning their phase (:func:`aligned`): its phase is free, and a
-  shift along a steep orbit is no error of its shape.
-- The refinement (:func:`levels`): equidistribute, solve on two levels, grow the mesh until the
-  estimate meets tol, with its stopping rules and the cost check of the delay integral
-  (:func:`check_cost`).
+  amplitudes, multipliers and u is the finer one's error estimate; with a third level (the
+  coarser's mesh merged, its ``coarser``) the period, amplitudes and multipliers by Richardson's
+  extrapolation where the three levels are steady (:func:`extrapolated`).  An autonomous orbit's
+  two solutions are compared after aligning their phase (:func:`aligned`): its phase is free, and
+  a shift along a steep orbit is no error of its shape.
+- The refinement (:func:`levels`): equidistribute, solve on three levels (:func:`two_levels`),
+  grow the mesh until the estimate meets tol (:func:`level_error`), with its stopping rules and
+  the cost check of the delay integral (:func:`check_cost`).
 
 May import: :mod:`.mesh`, :mod:`.signature`, :mod:`.system` (no module of the package above them).
 """
@@ -174,7 +176,8 @@ def extrema(lay: Layout, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 class Solved:
     """A solution on one layout, with its derived quantities: b, T, the amplitudes and the
-    multipliers ``mu`` (given; none by default)."""
+    multipliers ``mu`` (given; none by default), and ``coarser``, the solution on its mesh with
+    pairs merged (the estimate's third level; None unless :func:`two_levels` set it)."""
 
     def __init__(self, lay: Layout, x: np.ndarray, mu: np.ndarray | None = None):
         self.lay, self.x = lay, x
@@ -323,7 +326,8 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
             tol: float, what: str, capped: list[float] | None = None
             ) -> tuple[Solved, Solved]:
     """The orbit on L intervals equidistributed (``fixed``) or refined until the estimate is
-    below tol, and on that mesh halved: (coarser, finer).
+    below tol, and on that mesh halved: (coarser, finer), the coarser with its own ``coarser``
+    (its mesh merged; None where that solve failed).
 
     The refinement stops with a ValueError that names the estimate reached and its mesh when
     the estimate is at its floor (FLOOR times the period or the amplitudes, at least 1), when
