@@ -302,13 +302,14 @@ def two_levels(lay: Layout, terms: Terms, start: tuple[Layout, np.ndarray], ref:
     return c, Solved(fine, xf)
 
 
-def level_error(c: Solved, f: Solved) -> tuple[float, float | None]:
+def level_error(c: Solved, f: Solved) -> tuple[float, float, float | None]:
     """The estimated error of f's period (an autonomous orbit) or largest amplitude error (a
-    forced one), and the order its three levels show (None: two levels, or not steady)."""
+    forced one), the two levels' difference of it, and the order its three levels show (None:
+    two levels, or not steady)."""
+    two = (abs(c.T - f.T) if f.lay.autonomous
+           else float(np.max(np.abs(c.amplitude - f.amplitude))))
     if c.coarser is None:
-        d = (abs(c.T - f.T) if f.lay.autonomous
-             else float(np.max(np.abs(c.amplitude - f.amplitude))))
-        return d, None
+        return two, two, None
     g = c.coarser
     if f.lay.autonomous:
         x = (g.T, c.T, f.T)
@@ -319,7 +320,7 @@ def level_error(c: Solved, f: Solved) -> tuple[float, float | None]:
         d = float(np.max(extrapolated(g.amplitude, c.amplitude, f.amplitude, f.lay.m + 1)))
     d1, d2 = abs(x[0] - x[1]), abs(x[1] - x[2])
     steady = d < d2 and d2 > 0
-    return d, (math.log2(d1 / d2) if steady else None)
+    return d, two, (math.log2(d1 / d2) if steady else None)
 
 
 def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bool,
@@ -343,7 +344,7 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
         c, f = two_levels(lay2, terms, (lay, x), ref, what)
         if fixed:
             return c, f
-        d, seen = level_error(c, f)
+        d, two, seen = level_error(c, f)
         if d <= tol:
             return c, f
         size = f.T if autonomous else float(np.max(np.abs(f.amplitude)))
@@ -358,11 +359,12 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
         # the expected order: the period's h^(2m) (superconvergent), an extremum's h^(m+1)
         expected = 2 * lay.m if autonomous else lay.m + 1
         q = 1.0 if capped else None
-        if last is not None and last[1] > 0:                       # the observed order
-            q = math.log(last[1] / d) / math.log(L / last[0])
+        if last is not None and last[1] > 0:       # the observed order of the two levels' d
+            q = math.log(last[1] / two) / math.log(L / last[0])
             if q < LEAST_ORDER:
-                raise ValueError(f"collocate: the estimated error has stopped falling: it was "
-                                 f"{last[1]:.3g} at {2 * last[0]} intervals, {reached} "
+                raise ValueError(f"collocate: the estimated error has stopped falling: the "
+                                 f"two levels' difference was {last[1]:.3g} at {2 * last[0]} "
+                                 f"intervals and is {two:.3g}; {reached} "
                                  f"(observed order {q:.2g}): tol = {tol!r} is below what this "
                                  "orbit's collocation reaches (the floor of its conditioning); "
                                  f"ask tol >= {last[1]:.2g}, or a higher degree")
@@ -383,7 +385,7 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
         grow = (d / tol) ** (1.0 / expected) * 1.2
         if seen is not None or (q is not None and q > lay.m):
             grow = (d / tol) ** (1.0 / min(seen or q, expected + 2)) * 1.1
-        last = (L, d)
+        last = (L, two)
         L = min(MAX_INTERVALS, max(L + 2, math.ceil(L * min(grow, 8.0))))
         lay, x = f.lay, f.x
         if f.lay.L >= MAX_INTERVALS:
