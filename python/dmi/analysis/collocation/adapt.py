@@ -9,14 +9,16 @@ package (:mod:`dmi.analysis.collocation.collocate` and the collocated branch use
   interval (AUTO, COLSYS), :func:`adapted` does so piece by piece of a nonsmooth orbit.
 - The adaptation step (:func:`readapted`): an orbit moved onto its mesh equidistributed again (the
   same intervals), between the steps of a branch.
-- The two-level estimate (:func:`estimate`): the orbit on a mesh and on that mesh with every interval
+- The estimate (:func:`estimate`): the orbit on a mesh and on that mesh with every interval
   halved (:func:`halved`) or every pair merged (:func:`merged`); the difference of their period,
-  amplitudes, multipliers and u is the finer one's error estimate.  An autonomous orbit's two
-  solutions are compared after aligning their phase (:func:`aligned`): its phase is free, and a
-  shift along a steep orbit is no error of its shape.
-- The refinement (:func:`levels`): equidistribute, solve on two levels, grow the mesh until the
-  estimate meets tol, with its stopping rules and the cost check of the delay integral
-  (:func:`check_cost`).
+  amplitudes, multipliers and u is the finer one's error estimate; with a third level (the
+  coarser's mesh merged, its ``coarser``) the period, amplitudes and multipliers by Richardson's
+  extrapolation where the three levels are steady (:func:`extrapolated`).  An autonomous orbit's
+  two solutions are compared after aligning their phase (:func:`aligned`): its phase is free, and
+  a shift along a steep orbit is no error of its shape.
+- The refinement (:func:`levels`): equidistribute, solve on three levels (:func:`two_levels`),
+  grow the mesh until the estimate meets tol (:func:`level_error`), with its stopping rules and
+  the cost check of the delay integral (:func:`check_cost`).
 
 May import: :mod:`.mesh`, :mod:`.signature`, :mod:`.system` (no module of the package above them).
 """
@@ -28,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from .system import Layout, Terms, evaluate, interval_counts, node_times, reference, solve
+from ..core.newton import ShootingError
 
 #: Mesh refinement rounds at most (intervals=None).
 MAX_ROUNDS = 6
@@ -38,6 +41,14 @@ FLOOR = 1e-11
 #: The least observed order of the refinement's estimate (log of its fall over log of the mesh's
 #: growth): below it the estimate has stopped falling.
 LEAST_ORDER = 0.5
+#: The least observed order (from three levels) a Richardson estimate trusts.
+LEAST_RICHARDSON = 1.0
+#: The coarsest of three levels farther than this (relative, at least 1) from the middle one
+#: is not yet in the asymptotic range (a relaxation oscillation on 18 intervals of degree 6:
+#: 2e-2 off, its order seen 12.6, the true 3).
+ROUGH = 1e-3
+#: The Richardson estimate's safety factor over |d2| / (2^q - 1).
+SAFETY = 8.0
 #: Quadrature nodes of the delay integral at most on one mesh (about 100 bytes each): a memory
 #: spanning many periods (tau / T large) or a very fine mesh is refused before it is built.
 MAX_DELAY_NODES = 2e7
@@ -165,7 +176,8 @@ def extrema(lay: Layout, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 class Solved:
     """A solution on one layout, with its derived quantities: b, T, the amplitudes and the
-    multipliers ``mu`` (given; none by default)."""
+    multipliers ``mu`` (given; none by default), and ``coarser``, the solution on its mesh with
+    pairs merged (the estimate's third level; None unless :func:`two_levels` set it)."""
 
     def __init__(self, lay: Layout, x: np.ndarray, mu: np.ndarray | None = None):
         self.lay, self.x = lay, x
@@ -173,6 +185,7 @@ class Solved:
         hi, lo = extrema(lay, x)
         self.amplitude = 0.5 * (hi - lo)
         self.mu = np.empty(0, complex) if mu is None else mu
+        self.coarser: Solved | None = None
 
 
 def _match(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -182,19 +195,54 @@ def _match(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.min(np.abs(a[:, None] - b[None, :]), axis=1)
 
 
-def estimate(c: Solved, f: Solved, reached: float = 0.0) -> dict[str, Any]:
-    """The differences of the two levels: the finer's error estimate (each plus ``reached``,
-    the accuracy of a coarse solve stopped at its rounding floor, in the units of x).  ``u``
-    compares the two at equal phase theta = t / T, an autonomous orbit's after aligning its
-    phase (:func:`aligned`)."""
+def extrapolated(x0: Any, x1: Any, x2: Any, most: float) -> Any:
+    """The error estimate of x2 from three levels of one quantity, the mesh halved from each to
+    the next (Richardson's): d1 = x0 - x1 and d2 = x1 - x2 fall by 2^q; where they have one sign
+    and the observed order q is in [LEAST_RICHARDSON, ``most`` + 1] (``most`` the theory's)
+    while x0 is within ROUGH of x1 (relative, at least 1), SAFETY |d2| / (2^q' - 1) with q' = q
+    capped at ``most``, at most |d2|; elsewhere |d2| (the two-level difference: the coarsest
+    level is not yet in the asymptotic range).  On equidistributed meshes the order seen between
+    levels swings (6 to 9 for the period at degree 4): SAFETY covers a local order up to 3 below
+    the one seen."""
+    d1 = np.abs(np.asarray(x0) - np.asarray(x1))
+    d2 = np.abs(np.asarray(x1) - np.asarray(x2))
+    same = np.real(np.conj(np.asarray(x0) - np.asarray(x1)) * (np.asarray(x1) - np.asarray(x2))) > 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        q = np.log2(d1 / d2)
+    near = d1 <= ROUGH * np.maximum(1.0, np.abs(np.asarray(x1)))
+    trusted = same & near & np.isfinite(q) & (q >= LEAST_RICHARDSON) & (q <= most + 1.0)
+    qq = np.minimum(np.where(trusted, q, 1.0), most)
+    est = np.where(trusted, np.minimum(d2, SAFETY * d2 / (2.0 ** qq - 1.0)), d2)
+    return est if np.ndim(est) else float(est)
+
+
+def estimate(c: Solved, f: Solved, reached: float = 0.0,
+             coarser: Solved | None = None) -> dict[str, Any]:
+    """The finer's error estimate (each plus ``reached``, the accuracy of a coarse solve
+    stopped at its rounding floor, in the units of x): the differences of the two levels, or
+    with a third level (``coarser``, default ``c.coarser``: c's mesh with pairs merged) the
+    period, amplitudes and multipliers (where the coarser has them) by :func:`extrapolated`.
+    ``u`` compares the two at equal phase theta = t / T, an autonomous orbit's after aligning
+    its phase (:func:`aligned`)."""
     theta = np.linspace(0.0, 1.0, 40 * f.lay.L, endpoint=False)
     fine = evaluate(f.lay, f.x, theta * f.T)
     shift = aligned(c, theta[::5], fine[::5]) if f.lay.autonomous else 0.0    # 8 an interval
     du = float(np.max(np.abs(evaluate(c.lay, c.x, (theta + shift) * c.T) - fine)))
-    return with_floor({"period": abs(c.T - f.T) + reached,
-                       "amplitude": np.abs(c.amplitude - f.amplitude) + reached,
-                       "multipliers": _match(f.mu, c.mu) + reached, "u": du + reached},
-                      f.T, f.amplitude, f.mu, float(np.max(np.abs(f.x[:f.lay.rows * f.lay.n]))))
+    errors = {"period": abs(c.T - f.T), "amplitude": np.abs(c.amplitude - f.amplitude),
+              "multipliers": _match(f.mu, c.mu), "u": du}
+    g = coarser if coarser is not None else c.coarser
+    if g is not None:
+        m = f.lay.m
+        errors["period"] = extrapolated(g.T, c.T, f.T, 2 * m)
+        errors["amplitude"] = extrapolated(g.amplitude, c.amplitude, f.amplitude, m + 1)
+        if f.mu.size and g.mu.size and c.mu.size:
+            mc = c.mu[np.argmin(np.abs(f.mu[:, None] - c.mu[None, :]), axis=1)]
+            mg = g.mu[np.argmin(np.abs(mc[:, None] - g.mu[None, :]), axis=1)]
+            errors["multipliers"] = extrapolated(mg, mc, f.mu, 2 * m)
+    for k in errors:
+        errors[k] = errors[k] + reached
+    return with_floor(errors, f.T, f.amplitude, f.mu,
+                      float(np.max(np.abs(f.x[:f.lay.rows * f.lay.n]))))
 
 
 def aligned(c: Solved, theta: np.ndarray, target: np.ndarray, rounds: int = 8) -> float:
@@ -232,20 +280,55 @@ def with_floor(errors: dict[str, Any], T: float, amplitude: np.ndarray, mu: np.n
     return errors
 
 
-def two_levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, what: str
+def two_levels(lay: Layout, terms: Terms, start: tuple[Layout, np.ndarray], ref: Any, what: str
                ) -> tuple[Solved, Solved]:
-    """The orbit on ``lay`` (from x on another layout) and on ``lay`` halved."""
-    xc, _ = solve(lay, terms, x, ref, what=what)
+    """The orbit on ``lay`` (from ``start``, a solution on another layout) and on ``lay``
+    halved (from the first's solution, or where Newton fails from there, from ``start``), the
+    first with its ``coarser`` level: ``lay`` with pairs merged (from the first's solution; None
+    where that solve fails or merges nothing)."""
+    xc, _ = solve(lay, terms, transfer(*start, lay), ref, what=what)
     fine = lay.with_fractions(halved(lay.fractions))
-    xf, _ = solve(fine, terms, transfer(lay, xc, fine), ref, what=what)
-    return Solved(lay, xc), Solved(fine, xf)
+    try:
+        xf, _ = solve(fine, terms, transfer(lay, xc, fine), ref, what=what)
+    except ShootingError:                    # a coarse level far off (a steep orbit)
+        xf, _ = solve(fine, terms, transfer(*start, fine), ref, what=what)
+    c = Solved(lay, xc)
+    low = lay.with_fractions(merged(lay.fractions))
+    if low.L < lay.L:
+        try:
+            c.coarser = Solved(low, solve(low, terms, transfer(lay, xc, low), ref, what=what)[0])
+        except (ShootingError, ValueError):
+            c.coarser = None
+    return c, Solved(fine, xf)
+
+
+def level_error(c: Solved, f: Solved) -> tuple[float, float, float | None]:
+    """The estimated error of f's period (an autonomous orbit) or largest amplitude error (a
+    forced one), the two levels' difference of it, and the order its three levels show (None:
+    two levels, or not steady)."""
+    two = (abs(c.T - f.T) if f.lay.autonomous
+           else float(np.max(np.abs(c.amplitude - f.amplitude))))
+    if c.coarser is None:
+        return two, two, None
+    g = c.coarser
+    if f.lay.autonomous:
+        x = (g.T, c.T, f.T)
+        d = float(extrapolated(*x, 2 * f.lay.m))
+    else:
+        i = int(np.argmax(np.abs(c.amplitude - f.amplitude)))
+        x = (g.amplitude[i], c.amplitude[i], f.amplitude[i])
+        d = float(np.max(extrapolated(g.amplitude, c.amplitude, f.amplitude, f.lay.m + 1)))
+    d1, d2 = abs(x[0] - x[1]), abs(x[1] - x[2])
+    steady = d < d2 and d2 > 0
+    return d, two, (math.log2(d1 / d2) if steady else None)
 
 
 def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bool,
             tol: float, what: str, capped: list[float] | None = None
             ) -> tuple[Solved, Solved]:
     """The orbit on L intervals equidistributed (``fixed``) or refined until the estimate is
-    below tol, and on that mesh halved: (coarser, finer).
+    below tol, and on that mesh halved: (coarser, finer), the coarser with its own ``coarser``
+    (its mesh merged; None where that solve failed).
 
     The refinement stops with a ValueError that names the estimate reached and its mesh when
     the estimate is at its floor (FLOOR times the period or the amplitudes, at least 1), when
@@ -258,11 +341,10 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
     name = "period" if autonomous else "amplitudes"
     for _ in range(MAX_ROUNDS):
         lay2 = lay.with_fractions(adapted(lay, x, L))
-        c, f = two_levels(lay2, terms, transfer(lay, x, lay2), ref, what)
+        c, f = two_levels(lay2, terms, (lay, x), ref, what)
         if fixed:
             return c, f
-        d = (abs(c.T - f.T) if autonomous
-             else float(np.max(np.abs(c.amplitude - f.amplitude))))
+        d, two, seen = level_error(c, f)
         if d <= tol:
             return c, f
         size = f.T if autonomous else float(np.max(np.abs(f.amplitude)))
@@ -277,11 +359,12 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
         # the expected order: the period's h^(2m) (superconvergent), an extremum's h^(m+1)
         expected = 2 * lay.m if autonomous else lay.m + 1
         q = 1.0 if capped else None
-        if last is not None and last[1] > 0:                       # the observed order
-            q = math.log(last[1] / d) / math.log(L / last[0])
+        if last is not None and last[1] > 0:       # the observed order of the two levels' d
+            q = math.log(last[1] / two) / math.log(L / last[0])
             if q < LEAST_ORDER:
-                raise ValueError(f"collocate: the estimated error has stopped falling: it was "
-                                 f"{last[1]:.3g} at {2 * last[0]} intervals, {reached} "
+                raise ValueError(f"collocate: the estimated error has stopped falling: the "
+                                 f"two levels' difference was {last[1]:.3g} at {2 * last[0]} "
+                                 f"intervals and is {two:.3g}; {reached} "
                                  f"(observed order {q:.2g}): tol = {tol!r} is below what this "
                                  "orbit's collocation reaches (the floor of its conditioning); "
                                  f"ask tol >= {last[1]:.2g}, or a higher degree")
@@ -300,9 +383,9 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
                                  f"{need:.2g} intervals, more than MAX_INTERVALS = "
                                  f"{MAX_INTERVALS}: {fix}")
         grow = (d / tol) ** (1.0 / expected) * 1.2
-        if q is not None and q > lay.m:
-            grow = (d / tol) ** (1.0 / q) * 1.1
-        last = (L, d)
+        if seen is not None or (q is not None and q > lay.m):
+            grow = (d / tol) ** (1.0 / min(seen or q, expected + 2)) * 1.1
+        last = (L, two)
         L = min(MAX_INTERVALS, max(L + 2, math.ceil(L * min(grow, 8.0))))
         lay, x = f.lay, f.x
         if f.lay.L >= MAX_INTERVALS:

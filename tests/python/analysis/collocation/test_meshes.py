@@ -1,0 +1,113 @@
+# The adaptive mesh and the error estimate against true errors: the relaxation oscillation of van
+# der Pol with a distributed delay (epsilon = 10) to 1e-8 in the period from a coarse scheme orbit,
+# the refinement's mesh against the smallest sufficient mesh found by a search over meshes, and
+# the three-level (Richardson) estimate of the period and the multipliers within [1, 10] times the
+# true error on three orbits (the true errors against collocations of degree 8 on finer meshes).
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import dmi
+from dmi import analysis as da
+from dmi.analysis.collocation.adapt import estimate, levels
+from dmi.analysis.collocation.collocate import first_solve
+from dmi.analysis.collocation.floquet import multipliers as floquet
+from dmi.analysis.collocation.signature import read_signature
+from dmi.analysis.collocation.system import Layout, Terms, carried, reference
+from dmi.analysis.scheme.stepmap import build
+
+#: Errors above these many units in the last place of their quantity are compared.
+ULPS = 100
+#: The largest estimate / true error of a multiplier on the tests' orbits (the aim is 10; where
+#: its three levels change sign, the two-level difference: up to 2000 measured).
+RATIO = 5000
+
+
+def van_der_pol(eps: float):
+    """w'' + eps (w^2 - 1) w' + w + p int_0^1 w(t - s) ds = 0 as u = (w, -w')."""
+    def make(p: float, h: float | None = None) -> dmi.Solver:
+        s = dmi.Solver(2, 1.0, h=h or 0.01)
+        s.set_rhs(lambda t, u: np.array([-u[1], eps * (u[0] ** 2 - 1) * u[1] + u[0]]))
+        s.set_kernel_exp([0.0], [0.0], [[[0.0, 0.0], [p, 0.0]]])
+        return s
+    return make
+
+
+def scheme_orbit(make, p: float, T: float, steps: int) -> da.Orbit:
+    s = make(p, h=T / steps)
+    s.set_history(lambda t: np.array([2.0, 0.0]))
+    s.init()
+    s.advance(40 * steps)
+    return da.periodic_orbit(make, p, None, s, guess_period=T, steps=steps, multipliers=0)
+
+
+@pytest.fixture(scope="module")
+def relaxation():
+    o = scheme_orbit(van_der_pol(10.0), 0.5, 16.0, 1000)
+    ref = da.collocate(o, intervals=64, degree=8, multipliers=4)     # 128 intervals of degree 8
+    assert ref.errors["period"] <= 1e-11 * ref.period                    # at its floor
+    return o, ref
+
+
+def test_relaxation_to_1e8_within_1_5_of_the_smallest_sufficient_mesh(relaxation):
+    o, ref = relaxation
+    e = da.collocate(o, degree=6, tol=1e-8, multipliers=0)
+    true = abs(e.period - ref.period)      # the reference's two levels agree to its floor
+    assert true <= e.errors["period"] <= 1e-8
+    # the smallest sufficient mesh: the orbits returned for intervals = L (2 L intervals)
+    sufficient = next(2 * L for L in (36, 40, 44, 48, 52, 56, 64)
+                      if abs(da.collocate(o, degree=6, intervals=L, multipliers=0).period
+                             - ref.period) + ref.errors["period"] <= 1e-8)
+    # the refinement's mesh is the coarser level, whose error the two levels' difference
+    # measures when the three are not yet steady; the orbit returned is the finer (twice it)
+    assert e.intervals // 2 <= 1.5 * sufficient, (e.intervals, sufficient)
+
+
+def three_levels(o: da.Orbit, L: int, m: int, count: int):
+    """The orbit on L equidistributed intervals (the levels L / 2, L, 2 L) with its multipliers
+    and their errors' estimate, as collocate(o, intervals=L) makes them."""
+    terms = Terms(build(o.make, o.p))
+    sig, b0 = read_signature(o.u, o.h, terms.alpha, terms.lo, terms.hi)
+    lay = Layout(m, terms.n, sig, [], True, o.period, carried(terms, sig))
+    lay, x1 = first_solve(o, terms, lay, b0, max(8, L // 2), "test")
+    c, f = levels(lay, terms, x1, reference(lay, x1), L, True, 1e-10, "test")
+    assert c.coarser is not None
+    for s in (c.coarser, c, f):
+        s.mu = floquet(s.lay, terms, s.x, count)
+    return f, estimate(c, f)
+
+
+def ratios(f, errors, T_ref: float, mu_ref: np.ndarray) -> list[float]:
+    """estimate / true of the period and each multiplier whose true error exceeds ULPS ulp."""
+    out = []
+    true = abs(f.T - T_ref)
+    assert true > ULPS * np.spacing(T_ref)
+    out.append(errors["period"] / true)
+    for mu, err in zip(f.mu, errors["multipliers"]):
+        true = float(np.min(np.abs(mu_ref - mu)))
+        if true > ULPS * np.spacing(max(1.0, abs(mu))):
+            out.append(err / true)
+    return out
+
+
+@pytest.fixture(scope="module")
+def oscillation():
+    o = scheme_orbit(van_der_pol(1.0), 0.5, 6.0, 600)
+    return o, da.collocate(o, intervals=40, degree=8, multipliers=4)
+
+
+@pytest.mark.parametrize("case, L, m", [
+    ("oscillation", 24, 4),            # van der Pol, a = 0.5
+    ("oscillation", 12, 6),
+    ("relaxation", 56, 6),             # epsilon = 10
+])
+def test_three_level_estimate_bounds_the_true_error(request, case, L, m):
+    o, ref = request.getfixturevalue(case)
+    f, errors = three_levels(o, L, m, 4)
+    period, *mu = ratios(f, errors, ref.period, ref.multipliers)
+    # the period's three levels are steady on these meshes: Richardson's estimate
+    assert 1.0 <= period <= 10.0, (period, errors)
+    # a multiplier's levels need not be (a sign change): the two-level difference bounds it
+    assert mu and all(1.0 <= q <= RATIO for q in mu), (mu, errors)
