@@ -7,8 +7,10 @@
 #   its period-doubling curve in (d, e): at each point the monodromy has the multiplier -1, the
 #   doubling's d solved in the test at the point's e, the other multiplier -exp(-2 pi C)
 #   (Liouville: the product of the two is exp(-C T)); and the same with a memory,
-#   + K int_0^TAU e^-s x(t - s) ds, TAU so long that the memory is the ODE z' = x - z to
-#   e^-TAU (the test's integrator runs that ODE in (x, x', z));
+#   + K int_0^TAU e^-s x(t - s) ds, TAU = 2 T: on a T-periodic orbit, and on a perturbation
+#   with v(t + T) = -v(t), x(t - TAU) = x(t), so the memory is z' = (1 - e^-TAU) x - z there
+#   exactly, and the test's integrator runs that ODE in (x, x', z) (its multiplier -1 is the
+#   equation's);
 # - a forced van der Pol oscillator x'' + (x^2 - a) x' + x = F cos(1.5 t): its torus curve in
 #   (F, a): at each point the pair e^(+-i theta) (det M = 1, its argument against theta), the
 #   bifurcation's F solved in the test at the point's a.
@@ -31,14 +33,14 @@ from dmi.analysis.plane.orbit_bifurcations import (FlipCurvePoint, TorusCurvePoi
                                                    continue_flip_curve, continue_torus_curve)
 
 C, FM, GAM = 0.1, 0.2, 0.05       # the Mathieu equation's damping, forcing and cubic term
-K, TAU = 0.1, 25.0                # its memory's strength and length
+K, TAU = 0.05, 4 * math.pi       # its memory's strength and length (two periods)
 MP = 2 * math.pi                  # its period
 W = 1.5                           # the van der Pol oscillator's forcing frequency
 VP = 2 * math.pi / W
 
 
 def mathieu2(d: float, e: float, memory: bool = False):
-    s = dmi.Solver(2, TAU if memory else 1.0, h=MP / 400)
+    s = dmi.Solver(2, TAU if memory else 1.0, h=MP / (100 if memory else 400))
     s.set_rhs(lambda t, u: -np.array([u[1], -C * u[1] - (d + e * math.cos(t)) * u[0]
                                       - GAM * u[0] ** 3 + FM * math.cos(t)]))
     if memory:
@@ -69,8 +71,8 @@ def mathieu_rhs(d: float, e: float, memory: bool):
         A[0, 1], A[1, 0], A[1, 1] = 1.0, -(d + e * math.cos(t)) - 3 * GAM * x * x, -C
         f = [v, acc]
         if memory:
-            f = [v, acc - K * y[2], x - y[2]]
-            A[1, 2], A[2, 0], A[2, 2] = -K, 1.0, -1.0
+            f = [v, acc - K * y[2], (1 - math.exp(-TAU)) * x - y[2]]
+            A[1, 2], A[2, 0], A[2, 2] = -K, 1 - math.exp(-TAU), -1.0
         return np.concatenate([f, (A @ y[k:].reshape(k, k)).ravel()])
     return rhs, k
 
@@ -92,24 +94,26 @@ def monodromy(system, period: float, x0: np.ndarray) -> tuple[np.ndarray, np.nda
     return s.y[:k, -1], s.y[k:, -1].reshape(k, k)
 
 
-def solved(make_system, period: float, guess: np.ndarray, condition) -> tuple[np.ndarray, float]:
-    """(x0, p) with x(P) = x0 and condition(M) = 0 (the bifurcation's p at fixed q)."""
+def solved(make_system, period: float, guess: np.ndarray, condition=None
+           ) -> tuple[np.ndarray, float]:
+    """(x0, p) with x(P) = x0 and condition(M) = 0 (the bifurcation's p at fixed q); without a
+    condition, the orbit x0 at the guess's p."""
     k = guess.size - 1
 
     def eqs(z):
-        xe, M = monodromy(make_system(z[-1]), period, z[:k])
-        return np.concatenate([xe - z[:k], [condition(M)]])
-    z = so.fsolve(eqs, guess, xtol=1e-13)
+        xe, M = monodromy(make_system(z[-1] if condition else guess[-1]), period, z[:k])
+        return np.concatenate([xe - z[:k], [condition(M)] if condition else []])
+    z = so.fsolve(eqs, guess if condition else guess[:k], xtol=1e-13)
     assert np.max(np.abs(eqs(z))) < 1e-11
-    return z[:k], float(z[-1])
+    return z[:k], float(z[-1] if condition else guess[-1])
 
 
 def start_state(orbit, memory: bool) -> np.ndarray:
-    """The orbit's state at t = 0 (with z = int_0^TAU e^-s x(-s) ds for the memory)."""
+    """The orbit's state at t = 0 (with z = int_0^TAU e^-s x(-s) ds for the memory, a guess)."""
     u0 = orbit.u_at(0.0)
     if not memory:
         return u0
-    s = np.linspace(0.0, TAU, 20001)
+    s = np.linspace(0.0, TAU, 2001)
     x = orbit.u_at(np.mod(-s, orbit.period))[:, 0]
     return np.append(u0, np.trapezoid(np.exp(-s) * x, s))
 
@@ -131,20 +135,19 @@ def check_flip(curve, memory: bool) -> None:
     for pt in (curve.points[0], curve.points[len(curve.points) // 2], curve.points[-1]):
         assert isinstance(pt, FlipCurvePoint) and not pt.orbit.autonomous
         system = lambda d: mathieu_rhs(d, pt.q, memory)   # noqa: E731
-        x0, M = monodromy(system(pt.p), MP, start_state(pt.orbit, memory))
-        mu = np.linalg.eigvals(M)
+        x0, _ = solved(system, MP, np.append(start_state(pt.orbit, memory), pt.p))
+        assert np.max(np.abs(x0[:2] - pt.orbit.u_at(0.0))) <= 1e-8
+        mu = np.linalg.eigvals(monodromy(system(pt.p), MP, x0)[1])
         assert np.min(np.abs(mu + 1)) <= 1e-8                  # measured 3e-13
-        guess = np.append(x0, pt.p)
-        _, d = solved(system, MP, guess, lambda M: np.linalg.det(M + np.eye(M.shape[0])))
+        _, d = solved(system, MP, np.append(x0, pt.p),
+                      lambda M: np.linalg.det(M + np.eye(M.shape[0])))
         assert abs(pt.p - d) <= 1e-8 and abs(pt.p - d) <= pt.p_error
-        # the other multipliers: dmi's against the integrator's
+        if memory:   # the ODE's other multipliers are not the equation's
+            continue
         other = mu[np.argsort(np.abs(mu + 1))[1:]]
-        got = pt.orbit.multipliers
-        for z in other:
-            assert np.min(np.abs(got - z)) <= 1e-8
-        if not memory:   # Liouville: mu_1 mu_2 = exp(-C T)
-            assert abs(other[0] + math.exp(-C * MP)) <= 1e-9
-        assert pt.stable is bool(np.all(np.abs(other) < 1))
+        assert np.min(np.abs(pt.orbit.multipliers - other[0])) <= 1e-8
+        assert abs(other[0] + math.exp(-C * MP)) <= 1e-9   # Liouville: mu_1 mu_2 = exp(-C T)
+        assert pt.stable is True
 
 
 def test_the_flip_curve_against_the_integrators_multipliers(flip):
@@ -157,9 +160,11 @@ def test_the_flip_curve_against_the_integrators_multipliers(flip):
 
 
 def test_a_flip_curve_with_a_memory():
-    b = mathieu_branch(memory2)
-    (e,) = [e for e in b.events if e.kind == "period-doubling"]
-    c = continue_flip_curve(e, memory2, 0.6, 0.7, branch=b, step=0.05)
+    # from an orbit near the doubling (between the two points of a branch that brackets it)
+    o = da.periodic_orbit(lambda d: memory2(d, 0.6), 0.43, MP, np.array([-0.65, 0.0]),
+                          steps=100, multipliers=4)
+    near = da.collocate(o, multipliers=6, intervals=40)
+    c = da.continue_flip_curve(near, memory2, 0.6, 0.7, step=0.05)
     assert c.status == "reached q_end = 0.7"
     check_flip(c, True)
 
