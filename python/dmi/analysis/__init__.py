@@ -40,9 +40,8 @@ from .hopf_orbits import hopf_orbit
 from .orbits import continue_orbit, period_doubled_orbit
 from .plane.diagram import plot_curves
 from .plane.grid import Grid, GridEvent, GridRow, GridWarning, Trace, continue_over
-from .plane.orbit_bifurcations import (FlipCurvePoint, TorusCurvePoint, continue_flip_curve,
-                                       continue_torus_curve)
-from .plane.orbit_curves import OrbitCurvePoint, continue_orbit_curve
+from .plane.orbit_curves import (FlipCurvePoint, OrbitCurvePoint, TorusCurvePoint,
+                                 continue_flip_curve, continue_orbit_curve, continue_torus_curve)
 from .plot.branch import plot_branch
 from .scheme.floquet import Floquet, StabilityWarning, Verify, floquet_multipliers, floquet_verdict
 from .scheme.orbit import Orbit

@@ -4,10 +4,10 @@
 ``continuation`` takes a problem of any kind: a Hopf point or a fold of the equation's equilibria
 (:func:`dmi.analysis.equilibria.curves.continue_curve`), or a fold of the equation's periodic
 orbits, an orbit branch's ``fold`` event given with its ``branch=`` or an EquationOrbit near a fold
-(:func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`), or its ``period-doubling`` or
-``torus`` event (:func:`dmi.analysis.plane.orbit_bifurcations.continue_flip_curve`,
-:func:`dmi.analysis.plane.orbit_bifurcations.continue_torus_curve`).  It sits above the rooms because it
-reaches both."""
+(:func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`), or its ``period-doubling``
+or ``torus`` event (:func:`dmi.analysis.plane.orbit_curves.continue_flip_curve`,
+:func:`dmi.analysis.plane.orbit_curves.continue_torus_curve`).  It sits above the rooms because
+it reaches both."""
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -18,8 +18,7 @@ from .collocation.orbit import EquationOrbit
 from .equilibria.curves import Curve
 from .equilibria.curves import continue_curve as equilibrium_curve
 from .continuation.branch import Event
-from .plane.orbit_bifurcations import continue_flip_curve, continue_torus_curve
-from .plane.orbit_curves import continue_orbit_curve
+from .plane.orbit_curves import continue_flip_curve, continue_orbit_curve, continue_torus_curve
 
 
 def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: float, q_end: float,
@@ -33,8 +32,8 @@ def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: floa
         or ``fold`` event of a branch of the equation's equilibria, a ``fold``,
         ``period-doubling`` or ``torus`` event of a branch of EquationOrbits (with ``branch=``,
         that branch), or an EquationOrbit near a fold (for the others, call
-        :func:`~dmi.analysis.plane.orbit_bifurcations.continue_flip_curve` or
-        :func:`~dmi.analysis.plane.orbit_bifurcations.continue_torus_curve` with it).
+        :func:`~dmi.analysis.plane.orbit_curves.continue_flip_curve` or
+        :func:`~dmi.analysis.plane.orbit_curves.continue_torus_curve` with it).
     make2 : callable
         The model ``make2(p, q) -> dmi.Solver``, configured, not initialised.
     q0 : float

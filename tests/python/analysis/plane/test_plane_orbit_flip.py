@@ -29,8 +29,8 @@ import dmi
 
 from dmi import analysis as da
 from dmi.analysis.continuation.branch import Event
-from dmi.analysis.plane.orbit_bifurcations import (FlipCurvePoint, TorusCurvePoint,
-                                                   continue_flip_curve, continue_torus_curve)
+from dmi.analysis.plane.orbit_curves import (FlipCurvePoint, TorusCurvePoint,
+                                             continue_flip_curve, continue_torus_curve)
 
 C, FM, GAM = 0.1, 0.2, 0.05       # the Mathieu equation's damping, forcing and cubic term
 K, TAU = 0.05, 4 * math.pi       # its memory's strength and length (two periods)
