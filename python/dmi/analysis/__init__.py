@@ -12,8 +12,8 @@ scheme's (they match simulation); ``of="equation"`` (:func:`roots`, :func:`hopf`
 Interactive HTML figures (:mod:`dmi.analysis.plot.interactive`, Bokeh): ``Branch.to_html``,
 ``StabilityChart.to_html`` and the ``html`` of :func:`plot_branch` and
 :func:`plot_stability_chart`.  Two parameters: :func:`continue_curve` (Hopf and fold curves of
-equilibria, folds, period doublings and tori of orbits), :func:`continue_over` (one-parameter continuations over q, on Dask)
-and :func:`plot_curves` (the diagram).
+equilibria, folds, period doublings and tori of orbits), :func:`continue_over` (one-parameter
+continuations over q, on Dask) and :func:`plot_curves` (the diagram).
 
 The package is in rooms, each a subpackage whose docstring says what it holds and what it may
 import, lowest first: ``core`` and ``plot``, ``scheme``, ``continuation`` (the one driver),

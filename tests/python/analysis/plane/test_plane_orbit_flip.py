@@ -132,7 +132,8 @@ def flip():
 
 
 def check_flip(curve, memory: bool) -> None:
-    for pt in (curve.points[0], curve.points[len(curve.points) // 2], curve.points[-1]):
+    some = (0, -1) if memory else (0, len(curve.points) // 2, -1)
+    for pt in [curve.points[i] for i in some]:
         assert isinstance(pt, FlipCurvePoint) and not pt.orbit.autonomous
         system = lambda d: mathieu_rhs(d, pt.q, memory)   # noqa: E731
         x0, _ = solved(system, MP, np.append(start_state(pt.orbit, memory), pt.p))
