@@ -42,7 +42,8 @@ The systems are the fold's with another test function.  A_mu is the collocation 
 linearised at the orbit with the periodic boundary condition replaced by v(t + T) = mu v(t): the
 node at T is mu times the node at 0, and the memory reads the past before 0 as mu^k v(t - k T)
 (k the periods it reaches back; DDE-BIFTOOL's multiplier condition).  A_mu is singular exactly
-when mu is a Floquet multiplier of the collocated orbit.  The extra equation is g = 0, g from the bordered system
+when mu is a Floquet multiplier of the collocated orbit.  The extra equation is g = 0, g from
+the bordered system
 
     [[A_mu, b], [c', 0]] (v, g) = (0, 1),     [[A_mu', c], [b', 0]] (w, h) = (0, 1)
 
