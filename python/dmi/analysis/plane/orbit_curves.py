@@ -76,10 +76,11 @@ from ..collocation.adapt import FLOOR, Solved, adapted, merged, transfer
 from ..collocation.adapt import estimate as level_errors
 from ..collocation.floquet import multipliers as floquet
 from ..collocation.mend import check_inequalities
-from ..collocation.mesh import interval_of, point_matrix
+from ..collocation.mesh import interval_of, periodic_locator, point_matrix
 from ..collocation.orbit import EquationOrbit, equation_orbit
 from ..collocation.signature import HI, LO, STUCK
-from ..collocation.system import CollocationWarning, Layout, Terms, full_jacobian, reference
+from ..collocation.system import (CollocationWarning, Layout, Terms, assemble, full_jacobian,
+                                  reference)
 from ..continuation.branch import Branch, Curve, CurveEvent, Event
 from ..continuation.driver import Curve as DriverCurve
 from ..continuation.driver import continuation, newton_strategy
@@ -654,13 +655,15 @@ class Twisted:
         u at the collocation points from the unrolled rows (P n, R n).
     wrap, node : numpy.ndarray
         Each unrolled row's period and node row of the period.
-    tc, U : numpy.ndarray
-        The collocation times and the orbit there (P, n).
+    tc, U, fu : numpy.ndarray
+        The collocation times, the orbit there (P, n) and f_u there (P, n, n; given as ``fu``
+        for an autonomous f at a moved T, else from ``terms``).
     held : numpy.ndarray
         (P, n) booleans: held components (their rows are E's).
     """
 
-    def __init__(self, lay: Layout, terms: Terms, x: np.ndarray, T: float | None = None):
+    def __init__(self, lay: Layout, terms: Terms, x: np.ndarray, T: float | None = None,
+                 fu: np.ndarray | None = None):
         if lay.S:
             raise ValueError("the orbit has switches: period-doubling and torus curves of "
                              "orbits with switches (their saltation) are not covered yet")
@@ -677,8 +680,10 @@ class Twisted:
         self.E = point_matrix(self.tc, loc, basis, mesh, n, R)
         D = point_matrix(self.tc, loc, basis, mesh, n, R, derivative=True)
         self.wrap, self.node, self.n = np.arange(R) // Lm + kmin, np.arange(R) % Lm, n
-        self.U = (self.E @ self.fold(1.0) @ V.ravel()).reshape(-1, n)
-        fu = terms.fu(self.tc, self.U)
+        # u at the collocation points as the periodic system computes it (f_u's kept value)
+        self.U = (point_matrix(self.tc, periodic_locator(mesh, m), basis, mesh, n, Lm)
+                  @ V.ravel()).reshape(-1, n)
+        self.fu = fu = terms.fu(self.tc, self.U) if fu is None else fu
         A = D + sp.block_diag(list(fu), format="csr") @ self.E
         if terms.has_kernel:
             A = A + terms.delay(self.tc, mesh, T, loc, basis, R)
@@ -709,7 +714,7 @@ class Twisted:
         points along v (one difference a real part), against w, back to the node rows."""
         Ev = (self.E @ (self.fold(mu) @ v)).reshape(-1, self.n)
         W = np.where(self.held, 0.0, w.reshape(-1, self.n))
-        f0 = terms.fu(self.tc, self.U)
+        f0 = self.fu
         out = np.zeros(self.U.shape, dtype=complex)
         for part, unit in ((Ev.real, 1.0), (Ev.imag, 1j)):
             big = float(np.max(np.abs(part)))
@@ -835,10 +840,11 @@ class OrbitFlip(OrbitFold):
         if self.lay.autonomous:
             T = float(x[-1])
             dT = DIFF * T
-            gT = self._grad(ev, y, Twisted(self.lay, t, x, T + dT).matrix(mu), dT)
+            # f_u of an autonomous f is the same at the moved times
+            gT = self._grad(ev, y, Twisted(self.lay, t, x, T + dT, tw.fu).matrix(mu), dT)
         d = DIFF * max(1.0, abs(p))
         tp = self.terms(p + d, q)
-        Fp = (full_jacobian(self.lay, tp, x, self.ref)[0] - ev["r"]) / d
+        Fp = (assemble(self.lay, tp, x, self.ref, jacobian=False)[0] - ev["r"]) / d
         gp = self._grad(ev, y, Twisted(self.lay, tp, x).matrix(mu), d)
         rows = np.vstack([gx.real, gx.imag])[:self.extra]
         if self.lay.autonomous:
@@ -857,7 +863,7 @@ class OrbitFlip(OrbitFold):
         x, p = self._split(y)
         d = DIFF * max(1.0, abs(q))
         tq = self.terms(p, q + d)
-        Fq = (full_jacobian(self.lay, tq, x, self.ref)[0] - ev["r"]) / d
+        Fq = (assemble(self.lay, tq, x, self.ref, jacobian=False)[0] - ev["r"]) / d
         gq = self._grad(ev, y, Twisted(self.lay, tq, x).matrix(self.mu(y)), d)
         return sparse_bordered(J, cols, rows), np.concatenate([Fq, gq])
 
