@@ -11,6 +11,9 @@
 #   with v(t + T) = -v(t), x(t - TAU) = x(t), so the memory is z' = (1 - e^-TAU) x - z there
 #   exactly, and the test's integrator runs that ODE in (x, x', z) (its multiplier -1 is the
 #   equation's);
+# - the Roessler system x' = -y - z, y' = x + 0.2 y, z' = b + z (x - c) (autonomous: the period an
+#   unknown): its period-doubling curve in (c, b), each point against the doubling solved in the
+#   test (x0, T, c with x(T) = x0, a phase condition and det(M + I) = 0);
 # - a forced van der Pol oscillator x'' + (x^2 - a) x' + x = F cos(1.5 t): its torus curve in
 #   (F, a): at each point the pair e^(+-i theta) (det M = 1, its argument against theta), the
 #   bifurcation's F solved in the test at the point's a.
@@ -50,6 +53,21 @@ def mathieu2(d: float, e: float, memory: bool = False):
 
 def memory2(d: float, e: float):
     return mathieu2(d, e, True)
+
+
+def rossler2(c: float, b: float, h: float | None = None):
+    s = dmi.Solver(3, 1.0, h=0.01 if h is None else h)
+    s.set_rhs(lambda t, u: -np.array([-u[1] - u[2], u[0] + 0.2 * u[1], b + u[2] * (u[0] - c)]))
+    return s
+
+
+def rossler_rhs(c: float, b: float):
+    def rhs(t, y):
+        x, yy, z = y[:3]
+        A = np.array([[0.0, -1.0, -1.0], [1.0, 0.2, 0.0], [z, 0.0, x - c]])
+        return np.concatenate([[-yy - z, x + 0.2 * yy, b + z * (x - c)],
+                               (A @ y[3:].reshape(3, 3)).ravel()])
+    return rhs, 3
 
 
 def vdp2(F: float, a: float):
@@ -168,6 +186,34 @@ def test_a_flip_curve_with_a_memory():
     c = da.continue_flip_curve(near, memory2, 0.6, 0.7, step=0.05)
     assert c.status == "reached q_end = 0.7"
     check_flip(c, True)
+
+
+def test_an_autonomous_orbits_flip_curve():
+    s = rossler2(2.5, 0.2)
+    s.set_history(lambda t: np.array([1.0, 1.0, 0.0]))
+    s.init()
+    s.advance(20000)
+    o = da.periodic_orbit(lambda c, h=None: rossler2(c, 0.2, h), 2.5, None, s,
+                          guess_period=6.0, steps=600, multipliers=4)
+    b = da.continue_orbit(da.collocate(o, multipliers=6, intervals=40), 3.2, step=0.05)
+    (e,) = [e for e in b.events if e.kind == "period-doubling"]
+    c = da.continue_curve(e, rossler2, 0.2, 0.3, branch=b, step=0.05)
+    assert c.kind == "period-doubling" and c.status == "reached q_end = 0.3"
+    for pt in (c.points[0], c.points[len(c.points) // 2], c.points[-1]):
+        assert pt.orbit.autonomous
+        u0, y0 = pt.orbit.u_at(0.0), float(pt.orbit.u_at(0.0)[1])
+
+        def eqs(z, q=pt.q):
+            xe, M = monodromy(rossler_rhs(z[4], q), z[3], z[:3])
+            return np.concatenate([xe - z[:3], [z[1] - y0],
+                                   [np.linalg.det(M + np.eye(3))]])
+        z = so.fsolve(eqs, np.concatenate([u0, [pt.orbit.period, pt.p]]), xtol=1e-13)
+        assert np.max(np.abs(eqs(z))) < 1e-11
+        assert abs(pt.p - z[4]) <= 1e-8                        # measured 1e-9
+        assert abs(pt.orbit.period - z[3]) <= 1e-8
+        mu = np.linalg.eigvals(monodromy(rossler_rhs(pt.p, pt.q), pt.orbit.period, u0)[1])
+        assert np.min(np.abs(mu + 1)) <= 1e-7
+        assert pt.stable is True           # the third multiplier is near 0
 
 
 @pytest.fixture(scope="module")
