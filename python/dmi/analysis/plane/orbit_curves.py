@@ -696,8 +696,8 @@ class Twisted:
         """Phi(mu) (R n, L m n): row (r, a) to column (node(r), a) times mu^wrap(r); with
         ``derivative``, d Phi / d theta at mu = e^(i theta) (i wrap mu^wrap)."""
         n, R = self.n, self.wrap.size
-        val = np.power(complex(mu), self.wrap) if np.iscomplexobj(mu) or not float(
-            mu).is_integer() else float(mu) ** self.wrap.astype(float)
+        val = (complex(mu) ** self.wrap if isinstance(mu, complex)
+               else float(mu) ** self.wrap.astype(float))
         if derivative:
             val = 1j * self.wrap * val
         vals = np.repeat(val, n)
