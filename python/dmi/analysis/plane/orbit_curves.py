@@ -1070,9 +1070,10 @@ def _finished(b: Branch, disc: OrbitFlip, kind: str) -> Curve:
             on = [j for j, pt in enumerate(points) if pt.q == e.p]
             i = e.index if e.index in on or not on else min(on, key=lambda j: abs(j - e.index))
             events.append(CurveEvent("user", points[i].p, float(e.p), i, e.detail))
-    if disc.breach and "meets at" in disc.breach and points:
+    if disc.breach and "meets at" in disc.breach and points and disc.breach in status:
         res = "1:2 resonance" if "theta -> pi" in disc.breach else "1:1 resonance"
         events.append(CurveEvent(res, points[-1].p, points[-1].q, len(points) - 1, disc.breach))
+        status = disc.breach   # the driver's words around it repeat it
     return Curve(kind=kind, points=points, events=events, status=status, make2=disc.make2)
 
 

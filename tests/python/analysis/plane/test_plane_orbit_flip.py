@@ -14,9 +14,11 @@
 # - the Roessler system x' = -y - z, y' = x + 0.2 y, z' = b + z (x - c) (autonomous: the period an
 #   unknown): its period-doubling curve in (c, b), each point against the doubling solved in the
 #   test (x0, T, c with x(T) = x0, a phase condition and det(M + I) = 0);
-# - a forced van der Pol oscillator x'' + (x^2 - a) x' + x = F cos(1.5 t): its torus curve in
-#   (F, a): at each point the pair e^(+-i theta) (det M = 1, its argument against theta), the
-#   bifurcation's F solved in the test at the point's a.
+# - a forced van der Pol oscillator x'' + (x^2 - a) x' + k x = F cos(1.5 t): its torus curve in
+#   (F, a) at k = 1: at each point the pair e^(+-i theta) (det M = 1, its argument against
+#   theta), the bifurcation's F solved in the test at the point's a; and in (F, k) at a = 0.2,
+#   where theta grows to pi (about 2 pi sqrt(k) / 1.5 mod 2 pi: k near 0.56) and the curve ends
+#   at the 1:2 resonance, the integrator's pair there within THETA_END of -1.
 # Also the refusals.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
@@ -32,7 +34,7 @@ import dmi
 
 from dmi import analysis as da
 from dmi.analysis.continuation.branch import Event
-from dmi.analysis.plane.orbit_curves import (FlipCurvePoint, TorusCurvePoint,
+from dmi.analysis.plane.orbit_curves import (THETA_END, FlipCurvePoint, TorusCurvePoint,
                                              continue_flip_curve, continue_torus_curve)
 
 C, FM, GAM = 0.1, 0.2, 0.05       # the Mathieu equation's damping, forcing and cubic term
@@ -70,11 +72,15 @@ def rossler_rhs(c: float, b: float):
     return rhs, 3
 
 
-def vdp2(F: float, a: float):
+def vdp2(F: float, a: float, k: float = 1.0):
     s = dmi.Solver(2, 1.0, h=VP / 400)
-    s.set_rhs(lambda t, u: -np.array([u[1], -(u[0] ** 2 - a) * u[1] - u[0]
+    s.set_rhs(lambda t, u: -np.array([u[1], -(u[0] ** 2 - a) * u[1] - k * u[0]
                                       + F * math.cos(W * t)]))
     return s
+
+
+def vdpk(F: float, k: float):
+    return vdp2(F, 0.2, k)
 
 
 def mathieu_rhs(d: float, e: float, memory: bool):
@@ -95,11 +101,11 @@ def mathieu_rhs(d: float, e: float, memory: bool):
     return rhs, k
 
 
-def vdp_rhs(F: float, a: float):
+def vdp_rhs(F: float, a: float, k: float = 1.0):
     def rhs(t, y):
         x, v = y[0], y[1]
-        A = np.array([[0.0, 1.0], [-1 - 2 * x * v, a - x * x]])
-        return np.concatenate([[v, -(x * x - a) * v - x + F * math.cos(W * t)],
+        A = np.array([[0.0, 1.0], [-k - 2 * x * v, a - x * x]])
+        return np.concatenate([[v, -(x * x - a) * v - k * x + F * math.cos(W * t)],
                                (A @ y[2:].reshape(2, 2)).ravel()])
     return rhs, 2
 
@@ -223,6 +229,20 @@ def torus():
     b = da.continue_orbit(da.collocate(o, multipliers=6, intervals=40), 0.5, step=0.05)
     (e,) = [e for e in b.events if e.kind == "torus"]
     return b, e, da.continue_curve(e, vdp2, 0.2, 0.4, branch=b, step=0.05)
+
+
+def test_the_torus_curve_ends_at_the_1_2_resonance(torus):
+    b, e, _ = torus
+    c = continue_torus_curve(e, vdpk, 1.0, 0.3, branch=b, step=0.1, min_step=0.005)
+    assert c.status.startswith("near (p, q) = (") and "1:2 resonance" in c.status
+    (r,) = [ev for ev in c.events if ev.kind == "1:2 resonance"]
+    last = c.points[-1]
+    assert r.index == len(c.points) - 1 and r.q == last.q and 0.5 < last.q < 0.65
+    assert np.all(np.diff(c.q) < 0) and np.all(np.diff([pt.theta for pt in c.points]) > 0)
+    assert math.pi - THETA_END - 0.01 < last.theta < math.pi
+    mu = np.linalg.eigvals(monodromy(vdp_rhs(last.p, 0.2, last.q), VP, last.orbit.u_at(0.0))[1])
+    assert np.all(np.abs(np.abs(mu) - 1) <= 1e-8)
+    assert np.all(np.abs(np.abs(np.angle(mu)) - last.theta) <= 1e-8)
 
 
 def test_the_torus_curve_against_the_integrators_multipliers(torus):
