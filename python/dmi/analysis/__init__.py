@@ -12,8 +12,8 @@ scheme's (they match simulation); ``of="equation"`` (:func:`roots`, :func:`hopf`
 Interactive HTML figures (:mod:`dmi.analysis.plot.interactive`, Bokeh): ``Branch.to_html``,
 ``StabilityChart.to_html`` and the ``html`` of :func:`plot_branch` and
 :func:`plot_stability_chart`.  Two parameters: :func:`continue_curve` (Hopf and fold curves of
-equilibria, folds of orbits), :func:`continue_over` (one-parameter continuations over q, on Dask)
-and :func:`plot_curves` (the diagram).
+equilibria, folds, period doublings and tori of orbits), :func:`continue_over` (one-parameter
+continuations over q, on Dask) and :func:`plot_curves` (the diagram).
 
 The package is in rooms, each a subpackage whose docstring says what it holds and what it may
 import, lowest first: ``core`` and ``plot``, ``scheme``, ``continuation`` (the one driver),
@@ -40,7 +40,8 @@ from .hopf_orbits import hopf_orbit
 from .orbits import continue_orbit, period_doubled_orbit
 from .plane.diagram import plot_curves
 from .plane.grid import Grid, GridEvent, GridRow, GridWarning, Trace, continue_over
-from .plane.orbit_curves import OrbitCurvePoint, continue_orbit_curve
+from .plane.orbit_curves import (FlipCurvePoint, OrbitCurvePoint, TorusCurvePoint,
+                                 continue_flip_curve, continue_orbit_curve, continue_torus_curve)
 from .plot.branch import plot_branch
 from .scheme.floquet import Floquet, StabilityWarning, Verify, floquet_multipliers, floquet_verdict
 from .scheme.orbit import Orbit
@@ -62,9 +63,11 @@ __all__ = [
     # the equation's orbits by collocation
     "collocate", "EquationOrbit", "CollocationWarning", "EventWarning",
     "CollocationDiscretisation", "equation_hopf_orbit",
-    # curves in two parameters: Hopf and fold curves of equilibria, folds of orbits
+    # curves in two parameters: Hopf and fold curves of equilibria, folds, period doublings
+    # and tori of orbits
     "continue_curve", "Curve", "CurvePoint", "CurveEvent", "continue_orbit_curve",
-    "OrbitCurvePoint",
+    "OrbitCurvePoint", "continue_flip_curve", "FlipCurvePoint", "continue_torus_curve",
+    "TorusCurvePoint",
     # the plane (p, q): one-parameter continuations over q (serially or on Dask) and the diagram
     "continue_over", "Grid", "GridRow", "GridEvent", "Trace", "GridWarning", "plot_curves",
 ]

@@ -4,8 +4,10 @@
 ``continuation`` takes a problem of any kind: a Hopf point or a fold of the equation's equilibria
 (:func:`dmi.analysis.equilibria.curves.continue_curve`), or a fold of the equation's periodic
 orbits, an orbit branch's ``fold`` event given with its ``branch=`` or an EquationOrbit near a fold
-(:func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`).  It sits above the rooms because it
-reaches both."""
+(:func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`), or its ``period-doubling``
+or ``torus`` event (:func:`dmi.analysis.plane.orbit_curves.continue_flip_curve`,
+:func:`dmi.analysis.plane.orbit_curves.continue_torus_curve`).  It sits above the rooms because
+it reaches both."""
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -15,7 +17,8 @@ from .._solver import Solver
 from .collocation.orbit import EquationOrbit
 from .equilibria.curves import Curve
 from .equilibria.curves import continue_curve as equilibrium_curve
-from .plane.orbit_curves import continue_orbit_curve
+from .continuation.branch import Event
+from .plane.orbit_curves import continue_flip_curve, continue_orbit_curve, continue_torus_curve
 
 
 def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: float, q_end: float,
@@ -26,8 +29,11 @@ def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: floa
     ----------
     start : HopfPoint, Event or EquationOrbit
         A Hopf point of the equation (``hopf(..., of="equation")``, with ``u_eq=``), a ``hopf``
-        or ``fold`` event of a branch of the equation's equilibria, a ``fold`` event of a branch
-        of EquationOrbits (with ``branch=``, that branch), or an EquationOrbit near a fold.
+        or ``fold`` event of a branch of the equation's equilibria, a ``fold``,
+        ``period-doubling`` or ``torus`` event of a branch of EquationOrbits (with ``branch=``,
+        that branch), or an EquationOrbit near a fold (for the others, call
+        :func:`~dmi.analysis.plane.orbit_curves.continue_flip_curve` or
+        :func:`~dmi.analysis.plane.orbit_curves.continue_torus_curve` with it).
     make2 : callable
         The model ``make2(p, q) -> dmi.Solver``, configured, not initialised.
     q0 : float
@@ -36,14 +42,19 @@ def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: floa
         Where to stop; the last point lies on it exactly when the curve gets there.
     **options
         The options of :func:`dmi.analysis.equilibria.curves.continue_curve` (equilibria) or of
-        :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve` (orbits).
+        :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve` (orbits; the same for
+        period-doubling and torus curves).
 
     Returns
     -------
     Curve
-        The curve: ``kind`` ``"hopf"``, ``"fold"`` or ``"orbit-fold"``, its points, events and
-        status.
+        The curve: ``kind`` ``"hopf"``, ``"fold"``, ``"orbit-fold"``, ``"period-doubling"`` or
+        ``"torus"``, its points, events and status.
     """
+    if isinstance(start, Event) and start.kind == "period-doubling":
+        return continue_flip_curve(start, make2, q0, q_end, **options)
+    if isinstance(start, Event) and start.kind == "torus":
+        return continue_torus_curve(start, make2, q0, q_end, **options)
     if isinstance(start, EquationOrbit) or options.get("branch") is not None:
         return continue_orbit_curve(start, make2, q0, q_end, **options)
     return equilibrium_curve(start, make2, q0, q_end, **options)

@@ -1,5 +1,6 @@
-# Curves of the bifurcations of the equation's periodic orbits in two parameters: the fold of
-# collocated orbits continued in (p, q) by a minimally augmented system on the one driver.
+# Curves of the bifurcations of the equation's periodic orbits in two parameters: the fold, the
+# period doubling and the torus of collocated orbits continued in (p, q) by minimally augmented
+# systems on the one driver.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """The fold of collocated orbits (limit point of cycles) continued in the plane (p, q):
 :func:`continue_orbit_curve`, its points :class:`OrbitCurvePoint` in a
@@ -32,6 +33,32 @@ multiplier is 1 there).  A curve that would leave its orbits' signature (a stick
 grazing) ends there, its status saying so; a curve whose orbits shrink towards an equilibrium
 (the fold curve's end at a Bautin point of the Hopf curve) ends with a status that says where
 the amplitude extrapolates to 0.
+
+Period doubling and torus: :func:`continue_flip_curve` (a :class:`dmi.analysis.Curve` of kind
+``"period-doubling"``) and :func:`continue_torus_curve` (kind ``"torus"``), their points
+:class:`FlipCurvePoint` and :class:`TorusCurvePoint`.
+
+The systems are the fold's with another test function.  A_mu is the collocation system
+linearised at the orbit with the periodic boundary condition replaced by v(t + T) = mu v(t): the
+node at T is mu times the node at 0, and the memory reads the past before 0 as mu^k v(t - k T)
+(k the periods it reaches back; DDE-BIFTOOL's multiplier condition).  A_mu is singular exactly
+when mu is a Floquet multiplier of the collocated orbit.  The extra equation is g = 0, g from
+the bordered system
+
+    [[A_mu, b], [c', 0]] (v, g) = (0, 1),     [[A_mu', c], [b', 0]] (w, h) = (0, 1)
+
+(one bordered solve each): mu = -1 for the period doubling (real, one equation), mu = e^(i theta)
+for the torus, theta an extra unknown and g complex (two real equations, the complex system
+solved in its real form).  g's derivatives are -w' (d A_mu) v: along the node values from the
+change of f_u at the collocation points in the direction of v, along T, p and q by differences
+of A_mu, along theta exactly; they only steer Newton.  The borders start from a few steps of
+inverse iteration at the start and move to the last point's conj(v), conj(w) after every step.
+
+Covered: orbits without switches (smooth orbits; a component held for the whole period is
+allowed), with or without a memory.  An orbit with switches (stick-slip, contacts) is refused:
+its saltation is not in A_mu yet.  A curve ends where its orbit would leave its signature (a
+stick onset or grazing meets it), a torus curve where theta reaches 0 or pi (the pair e^(+-i
+theta) meets at +1 or -1: a 1:1 or 1:2 resonance, where a neutral saddle follows).
 """
 from __future__ import annotations
 
@@ -42,14 +69,18 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..._solver import Solver
 from ..collocation.adapt import FLOOR, Solved, adapted, merged, transfer
 from ..collocation.adapt import estimate as level_errors
 from ..collocation.floquet import multipliers as floquet
 from ..collocation.mend import check_inequalities
+from ..collocation.mesh import interval_of, periodic_locator, point_matrix
 from ..collocation.orbit import EquationOrbit, equation_orbit
-from ..collocation.system import CollocationWarning, Layout, Terms, full_jacobian, reference
+from ..collocation.signature import HI, LO, STUCK
+from ..collocation.system import (CollocationWarning, Layout, Terms, assemble, full_jacobian,
+                                  reference)
 from ..continuation.branch import Branch, Curve, CurveEvent, Event
 from ..continuation.driver import Curve as DriverCurve
 from ..continuation.driver import continuation, newton_strategy
@@ -573,4 +604,569 @@ def _curve_of(b: Branch, disc: OrbitFold) -> Curve:
                  make2=disc.make2)
 
 
-__all__ = ["OrbitCurvePoint", "continue_orbit_curve"]
+#: A torus curve ends where theta comes within this (radians) of 0 or pi.
+THETA_END = 0.02
+#: Steps of inverse iteration that give the start's borders.
+INVERSE_STEPS = 3
+
+
+@dataclass
+class FlipCurvePoint(OrbitCurvePoint):
+    """A point of a period-doubling curve (:func:`continue_flip_curve`): as
+    :class:`OrbitCurvePoint`, with ``stable`` the verdict on the multipliers but the trivial
+    one and the doubling's -1."""
+
+
+@dataclass
+class TorusCurvePoint(OrbitCurvePoint):
+    """A point of a torus curve (:func:`continue_torus_curve`): as :class:`OrbitCurvePoint`,
+    with ``theta`` the argument in (0, pi) of the critical pair e^(+-i theta), ``theta_error``
+    its estimated error (the difference to the merged mesh's; None where that failed), and
+    ``stable`` the verdict on the multipliers but the trivial one and the pair."""
+    theta: float = 0.0
+    theta_error: float | None = None
+
+
+def _unrolled(mesh: np.ndarray, m: int, kmin: int) -> Callable:
+    """The locator of node rows of the periods kmin, kmin + 1, ... laid end to end (period k's
+    node j is row (k - kmin) L m + j): times of any period keep which period they are in."""
+    T = float(mesh[-1])
+    Lm = (mesh.size - 1) * m
+    k = np.arange(m + 1)
+
+    def locate(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        t = np.asarray(t, dtype=float)
+        per = np.floor(t / T)
+        i, z = interval_of(mesh, t - per * T)
+        cols = (per.astype(int) - kmin)[:, None] * Lm + i[:, None] * m + k[None, :]
+        return i, z, cols
+    return locate
+
+
+class Twisted:
+    """The collocation system linearised at an orbit on the unrolled node rows (:func:`_unrolled`)
+    and its fold to one period by v(t + k T) = mu^k v(t): A_mu = A_v Phi(mu).
+
+    Attributes
+    ----------
+    Av : scipy.sparse.csr_matrix
+        The linearised rows (P n, R n) on the unrolled node rows.
+    E : scipy.sparse.csr_matrix
+        u at the collocation points from the unrolled rows (P n, R n).
+    wrap, node : numpy.ndarray
+        Each unrolled row's period and node row of the period.
+    tc, U, fu : numpy.ndarray
+        The collocation times, the orbit there (P, n) and f_u there (P, n, n; given as ``fu``
+        for an autonomous f at a moved T, else from ``terms``).
+    held : numpy.ndarray
+        (P, n) booleans: held components (their rows are E's).
+    """
+
+    def __init__(self, lay: Layout, terms: Terms, x: np.ndarray, T: float | None = None,
+                 fu: np.ndarray | None = None):
+        if lay.S:
+            raise ValueError("the orbit has switches: period-doubling and torus curves of "
+                             "orbits with switches (their saltation) are not covered yet")
+        m, n, basis = lay.m, lay.n, lay.basis
+        V, b, T0 = lay.split(x)
+        T = T0 if T is None else float(T)
+        mesh = lay.mesh(b, T)
+        Lm = (mesh.size - 1) * m
+        gz, _ = basis.gauss()
+        self.tc = (mesh[:-1, None] + np.diff(mesh)[:, None] * gz[None, :]).ravel()
+        kmin = (math.floor(-terms.tau / T) - 1) if terms.has_kernel else 0
+        R = (2 - kmin) * Lm + 1
+        loc = _unrolled(mesh, m, kmin)
+        self.E = point_matrix(self.tc, loc, basis, mesh, n, R)
+        D = point_matrix(self.tc, loc, basis, mesh, n, R, derivative=True)
+        self.wrap, self.node, self.n = np.arange(R) // Lm + kmin, np.arange(R) % Lm, n
+        # u at the collocation points as the periodic system computes it (f_u's kept value)
+        self.U = (point_matrix(self.tc, periodic_locator(mesh, m), basis, mesh, n, Lm)
+                  @ V.ravel()).reshape(-1, n)
+        self.fu = fu = terms.fu(self.tc, self.U) if fu is None else fu
+        A = D + sp.block_diag(list(fu), format="csr") @ self.E
+        if terms.has_kernel:
+            A = A + terms.delay(self.tc, mesh, T, loc, basis, R)
+        mode = np.repeat(np.array(lay.piece_modes(b, T))[lay.piece_of_interval()], m, axis=0)
+        self.held = (mode == STUCK) | (mode == LO) | (mode == HI)
+        hv = self.held.ravel().astype(float)
+        self.Av = (sp.diags(1.0 - hv) @ A + sp.diags(hv) @ self.E).tocsr()
+
+    def fold(self, mu: complex, derivative: bool = False) -> sp.csr_matrix:
+        """Phi(mu) (R n, L m n): row (r, a) to column (node(r), a) times mu^wrap(r); with
+        ``derivative``, d Phi / d theta at mu = e^(i theta) (i wrap mu^wrap)."""
+        n, R = self.n, self.wrap.size
+        val = (complex(mu) ** self.wrap if isinstance(mu, complex)
+               else float(mu) ** self.wrap.astype(float))
+        if derivative:
+            val = 1j * self.wrap * val
+        vals = np.repeat(val, n)
+        rows = np.arange(R * n)
+        cols = (self.node[:, None] * n + np.arange(n)[None, :]).ravel()
+        return sp.csr_matrix((vals, (rows, cols)), shape=(R * n, (self.node.max() + 1) * n))
+
+    def matrix(self, mu: complex) -> sp.csc_matrix:
+        """A_mu (L m n square)."""
+        return sp.csc_matrix(self.Av @ self.fold(mu))
+
+    def fu_row(self, terms: Terms, v: np.ndarray, w: np.ndarray, mu: complex) -> np.ndarray:
+        """w' (d A_mu / d x_j) v over the node values x_j: the change of f_u at the collocation
+        points along v (one difference a real part), against w, back to the node rows."""
+        Ev = (self.E @ (self.fold(mu) @ v)).reshape(-1, self.n)
+        W = np.where(self.held, 0.0, w.reshape(-1, self.n))
+        f0 = self.fu
+        out = np.zeros(self.U.shape, dtype=complex)
+        for part, unit in ((Ev.real, 1.0), (Ev.imag, 1j)):
+            big = float(np.max(np.abs(part)))
+            if big == 0:
+                continue
+            eps = DIFF * max(1.0, float(np.max(np.abs(self.U)))) / big
+            d = (np.array(terms.fu(self.tc, self.U + eps * part)) - f0) / eps
+            out += unit * np.einsum("pa,pab->pb", W, d)
+        row = (self.E @ self.fold(1.0)).T @ out.ravel()
+        return row
+
+
+def _twisted_pair(A: Any, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, complex, np.ndarray]:
+    """(v, g, w) of [[A, b], [c', 0]] (v, g) = (0, 1) and [[A', c], [b', 0]] (w, h) = (0, 1),
+    complex ones in their real form (one bordered solve each)."""
+    At = sp.csc_matrix(A.T)
+    if not (np.iscomplexobj(A.data) or np.iscomplexobj(b) or np.iscomplexobj(c)):
+        e1 = np.zeros(c.size + 1)
+        e1[-1] = 1.0
+        vg = bordered_solve(A, b, np.append(c, 0.0), e1)
+        wh = bordered_solve(At, c, np.append(b, 0.0), e1)
+        return vg[:-1], float(vg[-1]), wh[:-1]
+    v, g = _real_form(A, b, c)
+    w, _ = _real_form(At, c, b)
+    return v, g, w
+
+
+def _real_form(M: Any, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, complex]:
+    """(v, g) of the complex [[M, b], [c', 0]] (v, g) = (0, 1) in its real form (Re, Im)."""
+    N = M.shape[0]
+    Mr, Mi = sp.csr_matrix(M.real), sp.csr_matrix(M.imag)
+    big = sp.bmat([[Mr, -Mi], [Mi, Mr]], format="csc")
+    cols = np.column_stack([np.concatenate([b.real, b.imag]),
+                            np.concatenate([-b.imag, b.real])])
+    rows = np.array([np.concatenate([c.real, -c.imag, [0.0, 0.0]]),
+                     np.concatenate([c.imag, c.real, [0.0, 0.0]])])
+    rhs = np.zeros(2 * N + 2)
+    rhs[2 * N] = 1.0
+    z = bordered_solve(big, cols, rows, rhs)
+    return z[:N] + 1j * z[N:2 * N], complex(z[2 * N], z[2 * N + 1])
+
+
+class OrbitFlip(OrbitFold):
+    """The minimally augmented system of a period doubling (``theta`` None: mu = -1, unknowns
+    (x, p)) or of a torus (``theta`` the start's angle: mu = e^(i theta), unknowns (x, p,
+    theta)) of collocated orbits on the one driver (see the module); parameter q."""
+
+    def __init__(self, make2: Callable[[float, float], Solver], layout: Layout, x: np.ndarray,
+                 *, theta: float | None = None, **options: Any):
+        super().__init__(make2, layout, x, **options)
+        self.torus = theta is not None
+        self.theta0 = float(theta) if theta is not None else math.pi
+
+    @property
+    def extra(self) -> int:
+        """The unknowns past x: p (and theta on a torus curve)."""
+        return 2 if self.torus else 1
+
+    @property
+    def weight(self) -> np.ndarray:
+        """The driver's weights on y: x's RMS, p and theta as themselves."""
+        m = self.lay.size
+        return np.concatenate([np.full(m, 1.0 / m), np.ones(self.extra)])
+
+    def mu(self, y: np.ndarray) -> complex:
+        """The multiplier of y: -1, or e^(i theta)."""
+        return complex(np.exp(1j * y[-1])) if self.torus else -1.0
+
+    def _split(self, y: np.ndarray) -> tuple[np.ndarray, float]:
+        return y[:self.lay.size], float(y[self.lay.size])
+
+    def borders(self, x: np.ndarray, p: float, q: float) -> None:
+        """b and c by INVERSE_STEPS steps of inverse iteration from fixed pseudo-random vectors,
+        and g's unit (1 / its gradient's largest entry there)."""
+        y = np.concatenate([x, [p], [self.theta0] if self.torus else []])
+        A = Twisted(self.lay, self.terms(p, q), x).matrix(self.mu(y))
+        rng = np.random.default_rng(20260)
+        shape = (2, A.shape[0])
+        b, c = rng.standard_normal(shape) + (1j * rng.standard_normal(shape) if self.torus
+                                             else 0.0)
+        for _ in range(INVERSE_STEPS):
+            v, _, w = _twisted_pair(A, b, c)
+            c, b = np.conj(v) / np.linalg.norm(v), np.conj(w) / np.linalg.norm(w)
+        self.b, self.c, self.gscale, self._last = b, c, 1.0, None
+        rows = self._jy(y, q)[2]
+        self.gscale = 1.0 / max(float(np.max(np.abs(rows))), 1e-300)
+        self._last = None
+
+    def _eval(self, y: np.ndarray, q: float) -> dict[str, Any]:
+        """F, J, A_mu's parts, v, w and g at (y, q) (the last kept)."""
+        key = (y.tobytes(), float(q), id(self.lay), id(self.b), self.gscale)
+        if self._last is not None and self._last[0] == key:
+            return self._last[1]
+        x, p = self._split(y)
+        t = self.terms(p, q)
+        r, J = full_jacobian(self.lay, t, x, self.ref)
+        tw = Twisted(self.lay, t, x)
+        v, g, w = _twisted_pair(tw.matrix(self.mu(y)), self.b, self.c)
+        g = complex(g) * self.gscale
+        ev = {"r": r, "J": J, "v": v, "w": w, "g": np.array([g.real, g.imag][:self.extra]),
+              "terms": t, "tw": tw}
+        self._last = (key, ev)
+        return ev
+
+    def residual(self, y: np.ndarray, q: float) -> np.ndarray:
+        """(F, g) at (y, q) (g: Re and Im on a torus curve)."""
+        ev = self._eval(y, q)
+        return np.concatenate([ev["r"], ev["g"]])
+
+    def _grad(self, ev: dict, y: np.ndarray, A1: Any, d: float) -> np.ndarray:
+        """-w' (A1 - A_mu) v / d as g's rows (Re, Im)."""
+        mu = self.mu(y)
+        dg = -self.gscale * complex(ev["w"] @ ((A1 - ev["tw"].matrix(mu)) @ ev["v"])) / d
+        return np.array([dg.real, dg.imag][:self.extra])
+
+    def _jy(self, y: np.ndarray, q: float) -> tuple[Any, np.ndarray, np.ndarray, dict]:
+        """(J, the columns of p (and theta), g's rows in y, the evaluation) at (y, q)."""
+        ev = self._eval(y, q)
+        x, p = self._split(y)
+        mu, tw, t = self.mu(y), ev["tw"], ev["terms"]
+        gx = -self.gscale * tw.fu_row(t, ev["v"], ev["w"], mu)
+        gx = np.concatenate([gx, np.zeros(self.lay.size - gx.size, dtype=complex)])
+        if self.lay.autonomous:
+            T = float(x[-1])
+            dT = DIFF * T
+            # f_u of an autonomous f is the same at the moved times
+            gT = self._grad(ev, y, Twisted(self.lay, t, x, T + dT, tw.fu).matrix(mu), dT)
+        d = DIFF * max(1.0, abs(p))
+        tp = self.terms(p + d, q)
+        Fp = (assemble(self.lay, tp, x, self.ref, jacobian=False)[0] - ev["r"]) / d
+        gp = self._grad(ev, y, Twisted(self.lay, tp, x).matrix(mu), d)
+        rows = np.vstack([gx.real, gx.imag])[:self.extra]
+        if self.lay.autonomous:
+            rows[:, -1] = gT
+        rows = np.column_stack([rows, gp])
+        cols = Fp[:, None]
+        if self.torus:
+            dth = -self.gscale * complex(ev["w"] @ ((tw.Av @ tw.fold(mu, True)) @ ev["v"]))
+            rows = np.column_stack([rows, [dth.real, dth.imag]])
+            cols = np.column_stack([Fp, np.zeros(Fp.size)])
+        return ev["J"], cols, rows, ev
+
+    def jacobian(self, y: np.ndarray, q: float) -> tuple[Any, np.ndarray]:
+        """(J_y sparse, J_q): the driver's Jacobian in the unknowns y and in its parameter q."""
+        J, cols, rows, ev = self._jy(y, q)
+        x, p = self._split(y)
+        d = DIFF * max(1.0, abs(q))
+        tq = self.terms(p, q + d)
+        Fq = (assemble(self.lay, tq, x, self.ref, jacobian=False)[0] - ev["r"]) / d
+        gq = self._grad(ev, y, Twisted(self.lay, tq, x).matrix(self.mu(y)), d)
+        return sparse_bordered(J, cols, rows), np.concatenate([Fq, gq])
+
+    def strategies(self, y: np.ndarray, q: float, row: np.ndarray, target: float, far: float
+                   ) -> Iterator[Strategy]:
+        """The driver's Newton strategy (:func:`newton_strategy`)."""
+        what = "torus" if self.torus else "period doubling"
+        yield newton_strategy(DriverCurve(self, y.size), np.concatenate([y, [q]]), row, target,
+                              tol=self.tol, max_iter=self.max_iter, far=far,
+                              what=f"the orbits' {what} near q = {q!r}")
+
+    def accept(self, y: np.ndarray, q: float, step: bool) -> tuple[np.ndarray, float]:
+        """The orbit's inequalities checked (as the fold curve's: a curve does not cross
+        signatures), and on a torus curve theta kept away from 0 and pi."""
+        x, p = self._split(y)
+        super().accept(np.concatenate([x, [p]]), q, step)
+        if self.torus:
+            th = float(y[-1])
+            end = min((abs(th), "+1 (theta -> 0: a 1:1 resonance"),
+                      (abs(th - math.pi), "-1 (theta -> pi: a 1:2 resonance"))
+            if end[0] < THETA_END or not 0 < th < math.pi:
+                self.breach = (f"near (p, q) = ({p:.10g}, {q:.10g}) the pair e^(+-i theta) "
+                               f"meets at {end[1]}, theta = {th:.6g}): the torus curve "
+                               "ends there (a neutral saddle follows)")
+                raise ShootingError(self.breach, [])
+        return y, q
+
+    def adapt(self, y: np.ndarray, q: float) -> np.ndarray:
+        """Between steps: the borders moved to the point's conj(v) and conj(w), the mesh
+        equidistributed again, the phase condition's reference moved to the point."""
+        ev = self._eval(y, q)
+        self.c = np.conj(ev["v"]) / np.linalg.norm(ev["v"])
+        self.b = np.conj(ev["w"]) / np.linalg.norm(ev["w"])
+        x = y[:self.lay.size]
+        new = self.lay.with_fractions(adapted(self.lay, x, self.lay.L))
+        x = transfer(self.lay, x, new)
+        self.lay = new
+        if new.autonomous:
+            self.ref = reference(new, x)
+        self._last = None
+        return np.concatenate([x, y[self.lay.size:]])
+
+    def point(self, y: np.ndarray, q: float) -> OrbitCurvePoint:
+        """The curve's point at (y, q): the orbit, its errors from the merged mesh's solve,
+        the verdict on the other multipliers."""
+        x, p = self._split(y)
+        fine = self._solved(self.lay, self.terms(p, q), x)
+        errors: dict[str, Any] = {}
+        p_error = th_error = None
+        if self.estimate:
+            got = self._coarse(y, q)
+            if got is not None:
+                coarse, yc = got
+                errors = level_errors(coarse, fine)
+                p_error = max(abs(float(yc[-self.extra]) - p), FLOOR * max(1.0, abs(p)))
+                errors["p"] = p_error
+                if self.torus:
+                    th_error = max(abs(float(yc[-1] - y[-1])), FLOOR)
+                    errors["theta"] = th_error
+        with warnings.catch_warnings():   # a multiplier on the circle: the orbit's stable None
+            warnings.simplefilter("ignore", CollocationWarning)
+            orbit = equation_orbit(fine, p, _AtQ(self.make2, q), errors, self.jumps)
+        orbit.stable = None
+        stable = _others_stable_at(fine.mu, errors.get("multipliers"), self.lay.autonomous,
+                                self.mu(y), p, q)
+        if self.torus:
+            return TorusCurvePoint(p, float(q), orbit, p_error, stable, theta=float(y[-1]),
+                                   theta_error=th_error)
+        return FlipCurvePoint(p, float(q), orbit, p_error, stable)
+
+    def _coarse(self, y: np.ndarray, q: float) -> tuple[Solved, np.ndarray] | None:
+        """The bifurcation at q on the mesh of merged pairs of intervals (its y); None, with a
+        CollocationWarning, where that solve fails."""
+        x, p = self._split(y)
+        lay = self.lay.with_fractions(merged(self.lay.fractions))
+        xc = transfer(self.lay, x, lay)
+        other = OrbitFlip(self.make2, lay, xc, theta=float(y[-1]) if self.torus else None,
+                          jumps=self.jumps, multipliers=self.count, tol=self.tol,
+                          max_iter=self.max_iter, estimate=False)
+        other.ref, other.problem = self.ref, self.problem
+        try:
+            other.borders(xc, p, q)
+            yc = other.solve_at(np.concatenate([xc, y[self.lay.size:]]), q,
+                                f"the bifurcation at q = {q!r} on the merged mesh")
+        except (ShootingError, ValueError) as e:
+            warnings.warn(f"(p, q) = ({p!r}, {q!r}): the solve on the merged mesh failed ({e}): "
+                          "no error estimate, the verdict None", CollocationWarning,
+                          stacklevel=3)
+            return None
+        pc = float(yc[lay.size])
+        return self._solved(lay, self.terms(pc, q), yc[:lay.size]), yc
+
+
+def _others_stable_at(mu: np.ndarray, err: Any, autonomous: bool, crit: complex, p: float,
+                   q: float) -> bool | None:
+    """The multipliers but the trivial one (autonomous) and the critical ones (the nearest
+    -1, or the pair nearest e^(+-i theta)) all inside the unit circle (True) or one outside
+    (False) beyond their errors; None (with a CollocationWarning) otherwise."""
+    if mu.size == 0 or err is None:
+        return None
+    keep = np.ones(mu.size, bool)
+    targets = ([1.0] if autonomous else []) + [crit] + ([np.conj(crit)] if np.imag(crit) else [])
+    for z in targets:
+        rest = np.flatnonzero(keep)
+        if rest.size:
+            keep[rest[int(np.argmin(np.abs(mu[rest] - z)))]] = False
+    a, e = np.abs(mu[keep]), np.asarray(err)[keep]
+    if np.any(a > 1 + e):
+        return False
+    if np.all(a < 1 - e):
+        return True
+    warnings.warn(f"(p, q) = ({p!r}, {q!r}): a multiplier other than the critical ones is "
+                  "within its estimated error of the unit circle: the verdict is None",
+                  CollocationWarning, stacklevel=3)
+    return None
+
+
+def _start(start: Any, branch: Branch | None, kind: str, who: str
+           ) -> tuple[EquationOrbit, float, tuple[float, float]]:
+    """(the orbit nearest the event, the event's p, the bracket of p the bifurcation at q0 must
+    lie in: the event's two points, widened by their distance)."""
+    if isinstance(start, EquationOrbit):
+        return start, float(start.p), (-math.inf, math.inf)
+    if not (isinstance(start, Event) and start.kind == kind):
+        raise ValueError(f"{who}: start = {start!r}: give a '{kind}' event of a branch of "
+                         "EquationOrbits (with branch=) or an EquationOrbit near it")
+    if branch is None or not isinstance(branch, Branch):
+        raise ValueError(f"{who}: a '{kind}' event needs branch=, the Branch of EquationOrbits "
+                         "it belongs to (continue_orbit of an EquationOrbit)")
+    pts = branch.points
+    if not pts or not all(isinstance(pt, EquationOrbit) for pt in pts):
+        raise ValueError(f"{who}: branch= is not a branch of EquationOrbits (continue_orbit of "
+                         "an EquationOrbit, from collocate or hopf_orbit(..., of='equation'))")
+    if start not in branch.events:
+        raise ValueError(f"{who}: the '{kind}' event is not one of branch.events")
+    k = min(max(int(start.index), 1), len(pts) - 1)
+    before, after = pts[k - 1], pts[k]
+    orbit = before if abs(before.p - start.p) <= abs(after.p - start.p) else after
+    wide = abs(after.p - before.p)
+    return orbit, float(start.p), (min(before.p, after.p) - wide, max(before.p, after.p) + wide)
+
+
+def _angle(orbit: EquationOrbit, who: str) -> float:
+    """The argument in (0, pi) of the orbit's non-real multiplier nearest the unit circle."""
+    mu = np.asarray(orbit.multipliers)
+    pick = mu[np.abs(mu.imag) > 1e-9 * np.maximum(np.abs(mu), 1e-300)]
+    if pick.size == 0:
+        raise ValueError(f"{who}: the start's orbit has no non-real multiplier: not near a "
+                         "torus bifurcation (give its event, or an orbit whose multipliers "
+                         "include a complex pair near the unit circle)")
+    return abs(float(np.angle(pick[int(np.argmin(np.abs(np.abs(pick) - 1)))])))
+
+
+def _prepared(kind: str, start: Any, make2: Callable[[float, float], Solver], q0: float,
+              q_end: float, branch: Branch | None, step: float | None, **options: Any
+              ) -> tuple[OrbitFlip, np.ndarray, float]:
+    """(the system, its start solved at q0, the first step) of a curve of ``kind``
+    (``"period-doubling"`` or ``"torus"``; see :func:`continue_flip_curve`)."""
+    who = "continue_flip_curve" if kind == "period-doubling" else "continue_torus_curve"
+    orbit, p_event, bracket = _start(start, branch, kind, who)
+    if not (math.isfinite(q0) and math.isfinite(q_end)) or q0 == q_end:
+        raise ValueError(f"{who}: q0 = {q0!r}, q_end = {q_end!r}: give two different finite "
+                         "values")
+    step = abs(q_end - q0) / 20 if step is None else step
+    if not (isinstance(step, (int, float)) and math.isfinite(step) and step > 0):
+        raise ValueError(f"{who}: step = {step!r}: must be finite and > 0")
+    if not callable(make2):
+        raise ValueError(f"{who}: make2 = {make2!r}: give a function (p, q) -> dmi.Solver")
+    if orbit.switches.size:
+        raise ValueError(f"{who}: the start's orbit has switches (stick-slip or contacts): "
+                         f"{kind} curves of orbits with switches (their saltation) are not "
+                         "covered yet; continue one-parameter branches over q "
+                         "(continue_over) and read their events")
+    lay = Layout(orbit.degree, orbit.nodes.shape[1], orbit.signature,
+                 [f.copy() for f in orbit.fractions], orbit.autonomous, orbit.period,
+                 tuple(orbit.carried))
+    x = np.concatenate([orbit.nodes.ravel(), orbit.switches,
+                        [orbit.period] if orbit.autonomous else []])
+    theta = _angle(orbit, who) if kind == "torus" else None
+    disc = OrbitFlip(make2, lay, x, theta=theta, jumps=tuple(orbit.kernel_jumps), **options)
+    try:
+        disc.borders(x, p_event, q0)
+        y0 = disc.solve_at(np.concatenate([x, [p_event], [theta] if theta is not None else []]),
+                           q0, f"the orbits' {kind} at q0 = {q0!r} from p = {p_event!r}")
+    except (ShootingError, ValueError) as e:
+        raise ValueError(f"{who}: the start is not a {kind} of make2(., q0 = {q0!r}) near p = "
+                         f"{p_event!r}: {e}") from None
+    p0 = float(y0[lay.size])
+    if not bracket[0] <= p0 <= bracket[1]:
+        raise ValueError(f"{who}: the {kind} of make2(., q0 = {q0!r}) is at p = {p0!r}, outside "
+                         f"the event's bracket {bracket!r}: is make2(p, q0) the branch's model "
+                         "make(p)?")
+    return disc, y0, float(step)
+
+
+def _finished(b: Branch, disc: OrbitFlip, kind: str) -> Curve:
+    """The Curve of the driver's branch: its points, the user points, a torus curve's end at a
+    resonance, its status in q's words."""
+    status = b.status.replace("p_end", "q_end").replace(" near p = ", " near q = ")
+    points = list(b.points)
+    events = []
+    for e in b.events:
+        if e.kind == "user" and e.index < len(points):
+            on = [j for j, pt in enumerate(points) if pt.q == e.p]
+            i = e.index if e.index in on or not on else min(on, key=lambda j: abs(j - e.index))
+            events.append(CurveEvent("user", points[i].p, float(e.p), i, e.detail))
+    if disc.breach and "meets at" in disc.breach and points and disc.breach in status:
+        res = "1:2 resonance" if "theta -> pi" in disc.breach else "1:1 resonance"
+        events.append(CurveEvent(res, points[-1].p, points[-1].q, len(points) - 1, disc.breach))
+        status = disc.breach   # the driver's words around it repeat it
+    return Curve(kind=kind, points=points, events=events, status=status, make2=disc.make2)
+
+
+def continue_flip_curve(start: Any, make2: Callable[[float, float], Solver], q0: float,
+                        q_end: float, *, branch: Branch | None = None,
+                        step: float | None = None, at: Iterable[float] = (),
+                        max_points: int = 100, min_step: float | None = None,
+                        max_step: float | None = None, multipliers: int = 10,
+                        tol: float = 1e-10, max_iter: int = 10, estimate: bool = True
+                        ) -> Curve:
+    """Continues a period doubling of the equation's periodic orbits (collocated) in the plane
+    (p, q): the curve where a Floquet multiplier of the orbit of ``make2(p, q)`` is -1, by
+    pseudo-arclength in (x, p, q) with the minimally augmented system of
+    :mod:`dmi.analysis.plane.orbit_curves`, from q0 through turning points in q to q_end.
+
+    Parameters
+    ----------
+    start : Event or EquationOrbit
+        A ``period-doubling`` event of a branch of EquationOrbits of ``make2(., q0)`` (give that
+        Branch as ``branch=``), or an EquationOrbit of ``make2(., q0)`` near a period doubling.
+        Orbits without switches only.
+    make2, q0, q_end, branch, step, at, max_points, min_step, max_step, multipliers, tol,
+    max_iter, estimate
+        As :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`'s.
+
+    Returns
+    -------
+    Curve
+        ``kind`` ``"period-doubling"``; ``points`` (:class:`FlipCurvePoint`: ``p``, ``q``,
+        ``orbit``, ``p_error``, ``stable`` on the multipliers but the trivial one and -1),
+        ``events`` (``user``), ``status`` (q_end reached, a turn back past q0, max_points, a
+        signature the orbits would leave, or the corrector failing).
+
+    Raises
+    ------
+    ValueError
+        A start of another kind, an event without its branch, an orbit with switches, bad q0,
+        q_end or step; a start that is not a period doubling of ``make2(., q0)`` (Newton fails
+        at q0, or finds it outside the event's two points widened by their distance).
+    """
+    q0, q_end = float(q0), float(q_end)
+    disc, y0, step = _prepared("period-doubling", start, make2, q0, q_end, branch, step,
+                               multipliers=multipliers, tol=tol, max_iter=max_iter,
+                               estimate=estimate)
+    b = continuation(disc, y0, q0, q_end, step=step, min_step=min_step, max_step=max_step,
+                     max_points=max_points, at=at, tol=tol, max_iter=max_iter,
+                     predictor="tangent", easy=4, make=make2, kind="period-doubling")
+    return _finished(b, disc, "period-doubling")
+
+
+def continue_torus_curve(start: Any, make2: Callable[[float, float], Solver], q0: float,
+                         q_end: float, *, branch: Branch | None = None,
+                         step: float | None = None, at: Iterable[float] = (),
+                         max_points: int = 100, min_step: float | None = None,
+                         max_step: float | None = None, multipliers: int = 10,
+                         tol: float = 1e-10, max_iter: int = 10, estimate: bool = True
+                         ) -> Curve:
+    """Continues a torus (Neimark-Sacker) bifurcation of the equation's periodic orbits
+    (collocated) in the plane (p, q): the curve where a pair of Floquet multipliers is
+    e^(+-i theta), theta in (0, pi) an unknown, as :func:`continue_flip_curve` does.
+
+    Parameters
+    ----------
+    start : Event or EquationOrbit
+        A ``torus`` event of a branch of EquationOrbits of ``make2(., q0)`` (with ``branch=``),
+        or an EquationOrbit near a torus bifurcation (theta starts from its non-real
+        multiplier nearest the unit circle).  Orbits without switches only.
+    make2, q0, q_end, branch, step, at, max_points, min_step, max_step, multipliers, tol,
+    max_iter, estimate
+        As :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`'s (the arclength also
+        counts theta, in radians).
+
+    Returns
+    -------
+    Curve
+        ``kind`` ``"torus"``; ``points`` (:class:`TorusCurvePoint`: also ``theta`` and
+        ``theta_error``), ``events`` (``user``; ``"1:1 resonance"`` or ``"1:2 resonance"`` where
+        theta reaches 0 or pi and the curve ends), ``status``.
+
+    Raises
+    ------
+    ValueError
+        As :func:`continue_flip_curve`'s; a start orbit without a non-real multiplier.
+    """
+    q0, q_end = float(q0), float(q_end)
+    disc, y0, step = _prepared("torus", start, make2, q0, q_end, branch, step,
+                               multipliers=multipliers, tol=tol, max_iter=max_iter,
+                               estimate=estimate)
+    b = continuation(disc, y0, q0, q_end, step=step, min_step=min_step, max_step=max_step,
+                     max_points=max_points, at=at, tol=tol, max_iter=max_iter,
+                     predictor="tangent", easy=4, make=make2, kind="torus")
+    return _finished(b, disc, "torus")
+
+
+__all__ = ["OrbitCurvePoint", "continue_orbit_curve", "FlipCurvePoint", "TorusCurvePoint",
+           "continue_flip_curve", "continue_torus_curve"]
