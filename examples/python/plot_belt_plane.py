@@ -32,7 +32,7 @@ What the map shows, each from one call of :mod:`dmi.analysis`:
    unstable orbit grows with :math:`v_b` until the relative velocity touches 0: a *stick onset*,
    where it turns into the stable stick-slip orbit. The grid's events are marked: the Hopf points
    (open: subcritical), the stick onsets (squares), the folds of orbits (triangles).
-3. **The stick-onset curve** by :func:`~dmi.analysis.plane.stick_curves.continue_stick_curve`
+3. **The stick-onset curve** by :func:`~dmi.analysis.continue_curve`
    from the stick-onset event of the orbits' branch at :math:`c = 0.3`: where the unstable
    slipping orbit's relative velocity touches 0, continued in :math:`c` both ways (its least
    velocity held at 0 on the slipping orbit; each point with the estimated error of
@@ -64,7 +64,6 @@ import numpy as np
 
 import dmi
 from dmi import analysis
-from dmi.analysis.plane.stick_curves import continue_stick_curve
 
 K, G, TAU = 1.0, 0.5, 1.0                  # stiffness, memory gain, memory length
 MU_S, MU_D, V_S = 0.5, 0.3, 0.3            # static and dynamic friction, Stribeck velocity
@@ -129,8 +128,8 @@ with warnings.catch_warnings():
     warnings.simplefilter("ignore")      # the branch's own warnings (printed in the grid below)
     orbits = branches(C0)["orbits"]
 onset = [e for e in orbits.events if e.kind == "stick-onset"][0]
-sticks = [continue_stick_curve(onset, make2, C0, q_end, branch=orbits, step=0.03,
-                               at=dampings, multipliers=4) for q_end in (0.26, 0.40)]
+sticks = [analysis.continue_curve(onset, make2, C0, q_end, branch=orbits, step=0.03,
+                                   at=dampings, multipliers=4) for q_end in (0.26, 0.40)]
 for cur in sticks:
     print(f"stick-onset curve to c = {cur.q[-1]:.4f}: {len(cur.points)} points, {cur.status}; "
           f"v_b from {cur.p.min():.4f} to {cur.p.max():.4f}; largest estimated error of v_b "

@@ -42,6 +42,7 @@ from .plane.diagram import plot_curves
 from .plane.grid import Grid, GridEvent, GridRow, GridWarning, Trace, continue_over
 from .plane.orbit_curves import (FlipCurvePoint, OrbitCurvePoint, TorusCurvePoint,
                                  continue_flip_curve, continue_orbit_curve, continue_torus_curve)
+from .plane.stick_curves import StickCurvePoint, continue_stick_curve
 from .plot.branch import plot_branch
 from .scheme.floquet import Floquet, StabilityWarning, Verify, floquet_multipliers, floquet_verdict
 from .scheme.orbit import Orbit
@@ -64,10 +65,10 @@ __all__ = [
     "collocate", "EquationOrbit", "CollocationWarning", "EventWarning",
     "CollocationDiscretisation", "equation_hopf_orbit",
     # curves in two parameters: Hopf and fold curves of equilibria, folds, period doublings
-    # and tori of orbits
+    # tori and stick onsets of orbits
     "continue_curve", "Curve", "CurvePoint", "CurveEvent", "continue_orbit_curve",
     "OrbitCurvePoint", "continue_flip_curve", "FlipCurvePoint", "continue_torus_curve",
-    "TorusCurvePoint",
+    "TorusCurvePoint", "continue_stick_curve", "StickCurvePoint",
     # the plane (p, q): one-parameter continuations over q (serially or on Dask) and the diagram
     "continue_over", "Grid", "GridRow", "GridEvent", "Trace", "GridWarning", "plot_curves",
 ]

@@ -6,8 +6,9 @@
 orbits, an orbit branch's ``fold`` event given with its ``branch=`` or an EquationOrbit near a fold
 (:func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`), or its ``period-doubling``
 or ``torus`` event (:func:`dmi.analysis.plane.orbit_curves.continue_flip_curve`,
-:func:`dmi.analysis.plane.orbit_curves.continue_torus_curve`).  It sits above the rooms because
-it reaches both."""
+:func:`dmi.analysis.plane.orbit_curves.continue_torus_curve`), or its ``stick-onset`` or
+``grazing`` event (:func:`dmi.analysis.plane.stick_curves.continue_stick_curve`).  It sits above
+the rooms because it reaches both."""
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -19,6 +20,11 @@ from .equilibria.curves import Curve
 from .equilibria.curves import continue_curve as equilibrium_curve
 from .continuation.branch import Event
 from .plane.orbit_curves import continue_flip_curve, continue_orbit_curve, continue_torus_curve
+from .plane.stick_curves import continue_stick_curve
+
+#: The curve of each kind of an orbit branch's event other than a fold.
+BY_EVENT = {"period-doubling": continue_flip_curve, "torus": continue_torus_curve,
+            "stick-onset": continue_stick_curve, "grazing": continue_stick_curve}
 
 
 def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: float, q_end: float,
@@ -30,8 +36,8 @@ def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: floa
     start : HopfPoint, Event or EquationOrbit
         A Hopf point of the equation (``hopf(..., of="equation")``, with ``u_eq=``), a ``hopf``
         or ``fold`` event of a branch of the equation's equilibria, a ``fold``,
-        ``period-doubling`` or ``torus`` event of a branch of EquationOrbits (with ``branch=``,
-        that branch), or an EquationOrbit near a fold (for the others, call
+        ``period-doubling``, ``torus``, ``stick-onset`` or ``grazing`` event of a branch of
+        EquationOrbits (with ``branch=``, that branch), or an EquationOrbit near a fold (for the others, call
         :func:`~dmi.analysis.plane.orbit_curves.continue_flip_curve` or
         :func:`~dmi.analysis.plane.orbit_curves.continue_torus_curve` with it).
     make2 : callable
@@ -43,18 +49,17 @@ def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: floa
     **options
         The options of :func:`dmi.analysis.equilibria.curves.continue_curve` (equilibria) or of
         :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve` (orbits; the same for
-        period-doubling and torus curves).
+        period-doubling and torus curves) or of
+        :func:`dmi.analysis.plane.stick_curves.continue_stick_curve` (stick onset, grazing).
 
     Returns
     -------
     Curve
-        The curve: ``kind`` ``"hopf"``, ``"fold"``, ``"orbit-fold"``, ``"period-doubling"`` or
-        ``"torus"``, its points, events and status.
+        The curve: ``kind`` ``"hopf"``, ``"fold"``, ``"orbit-fold"``, ``"period-doubling"``,
+        ``"torus"``, ``"stick-onset"`` or ``"grazing"``, its points, events and status.
     """
-    if isinstance(start, Event) and start.kind == "period-doubling":
-        return continue_flip_curve(start, make2, q0, q_end, **options)
-    if isinstance(start, Event) and start.kind == "torus":
-        return continue_torus_curve(start, make2, q0, q_end, **options)
+    if isinstance(start, Event) and start.kind in BY_EVENT:
+        return BY_EVENT[start.kind](start, make2, q0, q_end, **options)
     if isinstance(start, EquationOrbit) or options.get("branch") is not None:
         return continue_orbit_curve(start, make2, q0, q_end, **options)
     return equilibrium_curve(start, make2, q0, q_end, **options)
