@@ -38,7 +38,9 @@ def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: floa
     start : HopfPoint, Event, CurveEvent or EquationOrbit
         A ``bautin`` event of a Hopf curve (the fold curve of orbits from it:
         :func:`dmi.analysis.plane.bautin_fold.continue_bautin_fold`, with ``make2`` the Hopf
-        curve's model), a Hopf point of the equation (``hopf(..., of="equation")``, with ``u_eq=``), a ``hopf``
+        curve's model; its options ``offset=``, ``amplitude=`` and those of
+        :func:`~dmi.analysis.plane.orbit_curves.continue_orbit_curve`), a Hopf point of the
+        equation (``hopf(..., of="equation")``, with ``u_eq=``), a ``hopf``
         or ``fold`` event of a branch of the equation's equilibria, a ``fold``,
         ``period-doubling``, ``torus``, ``stick-onset`` or ``grazing`` event of a branch of
         EquationOrbits (with ``branch=``, that branch), or an EquationOrbit near a fold (for the others, call
