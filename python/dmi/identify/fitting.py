@@ -19,6 +19,7 @@ from scipy import optimize, stats
 
 from .._cache import Cache
 from .._solver import Solver
+from . import _grouped
 from .sensitivity import MAX_STEPS, Sensitivities, _build, _sensitivities_of, check_steps
 
 #: Singular values of the column-normalised Jacobian below this fraction of the largest one mark
@@ -470,8 +471,12 @@ class _Problem:
         # the residuals and Jacobian at the last x, the models of the last Jacobian (the next one
         # at the same p, with or without the saltation, steps the same solvers again) and the
         # residuals at the last two x
-        self.cache = Cache(4 + len(makes))
+        self.cache = Cache(4 + 3 * len(makes))
         self.recent: list = []          # the keys of the residuals kept, oldest first
+        # and per record (in the cache): how its perturbed models are grouped, ("plan", k),
+        # learned from the last build of all of them (None: one model per parameter), and the
+        # model of the last residuals, ("made", k): (p, solver)
+        self.full_build = False         # True: a model per parameter (the covariance's Jacobian)
 
     def full(self, x: np.ndarray) -> np.ndarray:
         p = self.p0.copy()
@@ -522,12 +527,29 @@ class _Problem:
             return self._residuals(x, check)
         return r.copy()
 
+    def seed(self, x: np.ndarray) -> None:
+        """Keeps the residuals of the Jacobian's run at x (where one is kept) as the residuals at
+        x: the same run (the tangent steps the model as a plain run does, bit for bit)."""
+        got = self.cache.pop("linearised")
+        if got is None:
+            return
+        self.cache.cached("linearised", lambda: got)
+        if got[0][0] == x.tobytes():
+            key = ("residuals", x.tobytes())
+            self.cache.pop(key)
+            self.recent = [k for k in self.recent if k != key] + [key]
+            if len(self.recent) > 2:
+                self.cache.pop(self.recent.pop(0))
+            self.cache.cached(key, lambda: got[1][0].copy())
+
     def _residuals(self, x: np.ndarray, check: bool) -> np.ndarray:
         p = self.full(x)
         out = []
         for k, (make, d) in enumerate(zip(self.makes, self.data)):
             s = make(p.copy())
             s.init()
+            self.cache.pop(("made", k))
+            self.cache.cached(("made", k), lambda: (p.tobytes(), s))
             t_grid, U, X = s.run_terms(record_steps(s, d))
             val, _ = self._predict(d, t_grid, s.h, U, X, None, None)
             if check and not np.all(np.isfinite(val)):
@@ -564,7 +586,8 @@ class _Problem:
     def linearised(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(r, J): the weighted residuals and their Jacobian at the free parameters x, from the
         sensitivities' runs (kept in the problem's cache for the next call at the same x)."""
-        return self._slot("linearised", (x.tobytes(), self.jumps), lambda: self._linearise(x))
+        return self._slot("linearised", (x.tobytes(), self.jumps, self.full_build),
+                          lambda: self._linearise(x))
 
     def _slot(self, slot: Hashable, key: Hashable, factory: Callable[[], Any]) -> Any:
         """What the cache's ``slot`` holds for ``key``, else factory() there in its place (one
@@ -574,6 +597,24 @@ class _Problem:
             got = (key, factory())
         self.cache.cached(slot, lambda: got)
         return got[1]
+
+    def _models(self, k: int, make_free: Callable[[np.ndarray], Solver], p: np.ndarray
+                ) -> Any:
+        """The models of record k at p and at the perturbed free parameters: grouped by the
+        record's plan where it has one (and it still holds), else one per parameter (the plan
+        learned from them); the model at p that of the last residuals where made at p."""
+        q = p[self.free]
+        made = self.cache.pop(("made", k))
+        base = made[1] if made is not None and made[0] == p.tobytes() else None
+        plan = self.cache.pop(("plan", k))
+        mod = None
+        if plan is not None and not self.full_build:
+            mod = _grouped.build(make_free, q, plan, base)
+        if mod is None:
+            mod = _build(make_free, q, base)
+            plan = _grouped.plan(mod)
+        self.cache.cached(("plan", k), lambda: plan)
+        return mod
 
     def _linearise(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         p = self.full(x)
@@ -591,7 +632,8 @@ class _Problem:
                 return _make(self.full(q))
             # the models at p and p + delta_j e_j: those of the last Jacobian at this p (made by
             # make at the same parameters; each run starts from their init), else made now
-            mod = self._slot(("models", k), p.tobytes(), lambda: _build(make_free, p[idx]))
+            mod = self._slot(("models", k), (p.tobytes(), self.full_build),
+                             lambda: self._models(k, make_free, p))
             with warnings.catch_warnings():
                 # reversals left unplaced are gathered here and reported once by the estimate
                 warnings.filterwarnings("ignore", "sensitivities: .* could not be placed",
@@ -718,6 +760,7 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
                        polish, options.progress)
     best = min(fits, key=lambda f: f[1])
     x, cost, message, stopped, converged = best
+    problem.full_build = True           # the covariance's Jacobian: one model per parameter
     lower = None
     if converged and not stopped and options.saddle_check:
         lower = _saddle(problem, x, cost, names)
@@ -1055,6 +1098,7 @@ def _fit(problem: _Problem, start: np.ndarray, lo: np.ndarray, hi: np.ndarray, x
             raise StopIteration
     xs = x_scale if isinstance(x_scale, str) else np.broadcast_to(np.asarray(x_scale, float),
                                                                   (free.sum(),))
+    problem.seed(x0)
     r0 = problem.residuals(x0, check=True)
     cost0 = 0.5 * float(r0 @ r0)
     def solve(x_start: np.ndarray, jumps: bool, tol: float) -> Any:
@@ -1105,10 +1149,13 @@ def _gauss_newton(problem: _Problem, x: np.ndarray, cost: float, lo: np.ndarray,
     taken where it lowers the cost, until the next step is below ``tol`` (as least_squares's
     xtol: |dx| <= tol (tol + |x|)) or would lower the cost by less than ``tol`` of it (ftol, by
     the linear model), and is then not taken (its change is within the tolerance), or a step
-    taken lowered it by less than that.  A result as least_squares's (x, cost, fun, status,
+    taken lowered it by less than that, or the last two drops of the cost say that the steps
+    still to come would lower it by less than that together (:func:`_converged`: no Jacobian is
+    computed at the last point then).  A result as least_squares's (x, cost, fun, status,
     success, message; status -2 where ``progress`` stopped it); None where a step leaves the
     bounds or does not lower the cost (or after 20 steps): least_squares then polishes."""
     before, problem.jumps = problem.jumps, False
+    drop = math.inf
     try:
         r, J = problem.linearised(x)
         for _ in range(20):
@@ -1129,17 +1176,28 @@ def _gauss_newton(problem: _Problem, x: np.ndarray, cost: float, lo: np.ndarray,
             cy = 0.5 * float(ry @ ry)
             if not cy <= cost:
                 return None
-            x, r, drop, cost = y, ry, cost - cy, cy
+            x, r, drop, last, cost = y, ry, cost - cy, drop, cy
             try:
                 progress(optimize.OptimizeResult(x=x, cost=cost))
             except StopIteration:
                 return _result(x, r, -2, "stopped by the callback")
-            if drop < tol * cost:
+            if drop < tol * cost or _converged(drop, last, tol * cost):
                 return _result(x, r, 2, "`ftol` termination condition is satisfied.")
             r, J = problem.linearised(x)
         return None
     finally:
         problem.jumps = before
+
+
+def _converged(drop: float, last: float, tol: float) -> bool:
+    """Whether the polish's steps still to come lower the cost by less than ``tol`` together,
+    judged from the last two drops: where they shrink at least by half (rate q = drop / last),
+    the rest of a sequence converging at that rate (or faster, as Gauss-Newton's near a
+    minimum) is at most drop q / (1 - q)."""
+    if not (math.isfinite(last) and 0.0 < drop < 0.5 * last):
+        return False
+    q = drop / last
+    return drop * q / (1.0 - q) < tol
 
 
 def _result(x: np.ndarray, r: np.ndarray, status: int, message: str) -> Any:

@@ -118,23 +118,44 @@ class Sensitivities:
 
 @dataclasses.dataclass
 class _Perturbed:
-    """The model at p and at p + delta_j e_j, and what differs between them."""
+    """The model at p and at p + delta_j e_j, and what differs between them.  A grouped build
+    (``_grouped.build``: several parameters moved in one model) gives, per parameter, the model
+    the tangent loop reads for its f and resolvent (``others``), the one whose history carries its
+    perturbation (``sources``), the kernel terms of its own perturbed model (``terms``) and the
+    parameters that enter the history (``hist``); None: all read from ``others``."""
 
     base: Solver
     others: list        # the solvers at p + delta_j e_j
     delta: np.ndarray   # delta_j as applied: fl(p_j + step) - p_j
+    sources: list | None = None
+    terms: list | None = None
+    hist: list | None = None
+
+    def source(self, j: int) -> Solver:
+        """The solver whose history carries parameter j's perturbation."""
+        return self.others[j] if self.sources is None else self.sources[j]
+
+    def terms_of(self, j: int) -> tuple:
+        """The exponential kernel's terms (a, b, C, D) of the model at p + delta_j e_j."""
+        return self.others[j].kernel_terms if self.terms is None else self.terms[j]
 
 
-def _build(make: Callable[[np.ndarray], Solver], p: np.ndarray) -> _Perturbed:
-    """The solvers at p and p + delta_j e_j, after checking that the parameters change nothing
-    the sensitivities cannot follow."""
-    base = _call_make(make, p, "p")
+def perturbed_step(p: np.ndarray, j: int) -> float:
+    """p_j + delta_j, delta_j = REL_STEP max(1, |p_j|) before rounding (the step applied is the
+    difference of the two)."""
+    return p[j] + REL_STEP * max(1.0, abs(p[j]))
+
+
+def _build(make: Callable[[np.ndarray], Solver], p: np.ndarray,
+           base: Solver | None = None) -> _Perturbed:
+    """The solvers at p (``base``, else made here) and p + delta_j e_j, after checking that the
+    parameters change nothing the sensitivities cannot follow."""
+    base = _call_make(make, p, "p") if base is None else base
     structure = _structure(base)
     others, delta = [], np.empty(len(p))
     for j in range(len(p)):
-        step = REL_STEP * max(1.0, abs(p[j]))
         q = p.copy()
-        q[j] = p[j] + step
+        q[j] = perturbed_step(p, j)
         delta[j] = q[j] - p[j]          # the step actually applied
         other = _call_make(make, q, f"p + delta e_{j}")
         _same_structure(structure, other, j)
@@ -278,7 +299,7 @@ class _Memory:
             self.dl = np.empty((P, K), dtype=complex)
             fitted = s.kernel_fit
             for j, other in enumerate(mod.others):
-                a2, b2, C2, D2 = other.kernel_terms
+                a2, b2, C2, D2 = mod.terms_of(j)
                 self.dl[j] = ((a2 - a) + 1j * (b2 - b)) / mod.delta[j]
                 self.dE[j] = ((C2 - C) - 1j * (D2 - D)) / mod.delta[j]
                 refit = _refit_terms(fitted, other.kernel_fit, mod.delta[j], n)
@@ -516,9 +537,10 @@ def _sensitivities_of(mod: _Perturbed, p: np.ndarray, steps: int, *,
     # model has another history (Solver.same_callback); the other columns are 0.  libdmi's loop
     # samples compiled history callbacks itself (dmi_tangent_sample_history, as init does);
     # otherwise each such perturbed model's init samples its own
-    hist = [j for j, o in enumerate(mod.others) if not s.same_callback(o, "history")]
-    compiled_history = all(m.c_callback("history") is not None
-                           for m in [s, *(mod.others[j] for j in hist)])
+    hist = (mod.hist if mod.hist is not None else
+            [j for j, o in enumerate(mod.others) if not s.same_callback(o, "history")])
+    compiled_history = mod.sources is None and all(m.c_callback("history") is not None
+                                                   for m in [s, *(mod.others[j] for j in hist)])
     if not why:
         history = (hist if hist and compiled_history else _history_by_init(mod, hist, window))
         fast = _libdmi_loop(mod, steps, history, memory, run, depends, jumps)
@@ -664,7 +686,7 @@ def _history_by_init(mod: _Perturbed, hist: list, window: np.ndarray) -> np.ndar
     delta_j; 0 for the others."""
     S0 = np.zeros(window.shape + (len(mod.delta),))
     for j in hist:
-        other = mod.others[j]
+        other = mod.source(j)
         other.init()
         d = other.get_window() - window
         if d.any():                     # (the columns of parameters the history has not stay 0)
