@@ -742,14 +742,14 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
     options = _options(options)
     p0, names, mask, (lo, hi), records, makes = _parameters(make, p0, records, names, free, bounds)
     data = _records(records, makes, p0, mask, options.max_steps)
-    problem = _new_problem(makes, p0, mask, data, rhs, (lo, hi), options.max_steps)
+    problem = _new_problem(makes, p0, mask, data, rhs, (lo, hi), options.max_steps, polish)
     starts = _starts(multistart, p0, lo, hi, seed)
     # the parameters that do not move the records at p0: kept there and named, before a fit
     # could walk the others anywhere to make up for them
     insensitive = _insensitive(problem, names)
     if insensitive:
         mask = mask & ~np.isin(names, insensitive)
-        problem = _new_problem(makes, p0, mask, data, rhs, (lo, hi), options.max_steps)
+        problem = _new_problem(makes, p0, mask, data, rhs, (lo, hi), options.max_steps, polish)
         why = (f"{', '.join(insensitive)} do{'es' if len(insensitive) == 1 else ''} not move the "
                "records at p0 (a zero column of the Jacobian): kept at p0 and not fitted, infinite "
                "standard error; fix it in make, or start from a p0 where it acts")
@@ -760,7 +760,8 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
                        polish, options.progress)
     best = min(fits, key=lambda f: f[1])
     x, cost, message, stopped, converged = best
-    problem.full_build = True           # the covariance's Jacobian: one model per parameter
+    # the covariance's Jacobian: the equation's sensitivities, from one model per parameter
+    problem.full_build, problem.jumps = True, True
     lower = None
     if converged and not stopped and options.saddle_check:
         lower = _saddle(problem, x, cost, names)
@@ -842,9 +843,13 @@ def _records(records: list, makes: list, p0: np.ndarray, mask: np.ndarray,
 
 
 def _new_problem(makes: list, p0: np.ndarray, mask: np.ndarray, data: list, rhs: Any,
-                 bounds: tuple[np.ndarray, np.ndarray], max_steps: int | None) -> _Problem:
-    """The residuals' problem of a fit of the parameters ``mask`` within ``bounds``."""
+                 bounds: tuple[np.ndarray, np.ndarray], max_steps: int | None,
+                 polish: bool = False) -> _Problem:
+    """The residuals' problem of a fit of the parameters ``mask`` within ``bounds``, its
+    Jacobian (until the fit's end) that of the fit's first phase: the scheme's tangent with the
+    polish, else the equation's sensitivities."""
     problem = _Problem(makes, p0, mask, data, rhs)
+    problem.jumps = not polish
     problem.bounds = bounds
     problem.max_steps = max_steps
     return problem
@@ -1111,7 +1116,9 @@ def _fit(problem: _Problem, start: np.ndarray, lo: np.ndarray, hi: np.ndarray, x
         finally:
             problem.jumps = before
     try:
-        res = solve(x0, True, 1e-5 if polish else 1e-8)
+        # with the polish, the scheme's own tangent throughout (the polish then starts where the
+        # fit ends, at its last Jacobian); without, the equation's sensitivities
+        res = solve(x0, not polish, 1e-5 if polish else 1e-8)
         if res.status > 0 and polish:
             # the scheme's own tangent, exact where nothing switches: quadratic convergence to
             # the scheme's least squares from a point the equation's sensitivities found
