@@ -40,6 +40,8 @@ class Plan:
     history: list               # per group: the member moving the history, or None
     slots: list                 # per parameter: the indices into values() it moves
     rhs: list                   # per parameter: whether it moves f
+    union: list = dataclasses.field(default_factory=list)   # per group: the slots it moves
+    structure: list = dataclasses.field(default_factory=list)   # the model's, as learned
 
 
 def values(s: Solver) -> np.ndarray:
@@ -108,16 +110,20 @@ def plan(mod: _Perturbed) -> Plan | None:
             history.append(j if z else None)
     if len(groups) + len(own) == P:
         return None
-    return Plan(own, groups, reads, history, slots, rhs)
+    union = [frozenset(np.concatenate([slots[j] for j in g]).tolist()) for g in groups]
+    return Plan(own, groups, reads, history, slots, rhs, union, _structure(s))
 
 
 def build(make: Callable[[np.ndarray], Solver], p: np.ndarray, plan: Plan,
           base: Solver | None = None) -> _Perturbed | None:
     """The models at p (``base``, else made here) and, per ``plan``, one model per group and one
-    per own parameter; None where a group's model moves anything its members did not move in the
-    plan's build (its structure, a callback, a value slot): the plan no longer holds."""
+    per own parameter; None where the model's structure is not the plan's or a group's model
+    moves anything its members did not move in the plan's build (its structure, a callback, a
+    value slot): the plan no longer holds."""
     base = _call_make(make, p, "p") if base is None else base
     structure, v0 = _structure(base), values(base)
+    if structure != plan.structure:
+        return None
     P = len(p)
     others: list = [base] * P
     sources: list = [base] * P
@@ -144,8 +150,7 @@ def build(make: Callable[[np.ndarray], Solver], p: np.ndarray, plan: Plan,
                 or (not base.same_callback(comb, "history") and mover is None)):
             return None
         vc = values(comb)
-        moved = np.flatnonzero(vc != v0)
-        if not np.isin(moved, np.concatenate([plan.slots[j] for j in group])).all():
+        if not set(np.flatnonzero(vc != v0).tolist()) <= plan.union[g]:
             return None
         for j in group:
             sources[j] = comb

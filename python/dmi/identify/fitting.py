@@ -607,13 +607,15 @@ class _Problem:
         made = self.cache.pop(("made", k))
         base = made[1] if made is not None and made[0] == p.tobytes() else None
         plan = self.cache.pop(("plan", k))
+        self.cache.cached(("plan", k), lambda: plan)     # (kept where a make below fails)
         mod = None
         if plan is not None and not self.full_build:
             mod = _grouped.build(make_free, q, plan, base)
         if mod is None:
             mod = _build(make_free, q, base)
             plan = _grouped.plan(mod)
-        self.cache.cached(("plan", k), lambda: plan)
+            self.cache.pop(("plan", k))
+            self.cache.cached(("plan", k), lambda: plan)
         return mod
 
     def _linearise(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -294,14 +294,12 @@ class _Memory:
             self.lam = a + 1j * b
             self.E0 = C - 1j * D                                                 # (K, n, n)
             # the terms' derivatives: dE[j, k] of C - iD and dl[j, k] of lam_k in p_j
-            K = len(a)
-            self.dE = np.empty((P, K, n, n), dtype=complex)
-            self.dl = np.empty((P, K), dtype=complex)
+            terms = [mod.terms_of(j) for j in range(P)]
+            a2, b2, C2, D2 = (np.array([t[i] for t in terms]) for i in range(4))
+            self.dl = ((a2 - a) + 1j * (b2 - b)) / mod.delta[:, None]
+            self.dE = ((C2 - C) - 1j * (D2 - D)) / mod.delta[:, None, None, None]
             fitted = s.kernel_fit
-            for j, other in enumerate(mod.others):
-                a2, b2, C2, D2 = mod.terms_of(j)
-                self.dl[j] = ((a2 - a) + 1j * (b2 - b)) / mod.delta[j]
-                self.dE[j] = ((C2 - C) - 1j * (D2 - D)) / mod.delta[j]
+            for j, other in enumerate(mod.others if fitted is not None else []):
                 refit = _refit_terms(fitted, other.kernel_fit, mod.delta[j], n)
                 if refit is not None:
                     self.dE[j] = refit
@@ -522,12 +520,12 @@ def _sensitivities_of(mod: _Perturbed, p: np.ndarray, steps: int, *,
     window = s.get_window()                                          # U^{-N}, ..., U^0
     run: list = []                      # [U] of the run, once made
     memory = _Memory(mod, lambda: np.concatenate([window[1:], run[0][1:]]), len(p))
-    has_f = s.has("rhs") or any(o.has("rhs") for o in mod.others)
+    has_f = s.has("rhs") or any(o is not s and o.has("rhs") for o in mod.others)
     # f_u S + f_p: by n columns of f_u and one call for each parameter f depends on, where that
     # makes fewer calls of f than one directional difference per parameter
     fpar = depends = None
     if has_f and rhs is None:
-        depends = np.array([not s.same_callback(o, "rhs") for o in mod.others])
+        depends = np.array([o is not s and not s.same_callback(o, "rhs") for o in mod.others])
         if s.n + int(depends.sum()) < len(p):
             fpar = np.flatnonzero(depends).astype(np.int64)
     why = _not_compiled(mod, has_f, rhs) if engine != "python" else "engine='python'"
@@ -771,7 +769,7 @@ def _not_compiled(mod: _Perturbed, has_f: bool, rhs: Callable | None) -> str:
         return f"A is a {kind} (its resolvent is called from Python)"
     if has_f:
         for j, m in enumerate([mod.base, *mod.others]):
-            if m.c_callback("rhs") is None:
+            if (j == 0 or m is not mod.base) and m.c_callback("rhs") is None:
                 where = "p" if j == 0 else f"p + delta e_{j - 1}"
                 return (f"f of the model at {where} is a Python function (set_rhs(f, jit=True) or a "
                         "C function makes it compiled)")
