@@ -135,7 +135,8 @@ def build(make: Callable[[np.ndarray], Solver], p: np.ndarray, plan: Plan,
         others[j] = sources[j] = _call_make(make, q, f"p + delta e_{j}")
         if _structure(others[j]) != structure:
             return None
-    terms = [] if base.kernel_terms is None else [base.kernel_terms] * P
+    base_terms = base.kernel_terms
+    terms = [] if base_terms is None else [base_terms] * P
     for g, group in enumerate(plan.groups):
         q = p.copy()
         for j in group:
@@ -158,16 +159,16 @@ def build(make: Callable[[np.ndarray], Solver], p: np.ndarray, plan: Plan,
             if terms:
                 vj = v0.copy()
                 vj[plan.slots[j]] = vc[plan.slots[j]]
-                terms[j] = _terms(vj, base)
+                terms[j] = _terms(vj, base_terms, _resolvent_slots(base))
     hist = ([m for m in plan.history if m is not None]
             + [j for j in plan.own if not base.same_callback(others[j], "history")])
     return _Perturbed(base, others, delta, sources, terms or None, sorted(hist))
 
 
-def _terms(v: np.ndarray, s: Solver) -> tuple:
-    """The exponential kernel's (a, b, C, D) from values() v, shaped as those of s."""
-    a, b, C, D = s.kernel_terms
+def _terms(v: np.ndarray, like: tuple, off: int) -> tuple:
+    """The exponential kernel's (a, b, C, D) from values() v (the kernel's from index ``off``),
+    shaped as the terms ``like``."""
+    a, _, C, D = like
     K, nn = len(a), C.size
-    off = _resolvent_slots(s)
     return (v[off:off + K], v[off + K:off + 2 * K], v[off + 2 * K:off + 2 * K + nn].reshape(C.shape),
             v[off + 2 * K + nn:off + 2 * K + 2 * nn].reshape(D.shape))

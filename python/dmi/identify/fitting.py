@@ -18,6 +18,7 @@ import numpy as np
 from scipy import optimize, stats
 
 from .._cache import Cache
+from .._errors import Error
 from .._solver import Solver
 from . import _grouped
 from .sensitivity import MAX_STEPS, Sensitivities, _build, _sensitivities_of, check_steps
@@ -79,6 +80,12 @@ class FitOptions:
     progress : bool or None
         A one-line progress display on stderr (start, iteration, cost, model runs, time); None
         (default): shown only where stderr is a terminal.
+    group_models : bool
+        True (default): the Jacobians' perturbed models are shared by parameters that move
+        disjoint parts of the model (learned from one model per parameter at the first Jacobian,
+        checked at each: docs/identify-method.md, "Perturbed models in groups"); False: one model
+        per parameter at every Jacobian (for a ``make`` in which a parameter moves, at some
+        points only, a part that another parameter moves).
     """
 
     max_steps: int = MAX_STEPS
@@ -86,6 +93,7 @@ class FitOptions:
     chi2_alpha: float = 1e-3
     saddle_check: bool = True
     progress: bool | None = None
+    group_models: bool = True
 
 
 @dataclasses.dataclass
@@ -476,7 +484,11 @@ class _Problem:
         # and per record (in the cache): how its perturbed models are grouped, ("plan", k),
         # learned from the last build of all of them (None: one model per parameter), and the
         # model of the last residuals, ("made", k): (p, solver)
-        self.full_build = False         # True: a model per parameter (the covariance's Jacobian)
+        self.grouped = True             # False: one perturbed model per parameter, always
+        # True: the residuals come from the Jacobian's run where the last ones' Jacobian was asked
+        # for (``asked``: a Jacobian was asked for since the last residuals)
+        self.speculate = False
+        self.asked = True
 
     def full(self, x: np.ndarray) -> np.ndarray:
         p = self.p0.copy()
@@ -543,6 +555,20 @@ class _Problem:
             self.cache.cached(key, lambda: got[1][0].copy())
 
     def _residuals(self, x: np.ndarray, check: bool) -> np.ndarray:
+        if self.speculate and self.asked and not check:
+            # the optimiser asks for the Jacobian where it takes a step: the tangent's run gives
+            # the residuals too (bit for bit a plain run's) and keeps the Jacobian for that call;
+            # after a step not taken (no Jacobian asked there), a plain run
+            try:
+                r = self.linearised(x)[0]
+            except Error:
+                r = None                # (a run the tangent cannot follow: the plain run says)
+            self.asked = False
+            if r is not None:
+                cost = 0.5 * float(r @ r)
+                if np.isfinite(cost) and (self.best is None or cost < self.best[0]):
+                    self.best = (cost, x.copy())
+                return r.copy()
         p = self.full(x)
         out = []
         for k, (make, d) in enumerate(zip(self.makes, self.data)):
@@ -586,7 +612,8 @@ class _Problem:
     def linearised(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(r, J): the weighted residuals and their Jacobian at the free parameters x, from the
         sensitivities' runs (kept in the problem's cache for the next call at the same x)."""
-        return self._slot("linearised", (x.tobytes(), self.jumps, self.full_build),
+        self.asked = True
+        return self._slot("linearised", (x.tobytes(), self.jumps),
                           lambda: self._linearise(x))
 
     def _slot(self, slot: Hashable, key: Hashable, factory: Callable[[], Any]) -> Any:
@@ -609,7 +636,7 @@ class _Problem:
         plan = self.cache.pop(("plan", k))
         self.cache.cached(("plan", k), lambda: plan)     # (kept where a make below fails)
         mod = None
-        if plan is not None and not self.full_build:
+        if plan is not None and self.grouped:
             mod = _grouped.build(make_free, q, plan, base)
         if mod is None:
             mod = _build(make_free, q, base)
@@ -634,7 +661,7 @@ class _Problem:
                 return _make(self.full(q))
             # the models at p and p + delta_j e_j: those of the last Jacobian at this p (made by
             # make at the same parameters; each run starts from their init), else made now
-            mod = self._slot(("models", k), (p.tobytes(), self.full_build),
+            mod = self._slot(("models", k), p.tobytes(),
                              lambda: self._models(k, make_free, p))
             with warnings.catch_warnings():
                 # reversals left unplaced are gathered here and reported once by the estimate
@@ -744,14 +771,14 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
     options = _options(options)
     p0, names, mask, (lo, hi), records, makes = _parameters(make, p0, records, names, free, bounds)
     data = _records(records, makes, p0, mask, options.max_steps)
-    problem = _new_problem(makes, p0, mask, data, rhs, (lo, hi), options.max_steps, polish)
+    problem = _new_problem(makes, p0, mask, data, rhs, (lo, hi), options, polish)
     starts = _starts(multistart, p0, lo, hi, seed)
     # the parameters that do not move the records at p0: kept there and named, before a fit
     # could walk the others anywhere to make up for them
     insensitive = _insensitive(problem, names)
     if insensitive:
         mask = mask & ~np.isin(names, insensitive)
-        problem = _new_problem(makes, p0, mask, data, rhs, (lo, hi), options.max_steps, polish)
+        problem = _new_problem(makes, p0, mask, data, rhs, (lo, hi), options, polish)
         why = (f"{', '.join(insensitive)} do{'es' if len(insensitive) == 1 else ''} not move the "
                "records at p0 (a zero column of the Jacobian): kept at p0 and not fitted, infinite "
                "standard error; fix it in make, or start from a p0 where it acts")
@@ -762,8 +789,7 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
                        polish, options.progress)
     best = min(fits, key=lambda f: f[1])
     x, cost, message, stopped, converged = best
-    # the covariance's Jacobian: the equation's sensitivities, from one model per parameter
-    problem.full_build, problem.jumps = True, True
+    problem.jumps = True                # the covariance's Jacobian: the equation's sensitivities
     lower = None
     if converged and not stopped and options.saddle_check:
         lower = _saddle(problem, x, cost, names)
@@ -845,15 +871,16 @@ def _records(records: list, makes: list, p0: np.ndarray, mask: np.ndarray,
 
 
 def _new_problem(makes: list, p0: np.ndarray, mask: np.ndarray, data: list, rhs: Any,
-                 bounds: tuple[np.ndarray, np.ndarray], max_steps: int | None,
+                 bounds: tuple[np.ndarray, np.ndarray], options: FitOptions,
                  polish: bool = False) -> _Problem:
     """The residuals' problem of a fit of the parameters ``mask`` within ``bounds``, its
     Jacobian (until the fit's end) that of the fit's first phase: the scheme's tangent with the
     polish, else the equation's sensitivities."""
     problem = _Problem(makes, p0, mask, data, rhs)
     problem.jumps = not polish
+    problem.grouped = options.group_models
     problem.bounds = bounds
-    problem.max_steps = max_steps
+    problem.max_steps = options.max_steps
     return problem
 
 
@@ -1109,14 +1136,14 @@ def _fit(problem: _Problem, start: np.ndarray, lo: np.ndarray, hi: np.ndarray, x
     r0 = problem.residuals(x0, check=True)
     cost0 = 0.5 * float(r0 @ r0)
     def solve(x_start: np.ndarray, jumps: bool, tol: float) -> Any:
-        before, problem.jumps = problem.jumps, jumps
+        before, problem.jumps, problem.speculate = problem.jumps, jumps, True
         try:
             return optimize.least_squares(problem.residuals, x_start, jac=problem.jacobian,
                                           bounds=(lo[free], hi[free]), method="trf", x_scale=xs,
                                           loss=loss, max_nfev=max_nfev, callback=progress,
                                           ftol=tol, xtol=tol)
         finally:
-            problem.jumps = before
+            problem.jumps, problem.speculate = before, False
     try:
         # with the polish, the scheme's own tangent throughout (the polish then starts where the
         # fit ends, at its last Jacobian); without, the equation's sensitivities

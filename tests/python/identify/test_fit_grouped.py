@@ -16,8 +16,7 @@ import numpy as np
 import pytest
 
 import dmi
-from dmi.identify import Record, _grouped, estimate
-from dmi.identify import fitting
+from dmi.identify import FitOptions, Record, _grouped, estimate
 from dmi.identify.fitting import _check_record, _converged, _Problem
 from dmi.identify.sensitivity import _build, _sensitivities_of
 
@@ -104,7 +103,7 @@ def test_a_plan_that_no_longer_holds_falls_back_to_one_model_per_parameter():
     assert _grouped.build(make, x, plan) is None
     J = pr.jacobian(x)
     ref = problem(make)
-    ref.full_build = True
+    ref.grouped = False
     assert np.max(np.abs(J - ref.jacobian(x))) <= 1e-12 * np.max(np.abs(J))
 
 
@@ -130,12 +129,12 @@ def test_a_make_failing_at_a_grouped_point_is_named_and_leaves_the_problem_usabl
         pr.jacobian(x)
     fail[0] = None
     ref = problem(oscillator())
-    ref.full_build = True
+    ref.grouped = False
     J = pr.jacobian(x)
     assert np.max(np.abs(J - ref.jacobian(x))) <= 1e-12 * np.max(np.abs(J))
 
 
-def test_the_estimate_with_grouped_models_equals_the_one_without(monkeypatch):
+def test_the_estimate_with_grouped_models_equals_the_one_without():
     # k, mu, c1, c2, w0 free (the rates fixed): groups {k, c1, c2, w0} and {mu}
     make = oscillator()
     t = np.linspace(0.05, 8.0, 100)
@@ -146,8 +145,8 @@ def test_the_estimate_with_grouped_models_equals_the_one_without(monkeypatch):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         est = estimate(make, start, Record(t, y), free=free)
-        monkeypatch.setattr(fitting._grouped, "plan", lambda mod: None)
-        ref = estimate(make, start, Record(t, y), free=free)
+        ref = estimate(make, start, Record(t, y), free=free,
+                       options=FitOptions(group_models=False))
     assert est.success and ref.success
     assert est.njev == ref.njev and est.nfev == ref.nfev
     assert np.max(np.abs(est.p - ref.p) / np.abs(ref.p)) <= 1e-10
