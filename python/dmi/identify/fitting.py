@@ -812,6 +812,8 @@ def _options(options: FitOptions | None) -> FitOptions:
     options = FitOptions() if options is None else options
     if not isinstance(options, FitOptions):
         raise TypeError(f"options is a {type(options).__name__}; expected a dmi.identify.FitOptions")
+    if not isinstance(options.group_models, (bool, np.bool_)):
+        raise TypeError(f"FitOptions.group_models = {options.group_models!r}: expected True or False")
     if not 0.0 < options.chi2_alpha < 0.5:
         raise ValueError(f"FitOptions.chi2_alpha = {options.chi2_alpha!r}: expected a probability "
                          "in (0, 0.5)")

@@ -160,3 +160,10 @@ def test_the_polish_stops_where_a_geometric_rest_is_below_the_tolerance():
     assert not _converged(1e-6, 4e-6, rest * 0.99)
     assert not _converged(3e-6, 4e-6, 1.0)             # shrinking by less than half: no estimate
     assert not _converged(1e-6, math.inf, 1.0)         # one drop only
+
+
+def test_group_models_must_be_a_bool():
+    make = oscillator()
+    t = np.linspace(0.05, 2.0, 10)
+    with pytest.raises(TypeError, match=r"FitOptions.group_models = 'no': expected True or False"):
+        estimate(make, P0, Record(t, np.zeros(10)), options=FitOptions(group_models="no"))
