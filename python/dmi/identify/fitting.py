@@ -18,7 +18,6 @@ import numpy as np
 from scipy import optimize, stats
 
 from .._cache import Cache
-from .._errors import Error
 from .._solver import Solver
 from . import _grouped
 from .sensitivity import MAX_STEPS, Sensitivities, _build, _sensitivities_of, check_steps
@@ -164,7 +163,8 @@ class Estimate:
         The parameter combinations the data do not determine, named (e.g. ``"1.00*mu"``, or
         ``"0.71*C0 - 0.71*C1"`` in relative units: coefficient times parameter / |parameter|).
     nfev, njev : int
-        Model runs for residuals, and sensitivity runs (iterations).
+        Plain runs of the model for residuals, and sensitivity runs (Jacobians; a sensitivity
+        run gives the residuals too, where the optimiser asks for both at one point).
     dof : int
         Degrees of freedom M - F.
     sigma_known : bool
@@ -561,8 +561,10 @@ class _Problem:
             # after a step not taken (no Jacobian asked there), a plain run
             try:
                 r = self.linearised(x)[0]
-            except Error:
-                r = None                # (a run the tangent cannot follow: the plain run says)
+            except Exception:
+                # (the plain run below raises what fails there, as without the Jacobian; what
+                # fails in the Jacobian only is raised where the optimiser asks for it)
+                r = None
             self.asked = False
             if r is not None:
                 cost = 0.5 * float(r @ r)

@@ -167,3 +167,30 @@ def test_group_models_must_be_a_bool():
     t = np.linspace(0.05, 2.0, 10)
     with pytest.raises(TypeError, match=r"FitOptions.group_models = 'no': expected True or False"):
         estimate(make, P0, Record(t, np.zeros(10)), options=FitOptions(group_models="no"))
+
+
+def test_residuals_from_a_jacobian_that_fails_come_from_a_plain_run():
+    # the fit asks for the residuals from a Jacobian's run; where that Jacobian fails (make at a
+    # perturbed point), the residuals come from a plain run, and the Jacobian asked for next raises
+    fail: list = [None]
+    make = oscillator(fail=fail)
+    pr = problem(make)
+    pr.linearised(P0)
+    x = P0 * 1.01
+    fail[0] = x
+    pr.speculate = True
+    r = pr.residuals(x)
+    assert pr.nfev == 1 and pr.njev == 1                 # a plain run; no Jacobian at x
+    fail[0] = None
+    ref = problem(oscillator())
+    assert np.max(np.abs(r - ref.residuals(x))) == 0.0
+    fail[0] = x
+    with pytest.raises(ValueError, match=r"make\(p \+ delta e_0 .* raised RuntimeError"):
+        pr.jacobian(x)
+    # where the Jacobian's run works, the residuals are its own (no plain run), a plain run's bits
+    fail[0] = None
+    y = P0 * 0.99
+    pr.asked = True
+    r = pr.residuals(y)
+    assert pr.nfev == 1 and pr.njev == 2
+    assert np.max(np.abs(r - ref.residuals(y))) == 0.0
