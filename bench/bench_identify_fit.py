@@ -7,8 +7,9 @@
 # (its default polish: a second least_squares at tolerance 1e-8 after the first at 1e-5) and with
 # polish=False; least_squares at its default tolerances.  CPU seconds of
 # the process, fastest of the rounds (interleaved), one BLAS thread; each fit's runs of the model
-# and its cost at the end are printed.  Then the floor: one sensitivity run against the 1 + P plain
-# runs of one forward-difference Jacobian.  --baseline DIR fits with another version of
+# and its cost at the end are printed, and the machine's load.  Then the floor: one sensitivity run
+# against the 1 + P plain runs of one forward-difference Jacobian, and the costs of estimate's
+# Jacobians (one model per parameter, grouped models, kept models; the make calls, the tangent).  --baseline DIR fits with another version of
 # dmi.identify in the same rounds (as bench_identify.py); --baseline-package DIR with another
 # version of the whole package (a copy of a build's build/python/dmi, its libraries with it,
 # imported as dmi_baseline: its model, its estimate and least_squares on its runs), and prints
@@ -33,7 +34,8 @@ from scipy import optimize  # noqa: E402
 
 import bench_identify as b  # noqa: E402
 from benchtools import cpu, dir_holding, positive_int  # noqa: E402
-from dmi.identify import Record, estimate, sensitivities  # noqa: E402
+from dmi.identify import Record, _grouped, estimate, fitting, sensitivities  # noqa: E402
+from dmi.identify.sensitivity import _sensitivities_of  # noqa: E402
 
 STEPS = 1000
 G = 2.0
@@ -92,8 +94,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=(
         "Prints the CPU seconds of dmi.identify.estimate against least_squares with 2-point "
         "differences on a 7-parameter friction model with a two-term memory."))
-    ap.add_argument("--rounds", type=positive_int, default=3,
-                    help="interleaved rounds; the fastest of each counts (default 3)")
+    ap.add_argument("--rounds", type=positive_int, default=5,
+                    help="interleaved rounds; the fastest of each counts (default 5)")
     ap.add_argument("--baseline", metavar="DIR", type=dir_holding("__init__.py"),
                     help="a copy of another version's python/dmi/identify (default: none)")
     ap.add_argument("--baseline-package", metavar="DIR", type=dir_holding("__init__.py"),
@@ -129,7 +131,9 @@ def main() -> None:
                 best[name] = min(best[name], cpu(lambda: box.append(f())))
                 last[name] = box[0]
     ref = best["least_squares 2-point"]
-    print(f"7 parameters, {len(t)} samples, {STEPS} steps; CPU seconds, fastest of {args.rounds}")
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    print(f"7 parameters, {len(t)} samples, {STEPS} steps; CPU seconds, fastest of {args.rounds} "
+          f"interleaved rounds; load average {load:.2f} on {os.cpu_count()} CPUs")
     for name, r in last.items():
         x = r.x if hasattr(r, "x") else r.p
         cost = float(r.cost)
@@ -142,7 +146,15 @@ def main() -> None:
         print(f"estimate / least_squares: this version {best['estimate'] / ref:.2f}, the baseline "
               f"package {old:.2f}; estimate this / baseline "
               f"{best['estimate'] / best['estimate (package baseline)']:.2f}")
-    # the floor: a sensitivity run against the 1 + P runs of a forward difference
+    floor(make, t, y)
+
+
+def floor(make, t, y) -> None:
+    """The costs a fit is made of (CPU seconds, fastest of 5): a sensitivity run of one model per
+    parameter against the 1 + P runs of one forward-difference Jacobian, and the Jacobians of
+    estimate: of one model per parameter (its first), of the grouped models (the others), of
+    models kept from the last Jacobian at the same point (the covariance's), their make calls
+    and libdmi's tangent loop alone."""
     P = len(TRUTH)
     resid = residuals_fd(make, t, y)
     sens = min(cpu(lambda: sensitivities(make, START, STEPS)) for _ in range(5))
@@ -150,6 +162,31 @@ def main() -> None:
     one = min(cpu(lambda: resid(START)) for _ in range(5))
     print(f"one sensitivity run {sens:.4f} s; one residual run {one:.4f} s; 1 + P = {P + 1} "
           f"runs {fwd:.4f} s; sensitivities / (1 + P runs) = {sens / fwd:.2f}")
+    problem = fitting._Problem([make], START.copy(), np.ones(P, bool),
+                               [fitting._check_record(Record(t, y), 0, 2)], None)
+    problem.jumps = False
+    problem.linearised(START)                    # the groups, learned
+    plan = problem.cache.pop(("plan", 0))
+    rng = np.random.default_rng(0)
+
+    def jacobian(grouped: bool, kept: bool = False):
+        problem.grouped = grouped
+        x = START * (1 + 1e-4 * rng.standard_normal(P))
+        problem.linearised(x)
+        if kept:                                 # the same models, the other jumps setting
+            problem.jumps = True
+            problem.linearised(x)
+            problem.jumps = False
+    full = min(cpu(lambda: jacobian(False)) for _ in range(5))
+    grouped = min(cpu(lambda: jacobian(True)) for _ in range(5))
+    kept = min(cpu(lambda: jacobian(True, True)) for _ in range(5)) - grouped
+    makes = min(cpu(lambda: _grouped.build(make, START, plan)) for _ in range(5))
+    mod = _grouped.build(make, START, plan)
+    loop = min(cpu(lambda: _sensitivities_of(mod, START, STEPS, jumps=False)) for _ in range(5))
+    calls = 1 + len(plan.groups) + len(plan.own)
+    print(f"estimate's Jacobians: one model per parameter {full:.4f} s; grouped ({calls} make "
+          f"calls, groups {plan.groups}) {grouped:.4f} s, of which the make calls and their checks "
+          f"{makes:.4f} s, the sensitivities {loop:.4f} s; with the models kept {kept:.4f} s")
 
 
 if __name__ == "__main__":

@@ -19,6 +19,7 @@ from scipy import optimize, stats
 
 from .._cache import Cache
 from .._solver import Solver
+from . import _grouped
 from .sensitivity import MAX_STEPS, Sensitivities, _build, _sensitivities_of, check_steps
 
 #: Singular values of the column-normalised Jacobian below this fraction of the largest one mark
@@ -78,6 +79,12 @@ class FitOptions:
     progress : bool or None
         A one-line progress display on stderr (start, iteration, cost, model runs, time); None
         (default): shown only where stderr is a terminal.
+    group_models : bool
+        True (default): the Jacobians' perturbed models are shared by parameters that move
+        disjoint parts of the model (learned from one model per parameter at the first Jacobian,
+        checked at each: docs/identify-method.md, "Perturbed models in groups"); False: one model
+        per parameter at every Jacobian (for a ``make`` in which a parameter moves, at some
+        points only, a part that another parameter moves).
     """
 
     max_steps: int = MAX_STEPS
@@ -85,6 +92,7 @@ class FitOptions:
     chi2_alpha: float = 1e-3
     saddle_check: bool = True
     progress: bool | None = None
+    group_models: bool = True
 
 
 @dataclasses.dataclass
@@ -155,7 +163,8 @@ class Estimate:
         The parameter combinations the data do not determine, named (e.g. ``"1.00*mu"``, or
         ``"0.71*C0 - 0.71*C1"`` in relative units: coefficient times parameter / |parameter|).
     nfev, njev : int
-        Model runs for residuals, and sensitivity runs (iterations).
+        Plain runs of the model for residuals, and sensitivity runs (Jacobians; a sensitivity
+        run gives the residuals too, where the optimiser asks for both at one point).
     dof : int
         Degrees of freedom M - F.
     sigma_known : bool
@@ -470,8 +479,16 @@ class _Problem:
         # the residuals and Jacobian at the last x, the models of the last Jacobian (the next one
         # at the same p, with or without the saltation, steps the same solvers again) and the
         # residuals at the last two x
-        self.cache = Cache(4 + len(makes))
+        self.cache = Cache(4 + 3 * len(makes))
         self.recent: list = []          # the keys of the residuals kept, oldest first
+        # and per record (in the cache): how its perturbed models are grouped, ("plan", k),
+        # learned from the last build of all of them (None: one model per parameter), and the
+        # model of the last residuals, ("made", k): (p, solver)
+        self.grouped = True             # False: one perturbed model per parameter, always
+        # True: the residuals come from the Jacobian's run where the last ones' Jacobian was asked
+        # for (``asked``: a Jacobian was asked for since the last residuals)
+        self.speculate = False
+        self.asked = True
 
     def full(self, x: np.ndarray) -> np.ndarray:
         p = self.p0.copy()
@@ -522,12 +539,45 @@ class _Problem:
             return self._residuals(x, check)
         return r.copy()
 
+    def seed(self, x: np.ndarray) -> None:
+        """Keeps the residuals of the Jacobian's run at x (where one is kept) as the residuals at
+        x: the same run (the tangent steps the model as a plain run does, bit for bit)."""
+        got = self.cache.pop("linearised")
+        if got is None:
+            return
+        self.cache.cached("linearised", lambda: got)
+        if got[0][0] == x.tobytes():
+            key = ("residuals", x.tobytes())
+            self.cache.pop(key)
+            self.recent = [k for k in self.recent if k != key] + [key]
+            if len(self.recent) > 2:
+                self.cache.pop(self.recent.pop(0))
+            self.cache.cached(key, lambda: got[1][0].copy())
+
     def _residuals(self, x: np.ndarray, check: bool) -> np.ndarray:
+        if self.speculate and self.asked and not check:
+            # the optimiser asks for the Jacobian where it takes a step: the tangent's run gives
+            # the residuals too (bit for bit a plain run's) and keeps the Jacobian for that call;
+            # after a step not taken (no Jacobian asked there), a plain run
+            try:
+                r = self.linearised(x)[0]
+            except Exception:
+                # (the plain run below raises what fails there, as without the Jacobian; what
+                # fails in the Jacobian only is raised where the optimiser asks for it)
+                r = None
+            self.asked = False
+            if r is not None:
+                cost = 0.5 * float(r @ r)
+                if np.isfinite(cost) and (self.best is None or cost < self.best[0]):
+                    self.best = (cost, x.copy())
+                return r.copy()
         p = self.full(x)
         out = []
         for k, (make, d) in enumerate(zip(self.makes, self.data)):
             s = make(p.copy())
             s.init()
+            self.cache.pop(("made", k))
+            self.cache.cached(("made", k), lambda: (p.tobytes(), s))
             t_grid, U, X = s.run_terms(record_steps(s, d))
             val, _ = self._predict(d, t_grid, s.h, U, X, None, None)
             if check and not np.all(np.isfinite(val)):
@@ -564,7 +614,9 @@ class _Problem:
     def linearised(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(r, J): the weighted residuals and their Jacobian at the free parameters x, from the
         sensitivities' runs (kept in the problem's cache for the next call at the same x)."""
-        return self._slot("linearised", (x.tobytes(), self.jumps), lambda: self._linearise(x))
+        self.asked = True
+        return self._slot("linearised", (x.tobytes(), self.jumps),
+                          lambda: self._linearise(x))
 
     def _slot(self, slot: Hashable, key: Hashable, factory: Callable[[], Any]) -> Any:
         """What the cache's ``slot`` holds for ``key``, else factory() there in its place (one
@@ -574,6 +626,26 @@ class _Problem:
             got = (key, factory())
         self.cache.cached(slot, lambda: got)
         return got[1]
+
+    def _models(self, k: int, make_free: Callable[[np.ndarray], Solver], p: np.ndarray
+                ) -> Any:
+        """The models of record k at p and at the perturbed free parameters: grouped by the
+        record's plan where it has one (and it still holds), else one per parameter (the plan
+        learned from them); the model at p that of the last residuals where made at p."""
+        q = p[self.free]
+        made = self.cache.pop(("made", k))
+        base = made[1] if made is not None and made[0] == p.tobytes() else None
+        plan = self.cache.pop(("plan", k))
+        self.cache.cached(("plan", k), lambda: plan)     # (kept where a make below fails)
+        mod = None
+        if plan is not None and self.grouped:
+            mod = _grouped.build(make_free, q, plan, base)
+        if mod is None:
+            mod = _build(make_free, q, base)
+            plan = _grouped.plan(mod)
+            self.cache.pop(("plan", k))
+            self.cache.cached(("plan", k), lambda: plan)
+        return mod
 
     def _linearise(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         p = self.full(x)
@@ -591,7 +663,8 @@ class _Problem:
                 return _make(self.full(q))
             # the models at p and p + delta_j e_j: those of the last Jacobian at this p (made by
             # make at the same parameters; each run starts from their init), else made now
-            mod = self._slot(("models", k), p.tobytes(), lambda: _build(make_free, p[idx]))
+            mod = self._slot(("models", k), p.tobytes(),
+                             lambda: self._models(k, make_free, p))
             with warnings.catch_warnings():
                 # reversals left unplaced are gathered here and reported once by the estimate
                 warnings.filterwarnings("ignore", "sensitivities: .* could not be placed",
@@ -700,14 +773,14 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
     options = _options(options)
     p0, names, mask, (lo, hi), records, makes = _parameters(make, p0, records, names, free, bounds)
     data = _records(records, makes, p0, mask, options.max_steps)
-    problem = _new_problem(makes, p0, mask, data, rhs, (lo, hi), options.max_steps)
+    problem = _new_problem(makes, p0, mask, data, rhs, (lo, hi), options, polish)
     starts = _starts(multistart, p0, lo, hi, seed)
     # the parameters that do not move the records at p0: kept there and named, before a fit
     # could walk the others anywhere to make up for them
     insensitive = _insensitive(problem, names)
     if insensitive:
         mask = mask & ~np.isin(names, insensitive)
-        problem = _new_problem(makes, p0, mask, data, rhs, (lo, hi), options.max_steps)
+        problem = _new_problem(makes, p0, mask, data, rhs, (lo, hi), options, polish)
         why = (f"{', '.join(insensitive)} do{'es' if len(insensitive) == 1 else ''} not move the "
                "records at p0 (a zero column of the Jacobian): kept at p0 and not fitted, infinite "
                "standard error; fix it in make, or start from a p0 where it acts")
@@ -718,6 +791,7 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
                        polish, options.progress)
     best = min(fits, key=lambda f: f[1])
     x, cost, message, stopped, converged = best
+    problem.jumps = True                # the covariance's Jacobian: the equation's sensitivities
     lower = None
     if converged and not stopped and options.saddle_check:
         lower = _saddle(problem, x, cost, names)
@@ -740,6 +814,8 @@ def _options(options: FitOptions | None) -> FitOptions:
     options = FitOptions() if options is None else options
     if not isinstance(options, FitOptions):
         raise TypeError(f"options is a {type(options).__name__}; expected a dmi.identify.FitOptions")
+    if not isinstance(options.group_models, (bool, np.bool_)):
+        raise TypeError(f"FitOptions.group_models = {options.group_models!r}: expected True or False")
     if not 0.0 < options.chi2_alpha < 0.5:
         raise ValueError(f"FitOptions.chi2_alpha = {options.chi2_alpha!r}: expected a probability "
                          "in (0, 0.5)")
@@ -799,11 +875,16 @@ def _records(records: list, makes: list, p0: np.ndarray, mask: np.ndarray,
 
 
 def _new_problem(makes: list, p0: np.ndarray, mask: np.ndarray, data: list, rhs: Any,
-                 bounds: tuple[np.ndarray, np.ndarray], max_steps: int | None) -> _Problem:
-    """The residuals' problem of a fit of the parameters ``mask`` within ``bounds``."""
+                 bounds: tuple[np.ndarray, np.ndarray], options: FitOptions,
+                 polish: bool = False) -> _Problem:
+    """The residuals' problem of a fit of the parameters ``mask`` within ``bounds``, its
+    Jacobian (until the fit's end) that of the fit's first phase: the scheme's tangent with the
+    polish, else the equation's sensitivities."""
     problem = _Problem(makes, p0, mask, data, rhs)
+    problem.jumps = not polish
+    problem.grouped = options.group_models
     problem.bounds = bounds
-    problem.max_steps = max_steps
+    problem.max_steps = options.max_steps
     return problem
 
 
@@ -1055,19 +1136,22 @@ def _fit(problem: _Problem, start: np.ndarray, lo: np.ndarray, hi: np.ndarray, x
             raise StopIteration
     xs = x_scale if isinstance(x_scale, str) else np.broadcast_to(np.asarray(x_scale, float),
                                                                   (free.sum(),))
+    problem.seed(x0)
     r0 = problem.residuals(x0, check=True)
     cost0 = 0.5 * float(r0 @ r0)
     def solve(x_start: np.ndarray, jumps: bool, tol: float) -> Any:
-        before, problem.jumps = problem.jumps, jumps
+        before, problem.jumps, problem.speculate = problem.jumps, jumps, True
         try:
             return optimize.least_squares(problem.residuals, x_start, jac=problem.jacobian,
                                           bounds=(lo[free], hi[free]), method="trf", x_scale=xs,
                                           loss=loss, max_nfev=max_nfev, callback=progress,
                                           ftol=tol, xtol=tol)
         finally:
-            problem.jumps = before
+            problem.jumps, problem.speculate = before, False
     try:
-        res = solve(x0, True, 1e-5 if polish else 1e-8)
+        # with the polish, the scheme's own tangent throughout (the polish then starts where the
+        # fit ends, at its last Jacobian); without, the equation's sensitivities
+        res = solve(x0, not polish, 1e-5 if polish else 1e-8)
         if res.status > 0 and polish:
             # the scheme's own tangent, exact where nothing switches: quadratic convergence to
             # the scheme's least squares from a point the equation's sensitivities found
@@ -1105,10 +1189,13 @@ def _gauss_newton(problem: _Problem, x: np.ndarray, cost: float, lo: np.ndarray,
     taken where it lowers the cost, until the next step is below ``tol`` (as least_squares's
     xtol: |dx| <= tol (tol + |x|)) or would lower the cost by less than ``tol`` of it (ftol, by
     the linear model), and is then not taken (its change is within the tolerance), or a step
-    taken lowered it by less than that.  A result as least_squares's (x, cost, fun, status,
+    taken lowered it by less than that, or the last two drops of the cost say that the steps
+    still to come would lower it by less than that together (:func:`_converged`: no Jacobian is
+    computed at the last point then).  A result as least_squares's (x, cost, fun, status,
     success, message; status -2 where ``progress`` stopped it); None where a step leaves the
     bounds or does not lower the cost (or after 20 steps): least_squares then polishes."""
     before, problem.jumps = problem.jumps, False
+    drop = math.inf
     try:
         r, J = problem.linearised(x)
         for _ in range(20):
@@ -1129,17 +1216,28 @@ def _gauss_newton(problem: _Problem, x: np.ndarray, cost: float, lo: np.ndarray,
             cy = 0.5 * float(ry @ ry)
             if not cy <= cost:
                 return None
-            x, r, drop, cost = y, ry, cost - cy, cy
+            x, r, drop, last, cost = y, ry, cost - cy, drop, cy
             try:
                 progress(optimize.OptimizeResult(x=x, cost=cost))
             except StopIteration:
                 return _result(x, r, -2, "stopped by the callback")
-            if drop < tol * cost:
+            if drop < tol * cost or _converged(drop, last, tol * cost):
                 return _result(x, r, 2, "`ftol` termination condition is satisfied.")
             r, J = problem.linearised(x)
         return None
     finally:
         problem.jumps = before
+
+
+def _converged(drop: float, last: float, tol: float) -> bool:
+    """Whether the polish's steps still to come lower the cost by less than ``tol`` together,
+    judged from the last two drops: where they shrink at least by half (rate q = drop / last),
+    the rest of a sequence converging at that rate (or faster, as Gauss-Newton's near a
+    minimum) is at most drop q / (1 - q)."""
+    if not (math.isfinite(last) and 0.0 < drop < 0.5 * last):
+        return False
+    q = drop / last
+    return drop * q / (1.0 - q) < tol
 
 
 def _result(x: np.ndarray, r: np.ndarray, status: int, message: str) -> Any:

@@ -118,23 +118,44 @@ class Sensitivities:
 
 @dataclasses.dataclass
 class _Perturbed:
-    """The model at p and at p + delta_j e_j, and what differs between them."""
+    """The model at p and at p + delta_j e_j, and what differs between them.  A grouped build
+    (``_grouped.build``: several parameters moved in one model) gives, per parameter, the model
+    the tangent loop reads for its f and resolvent (``others``), the one whose history carries its
+    perturbation (``sources``), the kernel terms of its own perturbed model (``terms``) and the
+    parameters that enter the history (``hist``); None: all read from ``others``."""
 
     base: Solver
     others: list        # the solvers at p + delta_j e_j
     delta: np.ndarray   # delta_j as applied: fl(p_j + step) - p_j
+    sources: list | None = None
+    terms: list | None = None
+    hist: list | None = None
+
+    def source(self, j: int) -> Solver:
+        """The solver whose history carries parameter j's perturbation."""
+        return self.others[j] if self.sources is None else self.sources[j]
+
+    def terms_of(self, j: int) -> tuple:
+        """The exponential kernel's terms (a, b, C, D) of the model at p + delta_j e_j."""
+        return self.others[j].kernel_terms if self.terms is None else self.terms[j]
 
 
-def _build(make: Callable[[np.ndarray], Solver], p: np.ndarray) -> _Perturbed:
-    """The solvers at p and p + delta_j e_j, after checking that the parameters change nothing
-    the sensitivities cannot follow."""
-    base = _call_make(make, p, "p")
+def perturbed_step(p: np.ndarray, j: int) -> float:
+    """p_j + delta_j, delta_j = REL_STEP max(1, |p_j|) before rounding (the step applied is the
+    difference of the two)."""
+    return p[j] + REL_STEP * max(1.0, abs(p[j]))
+
+
+def _build(make: Callable[[np.ndarray], Solver], p: np.ndarray,
+           base: Solver | None = None) -> _Perturbed:
+    """The solvers at p (``base``, else made here) and p + delta_j e_j, after checking that the
+    parameters change nothing the sensitivities cannot follow."""
+    base = _call_make(make, p, "p") if base is None else base
     structure = _structure(base)
     others, delta = [], np.empty(len(p))
     for j in range(len(p)):
-        step = REL_STEP * max(1.0, abs(p[j]))
         q = p.copy()
-        q[j] = p[j] + step
+        q[j] = perturbed_step(p, j)
         delta[j] = q[j] - p[j]          # the step actually applied
         other = _call_make(make, q, f"p + delta e_{j}")
         _same_structure(structure, other, j)
@@ -273,14 +294,12 @@ class _Memory:
             self.lam = a + 1j * b
             self.E0 = C - 1j * D                                                 # (K, n, n)
             # the terms' derivatives: dE[j, k] of C - iD and dl[j, k] of lam_k in p_j
-            K = len(a)
-            self.dE = np.empty((P, K, n, n), dtype=complex)
-            self.dl = np.empty((P, K), dtype=complex)
+            terms = [mod.terms_of(j) for j in range(P)]
+            a2, b2, C2, D2 = (np.array([t[i] for t in terms]) for i in range(4))
+            self.dl = ((a2 - a) + 1j * (b2 - b)) / mod.delta[:, None]
+            self.dE = ((C2 - C) - 1j * (D2 - D)) / mod.delta[:, None, None, None]
             fitted = s.kernel_fit
-            for j, other in enumerate(mod.others):
-                a2, b2, C2, D2 = other.kernel_terms
-                self.dl[j] = ((a2 - a) + 1j * (b2 - b)) / mod.delta[j]
-                self.dE[j] = ((C2 - C) - 1j * (D2 - D)) / mod.delta[j]
+            for j, other in enumerate(mod.others if fitted is not None else []):
                 refit = _refit_terms(fitted, other.kernel_fit, mod.delta[j], n)
                 if refit is not None:
                     self.dE[j] = refit
@@ -501,12 +520,12 @@ def _sensitivities_of(mod: _Perturbed, p: np.ndarray, steps: int, *,
     window = s.get_window()                                          # U^{-N}, ..., U^0
     run: list = []                      # [U] of the run, once made
     memory = _Memory(mod, lambda: np.concatenate([window[1:], run[0][1:]]), len(p))
-    has_f = s.has("rhs") or any(o.has("rhs") for o in mod.others)
+    has_f = s.has("rhs") or any(o is not s and o.has("rhs") for o in mod.others)
     # f_u S + f_p: by n columns of f_u and one call for each parameter f depends on, where that
     # makes fewer calls of f than one directional difference per parameter
     fpar = depends = None
     if has_f and rhs is None:
-        depends = np.array([not s.same_callback(o, "rhs") for o in mod.others])
+        depends = np.array([o is not s and not s.same_callback(o, "rhs") for o in mod.others])
         if s.n + int(depends.sum()) < len(p):
             fpar = np.flatnonzero(depends).astype(np.int64)
     why = _not_compiled(mod, has_f, rhs) if engine != "python" else "engine='python'"
@@ -516,9 +535,10 @@ def _sensitivities_of(mod: _Perturbed, p: np.ndarray, steps: int, *,
     # model has another history (Solver.same_callback); the other columns are 0.  libdmi's loop
     # samples compiled history callbacks itself (dmi_tangent_sample_history, as init does);
     # otherwise each such perturbed model's init samples its own
-    hist = [j for j, o in enumerate(mod.others) if not s.same_callback(o, "history")]
-    compiled_history = all(m.c_callback("history") is not None
-                           for m in [s, *(mod.others[j] for j in hist)])
+    hist = (mod.hist if mod.hist is not None else
+            [j for j, o in enumerate(mod.others) if not s.same_callback(o, "history")])
+    compiled_history = mod.sources is None and all(m.c_callback("history") is not None
+                                                   for m in [s, *(mod.others[j] for j in hist)])
     if not why:
         history = (hist if hist and compiled_history else _history_by_init(mod, hist, window))
         fast = _libdmi_loop(mod, steps, history, memory, run, depends, jumps)
@@ -664,7 +684,7 @@ def _history_by_init(mod: _Perturbed, hist: list, window: np.ndarray) -> np.ndar
     delta_j; 0 for the others."""
     S0 = np.zeros(window.shape + (len(mod.delta),))
     for j in hist:
-        other = mod.others[j]
+        other = mod.source(j)
         other.init()
         d = other.get_window() - window
         if d.any():                     # (the columns of parameters the history has not stay 0)
@@ -749,7 +769,7 @@ def _not_compiled(mod: _Perturbed, has_f: bool, rhs: Callable | None) -> str:
         return f"A is a {kind} (its resolvent is called from Python)"
     if has_f:
         for j, m in enumerate([mod.base, *mod.others]):
-            if m.c_callback("rhs") is None:
+            if (j == 0 or m is not mod.base) and m.c_callback("rhs") is None:
                 where = "p" if j == 0 else f"p + delta e_{j - 1}"
                 return (f"f of the model at {where} is a Python function (set_rhs(f, jit=True) or a "
                         "C function makes it compiled)")
