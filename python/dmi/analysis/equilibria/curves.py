@@ -58,6 +58,7 @@ from ..continuation.branch import ON_AXIS, REAL, Curve, CurveEvent, Event, HopfP
 from ..continuation.driver import ContinuationOptions, continuation
 from ..core.model import Linearisation, call_make, equation_step
 from ..core.newton import ShootingError
+from ..scheme.problem import AtQ
 from .equation import Characteristic, RefinementWarning
 from .normal_form import CriticalityWarning, _check_hooks, _Forms, criticality
 from .numerics import forward_jacobian, null_vectors, signed_mean
@@ -255,7 +256,7 @@ class _Extended:
         u, p, omega, _ = self.split(x, q)
         if not self.tests:
             return CurvePoint(p=p, q=float(q), u=np.array(u, dtype=float), omega=omega)
-        make1 = _Fixed(self.make2, q)
+        make1 = AtQ(self.make2, q)
         # a root that cannot be refined (near a double root: Bogdanov-Takens) is NaN, which the
         # test functions leave out; its warning goes into the point's note
         with warnings.catch_warnings(record=True) as unrefined:
@@ -380,16 +381,6 @@ class _Extended:
                          "ends here as omega -> 0)")
             return {"detail": f"{what} ({val:.3g} at the located point)"}
         return {}
-
-
-class _Fixed:
-    """make2 at a fixed q as a one-parameter model make(p) (picklable where make2 is)."""
-
-    def __init__(self, make2: Callable[[float, float], Solver], q: float):
-        self.make2, self.q = make2, float(q)
-
-    def __call__(self, p: float) -> Solver:
-        return self.make2(p, self.q)
 
 
 def _start(start: Any, u_eq: Any) -> tuple[str, float, np.ndarray, float]:

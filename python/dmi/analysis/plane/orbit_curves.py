@@ -72,28 +72,20 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..._solver import Solver
-from ..collocation.adapt import FLOOR, Solved, adapted, merged, transfer
-from ..collocation.adapt import estimate as level_errors
-from ..collocation.floquet import multipliers as floquet
-from ..collocation.mend import check_inequalities
+from ..collocation.adapt import FLOOR
 from ..collocation.mesh import interval_of, periodic_locator, point_matrix
 from ..collocation.orbit import EquationOrbit, equation_orbit
 from ..collocation.signature import HI, LO, STUCK
-from ..collocation.system import (CollocationWarning, Layout, Terms, assemble, full_jacobian,
-                                  reference)
+from ..collocation.system import CollocationWarning, Layout, Terms, assemble, full_jacobian
 from ..continuation.branch import Branch, Curve, CurveEvent, Event
 from ..continuation.driver import Curve as DriverCurve
 from ..continuation.driver import continuation, newton_strategy
-from ..core.newton import ShootingError, Strategy, bordered_solve, newton_loop, sparse_bordered
-from ..scheme.problem import Problem
-from ..scheme.stepmap import build
+from ..core.newton import ShootingError, Strategy, bordered_solve, sparse_bordered
+from ..scheme.problem import AtQ
+from .orbit_system import DIFF, FoldSystem
 
-#: Relative step of the differences of J along v, p and q (they steer Newton only).
-DIFF = 1e-7
 #: A start's fold at q0 must lie within this (relative to max(1, |p|)) of the event's p.
 START_TOL = 1e-6
-#: Terms kept (the last few (p, q) evaluated).
-KEEP = 12
 #: A turn back in q where the orbits' amplitude is below this share of the curve's largest is
 #: the fold curve's end at a Bautin point (the curve in x passes through the equilibrium).
 BAUTIN_SHARE = 0.2
@@ -148,139 +140,16 @@ class OrbitCurvePoint:
         self.dqds = float(value)
 
 
-class _AtQ:
-    """make2 at a fixed q as a one-parameter model make(p) (picklable where make2 is)."""
 
-    def __init__(self, make2: Callable[[float, float], Solver], q: float):
-        self.make2, self.q = make2, float(q)
-
-    def __call__(self, p: float) -> Solver:
-        return self.make2(p, self.q)
-
-
-class OrbitFold:
-    """The minimally augmented system of a fold of collocated orbits (see the module) as a
-    discretisation of the one driver: unknowns y = (x, p), parameter q.
-
-    Parameters
-    ----------
-    make2 : callable
-        ``make2(p, q) -> dmi.Solver``.
-    layout : Layout
-        The collocation's layout.
-    x : numpy.ndarray
-        The orbit's unknowns on it (the phase condition's reference).
-    jumps : tuple of float
-        The kernel's jumps (lags).
-    multipliers : int
-        Leading multipliers a point carries.
-    tol, max_iter : float, int
-        The corrector's tolerance and iterations.
-    estimate : bool
-        A point's error estimates from the merged mesh (False: none, the verdict None).
-    """
+class OrbitFold(FoldSystem):
+    """The fold's system (:class:`dmi.analysis.plane.orbit_system.FoldSystem`) as a discretisation
+    of the one driver: its step control, the signature's check, the mesh moved between steps,
+    the points with their error estimates and verdicts (same parameters)."""
 
     def __init__(self, make2: Callable[[float, float], Solver], layout: Layout, x: np.ndarray,
-                 *, jumps: tuple[float, ...] = (), multipliers: int = 10, tol: float = 1e-12,
-                 max_iter: int = 10, estimate: bool = True):
-        self.make2, self.lay, self.jumps = make2, layout, tuple(jumps)
-        self.ref = reference(layout, x) if layout.autonomous else None
-        self.count, self.tol, self.max_iter = int(multipliers), float(tol), int(max_iter)
-        self.estimate = bool(estimate)
-        self.problem = Problem(make2, keep=KEEP)   # the terms of the last few (p, q)
-        self._last: tuple | None = None     # (key, evaluation) of the last y evaluated
-        self.b: np.ndarray | None = None
-        self.c: np.ndarray | None = None
-        self.gscale = 1.0   # g's unit: 1 / its gradient's largest entry at the start
-        self.breach = ""                    # why the last correction was refused (a signature)
+                 **options: Any):
+        super().__init__(make2, layout, x, **options)
         self._track: list[tuple[float, float]] = []   # (q, amplitude) of the points stepped to
-
-    @property
-    def weight(self) -> np.ndarray:
-        """The driver's weights on y: x's RMS, p as itself."""
-        m = self.lay.size
-        return np.concatenate([np.full(m, 1.0 / m), [1.0]])
-
-    def terms(self, p: float, q: float) -> Terms:
-        """The model's terms at (p, q) (the last few kept)."""
-        key = (float(p), float(q))
-        return self.problem.cached(("terms", key),
-                                   lambda: Terms(build(_AtQ(self.make2, key[1]), key[0]),
-                                                 self.jumps))
-
-    def borders(self, x: np.ndarray, p: float, q: float) -> None:
-        """b and c from the one-parameter branch's tangent at a fold: with F_p as J's border and
-        a uniform row, the null vectors of J and J' (F_p is outside J's range at a fold)."""
-        t = self.terms(p, q)
-        r, J = full_jacobian(self.lay, t, x, self.ref)
-        d = DIFF * max(1.0, abs(p))
-        Fp = (full_jacobian(self.lay, self.terms(p + d, q), x, self.ref)[0] - r) / d
-        m = x.size
-        one = np.full(m, 1.0 / math.sqrt(m))
-        v, w = _null_pair(J, Fp, one)
-        self.c, self.b = v / np.linalg.norm(v), w / np.linalg.norm(w)
-        self._last = None
-        self.gscale = 1.0
-        row = self._jy(np.concatenate([x, [p]]), q)[2]
-        self.gscale = 1.0 / max(float(np.max(np.abs(row))), 1e-300)
-        self._last = None
-
-    def _eval(self, y: np.ndarray, q: float) -> dict[str, Any]:
-        """F, J, v, w and g at (y, q) (the last kept)."""
-        key = (y.tobytes(), float(q), id(self.lay), id(self.b), self.gscale)
-        if self._last is not None and self._last[0] == key:
-            return self._last[1]
-        x, p = y[:-1], float(y[-1])
-        t = self.terms(p, q)
-        r, J = full_jacobian(self.lay, t, x, self.ref)
-        vg, wh = _pair(J, self.b, self.c)
-        ev = {"r": r, "J": J, "v": vg[:-1], "g": float(vg[-1]) * self.gscale, "w": wh[:-1],
-              "terms": t}
-        self._last = (key, ev)
-        return ev
-
-    def residual(self, y: np.ndarray, q: float) -> np.ndarray:
-        """(F, g) at (y, q): len(y) values."""
-        ev = self._eval(y, q)
-        return np.concatenate([ev["r"], [ev["g"]]])
-
-    def _jy(self, y: np.ndarray, q: float) -> tuple[Any, np.ndarray, np.ndarray, dict]:
-        """(J, F_p, (g_x, g_p), the evaluation) at (y, q): the blocks of the Jacobian in y."""
-        ev = self._eval(y, q)
-        x, p = y[:-1], float(y[-1])
-        J, v, w, t = ev["J"], ev["v"], ev["w"], ev["terms"]
-        eps = DIFF * max(1.0, float(np.max(np.abs(x)))) / max(float(np.max(np.abs(v))), 1e-300)
-        J1 = full_jacobian(self.lay, t, x + eps * v, self.ref)[1]
-        gx = -self.gscale * (J1.T @ w - J.T @ w) / eps
-        d = DIFF * max(1.0, abs(p))
-        rp, Jp = full_jacobian(self.lay, self.terms(p + d, q), x, self.ref)
-        Fp = (rp - ev["r"]) / d
-        gp = -self.gscale * float(w @ (Jp @ v - J @ v)) / d
-        return J, Fp, np.append(gx, gp), ev
-
-    def jacobian(self, y: np.ndarray, q: float) -> tuple[Any, np.ndarray]:
-        """(J_y sparse, J_q): the driver's Jacobian in the unknowns y and in its parameter q."""
-        J, Fp, grow, ev = self._jy(y, q)
-        x, p = y[:-1], float(y[-1])
-        d = DIFF * max(1.0, abs(q))
-        rq, Jq = full_jacobian(self.lay, self.terms(p, q + d), x, self.ref)
-        Fq = (rq - ev["r"]) / d
-        gq = -self.gscale * float(ev["w"] @ (Jq @ ev["v"] - ev["J"] @ ev["v"])) / d
-        return sparse_bordered(J, Fp, grow), np.concatenate([Fq, [gq]])
-
-    def solve_at(self, y0: np.ndarray, q: float, what: str) -> np.ndarray:
-        """The fold at fixed q from y0 (Newton on (F, g) in (x, p), sparse LU)."""
-        def evaluate(y: np.ndarray) -> tuple[np.ndarray, None]:
-            return self.residual(y, q), None
-
-        def factor(y: np.ndarray, r: np.ndarray, _: None) -> Callable[[np.ndarray], np.ndarray]:
-            J, Fp, grow, _ = self._jy(y, q)
-            return lambda rr: bordered_solve(J, Fp, grow, -rr)
-
-        y, _ = newton_loop(evaluate, factor, np.array(y0, dtype=float), tol=self.tol,
-                           max_iter=3 * self.max_iter, what=what, converge="correction",
-                           stall=False)
-        return y
 
     def strategies(self, y: np.ndarray, q: float, row: np.ndarray, target: float, far: float
                    ) -> Iterator[Strategy]:
@@ -297,12 +166,11 @@ class OrbitFold:
     def accept(self, y: np.ndarray, q: float, step: bool) -> tuple[np.ndarray, float]:
         """The orbit's inequalities checked: an orbit that breaks its signature is refused (the
         curve does not cross signatures yet)."""
-        x, p = y[:-1], float(y[-1])
-        bad = check_inequalities(self.lay, self.terms(p, q), x,
-                                 1e-9 * max(1.0, float(np.max(np.abs(x)))))
+        x, p = y[:self.lay.size], float(y[self.lay.size])
+        bad = self.broken(x, p, q, 1e-9)
         if bad:
             self.breach = (f"near (p, q) = ({p:.10g}, {q:.10g}) the fold's orbit breaks its "
-                           f"signature ({bad[0]}): a stick onset or grazing meets the fold "
+                           f"signature ({bad}): a stick onset or grazing meets the fold "
                            "curve there (curves across signatures are not continued yet)")
             raise ShootingError(self.breach, [])
         return y, q
@@ -316,84 +184,23 @@ class OrbitFold:
         self.c = ev["v"] / np.linalg.norm(ev["v"])
         self.b = ev["w"] / np.linalg.norm(ev["w"])
         x, p = y[:-1], float(y[-1])
-        new = self.lay.with_fractions(adapted(self.lay, x, self.lay.L))
-        x = transfer(self.lay, x, new)
-        self.lay = new
-        if new.autonomous:
-            self.ref = reference(new, x)
+        x = self.remesh(x)
         self._last = None
         return np.concatenate([x, [p]])
 
     def point(self, y: np.ndarray, q: float) -> OrbitCurvePoint:
         """The curve's point at (y, q): the orbit, its errors from the merged mesh's fold, the
         verdict on the other multipliers."""
-        x, p = y[:-1], float(y[-1])
-        t = self.terms(p, q)
-        fine = self._solved(self.lay, t, x)
-        errors: dict[str, Any] = {}
-        p_error = None
-        if self.estimate:
-            got = self._coarse(y, q)
-            if got is not None:
-                coarse, pc = got
-                errors = level_errors(coarse, fine)
-                p_error = max(abs(pc - p), FLOOR * max(1.0, abs(p)))
-                errors["p"] = p_error
+        p = float(y[-1])
+        fine, errors, _ = self.levels(y, q)
+        p_error = errors.get("p")
         with warnings.catch_warnings():   # a fold's multiplier at 1: the orbit's stable is None
             warnings.simplefilter("ignore", CollocationWarning)
-            orbit = equation_orbit(fine, p, _AtQ(self.make2, q), errors, self.jumps)
+            orbit = equation_orbit(fine, p, AtQ(self.make2, q), errors, self.jumps)
         orbit.stable = None
         return OrbitCurvePoint(p, float(q), orbit, p_error,
                                _others_stable(fine.mu, errors.get("multipliers"),
                                               self.lay.autonomous, p, q))
-
-    def _solved(self, lay: Layout, terms: Terms, x: np.ndarray) -> Solved:
-        """x on lay with its amplitudes and leading multipliers."""
-        return Solved(lay, x, floquet(lay, terms, x, self.count) if self.count > 0 else None)
-
-    def _coarse(self, y: np.ndarray, q: float) -> tuple[Solved, float] | None:
-        """The fold at q on the mesh of merged pairs of intervals (and its p); None, with a
-        CollocationWarning, where that solve fails."""
-        x, p = y[:-1], float(y[-1])
-        lay = self.lay.with_fractions(merged(self.lay.fractions))
-        xc = transfer(self.lay, x, lay)
-        other = OrbitFold(self.make2, lay, xc, jumps=self.jumps, multipliers=self.count,
-                          tol=self.tol, max_iter=self.max_iter, estimate=False)
-        other.ref = self.ref
-        other.problem = self.problem
-        try:
-            other.borders(xc, p, q)
-            yc = other.solve_at(np.concatenate([xc, [p]]), q,
-                                f"the fold at q = {q!r} on the merged mesh")
-        except (ShootingError, ValueError) as e:
-            warnings.warn(f"(p, q) = ({p!r}, {q!r}): the fold on the merged mesh failed ({e}): "
-                          "no error estimate, the verdict None", CollocationWarning,
-                          stacklevel=3)
-            return None
-        pc = float(yc[-1])
-        return self._solved(lay, self.terms(pc, q), yc[:-1]), pc
-
-    def corner(self, points: list[OrbitCurvePoint]) -> str:
-        """Why the curve could not go on: the signature its orbits would leave, or its turn
-        where they shrink to the equilibrium (a Bautin point), else ""."""
-        return self.breach
-
-
-def _pair(J: Any, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(v, g) of [[J, b], [c', 0]] (v, g) = (0, 1) and (w, h) of its transpose."""
-    e1 = np.zeros(c.size + 1)
-    e1[-1] = 1.0
-    try:
-        return (bordered_solve(J, b, np.append(c, 0.0), e1),
-                bordered_solve(J.T.tocsc(), c, np.append(b, 0.0), e1))
-    except ShootingError as e:
-        raise ShootingError(f"the fold's bordered matrix is singular: {e}", []) from None
-
-
-def _null_pair(J: Any, border: np.ndarray, row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """v and w of [[J, border], [row', 0]] (v, .) = (0, 1) and its transpose (w, .) = (0, 1)."""
-    vg, wh = _pair(J, border, row)
-    return vg[:-1], wh[:-1]
 
 
 def _others_stable(mu: np.ndarray, err: Any, autonomous: bool, p: float, q: float
@@ -761,6 +568,7 @@ class OrbitFlip(OrbitFold):
     """The minimally augmented system of a period doubling (``theta`` None: mu = -1, unknowns
     (x, p)) or of a torus (``theta`` the start's angle: mu = e^(i theta), unknowns (x, p,
     theta)) of collocated orbits on the one driver (see the module); parameter q."""
+    what = "the bifurcation"
 
     def __init__(self, make2: Callable[[float, float], Solver], layout: Layout, x: np.ndarray,
                  *, theta: float | None = None, **options: Any):
@@ -772,12 +580,6 @@ class OrbitFlip(OrbitFold):
     def extra(self) -> int:
         """The unknowns past x: p (and theta on a torus curve)."""
         return 2 if self.torus else 1
-
-    @property
-    def weight(self) -> np.ndarray:
-        """The driver's weights on y: x's RMS, p and theta as themselves."""
-        m = self.lay.size
-        return np.concatenate([np.full(m, 1.0 / m), np.ones(self.extra)])
 
     def mu(self, y: np.ndarray) -> complex:
         """The multiplier of y: -1, or e^(i theta)."""
@@ -897,35 +699,23 @@ class OrbitFlip(OrbitFold):
         ev = self._eval(y, q)
         self.c = np.conj(ev["v"]) / np.linalg.norm(ev["v"])
         self.b = np.conj(ev["w"]) / np.linalg.norm(ev["w"])
-        x = y[:self.lay.size]
-        new = self.lay.with_fractions(adapted(self.lay, x, self.lay.L))
-        x = transfer(self.lay, x, new)
-        self.lay = new
-        if new.autonomous:
-            self.ref = reference(new, x)
+        rest = y[self.lay.size:]
+        x = self.remesh(y[:self.lay.size])
         self._last = None
-        return np.concatenate([x, y[self.lay.size:]])
+        return np.concatenate([x, rest])
 
     def point(self, y: np.ndarray, q: float) -> OrbitCurvePoint:
         """The curve's point at (y, q): the orbit, its errors from the merged mesh's solve,
         the verdict on the other multipliers."""
-        x, p = self._split(y)
-        fine = self._solved(self.lay, self.terms(p, q), x)
-        errors: dict[str, Any] = {}
-        p_error = th_error = None
-        if self.estimate:
-            got = self._coarse(y, q)
-            if got is not None:
-                coarse, yc = got
-                errors = level_errors(coarse, fine)
-                p_error = max(abs(float(yc[-self.extra]) - p), FLOOR * max(1.0, abs(p)))
-                errors["p"] = p_error
-                if self.torus:
-                    th_error = max(abs(float(yc[-1] - y[-1])), FLOOR)
-                    errors["theta"] = th_error
+        p = float(y[self.lay.size])
+        fine, errors, yc = self.levels(y, q)
+        p_error, th_error = errors.get("p"), None
+        if self.torus and yc is not None:
+            th_error = max(abs(float(yc[-1] - y[-1])), FLOOR)
+            errors["theta"] = th_error
         with warnings.catch_warnings():   # a multiplier on the circle: the orbit's stable None
             warnings.simplefilter("ignore", CollocationWarning)
-            orbit = equation_orbit(fine, p, _AtQ(self.make2, q), errors, self.jumps)
+            orbit = equation_orbit(fine, p, AtQ(self.make2, q), errors, self.jumps)
         orbit.stable = None
         stable = _others_stable_at(fine.mu, errors.get("multipliers"), self.lay.autonomous,
                                 self.mu(y), p, q)
@@ -934,27 +724,14 @@ class OrbitFlip(OrbitFold):
                                    theta_error=th_error)
         return FlipCurvePoint(p, float(q), orbit, p_error, stable)
 
-    def _coarse(self, y: np.ndarray, q: float) -> tuple[Solved, np.ndarray] | None:
-        """The bifurcation at q on the mesh of merged pairs of intervals (its y); None, with a
-        CollocationWarning, where that solve fails."""
-        x, p = self._split(y)
-        lay = self.lay.with_fractions(merged(self.lay.fractions))
-        xc = transfer(self.lay, x, lay)
-        other = OrbitFlip(self.make2, lay, xc, theta=float(y[-1]) if self.torus else None,
+    def on_mesh(self, lay: Layout, x: np.ndarray, y: np.ndarray, q: float) -> OrbitFlip:
+        """The same system on lay from x (theta from y), its borders from there."""
+        other = OrbitFlip(self.make2, lay, x, theta=float(y[-1]) if self.torus else None,
                           jumps=self.jumps, multipliers=self.count, tol=self.tol,
                           max_iter=self.max_iter, estimate=False)
         other.ref, other.problem = self.ref, self.problem
-        try:
-            other.borders(xc, p, q)
-            yc = other.solve_at(np.concatenate([xc, y[self.lay.size:]]), q,
-                                f"the bifurcation at q = {q!r} on the merged mesh")
-        except (ShootingError, ValueError) as e:
-            warnings.warn(f"(p, q) = ({p!r}, {q!r}): the solve on the merged mesh failed ({e}): "
-                          "no error estimate, the verdict None", CollocationWarning,
-                          stacklevel=3)
-            return None
-        pc = float(yc[lay.size])
-        return self._solved(lay, self.terms(pc, q), yc[:lay.size]), yc
+        other.borders(x, float(y[self.lay.size]), q)
+        return other
 
 
 def _others_stable_at(mu: np.ndarray, err: Any, autonomous: bool, crit: complex, p: float,

@@ -31,14 +31,13 @@ boundary solved again at the same q on the mesh with every pair of intervals mer
 gives the error estimate of p) and the orbit's verified verdict.  Along the curve the sign of
 det F_x is followed (``fold_test``): where it changes, a fold of the orbits at fixed q meets the
 boundary (a fold curve of the orbits crosses it), located by Newton on F = 0, m = 0 and the fold's
-minimally augmented test function g = 0 (:class:`dmi.analysis.plane.orbit_curves.OrbitFold`) in
+minimally augmented test function g = 0 (:class:`dmi.analysis.plane.orbit_system.FoldSystem`) in
 (x, p, q): a curve event of kind ``"orbit-fold"``.  A curve whose orbits would break another
 inequality of their signature ends there (the status says which).
 """
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Any
@@ -48,28 +47,21 @@ import scipy.optimize as so
 import scipy.sparse as sp
 
 from ..._solver import Solver
-from ..collocation.adapt import FLOOR, Solved, adapted, merged, transfer
-from ..collocation.adapt import estimate as level_errors
-from ..collocation.floquet import multipliers as floquet
-from ..collocation.mend import check_inequalities
 from ..collocation.mesh import delay_matrix, periodic_locator, point_matrix
 from ..collocation.orbit import EquationOrbit, equation_orbit
 from ..collocation.signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
-from ..collocation.system import (CollocationWarning, Layout, Terms, assemble, evaluate,
-                                  full_jacobian, reference)
+from ..collocation.system import Layout, Terms, assemble, evaluate, full_jacobian
 from ..continuation.branch import Branch, Curve, CurveEvent, Event
 from ..continuation.driver import bordered_det, continuation
 from ..core.newton import ShootingError, bordered_solve, newton_loop, sparse_bordered
-from ..scheme.problem import Problem
+from ..scheme.problem import AtQ
 from ..scheme.stepmap import build
-from .orbit_curves import OrbitFold
+from .orbit_system import FoldSystem, OrbitSystem
 
 #: Relative step of the central differences (the margin's non-node columns, F_p, F_q).
 DIFF = 1e-7
 #: A start's boundary at q0 must lie within this (relative to max(1, |p|)) of the event's p.
 START_TOL = 1e-6
-#: Terms kept (the last few (p, q) evaluated).
-KEEP = 12
 #: Grid points an interval on which a least value is bracketed before Brent.
 GRID = 64
 
@@ -288,17 +280,7 @@ class StickCurvePoint:
         self.dqds = float(value)
 
 
-class _AtQ:
-    """make2 at a fixed q as a one-parameter model make(p)."""
-
-    def __init__(self, make2: Callable[[float, float], Solver], q: float):
-        self.make2, self.q = make2, float(q)
-
-    def __call__(self, p: float) -> Solver:
-        return self.make2(p, self.q)
-
-
-class StickBoundary:
+class StickBoundary(OrbitSystem):
     """The boundary's system (see the module) as a discretisation of the one driver: unknowns
     y = (x, p), parameter q.
 
@@ -328,28 +310,11 @@ class StickBoundary:
                  margin: Margin, kind: str, *, jumps: tuple[float, ...] = (),
                  multipliers: int = 10, tol: float = 1e-11, max_iter: int = 10,
                  estimate: bool = True):
-        self.make2, self.lay, self.margin, self.kind = make2, layout, margin, kind
-        self.jumps = tuple(jumps)
-        self.ref = reference(layout, x) if layout.autonomous else None
-        self.count, self.tol, self.max_iter = int(multipliers), float(tol), int(max_iter)
-        self.estimate = bool(estimate)
-        self.problem = Problem(make2, keep=KEEP)
-        self.breach = ""
+        super().__init__(make2, layout, x, jumps=jumps, multipliers=multipliers, tol=tol,
+                         max_iter=max_iter, estimate=estimate)
+        self.margin, self.kind = margin, kind
         self.t_star = 0.0
         self.y0: np.ndarray | None = None   # the start, solved at q0
-
-    @property
-    def weight(self) -> np.ndarray:
-        """The driver's weights on y: x's RMS, p as itself."""
-        m = self.lay.size
-        return np.concatenate([np.full(m, 1.0 / m), [1.0]])
-
-    def terms(self, p: float, q: float) -> Terms:
-        """The model's terms at (p, q) (the last few kept)."""
-        key = (float(p), float(q))
-        return self.problem.cached(("terms", key),
-                                   lambda: Terms(build(_AtQ(self.make2, key[1]), key[0]),
-                                                 self.jumps))
 
     def _margin(self, y: np.ndarray, q: float) -> tuple[float, float]:
         """(m, t*) at (y, q)."""
@@ -419,11 +384,10 @@ class StickBoundary:
         """The orbit's other inequalities checked: a point whose orbit breaks its signature
         elsewhere is refused (the curve ends there; :meth:`corner` says why)."""
         x, p = y[:-1], float(y[-1])
-        scale = max(1.0, float(np.max(np.abs(x))))
-        bad = check_inequalities(self.lay, self.terms(p, q), x, 1e-7 * scale)
+        bad = self.broken(x, p, q, 1e-7)
         if bad:
             self.breach = (f"near (p, q) = ({p:.10g}, {q:.10g}) the boundary's orbit breaks "
-                           f"its signature elsewhere ({bad[0]}): another stick onset or "
+                           f"its signature elsewhere ({bad}): another stick onset or "
                            "grazing meets this curve there")
             raise ShootingError(self.breach, [])
         return y, q
@@ -431,13 +395,7 @@ class StickBoundary:
     def adapt(self, y: np.ndarray, q: float) -> np.ndarray:
         """Between steps: the mesh equidistributed again, the phase condition's reference moved
         to the point."""
-        x, p = y[:-1], float(y[-1])
-        new = self.lay.with_fractions(adapted(self.lay, x, self.lay.L))
-        x = transfer(self.lay, x, new)
-        self.lay = new
-        if new.autonomous:
-            self.ref = reference(new, x)
-        return np.concatenate([x, [p]])
+        return np.concatenate([self.remesh(y[:-1]), y[-1:]])
 
     def fold_test(self, y: np.ndarray, q: float) -> float:
         """sign(det F_x) |g|, g the fold's bordered test function with fixed uniform borders
@@ -459,21 +417,11 @@ class StickBoundary:
     def point(self, y: np.ndarray, q: float) -> StickCurvePoint:
         """The curve's point at (y, q): the orbit, its errors from the merged mesh's boundary,
         its verdict, the fold test."""
-        x, p = y[:-1], float(y[-1])
-        t = self.terms(p, q)
-        fine = self._solved(self.lay, t, x)
-        errors: dict[str, Any] = {}
-        p_error = None
-        if self.estimate:
-            got = self._coarse(y, q)
-            if got is not None:
-                coarse, pc = got
-                errors = level_errors(coarse, fine)
-                p_error = max(abs(pc - p), FLOOR * max(1.0, abs(p)))
-                errors["p"] = p_error
-        orbit = equation_orbit(fine, p, _AtQ(self.make2, q), errors, self.jumps)
+        p = float(y[-1])
+        fine, errors, _ = self.levels(y, q)
+        orbit = equation_orbit(fine, p, AtQ(self.make2, q), errors, self.jumps)
         _, t_star = self._margin(y, q)
-        return StickCurvePoint(p, float(q), orbit, t_star, p_error, orbit.stable,
+        return StickCurvePoint(p, float(q), orbit, t_star, errors.get("p"), orbit.stable,
                                self.fold_test(y, q), self.side(y, q))
 
     def side(self, y: np.ndarray, q: float) -> int:
@@ -488,29 +436,11 @@ class StickBoundary:
             return 0
         return -int(np.sign(s))
 
-    def _solved(self, lay: Layout, terms: Terms, x: np.ndarray) -> Solved:
-        return Solved(lay, x, floquet(lay, terms, x, self.count) if self.count > 0 else None)
-
-    def _coarse(self, y: np.ndarray, q: float) -> tuple[Solved, float] | None:
-        """The boundary at q on the mesh of merged pairs of intervals (and its p); None, with a
-        CollocationWarning, where that solve fails."""
-        x, p = y[:-1], float(y[-1])
-        lay = self.lay.with_fractions(merged(self.lay.fractions))
-        xc = transfer(self.lay, x, lay)
-        other = StickBoundary(self.make2, lay, xc, self.margin, self.kind, jumps=self.jumps,
-                              multipliers=self.count, tol=self.tol, max_iter=self.max_iter,
-                              estimate=False)
-        other.ref, other.problem = self.ref, self.problem
-        try:
-            yc = other.solve_at(np.concatenate([xc, [p]]), q,
-                                f"the boundary at q = {q!r} on the merged mesh")
-        except (ShootingError, ValueError) as e:
-            warnings.warn(f"(p, q) = ({p!r}, {q!r}): the boundary on the merged mesh failed "
-                          f"({e}): no error estimate, the verdict None", CollocationWarning,
-                          stacklevel=3)
-            return None
-        pc = float(yc[-1])
-        return self._solved(lay, self.terms(pc, q), yc[:-1]), pc
+    def on_mesh(self, lay: Layout, x: np.ndarray, y: np.ndarray, q: float) -> StickBoundary:
+        """The same boundary on lay from x."""
+        return StickBoundary(self.make2, lay, x, self.margin, self.kind, jumps=self.jumps,
+                             multipliers=self.count, tol=self.tol, max_iter=self.max_iter,
+                             estimate=False)
 
     def between(self, za: np.ndarray, a: StickCurvePoint, zb: np.ndarray, b: StickCurvePoint,
                 middle: Any) -> list[Event]:
@@ -530,18 +460,14 @@ class StickBoundary:
                       f"{span}; located by Newton on the orbit, the margin and the fold's test "
                       "function in (x, p, q)", u=z[:-1].copy())]
 
-    def corner(self, points: list[StickCurvePoint]) -> str:
-        """Why the curve could not go on: the inequality its orbits would break, else ""."""
-        return self.breach
-
 
 def fold_crossing(disc: StickBoundary, zb: np.ndarray) -> np.ndarray:
     """(x, p, q) where the boundary meets a fold of the orbits at fixed q: Newton on F = 0,
-    m = 0 and the fold's minimally augmented test function (:class:`OrbitFold`'s, its borders
+    m = 0 and the fold's minimally augmented test function (:class:`FoldSystem`'s, its borders
     from zb) from zb = (x, p, q) on disc's layout.  ShootingError when Newton fails."""
     x0, p0, q0 = zb[:-2], float(zb[-2]), float(zb[-1])
-    fold = OrbitFold(disc.make2, disc.lay, x0, jumps=disc.jumps, multipliers=0,
-                     tol=disc.tol, estimate=False)
+    fold = FoldSystem(disc.make2, disc.lay, x0, jumps=disc.jumps, multipliers=0,
+                      tol=disc.tol, estimate=False)
     fold.ref, fold.problem = disc.ref, disc.problem
     fold.borders(x0, p0, q0)
 

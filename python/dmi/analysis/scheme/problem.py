@@ -28,6 +28,16 @@ from .stepmap import Model, StepMap, build, fixed_step, user_model
 KEEP = 8
 
 
+class AtQ:
+    """make2 at a fixed q as a one-parameter model make(p) (picklable where make2 is)."""
+
+    def __init__(self, make2: Callable[[float, float], Solver], q: float):
+        self.make2, self.q = make2, float(q)
+
+    def __call__(self, p: float) -> Solver:
+        return self.make2(p, self.q)
+
+
 class Problem:
     """A model, its step policy and one cache of recent objects built from it.
 
