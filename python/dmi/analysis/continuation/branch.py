@@ -335,6 +335,21 @@ class Branch:
         return branch_summary(self)
 
 
+class AlongQ:
+    """A curve point's tangent under the driver's name: the driver's parameter is q on a curve
+    in (p, q), so its ``dpds`` is the point's ``dqds`` (a dataclass field of the point)."""
+    dqds: float
+
+    @property
+    def dpds(self) -> float:
+        """The driver's name of ``dqds``."""
+        return self.dqds
+
+    @dpds.setter
+    def dpds(self, value: float) -> None:
+        self.dqds = float(value)
+
+
 @dataclass
 class CurveEvent:
     """A point of codimension two on a :class:`Curve`, or a point asked for with ``at=``.

@@ -54,7 +54,7 @@ import numpy as np
 
 from ..._errors import Error
 from ..._solver import Solver
-from ..continuation.branch import ON_AXIS, REAL, Curve, CurveEvent, Event, HopfPoint
+from ..continuation.branch import ON_AXIS, REAL, AlongQ, Curve, CurveEvent, Event, HopfPoint
 from ..continuation.driver import ContinuationOptions, continuation
 from ..core.model import Linearisation, call_make, equation_step
 from ..core.newton import ShootingError
@@ -69,7 +69,7 @@ ROOTS = 6
 
 
 @dataclass
-class CurvePoint:
+class CurvePoint(AlongQ):
     """A point of a :class:`Curve`.
 
     Attributes
@@ -119,18 +119,6 @@ class CurvePoint:
     def kappa(self) -> np.ndarray | None:
         """The Hopf point's amplitude coefficients (None on a fold curve)."""
         return None if self.hopf is None else self.hopf.kappa
-
-    @property
-    def dpds(self) -> float:
-        """The driver's name of :attr:`dqds` (its parameter is q)."""
-        return self.dqds
-
-    @dpds.setter
-    def dpds(self, value: float) -> None:
-        self.dqds = float(value)
-
-
-
 
 
 class _Extended:

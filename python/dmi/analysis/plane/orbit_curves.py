@@ -65,7 +65,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -82,63 +82,13 @@ from ..continuation.driver import Curve as DriverCurve
 from ..continuation.driver import continuation, newton_strategy
 from ..core.newton import ShootingError, Strategy, bordered_solve, sparse_bordered
 from ..scheme.problem import AtQ
-from .orbit_system import DIFF, FoldSystem
+from .orbit_system import DIFF, FoldSystem, OrbitCurvePoint
 
 #: A start's fold at q0 must lie within this (relative to max(1, |p|)) of the event's p.
 START_TOL = 1e-6
 #: A turn back in q where the orbits' amplitude is below this share of the curve's largest is
 #: the fold curve's end at a Bautin point (the curve in x passes through the equilibrium).
 BAUTIN_SHARE = 0.2
-
-
-@dataclass
-class OrbitCurvePoint:
-    """A point of an orbit curve (:func:`continue_orbit_curve`).
-
-    Attributes
-    ----------
-    p, q : float
-        The parameters.
-    orbit : EquationOrbit
-        The orbit there (at fixed q, ``orbit.make(p)`` is ``make2(p, q)``): its period,
-        amplitude, multipliers and their error estimates (``orbit.errors``; with ``"p"``, the
-        estimated error of p); its ``stable`` is None (a fold has a multiplier at 1).
-    p_error : float or None
-        The estimated error of p (the difference to the fold on the mesh of merged pairs of
-        intervals at the same q); None where that solve failed (a warning says so).
-    stable : bool or None
-        Every multiplier but the trivial one and the fold's inside the unit circle (True), one
-        outside (False), verified against their estimated errors; None where one is within its
-        error of the circle or no error estimate exists (a CollocationWarning says so).
-    dqds : float
-        The unit tangent's q component (its sign flips at a turning point in q).
-    """
-    p: float
-    q: float
-    orbit: EquationOrbit = field(repr=False)
-    p_error: float | None = None
-    stable: bool | None = None
-    dqds: float = 0.0
-
-    @property
-    def omega(self) -> float:
-        """The orbit's angular frequency 2 pi / period (radians / time unit)."""
-        return 2 * math.pi / self.orbit.period
-
-    @property
-    def u(self) -> np.ndarray:
-        """The orbit's node values (as a curve point's state)."""
-        return self.orbit.nodes
-
-    @property
-    def dpds(self) -> float:
-        """The driver's name of :attr:`dqds` (its parameter is q)."""
-        return self.dqds
-
-    @dpds.setter
-    def dpds(self, value: float) -> None:
-        self.dqds = float(value)
-
 
 
 class OrbitFold(FoldSystem):

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -21,7 +22,9 @@ from ..collocation.adapt import FLOOR, Solved, adapted, merged, transfer
 from ..collocation.adapt import estimate as level_errors
 from ..collocation.floquet import multipliers as floquet
 from ..collocation.mend import check_inequalities
+from ..collocation.orbit import EquationOrbit
 from ..collocation.system import CollocationWarning, Layout, Terms, full_jacobian, reference
+from ..continuation.branch import AlongQ
 from ..core.newton import ShootingError, bordered_solve, newton_loop, sparse_bordered
 from ..scheme.problem import AtQ, Problem
 from ..scheme.stepmap import build
@@ -30,6 +33,46 @@ from ..scheme.stepmap import build
 DIFF = 1e-7
 #: Terms kept (the last few (p, q) evaluated).
 KEEP = 12
+
+
+@dataclass
+class OrbitCurvePoint(AlongQ):
+    """A point of a curve of orbits in (p, q) (:func:`dmi.analysis.continue_curve`).
+
+    Attributes
+    ----------
+    p, q : float
+        The parameters.
+    orbit : EquationOrbit
+        The orbit there (at fixed q, ``orbit.make(p)`` is ``make2(p, q)``): its period,
+        amplitude, multipliers and their error estimates (``orbit.errors``; with ``"p"``, the
+        estimated error of p); its ``stable`` is None (a fold has a multiplier at 1).
+    p_error : float or None
+        The estimated error of p (the difference to the fold on the mesh of merged pairs of
+        intervals at the same q); None where that solve failed (a warning says so).
+    stable : bool or None
+        Every multiplier but the trivial one and the fold's inside the unit circle (True), one
+        outside (False), verified against their estimated errors; None where one is within its
+        error of the circle or no error estimate exists (a CollocationWarning says so).
+    dqds : float
+        The unit tangent's q component (its sign flips at a turning point in q).
+    """
+    p: float
+    q: float
+    orbit: EquationOrbit = field(repr=False)
+    p_error: float | None = None
+    stable: bool | None = None
+    dqds: float = 0.0
+
+    @property
+    def omega(self) -> float:
+        """The orbit's angular frequency 2 pi / period (radians / time unit)."""
+        return 2 * math.pi / self.orbit.period
+
+    @property
+    def u(self) -> np.ndarray:
+        """The orbit's node values (as a curve point's state)."""
+        return self.orbit.nodes
 
 
 class OrbitSystem:

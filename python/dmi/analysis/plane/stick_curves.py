@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -56,7 +56,7 @@ from ..continuation.driver import bordered_det, continuation
 from ..core.newton import ShootingError, bordered_solve, newton_loop, sparse_bordered
 from ..scheme.problem import AtQ
 from ..scheme.stepmap import build
-from .orbit_system import FoldSystem, OrbitSystem
+from .orbit_system import FoldSystem, OrbitCurvePoint, OrbitSystem
 
 #: Relative step of the central differences (the margin's non-node columns, F_p, F_q).
 DIFF = 1e-7
@@ -221,25 +221,17 @@ class _Values:
 
 
 @dataclass
-class StickCurvePoint:
-    """A point of a stick-onset or grazing curve (:func:`continue_stick_curve`).
+class StickCurvePoint(OrbitCurvePoint):
+    """A point of a stick-onset or grazing curve (:func:`continue_stick_curve`): an
+    :class:`~dmi.analysis.OrbitCurvePoint` (``p``, ``q``, ``orbit``,
+    ``p_error``, ``dqds``) whose ``orbit`` lies on the signature of the side where it holds and
+    whose ``stable`` is the orbit's own verdict (verified against the multipliers' errors, None
+    where one is within its error of the unit circle or no estimate exists).
 
     Attributes
     ----------
-    p, q : float
-        The parameters.
-    orbit : EquationOrbit
-        The orbit there, on the signature of the side where it holds (``orbit.make(p)`` is
-        ``make2(p, q)``): period, amplitude, multipliers, their error estimates (``orbit.errors``,
-        with ``"p"``) and its verified ``stable``.
     t_star : float
         The time of the margin's least value (a reversal's switching time).
-    p_error : float or None
-        The estimated error of p (the difference to the boundary on the mesh of merged pairs of
-        intervals at the same q); None where that solve failed (a warning says so).
-    stable : bool or None
-        The orbit's verdict (``orbit.stable``: verified against the multipliers' errors, None
-        where one is within its error of the unit circle or no estimate exists).
     fold_test : float
         det F_x's sign times the fold's test function (a fold of the orbits at fixed q where it
         changes sign).
@@ -247,37 +239,10 @@ class StickCurvePoint:
         Where in p, at this q, the orbits stick (stick onset) or graze into a new signature:
         +1 at larger p, -1 at smaller (the sign opposite to d m / d p along the orbits' branch
         at fixed q, m the margin); 0 where that derivative is not computable.
-    dqds : float
-        The unit tangent's q component.
     """
-    p: float
-    q: float
-    orbit: EquationOrbit = field(repr=False)
     t_star: float = 0.0
-    p_error: float | None = None
-    stable: bool | None = None
     fold_test: float = math.nan
     side: int = 0
-    dqds: float = 0.0
-
-    @property
-    def omega(self) -> float:
-        """The orbit's angular frequency 2 pi / period."""
-        return 2 * math.pi / self.orbit.period
-
-    @property
-    def u(self) -> np.ndarray:
-        """The orbit's node values."""
-        return self.orbit.nodes
-
-    @property
-    def dpds(self) -> float:
-        """The driver's name of :attr:`dqds` (its parameter is q)."""
-        return self.dqds
-
-    @dpds.setter
-    def dpds(self, value: float) -> None:
-        self.dqds = float(value)
 
 
 class StickBoundary(OrbitSystem):
@@ -421,8 +386,9 @@ class StickBoundary(OrbitSystem):
         fine, errors, _ = self.levels(y, q)
         orbit = equation_orbit(fine, p, AtQ(self.make2, q), errors, self.jumps)
         _, t_star = self._margin(y, q)
-        return StickCurvePoint(p, float(q), orbit, t_star, errors.get("p"), orbit.stable,
-                               self.fold_test(y, q), self.side(y, q))
+        return StickCurvePoint(p, float(q), orbit, p_error=errors.get("p"), stable=orbit.stable,
+                               t_star=t_star, fold_test=self.fold_test(y, q),
+                               side=self.side(y, q))
 
     def side(self, y: np.ndarray, q: float) -> int:
         """-sign(d m / d p) along the orbits' branch at fixed q: from the bordered system
