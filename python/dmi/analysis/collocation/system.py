@@ -30,8 +30,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from ..._solver import Solver
-from ..core.model import FD_STEP
-from .mesh import (STEEP, Basis, Kernel, Locator, Near, delay_matrix,
+from ..core.model import FD_STEP, ManyRhs
+from .mesh import (STEEP, Basis, Kernel, Locator, Near, _monomials, delay_matrix,
                                history_locator, history_rows, periodic_locator, point_matrix)
 from .signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
 from ..core.newton import Converge, NewtonOptions, Search, ShootingError, newton_loop
@@ -88,6 +88,7 @@ class Terms:
         self.terms = solver.kernel_terms
         self.kind = solver.kernel_kind
         self.has_rhs = solver.has("rhs")
+        self._many = ManyRhs(solver)
         rate = float(np.max(-self.terms[0], initial=0.0)) if self.kind == "exp" else 0.0
         self.H = Kernel(self._far, near_part(solver), kernel_jumps(jumps, self.tau),
                         rate if rate * self.tau > STEEP else 0.0)
@@ -158,7 +159,7 @@ class Terms:
         """f(t_c, U_c) (P, n) from the model's rhs (zero without one)."""
         if not self.has_rhs:
             return np.zeros_like(U)
-        out = self.solver.eval_rhs_many(t, U)
+        out = self._many(t, U)
         if not np.all(np.isfinite(out)):
             c = int(np.flatnonzero(~np.all(np.isfinite(out), axis=1))[0])
             raise ValueError(f"collocate: the model's rhs is not finite at t = {t[c]!r}, "
@@ -365,7 +366,7 @@ class Layout:
     basis: Basis = field(init=False)
 
     def __post_init__(self) -> None:
-        self.basis = Basis(self.m, self.m + QUAD_EXTRA)
+        self.basis = HornerBasis(self.m, self.m + QUAD_EXTRA)
 
     @property
     def L(self) -> int:
@@ -446,6 +447,23 @@ class Layout:
         """The same layout on other meshes of its pieces."""
         return Layout(self.m, self.n, self.signature, fractions, self.autonomous, self.period,
                       self.carried)
+
+
+@dataclass(frozen=True)
+class HornerBasis(Basis):
+    """The Basis with its derivatives by Horner's scheme on the monomial coefficients in
+    y = 2 z - 1 (as its values; the same polynomials' derivatives, to rounding), one pass over
+    all the points at once."""
+
+    def derivatives(self, z: np.ndarray) -> np.ndarray:
+        """(len(z), m + 1): the basis polynomials' first derivatives at z (d/dz)."""
+        y = 2.0 * np.asarray(z, dtype=float).ravel() - 1.0
+        C = _monomials(self.m)
+        out = np.broadcast_to(self.m * C[self.m], (y.size, self.m + 1)).copy()
+        for j in range(self.m - 1, 0, -1):
+            out *= y[:, None]
+            out += j * C[j]
+        return 2.0 * out
 
 
 class Degenerate(ValueError):
