@@ -534,14 +534,12 @@ def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray
     r = np.where(held, Uc - value, r)
     J = None
     if jacobian:
-        P = len(tc)
-        fu = terms.fu(tc, Uc)
-        FU = sp.block_diag(list(fu), format="csr") if P else None
-        J = D + FU @ E
+        J = D + fu_points(terms.fu(tc, Uc), tc, loc, basis, rows)
         if G is not None:
             J = J + G
-        hv = held.ravel().astype(float)
-        J = sp.diags(1.0 - hv) @ J + sp.diags(hv) @ E
+        if np.any(held):
+            hv = held.ravel().astype(float)
+            J = sp.diags(1.0 - hv) @ J + sp.diags(hv) @ E
     dT = None
     if scaled:        # d r / d T with the nodes fixed in theta = t / T (an autonomous rhs)
         dT = np.where(held, 0.0, -du / T + (dI if dI is not None else 0.0)).ravel()
@@ -573,6 +571,22 @@ def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray
     if dT is not None:                  # the phase condition does not move with T
         dT = np.concatenate([dT, np.zeros(res.size - dT.size)])
     return res, J, dT
+
+
+def fu_points(fu: np.ndarray, tc: np.ndarray, loc: Locator, basis: Basis, rows: int
+              ) -> sp.csr_matrix:
+    """The sparse matrix (P n, rows n) of f_u(t_c, u(t_c)) u(t_c) in the node values: the
+    block-diagonal f_u (P, n, n) times the point values' matrix, its entries f_u[c, a, b] B_k(z_c)
+    at row c n + a, column cols[c, k] n + b, built in one go."""
+    P, n, _ = fu.shape
+    _, z, cols = loc(tc)
+    B = basis.values(z)                                              # (P, m + 1)
+    val = fu[:, :, :, None] * B[:, None, None, :]                     # (P, a, b, k)
+    r = np.broadcast_to((np.arange(P) * n)[:, None, None, None]
+                        + np.arange(n)[None, :, None, None], val.shape)
+    c = np.broadcast_to(cols[:, None, None, :] * n + np.arange(n)[None, None, :, None],
+                        val.shape)
+    return sp.csr_matrix((val.ravel(), (r.ravel(), c.ravel())), shape=(P * n, rows * n))
 
 
 def _switch_condition(lay: Layout, terms: Terms, k: int, tb: float, mesh: np.ndarray, T: float,
