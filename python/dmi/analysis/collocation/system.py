@@ -205,9 +205,12 @@ class Terms:
         s = np.asarray(s, dtype=float)
         if self.kind == "exp":
             a, b, C, D = self.terms  # type: ignore[misc]
+            k, n = a.size, self.n
             e = np.exp(np.outer(s, a))
-            return (np.einsum("pk,kij->pij", e * np.cos(np.outer(s, b)), C)
-                    + np.einsum("pk,kij->pij", e * np.sin(np.outer(s, b)), D))
+            if not np.any(b):                     # real rates: cos = 1, sin = 0
+                return (e @ C.reshape(k, n * n)).reshape(-1, n, n)
+            return ((e * np.cos(np.outer(s, b))) @ C.reshape(k, n * n)
+                    + (e * np.sin(np.outer(s, b))) @ D.reshape(k, n * n)).reshape(-1, n, n)
         out = np.array([self.solver.eval_kernel(float(x)) for x in s]).reshape(-1, self.n, self.n)
         if not np.all(np.isfinite(out)):
             raise ValueError("collocate: the model's kernel is not finite on (0, tau)")
