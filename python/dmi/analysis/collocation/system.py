@@ -555,11 +555,11 @@ def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray
                                           (np.r_[np.arange(n), np.arange(n)],
                                            np.r_[np.arange(n), last * n + np.arange(n)])),
                                          shape=(n, rows * n)))
-    for k in range(1, lay.S + 1):
-        g, row = _switch_condition(lay, terms, k, b[k - 1], mesh, T, loc, rows, u, jacobian)
-        extra_r.append(np.array([g]))
+    if lay.S:
+        g, sw = _switch_conditions(lay, terms, b, mesh, T, loc, rows, u, jacobian)
+        extra_r.append(g)
         if jacobian:
-            extra_J.append(row)
+            extra_J.append(sw)
     if lay.autonomous and history is None and ref is not None:
         w = (h[:, None] * gw[None, :]).ravel() / T
         R = ref(tc / T)                                     # r'(theta_c) (P, n)
@@ -592,31 +592,44 @@ def fu_points(fu: np.ndarray, tc: np.ndarray, loc: Locator, basis: Basis, rows: 
     return sp.csr_matrix((val.ravel(), (r.ravel(), c.ravel())), shape=(P * n, rows * n))
 
 
-def _switch_condition(lay: Layout, terms: Terms, k: int, tb: float, mesh: np.ndarray, T: float,
-                      loc: Locator, rows: int, u: np.ndarray, jacobian: bool
-                      ) -> tuple[float, sp.csr_matrix | None]:
-    """The switching condition at b_k and its row in the node values: the component reaching
-    0 or a face (a slip ending, a contact starting), or its net force -f_i - (int H u)_i reaching
-    +-alpha_i (a stick ending) or 0 (a contact ending)."""
-    n = lay.n
-    i, before, after = lay.signature.switch(k)
-    t = np.array([tb])
+def _switch_conditions(lay: Layout, terms: Terms, b: np.ndarray, mesh: np.ndarray, T: float,
+                       loc: Locator, rows: int, u: np.ndarray, jacobian: bool
+                       ) -> tuple[np.ndarray, sp.csr_matrix | None]:
+    """The switching conditions at b_1..b_S (S,) and their rows in the node values (S, rows n),
+    the values at all the b's and the memory at those that need it each in one call: the
+    component reaching 0 or a face (a slip ending, a contact starting), or its net force
+    -f_i - (int H u)_i reaching +-alpha_i (a stick ending) or 0 (a contact ending)."""
+    n, S = lay.n, lay.S
+    t = np.asarray(b, dtype=float)
     Eb = point_matrix(t, loc, lay.basis, mesh, n, rows)
-    ub = Eb @ u
-    if before in (SLIP_POS, SLIP_NEG) or after in (LO, HI):
-        target = terms.lo[i] if after == LO else terms.hi[i] if after == HI else 0.0
-        return float(ub[i] - target), (Eb[i] if jacobian else None)
-    Gb = (delay_matrix(t, terms.tau, mesh, T, terms.H, loc, lay.basis, n, rows,
-                       pattern=terms.pattern)[0] if terms.has_kernel else None)
-    force = -terms.f(t, ub[None, :])[0] - (Gb @ u if Gb is not None else 0.0)
-    target = terms.alpha[i] * (after == SLIP_POS) - terms.alpha[i] * (after == SLIP_NEG)
-    row = None
-    if jacobian:
-        fu = terms.fu(t, ub[None, :])[0]
-        row = -(sp.csr_matrix(fu[i:i + 1]) @ Eb)
-        if Gb is not None:
-            row = row - Gb[i]
-    return float(force[i] - target), row
+    ub = (Eb @ u).reshape(S, n)
+    switch = [lay.signature.switch(k) for k in range(1, S + 1)]
+    g = np.empty(S)
+    out: list = [None] * S
+    force = []
+    for k, (i, before, after) in enumerate(switch):
+        if before in (SLIP_POS, SLIP_NEG) or after in (LO, HI):
+            target = terms.lo[i] if after == LO else terms.hi[i] if after == HI else 0.0
+            g[k] = ub[k, i] - target
+            out[k] = Eb[k * n + i]
+        else:
+            force.append(k)
+    if force:
+        tf = t[force]
+        Gb = (delay_matrix(tf, terms.tau, mesh, T, terms.H, loc, lay.basis, n, rows,
+                           pattern=terms.pattern)[0] if terms.has_kernel else None)
+        F = -terms.f(tf, ub[force]) - ((Gb @ u).reshape(-1, n) if Gb is not None else 0.0)
+        fu = terms.fu(tf, ub[force]) if jacobian else None
+        for j, k in enumerate(force):
+            i, _, after = switch[k]
+            target = terms.alpha[i] * (after == SLIP_POS) - terms.alpha[i] * (after == SLIP_NEG)
+            g[k] = F[j, i] - target
+            if jacobian:
+                row = -(sp.csr_matrix(fu[j, i:i + 1]) @ Eb[k * n:(k + 1) * n])
+                out[k] = row - Gb[j * n + i] if Gb is not None else row
+    if not jacobian:
+        return g, None
+    return g, sp.vstack(out, format="csr")
 
 
 def full_jacobian(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None,
