@@ -517,8 +517,7 @@ def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray
         rows = history_rows(lay.L, m, history.periods)
         loc = history_locator(mesh, history.hist, m, history.periods)
         u = np.concatenate([V.ravel(), V[0], history.phi.ravel()])
-    E = point_matrix(tc, loc, basis, mesh, n, rows)
-    D = point_matrix(tc, loc, basis, mesh, n, rows, derivative=True)
+    E, D = collocation_matrices(basis, h, n, rows, periodic=history is None)
     scaled = jacobian and lay.autonomous and history is None and lay.S == 0
     G, dI = None, None
     if terms.has_kernel and scaled:         # the T column's integral needs the node values
@@ -574,6 +573,35 @@ def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray
     if dT is not None:                  # the phase condition does not move with T
         dT = np.concatenate([dT, np.zeros(res.size - dT.size)])
     return res, J, dT
+
+
+def collocation_matrices(basis: Basis, h: np.ndarray, n: int, rows: int, periodic: bool
+                         ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """(E, D): u and u' (d/dt) at the m Gauss points of each of the L intervals of lengths h
+    (P = L m points, (P n, rows n) each) from the node rows (interval i's nodes i m .. i m + m,
+    wrapped mod L m when ``periodic``): the basis at the Gauss points, the same for every
+    interval, with the derivative's over h_i; each row's m + 1 entries written in place."""
+    m, L = basis.m, h.size
+    gz = basis.gauss()[0]
+    P = L * m
+    i = np.repeat(np.arange(L), m)
+    g = np.tile(np.arange(m), L)
+    cols = i[:, None] * m + np.arange(m + 1)[None, :]
+    if periodic:
+        cols %= L * m
+    index = np.broadcast_to(cols[:, None, :] * n + np.arange(n)[None, :, None],
+                            (P, n, m + 1)).ravel()
+    ptr = np.arange(0, P * n * (m + 1) + 1, m + 1)
+    shape = (P * n, rows * n)
+    ev = np.broadcast_to(basis.values(gz)[g][:, None, :], (P, n, m + 1)).ravel()
+    dv = np.broadcast_to((basis.derivatives(gz)[g] / h[i][:, None])[:, None, :],
+                         (P, n, m + 1)).ravel()
+    E = sp.csr_matrix((ev, index, ptr.copy()), shape=shape)
+    D = sp.csr_matrix((dv, index.copy(), ptr), shape=shape)
+    if periodic and L < 2:               # one interval: its first and last node are one row
+        E.sum_duplicates()
+        D.sum_duplicates()
+    return E, D
 
 
 def fu_points(fu: np.ndarray, tc: np.ndarray, loc: Locator, basis: Basis, rows: int
