@@ -92,14 +92,16 @@ class Terms:
         rate = float(np.max(-self.terms[0], initial=0.0)) if self.kind == "exp" else 0.0
         self.H = Kernel(self._far, near_part(solver), kernel_jumps(jumps, self.tau),
                         rate if rate * self.tau > STEEP else 0.0)
-        self._delays: OrderedDict[tuple, sp.csr_matrix] = OrderedDict()
+        self._delays: OrderedDict[tuple, tuple] = OrderedDict()
         self._kept: dict[str, tuple[tuple, np.ndarray]] = {}
 
     def delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc: Locator, basis: Basis,
-              rows: int, history: History | None = None) -> sp.csr_matrix:
+              rows: int, history: History | None = None, extra: np.ndarray | None = None
+              ) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
         """The delay integral's matrix (:func:`delay_matrix`) at the collocation times of
-        ``mesh``, kept for the last DELAY_CACHE meshes (it depends on the mesh, T, the basis and
-        the history's mesh only, not on the node values).
+        ``mesh`` and at the ``extra`` times (the switching conditions' that need the memory) in
+        one, kept for the last DELAY_CACHE meshes (it depends on the mesh, T, the basis, the
+        extra times and the history's mesh only, not on the node values).
 
         Parameters
         ----------
@@ -117,24 +119,31 @@ class Terms:
             The node rows.
         history : History, optional
             The past of the monodromy operator's system (its mesh and periods enter the key).
+        extra : numpy.ndarray, optional
+            More times, after the collocation times.
 
         Returns
         -------
-        scipy.sparse.csr_matrix
-            G (len(times) n, rows n).
+        tuple
+            G (len(times) n, rows n) and the rows of the extra times (len(extra) n, rows n;
+            None without them).
         """
+        more = np.empty(0) if extra is None else np.asarray(extra, dtype=float)
         key = (np.asarray(mesh, dtype=float).tobytes(), float(T), basis.m, basis.q, rows,
-               None if history is None else (history.hist.tobytes(), history.periods))
-        G = self._delays.get(key)
-        if G is None:
-            G = delay_matrix(times, self.tau, mesh, T, self.H, loc, basis, self.n, rows,
-                             pattern=self.pattern)[0]
-            self._delays[key] = G
+               None if history is None else (history.hist.tobytes(), history.periods),
+               more.tobytes())
+        got = self._delays.get(key)
+        if got is None:
+            G = delay_matrix(np.concatenate([times, more]), self.tau, mesh, T, self.H, loc,
+                             basis, self.n, rows, pattern=self.pattern)[0]
+            cut = len(times) * self.n
+            got = (G, None) if not more.size else (G[:cut], G[cut:])
+            self._delays[key] = got
             if len(self._delays) > DELAY_CACHE:
                 self._delays.popitem(last=False)
         else:
             self._delays.move_to_end(key)
-        return G
+        return got
 
     def _last(self, slot: str, t: np.ndarray, U: np.ndarray,
               compute: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> np.ndarray:
@@ -519,12 +528,12 @@ def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray
         u = np.concatenate([V.ravel(), V[0], history.phi.ravel()])
     E, D = collocation_matrices(basis, h, n, rows, periodic=history is None)
     scaled = jacobian and lay.autonomous and history is None and lay.S == 0
-    G, dI = None, None
+    G, dI, Gb = None, None, None
     if terms.has_kernel and scaled:         # the T column's integral needs the node values
         G, dI = delay_matrix(tc, terms.tau, mesh, T, terms.H, loc, basis, n, rows,
                              pattern=terms.pattern, slope_of=V)
-    elif terms.has_kernel:
-        G = terms.delay(tc, mesh, T, loc, basis, rows, history)
+    elif terms.has_kernel:                  # with the memory at the stick endings' b's
+        G, Gb = terms.delay(tc, mesh, T, loc, basis, rows, history, b[force_switches(lay)])
     Uc = (E @ u).reshape(-1, n)
     du = (D @ u).reshape(-1, n)
     r = du + terms.f(tc, Uc)
@@ -555,7 +564,7 @@ def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray
                                            np.r_[np.arange(n), last * n + np.arange(n)])),
                                          shape=(n, rows * n)))
     if lay.S:
-        g, sw = _switch_conditions(lay, terms, b, mesh, T, loc, rows, u, jacobian)
+        g, sw = _switch_conditions(lay, terms, b, mesh, T, loc, rows, u, jacobian, Gb)
         extra_r.append(g)
         if jacobian:
             extra_J.append(sw)
@@ -620,11 +629,24 @@ def fu_points(fu: np.ndarray, tc: np.ndarray, loc: Locator, basis: Basis, rows: 
     return sp.csr_matrix((val.ravel(), (r.ravel(), c.ravel())), shape=(P * n, rows * n))
 
 
+def force_switches(lay: Layout) -> list[int]:
+    """The indices k - 1 of the switches b_k whose condition is a net force (a stick ending, a
+    contact ending): those that need the memory at b_k."""
+    out = []
+    for k in range(1, lay.S + 1):
+        _, before, after = lay.signature.switch(k)
+        if not (before in (SLIP_POS, SLIP_NEG) or after in (LO, HI)):
+            out.append(k - 1)
+    return out
+
+
 def _switch_conditions(lay: Layout, terms: Terms, b: np.ndarray, mesh: np.ndarray, T: float,
-                       loc: Locator, rows: int, u: np.ndarray, jacobian: bool
+                       loc: Locator, rows: int, u: np.ndarray, jacobian: bool,
+                       Gb: sp.csr_matrix | None = None
                        ) -> tuple[np.ndarray, sp.csr_matrix | None]:
     """The switching conditions at b_1..b_S (S,) and their rows in the node values (S, rows n),
-    the values at all the b's and the memory at those that need it each in one call: the
+    the values at all the b's and the memory at those that need it each in one call (``Gb``:
+    the memory's rows at the :func:`force_switches`' b's, built with the collocation's): the
     component reaching 0 or a face (a slip ending, a contact starting), or its net force
     -f_i - (int H u)_i reaching +-alpha_i (a stick ending) or 0 (a contact ending)."""
     n, S = lay.n, lay.S
@@ -644,8 +666,9 @@ def _switch_conditions(lay: Layout, terms: Terms, b: np.ndarray, mesh: np.ndarra
             force.append(k)
     if force:
         tf = t[force]
-        Gb = (delay_matrix(tf, terms.tau, mesh, T, terms.H, loc, lay.basis, n, rows,
-                           pattern=terms.pattern)[0] if terms.has_kernel else None)
+        if Gb is None and terms.has_kernel:
+            Gb = delay_matrix(tf, terms.tau, mesh, T, terms.H, loc, lay.basis, n, rows,
+                              pattern=terms.pattern)[0]
         F = -terms.f(tf, ub[force]) - ((Gb @ u).reshape(-1, n) if Gb is not None else 0.0)
         fu = terms.fu(tf, ub[force]) if jacobian else None
         for j, k in enumerate(force):
