@@ -30,8 +30,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from ..._solver import Solver
-from ..core.model import FD_STEP
-from .mesh import (STEEP, Basis, Kernel, Locator, Near, delay_matrix,
+from ..core.model import FD_STEP, ManyRhs
+from .mesh import (STEEP, Basis, Kernel, Locator, Near, _monomials, delay_matrix,
                                history_locator, history_rows, periodic_locator, point_matrix)
 from .signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
 from ..core.newton import Converge, NewtonOptions, Search, ShootingError, newton_loop
@@ -88,17 +88,20 @@ class Terms:
         self.terms = solver.kernel_terms
         self.kind = solver.kernel_kind
         self.has_rhs = solver.has("rhs")
+        self._many = ManyRhs(solver)
         rate = float(np.max(-self.terms[0], initial=0.0)) if self.kind == "exp" else 0.0
         self.H = Kernel(self._far, near_part(solver), kernel_jumps(jumps, self.tau),
                         rate if rate * self.tau > STEEP else 0.0)
-        self._delays: OrderedDict[tuple, sp.csr_matrix] = OrderedDict()
+        self._delays: OrderedDict[tuple, tuple] = OrderedDict()
         self._kept: dict[str, tuple[tuple, np.ndarray]] = {}
 
     def delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc: Locator, basis: Basis,
-              rows: int, history: History | None = None) -> sp.csr_matrix:
+              rows: int, history: History | None = None, extra: np.ndarray | None = None
+              ) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
         """The delay integral's matrix (:func:`delay_matrix`) at the collocation times of
-        ``mesh``, kept for the last DELAY_CACHE meshes (it depends on the mesh, T, the basis and
-        the history's mesh only, not on the node values).
+        ``mesh`` and at the ``extra`` times (the switching conditions' that need the memory) in
+        one, kept for the last DELAY_CACHE meshes (it depends on the mesh, T, the basis, the
+        extra times and the history's mesh only, not on the node values).
 
         Parameters
         ----------
@@ -116,24 +119,31 @@ class Terms:
             The node rows.
         history : History, optional
             The past of the monodromy operator's system (its mesh and periods enter the key).
+        extra : numpy.ndarray, optional
+            More times, after the collocation times.
 
         Returns
         -------
-        scipy.sparse.csr_matrix
-            G (len(times) n, rows n).
+        tuple
+            G (len(times) n, rows n) and the rows of the extra times (len(extra) n, rows n;
+            None without them).
         """
+        more = np.empty(0) if extra is None else np.asarray(extra, dtype=float)
         key = (np.asarray(mesh, dtype=float).tobytes(), float(T), basis.m, basis.q, rows,
-               None if history is None else (history.hist.tobytes(), history.periods))
-        G = self._delays.get(key)
-        if G is None:
-            G = delay_matrix(times, self.tau, mesh, T, self.H, loc, basis, self.n, rows,
-                             pattern=self.pattern)[0]
-            self._delays[key] = G
+               None if history is None else (history.hist.tobytes(), history.periods),
+               more.tobytes())
+        got = self._delays.get(key)
+        if got is None:
+            G = delay_matrix(np.concatenate([times, more]), self.tau, mesh, T, self.H, loc,
+                             basis, self.n, rows, pattern=self.pattern)[0]
+            cut = len(times) * self.n
+            got = (G, None) if not more.size else (G[:cut], G[cut:])
+            self._delays[key] = got
             if len(self._delays) > DELAY_CACHE:
                 self._delays.popitem(last=False)
         else:
             self._delays.move_to_end(key)
-        return G
+        return got
 
     def _last(self, slot: str, t: np.ndarray, U: np.ndarray,
               compute: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> np.ndarray:
@@ -158,7 +168,7 @@ class Terms:
         """f(t_c, U_c) (P, n) from the model's rhs (zero without one)."""
         if not self.has_rhs:
             return np.zeros_like(U)
-        out = self.solver.eval_rhs_many(t, U)
+        out = self._many(t, U)
         if not np.all(np.isfinite(out)):
             c = int(np.flatnonzero(~np.all(np.isfinite(out), axis=1))[0])
             raise ValueError(f"collocate: the model's rhs is not finite at t = {t[c]!r}, "
@@ -204,9 +214,12 @@ class Terms:
         s = np.asarray(s, dtype=float)
         if self.kind == "exp":
             a, b, C, D = self.terms  # type: ignore[misc]
+            k, n = a.size, self.n
             e = np.exp(np.outer(s, a))
-            return (np.einsum("pk,kij->pij", e * np.cos(np.outer(s, b)), C)
-                    + np.einsum("pk,kij->pij", e * np.sin(np.outer(s, b)), D))
+            if not np.any(b):                     # real rates: cos = 1, sin = 0
+                return (e @ C.reshape(k, n * n)).reshape(-1, n, n)
+            return ((e * np.cos(np.outer(s, b))) @ C.reshape(k, n * n)
+                    + (e * np.sin(np.outer(s, b))) @ D.reshape(k, n * n)).reshape(-1, n, n)
         out = np.array([self.solver.eval_kernel(float(x)) for x in s]).reshape(-1, self.n, self.n)
         if not np.all(np.isfinite(out)):
             raise ValueError("collocate: the model's kernel is not finite on (0, tau)")
@@ -365,7 +378,7 @@ class Layout:
     basis: Basis = field(init=False)
 
     def __post_init__(self) -> None:
-        self.basis = Basis(self.m, self.m + QUAD_EXTRA)
+        self.basis = HornerBasis(self.m, self.m + QUAD_EXTRA)
 
     @property
     def L(self) -> int:
@@ -448,6 +461,23 @@ class Layout:
                       self.carried)
 
 
+@dataclass(frozen=True)
+class HornerBasis(Basis):
+    """The Basis with its derivatives by Horner's scheme on the monomial coefficients in
+    y = 2 z - 1 (as its values; the same polynomials' derivatives, to rounding), one pass over
+    all the points at once."""
+
+    def derivatives(self, z: np.ndarray) -> np.ndarray:
+        """(len(z), m + 1): the basis polynomials' first derivatives at z (d/dz)."""
+        y = 2.0 * np.asarray(z, dtype=float).ravel() - 1.0
+        C = _monomials(self.m)
+        out = np.broadcast_to(self.m * C[self.m], (y.size, self.m + 1)).copy()
+        for j in range(self.m - 1, 0, -1):
+            out *= y[:, None]
+            out += j * C[j]
+        return 2.0 * out
+
+
 class Degenerate(ValueError):
     """A piece's length went to zero or below (a segment vanishes)."""
 
@@ -496,15 +526,14 @@ def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray
         rows = history_rows(lay.L, m, history.periods)
         loc = history_locator(mesh, history.hist, m, history.periods)
         u = np.concatenate([V.ravel(), V[0], history.phi.ravel()])
-    E = point_matrix(tc, loc, basis, mesh, n, rows)
-    D = point_matrix(tc, loc, basis, mesh, n, rows, derivative=True)
+    E, D = collocation_matrices(basis, h, n, rows, periodic=history is None)
     scaled = jacobian and lay.autonomous and history is None and lay.S == 0
-    G, dI = None, None
+    G, dI, Gb = None, None, None
     if terms.has_kernel and scaled:         # the T column's integral needs the node values
         G, dI = delay_matrix(tc, terms.tau, mesh, T, terms.H, loc, basis, n, rows,
                              pattern=terms.pattern, slope_of=V)
-    elif terms.has_kernel:
-        G = terms.delay(tc, mesh, T, loc, basis, rows, history)
+    elif terms.has_kernel:                  # with the memory at the stick endings' b's
+        G, Gb = terms.delay(tc, mesh, T, loc, basis, rows, history, b[force_switches(lay)])
     Uc = (E @ u).reshape(-1, n)
     du = (D @ u).reshape(-1, n)
     r = du + terms.f(tc, Uc)
@@ -516,14 +545,12 @@ def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray
     r = np.where(held, Uc - value, r)
     J = None
     if jacobian:
-        P = len(tc)
-        fu = terms.fu(tc, Uc)
-        FU = sp.block_diag(list(fu), format="csr") if P else None
-        J = D + FU @ E
+        J = D + fu_points(terms.fu(tc, Uc), tc, loc, basis, rows)
         if G is not None:
             J = J + G
-        hv = held.ravel().astype(float)
-        J = sp.diags(1.0 - hv) @ J + sp.diags(hv) @ E
+        if np.any(held):
+            hv = held.ravel().astype(float)
+            J = sp.diags(1.0 - hv) @ J + sp.diags(hv) @ E
     dT = None
     if scaled:        # d r / d T with the nodes fixed in theta = t / T (an autonomous rhs)
         dT = np.where(held, 0.0, -du / T + (dI if dI is not None else 0.0)).ravel()
@@ -536,11 +563,11 @@ def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray
                                           (np.r_[np.arange(n), np.arange(n)],
                                            np.r_[np.arange(n), last * n + np.arange(n)])),
                                          shape=(n, rows * n)))
-    for k in range(1, lay.S + 1):
-        g, row = _switch_condition(lay, terms, k, b[k - 1], mesh, T, loc, rows, u, jacobian)
-        extra_r.append(np.array([g]))
+    if lay.S:
+        g, sw = _switch_conditions(lay, terms, b, mesh, T, loc, rows, u, jacobian, Gb)
+        extra_r.append(g)
         if jacobian:
-            extra_J.append(row)
+            extra_J.append(sw)
     if lay.autonomous and history is None and ref is not None:
         w = (h[:, None] * gw[None, :]).ravel() / T
         R = ref(tc / T)                                     # r'(theta_c) (P, n)
@@ -557,31 +584,103 @@ def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray
     return res, J, dT
 
 
-def _switch_condition(lay: Layout, terms: Terms, k: int, tb: float, mesh: np.ndarray, T: float,
-                      loc: Locator, rows: int, u: np.ndarray, jacobian: bool
-                      ) -> tuple[float, sp.csr_matrix | None]:
-    """The switching condition at b_k and its row in the node values: the component reaching
-    0 or a face (a slip ending, a contact starting), or its net force -f_i - (int H u)_i reaching
-    +-alpha_i (a stick ending) or 0 (a contact ending)."""
-    n = lay.n
-    i, before, after = lay.signature.switch(k)
-    t = np.array([tb])
+def collocation_matrices(basis: Basis, h: np.ndarray, n: int, rows: int, periodic: bool
+                         ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """(E, D): u and u' (d/dt) at the m Gauss points of each of the L intervals of lengths h
+    (P = L m points, (P n, rows n) each) from the node rows (interval i's nodes i m .. i m + m,
+    wrapped mod L m when ``periodic``): the basis at the Gauss points, the same for every
+    interval, with the derivative's over h_i; each row's m + 1 entries written in place."""
+    m, L = basis.m, h.size
+    gz = basis.gauss()[0]
+    P = L * m
+    i = np.repeat(np.arange(L), m)
+    g = np.tile(np.arange(m), L)
+    cols = i[:, None] * m + np.arange(m + 1)[None, :]
+    if periodic:
+        cols %= L * m
+    index = np.broadcast_to(cols[:, None, :] * n + np.arange(n)[None, :, None],
+                            (P, n, m + 1)).ravel()
+    ptr = np.arange(0, P * n * (m + 1) + 1, m + 1)
+    shape = (P * n, rows * n)
+    ev = np.broadcast_to(basis.values(gz)[g][:, None, :], (P, n, m + 1)).ravel()
+    dv = np.broadcast_to((basis.derivatives(gz)[g] / h[i][:, None])[:, None, :],
+                         (P, n, m + 1)).ravel()
+    E = sp.csr_matrix((ev, index, ptr.copy()), shape=shape)
+    D = sp.csr_matrix((dv, index.copy(), ptr), shape=shape)
+    if periodic and L < 2:               # one interval: its first and last node are one row
+        E.sum_duplicates()
+        D.sum_duplicates()
+    return E, D
+
+
+def fu_points(fu: np.ndarray, tc: np.ndarray, loc: Locator, basis: Basis, rows: int
+              ) -> sp.csr_matrix:
+    """The sparse matrix (P n, rows n) of f_u(t_c, u(t_c)) u(t_c) in the node values: the
+    block-diagonal f_u (P, n, n) times the point values' matrix, its entries f_u[c, a, b] B_k(z_c)
+    at row c n + a, column cols[c, k] n + b, built in one go."""
+    P, n, _ = fu.shape
+    _, z, cols = loc(tc)
+    B = basis.values(z)                                              # (P, m + 1)
+    val = fu[:, :, :, None] * B[:, None, None, :]                     # (P, a, b, k)
+    r = np.broadcast_to((np.arange(P) * n)[:, None, None, None]
+                        + np.arange(n)[None, :, None, None], val.shape)
+    c = np.broadcast_to(cols[:, None, None, :] * n + np.arange(n)[None, None, :, None],
+                        val.shape)
+    return sp.csr_matrix((val.ravel(), (r.ravel(), c.ravel())), shape=(P * n, rows * n))
+
+
+def force_switches(lay: Layout) -> list[int]:
+    """The indices k - 1 of the switches b_k whose condition is a net force (a stick ending, a
+    contact ending): those that need the memory at b_k."""
+    out = []
+    for k in range(1, lay.S + 1):
+        _, before, after = lay.signature.switch(k)
+        if not (before in (SLIP_POS, SLIP_NEG) or after in (LO, HI)):
+            out.append(k - 1)
+    return out
+
+
+def _switch_conditions(lay: Layout, terms: Terms, b: np.ndarray, mesh: np.ndarray, T: float,
+                       loc: Locator, rows: int, u: np.ndarray, jacobian: bool,
+                       Gb: sp.csr_matrix | None = None
+                       ) -> tuple[np.ndarray, sp.csr_matrix | None]:
+    """The switching conditions at b_1..b_S (S,) and their rows in the node values (S, rows n),
+    the values at all the b's and the memory at those that need it each in one call (``Gb``:
+    the memory's rows at the :func:`force_switches`' b's, built with the collocation's): the
+    component reaching 0 or a face (a slip ending, a contact starting), or its net force
+    -f_i - (int H u)_i reaching +-alpha_i (a stick ending) or 0 (a contact ending)."""
+    n, S = lay.n, lay.S
+    t = np.asarray(b, dtype=float)
     Eb = point_matrix(t, loc, lay.basis, mesh, n, rows)
-    ub = Eb @ u
-    if before in (SLIP_POS, SLIP_NEG) or after in (LO, HI):
-        target = terms.lo[i] if after == LO else terms.hi[i] if after == HI else 0.0
-        return float(ub[i] - target), (Eb[i] if jacobian else None)
-    Gb = (delay_matrix(t, terms.tau, mesh, T, terms.H, loc, lay.basis, n, rows,
-                       pattern=terms.pattern)[0] if terms.has_kernel else None)
-    force = -terms.f(t, ub[None, :])[0] - (Gb @ u if Gb is not None else 0.0)
-    target = terms.alpha[i] * (after == SLIP_POS) - terms.alpha[i] * (after == SLIP_NEG)
-    row = None
-    if jacobian:
-        fu = terms.fu(t, ub[None, :])[0]
-        row = -(sp.csr_matrix(fu[i:i + 1]) @ Eb)
-        if Gb is not None:
-            row = row - Gb[i]
-    return float(force[i] - target), row
+    ub = (Eb @ u).reshape(S, n)
+    switch = [lay.signature.switch(k) for k in range(1, S + 1)]
+    g = np.empty(S)
+    out: list = [None] * S
+    force = []
+    for k, (i, before, after) in enumerate(switch):
+        if before in (SLIP_POS, SLIP_NEG) or after in (LO, HI):
+            target = terms.lo[i] if after == LO else terms.hi[i] if after == HI else 0.0
+            g[k] = ub[k, i] - target
+            out[k] = Eb[k * n + i]
+        else:
+            force.append(k)
+    if force:
+        tf = t[force]
+        if Gb is None and terms.has_kernel:
+            Gb = delay_matrix(tf, terms.tau, mesh, T, terms.H, loc, lay.basis, n, rows,
+                              pattern=terms.pattern)[0]
+        F = -terms.f(tf, ub[force]) - ((Gb @ u).reshape(-1, n) if Gb is not None else 0.0)
+        fu = terms.fu(tf, ub[force]) if jacobian else None
+        for j, k in enumerate(force):
+            i, _, after = switch[k]
+            target = terms.alpha[i] * (after == SLIP_POS) - terms.alpha[i] * (after == SLIP_NEG)
+            g[k] = F[j, i] - target
+            if jacobian:
+                row = -(sp.csr_matrix(fu[j, i:i + 1]) @ Eb[k * n:(k + 1) * n])
+                out[k] = row - Gb[j * n + i] if Gb is not None else row
+    if not jacobian:
+        return g, None
+    return g, sp.vstack(out, format="csr")
 
 
 def full_jacobian(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None,
@@ -658,10 +757,12 @@ def reject_why(lay: Layout) -> str:
 
 def _factor(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None, what: str,
             res: list[float]) -> Any:
-    """The sparse LU of the Jacobian at x (ShootingError when singular)."""
+    """The sparse LU of the Jacobian at x (ShootingError when singular), its columns in their
+    own order (the node values in time: a band with the memory's reach and the wrap-around;
+    measured faster to factor and solve than COLAMD's order on the collocation Jacobians)."""
     _, J = full_jacobian(lay, terms, x, ref)
     try:
-        return sla.splu(J)
+        return sla.splu(J, permc_spec="NATURAL")
     except RuntimeError as err:
         raise ShootingError(f"{what}: singular Jacobian ({err})", res) from None
 

@@ -381,3 +381,66 @@ class Linearisation:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+#: A stacked evaluation of f (:class:`ManyRhs`) agrees with the per-point calls to this, relative
+#: to max(1, |f|) (the same operations on arrays: rounding only).
+STACKED_TOL = 1e-12
+
+
+def python_rhs(s: Solver) -> Callable[..., Any] | None:
+    """The model's rhs as the Python function the user gave (set_rhs of a function, or of one
+    with jit=True: its source function), None for a C function or none."""
+    bound = s._keep.get("rhs")          # the solver's record of the callback it hands libdmi
+    if bound is None or bound.address is None:
+        return None
+    if getattr(bound, "jit", False):
+        return getattr(bound, "f", None)
+    return bound.keep[1] if bound.python else None
+
+
+class ManyRhs:
+    """f(t_c, U_c) (P, n) at many points (t (P,), U (P, n)): one call of the model's Python
+    function on the stacked states, f(t, U.T) with t (P,) and u (n, P) -> (n, P), where the
+    function takes them (NumPy operations on u[i] and t broadcast), else the solver's per-point
+    loop (:meth:`dmi.Solver.eval_rhs_many`, the function the scheme calls).
+
+    The stacked call is checked against the per-point calls: at every point of its first use,
+    at three points (first, middle, last) of each later one (agreement to STACKED_TOL relative);
+    a stacked call that raises, returns another shape or disagrees is not tried again (the
+    per-point loop raises a model's own error with its point)."""
+
+    def __init__(self, s: Solver):
+        self.solver = s
+        self.f = python_rhs(s) if s.has("rhs") else None
+        self.checked = False
+
+    def __call__(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
+        t = np.asarray(t, dtype=float).ravel()
+        U = np.asarray(U, dtype=float)
+        if self.f is not None and U.ndim == 2 and U.shape[0] == t.size and t.size > 1:
+            out = self._stacked(t, U)
+            if out is not None:
+                return out
+        return self.solver.eval_rhs_many(t, U)
+
+    def _stacked(self, t: np.ndarray, U: np.ndarray) -> np.ndarray | None:
+        """The stacked call, checked; None (and no stacked call again) where it fails."""
+        P = t.size
+        try:
+            with np.errstate(all="ignore"):
+                got = self.f(t.copy(), np.ascontiguousarray(U.T))  # type: ignore[misc]
+                out = np.asarray(got, dtype=float)
+        except Exception:
+            out = None
+        if out is None or out.shape != (U.shape[1], P):
+            self.f = None
+            return None
+        out = np.ascontiguousarray(out.T)
+        at = np.arange(P) if not self.checked else np.unique([0, P // 2, P - 1])
+        ref = self.solver.eval_rhs_many(t[at], U[at])
+        if not np.all(np.abs(out[at] - ref) <= STACKED_TOL * np.maximum(1.0, np.abs(ref))):
+            self.f = None
+            return None
+        self.checked = True
+        return out
