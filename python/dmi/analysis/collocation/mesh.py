@@ -352,6 +352,8 @@ def delay_matrix(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: floa
     a, d = s[:, :-1], np.diff(s, axis=1)
     keep = d > 1e-14 * max(tau, 1.0)
     C = np.nonzero(keep)[0]
+    # a piece between two mesh crossings (no end at 0, tau or a break) is a whole interval of u
+    whole = ((a > 0) & (s[:, 1:] < tau) & ~np.isin(a, breaks) & ~np.isin(s[:, 1:], breaks))[keep]
     a, d = a[keep], d[keep]                                      # the pieces (k,)
     if pattern is None:
         pattern = np.ones((n, n), bool)
@@ -360,33 +362,45 @@ def delay_matrix(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: floa
     # the graded pieces up to start 2^K: each at least its own length from 0, Q_NEAR nodes
     steep = ~close & (a + d <= graded * (1.0 + 1e-12))
     groups = []
-    for f, rule in ((~close & ~steep, (gz, gw)), (steep, None)):
+    regular = ~close & ~steep
+    for f, rule, full in ((regular & whole, (gz, gw), True), (regular & ~whole, (gz, gw), False),
+                          (steep, None, False)):
         if not np.any(f):
             continue
         zz, ww = rule if rule is not None else _legendre(Q_NEAR)
         S = a[f, None] + d[f, None] * zz[None, :]                # (k, q)
         W = d[f, None] * ww[None, :]
         H = far(S.ravel()).reshape(S.shape + (n, n))             # (k, q, n, n)
-        groups.append((C[f], a[f], d[f], S, W, H))
+        groups.append((C[f], a[f], d[f], S, W, H, full))
     if np.any(close):
         groups.append((C[close], a[close], d[close])
-                      + _near_nodes(near, a[close], d[close], basis.q, n))
+                      + _near_nodes(near, a[close], d[close], basis.q, n) + (False,))
     vals, rr, cc = [], [], []
     dT = np.zeros((times.size, n)) if slope_of is not None else None
-    for Cg, ag, dg, S, W, H in groups:
+    for Cg, ag, dg, S, W, H, full in groups:
         if not Cg.size:
             continue
-        cols, z, slope = _local(locate, times[Cg], ag, dg, S)
-        B = basis.values(z.ravel()).reshape(S.shape + (basis.m + 1,))   # (k, q, m + 1)
-        val = np.einsum("kq,kqe,kqj->kej", W, H[:, :, ia, ib], B)   # (k, entries, m + 1)
+        if full:    # t - S at the interval's Gauss nodes backwards: z = 1 - gz, one B for all
+            _, _, cols = locate(times[Cg] - (ag + 0.5 * dg))
+            z = np.broadcast_to(1.0 - gz, S.shape)
+            slope = 1.0 / dg
+            B = basis.values(1.0 - gz)                                     # (q, m + 1)
+        else:
+            cols, z, slope = _local(locate, times[Cg], ag, dg, S)
+            B = basis.values(z.ravel()).reshape(S.shape + (basis.m + 1,))   # (k, q, m + 1)
+        WH = W[:, :, None] * H[:, :, ia, ib]                               # (k, q, entries)
+        val = np.matmul(WH.transpose(0, 2, 1), B)                   # (k, entries, m + 1)
         vals.append(val.ravel())
         rr.append(np.broadcast_to((Cg[:, None] * n + ia[None, :])[:, :, None],
                                   val.shape).ravel())
         cc.append(np.broadcast_to(cols[:, None, :] * n + ib[None, :, None], val.shape).ravel())
         if dT is not None:
-            Bd = basis.derivatives(z.ravel()).reshape(S.shape + (basis.m + 1,))
-            Ud = np.einsum("kqj,kjb->kqb", Bd * slope[:, None, None], slope_of[cols])
-            np.add.at(dT, Cg, np.einsum("kq,kqab,kqb->ka", W * S, H, Ud) / T)
+            Bd = (basis.derivatives(1.0 - gz) if full else
+                  basis.derivatives(z.ravel()).reshape(S.shape + (basis.m + 1,)))
+            Ud = np.matmul(Bd, slope_of[cols]) * slope[:, None, None]      # (k, q, n)
+            part = np.sum(WH * S[:, :, None] * Ud[:, :, ib], axis=1) / T  # (k, entries)
+            dT += np.bincount((Cg[:, None] * n + ia[None, :]).ravel(), part.ravel(),
+                              minlength=times.size * n).reshape(times.size, n)
     G = sp.csr_matrix((np.concatenate(vals) if vals else np.empty(0),
                        (np.concatenate(rr) if rr else np.empty(0, int),
                         np.concatenate(cc) if cc else np.empty(0, int))),
