@@ -44,6 +44,7 @@ from ..collocation.orbit import EquationOrbit
 from ..core.newton import Converge, NewtonOptions, ShootingError, bordered_solve, newton_loop
 from ..scheme.problem import Problem
 from ..continuation.branch import HopfPoint
+from ..equilibria.normal_form import predicted_parameter
 from ..scheme.stepmap import Model, build
 
 
@@ -359,7 +360,8 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     if not np.all(np.isfinite(ue)):
         raise ValueError(f"u_eq = {u_eq!r}: give {n} finite numbers (the equilibrium)")
     modes = _slipping(terms, ue)
-    checked_equilibrium(terms.solver, ue, (p0,), EQUILIBRIUM_TOL, "equation")
+    checked_equilibrium(terms.solver, ue, (p0,), EQUILIBRIUM_TOL, "equation",
+                        jumps=terms.H.jumps)
     Jf = terms.fu(np.zeros(1), ue[None, :])[0]
     _, _, Vh = sl.svd(1j * om * np.eye(n) + Jf + _hhat(terms, 1j * om))
     v = Vh[-1].conj()
@@ -373,6 +375,7 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     x = np.concatenate([V.ravel(), [T]])
     disc = CollocationDiscretisation(make, lay, x, multipliers=multipliers,
                                      kernel_jumps=terms.H.jumps)
+    p1 = _predicted(hopf_point, a, c)
     gz, gw = lay.basis.gauss()
 
     def evaluate(z: np.ndarray) -> tuple[np.ndarray, None]:
@@ -384,7 +387,7 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
         grow = _amplitude_condition(lay, z[:-1], ue, c, a, gz, gw)[1]
         return lambda r: bordered_solve(J, Jp, grow, -r)
 
-    z, _ = newton_loop(evaluate, factor, np.concatenate([x, [p0]]),
+    z, _ = newton_loop(evaluate, factor, np.concatenate([x, [p1]]),
                        NewtonOptions(tol=tol, max_iter=max_iter, converge=Converge.CORRECTION,
                                      stall=False),
                        what=f"the orbit from the Hopf point at p = {p0!r}")
@@ -395,6 +398,18 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     if pt is None:
         raise ShootingError("the orbit from the Hopf point breaks its signature", [])
     return pt
+
+
+def _predicted(hopf_point: HopfPoint, a: float, c: int) -> float:
+    """The start's parameter for the amplitude a of component c: p_H + side (a / kappa_c)^2
+    where the Hopf point carries kappa and its side (the amplitude's leading order,
+    :func:`dmi.analysis.equilibria.normal_form.predicted_parameter`); else p_H."""
+    kappa = getattr(hopf_point, "kappa", None)
+    if kappa is None or getattr(hopf_point, "side", None) is None:
+        return float(hopf_point.p)
+    if not (np.size(kappa) > c and np.asarray(kappa, dtype=float)[c] > 0):
+        return float(hopf_point.p)
+    return predicted_parameter(hopf_point, a, component=c)
 
 
 def _slipping(terms: Terms, ue: np.ndarray) -> np.ndarray:

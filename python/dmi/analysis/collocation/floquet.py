@@ -25,6 +25,7 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
+from .krylov import DENSE_MAX, leading, operator
 from .system import History, Layout, Terms, full_jacobian
 from ..core.blas import _one_blas_thread
 
@@ -86,9 +87,14 @@ def monodromy(lay: Layout, terms: Terms, x: np.ndarray) -> np.ndarray:
 
 
 def multipliers(lay: Layout, terms: Terms, x: np.ndarray, count: int = 10) -> np.ndarray:
-    """The ``count`` multipliers of largest modulus (largest first; below 1e-12: 0)."""
-    with _one_blas_thread():          # a small dense problem: BLAS threads only contend
-        mu = sl.eigvals(monodromy(lay, terms, x))
+    """The ``count`` multipliers of largest modulus (largest first; below 1e-12: 0): the dense
+    monodromy matrix's eigenvalues up to ``DENSE_MAX`` rows, beyond by ARPACK on the operator
+    (:mod:`dmi.analysis.collocation.krylov`; the dense matrix where ARPACK's are not verified)."""
+    op = operator(lay, terms, x)
+    with _one_blas_thread():          # small dense problems: BLAS threads only contend
+        mu = leading(op, count) if op.dim > DENSE_MAX else None
+        if mu is None:
+            mu = sl.eigvals(op.apply(np.eye(op.dim)))
     mu = mu[np.argsort(-np.abs(mu), kind="stable")][:count]
     return np.where(np.abs(mu) < 1e-12, 0.0, mu)
 

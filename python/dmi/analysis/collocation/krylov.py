@@ -1,0 +1,161 @@
+# The monodromy operator of a collocated orbit applied to vectors, and its leading multipliers by
+# a Krylov method (ARPACK), for long memories whose past makes the dense matrix large.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""The monodromy operator of :mod:`dmi.analysis.collocation.floquet` without its dense matrix;
+private to the package.
+
+The operator is :func:`dmi.analysis.collocation.floquet.monodromy`'s: the state is the past over
+[-tau, 0] on the orbit's mesh shifted back; one period forward moves the past's intervals that
+stay in [-tau, 0] by one period (a copy) and fills the newest period from the linearised
+collocation system of the period from that past (a sparse solve, the switching times' saltation
+included).  Its matrix has (intervals within tau) (m + 1) n rows: on a memory of many periods,
+thousands, and its dense eigenvalues cost minutes.  Here the operator is applied to vectors (one
+sparse product with the past's columns, one solve with the factored period block, the copies),
+and ARPACK's implicitly restarted Arnoldi method finds the leading multipliers from those
+products; each is checked by its residual |M v - mu v| against the operator's scale.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as sla
+
+from .system import History, Layout, Terms, full_jacobian
+
+#: The monodromy matrices up to this size are decomposed densely (LAPACK); larger ones by ARPACK.
+DENSE_MAX = 1200
+#: ARPACK's relative tolerance on the Ritz values.
+ARNOLDI_TOL = 1e-13
+#: A multiplier is accepted when |M v - mu v| <= RESIDUAL_TOL (|M| v's scale) |v|.
+RESIDUAL_TOL = 1e-9
+
+
+@dataclass
+class Monodromy:
+    """The monodromy operator of an orbit as the pieces its products need.
+
+    ``lu`` factors the Jacobian's columns of the period (nodes, switching times); ``B`` holds
+    its columns of the state (the past's nodes that meet [-tau, 0]); ``dst``/``src`` copy the
+    state's entries that stay in the past; ``new``, ``rows`` place the newest period's node
+    values; ``slope`` (len(new),) is u*' at them, ``left``/``right`` the nodes' motion with the
+    ends of their pieces and ``wl``/``wr`` the switch each end moves with (-1: none)."""
+    lu: sla.SuperLU
+    B: sp.csc_matrix
+    nc: int
+    dim: int
+    dst: np.ndarray
+    src: np.ndarray
+    new: np.ndarray
+    rows: np.ndarray
+    slope: np.ndarray
+    left: np.ndarray
+    right: np.ndarray
+    wl: np.ndarray
+    wr: np.ndarray
+
+    def apply(self, v: np.ndarray) -> np.ndarray:
+        """M v for v (dim,) or (dim, k), real or complex."""
+        v = np.asarray(v)
+        flat = v.ndim == 1
+        V = v[:, None] if flat else v
+        out = np.zeros(V.shape, dtype=np.result_type(V.dtype, float))
+        out[self.dst] = V[self.src]
+        rhs = self.B @ V
+        if np.iscomplexobj(rhs):
+            Z = -(self.lu.solve(np.ascontiguousarray(rhs.real))
+                  + 1j * self.lu.solve(np.ascontiguousarray(rhs.imag)))
+        else:
+            Z = -self.lu.solve(np.ascontiguousarray(rhs))
+        Z = Z.reshape(Z.shape[0], -1)
+        db = np.vstack([Z[self.nc:], np.zeros((1, Z.shape[1]))])    # row -1: no switch
+        move = self.left[:, None] * db[self.wl] + self.right[:, None] * db[self.wr]
+        out[self.new] = Z[self.rows] - self.slope[:, None] * move
+        return out[:, 0] if flat else out
+
+
+def state_intervals(lay: Layout, terms: Terms, mesh: np.ndarray, T: float, P: int) -> np.ndarray:
+    """The past's intervals (oldest first, of P periods behind 0) that meet (-tau, 0]: the
+    state of the monodromy operator (the newest always)."""
+    L = lay.L
+    g = np.arange(P * L)
+    end = mesh[g % L + 1] - (P - g // L) * T
+    state = g[end > -terms.tau + 1e-14 * T]
+    if state.size == 0 or state[-1] != P * L - 1:
+        state = np.append(state, P * L - 1)
+    return state
+
+
+def operator(lay: Layout, terms: Terms, x: np.ndarray) -> Monodromy:
+    """The monodromy operator of the orbit x (the same as
+    :func:`dmi.analysis.collocation.floquet.monodromy`'s matrix, applied to vectors)."""
+    m, n, L = lay.m, lay.n, lay.L
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    P = max(1, math.ceil(terms.tau / T - 1e-12))
+    k = np.arange(m + 1)
+    one = V[(np.arange(L)[:, None] * m + k[None, :]) % lay.rows]       # (L, m + 1, n)
+    _, J = full_jacobian(lay, terms, x, None,
+                         history=History(mesh, P, np.tile(one, (P, 1, 1)).reshape(-1, n)))
+    J = sp.csc_matrix(J)
+    nc = (lay.rows + 1) * n
+    nh = P * L * (m + 1) * n
+    state = state_intervals(lay, terms, mesh, T, P)
+    block = (m + 1) * n
+    inner = (k[:, None] * n + np.arange(n)[None, :]).ravel()         # a block's entries
+    scol = (state[:, None] * block + inner[None, :]).ravel()
+    lu = sla.splu(sp.hstack([J[:, :nc], J[:, nc + nh:]], format="csc"))
+    where = {int(g): j for j, g in enumerate(state)}
+    nxt = state + L
+    shift = nxt < P * L
+    jd = np.flatnonzero(shift)
+    js = np.array([where[int(g)] for g in nxt[shift]], dtype=int)
+    dst = (jd[:, None] * block + inner[None, :]).ravel()
+    src = (js[:, None] * block + inner[None, :]).ravel()
+    jn = np.flatnonzero(~shift)
+    iv = nxt[~shift] - P * L                                          # the period's intervals
+    new = (jn[:, None] * block + inner[None, :]).ravel()
+    rows = ((iv[:, None, None] * m + k[None, :, None]) * n
+            + np.arange(n)[None, None, :]).ravel()
+    h = np.diff(mesh)
+    dz = lay.basis.derivatives(lay.basis.nodes)                        # (m + 1, m + 1)
+    slope = (np.einsum("ij,ljn->lin", dz, one[iv]) / h[iv][:, None, None]).ravel()
+    left, right = lay.node_motion()
+    piece = lay.piece_of_interval()[iv]
+    who = lay.ends(b, T)[1]
+    S = lay.S
+
+    def spread(a: np.ndarray) -> np.ndarray:                          # (k, m + 1) -> entries
+        return np.repeat(a[:, :, None], n, axis=2).ravel()
+    wl = spread(np.broadcast_to(np.where(who[piece] >= 0, who[piece], S)[:, None], (iv.size,
+                                                                                    m + 1)))
+    wr = spread(np.broadcast_to(np.where(who[piece + 1] >= 0, who[piece + 1], S)[:, None],
+                                (iv.size, m + 1)))
+    return Monodromy(lu, J[:, nc + scol], nc, scol.size, dst, src, new, rows, slope,
+                     spread(left[iv]), spread(right[iv]), wl.astype(int), wr.astype(int))
+
+
+def leading(op: Monodromy, count: int) -> np.ndarray | None:
+    """The ``count`` multipliers of largest modulus by ARPACK (largest first), each checked by
+    its residual; None where ARPACK does not converge or a residual is too large (the caller
+    then decomposes the dense matrix)."""
+    k = min(count + 2, op.dim - 2)
+    if k < 1:
+        return None
+    A = sla.LinearOperator((op.dim, op.dim), matvec=op.apply, dtype=float)
+    ncv = min(op.dim, max(2 * k + 1, k + 40))
+    v0 = np.random.default_rng(12345).standard_normal(op.dim)
+    try:
+        mu, Y = sla.eigs(A, k=k, which="LM", tol=ARNOLDI_TOL, ncv=ncv, v0=v0,
+                         maxiter=50 * op.dim)
+    except sla.ArpackError:
+        return None
+    scale = max(float(np.max(np.abs(mu), initial=0.0)), 1.0)
+    R = op.apply(Y) - Y * mu[None, :]
+    res = np.linalg.norm(R, axis=0) / np.maximum(np.linalg.norm(Y, axis=0), 1e-300)
+    if not np.all(res <= RESIDUAL_TOL * scale):
+        return None
+    mu = mu[np.lexsort((-mu.imag, -np.abs(mu)))]       # a pair: Im > 0 first, as LAPACK's
+    return mu[:count]
