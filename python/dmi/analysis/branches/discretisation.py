@@ -44,7 +44,6 @@ from ..collocation.orbit import EquationOrbit
 from ..core.newton import Converge, NewtonOptions, ShootingError, bordered_solve, newton_loop
 from ..scheme.problem import Problem
 from ..continuation.branch import HopfPoint
-from ..equilibria.normal_form import predicted_parameter
 from ..scheme.stepmap import Model, build
 
 
@@ -297,7 +296,8 @@ def _hhat(terms: Terms, lam: complex) -> np.ndarray:
 def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude: float, *,
                         degree: int = 4, intervals: int = 24, multipliers: int = 10,
                         tol: float = 1e-12, max_iter: int = 30,
-                        kernel_jumps: tuple[float, ...] = ()) -> EquationOrbit:
+                        kernel_jumps: tuple[float, ...] = (), start: float | None = None
+                        ) -> EquationOrbit:
     """The equation's periodic orbit born at a Hopf point, of a given amplitude, p free.
 
     Parameters
@@ -324,6 +324,9 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     kernel_jumps : sequence of float
         The lags in (0, tau) where the kernel jumps (as :func:`dmi.analysis.collocate`'s; an
         undeclared jump of a callback kernel found is warned of).
+    start : float, optional
+        The parameter Newton starts from (default the Hopf point's p; :func:`hopf_orbit` gives
+        the amplitude's predicted parameter where the Hopf point has kappa).
 
     Returns
     -------
@@ -375,7 +378,7 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     x = np.concatenate([V.ravel(), [T]])
     disc = CollocationDiscretisation(make, lay, x, multipliers=multipliers,
                                      kernel_jumps=terms.H.jumps)
-    p1 = _predicted(hopf_point, a, c)
+    p1 = p0 if start is None else float(start)
     gz, gw = lay.basis.gauss()
 
     def evaluate(z: np.ndarray) -> tuple[np.ndarray, None]:
@@ -398,18 +401,6 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     if pt is None:
         raise ShootingError("the orbit from the Hopf point breaks its signature", [])
     return pt
-
-
-def _predicted(hopf_point: HopfPoint, a: float, c: int) -> float:
-    """The start's parameter for the amplitude a of component c: p_H + side (a / kappa_c)^2
-    where the Hopf point carries kappa and its side (the amplitude's leading order,
-    :func:`dmi.analysis.equilibria.normal_form.predicted_parameter`); else p_H."""
-    kappa = getattr(hopf_point, "kappa", None)
-    if kappa is None or getattr(hopf_point, "side", None) is None:
-        return float(hopf_point.p)
-    if not (np.size(kappa) > c and np.asarray(kappa, dtype=float)[c] > 0):
-        return float(hopf_point.p)
-    return predicted_parameter(hopf_point, a, component=c)
 
 
 def _slipping(terms: Terms, ue: np.ndarray) -> np.ndarray:

@@ -25,7 +25,7 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
-from .krylov import DENSE_MAX, leading, operator
+from .krylov import DENSE_MAX, Monodromy, leading
 from .system import History, Layout, Terms, full_jacobian
 from ..core.blas import _one_blas_thread
 
@@ -84,6 +84,67 @@ def monodromy(lay: Layout, terms: Terms, x: np.ndarray) -> np.ndarray:
             move += right[iv][:, None] * db[who[pc + 1]][None, :]
         M[out] = (rows - slope[:, :, None] * move[:, None, :]).reshape((m + 1) * n, dim)
     return M
+
+
+def state_intervals(lay: Layout, terms: Terms, mesh: np.ndarray, T: float, P: int) -> np.ndarray:
+    """The past's intervals (oldest first, of P periods behind 0) that meet (-tau, 0]: the
+    state of the monodromy operator (the newest always)."""
+    L = lay.L
+    g = np.arange(P * L)
+    end = mesh[g % L + 1] - (P - g // L) * T
+    state = g[end > -terms.tau + 1e-14 * T]
+    if state.size == 0 or state[-1] != P * L - 1:
+        state = np.append(state, P * L - 1)
+    return state
+
+
+def operator(lay: Layout, terms: Terms, x: np.ndarray) -> Monodromy:
+    """The monodromy operator of the orbit x: :func:`monodromy`'s matrix as the pieces of its
+    products (:class:`dmi.analysis.collocation.krylov.Monodromy`), without the dense matrix."""
+    m, n, L = lay.m, lay.n, lay.L
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    P = max(1, math.ceil(terms.tau / T - 1e-12))
+    k = np.arange(m + 1)
+    one = V[(np.arange(L)[:, None] * m + k[None, :]) % lay.rows]       # (L, m + 1, n)
+    _, J = full_jacobian(lay, terms, x, None,
+                         history=History(mesh, P, np.tile(one, (P, 1, 1)).reshape(-1, n)))
+    J = sp.csc_matrix(J)
+    nc = (lay.rows + 1) * n
+    nh = P * L * (m + 1) * n
+    state = state_intervals(lay, terms, mesh, T, P)
+    block = (m + 1) * n
+    inner = (k[:, None] * n + np.arange(n)[None, :]).ravel()         # a block's entries
+    scol = (state[:, None] * block + inner[None, :]).ravel()
+    lu = sla.splu(sp.hstack([J[:, :nc], J[:, nc + nh:]], format="csc"))
+    where = {int(g): j for j, g in enumerate(state)}
+    nxt = state + L
+    shift = nxt < P * L
+    jd = np.flatnonzero(shift)
+    js = np.array([where[int(g)] for g in nxt[shift]], dtype=int)
+    dst = (jd[:, None] * block + inner[None, :]).ravel()
+    src = (js[:, None] * block + inner[None, :]).ravel()
+    jn = np.flatnonzero(~shift)
+    iv = nxt[~shift] - P * L                                          # the period's intervals
+    new = (jn[:, None] * block + inner[None, :]).ravel()
+    rows = ((iv[:, None, None] * m + k[None, :, None]) * n
+            + np.arange(n)[None, None, :]).ravel()
+    h = np.diff(mesh)
+    dz = lay.basis.derivatives(lay.basis.nodes)                        # (m + 1, m + 1)
+    slope = (np.einsum("ij,ljn->lin", dz, one[iv]) / h[iv][:, None, None]).ravel()
+    left, right = lay.node_motion()
+    piece = lay.piece_of_interval()[iv]
+    who = lay.ends(b, T)[1]
+    S = lay.S
+
+    def spread(a: np.ndarray) -> np.ndarray:                          # (k, m + 1) -> entries
+        return np.repeat(a[:, :, None], n, axis=2).ravel()
+    wl = spread(np.broadcast_to(np.where(who[piece] >= 0, who[piece], S)[:, None], (iv.size,
+                                                                                    m + 1)))
+    wr = spread(np.broadcast_to(np.where(who[piece + 1] >= 0, who[piece + 1], S)[:, None],
+                                (iv.size, m + 1)))
+    return Monodromy(lu, J[:, nc + scol], nc, scol.size, dst, src, new, rows, slope,
+                     spread(left[iv]), spread(right[iv]), wl.astype(int), wr.astype(int))
 
 
 def multipliers(lay: Layout, terms: Terms, x: np.ndarray, count: int = 10) -> np.ndarray:
