@@ -12,7 +12,7 @@ included).  Its matrix has (intervals within tau) (m + 1) n rows: on a memory of
 thousands, and its dense eigenvalues cost minutes.  Here the operator is applied to vectors (one
 sparse product with the past's columns, one solve with the factored period block, the copies),
 and ARPACK's implicitly restarted Arnoldi method finds the leading multipliers from those
-products; each is checked by its residual |M v - mu v| against the operator's scale.
+products; each is checked by its residual |M v - mu v| against the largest multiplier (or 1).
 """
 from __future__ import annotations
 
@@ -26,7 +26,7 @@ import scipy.sparse.linalg as sla
 DENSE_MAX = 1200
 #: ARPACK's relative tolerance on the Ritz values.
 ARNOLDI_TOL = 1e-13
-#: A multiplier is accepted when |M v - mu v| <= RESIDUAL_TOL (|M| v's scale) |v|.
+#: A multiplier is accepted when |M v - mu v| <= RESIDUAL_TOL max(1, the largest |mu|) |v|.
 RESIDUAL_TOL = 1e-9
 
 
@@ -38,7 +38,7 @@ class Monodromy:
     its columns of the state (the past's nodes that meet [-tau, 0]); ``dst``/``src`` copy the
     state's entries that stay in the past; ``new``, ``rows`` place the newest period's node
     values; ``slope`` (len(new),) is u*' at them, ``left``/``right`` the nodes' motion with the
-    ends of their pieces and ``wl``/``wr`` the switch each end moves with (-1: none)."""
+    ends of their pieces and ``wl``/``wr`` the switch each end moves with (S: none)."""
     lu: sla.SuperLU
     B: sp.csc_matrix
     nc: int
@@ -67,7 +67,7 @@ class Monodromy:
         else:
             Z = -self.lu.solve(np.ascontiguousarray(rhs))
         Z = Z.reshape(Z.shape[0], -1)
-        db = np.vstack([Z[self.nc:], np.zeros((1, Z.shape[1]))])    # row -1: no switch
+        db = np.vstack([Z[self.nc:], np.zeros((1, Z.shape[1]))])    # the last row: no switch
         move = self.left[:, None] * db[self.wl] + self.right[:, None] * db[self.wr]
         out[self.new] = Z[self.rows] - self.slope[:, None] * move
         return out[:, 0] if flat else out
@@ -93,5 +93,5 @@ def leading(op: Monodromy, count: int) -> np.ndarray | None:
     res = np.linalg.norm(R, axis=0) / np.maximum(np.linalg.norm(Y, axis=0), 1e-300)
     if not np.all(res <= RESIDUAL_TOL * scale):
         return None
-    mu = mu[np.lexsort((-mu.imag, -np.abs(mu)))]       # a pair: Im > 0 first, as LAPACK's
+    mu = mu[np.lexsort((-mu.imag, -np.abs(mu)))]       # largest first; a pair: Im > 0 first
     return mu[:count]
