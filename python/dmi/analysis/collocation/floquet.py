@@ -25,7 +25,7 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
-from .krylov import DENSE_MAX, Monodromy, leading
+from .krylov import DENSE_MAX, Monodromy, leading, nearest
 from .system import History, Layout, Terms, full_jacobian
 from ..core.blas import _one_blas_thread
 
@@ -194,35 +194,19 @@ def eigenfunction(lay: Layout, terms: Terms, x: np.ndarray, near: complex = -1.0
     ValueError
         The eigenfunction vanishes on the period (a multiplier 0).
     """
-    m, n, L = lay.m, lay.n, lay.L
-    V, b, T = lay.split(x)
-    mesh = lay.mesh(b, T)
-    P = max(1, math.ceil(terms.tau / T - 1e-12))
-    k = np.arange(m + 1)
-    cols = (np.arange(L)[:, None] * m + k[None, :]) % lay.rows
-    phi = np.tile(V[cols], (P, 1, 1)).reshape(-1, n)
-    _, J = full_jacobian(lay, terms, x, None, history=History(mesh, P, phi))
-    J = sp.csc_matrix(J)
-    nc = (lay.rows + 1) * n
-    nh = P * L * (m + 1) * n
-    # the past's intervals that meet (-tau, 0], as monodromy's state (its columns' order)
-    g = np.arange(P * L)
-    state = g[mesh[g % L + 1] - (P - g // L) * T > -terms.tau + 1e-14 * T]
-    if state.size == 0 or state[-1] != P * L - 1:
-        state = np.append(state, P * L - 1)
-    scol = (state[:, None, None] * (m + 1) * n + k[None, :, None] * n
-            + np.arange(n)[None, None, :]).ravel()
+    op = operator(lay, terms, x)
     with _one_blas_thread():
-        mu, Y = sl.eig(monodromy(lay, terms, x))
-    j = int(np.argmin(np.abs(mu - near)))
-    Jcur = sp.hstack([J[:, :nc], J[:, nc + nh:]], format="csc")
-    lu = sla.splu(Jcur)
-    rhs = J[:, nc + scol] @ Y[:, j]
+        pair = nearest(op, near) if op.dim > DENSE_MAX else None
+        if pair is None:
+            mu, Y = sl.eig(op.apply(np.eye(op.dim)))
+            j = int(np.argmin(np.abs(mu - near)))
+            pair = (complex(mu[j]), Y[:, j])
+    rhs = op.B @ pair[1]
     re, im = np.ascontiguousarray(rhs.real), np.ascontiguousarray(rhs.imag)
-    dV = -(lu.solve(re) + 1j * lu.solve(im))
-    out = dV[:lay.rows * n].reshape(lay.rows, n)
+    dV = -(op.lu.solve(re) + 1j * op.lu.solve(im))
+    out = dV[:lay.rows * lay.n].reshape(lay.rows, lay.n)
     big = float(np.max(np.abs(out)))
     if not big > 0:
-        raise ValueError(f"the eigenfunction of the multiplier {mu[j]:.6g} vanishes on the "
+        raise ValueError(f"the eigenfunction of the multiplier {pair[0]:.6g} vanishes on the "
                          "period: no direction to follow")
-    return complex(mu[j]), out / out.flat[int(np.argmax(np.abs(out)))]
+    return pair[0], out / out.flat[int(np.argmax(np.abs(out)))]

@@ -77,6 +77,28 @@ def leading(op: Monodromy, count: int) -> np.ndarray | None:
     """The ``count`` multipliers of largest modulus by ARPACK (largest first), each checked by
     its residual; None where ARPACK does not converge or a residual is too large (the caller
     then decomposes the dense matrix)."""
+    got = _arnoldi(op, count)
+    return None if got is None else got[0][:count]
+
+
+def nearest(op: Monodromy, near: complex, count: int = 10
+            ) -> tuple[complex, np.ndarray] | None:
+    """The multiplier nearest ``near`` and its eigenvector, among the ``count`` leading ones by
+    ARPACK, where that is the nearest of all: its distance to ``near`` at most |near| minus the
+    modulus of the last one found (every other multiplier is smaller); None otherwise."""
+    got = _arnoldi(op, count)
+    if got is None:
+        return None
+    mu, Y = got
+    j = int(np.argmin(np.abs(mu - near)))
+    if not abs(mu[j] - near) <= abs(near) - abs(mu[-1]):
+        return None
+    return complex(mu[j]), Y[:, j]
+
+
+def _arnoldi(op: Monodromy, count: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """count + 2 leading multipliers and their eigenvectors by ARPACK (largest first), each
+    checked by its residual; None where that fails."""
     k = min(count + 2, op.dim - 2)
     if k < 1:
         return None
@@ -93,5 +115,5 @@ def leading(op: Monodromy, count: int) -> np.ndarray | None:
     res = np.linalg.norm(R, axis=0) / np.maximum(np.linalg.norm(Y, axis=0), 1e-300)
     if not np.all(res <= RESIDUAL_TOL * scale):
         return None
-    mu = mu[np.lexsort((-mu.imag, -np.abs(mu)))]       # largest first; a pair: Im > 0 first
-    return mu[:count]
+    order = np.lexsort((-mu.imag, -np.abs(mu)))         # largest first; a pair: Im > 0 first
+    return mu[order], Y[:, order]

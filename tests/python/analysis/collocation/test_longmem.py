@@ -2,8 +2,9 @@
 # (dmi.analysis.collocation.krylov) against the dense monodromy matrix and against an independent
 # computation: van der Pol with a three-term exponential memory of six periods, whose exponential
 # terms are ODE states of their own (z_k' = w - a_k z_k; the memory's truncation at tau is below
-# 1e-13), its monodromy integrated with scipy's DOP853; and hopf_orbit(of="equation") started at
-# the amplitude's predicted parameter against the closed-form circles and the start at p_H.
+# 1e-13), its monodromy integrated with scipy's DOP853; the Floquet eigenfunction by ARPACK against
+# the dense matrix's; and hopf_orbit(of="equation") started at the amplitude's predicted parameter
+# against the closed-form circles and the start at p_H.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -152,3 +153,18 @@ def test_hopf_orbit_starts_at_the_predicted_parameter():
     old = da.hopf_orbit(tc.rotating, dataclasses.replace(hp, kappa=None), [0.0, 0.0],
                         amplitude=a, of="equation")        # started at p_H, as before
     assert abs(e.p - old.p) < 1e-11 and abs(e.period - old.period) < 1e-11
+
+
+def test_eigenfunction_by_arpack_is_the_dense_one(scheme_orbit, reference, monkeypatch):
+    _, mu_ode = reference
+    e = da.collocate(scheme_orbit, intervals=4, multipliers=0)
+    lay, terms, x = operator_of(e)
+    mu, V = floquet.eigenfunction(lay, terms, x, near=0.3)           # the dense matrix's
+    monkeypatch.setattr(floquet, "DENSE_MAX", 50)
+    mu_a, V_a = floquet.eigenfunction(lay, terms, x, near=0.3)       # ARPACK's
+    assert abs(mu - mu_ode[1]) < 1e-4 and abs(mu_a - mu) <= 1e-9
+    assert np.max(np.abs(V_a - V)) <= 1e-7
+    assert np.max(np.abs(V)) == pytest.approx(1.0)
+    # a wanted multiplier that the leading ones cannot prove the nearest: the dense matrix's
+    mu0, _ = floquet.eigenfunction(lay, terms, x, near=0.01)
+    assert abs(mu0) < abs(mu_ode[1])
