@@ -7,8 +7,9 @@ As DDE-BIFTOOL does: the state is the past over [-tau, 0] as a piecewise polynom
 orbit's own mesh shifted back (each interval its own m + 1 nodes, so a perturbation may jump at a
 switch); one period forward is the collocation system of the period from that past (u(0) =
 phi(0-), the collocation, the switching conditions with their times unknown), linearised at the
-orbit; the image is the new past over [T - tau, T].  The monodromy matrix is dense and small (the
-intervals that meet [-tau, 0]), its eigenvalues the multipliers.
+orbit; the image is the new past over [T - tau, T].  The monodromy matrix (the intervals that meet
+[-tau, 0]) is decomposed densely up to DENSE_MAX rows; beyond (a memory of many periods) the
+operator's products give the leading multipliers by ARPACK (:mod:`dmi.analysis.collocation.krylov`).
 
 A switching time's variation moves the nodes of the pieces it bounds: the perturbation at a
 fixed time is the node value's minus u*' (one-sided, inside the node's interval) times the node's
