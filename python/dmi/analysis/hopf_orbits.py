@@ -20,6 +20,7 @@ from .core.model import Linearisation
 from .shooting.autonomous import no_equilibrium
 from .continuation.branch import Event, HopfPoint
 from .equilibria.equilibrium import equilibrium
+from .equilibria.normal_form import predicted_parameter
 from .branches.collocated import equation_branch_start
 from .collocation.orbit import EquationOrbit
 from .scheme.floquet import Verify
@@ -75,6 +76,17 @@ def positive_amplitude(value: Any) -> float:
     return v
 
 
+def predicted_start(hopf_point: HopfPoint, amplitude: float) -> float | None:
+    """Where the equation's orbit of the given amplitude (of the component that moves most) is
+    predicted, p_H + side (A / kappa_j)^2 (:func:`predicted_parameter`), for a Hopf point that
+    has kappa and its side; None (start at p_H) otherwise."""
+    if hopf_point.kappa is None or hopf_point.side is None:
+        return None
+    if not np.max(np.asarray(hopf_point.kappa, dtype=float), initial=0.0) > 0:
+        return None
+    return predicted_parameter(hopf_point, amplitude)
+
+
 def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: float,
                steps: int | None = None, component: int | None = None, multipliers: int = 10,
                tol: float = 1e-10, max_iter: int = 30, verify: Verify | None = None,
@@ -94,7 +106,9 @@ def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: floa
     ``hopf(..., of="equation")``): ``make(p)`` needs no h, ``steps`` is not used, the amplitude
     is sqrt(2) times the RMS distance from u_eq of the component that moves most in the critical
     mode (``component`` must be None), and the EquationOrbit returned continues by
-    :func:`dmi.analysis.continue_orbit`.
+    :func:`dmi.analysis.continue_orbit`; Newton starts at the parameter the Hopf point's kappa
+    predicts for that amplitude (:func:`dmi.analysis.equilibria.normal_form.predicted_parameter`;
+    at p_H where it has no kappa).
 
     Parameters
     ----------
@@ -155,7 +169,7 @@ def hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, *, amplitude: floa
                              "(the component is the critical mode's largest; the verdict is "
                              "the collocation's)")
         return equation_branch_start(make, hopf_point, u_eq, a, multipliers, tol, max_iter,
-                                     tuple(kernel_jumps))
+                                     tuple(kernel_jumps), start=predicted_start(hopf_point, a))
     if len(kernel_jumps):
         raise ValueError("hopf_orbit: kernel_jumps= is for of='equation' (the collocation's "
                          "delay integral); the scheme takes the kernel as libdmi samples it")

@@ -417,7 +417,7 @@ RAW_SOLVES = {
     ("continuation.driver", "bordered_det"): "the branch-point test function's determinant",
     ("collocation.system", "_factor"): "the collocation system's Jacobian",
     ("collocation.floquet", "monodromy"): "the monodromy's sensitivities",
-    ("collocation.floquet", "eigenfunction"): "the Floquet eigenfunction",
+    ("collocation.floquet", "operator"): "the monodromy operator's period block, factored",
     ("equilibria.normal_form", "_corrected"): "the equilibrium's Jacobian",
     ("equilibria.root_verdict", "_eval"): "the characteristic matrix's trace",
     ("equilibria.equation", "Characteristic.newton_step"): "the characteristic matrix's trace",

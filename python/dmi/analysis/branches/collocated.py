@@ -756,7 +756,8 @@ def continue_equation_orbit(orbit: EquationOrbit, p_end: float, options: Continu
 
 def equation_branch_start(make: Any, hopf_point: Any, u_eq: Any, amplitude: float,
                           multipliers: int, tol: float, max_iter: int,
-                          kernel_jumps: tuple[float, ...] = ()) -> EquationOrbit:
+                          kernel_jumps: tuple[float, ...] = (), start: float | None = None
+                          ) -> EquationOrbit:
     """``hopf_orbit(..., of="equation")``: :func:`equation_hopf_orbit` at the checked Hopf
     point.
 
@@ -778,6 +779,8 @@ def equation_branch_start(make: Any, hopf_point: Any, u_eq: Any, amplitude: floa
         Newton iterations at most.
     kernel_jumps : tuple of float
         The lags where H jumps (:func:`dmi.analysis.collocate`).
+    start : float, optional
+        The parameter Newton starts from (default the Hopf point's p).
 
     Returns
     -------
@@ -786,7 +789,7 @@ def equation_branch_start(make: Any, hopf_point: Any, u_eq: Any, amplitude: floa
     """
     return equation_hopf_orbit(make, hopf_point, u_eq, amplitude, multipliers=multipliers,
                                tol=min(tol, 1e-12), max_iter=max_iter,
-                               kernel_jumps=kernel_jumps)
+                               kernel_jumps=kernel_jumps, start=start)
 
 
 __all__ = ["EquationBranch", "continue_equation_orbit", "equation_branch_start"]

@@ -296,7 +296,8 @@ def _hhat(terms: Terms, lam: complex) -> np.ndarray:
 def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude: float, *,
                         degree: int = 4, intervals: int = 24, multipliers: int = 10,
                         tol: float = 1e-12, max_iter: int = 30,
-                        kernel_jumps: tuple[float, ...] = ()) -> EquationOrbit:
+                        kernel_jumps: tuple[float, ...] = (), start: float | None = None
+                        ) -> EquationOrbit:
     """The equation's periodic orbit born at a Hopf point, of a given amplitude, p free.
 
     Parameters
@@ -323,6 +324,9 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     kernel_jumps : sequence of float
         The lags in (0, tau) where the kernel jumps (as :func:`dmi.analysis.collocate`'s; an
         undeclared jump of a callback kernel found is warned of).
+    start : float, optional
+        The parameter Newton starts from (default the Hopf point's p; :func:`hopf_orbit` gives
+        the amplitude's predicted parameter where the Hopf point has kappa).
 
     Returns
     -------
@@ -359,7 +363,8 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     if not np.all(np.isfinite(ue)):
         raise ValueError(f"u_eq = {u_eq!r}: give {n} finite numbers (the equilibrium)")
     modes = _slipping(terms, ue)
-    checked_equilibrium(terms.solver, ue, (p0,), EQUILIBRIUM_TOL, "equation")
+    checked_equilibrium(terms.solver, ue, (p0,), EQUILIBRIUM_TOL, "equation",
+                        jumps=terms.H.jumps)
     Jf = terms.fu(np.zeros(1), ue[None, :])[0]
     _, _, Vh = sl.svd(1j * om * np.eye(n) + Jf + _hhat(terms, 1j * om))
     v = Vh[-1].conj()
@@ -373,6 +378,7 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
     x = np.concatenate([V.ravel(), [T]])
     disc = CollocationDiscretisation(make, lay, x, multipliers=multipliers,
                                      kernel_jumps=terms.H.jumps)
+    p1 = p0 if start is None else float(start)
     gz, gw = lay.basis.gauss()
 
     def evaluate(z: np.ndarray) -> tuple[np.ndarray, None]:
@@ -384,7 +390,7 @@ def equation_hopf_orbit(make: Model, hopf_point: HopfPoint, u_eq: Any, amplitude
         grow = _amplitude_condition(lay, z[:-1], ue, c, a, gz, gw)[1]
         return lambda r: bordered_solve(J, Jp, grow, -r)
 
-    z, _ = newton_loop(evaluate, factor, np.concatenate([x, [p0]]),
+    z, _ = newton_loop(evaluate, factor, np.concatenate([x, [p1]]),
                        NewtonOptions(tol=tol, max_iter=max_iter, converge=Converge.CORRECTION,
                                      stall=False),
                        what=f"the orbit from the Hopf point at p = {p0!r}")

@@ -7,8 +7,9 @@ As DDE-BIFTOOL does: the state is the past over [-tau, 0] as a piecewise polynom
 orbit's own mesh shifted back (each interval its own m + 1 nodes, so a perturbation may jump at a
 switch); one period forward is the collocation system of the period from that past (u(0) =
 phi(0-), the collocation, the switching conditions with their times unknown), linearised at the
-orbit; the image is the new past over [T - tau, T].  The monodromy matrix is dense and small (the
-intervals that meet [-tau, 0]), its eigenvalues the multipliers.
+orbit; the image is the new past over [T - tau, T].  The monodromy matrix (the intervals that meet
+[-tau, 0]) is decomposed densely up to DENSE_MAX rows; beyond (a memory of many periods) the
+operator's products give the leading multipliers by ARPACK (:mod:`dmi.analysis.collocation.krylov`).
 
 A switching time's variation moves the nodes of the pieces it bounds: the perturbation at a
 fixed time is the node value's minus u*' (one-sided, inside the node's interval) times the node's
@@ -25,6 +26,7 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
+from .krylov import DENSE_MAX, Monodromy, leading, nearest
 from .system import History, Layout, Terms, full_jacobian
 from ..core.blas import _one_blas_thread
 
@@ -85,10 +87,76 @@ def monodromy(lay: Layout, terms: Terms, x: np.ndarray) -> np.ndarray:
     return M
 
 
+def state_intervals(lay: Layout, terms: Terms, mesh: np.ndarray, T: float, P: int) -> np.ndarray:
+    """The past's intervals (oldest first, of P periods behind 0) that meet (-tau, 0]: the
+    state of the monodromy operator (the newest always)."""
+    L = lay.L
+    g = np.arange(P * L)
+    end = mesh[g % L + 1] - (P - g // L) * T
+    state = g[end > -terms.tau + 1e-14 * T]
+    if state.size == 0 or state[-1] != P * L - 1:
+        state = np.append(state, P * L - 1)
+    return state
+
+
+def operator(lay: Layout, terms: Terms, x: np.ndarray) -> Monodromy:
+    """The monodromy operator of the orbit x: :func:`monodromy`'s matrix as the pieces of its
+    products (:class:`dmi.analysis.collocation.krylov.Monodromy`), without the dense matrix."""
+    m, n, L = lay.m, lay.n, lay.L
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    P = max(1, math.ceil(terms.tau / T - 1e-12))
+    k = np.arange(m + 1)
+    one = V[(np.arange(L)[:, None] * m + k[None, :]) % lay.rows]       # (L, m + 1, n)
+    _, J = full_jacobian(lay, terms, x, None,
+                         history=History(mesh, P, np.tile(one, (P, 1, 1)).reshape(-1, n)))
+    J = sp.csc_matrix(J)
+    nc = (lay.rows + 1) * n
+    nh = P * L * (m + 1) * n
+    state = state_intervals(lay, terms, mesh, T, P)
+    block = (m + 1) * n
+    inner = (k[:, None] * n + np.arange(n)[None, :]).ravel()         # a block's entries
+    scol = (state[:, None] * block + inner[None, :]).ravel()
+    lu = sla.splu(sp.hstack([J[:, :nc], J[:, nc + nh:]], format="csc"))
+    where = {int(g): j for j, g in enumerate(state)}
+    nxt = state + L
+    shift = nxt < P * L
+    jd = np.flatnonzero(shift)
+    js = np.array([where[int(g)] for g in nxt[shift]], dtype=int)
+    dst = (jd[:, None] * block + inner[None, :]).ravel()
+    src = (js[:, None] * block + inner[None, :]).ravel()
+    jn = np.flatnonzero(~shift)
+    iv = nxt[~shift] - P * L                                          # the period's intervals
+    new = (jn[:, None] * block + inner[None, :]).ravel()
+    rows = ((iv[:, None, None] * m + k[None, :, None]) * n
+            + np.arange(n)[None, None, :]).ravel()
+    h = np.diff(mesh)
+    dz = lay.basis.derivatives(lay.basis.nodes)                        # (m + 1, m + 1)
+    slope = (np.einsum("ij,ljn->lin", dz, one[iv]) / h[iv][:, None, None]).ravel()
+    left, right = lay.node_motion()
+    piece = lay.piece_of_interval()[iv]
+    who = lay.ends(b, T)[1]
+    S = lay.S
+
+    def spread(a: np.ndarray) -> np.ndarray:                          # (k, m + 1) -> entries
+        return np.repeat(a[:, :, None], n, axis=2).ravel()
+    wl = spread(np.broadcast_to(np.where(who[piece] >= 0, who[piece], S)[:, None], (iv.size,
+                                                                                    m + 1)))
+    wr = spread(np.broadcast_to(np.where(who[piece + 1] >= 0, who[piece + 1], S)[:, None],
+                                (iv.size, m + 1)))
+    return Monodromy(lu, J[:, nc + scol], nc, scol.size, dst, src, new, rows, slope,
+                     spread(left[iv]), spread(right[iv]), wl.astype(int), wr.astype(int))
+
+
 def multipliers(lay: Layout, terms: Terms, x: np.ndarray, count: int = 10) -> np.ndarray:
-    """The ``count`` multipliers of largest modulus (largest first; below 1e-12: 0)."""
-    with _one_blas_thread():          # a small dense problem: BLAS threads only contend
-        mu = sl.eigvals(monodromy(lay, terms, x))
+    """The ``count`` multipliers of largest modulus (largest first; below 1e-12: 0): the dense
+    monodromy matrix's eigenvalues up to ``DENSE_MAX`` rows, beyond by ARPACK on the operator
+    (:mod:`dmi.analysis.collocation.krylov`; the dense matrix where ARPACK's are not verified)."""
+    op = operator(lay, terms, x)
+    with _one_blas_thread():          # small dense problems: BLAS threads only contend
+        mu = leading(op, count) if op.dim > DENSE_MAX else None
+        if mu is None:
+            mu = sl.eigvals(op.apply(np.eye(op.dim)))
     mu = mu[np.argsort(-np.abs(mu), kind="stable")][:count]
     return np.where(np.abs(mu) < 1e-12, 0.0, mu)
 
@@ -127,35 +195,19 @@ def eigenfunction(lay: Layout, terms: Terms, x: np.ndarray, near: complex = -1.0
     ValueError
         The eigenfunction vanishes on the period (a multiplier 0).
     """
-    m, n, L = lay.m, lay.n, lay.L
-    V, b, T = lay.split(x)
-    mesh = lay.mesh(b, T)
-    P = max(1, math.ceil(terms.tau / T - 1e-12))
-    k = np.arange(m + 1)
-    cols = (np.arange(L)[:, None] * m + k[None, :]) % lay.rows
-    phi = np.tile(V[cols], (P, 1, 1)).reshape(-1, n)
-    _, J = full_jacobian(lay, terms, x, None, history=History(mesh, P, phi))
-    J = sp.csc_matrix(J)
-    nc = (lay.rows + 1) * n
-    nh = P * L * (m + 1) * n
-    # the past's intervals that meet (-tau, 0], as monodromy's state (its columns' order)
-    g = np.arange(P * L)
-    state = g[mesh[g % L + 1] - (P - g // L) * T > -terms.tau + 1e-14 * T]
-    if state.size == 0 or state[-1] != P * L - 1:
-        state = np.append(state, P * L - 1)
-    scol = (state[:, None, None] * (m + 1) * n + k[None, :, None] * n
-            + np.arange(n)[None, None, :]).ravel()
+    op = operator(lay, terms, x)
     with _one_blas_thread():
-        mu, Y = sl.eig(monodromy(lay, terms, x))
-    j = int(np.argmin(np.abs(mu - near)))
-    Jcur = sp.hstack([J[:, :nc], J[:, nc + nh:]], format="csc")
-    lu = sla.splu(Jcur)
-    rhs = J[:, nc + scol] @ Y[:, j]
+        pair = nearest(op, near) if op.dim > DENSE_MAX else None
+        if pair is None:
+            mu, Y = sl.eig(op.apply(np.eye(op.dim)))
+            j = int(np.argmin(np.abs(mu - near)))
+            pair = (complex(mu[j]), Y[:, j])
+    rhs = op.B @ pair[1]
     re, im = np.ascontiguousarray(rhs.real), np.ascontiguousarray(rhs.imag)
-    dV = -(lu.solve(re) + 1j * lu.solve(im))
-    out = dV[:lay.rows * n].reshape(lay.rows, n)
+    dV = -(op.lu.solve(re) + 1j * op.lu.solve(im))
+    out = dV[:lay.rows * lay.n].reshape(lay.rows, lay.n)
     big = float(np.max(np.abs(out)))
     if not big > 0:
-        raise ValueError(f"the eigenfunction of the multiplier {mu[j]:.6g} vanishes on the "
+        raise ValueError(f"the eigenfunction of the multiplier {pair[0]:.6g} vanishes on the "
                          "period: no direction to follow")
-    return complex(mu[j]), out / out.flat[int(np.argmax(np.abs(out)))]
+    return pair[0], out / out.flat[int(np.argmax(np.abs(out)))]
