@@ -15,10 +15,12 @@ of the result: a breach splits a segment, a vanishing segment is removed
 never returned.  Multipliers: the discretised
 monodromy operator with the saltation at the switches (:mod:`dmi.analysis.collocation.floquet`).
 
-Errors: the orbit is solved on a mesh and on the same mesh with every interval halved; the
-difference of their period, amplitudes, multipliers and u is the error estimate of the finer one
-(which is returned): an upper estimate while the convergence is in its asymptotic range (the
-finer one's error is that difference over 2^p - 1, p >= m the order).  With ``intervals=None``
+Errors: the orbit is solved on a mesh, on the same mesh with every interval halved and, as a
+third level, with every pair of intervals merged; the difference of the two finer levels' period,
+amplitudes, multipliers and u is the error estimate of the finer one (which is returned), or,
+where the three levels converge steadily, Richardson's estimate from the order they show
+(:func:`dmi.analysis.collocation.adapt.estimate`): an upper estimate while the convergence is in
+its asymptotic range.  With ``intervals=None``
 the mesh is equidistributed (AUTO, COLSYS: equal integrals of |u^(m+1)|^(1 / (m + 1)),
 estimated from the jumps of u^(m) between intervals) and refined until the estimate of the
 period (an autonomous orbit; it converges as h^(2m) on smooth orbits) or of the amplitudes (a
@@ -203,10 +205,13 @@ def first_solve(orbit: Orbit, terms: Terms, lay: Layout, b0: np.ndarray, L0: int
 
 
 def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int) -> EquationOrbit:
-    """The EquationOrbit of the finer level f, with its multipliers and the coarser's."""
+    """The EquationOrbit of the finer level f, with its multipliers and the coarser levels'
+    (the third, where it was solved, for the multipliers' extrapolated estimate)."""
     if count > 0:
         c.mu = floquet(c.lay, terms, c.x, count)
         f.mu = floquet(f.lay, terms, f.x, count)
+        if c.coarser is not None:
+            c.coarser.mu = floquet(c.coarser.lay, terms, c.coarser.x, count)
     return equation_orbit(f, float(orbit.p), orbit.make, estimate(c, f), terms.H.jumps)
 
 

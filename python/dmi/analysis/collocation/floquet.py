@@ -56,7 +56,8 @@ def monodromy(lay: Layout, terms: Terms, x: np.ndarray) -> np.ndarray:
         state = np.append(state, P * L - 1)
     scol = (state[:, None, None] * (m + 1) * n + k[None, :, None] * n
             + np.arange(n)[None, None, :]).ravel()
-    Z = -sla.splu(Jcur).solve(J[:, nc + scol].toarray())   # d(nodes, b) / d(state)
+    lu = sla.splu(Jcur, permc_spec="NATURAL")     # the columns' own order, as Newton's LU
+    Z = -lu.solve(J[:, nc + scol].toarray())   # d(nodes, b) / d(state)
     dV, db = Z[:nc].reshape(lay.rows + 1, n, -1), Z[nc:]
     # the image: interval g + L of the past, or interval g + L - P L of the period
     h = np.diff(mesh)

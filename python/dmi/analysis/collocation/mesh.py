@@ -24,6 +24,7 @@ import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -323,38 +324,10 @@ def delay_matrix(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: floa
         (or None).
     """
     gz, gw = basis.gauss(basis.q)
-    pts = np.asarray(mesh_points[:-1], dtype=float)
     times = np.asarray(times, dtype=float)
     near = getattr(kernel, "near", None)
-    far = getattr(kernel, "far", kernel)
-    own = getattr(kernel, "breaks", np.empty(0))
-    breaks = own if breaks is None else np.concatenate([np.asarray(breaks, float), own])
-    graded = 0.0
-    start = getattr(kernel, "grading", 0.0)
-    if start > 0:                # a steep H near 0: cuts at start 2^k
-        grade = start * 2.0 ** np.arange(0, 64)
-        grade = grade[grade < tau * (1.0 - 1e-12)]
-        graded = float(grade[-1]) if grade.size else 0.0
-        breaks = np.concatenate([breaks, grade])
-    lo = math.floor((times.min() - tau - pts[-1]) / T) - 1
-    hi = math.floor((times.max() - pts[0]) / T) + 1
-    ext = (pts[None, :] + T * np.arange(lo, hi + 1)[:, None]).ravel()   # sorted
-    j0 = np.searchsorted(ext, times - tau, side="right")
-    j1 = np.searchsorted(ext, times, side="left")
-    K = int(np.max(j1 - j0)) if times.size else 0
-    idx = j0[:, None] + np.arange(K)[None, :]
-    inside = idx < j1[:, None]
-    cut = np.where(inside, times[:, None] - ext[np.minimum(idx, ext.size - 1)], 0.0)
-    extra = [np.zeros((times.size, 1)), np.full((times.size, 1), tau)]
-    if breaks.size:
-        extra.append(np.broadcast_to(breaks, (times.size, breaks.size)))
-    s = np.sort(np.concatenate([cut] + extra, axis=1), axis=1)
-    a, d = s[:, :-1], np.diff(s, axis=1)
-    keep = d > 1e-14 * max(tau, 1.0)
-    C = np.nonzero(keep)[0]
-    # a piece between two mesh crossings (no end at 0, tau or a break) is a whole interval of u
-    whole = ((a > 0) & (s[:, 1:] < tau) & ~np.isin(a, breaks) & ~np.isin(s[:, 1:], breaks))[keep]
-    a, d = a[keep], d[keep]                                      # the pieces (k,)
+    breaks, graded = _breaks(kernel, breaks, tau)
+    C, a, d, whole = _pieces(times, tau, np.asarray(mesh_points[:-1], dtype=float), T, breaks)
     if pattern is None:
         pattern = np.ones((n, n), bool)
     ia, ib = np.nonzero(pattern)
@@ -370,42 +343,92 @@ def delay_matrix(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: floa
         zz, ww = rule if rule is not None else _legendre(Q_NEAR)
         S = a[f, None] + d[f, None] * zz[None, :]                # (k, q)
         W = d[f, None] * ww[None, :]
-        H = far(S.ravel()).reshape(S.shape + (n, n))             # (k, q, n, n)
+        H = getattr(kernel, "far", kernel)(S.ravel()).reshape(S.shape + (n, n))   # (k, q, n, n)
         groups.append((C[f], a[f], d[f], S, W, H, full))
     if np.any(close):
         groups.append((C[close], a[close], d[close])
                       + _near_nodes(near, a[close], d[close], basis.q, n) + (False,))
     vals, rr, cc = [], [], []
     dT = np.zeros((times.size, n)) if slope_of is not None else None
-    for Cg, ag, dg, S, W, H, full in groups:
-        if not Cg.size:
-            continue
-        if full:    # t - S at the interval's Gauss nodes backwards: z = 1 - gz, one B for all
-            _, _, cols = locate(times[Cg] - (ag + 0.5 * dg))
-            z = np.broadcast_to(1.0 - gz, S.shape)
-            slope = 1.0 / dg
-            B = basis.values(1.0 - gz)                                     # (q, m + 1)
-        else:
-            cols, z, slope = _local(locate, times[Cg], ag, dg, S)
-            B = basis.values(z.ravel()).reshape(S.shape + (basis.m + 1,))   # (k, q, m + 1)
-        WH = W[:, :, None] * H[:, :, ia, ib]                               # (k, q, entries)
-        val = np.matmul(WH.transpose(0, 2, 1), B)                   # (k, entries, m + 1)
-        vals.append(val.ravel())
-        rr.append(np.broadcast_to((Cg[:, None] * n + ia[None, :])[:, :, None],
-                                  val.shape).ravel())
-        cc.append(np.broadcast_to(cols[:, None, :] * n + ib[None, :, None], val.shape).ravel())
-        if dT is not None:
-            Bd = (basis.derivatives(1.0 - gz) if full else
-                  basis.derivatives(z.ravel()).reshape(S.shape + (basis.m + 1,)))
-            Ud = np.matmul(Bd, slope_of[cols]) * slope[:, None, None]      # (k, q, n)
-            part = np.sum(WH * S[:, :, None] * Ud[:, :, ib], axis=1) / T  # (k, entries)
-            dT += np.bincount((Cg[:, None] * n + ia[None, :]).ravel(), part.ravel(),
-                              minlength=times.size * n).reshape(times.size, n)
+    for group in groups:
+        if group[0].size:
+            val, r, c = _group_entries(group, times, locate, basis, n, ia, ib, T, slope_of, dT)
+            vals.append(val)
+            rr.append(r)
+            cc.append(c)
     G = sp.csr_matrix((np.concatenate(vals) if vals else np.empty(0),
                        (np.concatenate(rr) if rr else np.empty(0, int),
                         np.concatenate(cc) if cc else np.empty(0, int))),
                       shape=(times.size * n, rows * n))
     return G, dT
+
+
+def _breaks(kernel: Any, breaks: np.ndarray | None, tau: float) -> tuple[np.ndarray, float]:
+    """(the kernel's breakpoints in (0, tau) with the given ones and, for a steep H near 0, the
+    grading's cuts at start 2^k; the last such cut, 0 without grading)."""
+    own = getattr(kernel, "breaks", np.empty(0))
+    breaks = own if breaks is None else np.concatenate([np.asarray(breaks, float), own])
+    graded = 0.0
+    start = getattr(kernel, "grading", 0.0)
+    if start > 0:                # a steep H near 0: cuts at start 2^k
+        grade = start * 2.0 ** np.arange(0, 64)
+        grade = grade[grade < tau * (1.0 - 1e-12)]
+        graded = float(grade[-1]) if grade.size else 0.0
+        breaks = np.concatenate([breaks, grade])
+    return breaks, graded
+
+
+def _pieces(times: np.ndarray, tau: float, pts: np.ndarray, T: float, breaks: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The pieces of [0, tau] on which s -> u(t_c - s) is one polynomial: (their time's index c,
+    their start a, their length d, whether a piece is a whole interval of u: its ends two mesh
+    crossings, neither 0, tau nor a break)."""
+    lo = math.floor((times.min() - tau - pts[-1]) / T) - 1
+    hi = math.floor((times.max() - pts[0]) / T) + 1
+    ext = (pts[None, :] + T * np.arange(lo, hi + 1)[:, None]).ravel()   # sorted
+    j0 = np.searchsorted(ext, times - tau, side="right")
+    j1 = np.searchsorted(ext, times, side="left")
+    K = int(np.max(j1 - j0)) if times.size else 0
+    idx = j0[:, None] + np.arange(K)[None, :]
+    inside = idx < j1[:, None]
+    cut = np.where(inside, times[:, None] - ext[np.minimum(idx, ext.size - 1)], 0.0)
+    extra = [np.zeros((times.size, 1)), np.full((times.size, 1), tau)]
+    if breaks.size:
+        extra.append(np.broadcast_to(breaks, (times.size, breaks.size)))
+    s = np.sort(np.concatenate([cut] + extra, axis=1), axis=1)
+    a, d = s[:, :-1], np.diff(s, axis=1)
+    keep = d > 1e-14 * max(tau, 1.0)
+    whole = ((a > 0) & (s[:, 1:] < tau) & ~np.isin(a, breaks) & ~np.isin(s[:, 1:], breaks))[keep]
+    return np.nonzero(keep)[0], a[keep], d[keep], whole
+
+
+def _group_entries(group: tuple, times: np.ndarray, locate: Locator, basis: Basis, n: int,
+                   ia: np.ndarray, ib: np.ndarray, T: float, slope_of: np.ndarray | None,
+                   dT: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """G's entries (values, rows, columns) of one group of pieces (times' index, start, length,
+    nodes S, weights W, H at S, whole intervals or not); the T derivative added into dT."""
+    Cg, ag, dg, S, W, H, full = group
+    gz = basis.gauss(basis.q)[0]
+    if full:    # t - S at the interval's Gauss nodes backwards: z = 1 - gz, one B for all
+        _, _, node = locate(times[Cg] - (ag + 0.5 * dg))
+        z = np.broadcast_to(1.0 - gz, S.shape)
+        slope = 1.0 / dg
+        B = basis.values(1.0 - gz)                                     # (q, m + 1)
+    else:
+        node, z, slope = _local(locate, times[Cg], ag, dg, S)
+        B = basis.values(z.ravel()).reshape(S.shape + (basis.m + 1,))   # (k, q, m + 1)
+    WH = W[:, :, None] * H[:, :, ia, ib]                               # (k, q, entries)
+    val = np.matmul(WH.transpose(0, 2, 1), B)                   # (k, entries, m + 1)
+    rows = np.broadcast_to((Cg[:, None] * n + ia[None, :])[:, :, None], val.shape).ravel()
+    cols = np.broadcast_to(node[:, None, :] * n + ib[None, :, None], val.shape).ravel()
+    if dT is not None and slope_of is not None:
+        Bd = (basis.derivatives(1.0 - gz) if full else
+              basis.derivatives(z.ravel()).reshape(S.shape + (basis.m + 1,)))
+        Ud = np.matmul(Bd, slope_of[node]) * slope[:, None, None]      # (k, q, n)
+        part = np.sum(WH * S[:, :, None] * Ud[:, :, ib], axis=1) / T  # (k, entries)
+        dT += np.bincount((Cg[:, None] * n + ia[None, :]).ravel(), part.ravel(),
+                          minlength=times.size * n).reshape(times.size, n)
+    return val.ravel(), rows, cols
 
 
 def point_matrix(times: np.ndarray, locate: Locator, basis: Basis, mesh: np.ndarray, n: int,
