@@ -663,7 +663,7 @@ class _Problem:
                 return _make(self.full(q))
             # the models at p and p + delta_j e_j: those of the last Jacobian at this p (made by
             # make at the same parameters; each run starts from their init), else made now
-            mod = self._slot(("models", k), p.tobytes(),
+            mod = self._slot(("models", k), (p.tobytes(), self.grouped),
                              lambda: self._models(k, make_free, p))
             with warnings.catch_warnings():
                 # reversals left unplaced are gathered here and reported once by the estimate
@@ -792,6 +792,7 @@ def estimate(make: Callable[[np.ndarray], Solver] | Sequence[Callable[[np.ndarra
     best = min(fits, key=lambda f: f[1])
     x, cost, message, stopped, converged = best
     problem.jumps = True                # the covariance's Jacobian: the equation's sensitivities
+    problem.grouped = False             # from one model per parameter (no plan trusted there)
     lower = None
     if converged and not stopped and options.saddle_check:
         lower = _saddle(problem, x, cost, names)
@@ -1221,8 +1222,12 @@ def _gauss_newton(problem: _Problem, x: np.ndarray, cost: float, lo: np.ndarray,
                 progress(optimize.OptimizeResult(x=x, cost=cost))
             except StopIteration:
                 return _result(x, r, -2, "stopped by the callback")
-            if drop < tol * cost or _converged(drop, last, tol * cost):
+            if drop < tol * cost:
                 return _result(x, r, 2, "`ftol` termination condition is satisfied.")
+            if _converged(drop, last, tol * cost):
+                return _result(x, r, 2, "`ftol` termination condition is satisfied (the drops "
+                                        "still to come, predicted from the last two, are below "
+                                        "it).")
             r, J = problem.linearised(x)
         return None
     finally:

@@ -406,14 +406,18 @@ class ManyRhs:
     loop (:meth:`dmi.Solver.eval_rhs_many`, the function the scheme calls).
 
     The stacked call is checked against the per-point calls: at every point of its first use,
-    at three points (first, middle, last) of each later one (agreement to STACKED_TOL relative);
-    a stacked call that raises, returns another shape or disagrees is not tried again (the
-    per-point loop raises a model's own error with its point)."""
+    at six points of each later one (first, middle, last and three that move from call to call;
+    agreement to STACKED_TOL relative, or the same inf or NaN); a stacked call that raises,
+    returns another shape or disagrees is not tried again (``why`` says which; the per-point
+    loop raises a model's own error with its point).  A model's function must treat each point
+    on its own (no reduction over the points, e.g. np.max(u[0]) or a norm of u)."""
 
     def __init__(self, s: Solver):
         self.solver = s
         self.f = python_rhs(s) if s.has("rhs") else None
         self.checked = False
+        self.calls = 0
+        self.why = ""           # why the stacked call was given up, for a debugging user
 
     def __call__(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
         t = np.asarray(t, dtype=float).ravel()
@@ -429,17 +433,28 @@ class ManyRhs:
         P = t.size
         try:
             with np.errstate(all="ignore"):
-                got = self.f(t.copy(), np.ascontiguousarray(U.T))  # type: ignore[misc]
+                got = self.f(t.copy(), np.array(U.T, order="C"))  # type: ignore[misc]
                 out = np.asarray(got, dtype=float)
-        except Exception:
+        except Exception as e:
+            self.why = f"the stacked call raised {type(e).__name__}: {e}"
             out = None
         if out is None or out.shape != (U.shape[1], P):
+            if out is not None:
+                self.why = f"the stacked call returned shape {out.shape}, not {(U.shape[1], P)}"
             self.f = None
             return None
         out = np.ascontiguousarray(out.T)
-        at = np.arange(P) if not self.checked else np.unique([0, P // 2, P - 1])
+        # every point at the first use; later three fixed points and three that move each call
+        self.calls += 1
+        at = (np.arange(P) if not self.checked else
+              np.unique([0, P // 2, P - 1] + [(self.calls * k * 7919) % P for k in (1, 2, 3)]))
         ref = self.solver.eval_rhs_many(t[at], U[at])
-        if not np.all(np.abs(out[at] - ref) <= STACKED_TOL * np.maximum(1.0, np.abs(ref))):
+        with np.errstate(invalid="ignore"):
+            ok = (out[at] == ref) | (np.abs(out[at] - ref) <= STACKED_TOL
+                                     * np.maximum(1.0, np.abs(ref)))
+        ok |= np.isnan(out[at]) & np.isnan(ref)
+        if not np.all(ok):
+            self.why = "the stacked call disagrees with the per-point calls"
             self.f = None
             return None
         self.checked = True

@@ -142,6 +142,7 @@ def test_circle_radius_and_period_closed_form():
     # tol is the period's: the radius and the amplitudes are within their own estimates
     assert np.max(np.abs(radius - r)) <= e.errors["u"]
     assert np.all(np.abs(e.amplitude - r) <= e.errors["amplitude"])
+    assert np.max(np.abs(radius - r)) < 1e-8 and e.errors["u"] < 1e-6   # and both small
     assert abs(e.multipliers[0] - 1) < 1e-8
 
 

@@ -131,7 +131,11 @@ def test_dense_and_arpack_paths_of_collocate_agree(scheme_orbit, monkeypatch):
     lay, terms, x = operator_of(e)
     assert floquet.operator(lay, terms, x).dim <= krylov.DENSE_MAX     # the dense path
     monkeypatch.setattr(floquet, "DENSE_MAX", 50)
+    found = []
+    monkeypatch.setattr(floquet, "leading",
+                        lambda op, count: found.append(krylov.leading(op, count)) or found[-1])
     a = da.collocate(scheme_orbit, intervals=4, multipliers=2)        # ARPACK's
+    assert found and all(f is not None for f in found)                # (not the dense fallback)
     assert np.max(np.abs(a.multipliers - e.multipliers)) <= 1e-9
     assert a.period == e.period
 
@@ -161,7 +165,12 @@ def test_eigenfunction_by_arpack_is_the_dense_one(scheme_orbit, reference, monke
     lay, terms, x = operator_of(e)
     mu, V = floquet.eigenfunction(lay, terms, x, near=0.3)           # the dense matrix's
     monkeypatch.setattr(floquet, "DENSE_MAX", 50)
+    found = []
+    monkeypatch.setattr(floquet, "nearest",
+                        lambda op, near: found.append(krylov.nearest(op, near)) or found[-1])
     mu_a, V_a = floquet.eigenfunction(lay, terms, x, near=0.3)       # ARPACK's
+    assert found and found[0] is not None                             # (not the dense fallback)
+    monkeypatch.setattr(floquet, "nearest", krylov.nearest)
     assert abs(mu - mu_ode[1]) < 1e-4 and abs(mu_a - mu) <= 1e-9
     assert np.max(np.abs(V_a - V)) <= 1e-7
     assert np.max(np.abs(V)) == pytest.approx(1.0)

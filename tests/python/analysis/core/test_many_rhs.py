@@ -59,3 +59,40 @@ def test_a_function_that_does_not_stack_falls_back(kind: str) -> None:
     out = many(t, U)
     assert many.f is None                           # not tried again
     assert np.allclose(out, by_hand(t, U), rtol=1e-14, atol=1e-14)
+    assert {"raises": "raised", "wrong values": "disagrees", "wrong shape": "shape"}[kind] \
+        in many.why                                 # and says why
+
+
+def test_a_nan_where_the_model_gives_nan_keeps_the_stacked_call() -> None:
+    # sqrt of a negative u[0]: NaN point by point and stacked alike (a Newton trial outside the
+    # model's domain), so the two agree and the stacked call stays
+    def f(t, u):
+        return np.array([-u[1], np.sqrt(u[0]) * u[1]])
+    many = ManyRhs(solver(f))
+    t, U = points()
+    U[3, 0] = -1.0
+    with np.errstate(invalid="ignore"):
+        out = many(t, U)
+    assert many.f is not None and many.why == ""
+    assert np.isnan(out[3, 1]) and np.all(np.isfinite(np.delete(out, 3, axis=0)))
+
+
+def test_later_calls_check_points_that_move() -> None:
+    # a function wrong at one point only from its second call on: the fixed checks (first,
+    # middle, last) miss it, the moving ones find it within the calls of a collocation solve
+    state = {"calls": 0}
+
+    def f(t, u):
+        state["calls"] += 1
+        out = np.array([-u[1], (u[0] ** 2 - 1) * u[1] + u[0] + np.sin(t)])
+        if state["calls"] > 1 and np.ndim(u) == 2:
+            out[1, 2] += 1.0
+        return out
+    many = ManyRhs(solver(f))
+    t, U = points()
+    many(t, U)                                     # checked at every point: right
+    for _ in range(20):
+        if many.f is None:
+            break
+        many(t, U)
+    assert many.f is None and "disagrees" in many.why
