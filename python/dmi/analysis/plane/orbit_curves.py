@@ -451,7 +451,7 @@ class Twisted:
         self.fu = fu = terms.fu(self.tc, self.U) if fu is None else fu
         A = D + sp.block_diag(list(fu), format="csr") @ self.E
         if terms.has_kernel:
-            A = A + terms.delay(self.tc, mesh, T, loc, basis, R)
+            A = A + terms.delay(self.tc, mesh, T, loc, basis, R)[0]   # (matrix, extra rows)
         mode = np.repeat(np.array(lay.piece_modes(b, T))[lay.piece_of_interval()], m, axis=0)
         self.held = (mode == STUCK) | (mode == LO) | (mode == HI)
         hv = self.held.ravel().astype(float)
