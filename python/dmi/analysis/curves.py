@@ -77,7 +77,9 @@ def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: floa
         The options of :func:`dmi.analysis.equilibria.curves.continue_curve` (equilibria) or of
         :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve` (orbits; the same for
         period-doubling and torus curves) or of
-        :func:`dmi.analysis.plane.stick_curves.continue_stick_curve` (stick onset, grazing).
+        :func:`dmi.analysis.plane.stick_curves.continue_stick_curve` (stick onset, grazing);
+        for a curve of forced orbits, ``period=lambda p, q: ...`` gives the orbit's period at
+        (p, q) where the forcing's period changes with them.
 
     Returns
     -------

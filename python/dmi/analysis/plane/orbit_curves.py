@@ -82,7 +82,7 @@ from ..continuation.driver import Curve as DriverCurve
 from ..continuation.driver import continuation, newton_strategy
 from ..core.newton import ShootingError, Strategy, bordered_solve, sparse_bordered
 from ..scheme.problem import AtQ
-from .orbit_system import DIFF, FoldSystem, OrbitCurvePoint
+from .orbit_system import DIFF, FoldSystem, OrbitCurvePoint, check_period
 
 #: A start's fold at q0 must lie within this (relative to max(1, |p|)) of the event's p.
 START_TOL = 1e-6
@@ -134,7 +134,7 @@ class OrbitFold(FoldSystem):
         self.c = ev["v"] / np.linalg.norm(ev["v"])
         self.b = ev["w"] / np.linalg.norm(ev["w"])
         x, p = y[:-1], float(y[-1])
-        x = self.remesh(x)
+        x = self.remesh(x, p, q)
         self._last = None
         return np.concatenate([x, [p]])
 
@@ -239,8 +239,8 @@ def continue_orbit_curve(start: Any, make2: Callable[[float, float], Solver], q0
                          step: float | None = None, at: Iterable[float] = (),
                          max_points: int = 100, min_step: float | None = None,
                          max_step: float | None = None, multipliers: int = 10,
-                         tol: float = 1e-10, max_iter: int = 10, estimate: bool = True
-                         ) -> Curve:
+                         tol: float = 1e-10, max_iter: int = 10, estimate: bool = True,
+                         period: Callable[[float, float], float] | None = None) -> Curve:
     """Continues a fold of the equation's periodic orbits (collocated) in the plane (p, q).
 
     The curve of (p, q) where the orbit of ``make2(p, q)`` folds (its branch in p at fixed q
@@ -281,6 +281,11 @@ def continue_orbit_curve(start: Any, make2: Callable[[float, float], Solver], q0
     estimate : bool
         Every point's error estimates (the fold solved again on the mesh of merged pairs of
         intervals); False: none, and every verdict None.
+    period : callable, optional
+        ``period(p, q)``: the period of a forced orbit whose forcing's period changes with
+        (p, q) (e.g. ``lambda p, q: 2 * math.pi / q``, q the forcing's angular frequency);
+        every evaluation at (p, q) takes the orbit of that period.  None: the start's period,
+        fixed.
 
     Returns
     -------
@@ -294,7 +299,9 @@ def continue_orbit_curve(start: Any, make2: Callable[[float, float], Solver], q0
     Raises
     ------
     ValueError
-        A start of another kind, an event without its branch, bad q0, q_end or step; a start
+        A start of another kind, an event without its branch, bad q0, q_end or step;
+        ``period=`` for an autonomous orbit, or period(p, q0) not the start orbit's period (to
+        1e-9 relative), or a period(p, q) that is not finite and > 0; a start
         that is not a fold of ``make2(., q0)`` (Newton fails at q0, or finds the fold farther
         than START_TOL from the event's p).
     """
@@ -310,13 +317,14 @@ def continue_orbit_curve(start: Any, make2: Callable[[float, float], Solver], q0
     if not callable(make2):
         raise ValueError(f"continue_orbit_curve: make2 = {make2!r}: give a function "
                          "(p, q) -> dmi.Solver")
+    check_period(period, orbit.autonomous, orbit.period, p_event, q0, "continue_orbit_curve")
     n = orbit.nodes.shape[1]
     lay = Layout(orbit.degree, n, orbit.signature, [f.copy() for f in orbit.fractions],
                  orbit.autonomous, orbit.period, tuple(orbit.carried))
     x = u if u is not None else np.concatenate([orbit.nodes.ravel(), orbit.switches,
                                                 [orbit.period] if orbit.autonomous else []])
     disc = OrbitFold(make2, lay, x, jumps=tuple(orbit.kernel_jumps), multipliers=multipliers,
-                     tol=tol, max_iter=max_iter, estimate=estimate)
+                     tol=tol, max_iter=max_iter, estimate=estimate, period=period)
     what = f"the orbits' fold at q0 = {q0!r} from p = {p_event!r}"
     try:
         disc.borders(x, p_event, q0)
@@ -443,7 +451,7 @@ class Twisted:
         self.fu = fu = terms.fu(self.tc, self.U) if fu is None else fu
         A = D + sp.block_diag(list(fu), format="csr") @ self.E
         if terms.has_kernel:
-            A = A + terms.delay(self.tc, mesh, T, loc, basis, R)
+            A = A + terms.delay(self.tc, mesh, T, loc, basis, R)[0]   # (matrix, extra rows)
         mode = np.repeat(np.array(lay.piece_modes(b, T))[lay.piece_of_interval()], m, axis=0)
         self.held = (mode == STUCK) | (mode == LO) | (mode == HI)
         hv = self.held.ravel().astype(float)
@@ -542,7 +550,7 @@ class OrbitFlip(OrbitFold):
         """b and c by INVERSE_STEPS steps of inverse iteration from fixed pseudo-random vectors,
         and g's unit (1 / its gradient's largest entry there)."""
         y = np.concatenate([x, [p], [self.theta0] if self.torus else []])
-        A = Twisted(self.lay, self.terms(p, q), x).matrix(self.mu(y))
+        A = Twisted(self.layout(p, q), self.terms(p, q), x).matrix(self.mu(y))
         rng = np.random.default_rng(20260)
         shape = (2, A.shape[0])
         b, c = rng.standard_normal(shape) + (1j * rng.standard_normal(shape) if self.torus
@@ -561,9 +569,9 @@ class OrbitFlip(OrbitFold):
         if self._last is not None and self._last[0] == key:
             return self._last[1]
         x, p = self._split(y)
-        t = self.terms(p, q)
-        r, J = full_jacobian(self.lay, t, x, self.ref)
-        tw = Twisted(self.lay, t, x)
+        t, lay = self.terms(p, q), self.layout(p, q)
+        r, J = full_jacobian(lay, t, x, self.ref)
+        tw = Twisted(lay, t, x)
         v, g, w = _twisted_pair(tw.matrix(self.mu(y)), self.b, self.c)
         g = complex(g) * self.gscale
         ev = {"r": r, "J": J, "v": v, "w": w, "g": np.array([g.real, g.imag][:self.extra]),
@@ -595,9 +603,9 @@ class OrbitFlip(OrbitFold):
             # f_u of an autonomous f is the same at the moved times
             gT = self._grad(ev, y, Twisted(self.lay, t, x, T + dT, tw.fu).matrix(mu), dT)
         d = DIFF * max(1.0, abs(p))
-        tp = self.terms(p + d, q)
-        Fp = (assemble(self.lay, tp, x, self.ref, jacobian=False)[0] - ev["r"]) / d
-        gp = self._grad(ev, y, Twisted(self.lay, tp, x).matrix(mu), d)
+        tp, lp = self.terms(p + d, q), self.layout(p + d, q)
+        Fp = (assemble(lp, tp, x, self.ref, jacobian=False)[0] - ev["r"]) / d
+        gp = self._grad(ev, y, Twisted(lp, tp, x).matrix(mu), d)
         rows = np.vstack([gx.real, gx.imag])[:self.extra]
         if self.lay.autonomous:
             rows[:, -1] = gT
@@ -614,9 +622,9 @@ class OrbitFlip(OrbitFold):
         J, cols, rows, ev = self._jy(y, q)
         x, p = self._split(y)
         d = DIFF * max(1.0, abs(q))
-        tq = self.terms(p, q + d)
-        Fq = (assemble(self.lay, tq, x, self.ref, jacobian=False)[0] - ev["r"]) / d
-        gq = self._grad(ev, y, Twisted(self.lay, tq, x).matrix(self.mu(y)), d)
+        tq, lq = self.terms(p, q + d), self.layout(p, q + d)
+        Fq = (assemble(lq, tq, x, self.ref, jacobian=False)[0] - ev["r"]) / d
+        gq = self._grad(ev, y, Twisted(lq, tq, x).matrix(self.mu(y)), d)
         return sparse_bordered(J, cols, rows), np.concatenate([Fq, gq])
 
     def strategies(self, y: np.ndarray, q: float, row: np.ndarray, target: float, far: float
@@ -650,7 +658,7 @@ class OrbitFlip(OrbitFold):
         self.c = np.conj(ev["v"]) / np.linalg.norm(ev["v"])
         self.b = np.conj(ev["w"]) / np.linalg.norm(ev["w"])
         rest = y[self.lay.size:]
-        x = self.remesh(y[:self.lay.size])
+        x = self.remesh(y[:self.lay.size], float(rest[0]), q)
         self._last = None
         return np.concatenate([x, rest])
 
@@ -677,8 +685,7 @@ class OrbitFlip(OrbitFold):
     def on_mesh(self, lay: Layout, x: np.ndarray, y: np.ndarray, q: float) -> OrbitFlip:
         """The same system on lay from x (theta from y), its borders from there."""
         other = OrbitFlip(self.make2, lay, x, theta=float(y[-1]) if self.torus else None,
-                          jumps=self.jumps, multipliers=self.count, tol=self.tol,
-                          max_iter=self.max_iter, estimate=False)
+                          **self.options)
         other.ref, other.problem = self.ref, self.problem
         other.borders(x, float(y[self.lay.size]), q)
         return other
@@ -764,6 +771,7 @@ def _prepared(kind: str, start: Any, make2: Callable[[float, float], Solver], q0
                          f"{kind} curves of orbits with switches (their saltation) are not "
                          "covered yet; continue one-parameter branches over q "
                          "(continue_over) and read their events")
+    check_period(options.get("period"), orbit.autonomous, orbit.period, p_event, q0, who)
     lay = Layout(orbit.degree, orbit.nodes.shape[1], orbit.signature,
                  [f.copy() for f in orbit.fractions], orbit.autonomous, orbit.period,
                  tuple(orbit.carried))
@@ -809,8 +817,8 @@ def continue_flip_curve(start: Any, make2: Callable[[float, float], Solver], q0:
                         step: float | None = None, at: Iterable[float] = (),
                         max_points: int = 100, min_step: float | None = None,
                         max_step: float | None = None, multipliers: int = 10,
-                        tol: float = 1e-10, max_iter: int = 10, estimate: bool = True
-                        ) -> Curve:
+                        tol: float = 1e-10, max_iter: int = 10, estimate: bool = True,
+                        period: Callable[[float, float], float] | None = None) -> Curve:
     """Continues a period doubling of the equation's periodic orbits (collocated) in the plane
     (p, q): the curve where a Floquet multiplier of the orbit of ``make2(p, q)`` is -1, by
     pseudo-arclength in (x, p, q) with the minimally augmented system of
@@ -823,7 +831,7 @@ def continue_flip_curve(start: Any, make2: Callable[[float, float], Solver], q0:
         Branch as ``branch=``), or an EquationOrbit of ``make2(., q0)`` near a period doubling.
         Orbits without switches only.
     make2, q0, q_end, branch, step, at, max_points, min_step, max_step, multipliers, tol,
-    max_iter, estimate
+    max_iter, estimate, period
         As :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`'s.
 
     Returns
@@ -844,7 +852,7 @@ def continue_flip_curve(start: Any, make2: Callable[[float, float], Solver], q0:
     q0, q_end = float(q0), float(q_end)
     disc, y0, step = _prepared("period-doubling", start, make2, q0, q_end, branch, step,
                                multipliers=multipliers, tol=tol, max_iter=max_iter,
-                               estimate=estimate)
+                               estimate=estimate, period=period)
     b = continuation(disc, y0, q0, q_end, step=step, min_step=min_step, max_step=max_step,
                      max_points=max_points, at=at, tol=tol, max_iter=max_iter,
                      predictor="tangent", easy=4, make=make2, kind="period-doubling")
@@ -856,8 +864,8 @@ def continue_torus_curve(start: Any, make2: Callable[[float, float], Solver], q0
                          step: float | None = None, at: Iterable[float] = (),
                          max_points: int = 100, min_step: float | None = None,
                          max_step: float | None = None, multipliers: int = 10,
-                         tol: float = 1e-10, max_iter: int = 10, estimate: bool = True
-                         ) -> Curve:
+                         tol: float = 1e-10, max_iter: int = 10, estimate: bool = True,
+                         period: Callable[[float, float], float] | None = None) -> Curve:
     """Continues a torus (Neimark-Sacker) bifurcation of the equation's periodic orbits
     (collocated) in the plane (p, q): the curve where a pair of Floquet multipliers is
     e^(+-i theta), theta in (0, pi) an unknown, as :func:`continue_flip_curve` does.
@@ -869,7 +877,7 @@ def continue_torus_curve(start: Any, make2: Callable[[float, float], Solver], q0
         or an EquationOrbit near a torus bifurcation (theta starts from its non-real
         multiplier nearest the unit circle).  Orbits without switches only.
     make2, q0, q_end, branch, step, at, max_points, min_step, max_step, multipliers, tol,
-    max_iter, estimate
+    max_iter, estimate, period
         As :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`'s (the arclength also
         counts theta, in radians).
 
@@ -888,7 +896,7 @@ def continue_torus_curve(start: Any, make2: Callable[[float, float], Solver], q0
     q0, q_end = float(q0), float(q_end)
     disc, y0, step = _prepared("torus", start, make2, q0, q_end, branch, step,
                                multipliers=multipliers, tol=tol, max_iter=max_iter,
-                               estimate=estimate)
+                               estimate=estimate, period=period)
     b = continuation(disc, y0, q0, q_end, step=step, min_step=min_step, max_step=max_step,
                      max_points=max_points, at=at, tol=tol, max_iter=max_iter,
                      predictor="tangent", easy=4, make=make2, kind="torus")

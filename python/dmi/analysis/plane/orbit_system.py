@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -95,6 +95,8 @@ class OrbitSystem:
         The corrector's tolerance and iterations.
     estimate : bool
         A point's error estimates from the merged mesh (False: none, the verdict None).
+    period : callable, optional
+        ``period(p, q)``: a forced orbit's period at (p, q) (None: the layout's, fixed).
     """
     #: The unknowns past x (p first).
     extra = 1
@@ -103,8 +105,13 @@ class OrbitSystem:
 
     def __init__(self, make2: Callable[[float, float], Solver], layout: Layout, x: np.ndarray,
                  *, jumps: tuple[float, ...] = (), multipliers: int = 10, tol: float = 1e-12,
-                 max_iter: int = 10, estimate: bool = True):
+                 max_iter: int = 10, estimate: bool = True,
+                 period: Callable[[float, float], float] | None = None):
+        if period is not None and layout.autonomous:
+            raise ValueError(f"period = {period!r}: the orbit is autonomous (its period is an "
+                             "unknown): give period= only for a forced orbit")
         self.make2, self.lay, self.jumps = make2, layout, tuple(jumps)
+        self.period = period
         self.ref = reference(layout, x) if layout.autonomous else None
         self.count, self.tol, self.max_iter = int(multipliers), float(tol), int(max_iter)
         self.estimate = bool(estimate)
@@ -124,11 +131,26 @@ class OrbitSystem:
                                    lambda: Terms(build(AtQ(self.make2, key[1]), key[0]),
                                                  self.jumps))
 
-    def remesh(self, x: np.ndarray) -> np.ndarray:
-        """x on the mesh equidistributed again (it becomes the system's), the phase condition's
-        reference moved to it."""
-        new = self.lay.with_fractions(adapted(self.lay, x, self.lay.L))
-        x = transfer(self.lay, x, new)
+    def layout(self, p: float, q: float, lay: Layout | None = None) -> Layout:
+        """The layout (lay, default the system's) of the orbit at (p, q): with the period
+        period(p, q) where :attr:`period` is given."""
+        lay = self.lay if lay is None else lay
+        if self.period is None:
+            return lay
+        return replace(lay, period=period_at(self.period, p, q))
+
+    @property
+    def options(self) -> dict[str, Any]:
+        """The options another system on another mesh takes (no estimates)."""
+        return {"jumps": self.jumps, "multipliers": self.count, "tol": self.tol,
+                "max_iter": self.max_iter, "estimate": False, "period": self.period}
+
+    def remesh(self, x: np.ndarray, p: float, q: float) -> np.ndarray:
+        """x, the orbit at (p, q), on the mesh equidistributed again (it becomes the
+        system's), the phase condition's reference moved to it."""
+        lay = self.layout(p, q)
+        new = lay.with_fractions(adapted(lay, x, lay.L))
+        x = transfer(lay, x, new)
         self.lay = new
         if new.autonomous:
             self.ref = reference(new, x)
@@ -137,7 +159,7 @@ class OrbitSystem:
     def broken(self, x: np.ndarray, p: float, q: float, rel: float) -> str:
         """The first inequality of the signature the orbit x at (p, q) breaks by more than rel
         times its scale, else ""."""
-        bad = check_inequalities(self.lay, self.terms(p, q), x,
+        bad = check_inequalities(self.layout(p, q), self.terms(p, q), x,
                                  rel * max(1.0, float(np.max(np.abs(x)))))
         return bad[0] if bad else ""
 
@@ -158,8 +180,9 @@ class OrbitSystem:
         """The system solved at q on the mesh of merged pairs of intervals (its y); None, with
         a CollocationWarning, where that solve fails."""
         m, p = self.lay.size, float(y[self.lay.size])
-        lay = self.lay.with_fractions(merged(self.lay.fractions))
-        xc = transfer(self.lay, y[:m], lay)
+        here = self.layout(p, q)
+        lay = here.with_fractions(merged(here.fractions))
+        xc = transfer(here, y[:m], lay)
         try:
             other = self.on_mesh(lay, xc, y, q)
             other.ref, other.problem = self.ref, self.problem
@@ -170,14 +193,15 @@ class OrbitSystem:
                           f"({e}): no error estimate, the verdict None", CollocationWarning,
                           stacklevel=4)
             return None
-        return self._solved(lay, self.terms(float(yc[lay.size]), q), yc[:lay.size]), yc
+        pc = float(yc[lay.size])
+        return self._solved(self.layout(pc, q, lay), self.terms(pc, q), yc[:lay.size]), yc
 
     def levels(self, y: np.ndarray, q: float
                ) -> tuple[Solved, dict[str, Any], np.ndarray | None]:
         """(the orbit of y with its multipliers, its error estimates with p's, the merged mesh's
         y or None): the errors are the differences to the merged mesh's solve."""
         m, p = self.lay.size, float(y[self.lay.size])
-        fine = self._solved(self.lay, self.terms(p, q), y[:m])
+        fine = self._solved(self.layout(p, q), self.terms(p, q), y[:m])
         got = self._coarse(y, q) if self.estimate else None
         if got is None:
             return fine, {}, None
@@ -209,9 +233,10 @@ class FoldSystem(OrbitSystem):
         """b and c from the one-parameter branch's tangent at a fold: with F_p as J's border and
         a uniform row, the null vectors of J and J' (F_p is outside J's range at a fold)."""
         t = self.terms(p, q)
-        r, J = full_jacobian(self.lay, t, x, self.ref)
+        r, J = full_jacobian(self.layout(p, q), t, x, self.ref)
         d = DIFF * max(1.0, abs(p))
-        Fp = (full_jacobian(self.lay, self.terms(p + d, q), x, self.ref)[0] - r) / d
+        Fp = (full_jacobian(self.layout(p + d, q), self.terms(p + d, q), x, self.ref)[0]
+              - r) / d
         m = x.size
         one = np.full(m, 1.0 / math.sqrt(m))
         v, w = _null_pair(J, Fp, one)
@@ -229,7 +254,7 @@ class FoldSystem(OrbitSystem):
             return self._last[1]
         x, p = y[:-1], float(y[-1])
         t = self.terms(p, q)
-        r, J = full_jacobian(self.lay, t, x, self.ref)
+        r, J = full_jacobian(self.layout(p, q), t, x, self.ref)
         vg, wh = _pair(J, self.b, self.c)
         ev = {"r": r, "J": J, "v": vg[:-1], "g": float(vg[-1]) * self.gscale, "w": wh[:-1],
               "terms": t}
@@ -247,10 +272,10 @@ class FoldSystem(OrbitSystem):
         x, p = y[:-1], float(y[-1])
         J, v, w, t = ev["J"], ev["v"], ev["w"], ev["terms"]
         eps = DIFF * max(1.0, float(np.max(np.abs(x)))) / max(float(np.max(np.abs(v))), 1e-300)
-        J1 = full_jacobian(self.lay, t, x + eps * v, self.ref)[1]
+        J1 = full_jacobian(self.layout(p, q), t, x + eps * v, self.ref)[1]
         gx = -self.gscale * (J1.T @ w - J.T @ w) / eps
         d = DIFF * max(1.0, abs(p))
-        rp, Jp = full_jacobian(self.lay, self.terms(p + d, q), x, self.ref)
+        rp, Jp = full_jacobian(self.layout(p + d, q), self.terms(p + d, q), x, self.ref)
         Fp = (rp - ev["r"]) / d
         gp = -self.gscale * float(w @ (Jp @ v - J @ v)) / d
         return J, Fp, np.append(gx, gp), ev
@@ -260,7 +285,7 @@ class FoldSystem(OrbitSystem):
         J, Fp, grow, ev = self._jy(y, q)
         x, p = y[:-1], float(y[-1])
         d = DIFF * max(1.0, abs(q))
-        rq, Jq = full_jacobian(self.lay, self.terms(p, q + d), x, self.ref)
+        rq, Jq = full_jacobian(self.layout(p, q + d), self.terms(p, q + d), x, self.ref)
         Fq = (rq - ev["r"]) / d
         gq = -self.gscale * float(ev["w"] @ (Jq @ ev["v"] - ev["J"] @ ev["v"])) / d
         return sparse_bordered(J, Fp, grow), np.concatenate([Fq, [gq]])
@@ -281,8 +306,7 @@ class FoldSystem(OrbitSystem):
 
     def on_mesh(self, lay: Layout, x: np.ndarray, y: np.ndarray, q: float) -> FoldSystem:
         """The fold's system on lay from x, its borders from there."""
-        other = type(self)(self.make2, lay, x, jumps=self.jumps, multipliers=self.count,
-                           tol=self.tol, max_iter=self.max_iter, estimate=False)
+        other = type(self)(self.make2, lay, x, **self.options)
         other.ref, other.problem = self.ref, self.problem
         other.borders(x, float(y[self.lay.size]), q)
         return other
@@ -303,3 +327,36 @@ def _null_pair(J: Any, border: np.ndarray, row: np.ndarray) -> tuple[np.ndarray,
     """v and w of [[J, border], [row', 0]] (v, .) = (0, 1) and its transpose (w, .) = (0, 1)."""
     vg, wh = _pair(J, border, row)
     return vg[:-1], wh[:-1]
+
+
+def period_at(period: Callable[[float, float], float], p: float, q: float) -> float:
+    """period(p, q), refused (ValueError) unless finite and > 0."""
+    T = period(p, q)
+    try:
+        T = float(T)
+    except (TypeError, ValueError):
+        T = math.nan
+    if not (math.isfinite(T) and T > 0):
+        raise ValueError(f"period(p = {p!r}, q = {q!r}) = {T!r}: a forced orbit's period must "
+                         "be finite and > 0")
+    return T
+
+
+def check_period(period: Callable[[float, float], float] | None, autonomous: bool,
+                 start: float, p: float, q: float, who: str) -> None:
+    """Refuses (ValueError, naming who) period= for an autonomous orbit, not callable, or
+    disagreeing with the start orbit's period at (p, q) by more than 1e-9 relative."""
+    if period is None:
+        return
+    if autonomous:
+        raise ValueError(f"{who}: period = {period!r}: the start orbit is autonomous (its "
+                         "period is an unknown): give period= only for a forced orbit")
+    if not callable(period):
+        raise ValueError(f"{who}: period = {period!r}: give a function (p, q) -> the forced "
+                         "orbit's period")
+    T = period_at(period, p, q)
+    if abs(T - start) > 1e-9 * abs(start):
+        raise ValueError(f"{who}: period(p = {p!r}, q0 = {q!r}) = {T!r} but the start orbit's "
+                         f"period is {start!r}: the branch's period and period= disagree (is "
+                         "make2(p, q0) the branch's model, and period(p, q) its forcing's "
+                         "period?)")

@@ -56,7 +56,7 @@ from ..continuation.driver import bordered_det, continuation
 from ..core.newton import ShootingError, bordered_solve, newton_loop, sparse_bordered
 from ..scheme.problem import AtQ
 from ..scheme.stepmap import build
-from .orbit_system import FoldSystem, OrbitCurvePoint, OrbitSystem
+from .orbit_system import FoldSystem, OrbitCurvePoint, OrbitSystem, check_period
 
 #: Relative step of the central differences (the margin's non-node columns, F_p, F_q).
 DIFF = 1e-7
@@ -269,37 +269,41 @@ class StickBoundary(OrbitSystem):
         The corrector's tolerance and iterations.
     estimate : bool
         A point's error estimates from the merged mesh (False: none, the verdict None).
+    period : callable, optional
+        ``period(p, q)``: a forced orbit's period at (p, q) (None: the layout's, fixed).
     """
 
     def __init__(self, make2: Callable[[float, float], Solver], layout: Layout, x: np.ndarray,
                  margin: Margin, kind: str, *, jumps: tuple[float, ...] = (),
                  multipliers: int = 10, tol: float = 1e-11, max_iter: int = 10,
-                 estimate: bool = True):
+                 estimate: bool = True, period: Callable[[float, float], float] | None = None):
         super().__init__(make2, layout, x, jumps=jumps, multipliers=multipliers, tol=tol,
-                         max_iter=max_iter, estimate=estimate)
+                         max_iter=max_iter, estimate=estimate, period=period)
         self.margin, self.kind = margin, kind
         self.t_star = 0.0
         self.y0: np.ndarray | None = None   # the start, solved at q0
 
     def _margin(self, y: np.ndarray, q: float) -> tuple[float, float]:
         """(m, t*) at (y, q)."""
-        return _Values(self.lay, self.margin).least(self.terms(float(y[-1]), q), y[:-1])
+        p = float(y[-1])
+        return _Values(self.layout(p, q), self.margin).least(self.terms(p, q), y[:-1])
 
     def residual(self, y: np.ndarray, q: float) -> np.ndarray:
         """(F, m) at (y, q)."""
         x, p = y[:-1], float(y[-1])
-        r = assemble(self.lay, self.terms(p, q), x, self.ref, jacobian=False)[0]
+        r = assemble(self.layout(p, q), self.terms(p, q), x, self.ref, jacobian=False)[0]
         m, self.t_star = self._margin(y, q)
         return np.append(r, m)
 
     def _row(self, y: np.ndarray, q: float, t_star: float) -> tuple[np.ndarray, float]:
         """(d m / d (x, p), d m / d q) at the time held."""
         x, p = y[:-1], float(y[-1])
-        vals = _Values(self.lay, self.margin)
-        first = self.lay.rows * self.lay.n
+        lay = self.layout(p, q)
+        vals = _Values(lay, self.margin)
+        first = lay.rows * lay.n
         row = np.zeros(y.size)
         row[:first] = vals.node_row(self.terms(p, q), x, t_star)
-        T = self.lay.split(x)[2]
+        T = lay.split(x)[2]
         for j in range(first, x.size):
             d = DIFF * T
             xp, xm = x.copy(), x.copy()
@@ -308,20 +312,25 @@ class StickBoundary(OrbitSystem):
             row[j] = (vals.value(self.terms(p, q), xp, t_star)
                       - vals.value(self.terms(p, q), xm, t_star)) / (2 * d)
         dp, dq = DIFF * max(1.0, abs(p)), DIFF * max(1.0, abs(q))
-        row[-1] = (vals.value(self.terms(p + dp, q), x, t_star)
-                   - vals.value(self.terms(p - dp, q), x, t_star)) / (2 * dp)
-        mq = (vals.value(self.terms(p, q + dq), x, t_star)
-              - vals.value(self.terms(p, q - dq), x, t_star)) / (2 * dq)
+        row[-1] = (self._value(p + dp, q, x, t_star)
+                   - self._value(p - dp, q, x, t_star)) / (2 * dp)
+        mq = (self._value(p, q + dq, x, t_star) - self._value(p, q - dq, x, t_star)) / (2 * dq)
         return row, mq
+
+    def _value(self, p: float, q: float, x: np.ndarray, t_star: float) -> float:
+        """The margin of x at (p, q) at the time held."""
+        return _Values(self.layout(p, q), self.margin).value(self.terms(p, q), x, t_star)
 
     def parts(self, y: np.ndarray, q: float) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray,
                                                        float]:
         """(F_x sparse, F_p, d m / d (x, p), F_q, d m / d q) at (y, q)."""
         x, p = y[:-1], float(y[-1])
-        r, J = full_jacobian(self.lay, self.terms(p, q), x, self.ref)
+        r, J = full_jacobian(self.layout(p, q), self.terms(p, q), x, self.ref)
         dp, dq = DIFF * max(1.0, abs(p)), DIFF * max(1.0, abs(q))
-        Fp = (assemble(self.lay, self.terms(p + dp, q), x, self.ref, jacobian=False)[0] - r) / dp
-        Fq = (assemble(self.lay, self.terms(p, q + dq), x, self.ref, jacobian=False)[0] - r) / dq
+        Fp = (assemble(self.layout(p + dp, q), self.terms(p + dp, q), x, self.ref,
+                       jacobian=False)[0] - r) / dp
+        Fq = (assemble(self.layout(p, q + dq), self.terms(p, q + dq), x, self.ref,
+                       jacobian=False)[0] - r) / dq
         _, t_star = self._margin(y, q)
         row, mq = self._row(y, q, t_star)
         return J, Fp, row, Fq, mq
@@ -360,14 +369,14 @@ class StickBoundary(OrbitSystem):
     def adapt(self, y: np.ndarray, q: float) -> np.ndarray:
         """Between steps: the mesh equidistributed again, the phase condition's reference moved
         to the point."""
-        return np.concatenate([self.remesh(y[:-1]), y[-1:]])
+        return np.concatenate([self.remesh(y[:-1], float(y[-1]), q), y[-1:]])
 
     def fold_test(self, y: np.ndarray, q: float) -> float:
         """sign(det F_x) |g|, g the fold's bordered test function with fixed uniform borders
         (sign(det F_x) = sign(g) sign(det) of the bordered matrix): its sign changes where the
         orbit's branch at fixed q folds, not where the borders change."""
         x, p = y[:-1], float(y[-1])
-        J = full_jacobian(self.lay, self.terms(p, q), x, self.ref)[1]
+        J = full_jacobian(self.layout(p, q), self.terms(p, q), x, self.ref)[1]
         m = x.size
         b = c = np.full(m, 1.0 / math.sqrt(m))
         e1 = np.zeros(m + 1)
@@ -404,9 +413,7 @@ class StickBoundary(OrbitSystem):
 
     def on_mesh(self, lay: Layout, x: np.ndarray, y: np.ndarray, q: float) -> StickBoundary:
         """The same boundary on lay from x."""
-        return StickBoundary(self.make2, lay, x, self.margin, self.kind, jumps=self.jumps,
-                             multipliers=self.count, tol=self.tol, max_iter=self.max_iter,
-                             estimate=False)
+        return StickBoundary(self.make2, lay, x, self.margin, self.kind, **self.options)
 
     def between(self, za: np.ndarray, a: StickCurvePoint, zb: np.ndarray, b: StickCurvePoint,
                 middle: Any) -> list[Event]:
@@ -433,7 +440,7 @@ def fold_crossing(disc: StickBoundary, zb: np.ndarray) -> np.ndarray:
     from zb) from zb = (x, p, q) on disc's layout.  ShootingError when Newton fails."""
     x0, p0, q0 = zb[:-2], float(zb[-2]), float(zb[-1])
     fold = FoldSystem(disc.make2, disc.lay, x0, jumps=disc.jumps, multipliers=0,
-                      tol=disc.tol, estimate=False)
+                      tol=disc.tol, estimate=False, period=disc.period)
     fold.ref, fold.problem = disc.ref, disc.problem
     fold.borders(x0, p0, q0)
 
@@ -496,6 +503,8 @@ def _start(start: Any, make2: Callable[[float, float], Solver], q0: float, branc
     margin whose boundary at q0 lies at the event's p, the margins nearest 0 tried first."""
     tries = []
     for mine, other in _sides(start, branch):
+        check_period(options.get("period"), mine.autonomous, mine.period, mine.p, q0,
+                     "continue_stick_curve")
         lay, x = _layout_of(mine)
         terms = Terms(build(mine.make, mine.p), tuple(mine.kernel_jumps))
         for m in margins(lay, terms, other.signature):
@@ -535,8 +544,8 @@ def continue_stick_curve(start: Any, make2: Callable[[float, float], Solver], q0
                          step: float | None = None, at: Iterable[float] = (),
                          max_points: int = 100, min_step: float | None = None,
                          max_step: float | None = None, multipliers: int = 10,
-                         tol: float = 1e-10, max_iter: int = 10, estimate: bool = True
-                         ) -> Curve:
+                         tol: float = 1e-10, max_iter: int = 10, estimate: bool = True,
+                         period: Callable[[float, float], float] | None = None) -> Curve:
     """Continues a stick onset or grazing of the equation's periodic orbits (collocated) in
     the plane (p, q).
 
@@ -575,6 +584,9 @@ def continue_stick_curve(start: Any, make2: Callable[[float, float], Solver], q0
     estimate : bool
         Every point's error estimates (the boundary solved again on the mesh of merged pairs
         of intervals); False: none, every verdict None.
+    period : callable, optional
+        ``period(p, q)``: a forced orbit's period at (p, q) (as
+        :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`'s).
 
     Returns
     -------
@@ -589,7 +601,8 @@ def continue_stick_curve(start: Any, make2: Callable[[float, float], Solver], q0
     ------
     ValueError
         A start of another kind, without its branch or not on it; bad q0, q_end or step; no
-        boundary of ``make2(., q0)`` at the event's p (within START_TOL).
+        boundary of ``make2(., q0)`` at the event's p (within START_TOL); ``period=`` for an
+        autonomous orbit, not the start's period at (p, q0), or not finite and > 0.
     """
     q0, q_end = float(q0), float(q_end)
     if not (math.isfinite(q0) and math.isfinite(q_end)) or q0 == q_end:
@@ -603,7 +616,8 @@ def continue_stick_curve(start: Any, make2: Callable[[float, float], Solver], q0
         raise ValueError(f"continue_stick_curve: make2 = {make2!r}: give a function "
                          "(p, q) -> dmi.Solver")
     disc = _start(start, make2, q0, branch, {"multipliers": multipliers, "tol": tol,
-                                             "max_iter": max_iter, "estimate": estimate})
+                                             "max_iter": max_iter, "estimate": estimate,
+                                             "period": period})
     b = continuation(disc, disc.y0, q0, q_end, step=float(step), min_step=min_step,
                      max_step=max_step, max_points=max_points, at=at, tol=tol,
                      max_iter=max_iter, predictor="tangent", easy=4, make=make2,
