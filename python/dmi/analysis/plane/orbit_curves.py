@@ -377,17 +377,51 @@ INVERSE_STEPS = 3
 
 @dataclass
 class FlipCurvePoint(OrbitCurvePoint):
-    """A point of a period-doubling curve (:func:`continue_flip_curve`): as
-    :class:`OrbitCurvePoint`, with ``stable`` the verdict on the multipliers but the trivial
-    one and the doubling's -1."""
+    """A point of a period-doubling curve (:func:`continue_flip_curve`), as
+    :class:`OrbitCurvePoint`.
+
+    Attributes
+    ----------
+    p, q : float
+        The parameters.
+    orbit : EquationOrbit
+        The orbit there (``orbit.make(p)`` is ``make2(p, q)``), its multipliers and their
+        error estimates (``orbit.errors``, with ``"p"``); its ``stable`` is None.
+    p_error : float or None
+        The estimated error of p (the difference to the merged mesh's solve at the same q);
+        None where that solve failed.
+    dqds : float
+        The unit tangent's q component.
+    stable : bool or None
+        The verdict on the multipliers but the trivial one and the doubling's -1 (verified
+        against their errors; None where one is within its error of the unit circle).
+    """
 
 
 @dataclass
 class TorusCurvePoint(OrbitCurvePoint):
-    """A point of a torus curve (:func:`continue_torus_curve`): as :class:`OrbitCurvePoint`,
-    with ``theta`` the argument in (0, pi) of the critical pair e^(+-i theta), ``theta_error``
-    its estimated error (the difference to the merged mesh's; None where that failed), and
-    ``stable`` the verdict on the multipliers but the trivial one and the pair."""
+    """A point of a torus curve (:func:`continue_torus_curve`), as :class:`OrbitCurvePoint`.
+
+    Attributes
+    ----------
+    p, q : float
+        The parameters.
+    orbit : EquationOrbit
+        The orbit there (``orbit.make(p)`` is ``make2(p, q)``), its multipliers and their
+        error estimates (``orbit.errors``, with ``"p"``); its ``stable`` is None.
+    p_error : float or None
+        The estimated error of p (the difference to the merged mesh's solve at the same q);
+        None where that solve failed.
+    dqds : float
+        The unit tangent's q component.
+    stable : bool or None
+        The verdict on the multipliers but the trivial one and the critical pair (verified
+        against their errors; None where one is within its error of the unit circle).
+    theta : float
+        The argument in (0, pi) of the critical pair e^(+-i theta), in radians.
+    theta_error : float or None
+        Its estimated error (the difference to the merged mesh's); None where that failed.
+    """
     theta: float = 0.0
     theta_error: float | None = None
 
@@ -830,8 +864,9 @@ def continue_flip_curve(start: Any, make2: Callable[[float, float], Solver], q0:
         A ``period-doubling`` event of a branch of EquationOrbits of ``make2(., q0)`` (give that
         Branch as ``branch=``), or an EquationOrbit of ``make2(., q0)`` near a period doubling.
         Orbits without switches only.
-    make2, q0, q_end, branch, step, at, max_points, min_step, max_step, multipliers, tol,
-    max_iter, estimate, period
+    make2, q0, q_end, branch, step, at, max_points
+        As :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`'s.
+    min_step, max_step, multipliers, tol, max_iter, estimate, period
         As :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`'s.
 
     Returns
@@ -876,10 +911,11 @@ def continue_torus_curve(start: Any, make2: Callable[[float, float], Solver], q0
         A ``torus`` event of a branch of EquationOrbits of ``make2(., q0)`` (with ``branch=``),
         or an EquationOrbit near a torus bifurcation (theta starts from its non-real
         multiplier nearest the unit circle).  Orbits without switches only.
-    make2, q0, q_end, branch, step, at, max_points, min_step, max_step, multipliers, tol,
-    max_iter, estimate, period
+    make2, q0, q_end, branch, step, at, max_points
         As :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`'s (the arclength also
         counts theta, in radians).
+    min_step, max_step, multipliers, tol, max_iter, estimate, period
+        As :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`'s.
 
     Returns
     -------

@@ -222,14 +222,25 @@ class _Values:
 
 @dataclass
 class StickCurvePoint(OrbitCurvePoint):
-    """A point of a stick-onset or grazing curve (:func:`continue_stick_curve`): an
-    :class:`~dmi.analysis.OrbitCurvePoint` (``p``, ``q``, ``orbit``,
-    ``p_error``, ``dqds``) whose ``orbit`` lies on the signature of the side where it holds and
-    whose ``stable`` is the orbit's own verdict (verified against the multipliers' errors, None
-    where one is within its error of the unit circle or no estimate exists).
+    """A point of a stick-onset or grazing curve (:func:`continue_stick_curve`), as
+    :class:`~dmi.analysis.OrbitCurvePoint`.
 
     Attributes
     ----------
+    p, q : float
+        The parameters.
+    orbit : EquationOrbit
+        The orbit there, on the signature of the side where it holds (``orbit.make(p)`` is
+        ``make2(p, q)``): period, amplitude, multipliers, their error estimates
+        (``orbit.errors``, with ``"p"``) and its verified ``stable``.
+    p_error : float or None
+        The estimated error of p (the difference to the boundary on the mesh of merged pairs of
+        intervals at the same q); None where that solve failed (a warning says so).
+    stable : bool or None
+        The orbit's verdict (``orbit.stable``: verified against the multipliers' errors, None
+        where one is within its error of the unit circle or no estimate exists).
+    dqds : float
+        The unit tangent's q component.
     t_star : float
         The time of the margin's least value (a reversal's switching time).
     fold_test : float
