@@ -37,7 +37,7 @@ from .._solver import Solver
 from .branches.collocated import continue_equation_orbit, equation_branch_start
 from .collocation.orbit import EquationOrbit
 from .continuation.branch import Curve, CurveEvent, Event
-from .continuation.driver import ContinuationOptions
+from .continuation.driver import ContinuationOptions, curve_range
 from .equilibria.curves import CurvePoint
 from .equilibria.curves import continue_curve as equilibrium_curve
 from .equilibria.normal_form import CriticalityWarning
@@ -132,11 +132,8 @@ def continue_bautin_fold(start: CurveEvent, make2: Callable[[float, float], Solv
     if start.hopf is None or start.u is None:
         raise ValueError("continue_curve: the bautin event has no Hopf point or equilibrium: "
                          "give a 'bautin' event of a Hopf curve (continue_curve of a Hopf point)")
-    q0, q_end = float(q0), float(q_end)
+    q0, q_end, _ = curve_range("continue_curve", q0, q_end)
     span = q_end - q0
-    if not (math.isfinite(q0) and math.isfinite(q_end)) or span == 0.0:
-        raise ValueError(f"continue_curve: q0 = {q0!r}, q_end = {q_end!r}: give two different "
-                         "finite values")
     dq = OFFSET_SHARE * abs(span) if offset is None else float(offset)
     if not (math.isfinite(dq) and 0.0 < dq < abs(span)):
         raise ValueError(f"continue_curve: offset = {offset!r}: give 0 < offset < |q_end - q0| "

@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 import numpy as np
+import scipy.optimize as so
 
 import dmi
 
@@ -66,3 +67,17 @@ def circle_solver(a: complex, c1: complex, c2: complex, G: float, tau: float, N:
 
         s.set_rhs_derivatives(fu, d2, d3)
     return s
+
+
+def circle_hopf(w0: float, G: float, tau: float) -> tuple[float, float]:
+    """(Om, mu_H) of the circle oscillator (circle_solver) with rotation w0: the frequency
+    where Om + Im ghat(i Om) = w0, and mu_H = Re ghat(i Om)."""
+    om = so.brentq(lambda w: w + ghat(1j * w, G, tau).imag - w0, 0.1, 3.0,
+                   xtol=1e-15, rtol=1e-15)
+    return om, ghat(1j * om, G, tau).real
+
+
+def circle_fold(q: float, c2: float, w0: float, G: float, tau: float) -> tuple[float, float]:
+    """(mu_F, r) of the fold of its circles at q > 0 (cubic coefficient q, quintic c2 < 0)."""
+    _, mu_h = circle_hopf(w0, G, tau)
+    return mu_h - q * q / (4 * abs(c2)), float(np.sqrt(q / (2 * abs(c2))))

@@ -2,12 +2,16 @@
 # from the equations, not from the code under test:
 # - Den Hartog's non-stick orbit of x'' + x + F0 sign(x') = F cos(w t) (Den Hartog 1931;
 #   Shaw 1986) and its Floquet multipliers by a saltation analysis;
-# - the stick-slip orbit of u' + sigma(u) ∋ c sin t, c > 1, slip phases in closed form.
+# - the stick-slip orbit of u' + sigma(u) ∋ c sin t, c > 1, slip phases in closed form;
+# - the fold of the forced Duffing oscillator's resonance by shooting with scipy's DOP853.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import scipy.optimize as so
+from scipy.integrate import solve_ivp
 
 import dmi
 
@@ -328,3 +332,25 @@ class BumpStick:
         if np.any(np.abs(Ft[stuck & ~down]) > 1 + 1e-12):
             raise RuntimeError("|F| > 1 in a stick phase")
         return 2 * np.pi - slip, phases
+
+
+def duffing_fold(c: float, w: float, guess: np.ndarray) -> float:
+    """F at the fold of x'' + c x' + x + x^3 = F cos(w t): (x(0), F) with x(P) = x(0) and
+    det(M - I) = 0 (M the monodromy, P = 2 pi / w), by scipy's DOP853 and fsolve from guess."""
+    P = 2 * math.pi / w
+
+    def flow(x0, F):
+        def rhs(t, z):
+            A = np.array([[0.0, 1.0], [-1 - 3 * z[0] ** 2, -c]])
+            return np.concatenate([[z[1], -c * z[1] - z[0] - z[0] ** 3 + F * math.cos(w * t)],
+                                   (A @ z[2:].reshape(2, 2)).ravel()])
+        s = solve_ivp(rhs, (0, P), np.concatenate([x0, np.eye(2).ravel()]), method="DOP853",
+                      rtol=1e-13, atol=1e-13)
+        return s.y[:2, -1], s.y[2:, -1].reshape(2, 2)
+
+    def eqs(z):
+        xe, M = flow(z[:2], z[2])
+        return np.concatenate([xe - z[:2], [np.linalg.det(M - np.eye(2))]])
+    z = so.fsolve(eqs, guess, xtol=1e-12)
+    assert np.max(np.abs(eqs(z))) < 1e-11
+    return float(z[2])

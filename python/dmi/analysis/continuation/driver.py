@@ -770,6 +770,22 @@ def _sign_change(fa: float, fb: float) -> bool:
     return math.isfinite(fa) and math.isfinite(fb) and fa * fb < 0
 
 
+def curve_range(who: str, q0: float, q_end: float, step: float | None = None
+                ) -> tuple[float, float, float]:
+    """(q0, q_end, the first step) of a curve in (p, q), checked: a ValueError naming ``who``
+    where q0 and q_end are not two different finite values, or the step (default
+    |q_end - q0| / 20) is not finite and > 0."""
+    q0, q_end = float(q0), float(q_end)
+    if not (math.isfinite(q0) and math.isfinite(q_end)) or q0 == q_end:
+        raise ValueError(f"{who}: q0 = {q0!r}, q_end = {q_end!r}: give two different finite "
+                         "values")
+    if step is None:
+        step = abs(q_end - q0) / 20
+    if not (isinstance(step, (int, float)) and math.isfinite(step) and step > 0):
+        raise ValueError(f"{who}: step = {step!r}: must be finite and > 0")
+    return q0, q_end, float(step)
+
+
 def continuation(disc: Discretisation, x0: np.ndarray, p0: float, p_end: float,
                  options: ContinuationOptions | None = None, *,
                  make: Callable[..., Any] | None = None, kind: str = "points",

@@ -55,7 +55,7 @@ import numpy as np
 from ..._errors import Error
 from ..._solver import Solver
 from ..continuation.branch import ON_AXIS, REAL, AlongQ, Curve, CurveEvent, Event, HopfPoint
-from ..continuation.driver import ContinuationOptions, continuation
+from ..continuation.driver import ContinuationOptions, continuation, curve_range
 from ..core.model import Linearisation, call_make, equation_step
 from ..core.newton import ShootingError
 from ..scheme.problem import AtQ
@@ -458,14 +458,7 @@ def continue_curve(start: Any, make2: Callable[[float, float], Solver], q0: floa
         q0: a ShootingError, a ValueError).
     """
     kind, p0, u0, omega0 = _start(start, u_eq)
-    q0, q_end = float(q0), float(q_end)
-    if not (math.isfinite(q0) and math.isfinite(q_end)) or q0 == q_end:
-        raise ValueError(f"continue_curve: q0 = {q0!r}, q_end = {q_end!r}: give two different "
-                         "finite values")
-    if step is None:
-        step = abs(q_end - q0) / 20
-    if not (isinstance(step, (int, float)) and math.isfinite(step) and step > 0):
-        raise ValueError(f"continue_curve: step = {step!r}: must be finite and > 0")
+    q0, q_end, step = curve_range("continue_curve", q0, q_end, step)
     disc, x0 = system(kind, p0, u0, omega0, make2, q0, tol=tol, count=count)
     try:
         options = ContinuationOptions(step=float(step), min_step=min_step, max_step=max_step,

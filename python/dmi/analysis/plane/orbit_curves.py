@@ -79,7 +79,7 @@ from ..collocation.signature import HI, LO, STUCK
 from ..collocation.system import CollocationWarning, Layout, Terms, assemble, full_jacobian
 from ..continuation.branch import Branch, Curve, CurveEvent, Event
 from ..continuation.driver import Curve as DriverCurve
-from ..continuation.driver import continuation, newton_strategy
+from ..continuation.driver import continuation, curve_range, newton_strategy
 from ..core.newton import ShootingError, Strategy, bordered_solve, sparse_bordered
 from ..scheme.problem import AtQ
 from .orbit_system import DIFF, FoldSystem, OrbitCurvePoint, check_period
@@ -306,14 +306,7 @@ def continue_orbit_curve(start: Any, make2: Callable[[float, float], Solver], q0
         than START_TOL from the event's p).
     """
     orbit, u, p_event = _start_orbit(start, branch)
-    q0, q_end = float(q0), float(q_end)
-    if not (math.isfinite(q0) and math.isfinite(q_end)) or q0 == q_end:
-        raise ValueError(f"continue_orbit_curve: q0 = {q0!r}, q_end = {q_end!r}: give two "
-                         "different finite values")
-    if step is None:
-        step = abs(q_end - q0) / 20
-    if not (isinstance(step, (int, float)) and math.isfinite(step) and step > 0):
-        raise ValueError(f"continue_orbit_curve: step = {step!r}: must be finite and > 0")
+    q0, q_end, step = curve_range("continue_orbit_curve", q0, q_end, step)
     if not callable(make2):
         raise ValueError(f"continue_orbit_curve: make2 = {make2!r}: give a function "
                          "(p, q) -> dmi.Solver")
@@ -792,12 +785,7 @@ def _prepared(kind: str, start: Any, make2: Callable[[float, float], Solver], q0
     (``"period-doubling"`` or ``"torus"``; see :func:`continue_flip_curve`)."""
     who = "continue_flip_curve" if kind == "period-doubling" else "continue_torus_curve"
     orbit, p_event, bracket = _start(start, branch, kind, who)
-    if not (math.isfinite(q0) and math.isfinite(q_end)) or q0 == q_end:
-        raise ValueError(f"{who}: q0 = {q0!r}, q_end = {q_end!r}: give two different finite "
-                         "values")
-    step = abs(q_end - q0) / 20 if step is None else step
-    if not (isinstance(step, (int, float)) and math.isfinite(step) and step > 0):
-        raise ValueError(f"{who}: step = {step!r}: must be finite and > 0")
+    q0, q_end, step = curve_range(who, q0, q_end, step)
     if not callable(make2):
         raise ValueError(f"{who}: make2 = {make2!r}: give a function (p, q) -> dmi.Solver")
     if orbit.switches.size:

@@ -52,7 +52,7 @@ from ..collocation.orbit import EquationOrbit, equation_orbit
 from ..collocation.signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
 from ..collocation.system import Layout, Terms, assemble, evaluate, full_jacobian
 from ..continuation.branch import Branch, Curve, CurveEvent, Event
-from ..continuation.driver import bordered_det, continuation
+from ..continuation.driver import bordered_det, continuation, curve_range
 from ..core.newton import ShootingError, bordered_solve, newton_loop, sparse_bordered
 from ..scheme.problem import AtQ
 from ..scheme.stepmap import build
@@ -615,14 +615,7 @@ def continue_stick_curve(start: Any, make2: Callable[[float, float], Solver], q0
         boundary of ``make2(., q0)`` at the event's p (within START_TOL); ``period=`` for an
         autonomous orbit, not the start's period at (p, q0), or not finite and > 0.
     """
-    q0, q_end = float(q0), float(q_end)
-    if not (math.isfinite(q0) and math.isfinite(q_end)) or q0 == q_end:
-        raise ValueError(f"continue_stick_curve: q0 = {q0!r}, q_end = {q_end!r}: give two "
-                         "different finite values")
-    if step is None:
-        step = abs(q_end - q0) / 20
-    if not (isinstance(step, (int, float)) and math.isfinite(step) and step > 0):
-        raise ValueError(f"continue_stick_curve: step = {step!r}: must be finite and > 0")
+    q0, q_end, step = curve_range("continue_stick_curve", q0, q_end, step)
     if not callable(make2):
         raise ValueError(f"continue_stick_curve: make2 = {make2!r}: give a function "
                          "(p, q) -> dmi.Solver")

@@ -14,7 +14,6 @@ import math
 
 import numpy as np
 import pytest
-import scipy.optimize as so
 
 from dmi import analysis as da
 from dmi.analysis.continuation.branch import CurveEvent
@@ -34,15 +33,12 @@ def make2(mu: float, q: float):
 
 def hopf_closed_form() -> tuple[float, float]:
     """(Om, mu_H)."""
-    om = so.brentq(lambda w: w + hopf_models.ghat(1j * w, G, TAU).imag - W0, 0.1, 3.0,
-                   xtol=1e-15, rtol=1e-15)
-    return om, hopf_models.ghat(1j * om, G, TAU).real
+    return hopf_models.circle_hopf(W0, G, TAU)
 
 
 def fold_closed_form(q: float) -> tuple[float, float]:
     """(mu_F, r) of the fold of circles at q > 0."""
-    _, mu_h = hopf_closed_form()
-    return mu_h - q * q / (4 * abs(C2)), math.sqrt(q / (2 * abs(C2)))
+    return hopf_models.circle_fold(q, C2, W0, G, TAU)
 
 
 @pytest.fixture(scope="module")

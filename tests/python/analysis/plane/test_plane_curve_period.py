@@ -11,13 +11,16 @@ import math
 
 import numpy as np
 import pytest
-import scipy.optimize as so
-from scipy.integrate import solve_ivp
 
 import dmi
 
 from dmi import analysis as da
 from dmi.analysis.plane.orbit_curves import continue_flip_curve, continue_orbit_curve
+
+try:
+    from models import orbit_models
+except ImportError:
+    import orbit_models
 
 C = 0.1                       # the damping
 W0 = 1.4                      # the start's forcing frequency
@@ -40,24 +43,8 @@ def duffing_phase(F: float, w: float):
 
 
 def shooting_fold(w: float, guess: np.ndarray) -> float:
-    """F at the fold at frequency w: (x(0), F) with x(P) = x(0) and det(M - I) = 0, by DOP853."""
-    P = 2 * math.pi / w
-
-    def flow(x0, F):
-        def rhs(t, z):
-            A = np.array([[0.0, 1.0], [-1 - 3 * z[0] ** 2, -C]])
-            return np.concatenate([[z[1], -C * z[1] - z[0] - z[0] ** 3 + F * math.cos(w * t)],
-                                   (A @ z[2:].reshape(2, 2)).ravel()])
-        s = solve_ivp(rhs, (0, P), np.concatenate([x0, np.eye(2).ravel()]), method="DOP853",
-                      rtol=1e-13, atol=1e-13)
-        return s.y[:2, -1], s.y[2:, -1].reshape(2, 2)
-
-    def eqs(z):
-        xe, M = flow(z[:2], z[2])
-        return np.concatenate([xe - z[:2], [np.linalg.det(M - np.eye(2))]])
-    z = so.fsolve(eqs, guess, xtol=1e-12)
-    assert np.max(np.abs(eqs(z))) < 1e-11
-    return float(z[2])
+    """F at the fold at frequency w, by shooting with scipy's DOP853."""
+    return orbit_models.duffing_fold(C, w, guess)
 
 
 def fold_start(make2, period: float):

@@ -20,8 +20,6 @@ import math
 
 import numpy as np
 import pytest
-import scipy.optimize as so
-from scipy.integrate import solve_ivp
 
 import dmi
 
@@ -30,9 +28,10 @@ from dmi.analysis.continuation.branch import Event
 from dmi.analysis.plane.orbit_curves import OrbitCurvePoint, continue_orbit_curve
 
 try:   # the shared models' package (tests/python/models) or, before it, tests/python itself
-    from models import hopf_models
+    from models import hopf_models, orbit_models
 except ImportError:
     import hopf_models
+    import orbit_models
 
 W0, TAU, G, C2 = 1.0, 2.0, 0.3, -1.0
 Q0 = 1.0
@@ -44,15 +43,12 @@ def make2(mu: float, q: float):
 
 def hopf_closed_form() -> tuple[float, float]:
     """(Om, mu_H)."""
-    om = so.brentq(lambda w: w + hopf_models.ghat(1j * w, G, TAU).imag - W0, 0.1, 3.0,
-                   xtol=1e-15, rtol=1e-15)
-    return om, hopf_models.ghat(1j * om, G, TAU).real
+    return hopf_models.circle_hopf(W0, G, TAU)
 
 
 def fold_closed_form(q: float) -> tuple[float, float]:
     """(mu_F, r) of the fold of circles at q > 0."""
-    _, mu_h = hopf_closed_form()
-    return mu_h - q * q / (4 * abs(C2)), math.sqrt(q / (2 * abs(C2)))
+    return hopf_models.circle_fold(q, C2, W0, G, TAU)
 
 
 def unstable_roots(mu: float, q: float, r: float, delta: float = 1e-3, R: float = 40.0) -> int:
@@ -191,22 +187,8 @@ def duffing2(F: float, c: float):
 
 
 def duffing_fold(c: float, guess: np.ndarray) -> float:
-    """F at the fold: (x(0), F) with x(P) = x(0) and det(M - I) = 0, by scipy's DOP853."""
-    def flow(x0, F):
-        def rhs(t, z):
-            A = np.array([[0.0, 1.0], [-1 - 3 * z[0] ** 2, -c]])
-            return np.concatenate([[z[1], -c * z[1] - z[0] - z[0] ** 3 + F * math.cos(DW * t)],
-                                   (A @ z[2:].reshape(2, 2)).ravel()])
-        s = solve_ivp(rhs, (0, DP), np.concatenate([x0, np.eye(2).ravel()]), method="DOP853",
-                      rtol=1e-13, atol=1e-13)
-        return s.y[:2, -1], s.y[2:, -1].reshape(2, 2)
-
-    def eqs(z):
-        xe, M = flow(z[:2], z[2])
-        return np.concatenate([xe - z[:2], [np.linalg.det(M - np.eye(2))]])
-    z = so.fsolve(eqs, guess, xtol=1e-12)
-    assert np.max(np.abs(eqs(z))) < 1e-11
-    return float(z[2])
+    """F at the fold at damping c (forcing frequency DW), by shooting with scipy's DOP853."""
+    return orbit_models.duffing_fold(c, DW, guess)
 
 
 def harmonic_balance_fold(c: float) -> float:
