@@ -203,6 +203,21 @@ class Terms:
                     | (near.C != 0 if near is not None else False))
         return np.ones((self.n, self.n), bool)
 
+    def same_memory(self, other: Terms) -> bool:
+        """Whether other's delay integral is this one's: no kernel in both, or the same
+        exponential sum, near part, jumps and tau (a callback kernel is never known to be)."""
+        if self.kind != other.kind or self.tau != other.tau:
+            return False
+        if self.kind == "":
+            return True
+        a, b = self.H.near, other.H.near
+        if self.kind != "exp" or (a is None) != (b is None) or self.H.jumps != other.H.jumps:
+            return False
+        if a is not None and not (a.delta == b.delta and a.beta == b.beta  # type: ignore[union-attr]
+                                  and np.array_equal(a.C, b.C)):         # type: ignore[union-attr]
+            return False
+        return all(np.array_equal(x, y) for x, y in zip(self.terms, other.terms))
+
     @property
     def has_kernel(self) -> bool:
         """Whether the model has a kernel."""

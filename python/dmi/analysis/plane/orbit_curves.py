@@ -73,10 +73,11 @@ import scipy.sparse as sp
 
 from ..._solver import Solver
 from ..collocation.adapt import FLOOR
-from ..collocation.mesh import interval_of, periodic_locator, point_matrix
+from ..collocation.mesh import interval_of, point_matrix
 from ..collocation.orbit import EquationOrbit, equation_orbit
 from ..collocation.signature import HI, LO, STUCK
-from ..collocation.system import CollocationWarning, Layout, Terms, assemble, full_jacobian
+from ..collocation.system import (CollocationWarning, Layout, Terms, assemble,
+                                  collocation_matrices, full_jacobian)
 from ..continuation.branch import Branch, Curve, CurveEvent, Event
 from ..continuation.driver import Curve as DriverCurve
 from ..continuation.driver import continuation, curve_range, newton_strategy
@@ -89,6 +90,9 @@ START_TOL = 1e-6
 #: A turn back in q where the orbits' amplitude is below this share of the curve's largest is
 #: the fold curve's end at a Bautin point (the curve in x passes through the equilibrium).
 BAUTIN_SHARE = 0.2
+# the step along v (relative, against the orbit's largest |u|) of the one-sided differences of
+# f's change at a moved parameter: its truncation and rounding errors balance near 3e-5
+CHANGE_STEP = 3e-5
 
 
 class OrbitFold(FoldSystem):
@@ -473,7 +477,7 @@ class Twisted:
         D = point_matrix(self.tc, loc, basis, mesh, n, R, derivative=True)
         self.wrap, self.node, self.n = np.arange(R) // Lm + kmin, np.arange(R) % Lm, n
         # u at the collocation points as the periodic system computes it (f_u's kept value)
-        self.U = (point_matrix(self.tc, periodic_locator(mesh, m), basis, mesh, n, Lm)
+        self.U = (collocation_matrices(basis, np.diff(mesh), n, lay.rows, periodic=True)[0]
                   @ V.ravel()).reshape(-1, n)
         self.fu = fu = terms.fu(self.tc, self.U) if fu is None else fu
         A = D + sp.block_diag(list(fu), format="csr") @ self.E
@@ -483,6 +487,7 @@ class Twisted:
         self.held = (mode == STUCK) | (mode == LO) | (mode == HI)
         hv = self.held.ravel().astype(float)
         self.Av = (sp.diags(1.0 - hv) @ A + sp.diags(hv) @ self.E).tocsr()
+        self._along: dict[tuple, np.ndarray] = {}
 
     def fold(self, mu: complex, derivative: bool = False) -> sp.csr_matrix:
         """Phi(mu) (R n, L m n): row (r, a) to column (node(r), a) times mu^wrap(r); with
@@ -517,6 +522,28 @@ class Twisted:
             out += unit * np.einsum("pa,pab->pb", W, d)
         row = (self.E @ self.fold(1.0)).T @ out.ravel()
         return row
+
+
+    def change(self, terms: Terms, moved: Terms, v: np.ndarray, w: np.ndarray, mu: complex
+               ) -> complex:
+        """w' (A_mu of ``moved`` - A_mu) v where ``moved`` (the model at a moved parameter) has
+        this mesh and this memory: f_u's change along v against w, by one-sided differences of
+        the change in f along v (f at the orbit kept by both)."""
+        Ev = (self.E @ (self.fold(mu) @ v)).reshape(-1, self.n)
+        W = np.where(self.held, 0.0, w.reshape(-1, self.n))
+        out = 0j
+        for k, (part, unit) in enumerate(((Ev.real, 1.0), (Ev.imag, 1j))):
+            big = float(np.max(np.abs(part)))
+            if big == 0:
+                continue
+            eps = CHANGE_STEP * max(1.0, float(np.max(np.abs(self.U)))) / big
+            key = (k, complex(mu), v.tobytes())
+            if key not in self._along:
+                self._along[key] = (terms._rhs(self.tc, self.U + eps * part)
+                                    - terms.f(self.tc, self.U)) / eps
+            d = (moved._rhs(self.tc, self.U + eps * part) - moved.f(self.tc, self.U)) / eps
+            out += unit * complex(np.sum(W * (d - self._along[key])))
+        return out
 
 
 def _twisted_pair(A: Any, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, complex, np.ndarray]:
@@ -614,8 +641,25 @@ class OrbitFlip(OrbitFold):
     def _grad(self, ev: dict, y: np.ndarray, A1: Any, d: float) -> np.ndarray:
         """-w' (A1 - A_mu) v / d as g's rows (Re, Im)."""
         mu = self.mu(y)
-        dg = -self.gscale * complex(ev["w"] @ ((A1 - ev["tw"].matrix(mu)) @ ev["v"])) / d
+        return self._rows(complex(ev["w"] @ ((A1 - ev["tw"].matrix(mu)) @ ev["v"])), d)
+
+    def _rows(self, change: complex, d: float) -> np.ndarray:
+        """-change / d as g's rows (Re, Im)."""
+        dg = -self.gscale * change / d
         return np.array([dg.real, dg.imag][:self.extra])
+
+    def _moved(self, ev: dict, y: np.ndarray, p1: float, q1: float, d: float
+               ) -> tuple[np.ndarray, np.ndarray]:
+        """(F's and g's derivatives) by the difference to (p1, q1) = (p, q) moved by d: g's
+        from f's change along v (:meth:`Twisted.change`) where the mesh and the memory stay,
+        else from the twisted matrix assembled there."""
+        x, _ = self._split(y)
+        t1, l1 = self.terms(p1, q1), self.layout(p1, q1)
+        F1 = (assemble(l1, t1, x, self.ref, jacobian=False)[0] - ev["r"]) / d
+        if self.period is None and ev["terms"].same_memory(t1):
+            return F1, self._rows(ev["tw"].change(ev["terms"], t1, ev["v"], ev["w"],
+                                                  self.mu(y)), d)
+        return F1, self._grad(ev, y, Twisted(l1, t1, x).matrix(self.mu(y)), d)
 
     def _jy(self, y: np.ndarray, q: float) -> tuple[Any, np.ndarray, np.ndarray, dict]:
         """(J, the columns of p (and theta), g's rows in y, the evaluation) at (y, q)."""
@@ -630,9 +674,7 @@ class OrbitFlip(OrbitFold):
             # f_u of an autonomous f is the same at the moved times
             gT = self._grad(ev, y, Twisted(self.lay, t, x, T + dT, tw.fu).matrix(mu), dT)
         d = DIFF * max(1.0, abs(p))
-        tp, lp = self.terms(p + d, q), self.layout(p + d, q)
-        Fp = (assemble(lp, tp, x, self.ref, jacobian=False)[0] - ev["r"]) / d
-        gp = self._grad(ev, y, Twisted(lp, tp, x).matrix(mu), d)
+        Fp, gp = self._moved(ev, y, p + d, q, d)
         rows = np.vstack([gx.real, gx.imag])[:self.extra]
         if self.lay.autonomous:
             rows[:, -1] = gT
@@ -649,9 +691,7 @@ class OrbitFlip(OrbitFold):
         J, cols, rows, ev = self._jy(y, q)
         x, p = self._split(y)
         d = DIFF * max(1.0, abs(q))
-        tq, lq = self.terms(p, q + d), self.layout(p, q + d)
-        Fq = (assemble(lq, tq, x, self.ref, jacobian=False)[0] - ev["r"]) / d
-        gq = self._grad(ev, y, Twisted(lq, tq, x).matrix(self.mu(y)), d)
+        Fq, gq = self._moved(ev, y, p, q + d, d)
         return sparse_bordered(J, cols, rows), np.concatenate([Fq, gq])
 
     def strategies(self, y: np.ndarray, q: float, row: np.ndarray, target: float, far: float
