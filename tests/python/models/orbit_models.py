@@ -3,7 +3,9 @@
 # - Den Hartog's non-stick orbit of x'' + x + F0 sign(x') = F cos(w t) (Den Hartog 1931;
 #   Shaw 1986) and its Floquet multipliers by a saltation analysis;
 # - the stick-slip orbit of u' + sigma(u) ∋ c sin t, c > 1, slip phases in closed form;
-# - the fold of the forced Duffing oscillator's resonance by shooting with scipy's DOP853.
+# - the stick onset of Den Hartog's orbit (where the net force at a reversal reaches F0);
+# - bifurcations of forced orbits by shooting with scipy's DOP853 (x(P) = x(0) and a condition
+#   on the monodromy matrix), the fold of the forced Duffing oscillator's resonance.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -46,20 +48,8 @@ class DenHartog:
     #     x(t0) = -a, x'(t0) = 0, x(t0 + T/2) = a, x'(t0 + T/2) = 0; x(t + T/2) = -x(t).
     def _solve(self) -> None:
         w, F0, T = self.w, self.F0, self.T
-        Q, Th = self.F / (1 - w * w), T / 2
-
-        def eqs(z):
-            C1, C2, a, t0 = z
-            s, c = np.sin(w * t0), np.cos(w * t0)
-            return [-F0 + C1 + Q * c + a, C2 - Q * w * s,
-                    -F0 + C1 * np.cos(Th) + C2 * np.sin(Th) - Q * c - a,
-                    -C1 * np.sin(Th) + C2 * np.cos(Th) + Q * w * s]
-        for t0 in np.linspace(0, T, 25, endpoint=False):
-            z, _, ier, _ = so.fsolve(eqs, [0, 0, abs(Q), t0], full_output=True, xtol=1e-14)
-            if ier == 1 and z[2] > 0 and max(map(abs, eqs(z))) < 1e-12:
-                break
-        else:
-            raise RuntimeError("no Den Hartog orbit")
+        Th = T / 2
+        z = den_hartog_orbit(w, self.F, F0, guesses=(1.0,))
         self.C1, self.C2, self.a, self.t0 = z[0], z[1], z[2], z[3] % T
         r = np.linspace(0, Th, 4001)[1:-1]  # x' > 0 inside the half [t0, t0 + T/2]
         if np.any(self.exact(self.t0 + r)[1] <= 0):
@@ -89,6 +79,36 @@ class DenHartog:
         x = s * (-self.F0 + self.C1 * np.cos(r) + self.C2 * np.sin(r)) + Q * np.cos(w * t)
         v = s * (-self.C1 * np.sin(r) + self.C2 * np.cos(r)) - Q * w * np.sin(w * np.asarray(t))
         return x, v
+
+
+def den_hartog_orbit(w: float, F: float, F0: float, guesses: tuple[float, ...] = (1.0, 0.5, 2.0)
+                     ) -> tuple[float, float, float, float]:
+    """(C1, C2, a, t0) of Den Hartog's orbit (zeta = 0, see :class:`DenHartog`): the four
+    conditions at the reversals by fsolve from a = g |Q| (g in guesses) and 25 phases t0."""
+    T = 2 * np.pi / w
+    Q, Th = F / (1 - w * w), T / 2
+
+    def eqs(z):
+        C1, C2, a, t0 = z
+        s, c = np.sin(w * t0), np.cos(w * t0)
+        return [-F0 + C1 + Q * c + a, C2 - Q * w * s,
+                -F0 + C1 * np.cos(Th) + C2 * np.sin(Th) - Q * c - a,
+                -C1 * np.sin(Th) + C2 * np.cos(Th) + Q * w * s]
+    for g in guesses:
+        for t0 in np.linspace(0, T, 25, endpoint=False):
+            z, _, ier, _ = so.fsolve(eqs, [0, 0, g * abs(Q), t0], full_output=True, xtol=1e-14)
+            if ier == 1 and z[2] > 0 and max(map(abs, eqs(z))) < 1e-12:
+                return tuple(float(v) for v in z)
+    raise RuntimeError(f"no Den Hartog orbit at w = {w}, F = {F}")
+
+
+def den_hartog_onset(w: float, F0: float, lo: float, hi: float) -> float:
+    """The forcing F in [lo, hi] where the net force at Den Hartog's orbit's reversal reaches
+    F0, |F cos(w (t0 + T / 2)) - a| = F0 (its stick onset), by brentq."""
+    def margin(F: float) -> float:
+        _, _, a, t0 = den_hartog_orbit(w, F, F0)
+        return abs(F * np.cos(w * t0 + np.pi) - a) - F0
+    return so.brentq(margin, lo, hi, xtol=1e-14, rtol=1e-15)
 
 
 class StickSlip1:
@@ -334,23 +354,36 @@ class BumpStick:
         return 2 * np.pi - slip, phases
 
 
+def flow(rhs, n: int, P: float, x0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(x(P), M) of x' = f(t, x) from x0 at t = 0 and its monodromy M, by scipy's DOP853 on the
+    variational equation; rhs(t, x) -> (f, f_x)."""
+    def both(t, z):
+        f, A = rhs(t, z[:n])
+        return np.concatenate([f, (np.asarray(A) @ z[n:].reshape(n, n)).ravel()])
+    s = solve_ivp(both, (0, P), np.concatenate([x0, np.eye(n).ravel()]), method="DOP853",
+                  rtol=1e-13, atol=1e-13)
+    return s.y[:n, -1], s.y[n:, -1].reshape(n, n)
+
+
+def forced_bifurcation(rhs_at, P: float, guess: np.ndarray, condition, xtol: float = 1e-13
+                       ) -> tuple[np.ndarray, float]:
+    """(x0, p) of the P-periodic orbit x(P) = x0 with condition(M) = 0 (M its monodromy), by
+    fsolve on :func:`flow` from guess = (x0, p); rhs_at(p) is flow's rhs at p."""
+    n = guess.size - 1
+
+    def eqs(z):
+        xe, M = flow(rhs_at(z[n]), n, P, z[:n])
+        return np.concatenate([xe - z[:n], [condition(M)]])
+    z = so.fsolve(eqs, guess, xtol=xtol)
+    assert np.max(np.abs(eqs(z))) < 1e-11
+    return z[:n], float(z[n])
+
+
 def duffing_fold(c: float, w: float, guess: np.ndarray) -> float:
     """F at the fold of x'' + c x' + x + x^3 = F cos(w t): (x(0), F) with x(P) = x(0) and
     det(M - I) = 0 (M the monodromy, P = 2 pi / w), by scipy's DOP853 and fsolve from guess."""
-    P = 2 * math.pi / w
-
-    def flow(x0, F):
-        def rhs(t, z):
-            A = np.array([[0.0, 1.0], [-1 - 3 * z[0] ** 2, -c]])
-            return np.concatenate([[z[1], -c * z[1] - z[0] - z[0] ** 3 + F * math.cos(w * t)],
-                                   (A @ z[2:].reshape(2, 2)).ravel()])
-        s = solve_ivp(rhs, (0, P), np.concatenate([x0, np.eye(2).ravel()]), method="DOP853",
-                      rtol=1e-13, atol=1e-13)
-        return s.y[:2, -1], s.y[2:, -1].reshape(2, 2)
-
-    def eqs(z):
-        xe, M = flow(z[:2], z[2])
-        return np.concatenate([xe - z[:2], [np.linalg.det(M - np.eye(2))]])
-    z = so.fsolve(eqs, guess, xtol=1e-12)
-    assert np.max(np.abs(eqs(z))) < 1e-11
-    return float(z[2])
+    def rhs_at(F):
+        return lambda t, x: ([x[1], -c * x[1] - x[0] - x[0] ** 3 + F * math.cos(w * t)],
+                             [[0.0, 1.0], [-1 - 3 * x[0] ** 2, -c]])
+    return forced_bifurcation(rhs_at, 2 * math.pi / w, guess,
+                              lambda M: np.linalg.det(M - np.eye(2)), xtol=1e-12)[1]
