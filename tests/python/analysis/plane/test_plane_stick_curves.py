@@ -37,7 +37,7 @@ from dmi import analysis as da
 from dmi.analysis.continuation.branch import Event
 from dmi.analysis.plane.stick_curves import StickCurvePoint, continue_stick_curve
 
-from models import hopf_models
+from models import hopf_models, orbit_models
 
 # ---- Den Hartog's oscillator in the forcing phase: p = F, q = w -----------------------------
 F0 = 0.3
@@ -52,31 +52,9 @@ def den_hartog(F: float, w: float, M: int = 400) -> dmi.Solver:
     return s
 
 
-def den_hartog_orbit(F: float, w: float) -> tuple[float, float, float, float]:
-    """(C1, C2, a, t0) of Den Hartog's non-stick orbit (time t)."""
-    T = 2 * np.pi / w
-    Th, Q = T / 2, F / (1 - w * w)
-
-    def eqs(z):
-        C1, C2, a, t0 = z
-        s, c = np.sin(w * t0), np.cos(w * t0)
-        return [-F0 + C1 + Q * c + a, C2 - Q * w * s,
-                -F0 + C1 * np.cos(Th) + C2 * np.sin(Th) - Q * c - a,
-                -C1 * np.sin(Th) + C2 * np.cos(Th) + Q * w * s]
-    for t0 in np.linspace(0, T, 25, endpoint=False):
-        for a0 in (abs(Q), 0.5 * abs(Q), 2 * abs(Q)):
-            z, _, _, _ = so.fsolve(eqs, [0, 0, a0, t0], full_output=True, xtol=1e-14)
-            if z[2] > 0 and max(map(abs, eqs(z))) < 1e-11:
-                return tuple(z)
-    raise RuntimeError(f"no Den Hartog orbit at F = {F}, w = {w}")
-
-
 def den_hartog_onset(w: float) -> float:
     """The forcing F where the net force at the reversal reaches F0 (the stick onset)."""
-    def margin(F: float) -> float:
-        _, _, a, t0 = den_hartog_orbit(F, w)
-        return abs(F * np.cos(w * (t0 + np.pi / w)) - a) - F0
-    return so.brentq(margin, 0.34, 0.9, xtol=1e-14, rtol=1e-15)
+    return orbit_models.den_hartog_onset(w, F0, 0.34, 0.9)
 
 
 @pytest.fixture(scope="module")
