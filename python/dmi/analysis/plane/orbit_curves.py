@@ -642,11 +642,9 @@ class SwitchTwisted:
         """w' (d A_mu / d x_j) v over x: the node values from f_u's change along v at the
         collocation points and the stick endings, the switching-time columns' change along v's
         switching times (two assemblies a real part) and u*''s in the past's saltation; the
-        switching times (and T) by differences of A_mu assembled again."""
+        switching times (and T) by central differences of A_mu assembled again."""
         lay, n = self.lay, self.n
         S, nc = lay.S, self.nc
-        A = self.matrix(mu)
-        base = complex(w @ (A @ v))
         full = np.zeros(nc + self.nh, dtype=complex)        # over the history system's nodes
         full[:nc] += self._fu_part(v, w)
         full += self._switch_part(v, w)
@@ -655,13 +653,14 @@ class SwitchTwisted:
         np.add.at(rows, self.node_of, full.reshape(-1, n))
         rows += self._slope_part(v, w, mu)
         out = np.concatenate([rows.ravel(), np.zeros(lay.size - rows.size, dtype=complex)])
-        T = lay.split(self.x)[2]
+        d = 1e-6 * lay.split(self.x)[2]          # central differences, as full_jacobian's
         for jx in range(lay.rows * n, lay.size):
-            d = DIFF * T
-            x1 = self.x.copy()
+            x1, x2 = self.x.copy(), self.x.copy()
             x1[jx] += d
+            x2[jx] -= d
             A1 = SwitchTwisted(lay, self.terms, x1).matrix(mu)
-            out[jx] = (complex(w @ (A1 @ v)) - base) / d
+            A2 = SwitchTwisted(lay, self.terms, x2).matrix(mu)
+            out[jx] = complex(w @ ((A1 - A2) @ v)) / (2 * d)
         return out
 
     def _fu_part(self, v: np.ndarray, w: np.ndarray) -> np.ndarray:
