@@ -55,8 +55,11 @@ of A_mu, along theta exactly; they only steer Newton.  The borders start from a 
 inverse iteration at the start and move to the last point's conj(v), conj(w) after every step.
 
 Covered: orbits without switches (smooth orbits; a component held for the whole period is
-allowed), with or without a memory.  An orbit with switches (stick-slip, contacts) is refused:
-its saltation is not in A_mu yet.  A curve ends where its orbit would leave its signature (a
+allowed), with or without a memory, and period doublings of orbits with switches
+(:class:`SwitchTwisted`: A_mu from the collocation system of one period forward from a past,
+the past read as mu^-k times the period's perturbation at fixed times, the saltation
+included; g's gradient also over the switching times).  A torus curve of an orbit with
+switches is refused (not covered yet).  A curve ends where its orbit would leave its signature (a
 stick onset or grazing meets it), a torus curve where theta reaches 0 or pi (the pair e^(+-i
 theta) meets at +1 or -1: a 1:1 or 1:2 resonance, where a neutral saddle follows).
 """
@@ -461,8 +464,8 @@ class Twisted:
     def __init__(self, lay: Layout, terms: Terms, x: np.ndarray, T: float | None = None,
                  fu: np.ndarray | None = None):
         if lay.S:
-            raise ValueError("the orbit has switches: period-doubling and torus curves of "
-                             "orbits with switches (their saltation) are not covered yet")
+            raise ValueError("the orbit has switches: its twisted matrix is SwitchTwisted's "
+                             "(the saltation included)")
         m, n, basis = lay.m, lay.n, lay.basis
         V, b, T0 = lay.split(x)
         T = T0 if T is None else float(T)
@@ -573,6 +576,12 @@ class SwitchTwisted:
         The period k >= 1 each past entry lies behind.
     U, fu, held : numpy.ndarray
         The orbit and f_u at the collocation points, the held components there.
+    n, mesh, hist, nc, nh : int, numpy.ndarray, History, int, int
+        The dimension, the mesh, the past (the orbit's periods), the period's and the past's
+        node columns.
+    dz, h, node_of, tc, E : numpy.ndarray, ..., scipy.sparse.csr_matrix
+        The basis' derivatives at its nodes, the intervals' lengths, x's node row of each node
+        row of the history system, the collocation times, u there from the period's nodes.
     """
 
     def __init__(self, lay: Layout, terms: Terms, x: np.ndarray):
@@ -641,10 +650,9 @@ class SwitchTwisted:
     def x_row(self, v: np.ndarray, w: np.ndarray, mu: complex) -> np.ndarray:
         """w' (d A_mu / d x_j) v over x: the node values from f_u's change along v at the
         collocation points and the stick endings, the switching-time columns' change along v's
-        switching times (two assemblies a real part) and u*''s in the past's saltation; the
+        switching times (two assemblies a real part) and u*' in the past's saltation; the
         switching times (and T) by central differences of A_mu assembled again."""
-        lay, n = self.lay, self.n
-        S, nc = lay.S, self.nc
+        lay, n, nc = self.lay, self.n, self.nc
         full = np.zeros(nc + self.nh, dtype=complex)        # over the history system's nodes
         full[:nc] += self._fu_part(v, w)
         full += self._switch_part(v, w)
@@ -1113,7 +1121,7 @@ def continue_flip_curve(start: Any, make2: Callable[[float, float], Solver], q0:
     start : Event or EquationOrbit
         A ``period-doubling`` event of a branch of EquationOrbits of ``make2(., q0)`` (give that
         Branch as ``branch=``), or an EquationOrbit of ``make2(., q0)`` near a period doubling.
-        Orbits without switches only.
+        Orbits with switches (stick-slip, reversals) too.
     make2, q0, q_end, branch, step, at, max_points
         As :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`'s.
     min_step, max_step, multipliers, tol, max_iter, estimate, period
@@ -1130,8 +1138,7 @@ def continue_flip_curve(start: Any, make2: Callable[[float, float], Solver], q0:
     Raises
     ------
     ValueError
-        A start of another kind, an event without its branch, an orbit with switches, bad q0,
-        q_end or step; a start that is not a period doubling of ``make2(., q0)`` (Newton fails
+        A start of another kind, an event without its branch, bad q0, q_end or step; a start that is not a period doubling of ``make2(., q0)`` (Newton fails
         at q0, or finds it outside the event's two points widened by their distance).
     """
     q0, q_end = float(q0), float(q_end)
@@ -1160,7 +1167,8 @@ def continue_torus_curve(start: Any, make2: Callable[[float, float], Solver], q0
     start : Event or EquationOrbit
         A ``torus`` event of a branch of EquationOrbits of ``make2(., q0)`` (with ``branch=``),
         or an EquationOrbit near a torus bifurcation (theta starts from its non-real
-        multiplier nearest the unit circle).  Orbits without switches only.
+        multiplier nearest the unit circle).  Orbits without switches only (an orbit with
+        switches is refused).
     make2, q0, q_end, branch, step, at, max_points
         As :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`'s (the arclength also
         counts theta, in radians).
@@ -1177,7 +1185,8 @@ def continue_torus_curve(start: Any, make2: Callable[[float, float], Solver], q0
     Raises
     ------
     ValueError
-        As :func:`continue_flip_curve`'s; a start orbit without a non-real multiplier.
+        As :func:`continue_flip_curve`'s; a start orbit without a non-real multiplier, or with
+        switches.
     """
     q0, q_end = float(q0), float(q_end)
     disc, y0, step = _prepared("torus", start, make2, q0, q_end, branch, step,
