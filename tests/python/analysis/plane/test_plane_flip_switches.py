@@ -12,7 +12,7 @@
 # moves by less than 1e-9 when the differences' step changes tenfold.
 # Also the twisted matrix A_mu of the orbit with switches, singular at the collocated orbit's
 # multipliers (floquet), g's gradient in x against differences, and the refusal of a torus curve
-# of an orbit with switches.  About 40 s.
+# of an orbit with switches.  About 60 s.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
