@@ -55,8 +55,11 @@ of A_mu, along theta exactly; they only steer Newton.  The borders start from a 
 inverse iteration at the start and move to the last point's conj(v), conj(w) after every step.
 
 Covered: orbits without switches (smooth orbits; a component held for the whole period is
-allowed), with or without a memory.  An orbit with switches (stick-slip, contacts) is refused:
-its saltation is not in A_mu yet.  A curve ends where its orbit would leave its signature (a
+allowed), with or without a memory, and period doublings of orbits with switches
+(:class:`SwitchTwisted`: A_mu from the collocation system of one period forward from a past,
+the past read as mu^-k times the period's perturbation at fixed times, the saltation
+included; g's gradient also over the switching times).  A torus curve of an orbit with
+switches is refused (not covered yet).  A curve ends where its orbit would leave its signature (a
 stick onset or grazing meets it), a torus curve where theta reaches 0 or pi (the pair e^(+-i
 theta) meets at +1 or -1: a 1:1 or 1:2 resonance, where a neutral saddle follows).
 """
@@ -76,8 +79,8 @@ from ..collocation.adapt import FLOOR
 from ..collocation.mesh import interval_of, point_matrix
 from ..collocation.orbit import EquationOrbit, equation_orbit
 from ..collocation.signature import HI, LO, STUCK
-from ..collocation.system import (CollocationWarning, Layout, Terms, assemble,
-                                  collocation_matrices, full_jacobian)
+from ..collocation.system import (CollocationWarning, History, Layout, Terms, assemble,
+                                  collocation_matrices, force_switches, full_jacobian)
 from ..continuation.branch import Branch, Curve, CurveEvent, Event
 from ..continuation.driver import Curve as DriverCurve
 from ..continuation.driver import continuation, curve_range, newton_strategy
@@ -461,8 +464,8 @@ class Twisted:
     def __init__(self, lay: Layout, terms: Terms, x: np.ndarray, T: float | None = None,
                  fu: np.ndarray | None = None):
         if lay.S:
-            raise ValueError("the orbit has switches: period-doubling and torus curves of "
-                             "orbits with switches (their saltation) are not covered yet")
+            raise ValueError("the orbit has switches: its twisted matrix is SwitchTwisted's "
+                             "(the saltation included)")
         m, n, basis = lay.m, lay.n, lay.basis
         V, b, T0 = lay.split(x)
         T = T0 if T is None else float(T)
@@ -487,7 +490,6 @@ class Twisted:
         self.held = (mode == STUCK) | (mode == LO) | (mode == HI)
         hv = self.held.ravel().astype(float)
         self.Av = (sp.diags(1.0 - hv) @ A + sp.diags(hv) @ self.E).tocsr()
-        self._along: dict[tuple, np.ndarray] = {}
 
     def fold(self, mu: complex, derivative: bool = False) -> sp.csr_matrix:
         """Phi(mu) (R n, L m n): row (r, a) to column (node(r), a) times mu^wrap(r); with
@@ -505,6 +507,10 @@ class Twisted:
     def matrix(self, mu: complex) -> sp.csc_matrix:
         """A_mu (L m n square)."""
         return sp.csc_matrix(self.Av @ self.fold(mu))
+
+    def dmatrix(self, mu: complex) -> sp.csc_matrix:
+        """d A_mu / d theta at mu = e^(i theta)."""
+        return sp.csc_matrix(self.Av @ self.fold(mu, True))
 
     def fu_row(self, terms: Terms, v: np.ndarray, w: np.ndarray, mu: complex) -> np.ndarray:
         """w' (d A_mu / d x_j) v over the node values x_j: the change of f_u at the collocation
@@ -532,18 +538,230 @@ class Twisted:
         Ev = (self.E @ (self.fold(mu) @ v)).reshape(-1, self.n)
         W = np.where(self.held, 0.0, w.reshape(-1, self.n))
         out = 0j
-        for k, (part, unit) in enumerate(((Ev.real, 1.0), (Ev.imag, 1j))):
+        for part, unit in ((Ev.real, 1.0), (Ev.imag, 1j)):
             big = float(np.max(np.abs(part)))
             if big == 0:
                 continue
             eps = CHANGE_STEP * max(1.0, float(np.max(np.abs(self.U)))) / big
-            key = (k, complex(mu), v.tobytes())
-            if key not in self._along:
-                self._along[key] = (terms._rhs(self.tc, self.U + eps * part)
-                                    - terms.f(self.tc, self.U)) / eps
+            here = (terms._rhs(self.tc, self.U + eps * part) - terms.f(self.tc, self.U)) / eps
             d = (moved._rhs(self.tc, self.U + eps * part) - moved.f(self.tc, self.U)) / eps
-            out += unit * complex(np.sum(W * (d - self._along[key])))
+            out += unit * complex(np.sum(W * (d - here)))
         return out
+
+
+class SwitchTwisted:
+    """The twisted matrix A_mu of an orbit with switches, from the collocation system of one
+    period forward from a history (the monodromy operator's,
+    :func:`dmi.analysis.collocation.floquet.monodromy`): its unknowns are the period's node
+    values (L m + 1 rows, u(T) too) and the switching times, its rows the collocation, u(0) =
+    phi(0-) and the switching conditions; the past's nodes (the perturbation at fixed times) are
+    read as mu^-k times the period's: the node's value minus u*' (one-sided, inside its interval)
+    times the node's motion with the switches (the saltation), so that A_mu is singular exactly
+    at the monodromy's multipliers.
+
+    Attributes
+    ----------
+    lay, terms, x : Layout, Terms, numpy.ndarray
+        The orbit.
+    Jcur, Jhist : scipy.sparse.csc_matrix
+        The history system's Jacobian: the period's columns (nodes, then switching times) and
+        the past's node columns.
+    B : scipy.sparse.csr_matrix
+        The past's nodes from the period's unknowns before the factor mu^-k.
+    back : numpy.ndarray
+        The period k >= 1 each past entry lies behind.
+    U, fu, held : numpy.ndarray
+        The orbit and f_u at the collocation points, the held components there.
+    n, mesh, hist, nc, nh : int, numpy.ndarray, History, int, int
+        The dimension, the mesh, the past (the orbit's periods), the period's and the past's
+        node columns.
+    dz, h, node_of, tc, E : numpy.ndarray, ..., scipy.sparse.csr_matrix
+        The basis' derivatives at its nodes, the intervals' lengths, x's node row of each node
+        row of the history system, the collocation times, u there from the period's nodes.
+    """
+
+    def __init__(self, lay: Layout, terms: Terms, x: np.ndarray):
+        m, n, L = lay.m, lay.n, lay.L
+        V, b, T = lay.split(x)
+        mesh = lay.mesh(b, T)
+        P = max(1, math.ceil(terms.tau / T - 1e-12))
+        k = np.arange(m + 1)
+        src = (np.arange(L)[:, None] * m + k[None, :]) % lay.rows           # (L, m + 1)
+        one = V[src]
+        self.lay, self.terms, self.x, self.n, self.mesh = lay, terms, x, n, mesh
+        self.hist = History(mesh, P, np.tile(one, (P, 1, 1)).reshape(-1, n))
+        J = sp.csc_matrix(full_jacobian(lay, terms, x, None, history=self.hist)[1])
+        nc, nh = (lay.rows + 1) * n, P * L * (m + 1) * n
+        self.nc, self.nh = nc, nh
+        self.Jcur = sp.hstack([J[:, :nc], J[:, nc + nh:]], format="csc")
+        self.Jhist = J[:, nc:nc + nh]
+        self.dz = lay.basis.derivatives(lay.basis.nodes)                     # (m + 1, m + 1)
+        self.h = np.diff(mesh)
+        slope = np.einsum("ij,ljn->lin", self.dz, one) / self.h[:, None, None]
+        left, right = lay.node_motion()
+        piece = lay.piece_of_interval()
+        who = lay.ends(b, T)[1]
+        # the past's entries (g, j, c): interval g (oldest first), node j, component c
+        g = np.repeat(np.arange(P * L), (m + 1) * n)
+        i = g % L
+        j = np.tile(np.repeat(k, n), P * L)
+        c = np.tile(np.arange(n), P * L * (m + 1))
+        self.back = P - g // L
+        row = np.arange(nh)
+        rr, cc, vv = [row], [(i * m + j) * n + c], [np.ones(nh)]
+        for motion, end in ((left, who[piece[i]]), (right, who[piece[i] + 1])):
+            on = end >= 0
+            rr.append(row[on])
+            cc.append(nc + end[on])
+            vv.append(-slope[i, j, c][on] * motion[i, j][on])
+        self.B = sp.csr_matrix((np.concatenate(vv), (np.concatenate(rr), np.concatenate(cc))),
+                               shape=(nh, nc + lay.S))
+        # the state's map to x's node values: the period's rows (u(T): row 0), the past's
+        self.node_of = np.concatenate([np.arange(lay.rows), [0],     # x's row of each node
+                                       src[np.arange(P * L) % L].ravel()])
+        gz, _ = lay.basis.gauss()
+        self.tc = (mesh[:-1, None] + self.h[:, None] * gz[None, :]).ravel()
+        self.E = collocation_matrices(lay.basis, self.h, n, lay.rows + 1, periodic=False)[0]
+        self.U = (self.E @ np.concatenate([V.ravel(), V[0]])).reshape(-1, n)
+        self.fu = terms.fu(self.tc, self.U)
+        mode = np.repeat(np.array(lay.piece_modes(b, T))[piece], m, axis=0)
+        self.held = (mode == STUCK) | (mode == LO) | (mode == HI)
+
+    def _phi(self, mu: complex, derivative: bool = False) -> sp.csr_matrix:
+        """mu^-k B (with ``derivative``: its derivative in theta at mu = e^(i theta))."""
+        k = self.back.astype(float)
+        val = complex(mu) ** (-k) if isinstance(mu, complex) else float(mu) ** (-k)
+        if derivative:
+            val = -1j * k * val
+        return sp.diags(val) @ self.B
+
+    def matrix(self, mu: complex) -> sp.csc_matrix:
+        """A_mu (square: (L m + 1) n + S)."""
+        return sp.csc_matrix(self.Jcur + self.Jhist @ self._phi(mu))
+
+    def dmatrix(self, mu: complex) -> sp.csc_matrix:
+        """d A_mu / d theta at mu = e^(i theta)."""
+        return sp.csc_matrix(self.Jhist @ self._phi(mu, True))
+
+    def x_row(self, v: np.ndarray, w: np.ndarray, mu: complex) -> np.ndarray:
+        """w' (d A_mu / d x_j) v over x: the node values from f_u's change along v at the
+        collocation points and the stick endings, the switching-time columns' change along v's
+        switching times (two assemblies a real part) and u*' in the past's saltation; the
+        switching times (and T) by central differences of A_mu assembled again."""
+        lay, n, nc = self.lay, self.n, self.nc
+        full = np.zeros(nc + self.nh, dtype=complex)        # over the history system's nodes
+        full[:nc] += self._fu_part(v, w)
+        full += self._switch_part(v, w)
+        full += self._time_part(v, w)
+        rows = np.zeros((lay.rows, n), dtype=complex)
+        np.add.at(rows, self.node_of, full.reshape(-1, n))
+        rows += self._slope_part(v, w, mu)
+        out = np.concatenate([rows.ravel(), np.zeros(lay.size - rows.size, dtype=complex)])
+        d = 1e-6 * lay.split(self.x)[2]          # central differences, as full_jacobian's
+        for jx in range(lay.rows * n, lay.size):
+            x1, x2 = self.x.copy(), self.x.copy()
+            x1[jx] += d
+            x2[jx] -= d
+            A1 = SwitchTwisted(lay, self.terms, x1).matrix(mu)
+            A2 = SwitchTwisted(lay, self.terms, x2).matrix(mu)
+            out[jx] = complex(w @ ((A1 - A2) @ v)) / (2 * d)
+        return out
+
+    def _fu_part(self, v: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """The collocation rows' f_u changed along v, against w, on the period's nodes."""
+        n = self.n
+        Ev = (self.E @ v[:self.nc]).reshape(-1, n)
+        W = np.where(self.held, 0.0, w[:self.U.size].reshape(-1, n))
+        out = np.zeros(self.U.shape, dtype=complex)
+        for part, unit in ((Ev.real, 1.0), (Ev.imag, 1j)):
+            big = float(np.max(np.abs(part)))
+            if big == 0:
+                continue
+            eps = DIFF * max(1.0, float(np.max(np.abs(self.U)))) / big
+            d = (np.array(self.terms.fu(self.tc, self.U + eps * part)) - self.fu) / eps
+            out += unit * np.einsum("pa,pab->pb", W, d)
+        return self.E.T @ out.ravel()
+
+    def _switch_part(self, v: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """The stick endings' rows -f_u(b, u(b)) changed along v, against w."""
+        lay, n = self.lay, self.n
+        force = force_switches(lay)
+        out = np.zeros(self.nc + self.nh, dtype=complex)
+        if not force:
+            return out
+        b = lay.split(self.x)[1][force]
+        Eb = point_matrix(b, _unrolled(self.mesh, lay.m, 0), lay.basis, self.mesh, n,
+                          lay.rows + 1)
+        ub = (Eb @ np.concatenate([self.x[:lay.rows * n], self.x[:n]])).reshape(-1, n)
+        Ev = (Eb @ v[:self.nc]).reshape(-1, n)
+        f0 = self.terms.fu(b, ub)
+        ws = w[w.size - lay.S:][force]
+        comp = [lay.signature.switch(k + 1)[0] for k in force]
+        acc = np.zeros(ub.shape, dtype=complex)
+        for part, unit in ((Ev.real, 1.0), (Ev.imag, 1j)):
+            big = float(np.max(np.abs(part)))
+            if big == 0:
+                continue
+            eps = DIFF * max(1.0, float(np.max(np.abs(ub)))) / big
+            d = (np.array(self.terms.fu(b, ub + eps * part)) - f0) / eps
+            for j, i in enumerate(comp):
+                acc[j] -= unit * ws[j] * d[j, i]
+        out[:self.nc] = Eb.T @ acc.ravel()
+        return out
+
+    def _time_part(self, v: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """The switching-time columns' change along v's switching times: w' (J_u(b + e db) -
+        J_u(b - e db)) / (2 e) over the history system's nodes (the past held)."""
+        lay = self.lay
+        db = v[self.nc:]
+        out = np.zeros(self.nc + self.nh, dtype=complex)
+        T = lay.split(self.x)[2]
+        for part, unit in ((db.real, 1.0), (db.imag, 1j)):
+            big = float(np.max(np.abs(part)))
+            if big == 0:
+                continue
+            eps = DIFF * T / big
+            J = []
+            for sgn in (1.0, -1.0):
+                x1 = self.x.copy()
+                x1[lay.rows * lay.n:lay.rows * lay.n + lay.S] += sgn * eps * part
+                J.append(assemble(lay, self.terms, x1, None, history=self.hist)[1])
+            out += unit * ((J[0] - J[1]).T @ w) / (2 * eps)
+        return out
+
+    def _slope_part(self, v: np.ndarray, w: np.ndarray, mu: complex) -> np.ndarray:
+        """u*' in the past's saltation changed with the node values: (L m, n)."""
+        lay, n, m, L = self.lay, self.n, self.lay.m, self.lay.L
+        k = self.back.astype(float)
+        scale = complex(mu) ** (-k) if isinstance(mu, complex) else float(mu) ** (-k)
+        aw = (self.Jhist.T @ w) * scale                                 # (nh,)
+        # -move (g, j, c) along v's switching times: the slope entries of B over -slope
+        mv = self._move(v)                                              # (P L, m + 1)
+        coef = (aw.reshape(-1, m + 1, n) * (-mv[:, :, None])).reshape(-1, L, m + 1, n).sum(0)
+        grad = np.einsum("ljn,jk->lkn", coef, self.dz) / self.h[:, None, None]
+        out = np.zeros((lay.rows, n), dtype=complex)
+        src = (np.arange(L)[:, None] * m + np.arange(m + 1)[None, :]) % lay.rows
+        np.add.at(out, src.ravel(), grad.reshape(-1, n))
+        return out
+
+    def _move(self, v: np.ndarray) -> np.ndarray:
+        """The past nodes' motion (P L, m + 1) along v's switching times."""
+        lay = self.lay
+        V, b, T = lay.split(self.x)
+        left, right = lay.node_motion()
+        piece = lay.piece_of_interval()
+        who = lay.ends(b, T)[1]
+        db = np.append(v[self.nc:], 0.0)                               # index S: no switch
+        wl = np.where(who[piece] >= 0, who[piece], lay.S)
+        wr = np.where(who[piece + 1] >= 0, who[piece + 1], lay.S)
+        one = left * db[wl][:, None] + right * db[wr][:, None]
+        return np.tile(one, (self.hist.periods, 1))
+
+
+def twisted(lay: Layout, terms: Terms, x: np.ndarray) -> Twisted | SwitchTwisted:
+    """The twisted matrix's builder of the orbit x: :class:`SwitchTwisted` with switches,
+    :class:`Twisted` without."""
+    return SwitchTwisted(lay, terms, x) if lay.S else Twisted(lay, terms, x)
 
 
 def _twisted_pair(A: Any, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, complex, np.ndarray]:
@@ -600,11 +818,11 @@ class OrbitFlip(OrbitFold):
     def _split(self, y: np.ndarray) -> tuple[np.ndarray, float]:
         return y[:self.lay.size], float(y[self.lay.size])
 
-    def borders(self, x: np.ndarray, p: float, q: float) -> None:
+    def borders(self, x: np.ndarray, p: float, q: float, scale: bool = True) -> None:
         """b and c by INVERSE_STEPS steps of inverse iteration from fixed pseudo-random vectors,
-        and g's unit (1 / its gradient's largest entry there)."""
+        and (``scale``) g's unit (1 / its gradient's largest entry there)."""
         y = np.concatenate([x, [p], [self.theta0] if self.torus else []])
-        A = Twisted(self.layout(p, q), self.terms(p, q), x).matrix(self.mu(y))
+        A = twisted(self.layout(p, q), self.terms(p, q), x).matrix(self.mu(y))
         rng = np.random.default_rng(20260)
         shape = (2, A.shape[0])
         b, c = rng.standard_normal(shape) + (1j * rng.standard_normal(shape) if self.torus
@@ -612,7 +830,10 @@ class OrbitFlip(OrbitFold):
         for _ in range(INVERSE_STEPS):
             v, _, w = _twisted_pair(A, b, c)
             c, b = np.conj(v) / np.linalg.norm(v), np.conj(w) / np.linalg.norm(w)
-        self.b, self.c, self.gscale, self._last = b, c, 1.0, None
+        self.b, self.c, self._last = b, c, None
+        if not scale:
+            return
+        self.gscale = 1.0
         rows = self._jy(y, q)[2]
         self.gscale = 1.0 / max(float(np.max(np.abs(rows))), 1e-300)
         self._last = None
@@ -625,7 +846,7 @@ class OrbitFlip(OrbitFold):
         x, p = self._split(y)
         t, lay = self.terms(p, q), self.layout(p, q)
         r, J = full_jacobian(lay, t, x, self.ref)
-        tw = Twisted(lay, t, x)
+        tw = twisted(lay, t, x)
         v, g, w = _twisted_pair(tw.matrix(self.mu(y)), self.b, self.c)
         g = complex(g) * self.gscale
         ev = {"r": r, "J": J, "v": v, "w": w, "g": np.array([g.real, g.imag][:self.extra]),
@@ -656,19 +877,22 @@ class OrbitFlip(OrbitFold):
         x, _ = self._split(y)
         t1, l1 = self.terms(p1, q1), self.layout(p1, q1)
         F1 = (assemble(l1, t1, x, self.ref, jacobian=False)[0] - ev["r"]) / d
-        if self.period is None and ev["terms"].same_memory(t1):
+        if not self.lay.S and self.period is None and ev["terms"].same_memory(t1):
             return F1, self._rows(ev["tw"].change(ev["terms"], t1, ev["v"], ev["w"],
                                                   self.mu(y)), d)
-        return F1, self._grad(ev, y, Twisted(l1, t1, x).matrix(self.mu(y)), d)
+        return F1, self._grad(ev, y, twisted(l1, t1, x).matrix(self.mu(y)), d)
 
     def _jy(self, y: np.ndarray, q: float) -> tuple[Any, np.ndarray, np.ndarray, dict]:
         """(J, the columns of p (and theta), g's rows in y, the evaluation) at (y, q)."""
         ev = self._eval(y, q)
         x, p = self._split(y)
         mu, tw, t = self.mu(y), ev["tw"], ev["terms"]
-        gx = -self.gscale * tw.fu_row(t, ev["v"], ev["w"], mu)
-        gx = np.concatenate([gx, np.zeros(self.lay.size - gx.size, dtype=complex)])
-        if self.lay.autonomous:
+        if self.lay.S:          # the switching times and T included
+            gx = -self.gscale * tw.x_row(ev["v"], ev["w"], mu)
+        else:
+            gx = -self.gscale * tw.fu_row(t, ev["v"], ev["w"], mu)
+            gx = np.concatenate([gx, np.zeros(self.lay.size - gx.size, dtype=complex)])
+        if self.lay.autonomous and not self.lay.S:
             T = float(x[-1])
             dT = DIFF * T
             # f_u of an autonomous f is the same at the moved times
@@ -676,12 +900,12 @@ class OrbitFlip(OrbitFold):
         d = DIFF * max(1.0, abs(p))
         Fp, gp = self._moved(ev, y, p + d, q, d)
         rows = np.vstack([gx.real, gx.imag])[:self.extra]
-        if self.lay.autonomous:
+        if self.lay.autonomous and not self.lay.S:
             rows[:, -1] = gT
         rows = np.column_stack([rows, gp])
         cols = Fp[:, None]
         if self.torus:
-            dth = -self.gscale * complex(ev["w"] @ ((tw.Av @ tw.fold(mu, True)) @ ev["v"]))
+            dth = -self.gscale * complex(ev["w"] @ (tw.dmatrix(mu) @ ev["v"]))
             rows = np.column_stack([rows, [dth.real, dth.imag]])
             cols = np.column_stack([Fp, np.zeros(Fp.size)])
         return ev["J"], cols, rows, ev
@@ -727,6 +951,8 @@ class OrbitFlip(OrbitFold):
         rest = y[self.lay.size:]
         x = self.remesh(y[:self.lay.size], float(rest[0]), q)
         self._last = None
+        if self.lay.S and self.c.size != (self.lay.rows + 1) * self.lay.n + self.lay.S:
+            self.borders(x, float(rest[0]), q, scale=False)   # the pieces' intervals moved
         return np.concatenate([x, rest])
 
     def point(self, y: np.ndarray, q: float) -> OrbitCurvePoint:
@@ -828,10 +1054,10 @@ def _prepared(kind: str, start: Any, make2: Callable[[float, float], Solver], q0
     q0, q_end, step = curve_range(who, q0, q_end, step)
     if not callable(make2):
         raise ValueError(f"{who}: make2 = {make2!r}: give a function (p, q) -> dmi.Solver")
-    if orbit.switches.size:
+    if orbit.switches.size and kind == "torus":
         raise ValueError(f"{who}: the start's orbit has switches (stick-slip or contacts): "
-                         f"{kind} curves of orbits with switches (their saltation) are not "
-                         "covered yet; continue one-parameter branches over q "
+                         "torus curves of orbits with switches are not covered yet (period-"
+                         "doubling curves are); continue one-parameter branches over q "
                          "(continue_over) and read their events")
     check_period(options.get("period"), orbit.autonomous, orbit.period, p_event, q0, who)
     lay = Layout(orbit.degree, orbit.nodes.shape[1], orbit.signature,
@@ -891,7 +1117,7 @@ def continue_flip_curve(start: Any, make2: Callable[[float, float], Solver], q0:
     start : Event or EquationOrbit
         A ``period-doubling`` event of a branch of EquationOrbits of ``make2(., q0)`` (give that
         Branch as ``branch=``), or an EquationOrbit of ``make2(., q0)`` near a period doubling.
-        Orbits without switches only.
+        Orbits with switches (stick-slip, reversals) too.
     make2, q0, q_end, branch, step, at, max_points
         As :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`'s.
     min_step, max_step, multipliers, tol, max_iter, estimate, period
@@ -908,8 +1134,7 @@ def continue_flip_curve(start: Any, make2: Callable[[float, float], Solver], q0:
     Raises
     ------
     ValueError
-        A start of another kind, an event without its branch, an orbit with switches, bad q0,
-        q_end or step; a start that is not a period doubling of ``make2(., q0)`` (Newton fails
+        A start of another kind, an event without its branch, bad q0, q_end or step; a start that is not a period doubling of ``make2(., q0)`` (Newton fails
         at q0, or finds it outside the event's two points widened by their distance).
     """
     q0, q_end = float(q0), float(q_end)
@@ -938,7 +1163,8 @@ def continue_torus_curve(start: Any, make2: Callable[[float, float], Solver], q0
     start : Event or EquationOrbit
         A ``torus`` event of a branch of EquationOrbits of ``make2(., q0)`` (with ``branch=``),
         or an EquationOrbit near a torus bifurcation (theta starts from its non-real
-        multiplier nearest the unit circle).  Orbits without switches only.
+        multiplier nearest the unit circle).  Orbits without switches only (an orbit with
+        switches is refused).
     make2, q0, q_end, branch, step, at, max_points
         As :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`'s (the arclength also
         counts theta, in radians).
@@ -955,7 +1181,8 @@ def continue_torus_curve(start: Any, make2: Callable[[float, float], Solver], q0
     Raises
     ------
     ValueError
-        As :func:`continue_flip_curve`'s; a start orbit without a non-real multiplier.
+        As :func:`continue_flip_curve`'s; a start orbit without a non-real multiplier, or with
+        switches.
     """
     q0, q_end = float(q0), float(q_end)
     disc, y0, step = _prepared("torus", start, make2, q0, q_end, branch, step,

@@ -1,0 +1,231 @@
+# The period-doubling curve of collocated orbits with switches continued in (p, q)
+# (continue_flip_curve on an orbit whose switching times are unknowns): the forced Duffing
+# oscillator in a well with dry friction,
+#     w'' + D w' - w + w^3 + q sigma(w') ∋ p cos(W t),
+# whose T-orbit reverses its velocity twice a period (slip +, slip -) and period-doubles near
+# p = 0.287 at q = 0.02; its doubling's curve in (p, q) = (forcing, friction).  Against an
+# event-driven integration written here: DOP853 (rtol 1e-13) between the velocity's zeros,
+# located by its event finder (a reversal where the net force exceeds q; a stick, where it does
+# not, held exactly: w' = 0 until |net force| reaches q, found by Brent's method on the closed
+# form), the period map's Jacobian by central differences, the T-orbit by Newton, the flip (the
+# multiplier -1) in p by Brent's method at three q.  The reference's own accuracy: its flip p
+# moves by less than 1e-9 when the differences' step changes tenfold.
+# Also the twisted matrix A_mu of the orbit with switches, singular at the collocated orbit's
+# multipliers (floquet), g's gradient in x against differences, and the refusal of a torus curve
+# of an orbit with switches.  About 60 s.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+
+import numpy as np
+import pytest
+import scipy.linalg as sl
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+
+import dmi
+from dmi import analysis as da
+from dmi.analysis.collocation import floquet
+from dmi.analysis.collocation.system import Layout, Terms
+from dmi.analysis.plane.orbit_curves import (FlipCurvePoint, SwitchTwisted, continue_flip_curve,
+                                             continue_torus_curve)
+
+D, W = 0.3, 1.2
+T = 2 * math.pi / W
+Q0, Q1, QM = 0.02, 0.03, 0.025       # the curve's q range and its user point
+STEP = {"dx": 1e-5}                  # the central differences' step of the reference
+
+
+def friction2(p: float, q: float, h: float | None = None) -> dmi.Solver:
+    """u = (w, w'): u' + A(u) + f(t, u) ∋ 0, f = (-w', D w' - w + w^3 - p cos(W t)),
+    A = (0, q sigma(w'))."""
+    s = dmi.Solver(2, T / 400 if h is None else h, 1)
+    s.set_rhs(lambda t, u: np.array([-u[1], D * u[1] - u[0] + u[0] ** 3 - p * math.cos(W * t)]))
+    s.set_friction([0.0, q])
+    return s
+
+
+# ---- the independent event-driven integration -------------------------------------------------
+def force(p: float, t: float, w: float) -> float:
+    """The net force on the mass but friction at rest."""
+    return w - w ** 3 + p * math.cos(W * t)
+
+
+def stick_end(p: float, q: float, t: float, w: float, t_end: float) -> float:
+    """The time the stick from t ends (|force| reaches q), or t_end."""
+    grid = np.linspace(t, t_end, 2001)
+    g = np.array([abs(force(p, s, w)) - q for s in grid])
+    k = np.flatnonzero(g[1:] >= 0)
+    if k.size == 0:
+        return t_end
+    j = int(k[0]) + 1
+    return brentq(lambda s: abs(force(p, s, w)) - q, grid[j - 1], grid[j], xtol=1e-15)
+
+
+def flow(p: float, q: float, x0: np.ndarray, t_end: float) -> tuple[np.ndarray, list]:
+    """The state at t_end from x0 = (w, w') at t = 0 (w' != 0), and the transitions (t, kind)."""
+    t, x = 0.0, np.array(x0, dtype=float)
+    mode = 1.0 if x[1] > 0 else -1.0
+    seen = []
+    while t < t_end:
+        if mode == 0.0:                                     # stuck: w held, w' = 0
+            t = stick_end(p, q, t, x[0], t_end)
+            mode = math.copysign(1.0, force(p, t, x[0]))
+            seen.append((t, "stick end"))
+            continue
+
+        def rhs(s, y, mode=mode):
+            return [y[1], -D * y[1] + force(p, s, y[0]) - q * mode]
+
+        def zero(s, y):
+            return y[1]
+        zero.terminal, zero.direction = True, -mode
+        sol = solve_ivp(rhs, (t, t_end), x, method="DOP853", rtol=1e-13, atol=1e-14,
+                        events=zero)
+        t, x = float(sol.t[-1]), sol.y[:, -1].copy()
+        if sol.status == 1:                 # w' = 0: the net force decides a new slip or a stick
+            x[1] = 0.0
+            F = force(p, t, x[0])
+            mode = math.copysign(1.0, F) if abs(F) > q else 0.0
+            seen.append((t, "reversal" if mode else "stick"))
+    return x, seen
+
+
+def jacobian(p: float, q: float, x: np.ndarray) -> np.ndarray:
+    """D_x of the period map, by central differences."""
+    cols = []
+    for i in range(2):
+        e = np.zeros(2)
+        e[i] = STEP["dx"]
+        cols.append((flow(p, q, x + e, T)[0] - flow(p, q, x - e, T)[0]) / (2 * STEP["dx"]))
+    return np.array(cols).T
+
+
+def orbit(p: float, q: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(x, M): the T-orbit's point at t = 0 near x by Newton, and its monodromy matrix."""
+    for _ in range(20):
+        J = jacobian(p, q, x)
+        dx = np.linalg.solve(J - np.eye(2), -(flow(p, q, x, T)[0] - x))
+        x = x + dx
+        if np.max(np.abs(dx)) < 1e-12:
+            return x, jacobian(p, q, x)
+    raise AssertionError(f"Newton on the period map did not converge at (p, q) = ({p}, {q})")
+
+
+@lru_cache(maxsize=None)
+def near(q: float) -> tuple[float, ...]:
+    """The T-orbit's point at t = 0 at (0.28, q), continued from the settled one at (0.27, Q0)."""
+    x = flow(0.27, Q0, np.array([0.57, 0.41]), 20 * T)[0]
+    x = orbit(0.27, Q0, x)[0]
+    for a, b in zip(np.linspace(0.27, 0.28, 3), np.linspace(Q0, q, 3)):
+        x = orbit(float(a), float(b), x)[0]
+    return tuple(x)
+
+
+@lru_cache(maxsize=None)
+def flip(q: float, guess: float) -> float:
+    """The p within 0.003 of guess where the T-orbit's multiplier crosses -1, at q."""
+    def g(p: float) -> float:
+        mu = np.linalg.eigvals(orbit(p, q, np.array(near(q)))[1])
+        assert np.all(np.abs(mu.imag) < 1e-12)
+        return float(np.min(mu.real)) + 1.0
+    return brentq(g, guess - 0.003, guess + 0.003, xtol=1e-13)
+
+
+# ---- the collocated branch and the curve ------------------------------------------------------
+@pytest.fixture(scope="module")
+def branch() -> da.Branch:
+    scheme = da.periodic_orbit(lambda p, h=None: friction2(p, Q0, h), 0.28, T, [0.57, 0.41],
+                               multipliers=2)
+    return da.continue_orbit(da.collocate(scheme, multipliers=4, intervals=20), 0.295,
+                             step=0.005, multipliers=4)
+
+
+@pytest.fixture(scope="module")
+def curve(branch) -> da.Curve:
+    pd = next(e for e in branch.events if e.kind == "period-doubling")
+    return continue_flip_curve(pd, friction2, Q0, Q1, branch=branch, step=0.005, at=(QM,),
+                               max_points=12)
+
+
+def test_the_reference_reverses_twice_and_is_accurate():
+    """Two reversals a period and no stick at the curve's ends; the flip's p moves by less
+    than 1e-9 with a tenfold smaller differences' step."""
+    p = flip(Q1, 0.2984)
+    x = orbit(p, Q1, np.array(near(Q1)))[0]
+    assert [k for _, k in flow(p, Q1, x, T)[1]] == ["reversal", "reversal"]
+    STEP["dx"] = 1e-6
+    try:
+        other = flip.__wrapped__(Q1, 0.2984)
+    finally:
+        STEP["dx"] = 1e-5
+    assert abs(other - p) < 1e-9, (other, p)
+
+
+def test_twisted_matrix_singular_at_the_multipliers(branch):
+    """A_mu of an orbit with switches (the period's nodes and switching times, the past read
+    as mu^-k times the period with its saltation) is singular exactly at the collocated orbit's
+    multipliers: its smallest singular value there is rounding, another mu's is not."""
+    o = branch.points[-1]
+    lay = Layout(o.degree, 2, o.signature, o.fractions, False, o.period, tuple(o.carried))
+    x = np.concatenate([o.nodes.ravel(), o.switches])
+    terms = Terms(friction2(o.p, Q0))
+    mu = floquet.multipliers(lay, terms, x, 2)
+    tw = SwitchTwisted(lay, terms, x)
+    for z in mu.real:
+        s = sl.svdvals(tw.matrix(float(z)).toarray())
+        assert s[-1] < 1e-12 * s[0] and s[-2] > 1e-4 * s[0], (z, s[-2:], s[0])
+    s = sl.svdvals(tw.matrix(-1.0).toarray())       # the orbit past the flip: -1 not a multiplier
+    assert s[-1] > 1e-6 * s[0]
+
+
+def test_gradient_of_the_test_function_against_differences(branch):
+    """w' (d A_mu / d x) v over node values and switching times against central differences of
+    A_mu assembled again (3e-4 relative: the differences' own noise, differences of the
+    Jacobian's switching-time columns that are differences themselves, is about 1e-4)."""
+    o = branch.points[-1]
+    lay = Layout(o.degree, 2, o.signature, o.fractions, False, o.period, tuple(o.carried))
+    x = np.concatenate([o.nodes.ravel(), o.switches])
+    terms = Terms(friction2(o.p, Q0))
+    tw = SwitchTwisted(lay, terms, x)
+    rng = np.random.default_rng(7)
+    v, w = rng.standard_normal((2, tw.matrix(-1.0).shape[0]))
+    row = tw.x_row(v, w, -1.0)
+    for j in [0, 1, 37, lay.rows, 2 * lay.rows - 1, x.size - 2, x.size - 1]:
+        d = 1e-5 if j < 2 * lay.rows else 1e-6
+        up, dn = x.copy(), x.copy()
+        up[j] += d
+        dn[j] -= d
+        ref = (w @ (SwitchTwisted(lay, terms, up).matrix(-1.0) @ v)
+               - w @ (SwitchTwisted(lay, terms, dn).matrix(-1.0) @ v)) / (2 * d)
+        assert abs(row[j] - ref) < 3e-4 * max(1.0, abs(ref)), (j, row[j], ref)
+
+
+def test_flip_curve_of_orbits_with_switches(curve):
+    """The curve reaches q_end; at q0, the user point and q_end its p is the reference's flip
+    to 1e-7, its orbit reverses twice (two switching times), its multiplier -1."""
+    assert curve.kind == "period-doubling" and "q_end" in curve.status, curve.status
+    pts = curve.points
+    assert all(isinstance(pt, FlipCurvePoint) for pt in pts)
+    user = [e for e in curve.events if e.kind == "user"]
+    assert len(user) == 1 and pts[user[0].index].q == QM
+    assert pts[0].q == Q0 and pts[-1].q == Q1
+    for pt in (pts[0], pts[user[0].index], pts[-1]):
+        ref = flip(pt.q, pt.p)
+        assert abs(pt.p - ref) < 1e-7, (pt.q, pt.p, ref)
+        assert pt.p_error is not None and pt.p_error < 1e-8
+        assert pt.orbit.switches.size == 2
+        mu = np.asarray(pt.orbit.multipliers)
+        assert np.min(np.abs(mu + 1)) < 1e-8, mu
+        other = np.linalg.eigvals(orbit(pt.p, pt.q, np.array(near(pt.q)))[1])
+        rest = mu[np.argsort(np.abs(mu + 1))[1]]
+        assert abs(rest - other[np.argmax(np.abs(other + 1))]) < 1e-6, (rest, other)
+        assert pt.stable is True
+
+
+def test_torus_curve_of_orbits_with_switches_is_refused(branch):
+    o = branch.points[-1]
+    with pytest.raises(ValueError, match="torus curves of orbits with switches are not covered"):
+        continue_torus_curve(o, friction2, Q0, Q1)
