@@ -44,7 +44,7 @@ from ..continuation.branch import Branch, Event, corner_sentence, travel
 from ..collocation.adapt import transfer
 from .discretisation import CollocationDiscretisation, equation_hopf_orbit
 from ..collocation.mend import check_inequalities, circle, memory, mend, relaid, removed
-from ..collocation.signature import FREE, HI, LO, SLIP_NEG, SLIP_POS, STUCK
+from ..collocation.signature import FREE, HI, LO, SLIP_NEG, SLIP_POS, STUCK, interior_least
 from ..collocation.system import CollocationWarning, evaluate, solve
 from ..continuation.driver import (ContinuationOptions, Curve, Predictor, continuation, locate,
                                    newton_corrector, tangent)
@@ -670,13 +670,9 @@ def _least(fn: Any, t0: float, t1: float, L: int, T: float, interior: bool) -> f
     where it has none."""
     grid = np.linspace(t0, t1, 64 * L + 1)
     v = fn(grid)
-    if interior:
-        inner = np.flatnonzero((v[1:-1] <= v[:-2]) & (v[1:-1] <= v[2:])) + 1
-        if inner.size == 0:
-            return math.inf
-        k = int(inner[np.argmin(v[inner])])
-    else:
-        k = int(np.argmin(v))
+    k = interior_least(v) if interior else int(np.argmin(v))
+    if k is None:
+        return math.inf
     lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
     r = so.minimize_scalar(lambda s: float(fn(np.array([s]))[0]), bounds=(lo, hi),
                            method="bounded", options={"xatol": 1e-13 * max(1.0, T)})
@@ -735,8 +731,7 @@ def _margin(disc: CollocationDiscretisation, x: np.ndarray, p: float, other: Any
             j, before, after = lay.signature.switch(k)
             if j != i:
                 continue
-            end = next(kk for kk in [(k - 1 + d) % lay.S + 1 for d in range(1, lay.S + 1)]
-                       if lay.signature.switch(kk)[0] == i)
+            end = lay.signature.run_end(k)
             t1 = float(b[end - 1]) + (T if end <= k else 0.0)   # the run's end
             runs = ([after] if not box and after in (SLIP_POS, SLIP_NEG) and STUCK in held
                     else [c for c in faces if c in held] if box and after == FREE else [])

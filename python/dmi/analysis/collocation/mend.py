@@ -10,7 +10,8 @@ segment shorter than VANISH of the period is removed (its neighbours meet at its
 when their modes agree); else the first breached stretch on a fine grid (a slip of the wrong sign,
 a stuck force above alpha, a free box component beyond a face, a net force that pulls a component
 off its face) becomes a segment of its own (stuck, slipping with the force's sign, on the face
-passed, free); a breach from a piece's start takes that start over (no sliver of the old mode before it).
+passed, free); a breach from a piece's start takes that start over (no sliver of the old mode
+before it).
 """
 from __future__ import annotations
 

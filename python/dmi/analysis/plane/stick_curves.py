@@ -53,7 +53,8 @@ import scipy.sparse as sp
 from ..._solver import Solver
 from ..collocation.mesh import delay_matrix, periodic_locator, point_matrix
 from ..collocation.orbit import EquationOrbit, equation_orbit
-from ..collocation.signature import FREE, HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
+from ..collocation.signature import (FREE, HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature,
+                                     interior_least)
 from ..collocation.system import Layout, Terms, assemble, evaluate, full_jacobian
 from ..continuation.branch import Branch, Curve, CurveEvent, Event
 from ..continuation.driver import bordered_det, continuation, curve_range
@@ -141,24 +142,6 @@ def margins(lay: Layout, terms: Terms, other: Signature) -> list[Margin]:
     return out
 
 
-def run_end(lay: Layout, k: int) -> int:
-    """The switch that ends the run of component i's mode started at b_k: the next switch of
-    that component around the circle (k' > k, or k' <= k past t = T)."""
-    i = lay.signature.switch(k)[0]
-    for d in range(1, lay.S + 1):
-        kk = (k - 1 + d) % lay.S + 1
-        if lay.signature.switch(kk)[0] == i:
-            return kk
-    return k
-
-
-def interior_least(v: np.ndarray) -> int | None:
-    """The index of the least interior local minimum of the grid values v (their ends left
-    out), or None when v has none."""
-    inner = np.flatnonzero((v[1:-1] <= v[:-2]) & (v[1:-1] <= v[2:])) + 1
-    return None if inner.size == 0 else int(inner[np.argmin(v[inner])])
-
-
 class _Values:
     """The margin's value at a fixed time (the minimiser held, or the reversal b_k read from
     x) and its gradient: node columns exact, the rest by central differences."""
@@ -210,7 +193,7 @@ class _Values:
         if self.m.kind == "stuck":
             return (float(b[k - 2]) if k >= 2 else float(b[-1] - T)), float(b[k - 1])
         if k:   # a run from b_k to the component's next switch (past T: + T)
-            end = run_end(self.lay, k)
+            end = self.lay.signature.run_end(k)
             return float(b[k - 1]), float(b[end - 1]) + (T if end <= k else 0.0)
         return 0.0, T
 
