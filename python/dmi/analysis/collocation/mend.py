@@ -8,15 +8,17 @@ signature changes for :mod:`dmi.analysis.collocation.collocate` (a result that b
 The segments around the circle are (modes, start) pairs, segment 0 the one holding t = 0.  A
 segment shorter than VANISH of the period is removed (its neighbours meet at its middle, or merge
 when their modes agree); else the first breached stretch on a fine grid (a slip of the wrong sign,
-a stuck force above alpha) becomes a segment of its own (stuck, or slipping with the force's
-sign); a breach from a piece's start takes that start over (no sliver of the old mode before it).
+a stuck force above alpha, a free box component beyond a face, a net force that pulls a component
+off its face) becomes a segment of its own (stuck, slipping with the force's sign, on the face
+passed, free); a breach from a piece's start takes that start over (no sliver of the old mode
+before it).
 """
 from __future__ import annotations
 
 import numpy as np
 
 from .mesh import delay_matrix, periodic_locator
-from .signature import SLIP_NEG, SLIP_POS, STUCK, Signature, violations
+from .signature import FREE, HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature, violations
 from .system import (Layout, Terms, carried, evaluate, node_times,
                                  uniform_fractions)
 
@@ -68,8 +70,9 @@ def removed(segs: list, j: int, T: float) -> list:
 
 def breached(lay: Layout, terms: Terms, x: np.ndarray, segs: list, T: float) -> list | None:
     """The segments with the first breached stretch (a slip component of the wrong sign, a
-    stuck one whose force exceeds alpha) made a segment of its own (stuck, or slipping with the
-    force's sign), or None when nothing is breached."""
+    stuck one whose force exceeds alpha, a free box component beyond a face, one on a face whose
+    net force pulls it off) made a segment of its own (stuck, slipping with the force's sign, on
+    the face passed, free), or None when nothing is breached."""
     _, b, _ = lay.split(x)
     pieces = lay.piece_modes(b, T)
     e = lay.bounds(b, T)
@@ -84,6 +87,13 @@ def breached(lay: Layout, terms: Terms, x: np.ndarray, segs: list, T: float) -> 
                 over = np.abs(force) > terms.alpha[i]
                 bad = over
                 new = SLIP_POS if np.any(force[over] > 0) else SLIP_NEG
+            elif c == FREE and (np.isfinite(terms.lo[i]) or np.isfinite(terms.hi[i])):
+                above, below = u[:, i] > terms.hi[i], u[:, i] < terms.lo[i]
+                bad = above | below
+                new = HI if np.any(bad) and above[int(np.argmax(bad))] else LO
+            elif c in (LO, HI):
+                force = -terms.f(t, u)[:, i] - memory(lay, terms, x, t)[:, i]
+                bad, new = (force > 0 if c == LO else force < 0), FREE
             else:
                 continue
             if np.any(bad):

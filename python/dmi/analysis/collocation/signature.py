@@ -49,9 +49,24 @@ class Signature:
         i = int(np.flatnonzero(before != after)[0])
         return i, int(before[i]), int(after[i])
 
+    def run_end(self, k: int) -> int:
+        """The switch that ends the run of the mode that b_k's component enters there: that
+        component's next switch around the circle (k' > k, or k' <= k past t = T)."""
+        i = self.switch(k)[0]
+        S = self.switches
+        return next(kk for kk in ((k - 1 + d) % S + 1 for d in range(1, S + 1))
+                    if self.switch(kk)[0] == i)
+
     def describe(self) -> list[str]:
         """One line a segment: its modes by component."""
         return ["(" + ", ".join(NAMES[int(c)] for c in row) + ")" for row in self.modes]
+
+
+def interior_least(v: np.ndarray) -> int | None:
+    """The index of the least interior local minimum of the grid values v (their ends left
+    out), or None when v has none."""
+    inner = np.flatnonzero((v[1:-1] <= v[:-2]) & (v[1:-1] <= v[2:])) + 1
+    return None if inner.size == 0 else int(inner[np.argmin(v[inner])])
 
 
 def step_modes(U: np.ndarray, alpha: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:

@@ -16,6 +16,10 @@ equation is the margin m(x, p; q) = 0 of the inequality that breaks (:class:`Mar
 * a friction component that slips throughout: its least s u_i(t) (s the slip's sign), 0 where
   the velocity touches 0 (a stick begins, or a grazing);
 * a box component free throughout: its least distance to the face the other side reaches;
+* a run of slip (a friction component) or of free motion (a box component) between two switches
+  of that component, where the other side holds more stuck (face) segments of it: the least
+  interior local minimum of s u_i (of the distance to the face) on the run, 0 where a second
+  stick (contact) begins inside it (the run's ends, where u_i is 0 or on a face, left out);
 * a reversal of a slip (u_i through 0 without a stick): |net force_i(b_k)| - alpha_i at the
   reversal b_k, 0 where the stick begins;
 * a stuck stretch that leaves into slip s: alpha_i + min s net force_i on it, 0 where the force
@@ -49,7 +53,8 @@ import scipy.sparse as sp
 from ..._solver import Solver
 from ..collocation.mesh import delay_matrix, periodic_locator, point_matrix
 from ..collocation.orbit import EquationOrbit, equation_orbit
-from ..collocation.signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
+from ..collocation.signature import (FREE, HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature,
+                                     interior_least)
 from ..collocation.system import Layout, Terms, assemble, evaluate, full_jacobian
 from ..continuation.branch import Branch, Curve, CurveEvent, Event
 from ..continuation.driver import bordered_det, continuation, curve_range
@@ -73,15 +78,17 @@ class Margin:
     Attributes
     ----------
     kind : str
-        ``"slip"`` (a friction component slipping throughout), ``"box"`` (a box component free
-        throughout), ``"reversal"`` (a slip's reversal) or ``"stuck"`` (a stuck stretch).
+        ``"slip"`` (a friction component slipping throughout, or, with ``switch``, a run of
+        slip), ``"box"`` (a box component free throughout, or a run of free motion),
+        ``"reversal"`` (a slip's reversal) or ``"stuck"`` (a stuck stretch).
     component : int
         The component i.
     sign : int
         The slip's sign (slip, stuck: the slip it leaves into), +1 towards hi or -1 towards lo
         (box); 0 for a reversal.
     switch : int
-        The switch b_k (1-based) of a reversal or of the stuck stretch's end; 0 otherwise.
+        The switch b_k (1-based) of a reversal, of the stuck stretch's end, or that starts the
+        run of slip or free motion (its interior least value the margin); 0 otherwise.
     """
     kind: str
     component: int
@@ -91,9 +98,10 @@ class Margin:
     def describe(self) -> str:
         """The margin in words."""
         i = self.component
-        return {"slip": f"the least {'+' if self.sign > 0 else '-'}u_{i} of a slip throughout",
+        where = f"inside the run from b_{self.switch}" if self.switch else "throughout"
+        return {"slip": f"the least {'+' if self.sign > 0 else '-'}u_{i} of a slip {where}",
                 "box": f"the least distance of u_{i} to its {'hi' if self.sign > 0 else 'lo'} "
-                       "face",
+                       f"face, free {where}",
                 "reversal": f"|net force_{i}| - alpha_{i} at the reversal b_{self.switch}",
                 "stuck": f"alpha_{i} + min {'+' if self.sign > 0 else '-'}net force_{i} on "
                          f"the stuck stretch ending at b_{self.switch}"}[self.kind]
@@ -116,14 +124,21 @@ def margins(lay: Layout, terms: Terms, other: Signature) -> list[Margin]:
                     if np.any(theirs[:, i] == face):
                         out.append(Margin("box", i, s))
             continue
+        held = [c for c in (STUCK, LO, HI) if np.sum(theirs[:, i] == c) > np.sum(col == c)]
         for k in range(1, lay.S + 1):
             j, before, after = lay.signature.switch(k)
-            if j != i or terms.alpha[i] <= 0:
+            if j != i:
+                continue
+            if terms.alpha[i] <= 0:   # a box component: a run of free motion between contacts
+                out += [Margin("box", i, s, k) for face, s in ((LO, -1), (HI, 1))
+                        if after == FREE and face in held]
                 continue
             if {before, after} == {SLIP_POS, SLIP_NEG}:
                 out.append(Margin("reversal", i, 0, k))
             elif before == STUCK and after in (SLIP_POS, SLIP_NEG):
                 out.append(Margin("stuck", i, int(after), k))
+            if after in (SLIP_POS, SLIP_NEG) and STUCK in held:
+                out.append(Margin("slip", i, int(after), k))
     return out
 
 
@@ -174,9 +189,12 @@ class _Values:
     def span(self, x: np.ndarray) -> tuple[float, float]:
         """The stretch of time the least value is sought on."""
         _, b, T = self.lay.split(x)
+        k = self.m.switch
         if self.m.kind == "stuck":
-            k = self.m.switch
             return (float(b[k - 2]) if k >= 2 else float(b[-1] - T)), float(b[k - 1])
+        if k:   # a run from b_k to the component's next switch (past T: + T)
+            end = self.lay.signature.run_end(k)
+            return float(b[k - 1]), float(b[end - 1]) + (T if end <= k else 0.0)
         return 0.0, T
 
     def least(self, terms: Terms, x: np.ndarray) -> tuple[float, float]:
@@ -187,7 +205,10 @@ class _Values:
         t0, t1 = self.span(x)
         grid = np.linspace(t0, t1, GRID * self.lay.L + 1)
         v = self.along(terms, x, grid)
-        k = int(np.argmin(v))
+        run = self.m.switch and self.m.kind in ("slip", "box")
+        k = interior_least(v) if run else int(np.argmin(v))
+        if k is None:   # no interior minimum on the run: no margin there
+            return math.inf, 0.5 * (t0 + t1)
         lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
         T = self.lay.split(x)[2]
         r = so.minimize_scalar(lambda s: float(self.along(terms, x, np.array([s]))[0]),
@@ -520,7 +541,8 @@ def _start(start: Any, make2: Callable[[float, float], Solver], q0: float, branc
         terms = Terms(build(mine.make, mine.p), tuple(mine.kernel_jumps))
         for m in margins(lay, terms, other.signature):
             got = _Values(lay, m).least(terms, x)[0]
-            tries.append((abs(got), mine, lay, x, m))
+            if math.isfinite(got):
+                tries.append((abs(got), mine, lay, x, m))
     if not tries:
         raise ValueError("continue_stick_curve: neither orbit around the event has an "
                          "inequality that breaks towards the other's signature")
