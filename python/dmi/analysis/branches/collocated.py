@@ -38,14 +38,14 @@ import warnings
 from typing import Any
 
 import numpy as np
-import scipy.optimize as so
 
 from ..continuation.branch import Branch, Event, corner_sentence, travel
 from ..collocation.adapt import transfer
 from .discretisation import CollocationDiscretisation, equation_hopf_orbit
-from ..collocation.mend import check_inequalities, circle, memory, mend, relaid, removed
-from ..collocation.signature import FREE, HI, LO, SLIP_NEG, SLIP_POS, STUCK, interior_least
-from ..collocation.system import CollocationWarning, evaluate, solve
+from ..collocation.mend import check_inequalities, circle, mend, relaid, removed
+from ..collocation.margins import MarginValues, margins
+from ..collocation.signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK
+from ..collocation.system import CollocationWarning, solve
 from ..continuation.driver import (ContinuationOptions, Curve, Predictor, continuation, locate,
                                    newton_corrector, tangent)
 from ..collocation.orbit import EquationOrbit
@@ -664,86 +664,17 @@ def _spread(lay: Any, x: np.ndarray, k: int | None = None) -> np.ndarray:
     return out
 
 
-def _least(fn: Any, t0: float, t1: float, L: int, T: float, interior: bool) -> float:
-    """The least value of fn on [t0, t1] (a grid of 64 points an interval of the L, then
-    bounded Brent); ``interior``: its least interior local minimum (the ends left out), inf
-    where it has none."""
-    grid = np.linspace(t0, t1, 64 * L + 1)
-    v = fn(grid)
-    k = interior_least(v) if interior else int(np.argmin(v))
-    if k is None:
-        return math.inf
-    lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
-    r = so.minimize_scalar(lambda s: float(fn(np.array([s]))[0]), bounds=(lo, hi),
-                           method="bounded", options={"xatol": 1e-13 * max(1.0, T)})
-    return min(float(v[k]), float(r.fun))
-
-
 def _margin(disc: CollocationDiscretisation, x: np.ndarray, p: float, other: Any
-            ) -> float | None:
-    """The least margin, at (x, p) on disc's layout, of the inequalities of the components
-    whose modes differ in the signature ``other``: a component slipping throughout one way,
-    its least |u_i| (0 at grazing); a box component free throughout, its least distance to a
-    face ``other`` holds it on; at a reversal of a slip (u_i through 0 without a stick),
-    |net force_i| - alpha_i there (0 at the stick's onset); on a stuck piece that leaves into
-    slip s, alpha_i + min s F_i (0 where the force reaches the other bound); a run of slip (of
-    free motion) between two switches of a component that ``other`` holds stuck (on a face)
-    more often, the least interior local minimum of s u_i (of the distance to the face), 0
-    where a second stick (contact) begins inside it.  Extrema located on the polynomial (a
-    grid of 64 points an interval, then bounded Brent).  None when no such component has one
-    of these."""
-    lay = disc.lay
+             ) -> float | None:
+    """The least margin, at (x, p) on disc's layout, of the inequalities that break towards
+    the signature ``other`` (:func:`dmi.analysis.collocation.margins.margins`: a slip's least
+    |u_i|, a box component's least distance to a face, |net force_i| - alpha_i at a reversal,
+    a stuck stretch's force against the other bound, a run's least interior value; 0 where
+    the orbit sticks, grazes or touches), each its least value on the orbit; None when no
+    component has one of these."""
     terms = disc.terms(p)
-    _, b, T = lay.split(x)
-    mine = np.asarray(lay.signature.modes)
-    theirs = np.asarray(other.modes)
-    out: list[float] = []
-
-    def least(fn: Any, t0: float, t1: float, interior: bool = False) -> float:
-        return _least(fn, t0, t1, lay.L, T, interior)
-
-    def force(t: np.ndarray, i: int) -> np.ndarray:   # the net force at the times t mod T
-        t = np.mod(t, T)
-        u = evaluate(lay, x, t)
-        return -terms.f(t, u)[:, i] - memory(lay, terms, x, t)[:, i]
-
-    def gap(i: int, face: int) -> Any:   # s u_i (slip s), or the distance to a face
-        if face in (SLIP_POS, SLIP_NEG):
-            return lambda t: face * evaluate(lay, x, np.mod(t, T))[:, i]
-        if face == HI:
-            return lambda t: terms.hi[i] - evaluate(lay, x, np.mod(t, T))[:, i]
-        return lambda t: evaluate(lay, x, np.mod(t, T))[:, i] - terms.lo[i]
-
-    for i in range(lay.n):
-        col = mine[:, i]
-        if sorted(col) == sorted(theirs[:, i]):
-            continue
-        box = terms.alpha[i] <= 0
-        faces = [c for c in (LO, HI) if box and np.any(theirs[:, i] == c)]
-        if lay.S == 0 or np.all(col == col[0]):
-            if not box and col[0] in (SLIP_POS, SLIP_NEG):
-                out.append(least(gap(i, int(col[0])), 0.0, T))
-            elif box and col[0] == FREE:
-                out += [least(gap(i, c), 0.0, T) for c in faces]
-            continue
-        held = [c for c in (STUCK, LO, HI) if np.sum(theirs[:, i] == c) > np.sum(col == c)]
-        for k in range(1, lay.S + 1):
-            j, before, after = lay.signature.switch(k)
-            if j != i:
-                continue
-            end = lay.signature.run_end(k)
-            t1 = float(b[end - 1]) + (T if end <= k else 0.0)   # the run's end
-            runs = ([after] if not box and after in (SLIP_POS, SLIP_NEG) and STUCK in held
-                    else [c for c in faces if c in held] if box and after == FREE else [])
-            out += [least(gap(i, c), float(b[k - 1]), t1, interior=True) for c in runs]
-            if box:
-                continue
-            if {before, after} == {SLIP_POS, SLIP_NEG}:
-                out.append(float(abs(force(np.array([b[k - 1]]), i)[0])) - terms.alpha[i])
-            elif before == STUCK and after in (SLIP_POS, SLIP_NEG):
-                start = b[k - 2] if k >= 2 else b[-1] - T
-                out.append(terms.alpha[i] + least(lambda t, i=i, s=after: s * force(t, i),
-                                                  float(start), float(b[k - 1])))
+    out = [MarginValues(disc.lay, m).least(terms, x)[0]
+           for m in margins(disc.lay, terms, other)]
     out = [v for v in out if math.isfinite(v)]
     return min(out) if out else None
 

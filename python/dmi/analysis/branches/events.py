@@ -131,11 +131,29 @@ def undecided(kind: str, mu: np.ndarray, err: np.ndarray) -> str | None:
     return None
 
 
+def _doubling(mu: np.ndarray, err: np.ndarray) -> tuple[float, int | None]:
+    """The period doubling's test function, -prod (1 + mu) over the multipliers left of the
+    imaginary axis (0 where one is -1; of the sign of the number of real multipliers below -1,
+    positive when it is odd; continuous where a complex pair meets on the negative axis and
+    splits, so that a pair that meets inside the circle and then crosses -1 changes its sign),
+    and the index of a multiplier that decides nothing (a real negative one within its error
+    bound of the unit circle, a complex one within its bound of -1), None when none does."""
+    left = np.flatnonzero(mu.real < 0)
+    real = set(_of_kind("period-doubling", mu).tolist())
+    for j in left:
+        d = abs(abs(mu[j]) - 1.0) if j in real else abs(1.0 + mu[j])
+        if not d > err[j]:
+            return 0.0, int(j)
+    return -float(np.prod(1.0 + mu[left]).real), None
+
+
 def verified_tests(mu: np.ndarray, err: np.ndarray, p: float) -> dict[str, float]:
     """The multipliers' test functions of a point with error bounds (a collocated branch's):
-    ``period-doubling`` the largest |mu| of the real negative multipliers minus 1, ``torus``
-    the largest |mu| of the non-real ones minus 1, each where defined, and 0 where it lies
-    within its multiplier's error bound (with an :class:`EventWarning`: an event is then
+    ``period-doubling`` -prod (1 + mu) over the multipliers left of the imaginary axis (its
+    sign changes where a real multiplier crosses -1, also one split off a complex pair that met
+    on the negative axis; -1 without such multipliers), ``torus`` the largest |mu| of the
+    non-real ones minus 1 where there are some, and 0 where it lies within its multiplier's
+    error bound (with an :class:`EventWarning`: an event is then
     reported only between points on either side of that bound).
 
     Parameters
@@ -163,15 +181,22 @@ def verified_tests(mu: np.ndarray, err: np.ndarray, p: float) -> dict[str, float
     out: dict[str, float] = {}
     for kind in KINDS:
         idx = _of_kind(kind, mu)
-        if idx.size == 0:
+        if kind == "period-doubling":
+            f, j = _doubling(mu, err)
+        elif idx.size == 0:
             continue
-        j = idx[int(np.argmax(np.abs(mu[idx])))]
-        f = float(abs(mu[j])) - 1.0
-        if abs(f) > err[j]:
+        else:
+            j = idx[int(np.argmax(np.abs(mu[idx])))]
+            f = float(abs(mu[j])) - 1.0
+            j = None if abs(f) > err[j] else j
+        if j is None:
             out[kind] = f
             continue
         out[kind] = 0.0
-        warnings.warn(f"p = {p!r}: {undecided(kind, mu[j:j + 1], err[j:j + 1])}; this point "
+        why = (undecided(kind, mu[j:j + 1], err[j:j + 1]) if j in idx else
+               f"the multiplier {mu[j]:.12g} is {abs(1 + mu[j]):.3g} from -1, within its error "
+               f"bound {err[j]:.3g}")
+        warnings.warn(f"p = {p!r}: {why}; this point "
                       f"does not decide a {kind} (an event is reported only between points on "
                       "either side of the circle beyond their error bounds; one located at "
                       "this point lies within its bound)", EventWarning, stacklevel=3)

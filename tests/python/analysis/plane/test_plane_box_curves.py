@@ -25,7 +25,8 @@ from scipy.integrate import solve_ivp
 import dmi
 from dmi import analysis as da
 from dmi.analysis.collocation.signature import Signature
-from dmi.analysis.plane.stick_curves import Margin, StickCurvePoint, continue_stick_curve, margins
+from dmi.analysis.collocation.margins import Margin, margins
+from dmi.analysis.plane.stick_curves import StickCurvePoint, continue_stick_curve
 
 # ---- the boxed oscillator: p = F, q = w ------------------------------------------------------
 C = 0.3

@@ -10,7 +10,8 @@
 #   + K int_0^TAU e^-s x(t - s) ds, TAU = 2 T: on a T-periodic orbit, and on a perturbation
 #   with v(t + T) = -v(t), x(t - TAU) = x(t), so the memory is z' = (1 - e^-TAU) x - z there
 #   exactly, and the test's integrator runs that ODE in (x, x', z) (its multiplier -1 is the
-#   equation's);
+#   equation's); its one-parameter branch's doubling, where a complex pair meets on the negative
+#   axis inside the circle and one of the two crosses -1, reported where the integrator has it;
 # - the Roessler system x' = -y - z, y' = x + 0.2 y, z' = b + z (x - c) (autonomous: the period an
 #   unknown): its period-doubling curve in (c, b), each point against the doubling solved in the
 #   test (x0, T, c with x(T) = x0, a phase condition and det(M + I) = 0);
@@ -185,11 +186,20 @@ def test_the_flip_curve_against_the_integrators_multipliers(flip):
 
 
 def test_a_flip_curve_with_a_memory():
-    # from an orbit near the doubling (between the two points of a branch that brackets it)
-    o = da.periodic_orbit(lambda d: memory2(d, 0.6), 0.43, MP, np.array([-0.65, 0.0]),
-                          steps=100, multipliers=4)
-    near = da.collocate(o, multipliers=6, intervals=40)
-    c = da.continue_flip_curve(near, memory2, 0.6, 0.7, step=0.05)
+    # the branch's complex pair meets on the negative axis inside the circle, splits, and one of
+    # the two crosses -1: the doubling is reported (its test function changes sign although
+    # the point before it has no real negative multiplier) where the integrator has it
+    b = mathieu_branch(memory2)
+    (e,) = [e for e in b.events if e.kind == "period-doubling"]
+    near = b.points[e.index - 1]
+    mu = near.multipliers
+    assert not np.any((np.abs(mu.imag) <= 1e-8 * np.abs(mu)) & (mu.real < 0))
+    system = lambda d: mathieu_rhs(d, 0.6, True)   # noqa: E731
+    x0, _ = solved(system, MP, np.append(start_state(near, True), near.p))
+    _, d = solved(system, MP, np.append(x0, e.p),
+                  lambda M: np.linalg.det(M + np.eye(M.shape[0])))
+    assert abs(e.p - d) <= 1e-8                                 # measured 3e-12
+    c = da.continue_curve(e, memory2, 0.6, 0.7, branch=b, step=0.05)
     assert c.status == "reached q_end = 0.7"
     check_flip(c, True)
 

@@ -87,6 +87,25 @@ def test_undecided_and_verified_tests():
         undecided("fold", mu, np.zeros(3))
 
 
+def test_the_doubling_test_changes_sign_with_the_real_multipliers_below_minus_one():
+    err = np.full(4, 1e-9)
+    small = [0.1 + 0.2j, 0.1 - 0.2j]
+    pair = verified_tests(np.array([-0.75 + 0.33j, -0.75 - 0.33j] + small), err, 0.0)
+    split = verified_tests(np.array([-1.87, -0.36] + small), err, 0.0)
+    both = verified_tests(np.array([-1.87, -1.2] + small), err, 0.0)
+    # -prod (1 + mu) over Re mu < 0: negative before the pair meets, positive with one real
+    # multiplier below -1, negative again with two
+    assert pair["period-doubling"] == pytest.approx(-abs(0.25 + 0.33j) ** 2, rel=1e-14)
+    assert split["period-doubling"] == pytest.approx(0.87 * 0.64, rel=1e-14)
+    assert both["period-doubling"] == pytest.approx(-0.87 * 0.2, rel=1e-14)
+    assert verified_tests(np.array(small), err[:2], 0.0)["period-doubling"] == -1.0
+    # a complex multiplier within its bound of -1 decides nothing
+    with pytest.warns(EventWarning, match="from -1, within its error bound"):
+        got = verified_tests(np.array([-1 + 1e-7j, -1 - 1e-7j] + small),
+                             np.array([1e-6, 1e-6, 1e-9, 1e-9]), 0.0)
+    assert got["period-doubling"] == 0.0
+
+
 def test_event_without_error_bounds_says_so():
     """With verify=False the Ritz multipliers have no error bound: the event is the scheme's,
     its detail says it is not verified."""
