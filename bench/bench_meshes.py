@@ -3,11 +3,14 @@
 # test): van der Pol with a distributed delay, w'' + eps (w^2 - 1) w' + w + a int_0^1 w(t - s) ds
 # = 0, a = 0.5, at eps = 1 (degree 4 to 6) and its relaxation oscillation at eps = 10 (degree 6),
 # each from a scheme orbit.  True errors against a collocation of degree 8 (80 intervals at eps =
-# 1, 128 at eps = 10).  For each mesh: the true error of the period and the multipliers of the
+# 1, 160 at eps = 10).  For each mesh: the true error of the period and the multipliers of the
 # orbit returned (the finer level), the two-level difference and the three-level estimate
-# (Richardson's where the levels are steady) over it; the refinement to tol = 1e-8 at eps = 10
-# (its mesh, true error, estimate); the Newton iterations and CPU time of each level: the orbit on
-# the mesh, the halved mesh from its solution (transfer) and from the start, the merged mesh.
+# (Richardson's where the levels are steady) over it; the Newton iterations and CPU time of each
+# level: the orbit on the mesh, the halved mesh from its solution (transfer) and from the start,
+# the merged mesh.  Then the refinement to several tol (eps = 1, degree 4; eps = 10, degree 6): its
+# counted (coarser) mesh against the smallest sufficient one of a scan of intervals = L, its true
+# error and estimate; and (not --small) the estimate by degree elevation on one mesh: the orbit of
+# degree 6 against 7 and 8 on the same mesh, re-equidistributed 1 to 3 times, and the halved mesh.
 # Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_meshes.py [--small]
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
@@ -102,15 +105,57 @@ def main() -> None:
     for L, m in ((24, 4),) if a.small else ((12, 4), (24, 4), (32, 4), (8, 5), (16, 5), (12, 6)):
         mesh_row(o1, ref1, L, m)
     o2 = scheme_orbit(10.0, 16.0, 1000)
-    ref2 = da.collocate(o2, intervals=64, degree=8, multipliers=4)
+    ref2 = da.collocate(o2, intervals=80, degree=8, multipliers=4)    # 160 x 8
     for L in (56,) if a.small else (40, 44, 48, 56, 64):
         mesh_row(o2, ref2, L, 6)
-    t = time.process_time()
-    e = da.collocate(o2, degree=6, tol=1e-8, multipliers=0)
-    print(f"eps = 10, tol = 1e-8: {e.intervals} x 6 returned (its coarser level "
-          f"{e.intervals // 2}), true {abs(e.period - ref2.period):.2e}, estimate "
-          f"{e.errors['period']:.2e}, CPU {time.process_time() - t:.1f} s")
+    if a.small:
+        refinements(o2, ref2, 6, (1e-8,), (44, 48, 56))
+        return
+    refinements(o1, ref1, 4, (1e-8, 1e-10), (16, 20, 24, 28, 32, 36))
+    refinements(o2, ref2, 6, (1e-7, 1e-8, 1e-9), (40, 44, 48, 50, 52, 56, 60))
+    print("same mesh, degree 6 against 7 and 8 (errors of the period; the mesh "
+          "equidistributed k times at L intervals): 6 | 7 | 8 | |x6 - x8| / |err 6| | 6 on 2L")
+    for L in (60, 70, 80, 90):
+        degree_rows(o2, ref2, L, 6)
 
+
+def refinements(o, ref, m: int, tols: tuple, scan: tuple) -> None:
+    """The refinement to each tol: its coarser (counted) mesh, the orbit returned, its true
+    error, estimate and CPU; the smallest L of ``scan`` whose orbit for intervals = L (2 L
+    returned) has a true error within tol and the smallest whose estimate is."""
+    runs = {L: da.collocate(o, degree=m, intervals=L, multipliers=0) for L in scan}
+    for tol in tols:
+        t = time.process_time()
+        e = da.collocate(o, degree=m, tol=tol, multipliers=0)
+        cpu = time.process_time() - t
+        true = abs(e.period - ref.period)
+        enough = next((L for L in scan if abs(runs[L].period - ref.period) <= tol), None)
+        shown = next((L for L in scan if runs[L].errors["period"] <= tol), None)
+        print(f"degree {m}, tol = {tol:g}: {e.intervals // 2} counted ({e.intervals} returned); "
+              f"true {true:.2e}, estimate {e.errors['period']:.2e} ({e.errors['period'] / true:.3g}"
+              f" x); CPU {cpu:.2f} s; smallest sufficient L {enough}, with its estimate within "
+              f"tol {shown}", flush=True)
+
+
+def degree_rows(o, ref, L: int, m: int) -> None:
+    """The degree-elevation estimate on one mesh re-equidistributed 1, 2, 3 times at L."""
+    terms = Terms(build(o.make, o.p))
+    sig, b0 = read_signature(o.u, o.h, terms.alpha, terms.lo, terms.hi)
+    lay = Layout(m, terms.n, sig, [], True, o.period, carried(terms, sig))
+    cur, x = first_solve(o, terms, lay, b0, max(8, L // 2), "bench")
+    r = reference(cur, x)
+    for k in range(1, 4):
+        new = cur.with_fractions(adapt.adapted(cur, x, L))
+        x = solve(new, terms, adapt.transfer(cur, x, new), r)[0]
+        cur = new
+        Ts = [x[-1]]
+        for ly in (Layout(m + 1, cur.n, sig, cur.fractions, True, cur.period, cur.carried),
+                   Layout(m + 2, cur.n, sig, cur.fractions, True, cur.period, cur.carried),
+                   cur.with_fractions(adapt.halved(cur.fractions))):
+            Ts.append(solve(ly, terms, adapt.transfer(cur, x, ly), r)[0][-1])
+        err = [T - ref.period for T in Ts]
+        print(f"L = {L}, k = {k}: {err[0]:+.2e} | {err[1]:+.2e} | {err[2]:+.2e} | "
+              f"{abs(Ts[0] - Ts[2]) / abs(err[0]):.3g} | {err[3]:+.2e}", flush=True)
 
 if __name__ == "__main__":
     main()

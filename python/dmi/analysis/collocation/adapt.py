@@ -323,6 +323,16 @@ def level_error(c: Solved, f: Solved) -> tuple[float, float, float | None]:
     return d, two, (math.log2(d1 / d2) if steady else None)
 
 
+def accepted(m: int, autonomous: bool) -> float:
+    """How far above tol the two levels' difference of a round whose three levels were not
+    steady may be aimed at: for the period (an autonomous orbit), what the next round's
+    levels, steady, accept: Richardson's SAFETY d2 / (2^q - 1) <= tol, q capped at m + 2, the
+    least order seen on delay equations (the delayed values are not superconvergent); 1 for
+    the amplitudes (a forced orbit), whose levels are seldom steady (an extremum inside an
+    interval: h^(m+1) with a constant that moves with the mesh)."""
+    return max(1.0, (2.0 ** (m + 2) - 1.0) / SAFETY) if autonomous else 1.0
+
+
 def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bool,
             tol: float, what: str, capped: list[float] | None = None
             ) -> tuple[Solved, Solved]:
@@ -337,6 +347,7 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
     intervals, when the next mesh's delay integral would exceed MAX_DELAY_NODES, or after
     MAX_ROUNDS rounds."""
     last = None
+    unsteady = False                               # the last round's levels were not steady
     autonomous = lay.autonomous
     name = "period" if autonomous else "amplitudes"
     for _ in range(MAX_ROUNDS):
@@ -382,9 +393,13 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
                 raise ValueError(f"collocate: {reached}; {why}, tol = {tol!r} needs about "
                                  f"{need:.2g} intervals, more than MAX_INTERVALS = "
                                  f"{MAX_INTERVALS}: {fix}")
-        grow = (d / tol) ** (1.0 / expected) * 1.2
+        # the next mesh's aim: where these levels were not steady (the first time), a
+        # difference the next round's Richardson estimate accepts, else tol itself
+        aim = tol if seen is not None or unsteady else tol * accepted(lay.m, autonomous)
+        unsteady = seen is None
+        grow = (d / aim) ** (1.0 / expected) * 1.2
         if seen is not None or (q is not None and q > lay.m):
-            grow = (d / tol) ** (1.0 / min(seen or q, expected + 2)) * 1.1
+            grow = (d / aim) ** (1.0 / min(seen or q, expected + 2)) * 1.1
         last = (L, two)
         L = min(MAX_INTERVALS, max(L + 2, math.ceil(L * min(grow, 8.0))))
         lay, x = f.lay, f.x
