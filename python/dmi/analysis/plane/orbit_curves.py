@@ -138,7 +138,9 @@ class OrbitFold(FoldSystem):
 
     def adapt(self, y: np.ndarray, q: float) -> np.ndarray:
         """Between steps: the borders moved to the point's v and w, the mesh equidistributed
-        again, the phase condition's reference moved to the point."""
+        again, the phase condition's reference moved to the point; where the pieces'
+        intervals come to another count (an orbit with switches), the borders from the new
+        mesh's null vectors."""
         ev = self._eval(y, q)
         V = y[:self.lay.rows * self.lay.n].reshape(-1, self.lay.n)
         self._track.append((float(q), float(np.max(V.max(axis=0) - V.min(axis=0))) / 2))
@@ -147,6 +149,10 @@ class OrbitFold(FoldSystem):
         x, p = y[:-1], float(y[-1])
         x = self.remesh(x, p, q)
         self._last = None
+        if x.size != self.c.size:   # the pieces' intervals rounded to another count (switches)
+            unit = self.gscale
+            self.borders(x, p, q)    # b and c of the new mesh; g keeps its unit
+            self.gscale, self._last = unit, None
         return np.concatenate([x, [p]])
 
     def point(self, y: np.ndarray, q: float) -> OrbitCurvePoint:

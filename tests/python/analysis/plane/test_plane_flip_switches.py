@@ -12,7 +12,10 @@
 # moves by less than 1e-9 when the differences' step changes tenfold.
 # Also the twisted matrix A_mu of the orbit with switches, singular at the collocated orbit's
 # multipliers (floquet), g's gradient in x against differences, and the refusal of a torus curve
-# of an orbit with switches.  About 60 s.
+# of an orbit with switches.  The same two checks on an orbit with stick phases (q = 0.2: slip +,
+# stuck, slip -, stuck; its switching times the event-driven reference's), without and with a
+# memory 0.3 int_0^7 e^(-s) w(t - s) ds reaching two periods back (the past read as mu^-1 and
+# mu^-2 times the period, the saltation's slope u*' in it).  About 90 s.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
