@@ -15,7 +15,7 @@
 # of an orbit with switches.  The same two checks on an orbit with stick phases (q = 0.2: slip +,
 # stuck, slip -, stuck; its switching times the event-driven reference's), without and with a
 # memory 0.3 int_0^7 e^(-s) w(t - s) ds reaching two periods back (the past read as mu^-1 and
-# mu^-2 times the period, the saltation's slope u*' in it).  About 90 s.
+# mu^-2 times the period, the saltation's slope u*' in it).  About 110 s on a loaded machine.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
