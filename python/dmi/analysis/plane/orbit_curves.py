@@ -96,6 +96,10 @@ BAUTIN_SHARE = 0.2
 # the step along v (relative, against the orbit's largest |u|) of the one-sided differences of
 # f's change at a moved parameter: its truncation and rounding errors balance near 3e-5
 CHANGE_STEP = 3e-5
+# the step (relative, against the orbit's largest |u| over the direction's largest entry) of
+# the central differences of f_u along a direction: f_u is a central difference of f itself
+# (its rounding about 1e-11 of f), truncation and rounding balance near 1e-4
+FU_STEP = 1e-4
 
 
 class OrbitFold(FoldSystem):
@@ -134,7 +138,9 @@ class OrbitFold(FoldSystem):
 
     def adapt(self, y: np.ndarray, q: float) -> np.ndarray:
         """Between steps: the borders moved to the point's v and w, the mesh equidistributed
-        again, the phase condition's reference moved to the point."""
+        again, the phase condition's reference moved to the point; where the pieces'
+        intervals come to another count (an orbit with switches), the borders from the new
+        mesh's null vectors."""
         ev = self._eval(y, q)
         V = y[:self.lay.rows * self.lay.n].reshape(-1, self.lay.n)
         self._track.append((float(q), float(np.max(V.max(axis=0) - V.min(axis=0))) / 2))
@@ -143,6 +149,10 @@ class OrbitFold(FoldSystem):
         x, p = y[:-1], float(y[-1])
         x = self.remesh(x, p, q)
         self._last = None
+        if x.size != self.c.size:   # the pieces' intervals rounded to another count (switches)
+            unit = self.gscale
+            self.borders(x, p, q)    # b and c of the new mesh; g keeps its unit
+            self.gscale, self._last = unit, None
         return np.concatenate([x, [p]])
 
     def point(self, y: np.ndarray, q: float) -> OrbitCurvePoint:
@@ -442,6 +452,22 @@ def _unrolled(mesh: np.ndarray, m: int, kmin: int) -> Callable:
     return locate
 
 
+def fu_along(terms: Terms, t: np.ndarray, U: np.ndarray, E: np.ndarray) -> np.ndarray:
+    """The derivative of f_u (P, n, n) at (t, U) along the direction E (P, n; complex: its real
+    and imaginary parts in turn), by central differences of step FU_STEP (relative to
+    max(1, |U|) over |E|'s largest part): f_u is itself a central difference of f (rounding
+    about 1e-11 of f), which a smaller step would amplify."""
+    out = np.zeros(U.shape + (U.shape[1],), dtype=complex)
+    for part, unit in ((np.real(E), 1.0), (np.imag(E), 1j)):
+        big = float(np.max(np.abs(part))) if part.size else 0.0
+        if big == 0:
+            continue
+        eps = FU_STEP * max(1.0, float(np.max(np.abs(U)))) / big
+        up = np.array(terms.fu(t, U + eps * part))
+        out += unit * (up - np.array(terms.fu(t, U - eps * part))) / (2 * eps)
+    return out
+
+
 class Twisted:
     """The collocation system linearised at an orbit on the unrolled node rows (:func:`_unrolled`)
     and its fold to one period by v(t + k T) = mu^k v(t): A_mu = A_v Phi(mu).
@@ -517,17 +543,8 @@ class Twisted:
         points along v (one difference a real part), against w, back to the node rows."""
         Ev = (self.E @ (self.fold(mu) @ v)).reshape(-1, self.n)
         W = np.where(self.held, 0.0, w.reshape(-1, self.n))
-        f0 = self.fu
-        out = np.zeros(self.U.shape, dtype=complex)
-        for part, unit in ((Ev.real, 1.0), (Ev.imag, 1j)):
-            big = float(np.max(np.abs(part)))
-            if big == 0:
-                continue
-            eps = DIFF * max(1.0, float(np.max(np.abs(self.U)))) / big
-            d = (np.array(terms.fu(self.tc, self.U + eps * part)) - f0) / eps
-            out += unit * np.einsum("pa,pab->pb", W, d)
-        row = (self.E @ self.fold(1.0)).T @ out.ravel()
-        return row
+        out = np.einsum("pa,pab->pb", W, fu_along(terms, self.tc, self.U, Ev))
+        return (self.E @ self.fold(1.0)).T @ out.ravel()
 
 
     def change(self, terms: Terms, moved: Terms, v: np.ndarray, w: np.ndarray, mu: complex
@@ -672,14 +689,7 @@ class SwitchTwisted:
         n = self.n
         Ev = (self.E @ v[:self.nc]).reshape(-1, n)
         W = np.where(self.held, 0.0, w[:self.U.size].reshape(-1, n))
-        out = np.zeros(self.U.shape, dtype=complex)
-        for part, unit in ((Ev.real, 1.0), (Ev.imag, 1j)):
-            big = float(np.max(np.abs(part)))
-            if big == 0:
-                continue
-            eps = DIFF * max(1.0, float(np.max(np.abs(self.U)))) / big
-            d = (np.array(self.terms.fu(self.tc, self.U + eps * part)) - self.fu) / eps
-            out += unit * np.einsum("pa,pab->pb", W, d)
+        out = np.einsum("pa,pab->pb", W, fu_along(self.terms, self.tc, self.U, Ev))
         return self.E.T @ out.ravel()
 
     def _switch_part(self, v: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -694,18 +704,10 @@ class SwitchTwisted:
                           lay.rows + 1)
         ub = (Eb @ np.concatenate([self.x[:lay.rows * n], self.x[:n]])).reshape(-1, n)
         Ev = (Eb @ v[:self.nc]).reshape(-1, n)
-        f0 = self.terms.fu(b, ub)
         ws = w[w.size - lay.S:][force]
         comp = [lay.signature.switch(k + 1)[0] for k in force]
-        acc = np.zeros(ub.shape, dtype=complex)
-        for part, unit in ((Ev.real, 1.0), (Ev.imag, 1j)):
-            big = float(np.max(np.abs(part)))
-            if big == 0:
-                continue
-            eps = DIFF * max(1.0, float(np.max(np.abs(ub)))) / big
-            d = (np.array(self.terms.fu(b, ub + eps * part)) - f0) / eps
-            for j, i in enumerate(comp):
-                acc[j] -= unit * ws[j] * d[j, i]
+        d = fu_along(self.terms, b, ub, Ev)
+        acc = np.array([-ws[j] * d[j, i] for j, i in enumerate(comp)])
         out[:self.nc] = Eb.T @ acc.ravel()
         return out
 

@@ -12,7 +12,10 @@
 # moves by less than 1e-9 when the differences' step changes tenfold.
 # Also the twisted matrix A_mu of the orbit with switches, singular at the collocated orbit's
 # multipliers (floquet), g's gradient in x against differences, and the refusal of a torus curve
-# of an orbit with switches.  About 60 s.
+# of an orbit with switches.  The same two checks on an orbit with stick phases (q = 0.2: slip +,
+# stuck, slip -, stuck; its switching times the event-driven reference's), without and with a
+# memory 0.3 int_0^7 e^(-s) w(t - s) ds reaching two periods back (the past read as mu^-1 and
+# mu^-2 times the period, the saltation's slope u*' in it).  About 110 s on a loaded machine.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -28,7 +31,8 @@ from scipy.optimize import brentq
 import dmi
 from dmi import analysis as da
 from dmi.analysis.collocation import floquet
-from dmi.analysis.collocation.system import Layout, Terms
+from dmi.analysis.core.blas import _one_blas_thread
+from dmi.analysis.collocation.system import Layout, Terms, node_times
 from dmi.analysis.plane.orbit_curves import (FlipCurvePoint, SwitchTwisted, continue_flip_curve,
                                              continue_torus_curve)
 
@@ -174,10 +178,11 @@ def test_twisted_matrix_singular_at_the_multipliers(branch):
     terms = Terms(friction2(o.p, Q0))
     mu = floquet.multipliers(lay, terms, x, 2)
     tw = SwitchTwisted(lay, terms, x)
-    for z in mu.real:
-        s = sl.svdvals(tw.matrix(float(z)).toarray())
-        assert s[-1] < 1e-12 * s[0] and s[-2] > 1e-4 * s[0], (z, s[-2:], s[0])
-    s = sl.svdvals(tw.matrix(-1.0).toarray())       # the orbit past the flip: -1 not a multiplier
+    with _one_blas_thread():
+        for z in mu.real:
+            s = sl.svdvals(tw.matrix(float(z)).toarray())
+            assert s[-1] < 1e-12 * s[0] and s[-2] > 1e-4 * s[0], (z, s[-2:], s[0])
+        s = sl.svdvals(tw.matrix(-1.0).toarray())   # the orbit past the flip: -1 not a multiplier
     assert s[-1] > 1e-6 * s[0]
 
 
@@ -229,3 +234,115 @@ def test_torus_curve_of_orbits_with_switches_is_refused(branch):
     o = branch.points[-1]
     with pytest.raises(ValueError, match="torus curves of orbits with switches are not covered"):
         continue_torus_curve(o, friction2, Q0, Q1)
+
+
+
+# ---- an orbit with stick phases, without and with a memory ------------------------------------
+PS, QS = 0.28, 0.2                   # the orbit sticks twice a period (w' = 0 while |force| <= q)
+G, TAU = 0.3, 7.0                    # the memory g e^(-s) w(t - s) on [0, 7]: two periods back
+
+
+def sticky(p: float, q: float, g: float, h: float | None = None) -> dmi.Solver:
+    """friction2 with the memory g int_0^TAU e^(-s) w(t - s) ds on w'' (g = 0: none)."""
+    h = T / 400 if h is None else h
+    s = dmi.Solver(2, TAU if g else h, h=h)
+    s.set_rhs(lambda t, u: np.array([-u[1], D * u[1] - u[0] + u[0] ** 3 - p * math.cos(W * t)]))
+    s.set_friction([0.0, q])
+    if g:
+        s.set_kernel_exp([-1.0], [0.0], [[[0.0, 0.0], [g, 0.0]]])
+    return s
+
+
+@pytest.fixture(scope="module", params=[0.0, G], ids=["no memory", "memory"])
+def stuck(request) -> tuple:
+    """(orbit, lay, terms, x) of the collocated stick-slip T-orbit at (PS, QS) with memory g."""
+    g = request.param
+    scheme = da.periodic_orbit(lambda p, h=None: sticky(p, QS, g, h), PS, T, [0.9694, 0.1471],
+                               multipliers=2)
+    o = da.collocate(scheme, multipliers=6, intervals=20)
+    lay = Layout(o.degree, 2, o.signature, o.fractions, False, o.period, tuple(o.carried))
+    return o, lay, Terms(sticky(PS, QS, g)), np.concatenate([o.nodes.ravel(), o.switches])
+
+
+def test_the_orbit_sticks_twice(stuck):
+    """Slip +, stuck, slip -, stuck; without memory its switching times are the event-driven
+    reference's (started from the collocated orbit's state at 0) to 1e-8."""
+    o, lay, terms, _ = stuck
+    assert o.signature.modes[:, 1].tolist() == [1, 2, -1, 2]
+    if terms.has_kernel:
+        return
+    seen = flow(PS, QS, o.nodes[0], T)[1]
+    assert [k for _, k in seen] == ["stick", "stick end", "stick", "stick end"]
+    assert np.max(np.abs(np.array([t for t, _ in seen]) - o.switches)) < 1e-8, (seen, o.switches)
+
+
+def test_twisted_matrix_with_sticks_singular_at_the_multipliers(stuck):
+    """A_mu of the stick-slip orbit (with a memory: the past two periods back, mu^-1 and
+    mu^-2, complex pairs among the multipliers) is singular at each multiplier the collocation
+    reports but its zeros (a held component's; mu^-k is not defined there): the smallest
+    singular value rounding, 1e-12 of the largest, the next beyond 1e-8; at mu = -1, 0.9 and
+    0.6i (no multipliers) the smallest is beyond 1e-8."""
+    o, lay, terms, x = stuck
+    tw = SwitchTwisted(lay, terms, x)
+    mu = np.asarray(o.multipliers)
+    live = mu[np.abs(mu) > 1e-3]
+    assert live.size >= (3 if terms.has_kernel else 1), mu
+    with _one_blas_thread():      # a loaded machine's spinning BLAS threads: 100 times slower
+        for z in live:
+            s = sl.svdvals(tw.matrix(complex(z) if z.imag else float(z.real)).toarray())
+            assert s[-1] < 1e-12 * s[0] and s[-2] > 1e-8 * s[0], (z, s[-2:], s[0])
+        for z in (-1.0, 0.9, 0.6j):
+            s = sl.svdvals(tw.matrix(z).toarray())
+            assert s[-1] > 1e-8 * s[0], (z, s[-1], s[0])
+
+
+def _wAv(lay: Layout, terms: Terms, x: np.ndarray, v: np.ndarray, w: np.ndarray) -> float:
+    """w' A_(-1) v of the orbit x and its history part w' Jhist Phi v."""
+    tw = SwitchTwisted(lay, terms, x)
+    return float(w @ (tw.matrix(-1.0) @ v)), float(w @ (tw.Jhist @ (tw._phi(-1.0) @ v)))
+
+
+def test_gradient_with_sticks_against_differences(stuck):
+    """w' (d A_mu / d x) v at mu = -1 on the stick-slip orbit against central differences of
+    A_mu assembled again (steps 1e-5 on node values, 1e-6 on switching times): every switching
+    time, the node values of the node rows at and after each switch (the stick endings' rows,
+    the switching-time columns' change), random directions over each piece's node values and
+    over all of x; with a memory also the history part alone (the saltation's slope u*'
+    changed with the node values) at its four largest entries.  To 2e-5 relative (node values;
+    the differences' noise, from a tenfold step, is below 2e-5) and 3e-4 (switching times,
+    where both sides are differences of differences)."""
+    o, lay, terms, x = stuck
+    tw = SwitchTwisted(lay, terms, x)
+    rng = np.random.default_rng(11)
+    v, w = rng.standard_normal((2, tw.matrix(-1.0).shape[0]))
+    row = tw.x_row(v, w, -1.0).real
+    first = lay.rows * 2
+    times = node_times(lay, o.switches, T)
+    idx = list(range(first, x.size))
+    for b in o.switches:
+        r = int(np.argmin(np.abs(times - b)))
+        idx += [2 * ((r + k) % lay.rows) + c for k in (0, 1) for c in (0, 1)]
+    dirs = [np.eye(x.size)[j] for j in idx]
+    piece = np.searchsorted(np.append(o.switches, T), times[:lay.rows], side="right")
+    for k in range(lay.S + 1):
+        d = np.zeros(x.size)
+        d[:first] = np.repeat(piece == k, 2) * rng.standard_normal(first)
+        dirs.append(d)
+    dirs.append(rng.standard_normal(x.size) * np.r_[np.ones(first), 0.1 * np.ones(lay.S)])
+    for d in dirs:
+        step = 1e-6 if np.all(d[:first] == 0) else 1e-5
+        ref = (_wAv(lay, terms, x + step * d, v, w)[0]
+               - _wAv(lay, terms, x - step * d, v, w)[0]) / (2 * step)
+        got = float(row @ d)
+        tol = 2e-5 if step == 1e-5 else 3e-4
+        assert abs(got - ref) < tol * max(1.0, abs(ref)), (np.flatnonzero(d)[:3], got, ref)
+    if not terms.has_kernel:
+        return
+    slope = tw._slope_part(v, w, -1.0).real.ravel()
+    for j in np.argsort(-np.abs(slope))[:4]:
+        up, dn = x.copy(), x.copy()
+        up[j] += 1e-5
+        dn[j] -= 1e-5
+        ref = (_wAv(lay, terms, up, v, w)[1] - _wAv(lay, terms, dn, v, w)[1]) / 2e-5
+        assert abs(slope[j] - ref) < 2e-5 * max(1.0, abs(ref)) and abs(ref) > 1e-3, \
+            (j, slope[j], ref)
