@@ -155,6 +155,9 @@ Q_NEAR = 12
 #: An exponential sum is steep when its fastest rate r exceeds STEEP / tau: its pieces near 0
 #: are then graded (:attr:`Kernel.grading`).
 STEEP = 20.0
+#: How far (in the local coordinate) a whole interval's middle and three-quarter point may lie
+#: from 0.5 and 0.75 on the locator's interval for its one basis matrix to be used.
+WHOLE_TOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -409,8 +412,20 @@ def _group_entries(group: tuple, times: np.ndarray, locate: Locator, basis: Basi
     nodes S, weights W, H at S, whole intervals or not); the T derivative added into dT."""
     Cg, ag, dg, S, W, H, full = group
     gz = basis.gauss(basis.q)[0]
+    if full:
+        mid = times[Cg] - (ag + 0.5 * dg)
+        _, z1, node = locate(mid)
+        _, z2, _ = locate(mid + 0.25 * dg)
+        # a whole interval of u's mesh is one of the locator's intervals only where their
+        # meshes agree (not the past's fixed mesh against a period whose switches moved)
+        other = (np.abs(z1 - 0.5) > WHOLE_TOL) | (np.abs(z2 - 0.75) > WHOLE_TOL)
+        if np.any(other):
+            parts = [(Cg[f], ag[f], dg[f], S[f], W[f], H[f], whole)
+                     for f, whole in ((~other, True), (other, False)) if np.any(f)]
+            got = [_group_entries(g, times, locate, basis, n, ia, ib, T, slope_of, dT)
+                   for g in parts]
+            return tuple(np.concatenate(v) for v in zip(*got))  # type: ignore[return-value]
     if full:    # t - S at the interval's Gauss nodes backwards: z = 1 - gz, one B for all
-        _, _, node = locate(times[Cg] - (ag + 0.5 * dg))
         z = np.broadcast_to(1.0 - gz, S.shape)
         slope = 1.0 / dg
         B = basis.values(1.0 - gz)                                     # (q, m + 1)

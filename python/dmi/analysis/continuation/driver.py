@@ -1113,7 +1113,10 @@ def _events(run: _Run, za: np.ndarray, ta: np.ndarray, fa: dict[str, float],
             events.append(Event("fold", float(zf[-1]), 0, None,
                                 "dp/ds changes sign (located on the branch)", u=zf[:-1].copy()))
         else:
-            events.append(Event("fold", _parabola(curve, last + [zb]), 0, None,
+            near = [z for z in last if z.size == zb.size]
+            if not near or not np.array_equal(near[-1], za):
+                near.append(za)
+            events.append(Event("fold", _parabola(curve, near + [zb]), 0, None,
                                 "dp/ds changes sign (p from a parabola in arclength)"))
     for kind in fa:
         if kind in fb and _sign_change(fa[kind], fb[kind]):
@@ -1166,8 +1169,11 @@ def _located(run: _Run, along: Along, kind: str, ta: np.ndarray, fa: float, fb: 
 
 def _parabola(curve: Curve, zs: list[np.ndarray]) -> float:
     """The fold's p: the vertex of the parabola p(s) through the last three points (s their
-    arclength), or the middle of the last two where it has none between them."""
+    arclength), or the middle of the last two where it has none between them (the last's p
+    where it is the only one of its size)."""
     zs = [z for z in zs if z.size == zs[-1].size][-3:]
+    if len(zs) < 2:
+        return float(zs[-1][-1])
     mid = 0.5 * float(zs[-2][-1] + zs[-1][-1])
     if len(zs) < 3:
         return mid

@@ -197,6 +197,17 @@ def test_points_without_a_verdict_say_why(branches):
         assert bool(said) == (q.stable is None), (q.p, q.stable, said)
 
 
+def test_the_stick_slip_orbits_trivial_multiplier_is_one(branches):
+    # an autonomous orbit's derivative is a Floquet solution of multiplier 1 exactly, with the
+    # memory and the switches (the monodromy reads the past on its own mesh while the period's
+    # switching times move)
+    slips = [q for q in branches[0].points + branches[1].points if is_stick_slip(q)]
+    assert slips
+    for q in slips:
+        j = int(np.argmin(np.abs(q.multipliers - 1)))
+        assert abs(q.multipliers[j] - 1) <= 1e-8, (q.p, q.multipliers[j])
+
+
 def corner(points: list[da.EquationOrbit], before, after) -> int:
     """The index of the first point of kind ``after``; every point before it of kind
     ``before``."""

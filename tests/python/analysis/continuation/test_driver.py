@@ -258,3 +258,14 @@ def test_continue_orbit_of_something_else_is_a_type_error():
     from dmi.analysis import continue_orbit
     with pytest.raises(TypeError, match="orbit is a dict: give an Orbit"):   # bad-inputs DC05
         continue_orbit({"p": 0.0}, 1.0)
+
+
+def test_a_folds_parabola_after_the_unknowns_changed():
+    # the points before a fold of another size (a signature changed) are left out; the vertex of
+    # p(s) = 1 - s^2 through three points of the new size, and with one of them only, its own p
+    from dmi.analysis.continuation.driver import _parabola
+    curve = SimpleNamespace(norm=lambda v: float(np.linalg.norm(v)))
+    old = [np.array([0.0, 0.0, 5.0]), np.array([1.0, 1.0, 6.0])]
+    new = [np.array([s, 1.0 - s * s]) for s in (-0.5, 0.1, 0.6)]
+    assert _parabola(curve, old + new) == pytest.approx(1.0, abs=0.02)
+    assert _parabola(curve, old + new[-1:]) == pytest.approx(1.0 - 0.36, abs=1e-15)
