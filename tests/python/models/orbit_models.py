@@ -387,3 +387,19 @@ def duffing_fold(c: float, w: float, guess: np.ndarray) -> float:
                              [[0.0, 1.0], [-1 - 3 * x[0] ** 2, -c]])
     return forced_bifurcation(rhs_at, 2 * math.pi / w, guess,
                               lambda M: np.linalg.det(M - np.eye(2)), xtol=1e-12)[1]
+
+
+def stick_event(make, p0: float, period: float, steps: int, intervals: int, p_end: float,
+                step: float):
+    """(branch, its one stick-onset event): the scheme's orbit of make(p0) after ``steps`` steps
+    from make's history, made periodic (period ``period``), collocated on ``intervals`` and
+    continued to ``p_end`` (2 multipliers a point)."""
+    from dmi import analysis as da
+    s = make(p0)
+    s.init()
+    s.advance(steps)
+    o = da.periodic_orbit(make, p0, period, s, multipliers=0)
+    e = da.collocate(o, intervals=intervals, multipliers=2)
+    br = da.continue_orbit(e, p_end, step=step, multipliers=2)
+    (ev,) = [x for x in br.events if x.kind == "stick-onset"]
+    return br, ev

@@ -23,10 +23,11 @@ import scipy.optimize as so
 from scipy.integrate import solve_ivp
 
 import dmi
-from dmi import analysis as da
 from dmi.analysis.collocation.signature import Signature
 from dmi.analysis.collocation.margins import Margin, margins
 from dmi.analysis.plane.stick_curves import StickCurvePoint, continue_stick_curve
+
+from models import orbit_models
 
 # ---- the boxed oscillator: p = F, q = w ------------------------------------------------------
 C = 0.3
@@ -78,14 +79,8 @@ def contact_times(F: float, w: float, guess: float) -> tuple[float, float]:
 
 @pytest.fixture(scope="module")
 def box_curve():
-    make = lambda F: boxed(F, W_START)   # noqa: E731
-    s = make(0.35)
-    s.init()
-    s.advance(20 * 400)
-    o = da.periodic_orbit(make, 0.35, 2 * math.pi, s, multipliers=0)
-    e = da.collocate(o, intervals=24, multipliers=2)
-    br = da.continue_orbit(e, 0.5, step=0.03, multipliers=2)
-    (ev,) = [x for x in br.events if x.kind == "stick-onset"]
+    br, ev = orbit_models.stick_event(lambda F: boxed(F, W_START), 0.35, 2 * math.pi, 20 * 400,
+                                      24, 0.5, 0.03)
     return br, ev, continue_stick_curve(ev, boxed, W_START, 1.0, branch=br, step=0.05,
                                         at=(0.9,), multipliers=2)
 
@@ -191,14 +186,8 @@ def second_stick(vb: float, guess: list[float]) -> tuple[float, float, float, fl
 
 @pytest.fixture(scope="module")
 def belt_curve():
-    make = lambda F: belt(F, VB_START)   # noqa: E731
-    s = make(1.1)
-    s.init()
-    s.advance(40 * 2000)
-    o = da.periodic_orbit(make, 1.1, T, s, multipliers=0)
-    e = da.collocate(o, intervals=40, multipliers=2)
-    br = da.continue_orbit(e, 1.2, step=0.02, multipliers=2)
-    (ev,) = [x for x in br.events if x.kind == "stick-onset"]
+    br, ev = orbit_models.stick_event(lambda F: belt(F, VB_START), 1.1, T, 40 * 2000, 40, 1.2,
+                                      0.02)
     return br, ev, continue_stick_curve(ev, belt, VB_START, 0.34, branch=br, step=0.02,
                                         at=(0.32,), multipliers=2)
 

@@ -59,15 +59,8 @@ def den_hartog_onset(w: float) -> float:
 
 @pytest.fixture(scope="module")
 def den_hartog_curve():
-    M = 400
-    make = lambda F: den_hartog(F, W_START, M)   # noqa: E731
-    s = make(1.0)
-    s.init()
-    s.advance(20 * M)
-    o = da.periodic_orbit(make, 1.0, 2 * math.pi, s, multipliers=0)
-    e = da.collocate(o, intervals=24, multipliers=2)
-    br = da.continue_orbit(e, 0.4, step=0.05, multipliers=2)
-    (ev,) = [x for x in br.events if x.kind == "stick-onset"]
+    br, ev = orbit_models.stick_event(lambda F: den_hartog(F, W_START), 1.0, 2 * math.pi,
+                                      20 * 400, 24, 0.4, 0.05)
     return br, ev, continue_stick_curve(ev, den_hartog, W_START, 0.8, branch=br, step=0.05,
                                         at=(0.75,), multipliers=2)
 
