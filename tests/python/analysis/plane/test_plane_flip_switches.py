@@ -11,8 +11,8 @@
 # multiplier -1) in p by Brent's method at three q.  The reference's own accuracy: its flip p
 # moves by less than 1e-9 when the differences' step changes tenfold.
 # Also the twisted matrix A_mu of the orbit with switches, singular at the collocated orbit's
-# multipliers (floquet), g's gradient in x against differences, and the refusal of a torus curve
-# of an orbit with switches.  About 60 s.
+# multipliers (floquet) and g's gradient in x against differences (the torus curve of an orbit
+# with switches: test_plane_torus_switches.py).  About 60 s.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -29,8 +29,7 @@ import dmi
 from dmi import analysis as da
 from dmi.analysis.collocation import floquet
 from dmi.analysis.collocation.system import Layout, Terms
-from dmi.analysis.plane.orbit_curves import (FlipCurvePoint, SwitchTwisted, continue_flip_curve,
-                                             continue_torus_curve)
+from dmi.analysis.plane.orbit_curves import FlipCurvePoint, SwitchTwisted, continue_flip_curve
 
 D, W = 0.3, 1.2
 T = 2 * math.pi / W
@@ -223,9 +222,3 @@ def test_flip_curve_of_orbits_with_switches(curve):
         rest = mu[np.argsort(np.abs(mu + 1))[1]]
         assert abs(rest - other[np.argmax(np.abs(other + 1))]) < 1e-6, (rest, other)
         assert pt.stable is True
-
-
-def test_torus_curve_of_orbits_with_switches_is_refused(branch):
-    o = branch.points[-1]
-    with pytest.raises(ValueError, match="torus curves of orbits with switches are not covered"):
-        continue_torus_curve(o, friction2, Q0, Q1)
