@@ -1056,11 +1056,6 @@ def _prepared(kind: str, start: Any, make2: Callable[[float, float], Solver], q0
     q0, q_end, step = curve_range(who, q0, q_end, step)
     if not callable(make2):
         raise ValueError(f"{who}: make2 = {make2!r}: give a function (p, q) -> dmi.Solver")
-    if orbit.switches.size and kind == "torus":
-        raise ValueError(f"{who}: the start's orbit has switches (stick-slip or contacts): "
-                         "torus curves of orbits with switches are not covered yet (period-"
-                         "doubling curves are); continue one-parameter branches over q "
-                         "(continue_over) and read their events")
     check_period(options.get("period"), orbit.autonomous, orbit.period, p_event, q0, who)
     lay = Layout(orbit.degree, orbit.nodes.shape[1], orbit.signature,
                  [f.copy() for f in orbit.fractions], orbit.autonomous, orbit.period,

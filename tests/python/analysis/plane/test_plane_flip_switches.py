@@ -11,10 +11,10 @@
 # multiplier -1) in p by Brent's method at three q.  The reference's own accuracy: its flip p
 # moves by less than 1e-9 when the differences' step changes tenfold.
 # Also the twisted matrix A_mu of the orbit with switches, singular at the collocated orbit's
-# multipliers (floquet), g's gradient in x against differences, and the refusal of a torus curve
-# of an orbit with switches.  The same two checks on an orbit with stick phases (q = 0.2: slip +,
-# stuck, slip -, stuck; its switching times the event-driven reference's), without and with a
-# memory 0.3 int_0^7 e^(-s) w(t - s) ds reaching two periods back (the past read as mu^-1 and
+# multipliers (floquet) and g's gradient in x against differences (the torus curve of an orbit
+# with switches: test_plane_torus_switches.py).  The same two checks on an orbit with stick
+# phases (q = 0.2: slip +, stuck, slip -, stuck; its switching times the event-driven
+# reference's), without and with a memory 0.3 int_0^7 e^(-s) w(t - s) ds reaching two periods back (the past read as mu^-1 and
 # mu^-2 times the period, the saltation's slope u*' in it).  About 110 s on a loaded machine.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
@@ -33,8 +33,7 @@ from dmi import analysis as da
 from dmi.analysis.collocation import floquet
 from dmi.analysis.core.blas import _one_blas_thread
 from dmi.analysis.collocation.system import Layout, Terms, node_times
-from dmi.analysis.plane.orbit_curves import (FlipCurvePoint, SwitchTwisted, continue_flip_curve,
-                                             continue_torus_curve)
+from dmi.analysis.plane.orbit_curves import FlipCurvePoint, SwitchTwisted, continue_flip_curve
 
 D, W = 0.3, 1.2
 T = 2 * math.pi / W
@@ -228,13 +227,6 @@ def test_flip_curve_of_orbits_with_switches(curve):
         rest = mu[np.argsort(np.abs(mu + 1))[1]]
         assert abs(rest - other[np.argmax(np.abs(other + 1))]) < 1e-6, (rest, other)
         assert pt.stable is True
-
-
-def test_torus_curve_of_orbits_with_switches_is_refused(branch):
-    o = branch.points[-1]
-    with pytest.raises(ValueError, match="torus curves of orbits with switches are not covered"):
-        continue_torus_curve(o, friction2, Q0, Q1)
-
 
 
 # ---- an orbit with stick phases, without and with a memory ------------------------------------
