@@ -55,11 +55,10 @@ of A_mu, along theta exactly; they only steer Newton.  The borders start from a 
 inverse iteration at the start and move to the last point's conj(v), conj(w) after every step.
 
 Covered: orbits without switches (smooth orbits; a component held for the whole period is
-allowed), with or without a memory, and period doublings of orbits with switches
-(:class:`SwitchTwisted`: A_mu from the collocation system of one period forward from a past,
-the past read as mu^-k times the period's perturbation at fixed times, the saltation
-included; g's gradient also over the switching times).  A torus curve of an orbit with
-switches is refused (not covered yet).  A curve ends where its orbit would leave its signature (a
+allowed), with or without a memory, and orbits with switches (:class:`SwitchTwisted`: A_mu from
+the collocation system of one period forward from a past, the past read as mu^-k times the
+period's perturbation at fixed times, the saltation included; g's gradient also over the
+switching times).  A curve ends where its orbit would leave its signature (a
 stick onset or grazing meets it), a torus curve where theta reaches 0 or pi (the pair e^(+-i
 theta) meets at +1 or -1: a 1:1 or 1:2 resonance, where a neutral saddle follows).
 """
@@ -1131,7 +1130,8 @@ def continue_flip_curve(start: Any, make2: Callable[[float, float], Solver], q0:
     Raises
     ------
     ValueError
-        A start of another kind, an event without its branch, bad q0, q_end or step; a start that is not a period doubling of ``make2(., q0)`` (Newton fails
+        A start of another kind, an event without its branch, bad q0, q_end or step; a start
+        that is not a period doubling of ``make2(., q0)`` (Newton fails
         at q0, or finds it outside the event's two points widened by their distance).
     """
     q0, q_end = float(q0), float(q_end)
@@ -1160,8 +1160,8 @@ def continue_torus_curve(start: Any, make2: Callable[[float, float], Solver], q0
     start : Event or EquationOrbit
         A ``torus`` event of a branch of EquationOrbits of ``make2(., q0)`` (with ``branch=``),
         or an EquationOrbit near a torus bifurcation (theta starts from its non-real
-        multiplier nearest the unit circle).  Orbits without switches only (an orbit with
-        switches is refused).
+        multiplier nearest the unit circle).  Orbits with switches (stick-slip, reversals)
+        too.
     make2, q0, q_end, branch, step, at, max_points
         As :func:`dmi.analysis.plane.orbit_curves.continue_orbit_curve`'s (the arclength also
         counts theta, in radians).
@@ -1178,8 +1178,7 @@ def continue_torus_curve(start: Any, make2: Callable[[float, float], Solver], q0
     Raises
     ------
     ValueError
-        As :func:`continue_flip_curve`'s; a start orbit without a non-real multiplier, or with
-        switches.
+        As :func:`continue_flip_curve`'s; a start orbit without a non-real multiplier.
     """
     q0, q_end = float(q0), float(q_end)
     disc, y0, step = _prepared("torus", start, make2, q0, q_end, branch, step,

@@ -14,8 +14,8 @@
 # multipliers (floquet) and g's gradient in x against differences (the torus curve of an orbit
 # with switches: test_plane_torus_switches.py).  The same two checks on an orbit with stick
 # phases (q = 0.2: slip +, stuck, slip -, stuck; its switching times the event-driven
-# reference's), without and with a memory 0.3 int_0^7 e^(-s) w(t - s) ds reaching two periods back (the past read as mu^-1 and
-# mu^-2 times the period, the saltation's slope u*' in it).  About 110 s on a loaded machine.
+# reference's), without and with a memory 0.3 int_0^7 e^(-s) w(t - s) ds reaching two periods
+# back (the past read as mu^-1 and mu^-2 times the period, the saltation's slope u*' in it).  About 110 s on a loaded machine.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
