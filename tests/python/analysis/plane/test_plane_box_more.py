@@ -143,6 +143,11 @@ def test_a_second_contact_inside_the_free_run(contact_curve):
     assert br.points[-1].signature.switches == 4
     assert abs(ev.p - c.points[0].p) <= 1e-10     # the curve starts at the branch's event
     _check(c, second_contact, 2)
+    lay, terms = _layout(c.points[0])
+    got = margins(lay, terms, Signature(np.asarray(br.points[-1].signature.modes)))
+    # both candidates: the free run from the lift-off b_2 (the one held) and the face stretch
+    assert got == [Margin("face", 0, 1, 1), Margin("box", 0, 1, 2)]
+    assert "inside the run from b_2" in got[1].describe()
 
 
 def test_a_lift_off_inside_the_face_stretch(lift_curve):
