@@ -13,6 +13,10 @@ touches a face:
   of that component, where the other side holds more stuck (face) segments of it: the least
   interior local minimum of s u_i (of the distance to the face) on the run, 0 where a second
   stick (contact) begins inside it (the run's ends, where u_i is 0 or on a face, left out);
+* a stretch on a face (a box component) between two of its switches, where the other side holds
+  more free segments of it: the least interior local minimum of s net force_i on the stretch (s
+  = -1 on lo, +1 on hi), 0 where a lift-off begins inside it (the stretch's ends, lift-offs
+  where the force is 0, left out);
 * a reversal of a slip (u_i through 0 without a stick): |net force_i(b_k)| - alpha_i at the
   reversal b_k, 0 where the stick begins;
 * a stuck stretch that leaves into slip s: alpha_i + min s net force_i on it, 0 where the force
@@ -47,15 +51,17 @@ class Margin:
     kind : str
         ``"slip"`` (a friction component slipping throughout, or, with ``switch``, a run of
         slip), ``"box"`` (a box component free throughout, or a run of free motion),
-        ``"reversal"`` (a slip's reversal) or ``"stuck"`` (a stuck stretch).
+        ``"face"`` (a stretch on a face), ``"reversal"`` (a slip's reversal) or ``"stuck"`` (a
+        stuck stretch).
     component : int
         The component i.
     sign : int
         The slip's sign (slip, stuck: the slip it leaves into), +1 towards hi or -1 towards lo
-        (box); 0 for a reversal.
+        (box), +1 on hi or -1 on lo (face); 0 for a reversal.
     switch : int
         The switch b_k (1-based) of a reversal, of the stuck stretch's end, or that starts the
-        run of slip or free motion (its interior least value the margin); 0 otherwise.
+        run of slip or free motion or the face stretch (its interior least value the margin); 0
+        otherwise.
     """
     kind: str
     component: int
@@ -69,6 +75,8 @@ class Margin:
         return {"slip": f"the least {'+' if self.sign > 0 else '-'}u_{i} of a slip {where}",
                 "box": f"the least distance of u_{i} to its {'hi' if self.sign > 0 else 'lo'} "
                        f"face, free {where}",
+                "face": f"the least {'+' if self.sign > 0 else '-'}net force_{i} on the "
+                        f"{'hi' if self.sign > 0 else 'lo'} face {where}",
                 "reversal": f"|net force_{i}| - alpha_{i} at the reversal b_{self.switch}",
                 "stuck": f"alpha_{i} + min {'+' if self.sign > 0 else '-'}net force_{i} on "
                          f"the stuck stretch ending at b_{self.switch}"}[self.kind]
@@ -99,6 +107,8 @@ def margins(lay: Layout, terms: Terms, other: Signature) -> list[Margin]:
             if terms.alpha[i] <= 0:   # a box component: a run of free motion between contacts
                 out += [Margin("box", i, s, k) for face, s in ((LO, -1), (HI, 1))
                         if after == FREE and face in held]
+                if after in (LO, HI) and np.sum(theirs[:, i] == FREE) > np.sum(col == FREE):
+                    out.append(Margin("face", i, -1 if after == LO else 1, k))  # a lift-off
                 continue
             if {before, after} == {SLIP_POS, SLIP_NEG}:
                 out.append(Margin("reversal", i, 0, k))
@@ -138,13 +148,16 @@ class MarginValues:
         return -terms.f(t, evaluate(lay, x, t))[:, i] - memory(lay, terms, x, t)[:, i]
 
     def along(self, terms: Terms, x: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """The function whose least value is the margin (slip, box, stuck), at the times t."""
+        """The function whose least value is the margin (slip, box, face, stuck), at the times
+        t."""
         m, i = self.m, self.m.component
         if m.kind == "slip":
             return m.sign * evaluate(self.lay, x, np.mod(t, self.lay.split(x)[2]))[:, i]
         if m.kind == "box":
             u = evaluate(self.lay, x, np.mod(t, self.lay.split(x)[2]))[:, i]
             return terms.hi[i] - u if m.sign > 0 else u - terms.lo[i]
+        if m.kind == "face":
+            return m.sign * self.force(terms, x, t)
         return terms.alpha[i] + m.sign * self.force(terms, x, t)
 
     def value(self, terms: Terms, x: np.ndarray, t_star: float) -> float:
@@ -167,13 +180,13 @@ class MarginValues:
 
     def least(self, terms: Terms, x: np.ndarray) -> tuple[float, float]:
         """(the margin, t*): the least value on the span, at its minimiser (a reversal: at
-        b_k)."""
+        b_k; a run or a face stretch: its least interior local minimum)."""
         if self.m.kind == "reversal":
             return self.value(terms, x, 0.0), self.time(x, 0.0)
         t0, t1 = self.span(x)
         grid = np.linspace(t0, t1, GRID * self.lay.L + 1)
         v = self.along(terms, x, grid)
-        run = self.m.switch and self.m.kind in ("slip", "box")
+        run = self.m.switch and self.m.kind in ("slip", "box", "face")
         k = interior_least(v) if run else int(np.argmin(v))
         if k is None:   # no interior minimum on the run: no margin there
             return math.inf, 0.5 * (t0 + t1)
@@ -205,7 +218,7 @@ class MarginValues:
             G = delay_matrix(t, terms.tau, mesh, T, terms.H, loc, lay.basis, lay.n, lay.rows,
                              pattern=terms.pattern)[0]
             row = row - G[i].toarray().ravel()
-        s = self.m.sign if self.m.kind == "stuck" else np.sign(self.force(terms, x, t)[0])
+        s = self.m.sign if self.m.kind in ("stuck", "face") else np.sign(self.force(terms, x, t)[0])
         return s * row
 
 
