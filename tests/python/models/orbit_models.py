@@ -403,3 +403,20 @@ def stick_event(make, p0: float, period: float, steps: int, intervals: int, p_en
     br = da.continue_orbit(e, p_end, step=step, multipliers=2)
     (ev,) = [x for x in br.events if x.kind == "stick-onset"]
     return br, ev
+
+
+def map_fixed_point(P, x: np.ndarray, dx: float, tol: float = 1e-12, max_iter: int = 20
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """(x, M): the fixed point of the map P near x by Newton and P's Jacobian M there, the
+    Jacobian by central differences of step dx (an event-driven period map: see the plane's
+    tests with switches)."""
+    def jac(z: np.ndarray) -> np.ndarray:
+        return np.column_stack([(P(z + dx * e) - P(z - dx * e)) / (2 * dx)
+                                for e in np.eye(z.size)])
+    x = np.asarray(x, dtype=float)
+    for _ in range(max_iter):
+        d = np.linalg.solve(jac(x) - np.eye(x.size), -(P(x) - x))
+        x = x + d
+        if np.max(np.abs(d)) < tol:
+            return x, jac(x)
+    raise AssertionError(f"Newton on the map did not converge from x = {x!r}")

@@ -35,6 +35,8 @@ from dmi.analysis.core.blas import _one_blas_thread
 from dmi.analysis.collocation.system import Layout, Terms, node_times
 from dmi.analysis.plane.orbit_curves import FlipCurvePoint, SwitchTwisted, continue_flip_curve
 
+from models import orbit_models
+
 D, W = 0.3, 1.2
 T = 2 * math.pi / W
 Q0, Q1, QM = 0.02, 0.03, 0.025       # the curve's q range and its user point
@@ -96,25 +98,10 @@ def flow(p: float, q: float, x0: np.ndarray, t_end: float) -> tuple[np.ndarray, 
     return x, seen
 
 
-def jacobian(p: float, q: float, x: np.ndarray) -> np.ndarray:
-    """D_x of the period map, by central differences."""
-    cols = []
-    for i in range(2):
-        e = np.zeros(2)
-        e[i] = STEP["dx"]
-        cols.append((flow(p, q, x + e, T)[0] - flow(p, q, x - e, T)[0]) / (2 * STEP["dx"]))
-    return np.array(cols).T
-
-
 def orbit(p: float, q: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(x, M): the T-orbit's point at t = 0 near x by Newton, and its monodromy matrix."""
-    for _ in range(20):
-        J = jacobian(p, q, x)
-        dx = np.linalg.solve(J - np.eye(2), -(flow(p, q, x, T)[0] - x))
-        x = x + dx
-        if np.max(np.abs(dx)) < 1e-12:
-            return x, jacobian(p, q, x)
-    raise AssertionError(f"Newton on the period map did not converge at (p, q) = ({p}, {q})")
+    """(x, M): the T-orbit's point at t = 0 near x by Newton, and its monodromy matrix (the
+    period map's Jacobian by central differences)."""
+    return orbit_models.map_fixed_point(lambda z: flow(p, q, z, T)[0], x, STEP["dx"])
 
 
 @lru_cache(maxsize=None)

@@ -32,6 +32,8 @@ from dmi.analysis.collocation import floquet
 from dmi.analysis.collocation.system import Layout, Terms
 from dmi.analysis.plane.orbit_curves import SwitchTwisted, TorusCurvePoint
 
+from models import orbit_models
+
 W, AL = 1.5, 0.02                    # the forcing's frequency, the dry friction
 T = 2 * math.pi / W
 Q0, Q1, QM = 0.2, 0.3, 0.25          # the curve's q range and its user point
@@ -77,25 +79,10 @@ def flow(p: float, q: float, x0: np.ndarray, t_end: float) -> tuple[np.ndarray, 
     return x, seen
 
 
-def jacobian(p: float, q: float, x: np.ndarray) -> np.ndarray:
-    """D_x of the period map, by central differences."""
-    cols = []
-    for i in range(2):
-        e = np.zeros(2)
-        e[i] = STEP["dx"]
-        cols.append((flow(p, q, x + e, T)[0] - flow(p, q, x - e, T)[0]) / (2 * STEP["dx"]))
-    return np.array(cols).T
-
-
 def orbit(p: float, q: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(x, M): the T-orbit's point at t = 0 near x by Newton, and its monodromy matrix."""
-    for _ in range(20):
-        J = jacobian(p, q, x)
-        dx = np.linalg.solve(J - np.eye(2), -(flow(p, q, x, T)[0] - x))
-        x = x + dx
-        if np.max(np.abs(dx)) < 1e-12:
-            return x, jacobian(p, q, x)
-    raise AssertionError(f"Newton on the period map did not converge at (p, q) = ({p}, {q})")
+    """(x, M): the T-orbit's point at t = 0 near x by Newton, and its monodromy matrix (the
+    period map's Jacobian by central differences)."""
+    return orbit_models.map_fixed_point(lambda z: flow(p, q, z, T)[0], x, STEP["dx"])
 
 
 @lru_cache(maxsize=None)
