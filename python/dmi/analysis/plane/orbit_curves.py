@@ -222,10 +222,12 @@ def bautin_end(points: list[OrbitCurvePoint]) -> tuple[int, float, float] | None
 
 
 def _start_orbit(start: Any, branch: Branch | None) -> tuple[EquationOrbit, np.ndarray | None,
-                                                              float]:
-    """(the orbit near the fold, the event's unknowns if on its layout, the event's p)."""
+                                                              float, float]:
+    """(the orbit near the fold, the event's unknowns if on its layout, the event's p, how far
+    from it the fold at q0 may lie: START_TOL relative for a fold located on the branch, twice
+    the event's two points' distance to it for one from a parabola, inf for an orbit)."""
     if isinstance(start, EquationOrbit):
-        return start, None, float(start.p)
+        return start, None, float(start.p), math.inf
     if isinstance(start, Event) and start.kind == "fold":
         if branch is None or not isinstance(branch, Branch):
             raise ValueError("continue_orbit_curve: a fold event needs branch=, the Branch of "
@@ -245,7 +247,10 @@ def _start_orbit(start: Any, branch: Branch | None) -> tuple[EquationOrbit, np.n
                 + int(after.autonomous):   # located on the layout of the point after it
             u = np.array(start.u, dtype=float)
             orbit = after
-        return orbit, u, float(start.p)
+        p = float(start.p)
+        slack = (START_TOL * max(1.0, abs(p)) if start.u is not None else
+                 2 * max(abs(before.p - p), abs(after.p - p), abs(after.p - before.p)))
+        return orbit, u, p, slack
     raise ValueError(f"continue_orbit_curve: start = {start!r}: give a 'fold' event of a branch "
                      "of EquationOrbits (with branch=) or an EquationOrbit near a fold")
 
@@ -319,9 +324,10 @@ def continue_orbit_curve(start: Any, make2: Callable[[float, float], Solver], q0
         ``period=`` for an autonomous orbit, or period(p, q0) not the start orbit's period (to
         1e-9 relative), or a period(p, q) that is not finite and > 0; a start
         that is not a fold of ``make2(., q0)`` (Newton fails at q0, or finds the fold farther
-        than START_TOL from the event's p).
+        from the event's p than START_TOL relative, or, for a fold the branch did not locate
+        (its p from a parabola), than twice its two points' distance to that p).
     """
-    orbit, u, p_event = _start_orbit(start, branch)
+    orbit, u, p_event, slack = _start_orbit(start, branch)
     q0, q_end, step = curve_range("continue_orbit_curve", q0, q_end, step)
     if not callable(make2):
         raise ValueError(f"continue_orbit_curve: make2 = {make2!r}: give a function "
@@ -341,11 +347,10 @@ def continue_orbit_curve(start: Any, make2: Callable[[float, float], Solver], q0
     except (ShootingError, ValueError) as e:
         raise ValueError(f"continue_orbit_curve: the start is not a fold of make2(., q0 = "
                          f"{q0!r}) near p = {p_event!r}: {e}") from None
-    if isinstance(start, Event) and abs(float(y0[-1]) - p_event) > START_TOL * max(1.0,
-                                                                                abs(p_event)):
+    if abs(float(y0[-1]) - p_event) > slack:
         raise ValueError(f"continue_orbit_curve: the fold of make2(., q0 = {q0!r}) is at p = "
-                         f"{float(y0[-1])!r}, not at the event's p = {p_event!r}: is make2(p, "
-                         "q0) the branch's model make(p)?")
+                         f"{float(y0[-1])!r}, not at the event's p = {p_event!r} (within "
+                         f"{slack:.3g}): is make2(p, q0) the branch's model make(p)?")
     b = continuation(disc, y0, q0, q_end, step=float(step), min_step=min_step,
                      max_step=max_step, max_points=max_points, at=at, tol=tol,
                      max_iter=max_iter, predictor="tangent", easy=4, make=make2,
