@@ -42,7 +42,8 @@ import numpy as np
 from ..continuation.branch import Branch, Event, corner_sentence, travel
 from ..collocation.adapt import transfer
 from .discretisation import CollocationDiscretisation, equation_hopf_orbit
-from ..collocation.mend import check_inequalities, circle, mend, relaid, removed
+from ..collocation.mend import (check_inequalities, circle, mend, relaid, removed, rotated,
+                                wrapping)
 from ..collocation.margins import MarginValues, margins
 from ..collocation.signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK
 from ..collocation.system import CollocationWarning, solve
@@ -57,6 +58,8 @@ MENDS = 4
 SHED = 0.02
 #: The amplitude held past such a removal: (1 - SHRINK^k) of the last point's, k = 1, 2, 3.
 SHRINK = 1e-3
+#: A switch moved across t = 0 (= T) lands at least this fraction of the period past it.
+WRAP = 1e-3
 #: Newton with a segment's length (or the amplitude) held, p free: converged on the correction,
 #: damped, a step that puts the switches out of order (Degenerate, a ValueError) halved.
 HELD = NewtonOptions(tol=1e-12, max_iter=40, converge=Converge.CORRECTION, search=Search.DESCENT,
@@ -167,8 +170,12 @@ class EquationBranch(CollocationDiscretisation):
             (x, p), or None: the failure stands.
         """
         landing = row[-1] == 1.0 and not np.any(row[:-1])
-        got = (self._shed(str(error), None) if step else
-               self._shed(str(error), float(target)) if landing else None)
+        if not (step or landing):
+            return None
+        at = None if step else float(target)
+        got = self._shed(str(error), at)
+        if got is None:
+            got = self._wrap(x, p, str(error), at)
         if got is None:
             return None
         xm, pm, lay, ref = got
@@ -269,6 +276,49 @@ class EquationBranch(CollocationDiscretisation):
                                       1e-9 * max(1.0, float(np.max(np.abs(xm))))):
                 return xm, pm, lay, probe.ref
         return None
+
+    def _wrap(self, x: np.ndarray, p: float, why: str, at: float | None
+              ) -> tuple[np.ndarray, float, Any, Any] | None:
+        """The forced orbit past a switch that crosses t = 0 (= T): where the last point's
+        switch nearest the period's ends lies within SHED of the period of it and the predictor
+        (x, p) moves it closer, the signature rotated (:func:`~dmi.analysis.collocation.mend.rotated`:
+        the same segments, the switch moved across to the other side, its distance there
+        max(its distance, WRAP of the period)), the orbit solved at p = ``at``, or, ``at`` None,
+        with p free and the moved switch held (the branch on the other side, in p beyond the
+        last point's as the predictor's); its inequalities held.  (x, p, layout, ref), or None."""
+        last = self._last
+        lay = self.lay
+        if (last is None or last[2] is not lay or lay.autonomous or lay.S == 0
+                or x.size != last[0].size):
+            return None
+        x0, p0, _ = last
+        T = lay.period
+        k, d = wrapping(lay, x0)
+        _, b, _ = lay.split(x)
+        ahead = float(b[0] if k == 1 else T - b[-1])
+        if not (d < SHED * T and ahead < d):
+            return None
+        try:
+            new, x1, j = rotated(lay, self.terms(p0), x0, max(d, WRAP * T))
+        except ValueError:
+            return None
+        probe = CollocationDiscretisation(self.make, new, x1, multipliers=self.count)
+        probe.problem = self.problem
+        try:
+            if at is not None:
+                xm, pm = solve(new, self.terms(at), x1, probe.ref, tol=1e-12)[0], at
+            else:
+                row = np.zeros(x1.size + 1)
+                row[new.rows * new.n + j] = 1.0
+                xm, pm = self._held(probe, x1, p0, row, float(row[:-1] @ x1),
+                                    f"{why}; switch {k} wrapped across t = 0 (= T)")
+        except (ShootingError, ValueError):
+            return None
+        if at is None and (pm - p0) * (p - p0) <= 0:   # not on in p as the step was
+            return None
+        if check_inequalities(new, self.terms(pm), xm, 1e-9 * max(1.0, float(np.max(np.abs(xm))))):
+            return None
+        return xm, pm, new, probe.ref
 
     def _grow(self, probe: CollocationDiscretisation, x: np.ndarray, p: float, why: str
               ) -> tuple[np.ndarray, float]:
@@ -526,7 +576,7 @@ class EquationBranch(CollocationDiscretisation):
             Zero or one event.
         """
         sa, sb = a.signature.describe(), b.signature.describe()
-        if sa == sb:
+        if sa == sb or a.signature.rotates_to(b.signature):   # the same, or a switch wrapped
             return []
         ha, hb = _stuck_like(a), _stuck_like(b)
         changed = np.flatnonzero(ha != hb)

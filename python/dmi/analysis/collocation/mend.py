@@ -68,6 +68,44 @@ def removed(segs: list, j: int, T: float) -> list:
     return sorted(out, key=lambda s: s[1] % T)
 
 
+def wrapping(lay: Layout, x: np.ndarray) -> tuple[int, float]:
+    """(k, d): the switch of a forced orbit nearest the period's ends, k = 1 (b_1, next to
+    t = 0) or S (b_S, next to T), and its distance d to that end.  ValueError for an
+    autonomous or smooth orbit (no switch, or a time origin of its own)."""
+    if lay.autonomous or lay.S == 0:
+        raise ValueError("only a forced orbit's switch wraps around t = 0 (= T): "
+                         f"{'autonomous' if lay.autonomous else 'no switch'}")
+    _, b, T = lay.split(x)
+    return (1, float(b[0])) if b[0] <= T - b[-1] else (lay.S, float(T - b[-1]))
+
+
+def rotated(lay: Layout, terms: Terms, x: np.ndarray, gap: float
+            ) -> tuple[Layout, np.ndarray, int]:
+    """A forced orbit whose switch b_1 (b_S) nears t = 0 (T) laid out with that switch moved
+    across the period's end to T - gap (gap): the same segments around the circle, the one
+    holding t = 0 now the next (the previous) one, its signature rotated (the phase origin is
+    the forcing's, so a switch that leaves the period at 0 re-enters at T).  Returns (the new
+    layout, x on it, the moved switch's index in the new b: S - 1 or 0).
+
+    Raises
+    ------
+    ValueError
+        An autonomous or smooth orbit, or a gap outside (0, the next switch's distance).
+    """
+    k, _ = wrapping(lay, x)
+    segs, T = circle(lay, x)
+    _, b, _ = lay.split(x)
+    room = T - b[-1] if k == 1 else b[0]     # the moved switch stays clear of the others
+    if not 0 < gap < room:
+        raise ValueError(f"gap = {gap!r}: the moved switch must land within (0, {room!r}) of "
+                         "the period's end, short of the switch there")
+    j = 1 if k == 1 else 0                 # the segment that starts at the moving switch
+    segs = list(segs)
+    segs[j] = (segs[j][0], -gap if k == 1 else gap)
+    new, xn = relaid(lay, terms, x, segs, T)
+    return new, xn, (lay.S - 1 if k == 1 else 0)
+
+
 def breached(lay: Layout, terms: Terms, x: np.ndarray, segs: list, T: float) -> list | None:
     """The segments with the first breached stretch (a slip component of the wrong sign, a
     stuck one whose force exceeds alpha, a free box component beyond a face, one on a face whose

@@ -57,6 +57,14 @@ class Signature:
         return next(kk for kk in ((k - 1 + d) % S + 1 for d in range(1, S + 1))
                     if self.switch(kk)[0] == i)
 
+    def rotates_to(self, other: Signature) -> bool:
+        """Whether ``other`` has the same segments around the circle in the same order, another
+        one holding t = 0 (a forced orbit's switch that crossed t = 0 = T); False when equal."""
+        a, b = np.asarray(self.modes), np.asarray(other.modes)
+        if a.shape != b.shape or len(a) < 2 or np.array_equal(a, b):
+            return False
+        return any(np.array_equal(np.roll(a, -k, axis=0), b) for k in range(1, len(a)))
+
     def describe(self) -> list[str]:
         """One line a segment: its modes by component."""
         return ["(" + ", ".join(NAMES[int(c)] for c in row) + ")" for row in self.modes]
