@@ -640,7 +640,8 @@ class EquationBranch(CollocationDiscretisation):
     def corner(self, points: list[EquationOrbit]) -> str:
         """Where a branch that failed at the smallest step ended, in the words of
         :func:`~dmi.analysis.continuation.branch.corner_sentence`: a friction component that slips
-        throughout and comes within 1 % of its half range of 0 (grazing), or else the component
+        throughout and comes within 1 % of its half range of 0 without crossing it (grazing; a
+        reversal, where it crosses 0, is none), or else the component
         that switches into the shortest segment of the last signature (a segment that vanishes
         or appears there); "" for a smooth orbit that does not graze.
 
@@ -689,16 +690,23 @@ class EquationBranch(CollocationDiscretisation):
 def _grazing(disc: CollocationDiscretisation, orbit: EquationOrbit
              ) -> tuple[int, float, float] | None:
     """(i, least |u_i|, half range of u_i) of the friction component that slips throughout and
-    comes nearest 0, on a fine grid of the orbit; None when no friction component slips
-    throughout."""
+    comes nearest 0 without crossing it (the least local minimum of |u_i| on a fine grid of the
+    orbit whose neighbours have one sign: a touch; the reversals, where u_i crosses 0, are not
+    read); None when no friction component slips throughout and touches."""
     alpha = disc.terms(orbit.p).alpha
     modes = np.asarray(orbit.signature.modes)
     best = None
-    t = np.linspace(0.0, orbit.period, 2001)
+    t = np.linspace(0.0, orbit.period, 2001)[:-1]   # periodic: the last point is the first
     u = orbit.u_at(t)
     for i in np.flatnonzero(alpha > 0):
         if np.all(np.isin(modes[:, i], (SLIP_POS, SLIP_NEG))):
-            least = float(np.min(np.abs(u[:, i])))
+            v = u[:, i]
+            before, after = np.roll(v, 1), np.roll(v, -1)
+            touch = ((np.abs(v) <= np.abs(before)) & (np.abs(v) <= np.abs(after))
+                     & (before * after > 0))
+            if not np.any(touch):
+                continue
+            least = float(np.min(np.abs(v[touch])))
             if best is None or least < best[1]:
                 best = (int(i), least, float(orbit.amplitude[i]))
     return best

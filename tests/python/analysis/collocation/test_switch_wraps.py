@@ -153,3 +153,35 @@ def test_branch_back_through_the_crossing(down):
     assert len(turns) == 1, [pt.signature.describe() for pt in pts]
     for pt in pts[turns[0]:]:
         check_against_reference(pt)
+
+
+# ---- the corner's grazing ---------------------------------------------------------------------
+K, C, AG = 1.0, math.sqrt(2.0), 0.5     # u' + K u + AG sigma(u) ∋ A + C sin t
+LEAST = 0.005                          # the closed form's least u: (A - AG) / K - C / sqrt(1 + K^2)
+
+
+def slip(p: float, h: float | None = None) -> dmi.Solver:
+    """A first-order slip orbit: f = K u - A - C sin t with A = AG + K (LEAST + C / sqrt(1 +
+    K^2)) p (p = 1: u > 0 throughout, u = c0 + C / sqrt(1 + K^2) sin(t - atan(1 / K)), least
+    LEAST, half range 1)."""
+    A = AG + K * (LEAST + C / math.sqrt(1 + K * K)) * p
+    s = dmi.Solver(1, 2 * math.pi / 400 if h is None else h, 1)
+    s.set_rhs(lambda t, u: np.array([K * u[0] - A - C * math.sin(t)]))
+    s.set_friction([AG])
+    return s
+
+
+def test_corner_reads_a_true_grazing_and_not_a_reversal(up):
+    """The corner's sentence on an orbit that slips throughout and touches u = 0 (least u
+    LEAST = 0.005 of the half range 1, closed form) names the grazing with that least velocity
+    (to the sentence's 3 digits); on the branch's orbit whose reversal lies 0.003 after t = 0
+    (its velocity crosses 0 twice a period, touching it nowhere) it names no grazing."""
+    scheme = da.periodic_orbit(slip, 1.0, 2 * math.pi, [1.0], multipliers=1)
+    o = da.collocate(scheme, multipliers=1, intervals=24)
+    assert o.signature.switches == 0 and abs(o.amplitude[0] - 1.0) < 1e-8, o.amplitude
+    said = EquationBranch.of(o)[0].corner([o])
+    assert "its velocity comes within 0.005 of 0 (half range 1): a grazing" in said, said
+    near = min(up.points, key=lambda pt: pt.switches[0])
+    assert 0 < near.switches[0] < 0.005, near.switches
+    said = EquationBranch.of(near)[0].corner([near])
+    assert "grazing" not in said, said
