@@ -281,9 +281,10 @@ class EquationBranch(CollocationDiscretisation):
               ) -> tuple[np.ndarray, float, Any, Any] | None:
         """The forced orbit past a switch that crosses t = 0 (= T): where the last point's
         switch nearest the period's ends lies within SHED of the period of it and the predictor
-        (x, p) moves it closer, the signature rotated (:func:`~dmi.analysis.collocation.mend.rotated`:
-        the same segments, the switch moved across to the other side, its distance there
-        max(its distance, WRAP of the period)), the orbit solved at p = ``at``, or, ``at`` None,
+        (x, p) moves it closer, the signature rotated
+        (:func:`~dmi.analysis.collocation.mend.rotated`: the same segments, the switch moved
+        across to the other side, its distance there max(its distance, WRAP of the period)),
+        the orbit solved at p = ``at``, or, ``at`` None,
         with p free and the moved switch held (the branch on the other side, in p beyond the
         last point's as the predictor's); its inequalities held.  (x, p, layout, ref), or None."""
         last = self._last
