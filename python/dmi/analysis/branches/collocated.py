@@ -279,25 +279,28 @@ class EquationBranch(CollocationDiscretisation):
 
     def _wrap(self, x: np.ndarray, p: float, why: str, at: float | None
               ) -> tuple[np.ndarray, float, Any, Any] | None:
-        """The forced orbit past a switch that crosses t = 0 (= T): where the last point's
-        switch nearest the period's ends lies within SHED of the period of it and the predictor
-        (x, p) moves it closer, the signature rotated
-        (:func:`~dmi.analysis.collocation.mend.rotated`: the same segments, the switch moved
-        across to the other side, its distance there max(its distance, WRAP of the period)),
-        the orbit solved at p = ``at``, or, ``at`` None,
-        with p free and the moved switch held (the branch on the other side, in p beyond the
-        last point's as the predictor's); its inequalities held.  (x, p, layout, ref), or None."""
-        last = self._last
-        lay = self.lay
-        if (last is None or last[2] is not lay or lay.autonomous or lay.S == 0
-                or x.size != last[0].size):
+        """The forced orbit past a switch that crosses t = 0 (= T): on a step, where the last
+        point's switch nearest the period's ends lies within SHED of the period of it and the
+        predictor (x, p) moves it closer; on a landing (``at``), where the predictor's does;
+        the signature rotated (:func:`~dmi.analysis.collocation.mend.rotated`: the same
+        segments, the switch moved across to the other side, its distance there max(its
+        distance, WRAP of the period)), the orbit solved at p = ``at``, or, ``at`` None, with p
+        free and the moved switch held (the branch on the other side, in p beyond the last
+        point's as the predictor's); its inequalities held.  (x, p, layout, ref), or None."""
+        lay, last = self.lay, self._last
+        if lay.autonomous or lay.S == 0:
             return None
-        x0, p0, _ = last
         T = lay.period
+        if at is None:
+            if last is None or last[2] is not lay or x.size != last[0].size:
+                return None
+            x0, p0, _ = last
+        else:
+            x0, p0 = x, p
         k, d = wrapping(lay, x0)
         _, b, _ = lay.split(x)
         ahead = float(b[0] if k == 1 else T - b[-1])
-        if not (d < SHED * T and ahead < d):
+        if not (d < SHED * T and (ahead < d or at is not None)):
             return None
         try:
             new, x1, j = rotated(lay, self.terms(p0), x0, max(d, WRAP * T))

@@ -84,8 +84,10 @@ def rotated(lay: Layout, terms: Terms, x: np.ndarray, gap: float
     """A forced orbit whose switch b_1 (b_S) nears t = 0 (T) laid out with that switch moved
     across the period's end to T - gap (gap): the same segments around the circle, the one
     holding t = 0 now the next (the previous) one, its signature rotated (the phase origin is
-    the forcing's, so a switch that leaves the period at 0 re-enters at T).  Returns (the new
-    layout, x on it, the moved switch's index in the new b: S - 1 or 0).
+    the forcing's, so a switch that leaves the period at 0 re-enters at T), on another number
+    of intervals than lay's (no unknown of the new layout means what one of the old meant: a
+    continuation restarts its tangent and locates no event across).  Returns (the new layout,
+    x on it, the moved switch's index in the new b: S - 1 or 0).
 
     Raises
     ------
@@ -102,7 +104,10 @@ def rotated(lay: Layout, terms: Terms, x: np.ndarray, gap: float
     j = 1 if k == 1 else 0                 # the segment that starts at the moving switch
     segs = list(segs)
     segs[j] = (segs[j][0], -gap if k == 1 else gap)
-    new, xn = relaid(lay, terms, x, segs, T)
+    for more in range(4):   # other unknowns (their number changes): none shared with the old
+        new, xn = relaid(lay, terms, x, segs, T, lay.L + more)
+        if new.L != lay.L:
+            break
     return new, xn, (lay.S - 1 if k == 1 else 0)
 
 
@@ -174,10 +179,11 @@ def memory(lay: Layout, terms: Terms, x: np.ndarray, t: np.ndarray) -> np.ndarra
     return (G @ V.ravel()).reshape(-1, lay.n)
 
 
-def relaid(lay: Layout, terms: Terms, x: np.ndarray, segs: list, T: float
-            ) -> tuple[Layout, np.ndarray]:
-    """The layout of the segments ``segs`` (same L, uniform in each piece) and x on it; an
-    autonomous orbit's time origin moved to the middle of its longest segment (no switch at 0)."""
+def relaid(lay: Layout, terms: Terms, x: np.ndarray, segs: list, T: float,
+           intervals: int | None = None) -> tuple[Layout, np.ndarray]:
+    """The layout of the segments ``segs`` (about ``intervals`` intervals, default the same L;
+    uniform in each piece) and x on it; an autonomous orbit's time origin moved to the middle
+    of its longest segment (no switch at 0)."""
     shift = 0.0
     segs = sorted(segs, key=lambda s: s[1] % T)
     # neighbours (around the circle) with the same modes are one segment: a smooth orbit's only
@@ -202,7 +208,8 @@ def relaid(lay: Layout, terms: Terms, x: np.ndarray, segs: list, T: float
             raise ValueError(f"the mended signature changes {i.size} components at once at "
                              f"t = {b[k - 1]:.6g}: not continued")
     new = Layout(lay.m, lay.n, sig, [], lay.autonomous, lay.period, carried(terms, sig))
-    new = new.with_fractions(uniform_fractions(new.bounds(b, T), lay.L))
+    new = new.with_fractions(uniform_fractions(new.bounds(b, T),
+                                               lay.L if intervals is None else intervals))
     V = evaluate(lay, x, node_times(new, b, T) + shift)
     return new, np.concatenate([V.ravel(), b, [T] if lay.autonomous else []])
 

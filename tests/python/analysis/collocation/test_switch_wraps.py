@@ -31,6 +31,7 @@ W, AL, Q = 1.5, 0.02, 0.2            # the forcing's frequency, the dry friction
 T = 2 * math.pi / W
 T0 = T / 4                           # the reference's section: far from both reversals
 P_LO, P_HI = 0.9, 1.02               # the branch's range: the reversal crosses t = 0 inside
+AT = (0.955, 0.97)                   # user points just before and after the crossing (p 0.961)
 
 
 def vdp(p: float, h: float | None = None) -> dmi.Solver:
@@ -93,7 +94,7 @@ def start() -> da.EquationOrbit:
 def up(start) -> da.Branch:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", da.CollocationWarning)
-        return da.continue_orbit(start, P_HI, step=0.03, multipliers=2)
+        return da.continue_orbit(start, P_HI, step=0.03, multipliers=2, at=AT)
 
 
 @pytest.fixture(scope="module")
@@ -131,8 +132,8 @@ def test_reference_reversal_crosses_t0(start, up):
 
 def test_branch_passes_a_switch_crossing_t0(up):
     """The branch reaches p_end; its signature turns once (the same two segments, the other
-    holding t = 0), no event is reported for it; every point before and after the turn agrees
-    with the reference."""
+    holding t = 0), between the user points on either side of the crossing, and no event is
+    reported for it; every point before and after the turn agrees with the reference."""
     assert up.status == f"reached p_end = {P_HI!r}", up.status
     pts = up.points
     turns = [k for k in range(1, len(pts)) if wrapped(pts[k - 1], pts[k])]
@@ -140,6 +141,7 @@ def test_branch_passes_a_switch_crossing_t0(up):
     assert not [e for e in up.events if e.kind in ("grazing", "stick-onset")], up.events
     k = turns[0]
     assert pts[k - 1].switches[0] < 0.05 and pts[k].switches[-1] > T - 0.05
+    assert [pt.p for pt in pts[k - 1:k + 1]] == list(AT)   # landed on either side of it
     for pt in pts:
         check_against_reference(pt)
 
