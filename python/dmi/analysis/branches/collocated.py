@@ -23,8 +23,11 @@ singular, at the corner of a vertical branch, with p free and the new segment's 
 up to four times; where a step fails next to a held segment shorter than SHED of the period
 (the branch back to a corner), the short held segments are removed and the orbit solved with p
 free and its amplitude held just inside (``recover``, :meth:`EquationBranch._shed`; a landing
-there: at the landing's p).  The mended point is the step's (``accept`` returns it on its new
-unknowns),
+there: at the landing's p); where a step fails as a forced orbit's switch nears t = 0 (= T),
+within SHED of the period, the signature is rotated (the switch moved across to the other end,
+:func:`dmi.analysis.collocation.mend.rotated`) and the orbit solved with p free and that switch
+held (``recover``, :meth:`EquationBranch._wrap`; a landing: at its p).  The mended point is
+the step's (``accept`` returns it on its new unknowns),
 the mesh is equidistributed after every step (``adapt``), and the driver restarts its tangent
 on the new unknowns (oriented by :meth:`EquationBranch.carry`; a vertical start by
 :meth:`EquationBranch.orient`, the amplitude growing).  A branch that fails at the smallest
@@ -147,7 +150,8 @@ class EquationBranch(CollocationDiscretisation):
     def recover(self, x: np.ndarray, p: float, row: np.ndarray, target: float, step: bool,
                 error: Exception) -> tuple[np.ndarray, float] | None:
         """Where the driver's corrector failed from the predictor (x, p): past a corner where
-        held segments vanish (:meth:`_shed`): on a step with p free, the step's point on the new
+        held segments vanish (:meth:`_shed`), or past a forced orbit's switch that crosses
+        t = 0 (:meth:`_wrap`): on a step with p free, the step's point on the new
         unknowns; on a landing (the hyperplane p = target) at that p, the mended orbit kept for
         :meth:`point` and the predictor returned (the unknowns stay).  None otherwise.
 
