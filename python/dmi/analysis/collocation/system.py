@@ -31,6 +31,7 @@ import scipy.sparse.linalg as sla
 
 from ..._solver import Solver
 from ..core.model import FD_STEP, ManyRhs
+from . import fold as _fold
 from .mesh import (STEEP, Basis, Kernel, Locator, Near, _monomials, delay_matrix,
                                history_locator, history_rows, periodic_locator, point_matrix)
 from .signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
@@ -94,14 +95,43 @@ class Terms:
                         rate if rate * self.tau > STEEP else 0.0)
         self._delays: OrderedDict[tuple, tuple] = OrderedDict()
         self._kept: dict[str, tuple[tuple, np.ndarray]] = {}
+        #: Whether a periodic orbit's delay integral is folded onto one period (an exponential
+        #: sum; :mod:`dmi.analysis.collocation.fold`).
+        self.fold = bool(_fold.FOLD) and self.kind == "exp"
+        self._folds: tuple[float, _fold.Fold | None] | None = None
+
+    def folded(self, T: float) -> _fold.Fold | None:
+        """The kernel folded onto the period T (:func:`fold.fold_of`; the last one kept), None
+        when it does not fold (folding off, a callback kernel, tau <= T, near cells reaching T)."""
+        if not self.fold:
+            return None
+        if self._folds is None or self._folds[0] != float(T):
+            self._folds = (float(T), _fold.fold_of(self.H, self.terms, self.tau, T))
+        return self._folds[1]
+
+    def periodic_delay(self, times: np.ndarray, mesh: np.ndarray, T: float, basis: Basis,
+                       rows: int, slope_of: np.ndarray | None = None
+                       ) -> tuple[sp.csr_matrix, np.ndarray | None]:
+        """delay_matrix's (G, T derivative) at ``times`` on the periodic orbit of ``mesh``
+        (period T, ``rows`` node rows): folded onto one period when the kernel folds, else over
+        the whole memory."""
+        loc = periodic_locator(mesh, basis.m)
+        f = self.folded(T)
+        if f is not None:
+            return _fold.periodic_delay(times, f, mesh, loc, basis, self.n, rows, self.pattern,
+                                        slope_of)
+        return delay_matrix(times, self.tau, mesh, T, self.H, loc, basis, self.n, rows,
+                            pattern=self.pattern, slope_of=slope_of)
 
     def delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc: Locator, basis: Basis,
-              rows: int, history: History | None = None, extra: np.ndarray | None = None
-              ) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
+              rows: int, history: History | None = None, extra: np.ndarray | None = None,
+              periodic: bool = False) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
         """The delay integral's matrix (:func:`delay_matrix`) at the collocation times of
         ``mesh`` and at the ``extra`` times (the switching conditions' that need the memory) in
         one, kept for the last DELAY_CACHE meshes (it depends on the mesh, T, the basis, the
-        extra times and the history's mesh only, not on the node values).
+        extra times and the history's mesh only, not on the node values).  With ``periodic``
+        (``loc`` the periodic locator of ``mesh``), folded onto one period
+        (:meth:`periodic_delay`).
 
         Parameters
         ----------
@@ -121,6 +151,8 @@ class Terms:
             The past of the monodromy operator's system (its mesh and periods enter the key).
         extra : numpy.ndarray, optional
             More times, after the collocation times.
+        periodic : bool
+            u is the periodic orbit of ``mesh`` (``loc`` its periodic locator, no history).
 
         Returns
         -------
@@ -131,11 +163,15 @@ class Terms:
         more = np.empty(0) if extra is None else np.asarray(extra, dtype=float)
         key = (np.asarray(mesh, dtype=float).tobytes(), float(T), basis.m, basis.q, rows,
                None if history is None else (history.hist.tobytes(), history.periods),
-               more.tobytes())
+               more.tobytes(), periodic and self.fold)
         got = self._delays.get(key)
         if got is None:
-            G = delay_matrix(np.concatenate([times, more]), self.tau, mesh, T, self.H, loc,
-                             basis, self.n, rows, pattern=self.pattern)[0]
+            every = np.concatenate([times, more])
+            if periodic and history is None:
+                G = self.periodic_delay(every, mesh, T, basis, rows)[0]
+            else:
+                G = delay_matrix(every, self.tau, mesh, T, self.H, loc, basis, self.n, rows,
+                                 pattern=self.pattern)[0]
             cut = len(times) * self.n
             got = (G, None) if not more.size else (G[:cut], G[cut:])
             self._delays[key] = got
@@ -228,13 +264,7 @@ class Terms:
         closed form, a callback one lag at a time."""
         s = np.asarray(s, dtype=float)
         if self.kind == "exp":
-            a, b, C, D = self.terms  # type: ignore[misc]
-            k, n = a.size, self.n
-            e = np.exp(np.outer(s, a))
-            if not np.any(b):                     # real rates: cos = 1, sin = 0
-                return (e @ C.reshape(k, n * n)).reshape(-1, n, n)
-            return ((e * np.cos(np.outer(s, b))) @ C.reshape(k, n * n)
-                    + (e * np.sin(np.outer(s, b))) @ D.reshape(k, n * n)).reshape(-1, n, n)
+            return _fold.exp_sum(s, *self.terms)  # type: ignore[misc]
         out = np.array([self.solver.eval_kernel(float(x)) for x in s]).reshape(-1, self.n, self.n)
         if not np.all(np.isfinite(out)):
             raise ValueError("collocate: the model's kernel is not finite on (0, tau)")
@@ -545,10 +575,10 @@ def assemble(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable[[np.ndarray
     scaled = jacobian and lay.autonomous and history is None and lay.S == 0
     G, dI, Gb = None, None, None
     if terms.has_kernel and scaled:         # the T column's integral needs the node values
-        G, dI = delay_matrix(tc, terms.tau, mesh, T, terms.H, loc, basis, n, rows,
-                             pattern=terms.pattern, slope_of=V)
+        G, dI = terms.periodic_delay(tc, mesh, T, basis, rows, slope_of=V)
     elif terms.has_kernel:                  # with the memory at the stick endings' b's
-        G, Gb = terms.delay(tc, mesh, T, loc, basis, rows, history, b[force_switches(lay)])
+        G, Gb = terms.delay(tc, mesh, T, loc, basis, rows, history, b[force_switches(lay)],
+                            periodic=history is None)
     Uc = (E @ u).reshape(-1, n)
     du = (D @ u).reshape(-1, n)
     r = du + terms.f(tc, Uc)

@@ -1,0 +1,207 @@
+# The delay integral of a periodic orbit over one period: the memory's periods folded onto one.
+# Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
+"""The folded delay integral of :mod:`dmi.analysis.collocation.system`; private to the package.
+
+On a T-periodic u the delay integral over a memory of K = floor(tau / T) periods and a rest
+r = tau - K T is one over a period:
+
+    int_0^tau H(s) u(t - s) ds = int_0^T H_T(s) u(t - s) ds,
+    H_T(s) = sum_{k=0}^{K-1} H(s + k T) + [s < r] H(s + K T),
+
+H_T jumping at s = r.  For an exponential sum H(s) = Re sum_j e^(lambda_j s) (C_j - i D_j) the fold
+is the same sum with each term's factor times sum_k e^(lambda_j k T) (plus e^(lambda_j K T) below
+r): one evaluation a lag instead of K + 1.  The near part s^-beta C on (0, delta] belongs to k = 0
+only: the folded kernel keeps it and the terms k >= 1 on (0, delta] (the *tail*, smooth) are a
+second, short delay integral over [0, delta].  The period derivative at fixed theta = t / T (an
+autonomous orbit) is (1 / T) int_0^tau s H(s) u'(t - s) ds; folded, the lag s + k T of period k
+adds int_0^T M_T(s) u'(t - s) ds with M_T(s) = sum_k k H(s + k T) (a third integral, its matrix
+unused).
+
+Only a periodic u folds: the monodromy operator's past (a perturbation, not periodic) keeps the
+whole memory (:func:`dmi.analysis.collocation.mesh.delay_matrix`).  Folded: an exponential sum,
+tau > T, a near part shorter than T; otherwise :func:`fold_of` returns None.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .mesh import Basis, Kernel, Locator, delay_matrix
+
+#: Whether the periodic orbit's delay integral folds (a switch for benchmarks and tests: False
+#: integrates over the whole memory; read when a Terms is made).
+FOLD = True
+#: Relative size (of max(tau, 1)) below which the rest r of the last period, or a folded jump's
+#: distance to 0 or T, is dropped (the pieces of delay_matrix drop the same lengths).
+FOLD_TOL = 1e-14
+
+
+def exp_sum(s: np.ndarray, a: np.ndarray, b: np.ndarray, C: np.ndarray, D: np.ndarray
+            ) -> np.ndarray:
+    """sum_j e^(a_j s) (C_j cos b_j s + D_j sin b_j s) (P, n, n) at the lags s (P,) (C, D:
+    (k, n, n)); no cos / sin when every b is 0."""
+    s = np.asarray(s, dtype=float)
+    k, n = a.size, C.shape[-1]
+    e = np.exp(np.outer(s, a))
+    if not np.any(b):
+        return (e @ C.reshape(k, n * n)).reshape(-1, n, n)
+    return ((e * np.cos(np.outer(s, b))) @ C.reshape(k, n * n)
+            + (e * np.sin(np.outer(s, b))) @ D.reshape(k, n * n)).reshape(-1, n, n)
+
+
+def _scaled(C: np.ndarray, D: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The factors (C', D') with C' - i D' = w (C - i D) (w complex (k,))."""
+    wr, wi = w.real[:, None, None], w.imag[:, None, None]
+    return wr * C + wi * D, wr * D - wi * C
+
+
+@dataclass(frozen=True)
+class Fold:
+    """The memory of an exponential sum folded onto one period T.
+
+    Attributes
+    ----------
+    T : float
+        The period.
+    K : int
+        The whole periods in tau (floor(tau / T)).
+    r : float
+        The rest tau - K T (0 when below FOLD_TOL max(tau, 1)): H_T jumps there.
+    kernel : Kernel
+        H_T on (0, T], with H's near part (k = 0 only), its jumps folded and r as jumps.
+    tail : callable or None
+        s -> sum_{k >= 1} H(s + k T) (the same truncation) on (0, delta] (None without near part).
+    moment : callable
+        s -> T M_T(s) / s, M_T(s) = sum_k k H(s + k T) (the same truncation): the period
+        derivative's kernel as delay_matrix's slope weighs it (by s / T).
+    jumps : tuple of float
+        H_T's jumps in (0, T), sorted (the folded declared lags and r).
+    """
+    T: float
+    K: int
+    r: float
+    kernel: Kernel
+    tail: Callable[[np.ndarray], np.ndarray] | None
+    moment: Callable[[np.ndarray], np.ndarray]
+    jumps: tuple[float, ...]
+
+
+def _weights(lam: np.ndarray, T: float, K: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(sum_{k<K} z^k, sum_{1<=k<K} z^k, sum_{k<K} k z^k) with z^k = e^(lambda k T), each
+    power in one exponential (no products accumulated)."""
+    g0 = np.zeros(lam.size, complex)
+    g1 = np.zeros(lam.size, complex)
+    g2 = np.zeros(lam.size, complex)
+    for k in range(K):
+        z = np.exp(lam * (k * T))
+        g0 += z
+        if k:
+            g1 += z
+            g2 += k * z
+    return g0, g1, g2
+
+
+def _piecewise(a: np.ndarray, b: np.ndarray, below: tuple, above: tuple, r: float
+               ) -> Callable[[np.ndarray], np.ndarray]:
+    """s -> the exponential sum with the factors ``below`` (C, D) at s < r, ``above`` else."""
+    def H(s: np.ndarray) -> np.ndarray:
+        s = np.asarray(s, dtype=float)
+        low = s < r
+        if not np.any(low):
+            return exp_sum(s, a, b, *above)
+        if np.all(low):
+            return exp_sum(s, a, b, *below)
+        out = np.empty((s.size,) + above[0].shape[1:])
+        out[low] = exp_sum(s[low], a, b, *below)
+        out[~low] = exp_sum(s[~low], a, b, *above)
+        return out
+    return H
+
+
+def fold_of(H: Kernel, terms: tuple, tau: float, T: float) -> Fold | None:
+    """The fold of the exponential sum ``terms`` = (a, b, C, D) (H's far part, with H's near part
+    and jumps) onto the period T; None when tau <= T (nothing to fold) or the near part reaches
+    T (its cells would meet a later period's lags)."""
+    T, tau = float(T), float(tau)
+    if not (T > 0 and math.isfinite(T)) or tau <= T:
+        return None
+    if H.near is not None and H.near.delta >= T:
+        return None
+    a, b, C, D = (np.asarray(x, dtype=float) for x in terms)
+    K = int(math.floor(tau / T))
+    r = tau - K * T
+    eps = FOLD_TOL * max(tau, 1.0)
+    if r >= T - eps:                    # tau is K + 1 periods to rounding
+        K, r = K + 1, 0.0
+    elif r <= eps:
+        r = 0.0
+    lam = a + 1j * b
+    g0, g1, g2 = _weights(lam, T, K)
+    last = np.exp(lam * (K * T)) if r > 0 else np.zeros(lam.size, complex)
+    kernel_far = _piecewise(a, b, _scaled(C, D, g0 + last), _scaled(C, D, g0), r)
+    tail_far = _piecewise(a, b, _scaled(C, D, g1 + last), _scaled(C, D, g1), r)
+    moment_far = _piecewise(a, b, _scaled(C, D, g2 + K * last), _scaled(C, D, g2), r)
+
+    def moment(s: np.ndarray) -> np.ndarray:
+        s = np.asarray(s, dtype=float)
+        return moment_far(s) * (T / s)[:, None, None]
+
+    folded = {float(j % T) for j in H.jumps} | ({r} if r > 0 else set())
+    jumps = tuple(sorted(j for j in folded if eps < j < T - eps))
+    kernel = Kernel(kernel_far, H.near, jumps, H.rate)
+    return Fold(T, K, r, kernel, tail_far if H.near is not None else None, moment, jumps)
+
+
+def periodic_delay(times: np.ndarray, fold: Fold, mesh: np.ndarray, loc: Locator, basis: Basis,
+                   n: int, rows: int, pattern: np.ndarray, slope_of: np.ndarray | None = None
+                   ) -> tuple[sp.csr_matrix, np.ndarray | None]:
+    """delay_matrix's (G, T derivative) of a periodic u over the whole memory, integrated over
+    one period with the folded kernel: H_T over [0, T] (near part included), the tail over
+    [0, delta] with a near part, and with ``slope_of`` the moment's period derivative.
+
+    Parameters
+    ----------
+    times : numpy.ndarray
+        The times t_c.
+    fold : Fold
+        The folded kernel (:func:`fold_of`) of the period mesh[-1].
+    mesh : numpy.ndarray
+        The mesh of one period.
+    loc : callable
+        The periodic locator of the node rows.
+    basis : Basis
+        The basis.
+    n : int
+        The state's dimension.
+    rows : int
+        The node rows.
+    pattern : numpy.ndarray
+        (n, n) booleans: H's entries that may be nonzero.
+    slope_of : numpy.ndarray, optional
+        Node rows (rows, n) of u: also the derivative of G u in T with the mesh scaled.
+
+    Returns
+    -------
+    tuple
+        G (len(times) n, rows n) and the T derivative (len(times), n) or None.
+    """
+    T = fold.T
+    G, dT = delay_matrix(times, T, mesh, T, fold.kernel, loc, basis, n, rows, pattern=pattern,
+                         slope_of=slope_of)
+    near = fold.kernel.near
+    if fold.tail is not None and near is not None:
+        cuts = np.array([j for j in fold.jumps if j < near.delta])
+        Gt, dt = delay_matrix(times, near.delta, mesh, T, fold.tail, loc, basis, n, rows,
+                              breaks=cuts, pattern=pattern, slope_of=slope_of)
+        G = G + Gt
+        if dT is not None:
+            dT = dT + dt
+    if slope_of is not None:
+        dm = delay_matrix(times, T, mesh, T, fold.moment, loc, basis, n, rows,
+                          breaks=np.asarray(fold.jumps), pattern=pattern, slope_of=slope_of)[1]
+        dT = dT + dm
+    return G, dT
