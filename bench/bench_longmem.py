@@ -13,9 +13,10 @@
 #               amplitude 0.1.
 # CPU time of the process, the fastest of --rounds rounds, one BLAS thread.  --small: tau = 15 (about
 # two periods) and 8 intervals for the stick-slip orbit, a size for a quick check.  --intervals L:
-# the stick-slip orbit at L intervals instead of the default tol.
+# the stick-slip orbit at L intervals instead of the default tol.  --unfolded: the periodic orbit's
+# delay integrals over the whole memory (dmi.analysis.collocation.fold.FOLD off), as before the fold.
 # Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_longmem.py [--rounds 1] [--small]
-#        [--intervals L] [--only stick-slip|hopf]
+#        [--intervals L] [--only stick-slip|hopf] [--unfolded]
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -122,7 +123,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--intervals", type=positive_int, default=None,
                     help="the stick-slip orbit at this many intervals (default: the default tol)")
     ap.add_argument("--only", choices=("stick-slip", "hopf"), default=None, help="one case")
+    ap.add_argument("--unfolded", action="store_true",
+                    help="the orbit's delay integrals over the whole memory (no fold)")
     a = ap.parse_args(argv)
+    if a.unfolded:
+        from dmi.analysis.collocation import fold
+        fold.FOLD = False
     warnings.simplefilter("ignore")
     cases = setup(a.small, a.intervals, a.only)
     best: dict = {}

@@ -27,10 +27,9 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
-import numpy as np
-import scipy.sparse as sp
+from typing import Any
 
-from .mesh import Basis, Kernel, Locator, delay_matrix
+import numpy as np
 
 #: Whether the periodic orbit's delay integral folds (a switch for benchmarks and tests: False
 #: integrates over the whole memory; read when a Terms is made).
@@ -38,6 +37,11 @@ FOLD = True
 #: Relative size (of max(tau, 1)) below which the rest r of the last period, or a folded jump's
 #: distance to 0 or T, is dropped (the pieces of delay_matrix drop the same lengths).
 FOLD_TOL = 1e-14
+
+
+def folding() -> bool:
+    """Whether a periodic orbit's delay integral folds (FOLD, read at the call)."""
+    return bool(FOLD)
 
 
 def exp_sum(s: np.ndarray, a: np.ndarray, b: np.ndarray, C: np.ndarray, D: np.ndarray
@@ -72,7 +76,8 @@ class Fold:
     r : float
         The rest tau - K T (0 when below FOLD_TOL max(tau, 1)): H_T jumps there.
     kernel : Kernel
-        H_T on (0, T], with H's near part (k = 0 only), its jumps folded and r as jumps.
+        H_T on (0, T] (a :class:`~.mesh.Kernel`), with H's near part (k = 0 only), its jumps
+        folded and r as jumps.
     tail : callable or None
         s -> sum_{k >= 1} H(s + k T) (the same truncation) on (0, delta] (None without near part).
     moment : callable
@@ -84,7 +89,7 @@ class Fold:
     T: float
     K: int
     r: float
-    kernel: Kernel
+    kernel: Any
     tail: Callable[[np.ndarray], np.ndarray] | None
     moment: Callable[[np.ndarray], np.ndarray]
     jumps: tuple[float, ...]
@@ -122,10 +127,11 @@ def _piecewise(a: np.ndarray, b: np.ndarray, below: tuple, above: tuple, r: floa
     return H
 
 
-def fold_of(H: Kernel, terms: tuple, tau: float, T: float) -> Fold | None:
-    """The fold of the exponential sum ``terms`` = (a, b, C, D) (H's far part, with H's near part
-    and jumps) onto the period T; None when tau <= T (nothing to fold) or the near part reaches
-    T (its cells would meet a later period's lags)."""
+def fold_of(H: Any, terms: tuple, tau: float, T: float) -> Fold | None:
+    """The fold of the exponential sum ``terms`` = (a, b, C, D) (the far part of H, a
+    :class:`~.mesh.Kernel` whose near part and jumps the fold keeps) onto the period T, a Kernel
+    of H's class; None when tau <= T (nothing to fold) or the near part reaches T (its cells
+    would meet a later period's lags)."""
     T, tau = float(T), float(tau)
     if not (T > 0 and math.isfinite(T)) or tau <= T:
         return None
@@ -152,56 +158,5 @@ def fold_of(H: Kernel, terms: tuple, tau: float, T: float) -> Fold | None:
 
     folded = {float(j % T) for j in H.jumps} | ({r} if r > 0 else set())
     jumps = tuple(sorted(j for j in folded if eps < j < T - eps))
-    kernel = Kernel(kernel_far, H.near, jumps, H.rate)
+    kernel = type(H)(kernel_far, H.near, jumps, H.rate)
     return Fold(T, K, r, kernel, tail_far if H.near is not None else None, moment, jumps)
-
-
-def periodic_delay(times: np.ndarray, fold: Fold, mesh: np.ndarray, loc: Locator, basis: Basis,
-                   n: int, rows: int, pattern: np.ndarray, slope_of: np.ndarray | None = None
-                   ) -> tuple[sp.csr_matrix, np.ndarray | None]:
-    """delay_matrix's (G, T derivative) of a periodic u over the whole memory, integrated over
-    one period with the folded kernel: H_T over [0, T] (near part included), the tail over
-    [0, delta] with a near part, and with ``slope_of`` the moment's period derivative.
-
-    Parameters
-    ----------
-    times : numpy.ndarray
-        The times t_c.
-    fold : Fold
-        The folded kernel (:func:`fold_of`) of the period mesh[-1].
-    mesh : numpy.ndarray
-        The mesh of one period.
-    loc : callable
-        The periodic locator of the node rows.
-    basis : Basis
-        The basis.
-    n : int
-        The state's dimension.
-    rows : int
-        The node rows.
-    pattern : numpy.ndarray
-        (n, n) booleans: H's entries that may be nonzero.
-    slope_of : numpy.ndarray, optional
-        Node rows (rows, n) of u: also the derivative of G u in T with the mesh scaled.
-
-    Returns
-    -------
-    tuple
-        G (len(times) n, rows n) and the T derivative (len(times), n) or None.
-    """
-    T = fold.T
-    G, dT = delay_matrix(times, T, mesh, T, fold.kernel, loc, basis, n, rows, pattern=pattern,
-                         slope_of=slope_of)
-    near = fold.kernel.near
-    if fold.tail is not None and near is not None:
-        cuts = np.array([j for j in fold.jumps if j < near.delta])
-        Gt, dt = delay_matrix(times, near.delta, mesh, T, fold.tail, loc, basis, n, rows,
-                              breaks=cuts, pattern=pattern, slope_of=slope_of)
-        G = G + Gt
-        if dT is not None:
-            dT = dT + dt
-    if slope_of is not None:
-        dm = delay_matrix(times, T, mesh, T, fold.moment, loc, basis, n, rows,
-                          breaks=np.asarray(fold.jumps), pattern=pattern, slope_of=slope_of)[1]
-        dT = dT + dm
-    return G, dT

@@ -31,7 +31,7 @@ import scipy.sparse.linalg as sla
 
 from ..._solver import Solver
 from ..core.model import FD_STEP, ManyRhs
-from . import fold as _fold
+from .fold import Fold, exp_sum, fold_of, folding
 from .mesh import (STEEP, Basis, Kernel, Locator, Near, _monomials, delay_matrix,
                                history_locator, history_rows, periodic_locator, point_matrix)
 from .signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
@@ -97,31 +97,47 @@ class Terms:
         self._kept: dict[str, tuple[tuple, np.ndarray]] = {}
         #: Whether a periodic orbit's delay integral is folded onto one period (an exponential
         #: sum; :mod:`dmi.analysis.collocation.fold`).
-        self.fold = bool(_fold.FOLD) and self.kind == "exp"
-        self._folds: tuple[float, _fold.Fold | None] | None = None
+        self.fold = bool(folding()) and self.kind == "exp"
+        self._folds: tuple[float, Fold | None] | None = None
 
-    def folded(self, T: float) -> _fold.Fold | None:
-        """The kernel folded onto the period T (:func:`fold.fold_of`; the last one kept), None
+    def folded(self, T: float) -> Fold | None:
+        """The kernel folded onto the period T (:func:`~.fold.fold_of`; the last one kept), None
         when it does not fold (folding off, a callback kernel, tau <= T, near cells reaching T)."""
         if not self.fold:
             return None
         if self._folds is None or self._folds[0] != float(T):
-            self._folds = (float(T), _fold.fold_of(self.H, self.terms, self.tau, T))
+            self._folds = (float(T), fold_of(self.H, self.terms, self.tau, T))
         return self._folds[1]
 
     def periodic_delay(self, times: np.ndarray, mesh: np.ndarray, T: float, basis: Basis,
                        rows: int, slope_of: np.ndarray | None = None
                        ) -> tuple[sp.csr_matrix, np.ndarray | None]:
         """delay_matrix's (G, T derivative) at ``times`` on the periodic orbit of ``mesh``
-        (period T, ``rows`` node rows): folded onto one period when the kernel folds, else over
-        the whole memory."""
+        (period T, ``rows`` node rows, ``slope_of`` its node values for the T derivative): when
+        the kernel folds (:meth:`folded`), the folded kernel H_T over [0, T] (near part
+        included), its later periods' tail over [0, delta] with a near part, and with
+        ``slope_of`` the moment's period derivative; else over the whole memory."""
         loc = periodic_locator(mesh, basis.m)
         f = self.folded(T)
-        if f is not None:
-            return _fold.periodic_delay(times, f, mesh, loc, basis, self.n, rows, self.pattern,
-                                        slope_of)
-        return delay_matrix(times, self.tau, mesh, T, self.H, loc, basis, self.n, rows,
-                            pattern=self.pattern, slope_of=slope_of)
+        if f is None:
+            return delay_matrix(times, self.tau, mesh, T, self.H, loc, basis, self.n, rows,
+                                pattern=self.pattern, slope_of=slope_of)
+        n, pattern = self.n, self.pattern
+        G, dT = delay_matrix(times, T, mesh, T, f.kernel, loc, basis, n, rows, pattern=pattern,
+                             slope_of=slope_of)
+        near = f.kernel.near
+        if f.tail is not None and near is not None:
+            cuts = np.array([j for j in f.jumps if j < near.delta])
+            Gt, dt = delay_matrix(times, near.delta, mesh, T, f.tail, loc, basis, n, rows,
+                                  breaks=cuts, pattern=pattern, slope_of=slope_of)
+            G = G + Gt
+            if dT is not None:
+                dT = dT + dt
+        if slope_of is not None:
+            dT = dT + delay_matrix(times, T, mesh, T, f.moment, loc, basis, n, rows,
+                                   breaks=np.asarray(f.jumps), pattern=pattern,
+                                   slope_of=slope_of)[1]
+        return G, dT
 
     def delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc: Locator, basis: Basis,
               rows: int, history: History | None = None, extra: np.ndarray | None = None,
@@ -264,7 +280,7 @@ class Terms:
         closed form, a callback one lag at a time."""
         s = np.asarray(s, dtype=float)
         if self.kind == "exp":
-            return _fold.exp_sum(s, *self.terms)  # type: ignore[misc]
+            return exp_sum(s, *self.terms)  # type: ignore[misc]
         out = np.array([self.solver.eval_kernel(float(x)) for x in s]).reshape(-1, self.n, self.n)
         if not np.all(np.isfinite(out)):
             raise ValueError("collocate: the model's kernel is not finite on (0, tau)")
