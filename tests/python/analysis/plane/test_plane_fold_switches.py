@@ -5,9 +5,10 @@
 # friction).  The branch's fold is not located on the branch (its p from a parabola, 7e-4 off):
 # the curve starts from it all the same (the fold at q0 within twice the event's points'
 # distance to its p).
-# Against an event-driven integration written here: DOP853 (rtol 1e-13) between the velocity's
-# zeros (each a reversal: asserted, no stick), the period map's Jacobian by central differences,
-# the fold (x(P) = x(0), det(M - I) = 0) by fsolve in (x(0), p) at q0 and q_end.
+# Against an event-driven integration in the tests' models (orbit_models.reversal_flow): DOP853
+# (rtol 1e-13) between the velocity's zeros (each a reversal: asserted, no stick), the period
+# map's Jacobian by central differences, the fold (x(P) = x(0), det(M - I) = 0) by fsolve in
+# (x(0), p) at q0 and q_end.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -17,10 +18,11 @@ import warnings
 import numpy as np
 import pytest
 import scipy.optimize as so
-from scipy.integrate import solve_ivp
 
 import dmi
 from dmi import analysis as da
+
+from models import orbit_models
 
 W = 1.4
 P = 2 * math.pi / W
@@ -39,24 +41,11 @@ def duffing(p: float, q: float) -> dmi.Solver:
 
 
 def flow(p: float, q: float, x0: np.ndarray) -> np.ndarray:
-    """The state at t = P from x0 = (x, x') at t = 0 (x' != 0), every zero of x' a reversal."""
-    t, x = 0.0, np.array(x0, dtype=float)
-    mode = 1.0 if x[1] > 0 else -1.0
-    while t < P:
-        def rhs(s, y, mode=mode):
-            return [y[1], -0.1 * y[1] - y[0] - y[0] ** 3 + p * math.cos(W * s) - q * mode]
-
-        def zero(s, y):
-            return y[1]
-        zero.terminal, zero.direction = True, -mode
-        sol = solve_ivp(rhs, (t, P), x, method="DOP853", rtol=1e-13, atol=1e-14, events=zero)
-        t, x = float(sol.t[-1]), sol.y[:, -1].copy()
-        if sol.status == 1:
-            x[1] = 0.0
-            F = -x[0] - x[0] ** 3 + p * math.cos(W * t)
-            assert abs(F) > q, f"a stick at t = {t}: not this test's orbit"
-            mode = math.copysign(1.0, F)
-    return x
+    """The state at t = P from x0 = (x, x') at t = 0 (x' != 0), every zero of x' a reversal:
+    orbit_models.reversal_flow."""
+    def accel(t: float, x: float, v: float) -> float:
+        return -0.1 * v - x - x ** 3 + p * math.cos(W * t)
+    return orbit_models.reversal_flow(accel, q, x0, P)[0]
 
 
 def fold(q: float, guess: np.ndarray) -> tuple[np.ndarray, float]:
