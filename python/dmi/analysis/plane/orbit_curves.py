@@ -564,8 +564,8 @@ class Twisted:
             if big == 0:
                 continue
             eps = CHANGE_STEP * max(1.0, float(np.max(np.abs(self.U)))) / big
-            here = (terms._rhs(self.tc, self.U + eps * part) - terms.f(self.tc, self.U)) / eps
-            d = (moved._rhs(self.tc, self.U + eps * part) - moved.f(self.tc, self.U)) / eps
+            here = (terms.f_anew(self.tc, self.U + eps * part) - terms.f(self.tc, self.U)) / eps
+            d = (moved.f_anew(self.tc, self.U + eps * part) - moved.f(self.tc, self.U)) / eps
             out += unit * complex(np.sum(W * (d - here)))
         return out
 
