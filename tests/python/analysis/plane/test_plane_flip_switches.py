@@ -56,7 +56,7 @@ def flow(p: float, q: float, x0: np.ndarray, t_end: float) -> tuple[np.ndarray, 
     """The state at t_end from x0 = (w, w') at t = 0 (w' != 0), and the transitions (t, kind):
     orbit_models.reversal_flow with sticks."""
     def accel(t: float, w: float, v: float) -> float:
-        return -D * v + w - w ** 3 + p * math.cos(W * t)
+        return -D * v + (w - w ** 3 + p * math.cos(W * t))
     return orbit_models.reversal_flow(accel, q, x0, t_end, sticks=True)
 
 

@@ -55,7 +55,7 @@ def flow(p: float, q: float, x0: np.ndarray, t_end: float) -> tuple[np.ndarray, 
     orbit_models.reversal_flow, every zero of x' a reversal (the net force there beyond AL,
     asserted)."""
     def accel(t: float, x: float, v: float) -> float:
-        return -(x ** 2 - q) * v - x + p * math.sin(W * t)
+        return -(x ** 2 - q) * v + (-x + p * math.sin(W * t))
     x, seen = orbit_models.reversal_flow(accel, AL, x0, t_end)
     return x, [t for t, _ in seen]
 
