@@ -5,7 +5,9 @@
 # - the stick-slip orbit of u' + sigma(u) ∋ c sin t, c > 1, slip phases in closed form;
 # - the stick onset of Den Hartog's orbit (where the net force at a reversal reaches F0);
 # - bifurcations of forced orbits by shooting with scipy's DOP853 (x(P) = x(0) and a condition
-#   on the monodromy matrix), the fold of the forced Duffing oscillator's resonance.
+#   on the monodromy matrix), the fold of the forced Duffing oscillator's resonance;
+# - event-driven flows by DOP853 with events: a forced oscillator with dry friction between its
+#   velocity's zeros (reversals, sticks), a forced oscillator held by a face x <= 1.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -420,3 +422,92 @@ def map_fixed_point(P, x: np.ndarray, dx: float, tol: float = 1e-12, max_iter: i
         if np.max(np.abs(d)) < tol:
             return x, jac(x)
     raise AssertionError(f"Newton on the map did not converge from x = {x!r}")
+
+
+def _stick_end(accel, level: float, t: float, w: float, t_end: float) -> float:
+    """The time the stick at position w from t ends (|accel(t, w, 0)| reaches level), or t_end:
+    the first sign change on a grid of 2001 points, then Brent's method."""
+    def excess(s: float) -> float:
+        return abs(accel(s, w, 0.0)) - level
+    grid = np.linspace(t, t_end, 2001)
+    k = np.flatnonzero(np.array([excess(s) for s in grid])[1:] >= 0)
+    if k.size == 0:
+        return t_end
+    j = int(k[0]) + 1
+    return so.brentq(excess, grid[j - 1], grid[j], xtol=1e-15)
+
+
+def reversal_flow(accel, level: float, x0, t_end: float, sticks: bool = False
+                  ) -> tuple[np.ndarray, list[tuple[float, str]]]:
+    """(state at t_end, transitions) of x'' + level sign(x') = accel(t, x, x') (dry friction
+    of the given level) from x0 = (x, x') at t = 0 (x' != 0), event-driven: DOP853 (rtol 1e-13)
+    between the velocity's zeros, located by its event finder.  At a zero the net force
+    accel(t, x, 0) decides: beyond level a reversal, else a stick (x held, x' = 0) until
+    |accel(t, x, 0)| reaches level (Brent's method); without ``sticks`` a stick raises an
+    AssertionError (not the caller's orbit).  The transitions are (t, kind), kind one of
+    "reversal", "stick", "stick end"."""
+    t, x = 0.0, np.array(x0, dtype=float)
+    mode = 1.0 if x[1] > 0 else -1.0
+    seen: list[tuple[float, str]] = []
+    while t < t_end:
+        if mode == 0.0:                                     # stuck: x held, x' = 0
+            t = _stick_end(accel, level, t, x[0], t_end)
+            mode = math.copysign(1.0, accel(t, x[0], 0.0))
+            seen.append((t, "stick end"))
+            continue
+
+        def rhs(s, y, mode=mode):
+            return [y[1], accel(s, y[0], y[1]) - level * mode]
+
+        def zero(s, y):
+            return y[1]
+        zero.terminal, zero.direction = True, -mode
+        sol = solve_ivp(rhs, (t, t_end), x, method="DOP853", rtol=1e-13, atol=1e-14,
+                        events=zero)
+        t, x = float(sol.t[-1]), sol.y[:, -1].copy()
+        if sol.status == 1:                 # x' = 0: the net force decides a new slip or a stick
+            x[1] = 0.0
+            F = accel(t, x[0], 0.0)
+            assert sticks or abs(F) > level, f"a stick at t = {t} (net force {F}): not this orbit"
+            mode = math.copysign(1.0, F) if abs(F) > level else 0.0
+            seen.append((t, "reversal" if mode else "stick"))
+    return x, seen
+
+
+_BOX_TOL = dict(method="DOP853", rtol=1e-13, atol=1e-15)
+
+
+def box_shoot(force, c: float, w: float, s0: float, z0, s_end: float | None = None
+              ) -> tuple[float, float, object]:
+    """(s_a, s_e, the stretch's solve_ivp solution) of the oscillator w^2 x'' + c w x' + x =
+    force(s) held by the face x <= 1 in the forcing phase s (x_s + N(x) ∋ y, y = dx/ds):
+    from z0 = (x, y) at s0 its free flight until it arrives on the face (x rising through 1) at
+    s_a, then its stretch on the face (x = 1, y_s = (force(s) - 1 - c w y) / w^2) from y(s_a)
+    until y falls to 0 at s_e (it leaves; within 4 pi) or, given s_end, until s_e = s_end; by
+    DOP853 (rtol 1e-13) with events, the stretch's solution with its dense output."""
+    def free(s, z):
+        return [z[1], (force(s) - z[0] - c * w * z[1]) / w ** 2]
+
+    def held(s, z):
+        return [(force(s) - 1.0 - c * w * z[0]) / w ** 2]
+
+    def arrive(s, z):
+        return z[0] - 1.0
+    arrive.terminal, arrive.direction = True, 1
+
+    def leave(s, z):
+        return z[0]
+    leave.terminal, leave.direction = True, -1
+    a = solve_ivp(free, (s0, s0 + 4 * math.pi), list(z0), events=arrive, **_BOX_TOL)
+    if a.t_events[0].size == 0:
+        raise AssertionError(f"no arrival on the face within 4 pi of s = {s0}")
+    sa = float(a.t_events[0][0])
+    ya = [float(a.y_events[0][0][1])]
+    if s_end is not None:
+        b = solve_ivp(held, (sa, s_end), ya, dense_output=True, **_BOX_TOL)
+        return sa, s_end, b
+    b = solve_ivp(held, (sa, sa + 4 * math.pi), ya, events=leave, dense_output=True,
+                  **_BOX_TOL)
+    if b.t_events[0].size == 0:
+        raise AssertionError(f"no lift-off within 4 pi of s = {sa}")
+    return sa, float(b.t_events[0][0]), b

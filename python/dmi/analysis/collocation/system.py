@@ -216,6 +216,11 @@ class Terms:
         """f(t_c, U_c) (P, n) at the times t (P,) and states U (P, n) (read-only)."""
         return self._last("f", t, U, self._rhs)
 
+    def f_anew(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
+        """f(t_c, U_c) (P, n) computed anew, not kept (f at moved states, without displacing
+        the kept f at the orbit)."""
+        return self._rhs(np.asarray(t, dtype=float), np.asarray(U, dtype=float))
+
     def _rhs(self, t: np.ndarray, U: np.ndarray) -> np.ndarray:
         """f(t_c, U_c) (P, n) from the model's rhs (zero without one)."""
         if not self.has_rhs:

@@ -85,7 +85,7 @@ from ..continuation.driver import Curve as DriverCurve
 from ..continuation.driver import continuation, curve_range, newton_strategy
 from ..core.newton import ShootingError, Strategy, bordered_solve, sparse_bordered
 from ..scheme.problem import AtQ
-from .orbit_system import DIFF, FoldSystem, OrbitCurvePoint, check_period
+from .orbit_system import DIFF, FoldSystem, OrbitCurvePoint, central_along, check_period
 
 #: A start's fold at q0 must lie within this (relative to max(1, |p|)) of the event's p.
 START_TOL = 1e-6
@@ -95,10 +95,6 @@ BAUTIN_SHARE = 0.2
 # the step along v (relative, against the orbit's largest |u|) of the one-sided differences of
 # f's change at a moved parameter: its truncation and rounding errors balance near 3e-5
 CHANGE_STEP = 3e-5
-# the step (relative, against the orbit's largest |u| over the direction's largest entry) of
-# the central differences of f_u along a direction: f_u is a central difference of f itself
-# (its rounding about 1e-11 of f), truncation and rounding balance near 1e-4
-FU_STEP = 1e-4
 
 
 class OrbitFold(FoldSystem):
@@ -458,17 +454,14 @@ def _unrolled(mesh: np.ndarray, m: int, kmin: int) -> Callable:
 
 def fu_along(terms: Terms, t: np.ndarray, U: np.ndarray, E: np.ndarray) -> np.ndarray:
     """The derivative of f_u (P, n, n) at (t, U) along the direction E (P, n; complex: its real
-    and imaginary parts in turn), by central differences of step FU_STEP (relative to
+    and imaginary parts in turn), by :func:`central_along` (its step ALONG_STEP relative to
     max(1, |U|) over |E|'s largest part): f_u is itself a central difference of f (rounding
     about 1e-11 of f), which a smaller step would amplify."""
     out = np.zeros(U.shape + (U.shape[1],), dtype=complex)
     for part, unit in ((np.real(E), 1.0), (np.imag(E), 1j)):
-        big = float(np.max(np.abs(part))) if part.size else 0.0
-        if big == 0:
+        if not np.any(part):
             continue
-        eps = FU_STEP * max(1.0, float(np.max(np.abs(U)))) / big
-        up = np.array(terms.fu(t, U + eps * part))
-        out += unit * (up - np.array(terms.fu(t, U - eps * part))) / (2 * eps)
+        out += unit * central_along(lambda Z: np.array(terms.fu(t, Z)), U, part)
     return out
 
 
@@ -564,8 +557,8 @@ class Twisted:
             if big == 0:
                 continue
             eps = CHANGE_STEP * max(1.0, float(np.max(np.abs(self.U)))) / big
-            here = (terms._rhs(self.tc, self.U + eps * part) - terms.f(self.tc, self.U)) / eps
-            d = (moved._rhs(self.tc, self.U + eps * part) - moved.f(self.tc, self.U)) / eps
+            here = (terms.f_anew(self.tc, self.U + eps * part) - terms.f(self.tc, self.U)) / eps
+            d = (moved.f_anew(self.tc, self.U + eps * part) - moved.f(self.tc, self.U)) / eps
             out += unit * complex(np.sum(W * (d - here)))
         return out
 

@@ -29,8 +29,13 @@ from ..core.newton import ShootingError, bordered_solve, newton_loop, sparse_bor
 from ..scheme.problem import AtQ, Problem
 from ..scheme.stepmap import build
 
-#: Relative step of the differences of J along v, p and q (they steer Newton only).
+#: Relative step of the differences of J in p and q (they steer Newton only).
 DIFF = 1e-7
+#: The step (relative, against max(1, the point's largest |x|) over the direction's largest
+#: entry) of the central differences along a direction of J or f_u (:func:`central_along`):
+#: f_u is a central difference of f itself (its rounding about 1e-11 of f), truncation and
+#: rounding balance near 1e-4.
+ALONG_STEP = 1e-4
 #: Terms kept (the last few (p, q) evaluated).
 KEEP = 12
 
@@ -271,9 +276,9 @@ class FoldSystem(OrbitSystem):
         ev = self._eval(y, q)
         x, p = y[:-1], float(y[-1])
         J, v, w, t = ev["J"], ev["v"], ev["w"], ev["terms"]
-        eps = DIFF * max(1.0, float(np.max(np.abs(x)))) / max(float(np.max(np.abs(v))), 1e-300)
-        J1 = full_jacobian(self.layout(p, q), t, x + eps * v, self.ref)[1]
-        gx = -self.gscale * (J1.T @ w - J.T @ w) / eps
+        lay = self.layout(p, q)
+        gx = -self.gscale * central_along(
+            lambda z: full_jacobian(lay, t, z, self.ref)[1].T @ w, x, v)
         d = DIFF * max(1.0, abs(p))
         rp, Jp = full_jacobian(self.layout(p + d, q), self.terms(p + d, q), x, self.ref)
         Fp = (rp - ev["r"]) / d
@@ -310,6 +315,13 @@ class FoldSystem(OrbitSystem):
         other.ref, other.problem = self.ref, self.problem
         other.borders(x, float(y[self.lay.size]), q)
         return other
+
+
+def central_along(fn: Callable[[np.ndarray], Any], x: np.ndarray, d: np.ndarray) -> Any:
+    """The derivative of fn at x along the real direction d (d != 0), by central differences
+    (fn(x + e d) - fn(x - e d)) / (2 e) of step e = ALONG_STEP max(1, max |x|) / max |d|."""
+    e = ALONG_STEP * max(1.0, float(np.max(np.abs(x)))) / max(float(np.max(np.abs(d))), 1e-300)
+    return (fn(x + e * d) - fn(x - e * d)) / (2 * e)
 
 
 def _pair(J: Any, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

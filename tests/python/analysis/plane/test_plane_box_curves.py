@@ -5,7 +5,7 @@
 #   orbit is x = A cos(s - phi), A = F / sqrt((1 - w^2)^2 + (c w)^2), which first touches the face
 #   hi = 1 at F = sqrt((1 - w^2)^2 + (c w)^2): the boundary in closed form; past it the orbit
 #   rests on the face from its arrival until y reaches 0, the contact's times against an
-#   event-driven DOP853 solve of that sweeping process written here;
+#   event-driven DOP853 solve of that sweeping process (orbit_models.box_shoot);
 # - a mass on a belt (speed vb) with a slow harmonic forcing, x'' + c x' + x + mu sign(x' - vb)
 #   = F cos(w t), that sticks once a period: where the relative velocity's hump inside its slip
 #   reaches 0 a second stick begins; the boundary F(vb) against the orbit solved here with
@@ -50,28 +50,11 @@ def contact_onset(w: float) -> float:
 def contact_times(F: float, w: float, guess: float) -> tuple[float, float]:
     """(s_a, s_l): the orbit of the sweeping process arrives on the face x = 1 at s_a and leaves
     it at s_l (y reaching 0), both mod 2 pi; shooting from the leaving time s_l (x = 1, y = 0)
-    over one free flight to the face and the stretch on it, by DOP853 with events."""
-    def free(s, z):
-        return [z[1], (F * math.cos(s) - z[0] - C * w * z[1]) / w ** 2]
-
-    def held(s, z):
-        return [(F * math.cos(s) - 1.0 - C * w * z[0]) / w ** 2]
-
-    def arrive(s, z):
-        return z[0] - 1.0
-    arrive.terminal, arrive.direction = True, 1
-
-    def leave(s, z):
-        return z[0]
-    leave.terminal, leave.direction = True, -1
-
+    over one free flight to the face and the stretch on it (orbit_models.box_shoot: DOP853 with
+    events), s_l by Newton."""
     def cycle(sl: float) -> tuple[float, float]:
-        a = solve_ivp(free, (sl, sl + 4 * math.pi), [1.0 - 1e-300, 0.0], method="DOP853",
-                      rtol=1e-13, atol=1e-15, events=arrive)
-        sa = float(a.t_events[0][-1])
-        b = solve_ivp(held, (sa, sa + 4 * math.pi), [float(a.y_events[0][-1][1])],
-                      method="DOP853", rtol=1e-13, atol=1e-15, events=leave)
-        return sa, float(b.t_events[0][0])
+        sa, se, _ = orbit_models.box_shoot(lambda s: F * math.cos(s), C, w, sl, [1.0, 0.0])
+        return sa, se
     sl = so.newton(lambda sl: cycle(sl)[1] - sl - 2 * math.pi, guess, tol=1e-14, maxiter=50)
     sa, _ = cycle(sl)
     return sa % (2 * math.pi), sl % (2 * math.pi)

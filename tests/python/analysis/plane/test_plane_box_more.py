@@ -8,8 +8,9 @@
 # - F falling (w = 0.3, F near 1.68): the net force y on the face stretch dips to 0 inside it
 #   (y's interior minimum, the "face" margin) and the contact splits in two.
 # The reference: the orbit from its lift-off s_l (x = 1, y = 0) through its free flight and its
-# stretch on the face back to s_l + 2 pi by DOP853 with events, the touch at s* (x = 1, y = 0,
-# or y = 0, y_s = 0 on the face) among the equations, solved by fsolve for (F, s_l, s*).
+# stretch on the face back to s_l + 2 pi by DOP853 with events (orbit_models.box_shoot), the
+# touch at s* (x = 1, y = 0, or y = 0, y_s = 0 on the face) among the equations, solved by
+# fsolve for (F, s_l, s*).
 # About 55 s on an idle machine.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
@@ -22,8 +23,8 @@ import scipy.optimize as so
 from scipy.integrate import solve_ivp
 
 import dmi
-from dmi.analysis.collocation.margins import Margin, margins
-from dmi.analysis.collocation.signature import Signature
+from dmi.analysis.collocation.margins import Margin, MarginValues, margins
+from dmi.analysis.collocation.signature import FREE, HI, Signature
 
 from models import orbit_models
 
@@ -40,30 +41,8 @@ def boxed(F: float, w: float, M: int = 400) -> dmi.Solver:
     return s
 
 
-def _fields(F: float, w: float):
-    def force(s):
-        return F * (math.cos(s) + G * math.cos(2 * s))
-
-    def free(s, z):
-        return [z[1], (force(s) - z[0] - C * w * z[1]) / w ** 2]
-
-    def held(s, z):
-        return [(force(s) - 1.0 - C * w * z[0]) / w ** 2]
-    return force, free, held
-
-
-def _arrive(s, z):
-    return z[0] - 1.0
-
-
-_arrive.terminal, _arrive.direction = True, 1
-
-
-def _leave(s, z):
-    return z[0]
-
-
-_leave.terminal, _leave.direction = True, -1
+def _force(F: float):
+    return lambda s: F * (math.cos(s) + G * math.cos(2 * s))
 
 
 def _solved(eqs, guess: list[float]) -> np.ndarray:
@@ -78,28 +57,23 @@ def second_contact(w: float, guess: list[float]) -> np.ndarray:
     0 there) and arrives on the face later; the stretch there ends at s_l + 2 pi."""
     def eqs(v):
         F, sl, ss = v
-        _, free, held = _fields(F, w)
-        a = solve_ivp(free, (sl, ss), [1.0, 0.0], **TOL)
+        force = _force(F)
+        a = solve_ivp(lambda s, z: [z[1], (force(s) - z[0] - C * w * z[1]) / w ** 2], (sl, ss),
+                      [1.0, 0.0], **TOL)
         xs, ys = a.y[:, -1]
-        b = solve_ivp(free, (ss, sl + 4 * math.pi), [xs, ys], events=_arrive, **TOL)
-        sa = float(b.t_events[0][0])
-        c = solve_ivp(held, (sa, sa + 4 * math.pi), [float(b.y_events[0][0][1])],
-                      events=_leave, **TOL)
-        return [float(c.t_events[0][0]) - sl - 2 * math.pi, xs - 1.0, ys]
+        _, se, _ = orbit_models.box_shoot(force, C, w, ss, [xs, ys])
+        return [se - sl - 2 * math.pi, xs - 1.0, ys]
     return _solved(eqs, guess)
 
 
 def lift_off(w: float, guess: list[float]) -> np.ndarray:
     """(F, s_l, s*): the orbit leaves the face at s_l, arrives on it after its free flight and
     stays until s_l + 2 pi (y = 0 there), its net force y touching 0 at s* inside (y = 0, y_s =
-    0 there); the stretch by DOP853 without events, y at s* from its dense output."""
+    0 there); the stretch without events, y at s* from its dense output."""
     def eqs(v):
         F, sl, ss = v
-        force, free, held = _fields(F, w)
-        a = solve_ivp(free, (sl, sl + 4 * math.pi), [1.0, 0.0], events=_arrive, **TOL)
-        sa = float(a.t_events[0][0])
-        b = solve_ivp(held, (sa, sl + 2 * math.pi), [float(a.y_events[0][0][1])],
-                      dense_output=True, **TOL)
+        force = _force(F)
+        _, _, b = orbit_models.box_shoot(force, C, w, sl, [1.0, 0.0], s_end=sl + 2 * math.pi)
         ys = float(b.sol(ss)[0])
         return [float(b.y[0, -1]), ys, force(ss) - 1.0 - C * w * ys]
     return _solved(eqs, guess)
@@ -112,12 +86,36 @@ def _curve(p0: float, p_end: float, step: float):
     return br, ev, da.continue_curve(ev, boxed, W0, 0.32, branch=br, step=0.01, multipliers=2)
 
 
-def _check(c, oracle, leave_switch: int):
+def _face_switches(sig) -> tuple[int, int]:
+    """(k_a, k_l) of an orbit that rests on the face once a period: it arrives on the face at
+    b_(k_a) and leaves it at b_(k_l) (piece k mod S of the signature starts at b_k)."""
+    modes = np.asarray(sig.modes)[:, 0]
+    S = modes.size
+    on = [k for k in range(1, S + 1) if modes[k % S] == HI]
+    assert len(on) == 1, modes
+    return on[0], on[0] % S + 1
+
+
+def _pieces(sig) -> set[tuple[int, ...]]:
+    """The signature's pieces' modes, whatever their order."""
+    return {tuple(int(v) for v in row) for row in np.asarray(sig.modes)}
+
+
+def _check_branch(br, ev, p_end: float) -> None:
+    """The branch reached p_end from orbits that rest on the face once a period (a free piece
+    and one on the face) to orbits with two contacts (four switches), its event on x."""
+    assert br.status == f"reached p_end = {p_end}" and ev.component == 0
+    sig = br.points[0].signature
+    assert sig.switches == 2 and _pieces(sig) == {(FREE, FREE), (HI, FREE)}
+    assert br.points[-1].signature.switches == 4
+
+
+def _check(c, oracle):
     assert c.kind == "stick-onset" and c.status == "reached q_end = 0.32"
     assert len(c.points) >= 3 and np.all(np.diff(c.q) > 0)
     errs = []
     for pt in c.points:
-        sl = float(pt.orbit.switches[leave_switch - 1])
+        sl = float(pt.orbit.switches[_face_switches(pt.orbit.signature)[1] - 1])
         ss = sl + (pt.t_star - sl) % (2 * math.pi)
         F, sl_ref, ss_ref = oracle(pt.q, [pt.p, sl, ss])
         errs.append((pt.q, pt.p - F, sl - sl_ref, ss - ss_ref))
@@ -138,34 +136,36 @@ def lift_curve():
 
 def test_a_second_contact_inside_the_free_run(contact_curve):
     br, ev, c = contact_curve
-    assert br.status == "reached p_end = 1.12" and ev.component == 0
-    assert br.points[0].signature.describe() == ["(free, free)", "(on hi, free)"]
-    assert br.points[-1].signature.switches == 4
+    _check_branch(br, ev, 1.12)
     assert abs(ev.p - c.points[0].p) <= 1e-10     # the curve starts at the branch's event
-    _check(c, second_contact, 2)
-    lay, terms = _layout(c.points[0])
+    _check(c, second_contact)
+    lay, terms, x = _layout(c.points[0])
     got = margins(lay, terms, Signature(np.asarray(br.points[-1].signature.modes)))
-    # both candidates: the free run from the lift-off b_2 (the one held) and the face stretch
-    assert got == [Margin("face", 0, 1, 1), Margin("box", 0, 1, 2)]
-    assert "inside the run from b_2" in got[1].describe()
+    # both candidates, in any order: the face stretch from the arrival and the free run from
+    # the lift-off, the one held (x's interior maximum on it at the face: 0 at the curve)
+    ka, kl = _face_switches(c.points[0].orbit.signature)
+    assert len(got) == 2 and set(got) == {Margin("face", 0, 1, ka), Margin("box", 0, 1, kl)}
+    held = MarginValues(lay, Margin("box", 0, 1, kl)).least(terms, x)[0]
+    assert abs(held) <= 1e-8, held
 
 
 def test_a_lift_off_inside_the_face_stretch(lift_curve):
     br, ev, c = lift_curve
-    assert br.status == "reached p_end = 1.6" and ev.component == 0
-    assert br.points[0].signature.describe() == ["(on hi, free)", "(free, free)"]
-    assert br.points[-1].signature.switches == 4
-    _check(c, lift_off, 1)
-    lay, terms = _layout(c.points[0])
+    _check_branch(br, ev, 1.6)
+    _check(c, lift_off)
+    lay, terms, x = _layout(c.points[0])
     got = [m for m in margins(lay, terms, Signature(np.asarray(br.points[-1].signature.modes)))
            if m.kind == "face"]
-    assert got == [Margin("face", 0, 1, 2)]
-    assert "hi face" in got[0].describe()
+    # the stretch on the hi face from the arrival, held: its net force's interior minimum 0
+    ka, _ = _face_switches(c.points[0].orbit.signature)
+    assert got == [Margin("face", 0, 1, ka)]
+    held = MarginValues(lay, got[0]).least(terms, x)[0]
+    assert abs(held) <= 1e-8, held
 
 
 def _layout(pt):
     from dmi.analysis.collocation.system import Terms
     from dmi.analysis.plane.stick_curves import _layout_of
     from dmi.analysis.scheme.stepmap import build
-    lay, _ = _layout_of(pt.orbit)
-    return lay, Terms(build(pt.orbit.make, pt.p), ())
+    lay, x = _layout_of(pt.orbit)
+    return lay, Terms(build(pt.orbit.make, pt.p), ()), x

@@ -4,12 +4,12 @@
 #     w'' + D w' - w + w^3 + q sigma(w') ∋ p cos(W t),
 # whose T-orbit reverses its velocity twice a period (slip +, slip -) and period-doubles near
 # p = 0.287 at q = 0.02; its doubling's curve in (p, q) = (forcing, friction).  Against an
-# event-driven integration written here: DOP853 (rtol 1e-13) between the velocity's zeros,
-# located by its event finder (a reversal where the net force exceeds q; a stick, where it does
-# not, held exactly: w' = 0 until |net force| reaches q, found by Brent's method on the closed
-# form), the period map's Jacobian by central differences, the T-orbit by Newton, the flip (the
-# multiplier -1) in p by Brent's method at three q.  The reference's own accuracy: its flip p
-# moves by less than 1e-9 when the differences' step changes tenfold.
+# event-driven integration in the tests' models (orbit_models.reversal_flow): DOP853 (rtol
+# 1e-13) between the velocity's zeros, located by its event finder (a reversal where the net
+# force exceeds q; a stick, where it does not, held exactly: w' = 0 until |net force| reaches q,
+# found by Brent's method), the period map's Jacobian by central differences, the T-orbit by
+# Newton, the flip (the multiplier -1) in p by Brent's method at three q.  The reference's own
+# accuracy: its flip p moves by less than 1e-9 when the differences' step changes tenfold.
 # Also the twisted matrix A_mu of the orbit with switches, singular at the collocated orbit's
 # multipliers (floquet) and g's gradient in x against differences (the torus curve of an orbit
 # with switches: test_plane_torus_switches.py).  The same two checks on an orbit with stick
@@ -25,7 +25,6 @@ from functools import lru_cache
 import numpy as np
 import pytest
 import scipy.linalg as sl
-from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 import dmi
@@ -53,49 +52,12 @@ def friction2(p: float, q: float, h: float | None = None) -> dmi.Solver:
 
 
 # ---- the independent event-driven integration -------------------------------------------------
-def force(p: float, t: float, w: float) -> float:
-    """The net force on the mass but friction at rest."""
-    return w - w ** 3 + p * math.cos(W * t)
-
-
-def stick_end(p: float, q: float, t: float, w: float, t_end: float) -> float:
-    """The time the stick from t ends (|force| reaches q), or t_end."""
-    grid = np.linspace(t, t_end, 2001)
-    g = np.array([abs(force(p, s, w)) - q for s in grid])
-    k = np.flatnonzero(g[1:] >= 0)
-    if k.size == 0:
-        return t_end
-    j = int(k[0]) + 1
-    return brentq(lambda s: abs(force(p, s, w)) - q, grid[j - 1], grid[j], xtol=1e-15)
-
-
 def flow(p: float, q: float, x0: np.ndarray, t_end: float) -> tuple[np.ndarray, list]:
-    """The state at t_end from x0 = (w, w') at t = 0 (w' != 0), and the transitions (t, kind)."""
-    t, x = 0.0, np.array(x0, dtype=float)
-    mode = 1.0 if x[1] > 0 else -1.0
-    seen = []
-    while t < t_end:
-        if mode == 0.0:                                     # stuck: w held, w' = 0
-            t = stick_end(p, q, t, x[0], t_end)
-            mode = math.copysign(1.0, force(p, t, x[0]))
-            seen.append((t, "stick end"))
-            continue
-
-        def rhs(s, y, mode=mode):
-            return [y[1], -D * y[1] + force(p, s, y[0]) - q * mode]
-
-        def zero(s, y):
-            return y[1]
-        zero.terminal, zero.direction = True, -mode
-        sol = solve_ivp(rhs, (t, t_end), x, method="DOP853", rtol=1e-13, atol=1e-14,
-                        events=zero)
-        t, x = float(sol.t[-1]), sol.y[:, -1].copy()
-        if sol.status == 1:                 # w' = 0: the net force decides a new slip or a stick
-            x[1] = 0.0
-            F = force(p, t, x[0])
-            mode = math.copysign(1.0, F) if abs(F) > q else 0.0
-            seen.append((t, "reversal" if mode else "stick"))
-    return x, seen
+    """The state at t_end from x0 = (w, w') at t = 0 (w' != 0), and the transitions (t, kind):
+    orbit_models.reversal_flow with sticks."""
+    def accel(t: float, w: float, v: float) -> float:
+        return -D * v + (w - w ** 3 + p * math.cos(W * t))
+    return orbit_models.reversal_flow(accel, q, x0, t_end, sticks=True)
 
 
 def orbit(p: float, q: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -5,9 +5,10 @@
 # friction).  The branch's fold is not located on the branch (its p from a parabola, 7e-4 off):
 # the curve starts from it all the same (the fold at q0 within twice the event's points'
 # distance to its p).
-# Against an event-driven integration written here: DOP853 (rtol 1e-13) between the velocity's
-# zeros (each a reversal: asserted, no stick), the period map's Jacobian by central differences,
-# the fold (x(P) = x(0), det(M - I) = 0) by fsolve in (x(0), p) at q0 and q_end.
+# Against an event-driven integration in the tests' models (orbit_models.reversal_flow): DOP853
+# (rtol 1e-13) between the velocity's zeros (each a reversal: asserted, no stick), the period
+# map's Jacobian by central differences, the fold (x(P) = x(0), det(M - I) = 0) by fsolve in
+# (x(0), p) at q0 and q_end.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -17,10 +18,11 @@ import warnings
 import numpy as np
 import pytest
 import scipy.optimize as so
-from scipy.integrate import solve_ivp
 
 import dmi
 from dmi import analysis as da
+
+from models import orbit_models
 
 W = 1.4
 P = 2 * math.pi / W
@@ -39,24 +41,11 @@ def duffing(p: float, q: float) -> dmi.Solver:
 
 
 def flow(p: float, q: float, x0: np.ndarray) -> np.ndarray:
-    """The state at t = P from x0 = (x, x') at t = 0 (x' != 0), every zero of x' a reversal."""
-    t, x = 0.0, np.array(x0, dtype=float)
-    mode = 1.0 if x[1] > 0 else -1.0
-    while t < P:
-        def rhs(s, y, mode=mode):
-            return [y[1], -0.1 * y[1] - y[0] - y[0] ** 3 + p * math.cos(W * s) - q * mode]
-
-        def zero(s, y):
-            return y[1]
-        zero.terminal, zero.direction = True, -mode
-        sol = solve_ivp(rhs, (t, P), x, method="DOP853", rtol=1e-13, atol=1e-14, events=zero)
-        t, x = float(sol.t[-1]), sol.y[:, -1].copy()
-        if sol.status == 1:
-            x[1] = 0.0
-            F = -x[0] - x[0] ** 3 + p * math.cos(W * t)
-            assert abs(F) > q, f"a stick at t = {t}: not this test's orbit"
-            mode = math.copysign(1.0, F)
-    return x
+    """The state at t = P from x0 = (x, x') at t = 0 (x' != 0), every zero of x' a reversal:
+    orbit_models.reversal_flow."""
+    def accel(t: float, x: float, v: float) -> float:
+        return -0.1 * v - x - x ** 3 + p * math.cos(W * t)
+    return orbit_models.reversal_flow(accel, q, x0, P)[0]
 
 
 def fold(q: float, guess: np.ndarray) -> tuple[np.ndarray, float]:
@@ -88,12 +77,45 @@ def curve():
 
 def test_the_fold_curve_of_orbits_with_switches_against_the_integration(curve):
     f, c = curve
-    assert "parabola" in f.detail                  # the branch did not locate it
     assert c.kind == "orbit-fold" and c.status == f"reached q_end = {Q1}"
+    refs = []
     for pt in (c.points[0], c.points[-1]):
         assert pt.orbit.switches.size == 2         # two reversals a period
         x0, p = fold(pt.q, np.append(pt.orbit.u_at(0.0), pt.p))
         # measured 1.2e-14 and 1.3e-13 (p_error 1.8e-11 and 3.9e-11); the states 1.4e-10
         assert abs(pt.p - p) <= 1e-10 and abs(pt.p - p) <= pt.p_error, (pt.q, pt.p - p)
         assert np.max(np.abs(pt.orbit.u_at(0.0) - x0)) <= 1e-8
-    assert abs(c.points[0].p - f.p) > 1e-4         # the event's p was a parabola's
+        refs.append(p)
+    # the start: the event's p is far from the fold at q0 (7e-4, beyond START_TOL's 1e-6: a
+    # fold the branch did not locate), the curve started all the same
+    assert abs(f.p - refs[0]) > 1e-4, (f.p, refs[0])
+
+
+def test_the_test_function_gradient_against_differences(curve):
+    """g's gradient in the orbit's unknowns (the last row of the fold system's Jacobian in y,
+    J along v by central differences) at the curve's first point, along three random
+    directions and the two switching times, against central differences of g itself
+    (Richardson on the steps 1e-3 and 5e-4): to 5e-6 of the sum |g_x| |d| (measured 1e-7 to
+    4e-6 of g_x d; a one-sided difference of J of step 1e-7 was 4e-5 to 1e-3 off)."""
+    from dmi.analysis.collocation.system import Layout
+    from dmi.analysis.plane.orbit_curves import OrbitFold
+    _, c = curve
+    pt = c.points[0]
+    o = pt.orbit
+    lay = Layout(o.degree, 2, o.signature, [f.copy() for f in o.fractions], False, o.period,
+                 tuple(o.carried))
+    x = np.concatenate([o.nodes.ravel(), o.switches])
+    fs = OrbitFold(duffing, lay, x)
+    fs.borders(x, pt.p, pt.q)
+    gx = fs.jacobian(np.append(x, pt.p), pt.q)[0].toarray()[-1, :x.size]
+
+    def g(z: np.ndarray) -> float:
+        return float(fs.residual(np.append(z, pt.p), pt.q)[-1])
+    rng = np.random.default_rng(5)
+    dirs = [rng.standard_normal(x.size) for _ in range(3)] + [np.eye(x.size)[-2],
+                                                              np.eye(x.size)[-1]]
+    for d in dirs:
+        h1, h2 = [(g(x + h * d) - g(x - h * d)) / (2 * h) for h in (1e-3, 5e-4)]
+        ref = (4 * h2 - h1) / 3
+        size = float(np.abs(gx) @ np.abs(d))           # the sum's terms' size
+        assert abs(gx @ d - ref) <= 5e-6 * size, (gx @ d, ref, size)

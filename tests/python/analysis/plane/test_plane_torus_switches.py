@@ -6,10 +6,11 @@
 # through a pair e^(+-i theta) near p = 0.767 at q = 0.2; its torus curve in (p, q) = (forcing,
 # negative damping).  (The forcing is a sine so that the reversals stay away from t = 0; theta
 # passes 2 pi / 3 just past q = 0.2, a 1:3 resonance the curve does not detect nor need to.)
-# Against an event-driven integration written here: DOP853 (rtol 1e-13) between the velocity's
-# zeros, located by its event finder (each a reversal: the net force there exceeds AL, asserted;
-# no stick), the period map's Jacobian by central differences, the T-orbit by Newton, the pair's
-# modulus 1 (det M = 1, the pair complex) in p by Brent's method at three q, theta = arg mu.
+# Against an event-driven integration in the tests' models (orbit_models.reversal_flow): DOP853
+# (rtol 1e-13) between the velocity's zeros, located by its event finder (each a reversal: the
+# net force there exceeds AL, asserted; no stick), the period map's Jacobian by central
+# differences, the T-orbit by Newton, the pair's modulus 1 (det M = 1, the pair complex) in p by
+# Brent's method at three q, theta = arg mu.
 # The reference's own accuracy: its p moves by less than 1e-10 and its theta by less than 5e-10
 # when the differences' step changes tenfold (measured 4e-11 and 2e-10).
 # Also the twisted matrix A_mu of the orbit with switches at the complex multipliers, and its
@@ -23,7 +24,6 @@ from functools import lru_cache
 import numpy as np
 import pytest
 import scipy.linalg as sl
-from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 import dmi
@@ -50,33 +50,14 @@ def vdp_friction(p: float, q: float, h: float | None = None) -> dmi.Solver:
 
 
 # ---- the independent event-driven integration -------------------------------------------------
-def force(p: float, t: float, x: float) -> float:
-    """The net force on the mass at rest but friction."""
-    return -x + p * math.sin(W * t)
-
-
 def flow(p: float, q: float, x0: np.ndarray, t_end: float) -> tuple[np.ndarray, list]:
-    """The state at t_end from x0 = (x, x') at t = 0 (x' != 0), and the reversals' times."""
-    t, x = 0.0, np.array(x0, dtype=float)
-    mode = 1.0 if x[1] > 0 else -1.0
-    seen = []
-    while t < t_end:
-        def rhs(s, y, mode=mode):
-            return [y[1], -(y[0] ** 2 - q) * y[1] + force(p, s, y[0]) - AL * mode]
-
-        def zero(s, y):
-            return y[1]
-        zero.terminal, zero.direction = True, -mode
-        sol = solve_ivp(rhs, (t, t_end), x, method="DOP853", rtol=1e-13, atol=1e-14,
-                        events=zero)
-        t, x = float(sol.t[-1]), sol.y[:, -1].copy()
-        if sol.status == 1:                 # x' = 0: a reversal where the net force exceeds AL
-            x[1] = 0.0
-            F = force(p, t, x[0])
-            assert abs(F) > AL, f"a stick at t = {t} (net force {F}): not this test's orbit"
-            mode = math.copysign(1.0, F)
-            seen.append(t)
-    return x, seen
+    """The state at t_end from x0 = (x, x') at t = 0 (x' != 0), and the reversals' times:
+    orbit_models.reversal_flow, every zero of x' a reversal (the net force there beyond AL,
+    asserted)."""
+    def accel(t: float, x: float, v: float) -> float:
+        return -(x ** 2 - q) * v + (-x + p * math.sin(W * t))
+    x, seen = orbit_models.reversal_flow(accel, AL, x0, t_end)
+    return x, [t for t, _ in seen]
 
 
 def orbit(p: float, q: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
