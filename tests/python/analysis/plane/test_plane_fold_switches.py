@@ -89,33 +89,3 @@ def test_the_fold_curve_of_orbits_with_switches_against_the_integration(curve):
     # the start: the event's p is far from the fold at q0 (7e-4, beyond START_TOL's 1e-6: a
     # fold the branch did not locate), the curve started all the same
     assert abs(f.p - refs[0]) > 1e-4, (f.p, refs[0])
-
-
-def test_the_test_function_gradient_against_differences(curve):
-    """g's gradient in the orbit's unknowns (the last row of the fold system's Jacobian in y,
-    J along v by central differences) at the curve's first point, along three random
-    directions and the two switching times, against central differences of g itself
-    (Richardson on the steps 1e-3 and 5e-4): to 5e-6 of the sum |g_x| |d| (measured 1e-7 to
-    4e-6 of g_x d; a one-sided difference of J of step 1e-7 was 4e-5 to 1e-3 off)."""
-    from dmi.analysis.collocation.system import Layout
-    from dmi.analysis.plane.orbit_curves import OrbitFold
-    _, c = curve
-    pt = c.points[0]
-    o = pt.orbit
-    lay = Layout(o.degree, 2, o.signature, [f.copy() for f in o.fractions], False, o.period,
-                 tuple(o.carried))
-    x = np.concatenate([o.nodes.ravel(), o.switches])
-    fs = OrbitFold(duffing, lay, x)
-    fs.borders(x, pt.p, pt.q)
-    gx = fs.jacobian(np.append(x, pt.p), pt.q)[0].toarray()[-1, :x.size]
-
-    def g(z: np.ndarray) -> float:
-        return float(fs.residual(np.append(z, pt.p), pt.q)[-1])
-    rng = np.random.default_rng(5)
-    dirs = [rng.standard_normal(x.size) for _ in range(3)] + [np.eye(x.size)[-2],
-                                                              np.eye(x.size)[-1]]
-    for d in dirs:
-        h1, h2 = [(g(x + h * d) - g(x - h * d)) / (2 * h) for h in (1e-3, 5e-4)]
-        ref = (4 * h2 - h1) / 3
-        size = float(np.abs(gx) @ np.abs(d))           # the sum's terms' size
-        assert abs(gx @ d - ref) <= 5e-6 * size, (gx @ d, ref, size)
