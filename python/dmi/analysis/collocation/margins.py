@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.optimize as so
 
-from .mesh import delay_matrix, periodic_locator, point_matrix
+from .mesh import periodic_locator, point_matrix
 from .mend import memory
 from .signature import FREE, HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature, interior_least
 from .system import Layout, Terms, evaluate
@@ -215,8 +215,7 @@ class MarginValues:
         row = -(terms.fu(t, u)[0][i:i + 1] @ E.toarray().reshape(lay.n, -1))[0] \
             if terms.has_rhs else np.zeros(E.shape[1])
         if terms.has_kernel:
-            G = delay_matrix(t, terms.tau, mesh, T, terms.H, loc, lay.basis, lay.n, lay.rows,
-                             pattern=terms.pattern)[0]
+            G = terms.periodic_delay(t, mesh, T, lay.basis, lay.rows)[0]
             row = row - G[i].toarray().ravel()
         s = self.m.sign if self.m.kind in ("stuck", "face") else np.sign(self.force(terms, x, t)[0])
         return s * row

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .mesh import delay_matrix, periodic_locator
 from .signature import FREE, HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature, violations
 from .system import (Layout, Terms, carried, evaluate, node_times,
                                  uniform_fractions)
@@ -174,8 +173,7 @@ def memory(lay: Layout, terms: Terms, x: np.ndarray, t: np.ndarray) -> np.ndarra
         return np.zeros((t.size, lay.n))
     V, b, T = lay.split(x)
     mesh = lay.mesh(b, T)
-    G = delay_matrix(t, terms.tau, mesh, T, terms.H, periodic_locator(mesh, lay.m), lay.basis,
-                     lay.n, lay.rows, pattern=terms.pattern)[0]
+    G = terms.periodic_delay(t, mesh, T, lay.basis, lay.rows)[0]
     return (G @ V.ravel()).reshape(-1, lay.n)
 
 
@@ -224,15 +222,13 @@ def check_inequalities(lay: Layout, terms: Terms, x: np.ndarray, tol: float) -> 
     mesh = lay.mesh(b, T)
     e = lay.bounds(b, T)
     grid, us, forces = [], [], []
-    loc = periodic_locator(mesh, lay.m)
     for j in range(len(e) - 1):
         count = (len(lay.fractions[j]) - 1) * CHECK_POINTS + 1
         t = np.linspace(e[j], e[j + 1], count)
         u = evaluate(lay, x, t)
         F = -terms.f(t, u)
         if terms.has_kernel:
-            G = delay_matrix(t, terms.tau, mesh, T, terms.H, loc, lay.basis, lay.n, lay.rows,
-                             pattern=terms.pattern)[0]
+            G = terms.periodic_delay(t, mesh, T, lay.basis, lay.rows)[0]
             F = F - (G @ V.ravel()).reshape(-1, lay.n)
         grid.append(t)
         us.append(u)
