@@ -14,9 +14,9 @@
 # or 0, I' = x - I integrated).  The fixed point of a Poincare map (the belt: the section y = -V
 # crossed downwards, state (x, I); the forced one: the stroboscopic map over a forcing period from
 # a phase inside a slip, state (x, v, I)) by Newton, its Jacobian's columns the linear
-# coefficients of polynomials of degree 8 fitted to the map on 25 points of z +- R e_k, its
+# coefficients of polynomials of degree 8 fitted to the map on 41 points of z +- R e_k, its
 # eigenvalues the multipliers (the belt's section: the nontrivial one and 0); the fits at R and
-# 2R/3 agree to about 1e-11, the oracle's own accuracy.  Differences at small steps are no oracle
+# 2R/3 agree to about 3e-11, the oracle's own accuracy.  Differences at small steps are no oracle
 # here: the map's values carry a noise of 1.3e-14 (2.5e-13 with the forcing's phase at t = 370:
 # the root finder locates an event to 4 eps relative in t), which a difference of step 5e-5
 # turns into 2e-8 in the forced pair (its condition number is 18): the gap of 2.1e-8 once seen.
@@ -33,7 +33,6 @@ import dmi
 from dmi import analysis as da
 
 TAU = 30.0                                  # e^{-tau} = 9.4e-14
-TAU_F = 40.0                                # the forced one's: its pair moves 2e-13 beyond
 V, ALPHA, G, K = 0.5, 0.4, 0.3, 0.05       # the belt (k: its negative damping, the parameter)
 W, FF, ALPHA_F, C, G_F = 0.5, 1.5, 0.5, 0.05, 0.5   # the forced one (FF: the forcing, p)
 PF = 2 * math.pi / W
@@ -50,7 +49,7 @@ def belt(p: float, h: float | None = None) -> dmi.Solver:
 def forced_for(M: int):
     """make(p), p the forcing's amplitude, h = PF / M."""
     def make(p: float) -> dmi.Solver:
-        s = dmi.Solver(2, TAU_F, h=PF / M)
+        s = dmi.Solver(2, TAU, h=PF / M)
         s.set_rhs(lambda t, u: np.array([-u[1], u[0] + C * u[1] - p * np.cos(W * t)]))
         s.set_friction([0.0, ALPHA_F])
         s.set_kernel_exp([-1.0], [0.0], [[[0.0, 0.0], [G_F, 0.0]]])
@@ -127,7 +126,7 @@ def dense(record: list):
     return at
 
 
-def fit_jacobian(P, z: np.ndarray, R: float, deg: int = 8, points: int = 25) -> np.ndarray:
+def fit_jacobian(P, z: np.ndarray, R: float, deg: int = 8, points: int = 41) -> np.ndarray:
     """P's Jacobian at z: column k the linear coefficient of the polynomial of degree deg
     fitted (least squares) to P on ``points`` equidistant points of z +- R e_k."""
     s = np.linspace(-1.0, 1.0, points)
@@ -220,11 +219,11 @@ def test_belt_stick_slip_multipliers_against_the_run(belt_case):
     assert abs(mu[1]) < 1e-6                              # the stick forgets y
     # the trivial multiplier: 1
     assert abs(q.multipliers[0] - 1) <= 1e-8, q.multipliers[0]
-    # the nontrivial one, mu = 0.0381803331: measured 2.2e-8 apart.  Not within the estimate
-    # (7e-11): the estimate is the collocation's of its own equation, whose truncated memory
+    # the nontrivial one, mu = 0.0381803331470: measured 2.2e-8 apart.  Not within the estimate
+    # (1.6e-10): the estimate is the collocation's of its own equation, whose truncated memory
     # (I' = x - I - e^{-tau} x(t - tau)) shifts mu by about e^{-tau} mu^{-tau/T} g ~ 2e-8 (the
-    # Floquet solution grows by 1/mu a period back in time: 7e6 over tau); at tau = 40 the gap
-    # is 9e-10.  So the bound is the model's gap, 5e-8 (0.7 % of mu, the regression's, is 3e-4).
+    # Floquet solution grows by 1/mu a period back in time: 7e6 over tau); at tau = 35 the gap
+    # is 3.7e-9.  So the bound is the model's gap, 5e-8 (0.7 % of mu, the regression's, is 3e-4).
     assert abs(q.multipliers[1].imag) < 1e-12
     assert abs(q.multipliers[1] - mu[0]) < 5e-8, (q.multipliers[1], mu[0])
     assert q.errors["multipliers"][1] < 5e-8
@@ -236,11 +235,12 @@ def test_forced_stick_slip_multipliers_against_the_run(forced_case):
     assert q.signature.describe() == ["(free, stuck)", "(free, slip -)", "(free, slip +)"]
     assert abs(mu[2]) < 1e-6                              # the stick forgets v
     assert spread < 1e-10, spread                         # the oracle's fits agree
-    # a complex pair, mu = -0.0457630896015 +- 0.0560868848150 i: measured 1.3e-11 apart with
-    # the estimate 1.0e-11 (at 40 intervals 1.7e-11 and 9.8e-11); the memory's truncation at
-    # tau = 40 moves it by about 2e-13 (at tau = 30 it moved it by 5e-10: the run's memory is not
-    # truncated), the fits' spread is about 1e-11.  Before the monodromy's switching columns were
-    # taken by Richardson with the past's mesh cut in, the pair was 1.8e-10 off at tau = 50.
+    # a complex pair, mu = -0.0457630896015 +- 0.0560868848150 i (fits on 81 points): measured
+    # 1.2e-11 apart with the estimate 1.3e-10 (tau = 40: 7.5e-12, estimate 2.1e-11, and on 40
+    # intervals 1.2e-11, estimate 1e-11; tau = 50: 2.0e-11, estimate 1.7e-11); the truncation at
+    # tau is below that (e^{-tau} |mu|^{-tau/T} ~ 5e-11 at most), the fits' spread 3e-11.  With the
+    # monodromy's switching columns by plain differences at 1e-6 T it was 5.4e-10 off at tau = 30
+    # (1.8e-10 at tau = 50, 2.6e-8 at 1e-5 T without the past's mesh cut in), the estimate 6e-11.
     for k in (0, 1):
         m = mu[np.argmin(np.abs(mu - q.multipliers[k]))]
         gap = abs(q.multipliers[k] - m)
