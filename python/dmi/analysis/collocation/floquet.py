@@ -23,6 +23,7 @@ period's, Richardson on two steps scaled to the shortest piece.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import scipy.linalg as sl
@@ -30,6 +31,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from .krylov import DENSE_MAX, Monodromy, leading, nearest
+from .mesh import Basis, Locator
 from .system import History, Layout, Terms, assemble
 from ..core.blas import _one_blas_thread
 
@@ -56,11 +58,12 @@ class FixedPast:
     def __init__(self, terms: Terms):
         self._terms = terms
 
-    def __getattr__(self, name: str):
+    def __getattr__(self, name: str) -> Any:
         return getattr(self._terms, name)
 
-    def delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc, basis, rows: int,
-              history: History | None = None, extra: np.ndarray | None = None):
+    def delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc: Locator, basis: Basis,
+              rows: int, history: History | None = None, extra: np.ndarray | None = None
+              ) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
         """:meth:`Terms.delay` with the pieces also cut at ``history``'s mesh."""
         if history is not None:
             mesh = np.union1d(mesh, history.hist)
