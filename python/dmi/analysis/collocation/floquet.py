@@ -37,11 +37,11 @@ from ..core.blas import _one_blas_thread
 
 #: The switching times' columns of the period's Jacobian from a fixed past: central differences at
 #: steps d and d / 2, d = STEP min(T, the shortest piece), combined by Richardson (O(d^4) relative
-#: to the shortest piece).  A forced orbit's multipliers (tests/python/analysis/collocation/
-#: test_stickslip_memory_multipliers.py) at plain central differences of 1e-6 T (Newton's): 1.3e-10
-#: off by their rounding, the same on every mesh, so the levels' estimate cannot see it; by
-#: Richardson at STEP 1e-4, 3e-4, 1e-3: 2.6e-10, 4.5e-11, 7.5e-12 (rounding), at 1e-3 T: 1.1e-10
-#: (truncation).
+#: to the shortest piece).  A forced orbit's complex pair (tests/python/analysis/collocation/
+#: test_stickslip_memory_multipliers.py) by plain central differences at 1e-6 T (Newton's): 5.4e-10
+#: off at tau = 30, 1.8e-10 at tau = 50, by their rounding, much the same on every mesh, so the
+#: levels' estimate (6e-11, 2e-11) did not see it; by Richardson at STEP 1e-4, 3e-4, 1e-3 (tau =
+#: 40): 2.6e-10, 4.5e-11, 7.5e-12 (rounding), at 1e-3 T: 1.1e-10 (truncation).
 STEP = 1e-3
 
 
