@@ -62,12 +62,13 @@ class FixedPast:
         return getattr(self._terms, name)
 
     def delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc: Locator, basis: Basis,
-              rows: int, history: History | None = None, extra: np.ndarray | None = None
-              ) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
+              rows: int, history: History | None = None, extra: np.ndarray | None = None,
+              periodic: bool = False) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
         """:meth:`Terms.delay` with the pieces also cut at ``history``'s mesh."""
         if history is not None:
             mesh = np.union1d(mesh, history.hist)
-        return self._terms.delay(times, mesh, T, loc, basis, rows, history, extra)
+        return self._terms.delay(times, mesh, T, loc, basis, rows, history, extra,
+                                 periodic=periodic)
 
 
 def period_jacobian(lay: Layout, terms: Terms, x: np.ndarray, history: History
