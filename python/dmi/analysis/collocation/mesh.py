@@ -245,18 +245,6 @@ def _legendre(q: int) -> tuple[np.ndarray, np.ndarray]:
     return _frozen(0.5 * (z + 1.0), 0.5 * w)  # type: ignore[return-value]
 
 
-def _local(locate: Locator, tp: np.ndarray, a: np.ndarray, d: np.ndarray, S: np.ndarray
-           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """For pieces [a, a + d] of lags at the times tp (each piece in one interval of u): the
-    columns (k, m + 1) of its interval, the local coordinates (k, q) of tp - S on that interval's
-    polynomial (extended past the interval: S may lie outside the piece) and dz/dt (k,)."""
-    mid = tp - (a + 0.5 * d)
-    _, z1, cols = locate(mid)
-    _, z2, _ = locate(mid + 0.25 * d)
-    slope = (z2 - z1) / (0.25 * d)
-    return cols, z1[:, None] + (tp[:, None] - S - mid[:, None]) * slope[:, None], slope
-
-
 def _near_nodes(near: Near, a: np.ndarray, d: np.ndarray, q: int, n: int
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Product integration of s^-beta C P(s) on the pieces [a, a + d] of (0, delta] (P a
@@ -326,7 +314,6 @@ def delay_matrix(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: floa
         G (scipy.sparse.csr_matrix; row c n + a, column (node row) n + b) and the T derivative
         (or None).
     """
-    gz, gw = basis.gauss(basis.q)
     times = np.asarray(times, dtype=float)
     near = getattr(kernel, "near", None)
     breaks, graded = _breaks(kernel, breaks, tau)
@@ -337,33 +324,89 @@ def delay_matrix(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: floa
     close = (a + d <= near.delta * (1.0 + 1e-12)) if near is not None else np.zeros(a.size, bool)
     # the graded pieces up to start 2^K: each at least its own length from 0, Q_NEAR nodes
     steep = ~close & (a + d <= graded * (1.0 + 1e-12))
-    groups = []
     regular = ~close & ~steep
-    for f, rule, full in ((regular & whole, (gz, gw), True), (regular & ~whole, (gz, gw), False),
-                          (steep, None, False)):
-        if not np.any(f):
-            continue
-        zz, ww = rule if rule is not None else _legendre(Q_NEAR)
-        S = a[f, None] + d[f, None] * zz[None, :]                # (k, q)
-        W = d[f, None] * ww[None, :]
-        H = getattr(kernel, "far", kernel)(S.ravel()).reshape(S.shape + (n, n))   # (k, q, n, n)
-        groups.append((C[f], a[f], d[f], S, W, H, full))
-    if np.any(close):
-        groups.append((C[close], a[close], d[close])
-                      + _near_nodes(near, a[close], d[close], basis.q, n) + (False,))
-    vals, rr, cc = [], [], []
+    # every piece located once, at its middle and three-quarter point (one call)
+    k = a.size
+    mid = times[C] - (a + 0.5 * d)
+    _, z, cols = locate(np.concatenate([mid, mid + 0.25 * d]))
+    z1, z2, node = z[:k], z[k:], cols[:k]
+    # a whole interval of u's mesh is one of the locator's intervals only where their meshes
+    # agree (not the past's fixed mesh against a period whose switches moved)
+    whole &= regular & (np.abs(z1 - 0.5) <= WHOLE_TOL) & (np.abs(z2 - 0.75) <= WHOLE_TOL)
+    slope = (z2 - z1) / (0.25 * d)
+    groups = _nodes(kernel, near, basis, a, d, whole, regular & ~whole, steep, close, n)
     dT = np.zeros((times.size, n)) if slope_of is not None else None
-    for group in groups:
-        if group[0].size:
-            val, r, c = _group_entries(group, times, locate, basis, n, ia, ib, T, slope_of, dT)
-            vals.append(val)
-            rr.append(r)
-            cc.append(c)
-    G = sp.csr_matrix((np.concatenate(vals) if vals else np.empty(0),
-                       (np.concatenate(rr) if rr else np.empty(0, int),
-                        np.concatenate(cc) if cc else np.empty(0, int))),
-                      shape=(times.size * n, rows * n))
-    return G, dT
+    val = np.empty((k, ia.size, basis.m + 1))
+    for f, S, W, H in groups:
+        WH = W[:, :, None] * H[:, :, ia, ib]                          # (k, r, entries)
+        if f is whole:      # t - S at the interval's Gauss nodes backwards: one B for all
+            z0 = 1.0 - basis.gauss(basis.q)[0]
+            val[f] = _whole_entries(WH, basis.values(z0))
+            Bd = basis.derivatives(z0) if dT is not None else None
+            sg = 1.0 / d[f]
+        else:
+            sg = slope[f]
+            zg = z1[f, None] + (times[C[f], None] - S - mid[f, None]) * sg[:, None]
+            B = basis.values(zg.ravel()).reshape(S.shape + (basis.m + 1,))   # (k, r, m + 1)
+            val[f] = np.matmul(WH.transpose(0, 2, 1), B)              # (k, entries, m + 1)
+            Bd = (basis.derivatives(zg.ravel()).reshape(B.shape) if dT is not None else None)
+        if dT is not None and slope_of is not None:
+            Ud = np.matmul(Bd, slope_of[node[f]]) * sg[:, None, None]    # (k, r, n)
+            part = np.sum(WH * S[:, :, None] * Ud[:, :, ib], axis=1) / T  # (k, entries)
+            dT += np.bincount((C[f, None] * n + ia[None, :]).ravel(), part.ravel(),
+                              minlength=times.size * n).reshape(times.size, n)
+    return _assemble(val, C, node, ia, ib, n, (times.size * n, rows * n)), dT
+
+
+def _nodes(kernel: Any, near: Near | None, basis: Basis, a: np.ndarray, d: np.ndarray,
+           *masks: np.ndarray) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+    """The quadrature of each group of pieces (masks: whole intervals, other regular pieces,
+    graded ones, the near part's; the last n): (its mask, nodes S (k, r), weights W (k, r),
+    H at S (k, r, n, n)); H(far) evaluated once for all but the near part's."""
+    *masks, close, n = masks
+    gz, gw = basis.gauss(basis.q)
+    lz, lw = _legendre(Q_NEAR)
+    out = []
+    for f, (zz, ww) in zip(masks, ((gz, gw), (gz, gw), (lz, lw))):
+        if np.any(f):
+            out.append((f, a[f, None] + d[f, None] * zz[None, :], d[f, None] * ww[None, :]))
+    groups = []
+    if out:
+        flat = np.concatenate([S.ravel() for _, S, _ in out])
+        H = np.asarray(getattr(kernel, "far", kernel)(flat)).reshape(flat.size, n, n)
+        at = 0
+        for f, S, W in out:
+            groups.append((f, S, W, H[at:at + S.size].reshape(S.shape + (n, n))))
+            at += S.size
+    if np.any(close):
+        groups.append((close,) + _near_nodes(near, a[close], d[close], basis.q, n))
+    return groups
+
+
+def _whole_entries(WH: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """(k, entries, m + 1): the entries sum_r WH[k, r, e] B[r, :] of pieces that share B."""
+    k, r, e = WH.shape
+    flat = WH.reshape(k, r) if e == 1 else np.moveaxis(WH, 2, 1).reshape(k * e, r)
+    return (flat @ B).reshape(k, e, B.shape[1])
+
+
+def _assemble(val: np.ndarray, C: np.ndarray, node: np.ndarray, ia: np.ndarray, ib: np.ndarray,
+              n: int, shape: tuple[int, int]) -> sp.csr_matrix:
+    """The sparse matrix of the pieces' entries val (k, entries, m + 1) (the pieces by time
+    index C, then by their start): row C n + ia, column node n + ib, summed.  The entries go in
+    by row, a row's pieces backwards (their columns then mostly ascend: little to sort)."""
+    k, e, m1 = val.shape
+    back = np.arange(k - 1, -1, -1)
+    unit = (C[back, None] * n + ia[None, :]).ravel()                # rows of (piece, entry)
+    o = np.argsort(unit, kind="stable")
+    p, en = back[o // e], o % e
+    idx = np.int32 if max(shape[1], k * e * m1) < 2 ** 31 - 1 else np.int64
+    cols = (node[p] * n + ib[en, None]).astype(idx).ravel()
+    ptr = np.zeros(shape[0] + 1, idx)
+    np.cumsum(np.bincount(unit, minlength=shape[0]) * m1, out=ptr[1:])
+    G = sp.csr_matrix((val[p, en].ravel(), cols, ptr), shape=shape)
+    G.sum_duplicates()
+    return G
 
 
 def _breaks(kernel: Any, breaks: np.ndarray | None, tau: float) -> tuple[np.ndarray, float]:
@@ -395,55 +438,20 @@ def _pieces(times: np.ndarray, tau: float, pts: np.ndarray, T: float, breaks: np
     idx = j0[:, None] + np.arange(K)[None, :]
     inside = idx < j1[:, None]
     cut = np.where(inside, times[:, None] - ext[np.minimum(idx, ext.size - 1)], 0.0)
-    extra = [np.zeros((times.size, 1)), np.full((times.size, 1), tau)]
+    zero, end = np.zeros((times.size, 1)), np.full((times.size, 1), tau)
     if breaks.size:
-        extra.append(np.broadcast_to(breaks, (times.size, breaks.size)))
-    s = np.sort(np.concatenate([cut] + extra, axis=1), axis=1)
+        s = np.sort(np.concatenate([cut, zero, end, np.broadcast_to(breaks, (times.size,
+                                                                            breaks.size))],
+                                   axis=1), axis=1)
+    else:       # the crossings descend in (0, tau), their padding 0: reversed, sorted
+        s = np.concatenate([end, cut, zero], axis=1)[:, ::-1]
     a, d = s[:, :-1], np.diff(s, axis=1)
     keep = d > 1e-14 * max(tau, 1.0)
-    whole = ((a > 0) & (s[:, 1:] < tau) & ~np.isin(a, breaks) & ~np.isin(s[:, 1:], breaks))[keep]
+    whole = (a > 0) & (s[:, 1:] < tau)
+    if breaks.size:
+        whole &= ~np.isin(a, breaks) & ~np.isin(s[:, 1:], breaks)
+    whole = whole[keep]
     return np.nonzero(keep)[0], a[keep], d[keep], whole
-
-
-def _group_entries(group: tuple, times: np.ndarray, locate: Locator, basis: Basis, n: int,
-                   ia: np.ndarray, ib: np.ndarray, T: float, slope_of: np.ndarray | None,
-                   dT: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """G's entries (values, rows, columns) of one group of pieces (times' index, start, length,
-    nodes S, weights W, H at S, whole intervals or not); the T derivative added into dT."""
-    Cg, ag, dg, S, W, H, full = group
-    gz = basis.gauss(basis.q)[0]
-    if full:
-        mid = times[Cg] - (ag + 0.5 * dg)
-        _, z1, node = locate(mid)
-        _, z2, _ = locate(mid + 0.25 * dg)
-        # a whole interval of u's mesh is one of the locator's intervals only where their
-        # meshes agree (not the past's fixed mesh against a period whose switches moved)
-        other = (np.abs(z1 - 0.5) > WHOLE_TOL) | (np.abs(z2 - 0.75) > WHOLE_TOL)
-        if np.any(other):
-            parts = [(Cg[f], ag[f], dg[f], S[f], W[f], H[f], whole)
-                     for f, whole in ((~other, True), (other, False)) if np.any(f)]
-            got = [_group_entries(g, times, locate, basis, n, ia, ib, T, slope_of, dT)
-                   for g in parts]
-            return tuple(np.concatenate(v) for v in zip(*got))  # type: ignore[return-value]
-    if full:    # t - S at the interval's Gauss nodes backwards: z = 1 - gz, one B for all
-        z = np.broadcast_to(1.0 - gz, S.shape)
-        slope = 1.0 / dg
-        B = basis.values(1.0 - gz)                                     # (q, m + 1)
-    else:
-        node, z, slope = _local(locate, times[Cg], ag, dg, S)
-        B = basis.values(z.ravel()).reshape(S.shape + (basis.m + 1,))   # (k, q, m + 1)
-    WH = W[:, :, None] * H[:, :, ia, ib]                               # (k, q, entries)
-    val = np.matmul(WH.transpose(0, 2, 1), B)                   # (k, entries, m + 1)
-    rows = np.broadcast_to((Cg[:, None] * n + ia[None, :])[:, :, None], val.shape).ravel()
-    cols = np.broadcast_to(node[:, None, :] * n + ib[None, :, None], val.shape).ravel()
-    if dT is not None and slope_of is not None:
-        Bd = (basis.derivatives(1.0 - gz) if full else
-              basis.derivatives(z.ravel()).reshape(S.shape + (basis.m + 1,)))
-        Ud = np.matmul(Bd, slope_of[node]) * slope[:, None, None]      # (k, q, n)
-        part = np.sum(WH * S[:, :, None] * Ud[:, :, ib], axis=1) / T  # (k, entries)
-        dT += np.bincount((Cg[:, None] * n + ia[None, :]).ravel(), part.ravel(),
-                          minlength=times.size * n).reshape(times.size, n)
-    return val.ravel(), rows, cols
 
 
 def point_matrix(times: np.ndarray, locate: Locator, basis: Basis, mesh: np.ndarray, n: int,
