@@ -35,7 +35,8 @@ def finite(text: str) -> list[float]:
 
 
 @pytest.mark.parametrize("name, args, lines", [
-    ("bench_meshes.py", ["--small"], [r"^\s*48 x 4 \|", r"^\s*112 x 6 \|", r"^degree 6, tol = 1e-08"]),
+    ("bench_meshes.py", ["--small"],
+     [r"^\s*48 x 4 \|", r"^\s*112 x 6 \|", r"^degree 6, tol = 1e-08"]),
     ("bench_identify_first_call.py", ["--rounds", "1", "--steps", "200"], [r"^this\s"]),
 ])
 def test_bench_runs_small(name, args, lines):
