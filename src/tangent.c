@@ -927,7 +927,7 @@ static int tangent_loop(const dmi_tangent *t, size_t steps, int flags, const dou
     }
     const int columns_mode = n + count < P; /* fewer calls of f than one per parameter */
     const int jumps = !(flags & DMI_TANGENT_PLAIN);
-    if (bk->on)
+    if (bk->on && t->S0) /* (a zero window: zero sums, as made) */
         block_anchor(bk, s, P, t->S0, S, 0);
     for (size_t q = 0; q < steps; q++) {
         const double tq = (double)(s->p + q) * h; /* as dmi_time */
