@@ -758,10 +758,10 @@ def _libdmi_loop(mod: _Perturbed, steps: int, history: np.ndarray | list, memory
     # the near cells' part, and any other kernel's, come as dWU from the states of a plain run
     by_terms = (memory.kind == "exp" and memory.recursive
                 and s.convolution in ("auto", "recursive"))
-    if by_terms and (np.any(memory.dE) or np.any(memory.dl)):
+    if by_terms and (memory.dE.any() or memory.dl.any()):
         dE = memory.dE.transpose(1, 2, 3, 0)                    # (K, n, n, P)
         terms = (memory.dl.real.T, memory.dl.imag.T, dE.real, -dE.imag)
-    if (np.any(memory.dnear) if by_terms else _kernel_depends(memory)):
+    if (memory.dnear.any() if by_terms else _kernel_depends(memory)):
         start = s.save_state()
         run[:] = [s.run_terms(steps)[1]]
         dWU = memory.near_kernel_part() if by_terms else memory.kernel_part()
@@ -774,7 +774,7 @@ def _libdmi_loop(mod: _Perturbed, steps: int, history: np.ndarray | list, memory
             raise
         return None     # a failing callback: the Python loop raises the callback's own error
     names = {1: "stick", 2: "reversal", 3: "unplaced"}
-    qs, comps = np.nonzero(codes)
+    qs, comps = np.nonzero(codes) if codes.any() else (np.zeros(0, int), np.zeros(0, int))
     switches = [(q, i, names[int(codes[q, i])]) for q, i in zip(qs.tolist(), comps.tolist())]
     t = np.arange(steps + 1) * h
     return _result(t, U, S, X, dX, h, switches, "compiled")
