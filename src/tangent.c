@@ -423,6 +423,185 @@ static int columns_make(columns *c, const dmi_solver *s, size_t P, const double 
     return DMI_OK;
 }
 
+/* The delay sum of all P columns of S at once where the solver's engine is
+ * the recursion alone (an exponential kernel, full cells, no near cells):
+ * per used column c of term k (C_k or D_k nonzero in column c) and per
+ * parameter j the sum Z = sum_{l<N} r_k^l S_c^{q-l}[j], stepped by
+ * Z <- r Z + S^{q+1} - r^N S^{q+1-N} and started (and restarted every
+ * BLOCK_PERIOD N steps) by Horner's rule over the stored rows of S; then
+ * W[i][j] = h sum (C Re Z + D Im Z) over the parts of row i, as the engine
+ * sums them.  r in double: the weights r^l are off by up to l units of
+ * rounding, so the block is taken for N <= BLOCK_MAX_N (relative error
+ * below about 1e-12 of the sum) and the engines per column beyond. */
+#define BLOCK_MAX_N 4096
+#define BLOCK_PERIOD 4
+
+typedef struct {
+    int on;                   /* the block is taken (else the engines per column) */
+    size_t nu;                /* the sums (used columns of the terms) */
+    size_t *col;              /* nu: the column of S each sum runs over */
+    double *rr, *ri, *nr, *ni; /* nu: r and r^N of each sum's term */
+    double *Zr, *Zi;          /* nu P: sum u of parameter j at u P + j */
+    size_t nparts;
+    size_t *prow, *psum;      /* per part: its row of W, its sum */
+    double *pC, *pD;          /* per part: W_row += C Re Z + D Im Z */
+    double *W;                /* n P: h times the sum, W[i P + j] */
+    size_t since;
+} block;
+
+static void block_free(block *b)
+{
+    free(b->col);
+    free(b->rr);
+    free(b->Zr);
+    free(b->prow);
+    free(b->pC);
+    free(b->W);
+    memset(b, 0, sizeof *b);
+}
+
+/* Whether s's engine is the recursion alone at a size the block takes. */
+static int block_applies(const dmi_solver *s)
+{
+    return s->H && s->rec && !s->near.nnz && s->theta == 1 && s->N <= BLOCK_MAX_N;
+}
+
+static int block_make(block *b, const dmi_solver *s, size_t P)
+{
+    memset(b, 0, sizeof *b);
+    if (!block_applies(s))
+        return DMI_OK;
+    const dmi_expk *x = s->quad == DMI_QUAD_CELL ? &s->cell_expk : &s->expk;
+    const size_t n = s->n, nn = n * n, K = x->K, N = s->N;
+    size_t nu = 0, np = 0;
+    for (size_t q = 0; q < K * nn; q++)
+        np += x->C[q] != 0 || (x->D && x->D[q] != 0);
+    for (size_t k = 0; k < K; k++)
+        for (size_t c = 0; c < n; c++) {
+            int used = 0;
+            for (size_t i = 0; i < n; i++)
+                used |= x->C[k * nn + i * n + c] != 0 || (x->D && x->D[k * nn + i * n + c] != 0);
+            nu += used;
+        }
+    const size_t su = nu ? nu : 1, spart = np ? np : 1;
+    b->col = malloc(su * sizeof *b->col);
+    b->rr = malloc(4 * su * sizeof *b->rr);
+    b->Zr = calloc(2 * su * P, sizeof *b->Zr);
+    b->prow = malloc(2 * spart * sizeof *b->prow);
+    b->pC = malloc(2 * spart * sizeof *b->pC);
+    b->W = calloc(n * P, sizeof *b->W);
+    if (!b->col || !b->rr || !b->Zr || !b->prow || !b->pC || !b->W) {
+        block_free(b);
+        return dmi_fail(s, DMI_ENOMEM, "dmi_tangent_run: out of memory");
+    }
+    b->ri = b->rr + su, b->nr = b->ri + su, b->ni = b->nr + su;
+    b->Zi = b->Zr + su * P;
+    b->psum = b->prow + spart;
+    b->pD = b->pC + spart;
+    b->on = 1;
+    b->nu = nu;
+    b->nparts = np;
+    size_t u = 0, p = 0;
+    for (size_t k = 0; k < K; k++) {
+        const double complex r = cexp((x->a[k] + I * x->b[k]) * s->h);
+        const double complex rN = cpow(r, (double)N);
+        for (size_t c = 0; c < n; c++) {
+            int used = 0;
+            for (size_t i = 0; i < n; i++) {
+                const size_t q = k * nn + i * n + c;
+                const double C = x->C[q], D = x->D ? x->D[q] : 0.0;
+                if (C == 0 && D == 0)
+                    continue;
+                b->prow[p] = i, b->psum[p] = u, b->pC[p] = C, b->pD[p] = D;
+                p++;
+                used = 1;
+            }
+            if (!used)
+                continue;
+            b->col[u] = c;
+            b->rr[u] = creal(r), b->ri[u] = x->b[k] == 0 ? 0.0 : cimag(r);
+            b->nr[u] = creal(rN), b->ni[u] = x->b[k] == 0 ? 0.0 : cimag(rN);
+            if (!isfinite(b->rr[u]) || !isfinite(b->ri[u]) || !isfinite(b->nr[u]) ||
+                !isfinite(b->ni[u]))
+                b->rr[u] = b->ri[u] = b->nr[u] = b->ni[u] = 0; /* (N = 1 only: r^l, l >= 1, 0) */
+            u++;
+        }
+    }
+    return DMI_OK;
+}
+
+/* Row m of S (n P), -N <= m: the window's (S0, NULL: zero) for m < 0. */
+static const double *block_row(const double *S0, const double *S, size_t N, size_t nP, long long m)
+{
+    if (m >= 0)
+        return S + (size_t)m * nP;
+    return S0 ? S0 + (size_t)((long long)N + m) * nP : NULL;
+}
+
+/* W from the sums. */
+static void block_w(block *b, size_t n, size_t P, double h)
+{
+    for (size_t i = 0; i < n * P; i++)
+        b->W[i] = 0;
+    for (size_t p = 0; p < b->nparts; p++) {
+        const double C = b->pC[p], D = b->pD[p];
+        const double *zr = b->Zr + b->psum[p] * P, *zi = b->Zi + b->psum[p] * P;
+        double *W = b->W + b->prow[p] * P;
+        for (size_t j = 0; j < P; j++)
+            W[j] += C * zr[j] + D * zi[j];
+    }
+    for (size_t i = 0; i < n * P; i++)
+        b->W[i] *= h;
+}
+
+/* The sums at step q by Horner's rule over S^{q-N+1..q}. */
+static void block_anchor(block *b, const dmi_solver *s, size_t P, const double *S0,
+                         const double *S, size_t q)
+{
+    const size_t n = s->n, N = s->N, nP = n * P;
+    for (size_t i = 0; i < 2 * b->nu * P; i++)
+        b->Zr[i] = 0;
+    for (long long m = (long long)q - (long long)N + 1; m <= (long long)q; m++) {
+        const double *row = block_row(S0, S, N, nP, m);
+        for (size_t u = 0; u < b->nu; u++) {
+            const double rr = b->rr[u], ri = b->ri[u];
+            double *zr = b->Zr + u * P, *zi = b->Zi + u * P;
+            const double *v = row ? row + b->col[u] * P : NULL;
+            for (size_t j = 0; j < P; j++) {
+                const double x = zr[j], y = zi[j];
+                zr[j] = (x * rr - y * ri) + (v ? v[j] : 0.0);
+                zi[j] = x * ri + y * rr;
+            }
+        }
+    }
+    b->since = 0;
+    block_w(b, n, P, s->h);
+}
+
+/* The sums from step q to q + 1, S^{q+1} stored. */
+static void block_advance(block *b, const dmi_solver *s, size_t P, const double *S0,
+                          const double *S, size_t q)
+{
+    const size_t n = s->n, N = s->N, nP = n * P;
+    if (++b->since >= BLOCK_PERIOD * N) {
+        block_anchor(b, s, P, S0, S, q + 1);
+        return;
+    }
+    const double *unew = S + (q + 1) * nP;
+    const double *uold = block_row(S0, S, N, nP, (long long)q + 1 - (long long)N);
+    for (size_t u = 0; u < b->nu; u++) {
+        const double rr = b->rr[u], ri = b->ri[u], nr = b->nr[u], ni = b->ni[u];
+        double *zr = b->Zr + u * P, *zi = b->Zi + u * P;
+        const double *a = unew + b->col[u] * P, *o = uold ? uold + b->col[u] * P : NULL;
+        for (size_t j = 0; j < P; j++) {
+            const double x = zr[j], y = zi[j], old = o ? o[j] : 0.0;
+            zr[j] = (x * rr - y * ri) + (a[j] - nr * old);
+            zi[j] = (x * ri + y * rr) - ni * old;
+        }
+    }
+    block_w(b, n, P, s->h);
+}
+
 /* out = f(t, u) of model m (0 without f); nonzero where f fails. */
 static int call_f(const model *m, double t, const double *u, double *out, size_t n)
 {
@@ -569,6 +748,10 @@ typedef struct {
     const double *window;                      /* U^{p0-N..p0}, (N + 1) n */
     const double *U;                           /* U^{p0..p0+steps} */
     size_t since;
+    /* the nonzero derivatives, listed once: dl_k in p_j (nl of them: index k P + j), dE_k
+     * [i][m] in p_j (ne: index ((k n + i) n + m) P + j) */
+    size_t nl, ne, *li, *ei;
+    double *acc;                               /* n P: the sum of each entry of T */
 } kpart;
 
 /* U^{p0+m}, -N <= m. */
@@ -624,7 +807,26 @@ static int kpart_make(kpart *kp, const dmi_tangent *t, const double *window, con
         for (size_t q = 0; q < n * n; q++)
             kp->E0[k * n * n + q] = x->C[k * n * n + q] - I * (x->D ? x->D[k * n * n + q] : 0.0);
     }
+    const size_t P = t->P, KP = K * P, KnnP = K * n * n * P;
+    kp->li = malloc((KP + KnnP) * sizeof *kp->li);
+    kp->acc = malloc(n * P * sizeof *kp->acc);
+    if (!kp->li || !kp->acc)
+        return dmi_fail(s, DMI_ENOMEM, "dmi_tangent_run: out of memory");
+    kp->ei = kp->li + KP;
+    for (size_t q = 0; q < KP; q++)
+        if (t->dl[q] != 0)
+            kp->li[kp->nl++] = q;
+    for (size_t q = 0; q < KnnP; q++)
+        if (t->dE[q] != 0)
+            kp->ei[kp->ne++] = q;
     return DMI_OK;
+}
+
+static void kpart_free(kpart *kp)
+{
+    free(kp->buf);
+    free(kp->li);
+    free(kp->acc);
 }
 
 /* Y and Y1 at step q by Horner's rule over U^{q-N+1..q}. */
@@ -671,19 +873,25 @@ static void kpart_apply(kpart *kp, const dmi_tangent *t, size_t q, double *T)
             kp->EB[k * n + i] = v;
         }
     }
-    for (size_t i = 0; i < n; i++)
-        for (size_t j = 0; j < P; j++) {
-            double acc = 0;
-            for (size_t k = 0; k < K; k++) {
-                const double complex *dE = t->dE + (k * n + i) * n * P, dl = t->dl[k * P + j];
-                double complex v = dl != 0 ? dl * kp->EB[k * n + i] : 0;
-                for (size_t m = 0; m < n; m++)
-                    if (dE[m * P + j] != 0) /* (a kernel acting on some entries: most are 0) */
-                        v += dE[m * P + j] * kp->A[k * n + m];
-                acc += creal(v);
-            }
-            T[i * P + j] -= h * acc;
+    /* Re(dl_k EB_k) and Re(dE_k A_k) of the nonzero derivatives only */
+    double *acc = kp->acc;
+    for (size_t e = 0; e < n * P; e++)
+        acc[e] = 0;
+    for (size_t e = 0; e < kp->nl; e++) {
+        const size_t x = kp->li[e], k = x / P, j = x % P;
+        const double dr = creal(t->dl[x]), di = cimag(t->dl[x]);
+        for (size_t i = 0; i < n; i++) {
+            const double complex eb = kp->EB[k * n + i];
+            acc[i * P + j] += dr * creal(eb) - di * cimag(eb);
         }
+    }
+    for (size_t e = 0; e < kp->ne; e++) {
+        const size_t x = kp->ei[e], j = x % P, m = x / P % n, i = x / P / n % n, k = x / P / n / n;
+        const double complex a = kp->A[k * n + m];
+        acc[i * P + j] += creal(t->dE[x]) * creal(a) - cimag(t->dE[x]) * cimag(a);
+    }
+    for (size_t e = 0; e < n * P; e++)
+        T[e] -= h * acc[e];
 }
 
 /* Y, Y1 from step q to q + 1. */
@@ -706,7 +914,7 @@ static void kpart_advance(kpart *kp, const dmi_solver *s, size_t q)
 /* The tangent along the run U, X from the solver's step p0 = s->p. */
 static int tangent_loop(const dmi_tangent *t, size_t steps, int flags, const double *dWU,
                         const double *U, const double *X, double *S, double *dX,
-                        signed char *switches, columns *cols, kpart *kp, scratch *w)
+                        signed char *switches, columns *cols, block *bk, kpart *kp, scratch *w)
 {
     const dmi_solver *s = t->s;
     const size_t n = s->n, P = t->P, nP = n * P;
@@ -719,6 +927,8 @@ static int tangent_loop(const dmi_tangent *t, size_t steps, int flags, const dou
     }
     const int columns_mode = n + count < P; /* fewer calls of f than one per parameter */
     const int jumps = !(flags & DMI_TANGENT_PLAIN);
+    if (bk->on && t->S0) /* (a zero window: zero sums, as made) */
+        block_anchor(bk, s, P, t->S0, S, 0);
     for (size_t q = 0; q < steps; q++) {
         const double tq = (double)(s->p + q) * h; /* as dmi_time */
         const double *Sq = S + q * nP;
@@ -730,7 +940,10 @@ static int tangent_loop(const dmi_tangent *t, size_t steps, int flags, const dou
             for (size_t i = 0; i < n; i++)
                 w->T[i * P + j] -= h * (Wj[i] + (dWU ? dWU[q * nP + i * P + j] : 0.0));
         }
-        if (!cols->col && dWU)
+        if (bk->on)
+            for (size_t i = 0; i < nP; i++) /* T -= h (sum_l G_l S^{q-l} + dW), all columns */
+                w->T[i] -= h * (bk->W[i] + (dWU ? dWU[q * nP + i] : 0.0));
+        else if (!cols->col && dWU)
             for (size_t i = 0; i < nP; i++)
                 w->T[i] -= h * dWU[q * nP + i];
         if (kp->K)
@@ -748,6 +961,8 @@ static int tangent_loop(const dmi_tangent *t, size_t steps, int flags, const dou
         memcpy(S + (q + 1) * nP, w->Snew, nP * sizeof *S);
         if (kp->K)
             kpart_advance(kp, s, q);
+        if (bk->on)
+            block_advance(bk, s, P, t->S0, S, q);
         for (size_t j = 0; cols->col && j < P; j++) { /* the windows and engines move on */
             dmi_solver *col = &cols->col[j];
             for (size_t i = 0; i < n; i++)
@@ -782,6 +997,7 @@ int dmi_tangent_run(dmi_tangent *t, size_t steps, int flags, const double *dWU, 
     double *Xb = X ? NULL : malloc(steps * n * sizeof *Xb);
     double *pool = malloc((5 * n * P + n * n + 4 * n + 2 * (N + 1) * n) * sizeof *pool);
     columns cols = {0};
+    block bk = {0};
     kpart kp = {0};
     if (!saved || (!U && !Ub) || (!X && !Xb) || !pool) {
         free(saved);
@@ -808,7 +1024,7 @@ int dmi_tangent_run(dmi_tangent *t, size_t steps, int flags, const double *dWU, 
                       "(dmi_tangent_set_kernel_terms) need the recursion (DMI_CONV_RECURSIVE, or "
                       "AUTO choosing it): give the kernel's part as dWU");
     if (rc == DMI_OK)
-        rc = columns_make(&cols, s, P, t->S0, row);
+        rc = block_applies(s) ? block_make(&bk, s, P) : columns_make(&cols, s, P, t->S0, row);
     if (rc == DMI_OK)
         rc = kpart_make(&kp, t, window, U);
     for (size_t k = 0; k <= N && rc == DMI_OK; k++) /* row k: U^{p-N+k} */
@@ -829,7 +1045,7 @@ int dmi_tangent_run(dmi_tangent *t, size_t steps, int flags, const double *dWU, 
             memset(switches, DMI_SWITCH_NONE, steps * n);
         for (size_t i = 0; i < n * P; i++) /* S^p: the window's last row */
             S[i] = t->S0 ? t->S0[N * n * P + i] : 0.0;
-        rc = tangent_loop(t, steps, flags, dWU, U, X, S, dX, switches, &cols, &kp, &w);
+        rc = tangent_loop(t, steps, flags, dWU, U, X, S, dX, switches, &cols, &bk, &kp, &w);
         s->p = p_end;
     }
     if (rc != DMI_OK && s->p != p0) {
@@ -840,7 +1056,8 @@ int dmi_tangent_run(dmi_tangent *t, size_t steps, int flags, const double *dWU, 
         memcpy(s->err, msg, sizeof msg);
     }
     columns_free(&cols);
-    free(kp.buf);
+    block_free(&bk);
+    kpart_free(&kp);
     free(saved);
     free(Ub);
     free(Xb);

@@ -88,29 +88,32 @@ def plan(mod: _Perturbed) -> Plan | None:
         f = not s.same_callback(o, "rhs")
         z = not s.same_callback(o, "history")
         rhs.append(f)
-        if any(not s.same_callback(o, part) for part in _OWN_PARTS) or not (len(moved) or f or z):
+        if not (len(moved) or f or z) or any(not s.same_callback(o, part) for part in _OWN_PARTS):
             own.append(j)
         else:
             members.append((j, f or bool(np.any(moved < R)), z))
     groups: list = []
     reads: list = []
     history: list = []
+    taken: list = []            # per group: the slots its members move
     for j, r, z in members:
+        mine = set(slots[j].tolist())
         for g, group in enumerate(groups):
-            taken = np.concatenate([slots[i] for i in group])
-            if (not np.intersect1d(taken, slots[j]).size and not (r and reads[g] is not None)
+            if (not taken[g] & mine and not (r and reads[g] is not None)
                     and not (z and history[g] is not None)):
                 group.append(j)
+                taken[g] |= mine
                 reads[g] = j if r else reads[g]
                 history[g] = j if z else history[g]
                 break
         else:
             groups.append([j])
+            taken.append(mine)
             reads.append(j if r else None)
             history.append(j if z else None)
     if len(groups) + len(own) == P:
         return None
-    union = [frozenset(np.concatenate([slots[j] for j in g]).tolist()) for g in groups]
+    union = [frozenset(t) for t in taken]
     return Plan(own, groups, reads, history, slots, rhs, union, _structure(s))
 
 

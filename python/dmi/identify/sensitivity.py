@@ -319,18 +319,9 @@ class _Memory:
                                      "differentiable, so the sensitivities would follow it wrongly; "
                                      "fit once, outside make, and set KernelFit.refit(kernel) in "
                                      "make (the same rates, coefficients linear in the kernel)")
-            wl, wsl, self.c, self.c1 = _exp_weights(s, self.lam, np.array([N - 1]))
-            self.wlast, self.wslast = wl[:, 0], wsl[:, 0]
             # the recursion: Z_k^p = sum_l r_k^l S^{p-l} (all N cells), then the last cell mended
-            self.recursive = bool(np.all(a <= 0.0) and np.all(np.abs(b) * s.h <= math.pi))
-            if self.recursive:
-                self.E = self.E0 * self.c[:, None, None]
-                self.r = np.exp(self.lam * s.h)
-                self.rN = np.exp(self.lam * s.h * N)
-                self._r3, self._rN3 = self.r[:, None, None], self.rN[:, None, None]
-                self.rlast = np.exp(self.lam * s.h * (N - 1))
-                # G_{N-1} less what the full-cell recursion puts on the last cell
-                self.last = np.einsum("k,kij->ij", self.wlast - self.rlast * self.c, self.E0).real
+            # (its factors, which only the Python loop reads, computed on first use: _recursion)
+            self.recursive = bool((a <= 0.0).all() and (np.abs(b) * self.h <= math.pi).all())
         elif kind == "callback":
             # the weights libdmi computed in init (the left rule's, or the cell rule's integrals),
             # and their derivatives from those of the models whose kernel differs
@@ -364,8 +355,30 @@ class _Memory:
             self.near = np.ascontiguousarray(D[:m])
             self.dnear = dD
 
+    def _recursion(self) -> None:
+        """The last cell's weights (``wlast``, ``wslast``), the full cells' factors (``c``,
+        ``c1``) and, under the recursion, its multipliers and the last cell's mend (``E``, ``r``,
+        ``rN``, ``rlast``, ``last``) of an exponential kernel."""
+        s, N = self._solver, self.N
+        wl, wsl, self.c, self.c1 = _exp_weights(s, self.lam, np.array([N - 1]))
+        self.wlast, self.wslast = wl[:, 0], wsl[:, 0]
+        if self.recursive:
+            self.E = self.E0 * self.c[:, None, None]
+            self.r = np.exp(self.lam * s.h)
+            self.rN = np.exp(self.lam * s.h * N)
+            self._r3, self._rN3 = self.r[:, None, None], self.rN[:, None, None]
+            self.rlast = np.exp(self.lam * s.h * (N - 1))
+            # G_{N-1} less what the full-cell recursion puts on the last cell
+            self.last = np.einsum("k,kij->ij", self.wlast - self.rlast * self.c, self.E0).real
+
     def __getattr__(self, name: str) -> Any:
-        # the all-cells weights of an exponential kernel, computed on first use
+        # the recursion's factors and the all-cells weights of an exponential kernel, computed on
+        # first use
+        if (name in ("wlast", "wslast", "c", "c1", "E", "r", "rN", "_r3", "_rN3", "rlast", "last")
+                and self.__dict__.get("kind") == "exp" and "lam" in self.__dict__):
+            self._recursion()
+            if name in self.__dict__:
+                return self.__dict__[name]
         if name in ("w", "ws", "G", "powers") and self.__dict__.get("kind") == "exp":
             N, K, n = self.N, len(self.lam), self.n
             w, ws, _, _ = _exp_weights(self._solver, self.lam, np.arange(N))
@@ -385,7 +398,7 @@ class _Memory:
         N, P, Uext = self.N, self.P, self._Uext()
         n = Uext.shape[1]
         if self.kind == "exp":
-            K = len(self.c)
+            K = len(self.lam)
             Ef = self.E0.reshape(K, n * n)
             wT = self.w.T
             dG = [(wT @ self.dE[j].reshape(K, n * n)
@@ -537,11 +550,13 @@ def _sensitivities_of(mod: _Perturbed, p: np.ndarray, steps: int, *,
     # otherwise each such perturbed model's init samples its own
     hist = (mod.hist if mod.hist is not None else
             [j for j, o in enumerate(mod.others) if not s.same_callback(o, "history")])
-    compiled_history = mod.sources is None and all(m.c_callback("history") is not None
-                                                   for m in [s, *(mod.others[j] for j in hist)])
+    handles = _history_handles(mod, hist)
+    compiled_history = handles is not None and all(m.c_callback("history") is not None
+                                                   for m in [s, *(handles[j] for j in hist)])
     if not why:
         history = (hist if hist and compiled_history else _history_by_init(mod, hist, window))
-        fast = _libdmi_loop(mod, steps, history, memory, run, depends, jumps)
+        fast = _libdmi_loop(mod, steps, history, memory, run, depends, jumps,
+                            handles if compiled_history else mod.others)
         if fast is not None:
             return fast
         # a call of f failed: the Python loop below raises the callback's own error
@@ -678,6 +693,39 @@ def _kernel_depends(memory: _Memory) -> bool:
     return bool(np.any(memory.dG))
 
 
+def _history_handles(mod: _Perturbed, hist: list) -> list | None:
+    """The models libdmi's loop is given per parameter so that its own sampling of the history
+    (``dmi_tangent_sample_history``) reads each parameter in ``hist`` from the model carrying its
+    perturbation: ``mod.others``, with a grouped build's history source put in the place of the
+    base model it reads f and the resolvent from, where that changes nothing else the loop reads
+    of it (f is read only for the parameters flagged as moving it, and the source's friction or
+    box is the base model's); None where a source cannot take that place."""
+    if mod.sources is None:
+        return mod.others
+    base, handles = mod.base, list(mod.others)
+    for j in hist:
+        src = mod.sources[j]
+        if src is handles[j]:
+            continue
+        if (handles[j] is not base or not _same_resolvent(base, src)
+                or src.has("rhs") != base.has("rhs")):
+            return None
+        handles[j] = src
+    return handles
+
+
+def _same_resolvent(a: Solver, b: Solver) -> bool:
+    """Whether the two models' friction coefficients or boxes are the same, bit for bit."""
+    kind = a.resolvent_kind
+    if kind != b.resolvent_kind or kind not in ("", "friction", "box"):
+        return False
+    if kind == "friction":
+        return np.array_equal(a.friction, b.friction)
+    if kind == "box":
+        return all(np.array_equal(x, y) for x, y in zip(a.box, b.box))
+    return True
+
+
 def _history_by_init(mod: _Perturbed, hist: list, window: np.ndarray) -> np.ndarray:
     """The history's S, (N + 1, n, P): for the parameters in ``hist``, the window of the
     perturbed model (after its init, which samples its own history) less the model's, over
@@ -693,14 +741,16 @@ def _history_by_init(mod: _Perturbed, hist: list, window: np.ndarray) -> np.ndar
 
 
 def _libdmi_loop(mod: _Perturbed, steps: int, history: np.ndarray | list, memory: _Memory,
-                 run: list, depends: np.ndarray | None, jumps: bool) -> Sensitivities | None:
+                 run: list, depends: np.ndarray | None, jumps: bool,
+                 handles: list | None = None) -> Sensitivities | None:
     """The run and its tangent by libdmi's loop (dmi_tangent_run) from the initialised model;
     None where it fails (the model is then where it was).  The history's S is ``history``,
     (N + 1, n, P), or, where it lists parameters, sampled by libdmi from those perturbed models'
     compiled history callbacks.  Where a parameter moves the kernel, the kernel parameters' part of the
     delay sum, sum_l dG_l U^{p-l}, comes from the exponential terms' derivatives in libdmi's loop
     or, for what they do not say, needs the states first: a plain run gives them, and the model
-    goes back to its start (its saved state) for libdmi's."""
+    goes back to its start (its saved state) for libdmi's.  ``handles``: the models given to
+    libdmi per parameter (:func:`_history_handles`; None: ``mod.others``)."""
     s = mod.base
     h = s.h
     dWU = terms = None
@@ -708,23 +758,23 @@ def _libdmi_loop(mod: _Perturbed, steps: int, history: np.ndarray | list, memory
     # the near cells' part, and any other kernel's, come as dWU from the states of a plain run
     by_terms = (memory.kind == "exp" and memory.recursive
                 and s.convolution in ("auto", "recursive"))
-    if by_terms and (np.any(memory.dE) or np.any(memory.dl)):
+    if by_terms and (memory.dE.any() or memory.dl.any()):
         dE = memory.dE.transpose(1, 2, 3, 0)                    # (K, n, n, P)
         terms = (memory.dl.real.T, memory.dl.imag.T, dE.real, -dE.imag)
-    if (np.any(memory.dnear) if by_terms else _kernel_depends(memory)):
+    if (memory.dnear.any() if by_terms else _kernel_depends(memory)):
         start = s.save_state()
         run[:] = [s.run_terms(steps)[1]]
         dWU = memory.near_kernel_part() if by_terms else memory.kernel_part()
         s.load_state(start)
     try:
-        U, X, S, dX, codes = s._tangent(mod.others, mod.delta, steps, history, dWU, depends,
-                                        jumps, terms)
+        U, X, S, dX, codes = s._tangent(mod.others if handles is None else handles, mod.delta,
+                                        steps, history, dWU, depends, jumps, terms)
     except Error as e:
         if e.code != _lib.ECALLBACK:
             raise
         return None     # a failing callback: the Python loop raises the callback's own error
     names = {1: "stick", 2: "reversal", 3: "unplaced"}
-    qs, comps = np.nonzero(codes)
+    qs, comps = np.nonzero(codes) if codes.any() else (np.zeros(0, int), np.zeros(0, int))
     switches = [(q, i, names[int(codes[q, i])]) for q, i in zip(qs.tolist(), comps.tolist())]
     t = np.arange(steps + 1) * h
     return _result(t, U, S, X, dX, h, switches, "compiled")
