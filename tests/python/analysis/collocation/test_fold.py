@@ -12,7 +12,6 @@ import math
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
 
 import dmi
 from dmi import analysis as da
@@ -20,6 +19,7 @@ from dmi import kernels
 from dmi.analysis.collocation import system as S
 from dmi.analysis.collocation.mesh import periodic_locator
 from dmi.analysis.collocation.signature import Signature
+from models.orbit_models import limit_cycle
 
 P = 0.15                        # van der Pol's damping
 A1, B1, G1, C1 = 1.0, 1.5, 0.5, 0.06      # c1 e^(-a1 s) (cos b1 s + g1 sin b1 s)
@@ -70,22 +70,7 @@ def ode_jacobian(y: np.ndarray) -> np.ndarray:
 def reference() -> tuple[float, np.ndarray]:
     """The ODE's period (between two upward crossings of w = 0 on the limit cycle) and its
     multipliers, largest first (the variational equations over a period)."""
-    run = solve_ivp(ode, (0, 400), [2.0, 0, 0, 0, 0], method="DOP853", rtol=1e-12, atol=1e-12)
-
-    def up(t: float, y: np.ndarray) -> float:
-        return y[0]
-    up.direction = 1
-    cross = solve_ivp(ode, (0, 30), run.y[:, -1], method="DOP853", rtol=1e-12, atol=1e-13,
-                      events=up)
-    t, y = cross.t_events[0], cross.y_events[0]
-    T = float(t[2] - t[1])
-
-    def variational(t: float, Y: np.ndarray) -> np.ndarray:
-        return np.concatenate([ode(t, Y[:5]), (ode_jacobian(Y[:5]) @ Y[5:].reshape(5, 5)).ravel()])
-    var = solve_ivp(variational, (0, T), np.concatenate([y[1], np.eye(5).ravel()]),
-                    method="DOP853", rtol=1e-12, atol=1e-13)
-    mu = np.linalg.eigvals(var.y[5:, -1].reshape(5, 5))
-    return T, mu[np.argsort(-np.abs(mu))]
+    return limit_cycle(ode, ode_jacobian, [2.0, 0, 0, 0, 0], 5)
 
 
 @pytest.fixture(scope="module")

@@ -15,13 +15,13 @@ import warnings
 import numpy as np
 import pytest
 import scipy.linalg as sl
-from scipy.integrate import solve_ivp
 
 import dmi
 from dmi import analysis as da
 from dmi.analysis.collocation import floquet, krylov
 
 from models import delay_models as tc
+from models.orbit_models import limit_cycle
 
 RATES = np.array([0.8, 1.6, 3.2])          # the memory's decay rates
 WEIGHTS = np.array([0.05, 0.05, 0.05])     # and weights: v' gets -sum_k w_k int e^-a_k s w(t - s)
@@ -59,22 +59,7 @@ def ode_jacobian(y: np.ndarray) -> np.ndarray:
 def reference() -> tuple[float, np.ndarray]:
     """The ODE's period and multipliers (largest first): the limit cycle reached from (2, 0),
     its period between two upward crossings of w = 0, the variational equations over it."""
-    run = solve_ivp(ode, (0, 400), [2.0, 0, 0, 0, 0], method="DOP853", rtol=1e-12, atol=1e-12)
-
-    def up(t: float, y: np.ndarray) -> float:
-        return y[0]
-    up.direction = 1
-    cross = solve_ivp(ode, (0, 30), run.y[:, -1], method="DOP853", rtol=1e-12, atol=1e-13,
-                      events=up)
-    t, y = cross.t_events[0], cross.y_events[0]
-    T = float(t[2] - t[1])
-
-    def variational(t: float, Y: np.ndarray) -> np.ndarray:
-        return np.concatenate([ode(t, Y[:5]), (ode_jacobian(Y[:5]) @ Y[5:].reshape(5, 5)).ravel()])
-    var = solve_ivp(variational, (0, T), np.concatenate([y[1], np.eye(5).ravel()]),
-                    method="DOP853", rtol=1e-12, atol=1e-13)
-    mu = np.linalg.eigvals(var.y[5:, -1].reshape(5, 5))
-    return T, mu[np.argsort(-np.abs(mu))]
+    return limit_cycle(ode, ode_jacobian, [2.0, 0, 0, 0, 0], 5)
 
 
 @pytest.fixture(scope="module")
