@@ -85,7 +85,7 @@ from ..continuation.driver import Curve as DriverCurve
 from ..continuation.driver import continuation, curve_range, newton_strategy
 from ..core.newton import ShootingError, Strategy, bordered_solve, sparse_bordered
 from ..scheme.problem import AtQ
-from .orbit_system import DIFF, FoldSystem, OrbitCurvePoint, central_along, check_period
+from .orbit_system import DIFF, FoldSystem, OrbitCurvePoint, check_period
 
 #: A start's fold at q0 must lie within this (relative to max(1, |p|)) of the event's p.
 START_TOL = 1e-6
@@ -95,6 +95,11 @@ BAUTIN_SHARE = 0.2
 # the step along v (relative, against the orbit's largest |u|) of the one-sided differences of
 # f's change at a moved parameter: its truncation and rounding errors balance near 3e-5
 CHANGE_STEP = 3e-5
+#: The step (relative, against max(1, the point's largest |x|) over the direction's largest
+#: entry) of the central differences along a direction of f_u (:func:`central_along`):
+#: f_u is a central difference of f itself (its rounding about 1e-11 of f), truncation and
+#: rounding balance near 1e-4.
+ALONG_STEP = 1e-4
 
 
 class OrbitFold(FoldSystem):
@@ -450,6 +455,13 @@ def _unrolled(mesh: np.ndarray, m: int, kmin: int) -> Callable:
         cols = (per.astype(int) - kmin)[:, None] * Lm + i[:, None] * m + k[None, :]
         return i, z, cols
     return locate
+
+
+def central_along(fn: Callable[[np.ndarray], Any], x: np.ndarray, d: np.ndarray) -> Any:
+    """The derivative of fn at x along the real direction d (d != 0), by central differences
+    (fn(x + e d) - fn(x - e d)) / (2 e) of step e = ALONG_STEP max(1, max |x|) / max |d|."""
+    e = ALONG_STEP * max(1.0, float(np.max(np.abs(x)))) / max(float(np.max(np.abs(d))), 1e-300)
+    return (fn(x + e * d) - fn(x - e * d)) / (2 * e)
 
 
 def fu_along(terms: Terms, t: np.ndarray, U: np.ndarray, E: np.ndarray) -> np.ndarray:

@@ -33,11 +33,6 @@ from ..scheme.stepmap import build
 #: g's gradient in x is 4e-5 to 1e-3 relative off with it; a central difference, 1e-7 off,
 #: took the same Newton iterations at two Jacobians a difference, 25 % slower a point).
 DIFF = 1e-7
-#: The step (relative, against max(1, the point's largest |x|) over the direction's largest
-#: entry) of the central differences along a direction of f_u (:func:`central_along`):
-#: f_u is a central difference of f itself (its rounding about 1e-11 of f), truncation and
-#: rounding balance near 1e-4.
-ALONG_STEP = 1e-4
 #: Terms kept (the last few (p, q) evaluated).
 KEEP = 12
 
@@ -317,13 +312,6 @@ class FoldSystem(OrbitSystem):
         other.ref, other.problem = self.ref, self.problem
         other.borders(x, float(y[self.lay.size]), q)
         return other
-
-
-def central_along(fn: Callable[[np.ndarray], Any], x: np.ndarray, d: np.ndarray) -> Any:
-    """The derivative of fn at x along the real direction d (d != 0), by central differences
-    (fn(x + e d) - fn(x - e d)) / (2 e) of step e = ALONG_STEP max(1, max |x|) / max |d|."""
-    e = ALONG_STEP * max(1.0, float(np.max(np.abs(x)))) / max(float(np.max(np.abs(d))), 1e-300)
-    return (fn(x + e * d) - fn(x - e * d)) / (2 * e)
 
 
 def _pair(J: Any, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
