@@ -32,6 +32,7 @@ import scipy.sparse.linalg as sla
 
 from .krylov import DENSE_MAX, Monodromy, leading, nearest
 from .mesh import Basis, Locator
+from .separable import delay_matrix_separable
 from .system import History, Layout, Terms, assemble
 from ..core.blas import _one_blas_thread
 
@@ -55,8 +56,9 @@ class FixedPast:
     O(d) in a difference quotient of step d (2.6e-8 in a multiplier at d = 1e-5 T).
     """
 
-    def __init__(self, terms: Terms):
+    def __init__(self, terms: Terms, separable: bool = True):
         self._terms = terms
+        self._separable = separable and terms.kind == "exp"
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._terms, name)
@@ -64,11 +66,22 @@ class FixedPast:
     def delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc: Locator, basis: Basis,
               rows: int, history: History | None = None, extra: np.ndarray | None = None,
               periodic: bool = False) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
-        """:meth:`Terms.delay` with the pieces also cut at ``history``'s mesh."""
-        if history is not None:
-            mesh = np.union1d(mesh, history.hist)
-        return self._terms.delay(times, mesh, T, loc, basis, rows, history, extra,
-                                 periodic=periodic)
+        """:meth:`Terms.delay` with the pieces also cut at ``history``'s mesh; an exponential
+        sum's far lags by :func:`~.separable.delay_matrix_separable` (unless built with
+        ``separable=False``)."""
+        if history is None:
+            return self._terms.delay(times, mesh, T, loc, basis, rows, history, extra,
+                                     periodic=periodic)
+        mesh = np.union1d(mesh, history.hist)
+        if not self._separable:
+            return self._terms.delay(times, mesh, T, loc, basis, rows, history, extra,
+                                     periodic=periodic)
+        more = np.empty(0) if extra is None else np.asarray(extra, dtype=float)
+        t = self._terms
+        G = delay_matrix_separable(np.concatenate([times, more]), t.tau, mesh, T, t.H,
+                                   t.terms, loc, basis, t.n, rows, pattern=t.pattern)
+        cut = len(times) * t.n
+        return (G, None) if not more.size else (G[:cut], G[cut:])
 
 
 def period_jacobian(lay: Layout, terms: Terms, x: np.ndarray, history: History

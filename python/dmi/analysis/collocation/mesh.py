@@ -275,7 +275,8 @@ def _near_nodes(near: Near, a: np.ndarray, d: np.ndarray, q: int, n: int
 def delay_matrix(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: float,
                  kernel: Callable[[np.ndarray], np.ndarray], locate: Locator, basis: Basis,
                  n: int, rows: int, breaks: np.ndarray | None = None,
-                 pattern: np.ndarray | None = None, slope_of: np.ndarray | None = None
+                 pattern: np.ndarray | None = None, slope_of: np.ndarray | None = None,
+                 omit: tuple[np.ndarray, np.ndarray] | None = None
                  ) -> tuple[sp.csr_matrix, np.ndarray | None]:
     """The sparse matrix G (len(times) n, rows n) with G u = (int_0^tau H(s) u(t_c - s) ds)_c.
 
@@ -307,6 +308,10 @@ def delay_matrix(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: floa
     slope_of : numpy.ndarray, optional
         Node rows (rows, n) of u: then also (1 / T) int_0^tau s H(s) u'(t_c - s) ds (len(times),
         n), the derivative of G u in T when the mesh scales with T (an autonomous orbit).
+    omit : tuple of numpy.ndarray, optional
+        (jb, ja) for each time: the lags between t_c - ext[ja] and t_c - ext[jb] (ext the mesh
+        crossings of :func:`crossings`, where jb < ja) left out, integrated elsewhere
+        (:mod:`dmi.analysis.collocation.separable`).
 
     Returns
     -------
@@ -317,7 +322,8 @@ def delay_matrix(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: floa
     times = np.asarray(times, dtype=float)
     near = getattr(kernel, "near", None)
     breaks, graded = _breaks(kernel, breaks, tau)
-    C, a, d, whole = _pieces(times, tau, np.asarray(mesh_points[:-1], dtype=float), T, breaks)
+    C, a, d, whole = _pieces(times, tau, np.asarray(mesh_points[:-1], dtype=float), T, breaks,
+                             omit)
     if pattern is None:
         pattern = np.ones((n, n), bool)
     ia, ib = np.nonzero(pattern)
@@ -424,20 +430,41 @@ def _breaks(kernel: Any, breaks: np.ndarray | None, tau: float) -> tuple[np.ndar
     return breaks, graded
 
 
-def _pieces(times: np.ndarray, tau: float, pts: np.ndarray, T: float, breaks: np.ndarray
-            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The pieces of [0, tau] on which s -> u(t_c - s) is one polynomial: (their time's index c,
-    their start a, their length d, whether a piece is a whole interval of u: its ends two mesh
-    crossings, neither 0, tau nor a break)."""
+def crossings(times: np.ndarray, tau: float, pts: np.ndarray, T: float
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The mesh points ``pts`` (one period's, without T) repeated every T over the memories of
+    the ``times`` (sorted), and for each time the index of the first one past t - tau and of the
+    first one at or past t: (ext, j0, j1)."""
     lo = math.floor((times.min() - tau - pts[-1]) / T) - 1
     hi = math.floor((times.max() - pts[0]) / T) + 1
     ext = (pts[None, :] + T * np.arange(lo, hi + 1)[:, None]).ravel()   # sorted
     j0 = np.searchsorted(ext, times - tau, side="right")
     j1 = np.searchsorted(ext, times, side="left")
-    K = int(np.max(j1 - j0)) if times.size else 0
-    idx = j0[:, None] + np.arange(K)[None, :]
-    inside = idx < j1[:, None]
-    cut = np.where(inside, times[:, None] - ext[np.minimum(idx, ext.size - 1)], 0.0)
+    return ext, j0, j1
+
+
+def _pieces(times: np.ndarray, tau: float, pts: np.ndarray, T: float, breaks: np.ndarray,
+            omit: tuple[np.ndarray, np.ndarray] | None = None
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The pieces of [0, tau] on which s -> u(t_c - s) is one polynomial: (their time's index c,
+    their start a, their length d, whether a piece is a whole interval of u: its ends two mesh
+    crossings, neither 0, tau nor a break).  ``omit`` (jb, ja): indices into the crossings of
+    :func:`crossings` for each time; where jb < ja the lags between t - ext[ja] and t - ext[jb]
+    (integrated elsewhere) are left out, the crossings between them not cut."""
+    ext, j0, j1 = crossings(times, tau, pts, T)
+    if omit is None:
+        jb = ja = j1
+    else:
+        jb, ja = omit
+        jb = np.where(jb < ja, np.clip(jb, j0, j1), j1)
+        ja = np.where(jb < j1, np.clip(ja, jb, j1), j1)
+    n1 = jb - j0 + (jb < ja)                        # the crossings up to jb (with jb in a window)
+    cnt = n1 + j1 - ja
+    K = int(np.max(cnt)) if times.size else 0
+    k = np.arange(K)[None, :]
+    idx = j0[:, None] + k + np.where(k >= n1[:, None], (ja - jb - 1 + (jb >= ja))[:, None], 0)
+    inside = k < cnt[:, None]
+    cut = np.where(inside, times[:, None] - ext[np.clip(idx, 0, ext.size - 1)], 0.0)
     zero, end = np.zeros((times.size, 1)), np.full((times.size, 1), tau)
     if breaks.size:
         s = np.sort(np.concatenate([cut, zero, end, np.broadcast_to(breaks, (times.size,
@@ -447,6 +474,12 @@ def _pieces(times: np.ndarray, tau: float, pts: np.ndarray, T: float, breaks: np
         s = np.concatenate([end, cut, zero], axis=1)[:, ::-1]
     a, d = s[:, :-1], np.diff(s, axis=1)
     keep = d > 1e-14 * max(tau, 1.0)
+    if omit is not None:        # the pieces inside a window
+        win = jb < ja
+        lo = np.where(win, times - ext[np.minimum(ja, ext.size - 1)], np.inf)[:, None]
+        hi = np.where(win, times - ext[np.minimum(jb, ext.size - 1)], -np.inf)[:, None]
+        mid = a + 0.5 * d
+        keep &= ~((mid > lo) & (mid < hi))
     whole = (a > 0) & (s[:, 1:] < tau)
     if breaks.size:
         whole &= ~np.isin(a, breaks) & ~np.isin(s[:, 1:], breaks)
