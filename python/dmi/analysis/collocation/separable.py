@@ -126,45 +126,62 @@ def _far_part(times: np.ndarray, ext: np.ndarray, ends: np.ndarray, jb: np.ndarr
               locate: Locator, basis: Basis, n: int, rows: int, pattern: np.ndarray,
               tau: float) -> sp.csr_matrix:
     """The window's cells (jb <= cell < ja for the times in ``win``) by the blocks' products
-    (lf: the rates lambda (K,) and factors F = C - i D (K, n, n))."""
+    (lf: the rates lambda (K,) and factors F = C - i D (K, n, n)), summed into the node rows
+    (cells of several periods share a periodic locator's rows)."""
     lam, F = lf
     first = int(np.min(jb[win]))
     cells = np.arange(first, int(np.max(ja[win])))
+    sig, B, node = _cells(ext, cells, locate, basis, tau)
+    m1 = basis.m + 1
+    nc = cells.size
+    scatter = sp.csr_matrix((np.ones(nc * m1), (np.arange(nc * m1), node.ravel())),
+                            shape=(nc * m1, rows))
+    ia, ib = np.nonzero(pattern)
+    bounds = np.concatenate([[first], ends[ends > first]])
+    refs = ext[bounds[1:]]                                  # each block's end, its reference
+    last = np.searchsorted(bounds[1:], ja, side="right") - 1        # a time's last block
+    use_all = np.flatnonzero(win)
+    # the times' factors at their last block's reference (bounded: t - that end >= s0)
+    E_last = np.exp(np.outer(times[use_all] - refs[last[use_all]], lam))
+    out = np.zeros((ia.size, times.size, rows))
+    for beta in range(refs.size):
+        sel = last[use_all] >= beta
+        use = use_all[sel]
+        if use.size == 0:
+            continue
+        lo, hi = bounds[beta] - first, bounds[beta + 1] - first
+        # e^(lambda (t - c_beta)) = e^(lambda (t - c_last)) e^(lambda (c_last - c_beta))
+        E = E_last[sel] * np.exp(np.outer(refs[last[use]] - refs[beta], lam))
+        Er = np.concatenate([E.real, -E.imag], axis=1)                  # Re(E Y) = [Er, -Ei] Y
+        Mo = np.einsum("kcr,crj->kcj", np.exp(lam[:, None, None] * (refs[beta] - sig[None, lo:hi])),
+                       B[lo:hi])                                        # (K, cells, m + 1)
+        early = cells[None, lo:hi] < jb[use][:, None]                   # before t - tau
+        part = scatter[lo * m1:hi * m1]
+        for e in range(ia.size):
+            Y = (F[:, ia[e], ib[e]][:, None, None] * Mo).reshape(lam.size, -1)
+            V = (Er @ np.concatenate([Y.real, Y.imag])).reshape(use.size, hi - lo, m1)
+            V[early] = 0.0
+            out[e, use] += (part.T @ V.reshape(use.size, -1).T).T
+    G = sp.csr_matrix((times.size * n, rows * n))
+    for e in range(ia.size):
+        unit = sp.csr_matrix(([1.0], ([ia[e]], [ib[e]])), shape=(n, n))
+        G = G + sp.kron(sp.csr_matrix(out[e]), unit, format="csr")
+    return G
+
+
+def _cells(ext: np.ndarray, cells: np.ndarray, locate: Locator, basis: Basis, tau: float
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The cells [ext[i], ext[i + 1]] (i in ``cells``): their Q_NEAR Gauss-Legendre nodes
+    (cells, r), the basis at them times the weights (cells, r, m + 1; 0 on a cell shorter than
+    delay_matrix's shortest piece) and their node rows (cells, m + 1)."""
     left, d = ext[cells], ext[cells + 1] - ext[cells]
     keep = d > 1e-14 * max(tau, 1.0)
     mid = left + 0.5 * d
-    _, z, cols = locate(np.concatenate([mid, mid + 0.25 * d]))
     nc = cells.size
-    z1, slope, node = z[:nc], (z[nc:] - z[:nc]) / (0.25 * d), cols[:nc]
+    _, z, cols = locate(np.concatenate([mid, mid + 0.25 * d]))
+    z1, slope = z[:nc], (z[nc:] - z[:nc]) / (0.25 * d)
     lz, lw = _legendre(Q_NEAR)
-    sig = left[:, None] + d[:, None] * lz[None, :]                      # (cells, r)
+    sig = left[:, None] + d[:, None] * lz[None, :]
     B = basis.values((z1[:, None] + (sig - mid[:, None]) * slope[:, None]).ravel())
-    B = (B.reshape(nc, Q_NEAR, -1) * (d[:, None] * lw[None, :] * keep[:, None])[:, :, None])
-    ia, ib = np.nonzero(pattern)
-    m1 = basis.m + 1
-    out_r, out_c, out_v = [], [], []
-    bounds = np.concatenate([[first], ends[ends > first]])
-    for lo, hi in zip(bounds[:-1], bounds[1:]):
-        use = np.flatnonzero(win & (ja >= hi))                          # times taking the block
-        if use.size == 0:
-            continue
-        sl = slice(lo - first, hi - first)
-        c_ref = ext[hi]
-        # the moments (K, cells, m + 1) and the times' factors (times, K), both bounded by 1
-        Mo = np.einsum("kcr,crj->kcj", np.exp(lam[:, None, None] * (c_ref - sig[None, sl])),
-                       B[sl])
-        E = np.exp(np.outer(times[use] - c_ref, lam))
-        Er = np.concatenate([E.real, -E.imag], axis=1)                  # Re(E Y) = [Er, -Ei] Y
-        for e in range(ia.size):
-            Y = (F[:, ia[e], ib[e]][:, None, None] * Mo).reshape(lam.size, -1)
-            V = (Er @ np.concatenate([Y.real, Y.imag])).reshape(use.size, -1, m1)
-            cell = cells[sl]
-            inwin = cell[None, :] >= jb[use][:, None]                   # starts past t - tau
-            cu, cc = np.nonzero(inwin)
-            out_v.append(V[cu, cc].ravel())
-            out_r.append(np.repeat(use[cu] * n + ia[e], m1))
-            out_c.append((node[sl][cc] * n + ib[e]).ravel())
-    G = sp.csr_matrix((np.concatenate(out_v), (np.concatenate(out_r), np.concatenate(out_c))),
-                      shape=(times.size * n, rows * n))
-    G.sum_duplicates()
-    return G
+    B = B.reshape(nc, Q_NEAR, -1) * (d[:, None] * lw[None, :] * keep[:, None])[:, :, None]
+    return sig, B, cols[:nc]
