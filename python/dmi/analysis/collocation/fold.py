@@ -85,6 +85,10 @@ class Fold:
         derivative's kernel as delay_matrix's slope weighs it (by s / T).
     jumps : tuple of float
         H_T's jumps in (0, T), sorted (the folded declared lags and r).
+    sums : tuple
+        H_T's far part as exponential sums without a jump: (the sum on (0, T], the one added on
+        (0, r) or None when r = 0), each (a, b, C, D) (the near part's lags (0, delta] of the
+        second belong to the tail).
     """
     T: float
     K: int
@@ -93,6 +97,7 @@ class Fold:
     tail: Callable[[np.ndarray], np.ndarray] | None
     moment: Callable[[np.ndarray], np.ndarray]
     jumps: tuple[float, ...]
+    sums: tuple = ()
 
 
 def _weights(lam: np.ndarray, T: float, K: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -159,4 +164,5 @@ def fold_of(H: Any, terms: tuple, tau: float, T: float) -> Fold | None:
     folded = {float(j % T) for j in H.jumps} | ({r} if r > 0 else set())
     jumps = tuple(sorted(j for j in folded if eps < j < T - eps))
     kernel = type(H)(kernel_far, H.near, jumps, H.rate)
-    return Fold(T, K, r, kernel, tail_far if H.near is not None else None, moment, jumps)
+    sums = ((a, b) + _scaled(C, D, g0), (a, b) + _scaled(C, D, last) if r > 0 else None)
+    return Fold(T, K, r, kernel, tail_far if H.near is not None else None, moment, jumps, sums)

@@ -29,7 +29,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .mesh import Basis, Locator, Q_NEAR, _legendre, crossings, delay_matrix
+from .fold import Fold, exp_sum
+from .mesh import Basis, Kernel, Locator, Near, Q_NEAR, _legendre, crossings, delay_matrix
 
 #: Cells a block of the period (after the past's block) takes: the direct pieces of a time end
 #: at most that many cells (and s0) behind it.
@@ -133,9 +134,6 @@ def _far_part(times: np.ndarray, ext: np.ndarray, ends: np.ndarray, jb: np.ndarr
     cells = np.arange(first, int(np.max(ja[win])))
     sig, B, node = _cells(ext, cells, locate, basis, tau)
     m1 = basis.m + 1
-    nc = cells.size
-    scatter = sp.csr_matrix((np.ones(nc * m1), (np.arange(nc * m1), node.ravel())),
-                            shape=(nc * m1, rows))
     ia, ib = np.nonzero(pattern)
     bounds = np.concatenate([[first], ends[ends > first]])
     refs = ext[bounds[1:]]                                  # each block's end, its reference
@@ -151,17 +149,22 @@ def _far_part(times: np.ndarray, ext: np.ndarray, ends: np.ndarray, jb: np.ndarr
             continue
         lo, hi = bounds[beta] - first, bounds[beta + 1] - first
         # e^(lambda (t - c_beta)) = e^(lambda (t - c_last)) e^(lambda (c_last - c_beta))
-        E = E_last[sel] * np.exp(np.outer(refs[last[use]] - refs[beta], lam))
+        step = np.exp(np.outer(refs[beta:] - refs[beta], lam))         # (later blocks, K)
+        E = E_last[sel] * step[last[use] - beta]
         Er = np.concatenate([E.real, -E.imag], axis=1)                  # Re(E Y) = [Er, -Ei] Y
         Mo = np.einsum("kcr,crj->kcj", np.exp(lam[:, None, None] * (refs[beta] - sig[None, lo:hi])),
                        B[lo:hi])                                        # (K, cells, m + 1)
         early = cells[None, lo:hi] < jb[use][:, None]                   # before t - tau
-        part = scatter[lo * m1:hi * m1]
+        hit = np.unique(node[lo:hi])                                   # the block's node rows
+        part = sp.csr_matrix((np.ones((hi - lo) * m1), (np.arange((hi - lo) * m1),
+                              np.searchsorted(hit, node[lo:hi]).ravel())),
+                             shape=((hi - lo) * m1, hit.size))
+        where = np.ix_(use, hit)
         for e in range(ia.size):
             Y = (F[:, ia[e], ib[e]][:, None, None] * Mo).reshape(lam.size, -1)
             V = (Er @ np.concatenate([Y.real, Y.imag])).reshape(use.size, hi - lo, m1)
             V[early] = 0.0
-            out[e, use] += (part.T @ V.reshape(use.size, -1).T).T
+            out[e][where] += (part.T @ V.reshape(use.size, -1).T).T
     G = sp.csr_matrix((times.size * n, rows * n))
     for e in range(ia.size):
         unit = sp.csr_matrix(([1.0], ([ia[e]], [ib[e]])), shape=(n, n))
@@ -185,3 +188,27 @@ def _cells(ext: np.ndarray, cells: np.ndarray, locate: Locator, basis: Basis, ta
     B = basis.values((z1[:, None] + (sig - mid[:, None]) * slope[:, None]).ravel())
     B = B.reshape(nc, Q_NEAR, -1) * (d[:, None] * lw[None, :] * keep[:, None])[:, :, None]
     return sig, B, cols[:nc]
+
+
+def folded_matrix(times: np.ndarray, fold: Fold, mesh_points: np.ndarray, T: float,
+                  locate: Locator, basis: Basis, n: int, rows: int,
+                  pattern: np.ndarray | None = None) -> sp.csr_matrix:
+    """delay_matrix's G of the folded kernel H_T over [0, T] (``fold``, :mod:`~.fold`), its
+    far cells by :func:`delay_matrix_separable`: H_T's near part and first sum over [0, T],
+    then its second sum over (0, r) without the near lags (0, delta] (the tail's); the folded
+    declared jumps stay cuts."""
+    first, second = fold.sums
+    H = fold.kernel
+    cuts = tuple(j for j in fold.jumps if j != fold.r)
+
+    def kernel(terms: tuple, near: Near | None) -> Kernel:
+        return Kernel(lambda s: exp_sum(s, *terms), near, cuts, H.rate)
+    G = delay_matrix_separable(times, T, mesh_points, T, kernel(first, H.near), first, locate,
+                               basis, n, rows, pattern=pattern)
+    near = H.near
+    if second is not None and (near is None or fold.r > near.delta):
+        zero = None if near is None else Near(near.delta, near.beta, np.zeros_like(near.C))
+        G = G + delay_matrix_separable(times, fold.r, mesh_points, T,
+                                       kernel(second, zero), second, locate, basis, n, rows,
+                                       pattern=pattern)
+    return G

@@ -32,6 +32,7 @@ import scipy.sparse.linalg as sla
 from ..._solver import Solver
 from ..core.model import FD_STEP, ManyRhs
 from .fold import Fold, exp_sum, fold_of, folding
+from .separable import folded_matrix
 from .mesh import (STEEP, Basis, Kernel, Locator, Near, _monomials, delay_matrix,
                                history_locator, history_rows, periodic_locator, point_matrix)
 from .signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
@@ -99,6 +100,9 @@ class Terms:
         #: sum; :mod:`dmi.analysis.collocation.fold`).
         self.fold = bool(folding()) and self.kind == "exp"
         self._folds: tuple[float, Fold | None] | None = None
+        #: Whether the folded kernel's far cells go by separated factors (False: every piece by
+        #: its own quadrature, delay_matrix's).
+        self.separable = True
 
     def folded(self, T: float) -> Fold | None:
         """The kernel folded onto the period T (:func:`~.fold.fold_of`; the last one kept), None
@@ -123,8 +127,11 @@ class Terms:
             return delay_matrix(times, self.tau, mesh, T, self.H, loc, basis, self.n, rows,
                                 pattern=self.pattern, slope_of=slope_of)
         n, pattern = self.n, self.pattern
-        G, dT = delay_matrix(times, T, mesh, T, f.kernel, loc, basis, n, rows, pattern=pattern,
-                             slope_of=slope_of)
+        if slope_of is None and self.separable:     # the far cells by products (separable.py)
+            G, dT = folded_matrix(times, f, mesh, T, loc, basis, n, rows, pattern), None
+        else:
+            G, dT = delay_matrix(times, T, mesh, T, f.kernel, loc, basis, n, rows,
+                                 pattern=pattern, slope_of=slope_of)
         near = f.kernel.near
         if f.tail is not None and near is not None:
             cuts = np.array([j for j in f.jumps if j < near.delta])
