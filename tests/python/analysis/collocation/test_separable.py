@@ -3,7 +3,8 @@
 # (collocation.mesh.delay_matrix), on the history locator of the monodromy's fixed past (several
 # periods, the period's mesh moved off the past's): the fractional kernel's fit with near cells
 # (the fractional belt's), and an oscillating sum (complex rates) with a near part; the memory
-# ends inside a cell for every time.  The two rules differ by their quadrature errors
+# ends inside a cell for every time.  The same for the periodic orbit's kernel folded onto one
+# period (collocation.fold), its memory's rest r beyond the near part, inside it, and 0.  The two rules differ by their quadrature errors
 # (Gauss-Legendre on pieces at least their own length from 0): agreement to 1e-13 of the
 # matrix's scale.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -18,9 +19,9 @@ import dmi
 from dmi import kernels
 from dmi.analysis.collocation import separable
 from dmi.analysis.collocation import system as S
-from dmi.analysis.collocation.fold import exp_sum
+from dmi.analysis.collocation.fold import exp_sum, fold_of
 from dmi.analysis.collocation.mesh import (Basis, Kernel, Near, crossings, delay_matrix,
-                                           history_locator, history_rows)
+                                           history_locator, history_rows, periodic_locator)
 
 M, Q, T, L = 4, 6, 6.3, 30
 
@@ -115,3 +116,25 @@ def test_growing_term_is_left_to_the_direct_quadrature() -> None:
     G1 = separable.delay_matrix_separable(times, 9.0, pts, T, grow, (a, b, C, D), loc, basis,
                                           2, rows)
     assert (G1 != G0).nnz == 0
+
+
+@pytest.mark.parametrize("which, tau", [("fractional", 25.9), ("oscillating", 17.2),
+                                        ("oscillating", 3 * T + 0.004), ("oscillating", 3 * T)])
+def test_folded_kernel(which: str, tau: float) -> None:
+    if which == "fractional":
+        terms = fractional(tau)
+        H, sums, pattern = terms.H, terms.terms, terms.pattern
+    else:
+        (H, sums), pattern = oscillating(), np.ones((2, 2), bool)
+    f = fold_of(H, sums, tau, T)
+    assert f is not None
+    assert (f.r > 0.01) == (tau in (25.9, 17.2))
+    now = meshes(4)[1]
+    basis = Basis(M, Q)
+    loc = periodic_locator(now, M)
+    gz = basis.gauss()[0]
+    times = np.concatenate([(now[:-1, None] + np.diff(now)[:, None] * gz).ravel(), [0.0, 2.2]])
+    G0 = delay_matrix(times, T, now, T, f.kernel, loc, basis, 2, L * M, pattern=pattern)[0]
+    G1 = separable.folded_matrix(times, f, now, T, loc, basis, 2, L * M, pattern=pattern)
+    A0, A1 = G0.toarray(), G1.toarray()
+    assert np.max(np.abs(A1 - A0)) < 1e-13 * np.max(np.abs(A0))
