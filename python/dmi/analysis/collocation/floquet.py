@@ -31,8 +31,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from .krylov import DENSE_MAX, Monodromy, leading, nearest
-from .mesh import Basis, Locator
-from .separable import delay_matrix_separable
+from .mesh import Basis, Locator, delay_matrix_separable
 from .system import History, Layout, Terms, assemble
 from ..core.blas import _one_blas_thread
 
@@ -67,7 +66,7 @@ class FixedPast:
               rows: int, history: History | None = None, extra: np.ndarray | None = None,
               periodic: bool = False) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
         """:meth:`Terms.delay` with the pieces also cut at ``history``'s mesh; an exponential
-        sum's far lags by :func:`~.separable.delay_matrix_separable` (unless built with
+        sum's far lags by :func:`~.mesh.delay_matrix_separable` (unless built with
         ``separable=False``)."""
         if history is None:
             return self._terms.delay(times, mesh, T, loc, basis, rows, history, extra,

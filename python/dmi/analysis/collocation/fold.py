@@ -87,8 +87,8 @@ class Fold:
         H_T's jumps in (0, T), sorted (the folded declared lags and r).
     sums : tuple
         H_T's far part as exponential sums without a jump: (the sum on (0, T], the one added on
-        (0, r) or None when r = 0), each (a, b, C, D) (the near part's lags (0, delta] of the
-        second belong to the tail).
+        (0, r) or None when r = 0), each ((a, b, C, D), s -> its values (k, n, n)) (the near
+        part's lags (0, delta] of the second belong to the tail).
     """
     T: float
     K: int
@@ -113,6 +113,11 @@ def _weights(lam: np.ndarray, T: float, K: int) -> tuple[np.ndarray, np.ndarray,
             g1 += z
             g2 += k * z
     return g0, g1, g2
+
+
+def _sum(terms: tuple) -> Callable[[np.ndarray], np.ndarray]:
+    """s -> the exponential sum ``terms`` (a, b, C, D) at s."""
+    return lambda s: exp_sum(s, *terms)
 
 
 def _piecewise(a: np.ndarray, b: np.ndarray, below: tuple, above: tuple, r: float
@@ -164,5 +169,7 @@ def fold_of(H: Any, terms: tuple, tau: float, T: float) -> Fold | None:
     folded = {float(j % T) for j in H.jumps} | ({r} if r > 0 else set())
     jumps = tuple(sorted(j for j in folded if eps < j < T - eps))
     kernel = type(H)(kernel_far, H.near, jumps, H.rate)
-    sums = ((a, b) + _scaled(C, D, g0), (a, b) + _scaled(C, D, last) if r > 0 else None)
+    first = (a, b) + _scaled(C, D, g0)
+    second = (a, b) + _scaled(C, D, last)
+    sums = ((first, _sum(first)), (second, _sum(second)) if r > 0 else None)
     return Fold(T, K, r, kernel, tail_far if H.near is not None else None, moment, jumps, sums)

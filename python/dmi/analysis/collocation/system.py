@@ -32,9 +32,8 @@ import scipy.sparse.linalg as sla
 from ..._solver import Solver
 from ..core.model import FD_STEP, ManyRhs
 from .fold import Fold, exp_sum, fold_of, folding
-from .separable import folded_matrix
 from .mesh import (STEEP, Basis, Kernel, Locator, Near, _monomials, delay_matrix,
-                               history_locator, history_rows, periodic_locator, point_matrix)
+                   folded_matrix, history_locator, history_rows, periodic_locator, point_matrix)
 from .signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
 from ..core.newton import Converge, NewtonOptions, Search, ShootingError, newton_loop
 
@@ -127,7 +126,7 @@ class Terms:
             return delay_matrix(times, self.tau, mesh, T, self.H, loc, basis, self.n, rows,
                                 pattern=self.pattern, slope_of=slope_of)
         n, pattern = self.n, self.pattern
-        if slope_of is None and self.separable:     # the far cells by products (separable.py)
+        if slope_of is None and self.separable:     # the far cells by products
             G, dT = folded_matrix(times, f, mesh, T, loc, basis, n, rows, pattern), None
         else:
             G, dT = delay_matrix(times, T, mesh, T, f.kernel, loc, basis, n, rows,

@@ -1,5 +1,5 @@
 # The delay matrix of an exponential-sum kernel with its far cells by separated factors
-# (dmi.analysis.collocation.separable) against the direct quadrature of every piece
+# (collocation.mesh.delay_matrix_separable) against the direct quadrature of every piece
 # (collocation.mesh.delay_matrix), on the history locator of the monodromy's fixed past (several
 # periods, the period's mesh moved off the past's): the fractional kernel's fit with near cells
 # (the fractional belt's), and an oscillating sum (complex rates) with a near part; the memory
@@ -17,7 +17,7 @@ import pytest
 
 import dmi
 from dmi import kernels
-from dmi.analysis.collocation import separable
+from dmi.analysis.collocation import mesh as separable
 from dmi.analysis.collocation import system as S
 from dmi.analysis.collocation.fold import exp_sum, fold_of
 from dmi.analysis.collocation.mesh import (Basis, Kernel, Near, crossings, delay_matrix,
