@@ -515,7 +515,7 @@ def point_matrix(times: np.ndarray, locate: Locator, basis: Basis, mesh: np.ndar
 # Cut the time axis at the mesh crossings (the mesh points repeated every T) into *cells*; each
 # lies inside one interval of u.  On a cell [l, l + d] whose lags t_c - sigma lie in [s0, tau],
 # past every kernel break (the near part's delta, its declared jumps, the grading's start) and at
-# least the cell's length from 0, the integral is
+# least twice the cell's length from 0, the integral is
 #
 #     int H(t_c - sigma) B_k(sigma) d sigma = Re sum_j e^(lambda_j (t_c - c)) F_j M_j,k,
 #     M_j,k = int_l^(l + d) e^(lambda_j (c - sigma)) B_k(sigma) d sigma,
@@ -527,9 +527,11 @@ def point_matrix(times: np.ndarray, locate: Locator, basis: Basis, mesh: np.ndar
 # the cells that start at or after t_c - tau), each by one product of its (times x terms) factors
 # with the block's (terms x columns) moments; the rest of [0, tau] (the near lags, the last block
 # not yet ended, the cell cut by tau) keeps delay_matrix's pieces (``omit``).  M is integrated by
-# Q_NEAR Gauss-Legendre nodes on the whole cell (a cell at least its own length from 0: the
-# graded pieces' rule), where delay_matrix cuts it at the grading and takes q or Q_NEAR nodes: the
-# two differ by their quadrature errors.
+# Q_NEAR Gauss-Legendre nodes on the whole cell, where delay_matrix cuts it at the grading (at most
+# once: the cuts double) and takes q or Q_NEAR nodes: the two differ by their quadrature errors.
+# Twice its length from 0 (not once, the graded pieces' rule): a steep term e^(-r s) on the cell
+# [a, a + d], a >= 2 d, keeps the rule's error bound below 4e-22 of its integral 1 / r for every
+# r d (at a = d it reaches 1.1e-14, at r d = 25).
 
 #: Cells a block of the period (after the past's block) takes: the direct pieces of a time end
 #: at most that many cells (and s0) behind it.
@@ -538,11 +540,11 @@ BLOCK_CELLS = 4
 
 def far_lag(kernel: object, pts: np.ndarray, T: float) -> float:
     """s0: the lag from which a cell is integrated by the separated factors, past the near part
-    (and its graded cuts' start), the kernel's jumps and the longest cell of the mesh ``pts``
-    (one period, 0 to T)."""
+    (and its graded cuts' start), the kernel's jumps and twice the longest cell of the mesh
+    ``pts`` (one period, 0 to T)."""
     near = getattr(kernel, "near", None)
     jumps = getattr(kernel, "jumps", ())
-    s0 = max([float(np.max(np.diff(pts))), getattr(kernel, "grading", 0.0),
+    s0 = max([2.0 * float(np.max(np.diff(pts))), getattr(kernel, "grading", 0.0),
               near.delta if near is not None else 0.0] + [float(j) for j in jumps])
     return s0 * (1.0 + 1e-9)
 
