@@ -536,6 +536,8 @@ def point_matrix(times: np.ndarray, locate: Locator, basis: Basis, mesh: np.ndar
 #: Cells a block of the period (after the past's block) takes: the direct pieces of a time end
 #: at most that many cells (and s0) behind it.
 BLOCK_CELLS = 4
+#: A block's node rows up to which its cells' columns are summed into them by a dense product.
+SCATTER_DENSE = 64
 
 
 def far_lag(kernel: object, pts: np.ndarray, T: float) -> float:
@@ -656,21 +658,33 @@ def _far_part(times: np.ndarray, ext: np.ndarray, ends: np.ndarray, jb: np.ndarr
         Mo = np.einsum("kcr,crj->kcj", np.exp(lam[:, None, None] * (refs[beta] - sig[None, lo:hi])),
                        B[lo:hi])                                        # (K, cells, m + 1)
         early = cells[None, lo:hi] < jb[use][:, None]                   # before t - tau
-        hit = np.unique(node[lo:hi])                                   # the block's node rows
-        part = sp.csr_matrix((np.ones((hi - lo) * m1), (np.arange((hi - lo) * m1),
-                              np.searchsorted(hit, node[lo:hi]).ravel())),
-                             shape=((hi - lo) * m1, hit.size))
+        hit, part = _scatter(node[lo:hi])
         where = np.ix_(use, hit)
         for e in range(ia.size):
             Y = (F[:, ia[e], ib[e]][:, None, None] * Mo).reshape(lam.size, -1)
             V = (Er @ np.concatenate([Y.real, Y.imag])).reshape(use.size, hi - lo, m1)
             V[early] = 0.0
-            out[e][where] += (part.T @ V.reshape(use.size, -1).T).T
-    G = sp.csr_matrix((times.size * n, rows * n))
+            out[e][where] += V.reshape(use.size, -1) @ part
+    r, c, v = [], [], []
     for e in range(ia.size):
-        unit = sp.csr_matrix(([1.0], ([ia[e]], [ib[e]])), shape=(n, n))
-        G = G + sp.kron(sp.csr_matrix(out[e]), unit, format="csr")
-    return G
+        i, j = np.nonzero(out[e])
+        r.append(i * n + ia[e])
+        c.append(j * n + ib[e])
+        v.append(out[e][i, j])
+    return sp.csr_matrix((np.concatenate(v), (np.concatenate(r), np.concatenate(c))),
+                         shape=(times.size * n, rows * n))
+
+
+def _scatter(node: np.ndarray) -> tuple[np.ndarray, Any]:
+    """(the distinct node rows of cells' columns ``node`` (cells, m + 1), the 0/1 matrix from
+    the cells' columns to them: dense for a few, sparse beyond SCATTER_DENSE)."""
+    hit, at = np.unique(node, return_inverse=True)
+    k = node.size
+    if hit.size <= SCATTER_DENSE:
+        P = np.zeros((k, hit.size))
+        P[np.arange(k), at.ravel()] = 1.0
+        return hit, P
+    return hit, sp.csr_matrix((np.ones(k), (np.arange(k), at.ravel())), shape=(k, hit.size))
 
 
 def _cells(ext: np.ndarray, cells: np.ndarray, locate: Locator, basis: Basis, tau: float
