@@ -97,7 +97,7 @@ class Fold:
     tail: Callable[[np.ndarray], np.ndarray] | None
     moment: Callable[[np.ndarray], np.ndarray]
     jumps: tuple[float, ...]
-    sums: tuple = ()
+    sums: tuple
 
 
 def _weights(lam: np.ndarray, T: float, K: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -17,7 +17,7 @@ import pytest
 
 import dmi
 from dmi import kernels
-from dmi.analysis.collocation import mesh as separable
+from dmi.analysis.collocation import mesh
 from dmi.analysis.collocation import system as S
 from dmi.analysis.collocation.fold import exp_sum, fold_of
 from dmi.analysis.collocation.mesh import (Basis, Kernel, Near, crossings, delay_matrix,
@@ -72,14 +72,14 @@ def check(kernel, terms, tau: float, pattern: np.ndarray) -> None:
     ext, j0, _ = crossings(times, tau, pts[:-1], T)
     assert np.all((ext[j0 - 1] < times - tau) & (times - tau < ext[j0]))
     used = []
-    real = separable._far_part
+    real = mesh._far_part
     G0 = delay_matrix(times, tau, pts, T, kernel, loc, basis, 2, rows, pattern=pattern)[0]
     try:
-        separable._far_part = lambda *a, **k: used.append(1) or real(*a, **k)
-        G1 = separable.delay_matrix_separable(times, tau, pts, T, kernel, terms, loc, basis, 2,
-                                              rows, pattern=pattern)
+        mesh._far_part = lambda *a, **k: used.append(1) or real(*a, **k)
+        G1 = mesh.delay_matrix_separable(times, tau, pts, T, kernel, terms, loc, basis, 2, rows,
+                                         pattern=pattern)
     finally:
-        separable._far_part = real
+        mesh._far_part = real
     assert used, "no far cells taken by the products"
     A0, A1 = G0.toarray(), G1.toarray()
     scale = np.max(np.abs(A0))
@@ -113,8 +113,8 @@ def test_growing_term_is_left_to_the_direct_quadrature() -> None:
     rows = history_rows(L, M, 2)
     pts = np.union1d(now, past)
     G0 = delay_matrix(times, 9.0, pts, T, grow, loc, basis, 2, rows)[0]
-    G1 = separable.delay_matrix_separable(times, 9.0, pts, T, grow, (a, b, C, D), loc, basis,
-                                          2, rows)
+    G1 = mesh.delay_matrix_separable(times, 9.0, pts, T, grow, (a, b, C, D), loc, basis, 2,
+                                     rows)
     assert (G1 != G0).nnz == 0
 
 
@@ -135,6 +135,6 @@ def test_folded_kernel(which: str, tau: float) -> None:
     gz = basis.gauss()[0]
     times = np.concatenate([(now[:-1, None] + np.diff(now)[:, None] * gz).ravel(), [0.0, 2.2]])
     G0 = delay_matrix(times, T, now, T, f.kernel, loc, basis, 2, L * M, pattern=pattern)[0]
-    G1 = separable.folded_matrix(times, f, now, T, loc, basis, 2, L * M, pattern=pattern)
+    G1 = mesh.folded_matrix(times, f, now, T, loc, basis, 2, L * M, pattern=pattern)
     A0, A1 = G0.toarray(), G1.toarray()
     assert np.max(np.abs(A1 - A0)) < 1e-13 * np.max(np.abs(A0))
