@@ -540,7 +540,7 @@ BLOCK_CELLS = 4
 SCATTER_DENSE = 64
 
 
-def far_lag(kernel: object, pts: np.ndarray, T: float) -> float:
+def far_lag(kernel: Kernel, pts: np.ndarray) -> float:
     """s0: the lag from which a cell is integrated by the separated factors, past the near part
     (and its graded cuts' start), the kernel's jumps and twice the longest cell of the mesh
     ``pts`` (one period, 0 to T)."""
@@ -552,10 +552,11 @@ def far_lag(kernel: object, pts: np.ndarray, T: float) -> float:
 
 
 def delay_matrix_separable(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: float,
-                           kernel: object, terms: tuple, locate: Locator, basis: Basis, n: int,
+                           kernel: Kernel, terms: tuple, locate: Locator, basis: Basis, n: int,
                            rows: int, pattern: np.ndarray | None = None) -> sp.csr_matrix:
     """:func:`dmi.analysis.collocation.mesh.delay_matrix`'s G for a kernel whose far part is
-    the exponential sum ``terms`` (a, b, C, D) (see the module), the far cells by products.
+    the exponential sum ``terms`` (a, b, C, D), its far cells by products (the comment above
+    :data:`BLOCK_CELLS`).
 
     Parameters
     ----------
@@ -594,9 +595,9 @@ def delay_matrix_separable(times: np.ndarray, tau: float, mesh_points: np.ndarra
     if pattern is None:
         pattern = np.ones((n, n), bool)
     if times.size == 0 or np.any(a > 0):
-        return delay_matrix(times, tau, pts, T, kernel, locate, basis, n, rows,  # type: ignore
+        return delay_matrix(times, tau, pts, T, kernel, locate, basis, n, rows,
                             pattern=pattern)[0]
-    s0 = far_lag(kernel, pts, T)
+    s0 = far_lag(kernel, pts)
     ext, j0, j1 = crossings(times, tau, pts[:-1], T)
     ends = _block_ends(ext, times, s0)
     # each time's window: the cells from its first crossing past t - tau to the last block end
@@ -606,10 +607,10 @@ def delay_matrix_separable(times: np.ndarray, tau: float, mesh_points: np.ndarra
     jb = np.clip(j0, 0, None)
     win = (at >= 0) & (jb < ja) & (ja < j1)
     if not np.any(win):
-        return delay_matrix(times, tau, pts, T, kernel, locate, basis, n, rows,  # type: ignore
+        return delay_matrix(times, tau, pts, T, kernel, locate, basis, n, rows,
                             pattern=pattern)[0]
     jb, ja = np.where(win, jb, j1), np.where(win, ja, j1)
-    G = delay_matrix(times, tau, pts, T, kernel, locate, basis, n, rows,  # type: ignore
+    G = delay_matrix(times, tau, pts, T, kernel, locate, basis, n, rows,
                      pattern=pattern, omit=(jb, ja))[0]
     return G + _far_part(times, ext, ends, jb, ja, win, (a + 1j * b, C - 1j * D), locate,
                          basis, n, rows, pattern, tau)
