@@ -58,6 +58,20 @@ def meshes(seed: int) -> tuple[np.ndarray, np.ndarray]:
     return past, now
 
 
+def products(build):
+    """build() with every window's far cells by the products (MIN_CELLS 0), checked taken."""
+    used = []
+    real, least = mesh._far_part, mesh.MIN_CELLS
+    try:
+        mesh._far_part = lambda *a, **k: used.append(1) or real(*a, **k)
+        mesh.MIN_CELLS = 0
+        out = build()
+    finally:
+        mesh._far_part, mesh.MIN_CELLS = real, least
+    assert used, "no far cells taken by the products"
+    return out
+
+
 def check(kernel, terms, tau: float, pattern: np.ndarray) -> None:
     past, now = meshes(1)
     P = math.ceil(tau / T)
@@ -71,16 +85,9 @@ def check(kernel, terms, tau: float, pattern: np.ndarray) -> None:
     # the memory's end t - tau inside a cell for every time (the cell cut by the truncation)
     ext, j0, _ = crossings(times, tau, pts[:-1], T)
     assert np.all((ext[j0 - 1] < times - tau) & (times - tau < ext[j0]))
-    used = []
-    real = mesh._far_part
     G0 = delay_matrix(times, tau, pts, T, kernel, loc, basis, 2, rows, pattern=pattern)[0]
-    try:
-        mesh._far_part = lambda *a, **k: used.append(1) or real(*a, **k)
-        G1 = mesh.delay_matrix_separable(times, tau, pts, T, kernel, terms, loc, basis, 2, rows,
-                                         pattern=pattern)
-    finally:
-        mesh._far_part = real
-    assert used, "no far cells taken by the products"
+    G1 = products(lambda: mesh.delay_matrix_separable(times, tau, pts, T, kernel, terms, loc,
+                                                      basis, 2, rows, pattern=pattern))
     A0, A1 = G0.toarray(), G1.toarray()
     scale = np.max(np.abs(A0))
     assert np.max(np.abs(A1 - A0)) < 1e-13 * scale
@@ -135,6 +142,7 @@ def test_folded_kernel(which: str, tau: float) -> None:
     gz = basis.gauss()[0]
     times = np.concatenate([(now[:-1, None] + np.diff(now)[:, None] * gz).ravel(), [0.0, 2.2]])
     G0 = delay_matrix(times, T, now, T, f.kernel, loc, basis, 2, L * M, pattern=pattern)[0]
-    G1 = mesh.folded_matrix(times, f, now, T, loc, basis, 2, L * M, pattern=pattern)
+    G1 = products(lambda: mesh.folded_matrix(times, f, now, T, loc, basis, 2, L * M,
+                                             pattern=pattern))
     A0, A1 = G0.toarray(), G1.toarray()
     assert np.max(np.abs(A1 - A0)) < 1e-13 * np.max(np.abs(A0))
