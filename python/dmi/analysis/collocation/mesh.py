@@ -730,10 +730,21 @@ def folded_matrix(times: np.ndarray, fold: Any, mesh_points: np.ndarray, T: floa
     (first, far), second = fold.sums
     H = fold.kernel
     pts = np.asarray(mesh_points, dtype=float)
+    times = np.asarray(times, dtype=float)
     cuts = tuple(j for j in fold.jumps if j != fold.r)
     whole = Kernel(far, H.near, cuts, H.rate)
-    if windows(np.asarray(times, dtype=float), T, pts, T, whole, first[0]) is None:
+    got = windows(times, T, pts, T, whole, first[0])
+    if got is None:
         return delay_matrix(times, T, pts, T, H, locate, basis, n, rows, pattern=pattern)[0]
+    near = H.near
+    if second is None or (near is not None and fold.r <= near.delta):   # H_T = whole past delta
+        return delay_matrix_separable(times, T, pts, T, whole, first, locate, basis, n, rows,
+                                      pattern=pattern)
+    ext, ends, jb, ja, win = got
+    if fold.r < np.min((times - ext[jb])[win]):       # r before every window's end
+        if pattern is None:
+            pattern = np.ones((n, n), bool)
+        return _folded_once(times, fold, pts, T, locate, basis, n, rows, pattern, got)
     G = delay_matrix_separable(times, T, pts, T, whole, first, locate, basis, n, rows,
                                pattern=pattern)
     near = H.near
@@ -743,3 +754,42 @@ def folded_matrix(times: np.ndarray, fold: Any, mesh_points: np.ndarray, T: floa
                                        Kernel(second[1], zero, cuts, H.rate), second[0],
                                        locate, basis, n, rows, pattern=pattern)
     return G
+
+
+def _folded_once(times: np.ndarray, fold: Any, pts: np.ndarray, T: float, locate: Locator,
+                 basis: Basis, n: int, rows: int, pattern: np.ndarray, got: tuple
+                 ) -> sp.csr_matrix:
+    """:func:`folded_matrix` with r before the end of every time's window (``got``, the first
+    sum's :func:`windows`): H_T's pieces outside the windows (its second sum where s < r with
+    them), the first sum's far cells, the second's far cells that end before t - r and its
+    piece of the cell cut by r."""
+    (first, _), (second, far2) = fold.sums
+    ext, ends, jb, ja, win = got
+    G = delay_matrix(times, T, pts, T, fold.kernel, locate, basis, n, rows, pattern=pattern,
+                     omit=(jb, ja))[0]
+    G = G + _far_part(times, ext, ends, jb, ja, win, _rates(first), locate, basis, n, rows,
+                      pattern, T)
+    # the second sum where the window passes r: its cells from t - r on, the cell cut by r
+    jr = np.searchsorted(ext, times - fold.r, side="right")
+    cut = win & (jr <= ja)
+    inner = cut & (jr < ja)
+    if np.any(inner):
+        G = G + _far_part(times, ext, ends, np.where(inner, jr, ja), ja, inner, _rates(second),
+                          locate, basis, n, rows, pattern, T)
+    if np.any(cut):
+        tc = times[cut]
+        _, j0, j1 = crossings(tc, fold.r, pts[:-1], T)
+        part = delay_matrix(tc, fold.r, pts, T, Kernel(far2), locate, basis, n, rows,
+                            pattern=pattern, omit=(j0, j1))[0]
+        which = np.flatnonzero(cut)
+        pick = sp.csr_matrix((np.ones(which.size * n), ((which[:, None] * n + np.arange(n))
+                                                         .ravel(), np.arange(which.size * n))),
+                             shape=(times.size * n, which.size * n))
+        G = G + pick @ part
+    return G
+
+
+def _rates(terms: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """(lambda = a + i b, F = C - i D) of an exponential sum (a, b, C, D)."""
+    a, b, C, D = (np.asarray(x, dtype=float) for x in terms)
+    return a + 1j * b, C - 1j * D

@@ -4,7 +4,8 @@
 # periods, the period's mesh moved off the past's): the fractional kernel's fit with near cells
 # (the fractional belt's), and an oscillating sum (complex rates) with a near part; the memory
 # ends inside a cell for every time.  The same for the periodic orbit's kernel folded onto one
-# period (collocation.fold), its memory's rest r beyond the near part, inside it, and 0.  The two rules differ by their quadrature errors
+# period (collocation.fold), its memory's rest r beyond the near part (inside the period, and
+# within a cell of its end), inside the near part, and 0.  The two rules differ by their quadrature errors
 # (Gauss-Legendre on pieces at least their own length from 0): agreement to 1e-13 of the
 # matrix's scale.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -126,6 +127,7 @@ def test_growing_term_is_left_to_the_direct_quadrature() -> None:
 
 
 @pytest.mark.parametrize("which, tau", [("fractional", 25.9), ("oscillating", 17.2),
+                                        ("fractional", 4 * T - 0.01),
                                         ("oscillating", 3 * T + 0.004), ("oscillating", 3 * T)])
 def test_folded_kernel(which: str, tau: float) -> None:
     if which == "fractional":
@@ -135,7 +137,7 @@ def test_folded_kernel(which: str, tau: float) -> None:
         (H, sums), pattern = oscillating(), np.ones((2, 2), bool)
     f = fold_of(H, sums, tau, T)
     assert f is not None
-    assert (f.r > 0.01) == (tau in (25.9, 17.2))
+    assert (f.r > 0.01) == (tau in (25.9, 17.2, 4 * T - 0.01))
     now = meshes(4)[1]
     basis = Basis(M, Q)
     loc = periodic_locator(now, M)
