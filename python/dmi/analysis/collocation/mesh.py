@@ -672,13 +672,27 @@ def _far_part(times: np.ndarray, ext: np.ndarray, ends: np.ndarray, jb: np.ndarr
         Mo = np.einsum("kcr,crj->kcj", np.exp(lam[:, None, None] * (refs[beta] - sig[None, lo:hi])),
                        B[lo:hi])                                        # (K, cells, m + 1)
         early = cells[None, lo:hi] < jb[use][:, None]                   # before t - tau
-        hit, part = _scatter(node[lo:hi])
-        where = np.ix_(use, hit)
+        # cells of one interval of u summed, then a run of whole intervals, each
+        # its own m + 1 rows (the history's past) in one slice, else by the scatter matrix
+        starts = np.flatnonzero(np.r_[True, np.any(np.diff(node[lo:hi], axis=0) != 0, axis=1)])
+        own = node[lo:hi][starts].ravel()
+        run = bool(np.all(np.diff(own) == 1))
+        extra = np.setdiff1d(np.arange(hi - lo), starts)                # a split interval's rest
+        group = np.searchsorted(starts, extra, side="right") - 1
+        hit, part = (None, None) if run else _scatter(node[lo:hi])
+        keep = ~early.T[:, None, :]                                       # (cells, 1, times)
         for e in range(ia.size):
             Y = (F[:, ia[e], ib[e]][:, None, None] * Mo).reshape(lam.size, -1)
-            V = (Er @ np.concatenate([Y.real, Y.imag])).reshape(use.size, hi - lo, m1)
-            V[early] = 0.0
-            out[e][where] += V.reshape(use.size, -1) @ part
+            # (cells, m + 1, times): the transpose, its cells' rows contiguous for reduceat
+            V = (np.concatenate([Y.real, Y.imag]).T @ Er.T).reshape(hi - lo, m1, use.size)
+            V *= keep
+            if run:
+                W = V[starts]
+                if extra.size:
+                    np.add.at(W, group, V[extra])
+                out[e][use, own[0]:own[-1] + 1] += W.reshape(-1, use.size).T
+            else:
+                out[e][np.ix_(use, hit)] += (part.T @ V.reshape(-1, use.size)).T
     r, c, v = [], [], []
     for e in range(ia.size):
         i, j = np.nonzero(out[e])
