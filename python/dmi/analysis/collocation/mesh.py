@@ -521,20 +521,20 @@ def point_matrix(times: np.ndarray, locate: Locator, basis: Basis, mesh: np.ndar
 #     M_j,k = int_l^(l + d) e^(lambda_j (c - sigma)) B_k(sigma) d sigma,
 #
 # for any reference c: with c at or after the cell's end and at or before t_c both factors are
-# at most 1 in modulus.  The cells are grouped in *blocks*: those that end at or before
-# min(t) - s0 (every time's memory, the past) in one, then BLOCK_CELLS cells at a time, each block
-# its end as reference.  A time takes every block that ends at or before t_c - s0 (its *window*,
-# the cells that start at or after t_c - tau), each by one product of its (times x terms) factors
-# with the block's (terms x columns) moments; the rest of [0, tau] (the near lags, the last block
-# not yet ended, the cell cut by tau) keeps delay_matrix's pieces (``omit``).  M is integrated by
+# at most 1 in modulus.  The cells are grouped in *blocks*: those far for every time (the past)
+# in one, then BLOCK_CELLS cells at a time, each block its end as reference.  A time takes every
+# block whose cells are all far for it (its *window*, the cells that start at or after
+# t_c - tau), each by one product of its (times x terms) factors with the block's (terms x
+# columns) moments; the rest of [0, tau] (the near lags, the last block not yet far, the cell cut
+# by tau) keeps delay_matrix's pieces (``omit``).  M is integrated by
 # Q_NEAR Gauss-Legendre nodes on the whole cell, where delay_matrix cuts it at the grading (at most
 # once: the cuts double) and takes q or Q_NEAR nodes: the two differ by their quadrature errors.
 # Twice its length from 0 (not once, the graded pieces' rule): a steep term e^(-r s) on the cell
 # [a, a + d], a >= 2 d, keeps the rule's error bound below 4e-22 of its integral 1 / r for every
 # r d (at a = d it reaches 1.1e-14, at r d = 25).
 
-#: Cells a block of the period (after the past's block) takes: the direct pieces of a time end
-#: at most that many cells (and s0) behind it.
+#: Cells a block of the period (after the past's block) takes: a time's direct pieces reach at
+#: most that many cells past its near ones.
 BLOCK_CELLS = 4
 #: The far cells a time must take on average for the products to pay (fewer: delay_matrix's own
 #: pieces; measured on the fractional belt's orbits of 16 and 94 intervals).
@@ -543,14 +543,13 @@ MIN_CELLS = 24
 SCATTER_DENSE = 64
 
 
-def far_lag(kernel: Kernel, pts: np.ndarray) -> float:
-    """s0: the lag from which a cell is integrated by the separated factors, past the near part
-    (and its graded cuts' start), the kernel's jumps and twice the longest cell of the mesh
-    ``pts`` (one period, 0 to T)."""
-    near = getattr(kernel, "near", None)
-    jumps = getattr(kernel, "jumps", ())
-    s0 = max([2.0 * float(np.max(np.diff(pts))), getattr(kernel, "grading", 0.0),
-              near.delta if near is not None else 0.0] + [float(j) for j in jumps])
+def far_lag(kernel: Kernel) -> float:
+    """The lag past which a cell may be integrated by the separated factors: past the near part
+    (and its graded cuts' start) and the kernel's jumps (each cell also twice its own length
+    from 0: :func:`windows`)."""
+    near = kernel.near
+    s0 = max([kernel.grading, near.delta if near is not None else 0.0]
+             + [float(j) for j in kernel.jumps])
     return s0 * (1.0 + 1e-9)
 
 
@@ -615,12 +614,16 @@ def windows(times: np.ndarray, tau: float, pts: np.ndarray, T: float, kernel: Ke
     None where they would not pay (fewer than MIN_CELLS a time) or a_j > 0."""
     if times.size == 0 or np.any(a > 0):
         return None
-    s0 = far_lag(kernel, pts)
+    s0 = far_lag(kernel)
     ext, j0, j1 = crossings(times, tau, pts[:-1], T)
-    ends = _block_ends(ext, times, s0)
+    # a block end e serves the times t with t - ext[e] >= s0 and every cell before it at least
+    # twice its length from t: t >= ready[e - 1] (both monotone in e)
+    ready = np.maximum.accumulate(ext[1:] + 2.0 * (1.0 + 1e-9) * np.diff(ext))
+    ends = _block_ends(ext, ready, times, s0)
     # each time's window: the cells from its first crossing past t - tau to the last block end
-    # at or before t - s0
-    at = np.searchsorted(ext[ends], times - s0, side="right") - 1
+    # that serves it
+    at = np.minimum(np.searchsorted(ext[ends], times - s0, side="right"),
+                    np.searchsorted(ready[ends - 1], times, side="right")) - 1
     ja = np.where(at >= 0, ends[np.maximum(at, 0)], -1)
     jb = np.clip(j0, 0, None)
     win = (at >= 0) & (jb < ja) & (ja < j1)
@@ -629,11 +632,14 @@ def windows(times: np.ndarray, tau: float, pts: np.ndarray, T: float, kernel: Ke
     return ext, ends, np.where(win, jb, j1), np.where(win, ja, j1), win
 
 
-def _block_ends(ext: np.ndarray, times: np.ndarray, s0: float) -> np.ndarray:
-    """The indices into ext of the blocks' ends (their references): the last crossing at or
-    before min(t) - s0, then every BLOCK_CELLS-th up to max(t) - s0."""
-    first = int(np.searchsorted(ext, times.min() - s0, side="right")) - 1
-    last = int(np.searchsorted(ext, times.max() - s0, side="right")) - 1
+def _block_ends(ext: np.ndarray, ready: np.ndarray, times: np.ndarray, s0: float
+                ) -> np.ndarray:
+    """The indices into ext of the blocks' ends (their references): the last that serves
+    min(t) (:func:`windows`), then every BLOCK_CELLS-th up to the last that serves max(t)."""
+    def last_for(t: float) -> int:
+        return min(int(np.searchsorted(ext, t - s0, side="right")),
+                   int(np.searchsorted(ready, t, side="right")) + 1) - 1
+    first, last = last_for(float(times.min())), last_for(float(times.max()))
     if first < 1:
         return np.empty(0, int)
     return np.arange(first, last + 1, BLOCK_CELLS)
