@@ -32,7 +32,7 @@ import scipy.sparse.linalg as sla
 
 from .krylov import DENSE_MAX, Monodromy, leading, nearest
 from .mesh import Basis, Locator, delay_matrix_separable
-from .system import History, Layout, Terms, assemble
+from .system import DELAY_CACHE, History, Layout, Terms, assemble
 from ..core.blas import _one_blas_thread
 
 #: The switching times' columns of the period's Jacobian from a fixed past: central differences at
@@ -77,10 +77,21 @@ class FixedPast:
                                      periodic=periodic)
         more = np.empty(0) if extra is None else np.asarray(extra, dtype=float)
         t = self._terms
-        G = delay_matrix_separable(np.concatenate([times, more]), t.tau, mesh, T, t.H, t.terms,
-                                   loc, basis, t.n, rows, pattern=t.pattern)
-        cut = len(times) * t.n
-        return (G, None) if not more.size else (G[:cut], G[cut:])
+        # kept with Terms.delay's matrices (its memo, their own key), as they were before
+        key = ("separable", mesh.tobytes(), float(T), basis.m, basis.q, rows,
+               history.hist.tobytes(), history.periods, more.tobytes())
+        got = t._delays.get(key)
+        if got is None:
+            G = delay_matrix_separable(np.concatenate([times, more]), t.tau, mesh, T, t.H,
+                                       t.terms, loc, basis, t.n, rows, pattern=t.pattern)
+            cut = len(times) * t.n
+            got = (G, None) if not more.size else (G[:cut], G[cut:])
+            t._delays[key] = got
+            if len(t._delays) > DELAY_CACHE:
+                t._delays.popitem(last=False)
+        else:
+            t._delays.move_to_end(key)
+        return got
 
 
 def period_jacobian(lay: Layout, terms: Terms, x: np.ndarray, history: History
