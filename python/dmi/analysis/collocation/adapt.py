@@ -323,18 +323,18 @@ def level_error(c: Solved, f: Solved) -> tuple[float, float, float | None]:
     return d, two, (math.log2(d1 / d2) if steady else None)
 
 
-def accepted(m: int, autonomous: bool, settled: bool = False) -> float:
+def accepted(m: int, autonomous: bool, asymptotic: bool = False) -> float:
     """How far above tol the two levels' difference of a round whose three levels were not
     steady may be aimed at: for the period (an autonomous orbit), what the next round's
     levels, steady, accept: Richardson's SAFETY d2 / (2^q - 1) <= tol, q capped at m + 2, the
-    least order seen on delay equations (the delayed values are not superconvergent), or
-    (``settled``: the round's coarsest level within ROUGH of the middle one, the levels in
-    the asymptotic range but for a sign) at 2 m, the period's superconvergent order; 1 for
-    the amplitudes (a forced orbit), whose levels are seldom steady (an extremum inside an
-    interval: h^(m+1) with a constant that moves with the mesh)."""
+    least order seen on delay equations (the delayed values are not superconvergent), or at
+    q = 2 m, the period's superconvergent order, where the round's levels are ``asymptotic``
+    (the coarsest within ROUGH of the middle one, :func:`settled`: in the asymptotic range,
+    unsteady by a sign); 1 for the amplitudes (a forced orbit), whose levels are seldom steady
+    (an extremum inside an interval: h^(m+1) with a constant that moves with the mesh)."""
     if not autonomous:
         return 1.0
-    return max(1.0, (2.0 ** (2 * m if settled else m + 2) - 1.0) / SAFETY)
+    return max(1.0, (2.0 ** (2 * m if asymptotic else m + 2) - 1.0) / SAFETY)
 
 
 def settled(c: Solved) -> bool:
