@@ -417,15 +417,19 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
                 raise ValueError(f"collocate: {reached}; {why}, tol = {tol!r} needs about "
                                  f"{need:.2g} intervals, more than MAX_INTERVALS = "
                                  f"{MAX_INTERVALS}: {fix}")
-        # the next mesh's aim: where these levels were not steady (the first time), a
-        # difference the next round's Richardson estimate accepts (in the asymptotic range,
-        # at the period's order 2 m, without margin), else tol itself
-        first = seen is None and not unsteady
-        near = first and autonomous and settled(c)
-        aim = tol * accepted(lay.m, autonomous, near) if first else tol
+        # the next mesh's aim: after a first round in the asymptotic range (steady or not),
+        # its two levels' difference at what a steady round of the period's order 2 m
+        # accepts, without margin; where these levels were not steady (the first time), a
+        # difference the next round's Richardson estimate accepts; else tol itself
+        if last is None and autonomous and settled(c):
+            L2 = next_intervals(L, two, tol * accepted(lay.m, True, True), expected, None,
+                                None, lay.m, 1.0)
+        else:
+            aim = tol if seen is not None or unsteady else tol * accepted(lay.m, autonomous)
+            L2 = next_intervals(L, d, aim, expected, seen, q, lay.m, 1.2)
         unsteady = seen is None
         last = (L, two)
-        L = next_intervals(L, d, aim, expected, seen, q, lay.m, 1.0 if near else 1.2)
+        L = L2
         lay, x = f.lay, f.x
         if f.lay.L >= MAX_INTERVALS:
             break
