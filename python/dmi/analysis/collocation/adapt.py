@@ -330,8 +330,9 @@ def accepted(m: int, autonomous: bool, asymptotic: bool = False) -> float:
     least order seen on delay equations (the delayed values are not superconvergent), or at
     q = 2 m, the period's superconvergent order, where the round's levels are ``asymptotic``
     (the coarsest within ROUGH of the middle one, :func:`settled`: in the asymptotic range,
-    unsteady by a sign); 1 for the amplitudes (a forced orbit), whose levels are seldom steady
-    (an extremum inside an interval: h^(m+1) with a constant that moves with the mesh)."""
+    steady or unsteady by a sign); 1 for the amplitudes (a forced orbit), whose levels are
+    seldom steady (an extremum inside an interval: h^(m+1) with a constant that moves with
+    the mesh)."""
     if not autonomous:
         return 1.0
     return max(1.0, (2.0 ** (2 * m if asymptotic else m + 2) - 1.0) / SAFETY)
@@ -419,9 +420,10 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
                                  f"{MAX_INTERVALS}: {fix}")
         # the next mesh's aim: after a first round in the asymptotic range (steady or not),
         # its two levels' difference at what a steady round of the period's order 2 m
-        # accepts, without margin; where these levels were not steady (the first time), a
-        # difference the next round's Richardson estimate accepts; else tol itself
-        if last is None and autonomous and settled(c):
+        # accepts, without margin (not with an undeclared jump of the kernel: order 1);
+        # where these levels were not steady (the first time), a difference the next
+        # round's Richardson estimate accepts; else tol itself
+        if last is None and autonomous and not capped and settled(c):
             L2 = next_intervals(L, two, tol * accepted(lay.m, True, True), expected, None,
                                 None, lay.m, 1.0)
         else:
