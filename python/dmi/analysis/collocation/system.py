@@ -33,7 +33,8 @@ from ..._solver import Solver
 from ..core.model import FD_STEP, ManyRhs
 from .fold import Fold, exp_sum, fold_of, folding
 from .mesh import (STEEP, Basis, Kernel, Locator, Near, _monomials, delay_matrix,
-                               history_locator, history_rows, periodic_locator, point_matrix)
+                               history_locator, history_rows, interval_of, periodic_locator,
+                               point_matrix)
 from .signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
 from ..core.newton import Converge, NewtonOptions, Search, ShootingError, newton_loop
 
@@ -48,6 +49,10 @@ FLOOR_ITERATIONS = 3
 #: orbit without switches) builds its matrix once, and the monodromy operator's once for its
 #: multipliers and eigenfunction.
 DELAY_CACHE = 6
+#: The step of f's t derivative in the switching times' columns of a forced orbit (five-point
+#: differences), relative to the period: truncation and rounding both near 1e-13 relative for a
+#: forcing of the orbit's own frequency.
+FT_STEP = 2e-4
 
 
 class CollocationWarning(RuntimeWarning):
@@ -110,14 +115,16 @@ class Terms:
         return self._folds[1]
 
     def periodic_delay(self, times: np.ndarray, mesh: np.ndarray, T: float, basis: Basis,
-                       rows: int, slope_of: np.ndarray | None = None
-                       ) -> tuple[sp.csr_matrix, np.ndarray | None]:
+                       rows: int, slope_of: np.ndarray | None = None,
+                       loc: Locator | None = None) -> tuple[sp.csr_matrix, np.ndarray | None]:
         """delay_matrix's (G, T derivative) at ``times`` on the periodic orbit of ``mesh``
-        (period T, ``rows`` node rows, ``slope_of`` its node values for the T derivative): when
-        the kernel folds (:meth:`folded`), the folded kernel H_T over [0, T] (near part
-        included), its later periods' tail over [0, delta] with a near part, and with
-        ``slope_of`` the moment's period derivative; else over the whole memory."""
-        loc = periodic_locator(mesh, basis.m)
+        (period T, ``rows`` node rows, ``slope_of`` its node values for the T derivative; ``loc``
+        a periodic locator of other node rows, default the continuous one): when the kernel
+        folds (:meth:`folded`), the folded kernel H_T over [0, T] (near part included), its later
+        periods' tail over [0, delta] with a near part, and with ``slope_of`` the moment's period
+        derivative; else over the whole memory."""
+        if loc is None:
+            loc = periodic_locator(mesh, basis.m)
         f = self.folded(T)
         if f is None:
             return delay_matrix(times, self.tau, mesh, T, self.H, loc, basis, self.n, rows,
@@ -749,17 +756,167 @@ def _switch_conditions(lay: Layout, terms: Terms, b: np.ndarray, mesh: np.ndarra
     return g, sp.vstack(out, format="csr")
 
 
+def broken_locator(mesh: np.ndarray, m: int, history: History | None = None
+                   ) -> tuple[Locator, int]:
+    """The locator of a discontinuous piecewise polynomial on ``mesh`` (each interval its own
+    m + 1 node rows, L (m + 1) of them), periodic, or with ``history``'s past behind t = 0 (its
+    rows after, as :func:`history_locator` has them), and its node rows."""
+    L = mesh.size - 1
+    k = np.arange(m + 1)
+    if history is None:
+        T = float(mesh[-1])
+
+        def periodic(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            i, z = interval_of(mesh, np.mod(t, T))
+            return i, z, i[:, None] * (m + 1) + k[None, :]
+        return periodic, L * (m + 1)
+    inner = history_locator(mesh, history.hist, m, history.periods)
+    shift = L * (m + 1) - (L * m + 1)
+
+    def forward(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        i, z, cols = inner(t)
+        front = np.asarray(t, dtype=float) >= 0
+        cols = np.where(front[:, None], i[:, None] * (m + 1) + k[None, :], cols + shift)
+        return i, z, cols
+    return forward, L * (m + 1) + history.periods * L * (m + 1)
+
+
+def f_t(terms: Terms, t: np.ndarray, U: np.ndarray, T: float) -> np.ndarray:
+    """df/dt (len(t), n) at (t, U): five-point central differences of step FT_STEP T (one call
+    of the model for the four shifts)."""
+    e = FT_STEP * T
+    P = len(t)
+    F = terms.f_anew(np.concatenate([t + e, t - e, t + 2 * e, t - 2 * e]),
+                     np.tile(U, (4, 1))).reshape(4, P, -1)
+    return (8.0 * (F[0] - F[1]) - (F[2] - F[3])) / (12.0 * e)
+
+
+def mesh_motion(lay: Layout, b: np.ndarray, T: float) -> np.ndarray:
+    """(S, L, m + 1): each interval node's motion with each switching time (its piece's ends
+    that move with b_j: b_j itself and the points the memory carries it to)."""
+    left, right = lay.node_motion()
+    piece = lay.piece_of_interval()
+    who = lay.ends(b, T)[1]
+    j = np.arange(lay.S)[:, None, None]
+    return (left[None] * (who[piece][None, :, None] == j)
+            + right[None] * (who[piece + 1][None, :, None] == j))
+
+
+def switch_columns(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None,
+                   history: History | None = None) -> np.ndarray:
+    """The residual's columns of the switching times (residual size, S), exact but for f's t
+    derivative (:func:`f_t`, a forced orbit) and the phase condition's (differences).
+
+    A switching time moves the mesh of the pieces it bounds, the nodes keeping their values:
+    at a fixed time the orbit changes by -nu u' (nu the time's motion, piecewise linear) and a
+    collocation time t_c by nu(t_c); so the collocation row's u' scales by -nu'(t_c), f moves
+    with t_c, and the delay integral by int_0^tau H(s) (nu(t_c) - nu(t_c - s)) u'(t_c - s) ds
+    (the delay matrix of the discontinuous node values of u' and nu u', exact in the basis; a
+    history's past does not move).  The stick endings' net force likewise at b_k."""
+    m, n, L, S = lay.m, lay.n, lay.L, lay.S
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    h = np.diff(mesh)
+    basis = lay.basis
+    gz = basis.gauss()[0]
+    one = V[(np.arange(L)[:, None] * m + np.arange(m + 1)[None, :]) % lay.rows]  # (L, m + 1, n)
+    slope = np.einsum("ij,ljn->lin", basis.derivatives(basis.nodes), one) / h[:, None, None]
+    nu = mesh_motion(lay, b, T)                                        # (S, L, m + 1)
+    ic = np.repeat(np.arange(L), m)
+    zc = np.tile(gz, L)
+    nu_c = nu[:, ic, 0] + zc * (nu[:, ic, m] - nu[:, ic, 0])          # (S, P)
+    force = force_switches(lay)
+    times = np.concatenate([(mesh[:-1, None] + h[:, None] * gz[None, :]).ravel(), b[force]])
+    P = L * m
+    Uc = np.einsum("gk,lkn->lgn", basis.values(gz), one).reshape(P, n)
+    du = np.einsum("gk,lkn->lgn", basis.derivatives(gz), one).reshape(P, n) / h[ic, None]
+    dW = _moved_delay(lay, terms, times, mesh, T, slope, nu, history)   # (S, len(times), n)
+    cols = np.zeros((S, P * n + (n if history is not None else 0) + S
+                     + int(lay.autonomous and history is None and ref is not None)))
+    rate = nu[:, ic, m] - nu[:, ic, 0]                                 # (S, P): h's motion
+    dr = -(rate / h[ic])[:, :, None] * du[None] + dW[:, :P]
+    ub = None
+    if not lay.autonomous:
+        dr += nu_c[:, :, None] * f_t(terms, times[:P], Uc, T)[None]
+    mode = np.repeat(np.array(lay.piece_modes(b, T))[lay.piece_of_interval()], m, axis=0)
+    dr[:, _held(mode, terms)[0]] = 0.0
+    cols[:, :P * n] = dr.reshape(S, -1)
+    first = P * n + (n if history is not None else 0)
+    for q, k in enumerate(force):
+        i = lay.signature.switch(k + 1)[0]
+        cols[:, first + k] = -dW[:, P + q, i]
+        if not lay.autonomous:
+            if ub is None:
+                ub = evaluate(lay, x, b[force])
+            cols[k, first + k] -= f_t(terms, b[k:k + 1], ub[q:q + 1], T)[0, i]
+    if cols.shape[1] > first + S:
+        cols[:, -1] = _phase_columns(lay, b, T, Uc, ref)
+    return cols.T
+
+
+def _moved_delay(lay: Layout, terms: Terms, times: np.ndarray, mesh: np.ndarray, T: float,
+                 slope: np.ndarray, nu: np.ndarray, history: History | None) -> np.ndarray:
+    """(S, len(times), n): the delay integral's change at ``times`` (the collocation times,
+    then switching times b_k, whose own motion is 1 with b_k) along each switching time's
+    motion nu (:func:`switch_columns`)."""
+    m, n, L, S = lay.m, lay.n, lay.L, lay.S
+    out = np.zeros((S, times.size, n))
+    if not terms.has_kernel:
+        return out
+    loc, rows = broken_locator(mesh, m, history)
+    if history is None:
+        G = terms.periodic_delay(times, mesh, T, lay.basis, rows, loc=loc)[0]
+        past = np.empty((0, n))
+    else:
+        G = delay_matrix(times, terms.tau, mesh, T, terms.H, loc, lay.basis, n, rows,
+                         pattern=terms.pattern)[0]
+        dz = lay.basis.derivatives(lay.basis.nodes)
+        hh = np.tile(np.diff(history.hist), history.periods)
+        ph = history.phi.reshape(-1, m + 1, n)
+        past = (np.einsum("ij,ljn->lin", dz, ph) / hh[:, None, None]).reshape(-1, n)
+    cur = slope.reshape(-1, n)
+    vec = np.column_stack([np.concatenate([cur, past]).ravel()]
+                          + [np.concatenate([(nu[j].reshape(-1)[:, None] * cur),
+                                             np.zeros_like(past)]).ravel() for j in range(S)])
+    W = (G @ vec).reshape(times.size, n, S + 1)
+    i, z, _ = loc(times)
+    nu_t = nu[:, i, 0] + z * (nu[:, i, m] - nu[:, i, 0])              # (S, len(times))
+    force = np.asarray(force_switches(lay), dtype=int)
+    nu_t[:, L * m:] = np.arange(S)[:, None] == force[None, :]       # b_k moves with itself
+    for j in range(S):
+        out[j] = nu_t[j][:, None] * W[:, :, 0] - W[:, :, j + 1]
+    return out
+
+
+def _phase_columns(lay: Layout, b: np.ndarray, T: float, Uc: np.ndarray, ref: Callable
+                   ) -> np.ndarray:
+    """(S,): the phase condition's derivatives in the switching times (its weights and
+    reference move with the mesh, u at the collocation points does not), central differences
+    of step 1e-6 T."""
+    gz, gw = lay.basis.gauss()
+
+    def phase(moved: np.ndarray) -> float:
+        mesh = lay.mesh(moved, T)
+        h = np.diff(mesh)
+        tc = (mesh[:-1, None] + h[:, None] * gz[None, :]).ravel()
+        w = (h[:, None] * gw[None, :]).ravel() / T
+        return float(np.sum(w[:, None] * ref(tc / T) * Uc))
+    d = 1e-6 * T
+    step = d * np.eye(lay.S)
+    return np.array([(phase(b + e) - phase(b - e)) / (2 * d) for e in step])
+
+
 def full_jacobian(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None,
                   history: History | None = None) -> tuple[np.ndarray, sp.csc_matrix]:
-    """The residual and the whole Jacobian: the node columns of :func:`assemble`, then the
-    columns of the b's and T by central differences of the residual (step 1e-6 T)."""
+    """The residual and the whole Jacobian: the node columns of :func:`assemble`, the
+    switching times' (:func:`switch_columns`), then T's (exact for a smooth autonomous orbit,
+    else central differences of the residual, step 1e-6 T)."""
     r, J, dT = assemble(lay, terms, x, ref, history=history)
-    extra = lay.S + int(lay.autonomous and history is None)
-    cols = []
-    first = lay.rows * lay.n
+    cols = [] if not lay.S else list(switch_columns(lay, terms, x, ref, history).T)
+    first = lay.rows * lay.n + lay.S
     T = lay.split(x)[2]
-    for j in range(first, first + extra):
-        if dT is not None and j == first + extra - 1:
+    for j in range(first, first + int(lay.autonomous and history is None)):
+        if dT is not None:
             cols.append(dT)
             continue
         d = 1e-6 * T
