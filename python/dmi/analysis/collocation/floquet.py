@@ -16,9 +16,8 @@ fixed time is the node value's minus u*' (one-sided, inside the node's interval)
 motion.  That is the saltation of Barton (2008) in the collocation's terms: linearising the
 switching condition with the switching time as an unknown gives it (a stuck piece's component
 is held, so its perturbation is wiped out: the zero multipliers it should give).  The system's
-columns of the switching times are differences of its residual with the past held at fixed times
-(:func:`period_jacobian`): the delay integral cut at the past's own mesh as well as the moved
-period's, Richardson on two steps scaled to the shortest piece.
+columns of the switching times are exact, the past held at fixed times (:func:`period_jacobian`,
+:func:`dmi.analysis.collocation.system.switch_columns`).
 """
 from __future__ import annotations
 
