@@ -16,9 +16,8 @@ fixed time is the node value's minus u*' (one-sided, inside the node's interval)
 motion.  That is the saltation of Barton (2008) in the collocation's terms: linearising the
 switching condition with the switching time as an unknown gives it (a stuck piece's component
 is held, so its perturbation is wiped out: the zero multipliers it should give).  The system's
-columns of the switching times are differences of its residual with the past held at fixed times
-(:func:`period_jacobian`): the delay integral cut at the past's own mesh as well as the moved
-period's, Richardson on two steps scaled to the shortest piece.
+columns of the switching times are exact, the past held at fixed times (:func:`period_jacobian`,
+:func:`dmi.analysis.collocation.system.switch_columns`).
 """
 from __future__ import annotations
 
@@ -32,7 +31,7 @@ import scipy.sparse.linalg as sla
 
 from .krylov import DENSE_MAX, Monodromy, leading, nearest
 from .mesh import Basis, Locator
-from .system import History, Layout, Terms, assemble
+from .system import History, Layout, Terms, assemble, switch_columns
 from ..core.blas import _one_blas_thread
 
 #: The switching times' columns of the period's Jacobian from a fixed past: central differences at
@@ -74,25 +73,12 @@ class FixedPast:
 def period_jacobian(lay: Layout, terms: Terms, x: np.ndarray, history: History
                     ) -> sp.csc_matrix:
     """The Jacobian of the period's system from the fixed past ``history`` at x: the node
-    columns of :func:`dmi.analysis.collocation.system.assemble`, then the switching times' by
-    Richardson on central differences (see :data:`STEP`), the delay integral cut at the past's
-    mesh too (:class:`FixedPast`)."""
-    fixed = FixedPast(terms)
-    _, J, _ = assemble(lay, fixed, x, None, history=history)   # type: ignore[arg-type]
-    V, b, T = lay.split(x)
-    d = STEP * min(T, float(np.min(np.diff(lay.bounds(b, T)))))
-    first = lay.rows * lay.n
-
-    def central(j: int, step: float) -> np.ndarray:
-        xp, xm = x.copy(), x.copy()
-        xp[j] += step
-        xm[j] -= step
-        rp = assemble(lay, fixed, xp, None, jacobian=False, history=history)[0]  # type: ignore
-        rm = assemble(lay, fixed, xm, None, jacobian=False, history=history)[0]  # type: ignore
-        return (rp - rm) / (2 * step)
-    cols = [(4 * central(j, d / 2) - central(j, d)) / 3 for j in range(first, first + lay.S)]
-    if cols:
-        J = sp.hstack([J, sp.csr_matrix(np.column_stack(cols))])
+    columns of :func:`dmi.analysis.collocation.system.assemble`, then the switching times'
+    (:func:`dmi.analysis.collocation.system.switch_columns`, exact: the past held at fixed
+    times)."""
+    _, J, _ = assemble(lay, terms, x, None, history=history)
+    if lay.S:
+        J = sp.hstack([J, sp.csr_matrix(switch_columns(lay, terms, x, None, history))])
     return sp.csc_matrix(J)
 
 
