@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from .mesh import _monomials
 from .system import Layout, Terms, evaluate, interval_counts, node_times, reference, solve
 from ..core.newton import ShootingError
 
@@ -157,7 +158,7 @@ def extrema(lay: Layout, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     m, n = lay.m, lay.n
     V = lay.split(x)[0]
     k = np.arange(m + 1)
-    y = 2 * lay.basis.nodes - 1
+    C = _monomials(m)                     # the interval's polynomial in y = 2 z - 1 from its nodes
     hi, lo = V.max(axis=0).copy(), V.min(axis=0).copy()
     for i in range(n):
         for sign, best in ((1.0, hi), (-1.0, lo)):
@@ -165,7 +166,7 @@ def extrema(lay: Layout, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             iv = node // m
             for j in {(iv - 1) % lay.L, iv, (iv + 1) % lay.L}:
                 vals = V[(j * m + k) % lay.rows, i]
-                c = np.polynomial.polynomial.polyfit(y, vals, m)
+                c = C @ vals
                 r = np.polynomial.polynomial.polyroots(np.polynomial.polynomial.polyder(c))
                 r = r.real[(np.abs(r.imag) < 1e-9) & (np.abs(r.real) <= 1)]
                 if r.size:
