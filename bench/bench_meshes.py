@@ -8,8 +8,8 @@
 # (Richardson's where the levels are steady) over it; the Newton iterations and CPU time of each
 # level: the orbit on the mesh, the halved mesh from its solution (transfer) and from the start,
 # the merged mesh.  Then the refinement to several tol (eps = 1, degree 4; eps = 10, degree 6): its
-# counted (coarser) mesh against the smallest sufficient one of a scan of intervals = L, its true
-# error and estimate; and (not --small) the estimate by degree elevation on one mesh: the orbit of
+# counted (coarser) mesh against the smallest sufficient one of a scan of intervals = L and their
+# ratio, its true error and estimate; and (not --small) the estimate by degree elevation on one mesh: the orbit of
 # degree 6 against 7 and 8 on the same mesh, re-equidistributed 1 to 3 times, and the halved mesh.
 # Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_meshes.py [--small]
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -111,7 +111,7 @@ def main() -> None:
     if a.small:
         refinements(o2, ref2, 6, (1e-8,), (44, 48, 56))
         return
-    refinements(o1, ref1, 4, (1e-8, 1e-10), (16, 20, 24, 28, 32, 36))
+    refinements(o1, ref1, 4, (1e-8, 1e-10), (12, 14, 16, 18, 20, 22, 24, 28, 32, 36))
     refinements(o2, ref2, 6, (1e-7, 1e-8, 1e-9), (40, 44, 48, 50, 52, 56, 60))
     print("same mesh, degree 6 against 7 and 8 (errors of the period; the mesh "
           "equidistributed k times at L intervals): 6 | 7 | 8 | |x6 - x8| / |err 6| | 6 on 2L")
@@ -131,10 +131,11 @@ def refinements(o, ref, m: int, tols: tuple, scan: tuple) -> None:
         true = abs(e.period - ref.period)
         enough = next((L for L in scan if abs(runs[L].period - ref.period) <= tol), None)
         shown = next((L for L in scan if runs[L].errors["period"] <= tol), None)
+        ratio = f"{e.intervals / 2 / enough:.3g}" if enough else "-"
         print(f"degree {m}, tol = {tol:g}: {e.intervals // 2} counted ({e.intervals} returned); "
               f"true {true:.2e}, estimate {e.errors['period']:.2e} ({e.errors['period'] / true:.3g}"
               f" x); CPU {cpu:.2f} s; smallest sufficient L {enough}, with its estimate within "
-              f"tol {shown}", flush=True)
+              f"tol {shown}; counted / sufficient {ratio}", flush=True)
 
 
 def degree_rows(o, ref, L: int, m: int) -> None:

@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from .mesh import _monomials
 from .system import Layout, Terms, evaluate, interval_counts, node_times, reference, solve
 from ..core.newton import ShootingError
 
@@ -157,7 +158,7 @@ def extrema(lay: Layout, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     m, n = lay.m, lay.n
     V = lay.split(x)[0]
     k = np.arange(m + 1)
-    y = 2 * lay.basis.nodes - 1
+    C = _monomials(m)                     # the interval's polynomial in y = 2 z - 1 from its nodes
     hi, lo = V.max(axis=0).copy(), V.min(axis=0).copy()
     for i in range(n):
         for sign, best in ((1.0, hi), (-1.0, lo)):
@@ -165,7 +166,7 @@ def extrema(lay: Layout, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             iv = node // m
             for j in {(iv - 1) % lay.L, iv, (iv + 1) % lay.L}:
                 vals = V[(j * m + k) % lay.rows, i]
-                c = np.polynomial.polynomial.polyfit(y, vals, m)
+                c = C @ vals
                 r = np.polynomial.polynomial.polyroots(np.polynomial.polynomial.polyder(c))
                 r = r.real[(np.abs(r.imag) < 1e-9) & (np.abs(r.real) <= 1)]
                 if r.size:
@@ -323,14 +324,39 @@ def level_error(c: Solved, f: Solved) -> tuple[float, float, float | None]:
     return d, two, (math.log2(d1 / d2) if steady else None)
 
 
-def accepted(m: int, autonomous: bool) -> float:
+def accepted(m: int, autonomous: bool, asymptotic: bool = False) -> float:
     """How far above tol the two levels' difference of a round whose three levels were not
     steady may be aimed at: for the period (an autonomous orbit), what the next round's
     levels, steady, accept: Richardson's SAFETY d2 / (2^q - 1) <= tol, q capped at m + 2, the
-    least order seen on delay equations (the delayed values are not superconvergent); 1 for
-    the amplitudes (a forced orbit), whose levels are seldom steady (an extremum inside an
-    interval: h^(m+1) with a constant that moves with the mesh)."""
-    return max(1.0, (2.0 ** (m + 2) - 1.0) / SAFETY) if autonomous else 1.0
+    least order seen on delay equations (the delayed values are not superconvergent), or at
+    q = 2 m, the period's superconvergent order, where the round's levels are ``asymptotic``
+    (the coarsest within ROUGH of the middle one, :func:`settled`: in the asymptotic range,
+    steady or unsteady by a sign); 1 for the amplitudes (a forced orbit), whose levels are
+    seldom steady (an extremum inside an interval: h^(m+1) with a constant that moves with
+    the mesh)."""
+    if not autonomous:
+        return 1.0
+    return max(1.0, (2.0 ** (2 * m if asymptotic else m + 2) - 1.0) / SAFETY)
+
+
+def settled(c: Solved) -> bool:
+    """Whether the coarsest of c's three levels (its ``coarser``) is within ROUGH (relative,
+    at least 1) of c in the period: the levels are in the asymptotic range, their
+    two-level difference the coarser level's error."""
+    g = c.coarser
+    return g is not None and abs(g.T - c.T) <= ROUGH * max(1.0, abs(c.T))
+
+
+def next_intervals(L: int, d: float, aim: float, expected: int, seen: float | None,
+                   q: float | None, m: int, margin: float) -> int:
+    """The next round's intervals from this round's L and estimate d, to bring it to ``aim``:
+    at the order its three levels show (``seen``) or the two rounds' (``q``, above m) at most
+    ``expected`` + 2, with a margin of 1.1; else at ``expected`` with ``margin``; at least L +
+    2, at most 8 L and MAX_INTERVALS."""
+    grow = (d / aim) ** (1.0 / expected) * margin
+    if seen is not None or (q is not None and q > m):
+        grow = (d / aim) ** (1.0 / min(seen or q, expected + 2)) * 1.1
+    return min(MAX_INTERVALS, max(L + 2, math.ceil(L * min(grow, 8.0))))
 
 
 def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bool,
@@ -393,15 +419,20 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
                 raise ValueError(f"collocate: {reached}; {why}, tol = {tol!r} needs about "
                                  f"{need:.2g} intervals, more than MAX_INTERVALS = "
                                  f"{MAX_INTERVALS}: {fix}")
-        # the next mesh's aim: where these levels were not steady (the first time), a
-        # difference the next round's Richardson estimate accepts, else tol itself
-        aim = tol if seen is not None or unsteady else tol * accepted(lay.m, autonomous)
+        # the next mesh's aim: after a first round in the asymptotic range (steady or not),
+        # its two levels' difference at what a steady round of the period's order 2 m
+        # accepts, without margin (not with an undeclared jump of the kernel: order 1);
+        # where these levels were not steady (the first time), a difference the next
+        # round's Richardson estimate accepts; else tol itself
+        if last is None and autonomous and not capped and settled(c):
+            L2 = next_intervals(L, two, tol * accepted(lay.m, True, True), expected, None,
+                                None, lay.m, 1.0)
+        else:
+            aim = tol if seen is not None or unsteady else tol * accepted(lay.m, autonomous)
+            L2 = next_intervals(L, d, aim, expected, seen, q, lay.m, 1.2)
         unsteady = seen is None
-        grow = (d / aim) ** (1.0 / expected) * 1.2
-        if seen is not None or (q is not None and q > lay.m):
-            grow = (d / aim) ** (1.0 / min(seen or q, expected + 2)) * 1.1
         last = (L, two)
-        L = min(MAX_INTERVALS, max(L + 2, math.ceil(L * min(grow, 8.0))))
+        L = L2
         lay, x = f.lay, f.x
         if f.lay.L >= MAX_INTERVALS:
             break

@@ -16,9 +16,8 @@ fixed time is the node value's minus u*' (one-sided, inside the node's interval)
 motion.  That is the saltation of Barton (2008) in the collocation's terms: linearising the
 switching condition with the switching time as an unknown gives it (a stuck piece's component
 is held, so its perturbation is wiped out: the zero multipliers it should give).  The system's
-columns of the switching times are differences of its residual with the past held at fixed times
-(:func:`period_jacobian`): the delay integral cut at the past's own mesh as well as the moved
-period's, Richardson on two steps scaled to the shortest piece.
+columns of the switching times are exact, the past held at fixed times (:func:`period_jacobian`,
+:func:`dmi.analysis.collocation.system.switch_columns`).
 """
 from __future__ import annotations
 
@@ -31,8 +30,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from .krylov import DENSE_MAX, Monodromy, leading, nearest
-from .mesh import Basis, Locator, delay_matrix_separable
-from .system import DELAY_CACHE, History, Layout, Terms, assemble
+from .mesh import Basis, Locator
+from .system import History, Layout, Terms, assemble, switch_columns
 from ..core.blas import _one_blas_thread
 
 #: The switching times' columns of the period's Jacobian from a fixed past: central differences at
@@ -55,9 +54,8 @@ class FixedPast:
     O(d) in a difference quotient of step d (2.6e-8 in a multiplier at d = 1e-5 T).
     """
 
-    def __init__(self, terms: Terms, separable: bool = True):
+    def __init__(self, terms: Terms):
         self._terms = terms
-        self._separable = separable and terms.kind == "exp"
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._terms, name)
@@ -65,57 +63,22 @@ class FixedPast:
     def delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc: Locator, basis: Basis,
               rows: int, history: History | None = None, extra: np.ndarray | None = None,
               periodic: bool = False) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
-        """:meth:`Terms.delay` with the pieces also cut at ``history``'s mesh; an exponential
-        sum's far lags by :func:`~.mesh.delay_matrix_separable` (unless built with
-        ``separable=False``)."""
-        if history is None:
-            return self._terms.delay(times, mesh, T, loc, basis, rows, history, extra,
-                                     periodic=periodic)
-        mesh = np.union1d(mesh, history.hist)
-        if not self._separable:
-            return self._terms.delay(times, mesh, T, loc, basis, rows, history, extra,
-                                     periodic=periodic)
-        more = np.empty(0) if extra is None else np.asarray(extra, dtype=float)
-        t = self._terms
-        # kept with Terms.delay's matrices (its memo, their own key), as they were before
-        key = ("separable", mesh.tobytes(), float(T), basis.m, basis.q, rows,
-               history.hist.tobytes(), history.periods, more.tobytes())
-        got = t._delays.get(key)
-        if got is None:
-            G = delay_matrix_separable(np.concatenate([times, more]), t.tau, mesh, T, t.H,
-                                       t.terms, loc, basis, t.n, rows, pattern=t.pattern)
-            cut = len(times) * t.n
-            got = (G, None) if not more.size else (G[:cut], G[cut:])
-            t._delays[key] = got
-            if len(t._delays) > DELAY_CACHE:
-                t._delays.popitem(last=False)
-        else:
-            t._delays.move_to_end(key)
-        return got
+        """:meth:`Terms.delay` with the pieces also cut at ``history``'s mesh."""
+        if history is not None:
+            mesh = np.union1d(mesh, history.hist)
+        return self._terms.delay(times, mesh, T, loc, basis, rows, history, extra,
+                                 periodic=periodic)
 
 
 def period_jacobian(lay: Layout, terms: Terms, x: np.ndarray, history: History
                     ) -> sp.csc_matrix:
     """The Jacobian of the period's system from the fixed past ``history`` at x: the node
-    columns of :func:`dmi.analysis.collocation.system.assemble`, then the switching times' by
-    Richardson on central differences (see :data:`STEP`), the delay integral cut at the past's
-    mesh too (:class:`FixedPast`)."""
-    fixed = FixedPast(terms)
-    _, J, _ = assemble(lay, fixed, x, None, history=history)   # type: ignore[arg-type]
-    V, b, T = lay.split(x)
-    d = STEP * min(T, float(np.min(np.diff(lay.bounds(b, T)))))
-    first = lay.rows * lay.n
-
-    def central(j: int, step: float) -> np.ndarray:
-        xp, xm = x.copy(), x.copy()
-        xp[j] += step
-        xm[j] -= step
-        rp = assemble(lay, fixed, xp, None, jacobian=False, history=history)[0]  # type: ignore
-        rm = assemble(lay, fixed, xm, None, jacobian=False, history=history)[0]  # type: ignore
-        return (rp - rm) / (2 * step)
-    cols = [(4 * central(j, d / 2) - central(j, d)) / 3 for j in range(first, first + lay.S)]
-    if cols:
-        J = sp.hstack([J, sp.csr_matrix(np.column_stack(cols))])
+    columns of :func:`dmi.analysis.collocation.system.assemble`, then the switching times'
+    (:func:`dmi.analysis.collocation.system.switch_columns`, exact: the past held at fixed
+    times)."""
+    _, J, _ = assemble(lay, terms, x, None, history=history)
+    if lay.S:
+        J = sp.hstack([J, sp.csr_matrix(switch_columns(lay, terms, x, None, history))])
     return sp.csc_matrix(J)
 
 

@@ -14,8 +14,9 @@ at its value instead; one switching condition at each b_k; for an autonomous orb
 phase condition int_0^1 <u(theta T), r'(theta)> d theta = 0 against a reference orbit r.
 
 The Jacobian's columns of the node values are exact (f_u by central differences of the model's
-rhs), T's exact for a smooth autonomous orbit; the few columns of the b's (and T with switches) by
-central differences of the residual.
+rhs), T's exact for a smooth autonomous orbit, the b's exact along the mesh's motion
+(:func:`switch_columns`; f's t derivative of a forced orbit and the phase condition's by
+differences); T's with switches by central differences of the residual.
 """
 from __future__ import annotations
 
@@ -33,7 +34,8 @@ from ..._solver import Solver
 from ..core.model import FD_STEP, ManyRhs
 from .fold import Fold, exp_sum, fold_of, folding
 from .mesh import (STEEP, Basis, Kernel, Locator, Near, _monomials, delay_matrix,
-                   folded_matrix, history_locator, history_rows, periodic_locator, point_matrix)
+                   delay_matrix_separable, folded_matrix, history_locator, history_rows,
+                   interval_of, periodic_locator, point_matrix)
 from .signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
 from ..core.newton import Converge, NewtonOptions, Search, ShootingError, newton_loop
 
@@ -48,6 +50,10 @@ FLOOR_ITERATIONS = 3
 #: orbit without switches) builds its matrix once, and the monodromy operator's once for its
 #: multipliers and eigenfunction.
 DELAY_CACHE = 6
+#: The step of f's t derivative in the switching times' columns of a forced orbit (five-point
+#: differences), relative to the period: truncation and rounding both near 1e-13 relative for a
+#: forcing of the orbit's own frequency.
+FT_STEP = 2e-4
 
 
 class CollocationWarning(RuntimeWarning):
@@ -99,8 +105,8 @@ class Terms:
         #: sum; :mod:`dmi.analysis.collocation.fold`).
         self.fold = bool(folding()) and self.kind == "exp"
         self._folds: tuple[float, Fold | None] | None = None
-        #: Whether the folded kernel's far cells go by separated factors (False: every piece by
-        #: its own quadrature, delay_matrix's).
+        #: Whether an exponential sum's far cells go by separated factors (the folded kernel's
+        #: and a history's memory; False: every piece by its own quadrature, delay_matrix's).
         self.separable = True
 
     def folded(self, T: float) -> Fold | None:
@@ -113,14 +119,16 @@ class Terms:
         return self._folds[1]
 
     def periodic_delay(self, times: np.ndarray, mesh: np.ndarray, T: float, basis: Basis,
-                       rows: int, slope_of: np.ndarray | None = None
-                       ) -> tuple[sp.csr_matrix, np.ndarray | None]:
+                       rows: int, slope_of: np.ndarray | None = None,
+                       loc: Locator | None = None) -> tuple[sp.csr_matrix, np.ndarray | None]:
         """delay_matrix's (G, T derivative) at ``times`` on the periodic orbit of ``mesh``
-        (period T, ``rows`` node rows, ``slope_of`` its node values for the T derivative): when
-        the kernel folds (:meth:`folded`), the folded kernel H_T over [0, T] (near part
-        included), its later periods' tail over [0, delta] with a near part, and with
-        ``slope_of`` the moment's period derivative; else over the whole memory."""
-        loc = periodic_locator(mesh, basis.m)
+        (period T, ``rows`` node rows, ``slope_of`` its node values for the T derivative; ``loc``
+        a periodic locator of other node rows, default the continuous one): when the kernel
+        folds (:meth:`folded`), the folded kernel H_T over [0, T] (near part included), its later
+        periods' tail over [0, delta] with a near part, and with ``slope_of`` the moment's period
+        derivative; else over the whole memory."""
+        if loc is None:
+            loc = periodic_locator(mesh, basis.m)
         f = self.folded(T)
         if f is None:
             return delay_matrix(times, self.tau, mesh, T, self.H, loc, basis, self.n, rows,
@@ -144,6 +152,17 @@ class Terms:
                                    breaks=np.asarray(f.jumps), pattern=pattern,
                                    slope_of=slope_of)[1]
         return G, dT
+
+    def memory_delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc: Locator,
+                     basis: Basis, rows: int) -> sp.csr_matrix:
+        """delay_matrix's G over the whole memory (a history's locator ``loc``): an exponential
+        sum's far cells by products (:func:`~.mesh.delay_matrix_separable`; every piece by its
+        own quadrature with ``separable`` off)."""
+        if self.separable and self.kind == "exp":
+            return delay_matrix_separable(times, self.tau, mesh, T, self.H, self.terms, loc,
+                                          basis, self.n, rows, pattern=self.pattern)
+        return delay_matrix(times, self.tau, mesh, T, self.H, loc, basis, self.n, rows,
+                            pattern=self.pattern)[0]
 
     def delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc: Locator, basis: Basis,
               rows: int, history: History | None = None, extra: np.ndarray | None = None,
@@ -192,8 +211,7 @@ class Terms:
             if periodic and history is None:
                 G = self.periodic_delay(every, mesh, T, basis, rows)[0]
             else:
-                G = delay_matrix(every, self.tau, mesh, T, self.H, loc, basis, self.n, rows,
-                                 pattern=self.pattern)[0]
+                G = self.memory_delay(every, mesh, T, loc, basis, rows)
             cut = len(times) * self.n
             got = (G, None) if not more.size else (G[:cut], G[cut:])
             self._delays[key] = got
@@ -481,16 +499,25 @@ class Layout:
     def ends(self, b: np.ndarray, T: float) -> tuple[np.ndarray, np.ndarray]:
         """The pieces' ends in order (0, the b_k, the carried (b_k + c) mod T, T) and the switch
         each moves with (k - 1 for b_k and its carried points, -1 for 0 and T)."""
+        t, who, _ = self.ends_in_T(b, T)
+        return t, who
+
+    def ends_in_T(self, b: np.ndarray, T: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`ends` and each end's motion with T at fixed b (1 for T, minus the wraps of a
+        carried point (b_k + c) mod T, 0 for the others)."""
         S = self.S
         t = [0.0, T] + list(b) + [float((b[k] + c) % T) for k in range(S) for c in self.carried]
         who = [-1, -1] + list(range(S)) + [k for k in range(S) for _ in self.carried]
+        dT = [0.0, 1.0] + [0.0] * S + [-float((b[k] + c) // T) for k in range(S)
+                                       for c in self.carried]
         order = np.argsort(t, kind="stable")
-        t, who = np.asarray(t)[order], np.asarray(who)[order]
+        t, who, dT = np.asarray(t)[order], np.asarray(who)[order], np.asarray(dT)[order]
         if t[0] != 0.0 or t[-1] != T:          # a carried point at 0 or T: keep 0 and T outside
             inner = (t > 0) & (t < T)
             t = np.concatenate([[0.0], t[inner], [T]])
             who = np.concatenate([[-1], who[inner], [-1]])
-        return t, who
+            dT = np.concatenate([[0.0], dT[inner], [1.0]])
+        return t, who, dT
 
     def bounds(self, b: np.ndarray, T: float) -> np.ndarray:
         """The pieces' ends (:meth:`ends`)."""
@@ -755,26 +782,201 @@ def _switch_conditions(lay: Layout, terms: Terms, b: np.ndarray, mesh: np.ndarra
     return g, sp.vstack(out, format="csr")
 
 
+def broken_locator(mesh: np.ndarray, m: int, history: History | None = None
+                   ) -> tuple[Locator, int]:
+    """The locator of a discontinuous piecewise polynomial on ``mesh`` (each interval its own
+    m + 1 node rows, L (m + 1) of them), periodic, or with ``history``'s past behind t = 0 (its
+    rows after, as :func:`history_locator` has them), and its node rows."""
+    L = mesh.size - 1
+    k = np.arange(m + 1)
+    if history is None:
+        T = float(mesh[-1])
+
+        def periodic(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            i, z = interval_of(mesh, np.mod(t, T))
+            return i, z, i[:, None] * (m + 1) + k[None, :]
+        return periodic, L * (m + 1)
+    inner = history_locator(mesh, history.hist, m, history.periods)
+    shift = L * (m + 1) - (L * m + 1)
+
+    def forward(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        i, z, cols = inner(t)
+        front = np.asarray(t, dtype=float) >= 0
+        cols = np.where(front[:, None], i[:, None] * (m + 1) + k[None, :], cols + shift)
+        return i, z, cols
+    return forward, L * (m + 1) + history.periods * L * (m + 1)
+
+
+def f_t(terms: Terms, t: np.ndarray, U: np.ndarray, T: float) -> np.ndarray:
+    """df/dt (len(t), n) at (t, U): five-point central differences of step FT_STEP T (one call
+    of the model for the four shifts)."""
+    e = FT_STEP * T
+    P = len(t)
+    F = terms.f_anew(np.concatenate([t + e, t - e, t + 2 * e, t - 2 * e]),
+                     np.tile(U, (4, 1))).reshape(4, P, -1)
+    return (8.0 * (F[0] - F[1]) - (F[2] - F[3])) / (12.0 * e)
+
+
+def mesh_motion(lay: Layout, ends: np.ndarray) -> np.ndarray:
+    """(K, L, m + 1): each interval node's motion when the pieces' ends move by ``ends`` (K,
+    ends) (a node moves with its piece's two ends, linearly)."""
+    left, right = lay.node_motion()
+    piece = lay.piece_of_interval()
+    return left[None] * ends[:, piece, None] + right[None] * ends[:, piece + 1, None]
+
+
+def switch_columns(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None,
+                   history: History | None = None) -> np.ndarray:
+    """The residual's columns of the switching times (residual size, S), exact but for f's t
+    derivative (:func:`f_t`, a forced orbit) and the phase condition's (differences):
+    :func:`motion_columns` of each b_k's motion (it and the points the memory carries it to)."""
+    V, b, T = lay.split(x)
+    who = lay.ends(b, T)[1]
+    S = lay.S
+    ends = (who[None, :] == np.arange(S)[:, None]).astype(float)
+    own = (np.arange(S)[:, None] == np.asarray(force_switches(lay), dtype=int)[None, :])
+    return motion_columns(lay, terms, x, ref, history, ends, own.astype(float))
+
+
+def period_column(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None
+                  ) -> np.ndarray:
+    """The residual's column of T (a periodic autonomous orbit with switches), exact: its
+    derivative with every time scaled (theta = t / T fixed: u' by -1 / T, the delay integral by
+    (1 / T) int_0^tau s H(s) u'(t - s) ds, the phase condition not at all), plus
+    :func:`motion_columns` of the ends' motion with T at fixed b less their scaling's."""
+    m, n, L = lay.m, lay.n, lay.L
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    h = np.diff(mesh)
+    gz = lay.basis.gauss()[0]
+    P = L * m
+    force = force_switches(lay)
+    times = np.concatenate([(mesh[:-1, None] + h[:, None] * gz[None, :]).ravel(), b[force]])
+    dI = np.zeros((times.size, n))
+    if terms.has_kernel:
+        dI = terms.periodic_delay(times, mesh, T, lay.basis, lay.rows, slope_of=V)[1]
+    one = V[(np.arange(L)[:, None] * m + np.arange(m + 1)[None, :]) % lay.rows]
+    du = np.einsum("gk,lkn->lgn", lay.basis.derivatives(gz), one).reshape(P, n)
+    du /= np.repeat(h, m)[:, None]
+    dr = -du / T + dI[:P]
+    mode = np.repeat(np.array(lay.piece_modes(b, T))[lay.piece_of_interval()], m, axis=0)
+    dr[_held(mode, terms)[0]] = 0.0
+    e, _, dT = lay.ends_in_T(b, T)
+    col = motion_columns(lay, terms, x, ref, None, (dT - e / T)[None, :],
+                         -(b[force] / T)[None, :])[:, 0]
+    col[:P * n] += dr.ravel()
+    for q, k in enumerate(force):
+        col[P * n + k] -= dI[P + q, lay.signature.switch(k + 1)[0]]
+    return col
+
+
+def motion_columns(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None,
+                   history: History | None, ends: np.ndarray, own: np.ndarray) -> np.ndarray:
+    """The residual's derivatives (residual size, K) along K motions of the pieces' ends
+    (``ends`` (K, ends), the nodes keeping their values; ``own`` (K, stick endings) the motion
+    of the :func:`force_switches`' b's), exact but for f's t derivative (:func:`f_t`, a forced
+    orbit) and the phase condition's (differences).
+
+    At a fixed time the orbit changes by -nu u' (nu the time's motion, piecewise linear) and a
+    collocation time t_c by nu(t_c); so the collocation row's u' scales by -nu'(t_c), f moves
+    with t_c, and the delay integral by int_0^tau H(s) (nu(t_c) - nu(t_c - s)) u'(t_c - s) ds
+    (the delay matrix of the discontinuous node values of u' and nu u', exact in the basis; a
+    history's past does not move).  The stick endings' net force likewise at b_k."""
+    m, n, L, K = lay.m, lay.n, lay.L, ends.shape[0]
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    h = np.diff(mesh)
+    basis = lay.basis
+    gz = basis.gauss()[0]
+    one = V[(np.arange(L)[:, None] * m + np.arange(m + 1)[None, :]) % lay.rows]  # (L, m + 1, n)
+    slope = np.einsum("ij,ljn->lin", basis.derivatives(basis.nodes), one) / h[:, None, None]
+    nu = mesh_motion(lay, ends)                                        # (K, L, m + 1)
+    ic = np.repeat(np.arange(L), m)
+    nu_c = nu[:, ic, 0] + np.tile(gz, L) * (nu[:, ic, m] - nu[:, ic, 0])   # (K, P)
+    force = force_switches(lay)
+    times = np.concatenate([(mesh[:-1, None] + h[:, None] * gz[None, :]).ravel(), b[force]])
+    P = L * m
+    Uc = np.einsum("gk,lkn->lgn", basis.values(gz), one).reshape(P, n)
+    du = np.einsum("gk,lkn->lgn", basis.derivatives(gz), one).reshape(P, n) / h[ic, None]
+    dW = _moved_delay(lay, terms, times, mesh, T, slope, nu, own, history)  # (K, times, n)
+    first = P * n + (n if history is not None else 0)
+    cols = np.zeros((K, first + lay.S + int(lay.autonomous and history is None
+                                             and ref is not None)))
+    dr = -((nu[:, ic, m] - nu[:, ic, 0]) / h[ic])[:, :, None] * du[None] + dW[:, :P]
+    if not lay.autonomous:
+        dr += nu_c[:, :, None] * f_t(terms, times[:P], Uc, T)[None]
+    mode = np.repeat(np.array(lay.piece_modes(b, T))[lay.piece_of_interval()], m, axis=0)
+    dr[:, _held(mode, terms)[0]] = 0.0
+    cols[:, :P * n] = dr.reshape(K, -1)
+    ft = (f_t(terms, b[force], evaluate(lay, x, b[force]), T)
+          if force and not lay.autonomous else None)
+    for q, k in enumerate(force):
+        i = lay.signature.switch(k + 1)[0]
+        cols[:, first + k] = -dW[:, P + q, i] - (own[:, q] * ft[q, i] if ft is not None else 0)
+    if cols.shape[1] > first + lay.S:
+        cols[:, -1] = _phase_columns(lay, mesh, nu, T, Uc, ref)
+    return cols.T
+
+
+def _moved_delay(lay: Layout, terms: Terms, times: np.ndarray, mesh: np.ndarray, T: float,
+                 slope: np.ndarray, nu: np.ndarray, own: np.ndarray, history: History | None
+                 ) -> np.ndarray:
+    """(K, len(times), n): the delay integral's change at ``times`` (the collocation times,
+    then stick endings' b's, which move by ``own`` (K, b's)) along each motion nu (K, L, m + 1)
+    of the nodes (:func:`motion_columns`)."""
+    m, n, L, S = lay.m, lay.n, lay.L, nu.shape[0]
+    out = np.zeros((S, times.size, n))
+    if not terms.has_kernel:
+        return out
+    loc, rows = broken_locator(mesh, m, history)
+    if history is None:
+        G = terms.periodic_delay(times, mesh, T, lay.basis, rows, loc=loc)[0]
+        past = np.empty((0, n))
+    else:
+        G = terms.memory_delay(times, mesh, T, loc, lay.basis, rows)
+        dz = lay.basis.derivatives(lay.basis.nodes)
+        hh = np.tile(np.diff(history.hist), history.periods)
+        ph = history.phi.reshape(-1, m + 1, n)
+        past = (np.einsum("ij,ljn->lin", dz, ph) / hh[:, None, None]).reshape(-1, n)
+    cur = slope.reshape(-1, n)
+    vec = np.column_stack([np.concatenate([cur, past]).ravel()]
+                          + [np.concatenate([(nu[j].reshape(-1)[:, None] * cur),
+                                             np.zeros_like(past)]).ravel() for j in range(S)])
+    W = (G @ vec).reshape(times.size, n, S + 1)
+    i, z, _ = loc(times)
+    nu_t = nu[:, i, 0] + z * (nu[:, i, m] - nu[:, i, 0])              # (S, len(times))
+    nu_t[:, L * m:] = own
+    for j in range(S):
+        out[j] = nu_t[j][:, None] * W[:, :, 0] - W[:, :, j + 1]
+    return out
+
+
+def _phase_columns(lay: Layout, mesh: np.ndarray, nu: np.ndarray, T: float, Uc: np.ndarray,
+                   ref: Callable) -> np.ndarray:
+    """(K,): the phase condition's derivatives along the nodes' motions nu (K, L, m + 1) (its
+    weights and reference move with the mesh, u at the collocation points does not), central
+    differences of step 1e-6 T."""
+    gz, gw = lay.basis.gauss()
+    moves = np.concatenate([nu[:, :, 0], nu[:, -1:, -1]], axis=1)      # (K, L + 1): the mesh
+
+    def phase(moved: np.ndarray) -> float:
+        h = np.diff(moved)
+        tc = (moved[:-1, None] + h[:, None] * gz[None, :]).ravel()
+        w = (h[:, None] * gw[None, :]).ravel() / T
+        return float(np.sum(w[:, None] * ref(tc / T) * Uc))
+    d = 1e-6 * T
+    return np.array([(phase(mesh + d * v) - phase(mesh - d * v)) / (2 * d) for v in moves])
+
+
 def full_jacobian(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None,
                   history: History | None = None) -> tuple[np.ndarray, sp.csc_matrix]:
-    """The residual and the whole Jacobian: the node columns of :func:`assemble`, then the
-    columns of the b's and T by central differences of the residual (step 1e-6 T)."""
+    """The residual and the whole Jacobian: the node columns of :func:`assemble`, the
+    switching times' (:func:`switch_columns`), then T's (:func:`assemble`'s for a smooth
+    autonomous orbit, :func:`period_column` with switches)."""
     r, J, dT = assemble(lay, terms, x, ref, history=history)
-    extra = lay.S + int(lay.autonomous and history is None)
-    cols = []
-    first = lay.rows * lay.n
-    T = lay.split(x)[2]
-    for j in range(first, first + extra):
-        if dT is not None and j == first + extra - 1:
-            cols.append(dT)
-            continue
-        d = 1e-6 * T
-        xp, xm = x.copy(), x.copy()
-        xp[j] += d
-        xm[j] -= d
-        rp = assemble(lay, terms, xp, ref, jacobian=False, history=history)[0]
-        rm = assemble(lay, terms, xm, ref, jacobian=False, history=history)[0]
-        cols.append((rp - rm) / (2 * d))
+    cols = [] if not lay.S else list(switch_columns(lay, terms, x, ref, history).T)
+    if lay.autonomous and history is None:
+        cols.append(dT if dT is not None else period_column(lay, terms, x, ref))
     if cols:
         J = sp.hstack([J, sp.csr_matrix(np.column_stack(cols))])
     return r, sp.csc_matrix(J)
