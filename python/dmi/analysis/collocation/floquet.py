@@ -22,7 +22,6 @@ columns of the switching times are exact, the past held at fixed times (:func:`p
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 import scipy.linalg as sl
@@ -30,44 +29,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from .krylov import DENSE_MAX, Monodromy, leading, nearest
-from .mesh import Basis, Locator
 from .system import History, Layout, Terms, assemble, switch_columns
 from ..core.blas import _one_blas_thread
-
-#: The switching times' columns of the period's Jacobian from a fixed past: central differences at
-#: steps d and d / 2, d = STEP min(T, the shortest piece), combined by Richardson (O(d^4) relative
-#: to the shortest piece).  A forced orbit's complex pair (tests/python/analysis/collocation/
-#: test_stickslip_memory_multipliers.py) by plain central differences at 1e-6 T (Newton's): 5.4e-10
-#: off at tau = 30, 1.8e-10 at tau = 50, by their rounding, much the same on every mesh, so the
-#: levels' estimate (6e-11, 2e-11) did not see it; by Richardson at STEP 1e-4, 3e-4, 1e-3 (tau =
-#: 40): 2.6e-10, 4.5e-11, 7.5e-12 (rounding), at 1e-3 T: 1.1e-10 (truncation).
-STEP = 1e-3
-
-
-class FixedPast:
-    """The model's terms (:class:`dmi.analysis.collocation.system.Terms`, every attribute passed
-    through) whose delay integral, from a fixed history, is cut at the history's own mesh too.
-
-    The period's mesh moves with its switching times while the past's does not; the delay
-    integral's pieces are cut at the period's mesh repeated every T, so a moved switching time
-    would leave a past breakpoint (where u' jumps: a switch) inside a Gauss piece, an error of
-    O(d) in a difference quotient of step d (2.6e-8 in a multiplier at d = 1e-5 T).
-    """
-
-    def __init__(self, terms: Terms):
-        self._terms = terms
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self._terms, name)
-
-    def delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc: Locator, basis: Basis,
-              rows: int, history: History | None = None, extra: np.ndarray | None = None,
-              periodic: bool = False) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
-        """:meth:`Terms.delay` with the pieces also cut at ``history``'s mesh."""
-        if history is not None:
-            mesh = np.union1d(mesh, history.hist)
-        return self._terms.delay(times, mesh, T, loc, basis, rows, history, extra,
-                                 periodic=periodic)
 
 
 def period_jacobian(lay: Layout, terms: Terms, x: np.ndarray, history: History
