@@ -24,27 +24,12 @@ import dmi
 from dmi import analysis as da
 from dmi.analysis.collocation.system import (History, Layout, Terms, assemble, period_column,
                                              reference, switch_columns)
-
-TAU = 30.0
-V, ALPHA, G, K = 0.5, 0.4, 0.3, 0.05
-W, FF, ALPHA_F, C, G_F = 0.5, 1.5, 0.5, 0.05, 0.5
-PF = 2 * math.pi / W
-
-
-def belt(p: float, h: float | None = None) -> dmi.Solver:
-    s = dmi.Solver(2, TAU, h=0.05 if h is None else h)
-    s.set_rhs(lambda t, u: np.array([-(u[1] + V), u[0] - p * (u[1] + V)]))
-    s.set_friction([0.0, ALPHA])
-    s.set_kernel_exp([-1.0], [0.0], [[[0.0, 0.0], [G, 0.0]]])
-    return s
+from models.memory_stickslip import FF, K, PF, belt, forced_for
 
 
 def forced(p: float, h: float | None = None) -> dmi.Solver:
-    s = dmi.Solver(2, TAU, h=PF / 200 if h is None else h)
-    s.set_rhs(lambda t, u: np.array([-u[1], u[0] + C * u[1] - p * np.cos(W * t)]))
-    s.set_friction([0.0, ALPHA_F])
-    s.set_kernel_exp([-1.0], [0.0], [[[0.0, 0.0], [G_F, 0.0]]])
-    return s
+    """The forced oscillator at the step h."""
+    return forced_for(round(PF / h) if h else 200)(p)
 
 
 def orbit(name: str):

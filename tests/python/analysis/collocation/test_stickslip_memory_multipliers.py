@@ -29,33 +29,9 @@ import numpy as np
 import pytest
 import scipy.integrate as si
 
-import dmi
 from dmi import analysis as da
-
-TAU = 30.0                                  # e^{-tau} = 9.4e-14
-V, ALPHA, G, K = 0.5, 0.4, 0.3, 0.05       # the belt (k: its negative damping, the parameter)
-W, FF, ALPHA_F, C, G_F = 0.5, 1.5, 0.5, 0.05, 0.5   # the forced one (FF: the forcing, p)
-PF = 2 * math.pi / W
-
-
-def belt(p: float, h: float | None = None) -> dmi.Solver:
-    s = dmi.Solver(2, TAU, h=0.05 if h is None else h)
-    s.set_rhs(lambda t, u: np.array([-(u[1] + V), u[0] - p * (u[1] + V)]))
-    s.set_friction([0.0, ALPHA])
-    s.set_kernel_exp([-1.0], [0.0], [[[0.0, 0.0], [G, 0.0]]])
-    return s
-
-
-def forced_for(M: int):
-    """make(p), p the forcing's amplitude, h = PF / M."""
-    def make(p: float) -> dmi.Solver:
-        s = dmi.Solver(2, TAU, h=PF / M)
-        s.set_rhs(lambda t, u: np.array([-u[1], u[0] + C * u[1] - p * np.cos(W * t)]))
-        s.set_friction([0.0, ALPHA_F])
-        s.set_kernel_exp([-1.0], [0.0], [[[0.0, 0.0], [G_F, 0.0]]])
-        return s
-    return make
-
+from models.memory_stickslip import (ALPHA, ALPHA_F, C, FF, G, G_F, K, PF, V, W, belt,
+                                     forced_for)
 
 class Run:
     """x' = y + v, y' in force(t, w) - alpha Sign(y), I' = x - I; stuck: y = 0, x' = v; modes
