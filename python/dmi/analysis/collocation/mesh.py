@@ -315,7 +315,7 @@ def delay_matrix(times: np.ndarray, tau: float, mesh_points: np.ndarray, T: floa
     omit : tuple of numpy.ndarray, optional
         (jb, ja) for each time: the lags between t_c - ext[ja] and t_c - ext[jb] (ext the mesh
         crossings of :func:`crossings`, where jb < ja) left out, integrated elsewhere
-        (:mod:`dmi.analysis.collocation.separable`).
+        (:func:`delay_matrix_separable`).
 
     Returns
     -------
@@ -767,13 +767,10 @@ def folded_matrix(times: np.ndarray, fold: Any, mesh_points: np.ndarray, T: floa
         return _folded_once(times, fold, pts, T, locate, basis, n, rows, pattern, got)
     G = delay_matrix_separable(times, T, pts, T, whole, first, locate, basis, n, rows,
                                pattern=pattern)
-    near = H.near
-    if second is not None and (near is None or fold.r > near.delta):
-        zero = None if near is None else Near(near.delta, near.beta, np.zeros_like(near.C))
-        G = G + delay_matrix_separable(times, fold.r, mesh_points, T,
-                                       Kernel(second[1], zero, cuts, H.rate), second[0],
-                                       locate, basis, n, rows, pattern=pattern)
-    return G
+    zero = None if near is None else Near(near.delta, near.beta, np.zeros_like(near.C))
+    return G + delay_matrix_separable(times, fold.r, mesh_points, T,
+                                      Kernel(second[1], zero, cuts, H.rate), second[0],
+                                      locate, basis, n, rows, pattern=pattern)
 
 
 def _folded_once(times: np.ndarray, fold: Any, pts: np.ndarray, T: float, locate: Locator,
