@@ -15,8 +15,8 @@ phase condition int_0^1 <u(theta T), r'(theta)> d theta = 0 against a reference 
 
 The Jacobian's columns of the node values are exact (f_u by central differences of the model's
 rhs), T's exact for a smooth autonomous orbit, the b's exact along the mesh's motion
-(:func:`switch_columns`; f's t derivative of a forced orbit and the phase condition's by
-differences); T's with switches by central differences of the residual.
+(:func:`switch_columns`, T's with switches too; f's t derivative of a forced orbit and the
+phase condition's row by differences).
 """
 from __future__ import annotations
 
@@ -167,7 +167,7 @@ class Terms:
     def delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc: Locator, basis: Basis,
               rows: int, history: History | None = None, extra: np.ndarray | None = None,
               periodic: bool = False) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
-        """The delay integral's matrix (:func:`delay_matrix`) at the collocation times of
+        """The delay integral's matrix (:meth:`memory_delay`) at the collocation times of
         ``mesh`` and at the ``extra`` times (the switching conditions' that need the memory) in
         one, kept for the last DELAY_CACHE meshes (it depends on the mesh, T, the basis, the
         extra times and the history's mesh only, not on the node values).  With ``periodic``
@@ -204,7 +204,7 @@ class Terms:
         more = np.empty(0) if extra is None else np.asarray(extra, dtype=float)
         key = (np.asarray(mesh, dtype=float).tobytes(), float(T), basis.m, basis.q, rows,
                None if history is None else (history.hist.tobytes(), history.periods),
-               more.tobytes(), periodic and self.fold)
+               more.tobytes(), periodic and self.fold, self.separable)
         got = self._delays.get(key)
         if got is None:
             every = np.concatenate([times, more])
@@ -826,24 +826,34 @@ def mesh_motion(lay: Layout, ends: np.ndarray) -> np.ndarray:
 
 
 def switch_columns(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None,
-                   history: History | None = None) -> np.ndarray:
-    """The residual's columns of the switching times (residual size, S), exact but for f's t
-    derivative (:func:`f_t`, a forced orbit) and the phase condition's (differences):
-    :func:`motion_columns` of each b_k's motion (it and the points the memory carries it to)."""
+                   history: History | None = None, period: bool = False) -> np.ndarray:
+    """The residual's columns of the switching times (residual size, S), and with ``period``
+    (a periodic autonomous orbit) T's after them: exact but for f's t derivative (:func:`f_t`, a
+    forced orbit) and the phase condition's row (differences).  Each b_k's column is
+    :func:`motion_columns` of its motion (it and the points the memory carries it to); T's is
+    its derivative with every time scaled (theta = t / T fixed: u' by -1 / T, the delay integral
+    by (1 / T) int_0^tau s H(s) u'(t - s) ds, the phase condition not at all) plus the ends'
+    motion with T at fixed b less their scaling's (one :func:`motion_columns` for all).  A
+    history must continue the period (no jump in the past, nor between it and u(0)): its jumps'
+    own motion terms are not in the columns."""
     V, b, T = lay.split(x)
-    who = lay.ends(b, T)[1]
+    e, who, dT = lay.ends_in_T(b, T)
     S = lay.S
+    force = np.asarray(force_switches(lay), dtype=int)
     ends = (who[None, :] == np.arange(S)[:, None]).astype(float)
-    own = (np.arange(S)[:, None] == np.asarray(force_switches(lay), dtype=int)[None, :])
-    return motion_columns(lay, terms, x, ref, history, ends, own.astype(float))
+    own = (np.arange(S)[:, None] == force[None, :]).astype(float)
+    if period:
+        ends = np.vstack([ends, (dT - e / T)[None, :]])
+        own = np.vstack([own, -(b[force] / T)[None, :]])
+    cols = motion_columns(lay, terms, x, ref, history, ends, own)
+    if period:
+        cols[:, -1] += _scaled_column(lay, terms, x, cols.shape[0])
+    return cols
 
 
-def period_column(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None
-                  ) -> np.ndarray:
-    """The residual's column of T (a periodic autonomous orbit with switches), exact: its
-    derivative with every time scaled (theta = t / T fixed: u' by -1 / T, the delay integral by
-    (1 / T) int_0^tau s H(s) u'(t - s) ds, the phase condition not at all), plus
-    :func:`motion_columns` of the ends' motion with T at fixed b less their scaling's."""
+def _scaled_column(lay: Layout, terms: Terms, x: np.ndarray, size: int) -> np.ndarray:
+    """The residual's derivative in T with every time scaled (theta = t / T fixed; the nodes
+    held; the phase condition's row 0), of a periodic autonomous orbit with switches."""
     m, n, L = lay.m, lay.n, lay.L
     V, b, T = lay.split(x)
     mesh = lay.mesh(b, T)
@@ -861,20 +871,18 @@ def period_column(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None
     dr = -du / T + dI[:P]
     mode = np.repeat(np.array(lay.piece_modes(b, T))[lay.piece_of_interval()], m, axis=0)
     dr[_held(mode, terms)[0]] = 0.0
-    e, _, dT = lay.ends_in_T(b, T)
-    col = motion_columns(lay, terms, x, ref, None, (dT - e / T)[None, :],
-                         -(b[force] / T)[None, :])[:, 0]
-    col[:P * n] += dr.ravel()
+    col = np.zeros(size)
+    col[:P * n] = dr.ravel()
     for q, k in enumerate(force):
-        col[P * n + k] -= dI[P + q, lay.signature.switch(k + 1)[0]]
+        col[P * n + k] = -dI[P + q, lay.signature.switch(k + 1)[0]]
     return col
 
 
 def motion_columns(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None,
                    history: History | None, ends: np.ndarray, own: np.ndarray) -> np.ndarray:
     """The residual's derivatives (residual size, K) along K motions of the pieces' ends
-    (``ends`` (K, ends), the nodes keeping their values; ``own`` (K, stick endings) the motion
-    of the :func:`force_switches`' b's), exact but for f's t derivative (:func:`f_t`, a forced
+    (``ends`` (K, ends), the nodes keeping their values; ``own`` (K, the :func:`force_switches`'
+    b's: stick and contact endings) their motion), exact but for f's t derivative (:func:`f_t`, a forced
     orbit) and the phase condition's (differences).
 
     At a fixed time the orbit changes by -nu u' (nu the time's motion, piecewise linear) and a
@@ -924,8 +932,8 @@ def _moved_delay(lay: Layout, terms: Terms, times: np.ndarray, mesh: np.ndarray,
     """(K, len(times), n): the delay integral's change at ``times`` (the collocation times,
     then stick endings' b's, which move by ``own`` (K, b's)) along each motion nu (K, L, m + 1)
     of the nodes (:func:`motion_columns`)."""
-    m, n, L, S = lay.m, lay.n, lay.L, nu.shape[0]
-    out = np.zeros((S, times.size, n))
+    m, n, L, K = lay.m, lay.n, lay.L, nu.shape[0]
+    out = np.zeros((K, times.size, n))
     if not terms.has_kernel:
         return out
     loc, rows = broken_locator(mesh, m, history)
@@ -941,12 +949,12 @@ def _moved_delay(lay: Layout, terms: Terms, times: np.ndarray, mesh: np.ndarray,
     cur = slope.reshape(-1, n)
     vec = np.column_stack([np.concatenate([cur, past]).ravel()]
                           + [np.concatenate([(nu[j].reshape(-1)[:, None] * cur),
-                                             np.zeros_like(past)]).ravel() for j in range(S)])
-    W = (G @ vec).reshape(times.size, n, S + 1)
+                                             np.zeros_like(past)]).ravel() for j in range(K)])
+    W = (G @ vec).reshape(times.size, n, K + 1)
     i, z, _ = loc(times)
-    nu_t = nu[:, i, 0] + z * (nu[:, i, m] - nu[:, i, 0])              # (S, len(times))
+    nu_t = nu[:, i, 0] + z * (nu[:, i, m] - nu[:, i, 0])              # (K, len(times))
     nu_t[:, L * m:] = own
-    for j in range(S):
+    for j in range(K):
         out[j] = nu_t[j][:, None] * W[:, :, 0] - W[:, :, j + 1]
     return out
 
@@ -971,12 +979,13 @@ def _phase_columns(lay: Layout, mesh: np.ndarray, nu: np.ndarray, T: float, Uc: 
 def full_jacobian(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None,
                   history: History | None = None) -> tuple[np.ndarray, sp.csc_matrix]:
     """The residual and the whole Jacobian: the node columns of :func:`assemble`, the
-    switching times' (:func:`switch_columns`), then T's (:func:`assemble`'s for a smooth
-    autonomous orbit, :func:`period_column` with switches)."""
+    switching times' and with them T's (:func:`switch_columns`), or T's of a smooth autonomous
+    orbit (:func:`assemble`'s)."""
     r, J, dT = assemble(lay, terms, x, ref, history=history)
-    cols = [] if not lay.S else list(switch_columns(lay, terms, x, ref, history).T)
-    if lay.autonomous and history is None:
-        cols.append(dT if dT is not None else period_column(lay, terms, x, ref))
+    both = lay.autonomous and history is None
+    cols = [] if not lay.S else list(switch_columns(lay, terms, x, ref, history, both).T)
+    if both and dT is not None:
+        cols.append(dT)
     if cols:
         J = sp.hstack([J, sp.csr_matrix(np.column_stack(cols))])
     return r, sp.csc_matrix(J)

@@ -1,6 +1,6 @@
 # The collocation system's exact columns of the switching times and of T against differences.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
-"""`switch_columns` and `period_column` (the residual's derivatives along the mesh's motion)
+"""`switch_columns`, with T's column and without (the residual's derivatives along the mesh's motion)
 against Richardson's extrapolation of central differences of the residual assembled again at
 moved switching times (step 1e-3 and 5e-4 of the shortest piece: their own error about 2e-10
 here, 7e-9 at ten times the step, 1e-9 at a fifth), on two stick-slip orbits with a memory:
@@ -22,8 +22,8 @@ import pytest
 
 import dmi
 from dmi import analysis as da
-from dmi.analysis.collocation.system import (History, Layout, Terms, assemble, period_column,
-                                             reference, switch_columns)
+from dmi.analysis.collocation.system import (History, Layout, Terms, assemble, reference,
+                                             switch_columns)
 from models.memory_stickslip import FF, K, PF, belt, forced_for
 
 
@@ -118,8 +118,10 @@ def test_periodic_columns(case):
     first = lay.rows * lay.n
     for k in range(lay.S):
         check(got[:, k], differences(lay, terms, x, ref, None, first + k))
-    if lay.autonomous:
-        check(period_column(lay, terms, x, ref), differences(lay, terms, x, ref, None, x.size - 1))
+    if lay.autonomous:                 # T's column after them, from the same motions
+        both = switch_columns(lay, terms, x, ref, period=True)
+        assert np.array_equal(both[:, :-1], got)
+        check(both[:, -1], differences(lay, terms, x, ref, None, x.size - 1))
 
 
 def test_columns_from_a_fixed_past(case):
