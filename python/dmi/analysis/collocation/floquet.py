@@ -16,7 +16,8 @@ fixed time is the node value's minus u*' (one-sided, inside the node's interval)
 motion.  That is the saltation of Barton (2008) in the collocation's terms: linearising the
 switching condition with the switching time as an unknown gives it (a stuck piece's component
 is held, so its perturbation is wiped out: the zero multipliers it should give).  The system's
-columns of the switching times are exact, the past held at fixed times (:func:`period_jacobian`,
+columns of the switching times are exact, the past held at fixed times
+(:func:`dmi.analysis.collocation.system.full_jacobian` with the history,
 :func:`dmi.analysis.collocation.system.switch_columns`).
 """
 from __future__ import annotations
@@ -29,20 +30,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from .krylov import DENSE_MAX, Monodromy, leading, nearest
-from .system import History, Layout, Terms, assemble, switch_columns
+from .system import History, Layout, Terms, full_jacobian
 from ..core.blas import _one_blas_thread
-
-
-def period_jacobian(lay: Layout, terms: Terms, x: np.ndarray, history: History
-                    ) -> sp.csc_matrix:
-    """The Jacobian of the period's system from the fixed past ``history`` at x: the node
-    columns of :func:`dmi.analysis.collocation.system.assemble`, then the switching times'
-    (:func:`dmi.analysis.collocation.system.switch_columns`, exact: the past held at fixed
-    times)."""
-    _, J, _ = assemble(lay, terms, x, None, history=history)
-    if lay.S:
-        J = sp.hstack([J, sp.csr_matrix(switch_columns(lay, terms, x, None, history))])
-    return sp.csc_matrix(J)
 
 
 def monodromy(lay: Layout, terms: Terms, x: np.ndarray) -> np.ndarray:
@@ -56,7 +45,7 @@ def monodromy(lay: Layout, terms: Terms, x: np.ndarray) -> np.ndarray:
     cols = (i[:, None] * m + k[None, :]) % lay.rows
     one = V[cols]                                          # (L, m + 1, n)
     phi = np.tile(one, (P, 1, 1)).reshape(-1, n)
-    J = period_jacobian(lay, terms, x, History(mesh, P, phi))
+    J = full_jacobian(lay, terms, x, None, history=History(mesh, P, phi))[1]
     nc = (lay.rows + 1) * n
     nh = P * L * (m + 1) * n
     Jcur = sp.hstack([J[:, :nc], J[:, nc + nh:]], format="csc")
@@ -122,7 +111,8 @@ def operator(lay: Layout, terms: Terms, x: np.ndarray) -> Monodromy:
     P = max(1, math.ceil(terms.tau / T - 1e-12))
     k = np.arange(m + 1)
     one = V[(np.arange(L)[:, None] * m + k[None, :]) % lay.rows]       # (L, m + 1, n)
-    J = period_jacobian(lay, terms, x, History(mesh, P, np.tile(one, (P, 1, 1)).reshape(-1, n)))
+    J = full_jacobian(lay, terms, x, None,
+                      history=History(mesh, P, np.tile(one, (P, 1, 1)).reshape(-1, n)))[1]
     nc = (lay.rows + 1) * n
     nh = P * L * (m + 1) * n
     state = state_intervals(lay, terms, mesh, T, P)

@@ -75,7 +75,6 @@ import scipy.sparse as sp
 
 from ..._solver import Solver
 from ..collocation.adapt import FLOOR
-from ..collocation.floquet import period_jacobian
 from ..collocation.mesh import interval_of, point_matrix
 from ..collocation.orbit import EquationOrbit, equation_orbit
 from ..collocation.signature import HI, LO, STUCK
@@ -585,7 +584,7 @@ class SwitchTwisted:
     read as mu^-k times the period's: the node's value minus u*' (one-sided, inside its interval)
     times the node's motion with the switches (the saltation), so that A_mu is singular exactly
     at the monodromy's multipliers (the system's Jacobian is the monodromy's own,
-    :func:`dmi.analysis.collocation.floquet.period_jacobian`).
+    :func:`dmi.analysis.collocation.system.full_jacobian` with the history).
 
     Attributes
     ----------
@@ -618,7 +617,7 @@ class SwitchTwisted:
         one = V[src]
         self.lay, self.terms, self.x, self.n, self.mesh = lay, terms, x, n, mesh
         self.hist = History(mesh, P, np.tile(one, (P, 1, 1)).reshape(-1, n))
-        J = period_jacobian(lay, terms, x, self.hist)
+        J = sp.csc_matrix(full_jacobian(lay, terms, x, None, history=self.hist)[1])
         nc, nh = (lay.rows + 1) * n, P * L * (m + 1) * n
         self.nc, self.nh = nc, nh
         self.Jcur = sp.hstack([J[:, :nc], J[:, nc + nh:]], format="csc")
