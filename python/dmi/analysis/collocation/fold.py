@@ -47,14 +47,15 @@ def folding() -> bool:
 def exp_sum(s: np.ndarray, a: np.ndarray, b: np.ndarray, C: np.ndarray, D: np.ndarray
             ) -> np.ndarray:
     """sum_j e^(a_j s) (C_j cos b_j s + D_j sin b_j s) (P, n, n) at the lags s (P,) (C, D:
-    (k, n, n)); no cos / sin when every b is 0."""
+    (k, n, n); or any (k, ...): then (P, ...), e.g. the entries of a pattern); no cos / sin when
+    every b is 0."""
     s = np.asarray(s, dtype=float)
-    k, n = a.size, C.shape[-1]
+    k, shape = a.size, (-1,) + C.shape[1:]
     e = np.exp(np.outer(s, a))
     if not np.any(b):
-        return (e @ C.reshape(k, n * n)).reshape(-1, n, n)
-    return ((e * np.cos(np.outer(s, b))) @ C.reshape(k, n * n)
-            + (e * np.sin(np.outer(s, b))) @ D.reshape(k, n * n)).reshape(-1, n, n)
+        return (e @ C.reshape(k, -1)).reshape(shape)
+    return ((e * np.cos(np.outer(s, b))) @ C.reshape(k, -1)
+            + (e * np.sin(np.outer(s, b))) @ D.reshape(k, -1)).reshape(shape)
 
 
 def _scaled(C: np.ndarray, D: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

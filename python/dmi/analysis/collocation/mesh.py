@@ -439,8 +439,7 @@ def crossings(times: np.ndarray, tau: float, pts: np.ndarray, T: float
     """The mesh points ``pts`` (one period's, without T) repeated every T over the memories of
     the ``times`` (sorted), and for each time the index of the first one past t - tau and of the
     first one at or past t: (ext, j0, j1)."""
-    lo = math.floor((times.min() - tau - pts[-1]) / T) - 1
-    hi = math.floor((times.max() - pts[0]) / T) + 1
+    lo, hi = _span(times, tau, pts, T)
     ext = (pts[None, :] + T * np.arange(lo, hi + 1)[:, None]).ravel()   # sorted
     j0 = np.searchsorted(ext, times - tau, side="right")
     j1 = np.searchsorted(ext, times, side="left")
@@ -507,6 +506,141 @@ def point_matrix(times: np.ndarray, locate: Locator, basis: Basis, mesh: np.ndar
     cc = cols[:, None, :] * n + np.arange(n)[None, :, None]
     return sp.csr_matrix((val.ravel(), (r.ravel(), cc.ravel())), shape=(P * n, rows * n))
 
+
+
+
+class DelayPlan:
+    """delay_matrix's G (and its T derivative) on a periodic orbit, for a kernel without a near
+    part, jumps or grading (the pieces are cut at the mesh crossings alone), made for the
+    crossings inside each time's memory and used again while they stay the same (Newton's
+    iterates: the mesh moves with T and the switching times, no crossing enters or leaves a
+    memory).  The pieces between two crossings keep their basis values (the Gauss nodes of their
+    interval); each call takes the kernel at the lags, the memory's two end pieces of each time
+    anew, and one sum into the kept sparse pattern.
+
+    Parameters
+    ----------
+    times : numpy.ndarray
+        The times t_c (in [0, T]).
+    mesh : numpy.ndarray
+        The mesh of one period, repeated every T.
+    tau : float
+        The memory's length.
+    T : float
+        The period.
+    kernel : callable
+        s (k,) -> the entries of H(s) in ``pattern`` (k, entries), row by row (those of a
+        :class:`Kernel`'s ``far``).
+    basis : Basis
+        The basis (q Gauss-Legendre nodes a piece).
+    n : int
+        The state's dimension.
+    rows : int
+        The node rows of u (L m, periodic).
+    pattern : numpy.ndarray of bool
+        (n, n): the entries of H that may be nonzero.
+    """
+
+    def __init__(self, times: np.ndarray, mesh: np.ndarray, tau: float, T: float,
+                 kernel: Callable[[np.ndarray], np.ndarray], basis: Basis, n: int, rows: int,
+                 pattern: np.ndarray):
+        times = np.asarray(times, dtype=float)
+        L, m, P = mesh.size - 1, basis.m, times.size
+        self.span = _span(times, tau, mesh[:-1], T)
+        ext = _extended(mesh, T, self.span)
+        self.j0 = np.searchsorted(ext, times - tau, side="right")
+        self.j1 = np.searchsorted(ext, times, side="left")
+        self.tau, self.kernel, self.basis, self.n = float(tau), kernel, basis, n
+        self.ia, self.ib = np.nonzero(pattern)
+        gz = basis.gauss(basis.q)[0]
+        # the pieces between two crossings: intervals j0 .. j1 - 2 of each time
+        inner = np.maximum(self.j1 - self.j0 - 1, 0)
+        C = np.repeat(np.arange(P), inner)
+        j = np.repeat(self.j0, inner) + (np.arange(C.size) - np.repeat(np.cumsum(inner) - inner,
+                                                                       inner))
+        self.inner = (C, j)
+        self.B, self.Bd = basis.values(gz), basis.derivatives(gz)              # (q, m + 1)
+        # the end pieces: the interval of t - tau (j0 - 1), and of t (j1 - 1) where it is another
+        two = self.j1 > self.j0
+        self.ends = (np.concatenate([np.arange(P), np.arange(P)[two]]),
+                     np.concatenate([self.j0 - 1, self.j1[two] - 1]))
+        self.C = np.concatenate([C, self.ends[0]])
+        jj = np.concatenate([j, self.ends[1]])
+        self.node = ((jj % L)[:, None] * m + np.arange(m + 1)[None, :]) % (L * m)
+        # the sparse pattern: each (piece, entry, basis polynomial)'s slot in G's data
+        e = self.ia.size
+        r = np.broadcast_to((self.C[:, None] * n + self.ia[None, :])[:, :, None],
+                            (self.C.size, e, m + 1))
+        c = self.node[:, None, :] * n + self.ib[None, :, None]
+        self.shape = (P * n, rows * n)
+        flat, self.slot = np.unique((r * self.shape[1] + c).ravel(), return_inverse=True)
+        self.indices = (flat % self.shape[1]).astype(np.int32)
+        self.indptr = np.zeros(self.shape[0] + 1, np.int32)
+        np.cumsum(np.bincount(flat // self.shape[1], minlength=self.shape[0]),
+                  out=self.indptr[1:])
+
+    def matrix(self, times: np.ndarray, mesh: np.ndarray, T: float,
+               slope_of: np.ndarray | None = None
+               ) -> tuple[sp.csr_matrix, np.ndarray | None] | None:
+        """delay_matrix's (G, T derivative) at these times, mesh and period; None when a
+        crossing entered or left a memory (the plan does not fit: make another)."""
+        times = np.asarray(times, dtype=float)
+        if times.size != self.j0.size:
+            return None
+        ext = _extended(mesh, T, self.span)
+        if not (np.array_equal(np.searchsorted(ext, times - self.tau, side="right"), self.j0)
+                and np.array_equal(np.searchsorted(ext, times, side="left"), self.j1)
+                and self.j0.min(initial=1) >= 1 and self.j1.max(initial=0) < ext.size):
+            return None
+        basis, n, ia = self.basis, self.n, self.ia
+        gz, gw = basis.gauss(basis.q)
+        C, j = self.inner
+        lo, h = ext[j], ext[j + 1] - ext[j]
+        Ce, je = self.ends
+        a, b = ext[je], ext[je + 1]
+        le, he = np.maximum(a, times[Ce] - self.tau), np.minimum(b, times[Ce])
+        x = np.concatenate([lo[:, None] + h[:, None] * gz[None, :],
+                            le[:, None] + (he - le)[:, None] * gz[None, :]])       # (k, q)
+        z = ((x[C.size:] - a[:, None]) / (b - a)[:, None]).ravel()
+        S = times[self.C, None] - x
+        W = np.concatenate([h, he - le])[:, None] * gw[None, :]
+        H = np.asarray(self.kernel(S.ravel())).reshape(S.shape + (ia.size,))
+        WH = W[:, :, None] * H                                                # (k, q, entries)
+        ends = (Ce.size, gz.size, basis.m + 1)
+        G = self._sparse(WH, self.B, basis.values(z).reshape(ends))
+        if slope_of is None:
+            return G, None
+        # the T derivative (1 / T) int s H(s) u'(t - s) ds: the same pattern with s H and B'
+        D = self._sparse(WH * S[:, :, None], self.Bd, basis.derivatives(z).reshape(ends),
+                         np.concatenate([h, b - a]))
+        return G, (D @ np.asarray(slope_of, dtype=float).ravel()).reshape(times.size, n) / T
+
+    def _sparse(self, WH: np.ndarray, B: np.ndarray, Be: np.ndarray,
+                h: np.ndarray | None = None) -> sp.csr_matrix:
+        """The matrix of the kept pattern with the entries sum_r WH[p, r, e] B[p, r, k] (B the
+        inner pieces' shared (q, m + 1), Be the end pieces' own), each piece's over h[p]."""
+        C = self.inner[0]
+        k, (q, m1), e = C.size, B.shape, WH.shape[2]
+        val = np.concatenate([(WH[:k].transpose(0, 2, 1).reshape(-1, q) @ B).reshape(k, e, m1),
+                              np.einsum("kqe,kqm->kem", WH[k:], Be)])   # (k, entries, m + 1)
+        if h is not None:
+            val /= h[:, None, None]
+        return sp.csr_matrix((np.bincount(self.slot, val.ravel(), minlength=self.indices.size),
+                              self.indices, self.indptr), shape=self.shape)
+
+
+def _span(times: np.ndarray, tau: float, pts: np.ndarray, T: float) -> tuple[int, int]:
+    """The periods lo .. hi whose mesh points (``pts`` shifted by k T) cover the memories of the
+    times, with one to spare at each end (:func:`crossings`)."""
+    return (math.floor((times.min() - tau - pts[-1]) / T) - 1,
+            math.floor((times.max() - pts[0]) / T) + 1)
+
+
+def _extended(mesh: np.ndarray, T: float, span: tuple[int, int]) -> np.ndarray:
+    """One period's mesh points (without T) repeated every T over the periods of ``span``,
+    sorted."""
+    return (np.asarray(mesh[:-1], dtype=float)[None, :]
+            + T * np.arange(span[0], span[1] + 1)[:, None]).ravel()
 
 # The far cells of an exponential sum by separated factors: delay_matrix's G for a kernel whose
 # far part is an exponential sum H(s) = Re sum_j e^(lambda_j s) F_j (F_j = C_j - i D_j,

@@ -20,6 +20,7 @@ phase condition's row by differences).
 """
 from __future__ import annotations
 
+import functools
 import warnings
 from collections import OrderedDict
 from collections.abc import Callable
@@ -33,9 +34,9 @@ import scipy.sparse.linalg as sla
 from ..._solver import Solver
 from ..core.model import FD_STEP, ManyRhs
 from .fold import Fold, exp_sum, fold_of, folding
-from .mesh import (STEEP, Basis, Kernel, Locator, Near, _monomials, delay_matrix,
-                   delay_matrix_separable, folded_matrix, history_locator, history_rows,
-                   interval_of, periodic_locator, point_matrix)
+from .mesh import (STEEP, Basis, DelayPlan, Kernel, Locator, Near, _monomials,
+                   delay_matrix, delay_matrix_separable, folded_matrix, history_locator,
+                   history_rows, interval_of, periodic_locator, point_matrix)
 from .signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
 from ..core.newton import Converge, NewtonOptions, Search, ShootingError, newton_loop
 
@@ -100,6 +101,7 @@ class Terms:
         self.H = Kernel(self._far, near_part(solver), kernel_jumps(jumps, self.tau),
                         rate if rate * self.tau > STEEP else 0.0)
         self._delays: OrderedDict[tuple, tuple] = OrderedDict()
+        self._plans: OrderedDict[tuple, DelayPlan] = OrderedDict()
         self._kept: dict[str, tuple[tuple, np.ndarray]] = {}
         #: Whether a periodic orbit's delay integral is folded onto one period (an exponential
         #: sum; :mod:`dmi.analysis.collocation.fold`).
@@ -127,9 +129,14 @@ class Terms:
         folds (:meth:`folded`), the folded kernel H_T over [0, T] (near part included), its later
         periods' tail over [0, delta] with a near part, and with ``slope_of`` the moment's period
         derivative; else over the whole memory."""
+        f = self.folded(T)
+        if loc is None and f is None:
+            got = self._planned(np.asarray(times, dtype=float), np.asarray(mesh, dtype=float), T,
+                                basis, rows, slope_of)
+            if got is not None:
+                return got
         if loc is None:
             loc = periodic_locator(mesh, basis.m)
-        f = self.folded(T)
         if f is None:
             return delay_matrix(times, self.tau, mesh, T, self.H, loc, basis, self.n, rows,
                                 pattern=self.pattern, slope_of=slope_of)
@@ -152,6 +159,28 @@ class Terms:
                                    breaks=np.asarray(f.jumps), pattern=pattern,
                                    slope_of=slope_of)[1]
         return G, dT
+
+    def _planned(self, times: np.ndarray, mesh: np.ndarray, T: float, basis: Basis, rows: int,
+                 slope_of: np.ndarray | None) -> tuple[sp.csr_matrix, np.ndarray | None] | None:
+        """delay_matrix's (G, T derivative) by a :class:`~.mesh.DelayPlan` (one kept for each
+        count of times, mesh size and basis, made anew where its crossings no longer fit); None
+        for a kernel with a near part, jumps or grading."""
+        H = self.H
+        if H.near is not None or H.jumps or H.grading > 0:
+            return None
+        key = (times.size, mesh.size, type(basis), basis.m, basis.q, rows)
+        plan = self._plans.get(key)
+        got = plan.matrix(times, mesh, T, slope_of) if plan is not None else None
+        if got is None:
+            plan = DelayPlan(times, mesh, self.tau, T, self._entries, basis, self.n, rows,
+                             self.pattern)
+            got = plan.matrix(times, mesh, T, slope_of)     # None: no memory in the span
+            self._plans[key] = plan
+            if len(self._plans) > DELAY_CACHE:
+                self._plans.popitem(last=False)
+        else:
+            self._plans.move_to_end(key)
+        return got
 
     def memory_delay(self, times: np.ndarray, mesh: np.ndarray, T: float, loc: Locator,
                      basis: Basis, rows: int) -> sp.csr_matrix:
@@ -303,6 +332,15 @@ class Terms:
     def has_kernel(self) -> bool:
         """Whether the model has a kernel."""
         return self.kind != ""
+
+    def _entries(self, s: np.ndarray) -> np.ndarray:
+        """The entries of H(s) in :attr:`pattern` (P, entries), row by row, at the lags s (P,)
+        (past a near part's delta)."""
+        ia, ib = np.nonzero(self.pattern)
+        if self.kind == "exp":
+            a, b, C, D = self.terms  # type: ignore[misc]
+            return exp_sum(s, a, b, C[:, ia, ib], D[:, ia, ib])
+        return self._far(s)[:, ia, ib]
 
     def _far(self, s: np.ndarray) -> np.ndarray:
         """H(s) (P, n, n) at the lags s (P,) (past a near part's delta): an exponential sum in
@@ -688,13 +726,24 @@ def collocation_matrices(basis: Basis, h: np.ndarray, n: int, rows: int, periodi
     """(E, D): u and u' (d/dt) at the m Gauss points of each of the L intervals of lengths h
     (P = L m points, (P n, rows n) each) from the node rows (interval i's nodes i m .. i m + m,
     wrapped mod L m when ``periodic``): the basis at the Gauss points, the same for every
-    interval, with the derivative's over h_i; each row's m + 1 entries written in place."""
-    m, L = basis.m, h.size
+    interval, with the derivative's over h_i; each row's m + 1 entries written in place (E and
+    D's pattern kept for each layout, D's values divided by h anew)."""
+    E, D, per = _collocation_pattern(basis, h.size, n, rows, periodic)
+    D = D.copy()
+    D.data /= np.repeat(h, per)
+    return E, D
+
+
+@functools.lru_cache(maxsize=16)
+def _collocation_pattern(basis: Basis, L: int, n: int, rows: int, periodic: bool
+                         ) -> tuple[sp.csr_matrix, sp.csr_matrix, int]:
+    """(E, D for intervals of length 1, the stored entries an interval) of
+    :func:`collocation_matrices` (E read-only: shared by every caller)."""
+    m = basis.m
     gz = basis.gauss()[0]
     P = L * m
-    i = np.repeat(np.arange(L), m)
     g = np.tile(np.arange(m), L)
-    cols = i[:, None] * m + np.arange(m + 1)[None, :]
+    cols = np.repeat(np.arange(L), m)[:, None] * m + np.arange(m + 1)[None, :]
     if periodic:
         cols %= L * m
     index = np.broadcast_to(cols[:, None, :] * n + np.arange(n)[None, :, None],
@@ -702,14 +751,15 @@ def collocation_matrices(basis: Basis, h: np.ndarray, n: int, rows: int, periodi
     ptr = np.arange(0, P * n * (m + 1) + 1, m + 1)
     shape = (P * n, rows * n)
     ev = np.broadcast_to(basis.values(gz)[g][:, None, :], (P, n, m + 1)).ravel()
-    dv = np.broadcast_to((basis.derivatives(gz)[g] / h[i][:, None])[:, None, :],
-                         (P, n, m + 1)).ravel()
+    dv = np.broadcast_to(basis.derivatives(gz)[g][:, None, :], (P, n, m + 1)).ravel()
     E = sp.csr_matrix((ev, index, ptr.copy()), shape=shape)
     D = sp.csr_matrix((dv, index.copy(), ptr), shape=shape)
     if periodic and L < 2:               # one interval: its first and last node are one row
         E.sum_duplicates()
         D.sum_duplicates()
-    return E, D
+    for a in (E.data, E.indices, E.indptr):
+        a.setflags(write=False)
+    return E, D, D.nnz // L
 
 
 def fu_points(fu: np.ndarray, tc: np.ndarray, loc: Locator, basis: Basis, rows: int

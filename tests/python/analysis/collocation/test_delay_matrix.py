@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from dmi.analysis.collocation.mesh import (Basis, delay_matrix, history_locator, history_rows,
-                                           periodic_locator)
+from dmi.analysis.collocation.mesh import (Basis, DelayPlan, delay_matrix, history_locator,
+                                           history_rows, periodic_locator)
 
 M, Q, N = 4, 5, 2
 PATTERN = np.array([[False, True], [True, False]])
@@ -111,3 +111,49 @@ def test_history_locator_on_its_own_past_mesh() -> None:
     for c, t in enumerate(times):
         want = reference(t, tau, p, cuts)
         assert np.max(np.abs(got[c] - want)) < 1e-13 * max(1.0, np.max(np.abs(want)))
+
+
+
+@pytest.mark.parametrize("tau", [0.05, 0.7, 2.3])
+def test_plan_follows_the_mesh(tau: float) -> None:
+    """DelayPlan (the pieces kept while no crossing enters or leaves a memory) made on one mesh
+    and used on meshes that scale with T (an autonomous orbit's Newton iterates: by 1e-6 and 1e-3
+    relative) or whose points 3..5 move by 1e-3 of the smallest interval (switching times
+    moving), the times each mesh's Gauss points: against quad (tau = 0.05 inside one interval for
+    some times); its T derivative (node values fixed in theta = t / T) against central
+    differences of quad's integrals (Richardson); a move that brings a crossing into a memory
+    does not fit."""
+    T0, L = 1.3, 9
+    grid = mesh_of(L, 1.0, 1)
+    U = np.random.default_rng(2).standard_normal((L * M, N))
+    gz = Basis(M, Q).gauss()[0]
+
+    def times(mesh: np.ndarray) -> np.ndarray:
+        return (mesh[:-1, None] + np.diff(mesh)[:, None] * gz[None, :]).ravel()[::3]
+
+    def integrals(mesh: np.ndarray) -> np.ndarray:
+        T = mesh[-1]
+
+        def u(t: float) -> np.ndarray:
+            i = min(int(np.searchsorted(mesh, t % T, side="right")) - 1, L - 1)
+            rows = (i * M + np.arange(M + 1)) % (L * M)
+            return lagrange(mesh[i], mesh[i + 1] - mesh[i], U[rows], t % T)
+        cuts = (mesh[:, None] + T * np.arange(-4, 3)[None, :]).ravel()
+        return np.array([reference(t, tau, u, cuts) for t in times(mesh)])
+
+    ia, ib = np.nonzero(PATTERN)
+    plan = DelayPlan(times(T0 * grid), T0 * grid, tau, T0, lambda s: kernel(s)[:, ia, ib],
+                     Basis(M, Q), N, L * M, PATTERN)
+    moved = T0 * grid
+    moved[3:6] += 1e-3 * np.min(np.diff(moved))
+    for mesh in (T0 * grid, T0 * (1 + 1e-6) * grid, T0 * (1 - 1e-3) * grid, moved):
+        G, _ = plan.matrix(times(mesh), mesh, mesh[-1])
+        want = integrals(mesh)
+        assert np.max(np.abs((G @ U.ravel()).reshape(-1, N) - want)) < 1e-13 * np.max(np.abs(want))
+
+    def central(step: float) -> np.ndarray:
+        return (integrals((T0 + step) * grid) - integrals((T0 - step) * grid)) / (2 * step)
+    fd = (4.0 * central(5e-5 * T0) - central(1e-4 * T0)) / 3.0     # Richardson: O(step^4)
+    dT = plan.matrix(times(T0 * grid), T0 * grid, T0, slope_of=U)[1]
+    assert np.max(np.abs(dT - fd)) < 1e-8 * np.max(np.abs(fd))
+    assert plan.matrix(times(1.3 * T0 * grid), 1.3 * T0 * grid, 1.3 * T0) is None
