@@ -48,9 +48,11 @@ def exp_sum(s: np.ndarray, a: np.ndarray, b: np.ndarray, C: np.ndarray, D: np.nd
             ) -> np.ndarray:
     """sum_j e^(a_j s) (C_j cos b_j s + D_j sin b_j s) (P, n, n) at the lags s (P,) (C, D:
     (k, n, n); or any (k, ...): then (P, ...), e.g. the entries of a pattern); no cos / sin when
-    every b is 0."""
+    every b is 0, a constant where every a is 0 too)."""
     s = np.asarray(s, dtype=float)
     k, shape = a.size, (-1,) + C.shape[1:]
+    if not np.any(b) and not np.any(a):
+        return np.broadcast_to(np.sum(C, axis=0), (s.size,) + C.shape[1:]).copy()
     e = np.exp(np.outer(s, a))
     if not np.any(b):
         return (e @ C.reshape(k, -1)).reshape(shape)
