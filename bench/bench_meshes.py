@@ -9,7 +9,9 @@
 # level: the orbit on the mesh, the halved mesh from its solution (transfer) and from the start,
 # the merged mesh.  Then the refinement to several tol (eps = 1, degree 4; eps = 10, degree 6): its
 # counted (coarser) mesh against the smallest sufficient one of a scan of intervals = L and their
-# ratio, its true error and estimate; and (not --small) the estimate by degree elevation on one mesh: the orbit of
+# ratio, its true error and estimate; and (not --small) the period's errors on nested levels and
+# their local orders (eps = 1, degree 4: why a two-level estimate of one order cannot be both never
+# below and within 10 x), and the estimate by degree elevation on one mesh: the orbit of
 # degree 6 against 7 and 8 on the same mesh, re-equidistributed 1 to 3 times, and the halved mesh.
 # Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_meshes.py [--small]
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
@@ -111,7 +113,9 @@ def main() -> None:
     if a.small:
         refinements(o2, ref2, 6, (1e-8,), (44, 48, 56))
         return
-    refinements(o1, ref1, 4, (1e-8, 1e-10), (12, 14, 16, 18, 20, 22, 24, 28, 32, 36))
+    refinements(o1, ref1, 4, (1e-6, 1e-7, 1e-8, 1e-10),
+                (6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 28, 32, 36))
+    nested_rows(o1, ref1, 4, (8, 10, 12, 16, 18, 20, 24, 32))
     refinements(o2, ref2, 6, (1e-7, 1e-8, 1e-9), (40, 44, 48, 50, 52, 56, 60))
     print("same mesh, degree 6 against 7 and 8 (errors of the period; the mesh "
           "equidistributed k times at L intervals): 6 | 7 | 8 | |x6 - x8| / |err 6| | 6 on 2L")
@@ -136,6 +140,32 @@ def refinements(o, ref, m: int, tols: tuple, scan: tuple) -> None:
               f"true {true:.2e}, estimate {e.errors['period']:.2e} ({e.errors['period'] / true:.3g}"
               f" x); CPU {cpu:.2f} s; smallest sufficient L {enough}, with its estimate within "
               f"tol {shown}; counted / sufficient {ratio}", flush=True)
+
+
+def nested_rows(o, ref, m: int, sizes: tuple) -> None:
+    """The period's errors on the three nested levels (L / 2, L, 2 L, as collocate(o,
+    intervals=L) makes them) and the local orders between them; then what a rule of one order
+    for the finer level's error (|d2| / (2^q - 1)) gives: never below the true error only with
+    q at most the least order seen, and then up to 2^(largest - least) above it."""
+    terms = Terms(build(o.make, o.p))
+    sig, b0 = read_signature(o.u, o.h, terms.alpha, terms.lo, terms.hi)
+    print(f"nested levels, degree {m}: L | period errors on L/2, L, 2L | local orders "
+          "(L/2 to L, L to 2L) | steady")
+    seen = []
+    for L in sizes:
+        lay = Layout(m, terms.n, sig, [], True, o.period, carried(terms, sig))
+        lay, x1 = first_solve(o, terms, lay, b0, max(8, L // 2), "bench")
+        c, f = adapt.levels(lay, terms, x1, reference(lay, x1), L, True, 1e-10, "bench")
+        e = [s.T - ref.period for s in (c.coarser, c, f)]
+        q = [float(np.log2(abs(e[0] / e[1]))), float(np.log2(abs(e[1] / e[2])))]
+        seen.append(q[1])
+        steady = adapt.level_error(c, f)[2] is not None
+        print(f"{L:3d} | {e[0]:+.2e} {e[1]:+.2e} {e[2]:+.2e} | {q[0]:.1f} {q[1]:.1f} | "
+              f"{'yes' if steady else 'no'}", flush=True)
+    lo, hi = min(seen), max(seen)
+    print(f"local order of the finer pair: {lo:.1f} to {hi:.1f} (theory {2 * m}); one order "
+          f"never below the true error: q <= {lo:.1f}, over it up to {2 ** (hi - lo):.3g} x",
+          flush=True)
 
 
 def degree_rows(o, ref, L: int, m: int) -> None:
