@@ -201,6 +201,8 @@ CONSTANT_CACHES = {
     ("analysis.collocation.mesh", "_monomials"): "the Lagrange basis' coefficients by its degree",
     ("analysis.collocation.mesh", "_jacobi"): "Gauss-Jacobi nodes and weights by (q, beta)",
     ("analysis.collocation.mesh", "_legendre"): "Gauss-Legendre nodes and weights by q",
+    ("analysis.collocation.system", "_collocation_pattern"): "the collocation matrices' pattern "
+    "by basis and mesh size (E read-only)",
 }
 #: Memos kept inside an object that the problem's cache itself holds (the collocation's Terms of
 #: one p, cached by CollocationDiscretisation's Problem): per problem already, by way of it;
@@ -208,6 +210,8 @@ CONSTANT_CACHES = {
 INSIDE_CACHED = {
     ("analysis.collocation.system", "_delays"): "the delay integral's matrices by mesh",
     ("analysis.collocation.system", "_kept"): "f and its Jacobian at the last iterate",
+    ("analysis.collocation.system", "_plans"): "the delay matrix's plans by count of times, "
+    "mesh size and basis",
 }
 
 
