@@ -566,18 +566,26 @@ class DelayPlan:
                      np.concatenate([self.j0 - 1, self.j1[two] - 1]))
         self.C = np.concatenate([C, self.ends[0]])
         jj = np.concatenate([j, self.ends[1]])
-        self.node = ((jj % L)[:, None] * m + np.arange(m + 1)[None, :]) % (L * m)
-        # the sparse pattern: each (piece, entry, basis polynomial)'s slot in G's data
+        node = ((jj % L)[:, None] * m + np.arange(m + 1)[None, :]) % (L * m)
+        #: The quadrature nodes of the plan (its memory: 10 bytes each with one pattern entry,
+        #: 28 with four, at m = 4).
+        self.nodes = self.C.size * gz.size
+        # the sparse pattern: each (piece, entry, basis polynomial)'s slot in G's data; the
+        # index arrays read-only (every G of the plan shares them)
         e = self.ia.size
         r = np.broadcast_to((self.C[:, None] * n + self.ia[None, :])[:, :, None],
                             (self.C.size, e, m + 1))
-        c = self.node[:, None, :] * n + self.ib[None, :, None]
+        c = node[:, None, :] * n + self.ib[None, :, None]
         self.shape = (P * n, rows * n)
-        flat, self.slot = np.unique((r * self.shape[1] + c).ravel(), return_inverse=True)
-        self.indices = (flat % self.shape[1]).astype(np.int32)
-        self.indptr = np.zeros(self.shape[0] + 1, np.int32)
+        flat, slot = np.unique((r * self.shape[1] + c).ravel(), return_inverse=True)
+        idx = np.int32 if max(self.shape[1], slot.size) < 2 ** 31 - 1 else np.int64
+        self.slot = slot.astype(idx)
+        self.indices = (flat % self.shape[1]).astype(idx)
+        self.indptr = np.zeros(self.shape[0] + 1, idx)
         np.cumsum(np.bincount(flat // self.shape[1], minlength=self.shape[0]),
                   out=self.indptr[1:])
+        for a in (self.indices, self.indptr):
+            a.setflags(write=False)
 
     def matrix(self, times: np.ndarray, mesh: np.ndarray, T: float,
                slope_of: np.ndarray | None = None

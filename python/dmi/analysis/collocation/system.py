@@ -51,6 +51,10 @@ FLOOR_ITERATIONS = 3
 #: orbit without switches) builds its matrix once, and the monodromy operator's once for its
 #: multipliers and eigenfunction.
 DELAY_CACHE = 6
+#: Quadrature nodes of the delay plans a Terms keeps, in all (10 bytes each with one kernel
+#: entry, 28 with four: at most 112 MB at n = 2 with a full kernel; measured, m = 4); a larger
+#: plan is used once and not kept.
+PLAN_NODES = 4e6
 #: The step of f's t derivative in the switching times' columns of a forced orbit (five-point
 #: differences), relative to the period: truncation and rounding both near 1e-13 relative for a
 #: forcing of the orbit's own frequency.
@@ -163,8 +167,9 @@ class Terms:
     def _planned(self, times: np.ndarray, mesh: np.ndarray, T: float, basis: Basis, rows: int,
                  slope_of: np.ndarray | None) -> tuple[sp.csr_matrix, np.ndarray | None] | None:
         """delay_matrix's (G, T derivative) by a :class:`~.mesh.DelayPlan` (one kept for each
-        count of times, mesh size and basis, made anew where its crossings no longer fit); None
-        for a kernel with a near part, jumps or grading."""
+        count of times, mesh size, basis and rows: the last DELAY_CACHE, PLAN_NODES quadrature
+        nodes in all at most; made anew where its crossings no longer fit); None for a kernel
+        with a near part, jumps or grading."""
         H = self.H
         if H.near is not None or H.jumps or H.grading > 0:
             return None
@@ -174,10 +179,13 @@ class Terms:
         if got is None:
             plan = DelayPlan(times, mesh, self.tau, T, self._entries, basis, self.n, rows,
                              self.pattern)
-            got = plan.matrix(times, mesh, T, slope_of)     # None: no memory in the span
-            self._plans[key] = plan
-            if len(self._plans) > DELAY_CACHE:
-                self._plans.popitem(last=False)
+            got = plan.matrix(times, mesh, T, slope_of)
+            self._plans.pop(key, None)
+            if plan.nodes <= PLAN_NODES:
+                self._plans[key] = plan
+                while (len(self._plans) > DELAY_CACHE
+                       or sum(q.nodes for q in self._plans.values()) > PLAN_NODES):
+                    self._plans.popitem(last=False)
         else:
             self._plans.move_to_end(key)
         return got
