@@ -507,16 +507,15 @@ def point_matrix(times: np.ndarray, locate: Locator, basis: Basis, mesh: np.ndar
     return sp.csr_matrix((val.ravel(), (r.ravel(), cc.ravel())), shape=(P * n, rows * n))
 
 
-
-
 class DelayPlan:
     """delay_matrix's G (and its T derivative) on a periodic orbit, for a kernel without a near
     part, jumps or grading (the pieces are cut at the mesh crossings alone), made for the
     crossings inside each time's memory and used again while they stay the same (Newton's
     iterates: the mesh moves with T and the switching times, no crossing enters or leaves a
     memory).  The pieces between two crossings keep their basis values (the Gauss nodes of their
-    interval); each call takes the kernel at the lags, the memory's two end pieces of each time
-    anew, and one sum into the kept sparse pattern.
+    interval); each call takes the kernel at the lags, the end pieces of each time's memory anew
+    (cut by t - tau and by t; one where no crossing lies inside it), and one sum into the kept
+    sparse pattern.
 
     Parameters
     ----------
@@ -649,6 +648,7 @@ def _extended(mesh: np.ndarray, T: float, span: tuple[int, int]) -> np.ndarray:
     sorted."""
     return (np.asarray(mesh[:-1], dtype=float)[None, :]
             + T * np.arange(span[0], span[1] + 1)[:, None]).ravel()
+
 
 # The far cells of an exponential sum by separated factors: delay_matrix's G for a kernel whose
 # far part is an exponential sum H(s) = Re sum_j e^(lambda_j s) F_j (F_j = C_j - i D_j,
