@@ -439,8 +439,7 @@ def crossings(times: np.ndarray, tau: float, pts: np.ndarray, T: float
     """The mesh points ``pts`` (one period's, without T) repeated every T over the memories of
     the ``times`` (sorted), and for each time the index of the first one past t - tau and of the
     first one at or past t: (ext, j0, j1)."""
-    lo, hi = _span(times, tau, pts, T)
-    ext = (pts[None, :] + T * np.arange(lo, hi + 1)[:, None]).ravel()   # sorted
+    ext = _extended(pts, T, _span(times, tau, pts, T))
     j0 = np.searchsorted(ext, times - tau, side="right")
     j1 = np.searchsorted(ext, times, side="left")
     return ext, j0, j1
@@ -546,9 +545,7 @@ class DelayPlan:
         times = np.asarray(times, dtype=float)
         L, m, P = mesh.size - 1, basis.m, times.size
         self.span = _span(times, tau, mesh[:-1], T)
-        ext = _extended(mesh, T, self.span)
-        self.j0 = np.searchsorted(ext, times - tau, side="right")
-        self.j1 = np.searchsorted(ext, times, side="left")
+        _, self.j0, self.j1 = crossings(times, tau, mesh[:-1], T)
         self.tau, self.kernel, self.basis, self.n = float(tau), kernel, basis, n
         self.ia, self.ib = np.nonzero(pattern)
         gz = basis.gauss(basis.q)[0]
@@ -594,7 +591,7 @@ class DelayPlan:
         times = np.asarray(times, dtype=float)
         if times.size != self.j0.size:
             return None
-        ext = _extended(mesh, T, self.span)
+        ext = _extended(mesh[:-1], T, self.span)
         if not (np.array_equal(np.searchsorted(ext, times - self.tau, side="right"), self.j0)
                 and np.array_equal(np.searchsorted(ext, times, side="left"), self.j1)
                 and self.j0.min(initial=1) >= 1 and self.j1.max(initial=0) < ext.size):
@@ -643,10 +640,10 @@ def _span(times: np.ndarray, tau: float, pts: np.ndarray, T: float) -> tuple[int
             math.floor((times.max() - pts[0]) / T) + 1)
 
 
-def _extended(mesh: np.ndarray, T: float, span: tuple[int, int]) -> np.ndarray:
-    """One period's mesh points (without T) repeated every T over the periods of ``span``,
-    sorted."""
-    return (np.asarray(mesh[:-1], dtype=float)[None, :]
+def _extended(pts: np.ndarray, T: float, span: tuple[int, int]) -> np.ndarray:
+    """One period's mesh points ``pts`` (without T) repeated every T over the periods of
+    ``span``, sorted."""
+    return (np.asarray(pts, dtype=float)[None, :]
             + T * np.arange(span[0], span[1] + 1)[:, None]).ravel()
 
 
