@@ -12,8 +12,11 @@
 # ratio, its true error and estimate; and (not --small) the period's errors on nested levels and
 # their local orders (eps = 1, degree 4: why a two-level estimate of one order cannot be both never
 # below and within 10 x), and the estimate by degree elevation on one mesh: the orbit of
-# degree 6 against 7 and 8 on the same mesh, re-equidistributed 1 to 3 times, and the halved mesh.
-# Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_meshes.py [--small]
+# degree 6 against 7 and 8 on the same mesh, re-equidistributed 1 to 3 times, and the halved mesh;
+# --scan: the estimate against the true error on every mesh of a scan of nine orbits and degrees;
+# --never-below: the refinements with an estimate never below |d2| / 7 (what such a rule costs).
+# Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_meshes.py
+#        [--small | --scan | --never-below]
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -46,13 +49,13 @@ def van_der_pol(eps: float):
     return make
 
 
-def scheme_orbit(eps: float, T: float, steps: int) -> da.Orbit:
+def scheme_orbit(eps: float, T: float, steps: int, a: float = 0.5) -> da.Orbit:
     make = van_der_pol(eps)
-    s = make(0.5, h=T / steps)
+    s = make(a, h=T / steps)
     s.set_history(lambda t: np.array([2.0, 0.0]))
     s.init()
     s.advance(40 * steps)
-    return da.periodic_orbit(make, 0.5, None, s, guess_period=T, steps=steps, multipliers=0)
+    return da.periodic_orbit(make, a, None, s, guess_period=T, steps=steps, multipliers=0)
 
 
 def timed_solve(lay, terms, x0, ref):
@@ -95,11 +98,25 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=(
         "Prints, for meshes of van der Pol with a distributed delay (eps = 1 and its relaxation "
         "oscillation at eps = 10), the true errors of the period and a multiplier, the two- and "
-        "three-level estimates over them and the Newton cost of each level; then the refinement "
-        "to tol = 1e-8 at eps = 10."))
+        "three-level estimates over them and the Newton cost of each level; then the "
+        "refinements to several tol against the least sufficient mesh (--small: 1e-8 at eps = "
+        "10)."))
     ap.add_argument("--small", action="store_true",
                     help="one mesh of each orbit (for CI; default: all meshes)")
+    ap.add_argument("--scan", action="store_true",
+                    help="only the period's estimate against its true error on every mesh of "
+                         "a scan of nine orbits and degrees (about 2 minutes)")
+    ap.add_argument("--never-below", action="store_true",
+                    help="only the refinements with an estimate never below |d2| / 7 (the "
+                         "finer pair's order at least 3) and the next mesh aimed at it: what a "
+                         "never-below rule costs (the library's own rule is not changed)")
     a = ap.parse_args()
+    if a.scan:
+        scan()
+        return
+    if a.never_below:
+        never_below()
+        return
     print("mesh | period: true | 2-level/true | 3-level/true | mu_2: true | 2-level/true | "
           "3-level/true | Newton its, CPU: on L | 2L from L | 2L from start | L/2 from L")
     o1 = scheme_orbit(1.0, 6.0, 600)
@@ -113,10 +130,11 @@ def main() -> None:
     if a.small:
         refinements(o2, ref2, 6, (1e-8,), (44, 48, 56))
         return
-    refinements(o1, ref1, 4, (1e-6, 1e-7, 1e-8, 1e-10),
-                (6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 28, 32, 36))
+    refinements(o1, ref1, 4, (1e-5, 1e-6, 1e-7, 1e-8, 1e-10),
+                tuple(range(6, 25)) + (28, 32, 36))
     nested_rows(o1, ref1, 4, (8, 10, 12, 16, 18, 20, 24, 32))
-    refinements(o2, ref2, 6, (1e-7, 1e-8, 1e-9), (40, 44, 48, 50, 52, 56, 60))
+    refinements(o2, ref2, 6, (1e-5, 1e-6, 1e-7, 1e-8, 1e-9),
+                (28, 30, 32, 36, 40, 44, 48, 50, 52, 56, 60))
     print("same mesh, degree 6 against 7 and 8 (errors of the period; the mesh "
           "equidistributed k times at L intervals): 6 | 7 | 8 | |x6 - x8| / |err 6| | 6 on 2L")
     for L in (60, 70, 80, 90):
@@ -187,6 +205,89 @@ def degree_rows(o, ref, L: int, m: int) -> None:
         err = [T - ref.period for T in Ts]
         print(f"L = {L}, k = {k}: {err[0]:+.2e} | {err[1]:+.2e} | {err[2]:+.2e} | "
               f"{abs(Ts[0] - Ts[2]) / abs(err[0]):.3g} | {err[3]:+.2e}", flush=True)
+
+
+
+def never_below() -> None:
+    """The refinements of both orbits with the period's estimate at least |d2| / 7 (never below
+    the true error where the finer pair's order is at least 3: the least the scan shows) and
+    the next mesh aimed at that estimate, the library's functions wrapped in this process."""
+    plain = adapt.extrapolated
+
+    def floored(x0, x1, x2, most):
+        d2 = np.abs(np.asarray(x1) - np.asarray(x2))
+        return np.maximum(plain(x0, x1, x2, most), d2 / 7.0)
+    adapt.extrapolated = floored
+    adapt.accepted = lambda m, autonomous, asymptotic=False: 7.0 if autonomous else 1.0
+    o1 = scheme_orbit(1.0, 6.0, 600)
+    ref1 = da.collocate(o1, intervals=40, degree=8, multipliers=0)
+    refinements(o1, ref1, 4, (1e-6, 1e-7, 1e-8, 1e-10), tuple(range(6, 41)))
+    o2 = scheme_orbit(10.0, 16.0, 1000)
+    ref2 = da.collocate(o2, intervals=80, degree=8, multipliers=0)
+    refinements(o2, ref2, 6, (1e-6, 1e-7, 1e-8, 1e-9),
+                (28, 30, 32, 36, 40, 44, 48, 50, 52, 56, 60, 64, 68, 72))
+
+
+#: The scan's orbits: eps, a (0: no memory), the scheme's period guess and steps, degree, the
+#: meshes L.
+SCAN = ((1.0, 0.0, 6.0, 600, 4, range(6, 48)), (1.0, 0.5, 6.0, 600, 4, range(6, 48)),
+        (1.0, 0.5, 6.0, 600, 5, range(4, 36)), (1.0, 0.5, 6.0, 600, 6, range(4, 30)),
+        (1.0, 0.2, 6.0, 600, 4, range(6, 40)), (0.5, 0.5, 6.0, 600, 4, range(6, 40)),
+        (10.0, 0.5, 16.0, 1000, 4, range(24, 120, 4)),
+        (10.0, 0.5, 16.0, 1000, 5, range(20, 100, 4)), (10.0, 0.5, 16.0, 1000, 6, range(16, 72, 2)))
+
+
+def scan() -> None:
+    """The period's estimate of the orbit returned for intervals = L against its true error
+    (degree 8 on 96 or 160 intervals; compared where above ten times that reference's own
+    uncertainty, at least 3e-12, and 100 ulp) on every L of SCAN: how many meshes, how many
+    with steady levels (Richardson's estimate), the estimate / true range of each kind, and
+    every estimate below its true error with the orders its levels show; for each orbit, the
+    range of the local orders of the levels' coarser pair (L/2 to L) and finer pair (L to 2L)."""
+    below, counts = [], {"steady": [], "two-level": []}
+    for eps, p, T, steps, m, sizes in SCAN:
+        o = scheme_orbit(eps, T, steps, p)
+        big = 80 if eps >= 10 else 48
+        ref = da.collocate(o, intervals=big, degree=8, multipliers=0)
+        gap = max(abs(da.collocate(o, intervals=big + big // 5, degree=8,
+                                   multipliers=0).period - ref.period), 3e-12)
+        terms = Terms(build(o.make, o.p))
+        sig, b0 = read_signature(o.u, o.h, terms.alpha, terms.lo, terms.hi)
+        orders = []
+        for L in sizes:
+            lay = Layout(m, terms.n, sig, [], True, o.period, carried(terms, sig))
+            try:
+                lay, x1 = first_solve(o, terms, lay, b0, max(8, L // 2), "bench")
+                c, f = adapt.levels(lay, terms, x1, reference(lay, x1), L, True, 1e-10, "bench")
+            except (ValueError, RuntimeError):     # Newton fails on a coarse relaxation mesh
+                continue
+            true = abs(f.T - ref.period)
+            if c.coarser is None or true < 10 * gap or true < 100 * np.spacing(f.T):
+                continue
+            est = adapt.estimate(c, f)["period"]
+            steady = adapt.level_error(c, f)[2] is not None
+            counts["steady" if steady else "two-level"].append(est / true)
+            e = [s.T - ref.period for s in (c.coarser, c, f)]
+            q = (float(np.log2(abs(e[0] / e[1]))), float(np.log2(abs(e[1] / e[2]))))
+            orders.append(q)
+            if est < true:
+                below.append(f"eps = {eps:g}, a = {p:g}, degree {m}, L = {L}: estimate / true "
+                             f"{est / true:.3g}, the levels' orders {q[0]:.1f} (L/2 to L) and "
+                             f"{q[1]:.1f} (L to 2L)")
+        q = np.array(orders).reshape(-1, 2)
+        print(f"eps = {eps:g}, a = {p:g}, degree {m}: {len(q)} meshes, local orders L/2 to L "
+              f"{q[:, 0].min():.1f} to {q[:, 0].max():.1f}, L to 2L {q[:, 1].min():.1f} to "
+              f"{q[:, 1].max():.1f} (theory {2 * m})", flush=True)
+    for kind, r in counts.items():
+        r = np.array(r)
+        if r.size:
+            print(f"{kind}: {r.size} meshes, estimate / true {r.min():.3g} to {r.max():.3g}, "
+                  f"within [1, 10] {int(np.sum((r >= 1) & (r <= 10)))}, below 1 "
+                  f"{int(np.sum(r < 1))}")
+    print("below the true error:" if below else "no estimate below its true error")
+    for line in below:
+        print("  " + line)
+
 
 if __name__ == "__main__":
     main()

@@ -16,9 +16,10 @@ package (:mod:`dmi.analysis.collocation.collocate` and the collocated branch use
   extrapolation where the three levels are steady (:func:`extrapolated`).  An autonomous orbit's
   two solutions are compared after aligning their phase (:func:`aligned`): its phase is free, and
   a shift along a steep orbit is no error of its shape.
-- The refinement (:func:`levels`): equidistribute, solve on three levels (:func:`two_levels`),
-  grow the mesh until the estimate meets tol (:func:`level_error`), with its stopping rules and
-  the cost check of the delay integral (:func:`check_cost`).
+- The refinement (:func:`levels`): from a first mesh that depends on tol
+  (:func:`first_intervals`), equidistribute, solve on three levels (:func:`two_levels`), grow
+  the mesh until the estimate meets tol (:func:`level_error`), with its stopping rules and the
+  cost check of the delay integral (:func:`check_cost`).
 
 May import: :mod:`.mesh`, :mod:`.signature`, :mod:`.system` (no module of the package above them).
 """
@@ -50,6 +51,11 @@ LEAST_RICHARDSON = 1.0
 ROUGH = 1e-3
 #: The Richardson estimate's safety factor over |d2| / (2^q - 1).
 SAFETY = 8.0
+#: The first round's intervals where tol <= FIRST_TOL (van der Pol of degree 4 meets 1e-8 there);
+#: a looser tol starts coarser (:func:`first_intervals`), at least at LEAST_FIRST.
+FIRST_INTERVALS = 16
+FIRST_TOL = 1e-8
+LEAST_FIRST = 8
 #: Quadrature nodes of the delay integral at most on one mesh (about 100 bytes each): a memory
 #: spanning many periods (tau / T large) or a very fine mesh is refused before it is built.
 MAX_DELAY_NODES = 2e7
@@ -359,12 +365,25 @@ def next_intervals(L: int, d: float, aim: float, expected: int, seen: float | No
     return min(MAX_INTERVALS, max(L + 2, math.ceil(L * min(grow, 8.0))))
 
 
+def first_intervals(tol: float, m: int, pieces: int) -> int:
+    """The first round's intervals: FIRST_INTERVALS at tol <= FIRST_TOL; for a looser tol
+    fewer, as the period's error falls (h^(2 m): L^(2 m) tol kept; a forced orbit's amplitudes,
+    h^(m+1), would allow fewer still), at least LEAST_FIRST; at least 4 for each of the
+    signature's ``pieces``."""
+    L = FIRST_INTERVALS * min(1.0, (FIRST_TOL / tol) ** (1.0 / (2 * m)))
+    return max(LEAST_FIRST, round(L), 4 * pieces)
+
+
 def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bool,
             tol: float, what: str, capped: list[float] | None = None
             ) -> tuple[Solved, Solved]:
     """The orbit on L intervals equidistributed (``fixed``) or refined until the estimate is
     below tol, and on that mesh halved: (coarser, finer), the coarser with its own ``coarser``
     (its mesh merged; None where that solve failed).
+
+    A first round on fewer than FIRST_INTERVALS intervals (a loose tol) whose solve fails, or
+    whose levels differ by more than ROUGH (relative) in the period or the amplitudes, is done
+    again on FIRST_INTERVALS: too coarse to aim the next mesh from.
 
     The refinement stops with a ValueError that names the estimate reached and its mesh when
     the estimate is at its floor (FLOOR times the period or the amplitudes, at least 1), when
@@ -378,10 +397,21 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
     name = "period" if autonomous else "amplitudes"
     for _ in range(MAX_ROUNDS):
         lay2 = lay.with_fractions(adapted(lay, x, L))
-        c, f = two_levels(lay2, terms, (lay, x), ref, what)
+        early = not fixed and last is None and L < FIRST_INTERVALS   # a loose tol's start
+        try:
+            c, f = two_levels(lay2, terms, (lay, x), ref, what)
+        except ShootingError:
+            if not early:
+                raise
+            L = FIRST_INTERVALS                    # too coarse for Newton: the usual start
+            continue
         if fixed:
             return c, f
         d, two, seen = level_error(c, f)
+        if early and two > ROUGH * max(1.0, abs(f.T) if autonomous else
+                                       float(np.max(np.abs(f.amplitude)))):
+            L = FIRST_INTERVALS                    # too coarse to steer the next mesh
+            continue
         if d <= tol:
             return c, f
         size = f.T if autonomous else float(np.max(np.abs(f.amplitude)))

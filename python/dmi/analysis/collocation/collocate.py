@@ -42,7 +42,7 @@ import math
 
 import numpy as np
 
-from .adapt import Solved, check_cost, equidistribute, estimate, levels
+from .adapt import Solved, check_cost, equidistribute, estimate, first_intervals, levels
 from .floquet import multipliers as floquet
 from .mend import check_inequalities, mend
 from .orbit import EquationOrbit, equation_orbit
@@ -136,7 +136,7 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     sig, b0 = read_signature(orbit.u, orbit.h, terms.alpha, terms.lo, terms.hi)
     lay = Layout(m, terms.n, sig, [], bool(orbit.autonomous), T0, carried(terms, sig))
     bounds = lay.bounds(b0, T0)
-    L = int(intervals) if intervals is not None else max(16, 4 * (bounds.size - 1))
+    L = int(intervals) if intervals is not None else first_intervals(tol, m, bounds.size - 1)
     L0 = max(8, 2 * (bounds.size - 1), L // 2)        # a first solve: the indicator, the phase
     what = f"collocation of the orbit at p = {orbit.p!r}"
     lay, x1 = first_solve(orbit, terms, lay, b0, L0, what)
