@@ -165,7 +165,8 @@ def first_solve(orbit: Orbit, terms: Terms, lay: Layout, b0: np.ndarray, L0: int
     """The first solve from the scheme's orbit, on L0 equal intervals of each piece; where
     Newton fails there (a steep orbit, a relaxation oscillation, on too coarse a mesh), again on
     2 L0 and 4 L0 intervals, a smooth orbit's graded to the scheme's speed |u'| (equal arc
-    length).  ShootingError saying what to do when the last fails too."""
+    length) and, where both fail, equal (a scheme's period far off the equation's puts its
+    steep stretches elsewhere).  ShootingError saying what to do when the last fails too."""
     T0 = float(orbit.period)
     t_s = np.asarray(orbit.t, dtype=float)
     U = np.asarray(orbit.u, dtype=float)
@@ -175,15 +176,18 @@ def first_solve(orbit: Orbit, terms: Terms, lay: Layout, b0: np.ndarray, L0: int
         tt = np.mod(t, T0)
         return np.column_stack([np.interp(tt, t_s, U[:, i]) for i in range(terms.n)])
     failed: ShootingError | None = None
-    for k, count in enumerate((L0, 2 * L0, 4 * L0)):
+    finer = (2 * L0, 4 * L0)
+    tries = [(L0, False)] + [(c, lay.S == 0) for c in finer] + (
+        [(c, False) for c in finer] if lay.S == 0 else [])
+    for count, graded in tries:
         try:
             check_cost(terms, lay.m, count, T0, "the first mesh", "check orbit.period (a "
                        "period far shorter than the memory is no orbit of the scheme)")
         except ValueError:
             if failed is None:
                 raise
-            break                                 # no finer first mesh: the first failure
-        if k > 0 and lay.S == 0:
+            continue                              # too fine a first mesh: the next try
+        if graded:
             speed = np.linalg.norm(np.diff(U, axis=0), axis=1) / np.diff(t_s)
             fractions = [equidistribute(t_s, speed, count) / T0]
         else:

@@ -13,7 +13,7 @@ import pytest
 
 import dmi
 from dmi import analysis as da
-from dmi.analysis.collocation.adapt import estimate, levels
+from dmi.analysis.collocation.adapt import FLOOR, estimate, levels
 from dmi.analysis.collocation.collocate import first_solve
 from dmi.analysis.collocation.floquet import multipliers as floquet
 from dmi.analysis.collocation.signature import read_signature
@@ -81,6 +81,20 @@ def test_relaxation_at_a_loose_tol_starts_again_where_its_first_round_is_too_coa
                       if abs(da.collocate(o, degree=6, intervals=L, multipliers=0).period
                              - ref.period) + ref.errors["period"] <= 1e-5)
     assert e.intervals // 2 <= 1.5 * sufficient, (e.intervals, sufficient)
+
+
+def test_relaxation_at_the_default_settings(relaxation):
+    """Degree 4 and tol = 1e-10 from the scheme's orbit of 1000 steps (its period 16.4, the
+    equation's 13.6): the first solve on 16 intervals graded to the scheme's speed fails, on 16
+    equal ones it converges; the refinement ends within its estimate, which has its floor
+    (FLOOR times the period, 1.4e-10) above tol."""
+    o, ref = relaxation
+    assert abs(o.period - ref.period) > 2.0
+    e = da.collocate(o, multipliers=0)
+    true = abs(e.period - ref.period)
+    # 5.5e-11 measured against an estimate at its floor, 1.36e-10; the reference's two levels
+    # agree to 1.3e-11
+    assert true + 2e-11 <= e.errors["period"] <= max(1e-10, FLOOR * e.period)
 
 
 def three_levels(o: da.Orbit, L: int, m: int, count: int):
