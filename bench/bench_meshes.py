@@ -132,7 +132,7 @@ def main() -> None:
         refinements(o2, ref2, 6, (1e-8,), (44, 48, 56))
         return
     refinements(o1, ref1, 4, (1e-5, 1e-6, 1e-7, 1e-8, 1e-10),
-                tuple(range(6, 25)) + (28, 32, 36))
+                tuple(range(4, 25)) + (28, 32, 36))
     nested_rows(o1, ref1, 4, (8, 10, 12, 16, 18, 20, 24, 32))
     refinements(o2, ref2, 6, (1e-5, 1e-6, 1e-7, 1e-8, 1e-9),
                 (28, 30, 32, 36, 40, 44, 48, 50, 52, 56, 60))

@@ -43,6 +43,12 @@ FLOOR = 1e-11
 #: The least observed order of the refinement's estimate (log of its fall over log of the mesh's
 #: growth): below it the estimate has stopped falling.
 LEAST_ORDER = 0.5
+#: An estimate that has not fallen (LEAST_ORDER) says it has stopped falling only over a growth
+#: of the mesh of LEAST_GROWTH at least and below CONDITIONED (relative to the period or the
+#: amplitudes, at least 1); a smaller step (aimed at a steady round that did not come) or a larger
+#: estimate (not yet in the asymptotic range) grows again by the expected order.
+LEAST_GROWTH = 1.2
+CONDITIONED = 1e-6
 #: The least observed order (from three levels) a Richardson estimate trusts.
 LEAST_RICHARDSON = 1.0
 #: The coarsest of three levels farther than this (relative, at least 1) from the middle one
@@ -365,13 +371,14 @@ def next_intervals(L: int, d: float, aim: float, expected: int, seen: float | No
     return min(MAX_INTERVALS, max(L + 2, math.ceil(L * min(grow, 8.0))))
 
 
-def first_intervals(tol: float, m: int, pieces: int) -> int:
-    """The first round's intervals: FIRST_INTERVALS at tol <= FIRST_TOL; for a looser tol
-    fewer, as the period's error falls (h^(2 m): L^(2 m) tol kept; a forced orbit's amplitudes,
-    h^(m+1), would allow fewer still), at least LEAST_FIRST; at least 4 for each of the
-    signature's ``pieces``."""
+def first_intervals(tol: float, m: int, pieces: int, steep: bool) -> int:
+    """The first round's intervals: FIRST_INTERVALS at tol <= FIRST_TOL or for a ``steep``
+    orbit (its first solve needed more than its first mesh); for a looser tol fewer, as the
+    period's error falls (h^(2 m): L^(2 m) tol kept; a forced orbit's amplitudes, h^(m+1), would
+    allow fewer still), at least LEAST_FIRST; at least 4 for each of the signature's
+    ``pieces``."""
     L = FIRST_INTERVALS * min(1.0, (FIRST_TOL / tol) ** (1.0 / (2 * m)))
-    return max(LEAST_FIRST, round(L), 4 * pieces)
+    return max(FIRST_INTERVALS if steep else LEAST_FIRST, round(L), 4 * pieces)
 
 
 def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bool,
@@ -381,13 +388,13 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
     below tol, and on that mesh halved: (coarser, finer), the coarser with its own ``coarser``
     (its mesh merged; None where that solve failed).
 
-    A first round on fewer than FIRST_INTERVALS intervals (a loose tol) whose solve fails, or
-    whose levels differ by more than ROUGH (relative) in the period or the amplitudes, is done
-    again on FIRST_INTERVALS: too coarse to aim the next mesh from.
+    A first round on fewer than FIRST_INTERVALS intervals (a loose tol) whose solve fails is
+    done again on FIRST_INTERVALS.
 
     The refinement stops with a ValueError that names the estimate reached and its mesh when
     the estimate is at its floor (FLOOR times the period or the amplitudes, at least 1), when
-    it has stopped falling (an observed order below LEAST_ORDER), when the observed order (1
+    it has stopped falling (an observed order below LEAST_ORDER over a growth of LEAST_GROWTH at
+    least, below CONDITIONED), when the observed order (1
     with an undeclared jump of the kernel, ``capped``) says tol needs more than MAX_INTERVALS
     intervals, when the next mesh's delay integral would exceed MAX_DELAY_NODES, or after
     MAX_ROUNDS rounds."""
@@ -397,24 +404,19 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
     name = "period" if autonomous else "amplitudes"
     for _ in range(MAX_ROUNDS):
         lay2 = lay.with_fractions(adapted(lay, x, L))
-        early = not fixed and last is None and L < FIRST_INTERVALS   # a loose tol's start
         try:
             c, f = two_levels(lay2, terms, (lay, x), ref, what)
         except ShootingError:
-            if not early:
+            if fixed or last is not None or L >= FIRST_INTERVALS:
                 raise
-            L = FIRST_INTERVALS                    # too coarse for Newton: the usual start
+            L = FIRST_INTERVALS                    # a loose tol's first mesh too coarse
             continue
         if fixed:
             return c, f
         d, two, seen = level_error(c, f)
-        if early and two > ROUGH * max(1.0, abs(f.T) if autonomous else
-                                       float(np.max(np.abs(f.amplitude)))):
-            L = FIRST_INTERVALS                    # too coarse to steer the next mesh
-            continue
+        size = f.T if autonomous else float(np.max(np.abs(f.amplitude)))
         if d <= tol:
             return c, f
-        size = f.T if autonomous else float(np.max(np.abs(f.amplitude)))
         floor = FLOOR * max(1.0, size)
         reached = (f"the estimated error of the {name} is {d:.3g} at {f.lay.L} intervals of "
                    f"degree {lay.m}")
@@ -428,7 +430,10 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
         q = 1.0 if capped else None
         if last is not None and last[1] > 0:       # the observed order of the two levels' d
             q = math.log(last[1] / two) / math.log(L / last[0])
-            if q < LEAST_ORDER:
+            if q < LEAST_ORDER and (L < LEAST_GROWTH * last[0] or
+                                    two > CONDITIONED * max(1.0, size)):
+                q = 1.0 if capped else None        # too small a step or too early to tell
+            elif q < LEAST_ORDER:
                 raise ValueError(f"collocate: the estimated error has stopped falling: the "
                                  f"two levels' difference was {last[1]:.3g} at {2 * last[0]} "
                                  f"intervals and is {two:.3g}; {reached} "

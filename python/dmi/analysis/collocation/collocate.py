@@ -136,10 +136,13 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     sig, b0 = read_signature(orbit.u, orbit.h, terms.alpha, terms.lo, terms.hi)
     lay = Layout(m, terms.n, sig, [], bool(orbit.autonomous), T0, carried(terms, sig))
     bounds = lay.bounds(b0, T0)
-    L = int(intervals) if intervals is not None else first_intervals(tol, m, bounds.size - 1)
-    L0 = max(8, 2 * (bounds.size - 1), L // 2)        # a first solve: the indicator, the phase
+    pieces = bounds.size - 1
+    L = int(intervals) if intervals is not None else 4 * pieces
+    L0 = max(8, 2 * pieces, L // 2)        # a first solve: the indicator, the phase
     what = f"collocation of the orbit at p = {orbit.p!r}"
     lay, x1 = first_solve(orbit, terms, lay, b0, L0, what)
+    if intervals is None:
+        L = first_intervals(tol, m, pieces, lay.L > L0)
     ref = reference(lay, x1) if orbit.autonomous else None
     count = int(multipliers)
     for attempt in range(MENDS + 1):
