@@ -162,6 +162,18 @@ def refinements(o, ref, m: int, tols: tuple, scan: tuple) -> None:
               f"tol {shown}; counted / sufficient {ratio}", flush=True)
 
 
+def nested(o, terms, sig, b0, L: int, m: int, T_ref: float):
+    """The three nested levels that collocate(o, intervals=L) solves (L / 2, L, 2 L), the
+    period's errors on them against T_ref and the local orders between them: (c, f, e, q)."""
+    lay = Layout(m, terms.n, sig, [], True, o.period, carried(terms, sig))
+    lay, x1 = first_solve(o, terms, lay, b0, max(8, L // 2), "bench")
+    c, f = adapt.levels(lay, terms, x1, reference(lay, x1), L, True, 1e-10, "bench")
+    if c.coarser is None:
+        return c, f, None, None
+    e = [s.T - T_ref for s in (c.coarser, c, f)]
+    return c, f, e, (float(np.log2(abs(e[0] / e[1]))), float(np.log2(abs(e[1] / e[2]))))
+
+
 def nested_rows(o, ref, m: int, sizes: tuple) -> None:
     """The period's errors on the three nested levels (L / 2, L, 2 L, as collocate(o,
     intervals=L) makes them) and the local orders between them; then what a rule of one order
@@ -173,11 +185,7 @@ def nested_rows(o, ref, m: int, sizes: tuple) -> None:
           "(L/2 to L, L to 2L) | steady")
     seen = []
     for L in sizes:
-        lay = Layout(m, terms.n, sig, [], True, o.period, carried(terms, sig))
-        lay, x1 = first_solve(o, terms, lay, b0, max(8, L // 2), "bench")
-        c, f = adapt.levels(lay, terms, x1, reference(lay, x1), L, True, 1e-10, "bench")
-        e = [s.T - ref.period for s in (c.coarser, c, f)]
-        q = [float(np.log2(abs(e[0] / e[1]))), float(np.log2(abs(e[1] / e[2])))]
+        c, f, e, q = nested(o, terms, sig, b0, L, m, ref.period)
         seen.append(q[1])
         steady = adapt.level_error(c, f)[2] is not None
         print(f"{L:3d} | {e[0]:+.2e} {e[1]:+.2e} {e[2]:+.2e} | {q[0]:.1f} {q[1]:.1f} | "
@@ -257,20 +265,16 @@ def scan() -> None:
         sig, b0 = read_signature(o.u, o.h, terms.alpha, terms.lo, terms.hi)
         orders = []
         for L in sizes:
-            lay = Layout(m, terms.n, sig, [], True, o.period, carried(terms, sig))
             try:
-                lay, x1 = first_solve(o, terms, lay, b0, max(8, L // 2), "bench")
-                c, f = adapt.levels(lay, terms, x1, reference(lay, x1), L, True, 1e-10, "bench")
+                c, f, _, q = nested(o, terms, sig, b0, L, m, ref.period)
             except (ValueError, RuntimeError):     # Newton fails on a coarse relaxation mesh
                 continue
             true = abs(f.T - ref.period)
-            if c.coarser is None or true < 10 * gap or true < 100 * np.spacing(f.T):
+            if q is None or true < 10 * gap or true < 100 * np.spacing(f.T):
                 continue
             est = adapt.estimate(c, f)["period"]
             steady = adapt.level_error(c, f)[2] is not None
             counts["steady" if steady else "two-level"].append(est / true)
-            e = [s.T - ref.period for s in (c.coarser, c, f)]
-            q = (float(np.log2(abs(e[0] / e[1]))), float(np.log2(abs(e[1] / e[2]))))
             orders.append(q)
             if est < true:
                 below.append(f"eps = {eps:g}, a = {p:g}, degree {m}, L = {L}: estimate / true "
