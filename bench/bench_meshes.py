@@ -254,7 +254,7 @@ def scan() -> None:
     with steady levels (Richardson's estimate), the estimate / true range of each kind, and
     every estimate below its true error with the orders its levels show; for each orbit, the
     range of the local orders of the levels' coarser pair (L/2 to L) and finer pair (L to 2L)."""
-    below, counts = [], {"steady": [], "two-level": []}
+    below, counts = [], {"steady": [], "not steady (checked)": []}
     for eps, p, T, steps, m, sizes in SCAN:
         o = scheme_orbit(eps, T, steps, p)
         big = 80 if eps >= 10 else 48
@@ -274,7 +274,7 @@ def scan() -> None:
                 continue
             est = adapt.estimate(c, f)["period"]
             steady = adapt.level_error(c, f)[2] is not None
-            counts["steady" if steady else "two-level"].append(est / true)
+            counts["steady" if steady else "not steady (checked)"].append(est / true)
             orders.append(q)
             if est < true:
                 below.append(f"eps = {eps:g}, a = {p:g}, degree {m}, L = {L}: estimate / true "

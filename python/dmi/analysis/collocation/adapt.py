@@ -13,7 +13,9 @@ package (:mod:`dmi.analysis.collocation.collocate` and the collocated branch use
   halved (:func:`halved`) or every pair merged (:func:`merged`); the difference of their period,
   amplitudes, multipliers and u is the finer one's error estimate; with a third level (the
   coarser's mesh merged, its ``coarser``) the period, amplitudes and multipliers by Richardson's
-  extrapolation where the three levels are steady (:func:`extrapolated`).  An autonomous orbit's
+  extrapolation where the three levels are steady (:func:`extrapolated`); where they are not, or
+  the orbit is steep, the finer against its own mesh halved (:func:`checked`, CHECK_SAFETY times
+  their difference: the period and amplitudes).  An autonomous orbit's
   two solutions are compared after aligning their phase (:func:`aligned`): its phase is free, and
   a shift along a steep orbit is no error of its shape.
 - The refinement (:func:`levels`): from a first mesh that depends on tol
@@ -62,6 +64,13 @@ SAFETY = 8.0
 FIRST_INTERVALS = 16
 FIRST_TOL = 1e-8
 LEAST_FIRST = 8
+#: The check's safety factor over |x_f - x_F| (:func:`checked`): never below the finer level's
+#: error where the check level's is at most half of it (an order of 1 from 2 L to 4 L).
+CHECK_SAFETY = 2.0
+#: A refinement's round is checked only where its two levels differ by at most CHECK_RANGE
+#: times tol (their difference is the coarser level's error, at most 2^(2 m) times the finer's;
+#: up to 1800 times measured): a round farther off cannot meet tol.
+CHECK_RANGE = 1e4
 #: Quadrature nodes of the delay integral at most on one mesh (about 100 bytes each): a memory
 #: spanning many periods (tau / T large) or a very fine mesh is refused before it is built.
 MAX_DELAY_NODES = 2e7
@@ -189,8 +198,9 @@ def extrema(lay: Layout, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 class Solved:
     """A solution on one layout, with its derived quantities: b, T, the amplitudes and the
-    multipliers ``mu`` (given; none by default), and ``coarser``, the solution on its mesh with
-    pairs merged (the estimate's third level; None unless :func:`two_levels` set it)."""
+    multipliers ``mu`` (given; none by default), ``coarser``, the solution on its mesh with
+    pairs merged (the estimate's third level; None unless :func:`two_levels` set it), and
+    ``check``, the solution on its mesh halved (:func:`checked`; None unless set)."""
 
     def __init__(self, lay: Layout, x: np.ndarray, mu: np.ndarray | None = None):
         self.lay, self.x = lay, x
@@ -199,6 +209,7 @@ class Solved:
         self.amplitude = 0.5 * (hi - lo)
         self.mu = np.empty(0, complex) if mu is None else mu
         self.coarser: Solved | None = None
+        self.check: Solved | None = None
 
 
 def _match(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -234,9 +245,10 @@ def estimate(c: Solved, f: Solved, reached: float = 0.0,
     """The finer's error estimate (each plus ``reached``, the accuracy of a coarse solve
     stopped at its rounding floor, in the units of x): the differences of the two levels, or
     with a third level (``coarser``, default ``c.coarser``: c's mesh with pairs merged) the
-    period, amplitudes and multipliers (where the coarser has them) by :func:`extrapolated`.
-    ``u`` compares the two at equal phase theta = t / T, an autonomous orbit's after aligning
-    its phase (:func:`aligned`)."""
+    period, amplitudes and multipliers (where the coarser has them) by :func:`extrapolated`;
+    where f has its ``check`` (f's mesh halved, :func:`checked`), the period and amplitudes
+    from it: CHECK_SAFETY |f - check|.  ``u`` compares c and f at equal phase theta = t / T,
+    an autonomous orbit's after aligning its phase (:func:`aligned`)."""
     theta = np.linspace(0.0, 1.0, 40 * f.lay.L, endpoint=False)
     fine = evaluate(f.lay, f.x, theta * f.T)
     shift = aligned(c, theta[::5], fine[::5]) if f.lay.autonomous else 0.0    # 8 an interval
@@ -252,6 +264,10 @@ def estimate(c: Solved, f: Solved, reached: float = 0.0,
             mc = c.mu[np.argmin(np.abs(f.mu[:, None] - c.mu[None, :]), axis=1)]
             mg = g.mu[np.argmin(np.abs(mc[:, None] - g.mu[None, :]), axis=1)]
             errors["multipliers"] = extrapolated(mg, mc, f.mu, 2 * m)
+    F = f.check
+    if F is not None:
+        errors["period"] = CHECK_SAFETY * abs(f.T - F.T)
+        errors["amplitude"] = CHECK_SAFETY * np.abs(f.amplitude - F.amplitude)
     for k in errors:
         errors[k] = errors[k] + reached
     return with_floor(errors, f.T, f.amplitude, f.mu,
@@ -315,25 +331,43 @@ def two_levels(lay: Layout, terms: Terms, start: tuple[Layout, np.ndarray], ref:
     return c, Solved(fine, xf)
 
 
+def checked(f: Solved, terms: Terms, ref: Any) -> Solved | None:
+    """The orbit on f's mesh halved (4 L where f has 2 L), solved from f's solution (its
+    first factorisation usually serves every Newton step: f is its error away), so that |f -
+    check| is f's error to a factor 1 +- (the check's error / f's); None where Newton fails
+    there or its delay integral would exceed MAX_DELAY_NODES."""
+    fine = f.lay.with_fractions(halved(f.lay.fractions))
+    try:
+        check_cost(terms, f.lay.m, fine.L, f.T, "", "")
+        return Solved(fine, solve(fine, terms, transfer(f.lay, f.x, fine), ref)[0])
+    except (ShootingError, ValueError):
+        return None
+
+
 def level_error(c: Solved, f: Solved) -> tuple[float, float, float | None]:
     """The estimated error of f's period (an autonomous orbit) or largest amplitude error (a
-    forced one), the two levels' difference of it, and the order its three levels show (None:
-    two levels, or not steady)."""
-    two = (abs(c.T - f.T) if f.lay.autonomous
-           else float(np.max(np.abs(c.amplitude - f.amplitude))))
-    if c.coarser is None:
-        return two, two, None
+    forced one): CHECK_SAFETY times its difference to f's ``check`` where f has one, else from
+    the three levels; the two levels' difference of it, and the order its three levels show
+    (None: two levels, or not steady)."""
+    def size(a: Solved, b: Solved) -> float:
+        return (abs(a.T - b.T) if f.lay.autonomous
+                else float(np.max(np.abs(a.amplitude - b.amplitude))))
+    two = size(c, f)
+    d, seen = two, None
     g = c.coarser
-    if f.lay.autonomous:
-        x = (g.T, c.T, f.T)
-        d = float(extrapolated(*x, 2 * f.lay.m))
-    else:
-        i = int(np.argmax(np.abs(c.amplitude - f.amplitude)))
-        x = (g.amplitude[i], c.amplitude[i], f.amplitude[i])
-        d = float(np.max(extrapolated(g.amplitude, c.amplitude, f.amplitude, f.lay.m + 1)))
-    d1, d2 = abs(x[0] - x[1]), abs(x[1] - x[2])
-    steady = d < d2 and d2 > 0
-    return d, two, (math.log2(d1 / d2) if steady else None)
+    if g is not None:
+        if f.lay.autonomous:
+            x = (g.T, c.T, f.T)
+            d = float(extrapolated(*x, 2 * f.lay.m))
+        else:
+            i = int(np.argmax(np.abs(c.amplitude - f.amplitude)))
+            x = (g.amplitude[i], c.amplitude[i], f.amplitude[i])
+            d = float(np.max(extrapolated(g.amplitude, c.amplitude, f.amplitude, f.lay.m + 1)))
+        d1, d2 = abs(x[0] - x[1]), abs(x[1] - x[2])
+        seen = math.log2(d1 / d2) if d < d2 and d2 > 0 else None
+    if f.check is not None:
+        d = CHECK_SAFETY * size(f, f.check)
+    return d, two, seen
 
 
 def accepted(m: int, autonomous: bool, asymptotic: bool = False) -> float:
@@ -382,11 +416,15 @@ def first_intervals(tol: float, m: int, pieces: int, steep: bool) -> int:
 
 
 def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bool,
-            tol: float, what: str, capped: list[float] | None = None
+            tol: float, what: str, capped: list[float] | None = None, steep: bool = False
             ) -> tuple[Solved, Solved]:
     """The orbit on L intervals equidistributed (``fixed``) or refined until the estimate is
     below tol, and on that mesh halved: (coarser, finer), the coarser with its own ``coarser``
-    (its mesh merged; None where that solve failed).
+    (its mesh merged; None where that solve failed), the finer with its ``check`` (its mesh
+    halved, :func:`checked`) where the orbit is ``steep`` (its first solve needed a finer mesh)
+    or the three levels are not steady (no Richardson estimate), in a refinement only where
+    the two levels differ by at most CHECK_RANGE tol: the estimate that stops the refinement
+    is then the check's; the next mesh is aimed by the three levels' estimate.
 
     A first round on fewer than FIRST_INTERVALS intervals (a loose tol) whose solve fails is
     done again on FIRST_INTERVALS.
@@ -411,9 +449,13 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
                 raise
             L = FIRST_INTERVALS                    # a loose tol's first mesh too coarse
             continue
+        d, two, seen = level_error(c, f)
+        steer = d                                  # the three levels' estimate aims the mesh
+        if (steep or seen is None) and (fixed or two <= CHECK_RANGE * tol):
+            f.check = checked(f, terms, ref)
+            d = level_error(c, f)[0]
         if fixed:
             return c, f
-        d, two, seen = level_error(c, f)
         size = f.T if autonomous else float(np.max(np.abs(f.amplitude)))
         if d <= tol:
             return c, f
@@ -464,7 +506,7 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
                                 None, lay.m, 1.0)
         else:
             aim = tol if seen is not None or unsteady else tol * accepted(lay.m, autonomous)
-            L2 = next_intervals(L, d, aim, expected, seen, q, lay.m, 1.2)
+            L2 = next_intervals(L, steer, aim, expected, seen, q, lay.m, 1.2)
         unsteady = seen is None
         last = (L, two)
         L = L2

@@ -20,7 +20,9 @@ third level, with every pair of intervals merged; the difference of the two fine
 amplitudes, multipliers and u is the error estimate of the finer one (which is returned), or,
 where the three levels converge steadily, Richardson's estimate from the order they show
 (:func:`dmi.analysis.collocation.adapt.estimate`): an upper estimate while the convergence is in
-its asymptotic range.  With ``intervals=None``
+its asymptotic range; where they do not, or the orbit is steep (its first solve needed a finer
+mesh), the period's and amplitudes' estimate is twice the finer level's difference to the orbit
+on its mesh halved (:func:`dmi.analysis.collocation.adapt.checked`).  With ``intervals=None``
 the mesh is equidistributed (AUTO, COLSYS: equal integrals of |u^(m+1)|^(1 / (m + 1)),
 estimated from the jumps of u^(m) between intervals) and refined until the estimate of the
 period (an autonomous orbit; it converges as h^(2m) on smooth orbits) or of the amplitudes (a
@@ -141,12 +143,14 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     L0 = max(8, 2 * pieces, L // 2)        # a first solve: the indicator, the phase
     what = f"collocation of the orbit at p = {orbit.p!r}"
     lay, x1 = first_solve(orbit, terms, lay, b0, L0, what)
+    steep = lay.L > L0                     # the first solve needed a finer mesh
     if intervals is None:
-        L = first_intervals(tol, m, pieces, lay.L > L0)
+        L = first_intervals(tol, m, pieces, steep)
     ref = reference(lay, x1) if orbit.autonomous else None
     count = int(multipliers)
     for attempt in range(MENDS + 1):
-        c, f = levels(lay, terms, x1, ref, L, intervals is not None, tol, what, capped)
+        c, f = levels(lay, terms, x1, ref, L, intervals is not None, tol, what, capped,
+                      steep)
         if orbit.autonomous:
             fell_to_equilibrium(f.lay, f.x, orbit)
         bad = check_inequalities(f.lay, terms, f.x, 1e-9 * max(1.0, float(np.max(np.abs(f.x)))))
