@@ -251,10 +251,11 @@ def scan() -> None:
     """The period's estimate of the orbit returned for intervals = L against its true error
     (degree 8 on 96 or 160 intervals; compared where above ten times that reference's own
     uncertainty, at least 3e-12, and 100 ulp) on every L of SCAN: how many meshes, how many
-    with steady levels (Richardson's estimate), the estimate / true range of each kind, and
+    checked (levels not steady or a graded mesh: the finer level against its mesh halved) and
+    how many with Richardson's estimate, the estimate / true range of each kind, and
     every estimate below its true error with the orders its levels show; for each orbit, the
     range of the local orders of the levels' coarser pair (L/2 to L) and finer pair (L to 2L)."""
-    below, counts = [], {"steady": [], "not steady (checked)": []}
+    below, counts = [], {"Richardson (steady, not graded)": [], "checked": []}
     for eps, p, T, steps, m, sizes in SCAN:
         o = scheme_orbit(eps, T, steps, p)
         big = 80 if eps >= 10 else 48
@@ -263,7 +264,7 @@ def scan() -> None:
                                    multipliers=0).period - ref.period), 3e-12)
         terms = Terms(build(o.make, o.p))
         sig, b0 = read_signature(o.u, o.h, terms.alpha, terms.lo, terms.hi)
-        orders = []
+        orders, mine = [], {k: [] for k in counts}
         for L in sizes:
             try:
                 c, f, _, q = nested(o, terms, sig, b0, L, m, ref.period)
@@ -273,8 +274,9 @@ def scan() -> None:
             if q is None or true < 10 * gap or true < 100 * np.spacing(f.T):
                 continue
             est = adapt.estimate(c, f)["period"]
-            steady = adapt.level_error(c, f)[2] is not None
-            counts["steady" if steady else "not steady (checked)"].append(est / true)
+            kind = "checked" if f.check is not None else "Richardson (steady, not graded)"
+            counts[kind].append(est / true)
+            mine[kind].append(est / true)
             orders.append(q)
             if est < true:
                 below.append(f"eps = {eps:g}, a = {p:g}, degree {m}, L = {L}: estimate / true "
@@ -283,7 +285,9 @@ def scan() -> None:
         q = np.array(orders).reshape(-1, 2)
         print(f"eps = {eps:g}, a = {p:g}, degree {m}: {len(q)} meshes, local orders L/2 to L "
               f"{q[:, 0].min():.1f} to {q[:, 0].max():.1f}, L to 2L {q[:, 1].min():.1f} to "
-              f"{q[:, 1].max():.1f} (theory {2 * m})", flush=True)
+              f"{q[:, 1].max():.1f} (theory {2 * m}); "
+              + "; ".join(f"{k}: {len(r)}" + (f", {min(r):.3g} to {max(r):.3g}" if r else "")
+                          for k, r in mine.items()), flush=True)
     for kind, r in counts.items():
         r = np.array(r)
         if r.size:

@@ -14,10 +14,10 @@ package (:mod:`dmi.analysis.collocation.collocate` and the collocated branch use
   amplitudes, multipliers and u is the finer one's error estimate; with a third level (the
   coarser's mesh merged, its ``coarser``) the period, amplitudes and multipliers by Richardson's
   extrapolation where the three levels are steady (:func:`extrapolated`); where they are not, or
-  the orbit is steep, the finer against its own mesh halved (:func:`checked`, CHECK_SAFETY times
-  their difference: the period and amplitudes).  An autonomous orbit's
-  two solutions are compared after aligning their phase (:func:`aligned`): its phase is free, and
-  a shift along a steep orbit is no error of its shape.
+  the mesh is graded (GRADED: a steep orbit), the period and amplitudes from the finer against
+  its own mesh halved (:func:`checked`: CHECK_SAFETY times their difference).  An autonomous
+  orbit's two solutions are compared after aligning their phase (:func:`aligned`): its phase is
+  free, and a shift along a steep orbit is no error of its shape.
 - The refinement (:func:`levels`): from a first mesh that depends on tol
   (:func:`first_intervals`), equidistribute, solve on three levels (:func:`two_levels`), grow
   the mesh until the estimate meets tol (:func:`level_error`), with its stopping rules and the
@@ -33,7 +33,8 @@ from typing import Any
 import numpy as np
 
 from .mesh import _monomials
-from .system import Layout, Terms, evaluate, interval_counts, node_times, reference, solve
+from .system import (GRADED, Layout, Terms, evaluate, interval_counts, node_times, reference,
+                     solve)
 from ..core.newton import ShootingError
 
 #: Mesh refinement rounds at most (intervals=None).
@@ -68,9 +69,13 @@ LEAST_FIRST = 8
 #: error where the check level's is at most half of it (an order of 1 from 2 L to 4 L).
 CHECK_SAFETY = 2.0
 #: A refinement's round is checked only where its two levels differ by at most CHECK_RANGE
-#: times tol (their difference is the coarser level's error, at most 2^(2 m) times the finer's;
-#: up to 1800 times measured): a round farther off cannot meet tol.
+#: times tol (their difference is about the coarser level's error, 2^q times the finer's: up to
+#: 1800 times measured at degrees 4 to 6): a round farther off is not expected to meet tol (at
+#: worst it costs one more round).
 CHECK_RANGE = 1e4
+#: A first round whose coarsest level is farther than ROUGH from the middle one grows the mesh
+#: by this factor at most (its levels say nothing of the order).
+FAR_GROWTH = 4
 #: Quadrature nodes of the delay integral at most on one mesh (about 100 bytes each): a memory
 #: spanning many periods (tau / T large) or a very fine mesh is refused before it is built.
 MAX_DELAY_NODES = 2e7
@@ -200,7 +205,8 @@ class Solved:
     """A solution on one layout, with its derived quantities: b, T, the amplitudes and the
     multipliers ``mu`` (given; none by default), ``coarser``, the solution on its mesh with
     pairs merged (the estimate's third level; None unless :func:`two_levels` set it), and
-    ``check``, the solution on its mesh halved (:func:`checked`; None unless set)."""
+    ``check``, the solution on its mesh halved (:func:`checked`; None unless set), and
+    ``unchecked``, why a check asked for could not be solved (None)."""
 
     def __init__(self, lay: Layout, x: np.ndarray, mu: np.ndarray | None = None):
         self.lay, self.x = lay, x
@@ -210,6 +216,7 @@ class Solved:
         self.mu = np.empty(0, complex) if mu is None else mu
         self.coarser: Solved | None = None
         self.check: Solved | None = None
+        self.unchecked: str | None = None
 
 
 def _match(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -335,12 +342,17 @@ def checked(f: Solved, terms: Terms, ref: Any) -> Solved | None:
     """The orbit on f's mesh halved (4 L where f has 2 L), solved from f's solution (its
     first factorisation usually serves every Newton step: f is its error away), so that |f -
     check| is f's error to a factor 1 +- (the check's error / f's); None where Newton fails
-    there or its delay integral would exceed MAX_DELAY_NODES."""
+    there or its delay integral would need more than MAX_DELAY_NODES quadrature nodes, with
+    the reason in f's ``unchecked``."""
     fine = f.lay.with_fractions(halved(f.lay.fractions))
+    if delay_nodes(terms, f.lay.m, fine.L, f.T) > MAX_DELAY_NODES:
+        f.unchecked = (f"its delay integral would need more than MAX_DELAY_NODES = "
+                       f"{MAX_DELAY_NODES:g} quadrature nodes")
+        return None
     try:
-        check_cost(terms, f.lay.m, fine.L, f.T, "", "")
         return Solved(fine, solve(fine, terms, transfer(f.lay, f.x, fine), ref)[0])
-    except (ShootingError, ValueError):
+    except (ShootingError, ValueError) as err:   # Newton fails; a model's f not finite there
+        f.unchecked = f"{type(err).__name__}: {err}"
         return None
 
 
@@ -416,15 +428,18 @@ def first_intervals(tol: float, m: int, pieces: int, steep: bool) -> int:
 
 
 def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bool,
-            tol: float, what: str, capped: list[float] | None = None, steep: bool = False
+            tol: float, what: str, capped: list[float] | None = None
             ) -> tuple[Solved, Solved]:
     """The orbit on L intervals equidistributed (``fixed``) or refined until the estimate is
     below tol, and on that mesh halved: (coarser, finer), the coarser with its own ``coarser``
     (its mesh merged; None where that solve failed), the finer with its ``check`` (its mesh
-    halved, :func:`checked`) where the orbit is ``steep`` (its first solve needed a finer mesh)
-    or the three levels are not steady (no Richardson estimate), in a refinement only where
-    the two levels differ by at most CHECK_RANGE tol: the estimate that stops the refinement
-    is then the check's; the next mesh is aimed by the three levels' estimate.
+    halved, :func:`checked`) where the mesh is graded (``Layout.interval_ratio`` at least
+    GRADED: a steep orbit) or the three levels are not steady (no Richardson estimate), in a
+    refinement only where the two levels differ by at most CHECK_RANGE tol: the estimate that
+    stops the refinement and aims the next mesh (at tol) is then the check's (a check that
+    cannot be solved leaves the three levels' estimate and its reason in the finer's
+    ``unchecked``).  A first round of an autonomous orbit whose coarsest level is more than
+    ROUGH off the middle one grows the mesh by FAR_GROWTH at most.
 
     A first round on fewer than FIRST_INTERVALS intervals (a loose tol) whose solve fails is
     done again on FIRST_INTERVALS.
@@ -450,8 +465,8 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
             L = FIRST_INTERVALS                    # a loose tol's first mesh too coarse
             continue
         d, two, seen = level_error(c, f)
-        steer = d                                  # the three levels' estimate aims the mesh
-        if (steep or seen is None) and (fixed or two <= CHECK_RANGE * tol):
+        graded = c.lay.interval_ratio() >= GRADED
+        if (seen is None or graded) and (fixed or two <= CHECK_RANGE * tol):
             f.check = checked(f, terms, ref)
             d = level_error(c, f)[0]
         if fixed:
@@ -501,12 +516,16 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
         # accepts, without margin (not with an undeclared jump of the kernel: order 1);
         # where these levels were not steady (the first time), a difference the next
         # round's Richardson estimate accepts; else tol itself
-        if last is None and autonomous and not capped and settled(c):
+        if f.check is not None:                    # the finer level's own error, aimed at tol
+            L2 = next_intervals(L, d, tol, expected, seen, q, lay.m, 1.2)
+        elif last is None and autonomous and not capped and settled(c):
             L2 = next_intervals(L, two, tol * accepted(lay.m, True, True), expected, None,
                                 None, lay.m, 1.0)
         else:
             aim = tol if seen is not None or unsteady else tol * accepted(lay.m, autonomous)
-            L2 = next_intervals(L, steer, aim, expected, seen, q, lay.m, 1.2)
+            L2 = next_intervals(L, d, aim, expected, seen, q, lay.m, 1.2)
+        if last is None and not settled(c):       # far off: the levels say nothing of the order
+            L2 = min(L2, FAR_GROWTH * L)
         unsteady = seen is None
         last = (L, two)
         L = L2
@@ -520,13 +539,20 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
                      f"{MAX_ROUNDS}): ask a larger tol or a higher degree")
 
 
+def delay_nodes(terms: Terms, m: int, L: int, T: float) -> float:
+    """About how many quadrature nodes the delay integral on a mesh of L intervals of one
+    period T needs (0 without a kernel): L m collocation times, each with about L (tau / T +
+    1) pieces of m + 1 nodes."""
+    if not terms.has_kernel:
+        return 0.0
+    return L * m * (L * (terms.tau / T + 1.0) + 2 + len(terms.H.jumps)) * (m + 1)
+
+
 def check_cost(terms: Terms, m: int, L: int, T: float, where: str, fix: str) -> None:
     """ValueError when the delay integral on a mesh of L intervals of one period T needs more
-    than MAX_DELAY_NODES quadrature nodes: L m collocation times, each with about L (tau / T
-    + 1) pieces of m + 1 nodes; the message says where and ``fix``."""
-    if not terms.has_kernel:
-        return
-    nodes = L * m * (L * (terms.tau / T + 1.0) + 2 + len(terms.H.jumps)) * (m + 1)
+    than MAX_DELAY_NODES quadrature nodes (:func:`delay_nodes`); the message says where and
+    ``fix``."""
+    nodes = delay_nodes(terms, m, L, T)
     if nodes > MAX_DELAY_NODES:
         raise ValueError(f"collocate: the delay integral on {where} would need about "
                          f"{nodes:.3g} quadrature nodes (L = {L} intervals; the memory tau = "

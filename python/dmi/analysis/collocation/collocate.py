@@ -20,9 +20,10 @@ third level, with every pair of intervals merged; the difference of the two fine
 amplitudes, multipliers and u is the error estimate of the finer one (which is returned), or,
 where the three levels converge steadily, Richardson's estimate from the order they show
 (:func:`dmi.analysis.collocation.adapt.estimate`): an upper estimate while the convergence is in
-its asymptotic range; where they do not, or the orbit is steep (its first solve needed a finer
-mesh), the period's and amplitudes' estimate is twice the finer level's difference to the orbit
-on its mesh halved (:func:`dmi.analysis.collocation.adapt.checked`).  With ``intervals=None``
+its asymptotic range; where they do not, or the mesh is graded (a steep orbit: intervals
+within a piece GRADED = 6 times apart or more), the period's and amplitudes' estimate is twice
+the finer level's difference to the orbit on its mesh halved
+(:func:`dmi.analysis.collocation.adapt.checked`).  With ``intervals=None``
 the mesh is equidistributed (AUTO, COLSYS: equal integrals of |u^(m+1)|^(1 / (m + 1)),
 estimated from the jumps of u^(m) between intervals) and refined until the estimate of the
 period (an autonomous orbit; it converges as h^(2m) on smooth orbits) or of the amplitudes (a
@@ -41,6 +42,7 @@ collocate (use ``refine_orbit``); near cells of any other form are refused.
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 
@@ -100,6 +102,13 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
         The orbit with its period, amplitude, multipliers, stability, mesh, signature and
         estimated errors (those of the returned, finer level).
 
+    Warns
+    -----
+    CollocationWarning
+        The returned level's check (its mesh halved, asked where its levels are not steady or
+        the mesh is graded) could not be solved: the message says why, and the estimate is
+        the three levels'; a callback kernel's undeclared jump (``kernel_jumps``).
+
     Raises
     ------
     TypeError
@@ -143,14 +152,12 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     L0 = max(8, 2 * pieces, L // 2)        # a first solve: the indicator, the phase
     what = f"collocation of the orbit at p = {orbit.p!r}"
     lay, x1 = first_solve(orbit, terms, lay, b0, L0, what)
-    steep = lay.L > L0                     # the first solve needed a finer mesh
     if intervals is None:
-        L = first_intervals(tol, m, pieces, steep)
+        L = first_intervals(tol, m, pieces, lay.L > L0)
     ref = reference(lay, x1) if orbit.autonomous else None
     count = int(multipliers)
     for attempt in range(MENDS + 1):
-        c, f = levels(lay, terms, x1, ref, L, intervals is not None, tol, what, capped,
-                      steep)
+        c, f = levels(lay, terms, x1, ref, L, intervals is not None, tol, what, capped)
         if orbit.autonomous:
             fell_to_equilibrium(f.lay, f.x, orbit)
         bad = check_inequalities(f.lay, terms, f.x, 1e-9 * max(1.0, float(np.max(np.abs(f.x)))))
@@ -218,6 +225,10 @@ def first_solve(orbit: Orbit, terms: Terms, lay: Layout, b0: np.ndarray, L0: int
 def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int) -> EquationOrbit:
     """The EquationOrbit of the finer level f, with its multipliers and the coarser levels'
     (the third, where it was solved, for the multipliers' extrapolated estimate)."""
+    if f.unchecked is not None:
+        warnings.warn(f"collocate: the orbit on {f.lay.L} intervals is not checked on its mesh "
+                      f"halved ({2 * f.lay.L} intervals): {f.unchecked}; its estimate is the "
+                      "three levels'", CollocationWarning, stacklevel=3)
     if count > 0:
         c.mu = floquet(c.lay, terms, c.x, count)
         f.mu = floquet(f.lay, terms, f.x, count)
