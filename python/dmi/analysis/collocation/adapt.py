@@ -382,6 +382,20 @@ def level_error(c: Solved, f: Solved) -> tuple[float, float, float | None]:
     return d, two, seen
 
 
+def checked_round(c: Solved, f: Solved, terms: Terms, ref: Any, tol: float | None
+                  ) -> tuple[float, float, float | None]:
+    """:func:`level_error` of a round (c, f), f checked first (:func:`checked`) where its mesh
+    is graded (``Layout.interval_ratio`` at least GRADED) or its three levels are not steady,
+    and (``tol`` given: a refinement's round) its two levels differ by at most CHECK_RANGE
+    tol."""
+    d, two, seen = level_error(c, f)
+    graded = c.lay.interval_ratio() >= GRADED
+    if (seen is None or graded) and (tol is None or two <= CHECK_RANGE * tol):
+        f.check = checked(f, terms, ref)
+        d = level_error(c, f)[0]
+    return d, two, seen
+
+
 def accepted(m: int, autonomous: bool, asymptotic: bool = False) -> float:
     """How far above tol the two levels' difference of a round whose three levels were not
     steady may be aimed at: for the period (an autonomous orbit), what the next round's
@@ -464,11 +478,7 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
                 raise
             L = FIRST_INTERVALS                    # a loose tol's first mesh too coarse
             continue
-        d, two, seen = level_error(c, f)
-        graded = c.lay.interval_ratio() >= GRADED
-        if (seen is None or graded) and (fixed or two <= CHECK_RANGE * tol):
-            f.check = checked(f, terms, ref)
-            d = level_error(c, f)[0]
+        d, two, seen = checked_round(c, f, terms, ref, None if fixed else tol)
         if fixed:
             return c, f
         size = f.T if autonomous else float(np.max(np.abs(f.amplitude)))
@@ -527,8 +537,7 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
         if last is None and not settled(c):       # far off: the levels say nothing of the order
             L2 = min(L2, FAR_GROWTH * L)
         unsteady = seen is None
-        last = (L, two)
-        L = L2
+        last, L = (L, two), L2
         lay, x = f.lay, f.x
         if f.lay.L >= MAX_INTERVALS:
             break
