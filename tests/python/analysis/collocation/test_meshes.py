@@ -171,13 +171,19 @@ def test_a_check_that_cannot_be_solved_warns_and_keeps_the_three_levels(oscillat
     assert sum("not checked" in str(w.message) for w in seen) == 1      # the returned level's
 
 
-def returned_period(o: da.Orbit, L: int, m: int) -> float:
-    """The period of the orbit collocate(o, intervals=L, degree=m) returns (its levels L and 2
-    L solved as collocate solves them; the estimate's merged level and check left out)."""
+def first_solved(o: da.Orbit, L: int, m: int):
+    """(terms, layout, solution) of the first solve collocate(o, intervals=L, degree=m) makes
+    (on max(8, L / 2) intervals)."""
     terms = Terms(build(o.make, o.p))
     sig, b0 = read_signature(o.u, o.h, terms.alpha, terms.lo, terms.hi)
     lay = Layout(m, terms.n, sig, [], True, o.period, carried(terms, sig))
-    lay, x1 = first_solve(o, terms, lay, b0, max(8, L // 2), "test")
+    return (terms, *first_solve(o, terms, lay, b0, max(8, L // 2), "test"))
+
+
+def returned_period(o: da.Orbit, L: int, m: int) -> float:
+    """The period of the orbit collocate(o, intervals=L, degree=m) returns (its levels L and 2
+    L solved as collocate solves them; the estimate's merged level and check left out)."""
+    terms, lay, x1 = first_solved(o, L, m)
     new = lay.with_fractions(adapt.adapted(lay, x1, L))
     return adapt.two_levels(new, terms, (lay, x1), reference(lay, x1), "test")[1].T
 
@@ -196,10 +202,7 @@ def test_the_check_bounds_the_period_where_three_levels_are_not_steady(request, 
     assert true > 1e-9                 # 40 times the references' uncertainty (2.2e-11) at least
     assert 1.0 <= e.errors["period"] / true <= 10.0, (e.errors["period"], true)
     # the mesh is one the check serves: its levels are not steady, their estimate over 10 times
-    terms = Terms(build(o.make, o.p))
-    sig, b0 = read_signature(o.u, o.h, terms.alpha, terms.lo, terms.hi)
-    lay = Layout(m, terms.n, sig, [], True, o.period, carried(terms, sig))
-    lay, x1 = first_solve(o, terms, lay, b0, max(8, L // 2), "test")
+    terms, lay, x1 = first_solved(o, L, m)
     c, f = levels(lay, terms, x1, reference(lay, x1), L, True, 1e-10, "test")
     assert f.check is not None and abs(f.T - e.period) == 0.0
     f.check = None
@@ -209,10 +212,7 @@ def test_the_check_bounds_the_period_where_three_levels_are_not_steady(request, 
 def three_levels(o: da.Orbit, L: int, m: int, count: int):
     """The orbit on L equidistributed intervals (the levels L / 2, L, 2 L) with its multipliers
     and their errors' estimate, as collocate(o, intervals=L) makes them."""
-    terms = Terms(build(o.make, o.p))
-    sig, b0 = read_signature(o.u, o.h, terms.alpha, terms.lo, terms.hi)
-    lay = Layout(m, terms.n, sig, [], True, o.period, carried(terms, sig))
-    lay, x1 = first_solve(o, terms, lay, b0, max(8, L // 2), "test")
+    terms, lay, x1 = first_solved(o, L, m)
     c, f = levels(lay, terms, x1, reference(lay, x1), L, True, 1e-10, "test")
     assert c.coarser is not None
     for s in (c.coarser, c, f):
