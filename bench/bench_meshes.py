@@ -7,17 +7,18 @@
 # orbit returned (the finer level), the two-level difference and the three-level estimate
 # (Richardson's where the levels are steady) over it; the Newton iterations and CPU time of each
 # level: the orbit on the mesh, the halved mesh from its solution (transfer) and from the start,
-# the merged mesh.  Then the refinement to several tol (eps = 1, degree 4; eps = 10, degree 6 and
-# the default 4): its counted (coarser) mesh against the smallest sufficient one of a scan of
-# intervals = L and their ratio, its true error and estimate; and (not --small) the period's
-# errors on nested levels and their local orders (eps = 1, degree 4: why a two-level estimate of
-# one order cannot be both never below and within 10 x), and the estimate by degree elevation on
-# one mesh: the orbit of degree 6 against 7 and 8 on the same mesh, re-equidistributed 1 to 3
-# times, and the halved mesh;
+# the merged mesh.  Then the refinement to several tol (eps = 1, degree 4, and not --small 5, 6
+# and 8; eps = 10, degree 6 and the default 4): its counted (coarser) mesh against the smallest
+# sufficient one of a scan of intervals = L and their ratio, its true error and estimate; and
+# (not --small) the period's errors on nested levels and their local orders (eps = 1, degree 4:
+# why a two-level estimate of one order cannot be both never below and within 10 x), and the
+# estimate by degree elevation on one mesh: the orbit of degree 6 against 7 and 8 on the same
+# mesh, re-equidistributed 1 to 3 times, and the halved mesh;
 # --scan: the estimate against the true error on every mesh of a scan of nine orbits and degrees;
-# --never-below: the refinements with an estimate never below |d2| / 7 (what such a rule costs).
+# --never-below: the refinements with an estimate never below |d2| / 7 (what such a rule costs);
+# --check-cost: collocate with check=True against without (CPU, interleaved, and estimates).
 # Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_meshes.py
-#        [--small | --scan | --never-below]
+#        [--small | --scan | --never-below | --check-cost [--rounds N]]
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -107,6 +108,10 @@ def main() -> None:
     ap.add_argument("--scan", action="store_true",
                     help="only the period's estimate against its true error on every mesh of "
                          "a scan of nine orbits and degrees (about 2 minutes)")
+    ap.add_argument("--check-cost", action="store_true",
+                    help="only the CPU of collocate with check=True against without, "
+                         "interleaved, and both estimates over the true error")
+    ap.add_argument("--rounds", type=int, default=5, help="rounds of --check-cost (5)")
     ap.add_argument("--never-below", action="store_true",
                     help="only the refinements with an estimate never below |d2| / 7 (the "
                          "finer pair's order at least 3) and the next mesh aimed at it: what a "
@@ -114,6 +119,9 @@ def main() -> None:
     a = ap.parse_args()
     if a.scan:
         scan()
+        return
+    if a.check_cost:
+        check_cost(a.rounds)
         return
     if a.never_below:
         never_below()
@@ -137,6 +145,8 @@ def main() -> None:
     refinements(o2, ref2, 6, (1e-5, 1e-6, 1e-7, 1e-8, 1e-9),
                 (28, 30, 32, 36, 40, 44, 48, 50, 52, 56, 60))
     refinements(o2, ref2, 4, (1e-7, 1e-8, 1e-9, 1e-10), tuple(range(60, 250, 10)))
+    for m in (5, 6, 8):
+        refinements(o1, ref1, m, (1e-6, 1e-8, 1e-9, 1e-10), tuple(range(4, 24)))
     print("same mesh, degree 6 against 7 and 8 (errors of the period; the mesh "
           "equidistributed k times at L intervals): 6 | 7 | 8 | |x6 - x8| / |err 6| | 6 on 2L")
     for L in (60, 70, 80, 90):
@@ -162,12 +172,14 @@ def refinements(o, ref, m: int, tols: tuple, scan: tuple) -> None:
               f"tol {shown}; counted / sufficient {ratio}", flush=True)
 
 
-def nested(o, terms, sig, b0, L: int, m: int, T_ref: float):
-    """The three nested levels that collocate(o, intervals=L) solves (L / 2, L, 2 L), the
-    period's errors on them against T_ref and the local orders between them: (c, f, e, q)."""
+def nested(o, terms, sig, b0, L: int, m: int, T_ref: float, every: bool = False):
+    """The three nested levels that collocate(o, intervals=L, check=every) solves (L / 2, L,
+    2 L; the finer's check where asked), the period's errors on them against T_ref and the
+    local orders between them: (c, f, e, q)."""
     lay = Layout(m, terms.n, sig, [], True, o.period, carried(terms, sig))
     lay, x1 = first_solve(o, terms, lay, b0, max(8, L // 2), "bench")
-    c, f = adapt.levels(lay, terms, x1, reference(lay, x1), L, True, 1e-10, "bench")
+    c, f = adapt.levels(lay, terms, x1, reference(lay, x1), L, True, 1e-10, "bench",
+                        every=every)
     if c.coarser is None:
         return c, f, None, None
     e = [s.T - T_ref for s in (c.coarser, c, f)]
@@ -238,6 +250,35 @@ def never_below() -> None:
                 (28, 30, 32, 36, 40, 44, 48, 50, 52, 56, 60, 64, 68, 72))
 
 
+def check_cost(rounds: int) -> None:
+    """collocate with check=True against without (the default multipliers, 10, included), in
+    interleaved rounds (the order swapped every round, the fastest CPU of each kept): their
+    ratio and both period estimates over the true error."""
+    o1 = scheme_orbit(1.0, 6.0, 600)
+    ref1 = da.collocate(o1, intervals=40, degree=8, multipliers=0)
+    o2 = scheme_orbit(10.0, 16.0, 1000)
+    ref2 = da.collocate(o2, intervals=80, degree=8, multipliers=0)
+    cases = {"eps = 1, intervals = 40": (o1, ref1, {"intervals": 40}),
+             "eps = 1, tol = 1e-10": (o1, ref1, {}),
+             "eps = 1, intervals = 8, degree 6": (o1, ref1, {"intervals": 8, "degree": 6}),
+             "eps = 1, tol = 1e-8, degree 6": (o1, ref1, {"tol": 1e-8, "degree": 6}),
+             "eps = 10, tol = 1e-8, degree 6": (o2, ref2, {"tol": 1e-8, "degree": 6})}
+    best = {(k, c): np.inf for k in cases for c in (False, True)}
+    ratio = {}
+    for r in range(rounds):
+        for k, (o, ref, kw) in cases.items():
+            for c in ((False, True) if r % 2 == 0 else (True, False)):
+                t = time.process_time()
+                e = da.collocate(o, check=c, **kw)
+                best[k, c] = min(best[k, c], time.process_time() - t)
+                ratio[k, c] = e.errors["period"] / abs(e.period - ref.period)
+    print("case | CPU: default | check=True | ratio | estimate / true: default | check=True")
+    for k in cases:
+        print(f"{k} | {best[k, False]:.3f} s | {best[k, True]:.3f} s | "
+              f"{best[k, True] / best[k, False]:.2f} | {ratio[k, False]:.3g} | "
+              f"{ratio[k, True]:.3g}", flush=True)
+
+
 #: The scan's orbits: eps, a (0: no memory), the scheme's period guess and steps, degree, the
 #: meshes L.
 SCAN = ((1.0, 0.0, 6.0, 600, 4, range(6, 48)), (1.0, 0.5, 6.0, 600, 4, range(6, 48)),
@@ -254,8 +295,10 @@ def scan() -> None:
     checked (levels not steady or a graded mesh: the finer level against its mesh halved) and
     how many with Richardson's estimate, the estimate / true range of each kind, and
     every estimate below its true error with the orders its levels show; for each orbit, the
-    range of the local orders of the levels' coarser pair (L/2 to L) and finer pair (L to 2L)."""
-    below, counts = [], {"Richardson (steady, not graded)": [], "checked": []}
+    range of the local orders of the levels' coarser pair (L/2 to L) and finer pair (L to 2L);
+    and the Richardson meshes' estimate with check=True (the finer level checked there too)."""
+    below, counts = [], {"Richardson (steady, not graded)": [], "checked": [],
+                         "the Richardson meshes with check=True": []}
     for eps, p, T, steps, m, sizes in SCAN:
         o = scheme_orbit(eps, T, steps, p)
         big = 80 if eps >= 10 else 48
@@ -277,6 +320,12 @@ def scan() -> None:
             kind = "checked" if f.check is not None else "Richardson (steady, not graded)"
             counts[kind].append(est / true)
             mine[kind].append(est / true)
+            if f.check is None:
+                c2, f2, _, _ = nested(o, terms, sig, b0, L, m, ref.period, every=True)
+                assert f2.T == f.T
+                kind = "the Richardson meshes with check=True"
+                counts[kind].append(adapt.estimate(c2, f2)["period"] / true)
+                mine[kind].append(counts[kind][-1])
             orders.append(q)
             if est < true:
                 below.append(f"eps = {eps:g}, a = {p:g}, degree {m}, L = {L}: estimate / true "

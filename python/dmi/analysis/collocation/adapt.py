@@ -60,10 +60,12 @@ LEAST_RICHARDSON = 1.0
 ROUGH = 1e-3
 #: The Richardson estimate's safety factor over |d2| / (2^q - 1).
 SAFETY = 8.0
-#: The first round's intervals where tol <= FIRST_TOL (van der Pol of degree 4 meets 1e-8 there);
-#: a looser tol starts coarser (:func:`first_intervals`), at least at LEAST_FIRST.
+#: The first round's intervals where tol <= FIRST_TOL at degree FIRST_DEGREE (van der Pol of
+#: degree 4 meets 1e-8 there); a looser tol or a higher degree starts coarser
+#: (:func:`first_intervals`), at least at LEAST_FIRST.
 FIRST_INTERVALS = 16
 FIRST_TOL = 1e-8
+FIRST_DEGREE = 4
 LEAST_FIRST = 8
 #: The check's safety factor over |x_f - x_F| (:func:`checked`): never below the finer level's
 #: error where the check level's is at most half of it (an order of 1 from 2 L to 4 L).
@@ -382,15 +384,19 @@ def level_error(c: Solved, f: Solved) -> tuple[float, float, float | None]:
     return d, two, seen
 
 
-def checked_round(c: Solved, f: Solved, terms: Terms, ref: Any, tol: float | None
-                  ) -> tuple[float, float, float | None]:
+def checked_round(c: Solved, f: Solved, terms: Terms, ref: Any, tol: float | None,
+                  every: bool = False) -> tuple[float, float, float | None]:
     """:func:`level_error` of a round (c, f), f checked first (:func:`checked`) where its mesh
-    is graded (``Layout.interval_ratio`` at least GRADED) or its three levels are not steady,
-    and (``tol`` given: a refinement's round) its two levels differ by at most CHECK_RANGE
-    tol."""
+    is graded (``Layout.interval_ratio`` at least GRADED), its three levels are not steady,
+    ``every`` round is to be checked, or (``tol`` given: a refinement's round) Richardson's
+    estimate is above tol by at most its SAFETY factor (the extrapolation itself meets tol: the
+    check may stop the refinement here); in a refinement only where its two levels differ by
+    at most CHECK_RANGE tol or its estimate meets tol (a round that stops is checked)."""
     d, two, seen = level_error(c, f)
     graded = c.lay.interval_ratio() >= GRADED
-    if (seen is None or graded) and (tol is None or two <= CHECK_RANGE * tol):
+    near = tol is not None and tol < d <= SAFETY * tol
+    if (seen is None or graded or every or near) and (tol is None or two <= CHECK_RANGE * tol
+                                                      or d <= tol):
         f.check = checked(f, terms, ref)
         d = level_error(c, f)[0]
     return d, two, seen
@@ -435,21 +441,27 @@ def first_intervals(tol: float, m: int, pieces: int, steep: bool) -> int:
     """The first round's intervals: FIRST_INTERVALS at tol <= FIRST_TOL or for a ``steep``
     orbit (its first solve needed more than its first mesh); for a looser tol fewer, as the
     period's error falls (h^(2 m): L^(2 m) tol kept; a forced orbit's amplitudes, h^(m+1), would
-    allow fewer still), at least LEAST_FIRST; at least 4 for each of the signature's
-    ``pieces``."""
-    L = FIRST_INTERVALS * min(1.0, (FIRST_TOL / tol) ** (1.0 / (2 * m)))
-    return max(FIRST_INTERVALS if steep else LEAST_FIRST, round(L), 4 * pieces)
+    allow fewer still); above FIRST_DEGREE fewer, the period's error taken as (A / L)^(2 m) with
+    the A of FIRST_INTERVALS at FIRST_TOL and degree FIRST_DEGREE (van der Pol at degree 6
+    meets 1e-8 on 6 intervals: 7.4 by this); at least LEAST_FIRST, above FIRST_DEGREE at least
+    as many collocation points (LEAST_FIRST FIRST_DEGREE / m intervals, at least 4); at least 4
+    for each of the signature's ``pieces``."""
+    higher = min(1.0, FIRST_TOL ** (1.0 / (2 * FIRST_DEGREE) - 1.0 / (2 * m)))
+    L = FIRST_INTERVALS * min(1.0, (FIRST_TOL / tol) ** (1.0 / (2 * m)) * higher)
+    least = max(4, min(LEAST_FIRST, round(LEAST_FIRST * FIRST_DEGREE / m)))
+    return max(FIRST_INTERVALS if steep else least, round(L), 4 * pieces)
 
 
 def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bool,
-            tol: float, what: str, capped: list[float] | None = None
+            tol: float, what: str, capped: list[float] | None = None, every: bool = False
             ) -> tuple[Solved, Solved]:
     """The orbit on L intervals equidistributed (``fixed``) or refined until the estimate is
     below tol, and on that mesh halved: (coarser, finer), the coarser with its own ``coarser``
     (its mesh merged; None where that solve failed), the finer with its ``check`` (its mesh
     halved, :func:`checked`) where the mesh is graded (``Layout.interval_ratio`` at least
-    GRADED: a steep orbit) or the three levels are not steady (no Richardson estimate), in a
-    refinement only where the two levels differ by at most CHECK_RANGE tol: the estimate that
+    GRADED: a steep orbit), the three levels are not steady (no Richardson estimate) or
+    ``every`` mesh is to be checked, in a refinement only where the two levels differ by at
+    most CHECK_RANGE tol or the estimate meets tol (:func:`checked_round`): the estimate that
     stops the refinement and aims the next mesh (at tol) is then the check's (a check that
     cannot be solved leaves the three levels' estimate and its reason in the finer's
     ``unchecked``).  A first round of an autonomous orbit whose coarsest level is more than
@@ -478,7 +490,7 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
                 raise
             L = FIRST_INTERVALS                    # a loose tol's first mesh too coarse
             continue
-        d, two, seen = checked_round(c, f, terms, ref, None if fixed else tol)
+        d, two, seen = checked_round(c, f, terms, ref, None if fixed else tol, every)
         if fixed:
             return c, f
         size = f.T if autonomous else float(np.max(np.abs(f.amplitude)))

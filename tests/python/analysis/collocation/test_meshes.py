@@ -209,6 +209,43 @@ def test_the_check_bounds_the_period_where_three_levels_are_not_steady(request, 
     assert adapt.level_error(c, f)[2] is None and estimate(c, f)["period"] > 10 * true
 
 
+@pytest.mark.parametrize("L, m", [
+    (8, 5),                            # the three levels' estimate 648 times the true error
+    (14, 5),                           # 0.966 times: below it
+    (14, 4),                           # 55 times
+])
+def test_check_bounds_the_period_where_three_levels_miss_it(oscillation, oscillation_gap, L, m):
+    """check=True: every mesh's period estimate from the finer level against its mesh halved,
+    also where the three levels are steady (Richardson's estimate, which on these meshes of van
+    der Pol is over 10 times or below the true error); the orbit returned is the same."""
+    o, ref = oscillation
+    plain = da.collocate(o, intervals=L, degree=m, multipliers=0)
+    e = da.collocate(o, intervals=L, degree=m, multipliers=0, check=True)
+    assert e.period == plain.period and e.intervals == plain.intervals == 2 * L
+    true = abs(e.period - ref.period)
+    assert true > 10 * oscillation_gap
+    assert not 1.0 <= plain.errors["period"] / true <= 10.0      # a mesh the check serves
+    assert 1.0 <= e.errors["period"] / true <= 10.0, (e.errors["period"], true)   # 1.95-2.0
+
+
+@pytest.mark.parametrize("m, tol", [(6, 1e-8), (6, 1e-9), (8, 1e-8), (8, 1e-9)])
+def test_higher_degrees_within_1_5_of_the_smallest_sufficient_mesh(oscillation, oscillation_gap,
+                                                                    m, tol):
+    """Degrees 6 and 8 start from fewer intervals than degree 4 (7, 8, 5 and 6 here: 16 and 8
+    before, 2.7 and 2 times the sufficient at 1e-8), and a round whose Richardson estimate is
+    above tol by at most its safety factor is checked (6 at 1e-9 and 8 at 1e-8 and 1e-9 counted
+    11, 7 and 8 without: 1.57, 1.75 and 1.6 times the sufficient; 9, 5 and 6 with)."""
+    o, ref = oscillation
+    e = da.collocate(o, degree=m, tol=tol, multipliers=0)
+    true = abs(e.period - ref.period)
+    assert true + oscillation_gap <= e.errors["period"] <= tol
+    # the least sufficient L of a scan (6 and 7 at degree 6, 4 and 5 at degree 8 measured)
+    sufficient = next(L for L in range(4, 20)
+                      if abs(da.collocate(o, degree=m, intervals=L, multipliers=0).period
+                             - ref.period) + oscillation_gap <= tol)
+    assert e.intervals // 2 <= 1.5 * sufficient, (e.intervals, sufficient)
+
+
 def three_levels(o: da.Orbit, L: int, m: int, count: int):
     """The orbit on L equidistributed intervals (the levels L / 2, L, 2 L) with its multipliers
     and their errors' estimate, as collocate(o, intervals=L) makes them."""
