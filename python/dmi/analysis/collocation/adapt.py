@@ -62,10 +62,12 @@ ROUGH = 1e-3
 SAFETY = 8.0
 #: The first round's intervals where tol <= FIRST_TOL at degree FIRST_DEGREE (van der Pol of
 #: degree 4 meets 1e-8 there); a looser tol or a higher degree starts coarser
-#: (:func:`first_intervals`), at least at LEAST_FIRST.
+#: (:func:`first_intervals`), on LEAST_POINTS collocation points at least (LEAST_POINTS / m
+#: intervals), and on 4 to LEAST_FIRST intervals.
 FIRST_INTERVALS = 16
 FIRST_TOL = 1e-8
 FIRST_DEGREE = 4
+LEAST_POINTS = 24
 LEAST_FIRST = 8
 #: The check's safety factor over |x_f - x_F| (:func:`checked`): never below the finer level's
 #: error where the check level's is at most half of it (an order of 1 from 2 L to 4 L).
@@ -443,12 +445,12 @@ def first_intervals(tol: float, m: int, pieces: int, steep: bool) -> int:
     period's error falls (h^(2 m): L^(2 m) tol kept; a forced orbit's amplitudes, h^(m+1), would
     allow fewer still); above FIRST_DEGREE fewer, the period's error taken as (A / L)^(2 m) with
     the A of FIRST_INTERVALS at FIRST_TOL and degree FIRST_DEGREE (van der Pol at degree 6
-    meets 1e-8 on 6 intervals: 7.4 by this); at least LEAST_FIRST, above FIRST_DEGREE at least
-    as many collocation points (LEAST_FIRST FIRST_DEGREE / m intervals, at least 4); at least 4
-    for each of the signature's ``pieces``."""
+    meets 1e-8 on 6 intervals: 7.4 by this); on LEAST_POINTS collocation points at least
+    (LEAST_POINTS / m intervals: 6 at degree 4), on 4 to LEAST_FIRST intervals; at least 4 for
+    each of the signature's ``pieces``."""
     higher = min(1.0, FIRST_TOL ** (1.0 / (2 * FIRST_DEGREE) - 1.0 / (2 * m)))
     L = FIRST_INTERVALS * min(1.0, (FIRST_TOL / tol) ** (1.0 / (2 * m)) * higher)
-    least = max(4, min(LEAST_FIRST, round(LEAST_FIRST * FIRST_DEGREE / m)))
+    least = max(4, min(LEAST_FIRST, round(LEAST_POINTS / m)))
     return max(FIRST_INTERVALS if steep else least, round(L), 4 * pieces)
 
 
