@@ -13,8 +13,9 @@ package (:mod:`dmi.analysis.collocation.collocate` and the collocated branch use
   halved (:func:`halved`) or every pair merged (:func:`merged`); the difference of their period,
   amplitudes, multipliers and u is the finer one's error estimate; with a third level (the
   coarser's mesh merged, its ``coarser``) the period, amplitudes and multipliers by Richardson's
-  extrapolation where the three levels are steady (:func:`extrapolated`); where they are not, or
-  the mesh is graded (GRADED: a steep orbit), the period and amplitudes from the finer against
+  extrapolation where the three levels are steady (:func:`extrapolated`); where they are not,
+  the mesh is graded (GRADED: a steep orbit), a refinement's round could stop by the check, or
+  every mesh is asked (collocate's ``check``), the period and amplitudes from the finer against
   its own mesh halved (:func:`checked`: CHECK_SAFETY times their difference).  An autonomous
   orbit's two solutions are compared after aligning their phase (:func:`aligned`): its phase is
   free, and a shift along a steep orbit is no error of its shape.
@@ -62,8 +63,8 @@ ROUGH = 1e-3
 SAFETY = 8.0
 #: The first round's intervals where tol <= FIRST_TOL at degree FIRST_DEGREE (van der Pol of
 #: degree 4 meets 1e-8 there); a looser tol or a higher degree starts coarser
-#: (:func:`first_intervals`), on LEAST_POINTS collocation points at least (LEAST_POINTS / m
-#: intervals), and on 4 to LEAST_FIRST intervals.
+#: (:func:`first_intervals`), on LEAST_POINTS / m intervals at least (rounded: LEAST_POINTS
+#: collocation points), within 4 to LEAST_FIRST.
 FIRST_INTERVALS = 16
 FIRST_TOL = 1e-8
 FIRST_DEGREE = 4
@@ -257,15 +258,11 @@ def estimate(c: Solved, f: Solved, reached: float = 0.0,
     stopped at its rounding floor, in the units of x): the differences of the two levels, or
     with a third level (``coarser``, default ``c.coarser``: c's mesh with pairs merged) the
     period, amplitudes and multipliers (where the coarser has them) by :func:`extrapolated`;
-    where f has its ``check`` (f's mesh halved, :func:`checked`), the period and amplitudes
-    from it: CHECK_SAFETY |f - check|.  ``u`` compares c and f at equal phase theta = t / T,
-    an autonomous orbit's after aligning its phase (:func:`aligned`)."""
-    theta = np.linspace(0.0, 1.0, 40 * f.lay.L, endpoint=False)
-    fine = evaluate(f.lay, f.x, theta * f.T)
-    shift = aligned(c, theta[::5], fine[::5]) if f.lay.autonomous else 0.0    # 8 an interval
-    du = float(np.max(np.abs(evaluate(c.lay, c.x, (theta + shift) * c.T) - fine)))
+    where f has its ``check`` (f's mesh halved, :func:`checked`), the period, amplitudes and u
+    from it, and the multipliers where the check has them: CHECK_SAFETY |f - check|.  ``u``
+    compares two levels at equal phase (:func:`gap`)."""
     errors = {"period": abs(c.T - f.T), "amplitude": np.abs(c.amplitude - f.amplitude),
-              "multipliers": _match(f.mu, c.mu), "u": du}
+              "multipliers": _match(f.mu, c.mu), "u": gap(c, f)}
     g = coarser if coarser is not None else c.coarser
     if g is not None:
         m = f.lay.m
@@ -279,10 +276,22 @@ def estimate(c: Solved, f: Solved, reached: float = 0.0,
     if F is not None:
         errors["period"] = CHECK_SAFETY * abs(f.T - F.T)
         errors["amplitude"] = CHECK_SAFETY * np.abs(f.amplitude - F.amplitude)
+        errors["u"] = CHECK_SAFETY * gap(f, F)
+        if F.mu.size and f.mu.size:
+            errors["multipliers"] = CHECK_SAFETY * _match(f.mu, F.mu)
     for k in errors:
         errors[k] = errors[k] + reached
     return with_floor(errors, f.T, f.amplitude, f.mu,
                       float(np.max(np.abs(f.x[:f.lay.rows * f.lay.n]))))
+
+
+def gap(a: Solved, b: Solved) -> float:
+    """max |u_a - u_b| at equal phase theta = t / T (40 phases an interval of b), an autonomous
+    orbit's a after aligning its phase to b's (:func:`aligned`)."""
+    theta = np.linspace(0.0, 1.0, 40 * b.lay.L, endpoint=False)
+    fine = evaluate(b.lay, b.x, theta * b.T)
+    shift = aligned(a, theta[::5], fine[::5]) if b.lay.autonomous else 0.0    # 8 an interval
+    return float(np.max(np.abs(evaluate(a.lay, a.x, (theta + shift) * a.T) - fine)))
 
 
 def aligned(c: Solved, theta: np.ndarray, target: np.ndarray, rounds: int = 8) -> float:
@@ -388,17 +397,18 @@ def level_error(c: Solved, f: Solved) -> tuple[float, float, float | None]:
 
 def checked_round(c: Solved, f: Solved, terms: Terms, ref: Any, tol: float | None,
                   every: bool = False) -> tuple[float, float, float | None]:
-    """:func:`level_error` of a round (c, f), f checked first (:func:`checked`) where its mesh
-    is graded (``Layout.interval_ratio`` at least GRADED), its three levels are not steady,
-    ``every`` round is to be checked, or (``tol`` given: a refinement's round) Richardson's
-    estimate is above tol by at most its SAFETY factor (the extrapolation itself meets tol: the
-    check may stop the refinement here); in a refinement only where its two levels differ by
-    at most CHECK_RANGE tol or its estimate meets tol (a round that stops is checked)."""
+    """:func:`level_error` of a round (c, f), f checked first (:func:`checked`) where (``tol``
+    given: a refinement's round) Richardson's estimate is above tol by at most its SAFETY factor
+    (the extrapolation itself meets tol: the check may stop the refinement here), or where its
+    mesh is graded (``Layout.interval_ratio`` at least GRADED), its three levels are not steady
+    or ``every`` round is to be checked, in a refinement only where its two levels differ by at
+    most CHECK_RANGE tol (a round whose estimate meets tol is never farther: the estimate is at
+    least SAFETY / (2^(2 m) - 1) times the difference, above 1 / CHECK_RANGE up to degree 8)."""
     d, two, seen = level_error(c, f)
     graded = c.lay.interval_ratio() >= GRADED
     near = tol is not None and tol < d <= SAFETY * tol
-    if (seen is None or graded or every or near) and (tol is None or two <= CHECK_RANGE * tol
-                                                      or d <= tol):
+    if near or (seen is None or graded or every) and (tol is None
+                                                      or two <= CHECK_RANGE * tol):
         f.check = checked(f, terms, ref)
         d = level_error(c, f)[0]
     return d, two, seen
@@ -445,9 +455,9 @@ def first_intervals(tol: float, m: int, pieces: int, steep: bool) -> int:
     period's error falls (h^(2 m): L^(2 m) tol kept; a forced orbit's amplitudes, h^(m+1), would
     allow fewer still); above FIRST_DEGREE fewer, the period's error taken as (A / L)^(2 m) with
     the A of FIRST_INTERVALS at FIRST_TOL and degree FIRST_DEGREE (van der Pol at degree 6
-    meets 1e-8 on 6 intervals: 7.4 by this); on LEAST_POINTS collocation points at least
-    (LEAST_POINTS / m intervals: 6 at degree 4), on 4 to LEAST_FIRST intervals; at least 4 for
-    each of the signature's ``pieces``."""
+    meets 1e-8 on 6 intervals: 7.4 by this); at least LEAST_POINTS / m intervals (rounded;
+    within 4 to LEAST_FIRST: 6 at degree 4); at least 4 for each of the signature's
+    ``pieces``."""
     higher = min(1.0, FIRST_TOL ** (1.0 / (2 * FIRST_DEGREE) - 1.0 / (2 * m)))
     L = FIRST_INTERVALS * min(1.0, (FIRST_TOL / tol) ** (1.0 / (2 * m)) * higher)
     least = max(4, min(LEAST_FIRST, round(LEAST_POINTS / m)))
@@ -463,14 +473,15 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
     halved, :func:`checked`) where the mesh is graded (``Layout.interval_ratio`` at least
     GRADED: a steep orbit), the three levels are not steady (no Richardson estimate) or
     ``every`` mesh is to be checked, in a refinement only where the two levels differ by at
-    most CHECK_RANGE tol or the estimate meets tol (:func:`checked_round`): the estimate that
+    most CHECK_RANGE tol, and where Richardson's estimate is above tol by at most its SAFETY
+    factor (:func:`checked_round`): the estimate that
     stops the refinement and aims the next mesh (at tol) is then the check's (a check that
     cannot be solved leaves the three levels' estimate and its reason in the finer's
     ``unchecked``).  A first round of an autonomous orbit whose coarsest level is more than
     ROUGH off the middle one grows the mesh by FAR_GROWTH at most.
 
-    A first round on fewer than FIRST_INTERVALS intervals (a loose tol) whose solve fails is
-    done again on FIRST_INTERVALS.
+    A first round on fewer than FIRST_INTERVALS intervals (a loose tol or a high degree) whose
+    solve fails is done again on FIRST_INTERVALS.
 
     The refinement stops with a ValueError that names the estimate reached and its mesh when
     the estimate is at its floor (FLOOR times the period or the amplitudes, at least 1), when

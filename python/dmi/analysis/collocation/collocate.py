@@ -23,9 +23,9 @@ where the three levels converge steadily, Richardson's estimate from the order t
 its asymptotic range; where they do not, or the mesh is graded (a steep orbit: intervals
 within a piece GRADED = 6 times apart or more), the period's and amplitudes' estimate is twice
 the finer level's difference to the orbit on its mesh halved
-(:func:`dmi.analysis.collocation.adapt.checked`), and so on every mesh with ``check=True``.  With
-``intervals=None``
-the mesh is equidistributed (AUTO, COLSYS: equal integrals of |u^(m+1)|^(1 / (m + 1)),
+(:func:`dmi.analysis.collocation.adapt.checked`), and so in a refinement where the check may
+stop it and on every mesh with ``check=True``.  With ``intervals=None`` the mesh is
+equidistributed (AUTO, COLSYS: equal integrals of |u^(m+1)|^(1 / (m + 1)),
 estimated from the jumps of u^(m) between intervals) and refined until the estimate of the
 period (an autonomous orbit; it converges as h^(2m) on smooth orbits) or of the amplitudes (a
 forced orbit; h^(m+1): an extremum is inside an interval) is below ``tol``
@@ -97,13 +97,16 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
         the order at 1: a callback kernel is sampled and a jump found is warned of
         (CollocationWarning, naming its lag); a lag given where it does not jump is refused.
     check : bool
-        True: the period's and amplitudes' estimate of every mesh from the finer level against
-        its mesh halved (twice their difference; in a refinement, of each round that could stop
-        it): 1.5-2.3 times the true error on every mesh of ``bench_meshes.py --scan``, at
-        about 1.2-1.6 times the CPU.  False: so only where the three levels are not steady or
-        the mesh is graded; elsewhere Richardson's estimate from the three levels, which
-        overstates the error up to some 650 times there (it fell below it on one of 159
-        meshes, 0.96 times).
+        True: the period's, amplitudes', u's and multipliers' estimate of every mesh from the
+        finer level against its mesh halved (twice their difference; in a refinement, of each
+        round that could stop it): the period's 1.46-2.24 times the true error on every mesh of
+        ``bench_meshes.py --scan``, u's and the multipliers' about 2 times; 1.5-1.9 times the
+        CPU of a smooth orbit without multipliers, 2-3 times with 10 (the monodromy on the mesh
+        halved).  False: the period's, amplitudes' and u's so only where the three levels are
+        not steady, the mesh is graded, or a refinement's round could stop by the check;
+        elsewhere Richardson's estimate from the three levels, which overstates the period's
+        error up to some 650 times there (it fell below it on one of 159 meshes, 0.96 times),
+        and u's and the multipliers' from the two or three levels.
 
     Returns
     -------
@@ -115,8 +118,9 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     -----
     CollocationWarning
         The returned level's check (its mesh halved, asked where its levels are not steady,
-        the mesh is graded, or ``check``) could not be solved: the message says why, and the estimate is
-        the three levels'; a callback kernel's undeclared jump (``kernel_jumps``).
+        the mesh is graded, or ``check``) could not be solved: the message says why, and the
+        estimate is the three levels'; a callback kernel's undeclared jump
+        (``kernel_jumps``).
 
     Raises
     ------
@@ -172,7 +176,7 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
             fell_to_equilibrium(f.lay, f.x, orbit)
         bad = check_inequalities(f.lay, terms, f.x, 1e-9 * max(1.0, float(np.max(np.abs(f.x)))))
         if not bad:
-            return _result(orbit, terms, c, f, count)
+            return _result(orbit, terms, c, f, count, bool(check))
         mended = mend(f.lay, terms, f.x) if attempt < MENDS else None
         if mended is None:
             break
@@ -232,9 +236,11 @@ def first_solve(orbit: Orbit, terms: Terms, lay: Layout, b0: np.ndarray, L0: int
     raise ShootingError(f"{failed} -- {too_far(orbit)}", failed.residuals) from None
 
 
-def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int) -> EquationOrbit:
+def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int, check: bool
+            ) -> EquationOrbit:
     """The EquationOrbit of the finer level f, with its multipliers and the coarser levels'
-    (the third, where it was solved, for the multipliers' extrapolated estimate)."""
+    (the third, where it was solved, for the multipliers' extrapolated estimate), and with
+    ``check`` its check's (f's mesh halved, for the multipliers' checked estimate)."""
     if f.unchecked is not None:
         warnings.warn(f"collocate: the orbit on {f.lay.L} intervals is not checked on its mesh "
                       f"halved ({2 * f.lay.L} intervals): {f.unchecked}; its estimate is the "
@@ -244,6 +250,8 @@ def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int) -> Equ
         f.mu = floquet(f.lay, terms, f.x, count)
         if c.coarser is not None:
             c.coarser.mu = floquet(c.coarser.lay, terms, c.coarser.x, count)
+        if check and f.check is not None:
+            f.check.mu = floquet(f.check.lay, terms, f.check.x, count)
     return equation_orbit(f, float(orbit.p), orbit.make, estimate(c, f), terms.H.jumps)
 
 
