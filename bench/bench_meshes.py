@@ -251,9 +251,10 @@ def never_below() -> None:
 
 
 def check_cost(rounds: int) -> None:
-    """collocate with check=True against without (the default multipliers, 10, included, and
-    none: the multipliers' check is the monodromy on the mesh halved), in interleaved rounds (the order swapped every round, the fastest CPU of each kept): their
-    ratio and both period estimates over the true error."""
+    """collocate with check=True against without (the default multipliers, 10, and none: the
+    multipliers' check is the monodromy on the mesh halved), in interleaved rounds (the order
+    swapped every round, the fastest CPU of each kept): their ratio and both period estimates
+    over the true error."""
     o1 = scheme_orbit(1.0, 6.0, 600)
     ref1 = da.collocate(o1, intervals=40, degree=8, multipliers=0)
     o2 = scheme_orbit(10.0, 16.0, 1000)

@@ -15,8 +15,9 @@ package (:mod:`dmi.analysis.collocation.collocate` and the collocated branch use
   coarser's mesh merged, its ``coarser``) the period, amplitudes and multipliers by Richardson's
   extrapolation where the three levels are steady (:func:`extrapolated`); where they are not,
   the mesh is graded (GRADED: a steep orbit), a refinement's round could stop by the check, or
-  every mesh is asked (collocate's ``check``), the period and amplitudes from the finer against
-  its own mesh halved (:func:`checked`: CHECK_SAFETY times their difference).  An autonomous
+  every mesh is asked (collocate's ``check``), the period, amplitudes and u from the finer
+  against its own mesh halved (:func:`checked`: CHECK_SAFETY times their difference; the
+  multipliers too where the check has them).  An autonomous
   orbit's two solutions are compared after aligning their phase (:func:`aligned`): its phase is
   free, and a shift along a steep orbit is no error of its shape.
 - The refinement (:func:`levels`): from a first mesh that depends on tol
@@ -474,10 +475,9 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
     GRADED: a steep orbit), the three levels are not steady (no Richardson estimate) or
     ``every`` mesh is to be checked, in a refinement only where the two levels differ by at
     most CHECK_RANGE tol, and where Richardson's estimate is above tol by at most its SAFETY
-    factor (:func:`checked_round`): the estimate that
-    stops the refinement and aims the next mesh (at tol) is then the check's (a check that
-    cannot be solved leaves the three levels' estimate and its reason in the finer's
-    ``unchecked``).  A first round of an autonomous orbit whose coarsest level is more than
+    factor (:func:`checked_round`): the estimate that stops the refinement and aims the next
+    mesh (at tol) is then the check's (a check that cannot be solved leaves the three levels'
+    estimate and its reason in the finer's ``unchecked``).  A first round of an autonomous orbit whose coarsest level is more than
     ROUGH off the middle one grows the mesh by FAR_GROWTH at most.
 
     A first round on fewer than FIRST_INTERVALS intervals (a loose tol or a high degree) whose

@@ -21,10 +21,10 @@ amplitudes, multipliers and u is the error estimate of the finer one (which is r
 where the three levels converge steadily, Richardson's estimate from the order they show
 (:func:`dmi.analysis.collocation.adapt.estimate`): an upper estimate while the convergence is in
 its asymptotic range; where they do not, or the mesh is graded (a steep orbit: intervals
-within a piece GRADED = 6 times apart or more), the period's and amplitudes' estimate is twice
-the finer level's difference to the orbit on its mesh halved
+within a piece GRADED = 6 times apart or more), the period's, amplitudes' and u's estimate is
+twice the finer level's difference to the orbit on its mesh halved
 (:func:`dmi.analysis.collocation.adapt.checked`), and so in a refinement where the check may
-stop it and on every mesh with ``check=True``.  With ``intervals=None`` the mesh is
+stop it and on every mesh with ``check=True`` (the multipliers' too).  With ``intervals=None`` the mesh is
 equidistributed (AUTO, COLSYS: equal integrals of |u^(m+1)|^(1 / (m + 1)),
 estimated from the jumps of u^(m) between intervals) and refined until the estimate of the
 period (an autonomous orbit; it converges as h^(2m) on smooth orbits) or of the amplitudes (a

@@ -6,7 +6,8 @@
 # its intervals), and the three-level (Richardson) estimate of the period and the multipliers
 # within [1, 10] times the true error on three orbits, the checked estimate (the finer level
 # against its mesh halved) where the levels are not steady and with check=True where the three
-# levels miss the true error (the true errors against collocations of degree 8 on finer meshes).
+# levels miss the true error, also for the multipliers and on a stick-slip orbit (the true errors
+# against collocations of degree 8 on finer meshes).
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -234,6 +235,39 @@ def test_check_bounds_the_period_where_three_levels_miss_it(oscillation, oscilla
     assert true > ULPS * np.spacing(1.0)
     assert 1.0 <= e.errors["multipliers"][1] / true <= 10.0, (e.errors["multipliers"], true)
     assert plain.errors["multipliers"][1] > 10 * true    # three levels: 100-400 times measured
+
+
+def belt(p: float, h: float | None = None) -> dmi.Solver:
+    """A belt oscillator in the relative velocity y = x' - V: x' = y + V, y' = -x + k (y + V) -
+    alpha sigma(y) - g int_0^2 e^-s x(t - s) ds (V = 0.5, k = 0.2, alpha = 0.4 p, g = 0.3): a
+    stick-slip orbit (slip -, slip +, stuck)."""
+    s = dmi.Solver(2, 2.0, h=h or 0.01)
+    s.set_rhs(lambda t, u: np.array([-(u[1] + 0.5), u[0] - 0.2 * (u[1] + 0.5)]))
+    s.set_friction([0.0, 0.4 * p])
+    s.set_kernel_exp([-1.0], [0.0], [[[0.0, 0.0], [0.3, 0.0]]])
+    return s
+
+
+def test_check_on_a_stick_slip_orbit():
+    """check=True on a stick-slip orbit (its switching times unknowns, its stuck segment held
+    by the friction): the period's and the leading multiplier's estimate about 2 times their
+    true error on 8 intervals (the multiplier's three levels: 203 times)."""
+    s = belt(1.0, h=6.46 / 1000)
+    s.set_history(lambda t: np.array([1.0, 0.0]))
+    s.init()
+    s.advance(40 * 1000)
+    o = da.periodic_orbit(belt, 1.0, None, s, guess_period=6.46, steps=1000, multipliers=0)
+    ref = da.collocate(o, intervals=40, degree=8, multipliers=4)
+    plain = da.collocate(o, intervals=8, multipliers=2)
+    e = da.collocate(o, intervals=8, multipliers=2, check=True)
+    assert e.signature.describe() == plain.signature.describe() == ref.signature.describe()
+    assert len(e.signature.describe()) == 3 and e.period == plain.period
+    true = abs(e.period - ref.period)                     # 6.8e-10; the reference's 1e-13
+    assert 1.0 <= e.errors["period"] / true <= 10.0, (e.errors["period"], true)
+    true = float(np.min(np.abs(ref.multipliers - e.multipliers[1])))       # 1.3e-9
+    assert true > 100 * ref.errors["multipliers"][1]
+    assert 1.0 <= e.errors["multipliers"][1] / true <= 10.0, (e.errors["multipliers"], true)
+    assert plain.errors["multipliers"][1] > 10 * true
 
 
 @pytest.mark.parametrize("m, tol", [(4, 1e-4), (6, 1e-8), (6, 1e-9), (8, 1e-8), (8, 1e-9)])
