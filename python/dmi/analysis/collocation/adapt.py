@@ -302,20 +302,20 @@ def aligned(c: Solved, theta: np.ndarray, target: np.ndarray, rounds: int = 8) -
     largest difference (an autonomous orbit's phase is free: two solutions of one orbit differ
     by a shift that is no error of its shape)."""
     slope = reference(c.lay, c.x)                          # d u_c / d theta
-    gap = evaluate(c.lay, c.x, theta * c.T) - target
-    start = float(np.max(np.abs(gap)))
+    diff = evaluate(c.lay, c.x, theta * c.T) - target
+    start = float(np.max(np.abs(diff)))
     s = 0.0
     for _ in range(rounds):
         R = slope(np.mod(theta + s, 1.0))
         norm = float(np.sum(R * R))
         if norm == 0.0:
             break
-        step = -float(np.sum(gap * R)) / norm
+        step = -float(np.sum(diff * R)) / norm
         s += step
-        gap = evaluate(c.lay, c.x, (theta + s) * c.T) - target
+        diff = evaluate(c.lay, c.x, (theta + s) * c.T) - target
         if abs(step) <= 1e-13:
             break
-    return s if abs(s) < 0.25 and float(np.max(np.abs(gap))) < start else 0.0
+    return s if abs(s) < 0.25 and float(np.max(np.abs(diff))) < start else 0.0
 
 
 def with_floor(errors: dict[str, Any], T: float, amplitude: np.ndarray, mu: np.ndarray,
@@ -474,9 +474,9 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
     halved, :func:`checked`) where the mesh is graded (``Layout.interval_ratio`` at least
     GRADED: a steep orbit), the three levels are not steady (no Richardson estimate) or
     ``every`` mesh is to be checked, in a refinement only where the two levels differ by at
-    most CHECK_RANGE tol, and where Richardson's estimate is above tol by at most its SAFETY
-    factor (:func:`checked_round`): the estimate that stops the refinement and aims the next
-    mesh (at tol) is then the check's (a check that cannot be solved leaves the three levels'
+    most CHECK_RANGE tol; and in a refinement wherever Richardson's estimate is above tol by at
+    most its SAFETY factor (:func:`checked_round`): the estimate that stops the refinement and
+    aims the next mesh (at tol) is then the check's (a check that cannot be solved leaves the three levels'
     estimate and its reason in the finer's ``unchecked``).  A first round of an autonomous orbit whose coarsest level is more than
     ROUGH off the middle one grows the mesh by FAR_GROWTH at most.
 

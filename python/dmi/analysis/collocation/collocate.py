@@ -105,8 +105,11 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
         halved).  False: the period's, amplitudes' and u's so only where the three levels are
         not steady, the mesh is graded, or a refinement's round could stop by the check;
         elsewhere Richardson's estimate from the three levels, which overstates the period's
-        error up to some 650 times there (it fell below it on one of 159 meshes, 0.96 times),
-        and u's and the multipliers' from the two or three levels.
+        error up to some 650 times there (and was below it on one of 159 meshes, 0.96 times),
+        and u's and the multipliers' from the two or three levels.  ``stable`` is judged
+        against the multipliers' estimate, so a verdict the levels leave undecided (None) may
+        be decided with ``check=True``.  With ``intervals=None`` the refinement may stop on
+        another mesh with ``check=True`` (its estimate is the check's).
 
     Returns
     -------
@@ -118,9 +121,9 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     -----
     CollocationWarning
         The returned level's check (its mesh halved, asked where its levels are not steady,
-        the mesh is graded, or ``check``) could not be solved: the message says why, and the
-        estimate is the three levels'; a callback kernel's undeclared jump
-        (``kernel_jumps``).
+        the mesh is graded, or ``check``) could not be solved, or with ``check`` its
+        multipliers could not be computed: the message says why, and the estimate is the
+        levels'; a callback kernel's undeclared jump (``kernel_jumps``).
 
     Raises
     ------
@@ -251,7 +254,13 @@ def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int, check:
         if c.coarser is not None:
             c.coarser.mu = floquet(c.coarser.lay, terms, c.coarser.x, count)
         if check and f.check is not None:
-            f.check.mu = floquet(f.check.lay, terms, f.check.x, count)
+            try:
+                f.check.mu = floquet(f.check.lay, terms, f.check.x, count)
+            except (RuntimeError, ValueError, np.linalg.LinAlgError) as err:
+                warnings.warn(f"collocate: the multipliers of the check ({f.check.lay.L} "
+                              f"intervals) could not be computed ({type(err).__name__}: {err}); "
+                              "the multipliers' estimate is the levels'", CollocationWarning,
+                              stacklevel=3)
     return equation_orbit(f, float(orbit.p), orbit.make, estimate(c, f), terms.H.jumps)
 
 
