@@ -111,7 +111,7 @@ def main() -> None:
     ap.add_argument("--check-cost", action="store_true",
                     help="only the CPU of collocate with check=True against without, "
                          "interleaved, and both estimates over the true error")
-    ap.add_argument("--rounds", type=int, default=5, help="rounds of --check-cost (5)")
+    ap.add_argument("--rounds", type=int, default=5, help="rounds of --check-cost (default: 5)")
     ap.add_argument("--never-below", action="store_true",
                     help="only the refinements with an estimate never below |d2| / 7 (the "
                          "finer pair's order at least 3) and the next mesh aimed at it: what a "
