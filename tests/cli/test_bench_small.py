@@ -1,8 +1,9 @@
 # The speed benchmarks of collocation, long memories, meshes and identification run at a small
-# size (their --small or smallest options; bench_collocation one round, without --against): each
-# exits 0 and prints its figures, every number finite; bench_longmem's folded and unfolded delay
-# integrals give the same period within the sum of the two printed estimates.  Sizes here, not
-# speed: the figures are in docs/benchmarks.md.
+# size (their --small or smallest options; bench_collocation one round, without --against;
+# bench_meshes also its --check-cost, one round): each exits 0 and prints its figures, every
+# number finite; bench_longmem's folded and unfolded delay integrals give the same period within
+# the sum of the two printed estimates.  Sizes here, not speed: the figures are in
+# docs/benchmarks.md.
 # PYTHONPATH holds the build's python/ and bench/ (the benches import benchtools and each other).
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 import math
@@ -38,6 +39,8 @@ def finite(text: str) -> list[float]:
 @pytest.mark.parametrize("name, args, lines", [
     ("bench_meshes.py", ["--small"],
      [r"^\s*48 x 4 \|", r"^\s*112 x 6 \|", r"^degree 6, tol = 1e-08"]),
+    ("bench_meshes.py", ["--check-cost", "--rounds", "1"],
+     [r"^eps = 1, tol = 1e-10 \|", r"^eps = 10, tol = 1e-8, degree 6 \|"]),
     ("bench_identify_first_call.py", ["--rounds", "1", "--steps", "200"], [r"^this\s"]),
     ("bench_collocation.py", ["--rounds", "1"],
      [r"^\s*vdp, tol 1e-10\s", r"^\s*vdp, branch point\s"]),
