@@ -241,18 +241,15 @@ def first_solve(orbit: Orbit, terms: Terms, lay: Layout, b0: np.ndarray, L0: int
 
 def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int, check: bool
             ) -> EquationOrbit:
-    """The EquationOrbit of the finer level f, with its multipliers and the coarser levels'
-    (the third, where it was solved, for the multipliers' extrapolated estimate), and with
-    ``check`` its check's (f's mesh halved, for the multipliers' checked estimate)."""
+    """The EquationOrbit of the finer level f, with its multipliers and, with ``check``, its
+    check's (f's mesh halved, for the multipliers' checked estimate); where there are none,
+    the coarser levels' (the third, where it was solved, for the extrapolated estimate)."""
     if f.unchecked is not None:
         warnings.warn(f"collocate: the orbit on {f.lay.L} intervals is not checked on its mesh "
                       f"halved ({2 * f.lay.L} intervals): {f.unchecked}; its estimate is the "
                       "three levels'", CollocationWarning, stacklevel=3)
     if count > 0:
-        c.mu = floquet(c.lay, terms, c.x, count)
         f.mu = floquet(f.lay, terms, f.x, count)
-        if c.coarser is not None:
-            c.coarser.mu = floquet(c.coarser.lay, terms, c.coarser.x, count)
         if check and f.check is not None:
             try:
                 f.check.mu = floquet(f.check.lay, terms, f.check.x, count)
@@ -261,6 +258,10 @@ def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int, check:
                               f"intervals) could not be computed ({type(err).__name__}: {err}); "
                               "the multipliers' estimate is the levels'", CollocationWarning,
                               stacklevel=3)
+        if f.check is None or not f.check.mu.size:     # the levels' estimate
+            c.mu = floquet(c.lay, terms, c.x, count)
+            if c.coarser is not None:
+                c.coarser.mu = floquet(c.coarser.lay, terms, c.coarser.x, count)
     return equation_orbit(f, float(orbit.p), orbit.make, estimate(c, f), terms.H.jumps)
 
 

@@ -295,8 +295,8 @@ def test_a_check_whose_multipliers_fail_warns_and_keeps_the_levels(oscillation, 
             raise RuntimeError("made to fail")
         return plain_floquet(lay, terms, x, count)
     monkeypatch.setattr(module, "floquet", failing)
-    with pytest.warns(CollocationWarning, match=r"multipliers of the check \(32 intervals\) could "
-                      r"not be computed \(RuntimeError: made to fail\)"):
+    with pytest.warns(CollocationWarning, match=r"multipliers of the check .* could not be "
+                      r"computed .RuntimeError: made to fail"):
         e = da.collocate(o, intervals=8, multipliers=2, check=True)
     plain = da.collocate(o, intervals=8, multipliers=2)
     assert np.array_equal(e.errors["multipliers"], plain.errors["multipliers"])
