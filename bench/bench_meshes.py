@@ -8,12 +8,12 @@
 # (Richardson's where the levels are steady) over it; the Newton iterations and CPU time of each
 # level: the orbit on the mesh, the halved mesh from its solution (transfer) and from the start,
 # the merged mesh.  Then the refinement to several tol (eps = 1, degree 4, and not --small 5, 6
-# and 8; eps = 10, degree 6 and the default 4): its counted (coarser) mesh against the smallest
-# sufficient one of a scan of intervals = L and their ratio, its true error and estimate; and
-# (not --small) the period's errors on nested levels and their local orders (eps = 1, degree 4:
-# why a two-level estimate of one order cannot be both never below and within 10 x), and the
-# estimate by degree elevation on one mesh: the orbit of degree 6 against 7 and 8 on the same
-# mesh, re-equidistributed 1 to 3 times, and the halved mesh;
+# and 8; eps = 5, degree 5; eps = 10, degree 6 and the default 4): its counted (coarser) mesh
+# against the smallest sufficient one of a scan of intervals = L and their ratio, its true
+# error and estimate; and (not --small) the period's errors on nested levels and their local
+# orders (eps = 1, degree 4: why a two-level estimate of one order cannot be both never below
+# and within 10 x), and the estimate by degree elevation on one mesh: the orbit of degree 6
+# against 7 and 8 on the same mesh, re-equidistributed 1 to 3 times, and the halved mesh;
 # --scan: the estimate against the true error on every mesh of a scan of nine orbits and degrees;
 # --never-below: the refinements with an estimate never below |d2| / 7 (what such a rule costs);
 # --check-cost: collocate with check=True against without (CPU, interleaved, and estimates).
@@ -147,6 +147,10 @@ def main() -> None:
     refinements(o2, ref2, 4, (1e-7, 1e-8, 1e-9, 1e-10), tuple(range(60, 250, 10)))
     for m in (5, 6, 8):
         refinements(o1, ref1, m, (1e-6, 1e-8, 1e-9, 1e-10), tuple(range(4, 24)))
+    print("eps = 5 (a steep orbit whose first round of a loose tol cannot be solved), degree 5:")
+    o5 = scheme_orbit(5.0, 9.0, 900)
+    ref5 = da.collocate(o5, intervals=80, degree=8, multipliers=0)
+    refinements(o5, ref5, 5, (1e-3, 1e-4, 1e-5, 1e-6), tuple(range(4, 40)))
     print("same mesh, degree 6 against 7 and 8 (errors of the period; the mesh "
           "equidistributed k times at L intervals): 6 | 7 | 8 | |x6 - x8| / |err 6| | 6 on 2L")
     for L in (60, 70, 80, 90):

@@ -109,8 +109,7 @@ class EquationBranch(CollocationDiscretisation):
         return NewtonOptions(tol=self.tol, max_iter=self.max_iter, converge=Converge.BOTH)
 
     def _breaks(self, x: np.ndarray, p: float) -> list[str]:
-        return check_inequalities(self.lay, self.terms(p), x,
-                                  1e-9 * max(1.0, float(np.max(np.abs(x)))))
+        return check_inequalities(self.lay, self.terms(p), x)
 
     def accept(self, x: np.ndarray, p: float, step: bool) -> tuple[np.ndarray, float]:
         """The driver's corrected point checked against its signature's inequalities: an orbit
@@ -220,7 +219,7 @@ class EquationBranch(CollocationDiscretisation):
                                         f"failed: {e}", []) from e
                 xs, p = self._grow(probe, xs, p, f"{bad[0]}; at fixed p: {e}")
                 terms = self.terms(p)
-            bad = check_inequalities(lay, terms, xs, 1e-9 * max(1.0, float(np.max(np.abs(xs)))))
+            bad = check_inequalities(lay, terms, xs)
             if not bad:
                 return (x0, p0 if not free else p, lay, ref, xs)
         raise ShootingError(f"p = {p!r}: the orbit breaks its signature ({bad[0]}) and "
@@ -276,8 +275,7 @@ class EquationBranch(CollocationDiscretisation):
                 except ShootingError:
                     continue
         for xm, pm in tries:
-            if not check_inequalities(lay, self.terms(pm), xm,
-                                      1e-9 * max(1.0, float(np.max(np.abs(xm))))):
+            if not check_inequalities(lay, self.terms(pm), xm):
                 return xm, pm, lay, probe.ref
         return None
 
@@ -324,7 +322,7 @@ class EquationBranch(CollocationDiscretisation):
             return None
         if at is None and (pm - p0) * (p - p0) <= 0:   # not on in p as the step was
             return None
-        if check_inequalities(new, self.terms(pm), xm, 1e-9 * max(1.0, float(np.max(np.abs(xm))))):
+        if check_inequalities(new, self.terms(pm), xm):
             return None
         return xm, pm, new, probe.ref
 

@@ -182,7 +182,7 @@ class CollocationDiscretisation:
             The point.
         """
         terms = self.terms(p)
-        bad = check_inequalities(self.lay, terms, x, 1e-9 * max(1.0, float(np.max(np.abs(x)))))
+        bad = check_inequalities(self.lay, terms, x)
         if bad:
             warnings.warn(f"p = {p!r}: the orbit breaks its signature ({bad[0]}): no point",
                           CollocationWarning, stacklevel=2)

@@ -79,8 +79,9 @@ CHECK_SAFETY = 2.0
 #: 1800 times measured at degrees 4 to 6): a round farther off is not expected to meet tol (at
 #: worst it costs one more round).
 CHECK_RANGE = 1e4
-#: A first round whose coarsest level is farther than ROUGH from the middle one grows the mesh
-#: by this factor at most (its levels say nothing of the order).
+#: A first round whose coarsest level is farther than ROUGH from the middle one in the period
+#: (an autonomous orbit), or could not be solved, grows the mesh by this factor at most (its
+#: levels say nothing of the order).
 FAR_GROWTH = 4
 #: Quadrature nodes of the delay integral at most on one mesh (about 100 bytes each): a memory
 #: spanning many periods (tau / T large) or a very fine mesh is refused before it is built.
@@ -235,20 +236,20 @@ def _match(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def extrapolated(x0: Any, x1: Any, x2: Any, most: float) -> Any:
     """The error estimate of x2 from three levels of one quantity, the mesh halved from each to
     the next (Richardson's): d1 = x0 - x1 and d2 = x1 - x2 fall by 2^q; where they have one sign
-    and the observed order q is in [LEAST_RICHARDSON, ``most`` + 1] (``most`` the theory's)
-    while x0 is within ROUGH of x1 (relative, at least 1), SAFETY |d2| / (2^q' - 1) with q' = q
-    capped at ``most``, at most |d2|; elsewhere |d2| (the two-level difference: the coarsest
-    level is not yet in the asymptotic range).  On equidistributed meshes the order seen between
-    levels swings (6 to 9 for the period at degree 4): SAFETY covers a local order up to 3 below
-    the one seen."""
+    and the observed order q is in [LEAST_RICHARDSON, ``most``] (``most`` the theory's: an
+    order seen above it is no asymptotic range, as one seen below LEAST_RICHARDSON) while x0 is
+    within ROUGH of x1 (relative, at least 1), SAFETY |d2| / (2^q - 1), at most |d2|; elsewhere
+    |d2| (the two-level difference: the coarsest level is not yet in the asymptotic range).  On
+    equidistributed meshes the order seen between levels swings (6 to 9 for the period at
+    degree 4): SAFETY covers a local order up to 3 below the one seen."""
     d1 = np.abs(np.asarray(x0) - np.asarray(x1))
     d2 = np.abs(np.asarray(x1) - np.asarray(x2))
     same = np.real(np.conj(np.asarray(x0) - np.asarray(x1)) * (np.asarray(x1) - np.asarray(x2))) > 0
     with np.errstate(divide="ignore", invalid="ignore"):
         q = np.log2(d1 / d2)
     near = d1 <= ROUGH * np.maximum(1.0, np.abs(np.asarray(x1)))
-    trusted = same & near & np.isfinite(q) & (q >= LEAST_RICHARDSON) & (q <= most + 1.0)
-    qq = np.minimum(np.where(trusted, q, 1.0), most)
+    trusted = same & near & np.isfinite(q) & (q >= LEAST_RICHARDSON) & (q <= most)
+    qq = np.where(trusted, q, 1.0)
     est = np.where(trusted, np.minimum(d2, SAFETY * d2 / (2.0 ** qq - 1.0)), d2)
     return est if np.ndim(est) else float(est)
 
@@ -476,12 +477,15 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
     ``every`` mesh is to be checked, in a refinement only where the two levels differ by at
     most CHECK_RANGE tol; and in a refinement wherever Richardson's estimate is above tol by at
     most its SAFETY factor (:func:`checked_round`): the estimate that stops the refinement and
-    aims the next mesh (at tol) is then the check's (a check that cannot be solved leaves the three levels'
-    estimate and its reason in the finer's ``unchecked``).  A first round of an autonomous orbit whose coarsest level is more than
-    ROUGH off the middle one grows the mesh by FAR_GROWTH at most.
+    aims the next mesh (at tol) is then the check's (a check that cannot be solved leaves the
+    levels' estimate and its reason in the finer's ``unchecked``).  A first round of an
+    autonomous orbit whose coarsest level is more than ROUGH off the middle one in the period,
+    or of any orbit whose coarsest level could not be solved, grows the mesh by FAR_GROWTH at
+    most.
 
     A first round on fewer than FIRST_INTERVALS intervals (a loose tol or a high degree) whose
-    solve fails is done again on FIRST_INTERVALS.
+    solve fails is done again on twice its intervals, at most FIRST_INTERVALS (not counted as a
+    round of MAX_ROUNDS).
 
     The refinement stops with a ValueError that names the estimate reached and its mesh when
     the estimate is at its floor (FLOOR times the period or the amplitudes, at least 1), when
@@ -494,15 +498,17 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
     unsteady = False                               # the last round's levels were not steady
     autonomous = lay.autonomous
     name = "period" if autonomous else "amplitudes"
-    for _ in range(MAX_ROUNDS):
+    rounds = 0
+    while rounds < MAX_ROUNDS:
         lay2 = lay.with_fractions(adapted(lay, x, L))
         try:
             c, f = two_levels(lay2, terms, (lay, x), ref, what)
         except ShootingError:
             if fixed or last is not None or L >= FIRST_INTERVALS:
                 raise
-            L = FIRST_INTERVALS                    # a loose tol's first mesh too coarse
-            continue
+            L = min(2 * L, FIRST_INTERVALS)        # a loose tol's first mesh too coarse: not
+            continue                               # a round
+        rounds += 1
         d, two, seen = checked_round(c, f, terms, ref, None if fixed else tol, every)
         if fixed:
             return c, f

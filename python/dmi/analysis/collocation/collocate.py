@@ -177,7 +177,7 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
                       bool(check))
         if orbit.autonomous:
             fell_to_equilibrium(f.lay, f.x, orbit)
-        bad = check_inequalities(f.lay, terms, f.x, 1e-9 * max(1.0, float(np.max(np.abs(f.x)))))
+        bad = check_inequalities(f.lay, terms, f.x)
         if not bad:
             return _result(orbit, terms, c, f, count, bool(check))
         mended = mend(f.lay, terms, f.x) if attempt < MENDS else None
@@ -243,11 +243,20 @@ def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int, check:
             ) -> EquationOrbit:
     """The EquationOrbit of the finer level f, with its multipliers and, with ``check``, its
     check's (f's mesh halved, for the multipliers' checked estimate); where there are none,
-    the coarser levels' (the third, where it was solved, for the extrapolated estimate)."""
+    the coarser levels' (the third, where it was solved, for the extrapolated estimate).  A
+    check whose solution breaks the signature's inequalities (checked as f is) is dropped:
+    the estimate is then the levels'."""
+    if f.check is not None:
+        broken = check_inequalities(f.check.lay, terms, f.check.x)
+        if broken:
+            f.unchecked = ("its solution breaks the signature's inequalities ("
+                           + "; ".join(broken[:2]) + ")")
+            f.check = None
     if f.unchecked is not None:
+        kept = "three" if c.coarser is not None else "two"
         warnings.warn(f"collocate: the orbit on {f.lay.L} intervals is not checked on its mesh "
                       f"halved ({2 * f.lay.L} intervals): {f.unchecked}; its estimate is the "
-                      "three levels'", CollocationWarning, stacklevel=3)
+                      f"{kept} levels'", CollocationWarning, stacklevel=3)
     if count > 0:
         f.mu = floquet(f.lay, terms, f.x, count)
         if check and f.check is not None:

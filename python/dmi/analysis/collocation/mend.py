@@ -212,8 +212,11 @@ def relaid(lay: Layout, terms: Terms, x: np.ndarray, segs: list, T: float,
     return new, np.concatenate([V.ravel(), b, [T] if lay.autonomous else []])
 
 
-def check_inequalities(lay: Layout, terms: Terms, x: np.ndarray, tol: float) -> list[str]:
-    """The inequalities the result breaks on a fine grid (CHECK_POINTS a mesh interval)."""
+def check_inequalities(lay: Layout, terms: Terms, x: np.ndarray, rel: float = 1e-9
+                       ) -> list[str]:
+    """The inequalities the result x breaks on a fine grid (CHECK_POINTS a mesh interval) by
+    more than rel times its scale (its largest entry, at least 1)."""
+    tol = rel * max(1.0, float(np.max(np.abs(x))))
     if lay.signature.switches == 0 and not (np.any(terms.alpha > 0)
                                             or np.any(np.isfinite(terms.lo))
                                             or np.any(np.isfinite(terms.hi))):

@@ -161,8 +161,7 @@ class OrbitSystem:
     def broken(self, x: np.ndarray, p: float, q: float, rel: float) -> str:
         """The first inequality of the signature the orbit x at (p, q) breaks by more than rel
         times its scale, else ""."""
-        bad = check_inequalities(self.layout(p, q), self.terms(p, q), x,
-                                 rel * max(1.0, float(np.max(np.abs(x)))))
+        bad = check_inequalities(self.layout(p, q), self.terms(p, q), x, rel)
         return bad[0] if bad else ""
 
     def _solved(self, lay: Layout, terms: Terms, x: np.ndarray) -> Solved:
