@@ -45,11 +45,10 @@ import numpy as np
 from ..continuation.branch import Branch, Event, corner_sentence, travel
 from ..collocation.adapt import transfer
 from .discretisation import CollocationDiscretisation, equation_hopf_orbit
-from ..collocation.mend import (check_inequalities, circle, mend, relaid, removed, rotated,
-                                wrapping)
+from ..collocation.mend import circle, mend, relaid, removed, rotated, wrapping
 from ..collocation.margins import MarginValues, margins
 from ..collocation.signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK
-from ..collocation.system import CollocationWarning, solve
+from ..collocation.system import CollocationWarning, check_inequalities, solve
 from ..continuation.driver import (ContinuationOptions, Curve, Predictor, continuation, locate,
                                    newton_corrector, tangent)
 from ..collocation.orbit import EquationOrbit

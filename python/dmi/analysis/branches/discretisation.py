@@ -34,9 +34,9 @@ import scipy.sparse as sp
 from ..core.model import checked_equilibrium
 from ..collocation.adapt import Solved, estimate, merged, readapted, transfer
 from ..collocation.floquet import multipliers as floquet
-from ..collocation.mend import check_inequalities, mend
+from ..collocation.mend import mend
 from ..collocation.orbit import equation_orbit
-from ..collocation.system import CollocationWarning, check_jumps, reference
+from ..collocation.system import CollocationWarning, check_inequalities, check_jumps, reference
 from ..collocation.mesh import periodic_locator, point_matrix
 from ..collocation.signature import SLIP_NEG, SLIP_POS, Signature
 from ..collocation.system import Layout, Terms, assemble, full_jacobian, node_times, solve

@@ -35,8 +35,8 @@ from typing import Any
 import numpy as np
 
 from .mesh import _monomials
-from .system import (GRADED, Layout, Terms, evaluate, interval_counts, node_times, reference,
-                     solve)
+from .system import (GRADED, Layout, Terms, check_inequalities, evaluate, interval_counts,
+                     node_times, reference, solve)
 from ..core.newton import ShootingError
 
 #: Mesh refinement rounds at most (intervals=None).
@@ -213,7 +213,8 @@ class Solved:
     multipliers ``mu`` (given; none by default), ``coarser``, the solution on its mesh with
     pairs merged (the estimate's third level; None unless :func:`two_levels` set it), and
     ``check``, the solution on its mesh halved (:func:`checked`; None unless set), and
-    ``unchecked``, why a check asked for could not be solved (None)."""
+    ``unchecked``, why a check asked for was not made (not solved, or its solution breaks the
+    signature's inequalities; None)."""
 
     def __init__(self, lay: Layout, x: np.ndarray, mu: np.ndarray | None = None):
         self.lay, self.x = lay, x
@@ -233,23 +234,27 @@ def _match(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.min(np.abs(a[:, None] - b[None, :]), axis=1)
 
 
-def extrapolated(x0: Any, x1: Any, x2: Any, most: float) -> Any:
+def extrapolated(x0: Any, x1: Any, x2: Any, most: float, bounded: bool = True) -> Any:
     """The error estimate of x2 from three levels of one quantity, the mesh halved from each to
     the next (Richardson's): d1 = x0 - x1 and d2 = x1 - x2 fall by 2^q; where they have one sign
-    and the observed order q is in [LEAST_RICHARDSON, ``most``] (``most`` the theory's: an
-    order seen above it is no asymptotic range, as one seen below LEAST_RICHARDSON) while x0 is
-    within ROUGH of x1 (relative, at least 1), SAFETY |d2| / (2^q - 1), at most |d2|; elsewhere
-    |d2| (the two-level difference: the coarsest level is not yet in the asymptotic range).  On
-    equidistributed meshes the order seen between levels swings (6 to 9 for the period at
-    degree 4): SAFETY covers a local order up to 3 below the one seen."""
+    and the observed order q is in [LEAST_RICHARDSON, ``most``] while x0 is within ROUGH of x1
+    (relative, at least 1), SAFETY |d2| / (2^q - 1), at most |d2|; elsewhere |d2| (the
+    two-level difference: the coarsest level is not yet in the asymptotic range).  ``most`` is
+    the theory's order; ``bounded``: it bounds the order (the period's and the multipliers'
+    superconvergent 2 m), so an order seen above it is no asymptotic range, as one below
+    LEAST_RICHARDSON; not ``bounded`` (the amplitudes' m + 1, an extremum's generic order,
+    exceeded where it falls near a mesh point): an order up to ``most`` + 1 is taken, capped at
+    ``most``.  On equidistributed meshes the order seen between levels swings (6 to 9 for the
+    period at degree 4): SAFETY covers a local order up to 3 below the one seen."""
     d1 = np.abs(np.asarray(x0) - np.asarray(x1))
     d2 = np.abs(np.asarray(x1) - np.asarray(x2))
     same = np.real(np.conj(np.asarray(x0) - np.asarray(x1)) * (np.asarray(x1) - np.asarray(x2))) > 0
     with np.errstate(divide="ignore", invalid="ignore"):
         q = np.log2(d1 / d2)
     near = d1 <= ROUGH * np.maximum(1.0, np.abs(np.asarray(x1)))
-    trusted = same & near & np.isfinite(q) & (q >= LEAST_RICHARDSON) & (q <= most)
-    qq = np.where(trusted, q, 1.0)
+    top = most if bounded else most + 1.0
+    trusted = same & near & np.isfinite(q) & (q >= LEAST_RICHARDSON) & (q <= top)
+    qq = np.minimum(np.where(trusted, q, 1.0), most)
     est = np.where(trusted, np.minimum(d2, SAFETY * d2 / (2.0 ** qq - 1.0)), d2)
     return est if np.ndim(est) else float(est)
 
@@ -269,7 +274,8 @@ def estimate(c: Solved, f: Solved, reached: float = 0.0,
     if g is not None:
         m = f.lay.m
         errors["period"] = extrapolated(g.T, c.T, f.T, 2 * m)
-        errors["amplitude"] = extrapolated(g.amplitude, c.amplitude, f.amplitude, m + 1)
+        errors["amplitude"] = extrapolated(g.amplitude, c.amplitude, f.amplitude, m + 1,
+                                           bounded=False)
         if f.mu.size and g.mu.size and c.mu.size:
             mc = c.mu[np.argmin(np.abs(f.mu[:, None] - c.mu[None, :]), axis=1)]
             mg = g.mu[np.argmin(np.abs(mc[:, None] - g.mu[None, :]), axis=1)]
@@ -357,18 +363,25 @@ def checked(f: Solved, terms: Terms, ref: Any) -> Solved | None:
     """The orbit on f's mesh halved (4 L where f has 2 L), solved from f's solution (its
     first factorisation usually serves every Newton step: f is its error away), so that |f -
     check| is f's error to a factor 1 +- (the check's error / f's); None where Newton fails
-    there or its delay integral would need more than MAX_DELAY_NODES quadrature nodes, with
-    the reason in f's ``unchecked``."""
+    there, its delay integral would need more than MAX_DELAY_NODES quadrature nodes or its
+    solution breaks the signature's inequalities (:func:`~.system.check_inequalities`, as
+    collocate checks the orbit it returns), with the reason in f's ``unchecked``."""
     fine = f.lay.with_fractions(halved(f.lay.fractions))
     if delay_nodes(terms, f.lay.m, fine.L, f.T) > MAX_DELAY_NODES:
         f.unchecked = (f"its delay integral would need more than MAX_DELAY_NODES = "
                        f"{MAX_DELAY_NODES:g} quadrature nodes")
         return None
     try:
-        return Solved(fine, solve(fine, terms, transfer(f.lay, f.x, fine), ref)[0])
+        x = solve(fine, terms, transfer(f.lay, f.x, fine), ref)[0]
+        broken = check_inequalities(fine, terms, x)
     except (ShootingError, ValueError) as err:   # Newton fails; a model's f not finite there
         f.unchecked = f"{type(err).__name__}: {err}"
         return None
+    if broken:
+        f.unchecked = ("its solution breaks the signature's inequalities ("
+                       + "; ".join(broken[:2]) + ")")
+        return None
+    return Solved(fine, x)
 
 
 def level_error(c: Solved, f: Solved) -> tuple[float, float, float | None]:
@@ -389,7 +402,8 @@ def level_error(c: Solved, f: Solved) -> tuple[float, float, float | None]:
         else:
             i = int(np.argmax(np.abs(c.amplitude - f.amplitude)))
             x = (g.amplitude[i], c.amplitude[i], f.amplitude[i])
-            d = float(np.max(extrapolated(g.amplitude, c.amplitude, f.amplitude, f.lay.m + 1)))
+            d = float(np.max(extrapolated(g.amplitude, c.amplitude, f.amplitude, f.lay.m + 1,
+                                          bounded=False)))
         d1, d2 = abs(x[0] - x[1]), abs(x[1] - x[2])
         seen = math.log2(d1 / d2) if d < d2 and d2 > 0 else None
     if f.check is not None:

@@ -49,11 +49,11 @@ import numpy as np
 
 from .adapt import Solved, check_cost, equidistribute, estimate, first_intervals, levels
 from .floquet import multipliers as floquet
-from .mend import check_inequalities, mend
+from .mend import mend
 from .orbit import EquationOrbit, equation_orbit
 from .signature import read_signature
-from .system import (CollocationWarning, Layout, Terms, carried, check_jumps, node_times,
-                     reference, solve, uniform_fractions)
+from .system import (CollocationWarning, Layout, Terms, carried, check_inequalities,
+                     check_jumps, node_times, reference, solve, uniform_fractions)
 from ..core.newton import ShootingError
 from ..scheme.orbit import Orbit
 from ..scheme.stepmap import build
@@ -103,10 +103,11 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
         ``bench_meshes.py --scan``, u's and the multipliers' about 2 times; 1.5-1.9 times the
         CPU of a smooth orbit without multipliers, 2-3 times with 10 (the monodromy on the mesh
         halved).  False: the period's, amplitudes' and u's so only where the three levels are
-        not steady, the mesh is graded, or a refinement's round could stop by the check;
-        elsewhere Richardson's estimate from the three levels, which overstates the period's
-        error up to some 650 times there (and was below it on one of 159 meshes, 0.96 times),
-        and u's and the multipliers' from the two or three levels.  ``stable`` is judged
+        not steady (an order seen above the period's 2 m is not steady), the mesh is graded, or
+        a refinement's round could stop by the check; elsewhere Richardson's estimate from the
+        three levels, which overstates the period's error up to some 650 times there (none
+        below it on the scan's 159 meshes), and u's and the multipliers' from the two or three
+        levels.  ``stable`` is judged
         against the multipliers' estimate, so a verdict the levels leave undecided (None) may
         be decided with ``check=True``.  With ``intervals=None`` the refinement may stop on
         another mesh with ``check=True`` (its estimate is the check's).
@@ -121,9 +122,10 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     -----
     CollocationWarning
         The returned level's check (its mesh halved, asked where its levels are not steady,
-        the mesh is graded, or ``check``) could not be solved, or with ``check`` its
-        multipliers could not be computed: the message says why, and the estimate is the
-        levels'; a callback kernel's undeclared jump (``kernel_jumps``).
+        the mesh is graded, or ``check``) could not be solved or its solution breaks the
+        signature's inequalities, or with ``check`` its multipliers could not be computed: the
+        message says why, and the estimate is the levels'; a callback kernel's undeclared jump
+        (``kernel_jumps``).
 
     Raises
     ------
@@ -243,15 +245,7 @@ def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int, check:
             ) -> EquationOrbit:
     """The EquationOrbit of the finer level f, with its multipliers and, with ``check``, its
     check's (f's mesh halved, for the multipliers' checked estimate); where there are none,
-    the coarser levels' (the third, where it was solved, for the extrapolated estimate).  A
-    check whose solution breaks the signature's inequalities (checked as f is) is dropped:
-    the estimate is then the levels'."""
-    if f.check is not None:
-        broken = check_inequalities(f.check.lay, terms, f.check.x)
-        if broken:
-            f.unchecked = ("its solution breaks the signature's inequalities ("
-                           + "; ".join(broken[:2]) + ")")
-            f.check = None
+    the coarser levels' (the third, where it was solved, for the extrapolated estimate)."""
     if f.unchecked is not None:
         kept = "three" if c.coarser is not None else "two"
         warnings.warn(f"collocate: the orbit on {f.lay.L} intervals is not checked on its mesh "

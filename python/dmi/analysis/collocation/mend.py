@@ -1,9 +1,9 @@
 # Mending a nonsmooth orbit's signature: a vanishing segment removed, a breached inequality's
 # stretch made a segment of its own, the orbit laid out again on the new segments.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
-"""The check of a result's inequalities on a fine grid (:func:`check_inequalities`) and the
-signature changes for :mod:`dmi.analysis.collocation.collocate` (a result that breaks an inequality) and
-:mod:`dmi.analysis.branches.discretisation` (between steps); private to the package.
+"""The signature changes for :mod:`dmi.analysis.collocation.collocate` (a result that breaks an
+inequality: :func:`~.system.check_inequalities`) and :mod:`dmi.analysis.branches.discretisation`
+(between steps); private to the package.
 
 The segments around the circle are (modes, start) pairs, segment 0 the one holding t = 0.  A
 segment shorter than VANISH of the period is removed (its neighbours meet at its middle, or merge
@@ -17,14 +17,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .signature import FREE, HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature, violations
+from .signature import FREE, HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
 from .system import (Layout, Terms, carried, evaluate, node_times,
                                  uniform_fractions)
 
 #: A segment shorter than this fraction of the period is removed.
 VANISH = 1e-7
-#: Points a mesh interval of the grid on which the inequalities are checked.
-CHECK_POINTS = 8
 
 
 def mend(lay: Layout, terms: Terms, x: np.ndarray) -> tuple[Layout, np.ndarray] | None:
@@ -210,31 +208,3 @@ def relaid(lay: Layout, terms: Terms, x: np.ndarray, segs: list, T: float,
                                                lay.L if intervals is None else intervals))
     V = evaluate(lay, x, node_times(new, b, T) + shift)
     return new, np.concatenate([V.ravel(), b, [T] if lay.autonomous else []])
-
-
-def check_inequalities(lay: Layout, terms: Terms, x: np.ndarray, rel: float = 1e-9
-                       ) -> list[str]:
-    """The inequalities the result x breaks on a fine grid (CHECK_POINTS a mesh interval) by
-    more than rel times its scale (its largest entry, at least 1)."""
-    tol = rel * max(1.0, float(np.max(np.abs(x))))
-    if lay.signature.switches == 0 and not (np.any(terms.alpha > 0)
-                                            or np.any(np.isfinite(terms.lo))
-                                            or np.any(np.isfinite(terms.hi))):
-        return []
-    V, b, T = lay.split(x)
-    mesh = lay.mesh(b, T)
-    e = lay.bounds(b, T)
-    grid, us, forces = [], [], []
-    for j in range(len(e) - 1):
-        count = (len(lay.fractions[j]) - 1) * CHECK_POINTS + 1
-        t = np.linspace(e[j], e[j + 1], count)
-        u = evaluate(lay, x, t)
-        F = -terms.f(t, u)
-        if terms.has_kernel:
-            G = terms.periodic_delay(t, mesh, T, lay.basis, lay.rows)[0]
-            F = F - (G @ V.ravel()).reshape(-1, lay.n)
-        grid.append(t)
-        us.append(u)
-        forces.append(F)
-    return violations(lay.piece_modes(b, T), grid, us, forces, terms.alpha, terms.lo, terms.hi,
-                      tol)

@@ -37,7 +37,7 @@ from .fold import Fold, exp_sum, fold_of, folding
 from .mesh import (STEEP, Basis, DelayPlan, Kernel, Locator, Near, _monomials,
                    delay_matrix, delay_matrix_separable, folded_matrix, history_locator,
                    history_rows, interval_of, periodic_locator, point_matrix)
-from .signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature
+from .signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature, violations
 from ..core.newton import Converge, NewtonOptions, Search, ShootingError, newton_loop
 
 #: Quadrature nodes a piece of the delay integral: m + QUAD_EXTRA (exact for H u with u of
@@ -65,6 +65,9 @@ GRADED = 6.0
 #: differences), relative to the period: truncation and rounding both near 1e-13 relative for a
 #: forcing of the orbit's own frequency.
 FT_STEP = 2e-4
+#: Points a mesh interval of the grid on which a solution's inequalities are checked
+#: (:func:`check_inequalities`).
+CHECK_POINTS = 8
 
 
 class CollocationWarning(RuntimeWarning):
@@ -1141,6 +1144,35 @@ def evaluate(lay: Layout, x: np.ndarray, t: np.ndarray) -> np.ndarray:
     mesh = lay.mesh(b, T)
     _, z, cols = periodic_locator(mesh, lay.m)(np.asarray(t, dtype=float))
     return np.einsum("pk,pkn->pn", lay.basis.values(z), V[cols])
+
+
+def check_inequalities(lay: Layout, terms: Terms, x: np.ndarray, rel: float = 1e-9
+                       ) -> list[str]:
+    """The inequalities of its signature (:func:`~.signature.violations`) the solution x breaks
+    on a fine grid (CHECK_POINTS a mesh interval) by more than rel times its scale (its largest
+    entry, at least 1)."""
+    tol = rel * max(1.0, float(np.max(np.abs(x))))
+    if lay.signature.switches == 0 and not (np.any(terms.alpha > 0)
+                                            or np.any(np.isfinite(terms.lo))
+                                            or np.any(np.isfinite(terms.hi))):
+        return []
+    V, b, T = lay.split(x)
+    mesh = lay.mesh(b, T)
+    e = lay.bounds(b, T)
+    grid, us, forces = [], [], []
+    for j in range(len(e) - 1):
+        count = (len(lay.fractions[j]) - 1) * CHECK_POINTS + 1
+        t = np.linspace(e[j], e[j + 1], count)
+        u = evaluate(lay, x, t)
+        F = -terms.f(t, u)
+        if terms.has_kernel:
+            G = terms.periodic_delay(t, mesh, T, lay.basis, lay.rows)[0]
+            F = F - (G @ V.ravel()).reshape(-1, lay.n)
+        grid.append(t)
+        us.append(u)
+        forces.append(F)
+    return violations(lay.piece_modes(b, T), grid, us, forces, terms.alpha, terms.lo, terms.hi,
+                      tol)
 
 
 def node_times(lay: Layout, b: np.ndarray, T: float) -> np.ndarray:

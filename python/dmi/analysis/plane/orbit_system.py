@@ -21,9 +21,9 @@ from ..._solver import Solver
 from ..collocation.adapt import FLOOR, Solved, adapted, merged, transfer
 from ..collocation.adapt import estimate as level_errors
 from ..collocation.floquet import multipliers as floquet
-from ..collocation.mend import check_inequalities
 from ..collocation.orbit import EquationOrbit
-from ..collocation.system import CollocationWarning, Layout, Terms, full_jacobian, reference
+from ..collocation.system import (CollocationWarning, Layout, Terms, check_inequalities,
+                                  full_jacobian, reference)
 from ..continuation.branch import AlongQ
 from ..core.newton import ShootingError, bordered_solve, newton_loop, sparse_bordered
 from ..scheme.problem import AtQ, Problem

@@ -233,16 +233,15 @@ def test_the_check_bounds_the_period_where_three_levels_are_not_steady(request, 
     assert adapt.level_error(c, f)[2] is None and estimate(c, f)["period"] > 10 * true
 
 
-@pytest.mark.parametrize("L, m, mu", [
-    (8, 5, True),                      # the three levels' estimate 648 times the true error
-    (14, 4, True),                     # 55 times
+@pytest.mark.parametrize("L, m", [
+    (8, 5),                            # the three levels' estimate 648 times the true error
+    (14, 4),                           # 55 times
 ])
-def test_check_bounds_the_period_where_three_levels_miss_it(oscillation, oscillation_gap, L, m,
-                                                            mu):
+def test_check_bounds_the_period_where_three_levels_miss_it(oscillation, oscillation_gap, L, m):
     """check=True: every mesh's period and multipliers' estimate from the finer level against
     its mesh halved, also where the three levels are steady (Richardson's estimate, which on
-    these meshes of van der Pol is over 10 times or below the true error); the orbit returned
-    is the same."""
+    these meshes of van der Pol is over 10 times the true error); the orbit returned is the
+    same."""
     o, ref = oscillation
     plain = da.collocate(o, intervals=L, degree=m, multipliers=2)
     e = da.collocate(o, intervals=L, degree=m, multipliers=2, check=True)
@@ -253,13 +252,11 @@ def test_check_bounds_the_period_where_three_levels_miss_it(oscillation, oscilla
     assert not 1.0 <= plain.errors["period"] / true <= 10.0      # a mesh the check serves
     assert 1.0 <= e.errors["period"] / true <= 10.0, (e.errors["period"], true)   # 1.95-2.0
     # the leading nontrivial multiplier (mu_0 = 1 is the orbit's own), where its true error is
-    # far above the estimates' floor, 1e-11 (5.2e-10 and 2.4e-10 measured; on 14 intervals of
-    # degree 5 it is 1.6e-12, and the estimate the floor)
-    if mu:
-        true = float(np.min(np.abs(ref.multipliers - e.multipliers[1])))
-        assert true > 1e-10
-        assert 1.0 <= e.errors["multipliers"][1] / true <= 10.0, (e.errors["multipliers"], true)
-        assert plain.errors["multipliers"][1] > 10 * true    # three levels: 369 and 290
+    # far above the estimates' floor, 1e-11 (5.2e-10 and 2.4e-10 measured)
+    true = float(np.min(np.abs(ref.multipliers - e.multipliers[1])))
+    assert true > 1e-10
+    assert 1.0 <= e.errors["multipliers"][1] / true <= 10.0, (e.errors["multipliers"], true)
+    assert plain.errors["multipliers"][1] > 10 * true        # three levels: 369 and 290
 
 
 def test_an_order_seen_above_the_theory_is_no_richardson_estimate(oscillation,
@@ -327,27 +324,23 @@ def test_check_on_a_stick_slip_orbit(stick_slip):
 
 
 def test_a_check_that_breaks_the_inequalities_is_no_check(stick_slip, monkeypatch):
-    """A check whose solution breaks the signature's inequalities (made to: collocate checks
-    the orbit it returns, then its check on that mesh halved) gives no estimate: a
-    CollocationWarning says why, and the estimate is the levels', as without check."""
+    """A check whose solution breaks the signature's inequalities (made to: the check's test,
+    in adapt.checked, where a refinement would stop by it) gives no estimate: a
+    CollocationWarning says why, and the estimate is the levels', not the check's."""
     o, _ = stick_slip
-    module = sys.modules["dmi.analysis.collocation.collocate"]
-    plain_check = module.check_inequalities
+    plain = da.collocate(o, intervals=8, multipliers=2)      # the default checks this mesh
     calls = []
 
     def breaking(lay, terms, x, *args):
         calls.append(lay.L)
-        return ["made to break"] if len(calls) == 2 else plain_check(lay, terms, x, *args)
-    monkeypatch.setattr(module, "check_inequalities", breaking)
+        return ["made to break"]
+    monkeypatch.setattr(adapt, "check_inequalities", breaking)
     with pytest.warns(CollocationWarning, match=r"not checked on its mesh halved .40 "
                       r"intervals.: its solution breaks the signature's inequalities .made to "
                       r"break."):
         e = da.collocate(o, intervals=8, multipliers=2, check=True)
-    assert calls == [20, 40] and e.intervals == 20       # the three pieces' meshes: 10 -> 20
-    # the estimate is the levels' (1.7e-7), not the check's (the default checks this mesh, its
-    # levels not steady: 1.4e-9)
-    calls.append(0)                                       # no more breaks
-    plain = da.collocate(o, intervals=8, multipliers=2)
+    assert calls == [40] and e.intervals == 20           # the three pieces' meshes: 10 -> 20
+    # the estimate is the levels' (1.7e-7), not the check's (its levels not steady: 1.4e-9)
     assert plain.period == e.period and e.errors["period"] > 10 * plain.errors["period"]
 
 
@@ -393,15 +386,16 @@ def test_first_rounds_by_degree_within_1_5_of_the_smallest_sufficient_mesh(
 
 
 def three_levels(o: da.Orbit, L: int, m: int, count: int):
-    """The orbit on L equidistributed intervals (the levels L / 2, L, 2 L) with its multipliers
-    and their errors' estimate, as collocate(o, intervals=L) makes them."""
+    """The orbit on L equidistributed intervals (the levels L / 2, L, 2 L) with its multipliers,
+    their errors' estimate from the three levels (without the check a graded or unsteady mesh
+    has) and the period's order its levels show (None: not steady)."""
     terms, lay, x1 = first_solved(o, L, m)
     c, f = levels(lay, terms, x1, reference(lay, x1), L, True, 1e-10, "test")
     assert c.coarser is not None
     for s in (c.coarser, c, f):
         s.mu = floquet(s.lay, terms, s.x, count)
     f.check = None                     # the three levels' own estimate (a graded mesh is checked)
-    return f, estimate(c, f)
+    return f, estimate(c, f), adapt.level_error(c, f)[2]
 
 
 def ratios(f, errors, T_ref: float, mu_ref: np.ndarray) -> list[float]:
@@ -460,9 +454,10 @@ def test_oscillation_within_1_5_of_the_smallest_sufficient_mesh(oscillation, osc
 ])
 def test_three_level_estimate_bounds_the_true_error(request, case, L, m):
     o, ref = request.getfixturevalue(case)
-    f, errors = three_levels(o, L, m, 4)
+    f, errors, seen = three_levels(o, L, m, 4)
     period, *mu = ratios(f, errors, ref.period, ref.multipliers)
     # the period's three levels are steady on these meshes: Richardson's estimate
+    assert seen is not None and seen <= 2 * m, seen
     assert 1.0 <= period <= 10.0, (period, errors)
     # a multiplier's levels need not be (a sign change): the two-level difference bounds it
     assert mu and all(1.0 <= q <= RATIO for q in mu), (mu, errors)
