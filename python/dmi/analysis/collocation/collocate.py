@@ -107,9 +107,8 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
         a refinement's round could stop by the check; elsewhere Richardson's estimate from the
         three levels, which overstates the period's error up to some 650 times there (none
         below it on the scan's 159 meshes), and u's and the multipliers' from the two or three
-        levels.  ``stable`` is judged
-        against the multipliers' estimate, so a verdict the levels leave undecided (None) may
-        be decided with ``check=True``.  With ``intervals=None`` the refinement may stop on
+        levels.  ``stable`` is judged against the multipliers' estimate, so a verdict the
+        levels leave undecided (None) may be decided with ``check=True``.  With ``intervals=None`` the refinement may stop on
         another mesh with ``check=True`` (its estimate is the check's).
 
     Returns

@@ -1,5 +1,6 @@
 # The collocation equations of a periodic orbit of the equation: the model's terms, the layout of
-# the unknowns, the residual with its sparse Jacobian, and Newton's method on them.
+# the unknowns, the residual with its sparse Jacobian, Newton's method on them, and a solution's
+# inequalities checked on a fine grid.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """The collocation system of :mod:`dmi.analysis.collocation.collocate`; private to the package.
 
