@@ -26,6 +26,7 @@
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
+import ctypes
 import importlib
 import json
 import os
@@ -53,6 +54,13 @@ def fail(msg: str) -> None:
     print("FAIL:", msg)
 
 
+def die_with_parent() -> None:
+    """In a child before it runs its program: SIGKILL it when the process that started it dies
+    (Linux's PR_SET_PDEATHSIG), so that a check killed from outside (a test's timeout, a kill -9)
+    leaves no browser behind; its own children follow it."""
+    ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)     # 1: PR_SET_PDEATHSIG
+
+
 class Browser:
     """Headless Chromium with one page, through the DevTools protocol (a websocket)."""
 
@@ -70,7 +78,8 @@ class Browser:
                "--host-resolver-rules=MAP * 127.0.0.1:9", "--remote-debugging-port=0",
                f"--user-data-dir={self.profile.name}", "about:blank"]
         self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                                     text=True, start_new_session=True)
+                                     text=True, start_new_session=True,
+                                     preexec_fn=die_with_parent)
         url, t0 = None, time.monotonic()
         while url is None and time.monotonic() - t0 < timeout:
             line = self.proc.stderr.readline()
