@@ -18,9 +18,11 @@
 # --multipliers-scan: the multipliers' default estimate against the true error on the scan's
 # smooth orbits;
 # --never-below: the refinements with an estimate never below |d2| / 7 (what such a rule costs);
-# --check-cost: collocate with check=True against without (CPU, interleaved, and estimates).
+# --check-cost: collocate with check=True against without (CPU, interleaved, and estimates);
+# --rounding: the period on several meshes and degrees where truncation is below rounding.
 # Usage: PYTHONPATH=build/python .venv/bin/python bench/bench_meshes.py
-#        [--small | --scan | --multipliers-scan | --never-below | --check-cost [--rounds N]]
+#        [--small | --scan | --multipliers-scan | --never-below | --rounding
+#         | --check-cost [--rounds N]]
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
@@ -122,6 +124,10 @@ def main() -> None:
                     help="only the refinements with an estimate never below |d2| / 7 (the "
                          "finer pair's order at least 3) and the next mesh aimed at it: what a "
                          "never-below rule costs (the library's own rule is not changed)")
+    ap.add_argument("--rounding", action="store_true",
+                    help="only the period of orbits whose truncation is below rounding, on "
+                         "several meshes and degrees: the spread is the collocation's "
+                         "rounding floor (about a minute)")
     a = ap.parse_args()
     if a.scan:
         scan()
@@ -134,6 +140,9 @@ def main() -> None:
         return
     if a.multipliers_scan:
         multipliers_scan()
+        return
+    if a.rounding:
+        rounding()
         return
     print("mesh | period: true | 2-level/true | 3-level/true | mu_2: true | 2-level/true | "
           "3-level/true | Newton its, CPU: on L | 2L from L | 2L from start | L/2 from L")
@@ -312,7 +321,7 @@ SCAN = ((1.0, 0.0, 6.0, 600, 4, range(6, 48)), (1.0, 0.5, 6.0, 600, 4, range(6, 
 def scan() -> None:
     """The period's estimate of the orbit returned for intervals = L against its true error
     (degree 8 on 96 or 160 intervals; compared where above ten times that reference's own
-    uncertainty, at least 3e-12, and 100 ulp) on every L of SCAN: how many meshes, how many
+    uncertainty, at least 1e-13, and 100 ulp) on every L of SCAN: how many meshes, how many
     checked (levels not steady or a graded mesh: the finer level against its mesh halved) and
     how many with Richardson's estimate, the estimate / true range of each kind, and
     every estimate below its true error with the orders its levels show; for each orbit, the
@@ -325,7 +334,7 @@ def scan() -> None:
         big = 80 if eps >= 10 else 48
         ref = da.collocate(o, intervals=big, degree=8, multipliers=0)
         gap = max(abs(da.collocate(o, intervals=big + big // 5, degree=8,
-                                   multipliers=0).period - ref.period), 3e-12)
+                                   multipliers=0).period - ref.period), 1e-13)
         terms = Terms(build(o.make, o.p))
         sig, b0 = read_signature(o.u, o.h, terms.alpha, terms.lo, terms.hi)
         orders, mine = [], {k: [] for k in counts}
@@ -368,6 +377,27 @@ def scan() -> None:
     for line in below:
         print("  " + line)
 
+
+
+def rounding() -> None:
+    """The period returned for intervals = L at degrees 6 to 8 on meshes fine enough that its
+    truncation error (h^(2 m): it would fall with L and with the degree) is below rounding (van
+    der Pol at eps = 1, the relaxation oscillation at eps = 10), and the spread of each degree
+    and of all: what the solve's rounding and Newton's stopping leave, the floor an estimate
+    cannot go below."""
+    for eps, T, steps, rows in ((1.0, 6.0, 600, ((8, (30, 42, 54, 66)), (6, (40, 60, 80)))),
+                                (10.0, 16.0, 1000, ((8, (80, 120, 160)), (7, (80, 110, 140)),
+                                                    (6, (100, 125, 150))))):
+        o = scheme_orbit(eps, T, steps)
+        every = []
+        for m, sizes in rows:
+            got = [da.collocate(o, intervals=L, degree=m, multipliers=0).period for L in sizes]
+            every += got
+            print(f"eps = {eps:g}, degree {m}, L = {', '.join(map(str, sizes))}: periods "
+                  + ", ".join(f"{t:.15f}" for t in got) + f"; spread {max(got) - min(got):.2g} "
+                  f"({(max(got) - min(got)) / got[0]:.2g} relative)", flush=True)
+        print(f"eps = {eps:g}, all degrees: spread {max(every) - min(every):.2g} "
+              f"({(max(every) - min(every)) / every[0]:.2g} relative)", flush=True)
 
 
 def multipliers_scan() -> None:

@@ -198,7 +198,7 @@ MEMO_DECORATORS = {"lru_cache", "cache"}
 #: Memoising tables of pure constants, the same for every problem (by (module, name)), allowed
 #: with the reason.
 CONSTANT_CACHES = {
-    ("analysis.collocation.mesh", "_monomials"): "the Lagrange basis' coefficients by its degree",
+    ("analysis.collocation.mesh", "_legendre_form"): "the Lagrange basis' Legendre coefficients",
     ("analysis.collocation.mesh", "_jacobi"): "Gauss-Jacobi nodes and weights by (q, beta)",
     ("analysis.collocation.mesh", "_legendre"): "Gauss-Legendre nodes and weights by q",
     ("analysis.collocation.system", "_collocation_pattern"): "the collocation matrices' pattern "

@@ -138,9 +138,9 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
         exceed MAX_DELAY_NODES; a model with a user resolvent (use ``refine_orbit``) or with
         near cells not of a fitted PowerKernel; a result that still breaks an inequality of its
         signature after MENDS mends (the message names it; refine the scheme's orbit); with
-        ``intervals=None``, the estimate at its floor (FLOOR) above ``tol``, stopped falling,
-        or needing more than MAX_INTERVALS intervals or MAX_ROUNDS rounds (the message names
-        the estimate reached and its mesh).
+        ``intervals=None``, the estimate at the floor of rounding (CHECKED_FLOOR) above ``tol``,
+        stopped falling, or needing more than MAX_INTERVALS intervals or MAX_ROUNDS rounds (the
+        message names the estimate reached and its mesh).
     ShootingError
         Newton fails; from the scheme's orbit (the first solve), or onto the equilibrium, with
         a message saying that the scheme's orbit is too far from the equation's and what to

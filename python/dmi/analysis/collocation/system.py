@@ -35,7 +35,7 @@ import scipy.sparse.linalg as sla
 from ..._solver import Solver
 from ..core.model import FD_STEP, ManyRhs
 from .fold import Fold, exp_sum, fold_of, folding
-from .mesh import (STEEP, Basis, DelayPlan, Kernel, Locator, Near, _monomials,
+from .mesh import (STEEP, Basis, DelayPlan, Kernel, Locator, Near,
                    delay_matrix, delay_matrix_separable, folded_matrix, history_locator,
                    history_rows, interval_of, periodic_locator, point_matrix)
 from .signature import HI, LO, SLIP_NEG, SLIP_POS, STUCK, Signature, violations
@@ -524,7 +524,7 @@ class Layout:
     basis: Basis = field(init=False)
 
     def __post_init__(self) -> None:
-        self.basis = HornerBasis(self.m, self.m + QUAD_EXTRA)
+        self.basis = Basis(self.m, self.m + QUAD_EXTRA)
 
     @property
     def L(self) -> int:
@@ -619,23 +619,6 @@ class Layout:
         """The same layout on other meshes of its pieces."""
         return Layout(self.m, self.n, self.signature, fractions, self.autonomous, self.period,
                       self.carried)
-
-
-@dataclass(frozen=True)
-class HornerBasis(Basis):
-    """The Basis with its derivatives by Horner's scheme on the monomial coefficients in
-    y = 2 z - 1 (as its values; the same polynomials' derivatives, to rounding), one pass over
-    all the points at once."""
-
-    def derivatives(self, z: np.ndarray) -> np.ndarray:
-        """(len(z), m + 1): the basis polynomials' first derivatives at z (d/dz)."""
-        y = 2.0 * np.asarray(z, dtype=float).ravel() - 1.0
-        C = _monomials(self.m)
-        out = np.broadcast_to(self.m * C[self.m], (y.size, self.m + 1)).copy()
-        for j in range(self.m - 1, 0, -1):
-            out *= y[:, None]
-            out += j * C[j]
-        return 2.0 * out
 
 
 class Degenerate(ValueError):

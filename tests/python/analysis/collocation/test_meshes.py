@@ -19,7 +19,7 @@ import pytest
 import dmi
 from dmi import analysis as da
 from dmi.analysis.collocation import adapt
-from dmi.analysis.collocation.adapt import FLOOR, estimate, levels
+from dmi.analysis.collocation.adapt import estimate, levels
 from dmi.analysis.collocation.collocate import first_solve
 from dmi.analysis.collocation.floquet import multipliers as floquet
 from dmi.analysis.collocation.signature import read_signature
@@ -130,16 +130,16 @@ def test_an_estimate_that_has_not_yet_fallen_is_no_floor():
 def test_relaxation_at_the_default_settings(relaxation):
     """Degree 4 and tol = 1e-10 from the scheme's orbit of 1000 steps (its period 16.4, the
     equation's 13.6): the first solve on 16 intervals graded to the scheme's speed fails, on 16
-    equal ones it converges; the refinement ends within its estimate, which has its floor
-    (FLOOR times the period, 1.4e-10) above tol."""
+    equal ones it converges; the refinement ends within its estimate, the check's (a graded
+    mesh), below tol (its floor, CHECKED_FLOOR times the period, 1.4e-11; at FLOOR's, 1.4e-10,
+    the estimate was above tol)."""
     o, ref = relaxation
     assert abs(o.period - ref.period) > 2.0
     e = da.collocate(o, multipliers=0)
     true = abs(e.period - ref.period)
-    # 8.6e-11 measured against an estimate at its floor, 1.36e-10 (the check's own, 6.6e-11, is
-    # below the floor and as close to the reference as the reference's uncertainty: 2.2e-11
-    # against collocations of degree 8 on other meshes, 56 to 96 intervals)
-    assert true + 3e-11 <= e.errors["period"] <= max(1e-10, FLOOR * e.period)
+    # 3.0e-11 measured against an estimate of 6.7e-11 (the reference's uncertainty: 3.6e-14
+    # against degree 8 on 80 intervals)
+    assert true <= e.errors["period"] <= min(1e-10, 10 * true), (true, e.errors["period"])
     # within 1.5 times the least sufficient mesh of a scan in steps of 10 from 60 intervals
     # (1e-10: 160 measured, the errors not monotone: 1.5e-9 at 80, 3.6e-10 at 100, 4.6e-9 at
     # 120): no L of it up to the counted level / 1.5 suffices.  210 counted measured (16, 64,
@@ -420,11 +420,23 @@ def oscillation():
 @pytest.fixture(scope="module")
 def oscillation_gap(oscillation):
     """The reference period's uncertainty: its difference to a second collocation of degree 8
-    on another mesh (56 intervals, 112 returned), measured 1.3e-12."""
+    on another mesh (56 intervals, 112 returned): 1.4e-14 measured (1.3e-12 with the basis in its
+    monomial form, whose rounding the derivatives divided by the intervals' lengths)."""
     o, ref = oscillation
     gap = abs(da.collocate(o, intervals=56, degree=8, multipliers=0).period - ref.period)
-    assert gap <= 1e-11
+    assert gap <= 2e-13
     return gap
+
+
+def test_a_tol_below_the_levels_floor_is_met_by_a_check(oscillation, oscillation_gap):
+    """tol = 1e-11, below FLOOR times the period (5.6e-11), where the levels' estimate is not
+    trusted: the round whose Richardson estimate meets tol is checked, and the check's estimate
+    (its floor CHECKED_FLOOR times the period, 5.6e-12) meets it (the levels' estimate, floored
+    at 5.6e-11, was returned above tol)."""
+    o, ref = oscillation
+    e = da.collocate(o, tol=1e-11, multipliers=0)
+    true = abs(e.period - ref.period)
+    assert true + oscillation_gap <= e.errors["period"] <= 1e-11, (true, e.errors["period"])
 
 
 @pytest.mark.parametrize("tol", [1e-6, 1e-7, 1e-8, 1e-10])
