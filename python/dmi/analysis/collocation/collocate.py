@@ -99,17 +99,19 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     check : bool
         True: the period's, amplitudes', u's and multipliers' estimate of every mesh from the
         finer level against its mesh halved (twice their difference; in a refinement, of each
-        round that could stop it): the period's 1.46-2.24 times the true error on every mesh of
-        ``bench_meshes.py --scan``, u's and the multipliers' about 2 times; 1.5-1.9 times the
-        CPU of a smooth orbit without multipliers, 2-3 times with 10 (the monodromy on the mesh
-        halved).  False: the period's, amplitudes' and u's so only where the three levels are
-        not steady (an order seen above the period's 2 m is not steady), the mesh is graded, or
-        a refinement's round could stop by the check; elsewhere Richardson's estimate from the
-        three levels, which overstates the period's error up to some 650 times there (none
-        below it on the scan's 159 meshes), and u's and the multipliers' from the two or three
-        levels.  ``stable`` is judged against the multipliers' estimate, so a verdict the
-        levels leave undecided (None) may be decided with ``check=True``.  With ``intervals=None`` the refinement may stop on
-        another mesh with ``check=True`` (its estimate is the check's).
+        round that could stop it): the period's 1.7-8.02 times the true error on every mesh of
+        ``bench_meshes.py --scan`` (1.46-2.24 above 3e-11; nearer 1e-12 relative, its floor),
+        u's and the multipliers' about 2 times; 1.5-1.9 times the CPU of a smooth orbit without
+        multipliers, 2-3 times with 10 (the monodromy on the mesh halved).  False: the period's,
+        amplitudes' and u's so only where the three levels are not steady (an order seen above
+        the period's 2 m is not steady), the mesh is graded, or a refinement's round could stop
+        by the check; elsewhere Richardson's estimate from the three levels, which overstates
+        the period's error up to some 650 times there (none below it on the scan's 231
+        meshes), and u's and the multipliers' from the two or three levels (a multiplier's
+        two-level difference counted twice).  ``stable`` is judged against the multipliers'
+        estimate, so a verdict the levels leave undecided (None) may be decided with
+        ``check=True``.  With ``intervals=None`` the refinement may stop on another mesh with
+        ``check=True`` (its estimate is the check's).
 
     Returns
     -------
