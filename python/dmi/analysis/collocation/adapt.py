@@ -440,11 +440,13 @@ def checked_round(c: Solved, f: Solved, terms: Terms, ref: Any, tol: float | Non
     most CHECK_RANGE tol (a round whose estimate meets tol is never farther: the estimate is at
     least SAFETY / (2^(2 m) - 1) times the difference, above 1 / CHECK_RANGE up to degree 8);
     and where Richardson's estimate meets a tol below FLOOR (relative to the period or the
-    amplitudes, at least 1), which the levels' estimate is not trusted below."""
+    amplitudes, at least 1), which the levels' estimate is not trusted below, and not below
+    CHECKED_FLOOR, which a check cannot go below either."""
     d, two, seen = level_error(c, f)
     graded = c.lay.interval_ratio() >= GRADED
-    size = f.T if f.lay.autonomous else float(np.max(np.abs(f.amplitude)))
-    near = tol is not None and (tol < d <= SAFETY * tol or d <= tol < FLOOR * max(1.0, size))
+    size = max(1.0, f.T if f.lay.autonomous else float(np.max(np.abs(f.amplitude))))
+    low = tol is not None and d <= tol and CHECKED_FLOOR * size <= tol < FLOOR * size
+    near = low or tol is not None and tol < d <= SAFETY * tol
     if near or (seen is None or graded or every) and (tol is None
                                                       or two <= CHECK_RANGE * tol):
         f.check = checked(f, terms, ref)

@@ -100,7 +100,7 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
         True: the period's, amplitudes', u's and multipliers' estimate of every mesh from the
         finer level against its mesh halved (twice their difference; in a refinement, of each
         round that could stop it): the period's 1.7-8.02 times the true error on every mesh of
-        ``bench_meshes.py --scan`` (1.46-2.24 above 3e-11; nearer 1e-12 relative, its floor),
+        ``bench_meshes.py --scan`` (the upper end where the true error is near the floor),
         u's and the multipliers' about 2 times; 1.5-1.9 times the CPU of a smooth orbit without
         multipliers, 2-3 times with 10 (the monodromy on the mesh halved).  False: the period's,
         amplitudes' and u's so only where the three levels are not steady (an order seen above

@@ -26,9 +26,9 @@ from __future__ import annotations
 
 import functools
 import math
-from fractions import Fraction
 from collections.abc import Callable
 from dataclasses import dataclass
+from fractions import Fraction
 from typing import Any
 
 import numpy as np
@@ -69,8 +69,8 @@ class Basis:
 
     def values(self, z: np.ndarray) -> np.ndarray:
         """(len(z), m + 1): the basis polynomials at the local coordinates z."""
-        return _legendre_values(2.0 * np.asarray(z, dtype=float).ravel() - 1.0, self.m) \
-            @ _legendre_form(self.m)[0]
+        y = 2.0 * np.asarray(z, dtype=float).ravel() - 1.0
+        return _legendre_values(y, self.m) @ _legendre_form(self.m)[0]
 
     def derivatives(self, z: np.ndarray) -> np.ndarray:
         """(len(z), m + 1): the basis polynomials' first derivatives at z (d/dz, z in [0, 1])."""
