@@ -527,7 +527,7 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
 
     The refinement stops with a ValueError that names the estimate reached and its mesh when
     the estimate is at the floor of rounding (CHECKED_FLOOR times the period or the
-    amplitudes, at least 1), when
+    amplitudes, at least 1) or meets a tol below that floor, when
     it has stopped falling (an observed order below LEAST_ORDER over a growth of LEAST_GROWTH at
     least, below CONDITIONED), when the observed order (1
     with an undeclared jump of the kernel, ``capped``) says tol needs more than MAX_INTERVALS
@@ -552,15 +552,15 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
         if fixed:
             return c, f
         size = f.T if autonomous else float(np.max(np.abs(f.amplitude)))
-        if d <= tol:
-            return c, f
         floor = CHECKED_FLOOR * max(1.0, size)
+        if d <= tol and floor <= tol:
+            return c, f
         reached = (f"the estimated error of the {name} is {d:.3g} at {f.lay.L} intervals of "
                    f"degree {lay.m}")
         below = (f"collocate: tol = {tol!r} is below the floor of double precision, {floor:.3g} "
                  f"(CHECKED_FLOOR = {CHECKED_FLOOR:g} times the {name}, at least 1), where a "
                  f"finer mesh no longer lowers the estimate: {reached}; ask tol >= {floor:.2g}")
-        if d <= floor:
+        if d <= floor or d <= tol:                 # an estimate at the floor, above tol
             raise ValueError(below)
         # the expected order: the period's h^(2m) (superconvergent), an extremum's h^(m+1)
         expected = 2 * lay.m if autonomous else lay.m + 1

@@ -411,6 +411,16 @@ def ratios(f, errors, T_ref: float, mu_ref: np.ndarray) -> list[float]:
     return out
 
 
+def test_a_tol_below_the_checked_floor_is_refused(oscillation):
+    """tol = 5e-12, below CHECKED_FLOOR times the period (5.6e-12): the refinement reaches a mesh
+    whose check meets tol (its estimate 1.2e-12 before the floor), but the estimate it can report
+    is its floor, above tol: refused, with the floor to ask (it returned the orbit with its
+    estimate above tol, silently)."""
+    o, _ = oscillation
+    with pytest.raises(ValueError, match=r"tol = 5e-12 is below the floor.*ask tol >= 5\.6e-12"):
+        da.collocate(o, tol=5e-12, multipliers=0)
+
+
 def test_a_multipliers_two_level_difference_counts_twice():
     """van der Pol without memory (eps = 1, a = 0), degree 4, intervals = 12: the multiplier near
     8.6e-4 does not converge monotonically (its middle level 2.0e-11 from the truth, its finer
