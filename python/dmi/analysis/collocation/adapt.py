@@ -240,6 +240,12 @@ class Solved:
         self.check: Solved | None = None
         self.unchecked: str | None = None
 
+    @property
+    def scale(self) -> float:
+        """The period (an autonomous orbit) or the largest amplitude (a forced one), at least 1:
+        what the floors and CONDITIONED are relative to."""
+        return max(1.0, self.T if self.lay.autonomous else float(np.max(np.abs(self.amplitude))))
+
 
 def _match(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """|a_j - (the nearest b)| for each a_j."""
@@ -444,8 +450,7 @@ def checked_round(c: Solved, f: Solved, terms: Terms, ref: Any, tol: float | Non
     CHECKED_FLOOR, which a check cannot go below either."""
     d, two, seen = level_error(c, f)
     graded = c.lay.interval_ratio() >= GRADED
-    size = max(1.0, f.T if f.lay.autonomous else float(np.max(np.abs(f.amplitude))))
-    low = tol is not None and d <= tol and CHECKED_FLOOR * size <= tol < FLOOR * size
+    low = tol is not None and d <= tol and CHECKED_FLOOR * f.scale <= tol < FLOOR * f.scale
     near = low or tol is not None and tol < d <= SAFETY * tol
     if near or (seen is None or graded or every) and (tol is None
                                                       or two <= CHECK_RANGE * tol):
@@ -551,8 +556,7 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
         d, two, seen = checked_round(c, f, terms, ref, None if fixed else tol, every)
         if fixed:
             return c, f
-        size = f.T if autonomous else float(np.max(np.abs(f.amplitude)))
-        floor = CHECKED_FLOOR * max(1.0, size)
+        floor = CHECKED_FLOOR * f.scale
         if d <= tol and floor <= tol:
             return c, f
         reached = (f"the estimated error of the {name} is {d:.3g} at {f.lay.L} intervals of "
@@ -568,7 +572,7 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
         if last is not None and last[1] > 0:       # the observed order of the two levels' d
             q = math.log(last[1] / two) / math.log(L / last[0])
             if q < LEAST_ORDER and (L < LEAST_GROWTH * last[0] or
-                                    two > CONDITIONED * max(1.0, size)):
+                                    two > CONDITIONED * f.scale):
                 q = 1.0 if capped else None        # too small a step or too early to tell
             elif q < LEAST_ORDER:
                 raise ValueError(f"collocate: the estimated error has stopped falling: the "
