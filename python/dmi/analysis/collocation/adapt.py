@@ -1,5 +1,5 @@
 # Mesh adaptation of a collocated orbit: the indicator, the equidistribution, the adaptation step
-# between solves, and the two-level error estimate with the refinement it steers.
+# between solves, and the error estimates with the refinement they steer.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 """Where the mesh of a collocated orbit comes from and how good the orbit on it is; private to the
 package (:mod:`dmi.analysis.collocation.collocate` and the collocated branch use it).
@@ -14,16 +14,19 @@ package (:mod:`dmi.analysis.collocation.collocate` and the collocated branch use
   amplitudes, multipliers and u is the finer one's error estimate; with a third level (the
   coarser's mesh merged, its ``coarser``) the period, amplitudes and multipliers by Richardson's
   extrapolation where the three levels are steady (:func:`extrapolated`); where they are not,
-  the mesh is graded (GRADED: a steep orbit), a refinement's round could stop by the check, or
-  every mesh is asked (collocate's ``check``), the period, amplitudes and u from the finer
-  against its own mesh halved (:func:`checked`: CHECK_SAFETY times their difference; the
-  multipliers too where the check has them).  An autonomous
-  orbit's two solutions are compared after aligning their phase (:func:`aligned`): its phase is
-  free, and a shift along a steep orbit is no error of its shape.
-- The refinement (:func:`levels`): from a first mesh that depends on tol
-  (:func:`first_intervals`), equidistribute, solve on three levels (:func:`two_levels`), grow
-  the mesh until the estimate meets tol (:func:`level_error`), with its stopping rules and the
-  cost check of the delay integral (:func:`check_cost`).
+  the mesh is graded (GRADED: a steep orbit), or every mesh is asked (collocate's ``check``),
+  the period, amplitudes and u from the finer against its own mesh halved (:func:`checked`:
+  CHECK_SAFETY times their difference; the multipliers too where the check has them).  An
+  autonomous orbit's two solutions are compared after aligning their phase (:func:`aligned`):
+  its phase is free, and a shift along a steep orbit is no error of its shape.
+- A fixed mesh (:func:`fixed_levels`, collocate's ``intervals=L``): L intervals equidistributed,
+  solved with that mesh halved (the orbit returned) and merged (:func:`two_levels`).
+- The refinement (:func:`refined`): from a first mesh that depends on tol
+  (:func:`first_intervals`), rounds of the orbit on a mesh equidistributed anew and on that mesh
+  halved (its check); the first whose check's estimate (:func:`round_error`) meets tol is
+  returned, its multipliers' estimate from its mesh merged once and twice (:func:`lower`) or
+  from the check; the next mesh by the order the rounds show (:func:`next_intervals`), with the
+  stopping rules and the cost check of the delay integral (:func:`check_cost`).
 
 May import: :mod:`.mesh`, :mod:`.signature`, :mod:`.system` (no module of the package above them).
 """
@@ -62,7 +65,7 @@ LEAST_ORDER = 0.5
 #: amplitudes, at least 1); a smaller step (aimed at a steady round that did not come) or a larger
 #: estimate (not yet in the asymptotic range) grows again by the expected order.
 LEAST_GROWTH = 1.2
-CONDITIONED = 1e-6
+CONDITIONED = 1e-9
 #: The least observed order (from three levels) a Richardson estimate trusts.
 LEAST_RICHARDSON = 1.0
 #: The coarsest of three levels farther than this (relative, at least 1) from the middle one
@@ -72,7 +75,7 @@ ROUGH = 1e-3
 #: The Richardson estimate's safety factor over |d2| / (2^q - 1).
 SAFETY = 8.0
 #: The first round's intervals where tol <= FIRST_TOL at degree FIRST_DEGREE (van der Pol of
-#: degree 4 meets 1e-8 there); a looser tol or a higher degree starts coarser
+#: degree 4 meets 1e-8 on twice that); a looser tol or a higher degree starts coarser
 #: (:func:`first_intervals`), on LEAST_POINTS / m intervals at least (rounded: LEAST_POINTS
 #: collocation points), within 4 to LEAST_FIRST.
 FIRST_INTERVALS = 16
@@ -88,14 +91,12 @@ CHECK_SAFETY = 2.0
 #: (van der Pol without memory, degree 4, L = 12: the middle level 2.0e-11 from the truth, the
 #: finer 3.5e-10, their difference 0.943 times the finer's error).
 TWO_LEVEL_SAFETY = 2.0
-#: A refinement's round is checked only where its two levels differ by at most CHECK_RANGE
-#: times tol (their difference is about the coarser level's error, 2^q times the finer's: up to
-#: 1800 times measured at degrees 4 to 6): a round farther off is not expected to meet tol (at
-#: worst it costs one more round).
-CHECK_RANGE = 1e4
-#: A first round whose coarsest level is farther than ROUGH from the middle one in the period
-#: (an autonomous orbit), or could not be solved, grows the mesh by this factor at most (its
-#: levels say nothing of the order).
+#: The next mesh's growth over what the order says (:func:`next_intervals`; the check's estimate
+#: is about twice the true error, so a mesh aimed at tol lands at about half of it).
+MARGIN = 1.1
+#: A first round whose check is farther than ROUGH from it in the period (an autonomous orbit),
+#: or could not be solved, grows the mesh by this factor at most (the round says nothing of the
+#: order).
 FAR_GROWTH = 4
 #: Quadrature nodes of the delay integral at most on one mesh (about 100 bytes each): a memory
 #: spanning many periods (tau / T large) or a very fine mesh is refused before it is built.
@@ -280,7 +281,7 @@ def extrapolated(x0: Any, x1: Any, x2: Any, most: float, bounded: bool = True,
     return est if np.ndim(est) else float(est)
 
 
-def estimate(c: Solved, f: Solved, reached: float = 0.0,
+def estimate(c: Solved | None, f: Solved, reached: float = 0.0,
              coarser: Solved | None = None) -> dict[str, Any]:
     """The finer's error estimate (each plus ``reached``, the accuracy of a coarse solve
     stopped at its rounding floor, in the units of x): the differences of the two levels, or
@@ -288,22 +289,27 @@ def estimate(c: Solved, f: Solved, reached: float = 0.0,
     period, amplitudes and multipliers (where the coarser has them) by :func:`extrapolated` (a
     multiplier's two-level difference, with or without a third level, TWO_LEVEL_SAFETY times);
     where f has its ``check`` (f's mesh halved, :func:`checked`), the period, amplitudes and u
-    from it, and the multipliers where the check has them: CHECK_SAFETY |f - check|.  ``u``
-    compares two levels at equal phase (:func:`gap`)."""
-    errors = {"period": abs(c.T - f.T), "amplitude": np.abs(c.amplitude - f.amplitude),
-              "multipliers": TWO_LEVEL_SAFETY * _match(f.mu, c.mu), "u": gap(c, f)}
-    g = coarser if coarser is not None else c.coarser
-    if g is not None:
-        m = f.lay.m
-        errors["period"] = extrapolated(g.T, c.T, f.T, 2 * m)
-        errors["amplitude"] = extrapolated(g.amplitude, c.amplitude, f.amplitude, m + 1,
-                                           bounded=False)
-        if f.mu.size and g.mu.size and c.mu.size:
-            mc = c.mu[np.argmin(np.abs(f.mu[:, None] - c.mu[None, :]), axis=1)]
-            mg = g.mu[np.argmin(np.abs(mc[:, None] - g.mu[None, :]), axis=1)]
-            errors["multipliers"] = extrapolated(mg, mc, f.mu, 2 * m,
-                                                 fallback=TWO_LEVEL_SAFETY)
+    from it, and the multipliers where the check has them (or where there is no c; inf where
+    neither has them): CHECK_SAFETY |f - check|.  ``u`` compares two levels at equal phase
+    (:func:`gap`).  c may be None only where f has its check."""
     F = f.check
+    if c is None and F is None:
+        raise ValueError("estimate: a coarser level or a check is needed")
+    errors: dict[str, Any] = {"multipliers": np.full(f.mu.shape, np.inf)}
+    if c is not None:
+        errors = {"period": abs(c.T - f.T), "amplitude": np.abs(c.amplitude - f.amplitude),
+                  "multipliers": TWO_LEVEL_SAFETY * _match(f.mu, c.mu), "u": gap(c, f)}
+        g = coarser if coarser is not None else c.coarser
+        if g is not None:
+            m = f.lay.m
+            errors["period"] = extrapolated(g.T, c.T, f.T, 2 * m)
+            errors["amplitude"] = extrapolated(g.amplitude, c.amplitude, f.amplitude, m + 1,
+                                               bounded=False)
+            if f.mu.size and g.mu.size and c.mu.size:
+                mc = c.mu[np.argmin(np.abs(f.mu[:, None] - c.mu[None, :]), axis=1)]
+                mg = g.mu[np.argmin(np.abs(mc[:, None] - g.mu[None, :]), axis=1)]
+                errors["multipliers"] = extrapolated(mg, mc, f.mu, 2 * m,
+                                                     fallback=TWO_LEVEL_SAFETY)
     if F is not None:
         errors["period"] = CHECK_SAFETY * abs(f.T - F.T)
         errors["amplitude"] = CHECK_SAFETY * np.abs(f.amplitude - F.amplitude)
@@ -436,50 +442,60 @@ def level_error(c: Solved, f: Solved) -> tuple[float, float, float | None]:
     return d, two, seen
 
 
-def checked_round(c: Solved, f: Solved, terms: Terms, ref: Any, tol: float | None,
-                  every: bool = False) -> tuple[float, float, float | None]:
-    """:func:`level_error` of a round (c, f), f checked first (:func:`checked`) where (``tol``
-    given: a refinement's round) Richardson's estimate is above tol by at most its SAFETY factor
-    (the extrapolation itself meets tol: the check may stop the refinement here), or where its
-    mesh is graded (``Layout.interval_ratio`` at least GRADED), its three levels are not steady
-    or ``every`` round is to be checked, in a refinement only where its two levels differ by at
-    most CHECK_RANGE tol (a round whose estimate meets tol is never farther: the estimate is at
-    least SAFETY / (2^(2 m) - 1) times the difference, above 1 / CHECK_RANGE up to degree 8);
-    and where Richardson's estimate meets a tol below FLOOR (relative to the period or the
-    amplitudes, at least 1), which the levels' estimate is not trusted below, and not below
-    CHECKED_FLOOR, which a check cannot go below either."""
+def checked_round(c: Solved, f: Solved, terms: Terms, ref: Any, every: bool = False
+                  ) -> tuple[float, float, float | None]:
+    """:func:`level_error` of the levels (c, f) of a fixed mesh, f checked first
+    (:func:`checked`) where its mesh is graded (``Layout.interval_ratio`` at least GRADED), its
+    three levels are not steady or ``every`` mesh is to be checked."""
     d, two, seen = level_error(c, f)
-    graded = c.lay.interval_ratio() >= GRADED
-    low = tol is not None and d <= tol and CHECKED_FLOOR * f.scale <= tol < FLOOR * f.scale
-    near = low or tol is not None and tol < d <= SAFETY * tol
-    if near or (seen is None or graded or every) and (tol is None
-                                                      or two <= CHECK_RANGE * tol):
+    if seen is None or every or c.lay.interval_ratio() >= GRADED:
         f.check = checked(f, terms, ref)
         d = level_error(c, f)[0]
     return d, two, seen
 
 
-def accepted(m: int, autonomous: bool, asymptotic: bool = False) -> float:
-    """How far above tol the two levels' difference of a round whose three levels were not
-    steady may be aimed at: for the period (an autonomous orbit), what the next round's
-    levels, steady, accept: Richardson's SAFETY d2 / (2^q - 1) <= tol, q capped at m + 2, the
-    least order seen on delay equations (the delayed values are not superconvergent), or at
-    q = 2 m, the period's superconvergent order, where the round's levels are ``asymptotic``
-    (the coarsest within ROUGH of the middle one, :func:`settled`: in the asymptotic range,
-    steady or unsteady by a sign); 1 for the amplitudes (a forced orbit), whose levels are
-    seldom steady (an extremum inside an interval: h^(m+1) with a constant that moves with
-    the mesh)."""
-    if not autonomous:
-        return 1.0
-    return max(1.0, (2.0 ** (2 * m if asymptotic else m + 2) - 1.0) / SAFETY)
+def lower(f: Solved, terms: Terms, ref: Any) -> Solved | None:
+    """The orbit on f's mesh with pairs merged (from f's solution) with its own ``coarser``, that
+    mesh merged again (None where that solve fails or merges nothing): the levels of f's
+    multipliers' estimate, and of its period's where f's check could not be solved; None where
+    the first merged solve fails or merges nothing."""
+    levels = []
+    lay, x = f.lay, f.x
+    for _ in range(2):
+        low = lay.with_fractions(merged(lay.fractions))
+        if low.L == lay.L:
+            break
+        try:
+            x = solve(low, terms, transfer(lay, x, low), ref)[0]
+        except (ShootingError, ValueError):
+            break
+        levels.append(Solved(low, x))
+        lay = low
+    if not levels:
+        return None
+    if len(levels) == 2:
+        levels[0].coarser = levels[1]
+    return levels[0]
 
 
-def settled(c: Solved) -> bool:
-    """Whether the coarsest of c's three levels (its ``coarser``) is within ROUGH (relative,
-    at least 1) of c in the period: the levels are in the asymptotic range, their
-    two-level difference the coarser level's error."""
-    g = c.coarser
-    return g is not None and abs(g.T - c.T) <= ROUGH * max(1.0, abs(c.T))
+def round_error(c: Solved | None, f: Solved) -> float:
+    """A refinement round's estimated error of f's period (an autonomous orbit) or largest
+    amplitude error (a forced one): CHECK_SAFETY times its difference to f's ``check``, else
+    the levels' (:func:`level_error`, c from :func:`lower`); inf where there are neither."""
+    if f.check is not None:
+        F = f.check
+        return CHECK_SAFETY * (abs(f.T - F.T) if f.lay.autonomous
+                               else float(np.max(np.abs(f.amplitude - F.amplitude))))
+    return math.inf if c is None else level_error(c, f)[0]
+
+
+def near_check(f: Solved) -> bool:
+    """Whether f's check is within ROUGH (relative, at least 1) of f in the period (an
+    autonomous orbit; a forced one's period is fixed): the round is in the asymptotic range,
+    its estimate says the order to grow by.  False without a check."""
+    F = f.check
+    return F is not None and (not f.lay.autonomous
+                              or abs(f.T - F.T) <= ROUGH * max(1.0, abs(F.T)))
 
 
 def next_intervals(L: int, d: float, aim: float, expected: int, seen: float | None,
@@ -510,53 +526,84 @@ def first_intervals(tol: float, m: int, pieces: int, steep: bool) -> int:
 
 
 def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bool,
-            tol: float, what: str, capped: list[float] | None = None, every: bool = False
-            ) -> tuple[Solved, Solved]:
-    """The orbit on L intervals equidistributed (``fixed``) or refined until the estimate is
-    below tol, and on that mesh halved: (coarser, finer), the coarser with its own ``coarser``
-    (its mesh merged; None where that solve failed), the finer with its ``check`` (its mesh
-    halved, :func:`checked`) where the mesh is graded (``Layout.interval_ratio`` at least
-    GRADED: a steep orbit), the three levels are not steady (no Richardson estimate) or
-    ``every`` mesh is to be checked, in a refinement only where the two levels differ by at
-    most CHECK_RANGE tol; and in a refinement wherever Richardson's estimate is above tol by at
-    most its SAFETY factor (:func:`checked_round`): the estimate that stops the refinement and
-    aims the next mesh (at tol) is then the check's (a check that cannot be solved leaves the
-    levels' estimate and its reason in the finer's ``unchecked``).  A first round of an
-    autonomous orbit whose coarsest level is more than ROUGH off the middle one in the period,
-    or of any orbit whose coarsest level could not be solved, grows the mesh by FAR_GROWTH at
-    most.
+           tol: float, what: str, capped: list[float] | None = None, every: bool = False
+           ) -> tuple[Solved | None, Solved]:
+    """The orbit on L intervals equidistributed (``fixed``: :func:`fixed_levels`) or refined
+    until its checked estimate is below tol (:func:`refined`): (coarser, finer), the finer the
+    orbit returned."""
+    if fixed:
+        return fixed_levels(lay, terms, x, ref, L, what, every)
+    return refined(lay, terms, x, ref, L, tol, what, capped)
+
+
+def fixed_levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, what: str,
+                 every: bool = False) -> tuple[Solved, Solved]:
+    """The orbit on L intervals equidistributed and on that mesh halved: (coarser, finer), the
+    coarser with its own ``coarser`` (its mesh merged; None where that solve failed), the finer
+    with its ``check`` (its mesh halved, :func:`checked`) where the mesh is graded
+    (``Layout.interval_ratio`` at least GRADED: a steep orbit), the three levels are not steady
+    (no Richardson estimate) or ``every`` mesh is to be checked (a check that cannot be solved
+    leaves the levels' estimate and its reason in the finer's ``unchecked``)."""
+    c, f = two_levels(lay.with_fractions(adapted(lay, x, L)), terms, (lay, x), ref, what)
+    checked_round(c, f, terms, ref, every)
+    return c, f
+
+
+def one_level(lay: Layout, terms: Terms, start: tuple[Layout, np.ndarray], ref: Any,
+              what: str) -> Solved:
+    """The orbit on ``lay`` from ``start`` (a solution on another layout)."""
+    return Solved(lay, solve(lay, terms, transfer(*start, lay), ref, what=what)[0])
+
+
+def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: float,
+            what: str, capped: list[float] | None = None) -> tuple[Solved | None, Solved]:
+    """The refinement: from L intervals, rounds of the orbit on a mesh equidistributed from the
+    last round's check (:func:`adapted`) and on that mesh halved (:func:`checked`), until the
+    check's estimate of the first meets tol (:func:`round_error`): (None, f), f the orbit
+    returned with its ``check``; where f's check cannot be solved, the estimate is the levels'
+    (f's mesh merged once and twice, :func:`lower`; returned as the coarser, with the reason in
+    f's ``unchecked``).  The next mesh grows by the order the two last rounds' estimates show
+    (above m, at most the theory's + 2), else by the theory's (the period's h^(2m), an
+    extremum's h^(m+1); 1 with an undeclared jump of the kernel, ``capped``), with MARGIN more,
+    by at most 8 times, and by at most FAR_GROWTH after a round whose check is more than ROUGH
+    off it in the period (or was not solved) while no round was nearer (such a round says
+    nothing of the order, and its estimate is left out of the rounds' order).
 
     A first round on fewer than FIRST_INTERVALS intervals (a loose tol or a high degree) whose
-    solve fails is done again on twice its intervals, at most FIRST_INTERVALS (not counted as a
-    round of MAX_ROUNDS).
+    solve fails, or whose check and merged level both fail (no estimate), is done again on
+    twice its intervals, at most FIRST_INTERVALS (not counted as a round of MAX_ROUNDS).
 
     The refinement stops with a ValueError that names the estimate reached and its mesh when
     the estimate is at the floor of rounding (CHECKED_FLOOR times the period or the
-    amplitudes, at least 1) or meets a tol below that floor, when
-    it has stopped falling (an observed order below LEAST_ORDER over a growth of LEAST_GROWTH at
-    least, below CONDITIONED), when the observed order (1
-    with an undeclared jump of the kernel, ``capped``) says tol needs more than MAX_INTERVALS
-    intervals, when the next mesh's delay integral would exceed MAX_DELAY_NODES, or after
+    amplitudes, at least 1; FLOOR for the levels' estimate) or meets a tol below that floor,
+    when it has stopped falling (an observed order below LEAST_ORDER over a growth of
+    LEAST_GROWTH at least, below CONDITIONED), when the observed order (1 with an undeclared
+    jump of the kernel, ``capped``) says tol needs more than MAX_INTERVALS intervals, when the
+    next mesh's check would need more than MAX_DELAY_NODES quadrature nodes, or after
     MAX_ROUNDS rounds."""
-    last = None
-    unsteady = False                               # the last round's levels were not steady
+    last = None                                    # the last round's (L, estimate)
     autonomous = lay.autonomous
     name = "period" if autonomous else "amplitudes"
+    # the expected order: the period's h^(2m) (superconvergent), an extremum's h^(m+1)
+    expected = 2 * lay.m if autonomous else lay.m + 1
     rounds = 0
     while rounds < MAX_ROUNDS:
-        lay2 = lay.with_fractions(adapted(lay, x, L))
+        new = lay.with_fractions(adapted(lay, x, L))
         try:
-            c, f = two_levels(lay2, terms, (lay, x), ref, what)
+            f = one_level(new, terms, (lay, x), ref, what)
         except ShootingError:
-            if fixed or last is not None or L >= FIRST_INTERVALS:
+            if rounds > 0 or L >= FIRST_INTERVALS:
                 raise
             L = min(2 * L, FIRST_INTERVALS)        # a loose tol's first mesh too coarse: not
             continue                               # a round
+        f.check = checked(f, terms, ref)
+        c = lower(f, terms, ref) if f.check is None else None
+        d = round_error(c, f)
+        if rounds == 0 and not math.isfinite(d) and L < FIRST_INTERVALS:
+            L = min(2 * L, FIRST_INTERVALS)        # no estimate on a first mesh that coarse:
+            continue                               # not a round either
         rounds += 1
-        d, two, seen = checked_round(c, f, terms, ref, None if fixed else tol, every)
-        if fixed:
-            return c, f
-        floor = CHECKED_FLOOR * f.scale
+        floor = (CHECKED_FLOOR if f.check is not None else FLOOR) * f.scale
         if d <= tol and floor <= tol:
             return c, f
         reached = (f"the estimated error of the {name} is {d:.3g} at {f.lay.L} intervals of "
@@ -566,22 +613,19 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
                  f"finer mesh no longer lowers the estimate: {reached}; ask tol >= {floor:.2g}")
         if d <= floor or d <= tol:                 # an estimate at the floor, above tol
             raise ValueError(below)
-        # the expected order: the period's h^(2m) (superconvergent), an extremum's h^(m+1)
-        expected = 2 * lay.m if autonomous else lay.m + 1
         q = 1.0 if capped else None
-        if last is not None and last[1] > 0:       # the observed order of the two levels' d
-            q = math.log(last[1] / two) / math.log(L / last[0])
-            if q < LEAST_ORDER and (L < LEAST_GROWTH * last[0] or
-                                    two > CONDITIONED * f.scale):
+        if last is not None and last[1] > 0 and math.isfinite(d):  # the rounds' observed order
+            q = math.log(last[1] / d) / math.log(L / last[0])
+            if q < LEAST_ORDER and (L < LEAST_GROWTH * last[0] or d > CONDITIONED * f.scale):
                 q = 1.0 if capped else None        # too small a step or too early to tell
             elif q < LEAST_ORDER:
-                raise ValueError(f"collocate: the estimated error has stopped falling: the "
-                                 f"two levels' difference was {last[1]:.3g} at {2 * last[0]} "
-                                 f"intervals and is {two:.3g}; {reached} "
-                                 f"(observed order {q:.2g}): tol = {tol!r} is below what this "
-                                 "orbit's collocation reaches (the floor of its conditioning); "
-                                 f"ask tol >= {last[1]:.2g}, or a higher degree")
-        if q is not None:
+                raise ValueError(f"collocate: the estimated error has stopped falling: it was "
+                                 f"{last[1]:.3g} at {last[0]} intervals and is {d:.3g}; "
+                                 f"{reached} (observed order {q:.2g}): tol = {tol!r} is below "
+                                 "what this orbit's collocation reaches (the floor of its "
+                                 f"conditioning); ask tol >= {min(last[1], d):.2g}, or a higher "
+                                 "degree")
+        if q is not None and math.isfinite(d):
             need = L * (d / tol) ** (1.0 / q)
             if need > MAX_INTERVALS and tol < floor:
                 raise ValueError(below)
@@ -595,27 +639,16 @@ def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bo
                 raise ValueError(f"collocate: {reached}; {why}, tol = {tol!r} needs about "
                                  f"{need:.2g} intervals, more than MAX_INTERVALS = "
                                  f"{MAX_INTERVALS}: {fix}")
-        # the next mesh's aim: after a first round in the asymptotic range (steady or not),
-        # its two levels' difference at what a steady round of the period's order 2 m
-        # accepts, without margin (not with an undeclared jump of the kernel: order 1);
-        # where these levels were not steady (the first time), a difference the next
-        # round's Richardson estimate accepts; else tol itself
-        if f.check is not None:                    # the finer level's own error, aimed at tol
-            L2 = next_intervals(L, d, tol, expected, seen, q, lay.m, 1.2)
-        elif last is None and autonomous and not capped and settled(c):
-            L2 = next_intervals(L, two, tol * accepted(lay.m, True, True), expected, None,
-                                None, lay.m, 1.0)
-        else:
-            aim = tol if seen is not None or unsteady else tol * accepted(lay.m, autonomous)
-            L2 = next_intervals(L, d, aim, expected, seen, q, lay.m, 1.2)
-        if last is None and not settled(c):       # far off: the levels say nothing of the order
+        L2 = next_intervals(L, d, tol, expected, None, q, lay.m, MARGIN)
+        if last is None and not near_check(f):    # far off: the round says nothing of the order
             L2 = min(L2, FAR_GROWTH * L)
-        unsteady = seen is None
-        last, L = (L, two), L2
-        lay, x = f.lay, f.x
+        else:
+            last = (L, d)
+        start = f.check if f.check is not None else f
+        lay, x, L = start.lay, start.x, L2
         if f.lay.L >= MAX_INTERVALS:
             break
-        check_cost(terms, lay.m, 2 * L, f.T, f"the next mesh ({reached})",
+        check_cost(terms, lay.m, 2 * L, f.T, f"the next mesh's check ({reached})",
                    "ask a larger tol, or a higher degree")
     raise ValueError(f"collocate: the estimated error {d:.3g} is still above tol = {tol!r} at "
                      f"{f.lay.L} intervals (MAX_INTERVALS = {MAX_INTERVALS}, MAX_ROUNDS = "

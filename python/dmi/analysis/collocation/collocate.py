@@ -15,22 +15,23 @@ of the result: a breach splits a segment, a vanishing segment is removed
 never returned.  Multipliers: the discretised
 monodromy operator with the saltation at the switches (:mod:`dmi.analysis.collocation.floquet`).
 
-Errors: the orbit is solved on a mesh, on the same mesh with every interval halved and, as a
-third level, with every pair of intervals merged; the difference of the two finer levels' period,
-amplitudes, multipliers and u is the error estimate of the finer one (which is returned), or,
-where the three levels converge steadily, Richardson's estimate from the order they show
-(:func:`dmi.analysis.collocation.adapt.estimate`): an upper estimate while the convergence is in
-its asymptotic range; where they do not, or the mesh is graded (a steep orbit: intervals
-within a piece GRADED = 6 times apart or more), the period's, amplitudes' and u's estimate is
-twice the finer level's difference to the orbit on its mesh halved
-(:func:`dmi.analysis.collocation.adapt.checked`), and so in a refinement where the check may
-stop it and on every mesh with ``check=True`` (the multipliers' too).  With ``intervals=None`` the mesh is
-equidistributed (AUTO, COLSYS: equal integrals of |u^(m+1)|^(1 / (m + 1)),
-estimated from the jumps of u^(m) between intervals) and refined until the estimate of the
-period (an autonomous orbit; it converges as h^(2m) on smooth orbits) or of the amplitudes (a
-forced orbit; h^(m+1): an extremum is inside an interval) is below ``tol``
-(:mod:`dmi.analysis.collocation.adapt`: the indicator, the equidistribution, the estimate and the
-refinement).
+Errors: with ``intervals=None`` the mesh is equidistributed (AUTO, COLSYS: equal integrals of
+|u^(m+1)|^(1 / (m + 1)), estimated from the jumps of u^(m) between intervals) and refined in
+rounds: each solves the orbit on its mesh and on that mesh with every interval halved (its
+check), and twice their difference is the orbit's error estimate
+(:func:`dmi.analysis.collocation.adapt.checked`); the first orbit whose estimate of the period (an autonomous orbit; it converges as h^(2m) on
+smooth orbits) or of the amplitudes (a forced one; h^(m+1): an extremum is inside an interval)
+is below ``tol`` is returned (:mod:`dmi.analysis.collocation.adapt`: the indicator, the
+equidistribution, the estimate and the refinement); its multipliers' estimate is from its mesh
+with pairs merged, once and twice (Richardson's extrapolation where the three levels converge
+steadily, else twice the two levels' difference), or with ``check=True`` from the check's.
+With ``intervals=L`` the orbit is solved on L intervals equidistributed, on that mesh halved
+(the orbit returned) and with pairs merged; the difference of the two finer levels is the
+estimate of the finer one, or, where the three levels converge steadily, Richardson's estimate
+from the order they show (:func:`dmi.analysis.collocation.adapt.estimate`): an upper estimate
+while the convergence is in its asymptotic range; where they do not, or the mesh is graded (a
+steep orbit: intervals within a piece GRADED = 6 times apart or more), and on every mesh with
+``check=True``, the check's, as in a refinement.
 
 Kernels: exponential sums and the truncation at tau exactly; a fitted kernel's near part
 s^-beta C on (0, delta] (``set_kernel_fit`` of a fitted PowerKernel) by product integration
@@ -47,7 +48,8 @@ import warnings
 
 import numpy as np
 
-from .adapt import Solved, check_cost, equidistribute, estimate, first_intervals, levels
+from .adapt import (Solved, check_cost, equidistribute, estimate, first_intervals, levels,
+                    lower)
 from .floquet import multipliers as floquet
 from .mend import mend
 from .orbit import EquationOrbit, equation_orbit
@@ -85,8 +87,9 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
     intervals : int, optional
         L, the mesh's intervals (equidistributed once, not refined; the orbit returned has 2 L,
         the estimate's finer level); None: refined until the estimated error of the period (an
-        autonomous orbit) or of the amplitudes (a forced one) is below ``tol``; the other
-        estimates are in ``errors``.
+        autonomous orbit) or of the amplitudes (a forced one) is below ``tol``, the estimate
+        checked (twice the difference to the orbit on the mesh halved); the other estimates
+        are in ``errors``.
     tol : float
         The error asked (time and state units), > 0.
     multipliers : int
@@ -97,36 +100,36 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
         the order at 1: a callback kernel is sampled and a jump found is warned of
         (CollocationWarning, naming its lag); a lag given where it does not jump is refused.
     check : bool
-        True: the period's, amplitudes', u's and multipliers' estimate of every mesh from the
-        finer level against its mesh halved (twice their difference; in a refinement, of each
-        round that could stop it): the period's 1.7-8.02 times the true error on every mesh of
-        ``bench_meshes.py --scan`` (the upper end where the true error is near the floor),
-        u's and the multipliers' about 2 times; 1.5-1.9 times the CPU of a smooth orbit without
-        multipliers, 2-3 times with 10 (the monodromy on the mesh halved).  False: the period's,
-        amplitudes' and u's so only where the three levels are not steady (an order seen above
-        the period's 2 m is not steady), the mesh is graded, or a refinement's round could stop
-        by the check; elsewhere Richardson's estimate from the three levels, which overstates
-        the period's error up to some 650 times there (none below it on the scan's 231
-        meshes), and u's and the multipliers' from the two or three levels (a multiplier's
-        two-level difference counted twice).  ``stable`` is judged against the multipliers'
-        estimate, so a verdict the levels leave undecided (None) may be decided with
-        ``check=True``.  With ``intervals=None`` the refinement may stop on another mesh with
-        ``check=True`` (its estimate is the check's).
+        True: every estimate from the orbit returned against its mesh halved (twice their
+        difference), the multipliers' too: the period's 1.7-8.02 times the true error on every
+        mesh of ``bench_meshes.py --scan`` (the upper end where the true error is near the
+        floor), u's and the multipliers' about 2 times; with ``intervals=L`` 1.5-1.9 times the
+        CPU of a smooth orbit without multipliers, 2-3 times with 10 (the monodromy on the mesh
+        halved).  False: with ``intervals=None`` the period's, amplitudes' and u's estimates
+        are the check's all the same (the refinement checks every round), the multipliers'
+        from the orbit's mesh merged once and twice; with ``intervals=L`` the check's only
+        where the three levels are not steady (an order seen above the period's 2 m is not
+        steady) or the mesh is graded, elsewhere Richardson's estimate from the three levels,
+        which overstates the period's error up to some 650 times there (none below it on the
+        scan's 231 meshes), and u's and the multipliers' from the two or three levels (a
+        multiplier's two-level difference counted twice).  ``stable`` is judged against the
+        multipliers' estimate, so a verdict the levels leave undecided (None) may be decided
+        with ``check=True``.
 
     Returns
     -------
     EquationOrbit
         The orbit with its period, amplitude, multipliers, stability, mesh, signature and
-        estimated errors (those of the returned, finer level).
+        estimated errors (those of the orbit returned).
 
     Warns
     -----
     CollocationWarning
-        The returned level's check (its mesh halved, asked where its levels are not steady,
-        the mesh is graded, or ``check``) could not be solved or its solution breaks the
-        signature's inequalities, or with ``check`` its multipliers could not be computed: the
-        message says why, and the estimate is the levels'; a callback kernel's undeclared jump
-        (``kernel_jumps``).
+        The returned orbit's check (its mesh halved: every round of a refinement; with
+        ``intervals=L`` where its levels are not steady, the mesh is graded, or ``check``) could
+        not be solved or its solution breaks the signature's inequalities, or the check's
+        multipliers asked for could not be computed: the message says why, and the estimate is
+        the levels'; a callback kernel's undeclared jump (``kernel_jumps``).
 
     Raises
     ------
@@ -182,6 +185,8 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
             fell_to_equilibrium(f.lay, f.x, orbit)
         bad = check_inequalities(f.lay, terms, f.x)
         if not bad:
+            if c is None and count > 0 and not check:     # the multipliers' levels
+                c = lower(f, terms, ref)
             return _result(orbit, terms, c, f, count, bool(check))
         mended = mend(f.lay, terms, f.x) if attempt < MENDS else None
         if mended is None:
@@ -242,19 +247,20 @@ def first_solve(orbit: Orbit, terms: Terms, lay: Layout, b0: np.ndarray, L0: int
     raise ShootingError(f"{failed} -- {too_far(orbit)}", failed.residuals) from None
 
 
-def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int, check: bool
+def _result(orbit: Orbit, terms: Terms, c: Solved | None, f: Solved, count: int, check: bool
             ) -> EquationOrbit:
-    """The EquationOrbit of the finer level f, with its multipliers and, with ``check``, its
-    check's (f's mesh halved, for the multipliers' checked estimate); where there are none,
-    the coarser levels' (the third, where it was solved, for the extrapolated estimate)."""
+    """The EquationOrbit of f (the orbit returned), with its multipliers and, with ``check`` or
+    where there are no coarser levels, its check's (f's mesh halved, for the multipliers'
+    checked estimate); where there are none, the coarser levels' (the third, where it was
+    solved, for the extrapolated estimate)."""
     if f.unchecked is not None:
-        kept = "three" if c.coarser is not None else "two"
+        kept = "three" if c is not None and c.coarser is not None else "two"
         warnings.warn(f"collocate: the orbit on {f.lay.L} intervals is not checked on its mesh "
                       f"halved ({2 * f.lay.L} intervals): {f.unchecked}; its estimate is the "
                       f"{kept} levels'", CollocationWarning, stacklevel=3)
     if count > 0:
         f.mu = floquet(f.lay, terms, f.x, count)
-        if check and f.check is not None:
+        if f.check is not None and (check or c is None):
             try:
                 f.check.mu = floquet(f.check.lay, terms, f.check.x, count)
             except (RuntimeError, ValueError, np.linalg.LinAlgError) as err:
@@ -262,7 +268,7 @@ def _result(orbit: Orbit, terms: Terms, c: Solved, f: Solved, count: int, check:
                               f"intervals) could not be computed ({type(err).__name__}: {err}); "
                               "the multipliers' estimate is the levels'", CollocationWarning,
                               stacklevel=3)
-        if f.check is None or not f.check.mu.size:     # the levels' estimate
+        if c is not None and (f.check is None or not f.check.mu.size):  # the levels' estimate
             c.mu = floquet(c.lay, terms, c.x, count)
             if c.coarser is not None:
                 c.coarser.mu = floquet(c.coarser.lay, terms, c.coarser.x, count)

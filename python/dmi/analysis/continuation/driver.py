@@ -650,13 +650,17 @@ class Along:
 
     def root(self, fn: Callable[[float], float], f0: float, f1: float) -> float | None:
         """Where fn (a function of the arclength s, fn(0) = f0, fn(L) = f1) changes sign, by
-        Brent's method; None when f0, f1 do not bracket a root or the corrector or Brent
-        fails."""
+        Brent's method (fn evaluated inside (0, L) only: at the ends f0 and f1); None when f0,
+        f1 do not bracket a root or the corrector or Brent fails."""
         if not _sign_change(f0, f1):
             return None
+
+        def inner(s: float) -> float:           # the ends' values are known: not evaluated
+            return f0 if s == 0.0 else f1 if s == self.L else fn(s)
         try:
-            return float(scipy.optimize.brentq(fn, 0.0, self.L, xtol=1e-13 * max(1.0, self.L),
-                                               rtol=1e-15, maxiter=100))
+            return float(scipy.optimize.brentq(inner, 0.0, self.L,
+                                               xtol=1e-13 * max(1.0, self.L), rtol=1e-15,
+                                               maxiter=100))
         except (ShootingError, ValueError, RuntimeError):
             return None
 

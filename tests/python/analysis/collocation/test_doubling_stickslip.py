@@ -166,6 +166,20 @@ def test_flip_on_the_collocated_stick_slip_branch(branch):
     assert abs(pds[0].p - flip()) < 1e-6, (pds[0].p, flip())
 
 
+def test_flip_located_from_another_mesh():
+    """The branch from the orbit on 154 intervals (intervals=77): the flip is located there too.
+    Brent's method evaluated the test function at the bracket's ends, whose values it had; the
+    end's point re-solved on the next step's mesh broke its signature (u_1 changing sign on a slip
+    + piece just before its reversal) and the flip was lost ("could not locate its zero ... no
+    event reported"; so on 67, 108, 154 and 190 intervals, found on 202 only)."""
+    scheme = da.periodic_orbit(friction_duffing, 0.27, T, [0.57, 0.41], multipliers=2)
+    b = da.continue_orbit(da.collocate(scheme, intervals=77, multipliers=4), 0.295, step=0.01,
+                          multipliers=4)
+    pds = [e for e in b.events if e.kind == "period-doubling"]
+    assert len(pds) == 1, (b.events, b.status)
+    assert abs(pds[0].p - flip()) < 1e-6, (pds[0].p, flip())
+
+
 @pytest.fixture(scope="module")
 def doubled_orbit(branch) -> da.EquationOrbit:
     pd = next(e for e in branch.events if e.kind == "period-doubling")
