@@ -178,27 +178,28 @@ def period_on(o, L: int, m: int) -> float:
 def refinements(o, ref, m: int, tols: tuple, scan: tuple) -> None:
     """The refinement to each tol: the orbit returned (its intervals, true error, estimate and
     CPU) against the least L of ``scan`` whose orbit on L intervals (:func:`period_on`) has a
-    true error within tol, and their ratio."""
-    runs = {}
+    true error within tol and against the least from which every L of the scan has (the errors
+    of one L are a lottery of its equidistribution: not monotone in L), and their ratios."""
+    errs = {}
+    for L in scan:
+        try:
+            errs[L] = abs(period_on(o, L, m) - ref.period)
+        except (ValueError, RuntimeError):          # Newton fails on a coarse mesh
+            errs[L] = np.inf
     for tol in tols:
         t = time.process_time()
         e = da.collocate(o, degree=m, tol=tol, multipliers=0)
         cpu = time.process_time() - t
         true = abs(e.period - ref.period)
-        enough = None
-        for L in scan:
-            if L not in runs:
-                try:
-                    runs[L] = period_on(o, L, m)
-                except (ValueError, RuntimeError):      # Newton fails on a coarse mesh
-                    runs[L] = np.inf
-            if abs(runs[L] - ref.period) <= tol:
-                enough = L
-                break
-        ratio = f"{e.intervals / enough:.3g}" if enough else "-"
+        enough = next((L for L in scan if errs[L] <= tol), None)
+        steady = next((L for i, L in enumerate(scan)
+                       if all(errs[k] <= tol for k in scan[i:])), None)
+        ratio = "; ".join(f"{name} {L}, returned / it {e.intervals / L:.3g}" if L else
+                          f"{name} -" for name, L in (("least sufficient L", enough),
+                                                      ("all from", steady)))
         print(f"degree {m}, tol = {tol:g}: {e.intervals} returned; true {true:.2e}, estimate "
               f"{e.errors['period']:.2e} ({e.errors['period'] / true:.3g} x); CPU {cpu:.2f} s; "
-              f"least sufficient L {enough}; returned / sufficient {ratio}", flush=True)
+              f"{ratio}", flush=True)
 
 
 def nested(o, terms, sig, b0, L: int, m: int, T_ref: float, every: bool = False):

@@ -234,12 +234,19 @@ class Solved:
     def __init__(self, lay: Layout, x: np.ndarray, mu: np.ndarray | None = None):
         self.lay, self.x = lay, x
         _, self.b, self.T = lay.split(x)
-        hi, lo = extrema(lay, x)
-        self.amplitude = 0.5 * (hi - lo)
+        self._amplitude: np.ndarray | None = None
         self.mu = np.empty(0, complex) if mu is None else mu
         self.coarser: Solved | None = None
         self.check: Solved | None = None
         self.unchecked: str | None = None
+
+    @property
+    def amplitude(self) -> np.ndarray:
+        """(max - min) / 2 of each component (:func:`extrema`), computed when first asked."""
+        if self._amplitude is None:
+            hi, lo = extrema(self.lay, self.x)
+            self._amplitude = 0.5 * (hi - lo)
+        return self._amplitude
 
     @property
     def scale(self) -> float:
@@ -297,19 +304,20 @@ def estimate(c: Solved | None, f: Solved, reached: float = 0.0,
         raise ValueError("estimate: a coarser level or a check is needed")
     errors: dict[str, Any] = {"multipliers": np.full(f.mu.shape, np.inf)}
     if c is not None:
-        errors = {"period": abs(c.T - f.T), "amplitude": np.abs(c.amplitude - f.amplitude),
-                  "multipliers": TWO_LEVEL_SAFETY * _match(f.mu, c.mu), "u": gap(c, f)}
+        m = f.lay.m
         g = coarser if coarser is not None else c.coarser
-        if g is not None:
-            m = f.lay.m
-            errors["period"] = extrapolated(g.T, c.T, f.T, 2 * m)
-            errors["amplitude"] = extrapolated(g.amplitude, c.amplitude, f.amplitude, m + 1,
-                                               bounded=False)
-            if f.mu.size and g.mu.size and c.mu.size:
-                mc = c.mu[np.argmin(np.abs(f.mu[:, None] - c.mu[None, :]), axis=1)]
-                mg = g.mu[np.argmin(np.abs(mc[:, None] - g.mu[None, :]), axis=1)]
-                errors["multipliers"] = extrapolated(mg, mc, f.mu, 2 * m,
-                                                     fallback=TWO_LEVEL_SAFETY)
+        errors["multipliers"] = TWO_LEVEL_SAFETY * _match(f.mu, c.mu)
+        if g is not None and f.mu.size and g.mu.size and c.mu.size:
+            mc = c.mu[np.argmin(np.abs(f.mu[:, None] - c.mu[None, :]), axis=1)]
+            mg = g.mu[np.argmin(np.abs(mc[:, None] - g.mu[None, :]), axis=1)]
+            errors["multipliers"] = extrapolated(mg, mc, f.mu, 2 * m, fallback=TWO_LEVEL_SAFETY)
+        if F is None:                       # the levels' period, amplitudes and u
+            errors.update(period=abs(c.T - f.T), amplitude=np.abs(c.amplitude - f.amplitude),
+                          u=gap(c, f))
+            if g is not None:
+                errors["period"] = extrapolated(g.T, c.T, f.T, 2 * m)
+                errors["amplitude"] = extrapolated(g.amplitude, c.amplitude, f.amplitude,
+                                                   m + 1, bounded=False)
     if F is not None:
         errors["period"] = CHECK_SAFETY * abs(f.T - F.T)
         errors["amplitude"] = CHECK_SAFETY * np.abs(f.amplitude - F.amplitude)
