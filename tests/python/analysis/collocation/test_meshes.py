@@ -503,3 +503,37 @@ def test_three_level_estimate_bounds_the_true_error(request, case, L, m):
     assert 1.0 <= period <= 10.0, (period, errors)
     # a multiplier's levels need not be (a sign change): the two-level difference bounds it
     assert mu and all(1.0 <= q <= RATIO for q in mu), (mu, errors)
+
+
+def test_a_refinement_whose_checks_fail_keeps_the_levels_estimate(oscillation, oscillation_gap,
+                                                                  monkeypatch):
+    """Every check of a refinement made to fail (as where Newton fails on the mesh halved): each
+    round's estimate is the levels' (its mesh merged once and twice), the refinement still meets
+    tol with it, and a CollocationWarning says that the orbit returned is not checked."""
+    o, ref = oscillation
+
+    def failing(f, terms, ref):
+        f.unchecked = "made to fail"
+        return None
+    monkeypatch.setattr(adapt, "checked", failing)
+    with pytest.warns(CollocationWarning, match=r"not checked on its mesh halved .* made to "
+                      r"fail; its estimate is the three levels'"):
+        e = da.collocate(o, tol=1e-8, multipliers=0)
+    true = abs(e.period - ref.period)
+    assert true + oscillation_gap <= e.errors["period"] <= 1e-8, (true, e.errors["period"])
+
+
+def test_a_refinements_multipliers_estimate(oscillation):
+    """The refinement's multipliers: their estimate from the orbit's mesh merged once and twice
+    (Richardson's, or twice the two levels' difference) at least the true error of the leading
+    nontrivial one (tol = 1e-6, 17 intervals: 5.5 times its error 4.7e-9 measured); with
+    check=True from the check's multipliers, within [1, 10] of it (1.99), the orbit returned the
+    same."""
+    o, ref = oscillation
+    plain = da.collocate(o, tol=1e-6, multipliers=4)
+    e = da.collocate(o, tol=1e-6, multipliers=4, check=True)
+    assert e.period == plain.period and e.intervals == plain.intervals
+    true = float(np.min(np.abs(ref.multipliers - e.multipliers[1])))
+    assert true > 1e-10                                     # far above the floor, 1e-11
+    assert plain.errors["multipliers"][1] >= true, (plain.errors["multipliers"], true)
+    assert 1.0 <= e.errors["multipliers"][1] / true <= 10.0, (e.errors["multipliers"], true)
