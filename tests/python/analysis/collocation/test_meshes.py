@@ -115,16 +115,38 @@ def test_a_loose_first_round_that_newton_cannot_solve_starts_again_on_twice_its_
 
 
 def test_an_estimate_that_has_not_yet_fallen_is_no_floor():
-    """van der Pol at eps = 5, degree 3, tol = 1e-3: the rounds' two-level differences 16 -> 21
-    -> 26 intervals hardly fall (the levels not yet in the asymptotic range, 1e-3 relative), which
-    is no floor of the conditioning: the refinement goes on (it stopped with "the estimated
-    error has stopped falling ... ask tol >= 0.0017") and meets tol."""
+    """van der Pol at eps = 5, degree 3, tol = 1e-3: when the rounds' estimates were the levels'
+    two-level differences, 16 -> 21 -> 26 intervals hardly fell (not yet in the asymptotic range,
+    1e-3 relative), and the refinement stopped with "the estimated error has stopped falling ...
+    ask tol >= 0.0017"; it meets tol (the checked rounds 16, 27, 32: 1.1e-2, 1.2e-3, 8.4e-4)."""
     make = van_der_pol(5.0)
     o = scheme_orbit(make, 0.5, 11.0, 800)
     ref = da.collocate(o, intervals=48, degree=8, multipliers=0)
     assert ref.errors["period"] <= 1e-9
     e = da.collocate(o, degree=3, tol=1e-3, multipliers=0)
     assert abs(e.period - ref.period) <= 1e-3
+
+
+def test_an_estimate_that_rises_between_rounds_is_no_floor(relaxation):
+    """The relaxation oscillation at degree 4, tol = 1e-8: the rounds' meshes are not nested, and
+    the round of 158 intervals had the estimate 9.0e-8 where the round of 128 before it had
+    2.3e-8 (the meshes' lottery, 6.6e-9 relative: CONDITIONED = 1e-6 took it for the floor of the
+    conditioning and refused the tol); the refinement goes on and meets tol (234 measured)."""
+    o, ref = relaxation
+    e = da.collocate(o, degree=4, tol=1e-8, multipliers=0)
+    assert abs(e.period - ref.period) <= e.errors["period"] <= 1e-8
+
+
+def test_an_estimate_that_stopped_falling_is_refused(oscillation, monkeypatch):
+    """An estimate that no longer falls over a growth of the mesh of LEAST_GROWTH, below
+    CONDITIONED = 1e-9 relative (made so: every round's estimate 3e-11, above the floor 5.6e-12;
+    tol = 6e-12 grows the mesh by 1.34 a round): the refinement stops with a ValueError naming
+    the estimate reached and the tol to ask."""
+    o, _ = oscillation
+    monkeypatch.setattr(adapt, "round_error", lambda c, f: 3e-11)
+    with pytest.raises(ValueError, match=r"the estimated error has stopped falling: it was "
+                       r"3e-11 at \d+ intervals and is 3e-11.* ask tol >= 3e-11"):
+        da.collocate(o, tol=6e-12, multipliers=0)
 
 
 def test_relaxation_at_the_default_settings(relaxation):
