@@ -9,9 +9,10 @@ package (:mod:`dmi.analysis.collocation.collocate` and the collocated branch use
   interval (AUTO, COLSYS), :func:`adapted` does so piece by piece of a nonsmooth orbit.
 - The adaptation step (:func:`readapted`): an orbit moved onto its mesh equidistributed again (the
   same intervals), between the steps of a branch.
-- The estimate (:func:`estimate`): the orbit on a mesh and on that mesh with every interval
-  halved (:func:`halved`) or every pair merged (:func:`merged`); the difference of their period,
-  amplitudes, multipliers and u is the finer one's error estimate; with a third level (the
+- The estimate (:func:`estimate`; a refinement's always checked): the orbit on a mesh and on
+  that mesh with every interval halved (:func:`halved`) or every pair merged (:func:`merged`);
+  the difference of their period, amplitudes, multipliers and u is the finer one's error
+  estimate; with a third level (the
   coarser's mesh merged, its ``coarser``) the period, amplitudes and multipliers by Richardson's
   extrapolation where the three levels are steady (:func:`extrapolated`); where they are not,
   the mesh is graded (GRADED: a steep orbit), or every mesh is asked (collocate's ``check``),
@@ -85,8 +86,8 @@ FIRST_TOL = 1e-8
 FIRST_DEGREE = 4
 LEAST_POINTS = 24
 LEAST_FIRST = 8
-#: The check's safety factor over |x_f - x_F| (:func:`checked`): never below the finer level's
-#: error where the check level's is at most half of it (an order of 1 from 2 L to 4 L).
+#: The check's safety factor over |x_f - x_F| (:func:`checked`): never below the checked level's
+#: error where the check's is at most half of it (an order of 1 from a mesh to its halving).
 CHECK_SAFETY = 2.0
 #: A multiplier's two-level difference (its levels not steady, or two levels) counts this many
 #: times as the finer level's error estimate: a multiplier's convergence is not always monotone
@@ -527,8 +528,8 @@ def first_intervals(tol: float, m: int, pieces: int, steep: bool) -> int:
     orbit (its first solve needed more than its first mesh); for a looser tol fewer, as the
     period's error falls (h^(2 m): L^(2 m) tol kept; a forced orbit's amplitudes, h^(m+1), would
     allow fewer still); above FIRST_DEGREE fewer, the period's error taken as (A / L)^(2 m) with
-    the A of FIRST_INTERVALS at FIRST_TOL and degree FIRST_DEGREE (van der Pol at degree 6
-    meets 1e-8 on 6 intervals: 7.4 by this); at least LEAST_POINTS / m intervals (rounded;
+    the A of FIRST_INTERVALS at FIRST_TOL and degree FIRST_DEGREE (7.4 at degree 6 and 1e-8:
+    7 intervals, 12 returned for van der Pol); at least LEAST_POINTS / m intervals (rounded;
     within 4 to LEAST_FIRST: 6 at degree 4); at least 4 for each of the signature's
     ``pieces``."""
     higher = min(1.0, FIRST_TOL ** (1.0 / (2 * FIRST_DEGREE) - 1.0 / (2 * m)))
@@ -578,8 +579,9 @@ def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: flo
     (above m, at most the theory's + 2), else by the theory's (the period's h^(2m), an
     extremum's h^(m+1); 1 with an undeclared jump of the kernel, ``capped``), with MARGIN more,
     by at most 8 times, and by at most FAR_GROWTH after a round whose check is more than ROUGH
-    off it in the period (or was not solved) while no round was nearer (such a round says
-    nothing of the order, and its estimate is left out of the rounds' order).
+    off it in the period (or was not solved) while no round was nearer, or that has no
+    estimate (its check and merged level not solved): such a round says nothing of the order,
+    and its estimate is left out of the rounds' order.
 
     A first round on fewer than FIRST_INTERVALS intervals (a loose tol or a high degree) whose
     solve fails, or whose check and merged level both fail (no estimate), is done again on
@@ -615,14 +617,18 @@ def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: flo
             L = min(2 * L, FIRST_INTERVALS)        # no estimate on a first mesh that coarse:
             continue                               # not a round either
         rounds += 1
-        floor = (CHECKED_FLOOR if f.check is not None else FLOOR) * f.scale
+        which = (("CHECKED_FLOOR", CHECKED_FLOOR) if f.check is not None else
+                 ("FLOOR", FLOOR))                 # the levels' floor where the check failed
+        floor = which[1] * f.scale
         if d <= tol and floor <= tol:
             return c, f
         reached = (f"the estimated error of the {name} is {d:.3g} at {f.lay.L} intervals of "
                    f"degree {lay.m}")
+        if f.check is None:
+            reached += f" (the levels' estimate: its check not solved, {f.unchecked})"
         below = (f"collocate: tol = {tol!r} is below the floor of double precision, {floor:.3g} "
-                 f"(CHECKED_FLOOR = {CHECKED_FLOOR:g} times the {name}, at least 1), where a "
-                 f"finer mesh no longer lowers the estimate: {reached}; ask tol >= {floor:.2g}")
+                 f"({which[0]} = {which[1]:g} times the {name}, at least 1), where a finer mesh "
+                 f"no longer lowers the estimate: {reached}; ask tol >= {floor:.2g}")
         if d <= floor or d <= tol:                 # an estimate at the floor, above tol
             raise ValueError(below)
         q = 1.0 if capped else None
@@ -652,8 +658,8 @@ def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: flo
                                  f"{need:.2g} intervals, more than MAX_INTERVALS = "
                                  f"{MAX_INTERVALS}: {fix}")
         L2 = next_intervals(L, d, tol, expected, None, q, lay.m, MARGIN)
-        if last is None and not near_check(f):    # far off: the round says nothing of the order
-            L2 = min(L2, FAR_GROWTH * L)
+        if not math.isfinite(d) or last is None and not near_check(f):
+            L2 = min(L2, FAR_GROWTH * L)           # far off: the round says nothing of the order
         else:
             last = (L, d)
         start = f.check if f.check is not None else f

@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from typing import Any
 
 import numpy as np
 
@@ -187,7 +188,7 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
         if not bad:
             if c is None and count > 0 and not check:     # the multipliers' levels
                 c = lower(f, terms, ref)
-            return _result(orbit, terms, c, f, count, bool(check))
+            return _result(orbit, terms, c, f, count, bool(check), ref)
         mended = mend(f.lay, terms, f.x) if attempt < MENDS else None
         if mended is None:
             break
@@ -247,12 +248,14 @@ def first_solve(orbit: Orbit, terms: Terms, lay: Layout, b0: np.ndarray, L0: int
     raise ShootingError(f"{failed} -- {too_far(orbit)}", failed.residuals) from None
 
 
-def _result(orbit: Orbit, terms: Terms, c: Solved | None, f: Solved, count: int, check: bool
-            ) -> EquationOrbit:
+def _result(orbit: Orbit, terms: Terms, c: Solved | None, f: Solved, count: int, check: bool,
+            ref: Any) -> EquationOrbit:
     """The EquationOrbit of f (the orbit returned), with its multipliers and, with ``check`` or
     where there are no coarser levels, its check's (f's mesh halved, for the multipliers'
     checked estimate); where there are none, the coarser levels' (the third, where it was
-    solved, for the extrapolated estimate)."""
+    solved, for the extrapolated estimate; a refinement's from f's mesh merged once and twice,
+    :func:`~.adapt.lower`, made here where the check's failed); where neither, the multipliers'
+    estimate is inf, and a CollocationWarning says so."""
     if f.unchecked is not None:
         kept = "three" if c is not None and c.coarser is not None else "two"
         warnings.warn(f"collocate: the orbit on {f.lay.L} intervals is not checked on its mesh "
@@ -264,9 +267,13 @@ def _result(orbit: Orbit, terms: Terms, c: Solved | None, f: Solved, count: int,
             try:
                 f.check.mu = floquet(f.check.lay, terms, f.check.x, count)
             except (RuntimeError, ValueError, np.linalg.LinAlgError) as err:
+                if c is None:
+                    c = lower(f, terms, ref)
+                kept = ("the levels'" if c is not None else "none: the orbit's mesh merged "
+                        "could not be solved either (inf)")
                 warnings.warn(f"collocate: the multipliers of the check ({f.check.lay.L} "
                               f"intervals) could not be computed ({type(err).__name__}: {err}); "
-                              "the multipliers' estimate is the levels'", CollocationWarning,
+                              f"the multipliers' estimate is {kept}", CollocationWarning,
                               stacklevel=3)
         if c is not None and (f.check is None or not f.check.mu.size):  # the levels' estimate
             c.mu = floquet(c.lay, terms, c.x, count)

@@ -48,9 +48,10 @@ class EquationOrbit:
         Estimated errors (same units): ``"period"``, ``"amplitude"`` (n,), ``"multipliers"``
         (as ``multipliers``), ``"u"`` (the largest over the period, at equal phase t / T; an
         autonomous orbit's after aligning the two solutions' phase: the error of its shape),
-        from the difference to the solve on the mesh with every interval halved (a
-        continuation point: with every pair of intervals merged), an upper estimate: the
-        returned orbit is the finer one; empty where that solve failed.
+        from the difference to the solve on another mesh (collocate: the orbit's mesh halved, in
+        a refinement twice their difference, the orbit returned the coarser; with ``intervals=L``
+        the L-interval mesh, the orbit returned the finer; a continuation point: its mesh with
+        every pair of intervals merged), an upper estimate; empty where that solve failed.
     degree : int
         m, the polynomials' degree.
     nodes : numpy.ndarray

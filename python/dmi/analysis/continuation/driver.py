@@ -655,7 +655,10 @@ class Along:
         if not _sign_change(f0, f1):
             return None
 
-        def inner(s: float) -> float:           # the ends' values are known: not evaluated
+        # the ends' values are known, not evaluated again: an end's point re-solved on another
+        # layout (a collocated branch's next mesh, the chord's on_current) can break its
+        # signature there and fail, and the bracket is the driver's, from its own points
+        def inner(s: float) -> float:
             return f0 if s == 0.0 else f1 if s == self.L else fn(s)
         try:
             return float(scipy.optimize.brentq(inner, 0.0, self.L,

@@ -114,7 +114,7 @@ def test_a_loose_first_round_that_newton_cannot_solve_starts_again_on_twice_its_
     assert abs(e.period - ref.period) <= tol
 
 
-def test_an_estimate_that_has_not_yet_fallen_is_no_floor():
+def test_a_steep_orbit_of_degree_3_meets_a_loose_tol():
     """van der Pol at eps = 5, degree 3, tol = 1e-3: when the rounds' estimates were the levels'
     two-level differences, 16 -> 21 -> 26 intervals hardly fell (not yet in the asymptotic range,
     1e-3 relative), and the refinement stopped with "the estimated error has stopped falling ...
@@ -371,7 +371,7 @@ def test_check_on_a_stick_slip_orbit(stick_slip):
 
 def test_a_check_that_breaks_the_inequalities_is_no_check(stick_slip, monkeypatch):
     """A check whose solution breaks the signature's inequalities (made to: the check's test,
-    in adapt.checked, where a refinement would stop by it) gives no estimate: a
+    in adapt.checked) gives no estimate: a
     CollocationWarning says why, and the estimate is the levels', not the check's."""
     o, _ = stick_slip
     plain = da.collocate(o, intervals=8, multipliers=2)      # the default checks this mesh
@@ -454,8 +454,8 @@ def ratios(f, errors, T_ref: float, mu_ref: np.ndarray) -> list[float]:
 
 def test_a_tol_below_the_checked_floor_is_refused(oscillation):
     """tol = 5e-12, below CHECKED_FLOOR times the period (5.6e-12): the refinement reaches a mesh
-    whose check meets tol (its estimate 1.2e-12 before the floor), but the estimate it can report
-    is its floor, above tol: refused, with the floor to ask (it returned the orbit with its
+    whose check meets tol (its estimate 3.1e-12 before the floor, 90 intervals), but the estimate
+    it can report is its floor, above tol: refused, with the floor to ask (it returned the orbit with its
     estimate above tol, silently)."""
     o, _ = oscillation
     with pytest.raises(ValueError, match=r"tol = 5e-12 is below the floor.*ask tol >= 5\.6e-12"):
@@ -496,10 +496,10 @@ def oscillation_gap(oscillation):
 
 def test_a_tol_below_the_levels_floor_is_met_by_a_check(oscillation, oscillation_gap):
     """Degree 5, tol = 2e-11, below FLOOR times the period (5.6e-11), where the levels' estimate
-    is not trusted: the round whose Richardson estimate meets tol is checked, and the check's
-    estimate (5.6e-12, its floor CHECKED_FLOOR times the period; the true error 1.7e-12) meets it
-    (unchecked, the levels' estimate floored at 5.6e-11 was returned above tol; with FLOOR for
-    every estimate such a tol was refused as below the floor)."""
+    is not trusted: the refinement's checked estimate (5.6e-12, its floor CHECKED_FLOOR times the
+    period; the true error 1.7e-12, 33 intervals) meets it (unchecked, the levels' estimate
+    floored at 5.6e-11 was returned above tol; with FLOOR for every estimate such a tol was
+    refused as below the floor)."""
     o, ref = oscillation
     e = da.collocate(o, degree=5, tol=2e-11, multipliers=0)
     true = abs(e.period - ref.period)
@@ -570,3 +570,56 @@ def test_a_refinements_multipliers_estimate(oscillation):
     assert true > 1e-10                                     # far above the floor, 1e-11
     assert plain.errors["multipliers"][1] >= true, (plain.errors["multipliers"], true)
     assert 1.0 <= e.errors["multipliers"][1] / true <= 10.0, (e.errors["multipliers"], true)
+
+
+def test_a_refinements_check_whose_multipliers_fail_takes_the_levels(oscillation, monkeypatch):
+    """check=True in a refinement where the check's monodromy fails (made to): the multipliers'
+    estimate is the levels' (the orbit's mesh merged once and twice, made then), as without
+    check, and a CollocationWarning says so (the estimate was inf, the warning naming the
+    levels all the same)."""
+    o, _ = oscillation
+    module = sys.modules["dmi.analysis.collocation.collocate"]
+    plain_floquet = module.floquet
+    calls = []
+
+    def failing(lay, terms, x, count):
+        calls.append(lay.L)
+        if len(calls) == 2:                       # the check's, after the orbit's own
+            raise RuntimeError("made to fail")
+        return plain_floquet(lay, terms, x, count)
+    monkeypatch.setattr(module, "floquet", failing)
+    with pytest.warns(CollocationWarning, match=r"multipliers of the check .* could not be "
+                      r"computed .RuntimeError: made to fail.; the multipliers' estimate is "
+                      r"the levels'"):
+        e = da.collocate(o, tol=1e-6, multipliers=2, check=True)
+    assert calls[1] == 2 * e.intervals
+    monkeypatch.setattr(module, "floquet", plain_floquet)
+    plain = da.collocate(o, tol=1e-6, multipliers=2)
+    assert np.all(np.isfinite(e.errors["multipliers"]))
+    assert np.array_equal(e.errors["multipliers"], plain.errors["multipliers"])
+
+
+def test_a_round_without_an_estimate_grows_by_far_growth(oscillation, oscillation_gap,
+                                                         monkeypatch):
+    """A refinement's second round whose check and merged levels both fail (made to): it has no
+    estimate, so the next mesh grows by FAR_GROWTH = 4 at most (it grew by the cap of 8, and the
+    infinite estimate entered the rounds' order), and the refinement meets tol after it."""
+    o, ref = oscillation
+    sizes = []
+    plain_checked, plain_one = adapt.checked, adapt.one_level
+
+    def one(lay, *args, **kwargs):
+        sizes.append(lay.L)
+        return plain_one(lay, *args, **kwargs)
+
+    def checked(f, terms, r):
+        if len(sizes) == 2:
+            f.unchecked = "made to fail"
+            return None
+        return plain_checked(f, terms, r)
+    monkeypatch.setattr(adapt, "one_level", one)
+    monkeypatch.setattr(adapt, "checked", checked)
+    monkeypatch.setattr(adapt, "lower", lambda f, terms, r: None)
+    e = da.collocate(o, tol=1e-10, multipliers=0)
+    assert len(sizes) == 3 and sizes[2] <= adapt.FAR_GROWTH * sizes[1], sizes
+    assert abs(e.period - ref.period) + oscillation_gap <= e.errors["period"] <= 1e-10
