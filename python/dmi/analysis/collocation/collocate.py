@@ -51,7 +51,7 @@ import numpy as np
 
 from .adapt import (Solved, check_cost, equidistribute, estimate, first_intervals, levels,
                     lower)
-from .floquet import multipliers as floquet
+from .floquet import multipliers as floquet, on_halved, pairs
 from .mend import mend
 from .orbit import EquationOrbit, equation_orbit
 from .signature import read_signature
@@ -186,8 +186,6 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
             fell_to_equilibrium(f.lay, f.x, orbit)
         bad = check_inequalities(f.lay, terms, f.x)
         if not bad:
-            if c is None and count > 0 and not check:     # the multipliers' levels
-                c = lower(f, terms, ref)
             return _result(orbit, terms, c, f, count, bool(check), ref)
         mended = mend(f.lay, terms, f.x) if attempt < MENDS else None
         if mended is None:
@@ -251,21 +249,20 @@ def first_solve(orbit: Orbit, terms: Terms, lay: Layout, b0: np.ndarray, L0: int
 def _result(orbit: Orbit, terms: Terms, c: Solved | None, f: Solved, count: int, check: bool,
             ref: Any) -> EquationOrbit:
     """The EquationOrbit of f (the orbit returned), with its multipliers and, with ``check`` or
-    where there are no coarser levels, its check's (f's mesh halved, for the multipliers'
-    checked estimate); where there are none, the coarser levels' (the third, where it was
-    solved, for the extrapolated estimate; a refinement's from f's mesh merged once and twice,
-    :func:`~.adapt.lower`, made here where the check's failed); where neither, the multipliers'
-    estimate is inf, and a CollocationWarning says so."""
+    where there are no coarser levels (a refinement), its check's (f's mesh halved, for the
+    multipliers' checked estimate: :func:`check_multipliers`); where there are none, the coarser
+    levels' (the third, where it was solved, for the extrapolated estimate; a refinement's from
+    f's mesh merged once and twice, :func:`~.adapt.lower`, made here); where neither, the
+    multipliers' estimate is inf, and a CollocationWarning says so."""
     if f.unchecked is not None:
         kept = "three" if c is not None and c.coarser is not None else "two"
         warnings.warn(f"collocate: the orbit on {f.lay.L} intervals is not checked on its mesh "
                       f"halved ({2 * f.lay.L} intervals): {f.unchecked}; its estimate is the "
                       f"{kept} levels'", CollocationWarning, stacklevel=3)
     if count > 0:
-        f.mu = floquet(f.lay, terms, f.x, count)
         if f.check is not None and (check or c is None):
             try:
-                f.check.mu = floquet(f.check.lay, terms, f.check.x, count)
+                check_multipliers(f, terms, count)
             except (RuntimeError, ValueError, np.linalg.LinAlgError) as err:
                 if c is None:
                     c = lower(f, terms, ref)
@@ -275,11 +272,25 @@ def _result(orbit: Orbit, terms: Terms, c: Solved | None, f: Solved, count: int,
                               f"intervals) could not be computed ({type(err).__name__}: {err}); "
                               f"the multipliers' estimate is {kept}", CollocationWarning,
                               stacklevel=3)
+        if not f.mu.size:
+            f.mu = floquet(f.lay, terms, f.x, count)
         if c is not None and (f.check is None or not f.check.mu.size):  # the levels' estimate
             c.mu = floquet(c.lay, terms, c.x, count)
             if c.coarser is not None:
                 c.coarser.mu = floquet(c.coarser.lay, terms, c.coarser.x, count)
     return equation_orbit(f, float(orbit.p), orbit.make, estimate(c, f), terms.H.jumps)
+
+
+def check_multipliers(f: Solved, terms: Terms, count: int) -> None:
+    """f's ``count`` multipliers with their eigenvectors (:func:`~.floquet.pairs`), and its
+    check's from them (:func:`~.floquet.on_halved`: a few products of the check's monodromy
+    operator from f's eigenvectors prolonged), or where those are not verified from the check's
+    monodromy matrix (:func:`~.floquet.multipliers`); set as f.mu and f.check.mu."""
+    F = f.check
+    assert F is not None
+    f.mu, V = pairs(f.lay, terms, f.x, count)
+    mu = None if V is None else on_halved(F.lay, F.x, f.lay, f.x, terms, f.mu, V)
+    F.mu = mu if mu is not None else floquet(F.lay, terms, F.x, count)
 
 
 def checked_period(orbit: Orbit) -> float:

@@ -29,9 +29,15 @@ import scipy.linalg as sl
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
-from .krylov import DENSE_MAX, Monodromy, leading, nearest
+from .krylov import DENSE_MAX, Monodromy, leading_pairs, nearest
 from .system import History, Layout, Terms, full_jacobian
 from ..core.blas import _one_blas_thread
+
+#: Products of :func:`on_halved`'s subspace iteration at most.
+RITZ_ROUNDS = 4
+#: A Ritz pair of :func:`on_halved` is accepted when |M y - theta y| <= RITZ_TOL max(1, the
+#: largest |theta|) |y|.
+RITZ_TOL = 1e-12
 
 
 def monodromy(lay: Layout, terms: Terms, x: np.ndarray) -> np.ndarray:
@@ -155,13 +161,88 @@ def multipliers(lay: Layout, terms: Terms, x: np.ndarray, count: int = 10) -> np
     """The ``count`` multipliers of largest modulus (largest first; below 1e-12: 0): the dense
     monodromy matrix's eigenvalues up to ``DENSE_MAX`` rows, beyond by ARPACK on the operator
     (:mod:`dmi.analysis.collocation.krylov`; the dense matrix where ARPACK's are not verified)."""
+    return pairs(lay, terms, x, count, False)[0]
+
+
+def pairs(lay: Layout, terms: Terms, x: np.ndarray, count: int = 10, vectors: bool = True
+          ) -> tuple[np.ndarray, np.ndarray | None]:
+    """:func:`multipliers` and, with ``vectors``, their eigenvectors on the monodromy's state
+    (columns, the same order; None where there are none)."""
     op = operator(lay, terms, x)
+    V = None
     with _one_blas_thread():          # small dense problems: BLAS threads only contend
-        mu = leading(op, count) if op.dim > DENSE_MAX else None
-        if mu is None:
+        got = leading_pairs(op, count) if op.dim > DENSE_MAX else None
+        if got is not None:
+            mu, V = got
+        elif vectors:
+            mu, V = sl.eig(op.apply(np.eye(op.dim)))
+        else:
             mu = sl.eigvals(op.apply(np.eye(op.dim)))
-    mu = mu[np.argsort(-np.abs(mu), kind="stable")][:count]
-    return np.where(np.abs(mu) < 1e-12, 0.0, mu)
+    order = np.argsort(-np.abs(mu), kind="stable")[:count]
+    mu = mu[order]
+    return np.where(np.abs(mu) < 1e-12, 0.0, mu), (None if V is None else V[:, order])
+
+
+def on_halved(fine: Layout, x: np.ndarray, coarse: Layout, xc: np.ndarray, terms: Terms,
+              mu: np.ndarray, V: np.ndarray) -> np.ndarray | None:
+    """The multipliers of the orbit x on ``fine``, the ``coarse`` layout's mesh halved, near
+    ``mu``, those of the coarse orbit xc (V: their eigenvectors, :func:`pairs`): subspace iteration on
+    fine's monodromy operator from V prolonged (exactly: each interval of ``fine`` is half of
+    one of ``coarse``, its polynomial the coarse one's there), with two more directions than
+    mu, and the Rayleigh-Ritz values of the subspace, up to RITZ_ROUNDS products; the same
+    number as mu, largest first, below 1e-12: 0.  None where a Ritz pair of a nonzero
+    multiplier keeps a residual |M y - theta y| above RITZ_TOL (relative to max(1, |theta|)
+    and |y|; the caller then decomposes the monodromy, :func:`multipliers`): a slow
+    convergence (moduli close to the next ones'), or V not of the coarse operator."""
+    op = operator(fine, terms, x)
+    k = min(mu.size + 2, V.shape[1], op.dim)
+    P = prolongation(coarse, xc, fine, x, terms)
+    if k < mu.size or P is None or P.shape != (op.dim, V.shape[0]):
+        return None
+    Y = P @ V[:, :k]
+    with _one_blas_thread():
+        for _ in range(RITZ_ROUNDS):
+            Q = np.linalg.qr(Y)[0]
+            Y = op.apply(Q)
+            theta, W = np.linalg.eig(Q.conj().T @ Y)
+            order = np.argsort(-np.abs(theta), kind="stable")[:mu.size]
+            theta, W = theta[order], W[:, order]
+            Z = Q @ W
+            res = (np.linalg.norm(Y @ W - Z * theta[None, :], axis=0)
+                   / np.maximum(np.linalg.norm(Z, axis=0), 1e-300))
+            big = np.abs(theta) >= 1e-12
+            if np.all(res[big] <= RITZ_TOL * max(1.0, float(np.max(np.abs(theta))))):
+                return np.where(big, theta, 0.0)
+    return None
+
+
+def prolongation(coarse: Layout, xc: np.ndarray, fine: Layout, x: np.ndarray, terms: Terms
+                 ) -> np.ndarray | None:
+    """The matrix taking a state of the monodromy of the orbit xc on ``coarse`` (its past's node
+    values) to the one of the orbit x on ``fine`` (the coarse mesh halved): each fine interval's
+    nodes the coarse polynomial's values there; None where a fine state interval's parent is not
+    in the coarse state (their periods span another number of periods of the past)."""
+    m, n = coarse.m, coarse.n
+    _, bc, Tc = coarse.split(xc)
+    _, b, T = fine.split(x)
+    P = max(1, math.ceil(terms.tau / T - 1e-12))
+    if P != max(1, math.ceil(terms.tau / Tc - 1e-12)):
+        return None
+    rows = state_intervals(fine, terms, fine.mesh(b, T), T, P)
+    cols = {int(g): j for j, g in enumerate(state_intervals(coarse, terms, coarse.mesh(bc, Tc),
+                                                            Tc, P))}
+    z = np.arange(m + 1) / m
+    halves = (np.kron(coarse.basis.values(0.5 * z), np.eye(n)),
+              np.kron(coarse.basis.values(0.5 + 0.5 * z), np.eye(n)))
+    block = (m + 1) * n
+    out = np.zeros((rows.size * block, len(cols) * block))
+    for j, g in enumerate(rows):
+        period, k = divmod(int(g), fine.L)
+        i = cols.get(period * coarse.L + k // 2)
+        if i is None:
+            return None
+        out[j * block:(j + 1) * block, i * block:(i + 1) * block] = halves[k % 2]
+    return out
 
 
 def eigenfunction(lay: Layout, terms: Terms, x: np.ndarray, near: complex = -1.0

@@ -73,12 +73,12 @@ class Monodromy:
         return out[:, 0] if flat else out
 
 
-def leading(op: Monodromy, count: int) -> np.ndarray | None:
-    """The ``count`` multipliers of largest modulus by ARPACK (largest first), each checked by
-    its residual; None where ARPACK does not converge or a residual is too large (the caller
-    then decomposes the dense matrix)."""
+def leading_pairs(op: Monodromy, count: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """The ``count`` multipliers of largest modulus by ARPACK (largest first) and their
+    eigenvectors (columns), each checked by its residual; None where ARPACK does not converge or
+    a residual is too large (the caller then decomposes the dense matrix)."""
     got = _arnoldi(op, count)
-    return None if got is None else got[0][:count]
+    return None if got is None else (got[0][:count], got[1][:, :count])
 
 
 def nearest(op: Monodromy, near: complex, count: int = 10

@@ -22,6 +22,7 @@ from dmi import analysis as da
 from dmi.analysis.collocation import adapt
 from dmi.analysis.collocation.adapt import estimate, levels
 from dmi.analysis.collocation.collocate import first_solve
+from dmi.analysis.collocation import floquet as floquet_module
 from dmi.analysis.collocation.floquet import multipliers as floquet
 from dmi.analysis.collocation.signature import read_signature
 from dmi.analysis.collocation.system import (CollocationWarning, Layout, Terms, carried,
@@ -391,9 +392,9 @@ def test_a_check_that_breaks_the_inequalities_is_no_check(stick_slip, monkeypatc
 
 
 def test_a_check_whose_multipliers_fail_warns_and_keeps_the_levels(oscillation, monkeypatch):
-    """check=True where the check's monodromy fails (made to, on its 32 intervals): a
-    CollocationWarning says so and the multipliers' estimate is the levels', as without
-    check."""
+    """check=True where the check's monodromy fails (made to, on its 32 intervals, its few
+    products from the orbit's eigenvectors not verified): a CollocationWarning says so and the
+    multipliers' estimate is the levels', as without check."""
     o, _ = oscillation
     module = sys.modules["dmi.analysis.collocation.collocate"]
     plain_floquet = module.floquet
@@ -403,11 +404,12 @@ def test_a_check_whose_multipliers_fail_warns_and_keeps_the_levels(oscillation, 
             raise RuntimeError("made to fail")
         return plain_floquet(lay, terms, x, count)
     monkeypatch.setattr(module, "floquet", failing)
+    monkeypatch.setattr(module, "on_halved", lambda *args: None)
     with pytest.warns(CollocationWarning, match=r"multipliers of the check .* could not be "
                       r"computed .RuntimeError: made to fail"):
         e = da.collocate(o, intervals=8, multipliers=2, check=True)
     plain = da.collocate(o, intervals=8, multipliers=2)
-    assert np.array_equal(e.errors["multipliers"], plain.errors["multipliers"])
+    assert np.allclose(e.errors["multipliers"], plain.errors["multipliers"], rtol=1e-9, atol=0)
 
 
 @pytest.mark.parametrize("m, tol", [(4, 1e-4), (6, 1e-8), (6, 1e-9), (8, 1e-8), (8, 1e-9)])
@@ -557,46 +559,48 @@ def test_a_refinement_whose_checks_fail_keeps_the_levels_estimate(oscillation, o
 
 
 def test_a_refinements_multipliers_estimate(oscillation):
-    """The refinement's multipliers: their estimate from the orbit's mesh merged once and twice
-    (Richardson's, or twice the two levels' difference) at least the true error of the leading
-    nontrivial one (tol = 1e-6, 17 intervals: 5.5 times its error 4.7e-9 measured); with
-    check=True from the check's multipliers, within [1, 10] of it (1.99), the orbit returned the
-    same."""
+    """The refinement's multipliers: their estimate from its check's multipliers (a few products
+    of the check's monodromy operator from the orbit's eigenvectors prolonged), within [1, 10]
+    of the true error of the trivial and the leading nontrivial one (tol = 1e-6, 17 intervals:
+    1.99 times 5.3e-7 and 4.7e-9 measured; from the orbit's mesh merged once and twice, 900 and
+    5.5 times), the same with check=True."""
     o, ref = oscillation
     plain = da.collocate(o, tol=1e-6, multipliers=4)
     e = da.collocate(o, tol=1e-6, multipliers=4, check=True)
     assert e.period == plain.period and e.intervals == plain.intervals
-    true = float(np.min(np.abs(ref.multipliers - e.multipliers[1])))
-    assert true > 1e-10                                     # far above the floor, 1e-11
-    assert plain.errors["multipliers"][1] >= true, (plain.errors["multipliers"], true)
-    assert 1.0 <= e.errors["multipliers"][1] / true <= 10.0, (e.errors["multipliers"], true)
+    assert np.array_equal(e.errors["multipliers"], plain.errors["multipliers"])
+    for j in (0, 1):
+        true = float(np.min(np.abs(ref.multipliers - e.multipliers[j])))
+        assert true > 1e-10                                 # far above the floor, 1e-11
+        assert 1.0 <= e.errors["multipliers"][j] / true <= 10.0, (e.errors["multipliers"], true)
 
 
 def test_a_refinements_check_whose_multipliers_fail_takes_the_levels(oscillation, monkeypatch):
-    """check=True in a refinement where the check's monodromy fails (made to): the multipliers'
-    estimate is the levels' (the orbit's mesh merged once and twice, made then), as without
-    check, and a CollocationWarning says so (the estimate was inf, the warning naming the
-    levels all the same)."""
-    o, _ = oscillation
+    """A refinement whose check's monodromy fails (made to): the multipliers' estimate is the
+    levels' (the orbit's mesh merged once and twice, made then) and a CollocationWarning says so
+    (the estimate was inf with check=True, the warning naming the levels all the same)."""
+    o, ref = oscillation
     module = sys.modules["dmi.analysis.collocation.collocate"]
     plain_floquet = module.floquet
     calls = []
 
     def failing(lay, terms, x, count):
         calls.append(lay.L)
-        if len(calls) == 2:                       # the check's, after the orbit's own
+        if len(calls) == 1:                       # the check's (the orbit's own by pairs)
             raise RuntimeError("made to fail")
         return plain_floquet(lay, terms, x, count)
     monkeypatch.setattr(module, "floquet", failing)
-    with pytest.warns(CollocationWarning, match=r"multipliers of the check .* could not be "
-                      r"computed .RuntimeError: made to fail.; the multipliers' estimate is "
-                      r"the levels'"):
-        e = da.collocate(o, tol=1e-6, multipliers=2, check=True)
-    assert calls[1] == 2 * e.intervals
-    monkeypatch.setattr(module, "floquet", plain_floquet)
-    plain = da.collocate(o, tol=1e-6, multipliers=2)
-    assert np.all(np.isfinite(e.errors["multipliers"]))
-    assert np.array_equal(e.errors["multipliers"], plain.errors["multipliers"])
+    monkeypatch.setattr(module, "on_halved", lambda *args: None)
+    for check in (True, False):
+        calls.clear()
+        with pytest.warns(CollocationWarning, match=r"multipliers of the check .* could not be "
+                          r"computed .RuntimeError: made to fail.; the multipliers' estimate "
+                          r"is the levels'"):
+            e = da.collocate(o, tol=1e-6, multipliers=2, check=check)
+        assert calls[0] == 2 * e.intervals and len(calls) == 3     # the check's, then N/2, N/4
+        true = float(np.min(np.abs(ref.multipliers - e.multipliers[1])))
+        assert np.all(np.isfinite(e.errors["multipliers"]))
+        assert e.errors["multipliers"][1] >= true
 
 
 def test_a_round_without_an_estimate_grows_by_far_growth(oscillation, oscillation_gap,
@@ -623,3 +627,26 @@ def test_a_round_without_an_estimate_grows_by_far_growth(oscillation, oscillatio
     e = da.collocate(o, tol=1e-10, multipliers=0)
     assert len(sizes) == 3 and sizes[2] <= adapt.FAR_GROWTH * sizes[1], sizes
     assert abs(e.period - ref.period) + oscillation_gap <= e.errors["period"] <= 1e-10
+
+
+@pytest.mark.parametrize("case, L", [("oscillation", 8), ("stick_slip", 8)])
+def test_the_checks_multipliers_from_the_orbits_eigenvectors(request, monkeypatch, case, L):
+    """The check's multipliers by a few products of its monodromy operator from the orbit's
+    eigenvectors prolonged to the halved mesh (floquet.on_halved) against the eigenvalues of the
+    check's monodromy matrix, on van der Pol and on the belt's stick-slip orbit (its switching
+    times' saltation in the operator, its stuck segment's zero multipliers): to 1e-12; from
+    vectors that are not the orbit's (random) in one product, not verified: None."""
+    o, _ = request.getfixturevalue(case)
+    terms, lay, x1 = first_solved(o, L, 4)
+    c, f = levels(lay, terms, x1, reference(lay, x1) if o.autonomous else None, L, True, 1e-10,
+                  "test", every=True)
+    F = f.check
+    assert F is not None and F.lay.L == 2 * f.lay.L
+    mu, V = floquet_module.pairs(f.lay, terms, f.x, 4)
+    got = floquet_module.on_halved(F.lay, F.x, f.lay, f.x, terms, mu, V)
+    dense = floquet(F.lay, terms, F.x, 4)
+    assert got is not None and np.max(np.abs(got - dense)) <= 1e-12, (got, dense)
+    assert np.max(np.abs(got - mu)) > 1e-11           # the check's, not the orbit's own
+    noise = np.random.default_rng(1).standard_normal(V.shape)
+    monkeypatch.setattr(floquet_module, "RITZ_ROUNDS", 1)
+    assert floquet_module.on_halved(F.lay, F.x, f.lay, f.x, terms, mu, noise) is None
