@@ -22,9 +22,12 @@ check), and twice their difference is the orbit's error estimate
 (:func:`dmi.analysis.collocation.adapt.checked`); the first orbit whose estimate of the period (an autonomous orbit; it converges as h^(2m) on
 smooth orbits) or of the amplitudes (a forced one; h^(m+1): an extremum is inside an interval)
 is below ``tol`` is returned (:mod:`dmi.analysis.collocation.adapt`: the indicator, the
-equidistribution, the estimate and the refinement); its multipliers' estimate is from its mesh
-with pairs merged, once and twice (Richardson's extrapolation where the three levels converge
-steadily, else twice the two levels' difference), or with ``check=True`` from the check's.
+equidistribution, the estimate and the refinement); its multipliers' estimate is twice their
+difference to the check's (those from a few products of the check's monodromy operator from
+the orbit's eigenvectors prolonged to the halved mesh, :func:`~.floquet.on_halved`, where their
+residuals verify them, else from the check's monodromy matrix), or where the check's cannot be
+computed from its mesh with pairs merged, once and twice (Richardson's extrapolation where the
+three levels converge steadily, else twice the two levels' difference).
 With ``intervals=L`` the orbit is solved on L intervals equidistributed, on that mesh halved
 (the orbit returned) and with pairs merged; the difference of the two finer levels is the
 estimate of the finer one, or, where the three levels converge steadily, Richardson's estimate
@@ -52,6 +55,7 @@ import numpy as np
 from .adapt import (Solved, check_cost, equidistribute, estimate, first_intervals, levels,
                     lower)
 from .floquet import multipliers as floquet, on_halved, pairs
+from .krylov import DENSE_MAX
 from .mend import mend
 from .orbit import EquationOrbit, equation_orbit
 from .signature import read_signature
@@ -105,10 +109,9 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
         difference), the multipliers' too: the period's 1.7-8.02 times the true error on every
         mesh of ``bench_meshes.py --scan`` (the upper end where the true error is near the
         floor), u's and the multipliers' about 2 times; with ``intervals=L`` 1.5-1.9 times the
-        CPU of a smooth orbit without multipliers, 2-3 times with 10 (the monodromy on the mesh
-        halved).  False: with ``intervals=None`` the period's, amplitudes' and u's estimates
-        are the check's all the same (the refinement checks every round), the multipliers'
-        from the orbit's mesh merged once and twice; with ``intervals=L`` the check's only
+        CPU of a smooth orbit without multipliers (the solve on the mesh halved).  False: with
+        ``intervals=None`` the same (the refinement checks every round, its multipliers
+        too); with ``intervals=L`` the check's only
         where the three levels are not steady (an order seen above the period's 2 m is not
         steady) or the mesh is graded, elsewhere Richardson's estimate from the three levels,
         which overstates the period's error up to some 650 times there (none below it on the
@@ -284,12 +287,15 @@ def _result(orbit: Orbit, terms: Terms, c: Solved | None, f: Solved, count: int,
 def check_multipliers(f: Solved, terms: Terms, count: int) -> None:
     """f's ``count`` multipliers with their eigenvectors (:func:`~.floquet.pairs`), and its
     check's from them (:func:`~.floquet.on_halved`: a few products of the check's monodromy
-    operator from f's eigenvectors prolonged), or where those are not verified from the check's
-    monodromy matrix (:func:`~.floquet.multipliers`); set as f.mu and f.check.mu."""
+    operator from f's eigenvectors prolonged) where the check's monodromy would be decomposed
+    densely (its state, twice f's, at most DENSE_MAX), or where those are not verified or the
+    state is larger (ARPACK's there), by :func:`~.floquet.multipliers`; set as f.mu and
+    f.check.mu."""
     F = f.check
     assert F is not None
     f.mu, V = pairs(f.lay, terms, f.x, count)
-    mu = None if V is None else on_halved(F.lay, F.x, f.lay, f.x, terms, f.mu, V)
+    small = V is not None and 2 * V.shape[0] <= DENSE_MAX    # else ARPACK's on the check
+    mu = on_halved(F.lay, F.x, f.lay, f.x, terms, f.mu, V) if small else None
     F.mu = mu if mu is not None else floquet(F.lay, terms, F.x, count)
 
 

@@ -217,7 +217,7 @@ def on_halved(fine: Layout, x: np.ndarray, coarse: Layout, xc: np.ndarray, terms
 
 
 def prolongation(coarse: Layout, xc: np.ndarray, fine: Layout, x: np.ndarray, terms: Terms
-                 ) -> np.ndarray | None:
+                 ) -> sp.csr_matrix | None:
     """The matrix taking a state of the monodromy of the orbit xc on ``coarse`` (its past's node
     values) to the one of the orbit x on ``fine`` (the coarse mesh halved): each fine interval's
     nodes the coarse polynomial's values there; None where a fine state interval's parent is not
@@ -234,15 +234,17 @@ def prolongation(coarse: Layout, xc: np.ndarray, fine: Layout, x: np.ndarray, te
     z = np.arange(m + 1) / m
     halves = (np.kron(coarse.basis.values(0.5 * z), np.eye(n)),
               np.kron(coarse.basis.values(0.5 + 0.5 * z), np.eye(n)))
-    block = (m + 1) * n
-    out = np.zeros((rows.size * block, len(cols) * block))
-    for j, g in enumerate(rows):
+    parent = []
+    for g in rows:
         period, k = divmod(int(g), fine.L)
         i = cols.get(period * coarse.L + k // 2)
         if i is None:
             return None
-        out[j * block:(j + 1) * block, i * block:(i + 1) * block] = halves[k % 2]
-    return out
+        parent.append((i, k % 2))
+    blocks = [[None] * len(cols) for _ in rows]
+    for j, (i, half) in enumerate(parent):
+        blocks[j][i] = halves[half]
+    return sp.bmat(blocks, format="csr", dtype=float) if blocks else None
 
 
 def eigenfunction(lay: Layout, terms: Terms, x: np.ndarray, near: complex = -1.0
