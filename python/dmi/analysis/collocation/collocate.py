@@ -108,8 +108,8 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
         True: every estimate from the orbit returned against its mesh halved (twice their
         difference), the multipliers' too: the period's 1.7-8.02 times the true error on every
         mesh of ``bench_meshes.py --scan`` (the upper end where the true error is near the
-        floor), u's and the multipliers' about 2 times; with ``intervals=L`` 1.5-1.9 times the
-        CPU of a smooth orbit without multipliers (the solve on the mesh halved).  False: with
+        floor), u's and the multipliers' about 2 times; with ``intervals=L`` 1.2-2.1 times the
+        CPU (the solve on the mesh halved; ``bench_meshes.py --check-cost``).  False: with
         ``intervals=None`` the same (the refinement checks every round, its multipliers
         too); with ``intervals=L`` the check's only
         where the three levels are not steady (an order seen above the period's 2 m is not
