@@ -26,8 +26,9 @@ package (:mod:`dmi.analysis.collocation.collocate` and the collocated branch use
   (:func:`first_intervals`), rounds of the orbit on a mesh equidistributed anew and on that mesh
   halved (its check); the first whose check's estimate (:func:`round_error`) meets tol is
   returned (its multipliers' estimate from the check's, or where those fail from its mesh
-  merged once and twice, :func:`lower`); the next mesh by the order the rounds show (:func:`next_intervals`), with the
-  stopping rules and the cost check of the delay integral (:func:`check_cost`).
+  merged once and twice, :func:`lower`); the next mesh by the order the rounds show
+  (:func:`next_intervals`), with the stopping rules and the cost check of the delay integral
+  (:func:`check_cost`).
 
 May import: :mod:`.mesh`, :mod:`.signature`, :mod:`.system` (no module of the package above them).
 """

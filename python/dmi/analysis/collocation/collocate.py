@@ -19,10 +19,11 @@ Errors: with ``intervals=None`` the mesh is equidistributed (AUTO, COLSYS: equal
 |u^(m+1)|^(1 / (m + 1)), estimated from the jumps of u^(m) between intervals) and refined in
 rounds: each solves the orbit on its mesh and on that mesh with every interval halved (its
 check), and twice their difference is the orbit's error estimate
-(:func:`dmi.analysis.collocation.adapt.checked`); the first orbit whose estimate of the period (an autonomous orbit; it converges as h^(2m) on
-smooth orbits) or of the amplitudes (a forced one; h^(m+1): an extremum is inside an interval)
-is below ``tol`` is returned (:mod:`dmi.analysis.collocation.adapt`: the indicator, the
-equidistribution, the estimate and the refinement); its multipliers' estimate is twice their
+(:func:`dmi.analysis.collocation.adapt.checked`); the first orbit whose estimate of the period
+(an autonomous orbit; it converges as h^(2m) on smooth orbits) or of the amplitudes (a forced
+one; h^(m+1): an extremum is inside an interval) is below ``tol`` is returned
+(:mod:`dmi.analysis.collocation.adapt`: the indicator, the equidistribution, the estimate and
+the refinement); its multipliers' estimate is twice their
 difference to the check's (those from a few products of the check's monodromy operator from
 the orbit's eigenvectors prolonged to the halved mesh, :func:`~.floquet.on_halved`, where their
 residuals verify them, else from the check's monodromy matrix), or where the check's cannot be
@@ -110,13 +111,13 @@ def collocate(orbit: Orbit, *, degree: int = 4, intervals: int | None = None,
         mesh of ``bench_meshes.py --scan`` (the upper end where the true error is near the
         floor), u's and the multipliers' about 2 times; with ``intervals=L`` 1.2-2.1 times the
         CPU (the solve on the mesh halved; ``bench_meshes.py --check-cost``).  False: with
-        ``intervals=None`` the same (the refinement checks every round, its multipliers
-        too); with ``intervals=L`` the check's only
-        where the three levels are not steady (an order seen above the period's 2 m is not
-        steady) or the mesh is graded, elsewhere Richardson's estimate from the three levels,
-        which overstates the period's error up to some 650 times there (none below it on the
-        scan's 231 meshes), and u's and the multipliers' from the two or three levels (a
-        multiplier's two-level difference counted twice).  ``stable`` is judged against the
+        ``intervals=None`` the same (the refinement checks every round, its multipliers too);
+        with ``intervals=L`` the check's only where the three levels are not steady (an order
+        seen above the period's 2 m is not steady) or the mesh is graded, elsewhere
+        Richardson's estimate from the three levels, which overstates the period's error up to
+        some 650 times there (none below it on the scan's 231 meshes), and u's and the
+        multipliers' from the two or three levels (a multiplier's two-level difference counted
+        twice).  ``stable`` is judged against the
         multipliers' estimate, so a verdict the levels leave undecided (None) may be decided
         with ``check=True``.
 

@@ -186,10 +186,11 @@ def pairs(lay: Layout, terms: Terms, x: np.ndarray, count: int = 10, vectors: bo
 def on_halved(fine: Layout, x: np.ndarray, coarse: Layout, xc: np.ndarray, terms: Terms,
               mu: np.ndarray, V: np.ndarray) -> np.ndarray | None:
     """The multipliers of the orbit x on ``fine``, the ``coarse`` layout's mesh halved, near
-    ``mu``, those of the coarse orbit xc (V: their eigenvectors, :func:`pairs`): subspace iteration on
-    fine's monodromy operator from V prolonged (exactly: each interval of ``fine`` is half of
-    one of ``coarse``, its polynomial the coarse one's there), with two more directions than
-    mu, and the Rayleigh-Ritz values of the subspace, up to RITZ_ROUNDS products; the same
+    ``mu``, those of the coarse orbit xc (V: their eigenvectors, :func:`pairs`): subspace
+    iteration on fine's monodromy operator from V prolonged (exactly: each interval of ``fine``
+    is half of one of ``coarse``, its polynomial the coarse one's there), with two more
+    directions than mu, and the Rayleigh-Ritz values of the subspace, up to RITZ_ROUNDS
+    products (M Q, Q orthonormal: the operator's products are its only cost); the same
     number as mu, largest first, below 1e-12: 0.  None where a Ritz pair of a nonzero
     multiplier keeps a residual |M y - theta y| above RITZ_TOL (relative to max(1, |theta|)
     and |y|; the caller then decomposes the monodromy, :func:`multipliers`): a slow
