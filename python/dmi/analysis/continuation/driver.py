@@ -650,16 +650,21 @@ class Along:
 
     def root(self, fn: Callable[[float], float], f0: float, f1: float) -> float | None:
         """Where fn (a function of the arclength s, fn(0) = f0, fn(L) = f1) changes sign, by
-        Brent's method (fn evaluated inside (0, L) only: at the ends f0 and f1); None when f0,
-        f1 do not bracket a root or the corrector or Brent fails."""
+        Brent's method (at an end where fn fails, f0 or f1); None when f0, f1 do not bracket a
+        root or the corrector or Brent fails."""
         if not _sign_change(f0, f1):
             return None
 
-        # the ends' values are known, not evaluated again: an end's point re-solved on another
-        # layout (a collocated branch's next mesh, the chord's on_current) can break its
-        # signature there and fail, and the bracket is the driver's, from its own points
+        # an end whose evaluation fails takes the driver's value there: its point re-solved on
+        # another layout (a collocated branch's next mesh, the chord's on_current) can break
+        # its signature and fail, while the bracket is the driver's, from its own points
         def inner(s: float) -> float:
-            return f0 if s == 0.0 else f1 if s == self.L else fn(s)
+            if s not in (0.0, self.L):
+                return fn(s)
+            try:
+                return fn(s)
+            except (ShootingError, ValueError):
+                return f0 if s == 0.0 else f1
         try:
             return float(scipy.optimize.brentq(inner, 0.0, self.L,
                                                xtol=1e-13 * max(1.0, self.L), rtol=1e-15,
