@@ -134,9 +134,9 @@ def test_an_estimate_that_rises_between_rounds_is_no_floor(oscillation, oscillat
     (the meshes' lottery: on the relaxation oscillation at degree 6 and 1e-8, 1.03e-8 on 64
     intervals, 1.71e-8 on 71; a draft of this refinement went from 128 to 158 intervals at
     degree 4 with 2.3e-8 then 9.0e-8, 6.6e-9 relative, which CONDITIONED = 1e-6 took for the
-    floor of the conditioning, refusing the tol).  Made so here:
-    the first two rounds' estimates 2e-8 and 4e-8 (3e-9 and 6e-9 relative, above CONDITIONED =
-    1e-9), the mesh grown by 1.6 between them: the refinement goes on and meets tol."""
+    floor of the conditioning, refusing the tol).  Made so here: the first two rounds'
+    estimates 2e-8 and 4e-8 (3e-9 and 6e-9 relative, above CONDITIONED = 1e-9), the mesh grown
+    by 1.6 between them: the refinement goes on and meets tol."""
     o, ref = oscillation
     plain = adapt.round_error
     made = [2e-8, 4e-8]
