@@ -380,25 +380,37 @@ def with_floor(errors: dict[str, Any], T: float, amplitude: np.ndarray, mu: np.n
     return errors
 
 
+def one_level(lay: Layout, terms: Terms, start: tuple[Layout, np.ndarray], ref: Any,
+              what: str = "collocation") -> Solved:
+    """The orbit on ``lay`` from ``start`` (a solution on another layout)."""
+    return Solved(lay, solve(lay, terms, transfer(*start, lay), ref, what=what)[0])
+
+
+def merged_level(s: Solved, terms: Terms, ref: Any, what: str = "collocation"
+                 ) -> Solved | None:
+    """The orbit on s's mesh with every pair of intervals merged, from s's solution; None where
+    that merges nothing or the solve fails (Newton, or a model's f not finite there)."""
+    low = s.lay.with_fractions(merged(s.lay.fractions))
+    if low.L == s.lay.L:
+        return None
+    try:
+        return one_level(low, terms, (s.lay, s.x), ref, what)
+    except (ShootingError, ValueError):
+        return None
+
+
 def two_levels(lay: Layout, terms: Terms, start: tuple[Layout, np.ndarray], ref: Any, what: str
                ) -> tuple[Solved, Solved]:
     """The orbit on ``lay`` (from ``start``, a solution on another layout) and on ``lay``
     halved (from the first's solution, or where Newton fails from there, from ``start``), the
-    first with its ``coarser`` level: ``lay`` with pairs merged (from the first's solution; None
-    where that solve fails or merges nothing)."""
-    xc, _ = solve(lay, terms, transfer(*start, lay), ref, what=what)
+    first with its ``coarser`` level: ``lay`` with pairs merged (:func:`merged_level`)."""
+    c = one_level(lay, terms, start, ref, what)
     fine = lay.with_fractions(halved(lay.fractions))
     try:
-        xf, _ = solve(fine, terms, transfer(lay, xc, fine), ref, what=what)
+        xf, _ = solve(fine, terms, transfer(lay, c.x, fine), ref, what=what)
     except ShootingError:                    # a coarse level far off (a steep orbit)
         xf, _ = solve(fine, terms, transfer(*start, fine), ref, what=what)
-    c = Solved(lay, xc)
-    low = lay.with_fractions(merged(lay.fractions))
-    if low.L < lay.L:
-        try:
-            c.coarser = Solved(low, solve(low, terms, transfer(lay, xc, low), ref, what=what)[0])
-        except (ShootingError, ValueError):
-            c.coarser = None
+    c.coarser = merged_level(c, terms, ref, what)
     return c, Solved(fine, xf)
 
 
@@ -471,27 +483,14 @@ def checked_round(c: Solved, f: Solved, terms: Terms, ref: Any, every: bool = Fa
 
 
 def lower(f: Solved, terms: Terms, ref: Any) -> Solved | None:
-    """The orbit on f's mesh with pairs merged (from f's solution) with its own ``coarser``, that
-    mesh merged again (None where that solve fails or merges nothing): the levels of f's
-    multipliers' estimate, and of its period's where f's check could not be solved; None where
-    the first merged solve fails or merges nothing."""
-    levels = []
-    lay, x = f.lay, f.x
-    for _ in range(2):
-        low = lay.with_fractions(merged(lay.fractions))
-        if low.L == lay.L:
-            break
-        try:
-            x = solve(low, terms, transfer(lay, x, low), ref)[0]
-        except (ShootingError, ValueError):
-            break
-        levels.append(Solved(low, x))
-        lay = low
-    if not levels:
-        return None
-    if len(levels) == 2:
-        levels[0].coarser = levels[1]
-    return levels[0]
+    """The orbit on f's mesh with pairs merged with its own ``coarser``, that mesh merged again
+    (:func:`merged_level`; None where that fails): the levels of f's multipliers' estimate, and
+    of its period's where f's check could not be solved; None where the first merged solve fails
+    or merges nothing."""
+    c = merged_level(f, terms, ref)
+    if c is not None:
+        c.coarser = merged_level(c, terms, ref)
+    return c
 
 
 def round_error(c: Solved | None, f: Solved) -> float:
@@ -561,12 +560,6 @@ def fixed_levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, wha
     c, f = two_levels(lay.with_fractions(adapted(lay, x, L)), terms, (lay, x), ref, what)
     checked_round(c, f, terms, ref, every)
     return c, f
-
-
-def one_level(lay: Layout, terms: Terms, start: tuple[Layout, np.ndarray], ref: Any,
-              what: str) -> Solved:
-    """The orbit on ``lay`` from ``start`` (a solution on another layout)."""
-    return Solved(lay, solve(lay, terms, transfer(*start, lay), ref, what=what)[0])
 
 
 def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: float,
