@@ -1,12 +1,9 @@
 #!/usr/bin/env python3
 # The cost of collocation on a long memory (a benchmark, not a test): the fractional belt, a mass on
-# a belt with velocity-weakening (Stribeck) friction and a Caputo damping of order 1/2,
-#     x'' + c_f D^(1/2) x + k x + F(x' - v_b) = 0,   m = k = 1, c_f = 0.1,
-# F(y) = mu(y) sign y, mu(y) = 0.5 + 0.3 e^(-|y| / 0.5), split as the docs' Stribeck section does (the
-# sign graph at the static level 0.8 in A, the continuous rest g in f); in u = (x, y), y = x' - v_b:
-# f = (-(y + v_b), x + g(y) + c_f W v_b), W = 2 sqrt(tau / pi), and the kernel c_f s^-1/2 / Gamma(1/2)
-# on y, fitted by dmi.kernels.fit(PowerKernel(...), tau, tol=1e-8, relative=True, delta=0.002)
-# (exponential terms plus exact near cells), tau = 50 (about eight periods).  Two cases:
+# a belt with velocity-weakening (Stribeck) friction and a Caputo damping of order 1/2
+# (tests/python/models/fractional_belt.py: the kernel c_f s^-1/2 / Gamma(1/2) on the relative
+# velocity, fitted by exponential terms plus exact near cells), tau = 50 (about eight periods).
+# Two cases:
 #   stick-slip: collocate (default tol, 10 multipliers) of the stick-slip orbit at v_b = 0.6 from
 #               the scheme's orbit (h = 0.005; the shooting not counted);
 #   hopf orbit: hopf_orbit(of="equation") at the equation's Hopf point (v_b ~ 1.025, not counted),
@@ -26,55 +23,19 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
-import math  # noqa: E402
+import sys  # noqa: E402
 import warnings  # noqa: E402
+from pathlib import Path  # noqa: E402
 
-import numba  # noqa: E402
 import numpy as np  # noqa: E402
 
-import dmi  # noqa: E402
 from dmi import analysis as da  # noqa: E402
-from dmi import kernels  # noqa: E402
 from benchtools import cpu, positive_int  # noqa: E402
 
-CF, H, DELTA = 0.1, 0.005, 0.002              # damping, the scheme's step, the near cells
-MU_S, MU_D, V_S = 0.8, 0.5, 0.5               # static, dynamic friction, Stribeck velocity
-VB_SLIP, PERIOD_SLIP = 0.6, 6.315             # the stick-slip orbit's belt speed and period
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "python"))
+from models.fractional_belt import model, stick_slip_orbit  # noqa: E402
+
 AMPLITUDE = 0.1                               # of the orbit born at the Hopf point
-
-
-@numba.njit
-def weakening(v: float) -> float:
-    """g(v) = F(v) - mu_s sign(v): continuous, g(0) = 0."""
-    return -math.copysign((MU_S - MU_D) * -math.expm1(-abs(v) / V_S), v)
-
-
-def model(tau: float):
-    """make(v_b, h=H): the fractional belt with the memory tau."""
-    fit = kernels.fit(kernels.PowerKernel(0.5, CF / math.sqrt(math.pi)), tau, tol=1e-8,
-                      relative=True, delta=DELTA)
-    w = 2 * math.sqrt(tau / math.pi)
-
-    def make(vb: float, h: float = H) -> dmi.Solver:
-        s = dmi.Solver(2, tau, h=h)
-        s.set_rhs(lambda t, u: np.array([-(u[1] + vb), u[0] + weakening(u[1]) + CF * w * vb]),
-                  jit=True)
-        s.set_friction([0.0, MU_S])
-        s.set_quadrature("cell")
-        s.set_kernel_fit(fit, entry=(1, 1))
-        return s
-    return make, fit
-
-
-def stick_slip_orbit(make) -> da.Orbit:
-    """The scheme's stick-slip orbit at v_b = 0.6 (steps of about H)."""
-    M = round(PERIOD_SLIP / H)
-    s = make(VB_SLIP, h=PERIOD_SLIP / M)
-    s.set_history(lambda t: np.array([0.5, 0.0]))
-    s.init()
-    s.advance(40 * M)
-    return da.periodic_orbit(make, VB_SLIP, None, s, guess_period=PERIOD_SLIP, steps=M,
-                             multipliers=0)
 
 
 def hopf_point(make):

@@ -419,7 +419,7 @@ def test_one_event_locator():
 RAW_SOLVES = {
     ("core.newton", "bordered_system"): "the one bordered solve",
     ("continuation.driver", "bordered_det"): "the branch-point test function's determinant",
-    ("collocation.system", "_factor"): "the collocation system's Jacobian",
+    ("collocation.system", "factored"): "the collocation system's Jacobian",
     ("collocation.floquet", "monodromy"): "the monodromy's sensitivities",
     ("collocation.floquet", "operator"): "the monodromy operator's period block, factored",
     ("equilibria.normal_form", "_corrected"): "the equilibrium's Jacobian",

@@ -27,8 +27,10 @@ package (:mod:`dmi.analysis.collocation.collocate` and the collocated branch use
   halved (its check); the first whose check's estimate (:func:`round_error`) meets tol is
   returned (its multipliers' estimate from the check's, or where those fail from its mesh
   merged once and twice, :func:`lower`); the next mesh by the order the rounds show
-  (:func:`next_intervals`), with the stopping rules and the cost check of the delay integral
-  (:func:`check_cost`).
+  (:func:`next_intervals`, :func:`rounds_order`), with the stopping rules and the cost check of
+  the delay integral (:func:`check_cost`); an autonomous orbit's switch whose interval carries
+  most of the round's difference to its check (:func:`contributions`, the dual-weighted
+  residual; :func:`hot_ends`) graded in the rounds after (:func:`graded`, :func:`regraded`).
 
 May import: :mod:`.mesh`, :mod:`.signature`, :mod:`.system` (no module of the package above them).
 """
@@ -40,8 +42,8 @@ from typing import Any
 import numpy as np
 
 from .mesh import _legendre_form
-from .system import (GRADED, Layout, Terms, check_inequalities, evaluate, interval_counts,
-                     node_times, reference, solve)
+from .system import (GRADED, Layout, Terms, assemble, check_inequalities, evaluate, factored,
+                     interval_counts, node_times, reference, solve)
 from ..core.newton import ShootingError
 
 #: Mesh refinement rounds at most (intervals=None).
@@ -102,6 +104,15 @@ MARGIN = 1.1
 #: orbit), or could not be solved, while no round was nearer, grows the mesh by this factor at
 #: most (the round says nothing of the order).
 FAR_GROWTH = 4
+#: An interval at a piece's end (a switch) carrying at least this share of the round's difference
+#: to its check in the period (:func:`contributions`) is graded towards that end
+#: (:func:`graded`): a weakly singular kernel makes the solution after a kink of the switch
+#: (t - t_s)^(5/2) (s^-1/2), whose interval the equidistribution of u^(m+1) does not see and
+#: whose share of the period falls at the order 3.5 instead of 2m.
+HOT_SHARE = 0.5
+#: The order assumed of a graded end's share (one more level halves that end's interval; 3.5
+#: seen on the fractional belt, 2 assumed).
+GRADE_ORDER = 2.0
 #: Quadrature nodes of the delay integral at most on one mesh (about 100 bytes each): a memory
 #: spanning many periods (tau / T large) or a very fine mesh is refused before it is built.
 MAX_DELAY_NODES = 2e7
@@ -511,15 +522,124 @@ def near_check(f: Solved) -> bool:
                               or abs(f.T - F.T) <= ROUGH * max(1.0, abs(F.T)))
 
 
-def next_intervals(L: int, d: float, aim: float, expected: int, seen: float | None,
-                   q: float | None, m: int, margin: float) -> int:
+def contributions(f: Solved, terms: Terms, ref: Any) -> np.ndarray | None:
+    """(L,): each interval's share of f's check's period less f's (the dual-weighted residual:
+    the check's orbit put into f's equations, weighted by the solution psi of J^T psi = e_T,
+    J f's Jacobian; the shares sum to that difference to first order); None without a check,
+    for a forced orbit (its period is fixed) or where J is singular."""
+    F = f.check
+    if F is None or not f.lay.autonomous:
+        return None
+    lay = f.lay
+    e = np.zeros(lay.size)
+    e[-1] = 1.0                                     # T, the last unknown
+    try:
+        psi = factored(lay, terms, f.x, ref, "collocate", []).solve(e, trans="T")
+    except ShootingError:
+        return None
+    r = assemble(lay, terms, transfer(F.lay, F.x, lay), ref, jacobian=False)[0]
+    cells = lay.L * lay.m * lay.n
+    return (psi[:cells] * r[:cells]).reshape(lay.L, -1).sum(axis=1)
+
+
+def hot_ends(lay: Layout, eta: np.ndarray) -> list[tuple[int, int, float]]:
+    """The pieces' end intervals carrying at least HOT_SHARE of sum |eta| (their shares of the
+    period's difference, :func:`contributions`): (piece, side (0 its start, 1 its end),
+    eta there); none for an orbit without switches (no ends)."""
+    if lay.signature.switches == 0:
+        return []
+    total = float(np.sum(np.abs(eta)))
+    first = np.cumsum([0] + [len(fr) - 1 for fr in lay.fractions])
+    out = []
+    for j in range(len(lay.fractions)):
+        for side, i in ((0, first[j]), (1, first[j + 1] - 1)):
+            if abs(eta[i]) >= HOT_SHARE * total and (side == 0 or i != first[j]):
+                out.append((j, side, float(eta[i])))
+    return out
+
+
+def graded(fractions: list[np.ndarray], ends: dict[tuple[int, int], int]) -> list[np.ndarray]:
+    """The fractions with the interval at each end in ``ends`` ((piece, side) -> k) cut k
+    times towards that end, each cut halving what is left of the end interval."""
+    out = [f.copy() for f in fractions]
+    for (j, side), k in ends.items():
+        f = out[j]
+        if side == 0:
+            cuts = f[1] * 0.5 ** np.arange(1, k + 1)
+        else:
+            cuts = 1.0 - (1.0 - f[-2]) * 0.5 ** np.arange(1, k + 1)
+        out[j] = np.sort(np.concatenate([f, cuts]))
+    return out
+
+
+def regraded(f: Solved, terms: Terms, ref: Any, tol: float, ends: dict[tuple[int, int], int]
+             ) -> float | None:
+    """Where f's round is near its check (:func:`near_check`) and one of its pieces' end
+    intervals carries at least HOT_SHARE of the period's difference (:func:`hot_ends`), that
+    end's grading in ``ends`` deepened by the levels that bring its share, CHECK_SAFETY |eta|, to
+    tol / 4 at GRADE_ORDER (at least one); returns the estimate of the rest (CHECK_SAFETY times
+    the sum of the other intervals' |eta|) where no hot end was graded before (a graded end hot
+    again: the grading did not take its share away, the mesh grows as without), else None."""
+    if not near_check(f) or f.lay.signature.switches == 0:
+        return None
+    eta = contributions(f, terms, ref)
+    hot = [] if eta is None else hot_ends(f.lay, eta)
+    if not hot:
+        return None
+    again = any((j, side) in ends for j, side, _ in hot)
+    for j, side, v in hot:
+        k = math.ceil(math.log2(max(CHECK_SAFETY * abs(v) / (0.25 * tol), 2.0)) / GRADE_ORDER)
+        ends[(j, side)] = ends.get((j, side), 0) + k
+    rest = float(np.sum(np.abs(eta))) - sum(abs(v) for _, _, v in hot)
+    return None if again else CHECK_SAFETY * rest
+
+
+def rounds_order(last: tuple[int, float] | None, L: int, d: float, scale: float, tol: float,
+                 floor: float, capped: list[float] | None, reached: str, below: str
+                 ) -> float | None:
+    """The order the last two rounds' estimates show (the last round's (L, estimate) and this
+    round's L and d; 1 with an undeclared jump of the kernel, ``capped``; None where unknown or
+    too small a step or too early to tell); a ValueError where it says the estimate has stopped
+    falling (below LEAST_ORDER over a growth of LEAST_GROWTH at least, below CONDITIONED
+    relative to ``scale``) or that tol needs more than MAX_INTERVALS intervals (``below``, the
+    floor's message, where tol is below ``floor``)."""
+    q = 1.0 if capped else None
+    if last is not None and last[1] > 0 and math.isfinite(d):
+        q = math.log(last[1] / d) / math.log(L / last[0])
+        if q < LEAST_ORDER and (L < LEAST_GROWTH * last[0] or d > CONDITIONED * scale):
+            q = 1.0 if capped else None
+        elif q < LEAST_ORDER:
+            raise ValueError(f"collocate: the estimated error has stopped falling: it was "
+                             f"{last[1]:.3g} at {last[0]} intervals and is {d:.3g}; "
+                             f"{reached} (observed order {q:.2g}): tol = {tol!r} is below "
+                             "what this orbit's collocation reaches (the floor of its "
+                             f"conditioning); ask tol >= {min(last[1], d):.2g}, or a higher "
+                             "degree")
+    if q is not None and math.isfinite(d):
+        need = L * (d / tol) ** (1.0 / q)
+        if need > MAX_INTERVALS and tol < floor:
+            raise ValueError(below)
+        if need > MAX_INTERVALS:
+            why, fix = (f"at the observed order {q:.2g}", "ask a larger tol, or a "
+                        "higher degree")
+            if capped:
+                why = (f"with the kernel's jump at s = {capped[0]:.10g} not declared (the "
+                       "order capped at 1)")
+                fix = f"give kernel_jumps=({capped[0]:.10g},), or ask a larger tol"
+            raise ValueError(f"collocate: {reached}; {why}, tol = {tol!r} needs about "
+                             f"{need:.2g} intervals, more than MAX_INTERVALS = "
+                             f"{MAX_INTERVALS}: {fix}")
+    return q
+
+
+def next_intervals(L: int, d: float, aim: float, expected: int, q: float | None, m: int
+                   ) -> int:
     """The next round's intervals from this round's L and estimate d, to bring it to ``aim``:
-    at the order its three levels show (``seen``) or the two rounds' (``q``, above m) at most
-    ``expected`` + 2, with a margin of 1.1; else at ``expected`` with ``margin``; at least L +
-    2, at most 8 L and MAX_INTERVALS."""
-    grow = (d / aim) ** (1.0 / expected) * margin
-    if seen is not None or (q is not None and q > m):
-        grow = (d / aim) ** (1.0 / min(seen or q, expected + 2)) * 1.1
+    at the two rounds' order ``q`` where above m (at most ``expected`` + 2) with a margin of
+    1.1, else at ``expected`` with MARGIN; at least L + 2, at most 8 L and MAX_INTERVALS."""
+    grow = (d / aim) ** (1.0 / expected) * MARGIN
+    if q is not None and q > m:
+        grow = (d / aim) ** (1.0 / min(q, expected + 2)) * 1.1
     return min(MAX_INTERVALS, max(L + 2, math.ceil(L * min(grow, 8.0))))
 
 
@@ -575,7 +695,10 @@ def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: flo
     by at most 8 times, and by at most FAR_GROWTH after a round whose check is more than ROUGH
     off it in the period (or was not solved) while no round was nearer, or that has no
     estimate (its check and merged level not solved): such a round says nothing of the order,
-    and its estimate is left out of the rounds' order.
+    and its estimate is left out of the rounds' order.  A round of an autonomous orbit with
+    switches whose end interval of a piece carries most of the difference to its check
+    (:func:`regraded`) has that end graded in every later round, and the next mesh grows for
+    the other intervals' shares only.
 
     A first round on fewer than FIRST_INTERVALS intervals (a loose tol or a high degree) whose
     solve fails, or whose check and merged level both fail (no estimate), is done again on
@@ -595,8 +718,9 @@ def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: flo
     # the expected order: the period's h^(2m) (superconvergent), an extremum's h^(m+1)
     expected = 2 * lay.m if autonomous else lay.m + 1
     rounds = 0
+    ends: dict[tuple[int, int], int] = {}         # the graded ends of pieces: levels
     while rounds < MAX_ROUNDS:
-        new = lay.with_fractions(adapted(lay, x, L))
+        new = lay.with_fractions(graded(adapted(lay, x, L), ends))
         try:
             f = one_level(new, terms, (lay, x), ref, what)
         except ShootingError:
@@ -625,34 +749,13 @@ def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: flo
                  f"no longer lowers the estimate: {reached}; ask tol >= {floor:.2g}")
         if d <= floor or d <= tol:                 # an estimate at the floor, above tol
             raise ValueError(below)
-        q = 1.0 if capped else None
-        if last is not None and last[1] > 0 and math.isfinite(d):  # the rounds' observed order
-            q = math.log(last[1] / d) / math.log(L / last[0])
-            if q < LEAST_ORDER and (L < LEAST_GROWTH * last[0] or d > CONDITIONED * f.scale):
-                q = 1.0 if capped else None        # too small a step or too early to tell
-            elif q < LEAST_ORDER:
-                raise ValueError(f"collocate: the estimated error has stopped falling: it was "
-                                 f"{last[1]:.3g} at {last[0]} intervals and is {d:.3g}; "
-                                 f"{reached} (observed order {q:.2g}): tol = {tol!r} is below "
-                                 "what this orbit's collocation reaches (the floor of its "
-                                 f"conditioning); ask tol >= {min(last[1], d):.2g}, or a higher "
-                                 "degree")
-        if q is not None and math.isfinite(d):
-            need = L * (d / tol) ** (1.0 / q)
-            if need > MAX_INTERVALS and tol < floor:
-                raise ValueError(below)
-            if need > MAX_INTERVALS:
-                why, fix = (f"at the observed order {q:.2g}", "ask a larger tol, or a "
-                            "higher degree")
-                if capped:
-                    why = (f"with the kernel's jump at s = {capped[0]:.10g} not declared (the "
-                           "order capped at 1)")
-                    fix = f"give kernel_jumps=({capped[0]:.10g},), or ask a larger tol"
-                raise ValueError(f"collocate: {reached}; {why}, tol = {tol!r} needs about "
-                                 f"{need:.2g} intervals, more than MAX_INTERVALS = "
-                                 f"{MAX_INTERVALS}: {fix}")
-        L2 = next_intervals(L, d, tol, expected, None, q, lay.m, MARGIN)
-        if not math.isfinite(d) or last is None and not near_check(f):
+        q = rounds_order(last, L, d, f.scale, tol, floor, capped, reached, below)
+        rest = regraded(f, terms, ref, tol, ends)
+        L2 = next_intervals(L, d, tol, expected, q, lay.m)
+        if rest is not None:                       # an end graded: the rest's growth, and the
+            L2 = next_intervals(L, rest, tol, expected, None, lay.m)
+            last = None                            # rounds' order starts anew
+        elif not math.isfinite(d) or last is None and not near_check(f):
             L2 = min(L2, FAR_GROWTH * L)           # far off: the round says nothing of the order
         else:
             last = (L, d)

@@ -37,6 +37,10 @@ FOLD = True
 #: Relative size (of max(tau, 1)) below which the rest r of the last period, or a folded jump's
 #: distance to 0 or T, is dropped (the pieces of delay_matrix drop the same lengths).
 FOLD_TOL = 1e-14
+#: Exponentials a block of :func:`exp_sum` at most (about 256 kB: the block stays in the cache).
+EXP_ENTRIES = 32768
+#: The least exponent :func:`exp_sum` evaluates (e^-700 is about 1e-304; e^-745 underflows).
+EXP_LEAST = -700.0
 
 
 def folding() -> bool:
@@ -48,16 +52,37 @@ def exp_sum(s: np.ndarray, a: np.ndarray, b: np.ndarray, C: np.ndarray, D: np.nd
             ) -> np.ndarray:
     """sum_j e^(a_j s) (C_j cos b_j s + D_j sin b_j s) (P, n, n) at the lags s (P,) (C, D:
     (k, n, n); or any (k, ...): then (P, ...), e.g. the entries of a pattern); no cos / sin when
-    every b is 0, a constant where every a is 0 too)."""
-    s = np.asarray(s, dtype=float)
+    every b is 0, a constant where every a is 0 too.  The lags are taken in blocks of at most
+    EXP_ENTRIES exponentials (those of a long memory's many lags at once would be an array that
+    does not fit the cache), each exponent at least EXP_LEAST (an exponential that underflows
+    costs about eight times one that does not; e^EXP_LEAST, about 1e-304, is below the last bit
+    of any sum it joins that is not itself about 0)."""
+    s = np.asarray(s, dtype=float).ravel()
     k, shape = a.size, (-1,) + C.shape[1:]
-    if not np.any(b) and not np.any(a):
+    osc = np.any(b)
+    if not osc and not np.any(a):
         return np.broadcast_to(np.sum(C, axis=0), (s.size,) + C.shape[1:]).copy()
-    e = np.exp(np.outer(s, a))
-    if not np.any(b):
-        return (e @ C.reshape(k, -1)).reshape(shape)
-    return ((e * np.cos(np.outer(s, b))) @ C.reshape(k, -1)
-            + (e * np.sin(np.outer(s, b))) @ D.reshape(k, -1)).reshape(shape)
+    Cf = C.reshape(k, -1)
+    rows = max(1, EXP_ENTRIES // k)
+    if s.size <= rows:
+        return _exp_block(s, a, b, Cf, D, osc).reshape(shape)
+    out = np.empty((s.size, Cf.shape[1]))
+    for i in range(0, s.size, rows):
+        out[i:i + rows] = _exp_block(s[i:i + rows], a, b, Cf, D, osc)
+    return out.reshape(shape)
+
+
+def _exp_block(s: np.ndarray, a: np.ndarray, b: np.ndarray, Cf: np.ndarray, D: np.ndarray,
+               osc: bool) -> np.ndarray:
+    """:func:`exp_sum` at the lags s of one block, C flattened to (k, -1) (``osc``: some b is
+    not 0)."""
+    e = np.multiply.outer(s, a)
+    np.maximum(e, EXP_LEAST, out=e)
+    np.exp(e, out=e)
+    if not osc:
+        return e @ Cf
+    return ((e * np.cos(np.multiply.outer(s, b))) @ Cf
+            + (e * np.sin(np.multiply.outer(s, b))) @ D.reshape(a.size, -1))
 
 
 def _scaled(C: np.ndarray, D: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -59,7 +59,7 @@ PLAN_NODES = 4e6
 #: A mesh whose intervals within one piece are this factor apart or more is graded
 #: (:meth:`Layout.interval_ratio`: the relaxation oscillation's equidistributed meshes 2 to 3 on
 #: 16 to 24 intervals, 5 to 136 from 48 on; van der Pol's at eps = 1 1.2 to 3.9, a stick-slip
-#: belt's 1.03): its Jacobian is factored in COLAMD's column order (:func:`_factor`), and its
+#: belt's 1.03): its Jacobian is factored in COLAMD's column order (:func:`factored`), and its
 #: collocation checked (adapt.checked).
 GRADED = 6.0
 #: The step of f's t derivative in the switching times' columns of a forced orbit (five-point
@@ -1073,7 +1073,7 @@ def solve(lay: Layout, terms: Terms, x0: np.ndarray, ref: Callable | None, *,
         return assemble(lay, terms, x, ref, jacobian=False)[0], None
 
     def factor(x: np.ndarray, r: np.ndarray, state: None) -> Callable[[np.ndarray], np.ndarray]:
-        lu = _factor(lay, terms, x, ref, what, res)
+        lu = factored(lay, terms, x, ref, what, res)
         return lambda r: lu.solve(-r)
 
     options = NewtonOptions(tol=tol, max_iter=max_iter, converge=Converge.CORRECTION, chord=0.1,
@@ -1094,8 +1094,8 @@ def reject_why(lay: Layout) -> str:
             "start)")
 
 
-def _factor(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None, what: str,
-            res: list[float]) -> Any:
+def factored(lay: Layout, terms: Terms, x: np.ndarray, ref: Callable | None, what: str,
+             res: list[float]) -> Any:
     """The sparse LU of the Jacobian at x (ShootingError when singular), its columns in their
     own order (the node values in time: a band with the memory's reach and the wrap-around;
     measured faster to factor and solve than COLAMD's order on van der Pol's Jacobians up to
