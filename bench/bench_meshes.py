@@ -8,7 +8,8 @@
 # (Richardson's where the levels are steady) over it; the Newton iterations and CPU time of each
 # level: the orbit on the mesh, the halved mesh from its solution (transfer) and from the start,
 # the merged mesh.  Then the refinement to several tol (eps = 1, degree 4, and not --small 5, 6
-# and 8; eps = 5, degree 5; eps = 10, degree 6 and the default 4): the orbit returned against
+# and 8; eps = 5, degrees 5 and 4; eps = 10, degree 6 and the default 4; eps = 0.5 and 3, degree
+# 3): the orbit returned against
 # the smallest sufficient mesh of a scan and their ratio, its true error and estimate; and (not --small) the period's errors on nested levels and their local
 # orders (eps = 1, degree 4: why a two-level estimate of one order cannot be both never below
 # and within 10 x), and the estimate by degree elevation on one mesh: the orbit of degree 6
@@ -158,6 +159,13 @@ def main() -> None:
     o5 = scheme_orbit(5.0, 9.0, 900)
     ref5 = da.collocate(o5, intervals=80, degree=8, multipliers=0)
     refinements(o5, ref5, 5, (1e-3, 1e-4, 1e-5, 1e-6), tuple(range(8, 80)))
+    refinements(o5, ref5, 4, (1e-3, 1e-4, 1e-5, 1e-6), tuple(range(8, 120)))
+    print("degree 3: eps = 0.5 and eps = 3:")
+    for eps, T, steps, tols, scan in ((0.5, 6.3, 630, (1e-2, 1e-3, 1e-4), range(4, 60)),
+                                      (3.0, 8.0, 800, (1e-2, 1e-3, 1e-4, 1e-5), range(8, 120))):
+        o = scheme_orbit(eps, T, steps)
+        refinements(o, da.collocate(o, intervals=80, degree=8, multipliers=0), 3, tols,
+                    tuple(scan))
     print("same mesh, degree 6 against 7 and 8 (errors of the period; the mesh "
           "equidistributed k times at L intervals): 6 | 7 | 8 | |x6 - x8| / |err 6| | 6 on 2L")
     for L in (60, 70, 80, 90):

@@ -28,9 +28,11 @@ package (:mod:`dmi.analysis.collocation.collocate` and the collocated branch use
   returned (its multipliers' estimate from the check's, or where those fail from its mesh
   merged once and twice, :func:`lower`); the next mesh by the order the rounds show
   (:func:`next_intervals`, :func:`rounds_order`), with the stopping rules and the cost check of
-  the delay integral (:func:`check_cost`); an autonomous orbit's switch whose interval carries
-  most of the round's difference to its check (:func:`contributions`, the dual-weighted
-  residual; :func:`hot_ends`) graded in the rounds after (:func:`graded`, :func:`regraded`).
+  the delay integral (:func:`check_cost`).  A round's difference to its check split among its
+  intervals (an autonomous orbit's, :func:`contributions`: the dual-weighted residual) reshapes
+  the next mesh (:func:`reshaped`): a switch whose interval carries most of it is graded in the
+  rounds after (:func:`hot_ends`, :func:`graded`, :func:`regraded`), and where a few intervals
+  carry enough of it, the next round is the same mesh with those halved (:func:`repaired`).
 
 May import: :mod:`.mesh`, :mod:`.signature`, :mod:`.system` (no module of the package above them).
 """
@@ -113,6 +115,11 @@ HOT_SHARE = 0.5
 #: The order assumed of a graded end's share (one more level halves that end's interval; 3.5
 #: seen on the fractional belt, 2 assumed).
 GRADE_ORDER = 2.0
+#: A round's hottest intervals are halved in place of a new mesh (:func:`repaired`) where at most
+#: this part of its intervals (at least 2) carries enough of its difference to its check: on the
+#: relaxation oscillation the mesh's lottery puts a third to three quarters of a round's
+#: difference into one or two intervals of the steep stretch.
+REPAIR_PART = 4
 #: Quadrature nodes of the delay integral at most on one mesh (about 100 bytes each): a memory
 #: spanning many periods (tau / T large) or a very fine mesh is refused before it is built.
 MAX_DELAY_NODES = 2e7
@@ -572,18 +579,15 @@ def graded(fractions: list[np.ndarray], ends: dict[tuple[int, int], int]) -> lis
     return out
 
 
-def regraded(f: Solved, terms: Terms, ref: Any, tol: float, ends: dict[tuple[int, int], int]
+def regraded(lay: Layout, eta: np.ndarray, tol: float, ends: dict[tuple[int, int], int]
              ) -> float | None:
-    """Where f's round is near its check (:func:`near_check`) and one of its pieces' end
-    intervals carries at least HOT_SHARE of the period's difference (:func:`hot_ends`), that
+    """Where one of the pieces' end intervals carries at least HOT_SHARE of the round's
+    difference to its check (its shares ``eta``, :func:`contributions`; :func:`hot_ends`), that
     end's grading in ``ends`` deepened by the levels that bring its share, CHECK_SAFETY |eta|, to
     tol / 4 at GRADE_ORDER (at least one); returns the estimate of the rest (CHECK_SAFETY times
     the sum of the other intervals' |eta|) where no hot end was graded before (a graded end hot
     again: the grading did not take its share away, the mesh grows as without), else None."""
-    if not near_check(f) or f.lay.signature.switches == 0:
-        return None
-    eta = contributions(f, terms, ref)
-    hot = [] if eta is None else hot_ends(f.lay, eta)
+    hot = hot_ends(lay, eta)
     if not hot:
         return None
     again = any((j, side) in ends for j, side, _ in hot)
@@ -592,6 +596,45 @@ def regraded(f: Solved, terms: Terms, ref: Any, tol: float, ends: dict[tuple[int
         ends[(j, side)] = ends.get((j, side), 0) + k
     rest = float(np.sum(np.abs(eta))) - sum(abs(v) for _, _, v in hot)
     return None if again else CHECK_SAFETY * rest
+
+
+def repaired(lay: Layout, eta: np.ndarray, tol: float) -> list[np.ndarray] | None:
+    """The round's fractions with its hottest intervals halved (the fewest, by their shares
+    ``eta`` of the difference to its check, :func:`contributions`) whose halving brings the
+    estimate to tol / MARGIN, each halved interval's share taken to fall by 2^(m+1) (u's local
+    order: the period's share falls at least so); None where that needs more than a
+    REPAIR_PART-th of the intervals (at least 2): the error is spread, the mesh grows."""
+    a = np.abs(eta)
+    order = np.argsort(-a)
+    left = CHECK_SAFETY * (a.sum() - np.cumsum(a[order]) * (1.0 - 2.0 ** -(lay.m + 1)))
+    enough = np.flatnonzero(left <= tol / MARGIN)
+    if enough.size == 0 or enough[0] + 1 > max(2, lay.L // REPAIR_PART):
+        return None
+    hot = set(order[:enough[0] + 1].tolist())
+    first = np.cumsum([0] + [len(fr) - 1 for fr in lay.fractions])
+    out = []
+    for j, fr in enumerate(lay.fractions):
+        mids = [0.5 * (fr[k] + fr[k + 1]) for k in range(len(fr) - 1) if first[j] + k in hot]
+        out.append(np.sort(np.concatenate([fr, mids])))
+    return out
+
+
+def reshaped(f: Solved, terms: Terms, ref: Any, d: float, tol: float,
+             ends: dict[tuple[int, int], int]) -> tuple[float | None, list[np.ndarray] | None]:
+    """What a round's shares of the difference to its check (:func:`contributions`, where the
+    round is near its check) make of the next mesh: (the rest's estimate where a piece's end was
+    graded (:func:`regraded`, ``ends`` deepened), the round's fractions with its hottest
+    intervals halved (:func:`repaired`)), each else None.  Not computed for an orbit without
+    switches whose estimate d, fallen by 2^(m+1) in every interval, would still miss tol (no
+    halving of a part of its intervals can meet it)."""
+    if not near_check(f) or (f.lay.signature.switches == 0
+                             and d * 2.0 ** -(f.lay.m + 1) > tol / MARGIN):
+        return None, None
+    eta = contributions(f, terms, ref)
+    if eta is None:
+        return None, None
+    rest = regraded(f.lay, eta, tol, ends)
+    return rest, (repaired(f.lay, eta, tol) if rest is None else None)
 
 
 def rounds_order(last: tuple[int, float] | None, L: int, d: float, scale: float, tol: float,
@@ -698,7 +741,9 @@ def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: flo
     and its estimate is left out of the rounds' order.  A round of an autonomous orbit with
     switches whose end interval of a piece carries most of the difference to its check
     (:func:`regraded`) has that end graded in every later round, and the next mesh grows for
-    the other intervals' shares only.
+    the other intervals' shares only; where halving a few of a round's intervals predicts tol
+    (:func:`repaired`), the next round is that mesh (the rounds' order starts anew after
+    either).
 
     A first round on fewer than FIRST_INTERVALS intervals (a loose tol or a high degree) whose
     solve fails, or whose check and merged level both fail (no estimate), is done again on
@@ -719,8 +764,10 @@ def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: flo
     expected = 2 * lay.m if autonomous else lay.m + 1
     rounds = 0
     ends: dict[tuple[int, int], int] = {}         # the graded ends of pieces: levels
+    repair = None
     while rounds < MAX_ROUNDS:
-        new = lay.with_fractions(graded(adapted(lay, x, L), ends))
+        new = (lay.with_fractions(repair) if repair is not None else
+               lay.with_fractions(graded(adapted(lay, x, L), ends)))
         try:
             f = one_level(new, terms, (lay, x), ref, what)
         except ShootingError:
@@ -750,7 +797,7 @@ def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: flo
         if d <= floor or d <= tol:                 # an estimate at the floor, above tol
             raise ValueError(below)
         q = rounds_order(last, L, d, f.scale, tol, floor, capped, reached, below)
-        rest = regraded(f, terms, ref, tol, ends)
+        rest, repair = reshaped(f, terms, ref, d, tol, ends)
         L2 = next_intervals(L, d, tol, expected, q, lay.m)
         if rest is not None:                       # an end graded: the rest's growth, and the
             L2 = next_intervals(L, rest, tol, expected, None, lay.m)
@@ -759,7 +806,9 @@ def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: flo
             L2 = min(L2, FAR_GROWTH * L)           # far off: the round says nothing of the order
         else:
             last = (L, d)
-        start = f.check if f.check is not None else f
+        start = f.check if f.check is not None and repair is None else f
+        if repair is not None:                     # the same mesh, its hottest intervals
+            L2, last = L, None                     # halved
         lay, x, L = start.lay, start.x, L2
         if f.lay.L >= MAX_INTERVALS:
             break

@@ -95,8 +95,8 @@ def test_refinement_grades_the_switch(orbit, reference_period):
     calls = []
     real = adapt.regraded
 
-    def spy(f, terms, ref, tol, ends):
-        out = real(f, terms, ref, tol, ends)
+    def spy(lay, eta, tol, ends):
+        out = real(lay, eta, tol, ends)
         calls.append(dict(ends))
         return out
     with pytest.MonkeyPatch.context() as mp:
@@ -128,3 +128,21 @@ def test_hot_ends_are_the_pieces_ends_only():
     smooth = SimpleNamespace(signature=SimpleNamespace(switches=0),
                              fractions=[np.linspace(0, 1, 6)])
     assert adapt.hot_ends(smooth, np.array([9.0, 1, 1, 1, 1])) == []   # no switch, no end
+
+
+def test_repaired_halves_the_fewest_hottest_intervals():
+    lay = SimpleNamespace(m=4, L=8, fractions=[np.linspace(0, 1, 5), np.linspace(0, 1, 5)])
+    # sum |eta| = 1e-8 (the estimate 2e-8); intervals 2 and 5 carry 90 % of it.  Halving k of
+    # the hottest leaves 2 (1e-8 - (their sum) (1 - 2^-5)): interval 2 alone 1.03e-8, with 5
+    # 2.56e-9, with a third 2.17e-9, a fourth 1.79e-9
+    eta = np.array([1e-10, 1e-10, 5e-9, 2e-10, 2e-10, -4e-9, 2e-10, 2e-10])
+    out = adapt.repaired(lay, eta, 3e-9 * adapt.MARGIN)
+    assert out is not None
+    assert np.array_equal(out[0], [0.0, 0.25, 0.5, 0.625, 0.75, 1.0])
+    assert np.array_equal(out[1], [0.0, 0.25, 0.375, 0.5, 0.75, 1.0])
+    assert adapt.repaired(lay, eta, 2e-9 * adapt.MARGIN) is None     # four: over L / 4 = 2
+    # spread: 1e-9 each; k halved leave 2 (8e-9 - k 1e-9 (31 / 32)): 1.41e-8, 1.21e-8, 1.02e-8
+    spread = np.full(8, 1e-9)
+    assert adapt.repaired(lay, spread, 1.1e-8 * adapt.MARGIN) is None  # three needed
+    two = adapt.repaired(lay, spread, 1.25e-8 * adapt.MARGIN)
+    assert two is not None and sum(len(f) - 5 for f in two) == 2
