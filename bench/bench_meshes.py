@@ -161,11 +161,11 @@ def main() -> None:
     refinements(o5, ref5, 5, (1e-3, 1e-4, 1e-5, 1e-6), tuple(range(8, 80)))
     refinements(o5, ref5, 4, (1e-3, 1e-4, 1e-5, 1e-6), tuple(range(8, 120)))
     print("degree 3: eps = 0.5 and eps = 3:")
-    for eps, T, steps, tols, scan in ((0.5, 6.3, 630, (1e-2, 1e-3, 1e-4), range(4, 60)),
-                                      (3.0, 8.0, 800, (1e-2, 1e-3, 1e-4, 1e-5), range(8, 120))):
+    for eps, T, steps, tols, sizes in ((0.5, 6.3, 630, (1e-2, 1e-3, 1e-4), range(4, 60)),
+                                       (3.0, 8.0, 800, (1e-2, 1e-3, 1e-4, 1e-5), range(8, 120))):
         o = scheme_orbit(eps, T, steps)
         refinements(o, da.collocate(o, intervals=80, degree=8, multipliers=0), 3, tols,
-                    tuple(scan))
+                    tuple(sizes))
     print("same mesh, degree 6 against 7 and 8 (errors of the period; the mesh "
           "equidistributed k times at L intervals): 6 | 7 | 8 | |x6 - x8| / |err 6| | 6 on 2L")
     for L in (60, 70, 80, 90):
