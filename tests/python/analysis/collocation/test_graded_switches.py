@@ -6,7 +6,8 @@
 # and grades the mesh towards the switch (adapt.graded).  Checked against independent solves: the
 # shares against the re-solved period of the mesh with one end graded and with everything else
 # halved; the refined period against a reference on a mesh with every switch graded deeply (its
-# own convergence shown by two finer such meshes).
+# own convergence shown by two finer such meshes).  The grading's cuts, the hot ends and the
+# halving of a round's hottest intervals (adapt.repaired) by hand.
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
