@@ -533,7 +533,8 @@ def contributions(f: Solved, terms: Terms, ref: Any) -> np.ndarray | None:
     """(L,): each interval's share of f's check's period less f's (the dual-weighted residual:
     the check's orbit put into f's equations, weighted by the solution psi of J^T psi = e_T,
     J f's Jacobian; the shares sum to that difference to first order); None without a check,
-    for a forced orbit (its period is fixed) or where J is singular."""
+    for a forced orbit (its period is fixed), where J is singular or the shares are not
+    finite."""
     F = f.check
     if F is None or not f.lay.autonomous:
         return None
@@ -542,11 +543,12 @@ def contributions(f: Solved, terms: Terms, ref: Any) -> np.ndarray | None:
     e[-1] = 1.0                                     # T, the last unknown
     try:
         psi = factored(lay, terms, f.x, ref, "collocate", []).solve(e, trans="T")
-    except ShootingError:
+        r = assemble(lay, terms, transfer(F.lay, F.x, lay), ref, jacobian=False)[0]
+    except (ShootingError, ValueError):          # singular; the check's b out of f's order
         return None
-    r = assemble(lay, terms, transfer(F.lay, F.x, lay), ref, jacobian=False)[0]
     cells = lay.L * lay.m * lay.n
-    return (psi[:cells] * r[:cells]).reshape(lay.L, -1).sum(axis=1)
+    eta = (psi[:cells] * r[:cells]).reshape(lay.L, -1).sum(axis=1)
+    return eta if np.all(np.isfinite(eta)) else None
 
 
 def hot_ends(lay: Layout, eta: np.ndarray) -> list[tuple[int, int, float]]:
