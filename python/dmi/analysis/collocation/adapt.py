@@ -108,13 +108,17 @@ MARGIN = 1.1
 FAR_GROWTH = 4
 #: An interval at a piece's end (a switch) carrying at least this share of the round's difference
 #: to its check in the period (:func:`contributions`) is graded towards that end
-#: (:func:`graded`): a weakly singular kernel makes the solution after a kink of the switch
-#: (t - t_s)^(5/2) (s^-1/2), whose interval the equidistribution of u^(m+1) does not see and
-#: whose share of the period falls at the order 3.5 instead of 2m.
+#: (:func:`graded`): a weakly singular kernel s^-beta makes the solution (t - t_s)^(j + 2 - beta)
+#: past a switch where its j-th derivative jumps (7/2 at the fractional belt's slip onset),
+#: which the equidistribution of u^(m+1) does not see, and that interval's share of the period
+#: falls at the order 3.5 instead of 2m.
 HOT_SHARE = 0.5
 #: The order assumed of a graded end's share (one more level halves that end's interval; 3.5
 #: seen on the fractional belt, 2 assumed).
 GRADE_ORDER = 2.0
+#: The levels of a graded end at most (2^-24 of its interval: past that the mesh's times lose
+#: their digits).
+GRADE_MOST = 24
 #: A round's hottest intervals are halved in place of a new mesh (:func:`repaired`) where at most
 #: this part of its intervals (at least 2) carries enough of its difference to its check: on the
 #: relaxation oscillation the mesh's lottery puts a third to three quarters of a round's
@@ -554,7 +558,9 @@ def contributions(f: Solved, terms: Terms, ref: Any) -> np.ndarray | None:
 def hot_ends(lay: Layout, eta: np.ndarray) -> list[tuple[int, int, float]]:
     """The pieces' end intervals carrying at least HOT_SHARE of sum |eta| (their shares of the
     period's difference, :func:`contributions`): (piece, side (0 its start, 1 its end),
-    eta there); none for an orbit without switches (no ends)."""
+    eta there); none for an orbit without switches (no ends).  The ends are the switches and
+    t = 0 and T; a piece of one interval is taken at its start (past a switch, where the
+    memory's singular part acts)."""
     if lay.signature.switches == 0:
         return []
     total = float(np.sum(np.abs(eta)))
@@ -595,22 +601,28 @@ def regraded(lay: Layout, eta: np.ndarray, tol: float, ends: dict[tuple[int, int
     again = any((j, side) in ends for j, side, _ in hot)
     for j, side, v in hot:
         k = math.ceil(math.log2(max(CHECK_SAFETY * abs(v) / (0.25 * tol), 2.0)) / GRADE_ORDER)
-        ends[(j, side)] = ends.get((j, side), 0) + k
+        ends[(j, side)] = min(GRADE_MOST, ends.get((j, side), 0) + k)
     rest = float(np.sum(np.abs(eta))) - sum(abs(v) for _, _, v in hot)
     return None if again else CHECK_SAFETY * rest
 
 
-def repaired(lay: Layout, eta: np.ndarray, tol: float) -> list[np.ndarray] | None:
+def repaired(lay: Layout, eta: np.ndarray, tol: float, d: float, grow: int
+             ) -> list[np.ndarray] | None:
     """The round's fractions with its hottest intervals halved (the fewest, by their shares
     ``eta`` of the difference to its check, :func:`contributions`) whose halving brings the
     estimate to tol / MARGIN, each halved interval's share taken to fall by 2^(m+1) (u's local
     order: the period's share falls at least so); None where that needs more than a
-    REPAIR_PART-th of the intervals (at least 2): the error is spread, the mesh grows."""
+    REPAIR_PART-th of the intervals (at least 2: the error is spread), more intervals than
+    ``grow`` (the next mesh it replaces), or where the shares say less than half the round's
+    estimate d (CHECK_SAFETY |sum eta| < d / 2: the linearisation does not hold)."""
+    if CHECK_SAFETY * abs(float(np.sum(eta))) < 0.5 * d:
+        return None
     a = np.abs(eta)
     order = np.argsort(-a)
     left = CHECK_SAFETY * (a.sum() - np.cumsum(a[order]) * (1.0 - 2.0 ** -(lay.m + 1)))
     enough = np.flatnonzero(left <= tol / MARGIN)
-    if enough.size == 0 or enough[0] + 1 > max(2, lay.L // REPAIR_PART):
+    if (enough.size == 0 or enough[0] + 1 > max(2, lay.L // REPAIR_PART)
+            or lay.L + enough[0] + 1 > grow):
         return None
     hot = set(order[:enough[0] + 1].tolist())
     first = np.cumsum([0] + [len(fr) - 1 for fr in lay.fractions])
@@ -621,14 +633,14 @@ def repaired(lay: Layout, eta: np.ndarray, tol: float) -> list[np.ndarray] | Non
     return out
 
 
-def reshaped(f: Solved, terms: Terms, ref: Any, d: float, tol: float,
+def reshaped(f: Solved, terms: Terms, ref: Any, d: float, tol: float, grow: int,
              ends: dict[tuple[int, int], int]) -> tuple[float | None, list[np.ndarray] | None]:
     """What a round's shares of the difference to its check (:func:`contributions`, where the
-    round is near its check) make of the next mesh: (the rest's estimate where a piece's end was
-    graded (:func:`regraded`, ``ends`` deepened), the round's fractions with its hottest
-    intervals halved (:func:`repaired`)), each else None.  Not computed for an orbit without
-    switches whose estimate d, fallen by 2^(m+1) in every interval, would still miss tol (no
-    halving of a part of its intervals can meet it)."""
+    round is near its check) make of the next mesh (``grow`` intervals without them): (the
+    rest's estimate where a piece's end was graded (:func:`regraded`, ``ends`` deepened), the
+    round's fractions with its hottest intervals halved (:func:`repaired`)), each else None.
+    Not computed for an orbit without switches whose estimate d, fallen by 2^(m+1) in every
+    interval, would still miss tol (no halving of a part of its intervals can meet it)."""
     if not near_check(f) or (f.lay.signature.switches == 0
                              and d * 2.0 ** -(f.lay.m + 1) > tol / MARGIN):
         return None, None
@@ -636,7 +648,7 @@ def reshaped(f: Solved, terms: Terms, ref: Any, d: float, tol: float,
     if eta is None:
         return None, None
     rest = regraded(f.lay, eta, tol, ends)
-    return rest, (repaired(f.lay, eta, tol) if rest is None else None)
+    return rest, (repaired(f.lay, eta, tol, d, grow) if rest is None else None)
 
 
 def rounds_order(last: tuple[int, float] | None, L: int, d: float, scale: float, tol: float,
@@ -799,8 +811,8 @@ def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: flo
         if d <= floor or d <= tol:                 # an estimate at the floor, above tol
             raise ValueError(below)
         q = rounds_order(last, L, d, f.scale, tol, floor, capped, reached, below)
-        rest, repair = reshaped(f, terms, ref, d, tol, ends)
         L2 = next_intervals(L, d, tol, expected, q, lay.m)
+        rest, repair = reshaped(f, terms, ref, d, tol, L2, ends)
         if rest is not None:                       # an end graded: the rest's growth, and the
             L2 = next_intervals(L, rest, tol, expected, None, lay.m)
             last = None                            # rounds' order starts anew
@@ -810,12 +822,12 @@ def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: flo
             last = (L, d)
         start = f.check if f.check is not None and repair is None else f
         if repair is not None:                     # the same mesh, its hottest intervals
-            L2, last = L, None                     # halved
+            L2, last = sum(len(r) - 1 for r in repair), None           # halved
         lay, x, L = start.lay, start.x, L2
         if f.lay.L >= MAX_INTERVALS:
             break
-        check_cost(terms, lay.m, 2 * L, f.T, f"the next mesh's check ({reached})",
-                   "ask a larger tol, or a higher degree")
+        check_cost(terms, lay.m, 2 * (L + (0 if repair else sum(ends.values()))), f.T,
+                   f"the next mesh's check ({reached})", "ask a larger tol, or a higher degree")
     raise ValueError(f"collocate: the estimated error {d:.3g} is still above tol = {tol!r} at "
                      f"{f.lay.L} intervals (MAX_INTERVALS = {MAX_INTERVALS}, MAX_ROUNDS = "
                      f"{MAX_ROUNDS}): ask a larger tol or a higher degree")

@@ -39,8 +39,9 @@ FOLD = True
 FOLD_TOL = 1e-14
 #: Exponentials a block of :func:`exp_sum` at most (about 256 kB: the block stays in the cache).
 EXP_ENTRIES = 32768
-#: The least exponent :func:`exp_sum` evaluates (e^-700 is about 1e-304; e^-745 underflows).
-EXP_LEAST = -700.0
+#: The least exponent :func:`exp_sum` evaluates (e^-708 is about the least normal double,
+#: 2.2e-308; e^-745 underflows to 0).
+EXP_LEAST = -708.0
 
 
 def folding() -> bool:
@@ -54,9 +55,10 @@ def exp_sum(s: np.ndarray, a: np.ndarray, b: np.ndarray, C: np.ndarray, D: np.nd
     (k, n, n); or any (k, ...): then (P, ...), e.g. the entries of a pattern); no cos / sin when
     every b is 0, a constant where every a is 0 too.  The lags are taken in blocks of at most
     EXP_ENTRIES exponentials (those of a long memory's many lags at once would be an array that
-    does not fit the cache), each exponent at least EXP_LEAST (an exponential that underflows
-    costs about eight times one that does not; e^EXP_LEAST, about 1e-304, is below the last bit
-    of any sum it joins that is not itself about 0)."""
+    does not fit the cache), each exponent at least EXP_LEAST (an exponential that underflows to
+    a subnormal costs numpy about 30 times one that does not): a term below it counts about
+    2e-308 |C_j| (below the last bit of any sum that is not itself about 0), and a lag whose
+    every exponent is below it gives exactly 0."""
     s = np.asarray(s, dtype=float).ravel()
     k, shape = a.size, (-1,) + C.shape[1:]
     osc = np.any(b)
@@ -75,14 +77,19 @@ def exp_sum(s: np.ndarray, a: np.ndarray, b: np.ndarray, C: np.ndarray, D: np.nd
 def _exp_block(s: np.ndarray, a: np.ndarray, b: np.ndarray, Cf: np.ndarray, D: np.ndarray,
                osc: bool) -> np.ndarray:
     """:func:`exp_sum` at the lags s of one block, C flattened to (k, -1) (``osc``: some b is
-    not 0)."""
+    not 0); a lag whose every exponent is below EXP_LEAST gives exactly 0."""
     e = np.multiply.outer(s, a)
+    dead = np.where(s >= 0, s * a.max(), s * a.min()) < EXP_LEAST      # max_j a_j s
     np.maximum(e, EXP_LEAST, out=e)
     np.exp(e, out=e)
     if not osc:
-        return e @ Cf
-    return ((e * np.cos(np.multiply.outer(s, b))) @ Cf
-            + (e * np.sin(np.multiply.outer(s, b))) @ D.reshape(a.size, -1))
+        out = e @ Cf
+    else:
+        out = ((e * np.cos(np.multiply.outer(s, b))) @ Cf
+               + (e * np.sin(np.multiply.outer(s, b))) @ D.reshape(a.size, -1))
+    if dead.any():
+        out[dead] = 0.0
+    return out
 
 
 def _scaled(C: np.ndarray, D: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

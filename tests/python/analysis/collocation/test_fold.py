@@ -180,3 +180,27 @@ def test_no_fold_within_a_period():
     fit = kernels.fit(kernels.PowerKernel(0.5, 0.1), 2.0, tol=1e-4, relative=True, delta=0.5)
     near = S.Terms(vdp(P, tau=2.0, kernel=fit))
     assert near.folded(0.4) is None and near.folded(1.5) is not None   # near cells reach T
+
+
+def test_exp_sum_in_blocks_against_mpmath():
+    # a fitted s^-1/2's rates (the fast ones underflow at most lags), oscillating terms, over
+    # several blocks of EXP_ENTRIES: each lag's sum against mpmath at 30 digits; a lag whose
+    # every term underflows gives exactly 0 (the breakpoint rule H(tau) != 0 relies on it)
+    import mpmath
+    from dmi.analysis.collocation.fold import EXP_ENTRIES, exp_sum
+    rng = np.random.default_rng(5)
+    k = 12
+    a = -np.logspace(-2, 3, k)
+    b = np.where(np.arange(k) % 3 == 0, 0.7, 0.0)
+    C, D = rng.standard_normal((k, 2, 2)), rng.standard_normal((k, 2, 2))
+    s = np.concatenate([np.linspace(0.0, 40.0, 3 * EXP_ENTRIES // k + 7), [1e5]])
+    got = exp_sum(s, a, b, C, D)
+    assert got.shape == (s.size, 2, 2)
+    mpmath.mp.dps = 30
+    for i in list(range(0, s.size - 1, 397)) + [s.size - 2]:
+        want = sum(mpmath.exp(mpmath.mpf(a[j]) * s[i])
+                   * (C[j] * mpmath.cos(b[j] * s[i]) + D[j] * mpmath.sin(b[j] * s[i]))
+                   for j in range(k))
+        want = np.array(want.tolist(), dtype=float)
+        assert np.allclose(got[i], want, rtol=1e-13, atol=1e-300), (s[i], got[i], want)
+    assert np.all(got[-1] == 0.0)                    # e^(-0.01 * 1e5): every term below e^-708

@@ -1,8 +1,8 @@
 # A stick-slip orbit with a weakly singular memory (the fractional belt of tests/python/models/
-# fractional_belt.py, tau = 15, about two and a half periods): after a kink at a switch the
-# convolution with s^-1/2 makes the solution behave as (t - t_s)^(5/2), which the equidistribution
-# of u^(m+1) does not see; the interval after that switch carries almost all of the period's
-# error.  The refinement finds that interval by the dual-weighted residual (adapt.contributions)
+# fractional_belt.py, tau = 15, about two and a half periods): past a switch where a derivative
+# of the solution jumps (its second at a slip onset), the convolution with s^-1/2 makes it behave
+# as a fractional power of t - t_s, which the equidistribution of u^(m+1) does not see; the
+# interval after that switch carries almost all of the period's error.  The refinement finds that interval by the dual-weighted residual (adapt.contributions)
 # and grades the mesh towards the switch (adapt.graded).  Checked against independent solves: the
 # shares against the re-solved period of the mesh with one end graded and with everything else
 # halved; the refined period against a reference on a mesh with every switch graded deeply (its
@@ -137,13 +137,21 @@ def test_repaired_halves_the_fewest_hottest_intervals():
     # the hottest leaves 2 (1e-8 - (their sum) (1 - 2^-5)): interval 2 alone 1.03e-8, with 5
     # 2.56e-9, with a third 2.17e-9, a fourth 1.79e-9
     eta = np.array([1e-10, 1e-10, 5e-9, 2e-10, 2e-10, -4e-9, 2e-10, 2e-10])
-    out = adapt.repaired(lay, eta, 3e-9 * adapt.MARGIN)
+    d = 2 * abs(eta.sum())                                  # the round's estimate, 1.84e-8
+
+    def repair(tol, d=d, grow=100):
+        return adapt.repaired(lay, eta, tol * adapt.MARGIN, d, grow)
+    out = repair(3e-9)
     assert out is not None
     assert np.array_equal(out[0], [0.0, 0.25, 0.5, 0.625, 0.75, 1.0])
     assert np.array_equal(out[1], [0.0, 0.25, 0.375, 0.5, 0.75, 1.0])
-    assert adapt.repaired(lay, eta, 2e-9 * adapt.MARGIN) is None     # four: over L / 4 = 2
+    assert repair(2e-9) is None                             # four: over L / 4 = 2
+    assert repair(3e-9, grow=9) is None                     # 10 intervals where 9 would do
+    assert repair(3e-9, grow=10) is not None
+    assert repair(3e-9, d=4 * d) is None                    # the shares say a quarter of d
     # spread: 1e-9 each; k halved leave 2 (8e-9 - k 1e-9 (31 / 32)): 1.41e-8, 1.21e-8, 1.02e-8
-    spread = np.full(8, 1e-9)
-    assert adapt.repaired(lay, spread, 1.1e-8 * adapt.MARGIN) is None  # three needed
-    two = adapt.repaired(lay, spread, 1.25e-8 * adapt.MARGIN)
+    eta = np.full(8, 1e-9)
+    d = 1.6e-8
+    assert repair(1.1e-8, d=d) is None                      # three needed
+    two = repair(1.25e-8, d=d)
     assert two is not None and sum(len(f) - 5 for f in two) == 2

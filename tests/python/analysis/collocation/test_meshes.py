@@ -73,7 +73,7 @@ def test_relaxation_to_1e8_within_1_5_of_the_smallest_sufficient_mesh(relaxation
     # meshes: 71 intervals of the refinement had 8.6e-9, 64 had 5.1e-9 with its estimate 1.03e-8)
     sufficient = next(L for L in (52, 56, 60, 64, 68, 72)
                       if abs(period_on(o, L, 6) - ref.period) + ref.errors["period"] <= 1e-8)
-    # 75 returned measured (rounds of 16 and 64, then 64 with its 11 hottest intervals halved);
+    # 72 returned measured (rounds of 16, 64 and 71, then 71 with its hottest interval halved);
     # 82 before a round's hottest intervals were halved (16, 64, 71, 82); 112 when the
     # refinement returned the finer of two levels (56 counted) and its estimate was Richardson's
     assert e.intervals <= 1.5 * sufficient, (e.intervals, sufficient)
