@@ -39,9 +39,10 @@ FOLD = True
 FOLD_TOL = 1e-14
 #: Exponentials a block of :func:`exp_sum` at most (about 256 kB: the block stays in the cache).
 EXP_ENTRIES = 32768
-#: The least exponent :func:`exp_sum` evaluates (e^-708 is about the least normal double,
-#: 2.2e-308; e^-745 underflows to 0).
-EXP_LEAST = -708.0
+#: The least exponent :func:`exp_sum` evaluates: e^-700 is about 1e-304, which times a term's
+#: factor stays a normal double (a subnormal one, from e^-708 on, slows numpy's exp and the
+#: products about 30 times; e^-745 underflows to 0).
+EXP_LEAST = -700.0
 
 
 def folding() -> bool:
@@ -57,7 +58,7 @@ def exp_sum(s: np.ndarray, a: np.ndarray, b: np.ndarray, C: np.ndarray, D: np.nd
     EXP_ENTRIES exponentials (those of a long memory's many lags at once would be an array that
     does not fit the cache), each exponent at least EXP_LEAST (an exponential that underflows to
     a subnormal costs numpy about 30 times one that does not): a term below it counts about
-    2e-308 |C_j| (below the last bit of any sum that is not itself about 0), and a lag whose
+    1e-304 |C_j| (below the last bit of any sum that is not itself about 0), and a lag whose
     every exponent is below it gives exactly 0."""
     s = np.asarray(s, dtype=float).ravel()
     k, shape = a.size, (-1,) + C.shape[1:]
@@ -66,28 +67,33 @@ def exp_sum(s: np.ndarray, a: np.ndarray, b: np.ndarray, C: np.ndarray, D: np.nd
         return np.broadcast_to(np.sum(C, axis=0), (s.size,) + C.shape[1:]).copy()
     Cf = C.reshape(k, -1)
     rows = max(1, EXP_ENTRIES // k)
+    # no exponent below EXP_LEAST where |s| |a| stays within it
+    low = s.size > 0 and float(np.max(np.abs(s))) * float(np.max(np.abs(a))) > -EXP_LEAST
     if s.size <= rows:
-        return _exp_block(s, a, b, Cf, D, osc).reshape(shape)
+        return _exp_block(s, a, b, Cf, D, osc, low).reshape(shape)
     out = np.empty((s.size, Cf.shape[1]))
     for i in range(0, s.size, rows):
-        out[i:i + rows] = _exp_block(s[i:i + rows], a, b, Cf, D, osc)
+        out[i:i + rows] = _exp_block(s[i:i + rows], a, b, Cf, D, osc, low)
     return out.reshape(shape)
 
 
 def _exp_block(s: np.ndarray, a: np.ndarray, b: np.ndarray, Cf: np.ndarray, D: np.ndarray,
-               osc: bool) -> np.ndarray:
+               osc: bool, low: bool) -> np.ndarray:
     """:func:`exp_sum` at the lags s of one block, C flattened to (k, -1) (``osc``: some b is
-    not 0); a lag whose every exponent is below EXP_LEAST gives exactly 0."""
+    not 0; ``low``: some exponent may be below EXP_LEAST, then each is at least that and a lag
+    whose every exponent is below it gives exactly 0)."""
     e = np.multiply.outer(s, a)
-    dead = np.where(s >= 0, s * a.max(), s * a.min()) < EXP_LEAST      # max_j a_j s
-    np.maximum(e, EXP_LEAST, out=e)
+    dead = None
+    if low:
+        dead = np.where(s >= 0, s * a.max(), s * a.min()) < EXP_LEAST      # max_j a_j s
+        np.maximum(e, EXP_LEAST, out=e)
     np.exp(e, out=e)
     if not osc:
         out = e @ Cf
     else:
         out = ((e * np.cos(np.multiply.outer(s, b))) @ Cf
                + (e * np.sin(np.multiply.outer(s, b))) @ D.reshape(a.size, -1))
-    if dead.any():
+    if dead is not None and dead.any():
         out[dead] = 0.0
     return out
 
