@@ -142,11 +142,16 @@ def equidistribute(mesh: np.ndarray, indicator: np.ndarray, L: int) -> np.ndarra
     return new
 
 
-def halved(fractions: list[np.ndarray]) -> list[np.ndarray]:
-    """Every interval cut in two."""
+def halved(fractions: list[np.ndarray], only: np.ndarray | None = None) -> list[np.ndarray]:
+    """Every interval cut in two, or those whose indices (counted over the pieces in turn, as
+    the mesh's) are in ``only``."""
     out = []
+    first = 0
     for f in fractions:
         mid = 0.5 * (f[:-1] + f[1:])
+        if only is not None:
+            mid = mid[np.isin(np.arange(first, first + mid.size), only)]
+        first += f.size - 1
         out.append(np.sort(np.concatenate([f, mid])))
     return out
 
@@ -564,7 +569,7 @@ def hot_ends(lay: Layout, eta: np.ndarray) -> list[tuple[int, int, float]]:
     if lay.signature.switches == 0:
         return []
     total = float(np.sum(np.abs(eta)))
-    first = np.cumsum([0] + [len(fr) - 1 for fr in lay.fractions])
+    first = np.cumsum([0] + [fr.size - 1 for fr in lay.fractions])   # each piece's first interval
     out = []
     for j in range(len(lay.fractions)):
         for side, i in ((0, first[j]), (1, first[j + 1] - 1)):
@@ -624,13 +629,7 @@ def repaired(lay: Layout, eta: np.ndarray, tol: float, d: float, grow: int
     if (enough.size == 0 or enough[0] + 1 > max(2, lay.L // REPAIR_PART)
             or lay.L + enough[0] + 1 > grow):
         return None
-    hot = set(order[:enough[0] + 1].tolist())
-    first = np.cumsum([0] + [len(fr) - 1 for fr in lay.fractions])
-    out = []
-    for j, fr in enumerate(lay.fractions):
-        mids = [0.5 * (fr[k] + fr[k + 1]) for k in range(len(fr) - 1) if first[j] + k in hot]
-        out.append(np.sort(np.concatenate([fr, mids])))
-    return out
+    return halved(lay.fractions, order[:enough[0] + 1])
 
 
 def reshaped(f: Solved, terms: Terms, ref: Any, d: float, tol: float, grow: int,

@@ -56,7 +56,6 @@ import numpy as np
 from .adapt import (Solved, check_cost, equidistribute, estimate, first_intervals, levels,
                     lower)
 from .floquet import multipliers as floquet, on_halved, pairs
-from .krylov import DENSE_MAX
 from .mend import mend
 from .orbit import EquationOrbit, equation_orbit
 from .signature import read_signature
@@ -288,15 +287,13 @@ def _result(orbit: Orbit, terms: Terms, c: Solved | None, f: Solved, count: int,
 def check_multipliers(f: Solved, terms: Terms, count: int) -> None:
     """f's ``count`` multipliers with their eigenvectors (:func:`~.floquet.pairs`), and its
     check's from them (:func:`~.floquet.on_halved`: a few products of the check's monodromy
-    operator from f's eigenvectors prolonged) where the check's monodromy would be decomposed
-    densely (its state, twice f's, at most DENSE_MAX), or where those are not verified or the
-    state is larger (ARPACK's there), by :func:`~.floquet.multipliers`; set as f.mu and
-    f.check.mu."""
+    operator from f's eigenvectors prolonged), or where those are not verified or the check's
+    state is beyond a dense decomposition (ARPACK's there), by :func:`~.floquet.multipliers`;
+    set as f.mu and f.check.mu."""
     F = f.check
     assert F is not None
     f.mu, V = pairs(f.lay, terms, f.x, count)
-    small = V is not None and 2 * V.shape[0] <= DENSE_MAX    # else ARPACK's on the check
-    mu = on_halved(F.lay, F.x, f.lay, f.x, terms, f.mu, V) if small else None
+    mu = None if V is None else on_halved(F.lay, F.x, f.lay, f.x, terms, f.mu, V)
     F.mu = mu if mu is not None else floquet(F.lay, terms, F.x, count)
 
 

@@ -194,7 +194,12 @@ def on_halved(fine: Layout, x: np.ndarray, coarse: Layout, xc: np.ndarray, terms
     number as mu, largest first, below 1e-12: 0.  None where a Ritz pair of a nonzero
     multiplier keeps a residual |M y - theta y| above RITZ_TOL (relative to max(1, |theta|)
     and |y|; the caller then decomposes the monodromy, :func:`multipliers`): a slow
-    convergence (moduli close to the next ones'), or V not of the coarse operator."""
+    convergence (moduli close to the next ones'), or V not of the coarse operator; None too,
+    without building fine's operator, where its state (twice V's rows) exceeds DENSE_MAX: there
+    :func:`multipliers` takes ARPACK's on it, and subspace iteration from V converges slowly
+    (a ring of multipliers near one modulus)."""
+    if 2 * V.shape[0] > DENSE_MAX:
+        return None
     op = operator(fine, terms, x)
     k = min(mu.size + 2, V.shape[1], op.dim)
     P = prolongation(coarse, xc, fine, x, terms)

@@ -66,21 +66,22 @@ def exp_sum(s: np.ndarray, a: np.ndarray, b: np.ndarray, C: np.ndarray, D: np.nd
     if not osc and not np.any(a):
         return np.broadcast_to(np.sum(C, axis=0), (s.size,) + C.shape[1:]).copy()
     Cf = C.reshape(k, -1)
+    Df = D.reshape(k, -1) if osc else None
     rows = max(1, EXP_ENTRIES // k)
     # no exponent below EXP_LEAST where |s| |a| stays within it
     low = s.size > 0 and float(np.max(np.abs(s))) * float(np.max(np.abs(a))) > -EXP_LEAST
     if s.size <= rows:
-        return _exp_block(s, a, b, Cf, D, osc, low).reshape(shape)
+        return _exp_block(s, a, b, Cf, Df, low).reshape(shape)
     out = np.empty((s.size, Cf.shape[1]))
     for i in range(0, s.size, rows):
-        out[i:i + rows] = _exp_block(s[i:i + rows], a, b, Cf, D, osc, low)
+        out[i:i + rows] = _exp_block(s[i:i + rows], a, b, Cf, Df, low)
     return out.reshape(shape)
 
 
-def _exp_block(s: np.ndarray, a: np.ndarray, b: np.ndarray, Cf: np.ndarray, D: np.ndarray,
-               osc: bool, low: bool) -> np.ndarray:
-    """:func:`exp_sum` at the lags s of one block, C flattened to (k, -1) (``osc``: some b is
-    not 0; ``low``: some exponent may be below EXP_LEAST, then each is at least that and a lag
+def _exp_block(s: np.ndarray, a: np.ndarray, b: np.ndarray, Cf: np.ndarray,
+               Df: np.ndarray | None, low: bool) -> np.ndarray:
+    """:func:`exp_sum` at the lags s of one block, C and D flattened to (k, -1) (Df None: every
+    b is 0; ``low``: some exponent may be below EXP_LEAST, then each is at least that and a lag
     whose every exponent is below it gives exactly 0)."""
     e = np.multiply.outer(s, a)
     dead = None
@@ -88,11 +89,11 @@ def _exp_block(s: np.ndarray, a: np.ndarray, b: np.ndarray, Cf: np.ndarray, D: n
         dead = np.where(s >= 0, s * a.max(), s * a.min()) < EXP_LEAST      # max_j a_j s
         np.maximum(e, EXP_LEAST, out=e)
     np.exp(e, out=e)
-    if not osc:
+    if Df is None:
         out = e @ Cf
     else:
         out = ((e * np.cos(np.multiply.outer(s, b))) @ Cf
-               + (e * np.sin(np.multiply.outer(s, b))) @ D.reshape(a.size, -1))
+               + (e * np.sin(np.multiply.outer(s, b))) @ Df)
     if dead is not None and dead.any():
         out[dead] = 0.0
     return out

@@ -87,8 +87,10 @@ def test_the_shares_locate_the_error(collocated):
 
 
 def test_reference_converged(reference_period):
-    _, uncertainty = reference_period
-    assert uncertainty <= 3e-13                      # rounding (about 5e-14 relative)
+    # within a quarter of the rounding floor a checked estimate claims (1.3e-13 measured, 2e-14
+    # relative): the refinement's estimate at that floor still bounds its true error
+    T, uncertainty = reference_period
+    assert uncertainty <= 0.25 * adapt.CHECKED_FLOOR * T
 
 
 def test_refinement_grades_the_switch(orbit, reference_period):
