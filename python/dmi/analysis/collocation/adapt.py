@@ -124,6 +124,12 @@ GRADE_MOST = 24
 #: relaxation oscillation the mesh's lottery puts a third to three quarters of a round's
 #: difference into one or two intervals of the steep stretch.
 REPAIR_PART = 4
+#: A refinement whose last round meets tol on more than this many times the intervals its
+#: estimate says suffice (at the expected order, with MARGIN) tries that fewer
+#: (:func:`coarsened`): a round aimed at tol lands below it, and one order of magnitude of
+#: the period's error is only (10)^(1/(2 m)) in the intervals (1.47 at degree 3).  Not tried
+#: where the round's estimate is at the floor of rounding (it says nothing of the order there).
+COARSER = 1.25
 #: Quadrature nodes of the delay integral at most on one mesh (about 100 bytes each): a memory
 #: spanning many periods (tau / T large) or a very fine mesh is refused before it is built.
 MAX_DELAY_NODES = 2e7
@@ -650,6 +656,35 @@ def reshaped(f: Solved, terms: Terms, ref: Any, d: float, tol: float, grow: int,
     return rest, (repaired(f.lay, eta, tol, d, grow) if rest is None else None)
 
 
+def coarsened(f: Solved, L: int, d: float, tol: float, expected: int,
+              ends: dict[tuple[int, int], int], terms: Terms, ref: Any, what: str
+              ) -> Solved | None:
+    """The orbit on fewer intervals than f's round (L equidistributed, its estimate d <= tol),
+    where its estimate at the ``expected`` order says more than COARSER times fewer suffice
+    (L (MARGIN d / tol)^(1/expected)): that mesh equidistributed from f's check (``ends``
+    graded as f's were), checked (:func:`checked`); returned where its estimate meets tol and
+    bounds its distance to f's check F plus |f - F| (F, at least 2 COARSER times finer, stands
+    for the truth; |f - F| bounds F's error where f's own estimate holds, an order of at least
+    1 from f to F; a coarse round whose check is not yet in the asymptotic range fails this);
+    None otherwise (not solved, not checked, or not that accurate: f stays)."""
+    F = f.check
+    fewer = math.ceil(L * (MARGIN * d / tol) ** (1.0 / expected))
+    if F is None or COARSER * fewer > L:
+        return None
+    try:
+        g = one_level(F.lay.with_fractions(graded(adapted(F.lay, F.x, fewer), ends)), terms,
+                      (F.lay, F.x), ref, what)
+    except (ShootingError, ValueError):
+        return None
+    if g.lay.L >= f.lay.L:
+        return None
+    g.check = checked(g, terms, ref)
+    dg = round_error(None, g)
+    if g.check is None or not dg <= tol or not difference(g, F) + difference(f, F) <= dg:
+        return None
+    return g
+
+
 def rounds_order(last: tuple[int, float] | None, L: int, d: float, scale: float, tol: float,
                  floor: float, capped: list[float] | None, reached: str, below: str
                  ) -> float | None:
@@ -756,7 +791,10 @@ def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: flo
     (:func:`regraded`) has that end graded in every later round, and the next mesh grows for
     the other intervals' shares only; where halving a few of a round's intervals predicts tol
     (:func:`repaired`), the next round is that mesh (the rounds' order starts anew after
-    either).
+    either).  A last round that meets tol on more than COARSER times the intervals its estimate
+    says suffice is followed by a try on that fewer (:func:`coarsened`; not where its estimate
+    is at the floor of rounding), returned where its check meets tol and covers its distance to
+    the round's check.
 
     A first round on fewer than FIRST_INTERVALS intervals (a loose tol or a high degree) whose
     solve fails, or whose check and merged level both fail (no estimate), is done again on
@@ -799,7 +837,9 @@ def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: flo
                  ("FLOOR", FLOOR))                 # the levels' floor where the check failed
         floor = which[1] * f.scale
         if d <= tol and floor <= tol:
-            return c, f
+            g = (coarsened(f, L, d, tol, expected, ends, terms, ref, what) if d > floor
+                 else None)                        # an estimate at the floor: no order in it
+            return (c, f) if g is None else (None, g)
         reached = (f"the estimated error of the {name} is {d:.3g} at {f.lay.L} intervals of "
                    f"degree {lay.m}")
         if f.check is None:
