@@ -125,10 +125,11 @@ GRADE_MOST = 24
 #: difference into one or two intervals of the steep stretch.
 REPAIR_PART = 4
 #: A refinement whose last round meets tol on more than this many times the intervals its
-#: estimate says suffice (at the expected order, with MARGIN) tries that fewer
-#: (:func:`coarsened`): a round aimed at tol lands below it, and one order of magnitude of
-#: the period's error is only (10)^(1/(2 m)) in the intervals (1.47 at degree 3).  Not tried
-#: where the round's estimate is at the floor of rounding (it says nothing of the order there).
+#: estimate says suffice (at the expected order, with MARGIN; at least :func:`least_intervals`)
+#: tries that fewer (:func:`coarsened`): a round aimed at tol lands below it, and one order of
+#: magnitude of the period's error is only (10)^(1/(2 m)) in the intervals (1.47 at degree 3).
+#: Not tried where the round's estimate is at the floor of rounding (it says nothing of the
+#: order there).
 COARSER = 1.25
 #: Quadrature nodes of the delay integral at most on one mesh (about 100 bytes each): a memory
 #: spanning many periods (tau / T large) or a very fine mesh is refused before it is built.
@@ -656,33 +657,36 @@ def reshaped(f: Solved, terms: Terms, ref: Any, d: float, tol: float, grow: int,
     return rest, (repaired(f.lay, eta, tol, d, grow) if rest is None else None)
 
 
-def coarsened(f: Solved, L: int, d: float, tol: float, expected: int,
-              ends: dict[tuple[int, int], int], terms: Terms, ref: Any, what: str
-              ) -> Solved | None:
-    """The orbit on fewer intervals than f's round (L equidistributed, its estimate d <= tol),
-    where its estimate at the ``expected`` order says more than COARSER times fewer suffice
-    (L (MARGIN d / tol)^(1/expected)): that mesh equidistributed from f's check (``ends``
-    graded as f's were), checked (:func:`checked`); returned where its estimate meets tol and
-    bounds its distance to f's check F plus |f - F| (F, at least 2 COARSER times finer, stands
-    for the truth; |f - F| bounds F's error where f's own estimate holds, an order of at least
-    1 from f to F; a coarse round whose check is not yet in the asymptotic range fails this);
-    None otherwise (not solved, not checked, or not that accurate: f stays)."""
+def coarsened(f: Solved, d: float, tol: float, expected: int, ends: dict[tuple[int, int], int],
+              terms: Terms, ref: Any, what: str) -> Solved | None:
+    """The orbit on fewer intervals than f's round (its estimate d <= tol), where its estimate
+    at the ``expected`` order says more than COARSER times fewer suffice (aimed at tol /
+    MARGIN, as :func:`repaired` aims: (MARGIN d / tol)^(1/expected) times f's intervals, its
+    graded ends' levels left out; at least :func:`least_intervals`): that mesh equidistributed
+    from f's check F (``ends`` graded as f's were), checked (:func:`checked`); returned where it
+    keeps the signature's inequalities, its estimate meets tol and covers its distance to F
+    plus |f - F| (F, more than twice as fine, stands for the truth; |f - F| bounds F's error
+    where f's own estimate holds, an order of at least 1 from f to F; a coarse try whose check
+    is not yet in the asymptotic range fails this); None otherwise (not solved, not checked,
+    not that accurate, or no fewer intervals: f stays)."""
     F = f.check
-    fewer = math.ceil(L * (MARGIN * d / tol) ** (1.0 / expected))
-    if F is None or COARSER * fewer > L:
+    base = f.lay.L - sum(ends.values())
+    fewer = max(least_intervals(f.lay.m, len(f.lay.fractions)),
+                math.ceil(base * (MARGIN * d / tol) ** (1.0 / expected)))
+    if F is None or COARSER * fewer > base:
+        return None
+    lay = F.lay.with_fractions(graded(adapted(F.lay, F.x, fewer), ends))
+    if lay.L >= f.lay.L:
         return None
     try:
-        g = one_level(F.lay.with_fractions(graded(adapted(F.lay, F.x, fewer), ends)), terms,
-                      (F.lay, F.x), ref, what)
+        g = one_level(lay, terms, (F.lay, F.x), ref, what)
+        if check_inequalities(g.lay, terms, g.x):
+            return None
     except (ShootingError, ValueError):
-        return None
-    if g.lay.L >= f.lay.L:
         return None
     g.check = checked(g, terms, ref)
     dg = round_error(None, g)
-    if g.check is None or not dg <= tol or not difference(g, F) + difference(f, F) <= dg:
-        return None
-    return g
+    return g if dg <= tol and difference(g, F) + d / CHECK_SAFETY <= dg else None
 
 
 def rounds_order(last: tuple[int, float] | None, L: int, d: float, scale: float, tol: float,
@@ -745,8 +749,14 @@ def first_intervals(tol: float, m: int, pieces: int, steep: bool) -> int:
     ``pieces``."""
     higher = min(1.0, FIRST_TOL ** (1.0 / (2 * FIRST_DEGREE) - 1.0 / (2 * m)))
     L = FIRST_INTERVALS * min(1.0, (FIRST_TOL / tol) ** (1.0 / (2 * m)) * higher)
-    least = max(4, min(LEAST_FIRST, round(LEAST_POINTS / m)))
-    return max(FIRST_INTERVALS if steep else least, round(L), 4 * pieces)
+    return max(FIRST_INTERVALS if steep else least_intervals(m, pieces), round(L))
+
+
+def least_intervals(m: int, pieces: int) -> int:
+    """The fewest intervals a refinement solves on: LEAST_POINTS / m (rounded, within 4 to
+    LEAST_FIRST: 6 at degree 4, 8 at degree 3), at least 4 for each of the signature's
+    ``pieces``."""
+    return max(4, min(LEAST_FIRST, round(LEAST_POINTS / m)), 4 * pieces)
 
 
 def levels(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, fixed: bool,
@@ -793,8 +803,9 @@ def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: flo
     (:func:`repaired`), the next round is that mesh (the rounds' order starts anew after
     either).  A last round that meets tol on more than COARSER times the intervals its estimate
     says suffice is followed by a try on that fewer (:func:`coarsened`; not where its estimate
-    is at the floor of rounding), returned where its check meets tol and covers its distance to
-    the round's check.
+    is at the floor of rounding), returned where it keeps the signature's inequalities, its
+    check meets tol and its estimate covers its distance to the round's check plus the round's
+    own distance to that check.
 
     A first round on fewer than FIRST_INTERVALS intervals (a loose tol or a high degree) whose
     solve fails, or whose check and merged level both fail (no estimate), is done again on
@@ -837,9 +848,9 @@ def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: flo
                  ("FLOOR", FLOOR))                 # the levels' floor where the check failed
         floor = which[1] * f.scale
         if d <= tol and floor <= tol:
-            g = (coarsened(f, L, d, tol, expected, ends, terms, ref, what) if d > floor
+            g = (coarsened(f, d, tol, expected, ends, terms, ref, what) if d > floor
                  else None)                        # an estimate at the floor: no order in it
-            return (c, f) if g is None else (None, g)
+            return c, g or f
         reached = (f"the estimated error of the {name} is {d:.3g} at {f.lay.L} intervals of "
                    f"degree {lay.m}")
         if f.check is None:

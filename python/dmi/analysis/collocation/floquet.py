@@ -247,10 +247,10 @@ def prolongation(coarse: Layout, xc: np.ndarray, fine: Layout, x: np.ndarray, te
         if i is None:
             return None
         parent.append((i, k % 2))
-    blocks = [[None] * len(cols) for _ in rows]
-    for j, (i, half) in enumerate(parent):
-        blocks[j][i] = halves[half]
-    return sp.bmat(blocks, format="csr", dtype=float) if blocks else None
+    blocks = np.empty((len(rows), len(cols)), dtype=object)   # (a list of one-block lists
+    for j, (i, half) in enumerate(parent):                     # would become a 4-D array)
+        blocks[j, i] = halves[half]
+    return sp.bmat(blocks, format="csr", dtype=float) if len(rows) else None
 
 
 def eigenfunction(lay: Layout, terms: Terms, x: np.ndarray, near: complex = -1.0

@@ -131,15 +131,17 @@ def test_a_steep_orbit_of_degree_3_meets_a_loose_tol():
 
 
 @pytest.mark.parametrize("eps, T, steps, m, tol, L_ref", [
-    (0.5, 6.3, 630, 3, 1e-2, 40),      # 8 returned before: the least first round (24 points)
+    (3.0, 8.0, 800, 3, 1e-2, 80),      # 16 returned before: a far first round grown 2 times
     (3.0, 8.0, 800, 3, 1e-5, 80),      # 52 before: rounds of 8, 32, 50 and 50 with two halved
+    (5.0, 9.0, 900, 4, 1e-6, 80),      # 64 before: a far first round grown by FAR_GROWTH
 ])
 def test_a_last_round_far_below_tol_is_coarsened(eps, T, steps, m, tol, L_ref):
     """A refinement whose last round meets tol on more than COARSER = 1.25 times the intervals
     its estimate says suffice tries that fewer, checked and within its estimate of the round's
-    check: van der Pol at eps = 0.5 (6 returned; 5 suffice, 8 before) and at eps = 3 (39
-    returned; 32 suffice, 52 before), both at degree 3; within 1.5 times the least sufficient
-    mesh of a scan, and its estimate bounds the true error."""
+    check: van der Pol at eps = 3, degree 3 (9 returned at 1e-2 where 10 suffice; 39 at 1e-5
+    where 32 do) and at eps = 5, degree 4 (50 at 1e-6 where 38 do); within 1.5 times the least
+    sufficient mesh of a scan (1.6, 1.62 and 1.68 before), and the estimate bounds the true
+    error."""
     o = scheme_orbit(van_der_pol(eps), 0.5, T, steps)
     ref = da.collocate(o, intervals=L_ref, degree=8, multipliers=0)
     gap = ref.errors["period"]
@@ -152,28 +154,36 @@ def test_a_last_round_far_below_tol_is_coarsened(eps, T, steps, m, tol, L_ref):
 
 
 def test_a_coarser_try_is_kept_only_where_its_estimate_covers_the_finer_round(monkeypatch):
-    """adapt.coarsened on a round of 8 intervals (van der Pol, eps = 0.5, degree 3, its estimate
-    1.0e-3) at tol = 1e-2: 6 intervals, checked, their estimate within tol and at least their
-    distance to the round's check plus the round's own distance to it; None where the coarser
-    check says it is exact (made to: its estimate 0 does not cover that distance), and no solve
-    at all where the estimate says less than COARSER times fewer intervals suffice."""
-    o = scheme_orbit(van_der_pol(0.5), 0.5, 6.3, 630)
-    terms, lay, x1 = first_solved(o, 8, 3)
-    r = reference(lay, x1)
-    f = adapt.one_level(lay.with_fractions(adapt.adapted(lay, x1, 8)), terms, (lay, x1), r, "t")
-    f.check = adapt.checked(f, terms, r)
-    d = adapt.round_error(None, f)
-    assert 5e-4 <= d <= 2e-3
-    g = adapt.coarsened(f, 8, d, 1e-2, 6, {}, terms, r, "t")
-    assert g is not None and g.lay.L == 6
+    """adapt.coarsened after the last round of van der Pol's refinement at eps = 3, degree 3,
+    tol = 1e-2 (16 intervals, its estimate 2.5e-4): fewer intervals (9), checked, their
+    estimate within tol and at least their distance to the round's check plus the round's own
+    distance to it; None where the try's solution breaks the signature's inequalities (made
+    to), where its check says it is exact (made to: its estimate 0 does not cover that
+    distance), and, without a solve, where the estimate says less than COARSER times fewer
+    intervals suffice."""
+    o = scheme_orbit(van_der_pol(3.0), 0.5, 8.0, 800)
+    seen = []
+    plain = adapt.coarsened
+
+    def recorded(f, d, *args):
+        seen.append((f, d, args, plain(f, d, *args)))
+        return seen[-1][-1]
+    monkeypatch.setattr(adapt, "coarsened", recorded)
+    e = da.collocate(o, degree=3, tol=1e-2, multipliers=0)
+    (f, d, (tol, expected, ends, terms, r, what), g), = seen
+    assert f.lay.L == 16 and d <= 1e-3 and g is not None and e.intervals == g.lay.L < 12
+    F = f.check
     dg = adapt.CHECK_SAFETY * abs(g.T - g.check.T)
-    assert abs(g.T - f.check.T) + abs(f.T - f.check.T) <= dg <= 1e-2
+    assert abs(g.T - F.T) + abs(f.T - F.T) <= dg <= tol
     solves = []
     plain_one = adapt.one_level
     monkeypatch.setattr(adapt, "one_level", lambda *a, **k: solves.append(1) or plain_one(*a, **k))
-    assert adapt.coarsened(f, 8, d, d, 6, {}, terms, r, "t") is None and not solves
+    assert plain(f, d, d, expected, ends, terms, r, what) is None and not solves
+    with monkeypatch.context() as mp:
+        mp.setattr(adapt, "check_inequalities", lambda lay, terms, x: ["made to"])
+        assert plain(f, d, tol, expected, ends, terms, r, what) is None and solves
     monkeypatch.setattr(adapt, "checked", lambda s, terms, r: adapt.Solved(s.lay, s.x))
-    assert adapt.coarsened(f, 8, d, 1e-2, 6, {}, terms, r, "t") is None and solves
+    assert plain(f, d, tol, expected, ends, terms, r, what) is None
 
 
 def test_an_estimate_that_rises_between_rounds_is_no_floor(oscillation, oscillation_gap,
@@ -655,8 +665,7 @@ def test_a_round_without_an_estimate_grows_by_far_growth(oscillation, oscillatio
                                                          monkeypatch):
     """A refinement's second round whose check and merged levels both fail (made to): it has no
     estimate, so the next mesh grows by FAR_GROWTH = 4 at most (it grew by the cap of 8, and the
-    infinite estimate entered the rounds' order), and the refinement meets tol after it (its
-    third round, 248 intervals, far below tol, is followed by a coarser try: 115 returned)."""
+    infinite estimate entered the rounds' order), and the refinement meets tol after it."""
     o, ref = oscillation
     sizes = []
     plain_checked, plain_one = adapt.checked, adapt.one_level
@@ -674,9 +683,28 @@ def test_a_round_without_an_estimate_grows_by_far_growth(oscillation, oscillatio
     monkeypatch.setattr(adapt, "checked", checked)
     monkeypatch.setattr(adapt, "lower", lambda f, terms, r: None)
     e = da.collocate(o, tol=1e-10, multipliers=0)
-    assert len(sizes) in (3, 4) and sizes[2] <= adapt.FAR_GROWTH * sizes[1], sizes
-    assert all(L < sizes[2] for L in sizes[3:]), sizes          # only a coarser try after
+    assert len(sizes) == 3 and sizes[2] <= adapt.FAR_GROWTH * sizes[1], sizes
     assert abs(e.period - ref.period) + oscillation_gap <= e.errors["period"] <= 1e-10
+
+
+def test_the_checks_multipliers_from_a_state_of_one_interval():
+    """The check's multipliers from the orbit's eigenvectors (floquet.on_halved) where the orbit's
+    state, its past over [-tau, 0], is one interval (van der Pol at eps = 0.5, 5 equal intervals
+    of degree 3, each 1.09 long, tau = 1) and its check's two: against the eigenvalues of the
+    check's monodromy matrix to 1e-12 (the prolongation's blocks, one column of them, were made
+    a 4-D array: "blocks must be 2-D", and the multipliers' estimate fell back to the levels')."""
+    o = scheme_orbit(van_der_pol(0.5), 0.5, 6.3, 630)
+    terms, lay, x1 = first_solved(o, 8, 3)
+    r = reference(lay, x1)
+    c = adapt.one_level(lay.with_fractions([np.linspace(0.0, 1.0, 6)]), terms, (lay, x1), r, "t")
+    F = adapt.one_level(c.lay.with_fractions(adapt.halved(c.lay.fractions)), terms, (c.lay, c.x),
+                        r, "t")
+    P = max(1, math.ceil(terms.tau / c.T))
+    assert len(floquet_module.state_intervals(c.lay, terms, c.lay.mesh(c.b, c.T), c.T, P)) == 1
+    mu, V = floquet_module.pairs(c.lay, terms, c.x, 2)
+    got = floquet_module.on_halved(F.lay, F.x, c.lay, c.x, terms, mu, V)
+    dense = floquet(F.lay, terms, F.x, 2)
+    assert got is not None and np.max(np.abs(got - dense)) <= 1e-12, (got, dense)
 
 
 @pytest.mark.parametrize("case, L", [("oscillation", 8), ("stick_slip", 8)])
