@@ -749,7 +749,7 @@ def first_intervals(tol: float, m: int, pieces: int, steep: bool) -> int:
     ``pieces``."""
     higher = min(1.0, FIRST_TOL ** (1.0 / (2 * FIRST_DEGREE) - 1.0 / (2 * m)))
     L = FIRST_INTERVALS * min(1.0, (FIRST_TOL / tol) ** (1.0 / (2 * m)) * higher)
-    return max(FIRST_INTERVALS if steep else least_intervals(m, pieces), round(L))
+    return max(least_intervals(m, pieces), FIRST_INTERVALS if steep else 0, round(L))
 
 
 def least_intervals(m: int, pieces: int) -> int:

@@ -486,6 +486,17 @@ def test_first_rounds_by_degree_within_1_5_of_the_smallest_sufficient_mesh(
     assert e.intervals <= 1.5 * sufficient, (e.intervals, sufficient)
 
 
+def test_the_fewest_intervals_of_a_first_round_and_of_a_coarser_try():
+    """24 collocation points (within 4 to 8 intervals) and 4 intervals a piece: 8 at degree 3,
+    6 at degree 4, 4 at degree 8, 12 for 3 pieces; a steep orbit's first round 16, or 4 a piece
+    where that is more (20 for the 5 pieces of a stick-slip orbit)."""
+    assert [adapt.least_intervals(m, 1) for m in (3, 4, 6, 8)] == [8, 6, 4, 4]
+    assert adapt.least_intervals(4, 3) == 12
+    assert adapt.first_intervals(1e-10, 4, 5, True) == 20
+    assert adapt.first_intervals(1e-10, 4, 1, True) == 16
+    assert adapt.first_intervals(1e-2, 3, 1, False) == 8
+
+
 def three_levels(o: da.Orbit, L: int, m: int, count: int):
     """The orbit on L equidistributed intervals (the levels L / 2, L, 2 L) with its multipliers,
     their errors' estimate from the three levels (without the check a graded or unsteady mesh
