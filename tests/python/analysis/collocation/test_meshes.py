@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import sys
+import warnings
 
 import numpy as np
 import pytest
@@ -140,14 +141,19 @@ def test_a_last_round_far_below_tol_is_coarsened(eps, T, steps, m, tol, L_ref):
     its estimate says suffice tries that fewer, checked and within its estimate of the round's
     check: van der Pol at eps = 3, degree 3 (9 returned at 1e-2 where 10 suffice; 39 at 1e-5
     where 32 do) and at eps = 5, degree 4 (50 at 1e-6 where 38 do); within 1.5 times the least
-    sufficient mesh of a scan (1.6, 1.62 and 1.68 before), and the estimate bounds the true
-    error."""
+    sufficient mesh of a scan (1.6, 1.62 and 1.68 before), and the estimates of the period and
+    of two multipliers bound their true errors, with no warning."""
     o = scheme_orbit(van_der_pol(eps), 0.5, T, steps)
-    ref = da.collocate(o, intervals=L_ref, degree=8, multipliers=0)
+    ref = da.collocate(o, intervals=L_ref, degree=8, multipliers=2, check=True)
     gap = ref.errors["period"]
     assert gap <= 1e-3 * tol
-    e = da.collocate(o, degree=m, tol=tol, multipliers=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", CollocationWarning)
+        e = da.collocate(o, degree=m, tol=tol, multipliers=2)
     assert abs(e.period - ref.period) + gap <= e.errors["period"] <= tol
+    near = np.argmin(np.abs(e.multipliers[:, None] - ref.multipliers[None, :]), axis=1)
+    mu_true = np.abs(e.multipliers - ref.multipliers[near]) + ref.errors["multipliers"][near]
+    assert np.all(mu_true <= e.errors["multipliers"]), (mu_true, e.errors["multipliers"])
     sufficient = next(L for L in range(4, 60)
                       if abs(period_on(o, L, m) - ref.period) + gap <= tol)
     assert e.intervals <= 1.5 * sufficient, (e.intervals, sufficient)
