@@ -265,9 +265,10 @@ class Solved:
     """A solution on one layout, with its derived quantities: b, T, the amplitudes and the
     multipliers ``mu`` (given; none by default), ``coarser``, the solution on its mesh with
     pairs merged (the estimate's third level; None unless :func:`two_levels` set it), and
-    ``check``, the solution on its mesh halved (:func:`checked`; None unless set), and
+    ``check``, the solution on its mesh halved (:func:`checked`; None unless set),
     ``unchecked``, why a check asked for was not made (not solved, or its solution breaks the
-    signature's inequalities; None)."""
+    signature's inequalities; None), and ``finer``, the refinement's round a coarser try
+    replaced (:func:`coarsened`; None)."""
 
     def __init__(self, lay: Layout, x: np.ndarray, mu: np.ndarray | None = None):
         self.lay, self.x = lay, x
@@ -277,6 +278,7 @@ class Solved:
         self.coarser: Solved | None = None
         self.check: Solved | None = None
         self.unchecked: str | None = None
+        self.finer: Solved | None = None
 
     @property
     def amplitude(self) -> np.ndarray:
@@ -663,12 +665,11 @@ def coarsened(f: Solved, d: float, tol: float, expected: int, ends: dict[tuple[i
     at the ``expected`` order says more than COARSER times fewer suffice (aimed at tol /
     MARGIN, as :func:`repaired` aims: (MARGIN d / tol)^(1/expected) times f's intervals, its
     graded ends' levels left out; at least :func:`least_intervals`): that mesh equidistributed
-    from f's check F (``ends`` graded as f's were), checked (:func:`checked`); returned where it
-    keeps the signature's inequalities, its estimate meets tol and covers its distance to F
-    plus |f - F| (F, more than twice as fine, stands for the truth; |f - F| bounds F's error
-    where f's own estimate holds, an order of at least 1 from f to F; a coarse try whose check
-    is not yet in the asymptotic range fails this); None otherwise (not solved, not checked,
-    not that accurate, or no fewer intervals: f stays)."""
+    from f's check F (``ends`` graded as f's were), checked (:func:`checked`), with f as its
+    ``finer``; returned where it keeps the signature's inequalities, its estimate meets tol
+    and its estimates of the period, the amplitudes and u (:func:`estimate`) cover their
+    distances to F (:func:`covered`); None otherwise (not solved, not checked, not that
+    accurate, or no fewer intervals: f stays)."""
     F = f.check
     base = f.lay.L - sum(ends.values())
     fewer = max(least_intervals(f.lay.m, len(f.lay.fractions)),
@@ -684,9 +685,29 @@ def coarsened(f: Solved, d: float, tol: float, expected: int, ends: dict[tuple[i
             return None
     except (ShootingError, ValueError):
         return None
-    g.check = checked(g, terms, ref)
-    dg = round_error(None, g)
-    return g if dg <= tol and difference(g, F) + d / CHECK_SAFETY <= dg else None
+    g.check, g.finer = checked(g, terms, ref), f
+    return g if round_error(None, g) <= tol and covered(g) else None
+
+
+def covered(g: Solved, multipliers: bool = False) -> bool:
+    """Whether the estimates of g, a coarser try (:func:`coarsened`), as :func:`estimate`
+    reports them (with their floors), cover g's distance to its ``finer`` round's check F (more
+    than twice as fine as g: it stands for the truth; a try whose check is not yet in the
+    asymptotic range fails this): the period's its distance plus the round's own distance to F
+    (which bounds F's error where the round's estimate holds, an order of at least 1 from the
+    round to F), every amplitude's and u's (phase-aligned, :func:`gap`) their distances, or
+    with ``multipliers`` each multiplier's its distance to the nearest of F's.  F's own error is
+    left out but in the period: the round's distance to F in u or an amplitude is the round's
+    error, which the try, equidistributed from F, may have less of (van der Pol at eps = 5,
+    degree 4, 1e-6: the round of 64 grown from a far round 1.5e-4 from F in u, the try on 50
+    1.6e-5)."""
+    f, F = g.finer, g.finer.check
+    errors = estimate(None, g)
+    if multipliers:
+        return bool(np.all(_match(g.mu, F.mu) <= errors["multipliers"]))
+    return bool(abs(g.T - F.T) + abs(f.T - F.T) <= errors["period"]
+                and np.all(np.abs(g.amplitude - F.amplitude) <= errors["amplitude"])
+                and gap(g, F) <= errors["u"])
 
 
 def rounds_order(last: tuple[int, float] | None, L: int, d: float, scale: float, tol: float,
@@ -804,8 +825,9 @@ def refined(lay: Layout, terms: Terms, x: np.ndarray, ref: Any, L: int, tol: flo
     either).  A last round that meets tol on more than COARSER times the intervals its estimate
     says suffice is followed by a try on that fewer (:func:`coarsened`; not where its estimate
     is at the floor of rounding), returned where it keeps the signature's inequalities, its
-    check meets tol and its estimate covers its distance to the round's check plus the round's
-    own distance to that check.
+    check meets tol and its estimates cover their distances to the round's check (the period's
+    plus the round's own distance to it; the multipliers' are covered where they are computed,
+    :func:`~.collocate.kept_coarser`).
 
     A first round on fewer than FIRST_INTERVALS intervals (a loose tol or a high degree) whose
     solve fails, or whose check and merged level both fail (no estimate), is done again on

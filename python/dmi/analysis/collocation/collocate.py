@@ -53,8 +53,8 @@ from typing import Any
 
 import numpy as np
 
-from .adapt import (Solved, check_cost, equidistribute, estimate, first_intervals, levels,
-                    lower)
+from .adapt import (Solved, check_cost, covered, equidistribute, estimate, first_intervals,
+                    levels, lower)
 from .floquet import multipliers as floquet, on_halved, pairs
 from .mend import mend
 from .orbit import EquationOrbit, equation_orbit
@@ -263,7 +263,9 @@ def _result(orbit: Orbit, terms: Terms, c: Solved | None, f: Solved, count: int,
                       f"halved ({2 * f.lay.L} intervals): {f.unchecked}; its estimate is the "
                       f"{kept} levels'", CollocationWarning, stacklevel=3)
     if count > 0:
-        if f.check is not None and (check or c is None):
+        if f.finer is not None:
+            f = kept_coarser(f, terms, count)
+        if f.check is not None and (check or c is None) and not f.mu.size:
             try:
                 check_multipliers(f, terms, count)
             except (RuntimeError, ValueError, np.linalg.LinAlgError) as err:
@@ -282,6 +284,22 @@ def _result(orbit: Orbit, terms: Terms, c: Solved | None, f: Solved, count: int,
             if c.coarser is not None:
                 c.coarser.mu = floquet(c.coarser.lay, terms, c.coarser.x, count)
     return equation_orbit(f, float(orbit.p), orbit.make, estimate(c, f), terms.H.jumps)
+
+
+def kept_coarser(g: Solved, terms: Terms, count: int) -> Solved:
+    """g, a refinement's coarser try (:func:`~.adapt.coarsened`), with its multipliers and its
+    check's (:func:`check_multipliers`) where their estimates cover their distances to those of
+    its finer round's check (:func:`~.adapt.covered`, computed from the round's); else the
+    round, with its multipliers and its check's (none where either level's failed: the caller
+    computes the round's as for any orbit)."""
+    f = g.finer
+    try:
+        check_multipliers(g, terms, count)
+        check_multipliers(f, terms, count)
+    except (RuntimeError, ValueError, np.linalg.LinAlgError):
+        f.mu = f.check.mu = np.empty(0, complex)
+        return f
+    return g if covered(g, multipliers=True) else f
 
 
 def check_multipliers(f: Solved, terms: Terms, count: int) -> None:

@@ -11,6 +11,7 @@
 # Copyright (C) 2026 the dmi authors.  SPDX-License-Identifier: GPL-3.0-or-later
 from __future__ import annotations
 
+import copy
 import math
 import sys
 import warnings
@@ -159,15 +160,52 @@ def test_a_last_round_far_below_tol_is_coarsened(eps, T, steps, m, tol, L_ref):
     assert e.intervals <= 1.5 * sufficient, (e.intervals, sufficient)
 
 
-def test_a_coarser_try_is_kept_only_where_its_estimate_covers_the_finer_round(monkeypatch):
-    """adapt.coarsened after the last round of van der Pol's refinement at eps = 3, degree 3,
-    tol = 1e-2 (16 intervals, its estimate 2.5e-4): fewer intervals (9), checked, their
-    estimate within tol and at least their distance to the round's check plus the round's own
-    distance to it; None where the try's solution breaks the signature's inequalities (made
-    to), where its check says it is exact (made to: its estimate 0 does not cover that
-    distance), and, without a solve, where the estimate says less than COARSER times fewer
-    intervals suffice."""
+def test_a_coarser_try_keeps_the_fewest_intervals_of_a_first_round():
+    """van der Pol at eps = 0.5, degree 3, tol = 3e-2: the first round of 8 intervals (24
+    collocation points, the fewest) is far below tol, and 4 intervals suffice, but no try goes
+    below 8 (one on 5 had its second multiplier's estimate 0.589 times its true error); the
+    multipliers' estimates over their true errors."""
+    o = scheme_orbit(van_der_pol(0.5), 0.5, 6.3, 630)
+    ref = da.collocate(o, intervals=40, degree=8, multipliers=2, check=True)
+    assert da.collocate(o, degree=3, tol=3e-2, multipliers=0).intervals == 8
+    e = da.collocate(o, degree=3, tol=3e-2, multipliers=2)
+    assert e.intervals == 8
+    near = np.argmin(np.abs(e.multipliers[:, None] - ref.multipliers[None, :]), axis=1)
+    true = np.abs(e.multipliers - ref.multipliers[near]) + ref.errors["multipliers"][near]
+    assert np.all(true <= e.errors["multipliers"]), (true, e.errors["multipliers"])
+
+
+@pytest.mark.parametrize("m, tol, count", [
+    (2, 1e-2, 3),      # a try of 23 on the round of 32: the trivial multiplier's estimate 0.01
+    (3, 3e-3, 0),      # a try of 15 on the round of 19: the first amplitude's estimate 0.18
+])
+def test_a_refinement_after_a_coarser_try_keeps_its_estimates_over_the_errors(m, tol, count):
+    """van der Pol at eps = 3: where a coarser try's estimates of the multipliers or of an
+    amplitude would not cover their distances to the round's check (the ratios above, against
+    a reference), the round is returned; every estimate of the orbit returned (period,
+    amplitudes, multipliers) over its true error."""
     o = scheme_orbit(van_der_pol(3.0), 0.5, 8.0, 800)
+    ref = da.collocate(o, intervals=80, degree=8, multipliers=3, check=True)
+    e = da.collocate(o, degree=m, tol=tol, multipliers=count)
+    assert abs(e.period - ref.period) + ref.errors["period"] <= e.errors["period"] <= tol
+    amp = np.abs(e.amplitude - ref.amplitude) + ref.errors["amplitude"]
+    assert np.all(amp <= e.errors["amplitude"]), (amp, e.errors["amplitude"])
+    near = np.argmin(np.abs(e.multipliers[:, None] - ref.multipliers[None, :]), axis=1)
+    true = np.abs(e.multipliers - ref.multipliers[near]) + ref.errors["multipliers"][near]
+    assert np.all(true <= e.errors["multipliers"]), (true, e.errors["multipliers"])
+
+
+def test_a_coarser_try_is_kept_only_where_its_estimates_cover_the_finer_round(monkeypatch):
+    """adapt.coarsened after the last round of van der Pol's refinement at eps = 3, degree 3,
+    tol = 1e-2 (16 intervals, its estimate 2.5e-4): 9 intervals, checked, within tol.  None
+    where the try's solution breaks the signature's inequalities (made to, for the try alone),
+    where the round's own distance to its check no longer leaves the period's estimate room
+    (made to: the round's period moved), and, without a solve, where the estimate says less
+    than COARSER times fewer intervals suffice.  Where its multipliers' estimates do not cover
+    their distances to the round's check's (made to), collocate returns the round, with its
+    multipliers' estimates over their true errors."""
+    o = scheme_orbit(van_der_pol(3.0), 0.5, 8.0, 800)
+    ref = da.collocate(o, intervals=80, degree=8, multipliers=2, check=True)
     seen = []
     plain = adapt.coarsened
 
@@ -179,17 +217,28 @@ def test_a_coarser_try_is_kept_only_where_its_estimate_covers_the_finer_round(mo
     (f, d, (tol, expected, ends, terms, r, what), g), = seen
     assert f.lay.L == 16 and d <= 1e-3 and g is not None and e.intervals == g.lay.L < 12
     F = f.check
-    dg = adapt.CHECK_SAFETY * abs(g.T - g.check.T)
-    assert abs(g.T - F.T) + abs(f.T - F.T) <= dg <= tol
+    room = adapt.estimate(None, g)["period"] - abs(g.T - F.T)
+    assert abs(f.T - F.T) <= room and adapt.covered(g)
+    moved = copy.copy(f)
+    moved.T = F.T + 1.01 * room
+    g.finer = moved
+    assert not adapt.covered(g)
     solves = []
     plain_one = adapt.one_level
     monkeypatch.setattr(adapt, "one_level", lambda *a, **k: solves.append(1) or plain_one(*a, **k))
-    assert plain(f, d, d, expected, ends, terms, r, what) is None and not solves
+    fewer = adapt.MARGIN * d / 0.9 ** expected           # 0.9 times the round's intervals
+    assert plain(f, d, fewer, expected, ends, terms, r, what) is None and not solves
     with monkeypatch.context() as mp:
-        mp.setattr(adapt, "check_inequalities", lambda lay, terms, x: ["made to"])
+        mp.setattr(adapt, "check_inequalities",
+                   lambda lay, terms, x: ["made to"] if lay.L == g.lay.L else [])
         assert plain(f, d, tol, expected, ends, terms, r, what) is None and solves
-    monkeypatch.setattr(adapt, "checked", lambda s, terms, r: adapt.Solved(s.lay, s.x))
-    assert plain(f, d, tol, expected, ends, terms, r, what) is None
+    monkeypatch.setattr(sys.modules["dmi.analysis.collocation.collocate"], "covered",
+                        lambda g, multipliers=False: not multipliers)
+    e = da.collocate(o, degree=3, tol=1e-2, multipliers=2)
+    assert e.intervals == 16
+    near = np.argmin(np.abs(e.multipliers[:, None] - ref.multipliers[None, :]), axis=1)
+    true = np.abs(e.multipliers - ref.multipliers[near]) + ref.errors["multipliers"][near]
+    assert np.all(true <= e.errors["multipliers"]), (true, e.errors["multipliers"])
 
 
 def test_an_estimate_that_rises_between_rounds_is_no_floor(oscillation, oscillation_gap,
