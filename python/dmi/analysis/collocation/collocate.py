@@ -21,8 +21,10 @@ rounds: each solves the orbit on its mesh and on that mesh with every interval h
 check), and twice their difference is the orbit's error estimate
 (:func:`dmi.analysis.collocation.adapt.checked`); the first orbit whose estimate of the period
 (an autonomous orbit; it converges as h^(2m) on smooth orbits) or of the amplitudes (a forced
-one; h^(m+1): an extremum is inside an interval) is below ``tol`` is returned
-(:mod:`dmi.analysis.collocation.adapt`: the indicator, the equidistribution, the estimate and
+one; h^(m+1): an extremum is inside an interval) is below ``tol`` is returned, or where it is
+far below, an orbit on fewer intervals whose estimates cover their distances to its check
+(:func:`dmi.analysis.collocation.adapt.coarsened`, :func:`kept_coarser`;
+:mod:`dmi.analysis.collocation.adapt`: the indicator, the equidistribution, the estimate and
 the refinement); its multipliers' estimate is twice their
 difference to the check's (those from a few products of the check's monodromy operator from
 the orbit's eigenvectors prolonged to the halved mesh, :func:`~.floquet.on_halved`, where their
