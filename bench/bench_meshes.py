@@ -119,6 +119,9 @@ def main() -> None:
                     help="only the default estimate of the two leading nontrivial multipliers "
                          "against their true error on every mesh of the scan's six smooth "
                          "orbits (about 30 seconds)")
+    ap.add_argument("--tol-scale", type=float, default=1.0,
+                    help="every refinement's tol times this (3: the tols between the table's; "
+                         "default: 1)")
     ap.add_argument("--rounding", action="store_true",
                     help="only the period of orbits whose truncation is below rounding, on "
                          "several meshes and degrees: the spread is the collocation's "
@@ -147,25 +150,27 @@ def main() -> None:
     for L in (56,) if a.small else (40, 44, 48, 56, 64):
         mesh_row(o2, ref2, L, 6)
     if a.small:
-        refinements(o2, ref2, 6, (1e-8,), (80, 88, 96, 104, 112))
+        refinements(o2, ref2, 6, (1e-8,), (80, 88, 96, 104, 112), a.tol_scale)
         return
-    refinements(o1, ref1, 4, (1e-5, 1e-6, 1e-7, 1e-8, 1e-10), tuple(range(4, 81)))
+    cpu, k = 0.0, a.tol_scale
+    cpu += refinements(o1, ref1, 4, (1e-5, 1e-6, 1e-7, 1e-8, 1e-10), tuple(range(4, 81)), k)
     nested_rows(o1, ref1, 4, (8, 10, 12, 16, 18, 20, 24, 32))
-    refinements(o2, ref2, 6, (1e-5, 1e-6, 1e-7, 1e-8, 1e-9), tuple(range(40, 160, 4)))
-    refinements(o2, ref2, 4, (1e-7, 1e-8, 1e-9, 1e-10), tuple(range(100, 500, 10)))
+    cpu += refinements(o2, ref2, 6, (1e-5, 1e-6, 1e-7, 1e-8, 1e-9), tuple(range(40, 160, 4)), k)
+    cpu += refinements(o2, ref2, 4, (1e-7, 1e-8, 1e-9, 1e-10), tuple(range(100, 500, 10)), k)
     for m in (5, 6, 8):
-        refinements(o1, ref1, m, (1e-6, 1e-8, 1e-9, 1e-10), tuple(range(4, 48)))
+        cpu += refinements(o1, ref1, m, (1e-6, 1e-8, 1e-9, 1e-10), tuple(range(4, 48)), k)
     print("eps = 5 (a steep orbit whose first round of a loose tol cannot be solved), degree 5:")
     o5 = scheme_orbit(5.0, 9.0, 900)
     ref5 = da.collocate(o5, intervals=80, degree=8, multipliers=0)
-    refinements(o5, ref5, 5, (1e-3, 1e-4, 1e-5, 1e-6), tuple(range(8, 80)))
-    refinements(o5, ref5, 4, (1e-3, 1e-4, 1e-5, 1e-6), tuple(range(8, 120)))
+    cpu += refinements(o5, ref5, 5, (1e-3, 1e-4, 1e-5, 1e-6), tuple(range(8, 80)), k)
+    cpu += refinements(o5, ref5, 4, (1e-3, 1e-4, 1e-5, 1e-6), tuple(range(8, 120)), k)
     print("degree 3: eps = 0.5 and eps = 3:")
     for eps, T, steps, tols, sizes in ((0.5, 6.3, 630, (1e-2, 1e-3, 1e-4), range(4, 60)),
                                        (3.0, 8.0, 800, (1e-2, 1e-3, 1e-4, 1e-5), range(8, 120))):
         o = scheme_orbit(eps, T, steps)
-        refinements(o, da.collocate(o, intervals=80, degree=8, multipliers=0), 3, tols,
-                    tuple(sizes))
+        cpu += refinements(o, da.collocate(o, intervals=80, degree=8, multipliers=0), 3, tols,
+                           tuple(sizes), k)
+    print(f"the refinements' CPU: {cpu:.2f} s")
     print("same mesh, degree 6 against 7 and 8 (errors of the period; the mesh "
           "equidistributed k times at L intervals): 6 | 7 | 8 | |x6 - x8| / |err 6| | 6 on 2L")
     for L in (60, 70, 80, 90):
@@ -183,21 +188,24 @@ def period_on(o, L: int, m: int) -> float:
     return float(solve(new, terms, adapt.transfer(lay0, x0, new), reference(lay0, x0))[0][-1])
 
 
-def refinements(o, ref, m: int, tols: tuple, scan: tuple) -> None:
-    """The refinement to each tol: the orbit returned (its intervals, true error, estimate and
-    CPU) against the least L of ``scan`` whose orbit on L intervals (:func:`period_on`) has a
-    true error within tol and against the least from which every L of the scan has (the errors
-    of one L are a lottery of its equidistribution: not monotone in L), and their ratios."""
+def refinements(o, ref, m: int, tols: tuple, scan: tuple, scale: float = 1.0) -> float:
+    """The refinement to each tol (times ``scale``; their CPU returned): the orbit returned (its
+    intervals, true error, estimate and CPU) against the least L of ``scan`` whose orbit on L
+    intervals (:func:`period_on`) has a true error within tol and against the least from which
+    every L of the scan has (the errors of one L are a lottery of its equidistribution: not
+    monotone in L), and their ratios."""
     errs = {}
     for L in scan:
         try:
             errs[L] = abs(period_on(o, L, m) - ref.period)
         except (ValueError, RuntimeError):          # Newton fails on a coarse mesh
             errs[L] = np.inf
-    for tol in tols:
+    total = 0.0
+    for tol in (t * scale for t in tols):
         t = time.process_time()
         e = da.collocate(o, degree=m, tol=tol, multipliers=0)
         cpu = time.process_time() - t
+        total += cpu
         true = abs(e.period - ref.period)
         enough = next((L for L in scan if errs[L] <= tol), None)
         steady = next((L for i, L in enumerate(scan)
@@ -208,6 +216,7 @@ def refinements(o, ref, m: int, tols: tuple, scan: tuple) -> None:
         print(f"degree {m}, tol = {tol:g}: {e.intervals} returned; true {true:.2e}, estimate "
               f"{e.errors['period']:.2e} ({e.errors['period'] / true:.3g} x); CPU {cpu:.2f} s; "
               f"{ratio}", flush=True)
+    return total
 
 
 def nested(o, terms, sig, b0, L: int, m: int, T_ref: float, every: bool = False):

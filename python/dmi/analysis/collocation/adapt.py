@@ -765,9 +765,8 @@ def first_intervals(tol: float, m: int, pieces: int, steep: bool) -> int:
     period's error falls (h^(2 m): L^(2 m) tol kept; a forced orbit's amplitudes, h^(m+1), would
     allow fewer still); above FIRST_DEGREE fewer, the period's error taken as (A / L)^(2 m) with
     the A of FIRST_INTERVALS at FIRST_TOL and degree FIRST_DEGREE (7.4 at degree 6 and 1e-8:
-    7 intervals, 12 returned for van der Pol); at least LEAST_POINTS / m intervals (rounded;
-    within 4 to LEAST_FIRST: 6 at degree 4); at least 4 for each of the signature's
-    ``pieces``."""
+    7 intervals, 12 returned for van der Pol); at least :func:`least_intervals` (of the
+    signature's ``pieces``)."""
     higher = min(1.0, FIRST_TOL ** (1.0 / (2 * FIRST_DEGREE) - 1.0 / (2 * m)))
     L = FIRST_INTERVALS * min(1.0, (FIRST_TOL / tol) ** (1.0 / (2 * m)) * higher)
     return max(least_intervals(m, pieces), FIRST_INTERVALS if steep else 0, round(L))
